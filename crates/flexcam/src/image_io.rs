@@ -1,0 +1,1 @@
+//! Writing frames: PNG colour, 16-bit PNG object ids, depth as OpenEXR or PFM.

@@ -1,0 +1,128 @@
+//! The projection: the object at the centre of flexcam.
+//!
+//! A projection maps a continuous image position to a ray (its projector) and, where it has an
+//! inverse, maps a scene point back to every image position that sees it, with depth. A
+//! projection may image a point zero, one or several times (a trilinear mesh can fold; a
+//! panorama can wrap), so the inverse appends to a list.
+//!
+//! [`ProjectionSpec`] is the parsed description (from a scene file); [`ProjectionSpec::build`]
+//! turns it into a [`Projection`] for a given image size, validating it on the way.
+
+use glam::{DVec2, DVec3};
+
+use crate::geometry::Ray;
+
+/// One image of a scene point under a projection.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImagePoint {
+    /// Continuous pixel position (pixel (x, y) covers [x, x+1) x [y, y+1); y grows down).
+    /// It may lie outside the image: callers clip.
+    pub pixel: DVec2,
+    /// The ray parameter at which `ray(pixel)` reaches the point: `ray(pixel).at(t) == point`.
+    pub t: f64,
+}
+
+/// A projection bound to an image size.
+pub trait Projection: Send + Sync {
+    /// The projection's type name as in scene files (`perspective`, `fisheye`, ...).
+    fn kind(&self) -> &'static str;
+
+    /// Image width and height in pixels.
+    fn resolution(&self) -> (u32, u32);
+
+    /// The ray through continuous pixel position `pixel` (a pixel's centre is at +0.5), or
+    /// `None` where that image position sees nothing (outside a fisheye's image circle,
+    /// outside every screen triangle of a trilinear mesh). The direction need not be unit
+    /// length; see [`Ray`].
+    fn ray(&self, pixel: DVec2) -> Option<Ray>;
+
+    /// Whether [`Projection::project`] is implemented.
+    fn has_inverse(&self) -> bool {
+        false
+    }
+
+    /// Appends to `out` every image position of scene point `point`, each with the ray
+    /// parameter that reaches it. Projections without an inverse append nothing.
+    fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
+        let _ = (point, out);
+    }
+}
+
+/// A camera placement shared by the single-viewpoint projections: an eye position, a point
+/// it looks at, and an up hint (need not be perpendicular to the view direction).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CameraFrame {
+    pub position: DVec3,
+    pub look_at: DVec3,
+    pub up: DVec3,
+}
+
+/// The vertices of a trilinear projection mesh (seed 000). Vertex `k` has a base point
+/// `points[k]`, a ray direction `normals[k]` (not normalised: its length is the depth scale)
+/// and a screen position `screen[k]` in [0,1]^2 with (0,0) the bottom-left of the image.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TrilinearMesh {
+    pub points: Vec<DVec3>,
+    pub normals: Vec<DVec3>,
+    pub screen: Vec<DVec2>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// A parsed projection description; angles in degrees as in scene files.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ProjectionSpec {
+    /// Pinhole; `fov` is the horizontal angle.
+    Perspective { frame: CameraFrame, fov: f64 },
+    /// Parallel rays; `width` is the horizontal extent in world units.
+    Orthographic { frame: CameraFrame, width: f64 },
+    /// Angular (equidistant) fisheye; `fov` is the angle across the inscribed image circle.
+    Fisheye { frame: CameraFrame, fov: f64 },
+    /// Longitude linear in x, latitude linear in y.
+    Equirectangular {
+        frame: CameraFrame,
+        h_fov: f64,
+        v_fov: f64,
+    },
+    /// Longitude linear in x, tan(latitude) linear in y.
+    Cylindrical {
+        frame: CameraFrame,
+        h_fov: f64,
+        v_fov: f64,
+    },
+    /// A mesh of trilinear projection triangles.
+    Trilinear(TrilinearMesh),
+}
+
+use crate::error::Result;
+use std::path::Path;
+
+impl ProjectionSpec {
+    /// Validates the description and builds the projection for a `width` x `height` image.
+    /// Degenerate descriptions (zero or non-finite fov, look_at == position, up parallel to
+    /// the view direction, inverted or empty trilinear triangles, ...) are errors.
+    pub fn build(&self, width: u32, height: u32) -> Result<Box<dyn Projection>> {
+        let _ = (width, height);
+        todo!("ProjectionSpec::build")
+    }
+
+    /// The scene-file type name.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            ProjectionSpec::Perspective { .. } => "perspective",
+            ProjectionSpec::Orthographic { .. } => "orthographic",
+            ProjectionSpec::Fisheye { .. } => "fisheye",
+            ProjectionSpec::Equirectangular { .. } => "equirectangular",
+            ProjectionSpec::Cylindrical { .. } => "cylindrical",
+            ProjectionSpec::Trilinear(_) => "trilinear",
+        }
+    }
+}
+
+impl TrilinearMesh {
+    /// Loads a trilinear projection mesh from an OBJ file: `v` = base point, `vn` = ray
+    /// direction, `vt` = screen position; every face corner needs all three.
+    pub fn load_obj(path: &Path) -> Result<TrilinearMesh> {
+        let _ = path;
+        todo!("TrilinearMesh::load_obj")
+    }
+}

@@ -1,0 +1,78 @@
+//! Renderers and what they produce: a [`Frame`] (colour, depth, object ids) and counters.
+
+use std::collections::BTreeMap;
+
+use glam::Vec3;
+
+/// How surfaces are shaded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Shading {
+    /// The base colour of the first surface hit, mirrors and glass passing the ray on (the
+    /// exact contract of the scene-and-CLI spec).
+    Flat,
+    /// Lambert + Phong with hard shadows, recursive reflection and refraction with Fresnel.
+    #[default]
+    Lit,
+}
+
+/// Options shared by all renderers.
+#[derive(Clone, Copy)]
+pub struct RenderOptions<'a> {
+    pub shading: Shading,
+    /// Samples per pixel (1 = one ray through each pixel centre).
+    pub spp: u32,
+    /// Maximum number of specular bounces.
+    pub max_bounces: u32,
+    /// Called from worker threads with (work units done, total) as rendering progresses.
+    pub progress: Option<&'a (dyn Fn(u64, u64) + Sync)>,
+}
+
+impl Default for RenderOptions<'_> {
+    fn default() -> Self {
+        RenderOptions {
+            shading: Shading::Lit,
+            spp: 1,
+            max_bounces: 8,
+            progress: None,
+        }
+    }
+}
+
+/// A rendered image with its arbitrary output variables, row-major, top row first.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    /// Linear RGB.
+    pub color: Vec<Vec3>,
+    /// Distance from the projector's origin to the first hit, along the projector;
+    /// `f32::INFINITY` where nothing is hit.
+    pub depth: Vec<f32>,
+    /// Object id of the first hit, 0 for background.
+    pub ids: Vec<u32>,
+}
+
+impl Frame {
+    /// A frame filled with `background`, infinite depth and id 0.
+    pub fn new(width: u32, height: u32, background: Vec3) -> Self {
+        let n = width as usize * height as usize;
+        Frame {
+            width,
+            height,
+            color: vec![background; n],
+            depth: vec![f32::INFINITY; n],
+            ids: vec![0; n],
+        }
+    }
+}
+
+/// One counter of a renderer's statistics.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Counter {
+    Count(u64),
+    Value(f64),
+}
+
+/// Named counters a renderer reports (rays cast, build times, ...), for `--stats`.
+pub type Stats = BTreeMap<&'static str, Counter>;
+pub mod raycast;

@@ -1,0 +1,1 @@
+//! Built-in scenes (`builtin:NAME`), listed by `flexcam scenes`.

@@ -1,0 +1,1 @@
+//! The TOML scene format of the scene-and-CLI spec.

@@ -1,0 +1,124 @@
+//! Materials: a base colour pattern and how light leaves the surface.
+
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
+
+/// How the base colour varies over a surface.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Pattern {
+    /// The material's `color` everywhere.
+    Solid,
+    /// A 3D checker in object space, alternating `color` and `other`, cells `size` wide:
+    /// cell parity is `floor(x/size) + floor(y/size) + floor(z/size)` (as POV-Ray's `checker`),
+    /// evaluated at the object-space hit point nudged by `1e-4 * size` so that an axis-aligned
+    /// face lying on a cell boundary (a floor at y = 0) does not flicker between cells.
+    Checker { other: Vec3, size: f32 },
+    /// An image texture looked up by the mesh's texture coordinates, multiplied by `color`.
+    Texture(Arc<Texture>),
+}
+
+/// How light leaves the surface.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Surface {
+    /// Lambert diffuse plus a Phong highlight in `lit` shading.
+    Diffuse,
+    /// A perfect mirror.
+    Mirror,
+    /// A dielectric with index of refraction `ior` (refraction and Fresnel reflection).
+    Glass { ior: f32 },
+    /// Emits its base colour; not lit.
+    Emissive,
+}
+
+/// A material: base colour, pattern and surface kind. The base colour at a point is
+/// `color * pattern * vertex colour` (the glTF convention: factor times texture times vertex
+/// colour; meshes without vertex colours count as white).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Material {
+    pub color: Vec3,
+    pub pattern: Pattern,
+    pub surface: Surface,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material {
+            color: Vec3::splat(0.8),
+            pattern: Pattern::Solid,
+            surface: Surface::Diffuse,
+        }
+    }
+}
+
+/// An RGB image in linear colour, addressed with OBJ-style texture coordinates
+/// ((0,0) bottom-left, (1,1) top-right), wrapping (repeat) outside [0,1].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Texture {
+    pub width: u32,
+    pub height: u32,
+    /// Row-major texels, top row first.
+    pub texels: Vec<Vec3>,
+}
+
+impl Texture {
+    /// Nearest-texel lookup (no filtering, as `--shading flat` requires).
+    pub fn nearest(&self, uv: Vec2) -> Vec3 {
+        let (x, y) = self.texel_coords(uv);
+        self.texel(x.floor() as i64, y.floor() as i64)
+    }
+
+    /// Bilinear lookup between the four nearest texel centres.
+    pub fn bilinear(&self, uv: Vec2) -> Vec3 {
+        let (x, y) = self.texel_coords(uv);
+        let (x, y) = (x - 0.5, y - 0.5);
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let top = self.texel(x0, y0).lerp(self.texel(x0 + 1, y0), fx);
+        let bottom = self.texel(x0, y0 + 1).lerp(self.texel(x0 + 1, y0 + 1), fx);
+        top.lerp(bottom, fy)
+    }
+
+    /// Continuous texel coordinates of `uv` (x right, y down from the top row).
+    fn texel_coords(&self, uv: Vec2) -> (f32, f32) {
+        let u = uv.x - uv.x.floor();
+        let v = uv.y - uv.y.floor();
+        (u * self.width as f32, (1.0 - v) * self.height as f32)
+    }
+
+    /// The texel at integer coordinates, wrapped into range.
+    fn texel(&self, x: i64, y: i64) -> Vec3 {
+        let x = x.rem_euclid(self.width as i64) as usize;
+        let y = y.rem_euclid(self.height as i64) as usize;
+        self.texels[y * self.width as usize + x]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn two_by_one() -> Texture {
+        Texture {
+            width: 2,
+            height: 1,
+            texels: vec![Vec3::ZERO, Vec3::ONE],
+        }
+    }
+
+    #[test]
+    fn nearest_wraps_and_picks_texel() {
+        let t = two_by_one();
+        assert_eq!(t.nearest(Vec2::new(0.25, 0.5)), Vec3::ZERO);
+        assert_eq!(t.nearest(Vec2::new(0.75, 0.5)), Vec3::ONE);
+        assert_eq!(t.nearest(Vec2::new(1.75, -3.5)), Vec3::ONE);
+    }
+
+    #[test]
+    fn bilinear_blends_between_centres() {
+        let t = two_by_one();
+        let mid = t.bilinear(Vec2::new(0.5, 0.5));
+        assert!((mid - Vec3::splat(0.5)).length() < 1e-6);
+    }
+}

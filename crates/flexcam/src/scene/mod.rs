@@ -1,0 +1,73 @@
+//! The scene model: objects (a world-space mesh and a material), lights, image settings and
+//! the projection named by the scene, with loaders for model files, built-in shapes and
+//! scenes, and the TOML scene-file format.
+
+mod light;
+mod material;
+mod mesh;
+
+pub use light::Light;
+pub use material::{Material, Pattern, Surface, Texture};
+pub use mesh::Mesh;
+
+use std::path::PathBuf;
+
+use glam::{Affine3A, Vec3};
+
+use crate::projection::ProjectionSpec;
+
+/// One object of a scene. Its id (1-based, in file order; 0 is the background) is what the
+/// `--ids` image holds.
+#[derive(Debug, Clone)]
+pub struct Object {
+    pub id: u32,
+    pub name: String,
+    /// The mesh, already transformed into world space.
+    pub mesh: Mesh,
+    pub material: Material,
+    /// World to object space, for patterns defined in object space (the checker).
+    pub world_to_object: Affine3A,
+}
+
+/// Image settings of a scene; CLI flags override them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImageSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Linear RGB of pixels whose ray hits nothing (or that no projector covers).
+    pub background: Vec3,
+}
+
+impl Default for ImageSettings {
+    fn default() -> Self {
+        ImageSettings {
+            width: 800,
+            height: 600,
+            background: Vec3::ZERO,
+        }
+    }
+}
+
+/// A loaded scene: everything a renderer needs, plus the projection the scene asks for.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    pub objects: Vec<Object>,
+    pub lights: Vec<Light>,
+    pub image: ImageSettings,
+    pub projection: ProjectionSpec,
+    /// The folder relative paths in the scene (models, textures, projection surfaces) are
+    /// resolved against; `None` for built-in scenes.
+    pub base_dir: Option<PathBuf>,
+}
+
+impl Scene {
+    /// Total number of triangles over all objects.
+    pub fn triangle_count(&self) -> usize {
+        self.objects.iter().map(|o| o.mesh.triangle_count()).sum()
+    }
+}
+
+pub mod builtin;
+pub mod file;
+pub mod loaders;
+pub mod shapes;
