@@ -1,1 +1,88 @@
-fn main() {}
+//! `flexcam`: render scenes through nonlinear projections from the command line.
+//!
+//! Every failure is reported as one line on stderr (`flexcam: FILE:LINE:COLUMN: message`)
+//! with a non-zero exit status, and leaves no partial output file.
+
+mod commands;
+mod progress;
+mod stats_json;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+/// Renders 3D scenes through nonlinear and multi-perspective projections.
+#[derive(Parser, Debug)]
+#[command(name = "flexcam", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Render a scene file or built-in scene to a PNG (and optional depth / id images).
+    Render(commands::render::RenderArgs),
+    /// List the built-in scenes: name, then a description.
+    Scenes,
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return report_usage_error(e),
+    };
+    let result = match cli.command {
+        Command::Render(args) => commands::render::run(&args),
+        Command::Scenes => commands::scenes::run(),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("flexcam: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// Help and version go to stdout as usual; a usage error is cut to its first line (clap adds
+/// usage text and hints on further lines) so that every error is one line.
+fn report_usage_error(e: clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    if matches!(
+        e.kind(),
+        ErrorKind::DisplayHelp
+            | ErrorKind::DisplayVersion
+            | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+    ) {
+        let _ = e.print();
+        return ExitCode::SUCCESS;
+    }
+    let text = e.render().to_string();
+    let first = text
+        .lines()
+        .find(|l| !l.trim().is_empty())
+        .unwrap_or("invalid arguments");
+    let first = first.trim_start_matches("error: ");
+    eprintln!("flexcam: {first}");
+    ExitCode::from(2)
+}
+
+/// A path argument that may be `-` for standard output.
+#[derive(Debug, Clone, PartialEq)]
+enum OutputTarget {
+    Stdout,
+    File(PathBuf),
+}
+
+impl std::str::FromStr for OutputTarget {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Ok(if s == "-" {
+            OutputTarget::Stdout
+        } else {
+            OutputTarget::File(PathBuf::from(s))
+        })
+    }
+}

@@ -44,7 +44,12 @@ impl Error {
     }
 
     /// An error at a 1-based line and column of a file.
-    pub fn at(file: impl AsRef<Path>, line: usize, column: usize, message: impl Into<String>) -> Self {
+    pub fn at(
+        file: impl AsRef<Path>,
+        line: usize,
+        column: usize,
+        message: impl Into<String>,
+    ) -> Self {
         Error {
             location: Some(Location {
                 file: file.as_ref().to_path_buf(),
@@ -69,7 +74,11 @@ impl Error {
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         // Messages are kept to one line: a multi-line message from a dependency is folded.
-        let message = self.message.split_whitespace().collect::<Vec<_>>().join(" ");
+        let message = self
+            .message
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
         match &self.location {
             None => write!(f, "{message}"),
             Some(Location {
@@ -92,12 +101,20 @@ mod tests {
 
     #[test]
     fn display_is_one_line_with_position() {
-        let e = Error::at("scene.toml", 3, 7, "unknown projection type \"fisheyes\"\n  expected one of ...");
+        let e = Error::at(
+            "scene.toml",
+            3,
+            7,
+            "unknown projection type \"fisheyes\"\n  expected one of ...",
+        );
         assert_eq!(
             e.to_string(),
             "scene.toml:3:7: unknown projection type \"fisheyes\" expected one of ..."
         );
-        assert_eq!(Error::in_file("a.obj", "not found").to_string(), "a.obj: not found");
+        assert_eq!(
+            Error::in_file("a.obj", "not found").to_string(),
+            "a.obj: not found"
+        );
         assert_eq!(Error::new("bad").to_string(), "bad");
     }
 

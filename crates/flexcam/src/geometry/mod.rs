@@ -3,6 +3,12 @@
 //! Projection algebra is done in f64 ([`glam::DVec3`]); meshes and the ray-casting inner loops
 //! use f32 ([`glam::Vec3`]) where precision has been shown to suffice.
 
+mod aabb;
 mod ray;
+mod roots;
+mod triangle;
 
+pub use aabb::Aabb;
 pub use ray::Ray;
+pub use roots::{solve_cubic, solve_quadratic, Roots};
+pub use triangle::{intersect_triangle, TriangleHit};

@@ -8,6 +8,24 @@
 //! [`ProjectionSpec`] is the parsed description (from a scene file); [`ProjectionSpec::build`]
 //! turns it into a [`Projection`] for a given image size, validating it on the way.
 
+mod build;
+mod camera_basis;
+mod fisheye;
+mod image_coords;
+#[cfg(test)]
+mod inverse_properties;
+mod linear;
+mod panoramic;
+mod params;
+mod trilinear;
+
+pub use camera_basis::CameraBasis;
+pub use fisheye::Fisheye;
+pub use image_coords::Resolution;
+pub use linear::{Orthographic, Perspective};
+pub use panoramic::{Cylindrical, Equirectangular};
+pub use trilinear::Trilinear;
+
 use glam::{DVec2, DVec3};
 
 use crate::geometry::Ray;
@@ -93,18 +111,7 @@ pub enum ProjectionSpec {
     Trilinear(TrilinearMesh),
 }
 
-use crate::error::Result;
-use std::path::Path;
-
 impl ProjectionSpec {
-    /// Validates the description and builds the projection for a `width` x `height` image.
-    /// Degenerate descriptions (zero or non-finite fov, look_at == position, up parallel to
-    /// the view direction, inverted or empty trilinear triangles, ...) are errors.
-    pub fn build(&self, width: u32, height: u32) -> Result<Box<dyn Projection>> {
-        let _ = (width, height);
-        todo!("ProjectionSpec::build")
-    }
-
     /// The scene-file type name.
     pub fn kind(&self) -> &'static str {
         match self {
@@ -115,14 +122,5 @@ impl ProjectionSpec {
             ProjectionSpec::Cylindrical { .. } => "cylindrical",
             ProjectionSpec::Trilinear(_) => "trilinear",
         }
-    }
-}
-
-impl TrilinearMesh {
-    /// Loads a trilinear projection mesh from an OBJ file: `v` = base point, `vn` = ray
-    /// direction, `vt` = screen position; every face corner needs all three.
-    pub fn load_obj(path: &Path) -> Result<TrilinearMesh> {
-        let _ = path;
-        todo!("TrilinearMesh::load_obj")
     }
 }

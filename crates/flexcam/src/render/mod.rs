@@ -75,4 +75,7 @@ pub enum Counter {
 
 /// Named counters a renderer reports (rays cast, build times, ...), for `--stats`.
 pub type Stats = BTreeMap<&'static str, Counter>;
+mod method;
 pub mod raycast;
+pub mod surface;
+pub use method::Method;

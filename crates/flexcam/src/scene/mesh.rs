@@ -39,7 +39,9 @@ impl Mesh {
             }
         }
         if let Some(bad) = self.positions.iter().position(|p| !p.is_finite()) {
-            return Err(Error::new(format!("vertex {bad} has a non-finite position")));
+            return Err(Error::new(format!(
+                "vertex {bad} has a non-finite position"
+            )));
         }
         if let Some((i, t)) = self
             .triangles
@@ -85,7 +87,13 @@ impl Mesh {
                 a.extend_from_slice(b);
             }
         }
-        merge(&mut self.normals, &other.normals, n_self, n_other, Vec3::ZERO);
+        merge(
+            &mut self.normals,
+            &other.normals,
+            n_self,
+            n_other,
+            Vec3::ZERO,
+        );
         merge(&mut self.uvs, &other.uvs, n_self, n_other, Vec2::ZERO);
         merge(&mut self.colors, &other.colors, n_self, n_other, Vec3::ONE);
         self.positions.extend_from_slice(&other.positions);

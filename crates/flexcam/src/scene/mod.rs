@@ -71,3 +71,14 @@ pub mod builtin;
 pub mod file;
 pub mod loaders;
 pub mod shapes;
+
+pub use file::validate_resolution;
+
+/// Loads a scene from `source`: `builtin:NAME` names a built-in scene, anything else is the
+/// path of a scene file. This is the SCENE argument of `flexcam render`.
+pub fn load(source: &str) -> crate::Result<Scene> {
+    match source.strip_prefix("builtin:") {
+        Some(name) => builtin::load(name),
+        None => file::load(std::path::Path::new(source)),
+    }
+}

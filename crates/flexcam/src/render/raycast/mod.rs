@@ -1,1 +1,161 @@
 //! The reference ray caster: a BVH built once per scene, tiles rendered in parallel.
+//!
+//! [`RayCaster::new`] gathers every object's world-space triangles into one BVH (binned SAH,
+//! f32 traversal) and keeps what shading needs: the objects (meshes, materials,
+//! `world_to_object`), lights and background. [`RayCaster::intersect`] is the exact closest-hit
+//! query other renderers are checked against; [`RayCaster::render`] renders a projection.
+//! See docs/raycast.md for the design and the measurements.
+
+mod bvh;
+mod optics;
+mod sampling;
+mod shade;
+mod tiles;
+mod triangle;
+
+use std::time::Instant;
+
+use glam::{DVec3, Vec2, Vec3};
+
+use self::bvh::Bvh;
+use self::triangle::FastRay;
+use crate::geometry::{intersect_triangle, Ray};
+use crate::projection::Projection;
+use crate::render::{Frame, RenderOptions, Stats};
+use crate::scene::{Light, Object, Scene};
+
+/// The first surface a ray meets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    /// Ray parameter of the hit (`ray.at(t)` is the point), within `[t_min, t_max]`.
+    pub t: f64,
+    /// Index of the object in `scene.objects` (not its 1-based id).
+    pub object: usize,
+    /// Index of the triangle within that object's mesh.
+    pub triangle: usize,
+    /// Barycentric weights `(u, v)` of the triangle's second and third vertices.
+    pub barycentric: Vec2,
+}
+
+/// A scene prepared for ray casting.
+#[derive(Debug, Clone)]
+pub struct RayCaster {
+    bvh: Bvh,
+    objects: Vec<Object>,
+    /// Global index of each object's first triangle, as the BVH numbers triangles.
+    first_triangle: Vec<u32>,
+    lights: Vec<Light>,
+    background: Vec3,
+    /// How far secondary rays start off a surface: a fixed fraction of the scene's largest
+    /// coordinate magnitude, so it covers f32 rounding at any scene scale.
+    offset: f64,
+    triangle_count: usize,
+    build_ms: f64,
+}
+
+/// Secondary-ray offset relative to the scene's largest coordinate magnitude: 2^-16, about
+/// 256 f32 ulps, well above the rounding of an f32 hit point and small against any feature.
+const OFFSET_SCALE: f64 = 1.0 / 65536.0;
+
+impl RayCaster {
+    /// Builds the BVH over all triangles of `scene` and keeps what rendering needs.
+    pub fn new(scene: &Scene) -> RayCaster {
+        let start = Instant::now();
+        let mut first_triangle = Vec::with_capacity(scene.objects.len());
+        let mut triangles = Vec::with_capacity(scene.triangle_count());
+        for object in &scene.objects {
+            first_triangle.push(triangles.len() as u32);
+            let p = &object.mesh.positions;
+            triangles.extend(
+                object
+                    .mesh
+                    .triangles
+                    .iter()
+                    .map(|t| t.map(|i| p[i as usize])),
+            );
+        }
+        let bvh = Bvh::build(&triangles);
+        let extent = scene
+            .objects
+            .iter()
+            .filter_map(|o| o.mesh.bounds())
+            .fold(0.0f32, |m, (lo, hi)| {
+                m.max(lo.abs().max_element()).max(hi.abs().max_element())
+            });
+        RayCaster {
+            bvh,
+            objects: scene.objects.clone(),
+            first_triangle,
+            lights: scene.lights.clone(),
+            background: scene.image.background,
+            offset: (extent as f64 * OFFSET_SCALE).max(f64::MIN_POSITIVE),
+            triangle_count: triangles.len(),
+            build_ms: start.elapsed().as_secs_f64() * 1e3,
+        }
+    }
+
+    /// The closest hit of `ray` with `t` in `[ray.t_min, ray.t_max]`, from either side of any
+    /// triangle, or `None`. Zero-area triangles are never hit; a ray with a zero or non-finite
+    /// direction or origin hits nothing.
+    ///
+    /// The BVH search runs in f32 (the interval is honoured to f32 precision); the hit found is
+    /// then refined in f64 against the triangle's vertices, so `t` and the barycentrics are
+    /// accurate to f64 precision for the triangle the f32 search chose.
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        let found = self.bvh.closest(&FastRay::new(ray)?)?;
+        let object = self.first_triangle.partition_point(|&f| f <= found.id) - 1;
+        let triangle = (found.id - self.first_triangle[object]) as usize;
+        let mesh = &self.objects[object].mesh;
+        let [a, b, c] = mesh.triangles[triangle];
+        let vertex = |i: u32| mesh.positions[i as usize].as_dvec3();
+        let vertices = [vertex(a), vertex(b), vertex(c)];
+        let (t, barycentric) = match intersect_triangle(ray.origin, ray.direction, vertices) {
+            Some(exact) => (exact.t, exact.barycentric.as_vec2()),
+            // Grazing an edge: f32 saw a hit where f64 does not; keep the f32 values.
+            None => (found.hit.t as f64, Vec2::new(found.hit.u, found.hit.v)),
+        };
+        Some(Hit {
+            t: t.clamp(ray.t_min, ray.t_max),
+            object,
+            triangle,
+            barycentric,
+        })
+    }
+
+    /// Whether anything is hit within the ray's interval (the shadow-ray query).
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        FastRay::new(ray).is_some_and(|r| self.bvh.occluded(&r))
+    }
+
+    /// Renders `projection` (colour, depth and object ids) with `options`, in parallel over
+    /// tiles; the image does not depend on the number of threads. `options.spp = 0` counts as
+    /// one sample. See [`shade`] for what the depth and id of a pixel are.
+    pub fn render(&self, projection: &dyn Projection, options: &RenderOptions) -> (Frame, Stats) {
+        let (frame, mut stats) = tiles::render(self, projection, options);
+        stats.insert("bvh_build_ms", crate::render::Counter::Value(self.build_ms));
+        stats.insert(
+            "bvh_nodes",
+            crate::render::Counter::Count(self.bvh.node_count() as u64),
+        );
+        stats.insert(
+            "triangles",
+            crate::render::Counter::Count(self.triangle_count as u64),
+        );
+        (frame, stats)
+    }
+
+    /// A ray leaving surface point `point` (geometric normal `normal`) along `direction`,
+    /// started [`RayCaster::offset`] off the surface on the side `direction` points to, so that
+    /// it does not hit the surface it leaves.
+    fn spawn(&self, point: DVec3, normal: DVec3, direction: DVec3) -> Ray {
+        let side = if direction.dot(normal) >= 0.0 {
+            1.0
+        } else {
+            -1.0
+        };
+        Ray::new(point + normal * (side * self.offset), direction)
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,44 +1,27 @@
 //! Built-in analytic shapes, tessellated into meshes in object space (y up, centred on the
 //! origin unless stated). `tessellation` is the number of segments around a full circle.
+//!
+//! Every shape has per-vertex unit normals pointing outward, texture coordinates in
+//! `[0,1]^2` and counter-clockwise triangles seen from outside; closed shapes (box, sphere,
+//! cylinder, torus) are closed once coincident positions are welded. Degenerate parameters
+//! never panic or produce NaN: tessellation is raised to each shape's minimum and negative
+//! sizes are taken by absolute value (the scene-file parser rejects them before this).
 
-use glam::Vec3;
+mod cuboid;
+mod cylinder;
+mod grid;
+mod plane;
+mod sphere;
+mod teapot;
+mod teapot_patches;
+mod torus;
 
-use super::Mesh;
+#[cfg(test)]
+mod test_support;
 
-/// A `width` x `depth` rectangle in the xz plane at y = 0, normal +y, split into
-/// `tessellation` x `tessellation` quads.
-pub fn plane(width: f32, depth: f32, tessellation: u32) -> Mesh {
-    let _ = (width, depth, tessellation);
-    todo!("shapes::plane")
-}
-
-/// An axis-aligned box with edge lengths `size`, centred on the origin, flat-shaded faces.
-pub fn cuboid(size: Vec3) -> Mesh {
-    let _ = size;
-    todo!("shapes::cuboid")
-}
-
-/// A UV sphere of `radius` centred on the origin.
-pub fn sphere(radius: f32, tessellation: u32) -> Mesh {
-    let _ = (radius, tessellation);
-    todo!("shapes::sphere")
-}
-
-/// A capped cylinder about the y axis, from y = -height/2 to y = height/2.
-pub fn cylinder(radius: f32, height: f32, tessellation: u32) -> Mesh {
-    let _ = (radius, height, tessellation);
-    todo!("shapes::cylinder")
-}
-
-/// A torus about the y axis with the given major (ring) and minor (tube) radii.
-pub fn torus(major: f32, minor: f32, tessellation: u32) -> Mesh {
-    let _ = (major, minor, tessellation);
-    todo!("shapes::torus")
-}
-
-/// The Utah teapot from Newell's Bezier patches, y up, resting on y = 0, uniformly scaled by
-/// `scale`; each patch is tessellated into `tessellation/4` x `tessellation/4` quads (at least 1).
-pub fn teapot(scale: f32, tessellation: u32) -> Mesh {
-    let _ = (scale, tessellation);
-    todo!("shapes::teapot")
-}
+pub use cuboid::cuboid;
+pub use cylinder::cylinder;
+pub use plane::plane;
+pub use sphere::sphere;
+pub use teapot::teapot;
+pub use torus::torus;

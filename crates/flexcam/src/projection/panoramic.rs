@@ -1,0 +1,321 @@
+//! The panoramas: equirectangular (latitude linear in y) and cylindrical (height on a unit
+//! cylinder linear in y). Both have longitude linear in x, zero at the image centre (the
+//! look_at direction), increasing to the right. Rays exist for every pixel position, also
+//! outside the image; ray directions are unit length, so `t` is the distance from the eye.
+
+use std::f64::consts::PI;
+
+use glam::{DVec2, DVec3};
+
+use super::camera_basis::CameraBasis;
+use super::image_coords::Resolution;
+use super::params::{angle_radians, UpTo};
+use super::{CameraFrame, ImagePoint, Projection};
+use crate::error::Result;
+use crate::geometry::Ray;
+
+/// The longitude of camera-local direction `local` in [-pi, pi): zero straight ahead,
+/// positive to the right. The half-open range gives a 360-degree panorama exactly one image
+/// column per direction (straight behind is the left edge, x = 0). `None` on the vertical
+/// axis, where the longitude is undefined.
+fn longitude(local: DVec3) -> Option<f64> {
+    if local.x == 0.0 && local.z == 0.0 {
+        return None;
+    }
+    let lon = local.x.atan2(local.z);
+    Some(if lon >= PI { -PI } else { lon })
+}
+
+/// The camera-local horizontal unit direction at longitude `lon`.
+fn horizontal(lon: f64) -> DVec2 {
+    DVec2::new(lon.sin(), lon.cos())
+}
+
+/// Longitude linear in x over `h_fov`, latitude linear in y over `v_fov` (top row at
+/// +v_fov/2). The defaults of the scene format, 360 x 180, image the whole sphere.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Equirectangular {
+    basis: CameraBasis,
+    radians_per_pixel: DVec2,
+    resolution: Resolution,
+}
+
+impl Equirectangular {
+    /// Errors: a degenerate frame, an empty image, `h_fov` not in (0, 360], `v_fov` not in
+    /// (0, 180].
+    pub fn new(
+        frame: &CameraFrame,
+        h_fov_degrees: f64,
+        v_fov_degrees: f64,
+        width: u32,
+        height: u32,
+    ) -> Result<Self> {
+        let h_fov = angle_radians(
+            "equirectangular",
+            "h_fov",
+            h_fov_degrees,
+            UpTo::Including(360.0),
+        )?;
+        let v_fov = angle_radians(
+            "equirectangular",
+            "v_fov",
+            v_fov_degrees,
+            UpTo::Including(180.0),
+        )?;
+        let resolution = Resolution::new(width, height)?;
+        Ok(Equirectangular {
+            basis: CameraBasis::new(frame)?,
+            radians_per_pixel: DVec2::new(h_fov, v_fov) / resolution.size(),
+            resolution,
+        })
+    }
+}
+
+impl Projection for Equirectangular {
+    fn kind(&self) -> &'static str {
+        "equirectangular"
+    }
+
+    fn resolution(&self) -> (u32, u32) {
+        (self.resolution.width, self.resolution.height)
+    }
+
+    fn ray(&self, pixel: DVec2) -> Option<Ray> {
+        let angles = self.resolution.centred(pixel) * self.radians_per_pixel;
+        let (lon, lat) = (angles.x, angles.y);
+        let h = lat.cos() * horizontal(lon);
+        let direction = self.basis.to_world(DVec3::new(h.x, lat.sin(), h.y));
+        Some(Ray::new(self.basis.origin, direction))
+    }
+
+    fn has_inverse(&self) -> bool {
+        true
+    }
+
+    /// Appends the one image of `point` with its longitude taken in [-pi, pi): for
+    /// h_fov = 360 that lies in the image, otherwise it may lie left or right of it.
+    /// Degenerate: the eye appends nothing; a point straight above or below the eye (a pole,
+    /// seen by a whole row) appends the centre column only.
+    fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
+        let offset = point - self.basis.origin;
+        let local = self.basis.to_local(offset);
+        if local == DVec3::ZERO {
+            return;
+        }
+        let lon = longitude(local).unwrap_or(0.0);
+        let lat = local.y.atan2(DVec2::new(local.x, local.z).length());
+        let centred = DVec2::new(lon, lat) / self.radians_per_pixel;
+        out.push(ImagePoint {
+            pixel: self.resolution.pixel(centred),
+            t: offset.length(),
+        });
+    }
+}
+
+/// Longitude linear in x over `h_fov`; y maps linearly to the height on a unit cylinder
+/// around the vertical axis, height = (0.5 - y/H) * 2 tan(v_fov/2), so tan(latitude) is linear
+/// in y and `v_fov` is the vertical angle at the image centre.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cylindrical {
+    basis: CameraBasis,
+    radians_per_pixel: f64,
+    height_per_pixel: f64,
+    resolution: Resolution,
+}
+
+impl Cylindrical {
+    /// Errors: a degenerate frame, an empty image, `h_fov` not in (0, 360], `v_fov` not in
+    /// (0, 180).
+    pub fn new(
+        frame: &CameraFrame,
+        h_fov_degrees: f64,
+        v_fov_degrees: f64,
+        width: u32,
+        height: u32,
+    ) -> Result<Self> {
+        let h_fov = angle_radians(
+            "cylindrical",
+            "h_fov",
+            h_fov_degrees,
+            UpTo::Including(360.0),
+        )?;
+        let v_fov = angle_radians("cylindrical", "v_fov", v_fov_degrees, UpTo::Below(180.0))?;
+        let resolution = Resolution::new(width, height)?;
+        Ok(Cylindrical {
+            basis: CameraBasis::new(frame)?,
+            radians_per_pixel: h_fov / f64::from(width),
+            height_per_pixel: 2.0 * (0.5 * v_fov).tan() / f64::from(height),
+            resolution,
+        })
+    }
+}
+
+impl Projection for Cylindrical {
+    fn kind(&self) -> &'static str {
+        "cylindrical"
+    }
+
+    fn resolution(&self) -> (u32, u32) {
+        (self.resolution.width, self.resolution.height)
+    }
+
+    fn ray(&self, pixel: DVec2) -> Option<Ray> {
+        let centred = self.resolution.centred(pixel);
+        let h = horizontal(centred.x * self.radians_per_pixel);
+        let height = centred.y * self.height_per_pixel;
+        let direction = self
+            .basis
+            .to_world(DVec3::new(h.x, height, h.y))
+            .normalize();
+        Some(Ray::new(self.basis.origin, direction))
+    }
+
+    fn has_inverse(&self) -> bool {
+        true
+    }
+
+    /// Appends the one image of `point` with its longitude taken in [-pi, pi) (see
+    /// [`Equirectangular::project`]); the row may lie above or below the image. Degenerate:
+    /// points on the cylinder's axis (the eye and the poles straight above or below it, at
+    /// infinite height) append nothing.
+    fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
+        let offset = point - self.basis.origin;
+        let local = self.basis.to_local(offset);
+        let Some(lon) = longitude(local) else {
+            return;
+        };
+        let height = local.y / DVec2::new(local.x, local.z).length();
+        let centred = DVec2::new(lon / self.radians_per_pixel, height / self.height_per_pixel);
+        out.push(ImagePoint {
+            pixel: self.resolution.pixel(centred),
+            t: offset.length(),
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame() -> CameraFrame {
+        CameraFrame {
+            position: DVec3::new(1.0, 2.0, 3.0),
+            look_at: DVec3::new(1.0, 2.0, 2.0),
+            up: DVec3::Y,
+        }
+    }
+
+    fn near(a: DVec3, b: DVec3) -> bool {
+        (a - b).length() < 1e-14
+    }
+
+    #[test]
+    fn equirectangular_closed_forms() {
+        let e = Equirectangular::new(&frame(), 360.0, 180.0, 360, 180).unwrap();
+        assert!(near(
+            e.ray(DVec2::new(180.0, 90.0)).unwrap().direction,
+            DVec3::NEG_Z
+        ));
+        // x = 0 looks straight backwards for h_fov = 360.
+        assert!(near(
+            e.ray(DVec2::new(0.0, 90.0)).unwrap().direction,
+            DVec3::Z
+        ));
+        // Longitude increases to the right: a quarter turn right is +x.
+        assert!(near(
+            e.ray(DVec2::new(270.0, 90.0)).unwrap().direction,
+            DVec3::X
+        ));
+        // The top row is +v_fov/2 = straight up.
+        assert!(near(
+            e.ray(DVec2::new(35.0, 0.0)).unwrap().direction,
+            DVec3::Y
+        ));
+        let narrow = Equirectangular::new(&frame(), 90.0, 60.0, 90, 60).unwrap();
+        let top = narrow.ray(DVec2::new(45.0, 0.0)).unwrap().direction;
+        let lat = 30f64.to_radians();
+        assert!(near(top, DVec3::new(0.0, lat.sin(), -lat.cos())));
+    }
+
+    #[test]
+    fn equirectangular_behind_maps_to_the_left_edge_once() {
+        let e = Equirectangular::new(&frame(), 360.0, 180.0, 360, 180).unwrap();
+        let mut out = Vec::new();
+        e.project(DVec3::new(1.0, 2.0, 7.0), &mut out);
+        assert_eq!(out.len(), 1);
+        assert!((out[0].pixel - DVec2::new(0.0, 90.0)).length() < 1e-12);
+        assert!((out[0].t - 4.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn equirectangular_degenerate_points() {
+        let e = Equirectangular::new(&frame(), 360.0, 180.0, 360, 180).unwrap();
+        let mut out = Vec::new();
+        e.project(DVec3::new(1.0, 2.0, 3.0), &mut out); // the eye
+        assert!(out.is_empty());
+        e.project(DVec3::new(1.0, 5.0, 3.0), &mut out); // north pole: centre column, top row
+        assert_eq!(
+            out,
+            vec![ImagePoint {
+                pixel: DVec2::new(180.0, 0.0),
+                t: 3.0
+            }]
+        );
+        let ray = e.ray(out[0].pixel).unwrap();
+        assert!(near(ray.at(out[0].t), DVec3::new(1.0, 5.0, 3.0)));
+    }
+
+    #[test]
+    fn cylindrical_closed_forms() {
+        let c = Cylindrical::new(&frame(), 180.0, 90.0, 200, 100).unwrap();
+        assert!(near(
+            c.ray(DVec2::new(100.0, 50.0)).unwrap().direction,
+            DVec3::NEG_Z
+        ));
+        // Top row at height tan(v_fov/2) = 1 on the unit cylinder: 45 degrees up.
+        let top = c.ray(DVec2::new(100.0, 0.0)).unwrap().direction;
+        assert!(near(top, DVec3::new(0.0, 1.0, -1.0).normalize()));
+        // Height is linear in y: a quarter of the way down is height 0.5.
+        let quarter = c.ray(DVec2::new(100.0, 25.0)).unwrap().direction;
+        assert!(near(quarter, DVec3::new(0.0, 0.5, -1.0).normalize()));
+        // The right edge is 90 degrees to the right.
+        assert!(near(
+            c.ray(DVec2::new(200.0, 50.0)).unwrap().direction,
+            DVec3::X
+        ));
+    }
+
+    #[test]
+    fn cylindrical_axis_points_have_no_image() {
+        let c = Cylindrical::new(&frame(), 360.0, 120.0, 64, 32).unwrap();
+        let mut out = Vec::new();
+        c.project(DVec3::new(1.0, 2.0, 3.0), &mut out); // the eye
+        c.project(DVec3::new(1.0, 9.0, 3.0), &mut out); // north pole
+        c.project(DVec3::new(1.0, -9.0, 3.0), &mut out); // south pole
+        assert!(out.is_empty());
+        c.project(DVec3::new(1.0, 9.0, 2.0), &mut out); // steep but off the axis
+        assert_eq!(out.len(), 1);
+        assert!(out[0].pixel.y < 0.0, "above the image, unclipped");
+    }
+
+    #[test]
+    fn invalid_fields_of_view_are_errors() {
+        let f = frame();
+        let cases = [
+            Equirectangular::new(&f, 361.0, 90.0, 8, 8).err(),
+            Equirectangular::new(&f, 90.0, 181.0, 8, 8).err(),
+            Equirectangular::new(&f, 0.0, 90.0, 8, 8).err(),
+            Cylindrical::new(&f, 360.5, 90.0, 8, 8).err(),
+            Cylindrical::new(&f, 90.0, 180.0, 8, 8).err(),
+            Cylindrical::new(&f, 90.0, f64::NAN, 8, 8).err(),
+        ];
+        let messages: Vec<String> = cases.into_iter().map(|e| e.unwrap().message).collect();
+        assert!(messages[0].starts_with("equirectangular h_fov must be in (0, 360]"));
+        assert!(messages[1].starts_with("equirectangular v_fov must be in (0, 180]"));
+        assert!(messages[2].starts_with("equirectangular h_fov"));
+        assert!(messages[3].starts_with("cylindrical h_fov must be in (0, 360]"));
+        assert!(messages[4].starts_with("cylindrical v_fov must be in (0, 180)"));
+        assert!(messages[5].starts_with("cylindrical v_fov"));
+        assert!(Equirectangular::new(&f, 360.0, 180.0, 8, 8).is_ok());
+    }
+}

@@ -1,0 +1,272 @@
+//! Point location among screen triangles: which triangle covers a screen point, and where.
+//!
+//! A uniform grid of bins over the triangles' bounding box lists, per bin, the triangles
+//! whose bounding boxes overlap it, in index order; a query tests only its bin's list.
+//!
+//! Tie rule, so that a mesh partitions the screen without cracks or double coverage: a point
+//! counts as inside a triangle when it would be strictly inside after an infinitesimal shift
+//! by (+e, -e^2) (right, then down). A point on an edge thus belongs to the triangle on the
+//! right of that edge (for horizontal edges, the one below it), and a shared vertex to exactly
+//! one triangle of its fan. With screen (s, t) = (x / W, 1 - y / H), a mesh covering
+//! [0,1]^2 covers exactly the pixel positions [0, W) x [0, H): its left and top boundaries
+//! are inside, its right and bottom ones outside.
+//!
+//! Each edge function is evaluated with the edge's endpoints in a canonical (lexicographic)
+//! order, so two triangles sharing an edge see exactly opposite values: whatever the
+//! rounding, no point is lost or doubled across a shared edge. Only within rounding distance
+//! of a vertex where several edges meet could the rounded signs disagree; on dyadic screen
+//! grids (such as k / 2^n) pixel positions are evaluated exactly.
+
+use glam::DVec2;
+
+/// Most bins along one axis: bounds the grid's memory for very large meshes.
+const MAX_BINS_PER_AXIS: usize = 256;
+
+/// A screen triangle covering a point, and the point's barycentrics there: `u` weighs the
+/// triangle's second vertex, `v` its third.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ScreenHit {
+    pub triangle: usize,
+    pub u: f64,
+    pub v: f64,
+}
+
+/// Screen triangles (each of non-zero area, either orientation) with a bin grid.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct ScreenLocator {
+    triangles: Vec<[DVec2; 3]>,
+    min: DVec2,
+    bin_size: DVec2,
+    bins_per_axis: usize,
+    /// Bin `b` holds `bin_triangles[bin_start[b]..bin_start[b + 1]]`, ascending.
+    bin_start: Vec<usize>,
+    bin_triangles: Vec<u32>,
+}
+
+impl ScreenLocator {
+    /// Builds the grid. Every triangle must have non-zero area (validated by the caller), so
+    /// the bounding box of a non-empty list has positive extent on both axes.
+    pub fn new(triangles: Vec<[DVec2; 3]>) -> Self {
+        let (min, max) = triangles.iter().flatten().fold(
+            (DVec2::splat(f64::INFINITY), DVec2::splat(f64::NEG_INFINITY)),
+            |(lo, hi), &p| (lo.min(p), hi.max(p)),
+        );
+        let bins_per_axis =
+            ((triangles.len() as f64).sqrt().ceil() as usize * 2).clamp(1, MAX_BINS_PER_AXIS);
+        let mut locator = ScreenLocator {
+            min,
+            bin_size: (max - min) / bins_per_axis as f64,
+            bins_per_axis,
+            bin_start: Vec::new(),
+            bin_triangles: Vec::new(),
+            triangles: Vec::new(),
+        };
+        let mut lists = vec![Vec::new(); bins_per_axis * bins_per_axis];
+        for (index, tri) in triangles.iter().enumerate() {
+            let lo = tri[0].min(tri[1]).min(tri[2]);
+            let hi = tri[0].max(tri[1]).max(tri[2]);
+            for by in locator.bin(lo.y, 1)..=locator.bin(hi.y, 1) {
+                for bx in locator.bin(lo.x, 0)..=locator.bin(hi.x, 0) {
+                    lists[by * bins_per_axis + bx].push(index as u32);
+                }
+            }
+        }
+        locator.bin_start.push(0);
+        for list in lists {
+            locator.bin_triangles.extend(list);
+            locator.bin_start.push(locator.bin_triangles.len());
+        }
+        locator.triangles = triangles;
+        locator
+    }
+
+    /// The bin index of coordinate `c` along `axis`, clamped to the grid. Monotone in `c`,
+    /// so a point inside a triangle's bounding box falls in one of the triangle's bins.
+    fn bin(&self, c: f64, axis: usize) -> usize {
+        let cell = ((c - self.min[axis]) / self.bin_size[axis]).floor();
+        (cell.max(0.0) as usize).min(self.bins_per_axis - 1)
+    }
+
+    /// The lowest-index triangle covering `p` under the tie rule, or `None`.
+    pub fn locate(&self, p: DVec2) -> Option<ScreenHit> {
+        let max = self.min + self.bin_size * self.bins_per_axis as f64;
+        if !(p.cmpge(self.min).all() && p.cmple(max).all()) {
+            return None;
+        }
+        let bin = self.bin(p.y, 1) * self.bins_per_axis + self.bin(p.x, 0);
+        self.bin_triangles[self.bin_start[bin]..self.bin_start[bin + 1]]
+            .iter()
+            .find_map(|&index| {
+                let (u, v) = barycentrics(&self.triangles[index as usize], p)?;
+                Some(ScreenHit {
+                    triangle: index as usize,
+                    u,
+                    v,
+                })
+            })
+    }
+}
+
+/// Twice the signed area of (a, b, p), computed with a and b in lexicographic order so that
+/// `edge_function(a, b, p) == -edge_function(b, a, p)` exactly.
+fn edge_function(a: DVec2, b: DVec2, p: DVec2) -> f64 {
+    let ordered = (a.x, a.y) <= (b.x, b.y);
+    let (from, to) = if ordered { (a, b) } else { (b, a) };
+    let w = (to - from).perp_dot(p - from);
+    if ordered {
+        w
+    } else {
+        -w
+    }
+}
+
+/// Whether a point exactly on an edge traversed counter-clockwise along `direction` belongs
+/// to the triangle: whether the shift (+e, -e^2) moves it into the triangle, to the left of
+/// the edge (the sign of `direction x (e, -e^2)`).
+fn owns_edge_point(direction: DVec2) -> bool {
+    direction.y < 0.0 || (direction.y == 0.0 && direction.x < 0.0)
+}
+
+/// Barycentrics (u, v) of `p` in `tri` if `p` is inside under the tie rule. `tri` must have
+/// non-zero area; either orientation works.
+pub(crate) fn barycentrics(tri: &[DVec2; 3], p: DVec2) -> Option<(f64, f64)> {
+    let orientation = (tri[1] - tri[0]).perp_dot(tri[2] - tri[0]).signum();
+    // weights[k] belongs to the edge opposite vertex k.
+    let mut weights = [0.0; 3];
+    for (k, weight) in weights.iter_mut().enumerate() {
+        let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
+        let w = orientation * edge_function(a, b, p);
+        if w < 0.0 || (w == 0.0 && !owns_edge_point(orientation * (b - a))) {
+            return None;
+        }
+        *weight = w;
+    }
+    let total = weights[0] + weights[1] + weights[2];
+    Some((weights[1] / total, weights[2] / total))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An n x n grid of unit-square quads over [0,1]^2, each split along one diagonal.
+    fn grid(n: usize) -> Vec<[DVec2; 3]> {
+        let at = |i: usize, j: usize| DVec2::new(i as f64, j as f64) / n as f64;
+        let mut tris = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+                if (i + j) % 2 == 0 {
+                    tris.push([a, b, c]);
+                    tris.push([a, c, d]);
+                } else {
+                    tris.push([a, b, d]);
+                    tris.push([d, c, b]); // clockwise: both orientations occur
+                }
+            }
+        }
+        tris
+    }
+
+    #[test]
+    fn barycentrics_reproduce_the_point() {
+        let tri = [
+            DVec2::new(0.1, 0.2),
+            DVec2::new(0.9, 0.3),
+            DVec2::new(0.4, 0.8),
+        ];
+        let p = DVec2::new(0.45, 0.4);
+        let (u, v) = barycentrics(&tri, p).unwrap();
+        let q = (1.0 - u - v) * tri[0] + u * tri[1] + v * tri[2];
+        assert!((q - p).length() < 1e-15);
+        let reversed = [tri[0], tri[2], tri[1]];
+        assert_eq!(barycentrics(&reversed, p), Some((v, u)));
+        assert_eq!(barycentrics(&tri, DVec2::new(0.9, 0.9)), None);
+    }
+
+    #[test]
+    fn grid_points_and_edge_points_are_covered_exactly_once() {
+        // Sample a lattice that hits every edge and vertex of the grid exactly (dyadic
+        // coordinates), plus interior points.
+        let n = 4;
+        let tris = grid(n);
+        let locator = ScreenLocator::new(tris.clone());
+        let samples = 64;
+        for j in 0..=samples {
+            for i in 0..=samples {
+                let p = DVec2::new(i as f64, j as f64) / samples as f64;
+                let owners: Vec<usize> = (0..tris.len())
+                    .filter(|&k| barycentrics(&tris[k], p).is_some())
+                    .collect();
+                let hit = locator.locate(p);
+                if i == samples || j == 0 {
+                    // The rule gives the mesh's right and bottom boundaries to the outside.
+                    assert!(owners.is_empty(), "point {p} owned by {owners:?}");
+                    assert!(hit.is_none());
+                    continue;
+                }
+                assert_eq!(owners.len(), 1, "point {p} owned by {owners:?}");
+                assert_eq!(hit.map(|h| h.triangle), Some(owners[0]), "point {p}");
+            }
+        }
+    }
+
+    #[test]
+    fn interior_shared_edges_are_owned_by_one_side() {
+        let a = DVec2::new(0.0, 0.0);
+        let b = DVec2::new(1.0, 0.0);
+        let c = DVec2::new(1.0, 1.0);
+        let d = DVec2::new(0.0, 1.0);
+        let lower = [a, b, c];
+        let upper = [a, c, d];
+        let on_diagonal = DVec2::new(0.25, 0.25);
+        let lower_has = barycentrics(&lower, on_diagonal).is_some();
+        let upper_has = barycentrics(&upper, on_diagonal).is_some();
+        assert!(lower_has != upper_has);
+        // The shared vertex in the middle of a fan of four belongs to exactly one triangle.
+        let m = DVec2::new(0.5, 0.5);
+        let fan = [[a, b, m], [b, c, m], [c, d, m], [d, a, m]];
+        assert_eq!(
+            fan.iter().filter(|t| barycentrics(t, m).is_some()).count(),
+            1
+        );
+    }
+
+    #[test]
+    fn overlapping_triangles_lowest_index_wins() {
+        let big = [DVec2::ZERO, DVec2::new(1.0, 0.0), DVec2::new(0.0, 1.0)];
+        let small = [
+            DVec2::new(0.1, 0.1),
+            DVec2::new(0.3, 0.1),
+            DVec2::new(0.1, 0.3),
+        ];
+        let p = DVec2::new(0.15, 0.15);
+        assert_eq!(
+            ScreenLocator::new(vec![big, small])
+                .locate(p)
+                .unwrap()
+                .triangle,
+            0
+        );
+        assert_eq!(
+            ScreenLocator::new(vec![small, big])
+                .locate(p)
+                .unwrap()
+                .triangle,
+            0
+        );
+    }
+
+    #[test]
+    fn points_outside_every_triangle_are_none() {
+        let locator = ScreenLocator::new(vec![[
+            DVec2::new(0.2, 0.2),
+            DVec2::new(0.8, 0.2),
+            DVec2::new(0.5, 0.8),
+        ]]);
+        assert!(locator.locate(DVec2::new(0.5, 0.1)).is_none()); // outside the bounds
+        assert!(locator.locate(DVec2::new(0.25, 0.7)).is_none()); // inside bounds, outside
+        assert!(locator.locate(DVec2::new(0.5, 0.4)).is_some());
+        assert!(locator.locate(DVec2::new(f64::NAN, 0.4)).is_none());
+    }
+}

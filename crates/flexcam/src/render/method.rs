@@ -1,0 +1,87 @@
+//! Rendering methods by name (`--method`), and the one entry point that dispatches to them.
+
+use std::fmt;
+use std::str::FromStr;
+
+use crate::error::{Error, Result};
+use crate::projection::Projection;
+use crate::render::raycast::RayCaster;
+use crate::render::{Frame, RenderOptions, Stats};
+use crate::scene::Scene;
+
+/// A way of rendering a projection.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Method {
+    /// The reference ray caster; renders every projection.
+    #[default]
+    Raycast,
+}
+
+impl Method {
+    /// Every method with its command-line name.
+    pub const ALL: [(&'static str, Method); 1] = [("raycast", Method::Raycast)];
+
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        Method::ALL
+            .iter()
+            .find(|(_, m)| *m == self)
+            .map_or("?", |(name, _)| name)
+    }
+
+    /// Renders `scene` through `projection`. Fails, rather than producing a wrong image, when
+    /// the method cannot render that projection. The returned stats hold the method's own
+    /// counters.
+    pub fn render(
+        self,
+        scene: &Scene,
+        projection: &dyn Projection,
+        options: &RenderOptions,
+    ) -> Result<(Frame, Stats)> {
+        if options.spp == 0 {
+            return Err(Error::new("samples per pixel must be at least 1"));
+        }
+        match self {
+            Method::Raycast => Ok(RayCaster::new(scene).render(projection, options)),
+        }
+    }
+}
+
+impl FromStr for Method {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<Method> {
+        Method::ALL
+            .iter()
+            .find(|(name, _)| *name == s)
+            .map(|(_, m)| *m)
+            .ok_or_else(|| {
+                let names: Vec<_> = Method::ALL.iter().map(|(n, _)| *n).collect();
+                Error::new(format!(
+                    "unknown method \"{s}\" (available: {})",
+                    names.join(", ")
+                ))
+            })
+    }
+}
+
+impl fmt::Display for Method {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_unknown_is_listed() {
+        for (name, m) in Method::ALL {
+            assert_eq!(name.parse::<Method>().unwrap(), m);
+            assert_eq!(m.to_string(), name);
+        }
+        let e = "raster-ish".parse::<Method>().unwrap_err();
+        assert!(e.to_string().contains("available: raycast"), "{e}");
+    }
+}

@@ -1,0 +1,127 @@
+//! The image cut into square tiles rendered in parallel (rayon); each tile is rendered into its
+//! own buffers and copied into the frame in tile order, so the result does not depend on the
+//! number of threads or the order tiles finish in.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use glam::{DVec2, Vec3};
+use rayon::prelude::*;
+
+use super::sampling::SamplePattern;
+use super::shade::{RayCounts, Tracer};
+use super::RayCaster;
+use crate::projection::Projection;
+use crate::render::{Counter, Frame, RenderOptions, Stats};
+
+/// Tile edge in pixels: small enough to balance two to many cores, large enough that the
+/// per-tile bookkeeping is negligible.
+const TILE: u32 = 16;
+
+/// One rendered tile: its rectangle and row-major pixels.
+struct Tile {
+    x0: u32,
+    y0: u32,
+    width: u32,
+    color: Vec<Vec3>,
+    depth: Vec<f32>,
+    ids: Vec<u32>,
+    counts: RayCounts,
+}
+
+/// Renders every pixel of `projection`'s image; see [`RayCaster::render`].
+pub(super) fn render(
+    caster: &RayCaster,
+    projection: &dyn Projection,
+    options: &RenderOptions,
+) -> (Frame, Stats) {
+    let (width, height) = projection.resolution();
+    let pattern = SamplePattern::new(options.spp);
+    let (tiles_x, tiles_y) = (width.div_ceil(TILE), height.div_ceil(TILE));
+    let total = tiles_x as u64 * tiles_y as u64;
+    let done = AtomicU64::new(0);
+    let tiles: Vec<Tile> = (0..total)
+        .into_par_iter()
+        .map(|k| {
+            let (x0, y0) = (
+                (k % tiles_x as u64) as u32 * TILE,
+                (k / tiles_x as u64) as u32 * TILE,
+            );
+            let rect = (x0, y0, TILE.min(width - x0), TILE.min(height - y0));
+            let tile = render_tile(caster, projection, options, &pattern, rect);
+            if let Some(progress) = options.progress {
+                progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+            }
+            tile
+        })
+        .collect();
+    let mut frame = Frame::new(width, height, caster.background);
+    let mut counts = RayCounts::default();
+    for tile in &tiles {
+        for (row, y) in (tile.y0..)
+            .take(tile.color.len() / tile.width as usize)
+            .enumerate()
+        {
+            let src = row * tile.width as usize..(row + 1) * tile.width as usize;
+            let dst = (y as usize * width as usize + tile.x0 as usize)..;
+            let dst = dst.start..dst.start + tile.width as usize;
+            frame.color[dst.clone()].copy_from_slice(&tile.color[src.clone()]);
+            frame.depth[dst.clone()].copy_from_slice(&tile.depth[src.clone()]);
+            frame.ids[dst].copy_from_slice(&tile.ids[src]);
+        }
+        counts.primary += tile.counts.primary;
+        counts.secondary += tile.counts.secondary;
+        counts.shadow += tile.counts.shadow;
+    }
+    let stats = Stats::from([
+        ("primary_rays", Counter::Count(counts.primary)),
+        ("secondary_rays", Counter::Count(counts.secondary)),
+        ("shadow_rays", Counter::Count(counts.shadow)),
+        (
+            "rays_cast",
+            Counter::Count(counts.primary + counts.secondary + counts.shadow),
+        ),
+    ]);
+    (frame, stats)
+}
+
+/// Renders the pixels of rectangle `(x0, y0, width, height)`: each averages its samples'
+/// colours and reports the depth and id of the sample nearest its centre.
+fn render_tile(
+    caster: &RayCaster,
+    projection: &dyn Projection,
+    options: &RenderOptions,
+    pattern: &SamplePattern,
+    (x0, y0, width, height): (u32, u32, u32, u32),
+) -> Tile {
+    let n = (width * height) as usize;
+    let mut tile = Tile {
+        x0,
+        y0,
+        width,
+        color: Vec::with_capacity(n),
+        depth: Vec::with_capacity(n),
+        ids: Vec::with_capacity(n),
+        counts: RayCounts::default(),
+    };
+    let mut tracer = Tracer::new(caster, options);
+    let scale = 1.0 / pattern.offsets.len() as f32;
+    for y in y0..y0 + height {
+        for x in x0..x0 + width {
+            let mut color = Vec3::ZERO;
+            let (mut depth, mut id) = (f32::INFINITY, 0);
+            for (k, offset) in pattern.offsets.iter().enumerate() {
+                let pixel = DVec2::new(x as f64, y as f64) + *offset;
+                let sample = tracer.sample(projection.ray(pixel).as_ref());
+                color += sample.color;
+                if k == pattern.centre {
+                    (depth, id) = (sample.depth, sample.id);
+                }
+            }
+            tile.color.push(color * scale);
+            tile.depth.push(depth);
+            tile.ids.push(id);
+        }
+    }
+    tile.counts = tracer.counts;
+    tile
+}

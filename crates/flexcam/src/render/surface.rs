@@ -1,0 +1,311 @@
+//! Surface attributes at a point of a triangle: normals, texture coordinates, vertex colour
+//! and base colour, shared by every renderer so that all of them shade a hit alike.
+//!
+//! A hit is given as an object, a triangle index within its mesh and the barycentric weights
+//! `(u, v)` of the triangle's second and third vertices (the first has `1 - u - v`).
+
+use glam::{Vec2, Vec3};
+
+use crate::scene::{Material, Object, Pattern};
+
+/// How image textures are sampled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TextureFilter {
+    /// The nearest texel (`--shading flat`: no filtering).
+    Nearest,
+    /// Bilinear between the four nearest texel centres (`lit`).
+    Bilinear,
+}
+
+/// The normals of a surface point as seen by a ray arriving along some direction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Normals {
+    /// Unit face normal, flipped to face the incoming ray (surfaces are two-sided).
+    pub geometric: Vec3,
+    /// Unit shading normal (interpolated vertex normals, or the face normal), on the same side
+    /// as `geometric`.
+    pub shading: Vec3,
+    /// Whether the ray arrives against the face normal of the triangle's winding (counter-
+    /// clockwise vertices seen from the front): it enters a closed mesh wound outward.
+    pub front_face: bool,
+}
+
+/// The barycentric weights of the three vertices.
+fn weights(barycentric: Vec2) -> Vec3 {
+    Vec3::new(
+        1.0 - barycentric.x - barycentric.y,
+        barycentric.x,
+        barycentric.y,
+    )
+}
+
+/// The vertex indices of triangle `triangle` (a valid index: meshes are validated on load).
+fn corners(object: &Object, triangle: usize) -> [usize; 3] {
+    let [a, b, c] = object.mesh.triangles[triangle];
+    [a as usize, b as usize, c as usize]
+}
+
+/// Interpolates a per-vertex attribute at barycentric weights `w`.
+fn interpolate<T>(values: &[T], [a, b, c]: [usize; 3], w: Vec3) -> T
+where
+    T: Copy + std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T>,
+{
+    values[a] * w.x + values[b] * w.y + values[c] * w.z
+}
+
+/// The world-space point at barycentrics `barycentric` of triangle `triangle` of `object`.
+pub fn position(object: &Object, triangle: usize, barycentric: Vec2) -> Vec3 {
+    interpolate(
+        &object.mesh.positions,
+        corners(object, triangle),
+        weights(barycentric),
+    )
+}
+
+/// The normals of triangle `triangle` of `object` at barycentrics `barycentric`, for a ray
+/// travelling along `incoming` (any length).
+///
+/// Degenerate cases: a zero-area triangle has no face normal, and a zero `incoming` decides
+/// no side; both give a zero `geometric` normal and `front_face = true`, and then the shading
+/// normal is used unflipped. A zero vertex normal means "use the face normal" (see
+/// [`crate::scene::Mesh::append`]) and an interpolated normal that cancels to zero falls back
+/// to the face normal.
+pub fn normals(object: &Object, triangle: usize, barycentric: Vec2, incoming: Vec3) -> Normals {
+    let mesh = &object.mesh;
+    let corners = corners(object, triangle);
+    let [p0, p1, p2] = corners.map(|i| mesh.positions[i]);
+    let face = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+    let front_face = face.dot(incoming) <= 0.0;
+    let geometric = if front_face { face } else { -face };
+    let interpolated = if mesh.normals.is_empty() {
+        Vec3::ZERO
+    } else {
+        let n = corners.map(|i| match mesh.normals[i] {
+            Vec3::ZERO => face,
+            n => n,
+        });
+        interpolate(&n, [0, 1, 2], weights(barycentric)).normalize_or_zero()
+    };
+    let mut shading = if interpolated == Vec3::ZERO {
+        face
+    } else {
+        interpolated
+    };
+    if geometric != Vec3::ZERO && shading.dot(geometric) < 0.0 {
+        shading = -shading;
+    }
+    Normals {
+        geometric,
+        shading,
+        front_face,
+    }
+}
+
+/// The base colour at barycentrics `barycentric` of triangle `triangle` of `object`:
+/// `material.color * pattern * vertex colour` (see [`Material`]; no vertex colours = white),
+/// with image textures sampled by `filter` (texture coordinates zero when the mesh has none).
+/// Only the attributes the material needs are interpolated.
+pub fn base_color(
+    object: &Object,
+    triangle: usize,
+    barycentric: Vec2,
+    filter: TextureFilter,
+) -> Vec3 {
+    let mesh = &object.mesh;
+    let corners = corners(object, triangle);
+    let w = weights(barycentric);
+    let pattern = pattern_color(object, filter, || {
+        (
+            interpolate(&mesh.positions, corners, w),
+            uv_at(mesh, corners, w),
+        )
+    });
+    if mesh.colors.is_empty() {
+        pattern
+    } else {
+        pattern * interpolate(&mesh.colors, corners, w)
+    }
+}
+
+/// Texture coordinates at weights `w` (zero when the mesh has none).
+fn uv_at(mesh: &crate::scene::Mesh, corners: [usize; 3], w: Vec3) -> Vec2 {
+    if mesh.uvs.is_empty() {
+        Vec2::ZERO
+    } else {
+        interpolate(&mesh.uvs, corners, w)
+    }
+}
+
+/// `material.color` times the pattern: the checker alternates `color` and `other` by the cell
+/// parity of the object-space point, textures multiply `color`. `point_and_uv` gives the
+/// world-space point and texture coordinates, computed only for the patterns that need them.
+fn pattern_color(
+    object: &Object,
+    filter: TextureFilter,
+    point_and_uv: impl Fn() -> (Vec3, Vec2),
+) -> Vec3 {
+    let Material { color, pattern, .. } = &object.material;
+    match pattern {
+        Pattern::Solid => *color,
+        Pattern::Checker { other, size } => {
+            let p = object.world_to_object.transform_point3(point_and_uv().0);
+            if checker_parity(p, *size) == 0 {
+                *color
+            } else {
+                *other
+            }
+        }
+        Pattern::Texture(texture) => {
+            let uv = point_and_uv().1;
+            *color
+                * match filter {
+                    TextureFilter::Nearest => texture.nearest(uv),
+                    TextureFilter::Bilinear => texture.bilinear(uv),
+                }
+        }
+    }
+}
+
+/// Parity (0 or 1) of the checker cell holding `p`: `floor(x/size) + floor(y/size) +
+/// floor(z/size)` at `p` nudged by `1e-4 * size` along every axis, so a face lying on a cell
+/// boundary (a floor at y = 0) falls wholly in the cell above it instead of flickering.
+/// A non-positive or non-finite `size` (rejected by the scene loader) gives parity 0.
+pub fn checker_parity(p: Vec3, size: f32) -> u32 {
+    if !(size > 0.0 && size.is_finite()) {
+        return 0;
+    }
+    let cell = ((p + Vec3::splat(1e-4 * size)) / size).floor();
+    let sum = cell.x as i64 + cell.y as i64 + cell.z as i64;
+    sum.rem_euclid(2) as u32
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use glam::Affine3A;
+
+    use super::*;
+    use crate::scene::{Mesh, Surface, Texture};
+
+    fn object(mesh: Mesh, pattern: Pattern) -> Object {
+        Object {
+            id: 1,
+            name: "t".into(),
+            mesh,
+            material: Material {
+                color: Vec3::new(1.0, 0.5, 0.25),
+                pattern,
+                surface: Surface::Diffuse,
+            },
+            world_to_object: Affine3A::IDENTITY,
+        }
+    }
+
+    fn triangle() -> Mesh {
+        Mesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            triangles: vec![[0, 1, 2]],
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn face_normal_flips_toward_the_ray() {
+        let o = object(triangle(), Pattern::Solid);
+        let b = Vec2::new(0.25, 0.25);
+        let front = normals(&o, 0, b, Vec3::NEG_Z);
+        assert!(front.front_face);
+        assert_eq!(front.geometric, Vec3::Z);
+        assert_eq!(front.shading, Vec3::Z);
+        assert_eq!(position(&o, 0, b), Vec3::new(0.25, 0.25, 0.0));
+        let back = normals(&o, 0, b, Vec3::new(0.0, 0.0, 3.0));
+        assert!(!back.front_face);
+        assert_eq!(back.geometric, Vec3::NEG_Z);
+        assert_eq!(back.shading, Vec3::NEG_Z);
+    }
+
+    #[test]
+    fn vertex_normals_interpolate_and_zero_means_face_normal() {
+        let mut mesh = triangle();
+        mesh.normals = vec![Vec3::X, Vec3::ZERO, Vec3::Z];
+        let o = object(mesh, Pattern::Solid);
+        // At vertex 0 the normal is +x, at vertex 1 (zero) the face normal +z.
+        let at0 = normals(&o, 0, Vec2::ZERO, Vec3::NEG_Z);
+        assert_eq!(at0.shading, Vec3::X);
+        let at1 = normals(&o, 0, Vec2::X, Vec3::NEG_Z);
+        assert_eq!(at1.shading, Vec3::Z);
+        // From behind, the shading normal follows the flipped face normal.
+        let behind = normals(&o, 0, Vec2::new(0.5, 0.0), Vec3::Z);
+        assert!(behind.shading.z < 0.0);
+        // Opposite vertex normals cancelling to zero fall back to the face normal.
+        let mut mesh = triangle();
+        mesh.normals = vec![Vec3::X, Vec3::NEG_X, Vec3::X];
+        let o = object(mesh, Pattern::Solid);
+        assert_eq!(
+            normals(&o, 0, Vec2::new(0.5, 0.0), Vec3::NEG_Z).shading,
+            Vec3::Z
+        );
+    }
+
+    #[test]
+    fn zero_area_triangle_has_no_geometric_normal() {
+        let mut mesh = triangle();
+        mesh.positions[2] = Vec3::X * 2.0;
+        let p = normals(
+            &object(mesh, Pattern::Solid),
+            0,
+            Vec2::new(0.3, 0.3),
+            Vec3::NEG_Z,
+        );
+        assert_eq!(p.geometric, Vec3::ZERO);
+        assert!(p.front_face);
+    }
+
+    #[test]
+    fn base_color_multiplies_color_texture_and_vertex_colour() {
+        let mut mesh = triangle();
+        mesh.uvs = vec![
+            Vec2::new(0.1, 0.5),
+            Vec2::new(0.9, 0.5),
+            Vec2::new(0.1, 0.5),
+        ];
+        mesh.colors = vec![Vec3::splat(0.5); 3];
+        let texture = Texture {
+            width: 2,
+            height: 1,
+            texels: vec![Vec3::new(0.2, 0.2, 0.2), Vec3::ONE],
+        };
+        let o = object(mesh, Pattern::Texture(Arc::new(texture)));
+        let flat = base_color(&o, 0, Vec2::ZERO, TextureFilter::Nearest);
+        assert!((flat - Vec3::new(1.0, 0.5, 0.25) * 0.2 * 0.5).length() < 1e-6);
+        // Bilinear at u = 0.1 blends texel 0 with the wrapped texel 1.
+        let lit = base_color(&o, 0, Vec2::ZERO, TextureFilter::Bilinear);
+        assert!(lit.x > flat.x);
+    }
+
+    #[test]
+    fn checker_uses_object_space_and_is_stable_on_cell_boundaries() {
+        assert_eq!(checker_parity(Vec3::new(0.5, 0.0, 0.5), 1.0), 0);
+        assert_eq!(checker_parity(Vec3::new(0.5, -1e-7, 0.5), 1.0), 0);
+        assert_eq!(checker_parity(Vec3::new(1.5, 0.0, 0.5), 1.0), 1);
+        assert_eq!(checker_parity(Vec3::new(-0.5, 0.0, 0.5), 1.0), 1);
+        assert_eq!(checker_parity(Vec3::new(2.5, 0.0, 0.5), 2.0), 1);
+        assert_eq!(checker_parity(Vec3::ONE, 0.0), 0);
+        assert_eq!(checker_parity(Vec3::ONE, f32::NAN), 0);
+        let mut o = object(
+            triangle(),
+            Pattern::Checker {
+                other: Vec3::ZERO,
+                size: 1.0,
+            },
+        );
+        let b = Vec2::new(0.25, 0.25);
+        assert_eq!(
+            base_color(&o, 0, b, TextureFilter::Nearest),
+            o.material.color
+        );
+        o.world_to_object = Affine3A::from_translation(Vec3::X);
+        assert_eq!(base_color(&o, 0, b, TextureFilter::Nearest), Vec3::ZERO);
+    }
+}

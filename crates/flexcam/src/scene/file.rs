@@ -1,1 +1,0 @@
-//! The TOML scene format of the scene-and-CLI spec.

@@ -1,0 +1,144 @@
+//! The TOML scene format of the scene-and-CLI spec (`scenes/README.md` documents every key).
+//!
+//! Parsing happens in two stages: serde reads the text into flat, span-carrying structs
+//! (module `raw`), then each table is checked and converted by hand, so that every error, from a
+//! TOML syntax error to a degenerate projection, is one line `FILE:LINE:COLUMN: message`.
+
+mod light;
+mod object;
+mod projection;
+mod raw;
+mod shape;
+mod source;
+mod values;
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use glam::Vec3;
+use toml::Spanned;
+
+use self::raw::{RawImage, RawScene};
+use self::source::Source;
+use super::{ImageSettings, Scene};
+use crate::error::{Error, Result};
+
+/// The largest accepted image side, in pixels. It keeps an image at or below 2^28 pixels, so
+/// that frame buffers (several values per pixel) fit in memory.
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+/// Checks an image resolution: both sides in 1..=[`MAX_IMAGE_SIDE`]. The CLI reuses it for
+/// its `--width` / `--height` overrides.
+pub fn validate_resolution(width: u32, height: u32) -> Result<()> {
+    for (name, value) in [("width", width), ("height", height)] {
+        if !(1..=MAX_IMAGE_SIDE).contains(&value) {
+            return Err(Error::new(format!(
+                "image {name} {value} is out of range: it must be in 1..={MAX_IMAGE_SIDE}"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Reads and parses the scene file at `path`. Errors name `path` as given.
+pub fn load(path: &Path) -> Result<Scene> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Error::in_file(path, format!("cannot read scene file: {e}")))?;
+    parse(&text, path)
+}
+
+/// Parses scene-file text. `path` names the file in errors, and its folder is the base for
+/// the relative paths in the file (models, textures, projection surfaces).
+pub fn parse(text: &str, path: &Path) -> Result<Scene> {
+    let src = Source { text, path };
+    projection::reject_unsupported(&src)?;
+    let raw: RawScene = toml::from_str(text).map_err(|e| src.toml_error(&e))?;
+    let base_dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
+
+    let image = image_settings(&src, raw.image.as_ref())?;
+    let projection_table = raw
+        .projection
+        .as_ref()
+        .ok_or_else(|| src.file_error("missing [projection] table: a scene needs exactly one"))?;
+    let projection = projection::convert(&src, projection_table, &base_dir)?;
+    check_unique_names(&src, &raw.object)?;
+    let mut objects = Vec::new();
+    for (index, table) in raw.object.iter().enumerate() {
+        let id =
+            u32::try_from(index + 1).map_err(|_| src.error(&table.span(), "too many objects"))?;
+        objects.extend(object::convert(&src, table, id, &base_dir)?);
+    }
+    let lights = raw
+        .light
+        .iter()
+        .map(|table| light::convert(&src, table))
+        .collect::<Result<Vec<_>>>()?;
+    // Building the projection is what detects degenerate parameters.
+    projection
+        .build(image.width, image.height)
+        .map_err(|e| match e.location {
+            Some(_) => e,
+            None => src.error(&projection_table.span(), e.message),
+        })?;
+    Ok(Scene {
+        objects,
+        lights,
+        image,
+        projection,
+        base_dir: Some(base_dir),
+    })
+}
+
+/// `[image]`, with [`ImageSettings::default`] for absent keys.
+fn image_settings(src: &Source, table: Option<&Spanned<RawImage>>) -> Result<ImageSettings> {
+    let defaults = ImageSettings::default();
+    let Some(table) = table else {
+        return Ok(defaults);
+    };
+    let raw = table.get_ref();
+    let side = |value: &Option<Spanned<u32>>, default: u32| {
+        value.as_ref().map_or(default, |v| *v.get_ref())
+    };
+    let (width, height) = (
+        side(&raw.width, defaults.width),
+        side(&raw.height, defaults.height),
+    );
+    validate_resolution(width, height).map_err(|e| {
+        let at = [&raw.width, &raw.height]
+            .into_iter()
+            .flatten()
+            .find(|v| !(1..=MAX_IMAGE_SIDE).contains(v.get_ref()))
+            .map_or(table.span(), Spanned::span);
+        src.error(&at, e.message)
+    })?;
+    let background = raw
+        .background
+        .as_ref()
+        .map_or(Ok(Vec3::ZERO), |b| src.color(b, "background"))?;
+    Ok(ImageSettings {
+        width,
+        height,
+        background,
+    })
+}
+
+/// Object names are optional but must be unique.
+fn check_unique_names(src: &Source, objects: &[Spanned<raw::RawObject>]) -> Result<()> {
+    let mut seen = HashMap::new();
+    for name in objects.iter().filter_map(|o| o.get_ref().name.as_ref()) {
+        if let Some(first) = seen.insert(name.get_ref().as_str(), name.span()) {
+            let (line, _) = src.line_column(first.start);
+            return Err(src.error(
+                &name.span(),
+                format!(
+                    "duplicate object name \"{}\" (first used on line {line})",
+                    name.get_ref()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,305 @@
+//! `[[object]]`: checks an object table against its shape and converts it into world-space
+//! [`Object`]s (one per part of a model file, all sharing the object's id).
+
+use std::path::Path;
+use std::sync::Arc;
+
+use glam::{Affine3A, Mat3, Vec3};
+use toml::Spanned;
+
+use super::raw::{Numbers, RawObject};
+use super::shape::{analytic_mesh, Shape, MAX_TESSELLATION};
+use super::source::Source;
+use crate::error::Result;
+use crate::scene::loaders::{load_model, load_texture};
+use crate::scene::{Material, Mesh, Object, Pattern, Surface};
+
+/// Surface names as written in scene files.
+const MATERIALS: [&str; 4] = ["diffuse", "mirror", "glass", "emissive"];
+
+/// Index of refraction of `glass` when `ior` is not given.
+const DEFAULT_IOR: f64 = 1.5;
+
+/// Converts one object table; `id` is its 1-based position in the file. Relative paths
+/// (`file`, `texture`) are resolved against `base_dir`.
+pub(super) fn convert(
+    src: &Source,
+    table: &Spanned<RawObject>,
+    id: u32,
+    base_dir: &Path,
+) -> Result<Vec<Object>> {
+    let raw = table.get_ref();
+    let shape = Shape::parse(raw.shape.get_ref()).ok_or_else(|| {
+        src.error(
+            &raw.shape.span(),
+            format!(
+                "unknown shape \"{}\"; expected one of: {}",
+                raw.shape.get_ref(),
+                Shape::all_names()
+            ),
+        )
+    })?;
+    check_keys_fit_shape(src, table, shape)?;
+    let overrides = MaterialOverrides::read(src, raw, base_dir)?;
+    let object_to_world = transform(src, raw)?;
+    let parts: Vec<(Mesh, Material)> = match (&raw.file, analytic(src, raw, shape)?) {
+        (_, Some((mesh, base))) => vec![(mesh, overrides.apply(base))],
+        (Some(file), None) => {
+            let path = base_dir.join(file.get_ref());
+            load_model(&path)
+                .map_err(|e| e.or_in_file(&path))?
+                .into_iter()
+                .map(|part| {
+                    (
+                        part.mesh,
+                        overrides.apply(part.material.unwrap_or_default()),
+                    )
+                })
+                .collect()
+        }
+        (None, None) => return Err(src.error(&table.span(), "shape \"mesh\" needs `file`")),
+    };
+    let name = raw
+        .name
+        .as_ref()
+        .map_or_else(|| shape.name().to_string(), |n| n.get_ref().clone());
+    let world_to_object = object_to_world.inverse();
+    Ok(parts
+        .into_iter()
+        .map(|(mut mesh, material)| {
+            mesh.transform(&object_to_world);
+            Object {
+                id,
+                name: name.clone(),
+                mesh,
+                material,
+                world_to_object,
+            }
+        })
+        .collect())
+}
+
+/// Rejects keys that the shape does not take: `file` belongs to meshes only, `size` and
+/// `tessellation` to analytic shapes only, `face_colors` to boxes only.
+fn check_keys_fit_shape(src: &Source, table: &Spanned<RawObject>, shape: Shape) -> Result<()> {
+    let raw = table.get_ref();
+    let is_mesh = shape == Shape::Mesh;
+    let misplaced = [
+        ("file", raw.file.as_ref().map(Spanned::span), !is_mesh),
+        ("size", raw.size.as_ref().map(Spanned::span), is_mesh),
+        (
+            "tessellation",
+            raw.tessellation.as_ref().map(Spanned::span),
+            is_mesh,
+        ),
+        (
+            "face_colors",
+            raw.face_colors.as_ref().map(Spanned::span),
+            shape != Shape::Box,
+        ),
+    ];
+    match misplaced
+        .into_iter()
+        .find(|(_, span, wrong)| span.is_some() && *wrong)
+    {
+        Some((key, Some(span), _)) => Err(src.error(
+            &span,
+            format!("`{key}` does not apply to shape \"{}\"", shape.name()),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// The object-space mesh and base material of an analytic shape; `None` for model files.
+fn analytic(src: &Source, raw: &RawObject, shape: Shape) -> Result<Option<(Mesh, Material)>> {
+    let (Some(form), Some((default_tessellation, min_tessellation))) =
+        (shape.size_form(), shape.tessellation_default_and_min())
+    else {
+        return Ok(None);
+    };
+    let mut size = [0.0; 3];
+    match &raw.size {
+        None => size[..form.default.len()].copy_from_slice(form.default),
+        Some(value) => {
+            let numbers = value.get_ref().as_slice();
+            if numbers.len() != form.default.len() {
+                return Err(src.error(
+                    &value.span(),
+                    format!("`size` of a {} is {}", shape.name(), form.written),
+                ));
+            }
+            src.all_finite(numbers, value, "size")?;
+            if let Some(bad) = numbers.iter().find(|&&x| x <= 0.0) {
+                return Err(src.error(&value.span(), format!("`size` must be positive, not {bad}")));
+            }
+            for (s, &x) in size.iter_mut().zip(numbers) {
+                *s = x as f32;
+            }
+        }
+    }
+    let tessellation = match &raw.tessellation {
+        None => default_tessellation,
+        Some(t) => {
+            let t_value = *t.get_ref();
+            if !(min_tessellation..=MAX_TESSELLATION).contains(&t_value) {
+                return Err(src.error(
+                    &t.span(),
+                    format!(
+                        "`tessellation` of a {} must be in {min_tessellation}..={MAX_TESSELLATION}, not {t_value}",
+                        shape.name()
+                    ),
+                ));
+            }
+            t_value
+        }
+    };
+    let face_colors = match &raw.face_colors {
+        None => None,
+        Some(value) => {
+            let mut colors = [Vec3::ZERO; 6];
+            for (c, rgb) in colors.iter_mut().zip(value.get_ref()) {
+                *c = src.color(&Spanned::new(value.span(), *rgb), "face_colors")?;
+            }
+            Some(colors)
+        }
+    };
+    // Face colours are vertex colours, which multiply the base colour: default it to white.
+    let base = Material {
+        color: if face_colors.is_some() {
+            Vec3::ONE
+        } else {
+            Material::default().color
+        },
+        ..Material::default()
+    };
+    Ok(analytic_mesh(shape, size, tessellation, face_colors).map(|mesh| (mesh, base)))
+}
+
+/// The material keys an object gives; each replaces that part of the base material (the
+/// shape's default, or the material a model file assigns).
+struct MaterialOverrides {
+    color: Option<Vec3>,
+    pattern: Option<Pattern>,
+    surface: Option<Surface>,
+}
+
+impl MaterialOverrides {
+    fn read(src: &Source, raw: &RawObject, base_dir: &Path) -> Result<Self> {
+        let color = raw
+            .color
+            .as_ref()
+            .map(|c| src.color(c, "color"))
+            .transpose()?;
+        if let (Some(_), Some(texture)) = (&raw.checker, &raw.texture) {
+            return Err(src.error(
+                &texture.span(),
+                "`texture` and `checker` cannot be combined",
+            ));
+        }
+        let pattern = if let Some(checker) = &raw.checker {
+            let checker = checker.get_ref();
+            Some(Pattern::Checker {
+                other: src.color(&checker.color, "checker.color")?,
+                size: checker
+                    .size
+                    .as_ref()
+                    .map_or(Ok(1.0), |s| src.positive(s, "checker.size"))?
+                    as f32,
+            })
+        } else if let Some(texture) = &raw.texture {
+            let path = base_dir.join(texture.get_ref());
+            let texture = load_texture(&path).map_err(|e| e.or_in_file(&path))?;
+            Some(Pattern::Texture(Arc::new(texture)))
+        } else {
+            None
+        };
+        Ok(MaterialOverrides {
+            color,
+            pattern,
+            surface: surface(src, raw)?,
+        })
+    }
+
+    fn apply(&self, base: Material) -> Material {
+        Material {
+            color: self.color.unwrap_or(base.color),
+            pattern: self.pattern.clone().unwrap_or(base.pattern),
+            surface: self.surface.unwrap_or(base.surface),
+        }
+    }
+}
+
+/// `material` and `ior`; `ior` belongs to glass only.
+fn surface(src: &Source, raw: &RawObject) -> Result<Option<Surface>> {
+    let is_glass = raw
+        .material
+        .as_ref()
+        .is_some_and(|m| m.get_ref() == "glass");
+    if let (Some(ior), false) = (&raw.ior, is_glass) {
+        return Err(src.error(&ior.span(), "`ior` applies only to material = \"glass\""));
+    }
+    let Some(material) = &raw.material else {
+        return Ok(None);
+    };
+    Ok(Some(match material.get_ref().as_str() {
+        "diffuse" => Surface::Diffuse,
+        "mirror" => Surface::Mirror,
+        "emissive" => Surface::Emissive,
+        "glass" => Surface::Glass {
+            ior: raw
+                .ior
+                .as_ref()
+                .map_or(Ok(DEFAULT_IOR), |ior| src.positive(ior, "ior"))? as f32,
+        },
+        other => {
+            return Err(src.error(
+                &material.span(),
+                format!(
+                    "unknown material \"{other}\"; expected one of: {}",
+                    MATERIALS.join(", ")
+                ),
+            ))
+        }
+    }))
+}
+
+/// The object-to-world transform T * R * S: scale, then rotate about x, then y, then z
+/// (R = Rz * Ry * Rx, degrees), then translate.
+fn transform(src: &Source, raw: &RawObject) -> Result<Affine3A> {
+    let translate = raw
+        .translate
+        .as_ref()
+        .map_or(Ok(Vec3::ZERO), |t| src.vec3(t, "translate"))?;
+    let rotate = raw
+        .rotate
+        .as_ref()
+        .map_or(Ok(Vec3::ZERO), |r| src.vec3(r, "rotate"))?;
+    let scale = match &raw.scale {
+        None => Vec3::ONE,
+        Some(value) => {
+            let numbers = value.get_ref();
+            src.all_finite(numbers.as_slice(), value, "scale")?;
+            let scale = match numbers {
+                Numbers::One(s) => Vec3::splat(*s as f32),
+                Numbers::List(xs) if xs.len() == 3 => {
+                    Vec3::new(xs[0] as f32, xs[1] as f32, xs[2] as f32)
+                }
+                Numbers::List(_) => {
+                    return Err(src.error(&value.span(), "`scale` is a number or [x, y, z]"));
+                }
+            };
+            // A zero (or vanishingly small) factor flattens the object and has no inverse.
+            if !(scale.x * scale.y * scale.z).is_normal() {
+                return Err(src.error(&value.span(), "`scale` must not be zero"));
+            }
+            scale
+        }
+    };
+    let r = rotate * (std::f32::consts::PI / 180.0);
+    let rotation =
+        Mat3::from_rotation_z(r.z) * Mat3::from_rotation_y(r.y) * Mat3::from_rotation_x(r.x);
+    Ok(Affine3A::from_mat3_translation(
+        rotation * Mat3::from_diagonal(scale),
+        translate,
+    ))
+}

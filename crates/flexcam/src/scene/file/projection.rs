@@ -1,0 +1,272 @@
+//! `[projection]`: checks a projection table against its type's parameters and converts it
+//! into a [`ProjectionSpec`].
+
+use std::path::Path;
+
+use glam::{DVec2, DVec3};
+use toml::Spanned;
+
+use super::raw::{ProjectionTypeProbe, RawProjection};
+use super::source::Source;
+use crate::error::Result;
+use crate::projection::{CameraFrame, ProjectionSpec, TrilinearMesh};
+
+/// The projection types this parser converts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Perspective,
+    Orthographic,
+    Fisheye,
+    Equirectangular,
+    Cylindrical,
+    Trilinear,
+}
+
+/// Type names as written in scene files.
+const KINDS: [(&str, Kind); 6] = [
+    ("perspective", Kind::Perspective),
+    ("orthographic", Kind::Orthographic),
+    ("fisheye", Kind::Fisheye),
+    ("equirectangular", Kind::Equirectangular),
+    ("cylindrical", Kind::Cylindrical),
+    ("trilinear", Kind::Trilinear),
+];
+
+/// Projection types of the spec that are recognised but not implemented yet.
+const UNSUPPORTED: [&str; 1] = ["flexible"];
+
+/// Parameters of the single-viewpoint projections, shared by all of them.
+const FRAME_KEYS: [&str; 3] = ["position", "look_at", "up"];
+
+impl Kind {
+    fn parse(name: &str) -> Option<Kind> {
+        KINDS
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|&(_, kind)| kind)
+    }
+
+    fn name(self) -> &'static str {
+        KINDS
+            .iter()
+            .find(|(_, k)| *k == self)
+            .map_or("", |(n, _)| n)
+    }
+
+    /// The keys (besides `type`) a table of this type may hold.
+    fn keys(self) -> Vec<&'static str> {
+        let own: &[&str] = match self {
+            Kind::Perspective | Kind::Fisheye => &["fov"],
+            Kind::Orthographic => &["width"],
+            Kind::Equirectangular | Kind::Cylindrical => &["h_fov", "v_fov"],
+            Kind::Trilinear => {
+                return vec!["surface", "points", "normals", "screen", "triangles"];
+            }
+        };
+        FRAME_KEYS.iter().chain(own).copied().collect()
+    }
+}
+
+/// Every projection type name a scene file may use, for error messages.
+fn all_type_names() -> String {
+    KINDS
+        .iter()
+        .map(|(name, _)| *name)
+        .chain(UNSUPPORTED)
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Fails with a clear message, at the `type` value, when the file asks for a projection type
+/// that is recognised but not supported yet. Runs before the strict parse, which would
+/// otherwise report that type's parameters as unknown keys.
+pub(super) fn reject_unsupported(src: &Source) -> Result<()> {
+    let Ok(probe) = toml::from_str::<ProjectionTypeProbe>(src.text) else {
+        return Ok(()); // The strict parse reports the problem.
+    };
+    match probe.projection {
+        Some(p) if UNSUPPORTED.contains(&p.kind.get_ref().as_str()) => Err(src.error(
+            &p.kind.span(),
+            format!(
+                "projection type \"{}\" is not supported yet",
+                p.kind.get_ref()
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// Converts the `[projection]` table. Relative paths (`surface`) are resolved against
+/// `base_dir`. Only the file's form is checked here; [`ProjectionSpec::build`] checks that
+/// the projection is not degenerate.
+pub(super) fn convert(
+    src: &Source,
+    table: &Spanned<RawProjection>,
+    base_dir: &Path,
+) -> Result<ProjectionSpec> {
+    let raw = table.get_ref();
+    let name = raw.kind.get_ref();
+    let kind = Kind::parse(name).ok_or_else(|| {
+        src.error(
+            &raw.kind.span(),
+            format!(
+                "unknown projection type \"{name}\"; expected one of: {}",
+                all_type_names()
+            ),
+        )
+    })?;
+    let keys = kind.keys();
+    if let Some((key, span)) = raw
+        .present_keys()
+        .into_iter()
+        .find(|(key, _)| !keys.contains(key))
+    {
+        return Err(src.error(
+            &span,
+            format!(
+                "`{key}` is not a parameter of {name} projections (they take: {})",
+                keys.join(", ")
+            ),
+        ));
+    }
+    let required = Required { src, table, kind };
+    let angle = |value: &Option<Spanned<f64>>, key: &str, default: f64| {
+        value.as_ref().map_or(Ok(default), |v| src.number(v, key))
+    };
+    Ok(match kind {
+        Kind::Trilinear => ProjectionSpec::Trilinear(trilinear(src, &required, base_dir)?),
+        Kind::Perspective => ProjectionSpec::Perspective {
+            frame: camera_frame(src, &required)?,
+            fov: src.number(required.get(&raw.fov, "fov")?, "fov")?,
+        },
+        Kind::Orthographic => ProjectionSpec::Orthographic {
+            frame: camera_frame(src, &required)?,
+            width: src.number(required.get(&raw.width, "width")?, "width")?,
+        },
+        Kind::Fisheye => ProjectionSpec::Fisheye {
+            frame: camera_frame(src, &required)?,
+            fov: src.number(required.get(&raw.fov, "fov")?, "fov")?,
+        },
+        Kind::Equirectangular => ProjectionSpec::Equirectangular {
+            frame: camera_frame(src, &required)?,
+            h_fov: angle(&raw.h_fov, "h_fov", 360.0)?,
+            v_fov: angle(&raw.v_fov, "v_fov", 180.0)?,
+        },
+        Kind::Cylindrical => ProjectionSpec::Cylindrical {
+            frame: camera_frame(src, &required)?,
+            h_fov: angle(&raw.h_fov, "h_fov", 360.0)?,
+            v_fov: angle(&raw.v_fov, "v_fov", 90.0)?,
+        },
+    })
+}
+
+/// Looks up parameters a projection type cannot do without; a missing one is reported at the
+/// table's header.
+struct Required<'a> {
+    src: &'a Source<'a>,
+    table: &'a Spanned<RawProjection>,
+    kind: Kind,
+}
+
+impl Required<'_> {
+    fn raw(&self) -> &RawProjection {
+        self.table.get_ref()
+    }
+
+    fn get<'v, T>(&self, value: &'v Option<Spanned<T>>, key: &str) -> Result<&'v Spanned<T>> {
+        value.as_ref().ok_or_else(|| {
+            self.src.error(
+                &self.table.span(),
+                format!("{} projection needs `{key}`", self.kind.name()),
+            )
+        })
+    }
+}
+
+/// `position`, `look_at` (required) and `up` (default +y).
+fn camera_frame(src: &Source, required: &Required) -> Result<CameraFrame> {
+    let raw = required.raw();
+    Ok(CameraFrame {
+        position: src.dvec3(required.get(&raw.position, "position")?, "position")?,
+        look_at: src.dvec3(required.get(&raw.look_at, "look_at")?, "look_at")?,
+        up: raw
+            .up
+            .as_ref()
+            .map_or(Ok(DVec3::Y), |up| src.dvec3(up, "up"))?,
+    })
+}
+
+/// A trilinear mesh from `surface = "file.obj"` or from the inline arrays.
+fn trilinear(src: &Source, required: &Required, base_dir: &Path) -> Result<TrilinearMesh> {
+    let raw = required.raw();
+    if let Some(surface) = &raw.surface {
+        let inline = [
+            ("points", raw.points.as_ref().map(Spanned::span)),
+            ("normals", raw.normals.as_ref().map(Spanned::span)),
+            ("screen", raw.screen.as_ref().map(Spanned::span)),
+            ("triangles", raw.triangles.as_ref().map(Spanned::span)),
+        ];
+        if let Some((key, Some(span))) = inline.into_iter().find(|(_, span)| span.is_some()) {
+            return Err(src.error(
+                &span,
+                format!("`{key}` cannot be combined with `surface`: give a surface file or inline arrays"),
+            ));
+        }
+        let path = base_dir.join(surface.get_ref());
+        return TrilinearMesh::load_obj(&path).map_err(|e| e.or_in_file(&path));
+    }
+    if raw.points.is_none() {
+        return Err(src.error(
+            &required.table.span(),
+            "trilinear projection needs `surface` or the inline `points`, `normals`, `screen` and `triangles`",
+        ));
+    }
+    let points = required.get(&raw.points, "points")?;
+    let normals = required.get(&raw.normals, "normals")?;
+    let screen = required.get(&raw.screen, "screen")?;
+    let triangles = required.get(&raw.triangles, "triangles")?;
+    let n = points.get_ref().len();
+    for (key, len, span) in [
+        ("normals", normals.get_ref().len(), normals.span()),
+        ("screen", screen.get_ref().len(), screen.span()),
+    ] {
+        if len != n {
+            return Err(src.error(
+                &span,
+                format!("`{key}` has {len} entries but `points` has {n}"),
+            ));
+        }
+    }
+    src.all_finite(points.get_ref().as_flattened(), points, "points")?;
+    src.all_finite(normals.get_ref().as_flattened(), normals, "normals")?;
+    src.all_finite(screen.get_ref().as_flattened(), screen, "screen")?;
+    if let Some((i, t)) = triangles
+        .get_ref()
+        .iter()
+        .enumerate()
+        .find(|(_, t)| t.iter().any(|&k| k as usize >= n))
+    {
+        return Err(src.error(
+            &triangles.span(),
+            format!("triangle {i} {t:?} refers to a vertex beyond the {n} `points` (indices start at 0)"),
+        ));
+    }
+    Ok(TrilinearMesh {
+        points: points
+            .get_ref()
+            .iter()
+            .map(|&p| DVec3::from_array(p))
+            .collect(),
+        normals: normals
+            .get_ref()
+            .iter()
+            .map(|&d| DVec3::from_array(d))
+            .collect(),
+        screen: screen
+            .get_ref()
+            .iter()
+            .map(|&s| DVec2::from_array(s))
+            .collect(),
+        triangles: triangles.get_ref().clone(),
+    })
+}

@@ -1,0 +1,187 @@
+//! The scene file as TOML gives it: flat structs of optional, span-carrying values.
+//!
+//! Every value keeps its byte span ([`Spanned`]) so that later checks can report a line and
+//! column. The structs are deliberately flat (no tagged enums, no `flatten`, which lose spans
+//! in serde); which keys a projection, shape or light type accepts is checked by hand in the
+//! modules that convert them. `deny_unknown_fields` turns typos into errors.
+
+use std::ops::Range;
+
+use serde::de::{self, Deserializer, SeqAccess, Visitor};
+use serde::Deserialize;
+use toml::Spanned;
+
+/// A 3-vector as written in the file: `[x, y, z]`.
+pub type Vec3Value = Spanned<[f64; 3]>;
+
+/// The whole file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawScene {
+    pub image: Option<Spanned<RawImage>>,
+    pub projection: Option<Spanned<RawProjection>>,
+    #[serde(default)]
+    pub object: Vec<Spanned<RawObject>>,
+    #[serde(default)]
+    pub light: Vec<Spanned<RawLight>>,
+}
+
+/// `[image]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawImage {
+    pub width: Option<Spanned<u32>>,
+    pub height: Option<Spanned<u32>>,
+    pub background: Option<Vec3Value>,
+}
+
+/// `[projection]`: the union of every projection type's parameters.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawProjection {
+    #[serde(rename = "type")]
+    pub kind: Spanned<String>,
+    pub position: Option<Vec3Value>,
+    pub look_at: Option<Vec3Value>,
+    pub up: Option<Vec3Value>,
+    pub fov: Option<Spanned<f64>>,
+    pub width: Option<Spanned<f64>>,
+    pub h_fov: Option<Spanned<f64>>,
+    pub v_fov: Option<Spanned<f64>>,
+    pub surface: Option<Spanned<String>>,
+    pub points: Option<Spanned<Vec<[f64; 3]>>>,
+    pub normals: Option<Spanned<Vec<[f64; 3]>>>,
+    pub screen: Option<Spanned<Vec<[f64; 2]>>>,
+    pub triangles: Option<Spanned<Vec<[u32; 3]>>>,
+}
+
+impl RawProjection {
+    /// The parameter keys present in the table (all but `type`), with their spans.
+    pub fn present_keys(&self) -> Vec<(&'static str, Range<usize>)> {
+        [
+            ("position", self.position.as_ref().map(Spanned::span)),
+            ("look_at", self.look_at.as_ref().map(Spanned::span)),
+            ("up", self.up.as_ref().map(Spanned::span)),
+            ("fov", self.fov.as_ref().map(Spanned::span)),
+            ("width", self.width.as_ref().map(Spanned::span)),
+            ("h_fov", self.h_fov.as_ref().map(Spanned::span)),
+            ("v_fov", self.v_fov.as_ref().map(Spanned::span)),
+            ("surface", self.surface.as_ref().map(Spanned::span)),
+            ("points", self.points.as_ref().map(Spanned::span)),
+            ("normals", self.normals.as_ref().map(Spanned::span)),
+            ("screen", self.screen.as_ref().map(Spanned::span)),
+            ("triangles", self.triangles.as_ref().map(Spanned::span)),
+        ]
+        .into_iter()
+        .filter_map(|(key, span)| Some((key, span?)))
+        .collect()
+    }
+}
+
+/// Only the projection type, read leniently (unknown keys allowed), to recognise projection
+/// types whose parameters this parser does not know before the strict parse rejects them.
+#[derive(Debug, Deserialize)]
+pub struct ProjectionTypeProbe {
+    pub projection: Option<ProbedProjection>,
+}
+
+/// See [`ProjectionTypeProbe`].
+#[derive(Debug, Deserialize)]
+pub struct ProbedProjection {
+    #[serde(rename = "type")]
+    pub kind: Spanned<String>,
+}
+
+/// `[[object]]`: the union of every shape's parameters.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawObject {
+    pub name: Option<Spanned<String>>,
+    pub shape: Spanned<String>,
+    pub size: Option<Spanned<Numbers>>,
+    pub file: Option<Spanned<String>>,
+    pub color: Option<Vec3Value>,
+    pub checker: Option<Spanned<RawChecker>>,
+    pub texture: Option<Spanned<String>>,
+    pub material: Option<Spanned<String>>,
+    pub ior: Option<Spanned<f64>>,
+    pub translate: Option<Vec3Value>,
+    pub rotate: Option<Vec3Value>,
+    pub scale: Option<Spanned<Numbers>>,
+    pub tessellation: Option<Spanned<u32>>,
+    pub face_colors: Option<Spanned<[[f64; 3]; 6]>>,
+}
+
+/// `checker = { color = [...], size = ... }`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawChecker {
+    pub color: Vec3Value,
+    pub size: Option<Spanned<f64>>,
+}
+
+/// `[[light]]`: the union of both light types' parameters.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawLight {
+    #[serde(rename = "type")]
+    pub kind: Spanned<String>,
+    pub position: Option<Vec3Value>,
+    pub direction: Option<Vec3Value>,
+    pub intensity: Option<Spanned<f64>>,
+    pub color: Option<Vec3Value>,
+}
+
+/// A value that may be one number or an array of numbers (`size`, `scale`); its meaning and
+/// the length it needs depend on the key and shape, and are checked where it is used.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Numbers {
+    One(f64),
+    List(Vec<f64>),
+}
+
+impl Numbers {
+    /// The numbers as a slice (one element for a single number).
+    pub fn as_slice(&self) -> &[f64] {
+        match self {
+            Numbers::One(x) => std::slice::from_ref(x),
+            Numbers::List(xs) => xs,
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for Numbers {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        struct NumbersVisitor;
+
+        impl<'de> Visitor<'de> for NumbersVisitor {
+            type Value = Numbers;
+
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number or an array of numbers")
+            }
+
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<Numbers, E> {
+                Ok(Numbers::One(v))
+            }
+
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<Numbers, E> {
+                Ok(Numbers::One(v as f64))
+            }
+
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<Numbers, E> {
+                Ok(Numbers::One(v as f64))
+            }
+
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Numbers, A::Error> {
+                let mut numbers = Vec::new();
+                while let Some(x) = seq.next_element::<f64>()? {
+                    numbers.push(x);
+                }
+                Ok(Numbers::List(numbers))
+            }
+        }
+
+        deserializer.deserialize_any(NumbersVisitor)
+    }
+}

@@ -1,0 +1,68 @@
+//! The text of a scene file and its name, for turning byte spans into `FILE:LINE:COLUMN`
+//! errors.
+
+use std::ops::Range;
+use std::path::Path;
+
+use crate::error::Error;
+
+/// A scene file being parsed: its text and the path the user gave for it.
+pub(super) struct Source<'a> {
+    pub text: &'a str,
+    pub path: &'a Path,
+}
+
+impl<'a> Source<'a> {
+    /// An error at the start of the byte span `span` of the text.
+    pub fn error(&self, span: &Range<usize>, message: impl Into<String>) -> Error {
+        let (line, column) = self.line_column(span.start);
+        Error::at(self.path, line, column, message)
+    }
+
+    /// An error about the file as a whole.
+    pub fn file_error(&self, message: impl Into<String>) -> Error {
+        Error::in_file(self.path, message)
+    }
+
+    /// Converts a TOML syntax or type error into a positioned one-line error.
+    pub fn toml_error(&self, error: &toml::de::Error) -> Error {
+        match error.span() {
+            Some(span) => self.error(&span, error.message()),
+            None => self.file_error(error.message()),
+        }
+    }
+
+    /// The 1-based line and column (in characters) of byte offset `offset`, clamped to the
+    /// text.
+    pub fn line_column(&self, offset: usize) -> (usize, usize) {
+        let mut offset = offset.min(self.text.len());
+        while !self.text.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        let before = &self.text[..offset];
+        let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+        let line = before.matches('\n').count() + 1;
+        let column = before[line_start..].chars().count() + 1;
+        (line, column)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn line_column_counts_characters_from_one() {
+        let src = Source {
+            text: "ab\nc\u{e9}d\n",
+            path: Path::new("s.toml"),
+        };
+        assert_eq!(src.line_column(0), (1, 1));
+        assert_eq!(src.line_column(1), (1, 2));
+        assert_eq!(src.line_column(3), (2, 1));
+        // 'é' is two bytes but one column.
+        assert_eq!(src.line_column(6), (2, 3));
+        assert_eq!(src.line_column(100), (3, 1));
+        assert_eq!(src.error(&(4..5), "x").to_string(), "s.toml:2:2: x");
+    }
+}

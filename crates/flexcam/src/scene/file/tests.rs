@@ -1,0 +1,788 @@
+//! Tests of the scene-file format: defaults, conversions and every kind of error.
+
+use std::path::Path;
+
+use glam::{Affine3A, DVec3, Vec3};
+
+use super::*;
+use crate::projection::ProjectionSpec;
+use crate::scene::{Light, Pattern, Surface};
+
+/// A valid projection table of five lines, so objects written after it start on line 6.
+const CAMERA: &str = "[projection]
+type = \"perspective\"
+position = [0, 0, 5]
+look_at = [0, 0, 0]
+fov = 60
+";
+
+fn parse_text(text: &str) -> Result<Scene> {
+    parse(text, Path::new("dir/s.toml"))
+}
+
+fn scene(text: &str) -> Scene {
+    parse_text(text).unwrap_or_else(|e| panic!("scene should parse: {e}"))
+}
+
+/// The one-line error message of an invalid scene.
+fn error(text: &str) -> String {
+    match parse_text(text) {
+        Ok(_) => panic!("scene should not parse:\n{text}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// Asserts the error starts with `dir/s.toml:LINE:COLUMN:` and mentions `needle`.
+fn assert_error_at(text: &str, line: usize, column: usize, needle: &str) {
+    let message = error(text);
+    let prefix = format!("dir/s.toml:{line}:{column}: ");
+    assert!(
+        message.starts_with(&prefix),
+        "expected {prefix}... got: {message}"
+    );
+    assert!(
+        message.contains(needle),
+        "expected {needle:?} in: {message}"
+    );
+    assert!(!message.contains('\n'), "not one line: {message}");
+}
+
+/// Asserts the error is positioned in the file and mentions `needle`.
+fn assert_error(text: &str, needle: &str) {
+    let message = error(text);
+    assert!(message.starts_with("dir/s.toml:"), "no file in: {message}");
+    assert!(
+        message.contains(needle),
+        "expected {needle:?} in: {message}"
+    );
+}
+
+fn object(body: &str) -> String {
+    format!("{CAMERA}[[object]]\n{body}")
+}
+
+#[test]
+fn minimal_scene_gets_defaults() {
+    let s = scene(CAMERA);
+    assert_eq!(s.image, ImageSettings::default());
+    assert!(s.objects.is_empty() && s.lights.is_empty());
+    assert_eq!(s.base_dir.as_deref(), Some(Path::new("dir")));
+    match s.projection {
+        ProjectionSpec::Perspective { frame, fov } => {
+            assert_eq!(fov, 60.0);
+            assert_eq!(frame.up, DVec3::Y);
+            assert_eq!(frame.position, DVec3::new(0.0, 0.0, 5.0));
+        }
+        other => panic!("wrong projection {other:?}"),
+    }
+}
+
+#[test]
+fn image_settings_are_read() {
+    let s = scene(&format!(
+        "[image]\nwidth = 320\nheight = 200\nbackground = [0.5, 0, 1]\n{CAMERA}"
+    ));
+    assert_eq!((s.image.width, s.image.height), (320, 200));
+    assert_eq!(s.image.background, Vec3::new(0.5, 0.0, 1.0));
+}
+
+#[test]
+fn syntax_error_is_positioned() {
+    assert_error_at("[image\nwidth = 3\n", 1, 7, "");
+    assert_error_at(&format!("{CAMERA}fov = = 3\n"), 6, 7, "");
+}
+
+#[test]
+fn unknown_keys_are_errors_everywhere() {
+    assert_error_at(
+        &format!("{CAMERA}[camera]\n"),
+        6,
+        2,
+        "unknown field `camera`",
+    );
+    assert_error_at("[image]\nwidht = 3\n", 2, 1, "unknown field `widht`");
+    assert_error_at(
+        &object("shape = \"sphere\"\nradius = 2\n"),
+        8,
+        1,
+        "unknown field `radius`",
+    );
+    assert_error(
+        &object("shape = \"plane\"\nchecker = { colour = [0, 0, 0] }\n"),
+        "unknown field `colour`",
+    );
+    assert_error(
+        &format!("{CAMERA}[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\npower = 2\n"),
+        "`power`",
+    );
+    assert_error_at(
+        &format!("{CAMERA}lookat = [0, 0, 0]\n"),
+        6,
+        1,
+        "unknown field `lookat`",
+    );
+}
+
+#[test]
+fn keys_of_another_type_are_errors() {
+    let text = "[projection]\ntype = \"orthographic\"\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\nfov = 60\n";
+    assert_error_at(
+        text,
+        5,
+        7,
+        "`fov` is not a parameter of orthographic projections",
+    );
+    assert_error_at(
+        &object("shape = \"sphere\"\nfile = \"a.obj\"\n"),
+        8,
+        8,
+        "`file` does not apply",
+    );
+    assert_error_at(
+        &object(
+            "shape = \"sphere\"\nface_colors = [[1,0,0],[1,0,0],[1,0,0],[1,0,0],[1,0,0],[1,0,0]]\n",
+        ),
+        8,
+        15,
+        "`face_colors`",
+    );
+    assert_error(
+        &object("shape = \"mesh\"\nfile = \"a.obj\"\nsize = 2\n"),
+        "`size` does not apply",
+    );
+    assert_error(
+        &object("shape = \"mesh\"\nfile = \"a.obj\"\ntessellation = 8\n"),
+        "`tessellation` does not apply",
+    );
+    assert_error(
+        &object("shape = \"sphere\"\nior = 1.3\n"),
+        "`ior` applies only to material = \"glass\"",
+    );
+    assert_error(&format!("{CAMERA}[[light]]\ntype = \"directional\"\ndirection = [0, -1, 0]\nposition = [0, 1, 0]\n"), "`position` does not apply to directional lights");
+}
+
+#[test]
+fn wrong_types_are_positioned() {
+    assert_error_at("[image]\nwidth = \"big\"\n", 2, 9, "expected u32");
+    assert_error_at("[image]\nwidth = -3\n", 2, 9, "expected u32");
+    assert_error_at("[image]\nbackground = [1, 2]\n", 2, 14, "length 3");
+    assert_error(
+        &object("shape = \"box\"\nscale = \"big\"\n"),
+        "a number or an array of numbers",
+    );
+}
+
+#[test]
+fn unknown_names_list_the_valid_ones() {
+    let message = error("[projection]\ntype = \"fisheyes\"\n");
+    assert!(
+        message.starts_with("dir/s.toml:2:8: unknown projection type \"fisheyes\""),
+        "{message}"
+    );
+    for name in [
+        "perspective",
+        "orthographic",
+        "fisheye",
+        "equirectangular",
+        "cylindrical",
+        "trilinear",
+        "flexible",
+    ] {
+        assert!(message.contains(name), "{name} missing in {message}");
+    }
+    assert_error_at(
+        &object("shape = \"cube\"\n"),
+        7,
+        9,
+        "expected one of: plane, box, sphere, cylinder, torus, teapot, mesh",
+    );
+    assert_error_at(
+        &object("shape = \"box\"\nmaterial = \"metal\"\n"),
+        8,
+        12,
+        "expected one of: diffuse, mirror, glass, emissive",
+    );
+    assert_error_at(
+        &format!("{CAMERA}[[light]]\ntype = \"spot\"\n"),
+        7,
+        8,
+        "expected one of: point, directional",
+    );
+}
+
+#[test]
+fn flexible_projection_is_reported_as_unsupported() {
+    assert_error_at(
+        "[projection]\ntype = \"flexible\"\nnear = [0, 0, 0]\n",
+        2,
+        8,
+        "not supported yet",
+    );
+}
+
+#[test]
+fn missing_required_parameters() {
+    assert_eq!(
+        error("[image]\nwidth = 10\n"),
+        "dir/s.toml: missing [projection] table: a scene needs exactly one"
+    );
+    assert_error_at(
+        "[projection]\ntype = \"perspective\"\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\n",
+        1,
+        1,
+        "perspective projection needs `fov`",
+    );
+    assert_error_at(
+        "[projection]\ntype = \"fisheye\"\nlook_at = [0, 0, 0]\nfov = 180\n",
+        1,
+        1,
+        "needs `position`",
+    );
+    assert_error_at(
+        "[projection]\ntype = \"orthographic\"\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\n",
+        1,
+        1,
+        "needs `width`",
+    );
+    assert_error_at(
+        &object("color = [1, 0, 0]\n"),
+        6,
+        1,
+        "missing field `shape`",
+    );
+    assert_error_at(
+        &object("shape = \"mesh\"\n"),
+        6,
+        1,
+        "shape \"mesh\" needs `file`",
+    );
+    assert_error(
+        &format!("{CAMERA}[[light]]\ntype = \"point\"\n"),
+        "point light needs `position`",
+    );
+    assert_error(
+        &format!("{CAMERA}[[light]]\nposition = [0, 1, 0]\n"),
+        "missing field `type`",
+    );
+}
+
+#[test]
+fn non_finite_numbers_are_rejected() {
+    assert_error_at(
+        &CAMERA.replace("fov = 60", "fov = nan"),
+        5,
+        7,
+        "`fov` must be a finite number, not NaN",
+    );
+    assert_error_at(
+        &object("shape = \"box\"\ntranslate = [0, inf, 0]\n"),
+        8,
+        13,
+        "`translate` must be a finite number",
+    );
+    assert_error(
+        &object("shape = \"sphere\"\nsize = -inf\n"),
+        "`size` must be a finite number",
+    );
+    assert_error(
+        &object("shape = \"box\"\nscale = [1, nan, 1]\n"),
+        "`scale` must be a finite number",
+    );
+    assert_error(
+        &format!("{CAMERA}[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\nintensity = inf\n"),
+        "`intensity`",
+    );
+    assert_error(
+        &object("shape = \"box\"\ntranslate = [0, 1e300, 0]\n"),
+        "out of range",
+    );
+    assert_error(
+        "[image]\nbackground = [0, nan, 0]\n[projection]\ntype = \"perspective\"\n",
+        "`background`",
+    );
+}
+
+#[test]
+fn non_positive_sizes_are_rejected() {
+    assert_error_at(
+        &object("shape = \"sphere\"\nsize = 0\n"),
+        8,
+        8,
+        "`size` must be positive, not 0",
+    );
+    assert_error(
+        &object("shape = \"box\"\nsize = [1, -1, 1]\n"),
+        "`size` must be positive, not -1",
+    );
+    assert_error(
+        &object("shape = \"cylinder\"\nsize = 1\n"),
+        "`size` of a cylinder is [radius, height]",
+    );
+    assert_error(
+        &object("shape = \"torus\"\nsize = [1, 0.2, 3]\n"),
+        "`size` of a torus is [major radius, minor radius]",
+    );
+    assert_error(
+        &object("shape = \"plane\"\nchecker = { color = [0, 0, 0], size = 0 }\n"),
+        "`checker.size` must be positive",
+    );
+    assert_error(
+        &object("shape = \"box\"\nscale = 0\n"),
+        "`scale` must not be zero",
+    );
+    assert_error(
+        &object("shape = \"box\"\nscale = [1, 0, 1]\n"),
+        "`scale` must not be zero",
+    );
+    assert_error(
+        &object("shape = \"box\"\nscale = [1, 2]\n"),
+        "`scale` is a number or [x, y, z]",
+    );
+    assert_error(
+        &object("shape = \"box\"\ncolor = [1, -0.5, 0]\n"),
+        "`color` components must not be negative",
+    );
+    assert_error(
+        &format!("{CAMERA}[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\nintensity = -1\n"),
+        "must not be negative",
+    );
+    assert_error(
+        &format!("{CAMERA}[[light]]\ntype = \"directional\"\ndirection = [0, 0, 0]\n"),
+        "`direction` must not be zero",
+    );
+}
+
+#[test]
+fn tessellation_out_of_range() {
+    assert_error_at(
+        &object("shape = \"sphere\"\ntessellation = 2\n"),
+        8,
+        16,
+        "must be in 3..=1024, not 2",
+    );
+    assert_error(
+        &object("shape = \"teapot\"\ntessellation = 5000\n"),
+        "must be in 4..=1024, not 5000",
+    );
+    assert_error(
+        &object("shape = \"plane\"\ntessellation = 0\n"),
+        "must be in 1..=1024, not 0",
+    );
+}
+
+#[test]
+fn ior_must_be_positive() {
+    assert_error_at(
+        &object("shape = \"sphere\"\nmaterial = \"glass\"\nior = 0\n"),
+        9,
+        7,
+        "`ior` must be positive",
+    );
+    assert_error(
+        &object("shape = \"sphere\"\nmaterial = \"glass\"\nior = -1.5\n"),
+        "`ior` must be positive",
+    );
+}
+
+#[test]
+fn absurd_resolutions_are_rejected() {
+    assert_error_at(
+        &format!("[image]\nwidth = 0\n{CAMERA}"),
+        2,
+        9,
+        "image width 0 is out of range",
+    );
+    assert_error_at(
+        &format!("[image]\nwidth = 10\nheight = 20000\n{CAMERA}"),
+        3,
+        10,
+        "image height 20000",
+    );
+    assert!(validate_resolution(16384, 16384).is_ok());
+    assert!(validate_resolution(1, 1).is_ok());
+    assert!(validate_resolution(16385, 1).is_err());
+    assert!(validate_resolution(640, 0).is_err());
+}
+
+#[test]
+fn duplicate_names_are_rejected() {
+    let text = object("name = \"a\"\nshape = \"box\"\n[[object]]\nname = \"b\"\nshape = \"box\"\n[[object]]\nname = \"a\"\nshape = \"box\"\n");
+    assert_error_at(
+        &text,
+        13,
+        8,
+        "duplicate object name \"a\" (first used on line 7)",
+    );
+}
+
+#[test]
+fn degenerate_projection_is_reported_at_its_table() {
+    let text = format!(
+        "[image]\nwidth = 10\n{}",
+        CAMERA.replace("fov = 60", "fov = 0")
+    );
+    assert_error_at(&text, 3, 1, "");
+    let text = format!(
+        "[image]\nwidth = 10\n{}",
+        CAMERA.replace("look_at = [0, 0, 0]", "look_at = [0, 0, 5]")
+    );
+    assert_error_at(&text, 3, 1, "");
+}
+
+#[test]
+fn missing_model_and_texture_files_name_the_file() {
+    let message = error(&object("shape = \"mesh\"\nfile = \"models/none.obj\"\n"));
+    assert!(message.contains("none.obj"), "{message}");
+    let message = error(&object("shape = \"plane\"\ntexture = \"none.png\"\n"));
+    assert!(message.contains("none.png"), "{message}");
+    assert_error(
+        &object("shape = \"plane\"\ntexture = \"a.png\"\nchecker = { color = [0, 0, 0] }\n"),
+        "`texture` and `checker` cannot be combined",
+    );
+}
+
+#[test]
+fn load_names_a_missing_file() {
+    let message = load(Path::new("no/such/scene.toml"))
+        .err()
+        .map(|e| e.to_string());
+    let message = message.unwrap_or_default();
+    assert!(
+        message.starts_with("no/such/scene.toml: cannot read scene file"),
+        "{message}"
+    );
+}
+
+#[test]
+fn panorama_defaults() {
+    let frame = "position = [0, 1, 0]\nlook_at = [0, 1, -1]\n";
+    match scene(&format!(
+        "[projection]\ntype = \"equirectangular\"\n{frame}"
+    ))
+    .projection
+    {
+        ProjectionSpec::Equirectangular { h_fov, v_fov, .. } => {
+            assert_eq!((h_fov, v_fov), (360.0, 180.0))
+        }
+        other => panic!("{other:?}"),
+    }
+    match scene(&format!("[projection]\ntype = \"cylindrical\"\n{frame}")).projection {
+        ProjectionSpec::Cylindrical { h_fov, v_fov, .. } => {
+            assert_eq!((h_fov, v_fov), (360.0, 90.0))
+        }
+        other => panic!("{other:?}"),
+    }
+    match scene(&format!(
+        "[projection]\ntype = \"cylindrical\"\n{frame}h_fov = 180\nv_fov = 60\nup = [1, 0, 0]\n"
+    ))
+    .projection
+    {
+        ProjectionSpec::Cylindrical {
+            h_fov,
+            v_fov,
+            frame,
+        } => {
+            assert_eq!((h_fov, v_fov), (180.0, 60.0));
+            assert_eq!(frame.up, DVec3::X);
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+/// A trilinear table with one triangle of inline arrays; `extra` is appended.
+fn inline_trilinear(triangles: &str, extra: &str) -> String {
+    format!(
+        "[projection]\ntype = \"trilinear\"\npoints = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\n\
+         normals = [[0, 0, -1], [0, 0, -1], [0, 0, -1]]\nscreen = [[0, 0], [1, 0], [0, 1]]\n\
+         triangles = {triangles}\n{extra}"
+    )
+}
+
+#[test]
+fn trilinear_inline_arrays() {
+    match scene(&inline_trilinear("[[0, 1, 2]]", "")).projection {
+        ProjectionSpec::Trilinear(mesh) => {
+            assert_eq!(mesh.points[1], DVec3::X);
+            assert_eq!(mesh.normals[2], DVec3::NEG_Z);
+            assert_eq!(mesh.screen[2], glam::DVec2::Y);
+            assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_error_at(
+        &inline_trilinear("[[0, 1, 3]]", ""),
+        6,
+        13,
+        "triangle 0 [0, 1, 3] refers to a vertex beyond the 3",
+    );
+    assert_error_at(
+        &inline_trilinear("[[0, 1, 2]]", "surface = \"s.obj\"\n"),
+        3,
+        10,
+        "`points` cannot be combined with `surface`",
+    );
+    assert_error_at(
+        &inline_trilinear("[[0, 1, 2]]", "").replace("[[0, 0], [1, 0], [0, 1]]", "[[0, 0]]"),
+        5,
+        10,
+        "`screen` has 1 entries but `points` has 3",
+    );
+    assert_error(
+        &inline_trilinear("[[0, 1, 2]]", "").replace("[0, 0, -1]]", "[0, 0, nan]]"),
+        "`normals` must be a finite number",
+    );
+    assert_error_at(
+        "[projection]\ntype = \"trilinear\"\n",
+        1,
+        1,
+        "needs `surface` or the inline",
+    );
+    assert_error_at(
+        &inline_trilinear("[[0, 1, 2]]", "")
+            .replace("normals = [[0, 0, -1], [0, 0, -1], [0, 0, -1]]\n", ""),
+        1,
+        1,
+        "needs `normals`",
+    );
+    assert_error_at(
+        &inline_trilinear("[[0, 1, 2]]", "position = [0, 0, 0]\n"),
+        7,
+        12,
+        "`position` is not a parameter of trilinear",
+    );
+}
+
+#[test]
+fn trilinear_surface_is_relative_to_the_scene_file() {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    let obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 -1\nf 1/1/1 2/2/1 3/3/1\n";
+    std::fs::create_dir(dir.path().join("surfaces")).unwrap_or_else(|e| panic!("{e}"));
+    std::fs::write(dir.path().join("surfaces/tri.obj"), obj).unwrap_or_else(|e| panic!("{e}"));
+    let path = dir.path().join("s.toml");
+    std::fs::write(
+        &path,
+        "[projection]\ntype = \"trilinear\"\nsurface = \"surfaces/tri.obj\"\n",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    match load(&path).unwrap_or_else(|e| panic!("{e}")).projection {
+        ProjectionSpec::Trilinear(mesh) => assert_eq!(mesh.triangles.len(), 1),
+        other => panic!("{other:?}"),
+    }
+    let message = error("[projection]\ntype = \"trilinear\"\nsurface = \"missing.obj\"\n");
+    assert!(message.starts_with("dir/missing.obj: "), "{message}");
+}
+
+#[test]
+fn objects_get_ids_in_file_order_and_default_names() {
+    let s = scene(&object(
+        "shape = \"box\"\n[[object]]\nname = \"ball\"\nshape = \"sphere\"\ntessellation = 8\n",
+    ));
+    let ids: Vec<(u32, &str)> = s.objects.iter().map(|o| (o.id, o.name.as_str())).collect();
+    assert_eq!(ids, vec![(1, "box"), (2, "ball")]);
+}
+
+#[test]
+fn material_defaults_and_keys() {
+    let s = scene(&object(
+        "shape = \"box\"\n[[object]]\nshape = \"sphere\"\nmaterial = \"glass\"\n\
+         [[object]]\nshape = \"sphere\"\nmaterial = \"glass\"\nior = 1.33\ncolor = [1, 0.5, 0]\n\
+         [[object]]\nshape = \"plane\"\nchecker = { color = [0.1, 0.2, 0.3] }\nmaterial = \"mirror\"\n\
+         [[object]]\nshape = \"torus\"\nmaterial = \"emissive\"\n",
+    ));
+    let m: Vec<_> = s.objects.iter().map(|o| &o.material).collect();
+    assert_eq!(
+        (m[0].color, m[0].surface, &m[0].pattern),
+        (Vec3::splat(0.8), Surface::Diffuse, &Pattern::Solid)
+    );
+    assert_eq!(m[1].surface, Surface::Glass { ior: 1.5 });
+    assert_eq!(
+        (m[2].surface, m[2].color),
+        (Surface::Glass { ior: 1.33 }, Vec3::new(1.0, 0.5, 0.0))
+    );
+    assert_eq!(
+        m[3].pattern,
+        Pattern::Checker {
+            other: Vec3::new(0.1, 0.2, 0.3),
+            size: 1.0
+        }
+    );
+    assert_eq!(m[3].surface, Surface::Mirror);
+    assert_eq!(m[4].surface, Surface::Emissive);
+}
+
+#[test]
+fn lights_defaults_and_types() {
+    let s = scene(&format!(
+        "{CAMERA}[[light]]\ntype = \"point\"\nposition = [1, 2, 3]\n\
+         [[light]]\ntype = \"directional\"\ndirection = [0, -2, 0]\nintensity = 0.5\ncolor = [1, 0.9, 0.8]\n"
+    ));
+    assert_eq!(
+        s.lights,
+        vec![
+            Light::Point {
+                position: Vec3::new(1.0, 2.0, 3.0),
+                color: Vec3::ONE,
+                intensity: 1.0
+            },
+            Light::Directional {
+                direction: Vec3::NEG_Y,
+                color: Vec3::new(1.0, 0.9, 0.8),
+                intensity: 0.5
+            },
+        ]
+    );
+}
+
+#[test]
+fn transform_is_translate_rotate_xyz_scale() {
+    let s = scene(&object(
+        "shape = \"box\"\ntranslate = [1, 2, 3]\nrotate = [90, 90, 0]\nscale = 2\n",
+    ));
+    let o = &s.objects[0];
+    let object_to_world: Affine3A = o.world_to_object.inverse();
+    // R = Rz * Ry * Rx: Rx(90) takes +y to +z, then Ry(90) takes +z to +x.
+    let y = object_to_world.transform_point3(Vec3::Y);
+    assert!((y - Vec3::new(3.0, 2.0, 3.0)).length() < 1e-5, "{y}");
+    let x = object_to_world.transform_point3(Vec3::X);
+    assert!((x - Vec3::new(1.0, 2.0, 1.0)).length() < 1e-5, "{x}");
+    // The mesh is in world space: a unit box scaled by 2 around (1, 2, 3).
+    let (lo, hi) = o.mesh.bounds().unwrap_or_default();
+    assert!(
+        (lo - Vec3::new(0.0, 1.0, 2.0)).length() < 1e-5
+            && (hi - Vec3::new(2.0, 3.0, 4.0)).length() < 1e-5
+    );
+}
+
+#[test]
+fn nonuniform_scale_keeps_normals_perpendicular() {
+    let s = scene(&object(
+        "shape = \"sphere\"\nscale = [2, 1, 0.5]\ntessellation = 16\n",
+    ));
+    let mesh = &s.objects[0].mesh;
+    assert!(!mesh.normals.is_empty());
+    for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+        // The gradient of the ellipsoid (x/2)^2 + y^2 + (2z)^2 = 1.
+        let gradient = Vec3::new(p.x / 4.0, p.y, 4.0 * p.z).normalize();
+        assert!(n.dot(gradient) > 0.999, "normal {n} at {p}");
+    }
+}
+
+#[test]
+fn box_is_tessellated_and_face_coloured() {
+    let colors = "[[1,0,0],[0,1,0],[0,0,1],[1,1,0],[0,1,1],[1,0,1]]";
+    let s = scene(&object(&format!(
+        "shape = \"box\"\nsize = [2, 4, 6]\ntessellation = 3\nface_colors = {colors}\n"
+    )));
+    let o = &s.objects[0];
+    assert_eq!(o.mesh.triangle_count(), 6 * 2 * 9);
+    assert_eq!(o.material.color, Vec3::ONE);
+    let (lo, hi) = o.mesh.bounds().unwrap_or_default();
+    assert_eq!(
+        (lo, hi),
+        (Vec3::new(-1.0, -2.0, -3.0), Vec3::new(1.0, 2.0, 3.0))
+    );
+    let expected = [
+        Vec3::X,
+        Vec3::NEG_X,
+        Vec3::Y,
+        Vec3::NEG_Y,
+        Vec3::Z,
+        Vec3::NEG_Z,
+    ];
+    let face_color = [
+        Vec3::X,
+        Vec3::Y,
+        Vec3::Z,
+        Vec3::new(1.0, 1.0, 0.0),
+        Vec3::new(0.0, 1.0, 1.0),
+        Vec3::new(1.0, 0.0, 1.0),
+    ];
+    for (p, c) in o.mesh.positions.iter().zip(&o.mesh.colors) {
+        // Each vertex lies on the face its colour belongs to.
+        let face = face_color.iter().position(|f| f == c).unwrap_or(usize::MAX);
+        let normal = expected[face];
+        assert!(
+            (p.dot(normal) - (hi * normal.abs()).element_sum()).abs() < 1e-5,
+            "{p} not on face {face}"
+        );
+    }
+    for (p, n) in o.mesh.positions.iter().zip(&o.mesh.normals) {
+        assert!(
+            (p.abs() * n.abs() - hi * n.abs()).length() < 1e-5,
+            "normal {n} at {p} not outward"
+        );
+        assert!(p.dot(*n) > 0.0);
+    }
+}
+
+/// Writes `files` (relative path, contents) into a fresh folder and loads `scene` from it.
+fn load_with_files(scene_text: &str, files: &[(&str, &[u8])]) -> Result<Scene> {
+    let dir = tempfile::tempdir().unwrap_or_else(|e| panic!("{e}"));
+    for (name, contents) in files {
+        let path = dir.path().join(name);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).unwrap_or_else(|e| panic!("{e}"));
+        }
+        std::fs::write(path, contents).unwrap_or_else(|e| panic!("{e}"));
+    }
+    let path = dir.path().join("s.toml");
+    std::fs::write(&path, scene_text).unwrap_or_else(|e| panic!("{e}"));
+    load(&path)
+}
+
+/// Two parts, one without a material, then one red (from the MTL).
+const TWO_PART_OBJ: &[u8] = b"mtllib m.mtl
+v 0 0 0
+v 1 0 0
+v 0 1 0
+o plain
+f 1 3 2
+o red
+usemtl red
+f 1 2 3
+";
+const RED_MTL: &[u8] = b"newmtl red\nKd 1 0 0\n";
+
+#[test]
+fn mesh_parts_share_the_id_and_keep_file_materials() {
+    let text = object("shape = \"box\"\n[[object]]\nshape = \"mesh\"\nfile = \"models/two.obj\"\ntranslate = [0, 0, 1]\n");
+    let files: [(&str, &[u8]); 2] = [("models/two.obj", TWO_PART_OBJ), ("models/m.mtl", RED_MTL)];
+    let s = load_with_files(&text, &files).unwrap_or_else(|e| panic!("{e}"));
+    let ids: Vec<u32> = s.objects.iter().map(|o| o.id).collect();
+    assert_eq!(ids, vec![1, 2, 2]);
+    assert_eq!(s.objects[1].material, crate::scene::Material::default());
+    assert_eq!(s.objects[2].material.color, Vec3::X);
+    assert_eq!(
+        s.objects[1].mesh.positions[0],
+        Vec3::Z,
+        "mesh moved to world space"
+    );
+}
+
+#[test]
+fn object_keys_override_file_materials() {
+    let text =
+        object("shape = \"mesh\"\nfile = \"two.obj\"\ncolor = [0, 1, 0]\nmaterial = \"mirror\"\n");
+    let files: [(&str, &[u8]); 2] = [("two.obj", TWO_PART_OBJ), ("m.mtl", RED_MTL)];
+    let s = load_with_files(&text, &files).unwrap_or_else(|e| panic!("{e}"));
+    for o in &s.objects {
+        assert_eq!(
+            (o.material.color, o.material.surface),
+            (Vec3::Y, Surface::Mirror)
+        );
+    }
+}
+
+#[test]
+fn texture_is_loaded_relative_to_the_scene() {
+    let mut png = Vec::new();
+    image::RgbImage::from_pixel(2, 2, image::Rgb([255, 0, 0]))
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let text = object("shape = \"plane\"\ntexture = \"textures/red.png\"\n");
+    let s = load_with_files(&text, &[("textures/red.png", &png)]).unwrap_or_else(|e| panic!("{e}"));
+    match &s.objects[0].material.pattern {
+        Pattern::Texture(t) => assert_eq!((t.width, t.height, t.texels[0]), (2, 2, Vec3::X)),
+        other => panic!("{other:?}"),
+    }
+}
