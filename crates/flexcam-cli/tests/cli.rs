@@ -73,10 +73,16 @@ fn default_render_writes_a_real_image() {
         .args(["render", "--width", "160", "--height", "80"])
         .assert()
         .success();
-    let img = image::open(dir.path().join("flexcam.png")).unwrap().to_rgb8();
+    let img = image::open(dir.path().join("flexcam.png"))
+        .unwrap()
+        .to_rgb8();
     assert_eq!(img.dimensions(), (160, 80));
     let distinct: std::collections::HashSet<_> = img.pixels().map(|p| p.0).collect();
-    assert!(distinct.len() > 50, "image looks blank: {} colours", distinct.len());
+    assert!(
+        distinct.len() > 50,
+        "image looks blank: {} colours",
+        distinct.len()
+    );
 }
 
 #[test]
@@ -85,11 +91,17 @@ fn scenes_lists_the_required_builtins() {
     let out = flexcam(dir.path()).arg("scenes").output().unwrap();
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
-    let names: Vec<&str> = text.lines().filter_map(|l| l.split_whitespace().next()).collect();
+    let names: Vec<&str> = text
+        .lines()
+        .filter_map(|l| l.split_whitespace().next())
+        .collect();
     for required in ["default", "cube-floor", "teapot-room"] {
         assert!(names.contains(&required), "{required} missing from {text}");
     }
-    assert!(text.lines().all(|l| l.split_whitespace().count() >= 2), "{text}");
+    assert!(
+        text.lines().all(|l| l.split_whitespace().count() >= 2),
+        "{text}"
+    );
 }
 
 #[test]
@@ -98,14 +110,37 @@ fn flat_render_with_all_outputs_and_stats_on_stdout() {
     write(&dir, "s.toml", GOOD_SCENE);
     let out = flexcam(dir.path())
         .args([
-            "render", "s.toml", "-o", "c.png", "--shading", "flat", "--depth", "d.exr", "--ids",
-            "i.png", "--stats", "-",
+            "render",
+            "s.toml",
+            "-o",
+            "c.png",
+            "--shading",
+            "flat",
+            "--depth",
+            "d.exr",
+            "--ids",
+            "i.png",
+            "--stats",
+            "-",
         ])
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("stdout is one JSON object");
-    for key in ["method", "width", "height", "triangles", "render_ms", "rays_cast", "bvh_build_ms"] {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value =
+        serde_json::from_slice(&out.stdout).expect("stdout is one JSON object");
+    for key in [
+        "method",
+        "width",
+        "height",
+        "triangles",
+        "render_ms",
+        "rays_cast",
+        "bvh_build_ms",
+    ] {
         assert!(json.get(key).is_some(), "stats lack {key}: {json}");
     }
     assert_eq!(json["method"], "raycast");
@@ -126,7 +161,10 @@ fn flat_render_with_all_outputs_and_stats_on_stdout() {
             1 => {
                 found_floor = true;
                 let c = img.get_pixel(x, y).0;
-                assert!(c == [204, 204, 204] || c == [26, 26, 26], "floor colour {c:?}");
+                assert!(
+                    c == [204, 204, 204] || c == [26, 26, 26],
+                    "floor colour {c:?}"
+                );
             }
             _ => {}
         }
@@ -141,7 +179,9 @@ fn stats_and_depth_to_files() {
     let dir = TempDir::new().unwrap();
     write(&dir, "s.toml", GOOD_SCENE);
     flexcam(dir.path())
-        .args(["render", "s.toml", "--depth", "d.pfm", "--stats", "st.json", "--spp", "4"])
+        .args([
+            "render", "s.toml", "--depth", "d.pfm", "--stats", "st.json", "--spp", "4",
+        ])
         .assert()
         .success()
         .stdout("");
@@ -163,7 +203,10 @@ fn missing_scene_file() {
 fn unknown_builtin_scene() {
     let dir = TempDir::new().unwrap();
     let e = expect_failure(&dir, &["render", "builtin:no-such-scene"]);
-    assert!(e.contains("no-such-scene") && e.contains("cube-floor"), "{e}");
+    assert!(
+        e.contains("no-such-scene") && e.contains("cube-floor"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -180,7 +223,11 @@ fn unknown_projection_type_is_located() {
     let text = GOOD_SCENE.replace("type = \"perspective\"", "type = \"perspektive\"");
     write(&dir, "bad.toml", &text);
     let e = expect_failure(&dir, &["render", "bad.toml"]);
-    let line = text.lines().position(|l| l.contains("perspektive")).unwrap() + 1;
+    let line = text
+        .lines()
+        .position(|l| l.contains("perspektive"))
+        .unwrap()
+        + 1;
     assert!(e.contains(&format!("bad.toml:{line}:")), "{e}");
     assert!(e.contains("perspektive"), "{e}");
 }
@@ -207,10 +254,18 @@ fn degenerate_projection() {
 #[test]
 fn unknown_shape_and_key() {
     let dir = TempDir::new().unwrap();
-    write(&dir, "a.toml", &GOOD_SCENE.replace("shape = \"sphere\"", "shape = \"spere\""));
+    write(
+        &dir,
+        "a.toml",
+        &GOOD_SCENE.replace("shape = \"sphere\"", "shape = \"spere\""),
+    );
     let e = expect_failure(&dir, &["render", "a.toml"]);
     assert!(e.contains("a.toml:") && e.contains("spere"), "{e}");
-    write(&dir, "b.toml", &GOOD_SCENE.replace("translate =", "translat ="));
+    write(
+        &dir,
+        "b.toml",
+        &GOOD_SCENE.replace("translate =", "translat ="),
+    );
     let e = expect_failure(&dir, &["render", "b.toml"]);
     assert!(e.contains("b.toml:") && e.contains("translat"), "{e}");
 }
@@ -218,7 +273,8 @@ fn unknown_shape_and_key() {
 #[test]
 fn missing_model_file_names_it() {
     let dir = TempDir::new().unwrap();
-    let text = format!("{GOOD_SCENE}\n[[object]]\nshape = \"mesh\"\nfile = \"models/missing.obj\"\n");
+    let text =
+        format!("{GOOD_SCENE}\n[[object]]\nshape = \"mesh\"\nfile = \"models/missing.obj\"\n");
     write(&dir, "m.toml", &text);
     let e = expect_failure(&dir, &["render", "m.toml"]);
     assert!(e.contains("missing.obj"), "{e}");
@@ -234,7 +290,11 @@ fn absurd_resolution() {
     ] {
         expect_failure(&dir, &args);
     }
-    write(&dir, "big.toml", &GOOD_SCENE.replace("width = 64", "width = 0"));
+    write(
+        &dir,
+        "big.toml",
+        &GOOD_SCENE.replace("width = 64", "width = 0"),
+    );
     let e = expect_failure(&dir, &["render", "big.toml"]);
     assert!(e.contains("big.toml:3:"), "{e}");
 }
@@ -253,4 +313,31 @@ fn bad_flags() {
     assert!(e.contains("d.png"), "{e}");
     let e = expect_failure(&dir, &["render", "s.toml", "-o", "no/such/dir/x.png"]);
     assert!(e.contains("x.png"), "{e}");
+}
+
+/// Every example scene in scenes/ renders (flat, small), so the examples stay true.
+#[test]
+fn every_example_scene_renders() {
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let mut rendered = 0;
+    for entry in fs::read_dir(&scenes).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let dir = TempDir::new().unwrap();
+            let out = flexcam(dir.path())
+                .arg("render")
+                .arg(&path)
+                .args(["--width", "48", "--height", "32", "--shading", "flat"])
+                .output()
+                .unwrap();
+            assert!(
+                out.status.success(),
+                "{}: {}",
+                path.display(),
+                String::from_utf8_lossy(&out.stderr)
+            );
+            rendered += 1;
+        }
+    }
+    assert!(rendered >= 5, "only {rendered} example scenes found");
 }
