@@ -1,6 +1,7 @@
 //! [`ProjectionSpec::build`]: from a parsed description to a validated projection.
 
 use super::fisheye::Fisheye;
+use super::flexible::Flexible;
 use super::linear::{Orthographic, Perspective};
 use super::panoramic::{Cylindrical, Equirectangular};
 use super::trilinear::Trilinear;
@@ -15,7 +16,8 @@ impl ProjectionSpec {
     /// (0, 180), fisheye fov in (0, 360], orthographic width > 0, equirectangular h_fov in
     /// (0, 360] and v_fov in (0, 180], cylindrical h_fov in (0, 360] and v_fov in (0, 180));
     /// a trilinear mesh with no triangles, mismatched arrays, an index out of range, a
-    /// zero-length normal or a zero-area screen triangle.
+    /// zero-length normal or a zero-area screen triangle; a flexible volume with a bad preset
+    /// parameter or surface, or whose near and far surfaces coincide everywhere.
     pub fn build(&self, width: u32, height: u32) -> Result<Box<dyn Projection>> {
         Ok(match self {
             ProjectionSpec::Perspective { frame, fov } => {
@@ -39,6 +41,7 @@ impl ProjectionSpec {
                 v_fov,
             } => Box::new(Cylindrical::new(frame, *h_fov, *v_fov, width, height)?),
             ProjectionSpec::Trilinear(mesh) => Box::new(Trilinear::new(mesh, width, height)?),
+            ProjectionSpec::Flexible(spec) => Box::new(Flexible::new(spec, width, height)?),
         })
     }
 }
@@ -100,7 +103,7 @@ mod tests {
         });
         let projection = trilinear.build(8, 8).unwrap();
         assert_eq!(projection.kind(), "trilinear");
-        assert!(!projection.has_inverse());
+        assert!(projection.has_inverse());
     }
 
     #[test]

@@ -11,6 +11,7 @@
 mod build;
 mod camera_basis;
 mod fisheye;
+pub mod flexible;
 mod image_coords;
 #[cfg(test)]
 mod inverse_properties;
@@ -21,10 +22,11 @@ mod trilinear;
 
 pub use camera_basis::CameraBasis;
 pub use fisheye::Fisheye;
+pub use flexible::{Flexible, FlexibleSpec};
 pub use image_coords::Resolution;
 pub use linear::{Orthographic, Perspective};
 pub use panoramic::{Cylindrical, Equirectangular};
-pub use trilinear::Trilinear;
+pub use trilinear::{ProjectionTriangleCache, Solutions, TriangleSolution, Trilinear};
 
 use glam::{DVec2, DVec3};
 
@@ -109,6 +111,9 @@ pub enum ProjectionSpec {
     },
     /// A mesh of trilinear projection triangles.
     Trilinear(TrilinearMesh),
+    /// A parametric viewing volume between control surfaces (seed 003); boxed, as it is
+    /// much larger than the other variants.
+    Flexible(Box<FlexibleSpec>),
 }
 
 impl ProjectionSpec {
@@ -121,6 +126,7 @@ impl ProjectionSpec {
             ProjectionSpec::Equirectangular { .. } => "equirectangular",
             ProjectionSpec::Cylindrical { .. } => "cylindrical",
             ProjectionSpec::Trilinear(_) => "trilinear",
+            ProjectionSpec::Flexible(_) => "flexible",
         }
     }
 }

@@ -5,18 +5,20 @@
 //! barycentrics (u, v) of a triangle's screen triangle emits the ray
 //! tripoint(u, v) + t * trinorm(u, v), t >= 0, where tripoint and trinorm interpolate the
 //! p_k and n_k linearly (trinorm is never renormalised: its length is the depth scale).
-//! The inverse (a cubic per triangle) belongs to the trilinear renderer: `has_inverse` is
-//! false here.
+//! The inverse solves a cubic per projection triangle ([`point_projection`], with the cached
+//! N/K form of each triangle): [`Projection::project`] returns every visible image.
 
 mod obj;
+mod point_projection;
 mod screen_locator;
 
 use glam::{DVec2, DVec3};
 
 use super::image_coords::Resolution;
-use super::{Projection, TrilinearMesh};
+use super::{ImagePoint, Projection, TrilinearMesh};
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
+pub use point_projection::{ProjectionTriangleCache, Solutions, TriangleSolution};
 use screen_locator::ScreenLocator;
 
 /// A screen triangle counts as degenerate when twice its area is below this fraction of the
@@ -29,6 +31,8 @@ pub struct Trilinear {
     mesh: TrilinearMesh,
     locator: ScreenLocator,
     resolution: Resolution,
+    /// The point-projection cache of each triangle, same order as `mesh.triangles`.
+    caches: Vec<ProjectionTriangleCache>,
 }
 
 impl Trilinear {
@@ -45,16 +49,34 @@ impl Trilinear {
             .iter()
             .map(|t| t.map(|k| mesh.screen[k as usize]))
             .collect();
+        let caches = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [i, j, k] = t.map(|k| k as usize);
+                ProjectionTriangleCache::new(
+                    [mesh.points[i], mesh.points[j], mesh.points[k]],
+                    [mesh.normals[i], mesh.normals[j], mesh.normals[k]],
+                )
+            })
+            .collect();
         Ok(Trilinear {
             mesh: mesh.clone(),
             locator: ScreenLocator::new(screen_triangles),
             resolution,
+            caches,
         })
     }
 
     /// The projection mesh.
     pub fn mesh(&self) -> &TrilinearMesh {
         &self.mesh
+    }
+
+    /// The point-projection cache of each projection triangle (same order as the mesh's
+    /// triangles): all solutions of a scene point, any `t`, inside or not.
+    pub fn triangle_caches(&self) -> &[ProjectionTriangleCache] {
+        &self.caches
     }
 }
 
@@ -127,6 +149,109 @@ impl Projection for Trilinear {
             return None;
         }
         Some(Ray::new(interpolate(&self.mesh.points), direction))
+    }
+
+    fn has_inverse(&self) -> bool {
+        true
+    }
+
+    /// Appends every image of `point`: per projection triangle, each solution of the cubic
+    /// that is inside (up to [`ProjectionTriangleCache::INSIDE_TOL`] in barycentrics)
+    /// and on a ray (`t >= 0`), at pixel `(s_x W, (1 - s_y) H)` of its screen position `s`
+    /// (the inverse of the pixel-to-screen map of [`Projection::ray`]). `t < 0` solutions
+    /// (behind the view plane) and outside ones are available from
+    /// [`Trilinear::triangle_caches`]. Details:
+    ///
+    /// * `t` slightly below 0 (the point is on the base triangle, within rounding:
+    ///   `-t |trinorm| <= 64 EPSILON (|point| + |p1| + triangle size)`) is reported as 0.
+    /// * A solution whose interpolated direction is (relative to the largest of the three
+    ///   normals, `1e-12`) zero is skipped: its projector is a single point, not a ray.
+    /// * Where screen triangles overlap, `ray` uses the lowest-index one: a solution of
+    ///   another triangle is only kept if the covering triangle's ray there is the same
+    ///   (relative `1e-8`), as on a shared edge of a continuous mesh.
+    /// * Images closer than `1e-6` pixels are one image (a point on an edge or vertex shared
+    ///   by several projection triangles is found by each of them).
+    fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
+        const DEDUP_PIXELS: f64 = 1e-6;
+        let start = out.len();
+        let size = self.resolution.size();
+        for (index, cache) in self.caches.iter().enumerate() {
+            let solutions = cache.project_point(point);
+            if solutions.is_empty() {
+                continue;
+            }
+            let [i, j, k] = self.mesh.triangles[index].map(|k| k as usize);
+            let normals = [
+                self.mesh.normals[i],
+                self.mesh.normals[j],
+                self.mesh.normals[k],
+            ];
+            let largest = normals.iter().fold(0.0_f64, |m, n| m.max(n.length()));
+            for s in solutions.iter().filter(|s| s.inside) {
+                let direction = cache.trinorm(s.u, s.v);
+                let length = direction.length();
+                if length <= 1e-12 * largest {
+                    continue;
+                }
+                let t = if s.t >= 0.0 {
+                    s.t
+                } else {
+                    let slack = 64.0
+                        * f64::EPSILON
+                        * (point.abs().max_element()
+                            + self.mesh.points[i].abs().max_element()
+                            + cache.tripoint(s.u, s.v).distance(self.mesh.points[i]));
+                    if -s.t * length > slack {
+                        continue;
+                    }
+                    0.0
+                };
+                let w = 1.0 - s.u - s.v;
+                let screen =
+                    w * self.mesh.screen[i] + s.u * self.mesh.screen[j] + s.v * self.mesh.screen[k];
+                if !self.covers(index, screen, cache, s, t) {
+                    continue;
+                }
+                let pixel = DVec2::new(screen.x * size.x, (1.0 - screen.y) * size.y);
+                if out[start..]
+                    .iter()
+                    .any(|o| (o.pixel - pixel).length() <= DEDUP_PIXELS)
+                {
+                    continue;
+                }
+                out.push(ImagePoint { pixel, t });
+            }
+        }
+    }
+}
+
+impl Trilinear {
+    /// Whether the ray at screen position `screen` is that of solution `s` of triangle
+    /// `index`: the locator picks `index` there, or picks another triangle whose ray at
+    /// `screen` reaches the same point at `t` (a shared edge of a continuous mesh), or
+    /// picks none (outside the covered screen, where `ray` gives nothing either: the image
+    /// position is still reported, callers clip).
+    fn covers(
+        &self,
+        index: usize,
+        screen: DVec2,
+        cache: &ProjectionTriangleCache,
+        s: TriangleSolution,
+        t: f64,
+    ) -> bool {
+        let Some(hit) = self.locator.locate(screen) else {
+            return true;
+        };
+        if hit.triangle == index {
+            return true;
+        }
+        let other = &self.caches[hit.triangle];
+        let theirs = other.ray_point(hit.u, hit.v, t);
+        let ours = cache.ray_point(s.u, s.v, t);
+        let scale = ours.abs().max_element()
+            + other.tripoint(hit.u, hit.v).abs().max_element()
+            + t * other.trinorm(hit.u, hit.v).length();
+        (theirs - ours).length() <= 1e-8 * scale
     }
 }
 
@@ -278,5 +403,241 @@ mod tests {
         let mut m = triangle_mesh();
         m.screen[2] = DVec2::new(0.5, 0.0); // collinear
         assert!(error_of(m).contains("triangle 0 has a zero-area"));
+    }
+
+    #[test]
+    fn pinhole_mesh_projects_like_the_perspective_projection() {
+        let eye = DVec3::new(0.5, 1.0, 4.0);
+        let (width, height) = (64, 48);
+        let fov = 70.0_f64;
+        let half_w = (0.5 * fov.to_radians()).tan();
+        let half_h = half_w * f64::from(height) / f64::from(width);
+        let trilinear = Trilinear::new(&pinhole_mesh(eye, half_w, half_h), width, height).unwrap();
+        let frame = CameraFrame {
+            position: eye,
+            look_at: eye + DVec3::NEG_Z,
+            up: DVec3::Y,
+        };
+        let perspective = Perspective::new(&frame, fov, width, height).unwrap();
+        let mut checked = 0;
+        for k in 0..2000 {
+            // A deterministic spread of points in front of and behind the image plane.
+            let a = f64::from(k);
+            let local = DVec3::new(
+                (a * 0.618_034).fract() * 2.0 - 1.0,
+                (a * 0.754_877).fract() * 2.0 - 1.0,
+                -0.2 - 9.0 * (a * 0.569_84).fract(),
+            );
+            let point = eye + DVec3::new(local.x * -local.z, local.y * -local.z, local.z);
+            let (mut tri, mut persp) = (Vec::new(), Vec::new());
+            trilinear.project(point, &mut tri);
+            perspective.project(point, &mut persp);
+            let [expected] = persp[..] else {
+                panic!("perspective: {persp:?}")
+            };
+            let inside = expected.pixel.x >= 0.0
+                && expected.pixel.x <= f64::from(width)
+                && expected.pixel.y >= 0.0
+                && expected.pixel.y <= f64::from(height);
+            if !inside || local.z > -1.0 {
+                // Outside the mesh, or between the eye and the image plane (t < 0).
+                assert!(tri.is_empty() || inside, "{point}: {tri:?}");
+                if local.z > -1.0 {
+                    assert!(tri.is_empty(), "behind the view plane: {tri:?}");
+                }
+                continue;
+            }
+            assert_eq!(tri.len(), 1, "{point}: {tri:?}");
+            let got = tri[0];
+            assert!(
+                (got.pixel - expected.pixel).length() < 1e-9,
+                "{got:?} vs {expected:?}"
+            );
+            let ray = trilinear.ray(got.pixel).unwrap();
+            assert!((ray.at(got.t) - point).length() < 1e-12 * (1.0 + point.length()));
+            // Distance from the eye = (1 + t) |trinorm|.
+            let distance = (1.0 + got.t) * ray.direction.length();
+            assert!((distance - expected.t).abs() < 1e-12 * expected.t);
+            checked += 1;
+        }
+        assert!(checked > 500, "{checked}");
+    }
+
+    #[test]
+    fn shared_edges_and_vertices_give_one_image() {
+        let mesh = pinhole_mesh(DVec3::ZERO, 1.0, 1.0);
+        let trilinear = Trilinear::new(&mesh, 16, 16).unwrap();
+        let mut out = Vec::new();
+        // The centre vertex (shared by six triangles), a point on a shared diagonal and one
+        // on a shared grid line, at depth t = 2 (distance 3 along n).
+        for screen in [
+            DVec2::new(0.5, 0.5),
+            DVec2::new(0.25, 0.25),
+            DVec2::new(0.5, 0.8),
+        ] {
+            let pixel = DVec2::new(screen.x * 16.0, (1.0 - screen.y) * 16.0);
+            let ray = trilinear.ray(pixel).unwrap();
+            out.clear();
+            trilinear.project(ray.at(2.0), &mut out);
+            assert_eq!(out.len(), 1, "{screen}: {out:?}");
+            assert!((out[0].pixel - pixel).length() < 1e-9);
+            assert!((out[0].t - 2.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn parallel_normals_mesh_projects_orthographically() {
+        let mut mesh = pinhole_mesh(DVec3::ZERO, 1.0, 1.0);
+        let n = DVec3::new(0.1, 0.05, -2.0);
+        mesh.normals.iter_mut().for_each(|x| *x = n);
+        let trilinear = Trilinear::new(&mesh, 20, 10).unwrap();
+        let mut out = Vec::new();
+        trilinear.project(DVec3::new(0.3, -0.5, -1.0) + 4.0 * n, &mut out);
+        assert_eq!(out.len(), 1, "{out:?}");
+        // Base (0.3, -0.5) on the plane z = -1 spanning [-1, 1]^2 -> screen (0.65, 0.25).
+        assert!(
+            (out[0].pixel - DVec2::new(13.0, 7.5)).length() < 1e-9,
+            "{out:?}"
+        );
+        assert!((out[0].t - 4.0).abs() < 1e-12);
+        // Behind the view plane: no image.
+        out.clear();
+        trilinear.project(DVec3::new(0.3, -0.5, -1.0) - 0.5 * n, &mut out);
+        assert!(out.is_empty());
+        // On it: t = 0.
+        trilinear.project(DVec3::new(0.3, -0.5, -1.0), &mut out);
+        assert_eq!(out.len(), 1);
+        assert!(out[0].t.abs() < 1e-15 && (out[0].pixel - DVec2::new(13.0, 7.5)).length() < 1e-9);
+    }
+
+    #[test]
+    fn folded_mesh_images_a_point_several_times() {
+        // One quad whose rays are ray(x, y) = (x, y, 0) + t (1 - 3x, 0, 1 + 2x): they cross,
+        // and the point (0.3, 0.5, 1) is seen from x = (2.6 +- sqrt(1.16)) / 4.
+        let (left, right) = (DVec3::new(1.0, 0.0, 1.0), DVec3::new(-2.0, 0.0, 3.0));
+        let mesh = TrilinearMesh {
+            points: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)],
+            normals: vec![left, right, left, right],
+            screen: vec![DVec2::ZERO, DVec2::X, DVec2::Y, DVec2::ONE],
+            triangles: vec![[0, 1, 3], [0, 3, 2]],
+        };
+        let trilinear = Trilinear::new(&mesh, 100, 80).unwrap();
+        let point = DVec3::new(0.3, 0.5, 1.0);
+        let mut out = Vec::new();
+        trilinear.project(point, &mut out);
+        out.sort_by(|a, b| a.pixel.x.total_cmp(&b.pixel.x));
+        assert_eq!(out.len(), 2, "{out:?}");
+        let root = 1.16_f64.sqrt();
+        for (image, x) in out.iter().zip([(2.6 - root) / 4.0, (2.6 + root) / 4.0]) {
+            assert!(
+                (image.pixel - DVec2::new(100.0 * x, 40.0)).length() < 1e-9,
+                "{out:?}"
+            );
+            assert!((image.t - 1.0 / (1.0 + 2.0 * x)).abs() < 1e-12);
+            let ray = trilinear.ray(image.pixel).unwrap();
+            assert!((ray.at(image.t) - point).length() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn overlapping_screen_triangles_keep_only_the_visible_ray() {
+        // Two projection triangles with the same screen triangle: `ray` uses the first, so
+        // only its image of a point counts.
+        let mesh = TrilinearMesh {
+            points: vec![
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::Y,
+                DVec3::new(0.0, 0.0, 1.0),
+                DVec3::new(1.0, 0.0, 1.0),
+                DVec3::new(0.0, 1.0, 1.0),
+            ],
+            normals: vec![DVec3::Z; 6],
+            screen: vec![
+                DVec2::ZERO,
+                DVec2::X,
+                DVec2::Y,
+                DVec2::ZERO,
+                DVec2::X,
+                DVec2::Y,
+            ],
+            triangles: vec![[0, 1, 2], [3, 4, 5]],
+        };
+        let trilinear = Trilinear::new(&mesh, 10, 10).unwrap();
+        let mut out = Vec::new();
+        trilinear.project(DVec3::new(0.2, 0.3, 3.0), &mut out);
+        assert_eq!(out.len(), 1, "{out:?}");
+        assert!((out[0].t - 3.0).abs() < 1e-12, "{out:?}");
+    }
+
+    mod round_trip {
+        use super::*;
+        use proptest::prelude::*;
+
+        /// A 4 x 4 vertex grid on screen; points on a plane grid with offsets up to 0.1 of
+        /// the spacing, normals (0, 0, 1) tilted by up to 0.01 per component (rays cross no
+        /// earlier than t ~ 15, so no fold for t <= 10), lengths 0.5..2.
+        fn perturbed_grid() -> impl Strategy<Value = TrilinearMesh> {
+            let n = 16;
+            (
+                proptest::collection::vec((-0.1..0.1f64, -0.1..0.1f64, -0.1..0.1f64), n),
+                proptest::collection::vec((-0.01..0.01f64, -0.01..0.01f64, 0.5..2.0f64), n),
+                -100.0..100.0f64,
+            )
+                .prop_map(|(offsets, tilts, shift)| {
+                    let mut mesh = TrilinearMesh::default();
+                    for j in 0..4 {
+                        for i in 0..4 {
+                            let k = j * 4 + i;
+                            let s = DVec2::new(i as f64, j as f64) / 3.0;
+                            let (ox, oy, oz) = offsets[k];
+                            let (tx, ty, len) = tilts[k];
+                            mesh.points.push(DVec3::new(
+                                shift + s.x + ox / 3.0,
+                                s.y + oy / 3.0,
+                                oz / 3.0,
+                            ));
+                            mesh.normals.push(DVec3::new(tx, ty, 1.0) * len);
+                            mesh.screen.push(s);
+                        }
+                    }
+                    for j in 0..3u32 {
+                        for i in 0..3u32 {
+                            let a = j * 4 + i;
+                            mesh.triangles.push([a, a + 1, a + 5]);
+                            mesh.triangles.push([a, a + 5, a + 4]);
+                        }
+                    }
+                    mesh
+                })
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(500))]
+
+            #[test]
+            fn pixel_to_point_to_pixel(
+                mesh in perturbed_grid(),
+                (x, y) in (0.0..1.0f64, 0.0..1.0f64),
+                t in 0.0..10.0f64,
+            ) {
+                let (width, height) = (640, 480);
+                let trilinear = Trilinear::new(&mesh, width, height).unwrap();
+                let pixel = DVec2::new(x * f64::from(width), y * f64::from(height));
+                let ray = trilinear.ray(pixel).unwrap();
+                let point = ray.at(t);
+                let mut out = Vec::new();
+                trilinear.project(point, &mut out);
+                let found = out.iter().any(|image| {
+                    (image.pixel - pixel).length() <= 1e-6
+                        && (image.t - t).abs() <= 1e-9 * t.max(1.0)
+                });
+                prop_assert!(found, "{pixel} t {t}: {out:?}");
+                for image in &out {
+                    let r = trilinear.ray(image.pixel).unwrap();
+                    prop_assert!((r.at(image.t) - point).length() <= 1e-9 * (1.0 + point.length()));
+                }
+            }
+        }
     }
 }

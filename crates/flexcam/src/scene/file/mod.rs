@@ -4,6 +4,7 @@
 //! (module `raw`), then each table is checked and converted by hand, so that every error, from a
 //! TOML syntax error to a degenerate projection, is one line `FILE:LINE:COLUMN: message`.
 
+mod flexible;
 mod light;
 mod object;
 mod projection;

@@ -20,20 +20,23 @@ enum Kind {
     Equirectangular,
     Cylindrical,
     Trilinear,
+    Flexible,
 }
 
 /// Type names as written in scene files.
-const KINDS: [(&str, Kind); 6] = [
+const KINDS: [(&str, Kind); 7] = [
     ("perspective", Kind::Perspective),
     ("orthographic", Kind::Orthographic),
     ("fisheye", Kind::Fisheye),
     ("equirectangular", Kind::Equirectangular),
     ("cylindrical", Kind::Cylindrical),
     ("trilinear", Kind::Trilinear),
+    ("flexible", Kind::Flexible),
 ];
 
-/// Projection types of the spec that are recognised but not implemented yet.
-const UNSUPPORTED: [&str; 1] = ["flexible"];
+/// Projection types of the spec that are recognised but not implemented yet (none now; the
+/// mechanism stays for the next one).
+const UNSUPPORTED: [&str; 0] = [];
 
 /// Parameters of the single-viewpoint projections, shared by all of them.
 const FRAME_KEYS: [&str; 3] = ["position", "look_at", "up"];
@@ -62,6 +65,7 @@ impl Kind {
             Kind::Trilinear => {
                 return vec!["surface", "points", "normals", "screen", "triangles"];
             }
+            Kind::Flexible => return super::flexible::KEYS.to_vec(),
         };
         FRAME_KEYS.iter().chain(own).copied().collect()
     }
@@ -135,6 +139,7 @@ pub(super) fn convert(
     };
     Ok(match kind {
         Kind::Trilinear => ProjectionSpec::Trilinear(trilinear(src, &required, base_dir)?),
+        Kind::Flexible => ProjectionSpec::Flexible(Box::new(super::flexible::convert(&required)?)),
         Kind::Perspective => ProjectionSpec::Perspective {
             frame: camera_frame(src, &required)?,
             fov: src.number(required.get(&raw.fov, "fov")?, "fov")?,
@@ -162,18 +167,18 @@ pub(super) fn convert(
 
 /// Looks up parameters a projection type cannot do without; a missing one is reported at the
 /// table's header.
-struct Required<'a> {
-    src: &'a Source<'a>,
-    table: &'a Spanned<RawProjection>,
+pub(super) struct Required<'a> {
+    pub src: &'a Source<'a>,
+    pub table: &'a Spanned<RawProjection>,
     kind: Kind,
 }
 
 impl Required<'_> {
-    fn raw(&self) -> &RawProjection {
+    pub fn raw(&self) -> &RawProjection {
         self.table.get_ref()
     }
 
-    fn get<'v, T>(&self, value: &'v Option<Spanned<T>>, key: &str) -> Result<&'v Spanned<T>> {
+    pub fn get<'v, T>(&self, value: &'v Option<Spanned<T>>, key: &str) -> Result<&'v Spanned<T>> {
         value.as_ref().ok_or_else(|| {
             self.src.error(
                 &self.table.span(),
@@ -184,7 +189,7 @@ impl Required<'_> {
 }
 
 /// `position`, `look_at` (required) and `up` (default +y).
-fn camera_frame(src: &Source, required: &Required) -> Result<CameraFrame> {
+pub(super) fn camera_frame(src: &Source, required: &Required) -> Result<CameraFrame> {
     let raw = required.raw();
     Ok(CameraFrame {
         position: src.dvec3(required.get(&raw.position, "position")?, "position")?,

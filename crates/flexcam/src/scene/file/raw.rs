@@ -53,6 +53,69 @@ pub struct RawProjection {
     pub normals: Option<Spanned<Vec<[f64; 3]>>>,
     pub screen: Option<Spanned<Vec<[f64; 2]>>>,
     pub triangles: Option<Spanned<Vec<[u32; 3]>>>,
+    pub preset: Option<Spanned<String>>,
+    pub near: Option<Spanned<RawSurface>>,
+    pub far: Option<Spanned<RawSurface>>,
+    pub reparam: Option<Spanned<String>>,
+    pub max_latitude: Option<Spanned<f64>>,
+    pub clip: Option<Spanned<[f64; 2]>>,
+    pub shear: Option<Spanned<[f64; 2]>>,
+    pub slit_distance: Option<Spanned<f64>>,
+}
+
+/// `near = { surface = "...", ... }` / `far`: a flexible projection's control surface, the
+/// union of every surface type's parameters.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSurface {
+    pub surface: Spanned<String>,
+    pub center: Option<Vec3Value>,
+    pub u_axis: Option<Vec3Value>,
+    pub v_axis: Option<Vec3Value>,
+    pub corner: Option<Vec3Value>,
+    pub u_edge: Option<Vec3Value>,
+    pub v_edge: Option<Vec3Value>,
+    pub corners: Option<Spanned<[[f64; 3]; 4]>>,
+    pub radius: Option<Spanned<f64>>,
+    pub longitude: Option<Spanned<[f64; 2]>>,
+    pub latitude: Option<Spanned<[f64; 2]>>,
+    pub angle: Option<Spanned<[f64; 2]>>,
+    pub height: Option<Spanned<[f64; 2]>>,
+    pub axis: Option<Vec3Value>,
+    pub front: Option<Vec3Value>,
+    pub point: Option<Vec3Value>,
+    pub start: Option<Vec3Value>,
+    pub end: Option<Vec3Value>,
+    pub along: Option<Spanned<String>>,
+}
+
+impl RawSurface {
+    /// The parameter keys present in the table (all but `surface`), with their spans.
+    pub fn present_keys(&self) -> Vec<(&'static str, Range<usize>)> {
+        [
+            ("center", self.center.as_ref().map(Spanned::span)),
+            ("u_axis", self.u_axis.as_ref().map(Spanned::span)),
+            ("v_axis", self.v_axis.as_ref().map(Spanned::span)),
+            ("corner", self.corner.as_ref().map(Spanned::span)),
+            ("u_edge", self.u_edge.as_ref().map(Spanned::span)),
+            ("v_edge", self.v_edge.as_ref().map(Spanned::span)),
+            ("corners", self.corners.as_ref().map(Spanned::span)),
+            ("radius", self.radius.as_ref().map(Spanned::span)),
+            ("longitude", self.longitude.as_ref().map(Spanned::span)),
+            ("latitude", self.latitude.as_ref().map(Spanned::span)),
+            ("angle", self.angle.as_ref().map(Spanned::span)),
+            ("height", self.height.as_ref().map(Spanned::span)),
+            ("axis", self.axis.as_ref().map(Spanned::span)),
+            ("front", self.front.as_ref().map(Spanned::span)),
+            ("point", self.point.as_ref().map(Spanned::span)),
+            ("start", self.start.as_ref().map(Spanned::span)),
+            ("end", self.end.as_ref().map(Spanned::span)),
+            ("along", self.along.as_ref().map(Spanned::span)),
+        ]
+        .into_iter()
+        .filter_map(|(key, span)| Some((key, span?)))
+        .collect()
+    }
 }
 
 impl RawProjection {
@@ -71,6 +134,20 @@ impl RawProjection {
             ("normals", self.normals.as_ref().map(Spanned::span)),
             ("screen", self.screen.as_ref().map(Spanned::span)),
             ("triangles", self.triangles.as_ref().map(Spanned::span)),
+            ("preset", self.preset.as_ref().map(Spanned::span)),
+            ("near", self.near.as_ref().map(Spanned::span)),
+            ("far", self.far.as_ref().map(Spanned::span)),
+            ("reparam", self.reparam.as_ref().map(Spanned::span)),
+            (
+                "max_latitude",
+                self.max_latitude.as_ref().map(Spanned::span),
+            ),
+            ("clip", self.clip.as_ref().map(Spanned::span)),
+            ("shear", self.shear.as_ref().map(Spanned::span)),
+            (
+                "slit_distance",
+                self.slit_distance.as_ref().map(Spanned::span),
+            ),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))

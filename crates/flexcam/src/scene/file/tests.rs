@@ -211,12 +211,96 @@ fn unknown_names_list_the_valid_ones() {
 }
 
 #[test]
-fn flexible_projection_is_reported_as_unsupported() {
+fn flexible_presets_and_surfaces_parse() {
+    let s = scene(
+        "[projection]\ntype = \"flexible\"\npreset = \"pushbroom\"\nposition = [0, 1, 5]\n\
+         look_at = [0, 1, 0]\nwidth = 4\nv_fov = 60\nclip = [0, 50]\n",
+    );
+    assert_eq!(s.projection.kind(), "flexible");
+    let s = scene(
+        "[projection]\ntype = \"flexible\"\nreparam = \"lens\"\n\
+         near = { surface = \"point\", point = [0, 1, 0] }\n\
+         far = { surface = \"hemisphere\", center = [0, 1, 0], radius = 30, axis = [0, 0, -1], front = [1, 0, 0] }\n",
+    );
+    let ProjectionSpec::Flexible(spec) = &s.projection else {
+        panic!("not flexible");
+    };
+    assert_eq!(spec.reparam.map(|r| r.name()), Some("lens"));
+    scene(
+        "[projection]\ntype = \"flexible\"\n\
+         near = { surface = \"line\", start = [-1, 0, 0], end = [1, 0, 0] }\n\
+         far = { surface = \"rectangle\", corner = [-2, -1, -5], u_edge = [4, 0, 0], v_edge = [0, 3, 0] }\n",
+    );
+    scene(
+        "[projection]\ntype = \"flexible\"\n\
+         near = { surface = \"cylinder\", center = [0, 0, 0], radius = 0.5, height = [-0.5, 0.5] }\n\
+         far = { surface = \"bilinear\", corners = [[-2, -1, -5], [2, -1, -5], [2, 2, -6], [-2, 2, -6]] }\n",
+    );
+}
+
+#[test]
+fn flexible_errors_have_positions() {
+    let head = "[projection]\ntype = \"flexible\"\n";
     assert_error_at(
-        "[projection]\ntype = \"flexible\"\nnear = [0, 0, 0]\n",
-        2,
+        &format!("{head}preset = \"fishbowl\"\n"),
+        3,
+        10,
+        "unknown flexible preset \"fishbowl\"; expected one of: perspective,",
+    );
+    assert_error_at(
+        &format!("{head}preset = \"perspective\"\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\nfov = 60\nwidth = 3\n"),
+        7,
+        9,
+        "`width` is not a parameter of flexible preset \"perspective\"",
+    );
+    assert_error_at(
+        &format!("{head}preset = \"perspective\"\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\nfov = 60\nclip = [5, 1]\n"),
+        7,
         8,
-        "not supported yet",
+        "`clip` must be [near, far]",
+    );
+    assert_error_at(
+        &format!("{head}near = {{ surface = \"disc\", center = [0, 0, 0] }}\nfar = {{ surface = \"point\", point = [0, 0, 1] }}\n"),
+        3,
+        20,
+        "unknown surface \"disc\"; expected one of: rectangle, bilinear,",
+    );
+    assert_error_at(
+        &format!("{head}near = {{ surface = \"point\", point = [0, 0, 0] }}\nfar = {{ surface = \"sphere\", center = [0, 0, 0], radius = 2, latitude = [0, 120] }}\n"),
+        4,
+        72,
+        "far sphere latitude must lie within [-90, 90]",
+    );
+    assert_error_at(
+        &format!("{head}near = {{ surface = \"point\", point = [0, 0, 0], radius = 1 }}\nfar = {{ surface = \"point\", point = [0, 0, 1] }}\n"),
+        3,
+        57,
+        "`radius` is not a parameter of point surfaces",
+    );
+    assert_error_at(
+        &format!("{head}near = {{ surface = \"point\", point = [0, 0, 0] }}\n"),
+        1,
+        1,
+        "flexible projection needs `far`",
+    );
+    assert_error_at(
+        &format!("{head}reparam = \"swirl\"\nnear = {{ surface = \"point\", point = [0, 0, 0] }}\nfar = {{ surface = \"point\", point = [0, 0, 1] }}\n"),
+        3,
+        11,
+        "unknown reparam \"swirl\"; expected one of: linear, polar, lens, mercator",
+    );
+    // Degenerate volumes are found by the build and reported at the table.
+    assert_error_at(
+        &format!("{head}near = {{ surface = \"point\", point = [0, 0, 0] }}\nfar = {{ surface = \"point\", point = [0, 0, 0] }}\n"),
+        1,
+        1,
+        "every projector has zero length",
+    );
+    assert_error_at(
+        &format!("{head}fov = 60\nnear = {{ surface = \"point\", point = [0, 0, 0] }}\n"),
+        3,
+        7,
+        "`fov` is not a parameter of flexible projections without a `preset`",
     );
 }
 

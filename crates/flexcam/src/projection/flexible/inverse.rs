@@ -1,0 +1,249 @@
+//! Q^-1: from a scene point p to (u, v, t) for the analytic class of the thesis (7.3): volumes
+//! where t follows directly from p and each surface type has a closed-form inverse.
+//!
+//! - Parallel planes: both surfaces affine (rectangle, parallelogram bilinear quad, point,
+//!   line) and perpendicular to one normal n, at different offsets: t from p.n, then (u, v)
+//!   from the interpolated affine surface (a 2 x 2 solve).
+//! - Nested spheres: sphere patches sharing centre, frame and angle ranges (or a point at the
+//!   other's centre, a sphere of radius 0), different radii: t from |p - c|, (u, v) from the
+//!   longitude and latitude.
+//! - Coaxial cylinders: cylinder patches sharing the axis line, frame and angle range, with
+//!   different radii: t from the distance to the axis, u from the angle, v from the height.
+//!
+//! Anything else has no inverse ([`Inverse::classify`] gives `None`).
+
+use std::f64::consts::PI;
+
+use glam::{DMat2, DVec2, DVec3};
+
+use super::surface::{CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface};
+
+/// Relative tolerance for "the same" centre, frame or range, and for the domain edges.
+const SAME: f64 = 1e-12;
+/// Tolerance on (u, v, t) at the domain boundary, so that edge points are not lost.
+const EDGE: f64 = 1e-9;
+
+/// An affine surface a + u b + v c.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Affine {
+    a: DVec3,
+    b: DVec3,
+    c: DVec3,
+}
+
+/// The inverse of one invertible volume.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) enum Inverse {
+    Planes {
+        near: Affine,
+        far: Affine,
+        normal: DVec3,
+    },
+    Spheres {
+        near: SpherePatch,
+        far: SpherePatch,
+    },
+    Cylinders {
+        near: CylinderPatch,
+        far: CylinderPatch,
+    },
+}
+
+fn affine(s: &Surface) -> Option<Affine> {
+    match *s {
+        Surface::Rectangle {
+            corner,
+            u_edge,
+            v_edge,
+        } => Some(Affine {
+            a: corner,
+            b: u_edge,
+            c: v_edge,
+        }),
+        Surface::Point(p) => Some(Affine {
+            a: p,
+            b: DVec3::ZERO,
+            c: DVec3::ZERO,
+        }),
+        Surface::Line { start, end, along } => Some(match along {
+            LineParam::U => Affine {
+                a: start,
+                b: end - start,
+                c: DVec3::ZERO,
+            },
+            LineParam::V => Affine {
+                a: start,
+                b: DVec3::ZERO,
+                c: end - start,
+            },
+        }),
+        Surface::Bilinear {
+            corners: [p00, p10, p11, p01],
+        } => {
+            let twist = p11 - p10 - p01 + p00;
+            let scale = (p10 - p00).length() + (p01 - p00).length();
+            (twist.length() <= SAME * scale).then_some(Affine {
+                a: p00,
+                b: p10 - p00,
+                c: p01 - p00,
+            })
+        }
+        Surface::Sphere(_) | Surface::Cylinder(_) => None,
+    }
+}
+
+fn same(a: DVec3, b: DVec3, scale: f64) -> bool {
+    (a - b).length() <= SAME * scale.max(1.0)
+}
+
+fn same_frame(a: &PolarFrame, b: &PolarFrame) -> bool {
+    same(a.axis, b.axis, 1.0) && same(a.front, b.front, 1.0)
+}
+
+fn same_range(a: [f64; 2], b: [f64; 2]) -> bool {
+    (a[0] - b[0]).abs() <= SAME && (a[1] - b[1]).abs() <= SAME && (a[1] - a[0]).abs() > SAME
+}
+
+/// A point surface at a sphere's centre, as a sphere of radius 0 with that sphere's ranges.
+fn as_sphere(s: &Surface, other: &Surface) -> Option<SpherePatch> {
+    match (s, other) {
+        (Surface::Sphere(p), _) => Some(*p),
+        (Surface::Point(c), Surface::Sphere(o)) if same(*c, o.center, o.radius) => {
+            Some(SpherePatch { radius: 0.0, ..*o })
+        }
+        _ => None,
+    }
+}
+
+impl Inverse {
+    /// The inverse of the volume between `near` and `far`, when it is in the analytic class.
+    pub fn classify(near: &Surface, far: &Surface) -> Option<Inverse> {
+        if let (Some(n), Some(f)) = (as_sphere(near, far), as_sphere(far, near)) {
+            let ok = same(n.center, f.center, n.radius.max(f.radius))
+                && same_frame(&n.frame, &f.frame)
+                && same_range(n.longitude, f.longitude)
+                && same_range(n.latitude, f.latitude)
+                && n.radius != f.radius;
+            return ok.then_some(Inverse::Spheres { near: n, far: f });
+        }
+        if let (Surface::Cylinder(n), Surface::Cylinder(f)) = (near, far) {
+            let offset = f.center - n.center;
+            let across = offset - offset.dot(n.frame.axis) * n.frame.axis;
+            let ok = same(across, DVec3::ZERO, offset.length())
+                && same_frame(&n.frame, &f.frame)
+                && same_range(n.angle, f.angle)
+                && n.radius != f.radius;
+            return ok.then_some(Inverse::Cylinders { near: *n, far: *f });
+        }
+        let (n, f) = (affine(near)?, affine(far)?);
+        let normal = [n.b.cross(n.c), f.b.cross(f.c)]
+            .into_iter()
+            .find(|m| m.length() > SAME * (1.0 + m.length()))?
+            .try_normalize()?;
+        let flat = |s: &Affine| {
+            let scale = s.b.length() + s.c.length();
+            s.b.dot(normal).abs() <= SAME * scale && s.c.dot(normal).abs() <= SAME * scale
+        };
+        let gap = (f.a - n.a).dot(normal);
+        let ok = flat(&n) && flat(&f) && gap.abs() > SAME * (f.a - n.a).length();
+        ok.then_some(Inverse::Planes {
+            near: n,
+            far: f,
+            normal,
+        })
+    }
+
+    /// The (u, v) and t of scene point `p`, or `None` when p is outside the volume (t or
+    /// (u, v) outside [0, 1], within a 1e-9 tolerance, then clamped) or on a degenerate
+    /// spot (a point where the projectors meet, a polar axis outside the longitude range).
+    pub fn solve(&self, p: DVec3) -> Option<(DVec2, f64)> {
+        let (uv, t) = match self {
+            Inverse::Planes { near, far, normal } => planes(near, far, *normal, p)?,
+            Inverse::Spheres { near, far } => spheres(near, far, p)?,
+            Inverse::Cylinders { near, far } => cylinders(near, far, p)?,
+        };
+        let inside = |x: f64| (-EDGE..=1.0 + EDGE).contains(&x);
+        (inside(uv.x) && inside(uv.y) && inside(t))
+            .then(|| (uv.clamp(DVec2::ZERO, DVec2::ONE), t.clamp(0.0, 1.0)))
+    }
+}
+
+fn planes(near: &Affine, far: &Affine, n: DVec3, p: DVec3) -> Option<(DVec2, f64)> {
+    let t = (p - near.a).dot(n) / (far.a - near.a).dot(n);
+    let a = near.a.lerp(far.a, t);
+    let b = near.b.lerp(far.b, t);
+    let c = near.c.lerp(far.c, t);
+    // Least squares in the plane: [b.b b.c; b.c c.c] (u, v) = (b.q, c.q).
+    let q = p - a;
+    let m = DMat2::from_cols(
+        DVec2::new(b.dot(b), b.dot(c)),
+        DVec2::new(b.dot(c), c.dot(c)),
+    );
+    let det = m.determinant();
+    if det.abs() <= SAME * SAME * (b.length_squared() * c.length_squared()) || det == 0.0 {
+        return None; // the cross-section is a point or a segment: no single (u, v)
+    }
+    Some((m.inverse() * DVec2::new(b.dot(q), c.dot(q)), t))
+}
+
+/// u for angle `angle` in the range `range` (radians, span at most 2 pi): of the angles
+/// 2 pi apart, the one inside the range (or the first above its low end).
+fn unwrap(range: [f64; 2], angle: f64) -> f64 {
+    let (lo, hi) = (range[0].min(range[1]), range[0].max(range[1]));
+    let turn = 2.0 * PI;
+    let above = angle + turn * ((lo - angle) / turn).ceil();
+    let a = [above - turn, above]
+        .into_iter()
+        .find(|a| (lo - EDGE..=hi + EDGE).contains(a))
+        .unwrap_or(above);
+    (a - range[0]) / (range[1] - range[0])
+}
+
+/// Longitude of a unit-frame direction, with a fallback on the polar axis where it is
+/// undefined: any longitude of the range gives the same point, so take the range's middle.
+fn longitude(frame: &PolarFrame, d: DVec3, range: [f64; 2]) -> (f64, f64) {
+    let (x, y) = (d.dot(frame.front), d.dot(frame.east));
+    if x == 0.0 && y == 0.0 {
+        return (0.5, DVec2::new(x, y).length());
+    }
+    (unwrap(range, y.atan2(x)), DVec2::new(x, y).length())
+}
+
+fn spheres(near: &SpherePatch, far: &SpherePatch, p: DVec3) -> Option<(DVec2, f64)> {
+    let q = p - near.center;
+    let rho = q.length();
+    if rho == 0.0 {
+        return None;
+    }
+    let t = (rho - near.radius) / (far.radius - near.radius);
+    let d = q / rho;
+    let (u, horizontal) = longitude(&near.frame, d, near.longitude);
+    let lat = d.dot(near.frame.axis).atan2(horizontal);
+    let v = (lat - near.latitude[0]) / (near.latitude[1] - near.latitude[0]);
+    Some((DVec2::new(u, v), t))
+}
+
+fn cylinders(near: &CylinderPatch, far: &CylinderPatch, p: DVec3) -> Option<(DVec2, f64)> {
+    let axis = near.frame.axis;
+    let q = p - near.center;
+    let h = q.dot(axis);
+    let across = q - h * axis;
+    let rho = across.length();
+    let t = (rho - near.radius) / (far.radius - near.radius);
+    let u = if rho == 0.0 {
+        0.5
+    } else {
+        longitude(&near.frame, across / rho, near.angle).0
+    };
+    // Height along the projector: (1 - t) h_near(v) + t h_far(v), far heights from near's
+    // centre.
+    let shift = (far.center - near.center).dot(axis);
+    let far_height = [far.height[0] + shift, far.height[1] + shift];
+    let start = (1.0 - t) * near.height[0] + t * far_height[0];
+    let span = (1.0 - t) * (near.height[1] - near.height[0]) + t * (far_height[1] - far_height[0]);
+    if span == 0.0 {
+        return None;
+    }
+    let v = (h - start) / span;
+    Some((DVec2::new(u, v), t))
+}

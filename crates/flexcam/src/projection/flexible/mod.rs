@@ -1,0 +1,145 @@
+//! The flexible projection (seed 003, Flexible Projection): a parametric viewing volume
+//! Q(u, v, t) between control surfaces, mapped to the image by a re-parameterisation.
+//!
+//! - [`surface`]: control surfaces Q_i(u, v) on the shared domain (u, v) in [0, 1]^2, u to the
+//!   right of the image, v up;
+//! - [`volume`]: Q(u, v, t) = (1 - t) Q_near + t Q_far and dQ/dt (straight projectors; the
+//!   place for polyline and Bezier projectors next);
+//! - [`reparam`]: pixel <-> (u, v) (linear, polar fisheye, lens-like, Mercator);
+//! - [`presets`]: named volumes from a camera frame (perspective, pushbroom, crossed slits, ...);
+//! - `inverse`: (u, v, t) from a scene point for the analytic class (parallel planes, nested
+//!   spheres, coaxial cylinders).
+//!
+//! A pixel's ray starts on the near surface and reaches the far surface at t = 1; t is
+//! limited to [0, 1] (the per-projector near and far clip of the framework).
+
+mod inverse;
+pub mod presets;
+pub mod reparam;
+pub mod surface;
+#[cfg(test)]
+mod tests;
+pub mod volume;
+
+use glam::{DVec2, DVec3};
+
+pub use presets::{Preset, PresetSpec};
+pub use reparam::Reparam;
+pub use surface::{CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface};
+pub use volume::{LinearVolume, Volume};
+
+use self::inverse::Inverse;
+use super::image_coords::Resolution;
+use super::{ImagePoint, Projection};
+use crate::error::Result;
+use crate::geometry::Ray;
+
+/// Where the control surfaces of a flexible projection come from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum VolumeSource {
+    /// A named volume placed by a camera frame.
+    Preset(PresetSpec),
+    /// Two explicit control surfaces, straight projectors between them.
+    Surfaces { near: Surface, far: Surface },
+}
+
+/// A parsed flexible projection: the volume and the re-parameterisation (`None`: the
+/// preset's own, linear for explicit surfaces).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlexibleSpec {
+    pub source: VolumeSource,
+    pub reparam: Option<Reparam>,
+}
+
+/// A flexible projection bound to an image size.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Flexible {
+    volume: Volume,
+    reparam: Reparam,
+    resolution: Resolution,
+    inverse: Option<Inverse>,
+}
+
+impl Flexible {
+    /// Builds the volume. Errors: an empty image; a bad preset parameter or camera frame; an
+    /// invalid surface; near and far surfaces that coincide everywhere; a Mercator latitude
+    /// outside (0, 90).
+    pub fn new(spec: &FlexibleSpec, width: u32, height: u32) -> Result<Self> {
+        let resolution = Resolution::new(width, height)?;
+        let aspect = f64::from(height) / f64::from(width);
+        let (near, far, default_reparam) = match &spec.source {
+            VolumeSource::Preset(p) => {
+                let (near, far) = p.surfaces(aspect)?;
+                (near, far, p.preset.default_reparam())
+            }
+            VolumeSource::Surfaces { near, far } => (*near, *far, Reparam::Linear),
+        };
+        let reparam = spec.reparam.unwrap_or(default_reparam);
+        reparam.validate()?;
+        let volume = LinearVolume::new(near, far)?;
+        Ok(Flexible {
+            inverse: Inverse::classify(&volume.near, &volume.far),
+            volume: Volume::Linear(volume),
+            reparam,
+            resolution,
+        })
+    }
+
+    /// The viewing volume.
+    pub fn volume(&self) -> &Volume {
+        &self.volume
+    }
+
+    /// The re-parameterisation in use.
+    pub fn reparam(&self) -> Reparam {
+        self.reparam
+    }
+
+    /// The (u, v) of continuous pixel position `pixel`, `None` outside the map's domain.
+    pub fn uv(&self, pixel: DVec2) -> Option<DVec2> {
+        self.reparam.to_uv(&self.resolution, pixel)
+    }
+
+    /// Q(u, v, t) for a pixel: the point at depth t on its projector.
+    pub fn point(&self, pixel: DVec2, t: f64) -> Option<DVec3> {
+        self.uv(pixel).map(|uv| self.volume.point(uv, t))
+    }
+}
+
+impl Projection for Flexible {
+    fn kind(&self) -> &'static str {
+        "flexible"
+    }
+
+    fn resolution(&self) -> (u32, u32) {
+        (self.resolution.width, self.resolution.height)
+    }
+
+    /// Origin Q_near(u, v), direction Q_far - Q_near (unnormalised: the ray parameter is t),
+    /// t in [0, 1]. `None` outside the re-parameterisation's domain and for zero-length
+    /// projectors.
+    fn ray(&self, pixel: DVec2) -> Option<Ray> {
+        self.volume.ray(self.uv(pixel)?)
+    }
+
+    /// True for the analytic class: parallel planes sharing a normal, nested spheres,
+    /// coaxial cylinders (see the `inverse` module).
+    fn has_inverse(&self) -> bool {
+        self.inverse.is_some()
+    }
+
+    /// Appends the one image of `point` when it lies inside the viewing volume (t and
+    /// (u, v) in [0, 1]); points outside it, and degenerate spots where a whole set of
+    /// projectors meets (the eye of a perspective volume), append nothing.
+    fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
+        let Some(inverse) = &self.inverse else {
+            return;
+        };
+        let Some((uv, t)) = inverse.solve(point) else {
+            return;
+        };
+        if let Some(pixel) = self.reparam.to_pixel(&self.resolution, uv) {
+            out.push(ImagePoint { pixel, t });
+        }
+    }
+}

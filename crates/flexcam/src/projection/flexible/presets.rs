@@ -1,0 +1,251 @@
+//! Named flexible volumes built from a camera frame: the projections of the thesis (ch. 4, 6)
+//! as pairs of control surfaces.
+//!
+//! All are described in the camera's local coordinates (x right, y up, z forward, eye at
+//! `position`), with U = 2u - 1 and V = 2v - 1 in [-1, 1] and control surfaces at the
+//! distances `clip = [n, f]` along the view direction (radii for the panoramas):
+//! - perspective: rectangles Q_d = d (U tan(fov/2), V tan(fov/2) H/W, 1);
+//! - inverse perspective: Q_d = ((e - d) U tan(fov/2), (e - d) V tan(fov/2) H/W, d), the
+//!   projectors converging at `look_at`, e = |look_at - position| (n < f <= e);
+//! - orthographic: Q_d = (U w/2, V w/2 H/W, d);
+//! - oblique: Q_d = (U w/2 - alpha d, V w/2 H/W - beta d, d): image (x + alpha z, y + beta z);
+//! - pushbroom: Q_d = (U w/2, V d tan(v_fov/2), d): projectors meet the slit y = z = 0;
+//! - crossed slits: Q_d = (U d tan(fov/2), V (d - s) tan(v_fov/2), d): every projector passes
+//!   the vertical slit x = z = 0 and the horizontal slit y = 0, z = s;
+//! - cylindrical: cylinders about the up axis, radius d, angle U h_fov/2, height
+//!   V d tan(v_fov/2);
+//! - equirectangular: spheres of radius d, longitude U h_fov/2, latitude V v_fov/2;
+//! - fisheye: spheres of radius d with the pole on the view axis, azimuth from u and angle
+//!   off the axis v fov/2, with the polar re-parameterisation.
+//!
+//! Near distance 0 puts the near surface at the eye (a point, or the slit): the rays then
+//! start where the single-viewpoint projections start theirs.
+
+use std::f64::consts::PI;
+
+use glam::{DVec2, DVec3};
+
+use super::super::camera_basis::CameraBasis;
+use super::super::params::{angle_radians, positive_length, UpTo};
+use super::super::CameraFrame;
+use super::reparam::Reparam;
+use super::surface::{CylinderPatch, PolarFrame, SpherePatch, Surface};
+use crate::error::{Error, Result};
+
+/// The default far clip distance of the presets, in world units.
+pub const DEFAULT_FAR: f64 = 1000.0;
+
+/// A named volume and its own parameters (angles in degrees).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Preset {
+    Perspective {
+        fov: f64,
+    },
+    InversePerspective {
+        fov: f64,
+    },
+    Orthographic {
+        width: f64,
+    },
+    Oblique {
+        width: f64,
+        shear: DVec2,
+    },
+    Pushbroom {
+        width: f64,
+        v_fov: f64,
+    },
+    /// `v_fov` defaults to the perspective one (from `fov` and the aspect ratio);
+    /// `slit_distance` is s, the signed distance from `position` to the horizontal slit.
+    CrossedSlits {
+        fov: f64,
+        v_fov: Option<f64>,
+        slit_distance: f64,
+    },
+    Cylindrical {
+        h_fov: f64,
+        v_fov: f64,
+    },
+    Equirectangular {
+        h_fov: f64,
+        v_fov: f64,
+    },
+    Fisheye {
+        fov: f64,
+    },
+}
+
+/// The preset names of scene files, in order.
+pub const PRESET_NAMES: [&str; 9] = [
+    "perspective",
+    "inverse_perspective",
+    "orthographic",
+    "oblique",
+    "pushbroom",
+    "crossed_slits",
+    "cylindrical",
+    "equirectangular",
+    "fisheye",
+];
+
+/// A preset placed in the scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PresetSpec {
+    pub preset: Preset,
+    pub frame: CameraFrame,
+    /// Near and far control-surface distances; `None` for [0, 1000], or [0, e] for the
+    /// inverse perspective.
+    pub clip: Option<[f64; 2]>,
+}
+
+impl Preset {
+    /// The scene-file name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Preset::Perspective { .. } => "perspective",
+            Preset::InversePerspective { .. } => "inverse_perspective",
+            Preset::Orthographic { .. } => "orthographic",
+            Preset::Oblique { .. } => "oblique",
+            Preset::Pushbroom { .. } => "pushbroom",
+            Preset::CrossedSlits { .. } => "crossed_slits",
+            Preset::Cylindrical { .. } => "cylindrical",
+            Preset::Equirectangular { .. } => "equirectangular",
+            Preset::Fisheye { .. } => "fisheye",
+        }
+    }
+
+    /// The re-parameterisation the preset is meant for (polar for the fisheye).
+    pub fn default_reparam(&self) -> Reparam {
+        match self {
+            Preset::Fisheye { .. } => Reparam::Polar,
+            _ => Reparam::Linear,
+        }
+    }
+}
+
+/// A parameter check with the preset's name in the message.
+fn angle(preset: &Preset, key: &str, degrees: f64, max: UpTo) -> Result<f64> {
+    angle_radians(&format!("flexible {}", preset.name()), key, degrees, max)
+}
+
+impl PresetSpec {
+    /// The near and far surfaces for an image of aspect ratio `aspect` = height / width.
+    /// Errors: a degenerate frame, a parameter out of range (as the single-viewpoint types),
+    /// a clip range that is not 0 <= near < far (and far <= e for the inverse perspective).
+    pub fn surfaces(&self, aspect: f64) -> Result<(Surface, Surface)> {
+        let b = CameraBasis::new(&self.frame)?;
+        let p = &self.preset;
+        let focus = (self.frame.look_at - self.frame.position).length();
+        let [near, far] = self.clip.unwrap_or(match p {
+            Preset::InversePerspective { .. } => [0.0, focus],
+            _ => [0.0, DEFAULT_FAR],
+        });
+        if !(near.is_finite() && far.is_finite() && 0.0 <= near && near < far) {
+            return Err(Error::new(format!(
+                "flexible clip must be [near, far] with 0 <= near < far, got [{near}, {far}]"
+            )));
+        }
+        let centre = |d: f64| b.origin + d * b.forward;
+        let rect = |d: f64, half: DVec2, shift: DVec2| {
+            Surface::rectangle_centred(
+                centre(d) + shift.x * b.right + shift.y * b.up,
+                half.x * b.right,
+                half.y * b.up,
+            )
+        };
+        let pair = |f: &dyn Fn(f64) -> Surface| (f(near), f(far));
+        Ok(match *p {
+            Preset::Perspective { fov } => {
+                let h = (0.5 * angle(p, "fov", fov, UpTo::Below(180.0))?).tan();
+                pair(&|d| rect(d, d * DVec2::new(h, h * aspect), DVec2::ZERO))
+            }
+            Preset::InversePerspective { fov } => {
+                let h = (0.5 * angle(p, "fov", fov, UpTo::Below(180.0))?).tan();
+                if far > focus {
+                    return Err(Error::new(format!(
+                        "flexible inverse_perspective far clip {far} is beyond the point \
+                         the projectors meet (look_at, at distance {focus})"
+                    )));
+                }
+                pair(&|d| rect(d, (focus - d) * DVec2::new(h, h * aspect), DVec2::ZERO))
+            }
+            Preset::Orthographic { width } => {
+                let w = 0.5 * positive_length("flexible orthographic", "width", width)?;
+                pair(&|d| rect(d, DVec2::new(w, w * aspect), DVec2::ZERO))
+            }
+            Preset::Oblique { width, shear } => {
+                let w = 0.5 * positive_length("flexible oblique", "width", width)?;
+                if !shear.is_finite() {
+                    return Err(Error::new("flexible oblique shear must be finite"));
+                }
+                pair(&|d| rect(d, DVec2::new(w, w * aspect), -d * shear))
+            }
+            Preset::Pushbroom { width, v_fov } => {
+                let w = 0.5 * positive_length("flexible pushbroom", "width", width)?;
+                let t = (0.5 * angle(p, "v_fov", v_fov, UpTo::Below(180.0))?).tan();
+                pair(&|d| rect(d, DVec2::new(w, d * t), DVec2::ZERO))
+            }
+            Preset::CrossedSlits {
+                fov,
+                v_fov,
+                slit_distance,
+            } => {
+                let h = (0.5 * angle(p, "fov", fov, UpTo::Below(180.0))?).tan();
+                let t = match v_fov {
+                    Some(v) => (0.5 * angle(p, "v_fov", v, UpTo::Below(180.0))?).tan(),
+                    None => h * aspect,
+                };
+                if !slit_distance.is_finite() {
+                    return Err(Error::new(
+                        "flexible crossed_slits slit_distance must be finite",
+                    ));
+                }
+                pair(&|d| rect(d, DVec2::new(d * h, (d - slit_distance) * t), DVec2::ZERO))
+            }
+            Preset::Cylindrical { h_fov, v_fov } => {
+                let half = 0.5 * angle(p, "h_fov", h_fov, UpTo::Including(360.0))?;
+                let t = (0.5 * angle(p, "v_fov", v_fov, UpTo::Below(180.0))?).tan();
+                let frame = PolarFrame::new(b.up, b.forward)?;
+                pair(&|d| {
+                    Surface::Cylinder(CylinderPatch {
+                        center: b.origin,
+                        radius: d,
+                        frame,
+                        angle: [-half, half],
+                        height: [-d * t, d * t],
+                    })
+                })
+            }
+            Preset::Equirectangular { h_fov, v_fov } => {
+                let h = 0.5 * angle(p, "h_fov", h_fov, UpTo::Including(360.0))?;
+                let v = 0.5 * angle(p, "v_fov", v_fov, UpTo::Including(180.0))?;
+                let frame = PolarFrame::new(b.up, b.forward)?;
+                pair(&|d| sphere(b.origin, d, frame, [-h, h], [-v, v]))
+            }
+            Preset::Fisheye { fov } => {
+                let half = 0.5 * angle(p, "fov", fov, UpTo::Including(360.0))?;
+                // Pole on the view axis, longitude 0 to the right, +90 up: the polar map's
+                // azimuth atan2(py, px) is then the longitude.
+                let frame = PolarFrame::new(b.forward, b.right)?;
+                let lat = [0.5 * PI, 0.5 * PI - half];
+                pair(&|d| sphere(b.origin, d, frame, [-PI, PI], lat))
+            }
+        })
+    }
+}
+
+fn sphere(
+    center: DVec3,
+    radius: f64,
+    frame: PolarFrame,
+    longitude: [f64; 2],
+    latitude: [f64; 2],
+) -> Surface {
+    Surface::Sphere(SpherePatch {
+        center,
+        radius,
+        frame,
+        longitude,
+        latitude,
+    })
+}

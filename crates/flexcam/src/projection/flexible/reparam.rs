@@ -1,0 +1,225 @@
+//! Re-parameterisation (thesis 4.3): the map between image positions and the (u, v) domain
+//! [0, 1]^2 of the control surfaces, in both directions (the inverse is what a scanline
+//! renderer needs).
+//!
+//! Centred coordinates: the polar maps use p = (px, py) with the origin at the image centre,
+//! y up, scaled so that the circle inscribed in the shorter image side is the unit circle
+//! (the notes' correction: the thesis says [0, 1] and atan). Mercator scales x by the width
+//! and y by the height, each to [-1, 1].
+
+use std::f64::consts::{FRAC_PI_4, PI};
+
+use glam::DVec2;
+
+use super::super::image_coords::Resolution;
+use crate::error::{Error, Result};
+
+/// A pixel <-> (u, v) map.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Reparam {
+    /// u = x / W, v = 1 - y / H: the image is the domain, v up.
+    Linear,
+    /// Polar fisheye: u = (atan2(py, px) + pi) / (2 pi), v = |p|; outside the unit circle
+    /// there is no (u, v).
+    Polar,
+    /// Lens-like fisheye (thesis fig. 4.12): as `Polar` but v = r/4 + 3 r^2 / 4 with r = |p|,
+    /// which magnifies the centre.
+    Lens,
+    /// Mercator map: u = x / W; the image row's Mercator ordinate y_m = py * M(max_latitude),
+    /// M(phi) = ln tan(pi/4 + phi/2), gives the latitude phi = atan(sinh(y_m)) and
+    /// v = (phi / max_latitude + 1) / 2. So it expects surfaces whose v spans the latitudes
+    /// [-max_latitude, max_latitude] linearly (the equirectangular preset with
+    /// v_fov = 2 max_latitude). `max_latitude` in radians, in (0, pi/2).
+    Mercator { max_latitude: f64 },
+}
+
+/// The names used in scene files, in order.
+pub const REPARAM_NAMES: [&str; 4] = ["linear", "polar", "lens", "mercator"];
+
+/// The default top latitude of the Mercator map, degrees.
+pub const DEFAULT_MERCATOR_LATITUDE: f64 = 85.0;
+
+impl Reparam {
+    /// The scene-file name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Reparam::Linear => "linear",
+            Reparam::Polar => "polar",
+            Reparam::Lens => "lens",
+            Reparam::Mercator { .. } => "mercator",
+        }
+    }
+
+    /// Errors: a Mercator latitude outside (0, 90) degrees.
+    pub fn validate(&self) -> Result<()> {
+        if let Reparam::Mercator { max_latitude } = self {
+            if !(max_latitude.is_finite() && *max_latitude > 0.0 && *max_latitude < 0.5 * PI) {
+                return Err(Error::new(format!(
+                    "flexible max_latitude must be in (0, 90) degrees, got {}",
+                    max_latitude.to_degrees()
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// The (u, v) of continuous pixel position `pixel`, or `None` outside the map's domain
+    /// (outside the image for linear and Mercator, outside the unit circle for the polar
+    /// maps).
+    pub fn to_uv(&self, resolution: &Resolution, pixel: DVec2) -> Option<DVec2> {
+        let size = resolution.size();
+        let uv = match self {
+            Reparam::Linear => DVec2::new(pixel.x / size.x, 1.0 - pixel.y / size.y),
+            Reparam::Polar | Reparam::Lens => {
+                let p = resolution.centred(pixel) / circle_radius(resolution);
+                let r = p.length();
+                if r > 1.0 {
+                    return None;
+                }
+                let v = if *self == Reparam::Lens {
+                    0.25 * r + 0.75 * r * r
+                } else {
+                    r
+                };
+                DVec2::new((p.y.atan2(p.x) + PI) / (2.0 * PI), v)
+            }
+            Reparam::Mercator { max_latitude } => {
+                let py = resolution.centred(pixel).y / (0.5 * size.y);
+                let latitude = (py * mercator(*max_latitude)).sinh().atan();
+                DVec2::new(pixel.x / size.x, 0.5 * (latitude / max_latitude + 1.0))
+            }
+        };
+        in_domain(uv).then_some(uv)
+    }
+
+    /// The continuous pixel position of `uv` (inverse of [`Reparam::to_uv`]); `None` outside
+    /// [0, 1]^2.
+    pub fn to_pixel(&self, resolution: &Resolution, uv: DVec2) -> Option<DVec2> {
+        if !in_domain(uv) {
+            return None;
+        }
+        let size = resolution.size();
+        Some(match self {
+            Reparam::Linear => DVec2::new(uv.x * size.x, (1.0 - uv.y) * size.y),
+            Reparam::Polar | Reparam::Lens => {
+                let r = if *self == Reparam::Lens {
+                    // v = r/4 + 3 r^2/4  <=>  3 r^2 + r - 4 v = 0, the root in [0, 1].
+                    (-1.0 + (1.0 + 48.0 * uv.y).sqrt()) / 6.0
+                } else {
+                    uv.y
+                };
+                let azimuth = 2.0 * PI * uv.x - PI;
+                let p = r * DVec2::new(azimuth.cos(), azimuth.sin());
+                resolution.pixel(p * circle_radius(resolution))
+            }
+            Reparam::Mercator { max_latitude } => {
+                let latitude = (2.0 * uv.y - 1.0) * max_latitude;
+                let py = mercator(latitude) / mercator(*max_latitude);
+                let y = resolution.pixel(DVec2::new(0.0, py * 0.5 * size.y)).y;
+                DVec2::new(uv.x * size.x, y)
+            }
+        })
+    }
+}
+
+/// Whether `uv` lies in the closed domain [0, 1]^2.
+fn in_domain(uv: DVec2) -> bool {
+    (0.0..=1.0).contains(&uv.x) && (0.0..=1.0).contains(&uv.y)
+}
+
+/// The radius in pixels of the circle inscribed in the shorter image side (as `Fisheye`).
+fn circle_radius(resolution: &Resolution) -> f64 {
+    0.5 * f64::from(resolution.width.min(resolution.height))
+}
+
+/// The Mercator ordinate of latitude `phi`.
+fn mercator(phi: f64) -> f64 {
+    (FRAC_PI_4 + 0.5 * phi).tan().ln()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn res() -> Resolution {
+        Resolution::new(200, 100).unwrap()
+    }
+
+    #[test]
+    fn linear_has_v_up_and_rejects_outside() {
+        let r = Reparam::Linear;
+        assert_eq!(r.to_uv(&res(), DVec2::new(0.0, 100.0)), Some(DVec2::ZERO));
+        assert_eq!(r.to_uv(&res(), DVec2::new(200.0, 0.0)), Some(DVec2::ONE));
+        assert_eq!(r.to_uv(&res(), DVec2::new(-0.1, 50.0)), None);
+        assert_eq!(r.to_uv(&res(), DVec2::new(50.0, 100.5)), None);
+    }
+
+    #[test]
+    fn polar_uses_centred_coordinates() {
+        let r = Reparam::Polar;
+        // Centre: radius 0. Right of centre on the circle: azimuth 0 -> u = 1/2.
+        assert_eq!(r.to_uv(&res(), DVec2::new(100.0, 50.0)).unwrap().y, 0.0);
+        let right = r.to_uv(&res(), DVec2::new(150.0, 50.0)).unwrap();
+        assert!((right - DVec2::new(0.5, 1.0)).length() < 1e-15);
+        // Above the centre: azimuth pi/2 -> u = 3/4, half way out -> v = 1/2.
+        let up = r.to_uv(&res(), DVec2::new(100.0, 25.0)).unwrap();
+        assert!((up - DVec2::new(0.75, 0.5)).length() < 1e-15);
+        // Outside the inscribed circle: nothing.
+        assert_eq!(r.to_uv(&res(), DVec2::new(10.0, 10.0)), None);
+    }
+
+    #[test]
+    fn lens_follows_the_thesis_weights() {
+        let p = Reparam::Lens
+            .to_uv(&res(), DVec2::new(125.0, 50.0))
+            .unwrap();
+        assert!((p.y - (0.25 * 0.5 + 0.75 * 0.25)).abs() < 1e-15);
+        assert_eq!(
+            Reparam::Lens
+                .to_uv(&res(), DVec2::new(150.0, 50.0))
+                .unwrap()
+                .y,
+            1.0
+        );
+    }
+
+    #[test]
+    fn mercator_centre_row_is_the_equator_and_edges_are_max_latitude() {
+        let r = Reparam::Mercator {
+            max_latitude: 80f64.to_radians(),
+        };
+        assert!(r.validate().is_ok());
+        let centre = r.to_uv(&res(), DVec2::new(100.0, 50.0)).unwrap();
+        assert!((centre - DVec2::new(0.5, 0.5)).length() < 1e-15);
+        let top = r.to_uv(&res(), DVec2::new(0.0, 0.0)).unwrap();
+        assert!((top - DVec2::new(0.0, 1.0)).length() < 1e-12);
+        // Mercator stretches high latitudes: a quarter of the way down is above 40 degrees.
+        let q = r.to_uv(&res(), DVec2::new(0.0, 25.0)).unwrap();
+        assert!(q.y > 0.75);
+        for bad in [0.0, 90f64.to_radians(), f64::NAN] {
+            assert!(Reparam::Mercator { max_latitude: bad }.validate().is_err());
+        }
+    }
+
+    #[test]
+    fn every_map_round_trips() {
+        let maps = [
+            Reparam::Linear,
+            Reparam::Polar,
+            Reparam::Lens,
+            Reparam::Mercator { max_latitude: 1.2 },
+        ];
+        for map in maps {
+            for pixel in [
+                DVec2::new(100.0, 50.0),
+                DVec2::new(73.25, 31.5),
+                DVec2::new(120.0, 80.0),
+            ] {
+                let uv = map.to_uv(&res(), pixel).unwrap();
+                let back = map.to_pixel(&res(), uv).unwrap();
+                assert!((back - pixel).length() < 1e-9, "{map:?}: {pixel} -> {back}");
+            }
+            assert_eq!(map.to_pixel(&res(), DVec2::new(1.5, 0.5)), None);
+        }
+    }
+}

@@ -1,0 +1,552 @@
+//! Presets against their closed forms (the notes' "Closed-form oracles"), against the
+//! single-viewpoint projections, and the inverse against the rays.
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use glam::{DVec2, DVec3};
+use proptest::prelude::*;
+
+use super::*;
+use crate::projection::camera_basis::CameraBasis;
+use crate::projection::{CameraFrame, ProjectionSpec};
+
+fn frame() -> CameraFrame {
+    CameraFrame {
+        position: DVec3::new(1.0, 2.0, 3.0),
+        look_at: DVec3::new(-2.0, 1.0, 0.0),
+        up: DVec3::Y,
+    }
+}
+
+fn preset(preset: Preset, clip: Option<[f64; 2]>) -> FlexibleSpec {
+    FlexibleSpec {
+        source: VolumeSource::Preset(PresetSpec {
+            preset,
+            frame: frame(),
+            clip,
+        }),
+        reparam: None,
+    }
+}
+
+fn build(spec: &FlexibleSpec, w: u32, h: u32) -> Flexible {
+    Flexible::new(spec, w, h).unwrap_or_else(|e| panic!("{spec:?}: {e}"))
+}
+
+/// For every pixel centre of a w x h image and t in {0, 0.4, 1}: the point on the ray, in
+/// camera-local coordinates, satisfies `oracle(local) == image(pixel)`; `t_of(local)` (when
+/// given) is the ray parameter.
+fn check_oracle(
+    spec: &FlexibleSpec,
+    (w, h): (u32, u32),
+    image: impl Fn(&Flexible, DVec2) -> DVec2,
+    oracle: impl Fn(DVec3) -> DVec2,
+    t_of: Option<&dyn Fn(DVec3) -> f64>,
+) {
+    let f = build(spec, w, h);
+    let basis = CameraBasis::new(&frame()).unwrap();
+    let mut rays = 0;
+    for y in 0..h {
+        for x in 0..w {
+            let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let Some(ray) = f.ray(pixel) else { continue };
+            rays += 1;
+            for t in [0.0, 0.4, 1.0] {
+                let local = basis.to_local(ray.at(t) - basis.origin);
+                let got = oracle(local);
+                let want = image(&f, pixel);
+                assert!(
+                    (got - want).length() < 1e-9,
+                    "{pixel} t {t}: {got} vs {want}"
+                );
+                if let Some(t_of) = t_of {
+                    assert!((t_of(local) - t).abs() < 1e-9);
+                }
+            }
+        }
+    }
+    assert!(rays > 0);
+}
+
+/// (U, V) = (2u - 1, 2v - 1) of a pixel.
+fn centred_uv(f: &Flexible, pixel: DVec2) -> DVec2 {
+    2.0 * f.uv(pixel).unwrap() - DVec2::ONE
+}
+
+#[test]
+fn perspective_is_u_x_over_z() {
+    // The thesis' squares: c_n = (0,0,1), l_n = 1; c_f = (0,0,2), l_f = 2.
+    let spec = preset(Preset::Perspective { fov: 90.0 }, Some([1.0, 2.0]));
+    let oracle = |p: DVec3| DVec2::new(p.x / p.z, p.y / p.z);
+    check_oracle(
+        &spec,
+        (8, 8),
+        centred_uv,
+        oracle,
+        Some(&|p: DVec3| p.z - 1.0),
+    );
+}
+
+#[test]
+fn inverse_perspective_is_u_x_over_e_minus_z() {
+    // l_n = 2 at z = 1, l_f = 1 at z = 2: the projectors meet at e = 3.
+    let mut spec = preset(Preset::InversePerspective { fov: 90.0 }, Some([1.0, 2.0]));
+    if let VolumeSource::Preset(p) = &mut spec.source {
+        let forward = (p.frame.look_at - p.frame.position).normalize();
+        p.frame.look_at = p.frame.position + 3.0 * forward;
+    }
+    let oracle = |p: DVec3| DVec2::new(p.x, p.y) / (3.0 - p.z);
+    check_oracle(
+        &spec,
+        (8, 8),
+        centred_uv,
+        oracle,
+        Some(&|p: DVec3| p.z - 1.0),
+    );
+}
+
+#[test]
+fn orthographic_and_oblique_are_affine() {
+    let spec = preset(Preset::Orthographic { width: 2.0 }, Some([1.0, 2.0]));
+    let oracle = |p: DVec3| DVec2::new(p.x, p.y);
+    check_oracle(
+        &spec,
+        (6, 6),
+        centred_uv,
+        oracle,
+        Some(&|p: DVec3| p.z - 1.0),
+    );
+    let shear = DVec2::new(0.5, -0.25);
+    let spec = preset(Preset::Oblique { width: 2.0, shear }, Some([1.0, 2.0]));
+    let oracle = |p: DVec3| DVec2::new(p.x + shear.x * p.z, p.y + shear.y * p.z);
+    check_oracle(&spec, (6, 6), centred_uv, oracle, None);
+}
+
+#[test]
+fn pushbroom_is_x_and_y_over_z() {
+    // Q_n = (u, v, 1), Q_f = (u, 2v, 2).
+    let spec = preset(
+        Preset::Pushbroom {
+            width: 2.0,
+            v_fov: 90.0,
+        },
+        Some([1.0, 2.0]),
+    );
+    let oracle = |p: DVec3| DVec2::new(p.x, p.y / p.z);
+    check_oracle(
+        &spec,
+        (6, 6),
+        centred_uv,
+        oracle,
+        Some(&|p: DVec3| p.z - 1.0),
+    );
+    // The notes' numbers (2,2,1) -> (2,2), (3,3,2) -> (3,1.5), (4,4,3) -> (4,4/3), through
+    // the inverse: half width 4 and tan(v_fov/2) = 4 put them inside the image.
+    let v_fov = 2.0 * 4f64.atan().to_degrees();
+    let spec = preset(Preset::Pushbroom { width: 8.0, v_fov }, Some([0.5, 4.0]));
+    let f = build(&spec, 10, 10);
+    let basis = CameraBasis::new(&frame()).unwrap();
+    for (local, want) in [
+        (DVec3::new(2.0, 2.0, 1.0), DVec2::new(2.0, 2.0)),
+        (DVec3::new(3.0, 3.0, 2.0), DVec2::new(3.0, 1.5)),
+        (DVec3::new(4.0, 4.0, 3.0), DVec2::new(4.0, 4.0 / 3.0)),
+    ] {
+        let mut out = Vec::new();
+        f.project(basis.origin + basis.to_world(local), &mut out);
+        assert_eq!(out.len(), 1);
+        let got = 4.0 * centred_uv(&f, out[0].pixel);
+        assert!((got - want).length() < 1e-9, "{local}: {got}");
+    }
+}
+
+#[test]
+fn crossed_slits_meet_both_slits() {
+    let preset_ = Preset::CrossedSlits {
+        fov: 90.0,
+        v_fov: Some(90.0),
+        slit_distance: -1.0,
+    };
+    let spec = preset(preset_, Some([1.0, 2.0]));
+    let oracle = |p: DVec3| DVec2::new(p.x / p.z, p.y / (p.z + 1.0));
+    check_oracle(
+        &spec,
+        (8, 6),
+        centred_uv,
+        oracle,
+        Some(&|p: DVec3| p.z - 1.0),
+    );
+}
+
+#[test]
+fn cylindrical_and_equirectangular_closed_forms() {
+    let spec = preset(
+        Preset::Cylindrical {
+            h_fov: 180.0,
+            v_fov: 90.0,
+        },
+        Some([1.0, 2.0]),
+    );
+    let oracle = |p: DVec3| DVec2::new(p.x.atan2(p.z) / FRAC_PI_2, p.y / p.x.hypot(p.z));
+    check_oracle(&spec, (8, 6), centred_uv, oracle, None);
+    let spec = preset(
+        Preset::Equirectangular {
+            h_fov: 360.0,
+            v_fov: 180.0,
+        },
+        Some([0.5, 2.0]),
+    );
+    let oracle = |p: DVec3| DVec2::new(p.x.atan2(p.z) / PI, p.y.atan2(p.x.hypot(p.z)) / FRAC_PI_2);
+    check_oracle(&spec, (8, 6), centred_uv, oracle, None);
+}
+
+#[test]
+fn angular_fisheye_radius_is_proportional_to_the_angle() {
+    let spec = preset(Preset::Fisheye { fov: 200.0 }, Some([0.5, 2.0]));
+    let half = 100f64.to_radians();
+    let image = |f: &Flexible, pixel: DVec2| {
+        let (w, h) = f.resolution();
+        f.resolution.centred(pixel) / (0.5 * f64::from(w.min(h)))
+    };
+    let oracle = |p: DVec3| {
+        let lateral = DVec2::new(p.x, p.y);
+        let angle = lateral.length().atan2(p.z);
+        lateral.normalize_or_zero() * angle / half
+    };
+    check_oracle(&spec, (9, 7), image, oracle, None);
+}
+
+/// Same rays (directions up to normalisation; origins too where the near surface is the
+/// eye or the view plane) as the single-viewpoint projection at every pixel centre.
+fn check_same_rays(flexible: Preset, existing: ProjectionSpec, same_origin: bool) {
+    let (w, h) = (9, 7);
+    let f = build(&preset(flexible, None), w, h);
+    let e = existing.build(w, h).unwrap();
+    for y in 0..h {
+        for x in 0..w {
+            let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            match (f.ray(pixel), e.ray(pixel)) {
+                (None, None) => {}
+                (Some(a), Some(b)) => {
+                    let (da, db) = (a.direction.normalize(), b.direction.normalize());
+                    assert!(
+                        (da - db).length() < 1e-12,
+                        "{flexible:?} {pixel}: {da} {db}"
+                    );
+                    if same_origin {
+                        assert!((a.origin - b.origin).length() < 1e-12);
+                    }
+                    assert_eq!((a.t_min, a.t_max), (0.0, 1.0));
+                }
+                (a, b) => panic!("{flexible:?} {pixel}: {a:?} vs {b:?}"),
+            }
+        }
+    }
+}
+
+#[test]
+fn presets_reproduce_the_single_viewpoint_projections() {
+    let frame = frame();
+    check_same_rays(
+        Preset::Perspective { fov: 70.0 },
+        ProjectionSpec::Perspective { frame, fov: 70.0 },
+        true,
+    );
+    check_same_rays(
+        Preset::Orthographic { width: 3.0 },
+        ProjectionSpec::Orthographic { frame, width: 3.0 },
+        true,
+    );
+    check_same_rays(
+        Preset::Fisheye { fov: 250.0 },
+        ProjectionSpec::Fisheye { frame, fov: 250.0 },
+        true,
+    );
+    check_same_rays(
+        Preset::Equirectangular {
+            h_fov: 360.0,
+            v_fov: 180.0,
+        },
+        ProjectionSpec::Equirectangular {
+            frame,
+            h_fov: 360.0,
+            v_fov: 180.0,
+        },
+        true,
+    );
+    check_same_rays(
+        Preset::Cylindrical {
+            h_fov: 300.0,
+            v_fov: 100.0,
+        },
+        ProjectionSpec::Cylindrical {
+            frame,
+            h_fov: 300.0,
+            v_fov: 100.0,
+        },
+        true,
+    );
+    // Crossed slits with the slits together is a perspective camera.
+    check_same_rays(
+        Preset::CrossedSlits {
+            fov: 70.0,
+            v_fov: None,
+            slit_distance: 0.0,
+        },
+        ProjectionSpec::Perspective { frame, fov: 70.0 },
+        true,
+    );
+}
+
+#[test]
+fn builds_through_projection_spec_and_checks_parameters() {
+    let spec = ProjectionSpec::Flexible(Box::new(preset(Preset::Perspective { fov: 60.0 }, None)));
+    let p = spec.build(20, 10).unwrap();
+    assert_eq!((p.kind(), spec.kind()), ("flexible", "flexible"));
+    assert!(p.has_inverse());
+    for (bad, needle) in [
+        (
+            Preset::Perspective { fov: 180.0 },
+            "flexible perspective fov",
+        ),
+        (
+            Preset::Orthographic { width: 0.0 },
+            "flexible orthographic width",
+        ),
+        (Preset::Fisheye { fov: 400.0 }, "flexible fisheye fov"),
+    ] {
+        let e = Flexible::new(&preset(bad, None), 8, 8).unwrap_err();
+        assert!(e.message.starts_with(needle), "{e}");
+    }
+    let e = Flexible::new(
+        &preset(Preset::Perspective { fov: 60.0 }, Some([2.0, 1.0])),
+        8,
+        8,
+    );
+    assert!(e.unwrap_err().message.contains("clip"));
+    let e = Flexible::new(
+        &preset(Preset::InversePerspective { fov: 60.0 }, Some([0.0, 100.0])),
+        8,
+        8,
+    );
+    assert!(e.unwrap_err().message.contains("beyond"));
+    assert!(Flexible::new(&preset(Preset::Perspective { fov: 60.0 }, None), 0, 8).is_err());
+}
+
+#[test]
+fn a_point_near_surface_is_a_pinhole() {
+    // Point near surface + far rectangle = the perspective preset with clip [0, 2].
+    let basis = CameraBasis::new(&frame()).unwrap();
+    let far = Surface::rectangle_centred(
+        basis.origin + 2.0 * basis.forward,
+        2.0 * basis.right,
+        2.0 * basis.up,
+    );
+    let custom = FlexibleSpec {
+        source: VolumeSource::Surfaces {
+            near: Surface::Point(basis.origin),
+            far,
+        },
+        reparam: None,
+    };
+    let a = build(&custom, 5, 5);
+    let b = build(
+        &preset(Preset::Perspective { fov: 90.0 }, Some([0.0, 2.0])),
+        5,
+        5,
+    );
+    let pixel = DVec2::new(1.5, 3.5);
+    let (ra, rb) = (a.ray(pixel).unwrap(), b.ray(pixel).unwrap());
+    assert!((ra.origin - rb.origin).length() < 1e-12);
+    assert!((ra.direction - rb.direction).length() < 1e-12);
+    assert!(a.has_inverse());
+    // The eye itself: every projector meets there, no single image.
+    let mut out = Vec::new();
+    a.project(basis.origin, &mut out);
+    assert!(out.is_empty());
+}
+
+#[test]
+fn outside_the_domain_there_is_no_ray() {
+    let f = build(&preset(Preset::Perspective { fov: 60.0 }, None), 10, 10);
+    assert!(f.ray(DVec2::new(-0.5, 5.0)).is_none());
+    assert!(f.ray(DVec2::new(5.0, 10.5)).is_none());
+    assert!(f.ray(DVec2::new(10.0, 0.0)).is_some());
+    let g = build(&preset(Preset::Fisheye { fov: 180.0 }, None), 20, 10);
+    assert!(g.ray(DVec2::new(1.0, 1.0)).is_none());
+}
+
+fn custom(near: Surface, far: Surface) -> Flexible {
+    build(
+        &FlexibleSpec {
+            source: VolumeSource::Surfaces { near, far },
+            reparam: None,
+        },
+        16,
+        12,
+    )
+}
+
+#[test]
+fn volumes_outside_the_analytic_class_have_no_inverse() {
+    let rect = |z: f64| Surface::rectangle_centred(DVec3::Z * z, DVec3::X, DVec3::Y);
+    let twisted = Surface::Bilinear {
+        corners: [
+            DVec3::new(-1.0, -1.0, 0.0),
+            DVec3::new(1.0, -1.0, 0.5),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(-1.0, 1.0, 0.0),
+        ],
+    };
+    let tilted = Surface::rectangle_centred(DVec3::Z * 2.0, DVec3::X, DVec3::new(0.0, 1.0, 0.3));
+    let sphere = Surface::Sphere(SpherePatch {
+        center: DVec3::ZERO,
+        radius: 3.0,
+        frame: PolarFrame::new(DVec3::Y, DVec3::Z).unwrap(),
+        longitude: [-1.0, 1.0],
+        latitude: [-0.5, 0.5],
+    });
+    for (near, far) in [
+        (twisted, rect(2.0)),
+        (rect(0.0), tilted),
+        (rect(0.0), sphere),
+    ] {
+        let f = custom(near, far);
+        assert!(!f.has_inverse(), "{near:?} {far:?}");
+        let mut out = Vec::new();
+        f.project(DVec3::new(0.1, 0.1, 1.0), &mut out);
+        assert!(out.is_empty());
+    }
+    // A flat (parallelogram) bilinear quad is affine: invertible.
+    let flat = Surface::Bilinear {
+        corners: [
+            DVec3::new(-1.0, -1.0, 0.0),
+            DVec3::new(1.0, -1.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(-1.0, 1.0, 0.0),
+        ],
+    };
+    assert!(custom(flat, rect(2.0)).has_inverse());
+}
+
+/// The invertible volumes of the proptest: every preset, and custom planes, spheres and
+/// cylinders whose surfaces differ in more than their size.
+fn invertible() -> Vec<Flexible> {
+    let mut all: Vec<Flexible> = [
+        Preset::Perspective { fov: 80.0 },
+        Preset::InversePerspective { fov: 50.0 },
+        Preset::Orthographic { width: 3.0 },
+        Preset::Oblique {
+            width: 3.0,
+            shear: DVec2::new(0.4, 0.2),
+        },
+        Preset::Pushbroom {
+            width: 3.0,
+            v_fov: 70.0,
+        },
+        Preset::CrossedSlits {
+            fov: 70.0,
+            v_fov: Some(50.0),
+            slit_distance: 1.5,
+        },
+        Preset::Cylindrical {
+            h_fov: 360.0,
+            v_fov: 120.0,
+        },
+        Preset::Equirectangular {
+            h_fov: 360.0,
+            v_fov: 180.0,
+        },
+        Preset::Fisheye { fov: 300.0 },
+    ]
+    .into_iter()
+    .map(|p| {
+        let far = match p {
+            Preset::InversePerspective { .. } => 4.0, // the projectors meet at 4.36
+            _ => 20.0,
+        };
+        build(&preset(p, Some([0.0, far])), 16, 12)
+    })
+    .collect();
+    let frame = PolarFrame::new(DVec3::new(0.2, 1.0, 0.1), DVec3::X).unwrap();
+    let sphere = |radius: f64| {
+        Surface::Sphere(SpherePatch {
+            center: DVec3::new(1.0, -2.0, 0.5),
+            radius,
+            frame,
+            longitude: [2.5, -1.0],
+            latitude: [1.2, -0.3],
+        })
+    };
+    let cylinder = |center: DVec3, radius: f64, height: [f64; 2]| {
+        Surface::Cylinder(CylinderPatch {
+            center,
+            radius,
+            frame,
+            angle: [-3.0, 2.0],
+            height,
+        })
+    };
+    let line = Surface::Line {
+        start: DVec3::new(-1.0, 0.0, 0.0),
+        end: DVec3::new(1.0, 0.0, 0.0),
+        along: LineParam::U,
+    };
+    let far = Surface::Rectangle {
+        corner: DVec3::new(-2.0, -3.0, 4.0),
+        u_edge: DVec3::new(5.0, 1.0, 0.0),
+        v_edge: DVec3::new(-1.0, 4.0, 0.0),
+    };
+    all.push(custom(sphere(5.0), sphere(1.0)));
+    all.push(custom(
+        cylinder(DVec3::ZERO, 0.5, [-1.0, 1.0]),
+        cylinder(frame.axis * 2.0, 4.0, [-5.0, 3.0]),
+    ));
+    all.push(custom(line, far));
+    all
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn project_then_ray_gives_the_point_back(
+        x in 0.0..16.0f64, y in 0.0..12.0f64, t in 0.01..1.0f64
+    ) {
+        for f in invertible() {
+            prop_assert!(f.has_inverse());
+            let Some(ray) = f.ray(DVec2::new(x, y)) else { continue };
+            let p = ray.at(t);
+            let mut out = Vec::new();
+            f.project(p, &mut out);
+            prop_assert_eq!(out.len(), 1, "{:?} {}", f.volume(), p);
+            let back = f.ray(out[0].pixel);
+            prop_assert!(back.is_some());
+            let q = back.unwrap().at(out[0].t);
+            let scale = 1.0 + p.length() + ray.direction.length();
+            prop_assert!((q - p).length() <= 1e-9 * scale, "{:?}: {} vs {}", f.volume(), p, q);
+        }
+    }
+}
+
+#[test]
+fn points_outside_the_volume_have_no_image() {
+    let f = build(
+        &preset(Preset::Perspective { fov: 60.0 }, Some([1.0, 2.0])),
+        8,
+        8,
+    );
+    let basis = CameraBasis::new(&frame()).unwrap();
+    let mut out = Vec::new();
+    for local in [
+        DVec3::new(0.0, 0.0, 0.5), // before the near clip
+        DVec3::new(0.0, 0.0, 3.0), // beyond the far clip
+        DVec3::new(5.0, 0.0, 1.5), // outside the frustum
+    ] {
+        f.project(basis.origin + basis.to_world(local), &mut out);
+    }
+    assert!(out.is_empty());
+    f.project(basis.origin + 1.5 * basis.forward, &mut out);
+    assert_eq!(out.len(), 1);
+    assert!((out[0].pixel - DVec2::new(4.0, 4.0)).length() < 1e-9);
+    assert!((out[0].t - 0.5).abs() < 1e-12);
+}

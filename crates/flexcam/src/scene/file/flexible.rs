@@ -1,0 +1,435 @@
+//! `[projection] type = "flexible"`: a named preset placed by a camera frame, or two explicit
+//! control surfaces `near` and `far`, with an optional re-parameterisation.
+
+use std::ops::Range;
+
+use glam::{DVec2, DVec3};
+use toml::Spanned;
+
+use super::projection::{camera_frame, Required};
+use super::raw::{RawProjection, RawSurface};
+use super::source::Source;
+use crate::error::Result;
+use crate::projection::flexible::presets::PRESET_NAMES;
+use crate::projection::flexible::reparam::{DEFAULT_MERCATOR_LATITUDE, REPARAM_NAMES};
+use crate::projection::flexible::{
+    CylinderPatch, FlexibleSpec, LineParam, PolarFrame, Preset, PresetSpec, Reparam, SpherePatch,
+    Surface, VolumeSource,
+};
+
+/// Every key of a flexible table (besides `type`).
+pub(super) const KEYS: [&str; 15] = [
+    "preset",
+    "position",
+    "look_at",
+    "up",
+    "fov",
+    "width",
+    "h_fov",
+    "v_fov",
+    "clip",
+    "shear",
+    "slit_distance",
+    "near",
+    "far",
+    "reparam",
+    "max_latitude",
+];
+
+/// Keys every preset accepts.
+const PRESET_COMMON: [&str; 6] = ["preset", "position", "look_at", "up", "clip", "reparam"];
+
+/// Keys of a flexible table given by surfaces.
+const SURFACE_KEYS: [&str; 4] = ["near", "far", "reparam", "max_latitude"];
+
+/// The surface type names of scene files.
+const SURFACE_NAMES: [&str; 7] = [
+    "rectangle",
+    "bilinear",
+    "sphere",
+    "hemisphere",
+    "cylinder",
+    "point",
+    "line",
+];
+
+/// The preset's own keys, besides [`PRESET_COMMON`] (and `max_latitude` with Mercator).
+fn preset_keys(name: &str) -> &'static [&'static str] {
+    match name {
+        "perspective" | "inverse_perspective" | "fisheye" => &["fov"],
+        "orthographic" => &["width"],
+        "oblique" => &["width", "shear"],
+        "pushbroom" => &["width", "v_fov"],
+        "crossed_slits" => &["fov", "v_fov", "slit_distance"],
+        _ => &["h_fov", "v_fov"],
+    }
+}
+
+/// Converts a flexible projection table.
+pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
+    let src = required.src;
+    let raw = required.raw();
+    let reparam = reparam(src, raw)?;
+    let present = raw.present_keys();
+    let source = match &raw.preset {
+        Some(name) => {
+            let own = preset_keys(name.get_ref());
+            if !PRESET_NAMES.contains(&name.get_ref().as_str()) {
+                return Err(src.error(
+                    &name.span(),
+                    format!(
+                        "unknown flexible preset \"{}\"; expected one of: {}",
+                        name.get_ref(),
+                        PRESET_NAMES.join(", ")
+                    ),
+                ));
+            }
+            let allowed = |key: &str| {
+                PRESET_COMMON.contains(&key)
+                    || own.contains(&key)
+                    || (key == "max_latitude" && matches!(reparam, Some(Reparam::Mercator { .. })))
+            };
+            reject_keys(src, &present, allowed, || {
+                format!(
+                    "preset \"{}\" (it takes: {}, {})",
+                    name.get_ref(),
+                    PRESET_COMMON.join(", "),
+                    own.join(", ")
+                )
+            })?;
+            VolumeSource::Preset(preset(required, name.get_ref())?)
+        }
+        None => {
+            reject_keys(
+                src,
+                &present,
+                |key| SURFACE_KEYS.contains(&key),
+                || {
+                    "projections without a `preset` (they take: near, far, reparam, \
+                     max_latitude)"
+                        .to_string()
+                },
+            )?;
+            let near = required.get(&raw.near, "near (or a preset)")?;
+            let far = required.get(&raw.far, "far")?;
+            VolumeSource::Surfaces {
+                near: surface(src, near, "near")?,
+                far: surface(src, far, "far")?,
+            }
+        }
+    };
+    if let (Some(at), Some(r)) = (&raw.max_latitude, reparam) {
+        if !matches!(r, Reparam::Mercator { .. }) {
+            return Err(src.error(
+                &at.span(),
+                "`max_latitude` belongs to reparam = \"mercator\"",
+            ));
+        }
+    }
+    Ok(FlexibleSpec { source, reparam })
+}
+
+/// Fails at the first present key that `allowed` refuses.
+fn reject_keys(
+    src: &Source,
+    present: &[(&'static str, Range<usize>)],
+    allowed: impl Fn(&str) -> bool,
+    what: impl Fn() -> String,
+) -> Result<()> {
+    match present.iter().find(|(key, _)| !allowed(key)) {
+        Some((key, span)) => Err(src.error(
+            span,
+            format!("`{key}` is not a parameter of flexible {}", what()),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// `reparam` (and `max_latitude`); `None` when absent.
+fn reparam(src: &Source, raw: &RawProjection) -> Result<Option<Reparam>> {
+    let Some(name) = &raw.reparam else {
+        return Ok(None);
+    };
+    Ok(Some(match name.get_ref().as_str() {
+        "linear" => Reparam::Linear,
+        "polar" => Reparam::Polar,
+        "lens" => Reparam::Lens,
+        "mercator" => {
+            let degrees = raw
+                .max_latitude
+                .as_ref()
+                .map_or(Ok(DEFAULT_MERCATOR_LATITUDE), |v| {
+                    src.number(v, "max_latitude")
+                })?;
+            if !(degrees > 0.0 && degrees < 90.0) {
+                let at = raw.max_latitude.as_ref().map_or(name.span(), Spanned::span);
+                return Err(src.error(
+                    &at,
+                    format!("`max_latitude` must be in (0, 90) degrees, got {degrees}"),
+                ));
+            }
+            Reparam::Mercator {
+                max_latitude: degrees.to_radians(),
+            }
+        }
+        other => {
+            return Err(src.error(
+                &name.span(),
+                format!(
+                    "unknown reparam \"{other}\"; expected one of: {}",
+                    REPARAM_NAMES.join(", ")
+                ),
+            ))
+        }
+    }))
+}
+
+/// A preset with its camera frame and parameters (already checked to belong to it).
+fn preset(required: &Required, name: &str) -> Result<PresetSpec> {
+    let src = required.src;
+    let raw = required.raw();
+    let number = |v: &Option<Spanned<f64>>, key: &str| -> Result<f64> {
+        src.number(required.get(v, key)?, key)
+    };
+    let optional = |v: &Option<Spanned<f64>>, key: &str, default: f64| -> Result<f64> {
+        v.as_ref().map_or(Ok(default), |v| src.number(v, key))
+    };
+    let preset = match name {
+        "perspective" => Preset::Perspective {
+            fov: number(&raw.fov, "fov")?,
+        },
+        "inverse_perspective" => Preset::InversePerspective {
+            fov: number(&raw.fov, "fov")?,
+        },
+        "orthographic" => Preset::Orthographic {
+            width: number(&raw.width, "width")?,
+        },
+        "oblique" => Preset::Oblique {
+            width: number(&raw.width, "width")?,
+            shear: DVec2::from_array(src.vector(required.get(&raw.shear, "shear")?, "shear")?),
+        },
+        "pushbroom" => Preset::Pushbroom {
+            width: number(&raw.width, "width")?,
+            v_fov: number(&raw.v_fov, "v_fov")?,
+        },
+        "crossed_slits" => Preset::CrossedSlits {
+            fov: number(&raw.fov, "fov")?,
+            v_fov: raw
+                .v_fov
+                .as_ref()
+                .map(|v| src.number(v, "v_fov"))
+                .transpose()?,
+            slit_distance: number(&raw.slit_distance, "slit_distance")?,
+        },
+        "cylindrical" => Preset::Cylindrical {
+            h_fov: optional(&raw.h_fov, "h_fov", 360.0)?,
+            v_fov: optional(&raw.v_fov, "v_fov", 90.0)?,
+        },
+        "equirectangular" => Preset::Equirectangular {
+            h_fov: optional(&raw.h_fov, "h_fov", 360.0)?,
+            v_fov: optional(&raw.v_fov, "v_fov", 180.0)?,
+        },
+        _ => Preset::Fisheye {
+            fov: number(&raw.fov, "fov")?,
+        },
+    };
+    let clip = match &raw.clip {
+        Some(c) => {
+            let [near, far] = src.vector(c, "clip")?;
+            if !(0.0 <= near && near < far) {
+                return Err(src.error(
+                    &c.span(),
+                    format!("`clip` must be [near, far] with 0 <= near < far, got [{near}, {far}]"),
+                ));
+            }
+            Some([near, far])
+        }
+        None => None,
+    };
+    Ok(PresetSpec {
+        preset,
+        frame: camera_frame(src, required)?,
+        clip,
+    })
+}
+
+/// The keys each surface type takes (besides `surface`).
+fn surface_keys(name: &str) -> &'static [&'static str] {
+    match name {
+        "rectangle" => &["center", "u_axis", "v_axis", "corner", "u_edge", "v_edge"],
+        "bilinear" => &["corners"],
+        "sphere" | "hemisphere" => &["center", "radius", "longitude", "latitude", "axis", "front"],
+        "cylinder" => &["center", "radius", "angle", "height", "axis", "front"],
+        "point" => &["point"],
+        _ => &["start", "end", "along"],
+    }
+}
+
+/// One control surface table (`which` is `near` or `far`, for messages).
+fn surface(src: &Source, table: &Spanned<RawSurface>, which: &str) -> Result<Surface> {
+    let raw = table.get_ref();
+    let name = raw.surface.get_ref().as_str();
+    if !SURFACE_NAMES.contains(&name) {
+        return Err(src.error(
+            &raw.surface.span(),
+            format!(
+                "unknown surface \"{name}\"; expected one of: {}",
+                SURFACE_NAMES.join(", ")
+            ),
+        ));
+    }
+    let keys = surface_keys(name);
+    if let Some((key, span)) = raw
+        .present_keys()
+        .into_iter()
+        .find(|(key, _)| !keys.contains(key))
+    {
+        return Err(src.error(
+            &span,
+            format!(
+                "`{key}` is not a parameter of {name} surfaces (they take: {})",
+                keys.join(", ")
+            ),
+        ));
+    }
+    let need = |v: &Option<Spanned<[f64; 3]>>, key: &str| -> Result<DVec3> {
+        let v = v.as_ref().ok_or_else(|| {
+            src.error(
+                &table.span(),
+                format!("{which} {name} surface needs `{key}`"),
+            )
+        })?;
+        src.dvec3(v, key)
+    };
+    let or = |v: &Option<Spanned<[f64; 3]>>, key: &str, default: DVec3| -> Result<DVec3> {
+        v.as_ref().map_or(Ok(default), |v| src.dvec3(v, key))
+    };
+    let range =
+        |v: &Option<Spanned<[f64; 2]>>, key: &str, default: Option<[f64; 2]>| match (v, default) {
+            (Some(v), _) => src.vector(v, key).map(|r| r.map(f64::to_radians)),
+            (None, Some(d)) => Ok(d.map(f64::to_radians)),
+            (None, None) => Err(src.error(
+                &table.span(),
+                format!("{which} {name} surface needs `{key}`"),
+            )),
+        };
+    let radius = || -> Result<f64> {
+        let r = raw.radius.as_ref().ok_or_else(|| {
+            src.error(
+                &table.span(),
+                format!("{which} {name} surface needs `radius`"),
+            )
+        })?;
+        let x = src.number(r, "radius")?;
+        if x < 0.0 {
+            return Err(src.error(&r.span(), format!("`radius` must not be negative, got {x}")));
+        }
+        Ok(x)
+    };
+    let frame = || -> Result<PolarFrame> {
+        let axis = or(&raw.axis, "axis", DVec3::Y)?;
+        let front = or(&raw.front, "front", DVec3::NEG_Z)?;
+        PolarFrame::new(axis, front).map_err(|e| {
+            let at = raw
+                .front
+                .as_ref()
+                .or(raw.axis.as_ref())
+                .map_or(table.span(), Spanned::span);
+            src.error(&at, e.message)
+        })
+    };
+    let surface = match name {
+        "rectangle" => {
+            if raw.corner.is_some() {
+                if let Some(c) = raw.center.as_ref() {
+                    return Err(src.error(
+                        &c.span(),
+                        "give a rectangle by `center`, `u_axis`, `v_axis` or by `corner`, \
+                         `u_edge`, `v_edge`, not both",
+                    ));
+                }
+                Surface::Rectangle {
+                    corner: need(&raw.corner, "corner")?,
+                    u_edge: need(&raw.u_edge, "u_edge")?,
+                    v_edge: need(&raw.v_edge, "v_edge")?,
+                }
+            } else {
+                Surface::rectangle_centred(
+                    need(&raw.center, "center")?,
+                    need(&raw.u_axis, "u_axis")?,
+                    need(&raw.v_axis, "v_axis")?,
+                )
+            }
+        }
+        "bilinear" => {
+            let c = raw.corners.as_ref().ok_or_else(|| {
+                src.error(
+                    &table.span(),
+                    format!("{which} bilinear surface needs `corners`"),
+                )
+            })?;
+            src.all_finite(c.get_ref().as_flattened(), c, "corners")?;
+            Surface::Bilinear {
+                corners: c.get_ref().map(DVec3::from_array),
+            }
+        }
+        "sphere" | "hemisphere" => {
+            let latitude = if name == "sphere" {
+                [-90.0, 90.0]
+            } else {
+                [90.0, 0.0]
+            };
+            Surface::Sphere(SpherePatch {
+                center: need(&raw.center, "center")?,
+                radius: radius()?,
+                frame: frame()?,
+                longitude: range(&raw.longitude, "longitude", Some([-180.0, 180.0]))?,
+                latitude: range(&raw.latitude, "latitude", Some(latitude))?,
+            })
+        }
+        "cylinder" => Surface::Cylinder(CylinderPatch {
+            center: need(&raw.center, "center")?,
+            radius: radius()?,
+            frame: frame()?,
+            angle: range(&raw.angle, "angle", Some([-180.0, 180.0]))?,
+            height: match &raw.height {
+                Some(h) => src.vector(h, "height")?,
+                None => range(&None, "height", None)?,
+            },
+        }),
+        "point" => Surface::Point(need(&raw.point, "point")?),
+        _ => {
+            let along = match raw.along.as_ref() {
+                None => LineParam::U,
+                Some(a) => match a.get_ref().as_str() {
+                    "u" => LineParam::U,
+                    "v" => LineParam::V,
+                    other => {
+                        return Err(src.error(
+                            &a.span(),
+                            format!("`along` must be \"u\" or \"v\", not \"{other}\""),
+                        ))
+                    }
+                },
+            };
+            Surface::Line {
+                start: need(&raw.start, "start")?,
+                end: need(&raw.end, "end")?,
+                along,
+            }
+        }
+    };
+    surface.validate().map_err(|e| {
+        let at = [
+            ("latitude", &raw.latitude),
+            ("longitude", &raw.longitude),
+            ("angle", &raw.angle),
+        ]
+        .into_iter()
+        .find(|(key, value)| value.is_some() && e.message.contains(key))
+        .and_then(|(_, value)| value.as_ref())
+        .map_or(table.span(), Spanned::span);
+        src.error(&at, format!("{which} {}", e.message))
+    })?;
+    Ok(surface)
+}
