@@ -10,7 +10,6 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use flexcam::geometry::Ray;
-use flexcam::projection::ProjectionSpec;
 use flexcam::render::raycast::RayCaster;
 use flexcam::scene::{builtin, Scene};
 use glam::DVec2;

@@ -37,6 +37,15 @@ pub struct Hit {
     pub barycentric: Vec2,
 }
 
+/// A hit as the f32 search reports it (see [`RayCaster::intersect_f32`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Hit32 {
+    t: f32,
+    object: usize,
+    triangle: usize,
+    barycentric: Vec2,
+}
+
 /// A scene prepared for ray casting.
 #[derive(Debug, Clone)]
 pub struct RayCaster {
@@ -102,24 +111,44 @@ impl RayCaster {
     /// then refined in f64 against the triangle's vertices, so `t` and the barycentrics are
     /// accurate to f64 precision for the triangle the f32 search chose.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        self.intersect_f32(ray).map(|found| self.refine(ray, found))
+    }
+
+    /// The closest hit as the f32 search finds it, without the f64 refinement: `t` and the
+    /// barycentrics carry f32 rounding (relative error about 1e-7 times the ratio of the
+    /// origin's magnitude to the hit distance). Enough for a flat colour and a depth stored
+    /// as f32; everything that spawns rays from the hit refines it first.
+    fn intersect_f32(&self, ray: &Ray) -> Option<Hit32> {
         let found = self.bvh.closest(&FastRay::new(ray)?)?;
-        let object = self.first_triangle.partition_point(|&f| f <= found.id) - 1;
-        let triangle = (found.id - self.first_triangle[object]) as usize;
-        let mesh = &self.objects[object].mesh;
-        let [a, b, c] = mesh.triangles[triangle];
+        let object = match self.first_triangle.len() {
+            1 => 0,
+            _ => self.first_triangle.partition_point(|&f| f <= found.id) - 1,
+        };
+        Some(Hit32 {
+            t: found.hit.t,
+            object,
+            triangle: (found.id - self.first_triangle[object]) as usize,
+            barycentric: Vec2::new(found.hit.u, found.hit.v),
+        })
+    }
+
+    /// `found` (a hit of `ray`) with `t` and the barycentrics recomputed in f64.
+    fn refine(&self, ray: &Ray, found: Hit32) -> Hit {
+        let mesh = &self.objects[found.object].mesh;
+        let [a, b, c] = mesh.triangles[found.triangle];
         let vertex = |i: u32| mesh.positions[i as usize].as_dvec3();
         let vertices = [vertex(a), vertex(b), vertex(c)];
         let (t, barycentric) = match intersect_triangle(ray.origin, ray.direction, vertices) {
             Some(exact) => (exact.t, exact.barycentric.as_vec2()),
             // Grazing an edge: f32 saw a hit where f64 does not; keep the f32 values.
-            None => (found.hit.t as f64, Vec2::new(found.hit.u, found.hit.v)),
+            None => (found.t as f64, found.barycentric),
         };
-        Some(Hit {
+        Hit {
             t: t.clamp(ray.t_min, ray.t_max),
-            object,
-            triangle,
+            object: found.object,
+            triangle: found.triangle,
             barycentric,
-        })
+        }
     }
 
     /// Whether anything is hit within the ray's interval (the shadow-ray query).

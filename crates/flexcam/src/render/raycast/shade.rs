@@ -36,6 +36,12 @@ const SHININESS: i32 = 32;
 /// Lit branches weighing less than this in the final pixel are not traced.
 const MIN_WEIGHT: f32 = 1.0 / 1024.0;
 
+/// Whether flat shading shows the base colour of `surface` (else it is specular and passes
+/// the ray on).
+fn shows_base_color(surface: Surface) -> bool {
+    matches!(surface, Surface::Diffuse | Surface::Emissive)
+}
+
 /// What one sample of a pixel reports.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Sample {
@@ -98,17 +104,35 @@ impl<'a> Tracer<'a> {
             return background;
         };
         self.counts.primary += 1;
-        let Some(hit) = self.caster.intersect(ray) else {
+        let Some(found) = self.caster.intersect_f32(ray) else {
             return background;
         };
-        let color = match self.shading {
-            Shading::Flat => self.flat(ray, hit),
-            Shading::Lit => self.lit(ray, hit, 0, 1.0),
+        let object = &self.caster.objects[found.object];
+        let (color, t) = match self.shading {
+            // The common flat case, a diffuse or emissive first hit, needs neither an exact
+            // hit point nor normals: the f32 hit gives the colour and the depth.
+            Shading::Flat if shows_base_color(object.material.surface) => (
+                base_color(
+                    object,
+                    found.triangle,
+                    found.barycentric,
+                    TextureFilter::Nearest,
+                ),
+                found.t as f64,
+            ),
+            Shading::Flat => {
+                let hit = self.caster.refine(ray, found);
+                (self.flat(ray, hit), hit.t)
+            }
+            Shading::Lit => {
+                let hit = self.caster.refine(ray, found);
+                (self.lit(ray, hit, 0, 1.0), hit.t)
+            }
         };
         Sample {
             color,
-            depth: (hit.t * ray.direction.length()) as f32,
-            id: self.caster.objects[hit.object].id,
+            depth: (t * ray.direction.length()) as f32,
+            id: object.id,
         }
     }
 
@@ -117,10 +141,7 @@ impl<'a> Tracer<'a> {
         let (mut ray, mut hit) = (*ray, hit);
         for bounce in 0.. {
             let object = &self.caster.objects[hit.object];
-            if matches!(
-                object.material.surface,
-                Surface::Diffuse | Surface::Emissive
-            ) {
+            if shows_base_color(object.material.surface) {
                 return base_color(
                     object,
                     hit.triangle,

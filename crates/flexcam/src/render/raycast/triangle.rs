@@ -79,10 +79,11 @@ impl PackedTriangle {
         (e1.cross(e2) != Vec3A::ZERO).then_some(PackedTriangle { v0: a, e1, e2 })
     }
 
-    /// Moller-Trumbore from either side, accepting `t` in `[ray.t_min, t_max]`. A direction
-    /// parallel to the plane gives a zero or tiny determinant: zero is rejected outright, and
-    /// a tiny one gives non-finite or out-of-range barycentrics, which the range tests (false
-    /// for NaN) reject.
+    /// Moller-Trumbore from either side, accepting `t` in `[ray.t_min, t_max]`. The
+    /// barycentric tests are made on the undivided numerators against the determinant (signs
+    /// folded so that it is positive), so the division is only paid where the line meets the
+    /// triangle. A direction parallel to the plane gives a zero determinant, rejected
+    /// outright; NaN anywhere fails the range tests (false for NaN).
     #[inline(always)]
     pub fn intersect(&self, ray: &FastRay, t_max: f32) -> Option<FastHit> {
         let p = ray.direction.cross(self.e2);
@@ -90,18 +91,25 @@ impl PackedTriangle {
         if det == 0.0 {
             return None;
         }
-        let inv_det = 1.0 / det;
+        let sign = 1.0f32.copysign(det);
+        let abs_det = det.abs();
         let s = ray.origin - self.v0;
-        let u = s.dot(p) * inv_det;
-        if !(0.0..=1.0).contains(&u) {
+        let u = s.dot(p) * sign;
+        if !(0.0..=abs_det).contains(&u) {
             return None;
         }
         let q = s.cross(self.e1);
-        let v = ray.direction.dot(q) * inv_det;
-        if !(0.0..=1.0 - u).contains(&v) {
+        let v = ray.direction.dot(q) * sign;
+        if !(v >= 0.0 && u + v <= abs_det) {
             return None;
         }
-        let t = self.e2.dot(q) * inv_det;
-        (t >= ray.t_min && t <= t_max).then_some(FastHit { t, u, v })
+        let inv_det = 1.0 / abs_det;
+        let t = self.e2.dot(q) * sign * inv_det;
+        // An infinite reciprocal (subnormal determinant) would give infinite or NaN values.
+        (t >= ray.t_min && t <= t_max && inv_det < f32::INFINITY).then_some(FastHit {
+            t,
+            u: u * inv_det,
+            v: v * inv_det,
+        })
     }
 }
