@@ -26,7 +26,10 @@ pub use flexible::{Flexible, FlexibleSpec};
 pub use image_coords::Resolution;
 pub use linear::{Orthographic, Perspective};
 pub use panoramic::{Cylindrical, Equirectangular};
-pub use trilinear::{ProjectionTriangleCache, Solutions, TriangleSolution, Trilinear};
+pub use trilinear::{
+    project_triangle, ProjectionTriangleCache, SceneEdge, Shape, ShapeVertex, Solutions,
+    TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
+};
 
 use glam::{DVec2, DVec3};
 

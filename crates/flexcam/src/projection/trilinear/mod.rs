@@ -11,6 +11,7 @@
 mod obj;
 mod point_projection;
 mod screen_locator;
+mod shapes;
 
 use glam::{DVec2, DVec3};
 
@@ -20,6 +21,7 @@ use crate::error::{Error, Result};
 use crate::geometry::Ray;
 pub use point_projection::{ProjectionTriangleCache, Solutions, TriangleSolution};
 use screen_locator::ScreenLocator;
+pub use shapes::{project_triangle, SceneEdge, Shape, ShapeVertex, TriangleShapes, Unprojectable};
 
 /// A screen triangle counts as degenerate when twice its area is below this fraction of the
 /// product of its two edge lengths from the first vertex (the sine of its angle there).
