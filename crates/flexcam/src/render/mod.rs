@@ -76,6 +76,7 @@ pub enum Counter {
 /// Named counters a renderer reports (rays cast, build times, ...), for `--stats`.
 pub type Stats = BTreeMap<&'static str, Counter>;
 mod method;
+pub mod raster;
 pub mod raycast;
 pub mod surface;
 pub use method::Method;

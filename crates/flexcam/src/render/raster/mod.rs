@@ -1,0 +1,154 @@
+//! The software polygon rasteriser shared by the fast renderers: shapes in continuous pixel
+//! coordinates (polygons of any shape, or two-vertex lines) with a depth and `N` attributes
+//! per vertex, scan-converted at pixel centres by an explicit [`FillRule`] with a top-left tie
+//! rule, z-tested and shaded into a [`Target`].
+//!
+//! - [`polygon`]: the input ([`Vertex`], [`Polygon`], [`PolygonBatch`]);
+//! - [`scan`]: polygon coverage, the fill and tie rules, and attribute interpolation;
+//! - [`line`](mod@line): one-pixel-wide lines for two-vertex shapes;
+//! - [`target`]: the z-buffered target and [`Fragment`]s;
+//! - [`stats`]: counters for `--stats`.
+//!
+//! Determinism: a pixel keeps the fragment with the smallest `(depth, primitive)` pair, and
+//! every fragment's position and values depend only on its own shape, so the image does not
+//! depend on the band size or the number of threads, and with distinct primitive keys not on
+//! the order of the shapes either. Shaders must be pure functions of the fragment.
+
+pub mod interpolate;
+pub mod line;
+pub mod polygon;
+pub mod scan;
+pub mod stats;
+pub mod target;
+#[cfg(test)]
+mod tests;
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+pub use interpolate::Varying;
+pub use polygon::{Polygon, PolygonBatch, Vertex, LIMIT};
+pub use scan::FillRule;
+pub use stats::RasterStats;
+pub use target::{Fragment, Target};
+
+use polygon::Kind;
+use scan::Scratch;
+use target::Band;
+
+/// Rows per band in [`rasterize_parallel`]: enough for little per-band overhead on small
+/// shapes, few enough for many tasks on typical images.
+pub const BAND_ROWS: u32 = 16;
+
+/// Draws `polygons` into `target` in order on the calling thread, shading each fragment that
+/// passes the z-test with `shader`. Returns what was done (`covered` counts the whole
+/// target after the pass).
+pub fn rasterize<const N: usize>(
+    target: &mut Target,
+    polygons: &PolygonBatch<N>,
+    rule: FillRule,
+    shader: &impl Fn(&Fragment<N>) -> Vec3,
+) -> RasterStats {
+    let mut stats = count_shapes(polygons);
+    let mut scratch = Scratch::default();
+    let mut band = target.band();
+    for polygon in polygons.iter() {
+        let (fragments, writes) = draw(&mut band, &polygon, rule, &mut scratch, shader);
+        stats.fragments += fragments;
+        stats.writes += writes;
+    }
+    stats.covered = target.covered();
+    stats
+}
+
+/// Like [`rasterize`], with the target cut into bands of `band_rows` rows drawn in parallel
+/// (rayon), each band by one task drawing the shapes that reach it in input order. The result
+/// is bit for bit that of [`rasterize`], whatever the thread count or band size.
+pub fn rasterize_parallel<const N: usize>(
+    target: &mut Target,
+    polygons: &PolygonBatch<N>,
+    rule: FillRule,
+    band_rows: u32,
+    shader: &(impl Fn(&Fragment<N>) -> Vec3 + Sync),
+) -> RasterStats {
+    let band_rows = band_rows.max(1);
+    let height = target.height();
+    // Bin: the shapes reaching each band, in input order.
+    let ranges: Vec<(u32, u32)> = (0..polygons.len())
+        .into_par_iter()
+        .map(|i| polygons.get(i).rows(height))
+        .collect();
+    let mut bins = vec![Vec::new(); height.div_ceil(band_rows) as usize];
+    for (i, &(first, end)) in ranges.iter().enumerate() {
+        if first < end {
+            for bin in &mut bins[(first / band_rows) as usize..=((end - 1) / band_rows) as usize] {
+                bin.push(i);
+            }
+        }
+    }
+    let (fragments, writes) = target
+        .bands(band_rows)
+        .into_par_iter()
+        .zip(bins)
+        .map(|(mut band, bin)| {
+            let mut scratch = Scratch::default();
+            bin.iter().fold((0, 0), |(f, w), &i| {
+                let (df, dw) = draw(&mut band, &polygons.get(i), rule, &mut scratch, shader);
+                (f + df, w + dw)
+            })
+        })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+    let mut stats = count_shapes(polygons);
+    stats.fragments = fragments;
+    stats.writes = writes;
+    stats.covered = target.covered();
+    stats
+}
+
+/// The shape counts of a batch (polygons, lines, skipped).
+fn count_shapes<const N: usize>(polygons: &PolygonBatch<N>) -> RasterStats {
+    let mut stats = RasterStats::default();
+    for polygon in polygons.iter() {
+        match polygon.kind() {
+            Kind::Fill => stats.polygons += 1,
+            Kind::Line => stats.lines += 1,
+            Kind::Skip => stats.skipped += 1,
+        }
+    }
+    stats
+}
+
+/// Draws one shape into the rows of `band`; returns (fragments, writes).
+fn draw<const N: usize>(
+    band: &mut Band<'_>,
+    polygon: &Polygon<'_, N>,
+    rule: FillRule,
+    scratch: &mut Scratch<N>,
+    shader: &impl Fn(&Fragment<N>) -> Vec3,
+) -> (u64, u64) {
+    let (mut fragments, mut writes) = (0, 0);
+    let (rows, width) = (band.rows, band.width);
+    let mut emit = |x, y, varying| {
+        let fragment = Fragment {
+            x,
+            y,
+            varying,
+            object: polygon.object,
+            primitive: polygon.primitive,
+        };
+        fragments += 1;
+        writes += u64::from(band.test_and_write(&fragment, shader));
+    };
+    match polygon.kind() {
+        Kind::Fill => scan::fill(polygon, rule, rows, width, scratch, &mut emit),
+        Kind::Line => line::line(
+            &polygon.vertices[0],
+            &polygon.vertices[1],
+            rows,
+            width,
+            &mut emit,
+        ),
+        Kind::Skip => {}
+    }
+    (fragments, writes)
+}
