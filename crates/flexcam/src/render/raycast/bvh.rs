@@ -100,6 +100,84 @@ impl Slabs {
     }
 }
 
+/// Whether the four rays' directions have the same sign on every axis (as their reciprocals,
+/// which are never zero, tell).
+fn same_signs(rays: [&FastRay; 4]) -> bool {
+    let mask = |r: &FastRay| r.inv_direction.cmplt(Vec3A::ZERO).bitmask();
+    let m = mask(rays[0]);
+    rays[1..].iter().all(|r| mask(r) == m)
+}
+
+/// Four rays of one direction-sign class in SoA form for [`Packet::entries`]: lane `r` is
+/// ray `r`.
+struct Packet {
+    origin: [Vec4; 3],
+    inv_direction: [Vec4; 3],
+    /// Per axis, whether the directions are negative (then a box is entered through its max
+    /// plane).
+    negative: [bool; 3],
+    t_min: Vec4,
+    t_max: Vec4,
+}
+
+impl Packet {
+    #[inline(always)]
+    fn new(rays: [&FastRay; 4]) -> Packet {
+        let [a, b, c, d] = rays;
+        let axis = |o: Vec3A, p: Vec3A, q: Vec3A, r: Vec3A| {
+            [
+                Vec4::new(o.x, p.x, q.x, r.x),
+                Vec4::new(o.y, p.y, q.y, r.y),
+                Vec4::new(o.z, p.z, q.z, r.z),
+            ]
+        };
+        Packet {
+            origin: axis(a.origin, b.origin, c.origin, d.origin),
+            inv_direction: axis(
+                a.inv_direction,
+                b.inv_direction,
+                c.inv_direction,
+                d.inv_direction,
+            ),
+            negative: [
+                a.inv_direction.x < 0.0,
+                a.inv_direction.y < 0.0,
+                a.inv_direction.z < 0.0,
+            ],
+            t_min: Vec4::new(a.t_min, b.t_min, c.t_min, d.t_min),
+            t_max: Vec4::new(a.t_max, b.t_max, c.t_max, d.t_max),
+        }
+    }
+
+    /// Entry parameters of the four rays into the two children's boxes of `node` (infinity
+    /// where a ray misses a box within `[t_min, t_max]`), bit for bit those of [`box_entry`]
+    /// (and so of [`Node::entries`]) for each ray: `(plane - origin) * inv_direction` with
+    /// the near plane the min plane for a positive direction, the max plane for a negative.
+    #[inline(always)]
+    fn entries(&self, node: &Node, t_max: Vec4) -> (Vec4, Vec4) {
+        let child = |c: usize| {
+            let mut near = self.t_min;
+            let mut far = t_max;
+            for axis in 0..3 {
+                let planes = node.planes[axis];
+                let (lo, hi) = (planes[c], -planes[c + 2]);
+                let (n, f) = if self.negative[axis] {
+                    (hi, lo)
+                } else {
+                    (lo, hi)
+                };
+                let o = self.origin[axis];
+                let inv = self.inv_direction[axis];
+                near = near.max((Vec4::splat(n) - o) * inv);
+                far = far.min((Vec4::splat(f) - o) * inv);
+            }
+            let inside = near.cmple(far + far.abs() * ROBUST_SLACK);
+            Vec4::select(inside, near, Vec4::INFINITY)
+        };
+        (child(0), child(1))
+    }
+}
+
 /// Entry parameter of `ray` into the box `[min, max]` if it meets it within
 /// `[ray.t_min, t_max]`, else infinity. The exit parameter is enlarged by a few ulps (Ize,
 /// "Robust BVH ray traversal", 2013) so that rounding never culls a box the ray touches.
@@ -240,6 +318,10 @@ impl Bvh {
         let slabs = Slabs::new(ray);
         let mut t_max = ray.t_max;
         let mut best: Option<(usize, FastHit)> = None;
+        // Stored index of `best` (past the end while there is none): on equal `t` the lower
+        // index wins, so the result does not depend on the order leaves are visited in, and
+        // packet traversal ([`Bvh::closest4`]) finds exactly the same hits.
+        let mut best_index = usize::MAX;
         // Left uninitialised: filling 65 entries per ray would cost as much as a few node
         // tests. Entries below `depth` are always initialised (each push writes one).
         let mut stack = [const { MaybeUninit::<(Child, f32)>::uninit() }; STACK_SIZE];
@@ -251,8 +333,11 @@ impl Bvh {
                 let count = current.count as usize;
                 for (i, tri) in self.triangles[first..first + count].iter().enumerate() {
                     if let Some(hit) = tri.intersect(ray, t_max) {
-                        t_max = hit.t;
-                        best = Some((first + i, hit));
+                        if hit.t < t_max || first + i < best_index {
+                            t_max = hit.t;
+                            best = Some((first + i, hit));
+                            best_index = first + i;
+                        }
                         if ANY {
                             return self.finish(best);
                         }
@@ -287,6 +372,116 @@ impl Bvh {
                 let (child, t_entry) = unsafe { stack[depth].assume_init() };
                 if t_entry <= t_max {
                     current = child;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// The closest hits of four rays, exactly as [`Bvh::closest`] finds them one by one, by
+    /// one traversal shared by the four: a node is entered when any of the rays meets its box,
+    /// and every ray keeps its own closest hit. Pays for coherent rays (neighbouring pixels'
+    /// primary rays); the rays' direction signs must agree on every axis, else (or when a
+    /// ray is `None`) each ray is traced alone.
+    pub fn closest4(&self, rays: [Option<&FastRay>; 4]) -> [Option<BvhHit>; 4] {
+        match rays {
+            [Some(a), Some(b), Some(c), Some(d)] if same_signs([a, b, c, d]) => {
+                self.traverse4([a, b, c, d])
+            }
+            [a, b, c, d] => {
+                let single = |r: Option<&FastRay>| r.and_then(|r| self.closest(r));
+                [single(a), single(b), single(c), single(d)]
+            }
+        }
+    }
+
+    /// The packet traversal of [`Bvh::closest4`]. The result per ray is the minimum of
+    /// `(t, stored index)` over the triangles it hits, as for [`Bvh::traverse`]: a ray's
+    /// winning leaf is always visited (its boxes pass the same slab test, at a `t_max` no
+    /// smaller than the winning `t`), and which other leaves are visited, or in what order,
+    /// does not change that minimum.
+    #[inline(always)]
+    fn traverse4(&self, rays: [&FastRay; 4]) -> [Option<BvhHit>; 4] {
+        if self.triangles.is_empty() {
+            return [None; 4];
+        }
+        let root_entry = Vec4::from_array(rays.map(|r| box_entry(&self.root_bounds, r, r.t_max)));
+        if root_entry.cmpne(Vec4::INFINITY).bitmask() == 0 {
+            return [None; 4];
+        }
+        let packet = Packet::new(rays);
+        let mut t_max = packet.t_max;
+        let mut best: [Option<(usize, FastHit)>; 4] = [None; 4];
+        let mut best_index = [usize::MAX; 4];
+        // As in `traverse`: entries below `depth` are initialised.
+        let mut stack = [const { MaybeUninit::<(Child, Vec4)>::uninit() }; STACK_SIZE];
+        let mut depth = 0;
+        let (mut current, mut entry) = (self.root, root_entry);
+        loop {
+            if current.count > 0 {
+                let first = current.index as usize;
+                let count = current.count as usize;
+                // Only the rays that reach this leaf in front of their closest hit.
+                let mut active = entry.cmple(t_max).bitmask();
+                let mut t_max_lanes = t_max.to_array();
+                while active != 0 {
+                    let r = active.trailing_zeros() as usize;
+                    active &= active - 1;
+                    let ray = rays[r];
+                    for (i, tri) in self.triangles[first..first + count].iter().enumerate() {
+                        if let Some(hit) = tri.intersect(ray, t_max_lanes[r]) {
+                            if hit.t < t_max_lanes[r] || first + i < best_index[r] {
+                                t_max_lanes[r] = hit.t;
+                                best[r] = Some((first + i, hit));
+                                best_index[r] = first + i;
+                            }
+                        }
+                    }
+                }
+                t_max = Vec4::from_array(t_max_lanes);
+            } else {
+                let node = &self.nodes[current.index as usize];
+                let (t0, t1) = packet.entries(node, t_max);
+                let (hit0, hit1) = (
+                    t0.cmpne(Vec4::INFINITY).bitmask() != 0,
+                    t1.cmpne(Vec4::INFINITY).bitmask() != 0,
+                );
+                let [c0, c1] = node.children;
+                if hit0 || hit1 {
+                    let (near, far, e_near, e_far, both) = if !hit0 {
+                        (c1, c0, t1, t0, false)
+                    } else if !hit1 {
+                        (c0, c1, t0, t1, false)
+                    } else if t1.min_element() < t0.min_element() {
+                        (c1, c0, t1, t0, true)
+                    } else {
+                        (c0, c1, t0, t1, true)
+                    };
+                    if both {
+                        stack[depth].write((far, e_far));
+                        depth += 1;
+                    }
+                    (current, entry) = (near, e_near);
+                    continue;
+                }
+            }
+            // Pop the next pending node some ray still enters in front of its closest hit.
+            loop {
+                if depth == 0 {
+                    let [a, b, c, d] = best;
+                    return [
+                        self.finish(a),
+                        self.finish(b),
+                        self.finish(c),
+                        self.finish(d),
+                    ];
+                }
+                depth -= 1;
+                // SAFETY: `stack[depth]` was written by the push that made `depth` this large
+                // (pushes write `stack[depth]` and then increment it; pops decrement it).
+                let (child, e) = unsafe { stack[depth].assume_init() };
+                if e.cmple(t_max).bitmask() != 0 {
+                    (current, entry) = (child, e);
                     break;
                 }
             }
@@ -655,6 +850,112 @@ mod tests {
             .iter()
             .flat_map(|n| n.children)
             .all(|c| c.count as usize <= MAX_LEAF));
+    }
+
+    /// `closest4` must give bit for bit what `closest` gives ray by ray.
+    fn assert_packet_matches(bvh: &Bvh, rays: [Option<FastRay>; 4], what: &str) -> usize {
+        let key = |h: Option<BvhHit>| {
+            h.map(|h| {
+                (
+                    h.id,
+                    h.hit.t.to_bits(),
+                    h.hit.u.to_bits(),
+                    h.hit.v.to_bits(),
+                )
+            })
+        };
+        let got = bvh.closest4([0, 1, 2, 3].map(|i| rays[i].as_ref()));
+        let mut hits = 0;
+        for (r, got) in rays.iter().zip(got) {
+            let expected = r.as_ref().and_then(|r| bvh.closest(r));
+            assert_eq!(key(got), key(expected), "{what}");
+            hits += usize::from(expected.is_some());
+        }
+        hits
+    }
+
+    #[test]
+    fn packets_find_exactly_the_single_ray_hits() {
+        let mut rng = Rng(11);
+        let mut hits = 0;
+        for n in [1, 3, 60, 2000, 20000] {
+            let triangles = soup(&mut rng, n);
+            let bvh = Bvh::build(&triangles);
+            for k in 0..300 {
+                // A pinhole quad: one origin, four directions a small angle apart (an
+                // occasional ray of the quad set far off, or missing, or with an interval).
+                let origin = rng.vec(15.0).as_dvec3();
+                let target = rng.vec(8.0).as_dvec3();
+                let spread = [1e-4, 1e-2, 0.3][k % 3];
+                let mut rays = [0; 4].map(|_| {
+                    let d = (target - origin).normalize() + rng.vec(spread).as_dvec3();
+                    let mut ray = Ray::new(origin, d * (0.5 + rng.next() as f64));
+                    if k % 7 == 0 {
+                        ray.t_min = 5.0;
+                        ray.t_max = 20.0;
+                    }
+                    FastRay::new(&ray)
+                });
+                match k % 10 {
+                    1 => rays[2] = None,
+                    2 => rays[1] = FastRay::new(&Ray::new(origin, -(target - origin))),
+                    3 => {
+                        rays[3] = FastRay::new(&Ray::new(
+                            rng.vec(15.0).as_dvec3(),
+                            rng.vec(1.0).as_dvec3(),
+                        ))
+                    }
+                    _ => {}
+                }
+                hits += assert_packet_matches(&bvh, rays, &format!("soup of {n}, quad {k}"));
+            }
+        }
+        assert!(hits > 1000, "too few hits ({hits}) to test anything");
+    }
+
+    #[test]
+    fn packets_and_single_rays_break_ties_alike() {
+        // Stacked copies of a triangle and a grid of triangles sharing edges: every ray
+        // meets several triangles at exactly the same `t`; the lowest stored index wins.
+        let tri = [Vec3::ZERO, Vec3::X, Vec3::Y];
+        let mut triangles = vec![tri; 300];
+        for i in 0..20 {
+            for j in 0..20 {
+                let c = Vec3::new(i as f32, j as f32, -1.0);
+                triangles.push([c, c + Vec3::X, c + Vec3::Y]);
+                triangles.push([c + Vec3::X, c + Vec3::ONE - Vec3::Z, c + Vec3::Y]);
+            }
+        }
+        let bvh = Bvh::build(&triangles);
+        let mut rng = Rng(5);
+        let mut hits = 0;
+        for k in 0..400 {
+            let origin = DVec3::new(0.3, 0.3, 4.0) + rng.vec(0.5).as_dvec3() * 4.0;
+            let target = DVec3::new(rng.next() as f64 * 20.0, rng.next() as f64 * 20.0, -1.0);
+            // Pixel-like steps, some of them through shared edges and vertices.
+            let step = [0.0, 0.5, 1.0][k % 3];
+            let rays = [(0.0, 0.0), (step, 0.0), (0.0, step), (step, step)].map(|(x, y)| {
+                FastRay::new(&Ray::new(origin, target + DVec3::new(x, y, 0.0) - origin))
+            });
+            hits += assert_packet_matches(&bvh, rays, &format!("ray {k}"));
+        }
+        assert!(hits > 1000);
+        // The stacked copies: the same one of the 300 wins (the first stored), whatever the
+        // ray, the order of traversal depending on the ray's direction.
+        let ids: Vec<u32> = [
+            DVec3::NEG_Z,
+            DVec3::new(0.3, 0.2, -1.0),
+            DVec3::new(-0.2, -0.1, -1.0),
+        ]
+        .map(|d| {
+            let ray = FastRay::new(&Ray::new(DVec3::new(0.2, 0.2, 0.0) - d, d)).unwrap();
+            bvh.closest(&ray).unwrap().id
+        })
+        .to_vec();
+        assert!(
+            ids[0] < 300 && ids.iter().all(|&id| id == ids[0]),
+            "{ids:?}"
+        );
     }
 
     #[test]

@@ -120,16 +120,33 @@ impl RayCaster {
     /// as f32; everything that spawns rays from the hit refines it first.
     fn intersect_f32(&self, ray: &Ray) -> Option<Hit32> {
         let found = self.bvh.closest(&FastRay::new(ray)?)?;
+        Some(self.hit32(found))
+    }
+
+    /// [`RayCaster::intersect_f32`] of four rays at once, with identical results: coherent
+    /// rays (a 2x2 quad of primary rays) share one BVH traversal.
+    fn intersect4_f32(&self, rays: [Option<&Ray>; 4]) -> [Option<Hit32>; 4] {
+        let fast = |i: usize| rays[i].and_then(FastRay::new);
+        let (a, b, c, d) = (fast(0), fast(1), fast(2), fast(3));
+        let [a, b, c, d] = self
+            .bvh
+            .closest4([a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref()]);
+        let hit = |f: Option<bvh::BvhHit>| f.map(|f| self.hit32(f));
+        [hit(a), hit(b), hit(c), hit(d)]
+    }
+
+    /// The hit of BVH triangle `found`, known by object and triangle within its mesh.
+    fn hit32(&self, found: bvh::BvhHit) -> Hit32 {
         let object = match self.first_triangle.len() {
             1 => 0,
             _ => self.first_triangle.partition_point(|&f| f <= found.id) - 1,
         };
-        Some(Hit32 {
+        Hit32 {
             t: found.hit.t,
             object,
             triangle: (found.id - self.first_triangle[object]) as usize,
             barycentric: Vec2::new(found.hit.u, found.hit.v),
-        })
+        }
     }
 
     /// `found` (a hit of `ray`) with `t` and the barycentrics recomputed in f64.

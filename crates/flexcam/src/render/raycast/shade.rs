@@ -22,7 +22,7 @@
 use glam::{DVec3, Vec3};
 
 use super::optics::{reflect, refract};
-use super::{Hit, RayCaster};
+use super::{Hit, Hit32, RayCaster};
 use crate::geometry::Ray;
 use crate::render::surface::{base_color, normals, Normals, TextureFilter};
 use crate::render::{RenderOptions, Shading};
@@ -103,9 +103,36 @@ impl<'a> Tracer<'a> {
         let Some(ray) = primary else {
             return background;
         };
+        let found = self.caster.intersect_f32(ray);
+        self.shade(ray, found)
+    }
+
+    /// The samples of four primary rays (a 2x2 pixel quad), exactly those of [`Tracer::sample`]
+    /// on each: the first hits come from one shared BVH traversal.
+    pub fn sample4(&mut self, primary: [Option<&Ray>; 4]) -> [Sample; 4] {
+        let found = self.caster.intersect4_f32(primary);
+        let mut samples = [Sample {
+            color: self.caster.background,
+            depth: f32::INFINITY,
+            id: 0,
+        }; 4];
+        for ((sample, ray), found) in samples.iter_mut().zip(primary).zip(found) {
+            if let Some(ray) = ray {
+                *sample = self.shade(ray, found);
+            }
+        }
+        samples
+    }
+
+    /// The sample of primary ray `ray` whose first hit (the f32 search's) is `found`.
+    fn shade(&mut self, ray: &Ray, found: Option<Hit32>) -> Sample {
         self.counts.primary += 1;
-        let Some(found) = self.caster.intersect_f32(ray) else {
-            return background;
+        let Some(found) = found else {
+            return Sample {
+                color: self.caster.background,
+                depth: f32::INFINITY,
+                id: 0,
+            };
         };
         let object = &self.caster.objects[found.object];
         let (color, t) = match self.shading {

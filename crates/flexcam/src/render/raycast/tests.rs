@@ -513,3 +513,76 @@ fn empty_scene_renders_background_and_reports_build_stats() {
     assert_eq!(stats["triangles"], Counter::Count(0));
     assert!(matches!(stats["bvh_build_ms"], Counter::Value(ms) if ms >= 0.0));
 }
+
+/// The image rendered pixel by pixel with single rays, as before packets.
+fn render_single_rays(
+    caster: &RayCaster,
+    camera: &dyn Projection,
+    options: &RenderOptions,
+) -> Frame {
+    let (w, h) = camera.resolution();
+    let mut frame = Frame::new(w, h, caster.background);
+    let mut tracer = shade::Tracer::new(caster, options);
+    for y in 0..h {
+        for x in 0..w {
+            let ray = camera.ray(DVec2::new(x as f64 + 0.5, y as f64 + 0.5));
+            let s = tracer.sample(ray.as_ref());
+            let i = (y * w + x) as usize;
+            (frame.color[i], frame.depth[i], frame.ids[i]) = (s.color, s.depth, s.id);
+        }
+    }
+    frame
+}
+
+#[test]
+fn packet_rendering_equals_single_ray_rendering() {
+    let light = Light::Point {
+        position: Vec3::new(-1.0, 2.0, 5.0),
+        color: Vec3::ONE,
+        intensity: 0.7,
+    };
+    let scene = busy_scene(vec![light]);
+    let caster = RayCaster::new(&scene);
+    let frame = |position: DVec3, look_at: DVec3| CameraFrame {
+        position,
+        look_at,
+        up: DVec3::Y,
+    };
+    let cameras: Vec<Box<dyn Projection>> = vec![
+        Box::new(Parallel {
+            blind: 7.0,
+            direction: DVec3::new(0.1, -0.05, -1.0),
+            ..Parallel::new(37, 29, (-4.0, 4.0), DVec3::NEG_Z)
+        }),
+        ProjectionSpec::Perspective {
+            frame: frame(DVec3::new(0.5, 0.3, 6.0), DVec3::ZERO),
+            fov: 70.0,
+        }
+        .build(41, 33)
+        .unwrap(),
+        ProjectionSpec::Fisheye {
+            frame: frame(DVec3::new(-0.5, 1.0, 3.0), DVec3::new(0.0, 0.0, -2.0)),
+            fov: 180.0,
+        }
+        .build(35, 35)
+        .unwrap(),
+    ];
+    for camera in &cameras {
+        for shading in [Shading::Flat, Shading::Lit] {
+            let options = RenderOptions { shading, ..flat(8) };
+            let (packets, _) = caster.render(camera.as_ref(), &options);
+            let single = render_single_rays(&caster, camera.as_ref(), &options);
+            assert_eq!(packets.ids, single.ids, "{}", camera.kind());
+            let bits = |f: &Frame| {
+                let c: Vec<[u32; 3]> = f
+                    .color
+                    .iter()
+                    .map(|c| c.to_array().map(f32::to_bits))
+                    .collect();
+                let d: Vec<u32> = f.depth.iter().map(|d| d.to_bits()).collect();
+                (c, d)
+            };
+            assert_eq!(bits(&packets), bits(&single), "{}", camera.kind());
+        }
+    }
+}

@@ -8,7 +8,7 @@ use glam::{DVec2, Vec3};
 use rayon::prelude::*;
 
 use super::sampling::SamplePattern;
-use super::shade::{RayCounts, Tracer};
+use super::shade::{RayCounts, Sample, Tracer};
 use super::RayCaster;
 use crate::projection::Projection;
 use crate::render::{Counter, Frame, RenderOptions, Stats};
@@ -98,28 +98,60 @@ fn render_tile(
         x0,
         y0,
         width,
-        color: Vec::with_capacity(n),
-        depth: Vec::with_capacity(n),
-        ids: Vec::with_capacity(n),
+        color: vec![Vec3::ZERO; n],
+        depth: vec![f32::INFINITY; n],
+        ids: vec![0; n],
         counts: RayCounts::default(),
     };
     let mut tracer = Tracer::new(caster, options);
+    let store = |tile: &mut Tile, (x, y): (u32, u32), color: Vec3, sample: Sample| {
+        let i = ((y - y0) * width + (x - x0)) as usize;
+        tile.color[i] = color;
+        tile.depth[i] = sample.depth;
+        tile.ids[i] = sample.id;
+    };
+    // One sample per pixel: 2x2 quads of pixels trace their first hits together (identical
+    // results, one BVH traversal for four coherent rays); the odd last row / column of an
+    // edge tile goes pixel by pixel.
+    let quads = if pattern.offsets.len() == 1 { 2 } else { 0 };
+    let (quad_w, quad_h) = (width / 2 * quads, height / 2 * quads);
+    let offset = pattern.offsets[0];
+    for qy in (0..quad_h).step_by(2) {
+        for qx in (0..quad_w).step_by(2) {
+            let (x, y) = (x0 + qx, y0 + qy);
+            let pixels = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)];
+            let ray = |(x, y): (u32, u32)| projection.ray(DVec2::new(x as f64, y as f64) + offset);
+            let rays = [
+                ray(pixels[0]),
+                ray(pixels[1]),
+                ray(pixels[2]),
+                ray(pixels[3]),
+            ];
+            let [a, b, c, d] = &rays;
+            let samples = tracer.sample4([a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref()]);
+            for (pixel, sample) in pixels.into_iter().zip(samples) {
+                store(&mut tile, pixel, Vec3::ZERO + sample.color, sample);
+            }
+        }
+    }
     let scale = 1.0 / pattern.offsets.len() as f32;
     for y in y0..y0 + height {
         for x in x0..x0 + width {
+            if x - x0 < quad_w && y - y0 < quad_h {
+                continue;
+            }
             let mut color = Vec3::ZERO;
-            let (mut depth, mut id) = (f32::INFINITY, 0);
+            let mut centre = None;
             for (k, offset) in pattern.offsets.iter().enumerate() {
                 let pixel = DVec2::new(x as f64, y as f64) + *offset;
                 let sample = tracer.sample(projection.ray(pixel).as_ref());
                 color += sample.color;
                 if k == pattern.centre {
-                    (depth, id) = (sample.depth, sample.id);
+                    centre = Some(sample);
                 }
             }
-            tile.color.push(color * scale);
-            tile.depth.push(depth);
-            tile.ids.push(id);
+            let centre = centre.expect("the centre sample is one of the pattern's");
+            store(&mut tile, (x, y), color * scale, centre);
         }
     }
     tile.counts = tracer.counts;
