@@ -288,10 +288,15 @@ mod tests {
         mesh
     }
 
-    #[test]
-    fn pinhole_mesh_matches_the_perspective_projection() {
-        let eye = DVec3::new(0.5, 1.0, 4.0);
-        let (width, height) = (64, 48);
+    /// The eye and image size of [`pinhole_and_perspective`].
+    const PINHOLE_EYE: DVec3 = DVec3::new(0.5, 1.0, 4.0);
+    const PINHOLE_SIZE: (u32, u32) = (64, 48);
+
+    /// A 64 x 48 trilinear mesh built from a pinhole (n_i = p_i - eye) and the perspective
+    /// projection it must reproduce (70 degrees horizontal, looking down -z).
+    fn pinhole_and_perspective() -> (Trilinear, Perspective) {
+        let eye = PINHOLE_EYE;
+        let (width, height) = PINHOLE_SIZE;
         let fov = 70.0_f64;
         let half_w = (0.5 * fov.to_radians()).tan();
         let half_h = half_w * f64::from(height) / f64::from(width);
@@ -302,8 +307,14 @@ mod tests {
             up: DVec3::Y,
         };
         let perspective = Perspective::new(&frame, fov, width, height).unwrap();
-        for y in 0..height {
-            for x in 0..width {
+        (trilinear, perspective)
+    }
+
+    #[test]
+    fn pinhole_mesh_matches_the_perspective_projection() {
+        let (trilinear, perspective) = pinhole_and_perspective();
+        for y in 0..PINHOLE_SIZE.1 {
+            for x in 0..PINHOLE_SIZE.0 {
                 let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
                 let tri = trilinear.ray(pixel).unwrap();
                 let persp = perspective.ray(pixel).unwrap();
@@ -312,8 +323,8 @@ mod tests {
                     (direction - persp.direction).length() < 1e-12,
                     "pixel {pixel}"
                 );
-                // The origin lies on the perspective ray, one unit of trinorm from the eye.
-                assert!((tri.origin - tri.direction - eye).length() < 1e-12);
+                // The origin lies on the perspective ray, one unit of trinorm from the PINHOLE_EYE.
+                assert!((tri.origin - tri.direction - PINHOLE_EYE).length() < 1e-12);
             }
         }
     }
@@ -409,18 +420,7 @@ mod tests {
 
     #[test]
     fn pinhole_mesh_projects_like_the_perspective_projection() {
-        let eye = DVec3::new(0.5, 1.0, 4.0);
-        let (width, height) = (64, 48);
-        let fov = 70.0_f64;
-        let half_w = (0.5 * fov.to_radians()).tan();
-        let half_h = half_w * f64::from(height) / f64::from(width);
-        let trilinear = Trilinear::new(&pinhole_mesh(eye, half_w, half_h), width, height).unwrap();
-        let frame = CameraFrame {
-            position: eye,
-            look_at: eye + DVec3::NEG_Z,
-            up: DVec3::Y,
-        };
-        let perspective = Perspective::new(&frame, fov, width, height).unwrap();
+        let (trilinear, perspective) = pinhole_and_perspective();
         let mut checked = 0;
         for k in 0..2000 {
             // A deterministic spread of points in front of and behind the image plane.
@@ -430,7 +430,7 @@ mod tests {
                 (a * 0.754_877).fract() * 2.0 - 1.0,
                 -0.2 - 9.0 * (a * 0.569_84).fract(),
             );
-            let point = eye + DVec3::new(local.x * -local.z, local.y * -local.z, local.z);
+            let point = PINHOLE_EYE + DVec3::new(local.x * -local.z, local.y * -local.z, local.z);
             let (mut tri, mut persp) = (Vec::new(), Vec::new());
             trilinear.project(point, &mut tri);
             perspective.project(point, &mut persp);
@@ -438,11 +438,11 @@ mod tests {
                 panic!("perspective: {persp:?}")
             };
             let inside = expected.pixel.x >= 0.0
-                && expected.pixel.x <= f64::from(width)
+                && expected.pixel.x <= f64::from(PINHOLE_SIZE.0)
                 && expected.pixel.y >= 0.0
-                && expected.pixel.y <= f64::from(height);
+                && expected.pixel.y <= f64::from(PINHOLE_SIZE.1);
             if !inside || local.z > -1.0 {
-                // Outside the mesh, or between the eye and the image plane (t < 0).
+                // Outside the mesh, or between the PINHOLE_EYE and the image plane (t < 0).
                 assert!(tri.is_empty() || inside, "{point}: {tri:?}");
                 if local.z > -1.0 {
                     assert!(tri.is_empty(), "behind the view plane: {tri:?}");
@@ -457,7 +457,7 @@ mod tests {
             );
             let ray = trilinear.ray(got.pixel).unwrap();
             assert!((ray.at(got.t) - point).length() < 1e-12 * (1.0 + point.length()));
-            // Distance from the eye = (1 + t) |trinorm|.
+            // Distance from the PINHOLE_EYE = (1 + t) |trinorm|.
             let distance = (1.0 + got.t) * ray.direction.length();
             assert!((distance - expected.t).abs() < 1e-12 * expected.t);
             checked += 1;

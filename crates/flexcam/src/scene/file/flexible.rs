@@ -278,20 +278,11 @@ fn surface(src: &Source, table: &Spanned<RawSurface>, which: &str) -> Result<Sur
             ),
         ));
     }
-    let keys = surface_keys(name);
-    if let Some((key, span)) = raw
-        .present_keys()
-        .into_iter()
-        .find(|(key, _)| !keys.contains(key))
-    {
-        return Err(src.error(
-            &span,
-            format!(
-                "`{key}` is not a parameter of {name} surfaces (they take: {})",
-                keys.join(", ")
-            ),
-        ));
-    }
+    src.reject_foreign_key(
+        raw.present_keys(),
+        surface_keys(name),
+        &format!("{name} surfaces"),
+    )?;
     let need = |v: &Option<Spanned<[f64; 3]>>, key: &str| -> Result<DVec3> {
         let v = v.as_ref().ok_or_else(|| {
             src.error(

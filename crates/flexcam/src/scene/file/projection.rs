@@ -119,20 +119,11 @@ pub(super) fn convert(
             ),
         )
     })?;
-    let keys = kind.keys();
-    if let Some((key, span)) = raw
-        .present_keys()
-        .into_iter()
-        .find(|(key, _)| !keys.contains(key))
-    {
-        return Err(src.error(
-            &span,
-            format!(
-                "`{key}` is not a parameter of {name} projections (they take: {})",
-                keys.join(", ")
-            ),
-        ));
-    }
+    src.reject_foreign_key(
+        raw.present_keys(),
+        &kind.keys(),
+        &format!("{name} projections"),
+    )?;
     let required = Required { src, table, kind };
     let angle = |value: &Option<Spanned<f64>>, key: &str, default: f64| {
         value.as_ref().map_or(Ok(default), |v| src.number(v, key))

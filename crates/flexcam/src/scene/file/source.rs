@@ -19,6 +19,26 @@ impl<'a> Source<'a> {
         Error::at(self.path, line, column, message)
     }
 
+    /// Fails at the first key of `present` (name, span) that is not in `allowed`, naming
+    /// `what` takes instead (e.g. "fisheye projections"), so a key of another type is caught.
+    pub fn reject_foreign_key(
+        &self,
+        present: Vec<(&'static str, Range<usize>)>,
+        allowed: &[&str],
+        what: &str,
+    ) -> Result<(), Error> {
+        match present.into_iter().find(|(key, _)| !allowed.contains(key)) {
+            Some((key, span)) => Err(self.error(
+                &span,
+                format!(
+                    "`{key}` is not a parameter of {what} (they take: {})",
+                    allowed.join(", ")
+                ),
+            )),
+            None => Ok(()),
+        }
+    }
+
     /// An error about the file as a whole.
     pub fn file_error(&self, message: impl Into<String>) -> Error {
         Error::in_file(self.path, message)
