@@ -378,7 +378,7 @@ fn non_finite_numbers_are_rejected() {
     );
     assert_error(
         &object("shape = \"box\"\ntranslate = [0, 1e300, 0]\n"),
-        "out of range",
+        "`translate` value 1e300 is out of range",
     );
     assert_error(
         "[image]\nbackground = [0, nan, 0]\n[projection]\ntype = \"perspective\"\n",

@@ -65,7 +65,12 @@ impl Source<'_> {
         if (*x as f32).is_finite() {
             Ok(())
         } else if x.is_finite() {
-            Err(self.error(&at.span(), format!("`{key}` value {x} is out of range")))
+            Err(self.error(
+                &at.span(),
+                format!(
+                    "`{key}` value {x:e} is out of range (beyond single precision, about 3.4e38)"
+                ),
+            ))
         } else {
             Err(self.error(
                 &at.span(),
