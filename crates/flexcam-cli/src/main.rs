@@ -26,6 +26,9 @@ enum Command {
     Render(commands::render::RenderArgs),
     /// List the built-in scenes: name, then a description.
     Scenes,
+    /// Render a scene with a method and with the reference ray caster, and report how closely
+    /// they agree (object ids, depth, relative RGB error).
+    Compare(commands::compare::CompareArgs),
 }
 
 fn main() -> ExitCode {
@@ -36,6 +39,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => commands::render::run(&args),
         Command::Scenes => commands::scenes::run(),
+        Command::Compare(args) => commands::compare::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

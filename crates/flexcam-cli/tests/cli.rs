@@ -341,3 +341,56 @@ fn every_example_scene_renders() {
     }
     assert!(rendered >= 5, "only {rendered} example scenes found");
 }
+
+#[test]
+fn compare_reports_agreement_and_enforces_thresholds() {
+    let dir = TempDir::new().unwrap();
+    write(&dir, "s.toml", GOOD_SCENE);
+    let out = flexcam(dir.path())
+        .args(["compare", "s.toml", "--method", "raycast", "--json"])
+        .args(["--min-id-agreement", "99.5", "--max-rgb-error", "0.02"])
+        .args(["--diff", "diff.png"])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["id_agreement"], 1.0);
+    assert_eq!(report["relative_rgb_error"], 0.0);
+    assert_eq!(report["pixels"], 64 * 48);
+    assert!(report["depth_pixels"].as_u64().unwrap() > 0);
+    let diff = image::open(dir.path().join("diff.png")).unwrap().to_rgb8();
+    assert!(
+        diff.pixels().all(|p| p.0 == [0, 0, 0]),
+        "identical renders differ"
+    );
+
+    // An unreachable threshold fails with one line naming the measure; the diff image of a
+    // failed check is kept on purpose (it is what one looks at next).
+    let out = flexcam(dir.path())
+        .args(["compare", "s.toml", "--method", "raycast"])
+        .args(["--min-id-agreement", "100.5"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("id agreement 100.000 % is below"),
+        "{stderr}"
+    );
+
+    let clean = TempDir::new().unwrap();
+    write(&clean, "s.toml", GOOD_SCENE);
+    let e = expect_failure(
+        &clean,
+        &[
+            "compare",
+            "s.toml",
+            "--method",
+            "raycast",
+            "--reference",
+            "x",
+        ],
+    );
+    assert!(e.contains("unknown method \"x\""), "{e}");
+}

@@ -3,12 +3,12 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use clap::{Args, ValueEnum};
+use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, StagedFile};
 use flexcam::render::{Method, RenderOptions, Shading};
-use flexcam::scene::{self, Scene};
 use flexcam::{Error, Result};
 
+use super::scene_args::{SceneArgs, ShadingArg};
 use crate::progress::RenderProgress;
 use crate::stats_json::{self, RunFacts};
 use crate::OutputTarget;
@@ -16,17 +16,11 @@ use crate::OutputTarget;
 /// Arguments of `flexcam render`.
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// A scene file (.toml) or `builtin:NAME`; the default built-in scene when omitted.
-    scene: Option<String>,
+    #[command(flatten)]
+    scene: SceneArgs,
     /// The colour image to write (PNG).
     #[arg(short, long, default_value = "flexcam.png")]
     output: PathBuf,
-    /// Image width in pixels (overrides the scene file).
-    #[arg(long)]
-    width: Option<u32>,
-    /// Image height in pixels (overrides the scene file).
-    #[arg(long)]
-    height: Option<u32>,
     /// Rendering method: `raycast` (the reference, every projection).
     #[arg(long, default_value = "raycast")]
     method: String,
@@ -47,45 +41,12 @@ pub struct RenderArgs {
     stats: Option<OutputTarget>,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
-enum ShadingArg {
-    Flat,
-    Lit,
-}
-
-impl ShadingArg {
-    fn shading(self) -> Shading {
-        match self {
-            ShadingArg::Flat => Shading::Flat,
-            ShadingArg::Lit => Shading::Lit,
-        }
-    }
-    fn name(self) -> &'static str {
-        match self {
-            ShadingArg::Flat => "flat",
-            ShadingArg::Lit => "lit",
-        }
-    }
-}
-
 /// Runs `flexcam render`. Outputs are written only once everything has succeeded.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let method: Method = args.method.parse()?;
     check_outputs(args)?;
 
-    let source = args
-        .scene
-        .clone()
-        .unwrap_or_else(|| format!("builtin:{}", scene::builtin::DEFAULT));
-    let load_start = Instant::now();
-    let scene = scene::load(&source)?;
-    let load_ms = load_start.elapsed().as_secs_f64() * 1e3;
-
-    let (width, height) = resolution(args, &scene)?;
-    let projection = scene
-        .projection
-        .build(width, height)
-        .map_err(|e| with_scene_file(e, &source))?;
+    let loaded = args.scene.load()?;
 
     let progress = RenderProgress::new();
     let report = |done: u64, total: u64| progress.update(done, total);
@@ -96,7 +57,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ..RenderOptions::default()
     };
     let render_start = Instant::now();
-    let rendered = method.render(&scene, projection.as_ref(), &options);
+    let rendered = method.render(&loaded.scene, loaded.projection.as_ref(), &options);
     let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
     progress.finish();
     let (frame, counters) = rendered?;
@@ -115,14 +76,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     let facts = RunFacts {
         method: method.name(),
-        scene: &source,
-        projection: projection.kind(),
+        scene: &loaded.source,
+        projection: loaded.projection.kind(),
         shading: args.shading.name(),
-        width,
-        height,
+        width: loaded.width,
+        height: loaded.height,
         spp: args.spp,
-        triangles: scene.triangle_count(),
-        load_ms,
+        triangles: loaded.scene.triangle_count(),
+        load_ms: loaded.load_ms,
         render_ms,
     };
     let json = stats_json::to_json(&facts, &counters).to_string();
@@ -136,14 +97,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         println!("{json}");
     }
     Ok(())
-}
-
-/// The image size: the scene's, overridden by the flags, validated.
-fn resolution(args: &RenderArgs, scene: &Scene) -> Result<(u32, u32)> {
-    let width = args.width.unwrap_or(scene.image.width);
-    let height = args.height.unwrap_or(scene.image.height);
-    scene::file::validate_resolution(width, height)?;
-    Ok((width, height))
 }
 
 /// Fails before rendering on output paths that could not be written afterwards.
@@ -170,9 +123,4 @@ fn check_outputs(args: &RenderArgs) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// Names the scene file in an error that has no location yet (built-ins are named as given).
-fn with_scene_file(e: Error, source: &str) -> Error {
-    e.or_in_file(source)
 }

@@ -1,0 +1,185 @@
+//! `flexcam compare`: render a scene with a method and with a reference method (the ray
+//! caster by default) at the same projection and size, and report how closely they agree
+//! (object-id agreement, depth error, the thesis's relative RGB error; see
+//! `flexcam::render::compare`). Optional thresholds turn it into a check with an exit status.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use clap::Args;
+use flexcam::image_io::{self, ColorEncoding};
+use flexcam::render::compare::{compare, Comparison};
+use flexcam::render::{Frame, Method, RenderOptions};
+use flexcam::{Error, Result};
+use glam::Vec3;
+use serde_json::json;
+
+use super::scene_args::{SceneArgs, ShadingArg};
+
+/// Arguments of `flexcam compare`.
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// The method under test.
+    #[arg(long)]
+    method: String,
+    /// The reference method.
+    #[arg(long, default_value = "raycast")]
+    reference: String,
+    /// Shading of both renders; `flat` compares base colours, which is what the accuracy
+    /// targets are stated for.
+    #[arg(long, value_enum, default_value_t = ShadingArg::Flat)]
+    shading: ShadingArg,
+    /// Write a difference image (PNG): id mismatches red, colour differences amplified 4x.
+    #[arg(long, value_name = "FILE")]
+    diff: Option<PathBuf>,
+    /// Print the report as one JSON object instead of text.
+    #[arg(long)]
+    json: bool,
+    /// Fail (exit 1) when the id agreement, in percent, is below this.
+    #[arg(long, value_name = "PERCENT")]
+    min_id_agreement: Option<f64>,
+    /// Fail (exit 1) when the relative RGB error is above this.
+    #[arg(long, value_name = "ERROR")]
+    max_rgb_error: Option<f64>,
+}
+
+/// Runs `flexcam compare`.
+pub fn run(args: &CompareArgs) -> Result<()> {
+    let method: Method = args.method.parse()?;
+    let reference: Method = args.reference.parse()?;
+    if let Some(path) = &args.diff {
+        image_io::check_output_path(path, &["png"])?;
+    }
+    let loaded = args.scene.load()?;
+    let options = RenderOptions {
+        shading: args.shading.shading(),
+        ..RenderOptions::default()
+    };
+    let timed_render = |m: Method| -> Result<(Frame, f64)> {
+        let start = Instant::now();
+        let (frame, _) = m.render(&loaded.scene, loaded.projection.as_ref(), &options)?;
+        Ok((frame, start.elapsed().as_secs_f64() * 1e3))
+    };
+    let (frame, method_ms) = timed_render(method)?;
+    let (reference_frame, reference_ms) = timed_render(reference)?;
+    let result = compare(&frame, &reference_frame)?;
+
+    if let Some(path) = &args.diff {
+        image_io::write_color_png(
+            &difference_image(&frame, &reference_frame),
+            path,
+            ColorEncoding::Linear,
+        )?
+        .commit()?;
+    }
+    let header = Header {
+        source: &loaded.source,
+        projection: loaded.projection.kind(),
+        method,
+        reference,
+        size: (loaded.width, loaded.height),
+        shading: args.shading.name(),
+        times_ms: (method_ms, reference_ms),
+    };
+    if args.json {
+        println!("{}", report_json(&header, &result));
+    } else {
+        print!("{}", report_text(&header, &result));
+    }
+    check_thresholds(args, &result)
+}
+
+/// What was compared, for the report.
+struct Header<'a> {
+    source: &'a str,
+    projection: &'a str,
+    method: Method,
+    reference: Method,
+    size: (u32, u32),
+    shading: &'a str,
+    /// Render times of the method and the reference, in milliseconds.
+    times_ms: (f64, f64),
+}
+
+fn report_text(h: &Header, c: &Comparison) -> String {
+    format!(
+        "{} ({}), {} vs {}, {}x{}, {} shading\n\
+         id agreement        {:.3} %\n\
+         relative RGB error  {:.5}\n\
+         depth error         max {:.3e}, mean {:.3e} (relative, over {} pixels on the same object)\n\
+         render time         {:.1} ms vs {:.1} ms\n",
+        h.source,
+        h.projection,
+        h.method,
+        h.reference,
+        h.size.0,
+        h.size.1,
+        h.shading,
+        100.0 * c.id_agreement,
+        c.relative_rgb_error,
+        c.depth_max,
+        c.depth_mean,
+        c.depth_pixels,
+        h.times_ms.0,
+        h.times_ms.1,
+    )
+}
+
+fn report_json(h: &Header, c: &Comparison) -> serde_json::Value {
+    // Non-finite errors (a black reference) are not JSON numbers: they become null.
+    let number = |v: f64| serde_json::Number::from_f64(v).map_or(json!(null), |n| json!(n));
+    json!({
+        "scene": h.source,
+        "projection": h.projection,
+        "method": h.method.name(),
+        "reference": h.reference.name(),
+        "width": h.size.0,
+        "height": h.size.1,
+        "shading": h.shading,
+        "pixels": c.pixels,
+        "id_agreement": number(c.id_agreement),
+        "relative_rgb_error": number(c.relative_rgb_error),
+        "depth_pixels": c.depth_pixels,
+        "depth_max": number(c.depth_max),
+        "depth_mean": number(c.depth_mean),
+        "method_ms": number(h.times_ms.0),
+        "reference_ms": number(h.times_ms.1),
+    })
+}
+
+/// The thresholds given on the command line, as one error line naming the first one missed.
+fn check_thresholds(args: &CompareArgs, c: &Comparison) -> Result<()> {
+    if let Some(min) = args.min_id_agreement {
+        let got = 100.0 * c.id_agreement;
+        if got < min {
+            return Err(Error::new(format!(
+                "id agreement {got:.3} % is below the required {min} %"
+            )));
+        }
+    }
+    if let Some(max) = args.max_rgb_error {
+        // Written so that a NaN error fails too.
+        if !(c.relative_rgb_error <= max) {
+            return Err(Error::new(format!(
+                "relative RGB error {:.5} is above the allowed {max}",
+                c.relative_rgb_error
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Red where the object ids differ; elsewhere the colour difference amplified 4x.
+fn difference_image(frame: &Frame, reference: &Frame) -> Frame {
+    let mut diff = Frame::new(frame.width, frame.height, Vec3::ZERO);
+    for (i, out) in diff.color.iter_mut().enumerate() {
+        *out = if frame.ids[i] != reference.ids[i] {
+            Vec3::new(1.0, 0.0, 0.0)
+        } else {
+            ((frame.color[i] - reference.color[i]).abs() * 4.0).min(Vec3::ONE)
+        };
+    }
+    diff
+}

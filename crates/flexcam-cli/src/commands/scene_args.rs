@@ -1,0 +1,86 @@
+//! What `render` and `compare` share: the scene argument, the size overrides and shading, and
+//! loading a scene and building its projection from them.
+
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use flexcam::projection::Projection;
+use flexcam::render::Shading;
+use flexcam::scene::{self, Scene};
+use flexcam::{Error, Result};
+
+/// The scene to render and its image size.
+#[derive(Args, Debug)]
+pub struct SceneArgs {
+    /// A scene file (.toml) or `builtin:NAME`; the default built-in scene when omitted.
+    pub scene: Option<String>,
+    /// Image width in pixels (overrides the scene file).
+    #[arg(long)]
+    pub width: Option<u32>,
+    /// Image height in pixels (overrides the scene file).
+    #[arg(long)]
+    pub height: Option<u32>,
+}
+
+/// A loaded scene with its projection bound to the image size.
+pub struct LoadedScene {
+    /// The scene as named on the command line (`builtin:NAME` for built-ins).
+    pub source: String,
+    pub scene: Scene,
+    pub projection: Box<dyn Projection>,
+    pub width: u32,
+    pub height: u32,
+    /// Time spent loading and building, in milliseconds.
+    pub load_ms: f64,
+}
+
+impl SceneArgs {
+    /// Loads the scene, applies the size overrides and builds the projection. Errors name the
+    /// scene file.
+    pub fn load(&self) -> Result<LoadedScene> {
+        let source = self
+            .scene
+            .clone()
+            .unwrap_or_else(|| format!("builtin:{}", scene::builtin::DEFAULT));
+        let start = Instant::now();
+        let scene = scene::load(&source)?;
+        let width = self.width.unwrap_or(scene.image.width);
+        let height = self.height.unwrap_or(scene.image.height);
+        scene::file::validate_resolution(width, height)?;
+        let projection = scene
+            .projection
+            .build(width, height)
+            .map_err(|e: Error| e.or_in_file(&source))?;
+        Ok(LoadedScene {
+            source,
+            scene,
+            projection,
+            width,
+            height,
+            load_ms: start.elapsed().as_secs_f64() * 1e3,
+        })
+    }
+}
+
+/// `--shading` on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum ShadingArg {
+    Flat,
+    Lit,
+}
+
+impl ShadingArg {
+    pub fn shading(self) -> Shading {
+        match self {
+            ShadingArg::Flat => Shading::Flat,
+            ShadingArg::Lit => Shading::Lit,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ShadingArg::Flat => "flat",
+            ShadingArg::Lit => "lit",
+        }
+    }
+}
