@@ -160,8 +160,8 @@ fn check_thresholds(args: &CompareArgs, c: &Comparison) -> Result<()> {
         }
     }
     if let Some(max) = args.max_rgb_error {
-        // Written so that a NaN error fails too.
-        if !(c.relative_rgb_error <= max) {
+        // A NaN error fails too.
+        if c.relative_rgb_error.is_nan() || c.relative_rgb_error > max {
             return Err(Error::new(format!(
                 "relative RGB error {:.5} is above the allowed {max}",
                 c.relative_rgb_error
