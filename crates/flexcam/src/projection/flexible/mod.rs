@@ -7,14 +7,18 @@
 //!   place for polyline and Bezier projectors next);
 //! - [`reparam`]: pixel <-> (u, v) (linear, polar fisheye, lens-like, Mercator);
 //! - [`presets`]: named volumes from a camera frame (perspective, pushbroom, crossed slits, ...);
+//! - [`projector_grid`]: a volume interpolated from a grid of placed projectors (5.2), and
+//!   [`fit`]: aiming all of them by least squares from point correspondences;
 //! - `inverse`: (u, v, t) from a scene point for the analytic class (parallel planes, nested
 //!   spheres, coaxial cylinders).
 //!
 //! A pixel's ray starts on the near surface and reaches the far surface at t = 1; t is
 //! limited to [0, 1] (the per-projector near and far clip of the framework).
 
+pub mod fit;
 mod inverse;
 pub mod presets;
+pub mod projector_grid;
 pub mod reparam;
 pub mod surface;
 #[cfg(test)]
