@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use flexcam::image_io::{self, ColorEncoding, StagedFile};
+use flexcam::render::inverse_raster::Subdivision;
 use flexcam::render::{Method, RenderOptions, Shading};
 use flexcam::scene::{self, Scene};
 use flexcam::{Error, Result};
@@ -27,9 +28,18 @@ pub struct RenderArgs {
     /// Image height in pixels (overrides the scene file).
     #[arg(long)]
     height: Option<u32>,
-    /// Rendering method: `raycast` (the reference, every projection).
+    /// Rendering method: `raycast` (the reference, every projection) or `raster`
+    /// (rasterisation by the analytic inverse, projections that have one).
     #[arg(long, default_value = "raycast")]
     method: String,
+    /// Method raster: cut every triangle into N x N pieces (uniform subdivision; without
+    /// --raster-tolerance there is then no adaptive step).
+    #[arg(long, value_name = "N")]
+    subdiv: Option<u32>,
+    /// Method raster: halve edges whose projected midpoint is more than PX pixels off the
+    /// straight line (adaptive subdivision, the default, with 0.5).
+    #[arg(long, value_name = "PX")]
+    raster_tolerance: Option<f64>,
     /// Shading: `flat` (base colours, exact) or `lit` (lights, shadows, reflections).
     #[arg(long, value_enum, default_value_t = ShadingArg::Lit)]
     shading: ShadingArg,
@@ -92,6 +102,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let options = RenderOptions {
         shading: args.shading.shading(),
         spp: args.spp,
+        subdivision: subdivision(args, method)?,
         progress: Some(&report),
         ..RenderOptions::default()
     };
@@ -136,6 +147,27 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         println!("{json}");
     }
     Ok(())
+}
+
+/// The subdivision of method raster from `--subdiv` and `--raster-tolerance`; an error
+/// when either is given to another method.
+fn subdivision(args: &RenderArgs, method: Method) -> Result<Subdivision> {
+    if method != Method::Raster && (args.subdiv.is_some() || args.raster_tolerance.is_some()) {
+        return Err(Error::new(format!(
+            "--subdiv and --raster-tolerance apply to --method raster, not {method}"
+        )));
+    }
+    let subdivision = match (args.subdiv, args.raster_tolerance) {
+        (None, None) => Subdivision::default(),
+        (Some(n), None) => Subdivision::uniform(n),
+        (None, Some(tolerance)) => Subdivision::adaptive(tolerance),
+        (Some(n), Some(tolerance)) => Subdivision {
+            uniform: n,
+            tolerance: Some(tolerance),
+        },
+    };
+    subdivision.validate()?;
+    Ok(subdivision)
 }
 
 /// The image size: the scene's, overridden by the flags, validated.
