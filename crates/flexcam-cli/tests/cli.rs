@@ -394,3 +394,52 @@ fn compare_reports_agreement_and_enforces_thresholds() {
     );
     assert!(e.contains("unknown method \"x\""), "{e}");
 }
+
+/// `--method raster` renders from the command line, with both subdivision flags, and
+/// reports its counters.
+#[test]
+fn raster_method_renders_and_reports() {
+    let dir = TempDir::new().unwrap();
+    write(&dir, "s.toml", GOOD_SCENE);
+    for flags in [
+        vec![],
+        vec!["--subdiv", "4"],
+        vec!["--raster-tolerance", "0.25"],
+    ] {
+        let out = flexcam(dir.path())
+            .args(["render", "s.toml", "--method", "raster", "--stats", "-"])
+            .args(&flags)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let stats = String::from_utf8(out.stdout).unwrap();
+        assert!(stats.contains("\"method\":\"raster\""), "{stats}");
+        assert!(stats.contains("\"raster_pieces\""), "{stats}");
+        assert!(dir.path().join("flexcam.png").exists());
+    }
+}
+
+#[test]
+fn raster_bad_input_is_one_line() {
+    let dir = TempDir::new().unwrap();
+    write(&dir, "s.toml", GOOD_SCENE);
+    let raster = ["render", "s.toml", "--method", "raster"];
+    let e = expect_failure(&dir, &[&raster[..], &["--subdiv", "0"]].concat());
+    assert!(e.contains("subdivision must be between 1 and 64"), "{e}");
+    let e = expect_failure(&dir, &[&raster[..], &["--raster-tolerance", "-1"]].concat());
+    assert!(e.contains("raster tolerance"), "{e}");
+    let e = expect_failure(&dir, &[&raster[..], &["--spp", "4"]].concat());
+    assert!(e.contains("one sample per pixel"), "{e}");
+    let e = expect_failure(&dir, &["render", "s.toml", "--subdiv", "2"]);
+    assert!(e.contains("apply to --method raster"), "{e}");
+    let trilinear = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/trilinear-fan.toml");
+    let e = expect_failure(
+        &dir,
+        &["render", trilinear.to_str().unwrap(), "--method", "raster"],
+    );
+    assert!(e.contains("method raster needs a projection"), "{e}");
+}

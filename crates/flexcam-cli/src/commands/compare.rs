@@ -14,7 +14,7 @@ use flexcam::{Error, Result};
 use glam::Vec3;
 use serde_json::json;
 
-use super::scene_args::{SceneArgs, ShadingArg};
+use super::scene_args::{MethodTuning, SceneArgs, ShadingArg};
 
 /// Arguments of `flexcam compare`.
 #[derive(Args, Debug)]
@@ -27,6 +27,9 @@ pub struct CompareArgs {
     /// The reference method.
     #[arg(long, default_value = "raycast")]
     reference: String,
+    /// Tuning of the method under test (the reference runs with its defaults).
+    #[command(flatten)]
+    tuning: MethodTuning,
     /// Shading of both renders; `flat` compares base colours, which is what the accuracy
     /// targets are stated for.
     #[arg(long, value_enum, default_value_t = ShadingArg::Flat)]
@@ -53,17 +56,21 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         image_io::check_output_path(path, &["png"])?;
     }
     let loaded = args.scene.load()?;
-    let options = RenderOptions {
+    let reference_options = RenderOptions {
         shading: args.shading.shading(),
         ..RenderOptions::default()
     };
-    let timed_render = |m: Method| -> Result<(Frame, f64)> {
+    let options = RenderOptions {
+        subdivision: args.tuning.subdivision(method)?,
+        ..reference_options
+    };
+    let timed_render = |m: Method, options: &RenderOptions| -> Result<(Frame, f64)> {
         let start = Instant::now();
-        let (frame, _) = m.render(&loaded.scene, loaded.projection.as_ref(), &options)?;
+        let (frame, _) = m.render(&loaded.scene, loaded.projection.as_ref(), options)?;
         Ok((frame, start.elapsed().as_secs_f64() * 1e3))
     };
-    let (frame, method_ms) = timed_render(method)?;
-    let (reference_frame, reference_ms) = timed_render(reference)?;
+    let (frame, method_ms) = timed_render(method, &options)?;
+    let (reference_frame, reference_ms) = timed_render(reference, &reference_options)?;
     let result = compare(&frame, &reference_frame)?;
 
     if let Some(path) = &args.diff {

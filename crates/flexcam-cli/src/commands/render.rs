@@ -8,7 +8,7 @@ use flexcam::image_io::{self, ColorEncoding, StagedFile};
 use flexcam::render::{Method, RenderOptions, Shading};
 use flexcam::{Error, Result};
 
-use super::scene_args::{SceneArgs, ShadingArg};
+use super::scene_args::{MethodTuning, SceneArgs, ShadingArg};
 use crate::progress::RenderProgress;
 use crate::stats_json::{self, RunFacts};
 use crate::OutputTarget;
@@ -21,9 +21,12 @@ pub struct RenderArgs {
     /// The colour image to write (PNG).
     #[arg(short, long, default_value = "flexcam.png")]
     output: PathBuf,
-    /// Rendering method: `raycast` (the reference, every projection).
+    /// Rendering method: `raycast` (the reference, every projection) or `raster`
+    /// (rasterisation by the analytic inverse, projections that have one).
     #[arg(long, default_value = "raycast")]
     method: String,
+    #[command(flatten)]
+    tuning: MethodTuning,
     /// Shading: `flat` (base colours, exact) or `lit` (lights, shadows, reflections).
     #[arg(long, value_enum, default_value_t = ShadingArg::Lit)]
     shading: ShadingArg,
@@ -53,6 +56,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let options = RenderOptions {
         shading: args.shading.shading(),
         spp: args.spp,
+        subdivision: args.tuning.subdivision(method)?,
         progress: Some(&report),
         ..RenderOptions::default()
     };

@@ -1,11 +1,12 @@
-//! What `render` and `compare` share: the scene argument, the size overrides and shading, and
-//! loading a scene and building its projection from them.
+//! What `render` and `compare` share: the scene argument, the size overrides, shading and the
+//! methods' tuning options, and loading a scene and building its projection from them.
 
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use flexcam::projection::Projection;
-use flexcam::render::Shading;
+use flexcam::render::inverse_raster::Subdivision;
+use flexcam::render::{Method, Shading};
 use flexcam::scene::{self, Scene};
 use flexcam::{Error, Result};
 
@@ -82,5 +83,41 @@ impl ShadingArg {
             ShadingArg::Flat => "flat",
             ShadingArg::Lit => "lit",
         }
+    }
+}
+
+/// The options that tune one rendering method (refused with any other method).
+#[derive(Args, Debug)]
+pub struct MethodTuning {
+    /// Method raster: cut every triangle into N x N pieces (uniform subdivision; without
+    /// --raster-tolerance there is then no adaptive step).
+    #[arg(long, value_name = "N")]
+    subdiv: Option<u32>,
+    /// Method raster: halve edges whose projected midpoint is more than PX pixels off the
+    /// straight line (adaptive subdivision, the default, with 0.5).
+    #[arg(long, value_name = "PX")]
+    raster_tolerance: Option<f64>,
+}
+
+impl MethodTuning {
+    /// The subdivision of method raster from `--subdiv` and `--raster-tolerance`; an error
+    /// when either is given to another method.
+    pub fn subdivision(&self, method: Method) -> Result<Subdivision> {
+        if method != Method::Raster && (self.subdiv.is_some() || self.raster_tolerance.is_some()) {
+            return Err(Error::new(format!(
+                "--subdiv and --raster-tolerance apply to --method raster, not {method}"
+            )));
+        }
+        let subdivision = match (self.subdiv, self.raster_tolerance) {
+            (None, None) => Subdivision::default(),
+            (Some(n), None) => Subdivision::uniform(n),
+            (None, Some(tolerance)) => Subdivision::adaptive(tolerance),
+            (Some(n), Some(tolerance)) => Subdivision {
+                uniform: n,
+                tolerance: Some(tolerance),
+            },
+        };
+        subdivision.validate()?;
+        Ok(subdivision)
     }
 }

@@ -4,6 +4,7 @@
 use glam::{DVec2, DVec3};
 
 use super::camera_basis::CameraBasis;
+use super::chart::{InverseChart, Pole};
 use super::image_coords::Resolution;
 use super::params::{angle_radians, UpTo};
 use super::{CameraFrame, ImagePoint, Projection};
@@ -75,27 +76,73 @@ impl Projection for Fisheye {
     /// image circle, where no ray exists); the point straight behind the eye when fov = 360
     /// (the whole image circle sees it: no single position).
     fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
+        if let Some((image, off_axis)) = self.image(point) {
+            if off_axis <= self.half_fov {
+                out.push(image);
+            }
+        }
+    }
+
+    /// The axis behind the eye is a pole (it maps to the whole circle of radius
+    /// pi / (fov/2) image-circle radii); no clip, no wrap.
+    fn inverse_chart(&self) -> Option<InverseChart> {
+        Some(InverseChart {
+            poles: vec![Pole {
+                origin: self.basis.origin,
+                direction: -self.basis.forward,
+                clearance: std::f64::consts::PI - self.widest_pixel_angle(),
+            }],
+            ..InverseChart::default()
+        })
+    }
+
+    /// The image of [`Projection::project`] without the field-of-view limit: points more
+    /// than fov/2 off the axis land outside the image circle, on the same radial line.
+    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
+        self.image(point).map(|(image, _)| image)
+    }
+}
+
+impl Fisheye {
+    /// The image of `point` with the radius unlimited, and its angle off the axis. `None`
+    /// for the eye and the axis behind it.
+    fn image(&self, point: DVec3) -> Option<(ImagePoint, f64)> {
         let offset = point - self.basis.origin;
         let local = self.basis.to_local(offset);
         let lateral = DVec2::new(local.x, local.y);
         let lateral_length = lateral.length();
         if lateral_length == 0.0 && local.z <= 0.0 {
-            return; // the eye, or on the axis behind it
+            return None; // the eye, or on the axis behind it
         }
         let off_axis = lateral_length.atan2(local.z);
-        if off_axis > self.half_fov {
-            return;
-        }
         let radius = off_axis / self.half_fov * self.circle_radius;
         let centred = if lateral_length > 0.0 {
             lateral * (radius / lateral_length)
         } else {
             DVec2::ZERO
         };
-        out.push(ImagePoint {
+        let image = ImagePoint {
             pixel: self.resolution.pixel(centred),
             t: offset.length(),
-        });
+        };
+        Some((image, off_axis))
+    }
+
+    /// The largest angle off the axis of a pixel centre inside the image circle (0 when no
+    /// centre is inside).
+    fn widest_pixel_angle(&self) -> f64 {
+        let (w, h) = (self.resolution.width, self.resolution.height);
+        let mut widest = 0.0f64;
+        for y in 0..h {
+            for x in 0..w {
+                let centre = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                let r = self.resolution.centred(centre).length() / self.circle_radius;
+                if r <= 1.0 {
+                    widest = widest.max(r);
+                }
+            }
+        }
+        widest * self.half_fov
     }
 }
 

@@ -7,6 +7,7 @@
 use glam::{DVec2, DVec3};
 
 use super::camera_basis::CameraBasis;
+use super::chart::{HalfSpace, InverseChart, EYE_CLEARANCE};
 use super::image_coords::Resolution;
 use super::params::{angle_radians, positive_length, UpTo};
 use super::{CameraFrame, ImagePoint, Projection};
@@ -64,16 +65,38 @@ impl Projection for Perspective {
     /// on or behind the plane through the eye perpendicular to the view direction (the eye
     /// itself included) has no image and appends nothing.
     fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
+        out.extend(self.project_continuous(point));
+    }
+
+    /// Triangles are clipped [`EYE_CLEARANCE`] in front of the eye plane.
+    fn inverse_chart(&self) -> Option<InverseChart> {
+        Some(InverseChart {
+            clip: vec![in_front(&self.basis, EYE_CLEARANCE)],
+            ..InverseChart::default()
+        })
+    }
+
+    /// The image [`Projection::project`] appends, `None` where it appends nothing.
+    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
         let offset = point - self.basis.origin;
         let local = self.basis.to_local(offset);
         if local.z <= 0.0 {
-            return;
+            return None;
         }
         let centred = DVec2::new(local.x, local.y) / (local.z * self.pixel_size);
-        out.push(ImagePoint {
+        Some(ImagePoint {
             pixel: self.resolution.pixel(centred),
             t: offset.length(),
-        });
+        })
+    }
+}
+
+/// The points at least `distance` in front of the plane through the eye perpendicular to
+/// the view direction.
+fn in_front(basis: &CameraBasis, distance: f64) -> HalfSpace {
+    HalfSpace {
+        normal: basis.forward,
+        offset: basis.forward.dot(basis.origin) + distance,
     }
 }
 
@@ -134,15 +157,25 @@ impl Projection for Orthographic {
     /// point behind the view plane (t < 0) is on no ray (rays start at t = 0) and appends
     /// nothing; a point on the plane has t = 0.
     fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
+        out.extend(
+            self.project_continuous(point)
+                .filter(|image| image.t >= 0.0),
+        );
+    }
+
+    /// The map is linear everywhere: no clip, no wrap, no pole.
+    fn inverse_chart(&self) -> Option<InverseChart> {
+        Some(InverseChart::default())
+    }
+
+    /// The image of `point` extended behind the view plane (negative `t`).
+    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
         let local = self.basis.to_local(point - self.basis.origin);
-        if local.z < 0.0 {
-            return;
-        }
         let centred = DVec2::new(local.x, local.y) / self.pixel_size;
-        out.push(ImagePoint {
+        Some(ImagePoint {
             pixel: self.resolution.pixel(centred),
             t: local.z,
-        });
+        })
     }
 }
 

@@ -10,6 +10,7 @@
 
 mod build;
 mod camera_basis;
+pub mod chart;
 mod fisheye;
 pub mod flexible;
 mod image_coords;
@@ -21,6 +22,7 @@ mod params;
 mod trilinear;
 
 pub use camera_basis::CameraBasis;
+pub use chart::{HalfSpace, InverseChart, Pole};
 pub use fisheye::Fisheye;
 pub use flexible::{Flexible, FlexibleSpec};
 pub use image_coords::Resolution;
@@ -68,6 +70,21 @@ pub trait Projection: Send + Sync {
     /// parameter that reaches it. Projections without an inverse append nothing.
     fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
         let _ = (point, out);
+    }
+
+    /// Where the inverse is a continuous map that a rasteriser can fill triangles by (see
+    /// [`chart`]); `None` when it is not (no inverse, or one that folds or jumps in ways a
+    /// chart cannot describe).
+    fn inverse_chart(&self) -> Option<InverseChart> {
+        None
+    }
+
+    /// The image of `point` on the continuous branch described by [`Projection::inverse_chart`]:
+    /// unclipped to the image and to the visible domain. `None` on the singular set (an eye,
+    /// a pole) and for projections without a chart.
+    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
+        let _ = point;
+        None
     }
 }
 

@@ -8,6 +8,7 @@ use std::f64::consts::PI;
 use glam::{DVec2, DVec3};
 
 use super::camera_basis::CameraBasis;
+use super::chart::{axis_poles, InverseChart};
 use super::image_coords::Resolution;
 use super::params::{angle_radians, UpTo};
 use super::{CameraFrame, ImagePoint, Projection};
@@ -97,18 +98,33 @@ impl Projection for Equirectangular {
     /// Degenerate: the eye appends nothing; a point straight above or below the eye (a pole,
     /// seen by a whole row) appends the centre column only.
     fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
+        out.extend(self.project_continuous(point));
+    }
+
+    /// Longitude wraps every 360 degrees; the poles straight up and down are singular.
+    fn inverse_chart(&self) -> Option<InverseChart> {
+        let top = (0.5 * f64::from(self.resolution.height) - 0.5) * self.radians_per_pixel.y;
+        Some(InverseChart {
+            clip: Vec::new(),
+            period: Some(2.0 * PI / self.radians_per_pixel.x),
+            poles: axis_poles(self.basis.origin, self.basis.up, -top, top),
+        })
+    }
+
+    /// The image [`Projection::project`] appends, `None` where it appends nothing.
+    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
         let offset = point - self.basis.origin;
         let local = self.basis.to_local(offset);
         if local == DVec3::ZERO {
-            return;
+            return None;
         }
         let lon = longitude(local).unwrap_or(0.0);
         let lat = local.y.atan2(DVec2::new(local.x, local.z).length());
         let centred = DVec2::new(lon, lat) / self.radians_per_pixel;
-        out.push(ImagePoint {
+        Some(ImagePoint {
             pixel: self.resolution.pixel(centred),
             t: offset.length(),
-        });
+        })
     }
 }
 
@@ -179,17 +195,30 @@ impl Projection for Cylindrical {
     /// points on the cylinder's axis (the eye and the poles straight above or below it, at
     /// infinite height) append nothing.
     fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
+        out.extend(self.project_continuous(point));
+    }
+
+    /// Longitude wraps every 360 degrees; the poles (at infinite height) are singular.
+    fn inverse_chart(&self) -> Option<InverseChart> {
+        let top = ((0.5 * f64::from(self.resolution.height) - 0.5) * self.height_per_pixel).atan();
+        Some(InverseChart {
+            clip: Vec::new(),
+            period: Some(2.0 * PI / self.radians_per_pixel),
+            poles: axis_poles(self.basis.origin, self.basis.up, -top, top),
+        })
+    }
+
+    /// The image [`Projection::project`] appends, `None` where it appends nothing.
+    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
         let offset = point - self.basis.origin;
         let local = self.basis.to_local(offset);
-        let Some(lon) = longitude(local) else {
-            return;
-        };
+        let lon = longitude(local)?;
         let height = local.y / DVec2::new(local.x, local.z).length();
         let centred = DVec2::new(lon / self.radians_per_pixel, height / self.height_per_pixel);
-        out.push(ImagePoint {
+        Some(ImagePoint {
             pixel: self.resolution.pixel(centred),
             t: offset.length(),
-        });
+        })
     }
 }
 

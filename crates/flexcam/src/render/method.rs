@@ -5,6 +5,7 @@ use std::str::FromStr;
 
 use crate::error::{Error, Result};
 use crate::projection::Projection;
+use crate::render::inverse_raster::InverseRaster;
 use crate::render::raycast::RayCaster;
 use crate::render::{Frame, RenderOptions, Stats};
 use crate::scene::Scene;
@@ -15,11 +16,15 @@ pub enum Method {
     /// The reference ray caster; renders every projection.
     #[default]
     Raycast,
+    /// Rasterisation by the analytic inverse with subdivision (see
+    /// [`crate::render::inverse_raster`]); projections with a continuous inverse only.
+    Raster,
 }
 
 impl Method {
     /// Every method with its command-line name.
-    pub const ALL: [(&'static str, Method); 1] = [("raycast", Method::Raycast)];
+    pub const ALL: [(&'static str, Method); 2] =
+        [("raycast", Method::Raycast), ("raster", Method::Raster)];
 
     /// The command-line name.
     pub fn name(self) -> &'static str {
@@ -43,6 +48,7 @@ impl Method {
         }
         match self {
             Method::Raycast => Ok(RayCaster::new(scene).render(projection, options)),
+            Method::Raster => Ok(InverseRaster::new(scene, projection, options)?.render()),
         }
     }
 }
@@ -82,6 +88,6 @@ mod tests {
             assert_eq!(m.to_string(), name);
         }
         let e = "raster-ish".parse::<Method>().unwrap_err();
-        assert!(e.to_string().contains("available: raycast"), "{e}");
+        assert!(e.to_string().contains("available: raycast, raster"), "{e}");
     }
 }

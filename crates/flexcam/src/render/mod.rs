@@ -23,6 +23,8 @@ pub struct RenderOptions<'a> {
     pub spp: u32,
     /// Maximum number of specular bounces.
     pub max_bounces: u32,
+    /// How method `raster` subdivides triangles (other methods ignore it).
+    pub subdivision: inverse_raster::Subdivision,
     /// Called from worker threads with (work units done, total) as rendering progresses.
     pub progress: Option<&'a (dyn Fn(u64, u64) + Sync)>,
 }
@@ -33,6 +35,7 @@ impl Default for RenderOptions<'_> {
             shading: Shading::Lit,
             spp: 1,
             max_bounces: 8,
+            subdivision: inverse_raster::Subdivision::default(),
             progress: None,
         }
     }
@@ -76,6 +79,7 @@ pub enum Counter {
 /// Named counters a renderer reports (rays cast, build times, ...), for `--stats`.
 pub type Stats = BTreeMap<&'static str, Counter>;
 pub mod compare;
+pub mod inverse_raster;
 mod method;
 pub mod raster;
 pub mod raycast;

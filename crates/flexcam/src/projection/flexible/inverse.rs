@@ -26,9 +26,9 @@ const EDGE: f64 = 1e-9;
 /// An affine surface a + u b + v c.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Affine {
-    a: DVec3,
-    b: DVec3,
-    c: DVec3,
+    pub a: DVec3,
+    pub b: DVec3,
+    pub c: DVec3,
 }
 
 /// The inverse of one invertible volume.
@@ -157,14 +157,21 @@ impl Inverse {
     /// (u, v) outside [0, 1], within a 1e-9 tolerance, then clamped) or on a degenerate
     /// spot (a point where the projectors meet, a polar axis outside the longitude range).
     pub fn solve(&self, p: DVec3) -> Option<(DVec2, f64)> {
-        let (uv, t) = match self {
-            Inverse::Planes { near, far, normal } => planes(near, far, *normal, p)?,
-            Inverse::Spheres { near, far } => spheres(near, far, p)?,
-            Inverse::Cylinders { near, far } => cylinders(near, far, p)?,
-        };
+        let (uv, t) = self.solve_unbounded(p)?;
         let inside = |x: f64| (-EDGE..=1.0 + EDGE).contains(&x);
         (inside(uv.x) && inside(uv.y) && inside(t))
             .then(|| (uv.clamp(DVec2::ZERO, DVec2::ONE), t.clamp(0.0, 1.0)))
+    }
+
+    /// (u, v) and t of `p` extended beyond the volume: the same formulas with no domain test
+    /// (longitudes outside the range continue past its ends). `None` only on the degenerate
+    /// spots of [`Inverse::solve`].
+    pub fn solve_unbounded(&self, p: DVec3) -> Option<(DVec2, f64)> {
+        match self {
+            Inverse::Planes { near, far, normal } => planes(near, far, *normal, p),
+            Inverse::Spheres { near, far } => spheres(near, far, p),
+            Inverse::Cylinders { near, far } => cylinders(near, far, p),
+        }
     }
 }
 

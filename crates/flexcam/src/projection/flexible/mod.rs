@@ -15,6 +15,7 @@
 //! A pixel's ray starts on the near surface and reaches the far surface at t = 1; t is
 //! limited to [0, 1] (the per-projector near and far clip of the framework).
 
+mod chart;
 pub mod fit;
 mod inverse;
 pub mod presets;
@@ -33,6 +34,7 @@ pub use surface::{CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface};
 pub use volume::{LinearVolume, Volume};
 
 use self::inverse::Inverse;
+use super::chart::InverseChart;
 use super::image_coords::Resolution;
 use super::{ImagePoint, Projection};
 use crate::error::Result;
@@ -145,5 +147,19 @@ impl Projection for Flexible {
         if let Some(pixel) = self.reparam.to_pixel(&self.resolution, uv) {
             out.push(ImagePoint { pixel, t });
         }
+    }
+
+    /// The analytic class under the maps that keep the extended inverse continuous (see
+    /// the `chart` module); `None` otherwise, also for volumes with an inverse.
+    fn inverse_chart(&self) -> Option<InverseChart> {
+        self.inverse.as_ref()?.chart(self.reparam, &self.resolution)
+    }
+
+    /// (u, v, t) by the inverse's formulas without the domain test, then the pixel by the
+    /// extended re-parameterisation.
+    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
+        let (uv, t) = self.inverse.as_ref()?.solve_unbounded(point)?;
+        let pixel = self.reparam.to_pixel_unbounded(&self.resolution, uv)?;
+        Some(ImagePoint { pixel, t })
     }
 }

@@ -98,8 +98,15 @@ impl Reparam {
         if !in_domain(uv) {
             return None;
         }
+        self.to_pixel_unbounded(resolution, uv)
+    }
+
+    /// [`Reparam::to_pixel`] extended beyond [0, 1]^2 by the same formulas. `None` where
+    /// they are undefined: a lens-like v below -1/48 (no real radius), a Mercator latitude
+    /// (2v - 1) max_latitude of 90 degrees or more.
+    pub fn to_pixel_unbounded(&self, resolution: &Resolution, uv: DVec2) -> Option<DVec2> {
         let size = resolution.size();
-        Some(match self {
+        let pixel = match self {
             Reparam::Linear => DVec2::new(uv.x * size.x, (1.0 - uv.y) * size.y),
             Reparam::Polar | Reparam::Lens => {
                 let r = if *self == Reparam::Lens {
@@ -114,11 +121,35 @@ impl Reparam {
             }
             Reparam::Mercator { max_latitude } => {
                 let latitude = (2.0 * uv.y - 1.0) * max_latitude;
+                if latitude.abs() >= 0.5 * PI {
+                    return None;
+                }
                 let py = mercator(latitude) / mercator(*max_latitude);
                 let y = resolution.pixel(DVec2::new(0.0, py * 0.5 * size.y)).y;
                 DVec2::new(uv.x * size.x, y)
             }
-        })
+        };
+        pixel.is_finite().then_some(pixel)
+    }
+
+    /// The smallest and largest v over the pixel centres inside the map's domain, `None` when
+    /// no pixel centre is inside it. The linear and Mercator maps take v from the row alone.
+    pub fn v_range(&self, resolution: &Resolution) -> Option<(f64, f64)> {
+        let columns = match self {
+            Reparam::Linear | Reparam::Mercator { .. } => 1,
+            Reparam::Polar | Reparam::Lens => resolution.width,
+        };
+        let mut range: Option<(f64, f64)> = None;
+        for y in 0..resolution.height {
+            for x in 0..columns {
+                let centre = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                if let Some(uv) = self.to_uv(resolution, centre) {
+                    let (lo, hi) = range.unwrap_or((uv.y, uv.y));
+                    range = Some((lo.min(uv.y), hi.max(uv.y)));
+                }
+            }
+        }
+        range
     }
 }
 

@@ -30,6 +30,8 @@ pub use interpolate::Varying;
 pub use polygon::{Polygon, PolygonBatch, Vertex, LIMIT};
 pub use scan::FillRule;
 pub use stats::RasterStats;
+
+use stats::FragmentCounts;
 pub use target::{Fragment, Target};
 
 use polygon::Kind;
@@ -53,9 +55,8 @@ pub fn rasterize<const N: usize>(
     let mut scratch = Scratch::default();
     let mut band = target.band();
     for polygon in polygons.iter() {
-        let (fragments, writes) = draw(&mut band, &polygon, rule, &mut scratch, shader);
-        stats.fragments += fragments;
-        stats.writes += writes;
+        let counts = draw(&mut band, &polygon, rule, &mut scratch, &keep, shader);
+        stats.add_fragments(counts);
     }
     stats.covered = target.covered();
     stats
@@ -69,6 +70,27 @@ pub fn rasterize_parallel<const N: usize>(
     polygons: &PolygonBatch<N>,
     rule: FillRule,
     band_rows: u32,
+    shader: &(impl Fn(&Fragment<N>) -> Vec3 + Sync),
+) -> RasterStats {
+    rasterize_parallel_resolved(target, polygons, rule, band_rows, &keep, shader)
+}
+
+/// Keeps every fragment as interpolated (the resolve step of plain rasterisation).
+fn keep<const N: usize>(_: &mut Fragment<N>) -> bool {
+    true
+}
+
+/// [`rasterize_parallel`] with a resolve step run on every covered fragment before its
+/// z-test: `resolve` may replace the interpolated depth and attributes (a renderer that
+/// computes exact per-pixel values from the fragment's primitive) or discard the fragment by
+/// returning `false` (counted in [`RasterStats::discarded`]). It must be a pure function of
+/// the fragment, like the shader, for the result to stay deterministic.
+pub fn rasterize_parallel_resolved<const N: usize>(
+    target: &mut Target,
+    polygons: &PolygonBatch<N>,
+    rule: FillRule,
+    band_rows: u32,
+    resolve: &(impl Fn(&mut Fragment<N>) -> bool + Sync),
     shader: &(impl Fn(&Fragment<N>) -> Vec3 + Sync),
 ) -> RasterStats {
     let band_rows = band_rows.max(1);
@@ -86,21 +108,20 @@ pub fn rasterize_parallel<const N: usize>(
             }
         }
     }
-    let (fragments, writes) = target
+    let counts = target
         .bands(band_rows)
         .into_par_iter()
         .zip(bins)
         .map(|(mut band, bin)| {
             let mut scratch = Scratch::default();
-            bin.iter().fold((0, 0), |(f, w), &i| {
-                let (df, dw) = draw(&mut band, &polygons.get(i), rule, &mut scratch, shader);
-                (f + df, w + dw)
+            bin.iter().fold(FragmentCounts::default(), |sum, &i| {
+                let polygon = polygons.get(i);
+                sum + draw(&mut band, &polygon, rule, &mut scratch, resolve, shader)
             })
         })
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        .reduce(FragmentCounts::default, |a, b| a + b);
     let mut stats = count_shapes(polygons);
-    stats.fragments = fragments;
-    stats.writes = writes;
+    stats.add_fragments(counts);
     stats.covered = target.covered();
     stats
 }
@@ -118,26 +139,31 @@ fn count_shapes<const N: usize>(polygons: &PolygonBatch<N>) -> RasterStats {
     stats
 }
 
-/// Draws one shape into the rows of `band`; returns (fragments, writes).
+/// Draws one shape into the rows of `band`, resolving each fragment before its z-test.
 fn draw<const N: usize>(
     band: &mut Band<'_>,
     polygon: &Polygon<'_, N>,
     rule: FillRule,
     scratch: &mut Scratch<N>,
+    resolve: &impl Fn(&mut Fragment<N>) -> bool,
     shader: &impl Fn(&Fragment<N>) -> Vec3,
-) -> (u64, u64) {
-    let (mut fragments, mut writes) = (0, 0);
+) -> FragmentCounts {
+    let mut counts = FragmentCounts::default();
     let (rows, width) = (band.rows, band.width);
     let mut emit = |x, y, varying| {
-        let fragment = Fragment {
+        let mut fragment = Fragment {
             x,
             y,
             varying,
             object: polygon.object,
             primitive: polygon.primitive,
         };
-        fragments += 1;
-        writes += u64::from(band.test_and_write(&fragment, shader));
+        counts.fragments += 1;
+        if resolve(&mut fragment) {
+            counts.writes += u64::from(band.test_and_write(&fragment, shader));
+        } else {
+            counts.discarded += 1;
+        }
     };
     match polygon.kind() {
         Kind::Fill => scan::fill(polygon, rule, rows, width, scratch, &mut emit),
@@ -150,5 +176,5 @@ fn draw<const N: usize>(
         ),
         Kind::Skip => {}
     }
-    (fragments, writes)
+    counts
 }

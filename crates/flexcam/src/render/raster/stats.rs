@@ -16,6 +16,9 @@ pub struct RasterStats {
     pub fragments: u64,
     /// Fragments that passed the z-test and were shaded and written.
     pub writes: u64,
+    /// Fragments dropped by a resolve step before the z-test (see
+    /// [`super::rasterize_parallel_resolved`]).
+    pub discarded: u64,
     /// Pixels of the target holding a fragment after the pass.
     pub covered: u64,
 }
@@ -28,7 +31,15 @@ impl RasterStats {
         self.skipped += other.skipped;
         self.fragments += other.fragments;
         self.writes += other.writes;
+        self.discarded += other.discarded;
         self.covered += other.covered;
+    }
+
+    /// Adds the fragment counts of some drawing.
+    pub(super) fn add_fragments(&mut self, counts: FragmentCounts) {
+        self.fragments += counts.fragments;
+        self.writes += counts.writes;
+        self.discarded += counts.discarded;
     }
 
     /// Fragments per covered pixel (1 = no overdraw); 0 when nothing is covered.
@@ -48,10 +59,31 @@ impl RasterStats {
             ("raster_skipped", self.skipped),
             ("raster_fragments", self.fragments),
             ("raster_writes", self.writes),
+            ("raster_discarded", self.discarded),
             ("raster_covered", self.covered),
         ] {
             stats.insert(name, Counter::Count(value));
         }
         stats.insert("raster_overdraw", Counter::Value(self.overdraw()));
+    }
+}
+
+/// What drawing some shapes did with their fragments.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(super) struct FragmentCounts {
+    pub fragments: u64,
+    pub writes: u64,
+    pub discarded: u64,
+}
+
+impl std::ops::Add for FragmentCounts {
+    type Output = FragmentCounts;
+
+    fn add(self, other: FragmentCounts) -> FragmentCounts {
+        FragmentCounts {
+            fragments: self.fragments + other.fragments,
+            writes: self.writes + other.writes,
+            discarded: self.discarded + other.discarded,
+        }
     }
 }

@@ -190,6 +190,14 @@ impl RayCaster {
         (frame, stats)
     }
 
+    /// The colour the reference shading gives primary ray `ray` whose first hit `hit` was
+    /// found by other means (a rasteriser that reconstructs the hit of each pixel's ray):
+    /// flat or lit by `options.shading`, with the same secondary and shadow rays as
+    /// [`RayCaster::render`], so that such a renderer shades exactly like the ray caster.
+    pub fn shade_hit(&self, ray: &Ray, hit: Hit, options: &RenderOptions) -> Vec3 {
+        shade::Tracer::new(self, options).shade_hit(ray, hit)
+    }
+
     /// A ray leaving surface point `point` (geometric normal `normal`) along `direction`,
     /// started [`RayCaster::offset`] off the surface on the side `direction` points to, so that
     /// it does not hit the surface it leaves.

@@ -163,6 +163,14 @@ impl<'a> Tracer<'a> {
         }
     }
 
+    /// The colour of primary ray `ray` whose first hit is `hit` (exact, f64).
+    pub fn shade_hit(&mut self, ray: &Ray, hit: Hit) -> Vec3 {
+        match self.shading {
+            Shading::Flat => self.flat(ray, hit),
+            Shading::Lit => self.lit(ray, hit, 0, 1.0),
+        }
+    }
+
     /// Flat shading from the first hit on: follow mirrors and glass, show a base colour.
     fn flat(&mut self, ray: &Ray, hit: Hit) -> Vec3 {
         let (mut ray, mut hit) = (*ray, hit);

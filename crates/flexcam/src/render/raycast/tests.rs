@@ -105,7 +105,7 @@ fn flat(max_bounces: u32) -> RenderOptions<'static> {
         shading: Shading::Flat,
         spp: 1,
         max_bounces,
-        progress: None,
+        ..RenderOptions::default()
     }
 }
 
@@ -453,6 +453,7 @@ fn rendering_is_deterministic_across_thread_counts_and_reports_progress() {
         spp: 4,
         max_bounces: 8,
         progress: Some(&progress),
+        ..RenderOptions::default()
     };
     let render_with = |threads| {
         let pool = rayon::ThreadPoolBuilder::new()

@@ -1,0 +1,155 @@
+//! The [`InverseChart`] of an invertible flexible volume: where its extended inverse
+//! ([`Inverse::solve_unbounded`] followed by [`Reparam::to_pixel_unbounded`]) is continuous,
+//! for rasterisation.
+//!
+//! - Parallel planes (linear re-parameterisation only): triangles are clipped to t in [0, 1]
+//!   (pulled in by [`END_MARGIN`] at an end whose cross-section is a point or a line, where
+//!   the image is at infinity). A volume whose cross-section degenerates strictly inside it
+//!   (a crossed-slits volume with its slit between the near and far surfaces) has no chart:
+//!   the image flips there.
+//! - Nested spheres: the image depends only on the direction from the centre; the poles
+//!   +-axis are singular, the longitude wraps every 360 degrees (linear and Mercator maps).
+//!   With the polar maps the longitude is the azimuth of the image, continuous when the
+//!   patch spans 360 degrees and starts (v = 0) at a pole; that pole is the image centre and
+//!   only the other one is singular.
+//! - Coaxial cylinders (linear map only) whose near surface is a single point on the axis
+//!   (the cylindrical preset): the image depends only on the direction from that point, with
+//!   poles along +-axis. Other cylinder volumes have no chart (their axis is singular at a
+//!   finite image row, which a chart cannot describe).
+
+use std::f64::consts::{FRAC_PI_2, PI};
+
+use glam::DVec3;
+
+use super::inverse::{Affine, Inverse};
+use super::reparam::Reparam;
+use super::surface::{lerp_range, CylinderPatch, SpherePatch};
+use crate::geometry::solve_quadratic;
+use crate::projection::chart::{axis_poles, HalfSpace, InverseChart};
+use crate::projection::image_coords::Resolution;
+
+/// The fraction of the volume's depth left out at an end where the cross-section
+/// degenerates (a pinhole or a slit): the image of that end is at infinity.
+pub const END_MARGIN: f64 = 1e-9;
+
+/// Relative size below which a cross-section counts as degenerate.
+const FLAT: f64 = 1e-12;
+
+impl Inverse {
+    /// The chart of this volume under `reparam` on an image of `resolution`, or `None` when
+    /// the extended inverse is not continuous in a way a chart describes (see the module).
+    pub fn chart(&self, reparam: Reparam, resolution: &Resolution) -> Option<InverseChart> {
+        match self {
+            Inverse::Planes { near, far, normal } => {
+                (reparam == Reparam::Linear).then_some(())?;
+                planes_chart(near, far, *normal)
+            }
+            Inverse::Spheres { near, .. } => spheres_chart(near, reparam, resolution),
+            Inverse::Cylinders { near, far } => {
+                (reparam == Reparam::Linear).then_some(())?;
+                cylinders_chart(near, far, resolution)
+            }
+        }
+    }
+}
+
+fn planes_chart(near: &Affine, far: &Affine, n: DVec3) -> Option<InverseChart> {
+    // The signed cross-section area (b(t) x c(t)) . n is a quadratic in t.
+    let (db, dc) = (far.b - near.b, far.c - near.c);
+    let f0 = near.b.cross(near.c).dot(n);
+    let f1 = (near.b.cross(dc) + db.cross(near.c)).dot(n);
+    let f2 = db.cross(dc).dot(n);
+    let area = |t: f64| f0 + t * (f1 + t * f2);
+    let scale = [0.0, 0.5, 1.0]
+        .map(|t| area(t).abs())
+        .into_iter()
+        .fold(0.0, f64::max);
+    let flat = |t: f64| area(t).abs() <= FLAT * scale;
+    let lo = if flat(0.0) { END_MARGIN } else { 0.0 };
+    let hi = if flat(1.0) { 1.0 - END_MARGIN } else { 1.0 };
+    let roots = solve_quadratic(f2, f1, f0);
+    if roots.is_identically_zero() || roots.into_iter().any(|t| lo < t && t < hi) {
+        return None;
+    }
+    // t(p) = s . (p - near.a).
+    let s = n / (far.a - near.a).dot(n);
+    let base = s.dot(near.a);
+    Some(InverseChart {
+        clip: vec![
+            HalfSpace {
+                normal: s,
+                offset: lo + base,
+            },
+            HalfSpace {
+                normal: -s,
+                offset: -hi - base,
+            },
+        ],
+        ..InverseChart::default()
+    })
+}
+
+/// The horizontal period in pixels of a map linear in u, for an angle range `range`.
+fn period(range: [f64; 2], resolution: &Resolution) -> f64 {
+    f64::from(resolution.width) * 2.0 * PI / (range[1] - range[0]).abs()
+}
+
+fn spheres_chart(
+    near: &SpherePatch,
+    reparam: Reparam,
+    resolution: &Resolution,
+) -> Option<InverseChart> {
+    let (v_lo, v_hi) = reparam.v_range(resolution)?;
+    let (a, b) = (
+        lerp_range(near.latitude, v_lo),
+        lerp_range(near.latitude, v_hi),
+    );
+    let mut poles = axis_poles(near.center, near.frame.axis, a.min(b), a.max(b));
+    let period = match reparam {
+        Reparam::Linear => Some(period(near.longitude, resolution)),
+        Reparam::Mercator { max_latitude } => {
+            // Every latitude in [-90, 90] must stay on the finite part of the map.
+            let finite = [-FRAC_PI_2, FRAC_PI_2].into_iter().all(|lat| {
+                let v = (lat - near.latitude[0]) / (near.latitude[1] - near.latitude[0]);
+                ((2.0 * v - 1.0) * max_latitude).abs() < FRAC_PI_2
+            });
+            finite.then_some(())?;
+            Some(period(near.longitude, resolution))
+        }
+        Reparam::Polar | Reparam::Lens => {
+            let full = ((near.longitude[1] - near.longitude[0]).abs() - 2.0 * PI).abs() <= FLAT;
+            let start = near.latitude[0];
+            let at_pole = (start.abs() - FRAC_PI_2).abs() <= FLAT;
+            (full && at_pole).then_some(())?;
+            // The pole at v = 0 is the image centre: not singular.
+            poles.remove(if start > 0.0 { 0 } else { 1 });
+            None
+        }
+    };
+    Some(InverseChart {
+        clip: Vec::new(),
+        period,
+        poles,
+    })
+}
+
+fn cylinders_chart(
+    near: &CylinderPatch,
+    far: &CylinderPatch,
+    resolution: &Resolution,
+) -> Option<InverseChart> {
+    let point = near.radius == 0.0 && near.height[0] == near.height[1];
+    point.then_some(())?;
+    let axis = near.frame.axis;
+    let eye = near.center + near.height[0] * axis;
+    // The elevation from the eye of v: tan = (far height(v) - eye height) / far radius.
+    let shift = (far.center - near.center).dot(axis) - near.height[0];
+    let elevation = |v: f64| ((lerp_range(far.height, v) + shift) / far.radius).atan();
+    let (v_lo, v_hi) = Reparam::Linear.v_range(resolution)?;
+    let (a, b) = (elevation(v_lo), elevation(v_hi));
+    Some(InverseChart {
+        clip: Vec::new(),
+        period: Some(period(near.angle, resolution)),
+        poles: axis_poles(eye, axis, a.min(b), a.max(b)),
+    })
+}

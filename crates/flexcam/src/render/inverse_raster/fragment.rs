@@ -1,0 +1,173 @@
+//! Per-fragment reconstruction and shading: a fragment is a pixel covered by the image of a
+//! piece of scene triangle; its scene point is where the pixel's projector meets the plane
+//! of that triangle, so its depth, barycentrics and colour are the ray caster's exactly, and
+//! only coverage (which triangle a pixel near a silhouette gets) depends on subdivision.
+//!
+//! The depth is the ray caster's: `t |direction|`, the distance along the projector from its
+//! origin. Fragments whose projector meets the plane outside the projector's range (behind a
+//! perspective eye, t outside [0, 1] of a flexible volume: the per-projector near and far
+//! clip), or runs parallel to it, are discarded. Barycentrics just outside the triangle (a
+//! silhouette pixel the polygon covers but the exact image does not) are clamped onto it.
+
+use glam::{DVec3, Vec2, Vec3};
+
+use super::pixel_rays::PixelRays;
+use crate::geometry::Ray;
+use crate::render::raster::Fragment;
+use crate::render::raycast::{Hit, RayCaster};
+use crate::render::surface::{base_color, TextureFilter};
+use crate::render::{RenderOptions, Shading};
+use crate::scene::{Object, Surface};
+
+/// Attributes carried by a resolved fragment: barycentrics (u, v) and the ray parameter t.
+pub const ATTRIBUTES: usize = 3;
+
+/// The primitive key of triangle `triangle` of object index `object`: objects in the high
+/// half, so keys order like (object, triangle).
+pub fn key(object: usize, triangle: usize) -> u64 {
+    ((object as u64) << 32) | triangle as u64
+}
+
+/// The object index and triangle of a key.
+fn unkey(key: u64) -> (usize, usize) {
+    ((key >> 32) as usize, (key & 0xffff_ffff) as usize)
+}
+
+/// Reconstructs and shades fragments of one render.
+pub struct Shader<'a> {
+    pub objects: &'a [Object],
+    pub rays: &'a PixelRays,
+    /// The ray caster, for what flat base colours cannot give: lit shading (lights,
+    /// shadows) and mirrors and glass (secondary rays). `None` when neither is needed.
+    pub caster: Option<&'a RayCaster>,
+    pub options: &'a RenderOptions<'a>,
+}
+
+impl Shader<'_> {
+    /// The resolve step: exact depth and attributes from the pixel's projector, or `false`
+    /// to discard.
+    pub fn resolve(&self, fragment: &mut Fragment<ATTRIBUTES>) -> bool {
+        let Some(ray) = self.rays.get(fragment.x, fragment.y) else {
+            return false;
+        };
+        let (object, triangle) = unkey(fragment.primitive);
+        let mesh = &self.objects[object].mesh;
+        let [a, b, c] = mesh.triangles[triangle].map(|i| mesh.positions[i as usize].as_dvec3());
+        let Some((t, u, v)) = plane_hit(ray, [a, b, c]) else {
+            return false;
+        };
+        fragment.varying.depth = t * ray.direction.length();
+        fragment.varying.attributes = [u, v, t];
+        true
+    }
+
+    /// The colour of a resolved fragment.
+    pub fn shade(&self, fragment: &Fragment<ATTRIBUTES>) -> Vec3 {
+        let (object_index, triangle) = unkey(fragment.primitive);
+        let object = &self.objects[object_index];
+        let [u, v, t] = fragment.varying.attributes;
+        let barycentric = Vec2::new(u as f32, v as f32);
+        let flat = matches!(
+            object.material.surface,
+            Surface::Diffuse | Surface::Emissive
+        );
+        match (
+            self.options.shading,
+            self.caster,
+            self.rays.get(fragment.x, fragment.y),
+        ) {
+            (Shading::Flat, _, _) if flat => {
+                base_color(object, triangle, barycentric, TextureFilter::Nearest)
+            }
+            (_, Some(caster), Some(ray)) => {
+                let hit = Hit {
+                    t,
+                    object: object_index,
+                    triangle,
+                    barycentric,
+                };
+                caster.shade_hit(ray, hit, self.options)
+            }
+            // Unreachable by construction (the caster exists whenever shading needs it and
+            // resolved fragments have a ray); the base colour is the safe answer.
+            _ => base_color(object, triangle, barycentric, TextureFilter::Nearest),
+        }
+    }
+}
+
+/// Where `ray` meets the plane of triangle `[a, b, c]`: its parameter t within the ray's
+/// range and the barycentrics (u, v) of the second and third vertices, clamped onto the
+/// triangle. `None` for a ray parallel to the plane (or a zero-area triangle) and for t
+/// outside `[t_min, t_max]`.
+pub fn plane_hit(ray: &Ray, [a, b, c]: [DVec3; 3]) -> Option<(f64, f64, f64)> {
+    let (e1, e2) = (b - a, c - a);
+    let p = ray.direction.cross(e2);
+    let det = e1.dot(p);
+    if det == 0.0 || !det.is_finite() {
+        return None;
+    }
+    let inv = 1.0 / det;
+    let s = ray.origin - a;
+    let q = s.cross(e1);
+    let t = e2.dot(q) * inv;
+    if !(ray.t_min..=ray.t_max).contains(&t) {
+        return None;
+    }
+    let (mut u, mut v) = (
+        (s.dot(p) * inv).max(0.0),
+        (ray.direction.dot(q) * inv).max(0.0),
+    );
+    if u + v > 1.0 {
+        let sum = u + v;
+        (u, v) = (u / sum, v / sum);
+    }
+    Some((t, u, v))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn triangle() -> [DVec3; 3] {
+        [
+            DVec3::new(0.0, 0.0, -2.0),
+            DVec3::new(1.0, 0.0, -2.0),
+            DVec3::new(0.0, 1.0, -2.0),
+        ]
+    }
+
+    #[test]
+    fn plane_hit_inside_and_clamped_outside() {
+        let ray = Ray::new(DVec3::ZERO, DVec3::new(0.25, 0.25, -1.0));
+        let (t, u, v) = plane_hit(&ray, triangle()).unwrap();
+        assert!((t - 2.0).abs() < 1e-15 && (u - 0.5).abs() < 1e-15 && (v - 0.5).abs() < 1e-15);
+        // Outside the triangle (u + v = 2, u < 0 would be -): clamped onto it.
+        let outside = Ray::new(DVec3::ZERO, DVec3::new(1.0, 1.0, -1.0));
+        let (_, u, v) = plane_hit(&outside, triangle()).unwrap();
+        assert!((u + v - 1.0).abs() < 1e-15);
+        let left = Ray::new(DVec3::ZERO, DVec3::new(-0.5, 0.1, -1.0));
+        assert_eq!(plane_hit(&left, triangle()).unwrap().1, 0.0);
+    }
+
+    /// Degenerate: parallel rays, zero-area triangles and hits outside the ray's range.
+    #[test]
+    fn plane_hit_misses() {
+        let parallel = Ray::new(DVec3::ZERO, DVec3::X);
+        assert!(plane_hit(&parallel, triangle()).is_none());
+        let flat = [DVec3::ZERO, DVec3::X, DVec3::X * 2.0];
+        assert!(plane_hit(&Ray::new(DVec3::Y, DVec3::NEG_Y), flat).is_none());
+        let away = Ray::new(DVec3::ZERO, DVec3::Z);
+        assert!(plane_hit(&away, triangle()).is_none());
+        let short = Ray {
+            t_max: 1.0,
+            ..Ray::new(DVec3::ZERO, DVec3::NEG_Z)
+        };
+        assert!(plane_hit(&short, triangle()).is_none());
+    }
+
+    #[test]
+    fn keys_round_trip_and_order_by_object() {
+        assert_eq!(unkey(key(3, 12345)), (3, 12345));
+        assert!(key(1, 0) > key(0, u32::MAX as usize));
+    }
+}

@@ -1,0 +1,335 @@
+//! `--method raster`: rasterisation of nonlinear projections by their analytic inverse
+//! (seed 003, 7.3 and 9.4).
+//!
+//! Per frame:
+//! 1. every scene vertex is projected once through [`Projection::project_continuous`] (the
+//!    per-vertex cache shared by the triangles around it);
+//! 2. each triangle is clipped in 3D to the chart's half-spaces ([`clip`]), cut by the
+//!    uniform grid and refined adaptively ([`refine`]) until the straight polygon of each
+//!    piece's projected corners follows its curved image within the tolerance;
+//! 3. each piece is placed on the screen ([`seam`]): unwrapped across a panorama's seam and
+//!    drawn once more on the other side when it straddles it; pieces around a pole are
+//!    dropped (they cover no pixel centre);
+//! 4. the pieces are filled by the polygon rasteriser in parallel bands; each fragment
+//!    reconstructs its scene point exactly from its pixel's projector ([`fragment`]), so
+//!    depth and shading are the ray caster's and only coverage near silhouettes depends on
+//!    the subdivision.
+//!
+//! Shading: flat base colours are computed here; lit shading (lights and shadows) and the
+//! secondary rays of mirrors and glass are delegated, per visible pixel, to the ray caster's
+//! own shading of the reconstructed hit ([`RayCaster::shade_hit`]), so a BVH is built when
+//! the render needs one. One sample per pixel (`--spp 1`).
+//!
+//! Supported: every projection with an [`InverseChart`] (perspective, orthographic,
+//! fisheye, equirectangular, cylindrical, and the flexible volumes described in
+//! `projection::flexible::chart`); others are refused with one line naming the projection.
+
+mod clip;
+mod fragment;
+mod pixel_rays;
+mod refine;
+mod seam;
+mod subdivision;
+#[cfg(test)]
+mod tests;
+
+use std::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+
+pub use subdivision::{Subdivision, DEFAULT_TOLERANCE, MAX_LEVEL, MAX_UNIFORM};
+
+use self::fragment::{key, Shader, ATTRIBUTES};
+use self::pixel_rays::PixelRays;
+use self::refine::{Node, Refiner};
+use self::seam::{place, Placement};
+use crate::error::{Error, Result};
+use crate::projection::{InverseChart, Projection};
+use crate::render::raster::{
+    rasterize_parallel_resolved, FillRule, PolygonBatch, Target, Vertex, BAND_ROWS,
+};
+use crate::render::raycast::RayCaster;
+use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
+use crate::scene::{Scene, Surface};
+
+/// Scene triangles per parallel task when building pieces.
+const CHUNK: usize = 2048;
+
+/// A scene and a projection prepared for rasterisation: the chart, the pixel projectors and,
+/// when shading needs rays, the ray caster.
+pub struct InverseRaster<'a> {
+    scene: &'a Scene,
+    projection: &'a dyn Projection,
+    chart: InverseChart,
+    rays: PixelRays,
+    caster: Option<RayCaster>,
+    options: RenderOptions<'a>,
+    setup_ms: f64,
+}
+
+/// What piece building did, for `--stats`.
+#[derive(Debug, Clone, Copy, Default)]
+struct PieceCounts {
+    /// Scene triangles clipped by a chart half-space (partly or wholly outside).
+    clipped: u64,
+    /// Pieces after subdivision.
+    pieces: u64,
+    /// Pieces crossed by a pole, dropped.
+    pole_pieces: u64,
+    /// Pieces with a corner on the singular set (an eye, a pole), dropped.
+    singular: u64,
+    /// Pieces whose outline winds around a pole, dropped.
+    winding: u64,
+    /// Screen triangles handed to the rasteriser (a seam straddler counts twice).
+    drawn: u64,
+}
+
+impl std::ops::AddAssign for PieceCounts {
+    fn add_assign(&mut self, o: PieceCounts) {
+        self.clipped += o.clipped;
+        self.pieces += o.pieces;
+        self.pole_pieces += o.pole_pieces;
+        self.singular += o.singular;
+        self.winding += o.winding;
+        self.drawn += o.drawn;
+    }
+}
+
+/// The projection's chart, or the one-line refusal of method raster.
+pub fn supported_chart(projection: &dyn Projection) -> Result<InverseChart> {
+    let kind = projection.kind();
+    if !projection.has_inverse() {
+        return Err(Error::new(format!(
+            "method raster needs a projection with an analytic inverse; {kind} has none \
+             (use --method raycast)"
+        )));
+    }
+    let chart = projection.inverse_chart().ok_or_else(|| {
+        Error::new(format!(
+            "method raster needs a projection with an analytic inverse it can fill triangles \
+             by; this {kind} projection's inverse is not continuous in a way it handles \
+             (see docs/raster.md; use --method raycast)"
+        ))
+    })?;
+    if chart.clip.len() > clip::MAX_PLANES {
+        return Err(Error::new(format!(
+            "method raster: {kind} projection clips by {} planes, at most {} are supported",
+            chart.clip.len(),
+            clip::MAX_PLANES
+        )));
+    }
+    Ok(chart)
+}
+
+impl<'a> InverseRaster<'a> {
+    /// Prepares `scene` and `projection` with `options`. Errors: a projection outside the
+    /// supported class, an invalid subdivision, more than one sample per pixel.
+    pub fn new(
+        scene: &'a Scene,
+        projection: &'a dyn Projection,
+        options: &RenderOptions<'a>,
+    ) -> Result<Self> {
+        let chart = supported_chart(projection)?;
+        options.subdivision.validate()?;
+        if options.spp != 1 {
+            return Err(Error::new(format!(
+                "method raster renders one sample per pixel; got --spp {}",
+                options.spp
+            )));
+        }
+        let start = Instant::now();
+        let rays = PixelRays::new(projection);
+        let specular = scene
+            .objects
+            .iter()
+            .any(|o| !matches!(o.material.surface, Surface::Diffuse | Surface::Emissive));
+        let caster = (options.shading == Shading::Lit || specular).then(|| RayCaster::new(scene));
+        Ok(InverseRaster {
+            scene,
+            projection,
+            chart,
+            rays,
+            caster,
+            options: *options,
+            setup_ms: start.elapsed().as_secs_f64() * 1e3,
+        })
+    }
+
+    /// Renders one frame: colour, depth (the ray caster's distance along the projector) and
+    /// object ids, with the counters of every stage.
+    pub fn render(&self) -> (Frame, Stats) {
+        let start = Instant::now();
+        let (batch, counts) = self.pieces();
+        let pieces_ms = start.elapsed().as_secs_f64() * 1e3;
+        let (width, height) = self.projection.resolution();
+        let mut target = Target::new(width, height, self.scene.image.background);
+        let shader = Shader {
+            objects: &self.scene.objects,
+            rays: &self.rays,
+            caster: self.caster.as_ref(),
+            options: &self.options,
+        };
+        let raster = rasterize_parallel_resolved(
+            &mut target,
+            &batch,
+            FillRule::NonZero,
+            BAND_ROWS,
+            &|f| shader.resolve(f),
+            &|f| shader.shade(f),
+        );
+        let mut stats = Stats::new();
+        raster.record(&mut stats);
+        let count = |n: u64| Counter::Count(n);
+        for (name, value) in [
+            ("triangles", self.scene.triangle_count() as u64),
+            ("raster_clipped_triangles", counts.clipped),
+            ("raster_pieces", counts.pieces),
+            ("raster_pole_pieces", counts.pole_pieces),
+            ("raster_singular_pieces", counts.singular),
+            ("raster_winding_pieces", counts.winding),
+            ("raster_screen_triangles", counts.drawn),
+            (
+                "raster_uniform",
+                u64::from(self.options.subdivision.uniform),
+            ),
+        ] {
+            stats.insert(name, count(value));
+        }
+        let tolerance = self.options.subdivision.tolerance.unwrap_or(0.0);
+        for (name, value) in [
+            ("raster_tolerance_px", tolerance),
+            ("raster_setup_ms", self.setup_ms),
+            ("raster_pieces_ms", pieces_ms),
+            (
+                "raster_fill_ms",
+                start.elapsed().as_secs_f64() * 1e3 - pieces_ms,
+            ),
+        ] {
+            stats.insert(name, Counter::Value(value));
+        }
+        (target.into_frame(), stats)
+    }
+
+    /// Steps 1 to 3 of the module documentation: the screen triangles of every scene
+    /// triangle, in scene order (object, then triangle), with their counters.
+    fn pieces(&self) -> (PolygonBatch<ATTRIBUTES>, PieceCounts) {
+        let refiner = Refiner::new(
+            self.projection,
+            &self.chart,
+            self.options.subdivision.tolerance,
+        );
+        let images: Vec<Vec<Option<DVec2>>> = self
+            .scene
+            .objects
+            .iter()
+            .map(|o| {
+                let positions = &o.mesh.positions;
+                positions
+                    .par_iter()
+                    .map(|p| refiner.node(p.as_dvec3()).image)
+                    .collect()
+            })
+            .collect();
+        let jobs: Vec<(usize, Range<usize>)> = self
+            .scene
+            .objects
+            .iter()
+            .enumerate()
+            .flat_map(|(o, object)| {
+                let n = object.mesh.triangles.len();
+                (0..n.div_ceil(CHUNK)).map(move |k| (o, k * CHUNK..((k + 1) * CHUNK).min(n)))
+            })
+            .collect();
+        let done = AtomicU64::new(0);
+        let parts: Vec<(PolygonBatch<ATTRIBUTES>, PieceCounts)> = jobs
+            .par_iter()
+            .map(|(o, range)| {
+                let mut part = (PolygonBatch::new(), PieceCounts::default());
+                let mut grid = Vec::new();
+                for triangle in range.clone() {
+                    self.triangle(&refiner, &images[*o], (*o, triangle), &mut grid, &mut part);
+                }
+                if let Some(progress) = self.options.progress {
+                    progress(done.fetch_add(1, Ordering::Relaxed) + 1, jobs.len() as u64);
+                }
+                part
+            })
+            .collect();
+        let mut batch = PolygonBatch::new();
+        let mut counts = PieceCounts::default();
+        for (part, part_counts) in &parts {
+            batch.append(part);
+            counts += *part_counts;
+        }
+        (batch, counts)
+    }
+
+    /// Clips, subdivides and places triangle `triangle` of object index `object`, whose
+    /// vertex images are `images`.
+    fn triangle(
+        &self,
+        refiner: &Refiner<'_>,
+        images: &[Option<DVec2>],
+        (object, triangle): (usize, usize),
+        grid: &mut Vec<Node>,
+        (batch, counts): &mut (PolygonBatch<ATTRIBUTES>, PieceCounts),
+    ) {
+        let item = &self.scene.objects[object];
+        let corners = item.mesh.triangles[triangle].map(|i| i as usize);
+        let points: [DVec3; 3] = corners.map(|i| item.mesh.positions[i].as_dvec3());
+        let (id, key) = (item.id, key(object, triangle));
+        let size = DVec2::new(
+            f64::from(self.projection.resolution().0),
+            f64::from(self.projection.resolution().1),
+        );
+        let period = self.chart.period;
+        let inside = self
+            .chart
+            .clip
+            .iter()
+            .all(|h| points.iter().all(|&p| h.signed_distance(p) >= 0.0));
+        if !inside {
+            counts.clipped += 1;
+        }
+        let mut draw = |nodes: [Node; 3]| {
+            counts.pieces += 1;
+            if refiner.is_pole_piece(nodes.map(|n| n.point)) {
+                counts.pole_pieces += 1;
+                return;
+            }
+            let [Some(a), Some(b), Some(c)] = nodes.map(|n| n.image) else {
+                counts.singular += 1;
+                return;
+            };
+            let placed = place([a, b, c], size, period, |screen| {
+                let vertices = screen.map(|p| Vertex::new(p.x, p.y, 0.0, [0.0; ATTRIBUTES]));
+                batch.push(&vertices, id, key);
+            });
+            match placed {
+                Placement::Copies(n) => counts.drawn += u64::from(n),
+                Placement::Winds => counts.winding += 1,
+            }
+        };
+        let uniform = self.options.subdivision.uniform;
+        let mut subdivide = |nodes: [Node; 3], grid: &mut Vec<Node>| {
+            refiner.uniform(nodes, uniform, grid, &mut |piece| {
+                refiner.refine(piece, [0; 3], &mut draw)
+            });
+        };
+        if inside {
+            let nodes = [0, 1, 2].map(|k| Node {
+                point: points[k],
+                image: images[corners[k]],
+            });
+            subdivide(nodes, grid);
+        } else {
+            let clipped = clip::clip(points, &self.chart.clip);
+            for fan in clipped.fan() {
+                subdivide(fan.map(|p| refiner.node(p)), grid);
+            }
+        }
+    }
+}

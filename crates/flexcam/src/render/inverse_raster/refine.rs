@@ -1,0 +1,247 @@
+//! Subdivision of scene triangles into pieces small enough that filling the straight-edged
+//! polygon of their projected corners approximates their curved image: a uniform grid, then
+//! adaptive halving of edges.
+//!
+//! Crack-free by construction: every decision about an edge (split or not, and where its
+//! midpoint goes) is taken from that edge's own data, its two end points and its level, in a
+//! canonical order of the ends ([`canonical`]), so the two triangles sharing an edge always
+//! agree and no T-junction appears. A triangle whose edges split is re-triangulated with the
+//! new midpoints (one, two or three of them), and the pieces are refined again.
+//!
+//! The adaptive rule halves an edge when
+//! - its projected midpoint lies more than `tolerance` pixels off the straight line between
+//!   its projected ends (unwrapped across a panorama's seam), or
+//! - it is longer, seen from a pole's centre, than the pole's clearance and lies within twice
+//!   its length of the pole: pieces containing a pole are thus brought within the clearance,
+//!   where they cover no pixel centre and are dropped (see [`Refiner::is_pole_piece`]).
+//!
+//! Degenerate cases: an edge whose ends coincide is never split; an edge with an end or a
+//! midpoint without image (on an eye or a pole) is not split by the midpoint rule (its
+//! pieces are dropped when drawn); edges stop splitting at [`MAX_LEVEL`] halvings.
+
+use glam::{DVec2, DVec3};
+
+use super::clip::canonical;
+use super::subdivision::MAX_LEVEL;
+use crate::geometry::intersect_triangle;
+use crate::projection::{InverseChart, Pole, Projection};
+
+/// A point of a scene triangle and its image (`None` on the singular set).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Node {
+    pub point: DVec3,
+    pub image: Option<DVec2>,
+}
+
+/// Decides and performs subdivision for one projection.
+pub struct Refiner<'a> {
+    projection: &'a dyn Projection,
+    chart: &'a InverseChart,
+    tolerance: Option<f64>,
+}
+
+/// `x` moved by a whole number of periods to within half a period of `reference`, and the
+/// number of periods added.
+pub fn unwrap(x: f64, reference: f64, period: Option<f64>) -> (f64, i64) {
+    match period {
+        Some(p) => {
+            let k = ((reference - x) / p).round();
+            (x + k * p, k as i64)
+        }
+        None => (x, 0),
+    }
+}
+
+/// The angle at `origin` between `a` and `b`.
+fn angle_between(a: DVec3, b: DVec3) -> f64 {
+    a.cross(b).length().atan2(a.dot(b))
+}
+
+impl<'a> Refiner<'a> {
+    pub fn new(
+        projection: &'a dyn Projection,
+        chart: &'a InverseChart,
+        tolerance: Option<f64>,
+    ) -> Self {
+        Refiner {
+            projection,
+            chart,
+            tolerance,
+        }
+    }
+
+    /// The node of scene point `point`.
+    pub fn node(&self, point: DVec3) -> Node {
+        Node {
+            point,
+            image: self.projection.project_continuous(point).map(|i| i.pixel),
+        }
+    }
+
+    /// The midpoint node of edge `a b` at `level` halvings if the edge must be split.
+    fn split(&self, a: &Node, b: &Node, level: u32) -> Option<Node> {
+        if level >= MAX_LEVEL || a.point == b.point {
+            return None;
+        }
+        let (a, b) = if canonical(a.point, b.point) {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        let mid = self.node(0.5 * (a.point + b.point));
+        let curved = match (self.tolerance, a.image, b.image, mid.image) {
+            (Some(tolerance), Some(pa), Some(pb), Some(pm)) => {
+                self.deviation(pa, pb, pm) > tolerance
+            }
+            _ => false,
+        };
+        (curved || self.near_pole(a.point, b.point)).then_some(mid)
+    }
+
+    /// How far `pm` is from the line through `pa` and `pb`, all unwrapped next to `pa`.
+    fn deviation(&self, pa: DVec2, pb: DVec2, pm: DVec2) -> f64 {
+        let period = self.chart.period;
+        let pb = DVec2::new(unwrap(pb.x, pa.x, period).0, pb.y);
+        let pm = DVec2::new(unwrap(pm.x, pa.x, period).0, pm.y);
+        let chord = pb - pa;
+        let length = chord.length();
+        if length == 0.0 {
+            (pm - pa).length()
+        } else {
+            chord.perp_dot(pm - pa).abs() / length
+        }
+    }
+
+    /// Whether edge `a b` is longer than some pole's clearance and within twice its length
+    /// of that pole (angles at the pole's origin).
+    fn near_pole(&self, a: DVec3, b: DVec3) -> bool {
+        self.chart.poles.iter().any(|pole| {
+            let (oa, ob) = (a - pole.origin, b - pole.origin);
+            let length = angle_between(oa, ob);
+            length > pole.clearance
+                && angle_between(oa, pole.direction).min(angle_between(ob, pole.direction))
+                    < 2.0 * length
+        })
+    }
+
+    /// Whether the piece `[a, b, c]` is crossed by a pole ray; such pieces are not drawn (by
+    /// the edge rule they lie within the pole's clearance, unless the level limit stopped
+    /// the splitting).
+    pub fn is_pole_piece(&self, [a, b, c]: [DVec3; 3]) -> bool {
+        self.chart.poles.iter().any(|pole: &Pole| {
+            intersect_triangle(pole.origin, pole.direction, [a, b, c]).is_some_and(|h| h.t >= 0.0)
+        })
+    }
+
+    /// Calls `emit` with the pieces of triangle `nodes` whose edges have been halved
+    /// `levels` times, after adaptive refinement.
+    pub fn refine(&self, nodes: [Node; 3], levels: [u32; 3], emit: &mut impl FnMut([Node; 3])) {
+        let [a, b, c] = nodes;
+        let splits = [
+            self.split(&a, &b, levels[0]),
+            self.split(&b, &c, levels[1]),
+            self.split(&c, &a, levels[2]),
+        ];
+        // Rotate so that the split edges come first: ab, then bc, then ca.
+        let count = splits.iter().filter(|s| s.is_some()).count();
+        if count == 0 {
+            emit(nodes);
+            return;
+        }
+        let rotation = (0..3)
+            .find(|&r| (0..count).all(|k| splits[(r + k) % 3].is_some()))
+            .unwrap_or(0);
+        let n = |k: usize| nodes[(rotation + k) % 3];
+        let l = |k: usize| levels[(rotation + k) % 3];
+        let m = |k: usize| splits[(rotation + k) % 3].unwrap_or(n(k));
+        let inner = 1 + levels.into_iter().max().unwrap_or(0);
+        let (a, b, c) = (n(0), n(1), n(2));
+        match count {
+            1 => {
+                let ab = m(0);
+                self.refine([a, ab, c], [l(0) + 1, inner, l(2)], emit);
+                self.refine([ab, b, c], [l(0) + 1, l(1), inner], emit);
+            }
+            2 => {
+                let (ab, bc) = (m(0), m(1));
+                self.refine([ab, b, bc], [l(0) + 1, l(1) + 1, inner], emit);
+                self.refine([a, ab, bc], [l(0) + 1, inner, inner], emit);
+                self.refine([a, bc, c], [inner, l(1) + 1, l(2)], emit);
+            }
+            _ => {
+                let (ab, bc, ca) = (m(0), m(1), m(2));
+                self.refine([a, ab, ca], [l(0) + 1, inner, l(2) + 1], emit);
+                self.refine([ab, b, bc], [l(0) + 1, l(1) + 1, inner], emit);
+                self.refine([ca, bc, c], [inner, l(1) + 1, l(2) + 1], emit);
+                self.refine([ab, bc, ca], [inner, inner, inner], emit);
+            }
+        }
+    }
+
+    /// Cuts `corners` into `n` x `n` pieces by the regular grid of barycentric steps 1/n
+    /// (grid points on an edge from the edge's ends in canonical order) and calls `emit`
+    /// with each piece's nodes. `grid` is scratch space.
+    pub fn uniform(
+        &self,
+        corners: [Node; 3],
+        n: u32,
+        grid: &mut Vec<Node>,
+        emit: &mut impl FnMut([Node; 3]),
+    ) {
+        if n <= 1 {
+            emit(corners);
+            return;
+        }
+        let [a, b, c] = corners.map(|c| c.point);
+        let on_edge = |p: DVec3, q: DVec3, k: u32| {
+            let (p, q, k) = if canonical(p, q) {
+                (p, q, k)
+            } else {
+                (q, p, n - k)
+            };
+            p + (q - p) * (f64::from(k) / f64::from(n))
+        };
+        grid.clear();
+        // Row j holds points (i, j), i = 0..=n-j: weight i/n on b, j/n on c.
+        for j in 0..=n {
+            for i in 0..=n - j {
+                let corner = match (i, j) {
+                    (0, 0) => Some(corners[0]),
+                    (i, 0) if i == n => Some(corners[1]),
+                    (0, j) if j == n => Some(corners[2]),
+                    _ => None,
+                };
+                grid.push(corner.unwrap_or_else(|| {
+                    let point = if j == 0 {
+                        on_edge(a, b, i)
+                    } else if i == 0 {
+                        on_edge(a, c, j)
+                    } else if i + j == n {
+                        on_edge(b, c, j)
+                    } else {
+                        let (s, t) = (f64::from(i) / f64::from(n), f64::from(j) / f64::from(n));
+                        a + (b - a) * s + (c - a) * t
+                    };
+                    self.node(point)
+                }));
+            }
+        }
+        let index = |i: u32, j: u32| (j * (2 * n + 3 - j) / 2 + i) as usize;
+        for j in 0..n {
+            for i in 0..n - j {
+                emit([
+                    grid[index(i, j)],
+                    grid[index(i + 1, j)],
+                    grid[index(i, j + 1)],
+                ]);
+                if i + j + 1 < n {
+                    emit([
+                        grid[index(i + 1, j)],
+                        grid[index(i + 1, j + 1)],
+                        grid[index(i, j + 1)],
+                    ]);
+                }
+            }
+        }
+    }
+}
