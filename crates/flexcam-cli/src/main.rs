@@ -26,6 +26,9 @@ enum Command {
     Render(commands::render::RenderArgs),
     /// List the built-in scenes: name, then a description.
     Scenes,
+    /// Rerun a source document's timing table with flexcam's renderers.
+    #[command(subcommand)]
+    Bench(commands::bench::BenchCommand),
 }
 
 fn main() -> ExitCode {
@@ -36,6 +39,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => commands::render::run(&args),
         Command::Scenes => commands::scenes::run(),
+        Command::Bench(command) => commands::bench::run(&command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
