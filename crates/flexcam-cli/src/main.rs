@@ -29,6 +29,9 @@ enum Command {
     /// Render a scene with a method and with the reference ray caster, and report how closely
     /// they agree (object ids, depth, relative RGB error).
     Compare(commands::compare::CompareArgs),
+    /// Rerun a source document's timing table with flexcam's renderers.
+    #[command(subcommand)]
+    Bench(commands::bench::BenchCommand),
 }
 
 fn main() -> ExitCode {
@@ -40,6 +43,7 @@ fn main() -> ExitCode {
         Command::Render(args) => commands::render::run(&args),
         Command::Scenes => commands::scenes::run(),
         Command::Compare(args) => commands::compare::run(&args),
+        Command::Bench(command) => commands::bench::run(&command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -19,6 +19,7 @@ mod inverse_properties;
 mod linear;
 mod panoramic;
 mod params;
+pub mod projector;
 mod trilinear;
 
 pub use camera_basis::CameraBasis;
@@ -28,6 +29,7 @@ pub use flexible::{Flexible, FlexibleSpec};
 pub use image_coords::Resolution;
 pub use linear::{Orthographic, Perspective};
 pub use panoramic::{Cylindrical, Equirectangular};
+pub use projector::Projector;
 pub use trilinear::{
     project_triangle, ProjectionTriangleCache, SceneEdge, Shape, ShapeVertex, Solutions,
     TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
@@ -60,6 +62,13 @@ pub trait Projection: Send + Sync {
     /// outside every screen triangle of a trilinear mesh). The direction need not be unit
     /// length; see [`Ray`].
     fn ray(&self, pixel: DVec2) -> Option<Ray>;
+
+    /// The projector through continuous pixel position `pixel`, straight or curved; `None`
+    /// where the position sees nothing. Projections with straight projectors keep the
+    /// default, [`Projection::ray`] as a [`Projector::Straight`].
+    fn projector(&self, pixel: DVec2) -> Option<Projector> {
+        self.ray(pixel).map(Projector::Straight)
+    }
 
     /// Whether [`Projection::project`] is implemented.
     fn has_inverse(&self) -> bool {

@@ -88,7 +88,9 @@ fn affine(s: &Surface) -> Option<Affine> {
                 c: p01 - p00,
             })
         }
-        Surface::Sphere(_) | Surface::Cylinder(_) => None,
+        Surface::Sphere(_) | Surface::Cylinder(_) | Surface::Bezier(_) | Surface::BSpline(_) => {
+            None
+        }
     }
 }
 

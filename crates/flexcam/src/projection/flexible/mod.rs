@@ -3,8 +3,10 @@
 //!
 //! - [`surface`]: control surfaces Q_i(u, v) on the shared domain (u, v) in [0, 1]^2, u to the
 //!   right of the image, v up;
-//! - [`volume`]: Q(u, v, t) = (1 - t) Q_near + t Q_far and dQ/dt (straight projectors; the
-//!   place for polyline and Bezier projectors next);
+//! - [`volume`]: Q(u, v, t) = (1 - t) Q_near + t Q_far and dQ/dt (straight projectors);
+//! - [`blend`]: volumes of two or more surfaces blended in t, piecewise-linear (polyline
+//!   projectors) or Bernstein (Bezier projectors);
+//! - `patch`: bicubic Bezier and uniform cubic B-spline control surfaces;
 //! - [`reparam`]: pixel <-> (u, v) (linear, polar fisheye, lens-like, Mercator);
 //! - [`presets`]: named volumes from a camera frame (perspective, pushbroom, crossed slits, ...);
 //! - [`projector_grid`]: a volume interpolated from a grid of placed projectors (5.2), and
@@ -12,12 +14,14 @@
 //! - `inverse`: (u, v, t) from a scene point for the analytic class (parallel planes, nested
 //!   spheres, coaxial cylinders).
 //!
-//! A pixel's ray starts on the near surface and reaches the far surface at t = 1; t is
-//! limited to [0, 1] (the per-projector near and far clip of the framework).
+//! A pixel's projector starts on the near (first) surface and reaches the far (last) surface at
+//! t = 1; t is limited to [0, 1] (the per-projector near and far clip of the framework).
 
+pub mod blend;
 mod chart;
 pub mod fit;
 mod inverse;
+mod patch;
 pub mod presets;
 pub mod projector_grid;
 pub mod reparam;
@@ -28,15 +32,18 @@ pub mod volume;
 
 use glam::{DVec2, DVec3};
 
+pub use blend::{BezierVolume, PiecewiseVolume};
 pub use presets::{Preset, PresetSpec};
 pub use reparam::Reparam;
-pub use surface::{CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface};
+pub use surface::{
+    BSplinePatch, BezierPatch, CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface,
+};
 pub use volume::{LinearVolume, Volume};
 
 use self::inverse::Inverse;
 use super::chart::InverseChart;
 use super::image_coords::Resolution;
-use super::{ImagePoint, Projection};
+use super::{ImagePoint, Projection, Projector};
 use crate::error::Result;
 use crate::geometry::Ray;
 
@@ -47,6 +54,21 @@ pub enum VolumeSource {
     Preset(PresetSpec),
     /// Two explicit control surfaces, straight projectors between them.
     Surfaces { near: Surface, far: Surface },
+    /// Two or more explicit control surfaces blended in t: curved projectors.
+    Blended {
+        surfaces: Vec<Surface>,
+        blend: Blend,
+    },
+}
+
+/// How the control surfaces of [`VolumeSource::Blended`] are blended in t.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Blend {
+    /// Linear between surfaces at `knots` (`None`: equally spaced): polyline projectors.
+    Piecewise { knots: Option<Vec<f64>> },
+    /// Bernstein polynomials: Bezier projectors, rendered as polylines of `segments` steps
+    /// when given (quadratic ones are analytic otherwise).
+    Bezier { segments: Option<u32> },
 }
 
 /// A parsed flexible projection: the volume and the re-parameterisation (`None`: the
@@ -68,24 +90,42 @@ pub struct Flexible {
 
 impl Flexible {
     /// Builds the volume. Errors: an empty image; a bad preset parameter or camera frame; an
-    /// invalid surface; near and far surfaces that coincide everywhere; a Mercator latitude
-    /// outside (0, 90).
+    /// invalid surface; control surfaces that coincide everywhere; bad knots or segments of
+    /// a blended volume (see [`PiecewiseVolume::new`], [`BezierVolume::new`]); a Mercator
+    /// latitude outside (0, 90).
     pub fn new(spec: &FlexibleSpec, width: u32, height: u32) -> Result<Self> {
         let resolution = Resolution::new(width, height)?;
         let aspect = f64::from(height) / f64::from(width);
-        let (near, far, default_reparam) = match &spec.source {
+        let linear = |near, far| LinearVolume::new(near, far).map(|v| Volume::Linear(Box::new(v)));
+        let (volume, default_reparam) = match &spec.source {
             VolumeSource::Preset(p) => {
                 let (near, far) = p.surfaces(aspect)?;
-                (near, far, p.preset.default_reparam())
+                (linear(near, far)?, p.preset.default_reparam())
             }
-            VolumeSource::Surfaces { near, far } => (*near, *far, Reparam::Linear),
+            VolumeSource::Surfaces { near, far } => {
+                (linear(near.clone(), far.clone())?, Reparam::Linear)
+            }
+            VolumeSource::Blended { surfaces, blend } => {
+                let volume = match blend {
+                    Blend::Piecewise { knots } => {
+                        Volume::Piecewise(PiecewiseVolume::new(surfaces.clone(), knots.clone())?)
+                    }
+                    Blend::Bezier { segments } => {
+                        Volume::Bezier(BezierVolume::new(surfaces.clone(), *segments)?)
+                    }
+                };
+                (volume, Reparam::Linear)
+            }
         };
         let reparam = spec.reparam.unwrap_or(default_reparam);
         reparam.validate()?;
-        let volume = LinearVolume::new(near, far)?;
+        let inverse = match &volume {
+            Volume::Linear(v) => Inverse::classify(&v.near, &v.far),
+            Volume::Piecewise(_) | Volume::Bezier(_) => None,
+        };
         Ok(Flexible {
-            inverse: Inverse::classify(&volume.near, &volume.far),
-            volume: Volume::Linear(volume),
+            inverse,
+            volume,
             reparam,
             resolution,
         })
@@ -123,9 +163,16 @@ impl Projection for Flexible {
 
     /// Origin Q_near(u, v), direction Q_far - Q_near (unnormalised: the ray parameter is t),
     /// t in [0, 1]. `None` outside the re-parameterisation's domain and for zero-length
-    /// projectors.
+    /// projectors. Curved volumes have no straight ray (`None`): see
+    /// [`Projection::projector`].
     fn ray(&self, pixel: DVec2) -> Option<Ray> {
         self.volume.ray(self.uv(pixel)?)
+    }
+
+    /// The straight, polyline or quadratic Bezier projector of the pixel's (u, v), t in
+    /// [0, 1]; `None` outside the re-parameterisation's domain and for zero-length projectors.
+    fn projector(&self, pixel: DVec2) -> Option<Projector> {
+        self.volume.projector(self.uv(pixel)?)
     }
 
     /// True for the analytic class: parallel planes sharing a normal, nested spheres,

@@ -10,6 +10,7 @@ use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
 
+pub use super::patch::{BSplinePatch, BezierPatch};
 use crate::error::{Error, Result};
 
 /// `axis` and `front` count as parallel when the sine of their angle is below this.
@@ -92,7 +93,7 @@ pub struct CylinderPatch {
 }
 
 /// One control surface over the (u, v) domain [0, 1]^2.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Surface {
     /// A parallelogram `corner + u * u_edge + v * v_edge` (`corner` at (u, v) = (0, 0), the
     /// bottom-left of the image). Zero edges are allowed (a segment or a point).
@@ -117,6 +118,10 @@ pub enum Surface {
         end: DVec3,
         along: LineParam,
     },
+    /// A bicubic Bezier patch (boxed: 16 control points).
+    Bezier(Box<BezierPatch>),
+    /// A uniform cubic B-spline patch.
+    BSpline(BSplinePatch),
 }
 
 /// Linear interpolation of a parameter range at `s` in [0, 1].
@@ -169,6 +174,8 @@ impl Surface {
                 };
                 start.lerp(*end, s)
             }
+            Surface::Bezier(b) => b.point(uv),
+            Surface::BSpline(b) => b.point(uv),
         }
     }
 
@@ -181,6 +188,8 @@ impl Surface {
             Surface::Cylinder(_) => "cylinder",
             Surface::Point(_) => "point",
             Surface::Line { .. } => "line",
+            Surface::Bezier(_) => "bezier",
+            Surface::BSpline(_) => "bspline",
         }
     }
 
@@ -197,6 +206,8 @@ impl Surface {
             Surface::Bilinear { corners } => finite(corners),
             Surface::Point(p) => finite(&[*p]),
             Surface::Line { start, end, .. } => finite(&[*start, *end]),
+            Surface::Bezier(b) => finite(b.control.as_flattened()),
+            Surface::BSpline(b) => finite(b.control()),
             Surface::Sphere(s) => {
                 check_radius(s.radius)?;
                 check_span("longitude", s.longitude)?;

@@ -410,7 +410,7 @@ fn volumes_outside_the_analytic_class_have_no_inverse() {
         (rect(0.0), tilted),
         (rect(0.0), sphere),
     ] {
-        let f = custom(near, far);
+        let f = custom(near.clone(), far.clone());
         assert!(!f.has_inverse(), "{near:?} {far:?}");
         let mut out = Vec::new();
         f.project(DVec3::new(0.1, 0.1, 1.0), &mut out);

@@ -2,15 +2,17 @@
 //!
 //! Two control surfaces give Q(u, v, t) = (1 - t) Q_near(u, v) + t Q_far(u, v), t in [0, 1]:
 //! the projector of (u, v) is the segment from Q_near to Q_far, and t outside [0, 1] is clipped
-//! (the framework's per-projector near and far clip). Curved projectors (polyline, Bezier in t
-//! over more control surfaces) will be further [`Volume`] variants with their own `point` and
-//! `tangent`; everything that only needs Q and dQ/dt works with them unchanged.
+//! (the framework's per-projector near and far clip). Volumes with curved projectors (polyline,
+//! Bezier in t over more control surfaces) are the other [`Volume`] variants, in
+//! [`super::blend`]; everything that only needs Q and dQ/dt works with all of them.
 
 use glam::{DVec2, DVec3};
 
+use super::blend::{BezierVolume, PiecewiseVolume};
 use super::surface::Surface;
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
+use crate::projection::Projector;
 
 /// Samples per side of the grid on which [`LinearVolume::new`] looks for a projector of
 /// non-zero length.
@@ -78,10 +80,15 @@ impl LinearVolume {
     }
 }
 
-/// A viewing volume. Only straight projectors so far (see the module documentation).
+/// A viewing volume.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Volume {
-    Linear(LinearVolume),
+    /// Straight projectors between two surfaces (boxed: two surfaces inline are large).
+    Linear(Box<LinearVolume>),
+    /// Polyline projectors through two or more surfaces.
+    Piecewise(PiecewiseVolume),
+    /// Bezier projectors from three or more surfaces.
+    Bezier(BezierVolume),
 }
 
 impl Volume {
@@ -89,21 +96,35 @@ impl Volume {
     pub fn point(&self, uv: DVec2, t: f64) -> DVec3 {
         match self {
             Volume::Linear(v) => v.point(uv, t),
+            Volume::Piecewise(v) => v.point(uv, t),
+            Volume::Bezier(v) => v.point(uv, t),
         }
     }
 
     /// dQ/dt at (u, v, t): the projector's tangent, the view direction for shading.
     pub fn tangent(&self, uv: DVec2, t: f64) -> DVec3 {
-        let _ = t; // straight projectors: constant along the projector
         match self {
             Volume::Linear(v) => v.tangent(uv),
+            Volume::Piecewise(v) => v.tangent(uv, t),
+            Volume::Bezier(v) => v.tangent(uv, t),
         }
     }
 
-    /// The projector of (u, v) when it is a straight ray, `None` when it has zero length.
+    /// The projector of (u, v) when it is a straight ray; `None` when it has zero length or
+    /// is curved (see [`Volume::projector`]).
     pub fn ray(&self, uv: DVec2) -> Option<Ray> {
         match self {
             Volume::Linear(v) => v.ray(uv),
+            Volume::Piecewise(_) | Volume::Bezier(_) => None,
+        }
+    }
+
+    /// The projector of (u, v), straight or curved; `None` when it has zero length.
+    pub fn projector(&self, uv: DVec2) -> Option<Projector> {
+        match self {
+            Volume::Linear(v) => v.ray(uv).map(Projector::Straight),
+            Volume::Piecewise(v) => v.projector(uv),
+            Volume::Bezier(v) => v.projector(uv),
         }
     }
 }
@@ -144,7 +165,7 @@ mod tests {
         let e = LinearVolume::new(square(1.0, 1.0), square(1.0, 1.0)).unwrap_err();
         assert!(e.message.contains("coincide"), "{e}");
         let p = Surface::Point(DVec3::ONE);
-        assert!(LinearVolume::new(p, p).is_err());
+        assert!(LinearVolume::new(p.clone(), p.clone()).is_err());
         // A point near surface and a zero-size far rectangle at the same place: also empty.
         let r = Surface::rectangle_centred(DVec3::ONE, DVec3::ZERO, DVec3::ZERO);
         assert!(LinearVolume::new(p, r).is_err());

@@ -178,6 +178,53 @@ impl Packet {
     }
 }
 
+/// The points within `pad` of the segment from `origin` to `origin + direction`, in f32, for
+/// [`Bvh::visit_near_segment`]. A zero direction is allowed (the segment is a point).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct NearSegment {
+    origin: Vec3A,
+    inv_direction: Vec3A,
+    pad: f32,
+}
+
+impl NearSegment {
+    /// The segment and its padding (f64, rounded outwards to cover the f32 conversion).
+    /// `None` for non-finite input.
+    pub fn new(origin: glam::DVec3, direction: glam::DVec3, pad: f64) -> Option<NearSegment> {
+        if !(origin.is_finite() && direction.is_finite() && pad.is_finite()) {
+            return None;
+        }
+        // The f32 rounding of the end points, at most one ulp of the largest coordinate.
+        let rounding = (origin.abs().max_element() + direction.abs().max_element()) as f32
+            * f32::EPSILON
+            * 4.0;
+        let safe = |c: f32| {
+            if c.abs() < 1e-30 {
+                1e-30f32.copysign(c)
+            } else {
+                c
+            }
+        };
+        let d = direction.as_vec3();
+        Some(NearSegment {
+            origin: Vec3A::from(origin.as_vec3()),
+            inv_direction: Vec3A::new(1.0 / safe(d.x), 1.0 / safe(d.y), 1.0 / safe(d.z)),
+            pad: pad as f32 * (1.0 + 4.0 * f32::EPSILON) + rounding,
+        })
+    }
+
+    /// Whether the segment meets the box `[min, max]` enlarged by `pad` (slab test over the
+    /// parameter range [0, 1], with the exit enlarged as in [`box_entry`]).
+    #[inline(always)]
+    fn meets(&self, min: Vec3, max: Vec3) -> bool {
+        let t0 = (Vec3A::from(min) - self.pad - self.origin) * self.inv_direction;
+        let t1 = (Vec3A::from(max) + self.pad - self.origin) * self.inv_direction;
+        let near = t0.min(t1).max_element().max(0.0);
+        let far = t0.max(t1).min_element().min(1.0);
+        near <= far + far.abs() * ROBUST_SLACK
+    }
+}
+
 /// Entry parameter of `ray` into the box `[min, max]` if it meets it within
 /// `[ray.t_min, t_max]`, else infinity. The exit parameter is enlarged by a few ulps (Ize,
 /// "Robust BVH ray traversal", 2013) so that rounding never culls a box the ray touches.
@@ -483,6 +530,46 @@ impl Bvh {
                 if e.cmple(t_max).bitmask() != 0 {
                     (current, entry) = (child, e);
                     break;
+                }
+            }
+        }
+    }
+
+    /// Calls `visit` with the build-input index and the triangle of every stored triangle in
+    /// every leaf whose box, enlarged by `segment.pad` on every side, the segment meets: a
+    /// conservative cull for anything that lies within `pad` of the segment (a curve inside
+    /// the convex hull of its control points, see [`NearSegment`]). Leaves are visited in
+    /// tree order, not by distance.
+    pub fn visit_near_segment(
+        &self,
+        segment: &NearSegment,
+        mut visit: impl FnMut(u32, &PackedTriangle),
+    ) {
+        if self.triangles.is_empty() || !segment.meets(self.root_bounds.min, self.root_bounds.max) {
+            return;
+        }
+        let mut stack = Vec::with_capacity(STACK_SIZE);
+        stack.push(self.root);
+        while let Some(current) = stack.pop() {
+            if current.count > 0 {
+                let first = current.index as usize;
+                let count = current.count as usize;
+                for i in first..first + count {
+                    visit(self.ids[i], &self.triangles[i]);
+                }
+                continue;
+            }
+            let node = &self.nodes[current.index as usize];
+            // Push the second child first, so that the first is visited first (tree order).
+            for k in [1, 0] {
+                let min = Vec3::new(node.planes[0][k], node.planes[1][k], node.planes[2][k]);
+                let max = -Vec3::new(
+                    node.planes[0][k + 2],
+                    node.planes[1][k + 2],
+                    node.planes[2][k + 2],
+                );
+                if segment.meets(min, max) {
+                    stack.push(node.children[k]);
                 }
             }
         }

@@ -7,6 +7,7 @@
 //! See docs/raycast.md for the design and the measurements.
 
 mod bvh;
+mod curve;
 mod optics;
 mod sampling;
 mod shade;
@@ -211,5 +212,7 @@ impl RayCaster {
     }
 }
 
+#[cfg(test)]
+mod projector_tests;
 #[cfg(test)]
 mod tests;

@@ -24,6 +24,8 @@ use glam::{DVec3, Vec3};
 use super::optics::{reflect, refract};
 use super::{Hit, Hit32, RayCaster};
 use crate::geometry::Ray;
+use crate::projection::projector::{quadratic_arc_length, quadratic_point, quadratic_tangent};
+use crate::projection::Projector;
 use crate::render::surface::{base_color, normals, Normals, TextureFilter};
 use crate::render::{RenderOptions, Shading};
 use crate::scene::{Light, Surface};
@@ -56,6 +58,24 @@ pub(super) struct RayCounts {
     pub primary: u64,
     pub secondary: u64,
     pub shadow: u64,
+}
+
+/// The straight ray a quadratic projector `p` continues as at its hit `s`: origin B(s),
+/// direction the tangent B'(s), with the hit at ray parameter 0 (any t is accepted, so that
+/// the f64 refinement may move it by rounding). Degenerate case: where B'(s) = 0 (a cusp of a
+/// curve doubling back on itself) the chord P2 - P0 stands in for the tangent, and P1 - P0
+/// where that is zero too (a closed curve).
+fn tangent_ray(p: &[DVec3; 3], s: f64) -> Ray {
+    let direction = [quadratic_tangent(p, s), p[2] - p[0], p[1] - p[0]]
+        .into_iter()
+        .find(|d| *d != DVec3::ZERO)
+        .unwrap_or(DVec3::X);
+    Ray {
+        origin: quadratic_point(p, s),
+        direction,
+        t_min: f64::NEG_INFINITY,
+        t_max: f64::INFINITY,
+    }
 }
 
 /// Traces primary rays of one render; counts what it casts.
@@ -104,7 +124,42 @@ impl<'a> Tracer<'a> {
             return background;
         };
         let found = self.caster.intersect_f32(ray);
-        self.shade(ray, found)
+        self.shade(ray, found, 0.0)
+    }
+
+    /// The sample a pixel gets for its projector (`None`: the background). A polyline is
+    /// searched segment by segment (each a ray over t in [0, 1]; zero-length segments see
+    /// nothing), the first segment with a hit winning; a quadratic Bezier analytically. Depth
+    /// is the arc length along the projector up to the hit; shading and secondary rays start
+    /// from a straight ray at the hit along the projector's tangent there.
+    pub fn sample_projector(&mut self, projector: Option<&Projector>) -> Sample {
+        match projector {
+            None => self.sample(None),
+            Some(Projector::Straight(ray)) => self.sample(Some(ray)),
+            Some(Projector::Polyline(points)) => {
+                let mut before = 0.0;
+                for pair in points.windows(2) {
+                    let ray = Ray {
+                        origin: pair[0],
+                        direction: pair[1] - pair[0],
+                        t_min: 0.0,
+                        t_max: 1.0,
+                    };
+                    if let Some(found) = self.caster.intersect_f32(&ray) {
+                        return self.shade(&ray, Some(found), before);
+                    }
+                    before += ray.direction.length();
+                }
+                self.shade_miss()
+            }
+            Some(Projector::QuadraticBezier(p)) => match self.caster.intersect_quadratic(p) {
+                Some((s, found)) => {
+                    let ray = tangent_ray(p, s);
+                    self.shade(&ray, Some(found), quadratic_arc_length(p, s))
+                }
+                None => self.shade_miss(),
+            },
+        }
     }
 
     /// The samples of four primary rays (a 2x2 pixel quad), exactly those of [`Tracer::sample`]
@@ -118,22 +173,37 @@ impl<'a> Tracer<'a> {
         }; 4];
         for ((sample, ray), found) in samples.iter_mut().zip(primary).zip(found) {
             if let Some(ray) = ray {
-                *sample = self.shade(ray, found);
+                *sample = self.shade(ray, found, 0.0);
             }
         }
         samples
     }
 
-    /// The sample of primary ray `ray` whose first hit (the f32 search's) is `found`.
-    fn shade(&mut self, ray: &Ray, found: Option<Hit32>) -> Sample {
-        self.counts.primary += 1;
+    /// The samples of four projectors (a 2x2 pixel quad): [`Tracer::sample4`] when all are
+    /// straight (or absent), else one by one.
+    pub fn sample4_projectors(&mut self, projectors: &[Option<Projector>; 4]) -> [Sample; 4] {
+        fn straight(p: &Option<Projector>) -> Option<Option<&Ray>> {
+            match p {
+                Some(Projector::Straight(ray)) => Some(Some(ray)),
+                None => Some(None),
+                Some(_) => None,
+            }
+        }
+        match projectors.each_ref().map(straight) {
+            [Some(a), Some(b), Some(c), Some(d)] => self.sample4([a, b, c, d]),
+            _ => projectors
+                .each_ref()
+                .map(|p| self.sample_projector(p.as_ref())),
+        }
+    }
+
+    /// The sample of primary ray `ray` whose first hit (the f32 search's) is `found`; the
+    /// projector has run `before` before the ray's origin (added to the depth).
+    fn shade(&mut self, ray: &Ray, found: Option<Hit32>, before: f64) -> Sample {
         let Some(found) = found else {
-            return Sample {
-                color: self.caster.background,
-                depth: f32::INFINITY,
-                id: 0,
-            };
+            return self.shade_miss();
         };
+        self.counts.primary += 1;
         let object = &self.caster.objects[found.object];
         let (color, t) = match self.shading {
             // The common flat case, a diffuse or emissive first hit, needs neither an exact
@@ -158,7 +228,7 @@ impl<'a> Tracer<'a> {
         };
         Sample {
             color,
-            depth: (t * ray.direction.length()) as f32,
+            depth: (before + t * ray.direction.length()) as f32,
             id: object.id,
         }
     }
@@ -168,6 +238,16 @@ impl<'a> Tracer<'a> {
         match self.shading {
             Shading::Flat => self.flat(ray, hit),
             Shading::Lit => self.lit(ray, hit, 0, 1.0),
+        }
+    }
+
+    /// The sample of a primary projector that hits nothing: the background.
+    fn shade_miss(&mut self) -> Sample {
+        self.counts.primary += 1;
+        Sample {
+            color: self.caster.background,
+            depth: f32::INFINITY,
+            id: 0,
         }
     }
 

@@ -120,15 +120,9 @@ fn render_tile(
         for qx in (0..quad_w).step_by(2) {
             let (x, y) = (x0 + qx, y0 + qy);
             let pixels = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)];
-            let ray = |(x, y): (u32, u32)| projection.ray(DVec2::new(x as f64, y as f64) + offset);
-            let rays = [
-                ray(pixels[0]),
-                ray(pixels[1]),
-                ray(pixels[2]),
-                ray(pixels[3]),
-            ];
-            let [a, b, c, d] = &rays;
-            let samples = tracer.sample4([a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref()]);
+            let projectors =
+                pixels.map(|(x, y)| projection.projector(DVec2::new(x as f64, y as f64) + offset));
+            let samples = tracer.sample4_projectors(&projectors);
             for (pixel, sample) in pixels.into_iter().zip(samples) {
                 store(&mut tile, pixel, Vec3::ZERO + sample.color, sample);
             }
@@ -144,7 +138,7 @@ fn render_tile(
             let mut centre = None;
             for (k, offset) in pattern.offsets.iter().enumerate() {
                 let pixel = DVec2::new(x as f64, y as f64) + *offset;
-                let sample = tracer.sample(projection.ray(pixel).as_ref());
+                let sample = tracer.sample_projector(projection.projector(pixel).as_ref());
                 color += sample.color;
                 if k == pattern.centre {
                     centre = Some(sample);

@@ -1,5 +1,6 @@
-//! `[projection] type = "flexible"`: a named preset placed by a camera frame, or two explicit
-//! control surfaces `near` and `far`, with an optional re-parameterisation.
+//! `[projection] type = "flexible"`: a named preset placed by a camera frame, two explicit
+//! control surfaces `near` and `far`, or a list `surfaces` blended in t (`blend`, `knots`,
+//! `segments`), with an optional re-parameterisation.
 
 use std::ops::Range;
 
@@ -9,16 +10,16 @@ use toml::Spanned;
 use super::projection::{camera_frame, Required};
 use super::raw::{RawProjection, RawSurface};
 use super::source::Source;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::projection::flexible::presets::PRESET_NAMES;
 use crate::projection::flexible::reparam::{DEFAULT_MERCATOR_LATITUDE, REPARAM_NAMES};
 use crate::projection::flexible::{
-    CylinderPatch, FlexibleSpec, LineParam, PolarFrame, Preset, PresetSpec, Reparam, SpherePatch,
-    Surface, VolumeSource,
+    BSplinePatch, BezierPatch, BezierVolume, Blend, CylinderPatch, FlexibleSpec, LineParam,
+    PiecewiseVolume, PolarFrame, Preset, PresetSpec, Reparam, SpherePatch, Surface, VolumeSource,
 };
 
 /// Every key of a flexible table (besides `type`).
-pub(super) const KEYS: [&str; 15] = [
+pub(super) const KEYS: [&str; 19] = [
     "preset",
     "position",
     "look_at",
@@ -32,6 +33,10 @@ pub(super) const KEYS: [&str; 15] = [
     "slit_distance",
     "near",
     "far",
+    "surfaces",
+    "blend",
+    "knots",
+    "segments",
     "reparam",
     "max_latitude",
 ];
@@ -39,11 +44,21 @@ pub(super) const KEYS: [&str; 15] = [
 /// Keys every preset accepts.
 const PRESET_COMMON: [&str; 6] = ["preset", "position", "look_at", "up", "clip", "reparam"];
 
-/// Keys of a flexible table given by surfaces.
+/// Keys of a flexible table given by a near and a far surface.
 const SURFACE_KEYS: [&str; 4] = ["near", "far", "reparam", "max_latitude"];
 
+/// Keys of a flexible table given by a list of surfaces blended in t.
+const BLEND_KEYS: [&str; 6] = [
+    "surfaces",
+    "blend",
+    "knots",
+    "segments",
+    "reparam",
+    "max_latitude",
+];
+
 /// The surface type names of scene files.
-const SURFACE_NAMES: [&str; 7] = [
+const SURFACE_NAMES: [&str; 9] = [
     "rectangle",
     "bilinear",
     "sphere",
@@ -51,7 +66,12 @@ const SURFACE_NAMES: [&str; 7] = [
     "cylinder",
     "point",
     "line",
+    "bezier",
+    "bspline",
 ];
+
+/// The `blend` names of scene files.
+const BLEND_NAMES: [&str; 2] = ["piecewise", "bezier"];
 
 /// The preset's own keys, besides [`PRESET_COMMON`] (and `max_latitude` with Mercator).
 fn preset_keys(name: &str) -> &'static [&'static str] {
@@ -99,6 +119,20 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
             })?;
             VolumeSource::Preset(preset(required, name.get_ref())?)
         }
+        None if raw.surfaces.is_some() || raw.blend.is_some() => {
+            reject_keys(
+                src,
+                &present,
+                |key| BLEND_KEYS.contains(&key),
+                || {
+                    "projections given by `surfaces` (they take: surfaces, blend, knots, \
+                     segments, reparam, max_latitude)"
+                        .to_string()
+                },
+            )?;
+            let list = required.get(&raw.surfaces, "surfaces")?;
+            blended(src, raw, list)?
+        }
         None => {
             reject_keys(
                 src,
@@ -127,6 +161,78 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
         }
     }
     Ok(FlexibleSpec { source, reparam })
+}
+
+/// `surfaces = [...]` with `blend` (default piecewise), `knots` (piecewise only) and
+/// `segments` (bezier only). Counts and knot values are checked when the volume is built;
+/// the errors point at the key they concern.
+fn blended(
+    src: &Source,
+    raw: &RawProjection,
+    list: &Spanned<Vec<Spanned<RawSurface>>>,
+) -> Result<VolumeSource> {
+    let surfaces = list
+        .get_ref()
+        .iter()
+        .enumerate()
+        .map(|(i, table)| surface(src, table, &format!("surface {}", i + 1)))
+        .collect::<Result<Vec<_>>>()?;
+    let name = raw
+        .blend
+        .as_ref()
+        .map_or("piecewise", |b| b.get_ref().as_str());
+    let at_blend = raw.blend.as_ref().map_or(list.span(), Spanned::span);
+    let blend = match name {
+        "piecewise" => {
+            if let Some(s) = &raw.segments {
+                return Err(src.error(&s.span(), "`segments` belongs to blend = \"bezier\""));
+            }
+            let knots = match &raw.knots {
+                Some(k) => {
+                    src.all_finite(k.get_ref(), k, "knots")?;
+                    Some(k.get_ref().clone())
+                }
+                None => None,
+            };
+            Blend::Piecewise { knots }
+        }
+        "bezier" => {
+            if let Some(k) = &raw.knots {
+                return Err(src.error(&k.span(), "`knots` belongs to blend = \"piecewise\""));
+            }
+            Blend::Bezier {
+                segments: raw.segments.as_ref().map(|s| *s.get_ref()),
+            }
+        }
+        other => {
+            return Err(src.error(
+                &at_blend,
+                format!(
+                    "unknown blend \"{other}\"; expected one of: {}",
+                    BLEND_NAMES.join(", ")
+                ),
+            ))
+        }
+    };
+    // Build the volume once here so that a bad count, knot list or segment count is
+    // reported at its key, not later without a position.
+    let check = match &blend {
+        Blend::Piecewise { knots } => {
+            PiecewiseVolume::new(surfaces.clone(), knots.clone()).map(|_| ())
+        }
+        Blend::Bezier { segments } => BezierVolume::new(surfaces.clone(), *segments).map(|_| ()),
+    };
+    check.map_err(|e| {
+        let at = if e.message.contains("knots") {
+            raw.knots.as_ref().map(Spanned::span)
+        } else if e.message.contains("segments") {
+            raw.segments.as_ref().map(Spanned::span)
+        } else {
+            None
+        };
+        src.error(&at.unwrap_or(list.span()), e.message)
+    })?;
+    Ok(VolumeSource::Blended { surfaces, blend })
 }
 
 /// Fails at the first present key that `allowed` refuses.
@@ -253,6 +359,29 @@ fn preset(required: &Required, name: &str) -> Result<PresetSpec> {
     })
 }
 
+/// A bicubic Bezier surface from `control[row][column]`. Errors: not 4 rows of 4 points.
+fn bezier_patch(rows: Vec<Vec<DVec3>>) -> Result<Surface> {
+    let size = |rows: &[Vec<DVec3>]| {
+        format!(
+            "{} x {}",
+            rows.len(),
+            rows.iter().map(Vec::len).max().unwrap_or(0)
+        )
+    };
+    let grid: Option<[[DVec3; 4]; 4]> = rows
+        .iter()
+        .map(|row| <[DVec3; 4]>::try_from(row.as_slice()).ok())
+        .collect::<Option<Vec<_>>>()
+        .and_then(|r| r.try_into().ok());
+    match grid {
+        Some(control) => Ok(Surface::Bezier(Box::new(BezierPatch { control }))),
+        None => Err(Error::new(format!(
+            "bezier surface needs 4 rows of 4 control points, got {}",
+            size(&rows)
+        ))),
+    }
+}
+
 /// The keys each surface type takes (besides `surface`).
 fn surface_keys(name: &str) -> &'static [&'static str] {
     match name {
@@ -261,11 +390,12 @@ fn surface_keys(name: &str) -> &'static [&'static str] {
         "sphere" | "hemisphere" => &["center", "radius", "longitude", "latitude", "axis", "front"],
         "cylinder" => &["center", "radius", "angle", "height", "axis", "front"],
         "point" => &["point"],
+        "bezier" | "bspline" => &["control"],
         _ => &["start", "end", "along"],
     }
 }
 
-/// One control surface table (`which` is `near` or `far`, for messages).
+/// One control surface table (`which` is `near`, `far` or `surface N`, for messages).
 fn surface(src: &Source, table: &Spanned<RawSurface>, which: &str) -> Result<Surface> {
     let raw = table.get_ref();
     let name = raw.surface.get_ref().as_str();
@@ -389,6 +519,26 @@ fn surface(src: &Source, table: &Spanned<RawSurface>, which: &str) -> Result<Sur
             },
         }),
         "point" => Surface::Point(need(&raw.point, "point")?),
+        "bezier" | "bspline" => {
+            let c = raw.control.as_ref().ok_or_else(|| {
+                src.error(
+                    &table.span(),
+                    format!("{which} {name} surface needs `control`"),
+                )
+            })?;
+            let rows: Vec<Vec<DVec3>> = c
+                .get_ref()
+                .iter()
+                .map(|row| row.iter().map(|p| DVec3::from_array(*p)).collect())
+                .collect();
+            src.all_finite(c.get_ref().concat().as_flattened(), c, "control")?;
+            let patch = if name == "bezier" {
+                bezier_patch(rows)
+            } else {
+                BSplinePatch::new(rows).map(Surface::BSpline)
+            };
+            patch.map_err(|e| src.error(&c.span(), format!("{which} {}", e.message)))?
+        }
         _ => {
             let along = match raw.along.as_ref() {
                 None => LineParam::U,

@@ -56,6 +56,10 @@ pub struct RawProjection {
     pub preset: Option<Spanned<String>>,
     pub near: Option<Spanned<RawSurface>>,
     pub far: Option<Spanned<RawSurface>>,
+    pub surfaces: Option<Spanned<Vec<Spanned<RawSurface>>>>,
+    pub blend: Option<Spanned<String>>,
+    pub knots: Option<Spanned<Vec<f64>>>,
+    pub segments: Option<Spanned<u32>>,
     pub reparam: Option<Spanned<String>>,
     pub max_latitude: Option<Spanned<f64>>,
     pub clip: Option<Spanned<[f64; 2]>>,
@@ -87,6 +91,7 @@ pub struct RawSurface {
     pub start: Option<Vec3Value>,
     pub end: Option<Vec3Value>,
     pub along: Option<Spanned<String>>,
+    pub control: Option<Spanned<Vec<Vec<[f64; 3]>>>>,
 }
 
 impl RawSurface {
@@ -111,6 +116,7 @@ impl RawSurface {
             ("start", self.start.as_ref().map(Spanned::span)),
             ("end", self.end.as_ref().map(Spanned::span)),
             ("along", self.along.as_ref().map(Spanned::span)),
+            ("control", self.control.as_ref().map(Spanned::span)),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))
@@ -137,6 +143,10 @@ impl RawProjection {
             ("preset", self.preset.as_ref().map(Spanned::span)),
             ("near", self.near.as_ref().map(Spanned::span)),
             ("far", self.far.as_ref().map(Spanned::span)),
+            ("surfaces", self.surfaces.as_ref().map(Spanned::span)),
+            ("blend", self.blend.as_ref().map(Spanned::span)),
+            ("knots", self.knots.as_ref().map(Spanned::span)),
+            ("segments", self.segments.as_ref().map(Spanned::span)),
             ("reparam", self.reparam.as_ref().map(Spanned::span)),
             (
                 "max_latitude",

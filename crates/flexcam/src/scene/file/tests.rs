@@ -870,3 +870,114 @@ fn texture_is_loaded_relative_to_the_scene() {
         other => panic!("{other:?}"),
     }
 }
+
+/// Three rectangles for blended flexible volumes, as a `surfaces` value on one line.
+const THREE: &str = "surfaces = [{ surface = \"rectangle\", center = [0, 0, 1], u_axis = [1, 0, 0], v_axis = [0, 1, 0] }, { surface = \"rectangle\", center = [1, 0, 2], u_axis = [1, 0, 0], v_axis = [0, 1, 0] }, { surface = \"rectangle\", center = [0, 0, 3], u_axis = [2, 0, 0], v_axis = [0, 2, 0] }]\n";
+
+#[test]
+fn flexible_blended_surfaces_and_patches_parse() {
+    use crate::projection::flexible::{Blend, Surface as Control, VolumeSource};
+    let head = "[projection]\ntype = \"flexible\"\n";
+    let source = |text: &str| match scene(text).projection {
+        ProjectionSpec::Flexible(f) => f.source,
+        other => panic!("not flexible: {other:?}"),
+    };
+    match source(&format!("{head}blend = \"bezier\"\nsegments = 4\n{THREE}")) {
+        VolumeSource::Blended { surfaces, blend } => {
+            assert_eq!(surfaces.len(), 3);
+            assert_eq!(blend, Blend::Bezier { segments: Some(4) });
+        }
+        other => panic!("{other:?}"),
+    }
+    match source(&format!("{head}knots = [0, 0.25, 1]\n{THREE}")) {
+        VolumeSource::Blended { blend, .. } => assert_eq!(
+            blend,
+            Blend::Piecewise {
+                knots: Some(vec![0.0, 0.25, 1.0])
+            }
+        ),
+        other => panic!("{other:?}"),
+    }
+    let row = |z: f64| format!("[[0, 0, {z}], [1, 0, {z}], [2, 0, {z}], [3, 0, {z}]]");
+    let grid = |rows: usize| {
+        (0..rows)
+            .map(|r| row(r as f64))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let text = format!(
+        "{head}surfaces = [{{ surface = \"bezier\", control = [{}] }}, {{ surface = \"bspline\", control = [{}] }}]\n",
+        grid(4),
+        grid(5)
+    );
+    match source(&text) {
+        VolumeSource::Blended { surfaces, .. } => {
+            assert!(matches!(surfaces[0], Control::Bezier(_)));
+            assert!(matches!(&surfaces[1], Control::BSpline(b) if b.size() == (5, 4)));
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn flexible_blended_errors_have_positions() {
+    let head = "[projection]\ntype = \"flexible\"\n";
+    assert_error_at(
+        &format!("{head}blend = \"spline\"\n{THREE}"),
+        3,
+        9,
+        "unknown blend \"spline\"; expected one of: piecewise, bezier",
+    );
+    assert_error_at(
+        &format!("{head}knots = [0, 0.7, 0.5]\n{THREE}"),
+        3,
+        9,
+        "flexible knots must increase strictly from 0 to 1",
+    );
+    assert_error_at(
+        &format!("{head}knots = [0, 1]\n{THREE}"),
+        3,
+        9,
+        "2 knots for 3 surfaces",
+    );
+    assert_error_at(
+        &format!("{head}segments = 3\n{THREE}"),
+        3,
+        12,
+        "`segments` belongs to blend = \"bezier\"",
+    );
+    assert_error_at(
+        &format!("{head}blend = \"bezier\"\nsegments = 0\n{THREE}"),
+        4,
+        12,
+        "segments must be at least 1",
+    );
+    assert_error_at(
+        &format!("{head}near = {{ surface = \"point\", point = [0, 0, 0] }}\n{THREE}"),
+        3,
+        8,
+        "`near` is not a parameter of flexible projections given by `surfaces`",
+    );
+    assert_error_at(
+        &format!("{head}blend = \"bezier\"\nsurfaces = [{{ surface = \"point\", point = [0, 0, 0] }}, {{ surface = \"point\", point = [0, 0, 1] }}]\n"),
+        4,
+        12,
+        "a bezier flexible volume needs at least 3 surfaces",
+    );
+    assert_error_at(
+        &format!("{head}surfaces = [{{ surface = \"point\", point = [0, 0, 0] }}, {{ surface = \"bezier\", control = [[[0, 0, 0]]] }}]\n"),
+        3,
+        87,
+        "surface 2 bezier surface needs 4 rows of 4 control points, got 1 x 1",
+    );
+    assert_error_at(
+        &format!("{head}surfaces = [{{ surface = \"point\", point = [0, 0, 0] }}, {{ surface = \"bspline\", control = [[[0, 0, 0]]] }}]\n"),
+        3,
+        88,
+        "surface 2 bspline surface needs at least 4 x 4 control points, got 1 x 1",
+    );
+    assert_error(
+        &format!("{head}blend = \"bezier\"\n"),
+        "flexible projection needs `surfaces`",
+    );
+}

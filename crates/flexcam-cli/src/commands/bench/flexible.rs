@@ -1,0 +1,214 @@
+//! `flexcam bench flexible`: Table 7.1 of seed 003 (Brosz, The Flexible Projection Framework)
+//! with flexcam's BVH-accelerated ray caster.
+//!
+//! The thesis timed one frame at 800 x 800 through a perspective-to-perspective volume with
+//! quadratic Bezier projectors and with 2 to 6 segment polylines approximating them, on six
+//! models of 520 to 37,127 faces, with no acceleration structure. Its models are not
+//! available; each row here renders the Utah teapot tessellated to the face count nearest the
+//! thesis's (64 n^2 - 8 n triangles for n x n quads per patch), and prints the count used.
+//! The volume is three rectangles (near, bent middle, far) placed around the model's bounding
+//! box; the polylines are the quadratic sampled at equal steps in t.
+
+use std::time::Instant;
+
+use clap::Args;
+use flexcam::projection::flexible::{Blend, Flexible, FlexibleSpec, Surface, VolumeSource};
+use flexcam::render::raycast::RayCaster;
+use flexcam::render::{RenderOptions, Shading};
+use flexcam::scene::{shapes, ImageSettings, Material, Mesh, Object, Scene};
+use flexcam::{Error, Result};
+use glam::{Affine3A, DVec3, Vec3};
+
+/// Table 7.1's rows: model, faces, then seconds for quadratic and 2, 3, 4, 5, 6 segments.
+const THESIS: [(&str, u32, [f64; 6]); 6] = [
+    ("Kia", 520, [72.74, 48.56, 59.73, 69.98, 84.99, 114.57]),
+    (
+        "Teapot",
+        2256,
+        [326.06, 185.99, 296.43, 380.10, 433.48, 474.40],
+    ),
+    (
+        "Cowboy",
+        7695,
+        [1167.76, 875.53, 1261.39, 1640.88, 1807.96, 2078.57],
+    ),
+    (
+        "Alley",
+        12602,
+        [1711.28, 1342.75, 1604.97, 2192.11, 2583.69, 2891.87],
+    ),
+    (
+        "City",
+        22123,
+        [3494.66, 1837.91, 2537.59, 2862.20, 3345.76, 4554.37],
+    ),
+    (
+        "Saloon",
+        37127,
+        [4642.61, 3235.35, 5075.96, 6175.63, 6810.99, 7239.51],
+    ),
+];
+
+/// The thesis's image size.
+const SIZE: u32 = 800;
+
+/// Arguments of `flexcam bench flexible`.
+#[derive(Args, Debug)]
+pub struct FlexibleArgs {
+    /// Renders per cell; the fastest is reported.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100))]
+    repeat: u32,
+    /// Only the first N rows of the table (smallest models first).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=6))]
+    rows: Option<u32>,
+}
+
+/// The projector kinds of the table's columns: `None` is the analytic quadratic.
+const COLUMNS: [Option<u32>; 6] = [None, Some(2), Some(3), Some(4), Some(5), Some(6)];
+
+/// Runs the benchmark and prints the thesis's times, ours, and the speed-up.
+pub fn run(args: &FlexibleArgs) -> Result<()> {
+    let rows = args.rows.map_or(THESIS.len(), |r| r as usize);
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    println!(
+        "Table 7.1 (seed 003): {SIZE}x{SIZE}, lit shading (headlight), one frame per cell, best \
+         of {}, {threads} threads; models: the Utah teapot at the tessellation nearest each \
+         face count",
+        args.repeat
+    );
+    let mut ours = Vec::with_capacity(rows);
+    for (name, faces, _) in &THESIS[..rows] {
+        let (scene, used) = teapot_scene(*faces);
+        let caster = RayCaster::new(&scene);
+        let (lo, hi) = bounds(&scene)?;
+        let mut times = [0.0; 6];
+        for (time, column) in times.iter_mut().zip(COLUMNS) {
+            let projection = volume(lo, hi, column)?;
+            *time = best_of(args.repeat, || {
+                caster.render(
+                    &projection,
+                    &RenderOptions {
+                        shading: Shading::Lit,
+                        ..RenderOptions::default()
+                    },
+                );
+            });
+        }
+        eprintln!("{name}: {used} faces done");
+        ours.push((*name, *faces, used, times));
+    }
+    print_table("thesis (seconds, no acceleration structure)", rows, |r| {
+        THESIS[r].2.map(|t| format!("{t:.2}"))
+    });
+    print_table("flexcam (seconds)", rows, |r| {
+        ours[r].3.map(|t| format!("{t:.4}"))
+    });
+    print_table("speed-up (thesis / flexcam)", rows, |r| {
+        std::array::from_fn(|c| format!("{:.0}x", THESIS[r].2[c] / ours[r].3[c]))
+    });
+    println!("faces used per row:");
+    for (name, faces, used, _) in &ours {
+        println!("  {name:<7} thesis {faces:>6}, teapot {used:>6}");
+    }
+    Ok(())
+}
+
+/// Prints one table in the thesis's layout with the cells `cell(row)`.
+fn print_table(title: &str, rows: usize, cell: impl Fn(usize) -> [String; 6]) {
+    println!("\n{title}");
+    println!(
+        "{:<8}{:>7}{:>11}{:>10}{:>10}{:>10}{:>10}{:>10}",
+        "model", "faces", "quadratic", "2 seg", "3 seg", "4 seg", "5 seg", "6 seg"
+    );
+    for (r, (name, faces, _)) in THESIS[..rows].iter().enumerate() {
+        let c = cell(r);
+        println!(
+            "{name:<8}{faces:>7}{:>11}{:>10}{:>10}{:>10}{:>10}{:>10}",
+            c[0], c[1], c[2], c[3], c[4], c[5]
+        );
+    }
+}
+
+/// The fastest of `repeat` runs of `f`, in seconds.
+fn best_of(repeat: u32, mut f: impl FnMut()) -> f64 {
+    (0..repeat)
+        .map(|_| {
+            let start = Instant::now();
+            f();
+            start.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// A scene of one teapot whose triangle count is nearest `faces`, and that count.
+fn teapot_scene(faces: u32) -> (Scene, usize) {
+    let count = |n: u32| 64 * n * n - 8 * n;
+    let n = (1..=64)
+        .min_by_key(|&n| count(n).abs_diff(faces))
+        .unwrap_or(1);
+    let mesh: Mesh = shapes::teapot(1.0, 4 * n);
+    let used = mesh.triangle_count();
+    let object = Object {
+        id: 1,
+        name: "teapot".to_string(),
+        mesh,
+        material: Material {
+            color: Vec3::new(0.85, 0.3, 0.2),
+            ..Material::default()
+        },
+        world_to_object: Affine3A::IDENTITY,
+    };
+    let scene = Scene {
+        objects: vec![object],
+        lights: Vec::new(),
+        image: ImageSettings {
+            width: SIZE,
+            height: SIZE,
+            background: Vec3::new(0.55, 0.7, 0.9),
+        },
+        projection: flexcam::projection::ProjectionSpec::Perspective {
+            frame: flexcam::projection::CameraFrame {
+                position: DVec3::Z,
+                look_at: DVec3::ZERO,
+                up: DVec3::Y,
+            },
+            fov: 60.0,
+        },
+        base_dir: None,
+    };
+    (scene, used)
+}
+
+/// The bounding box of the scene's meshes.
+fn bounds(scene: &Scene) -> Result<(DVec3, DVec3)> {
+    scene
+        .objects
+        .iter()
+        .filter_map(|o| o.mesh.bounds())
+        .map(|(lo, hi)| (lo.as_dvec3(), hi.as_dvec3()))
+        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+        .ok_or_else(|| Error::new("the benchmark scene is empty"))
+}
+
+/// The perspective-to-perspective volume around the box `[lo, hi]`: a small near square in
+/// front (+z), a middle square shifted up and to the right, a far square behind the model.
+/// `segments`: `None` for quadratic projectors, else polylines of that many segments.
+fn volume(lo: DVec3, hi: DVec3, segments: Option<u32>) -> Result<Flexible> {
+    let centre = 0.5 * (lo + hi);
+    let r = 0.5 * (hi - lo).length();
+    let square =
+        |c: DVec3, half: f64| Surface::rectangle_centred(c, DVec3::X * half, DVec3::Y * half);
+    let surfaces = vec![
+        square(centre + DVec3::new(0.0, 0.0, 4.0 * r), 0.1 * r),
+        square(centre + DVec3::new(0.4 * r, 0.3 * r, 1.0 * r), 0.9 * r),
+        square(centre + DVec3::new(0.0, 0.0, -2.0 * r), 1.3 * r),
+    ];
+    let spec = FlexibleSpec {
+        source: VolumeSource::Blended {
+            surfaces,
+            blend: Blend::Bezier { segments },
+        },
+        reparam: None,
+    };
+    Flexible::new(&spec, SIZE, SIZE)
+}

@@ -1,0 +1,20 @@
+//! `flexcam bench`: the source documents' timing tables, rerun with flexcam's renderers.
+
+pub mod flexible;
+
+use clap::Subcommand;
+use flexcam::Result;
+
+/// Which table to measure.
+#[derive(Subcommand, Debug)]
+pub enum BenchCommand {
+    /// Table 7.1 of seed 003: quadratic vs 2 to 6 segment projectors at 800 x 800.
+    Flexible(flexible::FlexibleArgs),
+}
+
+/// Runs `flexcam bench`.
+pub fn run(command: &BenchCommand) -> Result<()> {
+    match command {
+        BenchCommand::Flexible(args) => flexible::run(args),
+    }
+}

@@ -1,0 +1,326 @@
+//! Volumes of two or more control surfaces blended in t (seed 003, 4.2 and 7.2): curved
+//! projectors.
+//!
+//! - [`PiecewiseVolume`]: Q(u, v, t) is linear in t between surfaces at knots t_0 = 0 < t_1 <
+//!   ... < t_{N-1} = 1 (hat-function blending): polyline projectors through every surface.
+//! - [`BezierVolume`]: Q(u, v, t) = sum_i b_{i,n}(t) Q_i(u, v) with the Bernstein polynomials
+//!   of degree n = N - 1 (evaluated by de Casteljau): Bezier projectors through the first and
+//!   last surface only. Degree 2 gives quadratic projectors, which the ray caster intersects
+//!   analytically; any degree can be rendered as a polyline of a stated number of segments.
+
+use glam::{DVec2, DVec3};
+
+use super::surface::Surface;
+use crate::error::{Error, Result};
+use crate::projection::Projector;
+
+/// Segments of the polyline that renders a Bezier volume of degree above 2 when the scene does
+/// not say.
+pub const DEFAULT_SEGMENTS: u32 = 16;
+
+/// Samples per side of the grid on which a volume is checked to have a projector of non-zero
+/// length.
+const CHECK_SAMPLES: u32 = 17;
+
+/// Validates `surfaces` (named `surface 1`, `surface 2`, ... in messages) and checks that at
+/// least one projector on a 17 x 17 grid of (u, v) has non-zero length: otherwise every
+/// projector is a point and nothing can be seen.
+pub(super) fn check_surfaces(surfaces: &[Surface]) -> Result<()> {
+    for (i, s) in surfaces.iter().enumerate() {
+        s.validate()
+            .map_err(|e| Error::new(format!("flexible surface {} {}", i + 1, e.message)))?;
+    }
+    let n = f64::from(CHECK_SAMPLES - 1);
+    let any_length = (0..CHECK_SAMPLES).any(|i| {
+        (0..CHECK_SAMPLES).any(|j| {
+            let uv = DVec2::new(f64::from(i) / n, f64::from(j) / n);
+            let first = surfaces[0].point(uv);
+            surfaces[1..].iter().any(|s| s.point(uv) != first)
+        })
+    });
+    if any_length {
+        Ok(())
+    } else {
+        Err(Error::new(
+            "flexible control surfaces coincide: every projector has zero length",
+        ))
+    }
+}
+
+/// The control points of the projector of (u, v): each surface's point. `None` when they
+/// all coincide (a projector of zero length) or one is not finite.
+fn control_points(surfaces: &[Surface], uv: DVec2) -> Option<Vec<DVec3>> {
+    let points: Vec<DVec3> = surfaces.iter().map(|s| s.point(uv)).collect();
+    let moves = points.iter().any(|p| *p != points[0]);
+    (moves && points.iter().all(|p| p.is_finite())).then_some(points)
+}
+
+/// Piecewise-linear blending of surfaces at knots in t.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PiecewiseVolume {
+    surfaces: Vec<Surface>,
+    knots: Vec<f64>,
+}
+
+impl PiecewiseVolume {
+    /// Surfaces at `knots` (default: equally spaced). Errors: fewer than 2 surfaces; knots
+    /// whose count differs from the surfaces', that do not start at 0 and end at 1, or do not
+    /// increase strictly; invalid or everywhere coincident surfaces (see [`check_surfaces`]).
+    /// Two successive surfaces may coincide at some or all (u, v): that piece of the
+    /// projector has zero length and sees nothing.
+    pub fn new(surfaces: Vec<Surface>, knots: Option<Vec<f64>>) -> Result<Self> {
+        let n = surfaces.len();
+        if n < 2 {
+            return Err(Error::new(format!(
+                "a piecewise flexible volume needs at least 2 surfaces, got {n}"
+            )));
+        }
+        let knots = knots.unwrap_or_else(|| (0..n).map(|i| i as f64 / (n - 1) as f64).collect());
+        if knots.len() != n {
+            return Err(Error::new(format!(
+                "flexible knots must give one t per surface: {} knots for {n} surfaces",
+                knots.len()
+            )));
+        }
+        let increasing = knots.windows(2).all(|w| w[0] < w[1]);
+        if knots[0] != 0.0 || knots[n - 1] != 1.0 || !increasing {
+            return Err(Error::new(format!(
+                "flexible knots must increase strictly from 0 to 1, got {knots:?}"
+            )));
+        }
+        check_surfaces(&surfaces)?;
+        Ok(PiecewiseVolume { surfaces, knots })
+    }
+
+    /// The piece that `t` falls in: `i` with knots[i] <= t <= knots[i+1] (t below 0 or
+    /// above 1 extrapolates the first or last piece), and the local parameter in it.
+    fn piece(&self, t: f64) -> (usize, f64) {
+        let last = self.knots.len() - 2;
+        let i = self.knots[1..=last].partition_point(|&k| k <= t).min(last);
+        let (a, b) = (self.knots[i], self.knots[i + 1]);
+        (i, (t - a) / (b - a))
+    }
+
+    /// Q(u, v, t).
+    pub fn point(&self, uv: DVec2, t: f64) -> DVec3 {
+        let (i, s) = self.piece(t);
+        self.surfaces[i]
+            .point(uv)
+            .lerp(self.surfaces[i + 1].point(uv), s)
+    }
+
+    /// dQ/dt at (u, v, t): constant within a piece. At an inner knot (where the projector has
+    /// a corner) it is the derivative of the piece that starts there.
+    pub fn tangent(&self, uv: DVec2, t: f64) -> DVec3 {
+        let (i, _) = self.piece(t);
+        (self.surfaces[i + 1].point(uv) - self.surfaces[i].point(uv))
+            / (self.knots[i + 1] - self.knots[i])
+    }
+
+    /// The polyline through every surface's point at (u, v); `None` for a projector of zero
+    /// length.
+    pub fn projector(&self, uv: DVec2) -> Option<Projector> {
+        control_points(&self.surfaces, uv).map(Projector::Polyline)
+    }
+}
+
+/// Bernstein blending of surfaces: Bezier projectors.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BezierVolume {
+    surfaces: Vec<Surface>,
+    /// `None`: quadratic projectors, intersected analytically; `Some(n)`: projectors rendered
+    /// as polylines of `n` equal steps in t.
+    segments: Option<u32>,
+}
+
+impl BezierVolume {
+    /// A Bezier volume of degree `surfaces.len() - 1`. `segments`: render the projectors as
+    /// polylines of that many steps in t; without it degree 2 is analytic and higher degrees
+    /// take [`DEFAULT_SEGMENTS`]. Errors: fewer than 3 surfaces (2 are a linear volume), 0
+    /// segments, invalid or everywhere coincident surfaces.
+    pub fn new(surfaces: Vec<Surface>, segments: Option<u32>) -> Result<Self> {
+        let n = surfaces.len();
+        if n < 3 {
+            return Err(Error::new(format!(
+                "a bezier flexible volume needs at least 3 surfaces (2 give straight \
+                 projectors: use near and far), got {n}"
+            )));
+        }
+        if segments == Some(0) {
+            return Err(Error::new("flexible segments must be at least 1"));
+        }
+        check_surfaces(&surfaces)?;
+        let segments = match (n, segments) {
+            (3, s) => s,
+            (_, s) => Some(s.unwrap_or(DEFAULT_SEGMENTS)),
+        };
+        Ok(BezierVolume { surfaces, segments })
+    }
+
+    /// The de Casteljau pyramid of the control points at (u, v) down to its last two points,
+    /// at `t`: their lerp is Q and their difference times the degree is dQ/dt.
+    fn last_pair(&self, uv: DVec2, t: f64) -> (DVec3, DVec3) {
+        let mut points: Vec<DVec3> = self.surfaces.iter().map(|s| s.point(uv)).collect();
+        while points.len() > 2 {
+            for i in 0..points.len() - 1 {
+                points[i] = points[i].lerp(points[i + 1], t);
+            }
+            points.pop();
+        }
+        (points[0], points[1])
+    }
+
+    /// Q(u, v, t) by de Casteljau.
+    pub fn point(&self, uv: DVec2, t: f64) -> DVec3 {
+        let (a, b) = self.last_pair(uv, t);
+        a.lerp(b, t)
+    }
+
+    /// dQ/dt at (u, v, t): the degree times the difference of the last de Casteljau pair.
+    pub fn tangent(&self, uv: DVec2, t: f64) -> DVec3 {
+        let (a, b) = self.last_pair(uv, t);
+        (self.surfaces.len() - 1) as f64 * (b - a)
+    }
+
+    /// The projector of (u, v): the analytic quadratic, or the polyline through Q at
+    /// `segments + 1` equally spaced t; `None` for a projector of zero length.
+    pub fn projector(&self, uv: DVec2) -> Option<Projector> {
+        let points = control_points(&self.surfaces, uv)?;
+        match self.segments {
+            None => Some(Projector::QuadraticBezier([
+                points[0], points[1], points[2],
+            ])),
+            Some(n) => Some(Projector::Polyline(
+                (0..=n)
+                    .map(|k| self.point(uv, f64::from(k) / f64::from(n)))
+                    .collect(),
+            )),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(z: f64, half: f64) -> Surface {
+        Surface::rectangle_centred(DVec3::new(0.0, 0.0, z), DVec3::X * half, DVec3::Y * half)
+    }
+
+    fn close(a: DVec3, b: DVec3) -> bool {
+        (a - b).length() < 1e-12
+    }
+
+    #[test]
+    fn piecewise_passes_through_every_surface_at_its_knot() {
+        let surfaces = vec![square(1.0, 1.0), square(2.0, 3.0), square(4.0, 3.0)];
+        let v = PiecewiseVolume::new(surfaces.clone(), Some(vec![0.0, 0.25, 1.0])).unwrap();
+        let uv = DVec2::new(1.0, 0.5);
+        for (s, t) in surfaces.iter().zip([0.0, 0.25, 1.0]) {
+            assert!(close(v.point(uv, t), s.point(uv)));
+        }
+        assert!(close(v.point(uv, 0.125), DVec3::new(2.0, 0.0, 1.5)));
+        assert!(close(v.tangent(uv, 0.1), DVec3::new(8.0, 0.0, 4.0)));
+        // At the inner knot: the derivative of the piece that starts there.
+        assert!(close(v.tangent(uv, 0.25), DVec3::new(0.0, 0.0, 8.0 / 3.0)));
+        assert!(close(v.tangent(uv, 1.0), DVec3::new(0.0, 0.0, 8.0 / 3.0)));
+        match v.projector(uv) {
+            Some(Projector::Polyline(p)) => assert_eq!(p.len(), 3),
+            other => panic!("{other:?}"),
+        }
+    }
+
+    #[test]
+    fn default_knots_are_equally_spaced() {
+        let v = PiecewiseVolume::new(
+            vec![square(1.0, 1.0), square(2.0, 1.0), square(4.0, 1.0)],
+            None,
+        )
+        .unwrap();
+        assert!(close(
+            v.point(DVec2::splat(0.5), 0.5),
+            DVec3::new(0.0, 0.0, 2.0)
+        ));
+    }
+
+    #[test]
+    fn bad_knots_and_counts_are_errors() {
+        let s = vec![square(1.0, 1.0), square(2.0, 1.0), square(3.0, 1.0)];
+        for knots in [
+            vec![0.0, 1.0],
+            vec![0.0, 0.5, 0.9],
+            vec![0.0, 0.6, 0.6],
+            vec![0.1, 0.5, 1.0],
+        ] {
+            assert!(PiecewiseVolume::new(s.clone(), Some(knots)).is_err());
+        }
+        assert!(PiecewiseVolume::new(vec![square(1.0, 1.0)], None).is_err());
+        assert!(BezierVolume::new(s[..2].to_vec(), None).is_err());
+        assert!(BezierVolume::new(s.clone(), Some(0)).is_err());
+        let same = vec![square(1.0, 1.0); 3];
+        let e = BezierVolume::new(same, None).unwrap_err();
+        assert!(e.message.contains("coincide"), "{e}");
+    }
+
+    #[test]
+    fn zero_length_pieces_are_allowed_but_a_point_projector_has_none() {
+        // The first two surfaces coincide: the first piece has zero length everywhere.
+        let v = PiecewiseVolume::new(
+            vec![square(1.0, 1.0), square(1.0, 1.0), square(2.0, 2.0)],
+            None,
+        )
+        .unwrap();
+        assert!(v.projector(DVec2::ZERO).is_some());
+        // Three surfaces crossing at the centre: the projector of (1/2, 1/2) is a point.
+        let crossing = vec![
+            Surface::rectangle_centred(DVec3::ZERO, DVec3::X, DVec3::Y),
+            Surface::rectangle_centred(DVec3::ZERO, DVec3::X, DVec3::Z),
+            Surface::rectangle_centred(DVec3::ZERO, DVec3::Y, DVec3::Z),
+        ];
+        let b = BezierVolume::new(crossing, None).unwrap();
+        assert_eq!(b.projector(DVec2::splat(0.5)), None);
+        assert!(b.projector(DVec2::new(0.5, 0.9)).is_some());
+    }
+
+    #[test]
+    fn quadratic_bezier_matches_bernstein_form_and_derivative() {
+        let s = vec![square(1.0, 1.0), square(3.0, 1.0), square(2.0, 4.0)];
+        let v = BezierVolume::new(s.clone(), None).unwrap();
+        let uv = DVec2::new(0.2, 0.7);
+        let p: Vec<DVec3> = s.iter().map(|s| s.point(uv)).collect();
+        let t = 0.3;
+        let want = 0.49 * p[0] + 0.42 * p[1] + 0.09 * p[2];
+        assert!(close(v.point(uv, t), want));
+        let want_d = 2.0 * (0.7 * (p[1] - p[0]) + 0.3 * (p[2] - p[1]));
+        assert!(close(v.tangent(uv, t), want_d));
+        assert!(close(v.point(uv, 1.0), p[2]));
+        assert_eq!(
+            v.projector(uv),
+            Some(Projector::QuadraticBezier([p[0], p[1], p[2]]))
+        );
+    }
+
+    #[test]
+    fn cubic_bezier_tangent_is_the_derivative_and_renders_as_a_polyline() {
+        let s = vec![
+            square(1.0, 1.0),
+            square(3.0, 1.0),
+            square(2.0, 4.0),
+            square(5.0, 2.0),
+        ];
+        let v = BezierVolume::new(s, None).unwrap();
+        let uv = DVec2::new(0.9, 0.1);
+        let h = 1e-6;
+        for t in [0.0, 0.4, 1.0] {
+            let numeric = (v.point(uv, t + h) - v.point(uv, t - h)) / (2.0 * h);
+            assert!((numeric - v.tangent(uv, t)).length() < 1e-6);
+        }
+        match v.projector(uv) {
+            Some(Projector::Polyline(p)) => {
+                assert_eq!(p.len(), DEFAULT_SEGMENTS as usize + 1);
+                assert!(close(p[8], v.point(uv, 0.5)));
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+}
