@@ -27,7 +27,7 @@ pub use image_coords::Resolution;
 pub use linear::{Orthographic, Perspective};
 pub use panoramic::{Cylindrical, Equirectangular};
 pub use trilinear::{
-    project_triangle, ProjectionTriangleCache, SceneEdge, Shape, ShapeVertex, Solutions,
+    project_triangle, surfaces, ProjectionTriangleCache, SceneEdge, Shape, ShapeVertex, Solutions,
     TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
 };
 

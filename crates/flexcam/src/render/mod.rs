@@ -76,6 +76,7 @@ pub enum Counter {
 /// Named counters a renderer reports (rays cast, build times, ...), for `--stats`.
 pub type Stats = BTreeMap<&'static str, Counter>;
 pub mod compare;
+pub mod composite;
 mod method;
 pub mod raster;
 pub mod raycast;

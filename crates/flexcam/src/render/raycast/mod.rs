@@ -7,7 +7,7 @@
 //! See docs/raycast.md for the design and the measurements.
 
 mod bvh;
-mod optics;
+pub(crate) mod optics;
 mod sampling;
 mod shade;
 mod tiles;
