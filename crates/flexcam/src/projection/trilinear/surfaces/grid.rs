@@ -191,4 +191,51 @@ mod tests {
             "centre meets"
         );
     }
+
+    mod round_trip {
+        use super::*;
+        use crate::projection::flexible::{CylinderPatch, PolarFrame};
+        use proptest::prelude::*;
+
+        /// A bent base: rays outwards from a cylinder of radius 0.5 to one of radius 20,
+        /// 160 degrees around and 2 (near) to 30 (far) high.
+        fn bent() -> (Surface, Surface) {
+            let frame = PolarFrame::new(DVec3::Y, DVec3::NEG_Z).unwrap();
+            let patch = |radius: f64, half_height: f64| {
+                Surface::Cylinder(CylinderPatch {
+                    center: DVec3::ZERO,
+                    radius,
+                    frame,
+                    angle: [-80f64.to_radians(), 80f64.to_radians()],
+                    height: [-half_height, half_height],
+                })
+            };
+            (patch(0.5, 1.0), patch(20.0, 15.0))
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(300))]
+
+            /// The grid's projection inverts its rays: a point on the ray of a pixel
+            /// projects back to that pixel, at that depth.
+            #[test]
+            fn grid_pixel_to_point_to_pixel(
+                n in 1u32..7,
+                (x, y) in (0.0..1.0f64, 0.0..1.0f64),
+                t in 0.0..3.0f64,
+            ) {
+                let (near, far) = bent();
+                let mesh = screen_grid(n, between_surfaces(&near, &far)).unwrap();
+                let trilinear = Trilinear::new(&mesh, 320, 120).unwrap();
+                let pixel = DVec2::new(x * 320.0, y * 120.0);
+                let point = trilinear.ray(pixel).unwrap().at(t);
+                let mut images = Vec::new();
+                trilinear.project(point, &mut images);
+                let found = images.iter().any(|image| {
+                    (image.pixel - pixel).length() <= 1e-6 && (image.t - t).abs() <= 1e-9
+                });
+                prop_assert!(found, "{pixel} t {t}: {images:?}");
+            }
+        }
+    }
 }

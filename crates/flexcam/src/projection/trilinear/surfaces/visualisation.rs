@@ -268,4 +268,35 @@ mod tests {
         let (near, far) = inward_sphere(center, 0.0, frame, [-PI, PI], [-1.0, 1.0]);
         assert!(screen_grid(2, between_surfaces(&near, &far)).is_err());
     }
+
+    mod properties {
+        use super::*;
+        use proptest::prelude::*;
+
+        proptest! {
+            /// The detail-in-context map is invertible: it keeps the direction from the
+            /// focus and is strictly increasing in the distance, so no two screen positions
+            /// show the same view (no fold) for any valid inset.
+            #[test]
+            fn detail_in_context_is_radially_monotone(
+                inner in 0.01..0.4f64,
+                width in 0.01..0.4f64,
+                magnification in 0.3..8.0f64,
+                angle in 0.0..6.3f64,
+                (r1, r2) in (0.0..0.9f64, 0.0..0.9f64),
+            ) {
+                let focus = DVec2::new(0.45, 0.55);
+                let outer = inner + width;
+                prop_assume!(inner / magnification < outer);
+                let view = DetailInContext::new(camera(), focus, [inner, outer], magnification).unwrap();
+                let dir = DVec2::from_angle(angle);
+                let (a, b) = (view.source(focus + r1 * dir) - focus, view.source(focus + r2 * dir) - focus);
+                prop_assert!(a.perp_dot(dir).abs() <= 1e-12 && b.perp_dot(dir).abs() <= 1e-12);
+                prop_assert!(a.dot(dir) >= 0.0 && b.dot(dir) >= 0.0);
+                if r1 < r2 {
+                    prop_assert!(a.length() < b.length(), "{r1} {r2}: {a} {b}");
+                }
+            }
+        }
+    }
 }
