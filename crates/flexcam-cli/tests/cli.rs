@@ -443,3 +443,60 @@ fn raster_bad_input_is_one_line() {
     );
     assert!(e.contains("method raster needs a projection"), "{e}");
 }
+
+/// A trilinear reflector is composited by `flexcam render`, and says so in the stats.
+#[test]
+fn trilinear_reflector_renders_with_its_counters() {
+    let dir = TempDir::new().unwrap();
+    let text = GOOD_SCENE.replace(
+        "color = [1.0, 0.0, 0.0]",
+        "material = \"mirror\"\ntrilinear_reflector = true",
+    );
+    write(&dir, "r.toml", &text);
+    let out = flexcam(dir.path())
+        .args(["render", "r.toml", "--shading", "flat", "--stats", "-"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stats: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(stats["reflectors"], 1);
+    assert!(
+        stats["reflector_triangles"].as_u64().unwrap() > 100,
+        "{stats}"
+    );
+    assert!(stats["reflector_pixels"].as_u64().unwrap() > 50, "{stats}");
+    assert!(dir.path().join("flexcam.png").exists());
+}
+
+/// `trilinear_reflector` on a diffuse object, or under a non-perspective camera, is one
+/// positioned error line.
+#[test]
+fn trilinear_reflector_errors_are_positioned() {
+    let dir = TempDir::new().unwrap();
+    let text = GOOD_SCENE.replace(
+        "color = [1.0, 0.0, 0.0]",
+        "color = [1.0, 0.0, 0.0]\ntrilinear_reflector = true",
+    );
+    write(&dir, "d.toml", &text);
+    let e = expect_failure(&dir, &["render", "d.toml"]);
+    assert!(
+        e.contains("d.toml:23:23:") && e.contains("needs material"),
+        "{e}"
+    );
+    let text = GOOD_SCENE
+        .replace(
+            "color = [1.0, 0.0, 0.0]",
+            "material = \"mirror\"\ntrilinear_reflector = true",
+        )
+        .replace("type = \"perspective\"", "type = \"fisheye\"");
+    write(&dir, "f.toml", &text);
+    let e = expect_failure(&dir, &["render", "f.toml"]);
+    assert!(
+        e.contains("f.toml:23:23:") && e.contains("perspective"),
+        "{e}"
+    );
+}

@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, StagedFile};
-use flexcam::render::{Method, RenderOptions, Shading};
+use flexcam::render::{composite, Method, RenderOptions, Shading};
 use flexcam::{Error, Result};
 
 use super::scene_args::{MethodTuning, SceneArgs, ShadingArg};
@@ -61,7 +61,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ..RenderOptions::default()
     };
     let render_start = Instant::now();
-    let rendered = method.render(&loaded.scene, loaded.projection.as_ref(), &options);
+    // Trilinear reflectors (if the scene has any) are composited into the main view, each
+    // rendered by the same method.
+    let rendered = composite::render(
+        &loaded.scene,
+        loaded.projection.as_ref(),
+        &options,
+        &|s, p, o| method.render(s, p, o),
+    );
     let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
     progress.finish();
     let (frame, counters) = rendered?;

@@ -31,7 +31,7 @@ pub use linear::{Orthographic, Perspective};
 pub use panoramic::{Cylindrical, Equirectangular};
 pub use projector::Projector;
 pub use trilinear::{
-    project_triangle, ProjectionTriangleCache, SceneEdge, Shape, ShapeVertex, Solutions,
+    project_triangle, surfaces, ProjectionTriangleCache, SceneEdge, Shape, ShapeVertex, Solutions,
     TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
 };
 

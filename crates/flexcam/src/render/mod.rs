@@ -79,6 +79,7 @@ pub enum Counter {
 /// Named counters a renderer reports (rays cast, build times, ...), for `--stats`.
 pub type Stats = BTreeMap<&'static str, Counter>;
 pub mod compare;
+pub mod composite;
 pub mod inverse_raster;
 mod method;
 pub mod raster;

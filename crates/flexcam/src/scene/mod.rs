@@ -58,6 +58,10 @@ pub struct Scene {
     /// The folder relative paths in the scene (models, textures, projection surfaces) are
     /// resolved against; `None` for built-in scenes.
     pub base_dir: Option<PathBuf>,
+    /// Ids of the mirror and glass objects whose reflection or refraction is rendered
+    /// through a trilinear surface and composited into the main image (scene-file key
+    /// `trilinear_reflector`; see [`crate::render::composite`]). Empty: plain rendering.
+    pub trilinear_reflectors: Vec<u32>,
 }
 
 impl Scene {

@@ -161,6 +161,7 @@ fn teapot_scene(faces: u32) -> (Scene, usize) {
     let scene = Scene {
         objects: vec![object],
         lights: Vec::new(),
+        trilinear_reflectors: Vec::new(),
         image: ImageSettings {
             width: SIZE,
             height: SIZE,

@@ -12,6 +12,7 @@ mod obj;
 mod point_projection;
 mod screen_locator;
 mod shapes;
+pub mod surfaces;
 
 use glam::{DVec2, DVec3};
 
@@ -116,15 +117,20 @@ fn validate(mesh: &TrilinearMesh) -> Result<()> {
                  but there are only {count} vertices"
             )));
         }
-        let [a, b, c] = triangle.map(|k| mesh.screen[k as usize]);
-        let (e1, e2) = (b - a, c - a);
-        if e1.perp_dot(e2).abs() <= DEGENERATE_SINE * e1.length() * e2.length() {
+        if is_degenerate_screen_triangle(triangle.map(|k| mesh.screen[k as usize])) {
             return Err(Error::new(format!(
                 "trilinear triangle {index} has a zero-area (degenerate) screen triangle"
             )));
         }
     }
     Ok(())
+}
+
+/// Whether a screen triangle has zero area up to [`DEGENERATE_SINE`] (such a triangle cannot
+/// locate a screen position).
+pub(super) fn is_degenerate_screen_triangle([a, b, c]: [DVec2; 3]) -> bool {
+    let (e1, e2) = (b - a, c - a);
+    e1.perp_dot(e2).abs() <= DEGENERATE_SINE * e1.length() * e2.length()
 }
 
 impl Projection for Trilinear {

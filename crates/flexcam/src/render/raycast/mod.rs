@@ -8,7 +8,7 @@
 
 mod bvh;
 mod curve;
-mod optics;
+pub(crate) mod optics;
 mod sampling;
 mod shade;
 mod tiles;

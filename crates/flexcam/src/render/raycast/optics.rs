@@ -6,13 +6,13 @@
 use glam::DVec3;
 
 /// The mirror image of `direction` about the plane with normal `normal`.
-pub(super) fn reflect(direction: DVec3, normal: DVec3) -> DVec3 {
+pub(crate) fn reflect(direction: DVec3, normal: DVec3) -> DVec3 {
     direction - 2.0 * direction.dot(normal) * normal
 }
 
 /// A refracted direction and the fraction of light reflected instead.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Refraction {
+pub(crate) struct Refraction {
     pub direction: DVec3,
     /// Unpolarised Fresnel reflectance, in [0, 1].
     pub reflectance: f64,
@@ -22,7 +22,7 @@ pub(super) struct Refraction {
 /// from) / (index of the side it enters), or `None` on total internal reflection
 /// (`eta * sin(incidence) > 1`). At normal incidence the ray goes straight through; at
 /// grazing incidence (`cos = 0`) the reflectance is 1.
-pub(super) fn refract(direction: DVec3, normal: DVec3, eta: f64) -> Option<Refraction> {
+pub(crate) fn refract(direction: DVec3, normal: DVec3, eta: f64) -> Option<Refraction> {
     let cos_i = (-direction.dot(normal)).clamp(0.0, 1.0);
     let sin2_t = eta * eta * (1.0 - cos_i * cos_i);
     if sin2_t > 1.0 {

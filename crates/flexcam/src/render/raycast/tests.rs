@@ -93,6 +93,7 @@ fn scene(objects: Vec<Object>, lights: Vec<Light>) -> Scene {
             fov: 60.0,
         },
         base_dir: None,
+        trilinear_reflectors: Vec::new(),
     }
 }
 

@@ -396,7 +396,7 @@ fn surface_keys(name: &str) -> &'static [&'static str] {
 }
 
 /// One control surface table (`which` is `near`, `far` or `surface N`, for messages).
-fn surface(src: &Source, table: &Spanned<RawSurface>, which: &str) -> Result<Surface> {
+pub(super) fn surface(src: &Source, table: &Spanned<RawSurface>, which: &str) -> Result<Surface> {
     let raw = table.get_ref();
     let name = raw.surface.get_ref().as_str();
     if !SURFACE_NAMES.contains(&name) {

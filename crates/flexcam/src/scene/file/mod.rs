@@ -11,6 +11,7 @@ mod projection;
 mod raw;
 mod shape;
 mod source;
+mod trilinear_grid;
 mod values;
 
 use std::collections::HashMap;
@@ -64,10 +65,15 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene> {
     let projection = projection::convert(&src, projection_table, &base_dir)?;
     check_unique_names(&src, &raw.object)?;
     let mut objects = Vec::new();
+    let mut trilinear_reflectors = Vec::new();
     for (index, table) in raw.object.iter().enumerate() {
         let id =
             u32::try_from(index + 1).map_err(|_| src.error(&table.span(), "too many objects"))?;
-        objects.extend(object::convert(&src, table, id, &base_dir)?);
+        let parts = object::convert(&src, table, id, &base_dir)?;
+        if object::is_trilinear_reflector(&src, table, &parts, &projection)? {
+            trilinear_reflectors.push(id);
+        }
+        objects.extend(parts);
     }
     let lights = raw
         .light
@@ -87,6 +93,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene> {
         image,
         projection,
         base_dir: Some(base_dir),
+        trilinear_reflectors,
     })
 }
 

@@ -11,6 +11,7 @@ use super::raw::{Numbers, RawObject};
 use super::shape::{analytic_mesh, Shape, MAX_TESSELLATION};
 use super::source::Source;
 use crate::error::Result;
+use crate::projection::ProjectionSpec;
 use crate::scene::loaders::{load_model, load_texture};
 use crate::scene::{Material, Mesh, Object, Pattern, Surface};
 
@@ -77,6 +78,58 @@ pub(super) fn convert(
             }
         })
         .collect())
+}
+
+/// Whether the object asks for `trilinear_reflector = true`: its reflection (mirror) or
+/// refraction (glass) is then rendered through a trilinear surface built from its mesh and
+/// composited into the main image. Errors, at the key: an object whose material is neither
+/// mirror nor glass, and a scene whose projection is not perspective (the surface's screen
+/// positions are the main camera's image of the reflector).
+pub(super) fn is_trilinear_reflector(
+    src: &Source,
+    table: &Spanned<RawObject>,
+    parts: &[Object],
+    projection: &ProjectionSpec,
+) -> Result<bool> {
+    let Some(flag) = &table.get_ref().trilinear_reflector else {
+        return Ok(false);
+    };
+    if !*flag.get_ref() {
+        return Ok(false);
+    }
+    if let Some(part) = parts
+        .iter()
+        .find(|p| !matches!(p.material.surface, Surface::Mirror | Surface::Glass { .. }))
+    {
+        return Err(src.error(
+            &flag.span(),
+            format!(
+                "`trilinear_reflector` needs material \"mirror\" or \"glass\", but \"{}\" is {}",
+                part.name,
+                surface_name(part.material.surface)
+            ),
+        ));
+    }
+    if !matches!(projection, ProjectionSpec::Perspective { .. }) {
+        return Err(src.error(
+            &flag.span(),
+            format!(
+                "`trilinear_reflector` needs a perspective [projection] (the main camera), not {}",
+                projection.kind()
+            ),
+        ));
+    }
+    Ok(true)
+}
+
+/// The scene-file name of a surface kind.
+fn surface_name(surface: Surface) -> &'static str {
+    match surface {
+        Surface::Diffuse => "diffuse",
+        Surface::Mirror => "mirror",
+        Surface::Glass { .. } => "glass",
+        Surface::Emissive => "emissive",
+    }
 }
 
 /// Rejects keys that the shape does not take: `file` belongs to meshes only, `size` and

@@ -38,6 +38,24 @@ const KINDS: [(&str, Kind); 7] = [
 /// mechanism stays for the next one).
 const UNSUPPORTED: [&str; 0] = [];
 
+/// Keys of a trilinear projection given as a mesh (a surface file or inline arrays).
+const MESH_KEYS: [&str; 5] = ["surface", "points", "normals", "screen", "triangles"];
+
+/// Keys of a trilinear projection given as a grid (`grid` and its bases).
+const GRID_KEYS: [&str; 11] = [
+    "grid",
+    "near",
+    "far",
+    "view",
+    "camera",
+    "focus",
+    "inset",
+    "magnification",
+    "first",
+    "second",
+    "band",
+];
+
 /// Parameters of the single-viewpoint projections, shared by all of them.
 const FRAME_KEYS: [&str; 3] = ["position", "look_at", "up"];
 
@@ -63,7 +81,7 @@ impl Kind {
             Kind::Orthographic => &["width"],
             Kind::Equirectangular | Kind::Cylindrical => &["h_fov", "v_fov"],
             Kind::Trilinear => {
-                return vec!["surface", "points", "normals", "screen", "triangles"];
+                return MESH_KEYS.iter().chain(&GRID_KEYS).copied().collect();
             }
             Kind::Flexible => return super::flexible::KEYS.to_vec(),
         };
@@ -192,9 +210,22 @@ pub(super) fn camera_frame(src: &Source, required: &Required) -> Result<CameraFr
     })
 }
 
-/// A trilinear mesh from `surface = "file.obj"` or from the inline arrays.
+/// A trilinear mesh from `surface = "file.obj"`, from the inline arrays, or from `grid`.
 fn trilinear(src: &Source, required: &Required, base_dir: &Path) -> Result<TrilinearMesh> {
     let raw = required.raw();
+    let present = raw.present_keys();
+    if let Some(cells) = &raw.grid {
+        if let Some((key, span)) = present.iter().find(|(k, _)| MESH_KEYS.contains(k)) {
+            return Err(src.error(
+                span,
+                format!("`{key}` cannot be combined with `grid`: give a grid or a mesh"),
+            ));
+        }
+        return super::trilinear_grid::convert(required, cells);
+    }
+    if let Some((key, span)) = present.iter().find(|(k, _)| GRID_KEYS.contains(k)) {
+        return Err(src.error(span, format!("`{key}` belongs to a trilinear `grid`")));
+    }
     if let Some(surface) = &raw.surface {
         let inline = [
             ("points", raw.points.as_ref().map(Spanned::span)),
@@ -214,7 +245,7 @@ fn trilinear(src: &Source, required: &Required, base_dir: &Path) -> Result<Trili
     if raw.points.is_none() {
         return Err(src.error(
             &required.table.span(),
-            "trilinear projection needs `surface` or the inline `points`, `normals`, `screen` and `triangles`",
+            "trilinear projection needs `surface` or the inline `points`, `normals`, `screen` and `triangles`, or a `grid`",
         ));
     }
     let points = required.get(&raw.points, "points")?;

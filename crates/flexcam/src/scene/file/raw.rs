@@ -65,6 +65,29 @@ pub struct RawProjection {
     pub clip: Option<Spanned<[f64; 2]>>,
     pub shear: Option<Spanned<[f64; 2]>>,
     pub slit_distance: Option<Spanned<f64>>,
+    pub grid: Option<Spanned<u32>>,
+    pub view: Option<Spanned<String>>,
+    pub camera: Option<Spanned<RawCamera>>,
+    pub focus: Option<Spanned<[f64; 2]>>,
+    pub inset: Option<Spanned<[f64; 2]>>,
+    pub magnification: Option<Spanned<f64>>,
+    pub first: Option<Spanned<RawCamera>>,
+    pub second: Option<Spanned<RawCamera>>,
+    pub band: Option<Spanned<[f64; 2]>>,
+}
+
+/// `camera = { ... }`, `first`, `second`: a camera of a trilinear grid's visualisation
+/// surface; `h_fov` and `v_fov` (pinhole) or `width` and `height` (parallel).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawCamera {
+    pub position: Vec3Value,
+    pub look_at: Vec3Value,
+    pub up: Option<Vec3Value>,
+    pub h_fov: Option<Spanned<f64>>,
+    pub v_fov: Option<Spanned<f64>>,
+    pub width: Option<Spanned<f64>>,
+    pub height: Option<Spanned<f64>>,
 }
 
 /// `near = { surface = "...", ... }` / `far`: a flexible projection's control surface, the
@@ -158,6 +181,18 @@ impl RawProjection {
                 "slit_distance",
                 self.slit_distance.as_ref().map(Spanned::span),
             ),
+            ("grid", self.grid.as_ref().map(Spanned::span)),
+            ("view", self.view.as_ref().map(Spanned::span)),
+            ("camera", self.camera.as_ref().map(Spanned::span)),
+            ("focus", self.focus.as_ref().map(Spanned::span)),
+            ("inset", self.inset.as_ref().map(Spanned::span)),
+            (
+                "magnification",
+                self.magnification.as_ref().map(Spanned::span),
+            ),
+            ("first", self.first.as_ref().map(Spanned::span)),
+            ("second", self.second.as_ref().map(Spanned::span)),
+            ("band", self.band.as_ref().map(Spanned::span)),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))
@@ -197,6 +232,7 @@ pub struct RawObject {
     pub scale: Option<Spanned<Numbers>>,
     pub tessellation: Option<Spanned<u32>>,
     pub face_colors: Option<Spanned<[[f64; 3]; 6]>>,
+    pub trilinear_reflector: Option<Spanned<bool>>,
 }
 
 /// `checker = { color = [...], size = ... }`.

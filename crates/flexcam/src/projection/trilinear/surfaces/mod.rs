@@ -1,0 +1,25 @@
+//! Surfaces to project through (seed 000, chapters 6 and 7): trilinear projection meshes
+//! built from a description instead of listed vertex by vertex.
+//!
+//! - [`screen_grid`]: a regular n x n grid of screen cells (two projection triangles each,
+//!   shared vertices and ray directions) over any base given as a function from screen
+//!   position to a base point and ray direction ([`GridVertex`]); [`between_surfaces`] takes
+//!   the base from two control surfaces of a flexible volume (a bent, cylindrical or
+//!   spherical base; [`inward_sphere`] is the mapping surface of section 6.3).
+//! - [`DetailInContext`] and [`TwoViews`]: the visualisation surfaces of sections 6.1 and
+//!   6.2, defined over [`GridCamera`]s.
+//! - [`reflector_surface`]: the reflection and refraction surfaces of chapter 7, built from a
+//!   reflector mesh and the main camera, so that the image through them is already in the
+//!   main image's coordinates.
+//!
+//! See docs/trilinear-surfaces.md for the design and the degenerate cases.
+
+mod camera;
+mod grid;
+mod reflector;
+mod visualisation;
+
+pub use camera::GridCamera;
+pub use grid::{between_surfaces, screen_grid, GridVertex, MAX_GRID_CELLS};
+pub use reflector::{reflector_surface, vertex_ray, Optic, ReflectorSurface};
+pub use visualisation::{inward_sphere, DetailInContext, TwoViews};

@@ -1,0 +1,210 @@
+//! Reflection and refraction surfaces (seed 000, chapter 7): a trilinear projection whose
+//! base triangles are a reflector's (or lens's) triangles and whose vertex rays are the
+//! reflected (refracted) rays of the eye's rays at the vertices.
+//!
+//! Each vertex's screen position is where the main camera images it, so the image rendered
+//! through the surface is already in the main image's coordinates: a pixel that sees the
+//! reflector in the main image sees, through the surface, the interpolated vertex rays of the
+//! reflector point under it (exact at the vertices, an approximation in between: 7.2.2).
+
+use glam::{DVec2, DVec3};
+
+use crate::error::{Error, Result};
+use crate::projection::trilinear::is_degenerate_screen_triangle;
+use crate::projection::{ImagePoint, Perspective, Projection, TrilinearMesh};
+use crate::render::raycast::optics::{reflect, refract};
+use crate::scene::Mesh;
+
+/// What the reflector does to the eye's rays.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Optic {
+    /// A mirror: r = i - 2 (n . i) n.
+    Reflect,
+    /// A refracting surface between air (index 1, the side the vertex normals point to) and a
+    /// material of index `ior` (behind the surface).
+    Refract { ior: f64 },
+}
+
+/// The vertex ray of unit incident direction `incident` (eye to vertex) at a vertex with unit
+/// shading normal `normal` and outward face normal `face` (the winding's; any length), as the
+/// ray caster's mirror and glass treat a hit there:
+///
+/// - the shading normal is first turned to the side of the face the ray arrives from;
+/// - [`Optic::Reflect`]: `incident - 2 (normal . incident) normal`; grazing incidence
+///   (`normal . incident = 0`) gives the incident direction itself;
+/// - [`Optic::Refract`]: Snell's law in vector form with `eta = 1 / ior` when the ray enters
+///   (arrives against `face`) and `eta = ior` when it leaves; on total internal reflection
+///   (`eta sin(incidence) > 1`) the vertex ray is the mirror reflection. A shading normal
+///   that faces away from the ray (bent normals seen at grazing angles) counts as grazing
+///   incidence (cos = 0), as in the ray caster.
+///
+/// A zero `face` (a vertex of degenerate triangles only) takes `normal` as the face.
+pub fn vertex_ray(incident: DVec3, normal: DVec3, face: DVec3, optic: Optic) -> DVec3 {
+    let face = if face == DVec3::ZERO { normal } else { face };
+    let entering = incident.dot(face) <= 0.0;
+    let towards_ray = if entering { face } else { -face };
+    let normal = if normal.dot(towards_ray) < 0.0 {
+        -normal
+    } else {
+        normal
+    };
+    match optic {
+        Optic::Reflect => reflect(incident, normal),
+        Optic::Refract { ior } => {
+            let eta = if entering { 1.0 / ior } else { ior };
+            refract(incident, normal, eta)
+                .map_or_else(|| reflect(incident, normal), |r| r.direction)
+        }
+    }
+}
+
+/// A reflection or refraction surface and what was left out of it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReflectorSurface {
+    /// The projection mesh: used reflector vertices only, unit vertex rays, screen positions
+    /// in the main image; triangles ordered for visibility (see [`reflector_surface`]).
+    pub mesh: TrilinearMesh,
+    /// Reflector triangles left out (see [`reflector_surface`]).
+    pub dropped: usize,
+}
+
+/// Builds the surface of `reflector` (a world-space mesh) seen by the main camera `camera`
+/// (whose eye is the eye of the first-hit reflections) with `optic`.
+///
+/// Vertex `k` at `p` gets the ray `vertex_ray(i, n)` with `i = (p - eye) / |p - eye|` and `n`
+/// its unit vertex normal, and the screen position `(x / W, 1 - y / H)` of its pixel
+/// position `(x, y)` in the main image (outside [0, 1]^2 when it is outside the image).
+///
+/// Degenerate cases:
+/// - a mesh without vertex normals, or a zero normal: the area-weighted mean of the adjacent
+///   face normals is used; a vertex with no usable normal at all has no ray;
+/// - a vertex at the eye, or on or behind the plane of the eye (the main camera does not
+///   image it): no ray and no screen position;
+/// - a triangle is left out when a vertex has no ray, when the eye is not on the side of its
+///   plane that its vertex normals point to (the back of a closed reflector, hidden in the
+///   main image, or the back of an open one; also when the normals lie in the plane), or
+///   when its screen triangle has zero area (seen edge on). A vertex normal may still face
+///   away from the eye (grazing views of bent normals): its ray is the continuation above;
+/// - kept triangles can overlap on screen (a reflector that hides part of itself); the
+///   trilinear projection then uses the first, so nearer triangles (centroid distance from
+///   the eye) come first. The front-facing triangles of a convex reflector do not overlap,
+///   and they cover its whole image, silhouette included.
+///
+/// A reflector that the camera does not see gives a surface without triangles. Errors: a
+/// refractive index that is not finite and positive.
+pub fn reflector_surface(
+    reflector: &Mesh,
+    camera: &Perspective,
+    optic: Optic,
+) -> Result<ReflectorSurface> {
+    if let Optic::Refract { ior } = optic {
+        if !ior.is_finite() || ior <= 0.0 {
+            return Err(Error::new(format!(
+                "index of refraction must be finite and positive, got {ior}"
+            )));
+        }
+    }
+    let eye = camera.basis().origin;
+    let normals = vertex_normals(reflector);
+    let size = {
+        let (w, h) = camera.resolution();
+        DVec2::new(f64::from(w), f64::from(h))
+    };
+    let mut images = Vec::new();
+    let vertices: Vec<Option<SurfaceVertex>> = reflector
+        .positions
+        .iter()
+        .zip(&normals)
+        .map(|(p, &(normal, face))| {
+            let point = p.as_dvec3();
+            let incident = (point - eye).try_normalize()?;
+            let normal = normal.try_normalize()?;
+            images.clear();
+            camera.project(point, &mut images);
+            let &ImagePoint { pixel, .. } = images.first()?;
+            Some(SurfaceVertex {
+                point,
+                normal,
+                direction: vertex_ray(incident, normal, face, optic),
+                screen: DVec2::new(pixel.x / size.x, 1.0 - pixel.y / size.y),
+            })
+        })
+        .collect();
+
+    let mut kept: Vec<(f64, [u32; 3])> = Vec::new();
+    for triangle in &reflector.triangles {
+        let [Some(a), Some(b), Some(c)] = triangle.map(|k| vertices[k as usize]) else {
+            continue;
+        };
+        let face = (b.point - a.point).cross(c.point - a.point);
+        let reflecting_side = face.dot(a.normal + b.normal + c.normal);
+        let eye_side = face.dot(eye - a.point);
+        if reflecting_side * eye_side <= 0.0
+            || is_degenerate_screen_triangle([a.screen, b.screen, c.screen])
+        {
+            continue;
+        }
+        let centroid = (a.point + b.point + c.point) / 3.0;
+        kept.push((centroid.distance(eye), *triangle));
+    }
+    kept.sort_by(|x, y| x.0.total_cmp(&y.0));
+
+    let mut mesh = TrilinearMesh::default();
+    let mut new_index = vec![u32::MAX; vertices.len()];
+    for &(_, triangle) in &kept {
+        let mapped = triangle.map(|k| {
+            let slot = &mut new_index[k as usize];
+            if *slot == u32::MAX {
+                // Kept triangles only use vertices that have a ray.
+                if let Some(v) = vertices[k as usize] {
+                    *slot = mesh.points.len() as u32;
+                    mesh.points.push(v.point);
+                    mesh.normals.push(v.direction);
+                    mesh.screen.push(v.screen);
+                }
+            }
+            *slot
+        });
+        mesh.triangles.push(mapped);
+    }
+    Ok(ReflectorSurface {
+        dropped: reflector.triangles.len() - mesh.triangles.len(),
+        mesh,
+    })
+}
+
+/// A reflector vertex that has a ray.
+#[derive(Debug, Clone, Copy)]
+struct SurfaceVertex {
+    point: DVec3,
+    /// The unit vertex normal.
+    normal: DVec3,
+    direction: DVec3,
+    screen: DVec2,
+}
+
+/// The shading and face normals of each vertex of `mesh` (not normalised): the face normal is
+/// the sum of the adjacent faces' normals weighted by area (outward for an outward winding);
+/// the shading normal is the mesh's own where present and non-zero, else the face normal.
+/// Both are zero for a vertex of no triangle.
+fn vertex_normals(mesh: &Mesh) -> Vec<(DVec3, DVec3)> {
+    let mut from_faces = vec![DVec3::ZERO; mesh.positions.len()];
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|k| mesh.positions[k as usize].as_dvec3());
+        let area_normal = (b - a).cross(c - a);
+        for &k in t {
+            from_faces[k as usize] += area_normal;
+        }
+    }
+    from_faces
+        .into_iter()
+        .enumerate()
+        .map(|(k, face)| match mesh.normals.get(k) {
+            Some(n) if *n != glam::Vec3::ZERO => (n.as_dvec3(), face),
+            _ => (face, face),
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,185 @@
+//! Reflections and refractions through trilinear surfaces (seed 000, chapter 7), composited
+//! into the main image.
+//!
+//! The main view is rendered with the reflectors treated as diffuse (their pixels are
+//! replaced, so no exact secondary rays are spent on them). Each reflector then gets a
+//! [`reflector_surface`] built from its mesh and the main camera, the scene without that
+//! reflector is rendered through it, and every main-image pixel that sees the reflector takes
+//! its colour from that image, which is already in main-image coordinates ([`paste`]).
+//! Depth and object id stay those of the main view (the reflector's own, as for a mirror in
+//! the ray caster).
+//!
+//! The renderer is a parameter ([`Renderer`]): any method that renders a scene through a
+//! projection, e.g. `|s, p, o| Method::Raycast.render(s, p, o)`, or a faster trilinear one.
+//! In `lit` shading the reflected or refracted colour is tinted by the reflector's base
+//! colour (no Fresnel mixing for glass); in `flat` shading it is taken as is, as the flat
+//! contract asks of mirrors and glass.
+
+use std::time::Instant;
+
+use glam::Vec3;
+
+use crate::error::{Error, Result};
+use crate::projection::surfaces::{reflector_surface, Optic, ReflectorSurface};
+use crate::projection::{Perspective, Projection, ProjectionSpec, Trilinear};
+use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
+use crate::scene::{Mesh, Object, Scene, Surface};
+
+/// A way of rendering a scene through a projection (a [`crate::render::Method`] or any
+/// other renderer).
+pub type Renderer<'a> =
+    dyn Fn(&Scene, &dyn Projection, &RenderOptions) -> Result<(Frame, Stats)> + 'a;
+
+/// Renders `scene` through `main` with `renderer`, compositing the reflections and
+/// refractions of `scene.trilinear_reflectors` (none: exactly `renderer`'s image). The stats
+/// are the main render's, plus `reflectors`, `reflector_triangles` (in the surfaces),
+/// `reflector_dropped_triangles` (see [`reflector_surface`]), `reflector_pixels` (main-image
+/// pixels replaced) and `reflector_render_ms` (surface building and rendering).
+///
+/// Errors: the renderer's; a scene projection that is not perspective (the main camera);
+/// a reflector id that no object has, or whose material is not mirror or glass.
+pub fn render(
+    scene: &Scene,
+    main: &dyn Projection,
+    options: &RenderOptions,
+    renderer: &Renderer,
+) -> Result<(Frame, Stats)> {
+    if scene.trilinear_reflectors.is_empty() {
+        return renderer(scene, main, options);
+    }
+    let camera = main_camera(scene, main)?;
+    let mut main_scene = scene.clone();
+    for object in &mut main_scene.objects {
+        if scene.trilinear_reflectors.contains(&object.id) {
+            object.material.surface = Surface::Diffuse;
+        }
+    }
+    let (mut frame, mut stats) = renderer(&main_scene, main, options)?;
+    let start = Instant::now();
+    let (mut triangles, mut dropped, mut pixels) = (0, 0, 0);
+    for &id in &scene.trilinear_reflectors {
+        let reflector = Reflector::of(scene, id)?;
+        let surface = reflector_surface(&reflector.mesh, &camera, reflector.optic)?;
+        triangles += surface.mesh.triangles.len();
+        dropped += surface.dropped;
+        let Some(image) = render_through(scene, id, &surface, &camera, options, renderer)? else {
+            continue;
+        };
+        let tint = match options.shading {
+            Shading::Flat => Vec3::ONE,
+            Shading::Lit => reflector.tint,
+        };
+        pixels += paste(&mut frame, id, &image, tint);
+    }
+    let count = |n: usize| Counter::Count(n as u64);
+    stats.insert("reflectors", count(scene.trilinear_reflectors.len()));
+    stats.insert("reflector_triangles", count(triangles));
+    stats.insert("reflector_dropped_triangles", count(dropped));
+    stats.insert("reflector_pixels", Counter::Count(pixels));
+    stats.insert(
+        "reflector_render_ms",
+        Counter::Value(start.elapsed().as_secs_f64() * 1e3),
+    );
+    Ok((frame, stats))
+}
+
+/// The main camera: the scene's perspective projection at `main`'s resolution.
+pub fn main_camera(scene: &Scene, main: &dyn Projection) -> Result<Perspective> {
+    let ProjectionSpec::Perspective { frame, fov } = &scene.projection else {
+        return Err(Error::new(format!(
+            "trilinear reflectors need a perspective projection (the main camera), not {}",
+            scene.projection.kind()
+        )));
+    };
+    let (width, height) = main.resolution();
+    Perspective::new(frame, *fov, width, height)
+}
+
+/// A reflector object: its parts' meshes merged, its optic and its base colour.
+#[derive(Debug, Clone)]
+pub struct Reflector {
+    pub mesh: Mesh,
+    pub optic: Optic,
+    pub tint: Vec3,
+}
+
+impl Reflector {
+    /// The reflector with object id `id`. Errors: no object has the id; a part that is
+    /// neither mirror nor glass.
+    pub fn of(scene: &Scene, id: u32) -> Result<Reflector> {
+        let parts: Vec<&Object> = scene.objects.iter().filter(|o| o.id == id).collect();
+        let first = parts.first().ok_or_else(|| {
+            Error::new(format!("trilinear reflector {id}: no object has this id"))
+        })?;
+        let optic = match first.material.surface {
+            Surface::Mirror => Optic::Reflect,
+            Surface::Glass { ior } => Optic::Refract {
+                ior: f64::from(ior),
+            },
+            _ => {
+                return Err(Error::new(format!(
+                    "trilinear reflector \"{}\" must be a mirror or glass",
+                    first.name
+                )))
+            }
+        };
+        let mut mesh = Mesh::default();
+        for part in &parts {
+            if part.material.surface != first.material.surface {
+                return Err(Error::new(format!(
+                    "trilinear reflector \"{}\" has parts of different materials",
+                    first.name
+                )));
+            }
+            mesh.append(&part.mesh);
+        }
+        Ok(Reflector {
+            mesh,
+            optic,
+            tint: first.material.color,
+        })
+    }
+}
+
+/// Renders `scene` without object `id` through `surface` at the main camera's resolution:
+/// the reflected or refracted view in main-image coordinates; `None` when the surface has no
+/// triangles (the main camera does not see the reflector).
+pub fn render_through(
+    scene: &Scene,
+    id: u32,
+    surface: &ReflectorSurface,
+    camera: &Perspective,
+    options: &RenderOptions,
+    renderer: &Renderer,
+) -> Result<Option<Frame>> {
+    if surface.mesh.triangles.is_empty() {
+        return Ok(None);
+    }
+    let (width, height) = camera.resolution();
+    let projection = Trilinear::new(&surface.mesh, width, height)?;
+    let mut others = scene.clone();
+    others.objects.retain(|o| o.id != id);
+    others.trilinear_reflectors.clear();
+    Ok(Some(renderer(&others, &projection, options)?.0))
+}
+
+/// Replaces the colour of every pixel of `main` that sees object `id` by `tint` times the
+/// same pixel of `reflection`; returns the number of pixels replaced. Pixels that no
+/// triangle of the surface covers hold `reflection`'s background. Frames of different
+/// sizes are a programming error: nothing is replaced.
+pub fn paste(main: &mut Frame, id: u32, reflection: &Frame, tint: Vec3) -> u64 {
+    if (main.width, main.height) != (reflection.width, reflection.height) {
+        return 0;
+    }
+    let mut replaced = 0;
+    for (k, color) in main.color.iter_mut().enumerate() {
+        if main.ids[k] == id {
+            *color = tint * reflection.color[k];
+            replaced += 1;
+        }
+    }
+    replaced
+}
+
+#[cfg(test)]
+mod tests;
