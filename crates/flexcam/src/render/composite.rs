@@ -69,7 +69,7 @@ pub fn render(
             Shading::Flat => Vec3::ONE,
             Shading::Lit => reflector.tint,
         };
-        pixels += paste(&mut frame, id, &image, tint);
+        pixels += paste(&mut frame, id, &image, tint)?;
     }
     let count = |n: usize| Counter::Count(n as u64);
     stats.insert("reflectors", count(scene.trilinear_reflectors.len()));
@@ -165,11 +165,14 @@ pub fn render_through(
 
 /// Replaces the colour of every pixel of `main` that sees object `id` by `tint` times the
 /// same pixel of `reflection`; returns the number of pixels replaced. Pixels that no
-/// triangle of the surface covers hold `reflection`'s background. Frames of different
-/// sizes are a programming error: nothing is replaced.
-pub fn paste(main: &mut Frame, id: u32, reflection: &Frame, tint: Vec3) -> u64 {
+/// triangle of the surface covers hold `reflection`'s background. Errors: frames of
+/// different sizes.
+pub fn paste(main: &mut Frame, id: u32, reflection: &Frame, tint: Vec3) -> Result<u64> {
     if (main.width, main.height) != (reflection.width, reflection.height) {
-        return 0;
+        return Err(Error::new(format!(
+            "cannot paste a {}x{} reflection into a {}x{} image",
+            reflection.width, reflection.height, main.width, main.height
+        )));
     }
     let mut replaced = 0;
     for (k, color) in main.color.iter_mut().enumerate() {
@@ -178,7 +181,7 @@ pub fn paste(main: &mut Frame, id: u32, reflection: &Frame, tint: Vec3) -> u64 {
             replaced += 1;
         }
     }
-    replaced
+    Ok(replaced)
 }
 
 #[cfg(test)]
