@@ -430,7 +430,7 @@ fn raster_bad_input_is_one_line() {
     let raster = ["render", "s.toml", "--method", "raster"];
     let e = expect_failure(&dir, &[&raster[..], &["--subdiv", "0"]].concat());
     assert!(e.contains("subdivision must be between 1 and 64"), "{e}");
-    let e = expect_failure(&dir, &[&raster[..], &["--raster-tolerance", "-1"]].concat());
+    let e = expect_failure(&dir, &[&raster[..], &["--raster-tolerance=-1"]].concat());
     assert!(e.contains("raster tolerance"), "{e}");
     let e = expect_failure(&dir, &[&raster[..], &["--spp", "4"]].concat());
     assert!(e.contains("one sample per pixel"), "{e}");

@@ -114,9 +114,23 @@ impl<'a> Refiner<'a> {
 
     /// Whether edge `a b` is longer than some pole's clearance and within twice its length
     /// of that pole (angles at the pole's origin).
+    ///
+    /// Most edges are far from every pole: they are rejected first by bounds on the angles
+    /// from chords of unit vectors (an angle is at least its chord and at most pi/2 times
+    /// it), without trigonometry.
     fn near_pole(&self, a: DVec3, b: DVec3) -> bool {
         self.chart.poles.iter().any(|pole| {
             let (oa, ob) = (a - pole.origin, b - pole.origin);
+            let (Some(ua), Some(ub)) = (oa.try_normalize(), ob.try_normalize()) else {
+                return false;
+            };
+            let longest = std::f64::consts::FRAC_PI_2 * (ua - ub).length();
+            let nearest = (ua - pole.direction)
+                .length()
+                .min((ub - pole.direction).length());
+            if longest <= pole.clearance || nearest >= 2.0 * longest {
+                return false;
+            }
             let length = angle_between(oa, ob);
             length > pole.clearance
                 && angle_between(oa, pole.direction).min(angle_between(ob, pole.direction))
@@ -242,6 +256,108 @@ impl<'a> Refiner<'a> {
                     ]);
                 }
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::projection::{CameraFrame, ProjectionSpec};
+
+    fn panorama() -> Box<dyn Projection> {
+        let frame = CameraFrame {
+            position: DVec3::ZERO,
+            look_at: DVec3::NEG_Z,
+            up: DVec3::Y,
+        };
+        let spec = ProjectionSpec::Equirectangular {
+            frame,
+            h_fov: 360.0,
+            v_fov: 180.0,
+        };
+        spec.build(360, 180).unwrap()
+    }
+
+    #[test]
+    fn curved_edges_split_and_straight_or_degenerate_ones_do_not() {
+        let projection = panorama();
+        let chart = projection.inverse_chart().unwrap();
+        let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
+        let node = |p: DVec3| refiner.node(p);
+        // A horizontal edge 90 degrees wide above the horizon bends in the panorama.
+        let (a, b) = (
+            node(DVec3::new(-1.0, 0.5, -1.0)),
+            node(DVec3::new(1.0, 0.5, -1.0)),
+        );
+        assert!(refiner.split(&a, &b, 0).is_some());
+        // The same decision from either end, with the same midpoint.
+        assert_eq!(refiner.split(&a, &b, 0), refiner.split(&b, &a, 0));
+        // Degenerate: the level limit, and an edge whose ends coincide.
+        assert!(refiner.split(&a, &b, MAX_LEVEL).is_none());
+        assert!(refiner.split(&a, &a, 0).is_none());
+        // A short vertical edge straight ahead, far from the poles, stays straight (a
+        // column of the panorama).
+        let (c, d) = (
+            node(DVec3::new(0.0, -0.1, -1.0)),
+            node(DVec3::new(0.0, 0.1, -1.0)),
+        );
+        assert!(refiner.split(&c, &d, 0).is_none());
+        // Degenerate: an end on the eye has no image; the midpoint rule does not split.
+        let eye = node(DVec3::ZERO);
+        assert!(eye.image.is_none());
+        assert!(refiner.split(&eye, &c, 0).is_none());
+    }
+
+    #[test]
+    fn pieces_around_a_pole_are_found_and_shrunk() {
+        let projection = panorama();
+        let chart = projection.inverse_chart().unwrap();
+        let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
+        let ceiling = [
+            DVec3::new(-1.0, 1.0, -1.0),
+            DVec3::new(1.0, 1.0, -1.0),
+            DVec3::new(0.0, 1.0, 1.0),
+        ];
+        assert!(refiner.is_pole_piece(ceiling));
+        assert!(!refiner.is_pole_piece(ceiling.map(|p| p + DVec3::X * 5.0)));
+        // Refined, only pieces within the pole's clearance still contain the pole.
+        let clearance = chart.poles[0].clearance;
+        let mut pole_pieces = 0;
+        refiner.refine(ceiling.map(|p| refiner.node(p)), [0; 3], &mut |piece| {
+            let points = piece.map(|n| n.point);
+            if refiner.is_pole_piece(points) {
+                pole_pieces += 1;
+                let widest = points
+                    .iter()
+                    .map(|&p| angle_between(p, DVec3::Y))
+                    .fold(0.0, f64::max);
+                assert!(widest <= clearance, "{widest} > {clearance}");
+            }
+        });
+        assert!(pole_pieces >= 1);
+    }
+
+    #[test]
+    fn uniform_grid_makes_n_squared_pieces() {
+        let projection = panorama();
+        let chart = projection.inverse_chart().unwrap();
+        let refiner = Refiner::new(projection.as_ref(), &chart, None);
+        let corners = [
+            DVec3::new(-1.0, 0.0, -2.0),
+            DVec3::new(1.0, 0.0, -2.0),
+            DVec3::new(0.0, 1.0, -2.0),
+        ]
+        .map(|p| refiner.node(p));
+        for n in [1, 2, 3, 8] {
+            let mut pieces = Vec::new();
+            refiner.uniform(corners, n, &mut Vec::new(), &mut |p| pieces.push(p));
+            assert_eq!(pieces.len() as u32, n * n);
+            let area: f64 = pieces
+                .iter()
+                .map(|[a, b, c]| 0.5 * (b.point - a.point).cross(c.point - a.point).length())
+                .sum();
+            assert!((area - 1.0).abs() < 1e-12, "{n}: {area}");
         }
     }
 }
