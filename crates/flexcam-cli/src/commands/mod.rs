@@ -1,4 +1,5 @@
 //! The subcommands.
 
+pub mod animate;
 pub mod render;
 pub mod scenes;

@@ -47,14 +47,15 @@ pub struct RenderArgs {
     stats: Option<OutputTarget>,
 }
 
+/// `--shading`, shared with `flexcam animate`.
 #[derive(Clone, Copy, Debug, ValueEnum)]
-enum ShadingArg {
+pub enum ShadingArg {
     Flat,
     Lit,
 }
 
 impl ShadingArg {
-    fn shading(self) -> Shading {
+    pub fn shading(self) -> Shading {
         match self {
             ShadingArg::Flat => Shading::Flat,
             ShadingArg::Lit => Shading::Lit,

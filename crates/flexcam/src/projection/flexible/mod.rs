@@ -8,11 +8,15 @@
 //! - [`reparam`]: pixel <-> (u, v) (linear, polar fisheye, lens-like, Mercator);
 //! - [`presets`]: named volumes from a camera frame (perspective, pushbroom, crossed slits, ...);
 //! - `inverse`: (u, v, t) from a scene point for the analytic class (parallel planes, nested
-//!   spheres, coaxial cylinders).
+//!   spheres, coaxial cylinders);
+//! - [`blend`]: Q = a Q1 + (1 - a) Q2, interpolation and extrapolation between volumes;
+//! - [`animation`]: keyframed flexible cameras, a blend of neighbouring keys per frame.
 //!
 //! A pixel's ray starts on the near surface and reaches the far surface at t = 1; t is
 //! limited to [0, 1] (the per-projector near and far clip of the framework).
 
+pub mod animation;
+pub mod blend;
 mod inverse;
 pub mod presets;
 pub mod reparam;
@@ -23,6 +27,8 @@ pub mod volume;
 
 use glam::{DVec2, DVec3};
 
+pub use animation::{Animation, Easing, Keyframe};
+pub use blend::BlendVolume;
 pub use presets::{Preset, PresetSpec};
 pub use reparam::Reparam;
 pub use surface::{CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface};
@@ -31,7 +37,7 @@ pub use volume::{LinearVolume, Volume};
 use self::inverse::Inverse;
 use super::image_coords::Resolution;
 use super::{ImagePoint, Projection};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::geometry::Ray;
 
 /// Where the control surfaces of a flexible projection come from.
@@ -41,6 +47,13 @@ pub enum VolumeSource {
     Preset(PresetSpec),
     /// Two explicit control surfaces, straight projectors between them.
     Surfaces { near: Surface, far: Surface },
+    /// `weight` Q1 + (1 - `weight`) Q2 of two flexible projections (module [`blend`]); both
+    /// must end up with the same re-parameterisation (their own or the preset's).
+    Blend {
+        weight: f64,
+        first: Box<FlexibleSpec>,
+        second: Box<FlexibleSpec>,
+    },
 }
 
 /// A parsed flexible projection: the volume and the re-parameterisation (`None`: the
@@ -62,24 +75,19 @@ pub struct Flexible {
 
 impl Flexible {
     /// Builds the volume. Errors: an empty image; a bad preset parameter or camera frame; an
-    /// invalid surface; near and far surfaces that coincide everywhere; a Mercator latitude
-    /// outside (0, 90).
+    /// invalid surface; near and far surfaces that coincide everywhere; a map latitude out of
+    /// range; a blend of volumes with different re-parameterisations or a non-finite weight.
     pub fn new(spec: &FlexibleSpec, width: u32, height: u32) -> Result<Self> {
         let resolution = Resolution::new(width, height)?;
         let aspect = f64::from(height) / f64::from(width);
-        let (near, far, default_reparam) = match &spec.source {
-            VolumeSource::Preset(p) => {
-                let (near, far) = p.surfaces(aspect)?;
-                (near, far, p.preset.default_reparam())
-            }
-            VolumeSource::Surfaces { near, far } => (*near, *far, Reparam::Linear),
+        let (volume, reparam) = build_volume(spec, aspect)?;
+        let inverse = match &volume {
+            Volume::Linear(v) => Inverse::classify(&v.near, &v.far),
+            Volume::Blend(_) => None,
         };
-        let reparam = spec.reparam.unwrap_or(default_reparam);
-        reparam.validate()?;
-        let volume = LinearVolume::new(near, far)?;
         Ok(Flexible {
-            inverse: Inverse::classify(&volume.near, &volume.far),
-            volume: Volume::Linear(volume),
+            inverse,
+            volume,
             reparam,
             resolution,
         })
@@ -103,6 +111,57 @@ impl Flexible {
     /// Q(u, v, t) for a pixel: the point at depth t on its projector.
     pub fn point(&self, pixel: DVec2, t: f64) -> Option<DVec3> {
         self.uv(pixel).map(|uv| self.volume.point(uv, t))
+    }
+}
+
+/// The volume and re-parameterisation of `spec` for an image of aspect ratio
+/// `aspect` = height / width.
+fn build_volume(spec: &FlexibleSpec, aspect: f64) -> Result<(Volume, Reparam)> {
+    let (volume, default_reparam) = match &spec.source {
+        VolumeSource::Preset(p) => {
+            let (near, far) = p.surfaces(aspect)?;
+            (
+                Volume::Linear(LinearVolume::new(near, far)?),
+                p.preset.default_reparam(),
+            )
+        }
+        VolumeSource::Surfaces { near, far } => (
+            Volume::Linear(LinearVolume::new(*near, *far)?),
+            Reparam::Linear,
+        ),
+        VolumeSource::Blend {
+            weight,
+            first,
+            second,
+        } => {
+            let (a, map_a) = build_volume(first, aspect)?;
+            let (b, map_b) = build_volume(second, aspect)?;
+            if map_a != map_b {
+                return Err(Error::new(format!(
+                    "flexible interpolation needs both volumes on one (u, v) domain: they \
+                     have different re-parameterisations ({} and {}); give both the same \
+                     `reparam`",
+                    describe(&map_a),
+                    describe(&map_b)
+                )));
+            }
+            (blend::blend(*weight, a, b)?, map_a)
+        }
+    };
+    let reparam = spec.reparam.unwrap_or(default_reparam);
+    reparam.validate()?;
+    Ok((volume, reparam))
+}
+
+/// A re-parameterisation's name with its latitude, for messages.
+fn describe(reparam: &Reparam) -> String {
+    match reparam {
+        Reparam::Mercator { max_latitude } | Reparam::EqualArea { max_latitude } => format!(
+            "{} to {} degrees",
+            reparam.name(),
+            max_latitude.to_degrees()
+        ),
+        _ => reparam.name().to_string(),
     }
 }
 

@@ -8,12 +8,13 @@
 
 use glam::{DVec2, DVec3};
 
+use super::blend::BlendVolume;
 use super::surface::Surface;
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
 
-/// Samples per side of the grid on which [`LinearVolume::new`] looks for a projector of
-/// non-zero length.
+/// Samples per side of the grid on which [`Volume::check_projectors`] looks for a projector
+/// of non-zero length.
 const CHECK_SAMPLES: u32 = 17;
 
 /// A volume with straight projectors between a near and a far control surface.
@@ -34,18 +35,7 @@ impl LinearVolume {
         far.validate()
             .map_err(|e| Error::new(format!("flexible far {}", e.message)))?;
         let volume = LinearVolume { near, far };
-        let n = f64::from(CHECK_SAMPLES - 1);
-        let any_length = (0..CHECK_SAMPLES).any(|i| {
-            (0..CHECK_SAMPLES).any(|j| {
-                let uv = DVec2::new(f64::from(i) / n, f64::from(j) / n);
-                volume.tangent(uv) != DVec3::ZERO
-            })
-        });
-        if !any_length {
-            return Err(Error::new(
-                "flexible near and far surfaces coincide: every projector has zero length",
-            ));
-        }
+        check_projectors(|uv, _| volume.tangent(uv))?;
         Ok(volume)
     }
 
@@ -78,10 +68,15 @@ impl LinearVolume {
     }
 }
 
-/// A viewing volume. Only straight projectors so far (see the module documentation).
+/// A viewing volume (see the module documentation). One per projection, so the size of the
+/// common linear variant does not matter; the rare blend is boxed because it nests volumes.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq)]
 pub enum Volume {
     Linear(LinearVolume),
+    /// a Q1 + (1 - a) Q2 of two volumes that do not blend into a simpler one (module
+    /// `blend`).
+    Blend(Box<BlendVolume>),
 }
 
 impl Volume {
@@ -89,14 +84,15 @@ impl Volume {
     pub fn point(&self, uv: DVec2, t: f64) -> DVec3 {
         match self {
             Volume::Linear(v) => v.point(uv, t),
+            Volume::Blend(v) => v.point(uv, t),
         }
     }
 
     /// dQ/dt at (u, v, t): the projector's tangent, the view direction for shading.
     pub fn tangent(&self, uv: DVec2, t: f64) -> DVec3 {
-        let _ = t; // straight projectors: constant along the projector
         match self {
-            Volume::Linear(v) => v.tangent(uv),
+            Volume::Linear(v) => v.tangent(uv), // straight: constant along the projector
+            Volume::Blend(v) => v.tangent(uv, t),
         }
     }
 
@@ -104,7 +100,32 @@ impl Volume {
     pub fn ray(&self, uv: DVec2) -> Option<Ray> {
         match self {
             Volume::Linear(v) => v.ray(uv),
+            Volume::Blend(v) => v.ray(uv),
         }
+    }
+
+    /// Errors when every projector on a 17 x 17 grid of (u, v) has zero length at t = 0
+    /// and t = 1 (nothing can be seen: near and far surfaces coincide).
+    pub fn check_projectors(&self) -> Result<()> {
+        check_projectors(|uv, t| self.tangent(uv, t))
+    }
+}
+
+/// See [`Volume::check_projectors`]; `tangent` is dQ/dt at (u, v, t).
+fn check_projectors(tangent: impl Fn(DVec2, f64) -> DVec3) -> Result<()> {
+    let n = f64::from(CHECK_SAMPLES - 1);
+    let any_length = (0..CHECK_SAMPLES).any(|i| {
+        (0..CHECK_SAMPLES).any(|j| {
+            let uv = DVec2::new(f64::from(i) / n, f64::from(j) / n);
+            tangent(uv, 0.0) != DVec3::ZERO || tangent(uv, 1.0) != DVec3::ZERO
+        })
+    });
+    if any_length {
+        Ok(())
+    } else {
+        Err(Error::new(
+            "flexible near and far surfaces coincide: every projector has zero length",
+        ))
     }
 }
 
