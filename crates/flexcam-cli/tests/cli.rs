@@ -500,3 +500,124 @@ fn trilinear_reflector_errors_are_positioned() {
         "{e}"
     );
 }
+
+/// A small animated scene: three keys (perspective, pushbroom, perspective) over 5 frames.
+fn animated_scene(second_key_time: &str) -> String {
+    let key = |time: &str, body: &str| {
+        format!(
+            "\n[[animation.key]]\ntime = {time}\n[animation.key.projection]\ntype = \"flexible\"\n\
+             position = [0.0, 1.0, 5.0]\nlook_at = [0.0, 0.5, 0.0]\nclip = [0.0, 30.0]\n{body}"
+        )
+    };
+    let perspective = "preset = \"perspective\"\nfov = 60.0\n";
+    format!(
+        "{GOOD_SCENE}\n[animation]\nframes = 5\nfps = 2.0\n{}{}{}",
+        key("0.0", perspective),
+        key(
+            second_key_time,
+            "preset = \"pushbroom\"\nwidth = 4.0\nv_fov = 45.0\n"
+        ),
+        key("2.0", "preset = \"perspective\"\nfov = 40.0\n"),
+    )
+}
+
+#[test]
+fn animate_writes_numbered_frames_and_a_gif() {
+    let dir = TempDir::new().unwrap();
+    write(&dir, "a.toml", &animated_scene("1.0"));
+    fs::create_dir(dir.path().join("frames")).unwrap();
+    let out = flexcam(dir.path())
+        .args([
+            "animate",
+            "a.toml",
+            "-o",
+            "frames/out_###.png",
+            "--gif",
+            "a.gif",
+        ])
+        .args(["--shading", "flat"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut names: Vec<String> = fs::read_dir(dir.path().join("frames"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    let want: Vec<String> = (0..5).map(|i| format!("out_{i:03}.png")).collect();
+    assert_eq!(names, want);
+    let frame = |i: usize| image::open(dir.path().join("frames").join(&want[i])).unwrap();
+    assert_eq!((frame(0).width(), frame(0).height()), (64, 48));
+    // Frame 0 is the first key; frame 1 (t = 0.5 s) is half way to the pushbroom key.
+    assert_ne!(frame(0).to_rgb8(), frame(1).to_rgb8());
+    let gif = fs::File::open(dir.path().join("a.gif")).unwrap();
+    let decoded = {
+        use image::AnimationDecoder;
+        image::codecs::gif::GifDecoder::new(std::io::BufReader::new(gif))
+            .unwrap()
+            .into_frames()
+            .collect_frames()
+            .unwrap()
+    };
+    assert_eq!(decoded.len(), 5);
+    assert_eq!(decoded[0].delay().numer_denom_ms(), (500, 1));
+    // Frame 0 renders the same as the first key alone through `flexcam render`.
+    let single = GOOD_SCENE.replace(
+        "type = \"perspective\"",
+        "type = \"flexible\"\npreset = \"perspective\"\nclip = [0.0, 30.0]",
+    );
+    write(&dir, "k.toml", &single);
+    let out = flexcam(dir.path())
+        .args(["render", "k.toml", "-o", "k.png", "--shading", "flat"])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        image::open(dir.path().join("k.png")).unwrap().to_rgb8(),
+        frame(0).to_rgb8()
+    );
+}
+
+#[test]
+fn animate_errors_are_one_line_and_write_nothing() {
+    let dir = TempDir::new().unwrap();
+    // Key 1 at 2.5 s comes after key 2 at 2 s: wrong order, reported at the next key's time.
+    write(&dir, "bad.toml", &animated_scene("2.5"));
+    let e = expect_failure(
+        &dir,
+        &["animate", "bad.toml", "-o", "f_#.png", "--gif", "a.gif"],
+    );
+    assert!(
+        e.contains("bad.toml:") && e.contains("must be later than the key before it"),
+        "{e}"
+    );
+    let line = animated_scene("2.5")
+        .lines()
+        .position(|l| l == "time = 2.0")
+        .unwrap()
+        + 1;
+    assert!(e.contains(&format!("bad.toml:{line}:8:")), "{e}");
+    write(&dir, "nan.toml", &animated_scene("nan"));
+    let e = expect_failure(&dir, &["animate", "nan.toml", "--gif", "a.gif"]);
+    assert!(e.contains("nan.toml:") && e.contains("time"), "{e}");
+    write(&dir, "a.toml", &animated_scene("1.0"));
+    let e = expect_failure(&dir, &["animate", "a.toml"]);
+    assert!(e.contains("nothing to write"), "{e}");
+    let e = expect_failure(&dir, &["animate", "a.toml", "-o", "frames.png"]);
+    assert!(e.contains("run of `#`"), "{e}");
+    let e = expect_failure(&dir, &["animate", "a.toml", "-o", "f_#_#.png"]);
+    assert!(e.contains("not several"), "{e}");
+    let e = expect_failure(&dir, &["animate", "a.toml", "--gif", "a.png"]);
+    assert!(e.contains("a.png"), "{e}");
+    write(&dir, "still.toml", GOOD_SCENE);
+    let e = expect_failure(&dir, &["animate", "still.toml", "--gif", "a.gif"]);
+    assert!(e.contains("no [animation] table"), "{e}");
+}

@@ -1,4 +1,4 @@
-//! Writing frames: PNG colour, 16-bit PNG object ids, depth as OpenEXR or PFM.
+//! Writing frames: PNG colour, 16-bit PNG object ids, depth as OpenEXR or PFM, animated GIF.
 //!
 //! Writers never leave a partial file behind: each output goes to a temporary file beside its
 //! destination ([`StagedFile`]) and is renamed into place only when the caller commits all of
@@ -135,13 +135,18 @@ pub fn encode_channel(c: f32, encoding: ColorEncoding) -> u8 {
     (255.0 * v).round() as u8
 }
 
-/// Writes the colour of `frame` as an 8-bit RGB PNG (staged).
-pub fn write_color_png(frame: &Frame, path: &Path, encoding: ColorEncoding) -> Result<StagedFile> {
-    let bytes: Vec<u8> = frame
+/// The 8-bit RGB bytes of the colour of `frame`, row by row from the top.
+fn rgb_bytes(frame: &Frame, encoding: ColorEncoding) -> Vec<u8> {
+    frame
         .color
         .iter()
         .flat_map(|c: &Vec3| c.to_array().map(|v| encode_channel(v, encoding)))
-        .collect();
+        .collect()
+}
+
+/// Writes the colour of `frame` as an 8-bit RGB PNG (staged).
+pub fn write_color_png(frame: &Frame, path: &Path, encoding: ColorEncoding) -> Result<StagedFile> {
+    let bytes = rgb_bytes(frame, encoding);
     stage(path, |tmp| {
         image::save_buffer_with_format(
             tmp,
@@ -153,6 +158,50 @@ pub fn write_color_png(frame: &Frame, path: &Path, encoding: ColorEncoding) -> R
         )
         .map_err(|e| Error::new(format!("cannot write PNG: {e}")))
     })
+}
+
+/// The frames of an animated GIF, added one at a time so that only their 8-bit colours are
+/// kept, not whole [`Frame`]s.
+#[derive(Debug, Default)]
+pub struct GifFrames {
+    frames: Vec<image::RgbaImage>,
+}
+
+impl GifFrames {
+    /// Appends the colour of `frame`.
+    pub fn push(&mut self, frame: &Frame, encoding: ColorEncoding) -> Result<()> {
+        let rgba: Vec<u8> = rgb_bytes(frame, encoding)
+            .chunks_exact(3)
+            .flat_map(|rgb| [rgb[0], rgb[1], rgb[2], 255])
+            .collect();
+        let image = image::RgbaImage::from_raw(frame.width, frame.height, rgba)
+            .ok_or_else(|| Error::new("colour buffer does not match the image size"))?;
+        self.frames.push(image);
+        Ok(())
+    }
+
+    /// Writes the frames as an animated GIF that loops forever, each frame shown for
+    /// 1 / `fps` seconds (GIF stores delays in hundredths of a second: rounded, at least
+    /// 1/100 s), staged.
+    pub fn write(self, path: &Path, fps: f64) -> Result<StagedFile> {
+        use image::codecs::gif::{GifEncoder, Repeat};
+        let hundredths = (100.0 / fps).round().max(1.0) as u32;
+        let delay = image::Delay::from_numer_denom_ms(10 * hundredths, 1);
+        stage(path, |tmp| {
+            let file =
+                fs::File::create(tmp).map_err(|e| Error::new(format!("cannot write: {e}")))?;
+            let mut encoder = GifEncoder::new_with_speed(BufWriter::new(file), 10);
+            let gif_error = |e: image::ImageError| Error::new(format!("cannot write GIF: {e}"));
+            encoder.set_repeat(Repeat::Infinite).map_err(gif_error)?;
+            encoder
+                .encode_frames(
+                    self.frames
+                        .into_iter()
+                        .map(|f| image::Frame::from_parts(f, 0, 0, delay)),
+                )
+                .map_err(gif_error)
+        })
+    }
 }
 
 /// Writes object ids as a 16-bit grayscale PNG (0 = background); ids above 65535 are an error
@@ -268,6 +317,33 @@ mod tests {
             f32::from_le_bytes(bytes[header.len()..header.len() + 4].try_into().unwrap())
                 .is_infinite()
         );
+    }
+
+    #[test]
+    fn gif_frames_read_back_in_order_with_their_delay() {
+        use image::AnimationDecoder;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("a.gif");
+        let mut gif = GifFrames::default();
+        let mut second = frame();
+        second
+            .color
+            .iter_mut()
+            .for_each(|c| *c = Vec3::new(0.0, 0.0, 1.0));
+        gif.push(&frame(), ColorEncoding::Linear).unwrap();
+        gif.push(&second, ColorEncoding::Linear).unwrap();
+        let staged = gif.write(&path, 25.0).unwrap();
+        assert!(!path.exists());
+        staged.commit().unwrap();
+        let file = std::io::BufReader::new(fs::File::open(&path).unwrap());
+        let decoded = image::codecs::gif::GifDecoder::new(file)
+            .unwrap()
+            .into_frames()
+            .collect_frames()
+            .unwrap();
+        assert_eq!(decoded.len(), 2);
+        assert_eq!(decoded[0].delay().numer_denom_ms(), (40, 1));
+        assert_eq!(decoded[1].buffer().get_pixel(0, 0).0, [0, 0, 255, 255]);
     }
 
     #[test]

@@ -1,5 +1,6 @@
 //! The subcommands.
 
+pub mod animate;
 pub mod bench;
 pub mod compare;
 pub mod render;

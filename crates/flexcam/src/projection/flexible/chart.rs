@@ -107,8 +107,9 @@ fn spheres_chart(
     let mut poles = axis_poles(near.center, near.frame.axis, a.min(b), a.max(b));
     let period = match reparam {
         Reparam::Linear => Some(period(near.longitude, resolution)),
-        Reparam::Mercator { max_latitude } => {
-            // Every latitude in [-90, 90] must stay on the finite part of the map.
+        Reparam::Mercator { max_latitude } | Reparam::EqualArea { max_latitude } => {
+            // Every latitude in [-90, 90] must stay on the finite (Mercator) and monotonic
+            // (equal area: sin) part of the map.
             let finite = [-FRAC_PI_2, FRAC_PI_2].into_iter().all(|lat| {
                 let v = (lat - near.latitude[0]) / (near.latitude[1] - near.latitude[0]);
                 ((2.0 * v - 1.0) * max_latitude).abs() < FRAC_PI_2

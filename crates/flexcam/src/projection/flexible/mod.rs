@@ -12,14 +12,18 @@
 //! - [`projector_grid`]: a volume interpolated from a grid of placed projectors (5.2), and
 //!   [`fit`]: aiming all of them by least squares from point correspondences;
 //! - `inverse`: (u, v, t) from a scene point for the analytic class (parallel planes, nested
-//!   spheres, coaxial cylinders).
+//!   spheres, coaxial cylinders);
+//! - [`blend`]: Q = a Q1 + (1 - a) Q2, interpolation and extrapolation between volumes;
+//! - [`animation`]: keyframed flexible cameras, a blend of neighbouring keys per frame.
 //!
 //! A pixel's projector starts on the near (first) surface and reaches the far (last) surface at
 //! t = 1; t is limited to [0, 1] (the per-projector near and far clip of the framework).
 
+pub mod animation;
 pub mod blend;
 mod chart;
 pub mod fit;
+pub mod interpolate;
 mod inverse;
 mod patch;
 pub mod presets;
@@ -32,7 +36,9 @@ pub mod volume;
 
 use glam::{DVec2, DVec3};
 
+pub use animation::{Animation, Easing, Keyframe};
 pub use blend::{BezierVolume, PiecewiseVolume};
+pub use interpolate::InterpolatedVolume;
 pub use presets::{Preset, PresetSpec};
 pub use reparam::Reparam;
 pub use surface::{
@@ -44,7 +50,7 @@ use self::inverse::Inverse;
 use super::chart::InverseChart;
 use super::image_coords::Resolution;
 use super::{ImagePoint, Projection, Projector};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::geometry::Ray;
 
 /// Where the control surfaces of a flexible projection come from.
@@ -58,6 +64,13 @@ pub enum VolumeSource {
     Blended {
         surfaces: Vec<Surface>,
         blend: Blend,
+    },
+    /// `weight` Q1 + (1 - `weight`) Q2 of two flexible projections (module [`interpolate`]);
+    /// both must end up with the same re-parameterisation (their own or the preset's).
+    Interpolated {
+        weight: f64,
+        first: Box<FlexibleSpec>,
+        second: Box<FlexibleSpec>,
     },
 }
 
@@ -91,37 +104,16 @@ pub struct Flexible {
 impl Flexible {
     /// Builds the volume. Errors: an empty image; a bad preset parameter or camera frame; an
     /// invalid surface; control surfaces that coincide everywhere; bad knots or segments of
-    /// a blended volume (see [`PiecewiseVolume::new`], [`BezierVolume::new`]); a Mercator
-    /// latitude outside (0, 90).
+    /// a blended volume (see [`PiecewiseVolume::new`], [`BezierVolume::new`]); a map latitude
+    /// out of range; an interpolation of volumes with different re-parameterisations or a
+    /// non-finite weight.
     pub fn new(spec: &FlexibleSpec, width: u32, height: u32) -> Result<Self> {
         let resolution = Resolution::new(width, height)?;
         let aspect = f64::from(height) / f64::from(width);
-        let linear = |near, far| LinearVolume::new(near, far).map(|v| Volume::Linear(Box::new(v)));
-        let (volume, default_reparam) = match &spec.source {
-            VolumeSource::Preset(p) => {
-                let (near, far) = p.surfaces(aspect)?;
-                (linear(near, far)?, p.preset.default_reparam())
-            }
-            VolumeSource::Surfaces { near, far } => {
-                (linear(near.clone(), far.clone())?, Reparam::Linear)
-            }
-            VolumeSource::Blended { surfaces, blend } => {
-                let volume = match blend {
-                    Blend::Piecewise { knots } => {
-                        Volume::Piecewise(PiecewiseVolume::new(surfaces.clone(), knots.clone())?)
-                    }
-                    Blend::Bezier { segments } => {
-                        Volume::Bezier(BezierVolume::new(surfaces.clone(), *segments)?)
-                    }
-                };
-                (volume, Reparam::Linear)
-            }
-        };
-        let reparam = spec.reparam.unwrap_or(default_reparam);
-        reparam.validate()?;
+        let (volume, reparam) = build_volume(spec, aspect)?;
         let inverse = match &volume {
             Volume::Linear(v) => Inverse::classify(&v.near, &v.far),
-            Volume::Piecewise(_) | Volume::Bezier(_) => None,
+            Volume::Piecewise(_) | Volume::Bezier(_) | Volume::Interpolated(_) => None,
         };
         Ok(Flexible {
             inverse,
@@ -149,6 +141,65 @@ impl Flexible {
     /// Q(u, v, t) for a pixel: the point at depth t on its projector.
     pub fn point(&self, pixel: DVec2, t: f64) -> Option<DVec3> {
         self.uv(pixel).map(|uv| self.volume.point(uv, t))
+    }
+}
+
+/// The volume and re-parameterisation of `spec` for an image of aspect ratio
+/// `aspect` = height / width.
+fn build_volume(spec: &FlexibleSpec, aspect: f64) -> Result<(Volume, Reparam)> {
+    let linear = |near, far| LinearVolume::new(near, far).map(|v| Volume::Linear(Box::new(v)));
+    let (volume, default_reparam) = match &spec.source {
+        VolumeSource::Preset(p) => {
+            let (near, far) = p.surfaces(aspect)?;
+            (linear(near, far)?, p.preset.default_reparam())
+        }
+        VolumeSource::Surfaces { near, far } => {
+            (linear(near.clone(), far.clone())?, Reparam::Linear)
+        }
+        VolumeSource::Blended { surfaces, blend } => {
+            let volume = match blend {
+                Blend::Piecewise { knots } => {
+                    Volume::Piecewise(PiecewiseVolume::new(surfaces.clone(), knots.clone())?)
+                }
+                Blend::Bezier { segments } => {
+                    Volume::Bezier(BezierVolume::new(surfaces.clone(), *segments)?)
+                }
+            };
+            (volume, Reparam::Linear)
+        }
+        VolumeSource::Interpolated {
+            weight,
+            first,
+            second,
+        } => {
+            let (a, map_a) = build_volume(first, aspect)?;
+            let (b, map_b) = build_volume(second, aspect)?;
+            if map_a != map_b {
+                return Err(Error::new(format!(
+                    "flexible interpolation needs both volumes on one (u, v) domain: they \
+                     have different re-parameterisations ({} and {}); give both the same \
+                     `reparam`",
+                    describe(&map_a),
+                    describe(&map_b)
+                )));
+            }
+            (interpolate::interpolate(*weight, a, b)?, map_a)
+        }
+    };
+    let reparam = spec.reparam.unwrap_or(default_reparam);
+    reparam.validate()?;
+    Ok((volume, reparam))
+}
+
+/// A re-parameterisation's name with its latitude, for messages.
+fn describe(reparam: &Reparam) -> String {
+    match reparam {
+        Reparam::Mercator { max_latitude } | Reparam::EqualArea { max_latitude } => format!(
+            "{} to {} degrees",
+            reparam.name(),
+            max_latitude.to_degrees()
+        ),
+        _ => reparam.name().to_string(),
     }
 }
 

@@ -31,10 +31,15 @@ pub enum Reparam {
     /// [-max_latitude, max_latitude] linearly (the equirectangular preset with
     /// v_fov = 2 max_latitude). `max_latitude` in radians, in (0, pi/2).
     Mercator { max_latitude: f64 },
+    /// Lambert cylindrical equal-area map: u = x / W; the image row's ordinate is
+    /// proportional to sin(latitude), py = sin(phi) / sin(max_latitude), so equal image areas
+    /// cover equal areas of the sphere. Surfaces as for `Mercator`; `max_latitude` in
+    /// (0, pi/2] (the poles can be shown: sin stays finite there).
+    EqualArea { max_latitude: f64 },
 }
 
 /// The names used in scene files, in order.
-pub const REPARAM_NAMES: [&str; 4] = ["linear", "polar", "lens", "mercator"];
+pub const REPARAM_NAMES: [&str; 5] = ["linear", "polar", "lens", "mercator", "equal_area"];
 
 /// The default top latitude of the Mercator map, degrees.
 pub const DEFAULT_MERCATOR_LATITUDE: f64 = 85.0;
@@ -47,18 +52,26 @@ impl Reparam {
             Reparam::Polar => "polar",
             Reparam::Lens => "lens",
             Reparam::Mercator { .. } => "mercator",
+            Reparam::EqualArea { .. } => "equal_area",
         }
     }
 
-    /// Errors: a Mercator latitude outside (0, 90) degrees.
+    /// Errors: a Mercator latitude outside (0, 90) degrees (the Mercator ordinate is
+    /// infinite at the pole), an equal-area one outside (0, 90].
     pub fn validate(&self) -> Result<()> {
-        if let Reparam::Mercator { max_latitude } = self {
-            if !(max_latitude.is_finite() && *max_latitude > 0.0 && *max_latitude < 0.5 * PI) {
-                return Err(Error::new(format!(
-                    "flexible max_latitude must be in (0, 90) degrees, got {}",
-                    max_latitude.to_degrees()
-                )));
-            }
+        let (latitude, pole_allowed) = match *self {
+            Reparam::Mercator { max_latitude } => (max_latitude, false),
+            Reparam::EqualArea { max_latitude } => (max_latitude, true),
+            _ => return Ok(()),
+        };
+        let below_pole = latitude < 0.5 * PI || (pole_allowed && latitude == 0.5 * PI);
+        if !(latitude > 0.0 && below_pole) {
+            let bracket = if pole_allowed { ']' } else { ')' };
+            return Err(Error::new(format!(
+                "flexible {} max_latitude must be in (0, 90{bracket} degrees, got {}",
+                self.name(),
+                latitude.to_degrees()
+            )));
         }
         Ok(())
     }
@@ -86,6 +99,11 @@ impl Reparam {
             Reparam::Mercator { max_latitude } => {
                 let py = resolution.centred(pixel).y / (0.5 * size.y);
                 let latitude = (py * mercator(*max_latitude)).sinh().atan();
+                DVec2::new(pixel.x / size.x, 0.5 * (latitude / max_latitude + 1.0))
+            }
+            Reparam::EqualArea { max_latitude } => {
+                let py = resolution.centred(pixel).y / (0.5 * size.y);
+                let latitude = (py * max_latitude.sin()).clamp(-1.0, 1.0).asin();
                 DVec2::new(pixel.x / size.x, 0.5 * (latitude / max_latitude + 1.0))
             }
         };
@@ -128,6 +146,12 @@ impl Reparam {
                 let y = resolution.pixel(DVec2::new(0.0, py * 0.5 * size.y)).y;
                 DVec2::new(uv.x * size.x, y)
             }
+            Reparam::EqualArea { max_latitude } => {
+                let latitude = (2.0 * uv.y - 1.0) * max_latitude;
+                let py = latitude.sin() / max_latitude.sin();
+                let y = resolution.pixel(DVec2::new(0.0, py * 0.5 * size.y)).y;
+                DVec2::new(uv.x * size.x, y)
+            }
         };
         pixel.is_finite().then_some(pixel)
     }
@@ -136,7 +160,7 @@ impl Reparam {
     /// no pixel centre is inside it. The linear and Mercator maps take v from the row alone.
     pub fn v_range(&self, resolution: &Resolution) -> Option<(f64, f64)> {
         let columns = match self {
-            Reparam::Linear | Reparam::Mercator { .. } => 1,
+            Reparam::Linear | Reparam::Mercator { .. } | Reparam::EqualArea { .. } => 1,
             Reparam::Polar | Reparam::Lens => resolution.width,
         };
         let mut range: Option<(f64, f64)> = None;
@@ -233,12 +257,41 @@ mod tests {
     }
 
     #[test]
+    fn equal_area_ordinate_is_proportional_to_the_sine_of_the_latitude() {
+        // Lambert's cylindrical equal-area map: y = R sin(phi). With the top row at 90
+        // degrees, the row a quarter of the height below the top (py = 1/2) is at 30 degrees.
+        let r = Reparam::EqualArea {
+            max_latitude: 0.5 * PI,
+        };
+        assert!(r.validate().is_ok());
+        for (row, degrees) in [(25.0, 30.0), (50.0, 0.0), (0.0, 90.0), (100.0, -90.0)] {
+            let uv = r.to_uv(&res(), DVec2::new(10.0, row)).unwrap();
+            let latitude = (2.0 * uv.y - 1.0) * 0.5 * PI;
+            assert!((latitude.to_degrees() - degrees).abs() < 1e-9, "{row}");
+        }
+        // A 60-degree map: the top row is 60 degrees, row 25 has sin(phi) = sin(60)/2.
+        let r = Reparam::EqualArea {
+            max_latitude: 60f64.to_radians(),
+        };
+        let uv = r.to_uv(&res(), DVec2::new(0.0, 25.0)).unwrap();
+        let latitude = (2.0 * uv.y - 1.0) * 60f64.to_radians();
+        assert!((latitude.sin() - 0.5 * 60f64.to_radians().sin()).abs() < 1e-12);
+        for bad in [0.0, 91f64.to_radians(), f64::NAN] {
+            assert!(Reparam::EqualArea { max_latitude: bad }.validate().is_err());
+        }
+    }
+
+    #[test]
     fn every_map_round_trips() {
         let maps = [
             Reparam::Linear,
             Reparam::Polar,
             Reparam::Lens,
             Reparam::Mercator { max_latitude: 1.2 },
+            Reparam::EqualArea { max_latitude: 1.2 },
+            Reparam::EqualArea {
+                max_latitude: 0.5 * PI,
+            },
         ];
         for map in maps {
             for pixel in [

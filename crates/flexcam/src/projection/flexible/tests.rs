@@ -38,7 +38,19 @@ fn build(spec: &FlexibleSpec, w: u32, h: u32) -> Flexible {
 /// given) is the ray parameter.
 fn check_oracle(
     spec: &FlexibleSpec,
+    size: (u32, u32),
+    image: impl Fn(&Flexible, DVec2) -> DVec2,
+    oracle: impl Fn(DVec3) -> DVec2,
+    t_of: Option<&dyn Fn(DVec3) -> f64>,
+) {
+    check_oracle_at(spec, size, &[0.0, 0.4, 1.0], image, oracle, t_of);
+}
+
+/// [`check_oracle`] at the ray parameters `ts`.
+fn check_oracle_at(
+    spec: &FlexibleSpec,
     (w, h): (u32, u32),
+    ts: &[f64],
     image: impl Fn(&Flexible, DVec2) -> DVec2,
     oracle: impl Fn(DVec3) -> DVec2,
     t_of: Option<&dyn Fn(DVec3) -> f64>,
@@ -51,7 +63,7 @@ fn check_oracle(
             let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
             let Some(ray) = f.ray(pixel) else { continue };
             rays += 1;
-            for t in [0.0, 0.4, 1.0] {
+            for &t in ts {
                 let local = basis.to_local(ray.at(t) - basis.origin);
                 let got = oracle(local);
                 let want = image(&f, pixel);
@@ -457,6 +469,23 @@ fn invertible() -> Vec<Flexible> {
             v_fov: 180.0,
         },
         Preset::Fisheye { fov: 300.0 },
+        Preset::OffAxis {
+            fov: 60.0,
+            shift: DVec2::new(0.5, -0.3),
+        },
+        Preset::Twist {
+            fov: 60.0,
+            twist: 70.0,
+        },
+        Preset::Axonometric {
+            width: 3.0,
+            azimuth: 45.0,
+            elevation: ISOMETRIC_ELEVATION,
+        },
+        Preset::Glc {
+            width: 2.0,
+            generators: GLC_GENERATORS,
+        },
     ]
     .into_iter()
     .map(|p| {
@@ -502,6 +531,17 @@ fn invertible() -> Vec<Flexible> {
         cylinder(frame.axis * 2.0, 4.0, [-5.0, 3.0]),
     ));
     all.push(custom(line, far));
+    let pairs = blend_pairs();
+    all.push(build(
+        &blend_of(0.3, pairs[0].0.clone(), pairs[0].1.clone()),
+        16,
+        12,
+    ));
+    all.push(build(
+        &blend_of(-0.4, pairs[2].0.clone(), pairs[2].1.clone()),
+        16,
+        12,
+    ));
     all
 }
 
@@ -549,4 +589,398 @@ fn points_outside_the_volume_have_no_image() {
     assert_eq!(out.len(), 1);
     assert!((out[0].pixel - DVec2::new(4.0, 4.0)).length() < 1e-9);
     assert!((out[0].t - 0.5).abs() < 1e-12);
+}
+
+/// The elevation of the isometric view: asin(tan 30 degrees) = 35.264 degrees.
+const ISOMETRIC_ELEVATION: f64 = 35.264_389_682_754_654;
+
+/// Three generator rays of a general (non-degenerate, non-pinhole) linear camera.
+const GLC_GENERATORS: [[f64; 4]; 3] = [
+    [-1.0, -0.5, -1.5, -0.25],
+    [1.0, -0.5, 1.25, -1.0],
+    [0.0, 1.0, 0.5, 1.75],
+];
+
+#[test]
+fn off_axis_matches_the_gl_frustum_matrix() {
+    // glFrustum(l, r, b, t, n, f): x_ndc = 2 n x / ((r - l) z) - (r + l) / (r - l) for a
+    // point at depth z in front of the eye, with the window [l, r] x [b, t] at depth n.
+    let shift = DVec2::new(0.5, -0.25);
+    let spec = preset(Preset::OffAxis { fov: 90.0, shift }, Some([1.0, 2.0]));
+    let (w, h) = (8u32, 6u32);
+    let n = 1.0;
+    let (l, r) = (n * (-1.0 + shift.x), n * (1.0 + shift.x));
+    let a = f64::from(h) / f64::from(w);
+    let (b, t) = (n * a * (-1.0 + shift.y), n * a * (1.0 + shift.y));
+    let oracle = |p: DVec3| {
+        DVec2::new(
+            2.0 * n * p.x / ((r - l) * p.z) - (r + l) / (r - l),
+            2.0 * n * p.y / ((t - b) * p.z) - (t + b) / (t - b),
+        )
+    };
+    check_oracle(
+        &spec,
+        (w, h),
+        centred_uv,
+        oracle,
+        Some(&|p: DVec3| p.z - 1.0),
+    );
+}
+
+#[test]
+fn twist_turns_the_far_image_about_the_axis() {
+    // Near surface at the eye: every projector is a perspective ray turned by the twist
+    // angle, so turning a point back by -angle gives the perspective image (x/z, y/z).
+    let angle = 30.0f64;
+    let spec = preset(
+        Preset::Twist {
+            fov: 90.0,
+            twist: angle,
+        },
+        Some([0.0, 2.0]),
+    );
+    let (sin, cos) = angle.to_radians().sin_cos();
+    let oracle = |p: DVec3| {
+        let back = DVec2::new(cos * p.x + sin * p.y, -sin * p.x + cos * p.y);
+        back / p.z
+    };
+    let image = |f: &Flexible, pixel: DVec2| centred_uv(f, pixel) * DVec2::new(1.0, 0.75);
+    check_oracle_at(&spec, (8, 6), &[0.4, 1.0], image, oracle, None);
+    // With a near rectangle, t = 0 is the untwisted perspective window.
+    let spec = preset(
+        Preset::Twist {
+            fov: 90.0,
+            twist: angle,
+        },
+        Some([1.0, 2.0]),
+    );
+    let oracle = |p: DVec3| DVec2::new(p.x / p.z, p.y / p.z);
+    check_oracle_at(&spec, (8, 6), &[0.0], image, oracle, None);
+}
+
+/// The pixel offsets, in world units, of the images of the three world axes from the image
+/// of `look_at` under an axonometric preset.
+fn axonometric_axes(azimuth: f64, elevation: f64) -> [DVec2; 3] {
+    let (w, width) = (100u32, 4.0);
+    let spec = preset(
+        Preset::Axonometric {
+            width,
+            azimuth,
+            elevation,
+        },
+        None,
+    );
+    let f = build(&spec, w, w);
+    let image = |p: DVec3| {
+        let mut out = Vec::new();
+        f.project(p, &mut out);
+        assert_eq!(out.len(), 1, "{p}");
+        out[0].pixel * (width / f64::from(w))
+    };
+    let centre = frame().look_at;
+    [DVec3::X, DVec3::Y, DVec3::Z].map(|axis| image(centre + axis) - image(centre))
+}
+
+#[test]
+fn axonometric_foreshortening_follows_the_drafting_formulas() {
+    // Foreshortening of the world axes for azimuth a and elevation e (Carlbom and Paciorek):
+    // f_x = sqrt(cos^2 a + sin^2 a sin^2 e), f_y = cos e, f_z = sqrt(sin^2 a + cos^2 a sin^2 e).
+    for (a, e) in [
+        (45.0, ISOMETRIC_ELEVATION),
+        (45.0, 20.0),
+        (30.0, 25.0),
+        (-120.0, -40.0),
+    ] {
+        let (sa, ca) = f64::to_radians(a).sin_cos();
+        let (se, ce) = f64::to_radians(e).sin_cos();
+        let want = [
+            (ca * ca + sa * sa * se * se).sqrt(),
+            ce,
+            (sa * sa + ca * ca * se * se).sqrt(),
+        ];
+        let got = axonometric_axes(a, e).map(|v| v.length());
+        for k in 0..3 {
+            assert!((got[k] - want[k]).abs() < 1e-9, "{a} {e}: {got:?} {want:?}");
+        }
+    }
+    // Isometric: equal foreshortening sqrt(2/3) and the axes 120 degrees apart on the image.
+    let iso = axonometric_axes(45.0, ISOMETRIC_ELEVATION);
+    for (i, j) in [(0, 1), (1, 2), (2, 0)] {
+        assert!((iso[i].length() - (2.0f64 / 3.0).sqrt()).abs() < 1e-9);
+        let cos = iso[i].dot(iso[j]) / (iso[i].length() * iso[j].length());
+        assert!((cos + 0.5).abs() < 1e-9, "{i} {j}: {cos}");
+    }
+    // The image y axis is the world up: +y goes straight up the image (pixel y down).
+    assert!(iso[1].x.abs() < 1e-12 && iso[1].y < 0.0);
+    let e = Flexible::new(
+        &preset(
+            Preset::Axonometric {
+                width: 1.0,
+                azimuth: 0.0,
+                elevation: 90.0,
+            },
+            None,
+        ),
+        8,
+        8,
+    );
+    assert!(e.unwrap_err().message.contains("elevation"));
+}
+
+#[test]
+fn glc_rays_are_the_affine_combinations_of_the_generators() {
+    let (w, h) = (8u32, 6u32);
+    let width = 2.0;
+    let spec = preset(
+        Preset::Glc {
+            width,
+            generators: GLC_GENERATORS,
+        },
+        Some([0.0, 3.0]),
+    );
+    let f = build(&spec, w, h);
+    let basis = CameraBasis::new(&frame()).unwrap();
+    let g = GLC_GENERATORS.map(|r| (DVec2::new(r[0], r[1]), DVec2::new(r[2], r[3])));
+    let cross = |a: DVec2, b: DVec2| a.x * b.y - a.y * b.x;
+    let area = cross(g[1].0 - g[0].0, g[2].0 - g[0].0);
+    for y in 0..h {
+        for x in 0..w {
+            let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let s = centred_uv(&f, pixel) * 0.5 * DVec2::new(width, width * 0.75);
+            // Barycentric coordinates of s in the generators' image-plane triangle (ratios
+            // of signed areas), then the same combination of their z = 1 crossings.
+            let l0 = cross(g[1].0 - s, g[2].0 - s) / area;
+            let l1 = cross(g[2].0 - s, g[0].0 - s) / area;
+            let l2 = 1.0 - l0 - l1;
+            let q = l0 * g[0].1 + l1 * g[1].1 + l2 * g[2].1;
+            let ray = f.ray(pixel).unwrap();
+            for t in [0.0, 0.5, 1.0] {
+                let local = basis.to_local(ray.at(t) - basis.origin);
+                let want = s.lerp(q, local.z).extend(local.z);
+                assert!(
+                    (local - want).length() < 1e-9,
+                    "{pixel} {t}: {local} {want}"
+                );
+                assert!((local.z - 3.0 * t).abs() < 1e-9);
+            }
+        }
+    }
+    // Three generators through one point (0, 0, -1): a pinhole camera one unit behind the
+    // image plane, image (x, y) / (z + 1).
+    let pinhole = [
+        [-1.0, -1.0, -2.0, -2.0],
+        [1.0, -1.0, 2.0, -2.0],
+        [0.0, 1.0, 0.0, 2.0],
+    ];
+    let spec = preset(
+        Preset::Glc {
+            width: 2.0,
+            generators: pinhole,
+        },
+        Some([0.0, 2.0]),
+    );
+    let oracle = |p: DVec3| DVec2::new(p.x, p.y / 0.75) / (p.z + 1.0);
+    check_oracle(&spec, (8, 6), centred_uv, oracle, None);
+    // Generators crossing the image plane on one line: no camera.
+    let line = [
+        [0.0, 0.0, 0.0, 0.0],
+        [1.0, 1.0, 1.0, 1.0],
+        [2.0, 2.0, 0.0, 1.0],
+    ];
+    let e = Flexible::new(
+        &preset(
+            Preset::Glc {
+                width: 2.0,
+                generators: line,
+            },
+            None,
+        ),
+        8,
+        8,
+    );
+    assert!(e.unwrap_err().message.contains("not on one line"));
+}
+
+#[test]
+fn lens_fisheye_angle_is_the_thesis_polynomial_of_the_radius() {
+    // Fig. 4.12: v = r/4 + 3 r^2/4 of the normalised image radius r, and the angle off the
+    // axis is v fov/2 (the angular fisheye's v = r).
+    let mut spec = preset(Preset::Fisheye { fov: 180.0 }, Some([0.5, 2.0]));
+    spec.reparam = Some(Reparam::Lens);
+    let image = |f: &Flexible, pixel: DVec2| {
+        let (w, h) = f.resolution();
+        let p = f.resolution.centred(pixel) / (0.5 * f64::from(w.min(h)));
+        let r = p.length();
+        p.normalize_or_zero() * (0.25 * r + 0.75 * r * r)
+    };
+    let oracle = |p: DVec3| {
+        let lateral = DVec2::new(p.x, p.y);
+        lateral.normalize_or_zero() * lateral.length().atan2(p.z) / FRAC_PI_2
+    };
+    check_oracle(&spec, (9, 7), image, oracle, None);
+}
+
+#[test]
+fn equal_area_map_rows_follow_the_sine_of_the_latitude() {
+    // Lambert cylindrical equal-area: x = longitude, y = sin(latitude) (unit sphere).
+    let mut spec = preset(
+        Preset::Equirectangular {
+            h_fov: 360.0,
+            v_fov: 180.0,
+        },
+        Some([0.5, 2.0]),
+    );
+    spec.reparam = Some(Reparam::EqualArea {
+        max_latitude: FRAC_PI_2,
+    });
+    let image = |f: &Flexible, pixel: DVec2| {
+        let (w, h) = f.resolution();
+        f.resolution.centred(pixel) / (0.5 * DVec2::new(f64::from(w), f64::from(h)))
+    };
+    let oracle = |p: DVec3| DVec2::new(p.x.atan2(p.z) / PI, p.y / p.length());
+    check_oracle(&spec, (8, 6), image, oracle, None);
+}
+
+fn blend_of(weight: f64, first: FlexibleSpec, second: FlexibleSpec) -> FlexibleSpec {
+    FlexibleSpec {
+        source: VolumeSource::Interpolated {
+            weight,
+            first: Box::new(first),
+            second: Box::new(second),
+        },
+        reparam: None,
+    }
+}
+
+/// Pairs of volumes on one (u, v) domain: rectangles with rectangles (blended surface by
+/// surface), spheres with rectangles (blended point by point), spheres with spheres.
+fn blend_pairs() -> Vec<(FlexibleSpec, FlexibleSpec)> {
+    let persp = preset(Preset::Perspective { fov: 70.0 }, Some([0.5, 20.0]));
+    let push = preset(
+        Preset::Pushbroom {
+            width: 3.0,
+            v_fov: 60.0,
+        },
+        Some([0.0, 15.0]),
+    );
+    let equi = |clip| {
+        preset(
+            Preset::Equirectangular {
+                h_fov: 200.0,
+                v_fov: 120.0,
+            },
+            Some(clip),
+        )
+    };
+    vec![
+        (persp.clone(), push),
+        (equi([0.0, 10.0]), persp),
+        (equi([0.0, 10.0]), equi([1.0, 30.0])),
+    ]
+}
+
+/// Every pixel-centre ray of `spec` at t in {0, 0.3, 1}, `None` where there is no ray.
+fn ray_points(spec: &FlexibleSpec) -> Vec<Option<[DVec3; 3]>> {
+    let f = build(spec, 9, 7);
+    let mut out = Vec::new();
+    for y in 0..7 {
+        for x in 0..9 {
+            let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            out.push(f.ray(pixel).map(|r| [0.0, 0.3, 1.0].map(|t| r.at(t))));
+        }
+    }
+    out
+}
+
+#[test]
+fn blend_weights_one_and_zero_reproduce_the_volumes_exactly() {
+    for (a, b) in blend_pairs() {
+        assert_eq!(
+            ray_points(&blend_of(1.0, a.clone(), b.clone())),
+            ray_points(&a)
+        );
+        assert_eq!(
+            ray_points(&blend_of(0.0, a.clone(), b.clone())),
+            ray_points(&b)
+        );
+        // The point-by-point form is exact at the ends too (a x + 0 y = x).
+        let (va, vb) = (build(&a, 9, 7).volume, build(&b, 9, 7).volume);
+        let mixed = InterpolatedVolume {
+            weight: 1.0,
+            first: va.clone(),
+            second: vb,
+        };
+        let uv = DVec2::new(0.3, 0.8);
+        assert_eq!(mixed.point(uv, 0.7), va.point(uv, 0.7));
+    }
+}
+
+#[test]
+fn blends_are_affine_in_the_weight_inside_and_outside_zero_to_one() {
+    // a = 1/2: midpoints; a = 2 and a = -1: extrapolation 2 Q1 - Q2 and 2 Q2 - Q1.
+    for (a, b) in blend_pairs() {
+        let (pa, pb) = (ray_points(&a), ray_points(&b));
+        for weight in [0.5, 0.25, 2.0, -1.0] {
+            let blended = ray_points(&blend_of(weight, a.clone(), b.clone()));
+            for ((q, p1), p2) in blended.iter().zip(&pa).zip(&pb) {
+                let (Some(q), Some(p1), Some(p2)) = (q, p1, p2) else {
+                    assert!(q.is_none(), "a ray where a part has none");
+                    continue;
+                };
+                for k in 0..3 {
+                    let want = weight * p1[k] + (1.0 - weight) * p2[k];
+                    let scale = 1.0 + p1[k].length() + p2[k].length();
+                    assert!(
+                        (q[k] - want).length() < 1e-12 * scale,
+                        "{weight}: {} {want}",
+                        q[k]
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn blends_of_matching_surfaces_stay_invertible() {
+    let pairs = blend_pairs();
+    for (i, weight) in [(0, 0.3), (0, 1.7), (2, 0.5), (2, -0.2)] {
+        let (a, b) = pairs[i].clone();
+        let f = build(&blend_of(weight, a, b), 9, 7);
+        assert!(matches!(f.volume, Volume::Linear(_)), "{i} {weight}");
+        assert!(f.has_inverse(), "{i} {weight}");
+    }
+    let (a, b) = pairs[1].clone();
+    let f = build(&blend_of(0.5, a, b), 9, 7);
+    assert!(matches!(f.volume, Volume::Interpolated(_)));
+    assert!(!f.has_inverse());
+}
+
+#[test]
+fn incompatible_blends_are_errors() {
+    let persp = preset(Preset::Perspective { fov: 70.0 }, None);
+    let fish = preset(Preset::Fisheye { fov: 180.0 }, None);
+    let e = Flexible::new(&blend_of(0.5, persp.clone(), fish), 8, 8).unwrap_err();
+    assert!(
+        e.message
+            .contains("different re-parameterisations (linear and polar)"),
+        "{e}"
+    );
+    let e = Flexible::new(&blend_of(f64::NAN, persp.clone(), persp.clone()), 8, 8).unwrap_err();
+    assert!(e.message.contains("weight must be finite"), "{e}");
+    // a = 1/2 between a volume and its mirror through the eye: every projector vanishes.
+    let looking = |z: f64| FlexibleSpec {
+        source: VolumeSource::Preset(PresetSpec {
+            preset: Preset::Orthographic { width: 2.0 },
+            frame: CameraFrame {
+                position: DVec3::ZERO,
+                look_at: DVec3::Z * z,
+                up: DVec3::Y,
+            },
+            clip: Some([0.0, 1.0]),
+        }),
+        reparam: None,
+    };
+    let e = Flexible::new(&blend_of(0.5, looking(1.0), looking(-1.0)), 8, 8).unwrap_err();
+    assert!(e.message.contains("interpolation"), "{e}");
 }

@@ -9,13 +9,14 @@
 use glam::{DVec2, DVec3};
 
 use super::blend::{BezierVolume, PiecewiseVolume};
+use super::interpolate::InterpolatedVolume;
 use super::surface::Surface;
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
 use crate::projection::Projector;
 
-/// Samples per side of the grid on which [`LinearVolume::new`] looks for a projector of
-/// non-zero length.
+/// Samples per side of the grid on which [`Volume::check_projectors`] looks for a projector
+/// of non-zero length.
 const CHECK_SAMPLES: u32 = 17;
 
 /// A volume with straight projectors between a near and a far control surface.
@@ -36,18 +37,7 @@ impl LinearVolume {
         far.validate()
             .map_err(|e| Error::new(format!("flexible far {}", e.message)))?;
         let volume = LinearVolume { near, far };
-        let n = f64::from(CHECK_SAMPLES - 1);
-        let any_length = (0..CHECK_SAMPLES).any(|i| {
-            (0..CHECK_SAMPLES).any(|j| {
-                let uv = DVec2::new(f64::from(i) / n, f64::from(j) / n);
-                volume.tangent(uv) != DVec3::ZERO
-            })
-        });
-        if !any_length {
-            return Err(Error::new(
-                "flexible near and far surfaces coincide: every projector has zero length",
-            ));
-        }
+        check_projectors(|uv, _| volume.tangent(uv))?;
         Ok(volume)
     }
 
@@ -89,6 +79,9 @@ pub enum Volume {
     Piecewise(PiecewiseVolume),
     /// Bezier projectors from three or more surfaces.
     Bezier(BezierVolume),
+    /// a Q1 + (1 - a) Q2 of two volumes that do not blend into a simpler one (module
+    /// `interpolate`).
+    Interpolated(Box<InterpolatedVolume>),
 }
 
 impl Volume {
@@ -98,6 +91,7 @@ impl Volume {
             Volume::Linear(v) => v.point(uv, t),
             Volume::Piecewise(v) => v.point(uv, t),
             Volume::Bezier(v) => v.point(uv, t),
+            Volume::Interpolated(v) => v.point(uv, t),
         }
     }
 
@@ -107,6 +101,7 @@ impl Volume {
             Volume::Linear(v) => v.tangent(uv),
             Volume::Piecewise(v) => v.tangent(uv, t),
             Volume::Bezier(v) => v.tangent(uv, t),
+            Volume::Interpolated(v) => v.tangent(uv, t),
         }
     }
 
@@ -115,6 +110,7 @@ impl Volume {
     pub fn ray(&self, uv: DVec2) -> Option<Ray> {
         match self {
             Volume::Linear(v) => v.ray(uv),
+            Volume::Interpolated(v) => v.ray(uv),
             Volume::Piecewise(_) | Volume::Bezier(_) => None,
         }
     }
@@ -125,7 +121,32 @@ impl Volume {
             Volume::Linear(v) => v.ray(uv).map(Projector::Straight),
             Volume::Piecewise(v) => v.projector(uv),
             Volume::Bezier(v) => v.projector(uv),
+            Volume::Interpolated(v) => v.projector(uv),
         }
+    }
+
+    /// Errors when every projector on a 17 x 17 grid of (u, v) has zero length at t = 0
+    /// and t = 1 (nothing can be seen: near and far surfaces coincide).
+    pub fn check_projectors(&self) -> Result<()> {
+        check_projectors(|uv, t| self.tangent(uv, t))
+    }
+}
+
+/// See [`Volume::check_projectors`]; `tangent` is dQ/dt at (u, v, t).
+fn check_projectors(tangent: impl Fn(DVec2, f64) -> DVec3) -> Result<()> {
+    let n = f64::from(CHECK_SAMPLES - 1);
+    let any_length = (0..CHECK_SAMPLES).any(|i| {
+        (0..CHECK_SAMPLES).any(|j| {
+            let uv = DVec2::new(f64::from(i) / n, f64::from(j) / n);
+            tangent(uv, 0.0) != DVec3::ZERO || tangent(uv, 1.0) != DVec3::ZERO
+        })
+    });
+    if any_length {
+        Ok(())
+    } else {
+        Err(Error::new(
+            "flexible near and far surfaces coincide: every projector has zero length",
+        ))
     }
 }
 

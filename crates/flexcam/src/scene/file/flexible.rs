@@ -19,7 +19,7 @@ use crate::projection::flexible::{
 };
 
 /// Every key of a flexible table (besides `type`).
-pub(super) const KEYS: [&str; 19] = [
+pub(super) const KEYS: [&str; 24] = [
     "preset",
     "position",
     "look_at",
@@ -39,9 +39,14 @@ pub(super) const KEYS: [&str; 19] = [
     "segments",
     "reparam",
     "max_latitude",
+    "shift",
+    "twist",
+    "azimuth",
+    "elevation",
+    "generators",
 ];
 
-/// Keys every preset accepts.
+/// Keys every preset accepts (but `up` for the axonometric one, which is always +y).
 const PRESET_COMMON: [&str; 6] = ["preset", "position", "look_at", "up", "clip", "reparam"];
 
 /// Keys of a flexible table given by a near and a far surface.
@@ -73,11 +78,16 @@ const SURFACE_NAMES: [&str; 9] = [
 /// The `blend` names of scene files.
 const BLEND_NAMES: [&str; 2] = ["piecewise", "bezier"];
 
-/// The preset's own keys, besides [`PRESET_COMMON`] (and `max_latitude` with Mercator).
+/// The preset's own keys, besides [`PRESET_COMMON`] (and `max_latitude` with the map
+/// re-parameterisations).
 fn preset_keys(name: &str) -> &'static [&'static str] {
     match name {
         "perspective" | "inverse_perspective" | "fisheye" => &["fov"],
         "orthographic" => &["width"],
+        "off_axis" => &["fov", "shift"],
+        "twist" => &["fov", "twist"],
+        "axonometric" => &["width", "azimuth", "elevation"],
+        "glc" => &["width", "generators"],
         "oblique" => &["width", "shear"],
         "pushbroom" => &["width", "v_fov"],
         "crossed_slits" => &["fov", "v_fov", "slit_distance"],
@@ -104,10 +114,13 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
                     ),
                 ));
             }
+            let common = |key: &str| {
+                PRESET_COMMON.contains(&key) && !(key == "up" && name.get_ref() == "axonometric")
+            };
             let allowed = |key: &str| {
-                PRESET_COMMON.contains(&key)
+                common(key)
                     || own.contains(&key)
-                    || (key == "max_latitude" && matches!(reparam, Some(Reparam::Mercator { .. })))
+                    || (key == "max_latitude" && reparam.is_some_and(|r| has_latitude(&r)))
             };
             reject_keys(src, &present, allowed, || {
                 format!(
@@ -153,10 +166,10 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
         }
     };
     if let (Some(at), Some(r)) = (&raw.max_latitude, reparam) {
-        if !matches!(r, Reparam::Mercator { .. }) {
+        if !has_latitude(&r) {
             return Err(src.error(
                 &at.span(),
-                "`max_latitude` belongs to reparam = \"mercator\"",
+                "`max_latitude` belongs to reparam = \"mercator\" or \"equal_area\"",
             ));
         }
     }
@@ -235,6 +248,14 @@ fn blended(
     Ok(VolumeSource::Blended { surfaces, blend })
 }
 
+/// Whether the re-parameterisation is a map projection with a `max_latitude`.
+fn has_latitude(reparam: &Reparam) -> bool {
+    matches!(
+        reparam,
+        Reparam::Mercator { .. } | Reparam::EqualArea { .. }
+    )
+}
+
 /// Fails at the first present key that `allowed` refuses.
 fn reject_keys(
     src: &Source,
@@ -260,23 +281,24 @@ fn reparam(src: &Source, raw: &RawProjection) -> Result<Option<Reparam>> {
         "linear" => Reparam::Linear,
         "polar" => Reparam::Polar,
         "lens" => Reparam::Lens,
-        "mercator" => {
+        map @ ("mercator" | "equal_area") => {
+            let (default, make): (f64, fn(f64) -> Reparam) = if map == "mercator" {
+                (DEFAULT_MERCATOR_LATITUDE, |max_latitude| {
+                    Reparam::Mercator { max_latitude }
+                })
+            } else {
+                (90.0, |max_latitude| Reparam::EqualArea { max_latitude })
+            };
             let degrees = raw
                 .max_latitude
                 .as_ref()
-                .map_or(Ok(DEFAULT_MERCATOR_LATITUDE), |v| {
-                    src.number(v, "max_latitude")
-                })?;
-            if !(degrees > 0.0 && degrees < 90.0) {
+                .map_or(Ok(default), |v| src.number(v, "max_latitude"))?;
+            let reparam = make(degrees.to_radians());
+            reparam.validate().map_err(|e| {
                 let at = raw.max_latitude.as_ref().map_or(name.span(), Spanned::span);
-                return Err(src.error(
-                    &at,
-                    format!("`max_latitude` must be in (0, 90) degrees, got {degrees}"),
-                ));
-            }
-            Reparam::Mercator {
-                max_latitude: degrees.to_radians(),
-            }
+                src.error(&at, e.message)
+            })?;
+            reparam
         }
         other => {
             return Err(src.error(
@@ -335,8 +357,25 @@ fn preset(required: &Required, name: &str) -> Result<PresetSpec> {
             h_fov: optional(&raw.h_fov, "h_fov", 360.0)?,
             v_fov: optional(&raw.v_fov, "v_fov", 180.0)?,
         },
-        _ => Preset::Fisheye {
+        "fisheye" => Preset::Fisheye {
             fov: number(&raw.fov, "fov")?,
+        },
+        "off_axis" => Preset::OffAxis {
+            fov: number(&raw.fov, "fov")?,
+            shift: DVec2::from_array(src.vector(required.get(&raw.shift, "shift")?, "shift")?),
+        },
+        "twist" => Preset::Twist {
+            fov: number(&raw.fov, "fov")?,
+            twist: number(&raw.twist, "twist")?,
+        },
+        "axonometric" => Preset::Axonometric {
+            width: number(&raw.width, "width")?,
+            azimuth: number(&raw.azimuth, "azimuth")?,
+            elevation: number(&raw.elevation, "elevation")?,
+        },
+        _ => Preset::Glc {
+            width: number(&raw.width, "width")?,
+            generators: generators(src, required.get(&raw.generators, "generators")?)?,
         },
     };
     let clip = match &raw.clip {
@@ -380,6 +419,21 @@ fn bezier_patch(rows: Vec<Vec<DVec3>>) -> Result<Surface> {
             size(&rows)
         ))),
     }
+}
+
+/// `generators`: exactly three finite rays [x0, y0, x1, y1].
+fn generators(src: &Source, value: &Spanned<Vec<[f64; 4]>>) -> Result<[[f64; 4]; 3]> {
+    let rays: [[f64; 4]; 3] = value.get_ref().as_slice().try_into().map_err(|_| {
+        src.error(
+            &value.span(),
+            format!(
+                "`generators` must hold exactly three rays [x0, y0, x1, y1], got {}",
+                value.get_ref().len()
+            ),
+        )
+    })?;
+    src.all_finite(rays.as_flattened(), value, "generators")?;
+    Ok(rays)
 }
 
 /// The keys each surface type takes (besides `surface`).

@@ -4,6 +4,7 @@
 //! (module `raw`), then each table is checked and converted by hand, so that every error, from a
 //! TOML syntax error to a degenerate projection, is one line `FILE:LINE:COLUMN: message`.
 
+mod animation;
 mod flexible;
 mod light;
 mod object;
@@ -24,6 +25,9 @@ use self::raw::{RawImage, RawScene};
 use self::source::Source;
 use super::{ImageSettings, Scene};
 use crate::error::{Error, Result};
+use crate::projection::flexible::Animation;
+
+pub use self::animation::DEFAULT_FPS;
 
 /// The largest accepted image side, in pixels. It keeps an image at or below 2^28 pixels, so
 /// that frame buffers (several values per pixel) fit in memory.
@@ -50,8 +54,21 @@ pub fn load(path: &Path) -> Result<Scene> {
 }
 
 /// Parses scene-file text. `path` names the file in errors, and its folder is the base for
-/// the relative paths in the file (models, textures, projection surfaces).
+/// the relative paths in the file (models, textures, projection surfaces). An `[animation]`
+/// table is checked but left out: see [`parse_animated`].
 pub fn parse(text: &str, path: &Path) -> Result<Scene> {
+    parse_animated(text, path).map(|(scene, _)| scene)
+}
+
+/// Reads and parses the scene file at `path` with its `[animation]` table, if any.
+pub fn load_animated(path: &Path) -> Result<(Scene, Option<Animation>)> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Error::in_file(path, format!("cannot read scene file: {e}")))?;
+    parse_animated(&text, path)
+}
+
+/// As [`parse`], also giving the keyframed camera of the `[animation]` table, if any.
+pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animation>)> {
     let src = Source { text, path };
     projection::reject_unsupported(&src)?;
     let raw: RawScene = toml::from_str(text).map_err(|e| src.toml_error(&e))?;
@@ -87,14 +104,20 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene> {
             Some(_) => e,
             None => src.error(&projection_table.span(), e.message),
         })?;
-    Ok(Scene {
+    let animation = raw
+        .animation
+        .as_ref()
+        .map(|table| animation::convert(&src, table, &base_dir, &image))
+        .transpose()?;
+    let scene = Scene {
         objects,
         lights,
         image,
         projection,
         base_dir: Some(base_dir),
         trilinear_reflectors,
-    })
+    };
+    Ok((scene, animation))
 }
 
 /// `[image]`, with [`ImageSettings::default`] for absent keys.

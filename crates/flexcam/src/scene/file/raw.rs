@@ -24,6 +24,26 @@ pub struct RawScene {
     pub object: Vec<Spanned<RawObject>>,
     #[serde(default)]
     pub light: Vec<Spanned<RawLight>>,
+    pub animation: Option<Spanned<RawAnimation>>,
+}
+
+/// `[animation]`: a keyframed flexible camera.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawAnimation {
+    pub frames: Spanned<u32>,
+    pub fps: Option<Spanned<f64>>,
+    pub interpolation: Option<Spanned<String>>,
+    #[serde(default)]
+    pub key: Vec<Spanned<RawKey>>,
+}
+
+/// `[[animation.key]]`: the projection at one time.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawKey {
+    pub time: Spanned<f64>,
+    pub projection: Spanned<RawProjection>,
 }
 
 /// `[image]`.
@@ -74,6 +94,11 @@ pub struct RawProjection {
     pub first: Option<Spanned<RawCamera>>,
     pub second: Option<Spanned<RawCamera>>,
     pub band: Option<Spanned<[f64; 2]>>,
+    pub shift: Option<Spanned<[f64; 2]>>,
+    pub twist: Option<Spanned<f64>>,
+    pub azimuth: Option<Spanned<f64>>,
+    pub elevation: Option<Spanned<f64>>,
+    pub generators: Option<Spanned<Vec<[f64; 4]>>>,
 }
 
 /// `camera = { ... }`, `first`, `second`: a camera of a trilinear grid's visualisation
@@ -193,6 +218,11 @@ impl RawProjection {
             ("first", self.first.as_ref().map(Spanned::span)),
             ("second", self.second.as_ref().map(Spanned::span)),
             ("band", self.band.as_ref().map(Spanned::span)),
+            ("shift", self.shift.as_ref().map(Spanned::span)),
+            ("twist", self.twist.as_ref().map(Spanned::span)),
+            ("azimuth", self.azimuth.as_ref().map(Spanned::span)),
+            ("elevation", self.elevation.as_ref().map(Spanned::span)),
+            ("generators", self.generators.as_ref().map(Spanned::span)),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))

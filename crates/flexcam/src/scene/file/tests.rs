@@ -305,6 +305,64 @@ fn flexible_errors_have_positions() {
 }
 
 #[test]
+fn new_flexible_presets_parse_with_their_keys() {
+    let head = "[projection]\ntype = \"flexible\"\nposition = [0, 1, 5]\nlook_at = [0, 1, 0]\n";
+    for body in [
+        "preset = \"off_axis\"\nfov = 60\nshift = [0.5, -0.25]\n",
+        "preset = \"twist\"\nfov = 60\ntwist = 45\nclip = [0, 20]\n",
+        "preset = \"axonometric\"\nwidth = 4\nazimuth = 45\nelevation = 35.264\n",
+        "preset = \"glc\"\nwidth = 2\ngenerators = [[-1, -1, -2, -2], [1, -1, 2, -2], [0, 1, 0, 2]]\n",
+        "preset = \"equirectangular\"\nreparam = \"equal_area\"\nmax_latitude = 80\n",
+    ] {
+        let s = scene(&format!("{head}{body}"));
+        assert_eq!(s.projection.kind(), "flexible", "{body}");
+    }
+}
+
+#[test]
+fn new_flexible_preset_errors_have_positions() {
+    let head = "[projection]\ntype = \"flexible\"\nposition = [0, 1, 5]\nlook_at = [0, 1, 0]\n";
+    assert_error_at(
+        &format!("{head}preset = \"glc\"\nwidth = 2\ngenerators = [[0, 0, 0, 0], [1, 1, 1, 1]]\n"),
+        7,
+        14,
+        "`generators` must hold exactly three rays",
+    );
+    assert_error_at(
+        &format!("{head}preset = \"glc\"\nwidth = 2\ngenerators = [[0, 0, 0, 0], [1, 1, 1, 1], [2, 2, 0, 0]]\n"),
+        1,
+        1,
+        "not on one line",
+    );
+    assert_error_at(
+        &format!("{head}preset = \"axonometric\"\nwidth = 2\nazimuth = 0\nelevation = 10\nup = [0, 0, 1]\n"),
+        9,
+        6,
+        "`up` is not a parameter of flexible preset \"axonometric\"",
+    );
+    assert_error_at(
+        &format!("{head}preset = \"twist\"\nfov = 60\n"),
+        1,
+        1,
+        "flexible projection needs `twist`",
+    );
+    assert_error_at(
+        &format!(
+            "{head}preset = \"equirectangular\"\nreparam = \"equal_area\"\nmax_latitude = 95\n"
+        ),
+        7,
+        16,
+        "equal_area max_latitude must be in (0, 90] degrees, got 95",
+    );
+    assert_error_at(
+        &format!("{head}preset = \"twist\"\nfov = 60\ntwist = 10\nmax_latitude = 10\n"),
+        8,
+        16,
+        "`max_latitude` is not a parameter",
+    );
+}
+
+#[test]
 fn missing_required_parameters() {
     assert_eq!(
         error("[image]\nwidth = 10\n"),
@@ -979,5 +1037,101 @@ fn flexible_blended_errors_have_positions() {
     assert_error(
         &format!("{head}blend = \"bezier\"\n"),
         "flexible projection needs `surfaces`",
+    );
+}
+
+/// A flexible key table at `time` with the perspective preset of field of view `fov`.
+fn animation_key(time: &str, fov: &str) -> String {
+    format!(
+        "[[animation.key]]\ntime = {time}\n[animation.key.projection]\ntype = \"flexible\"\n\
+         preset = \"perspective\"\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\nfov = {fov}\n"
+    )
+}
+
+#[test]
+fn animation_tables_parse_into_keyframes() {
+    let text = format!(
+        "{CAMERA}[animation]\nframes = 3\nfps = 10\ninterpolation = \"smooth\"\n{}{}",
+        animation_key("0", "40"),
+        animation_key("0.5", "70")
+    );
+    let (_, animation) = parse_animated(&text, Path::new("dir/s.toml")).unwrap();
+    let animation = animation.expect("an animation");
+    assert_eq!((animation.frames(), animation.fps()), (3, 10.0));
+    assert_eq!(animation.keys().len(), 2);
+    assert_eq!(animation.keys()[1].time, 0.5);
+    // Without [animation] there is none; `parse` checks the table but leaves it out.
+    assert!(parse_animated(CAMERA, Path::new("s.toml"))
+        .unwrap()
+        .1
+        .is_none());
+    scene(&text);
+}
+
+#[test]
+fn animation_errors_have_positions() {
+    let head = format!("{CAMERA}[animation]\nframes = 3\n");
+    // Line 6 is [animation], 7 frames; keys start on line 8 (time on line 9).
+    assert_error_at(
+        &format!(
+            "{head}{}{}",
+            animation_key("1", "40"),
+            animation_key("1", "50")
+        ),
+        17,
+        8,
+        "animation key time 1 must be later than the key before it (1)",
+    );
+    assert_error_at(
+        &format!("{head}{}", animation_key("-2", "40")),
+        9,
+        8,
+        "at least 0 seconds",
+    );
+    assert_error_at(
+        &format!("{head}{}", animation_key("inf", "40")),
+        9,
+        8,
+        "`time`",
+    );
+    assert_error_at(
+        &format!("{head}{}", animation_key("0", "200")),
+        10,
+        1,
+        "flexible perspective fov",
+    );
+    assert_error_at(
+        &format!(
+            "{CAMERA}[animation]\nframes = 0\n{}",
+            animation_key("0", "40")
+        ),
+        7,
+        10,
+        "`frames` must be at least 1",
+    );
+    assert_error_at(
+        &format!(
+            "{CAMERA}[animation]\nframes = 2\ninterpolation = \"cubic\"\n{}",
+            animation_key("0", "40")
+        ),
+        8,
+        17,
+        "unknown interpolation \"cubic\"",
+    );
+    assert_error_at(&head, 6, 1, "needs at least one [[animation.key]]");
+    let perspective_key = "[[animation.key]]\ntime = 0\n[animation.key.projection]\n\
+                           type = \"perspective\"\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\nfov = 40\n";
+    assert_error_at(
+        &format!("{head}{perspective_key}"),
+        11,
+        8,
+        "animation keys need type = \"flexible\"",
+    );
+    let fisheye = animation_key("1", "40").replace("perspective", "fisheye");
+    assert_error_at(
+        &format!("{head}{}{fisheye}", animation_key("0", "40")),
+        18,
+        1,
+        "keys 0 and 1 cannot be interpolated",
     );
 }

@@ -18,8 +18,19 @@
 //! - fisheye: spheres of radius d with the pole on the view axis, azimuth from u and angle
 //!   off the axis v fov/2, with the polar re-parameterisation.
 //!
+//! - off-axis perspective: the perspective rectangles with the window shifted by `shift`
+//!   (in half-extents): Q_d = d ((U + s_x) tan(fov/2), (V + s_y) tan(fov/2) H/W, 1);
+//! - twist: the perspective volume with the far rectangle turned by `twist` about the view
+//!   axis (thesis 4.2, 6.3: "rotating the far surface of a perspective projection");
+//! - axonometric: the orthographic volume seen from the direction given by `azimuth` and
+//!   `elevation` ([`axonometric`]);
+//! - general linear camera: the affine combinations of three generator rays ([`glc`]).
+//!
 //! Near distance 0 puts the near surface at the eye (a point, or the slit): the rays then
 //! start where the single-viewpoint projections start theirs.
+
+mod axonometric;
+mod glc;
 
 use std::f64::consts::PI;
 
@@ -73,10 +84,36 @@ pub enum Preset {
     Fisheye {
         fov: f64,
     },
+    /// Perspective with the window shifted by `shift` half-widths and half-heights.
+    OffAxis {
+        fov: f64,
+        shift: DVec2,
+    },
+    /// Perspective with the far surface turned by `twist` degrees about the view axis
+    /// (counter-clockwise as seen from the eye).
+    Twist {
+        fov: f64,
+        twist: f64,
+    },
+    /// Orthographic, looking at `look_at` from the world direction at `azimuth` degrees
+    /// about +y (0 = from +z) and `elevation` degrees above the x-z plane; `position` only
+    /// gives the distance of the near clip origin from `look_at`.
+    Axonometric {
+        width: f64,
+        azimuth: f64,
+        elevation: f64,
+    },
+    /// General linear camera (Yu and McMillan): generator k = [x0, y0, x1, y1] is the ray
+    /// through the camera-local points (x0, y0, 0) and (x1, y1, 1); the image plane z = 0
+    /// spans `width` across.
+    Glc {
+        width: f64,
+        generators: [[f64; 4]; 3],
+    },
 }
 
 /// The preset names of scene files, in order.
-pub const PRESET_NAMES: [&str; 9] = [
+pub const PRESET_NAMES: [&str; 13] = [
     "perspective",
     "inverse_perspective",
     "orthographic",
@@ -86,6 +123,10 @@ pub const PRESET_NAMES: [&str; 9] = [
     "cylindrical",
     "equirectangular",
     "fisheye",
+    "off_axis",
+    "twist",
+    "axonometric",
+    "glc",
 ];
 
 /// A preset placed in the scene.
@@ -111,6 +152,10 @@ impl Preset {
             Preset::Cylindrical { .. } => "cylindrical",
             Preset::Equirectangular { .. } => "equirectangular",
             Preset::Fisheye { .. } => "fisheye",
+            Preset::OffAxis { .. } => "off_axis",
+            Preset::Twist { .. } => "twist",
+            Preset::Axonometric { .. } => "axonometric",
+            Preset::Glc { .. } => "glc",
         }
     }
 
@@ -133,9 +178,15 @@ impl PresetSpec {
     /// Errors: a degenerate frame, a parameter out of range (as the single-viewpoint types),
     /// a clip range that is not 0 <= near < far (and far <= e for the inverse perspective).
     pub fn surfaces(&self, aspect: f64) -> Result<(Surface, Surface)> {
-        let b = CameraBasis::new(&self.frame)?;
         let p = &self.preset;
-        let focus = (self.frame.look_at - self.frame.position).length();
+        let frame = match *p {
+            Preset::Axonometric {
+                azimuth, elevation, ..
+            } => axonometric::frame(&self.frame, azimuth, elevation)?,
+            _ => self.frame,
+        };
+        let b = CameraBasis::new(&frame)?;
+        let focus = (frame.look_at - frame.position).length();
         let [near, far] = self.clip.unwrap_or(match p {
             Preset::InversePerspective { .. } => [0.0, focus],
             _ => [0.0, DEFAULT_FAR],
@@ -169,8 +220,8 @@ impl PresetSpec {
                 }
                 pair(&|d| rect(d, (focus - d) * DVec2::new(h, h * aspect), DVec2::ZERO))
             }
-            Preset::Orthographic { width } => {
-                let w = 0.5 * positive_length("flexible orthographic", "width", width)?;
+            Preset::Orthographic { width } | Preset::Axonometric { width, .. } => {
+                let w = 0.5 * positive_length(&format!("flexible {}", p.name()), "width", width)?;
                 pair(&|d| rect(d, DVec2::new(w, w * aspect), DVec2::ZERO))
             }
             Preset::Oblique { width, shear } => {
@@ -229,6 +280,45 @@ impl PresetSpec {
                 let frame = PolarFrame::new(b.forward, b.right)?;
                 let lat = [0.5 * PI, 0.5 * PI - half];
                 pair(&|d| sphere(b.origin, d, frame, [-PI, PI], lat))
+            }
+            Preset::OffAxis { fov, shift } => {
+                let h = (0.5 * angle(p, "fov", fov, UpTo::Below(180.0))?).tan();
+                if !shift.is_finite() {
+                    return Err(Error::new("flexible off_axis shift must be finite"));
+                }
+                let half = DVec2::new(h, h * aspect);
+                pair(&|d| rect(d, d * half, d * shift * half))
+            }
+            Preset::Twist { fov, twist } => {
+                let h = (0.5 * angle(p, "fov", fov, UpTo::Below(180.0))?).tan();
+                if !twist.is_finite() {
+                    return Err(Error::new("flexible twist angle must be finite"));
+                }
+                let (sin, cos) = twist.to_radians().sin_cos();
+                let (right, up) = (cos * b.right + sin * b.up, cos * b.up - sin * b.right);
+                let turned = |d: f64| {
+                    Surface::rectangle_centred(centre(d), d * h * right, d * h * aspect * up)
+                };
+                (
+                    rect(near, near * DVec2::new(h, h * aspect), DVec2::ZERO),
+                    turned(far),
+                )
+            }
+            Preset::Glc { width, generators } => {
+                let w = 0.5 * positive_length("flexible glc", "width", width)?;
+                let camera = glc::GeneralLinearCamera::new(generators)?;
+                let at = |d: f64, corner: DVec2| {
+                    let local = camera.point(corner * DVec2::new(w, w * aspect), d);
+                    b.origin + b.to_world(local)
+                };
+                pair(&|d| {
+                    let origin = at(d, DVec2::NEG_ONE);
+                    Surface::Rectangle {
+                        corner: origin,
+                        u_edge: at(d, DVec2::new(1.0, -1.0)) - origin,
+                        v_edge: at(d, DVec2::new(-1.0, 1.0)) - origin,
+                    }
+                })
             }
         })
     }

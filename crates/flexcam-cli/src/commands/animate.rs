@@ -1,0 +1,173 @@
+//! `flexcam animate`: render every frame of a scene's keyframed flexible camera
+//! (`[animation]`) to a numbered PNG sequence and/or an animated GIF. Nothing is written
+//! unless every frame renders.
+
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+use flexcam::image_io::{self, ColorEncoding, GifFrames, StagedFile};
+use flexcam::projection::ProjectionSpec;
+use flexcam::render::{Method, RenderOptions, Shading};
+use flexcam::scene;
+use flexcam::{Error, Result};
+
+use super::scene_args::ShadingArg;
+use crate::progress::RenderProgress;
+
+/// Arguments of `flexcam animate`.
+#[derive(Args, Debug)]
+pub struct AnimateArgs {
+    /// A scene file (.toml) with an `[animation]` table.
+    scene: PathBuf,
+    /// Numbered PNG frames: the run of `#` in the file name becomes the zero-padded frame
+    /// number, from 0 (e.g. `frames/out_####.png`).
+    #[arg(short, long, value_name = "PATTERN")]
+    output: Option<PathBuf>,
+    /// An animated GIF of all frames.
+    #[arg(long, value_name = "FILE")]
+    gif: Option<PathBuf>,
+    /// Image width in pixels (overrides the scene file).
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels (overrides the scene file).
+    #[arg(long)]
+    height: Option<u32>,
+    /// Rendering method: `raycast` (the reference, every projection).
+    #[arg(long, default_value = "raycast")]
+    method: String,
+    /// Shading: `flat` (base colours, exact) or `lit` (lights, shadows, reflections).
+    #[arg(long, value_enum, default_value_t = ShadingArg::Lit)]
+    shading: ShadingArg,
+    /// Samples per pixel.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    spp: u32,
+}
+
+/// A file name with one run of `#` to be replaced by the frame number.
+struct FramePattern {
+    folder: PathBuf,
+    before: String,
+    digits: usize,
+    after: String,
+}
+
+impl FramePattern {
+    /// Errors: no `#` in the file name, two separate runs of them, an extension other than
+    /// .png, a missing folder, or fewer `#` than the last frame number has digits.
+    fn new(path: &Path, frames: u32) -> Result<Self> {
+        image_io::check_output_path(path, &["png"])?;
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let start = name.find('#').ok_or_else(|| {
+            Error::in_file(
+                path,
+                "the frame pattern needs a run of `#` for the frame number",
+            )
+        })?;
+        let digits = name[start..].chars().take_while(|&c| c == '#').count();
+        let after = name[start + digits..].to_string();
+        if after.contains('#') {
+            return Err(Error::in_file(
+                path,
+                "the frame pattern must hold one run of `#`, not several",
+            ));
+        }
+        let needed = (frames - 1).to_string().len();
+        if digits < needed {
+            return Err(Error::in_file(
+                path,
+                format!(
+                    "{frames} frames need {needed} `#` for their numbers, the pattern has {digits}"
+                ),
+            ));
+        }
+        Ok(FramePattern {
+            folder: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+            before: name[..start].to_string(),
+            digits,
+            after,
+        })
+    }
+
+    /// The path of frame `frame`.
+    fn path(&self, frame: u32) -> PathBuf {
+        let name = format!(
+            "{}{frame:0width$}{}",
+            self.before,
+            self.after,
+            width = self.digits
+        );
+        self.folder.join(name)
+    }
+}
+
+/// Runs `flexcam animate`.
+pub fn run(args: &AnimateArgs) -> Result<()> {
+    let method: Method = args.method.parse()?;
+    if args.output.is_none() && args.gif.is_none() {
+        return Err(Error::new(
+            "nothing to write: give -o PATTERN (numbered PNG frames), --gif FILE, or both",
+        ));
+    }
+    if let Some(gif) = &args.gif {
+        image_io::check_output_path(gif, &["gif"])?;
+    }
+    let (scene, animation) = scene::file::load_animated(&args.scene)?;
+    let animation = animation.ok_or_else(|| {
+        Error::in_file(&args.scene, "the scene has no [animation] table to animate")
+    })?;
+    let frames = animation.frames();
+    let pattern = args
+        .output
+        .as_deref()
+        .map(|p| FramePattern::new(p, frames))
+        .transpose()?;
+    let width = args.width.unwrap_or(scene.image.width);
+    let height = args.height.unwrap_or(scene.image.height);
+    scene::file::validate_resolution(width, height)?;
+
+    let encoding = match args.shading.shading() {
+        Shading::Flat => ColorEncoding::Linear,
+        Shading::Lit => ColorEncoding::Srgb,
+    };
+    let progress = RenderProgress::new();
+    let mut staged: Vec<StagedFile> = Vec::new();
+    let mut gif = args.gif.as_ref().map(|_| GifFrames::default());
+    for frame_number in 0..frames {
+        let spec = ProjectionSpec::Flexible(Box::new(animation.projection(frame_number)));
+        let projection = spec
+            .build(width, height)
+            .map_err(|e| e.or_in_file(&args.scene))?;
+        let done_before = u64::from(frame_number);
+        let report = |done: u64, total: u64| {
+            progress.update(done_before * total + done, u64::from(frames) * total)
+        };
+        let options = RenderOptions {
+            shading: args.shading.shading(),
+            spp: args.spp,
+            progress: Some(&report),
+            ..RenderOptions::default()
+        };
+        let (frame, _) = method.render(&scene, projection.as_ref(), &options)?;
+        if let Some(pattern) = &pattern {
+            staged.push(image_io::write_color_png(
+                &frame,
+                &pattern.path(frame_number),
+                encoding,
+            )?);
+        }
+        if let Some(gif) = &mut gif {
+            gif.push(&frame, encoding)?;
+        }
+    }
+    progress.finish();
+    if let (Some(gif), Some(path)) = (gif, &args.gif) {
+        staged.push(gif.write(path, animation.fps())?);
+    }
+    for file in staged {
+        file.commit()?;
+    }
+    Ok(())
+}
