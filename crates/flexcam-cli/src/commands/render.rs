@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use flexcam::image_io::{self, ColorEncoding, StagedFile};
+use flexcam::render::trilinear::CurveOptions;
 use flexcam::render::{Method, RenderOptions, Shading};
 use flexcam::scene::{self, Scene};
 use flexcam::{Error, Result};
@@ -27,9 +28,17 @@ pub struct RenderArgs {
     /// Image height in pixels (overrides the scene file).
     #[arg(long)]
     height: Option<u32>,
-    /// Rendering method: `raycast` (the reference, every projection).
+    /// Rendering method: `raycast` (the reference, every projection) or `trilinear`
+    /// (rasterisation of trilinear projections).
     #[arg(long, default_value = "raycast")]
     method: String,
+    /// How `--method trilinear` follows curved edges: `tessellate`, `slice` or `adaptive`.
+    #[arg(long, default_value = "adaptive")]
+    curves: String,
+    /// Steps of the curve mode: segments per scene edge (tessellate), slices per shape
+    /// (slice) or most segments per edge piece (adaptive); defaults 8, 10 and 256.
+    #[arg(long, value_name = "N")]
+    curve_steps: Option<u32>,
     /// Shading: `flat` (base colours, exact) or `lit` (lights, shadows, reflections).
     #[arg(long, value_enum, default_value_t = ShadingArg::Lit)]
     shading: ShadingArg,
@@ -70,7 +79,12 @@ impl ShadingArg {
 
 /// Runs `flexcam render`. Outputs are written only once everything has succeeded.
 pub fn run(args: &RenderArgs) -> Result<()> {
-    let method: Method = args.method.parse()?;
+    let method = match args.method.parse()? {
+        Method::Trilinear(_) => {
+            Method::Trilinear(CurveOptions::new(args.curves.parse()?, args.curve_steps)?)
+        }
+        other => other,
+    };
     check_outputs(args)?;
 
     let source = args

@@ -27,8 +27,8 @@ pub use image_coords::Resolution;
 pub use linear::{Orthographic, Perspective};
 pub use panoramic::{Cylindrical, Equirectangular};
 pub use trilinear::{
-    project_triangle, ProjectionTriangleCache, SceneEdge, Shape, ShapeVertex, Solutions,
-    TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
+    project_solved_triangle, project_triangle, ProjectionTriangleCache, SceneEdge, Shape,
+    ShapeVertex, Solutions, TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
 };
 
 use glam::{DVec2, DVec3};
@@ -68,6 +68,12 @@ pub trait Projection: Send + Sync {
     /// parameter that reaches it. Projections without an inverse append nothing.
     fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
         let _ = (point, out);
+    }
+
+    /// This projection as a trilinear mesh, for the renderers that need its triangles
+    /// (`--method trilinear`); `None` for every other kind.
+    fn as_trilinear(&self) -> Option<&Trilinear> {
+        None
     }
 }
 

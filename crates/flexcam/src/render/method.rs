@@ -6,6 +6,7 @@ use std::str::FromStr;
 use crate::error::{Error, Result};
 use crate::projection::Projection;
 use crate::render::raycast::RayCaster;
+use crate::render::trilinear::{CurveOptions, TrilinearRenderer};
 use crate::render::{Frame, RenderOptions, Stats};
 use crate::scene::Scene;
 
@@ -15,18 +16,24 @@ pub enum Method {
     /// The reference ray caster; renders every projection.
     #[default]
     Raycast,
+    /// Trilinear rasterisation (seed 000) with the given curve handling; renders trilinear
+    /// projections only.
+    Trilinear(CurveOptions),
 }
 
 impl Method {
     /// Every method with its command-line name.
-    pub const ALL: [(&'static str, Method); 1] = [("raycast", Method::Raycast)];
+    pub const ALL: [(&'static str, Method); 2] = [
+        ("raycast", Method::Raycast),
+        ("trilinear", Method::Trilinear(CurveOptions::ADAPTIVE)),
+    ];
 
     /// The command-line name.
     pub fn name(self) -> &'static str {
-        Method::ALL
-            .iter()
-            .find(|(_, m)| *m == self)
-            .map_or("?", |(name, _)| name)
+        match self {
+            Method::Raycast => "raycast",
+            Method::Trilinear(_) => "trilinear",
+        }
     }
 
     /// Renders `scene` through `projection`. Fails, rather than producing a wrong image, when
@@ -43,6 +50,16 @@ impl Method {
         }
         match self {
             Method::Raycast => Ok(RayCaster::new(scene).render(projection, options)),
+            Method::Trilinear(curves) => {
+                let trilinear = projection.as_trilinear().ok_or_else(|| {
+                    Error::new(format!(
+                        "the trilinear method renders only trilinear projections, \
+                         not a {} projection",
+                        projection.kind()
+                    ))
+                })?;
+                TrilinearRenderer::new(scene).render(trilinear, options, curves)
+            }
         }
     }
 }
@@ -82,6 +99,25 @@ mod tests {
             assert_eq!(m.to_string(), name);
         }
         let e = "raster-ish".parse::<Method>().unwrap_err();
-        assert!(e.to_string().contains("available: raycast"), "{e}");
+        assert!(
+            e.to_string().contains("available: raycast, trilinear"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn trilinear_refuses_other_projections() {
+        let scene = crate::scene::load("builtin:cube-floor").unwrap();
+        let projection = scene.projection.build(8, 8).unwrap();
+        let e = Method::Trilinear(CurveOptions::ADAPTIVE)
+            .render(&scene, projection.as_ref(), &RenderOptions::default())
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "the trilinear method renders only trilinear projections, not a {} projection",
+                projection.kind()
+            )
+        );
     }
 }

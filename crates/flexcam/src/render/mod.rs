@@ -80,4 +80,5 @@ mod method;
 pub mod raster;
 pub mod raycast;
 pub mod surface;
+pub mod trilinear;
 pub use method::Method;

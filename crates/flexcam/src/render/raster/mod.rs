@@ -9,6 +9,9 @@
 //! - [`target`]: the z-buffered target and [`Fragment`]s;
 //! - [`stats`]: counters for `--stats`.
 //!
+//! A *stage* (see [`rasterize_parallel_staged`]) may rewrite each fragment before its z-test
+//! (an exact per-pixel depth instead of the interpolated one) or discard it.
+//!
 //! Determinism: a pixel keeps the fragment with the smallest `(depth, primitive)` pair, and
 //! every fragment's position and values depend only on its own shape, so the image does not
 //! depend on the band size or the number of threads, and with distinct primitive keys not on
@@ -53,9 +56,8 @@ pub fn rasterize<const N: usize>(
     let mut scratch = Scratch::default();
     let mut band = target.band();
     for polygon in polygons.iter() {
-        let (fragments, writes) = draw(&mut band, &polygon, rule, &mut scratch, shader);
-        stats.fragments += fragments;
-        stats.writes += writes;
+        let counts = draw(&mut band, &polygon, rule, &mut scratch, &keep, shader);
+        stats.add_fragments(counts);
     }
     stats.covered = target.covered();
     stats
@@ -69,6 +71,21 @@ pub fn rasterize_parallel<const N: usize>(
     polygons: &PolygonBatch<N>,
     rule: FillRule,
     band_rows: u32,
+    shader: &(impl Fn(&Fragment<N>) -> Vec3 + Sync),
+) -> RasterStats {
+    rasterize_parallel_staged(target, polygons, rule, band_rows, &keep, shader)
+}
+
+/// [`rasterize_parallel`] with a `stage` run on every covered fragment before its z-test: it
+/// may replace the fragment's depth and attributes (keeping `x`, `y`, `object` and
+/// `primitive`) and returns `false` to discard it. The stage must be a pure function of the
+/// fragment, like the shader, for the result to stay deterministic.
+pub fn rasterize_parallel_staged<const N: usize>(
+    target: &mut Target,
+    polygons: &PolygonBatch<N>,
+    rule: FillRule,
+    band_rows: u32,
+    stage: &(impl Fn(&mut Fragment<N>) -> bool + Sync),
     shader: &(impl Fn(&Fragment<N>) -> Vec3 + Sync),
 ) -> RasterStats {
     let band_rows = band_rows.max(1);
@@ -86,21 +103,20 @@ pub fn rasterize_parallel<const N: usize>(
             }
         }
     }
-    let (fragments, writes) = target
+    let counts = target
         .bands(band_rows)
         .into_par_iter()
         .zip(bins)
         .map(|(mut band, bin)| {
             let mut scratch = Scratch::default();
-            bin.iter().fold((0, 0), |(f, w), &i| {
-                let (df, dw) = draw(&mut band, &polygons.get(i), rule, &mut scratch, shader);
-                (f + df, w + dw)
+            bin.iter().fold(DrawCounts::default(), |sum, &i| {
+                let polygon = polygons.get(i);
+                sum.plus(draw(&mut band, &polygon, rule, &mut scratch, stage, shader))
             })
         })
-        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        .reduce(DrawCounts::default, DrawCounts::plus);
     let mut stats = count_shapes(polygons);
-    stats.fragments = fragments;
-    stats.writes = writes;
+    stats.add_fragments(counts);
     stats.covered = target.covered();
     stats
 }
@@ -118,26 +134,54 @@ fn count_shapes<const N: usize>(polygons: &PolygonBatch<N>) -> RasterStats {
     stats
 }
 
-/// Draws one shape into the rows of `band`; returns (fragments, writes).
+/// The stage of the unstaged entry points: keeps every fragment as interpolated.
+fn keep<const N: usize>(_: &mut Fragment<N>) -> bool {
+    true
+}
+
+/// What drawing some shapes did to the fragments (see [`RasterStats`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(super) struct DrawCounts {
+    pub fragments: u64,
+    pub discarded: u64,
+    pub writes: u64,
+}
+
+impl DrawCounts {
+    fn plus(self, other: DrawCounts) -> DrawCounts {
+        DrawCounts {
+            fragments: self.fragments + other.fragments,
+            discarded: self.discarded + other.discarded,
+            writes: self.writes + other.writes,
+        }
+    }
+}
+
+/// Draws one shape into the rows of `band`, each fragment through `stage` first.
 fn draw<const N: usize>(
     band: &mut Band<'_>,
     polygon: &Polygon<'_, N>,
     rule: FillRule,
     scratch: &mut Scratch<N>,
+    stage: &impl Fn(&mut Fragment<N>) -> bool,
     shader: &impl Fn(&Fragment<N>) -> Vec3,
-) -> (u64, u64) {
-    let (mut fragments, mut writes) = (0, 0);
+) -> DrawCounts {
+    let mut counts = DrawCounts::default();
     let (rows, width) = (band.rows, band.width);
     let mut emit = |x, y, varying| {
-        let fragment = Fragment {
+        let mut fragment = Fragment {
             x,
             y,
             varying,
             object: polygon.object,
             primitive: polygon.primitive,
         };
-        fragments += 1;
-        writes += u64::from(band.test_and_write(&fragment, shader));
+        counts.fragments += 1;
+        if !stage(&mut fragment) {
+            counts.discarded += 1;
+            return;
+        }
+        counts.writes += u64::from(band.test_and_write(&fragment, shader));
     };
     match polygon.kind() {
         Kind::Fill => scan::fill(polygon, rule, rows, width, scratch, &mut emit),
@@ -150,5 +194,5 @@ fn draw<const N: usize>(
         ),
         Kind::Skip => {}
     }
-    (fragments, writes)
+    counts
 }

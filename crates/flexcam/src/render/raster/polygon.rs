@@ -148,6 +148,17 @@ impl<const N: usize> PolygonBatch<N> {
         });
     }
 
+    /// Appends every shape of `other`, in order.
+    pub fn append(&mut self, other: &PolygonBatch<N>) {
+        let offset = self.vertices.len();
+        self.vertices.extend_from_slice(&other.vertices);
+        self.shapes.extend(other.shapes.iter().map(|s| Shape {
+            start: s.start + offset,
+            end: s.end + offset,
+            ..*s
+        }));
+    }
+
     pub fn len(&self) -> usize {
         self.shapes.len()
     }

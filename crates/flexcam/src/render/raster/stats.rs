@@ -14,6 +14,9 @@ pub struct RasterStats {
     pub skipped: u64,
     /// Pixel centres covered by some shape, each tested against the z-buffer.
     pub fragments: u64,
+    /// Fragments a stage discarded before the z-test (see
+    /// [`super::rasterize_parallel_staged`]).
+    pub discarded: u64,
     /// Fragments that passed the z-test and were shaded and written.
     pub writes: u64,
     /// Pixels of the target holding a fragment after the pass.
@@ -27,8 +30,16 @@ impl RasterStats {
         self.lines += other.lines;
         self.skipped += other.skipped;
         self.fragments += other.fragments;
+        self.discarded += other.discarded;
         self.writes += other.writes;
         self.covered += other.covered;
+    }
+
+    /// Adds the fragment counts of drawing some shapes.
+    pub(super) fn add_fragments(&mut self, counts: super::DrawCounts) {
+        self.fragments += counts.fragments;
+        self.discarded += counts.discarded;
+        self.writes += counts.writes;
     }
 
     /// Fragments per covered pixel (1 = no overdraw); 0 when nothing is covered.
@@ -47,6 +58,7 @@ impl RasterStats {
             ("raster_lines", self.lines),
             ("raster_skipped", self.skipped),
             ("raster_fragments", self.fragments),
+            ("raster_discarded", self.discarded),
             ("raster_writes", self.writes),
             ("raster_covered", self.covered),
         ] {

@@ -168,6 +168,16 @@ impl RayCaster {
         }
     }
 
+    /// The colour `options.shading` gives primary ray `ray` whose first hit is `hit` (found by
+    /// any means, e.g. rasterisation), exactly as [`RayCaster::render`] shades it: mirrors,
+    /// glass and shadows are traced from there with this caster. Also returns the number of
+    /// secondary and shadow rays that took.
+    pub fn shade_hit(&self, ray: &Ray, hit: Hit, options: &RenderOptions) -> (Vec3, u64) {
+        let mut tracer = shade::Tracer::new(self, options);
+        let color = tracer.first_hit(ray, hit);
+        (color, tracer.counts.secondary + tracer.counts.shadow)
+    }
+
     /// Whether anything is hit within the ray's interval (the shadow-ray query).
     pub fn occluded(&self, ray: &Ray) -> bool {
         FastRay::new(ray).is_some_and(|r| self.bvh.occluded(&r))

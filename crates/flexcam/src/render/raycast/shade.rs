@@ -147,19 +147,24 @@ impl<'a> Tracer<'a> {
                 ),
                 found.t as f64,
             ),
-            Shading::Flat => {
+            _ => {
                 let hit = self.caster.refine(ray, found);
-                (self.flat(ray, hit), hit.t)
-            }
-            Shading::Lit => {
-                let hit = self.caster.refine(ray, found);
-                (self.lit(ray, hit, 0, 1.0), hit.t)
+                (self.first_hit(ray, hit), hit.t)
             }
         };
         Sample {
             color,
             depth: (t * ray.direction.length()) as f32,
             id: object.id,
+        }
+    }
+
+    /// The colour of primary ray `ray` whose first hit (exact, f64) is `hit`, by the
+    /// tracer's shading mode.
+    pub fn first_hit(&mut self, ray: &Ray, hit: Hit) -> Vec3 {
+        match self.shading {
+            Shading::Flat => self.flat(ray, hit),
+            Shading::Lit => self.lit(ray, hit, 0, 1.0),
         }
     }
 
