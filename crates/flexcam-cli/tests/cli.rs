@@ -373,6 +373,8 @@ fn trilinear_method_renders_a_trilinear_scene_and_refuses_others() {
         assert!(json["shapes"].as_u64().unwrap() > 0, "{json}");
         assert!(json["raster_covered"].as_u64().unwrap() > 0, "{json}");
     }
+    // A fresh folder: the renders above left flexcam.png, and failures must leave nothing.
+    let dir = TempDir::new().unwrap();
     write(&dir, "s.toml", GOOD_SCENE);
     let e = expect_failure(&dir, &["render", "s.toml", "--method", "trilinear"]);
     assert!(e.contains("only trilinear projections"), "{e}");
