@@ -621,3 +621,65 @@ fn animate_errors_are_one_line_and_write_nothing() {
     let e = expect_failure(&dir, &["animate", "still.toml", "--gif", "a.gif"]);
     assert!(e.contains("no [animation] table"), "{e}");
 }
+
+#[test]
+fn trilinear_method_renders_a_trilinear_scene_and_refuses_others() {
+    let fan = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/trilinear-fan.toml");
+    let dir = TempDir::new().unwrap();
+    for curves in ["tessellate", "slice", "adaptive"] {
+        let out = flexcam(dir.path())
+            .arg("render")
+            .arg(&fan)
+            .args(["--width", "60", "--height", "40", "--shading", "flat"])
+            .args([
+                "--method",
+                "trilinear",
+                "--curves",
+                curves,
+                "--curve-steps",
+                "4",
+            ])
+            .args(["--stats", "-"])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{curves}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(json["method"], "trilinear");
+        assert_eq!(json["curve_steps"], 4);
+        assert!(json["shapes"].as_u64().unwrap() > 0, "{json}");
+        assert!(json["raster_covered"].as_u64().unwrap() > 0, "{json}");
+    }
+    // A fresh folder: the renders above left flexcam.png, and failures must leave nothing.
+    let dir = TempDir::new().unwrap();
+    write(&dir, "s.toml", GOOD_SCENE);
+    let e = expect_failure(&dir, &["render", "s.toml", "--method", "trilinear"]);
+    assert!(e.contains("only trilinear projections"), "{e}");
+    let e = expect_failure(
+        &dir,
+        &[
+            "render",
+            "s.toml",
+            "--method",
+            "trilinear",
+            "--curves",
+            "bezier",
+        ],
+    );
+    assert!(e.contains("bezier"), "{e}");
+    let e = expect_failure(
+        &dir,
+        &[
+            "render",
+            "s.toml",
+            "--method",
+            "trilinear",
+            "--curve-steps",
+            "0",
+        ],
+    );
+    assert!(e.contains("curve steps"), "{e}");
+}

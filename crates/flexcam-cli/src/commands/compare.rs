@@ -62,6 +62,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     };
     let options = RenderOptions {
         subdivision: args.tuning.subdivision(method)?,
+        curves: args.tuning.curves(method)?,
         ..reference_options
     };
     let timed_render = |m: Method, options: &RenderOptions| -> Result<(Frame, f64)> {

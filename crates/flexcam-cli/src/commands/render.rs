@@ -21,8 +21,9 @@ pub struct RenderArgs {
     /// The colour image to write (PNG).
     #[arg(short, long, default_value = "flexcam.png")]
     output: PathBuf,
-    /// Rendering method: `raycast` (the reference, every projection) or `raster`
-    /// (rasterisation by the analytic inverse, projections that have one).
+    /// Rendering method: `raycast` (the reference, every projection), `raster`
+    /// (rasterisation by the analytic inverse, projections that have one) or `trilinear`
+    /// (rasterisation of trilinear projections).
     #[arg(long, default_value = "raycast")]
     method: String,
     #[command(flatten)]
@@ -57,6 +58,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         shading: args.shading.shading(),
         spp: args.spp,
         subdivision: args.tuning.subdivision(method)?,
+        curves: args.tuning.curves(method)?,
         progress: Some(&report),
         ..RenderOptions::default()
     };

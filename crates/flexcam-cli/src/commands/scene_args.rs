@@ -6,6 +6,7 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 use flexcam::projection::Projection;
 use flexcam::render::inverse_raster::Subdivision;
+use flexcam::render::trilinear::CurveOptions;
 use flexcam::render::{Method, Shading};
 use flexcam::scene::{self, Scene};
 use flexcam::{Error, Result};
@@ -86,7 +87,7 @@ impl ShadingArg {
     }
 }
 
-/// The options that tune one rendering method (refused with any other method).
+/// The options that tune one rendering method (each refused with any other method).
 #[derive(Args, Debug)]
 pub struct MethodTuning {
     /// Method raster: cut every triangle into N x N pieces (uniform subdivision; without
@@ -97,6 +98,15 @@ pub struct MethodTuning {
     /// straight line (adaptive subdivision, the default, with 0.5).
     #[arg(long, value_name = "PX")]
     raster_tolerance: Option<f64>,
+    /// Method trilinear: how curved edges are followed, `tessellate`, `slice` or `adaptive`
+    /// (the default).
+    #[arg(long, value_name = "MODE")]
+    curves: Option<String>,
+    /// Method trilinear: steps of the curve mode: segments per scene edge (tessellate),
+    /// slices per shape (slice) or most segments per edge piece (adaptive); defaults 8, 10
+    /// and 256.
+    #[arg(long, value_name = "N")]
+    curve_steps: Option<u32>,
 }
 
 impl MethodTuning {
@@ -119,5 +129,20 @@ impl MethodTuning {
         };
         subdivision.validate()?;
         Ok(subdivision)
+    }
+
+    /// The curve handling of method trilinear from `--curves` and `--curve-steps`; an error
+    /// when either is given to another method.
+    pub fn curves(&self, method: Method) -> Result<CurveOptions> {
+        if method != Method::Trilinear && (self.curves.is_some() || self.curve_steps.is_some()) {
+            return Err(Error::new(format!(
+                "--curves and --curve-steps apply to --method trilinear, not {method}"
+            )));
+        }
+        let mode = match &self.curves {
+            Some(name) => name.parse()?,
+            None => CurveOptions::ADAPTIVE.mode,
+        };
+        CurveOptions::new(mode, self.curve_steps)
     }
 }

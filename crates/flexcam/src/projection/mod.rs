@@ -31,8 +31,8 @@ pub use linear::{Orthographic, Perspective};
 pub use panoramic::{Cylindrical, Equirectangular};
 pub use projector::Projector;
 pub use trilinear::{
-    project_triangle, surfaces, ProjectionTriangleCache, SceneEdge, Shape, ShapeVertex, Solutions,
-    TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
+    project_solved_triangle, project_triangle, surfaces, ProjectionTriangleCache, SceneEdge, Shape,
+    ShapeVertex, Solutions, TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
 };
 
 use glam::{DVec2, DVec3};
@@ -93,6 +93,12 @@ pub trait Projection: Send + Sync {
     /// a pole) and for projections without a chart.
     fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
         let _ = point;
+        None
+    }
+
+    /// This projection as a trilinear mesh, for the renderers that need its triangles
+    /// (`--method trilinear`); `None` for every other kind.
+    fn as_trilinear(&self) -> Option<&Trilinear> {
         None
     }
 }

@@ -7,6 +7,7 @@ use crate::error::{Error, Result};
 use crate::projection::Projection;
 use crate::render::inverse_raster::InverseRaster;
 use crate::render::raycast::RayCaster;
+use crate::render::trilinear::TrilinearRenderer;
 use crate::render::{Frame, RenderOptions, Stats};
 use crate::scene::Scene;
 
@@ -19,19 +20,26 @@ pub enum Method {
     /// Rasterisation by the analytic inverse with subdivision (see
     /// [`crate::render::inverse_raster`]); projections with a continuous inverse only.
     Raster,
+    /// Trilinear rasterisation (seed 000), curved edges followed as `options.curves` says;
+    /// renders trilinear projections only.
+    Trilinear,
 }
 
 impl Method {
     /// Every method with its command-line name.
-    pub const ALL: [(&'static str, Method); 2] =
-        [("raycast", Method::Raycast), ("raster", Method::Raster)];
+    pub const ALL: [(&'static str, Method); 3] = [
+        ("raycast", Method::Raycast),
+        ("raster", Method::Raster),
+        ("trilinear", Method::Trilinear),
+    ];
 
     /// The command-line name.
     pub fn name(self) -> &'static str {
-        Method::ALL
-            .iter()
-            .find(|(_, m)| *m == self)
-            .map_or("?", |(name, _)| name)
+        match self {
+            Method::Raycast => "raycast",
+            Method::Raster => "raster",
+            Method::Trilinear => "trilinear",
+        }
     }
 
     /// Renders `scene` through `projection`. Fails, rather than producing a wrong image, when
@@ -49,6 +57,16 @@ impl Method {
         match self {
             Method::Raycast => Ok(RayCaster::new(scene).render(projection, options)),
             Method::Raster => Ok(InverseRaster::new(scene, projection, options)?.render()),
+            Method::Trilinear => {
+                let trilinear = projection.as_trilinear().ok_or_else(|| {
+                    Error::new(format!(
+                        "the trilinear method renders only trilinear projections, \
+                         not a {} projection",
+                        projection.kind()
+                    ))
+                })?;
+                TrilinearRenderer::new(scene).render(trilinear, options, options.curves)
+            }
         }
     }
 }
@@ -88,6 +106,26 @@ mod tests {
             assert_eq!(m.to_string(), name);
         }
         let e = "raster-ish".parse::<Method>().unwrap_err();
-        assert!(e.to_string().contains("available: raycast, raster"), "{e}");
+        assert!(
+            e.to_string()
+                .contains("available: raycast, raster, trilinear"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn trilinear_refuses_other_projections() {
+        let scene = crate::scene::load("builtin:cube-floor").unwrap();
+        let projection = scene.projection.build(8, 8).unwrap();
+        let e = Method::Trilinear
+            .render(&scene, projection.as_ref(), &RenderOptions::default())
+            .unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "the trilinear method renders only trilinear projections, not a {} projection",
+                projection.kind()
+            )
+        );
     }
 }

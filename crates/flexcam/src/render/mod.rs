@@ -25,6 +25,8 @@ pub struct RenderOptions<'a> {
     pub max_bounces: u32,
     /// How method `raster` subdivides triangles (other methods ignore it).
     pub subdivision: inverse_raster::Subdivision,
+    /// How method trilinear follows curved edges.
+    pub curves: trilinear::CurveOptions,
     /// Called from worker threads with (work units done, total) as rendering progresses.
     pub progress: Option<&'a (dyn Fn(u64, u64) + Sync)>,
 }
@@ -36,6 +38,7 @@ impl Default for RenderOptions<'_> {
             spp: 1,
             max_bounces: 8,
             subdivision: inverse_raster::Subdivision::default(),
+            curves: trilinear::CurveOptions::ADAPTIVE,
             progress: None,
         }
     }
@@ -85,4 +88,5 @@ mod method;
 pub mod raster;
 pub mod raycast;
 pub mod surface;
+pub mod trilinear;
 pub use method::Method;

@@ -75,9 +75,9 @@ impl InterpolatedVolume {
             return self.ray(uv).map(Projector::Straight);
         }
         if let (Some(qa), Some(qb)) = (as_quadratic(&a), as_quadratic(&b)) {
-            return Some(Projector::QuadraticBezier([0, 1, 2].map(|i| {
-                mix(self.weight, qa[i], qb[i])
-            })));
+            return Some(Projector::QuadraticBezier(
+                [0, 1, 2].map(|i| mix(self.weight, qa[i], qb[i])),
+            ));
         }
         Some(Projector::Polyline(
             (0..=MIXED_SEGMENTS)

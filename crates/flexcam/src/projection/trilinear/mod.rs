@@ -22,7 +22,10 @@ use crate::error::{Error, Result};
 use crate::geometry::Ray;
 pub use point_projection::{ProjectionTriangleCache, Solutions, TriangleSolution};
 use screen_locator::ScreenLocator;
-pub use shapes::{project_triangle, SceneEdge, Shape, ShapeVertex, TriangleShapes, Unprojectable};
+pub use shapes::{
+    project_solved_triangle, project_triangle, SceneEdge, Shape, ShapeVertex, TriangleShapes,
+    Unprojectable,
+};
 
 /// A screen triangle counts as degenerate when twice its area is below this fraction of the
 /// product of its two edge lengths from the first vertex (the sine of its angle there).
@@ -74,6 +77,17 @@ impl Trilinear {
     /// The projection mesh.
     pub fn mesh(&self) -> &TrilinearMesh {
         &self.mesh
+    }
+
+    /// The projection triangle whose screen triangle covers `pixel` (the one [`Projection::ray`]
+    /// uses there), with the barycentrics `(u, v)` of the pixel in it; `None` where no screen
+    /// triangle covers it.
+    pub fn locate(&self, pixel: DVec2) -> Option<(usize, f64, f64)> {
+        let size = self.resolution.size();
+        let screen = DVec2::new(pixel.x / size.x, 1.0 - pixel.y / size.y);
+        self.locator
+            .locate(screen)
+            .map(|hit| (hit.triangle, hit.u, hit.v))
     }
 
     /// The point-projection cache of each projection triangle (same order as the mesh's
@@ -146,12 +160,10 @@ impl Projection for Trilinear {
     /// and where the interpolated direction trinorm is exactly zero (possible inside a
     /// triangle whose normals point in opposing directions: the projector is a single point).
     fn ray(&self, pixel: DVec2) -> Option<Ray> {
-        let size = self.resolution.size();
-        let screen = DVec2::new(pixel.x / size.x, 1.0 - pixel.y / size.y);
-        let hit = self.locator.locate(screen)?;
-        let [i, j, k] = self.mesh.triangles[hit.triangle].map(|k| k as usize);
-        let w = 1.0 - hit.u - hit.v;
-        let interpolate = |values: &[DVec3]| w * values[i] + hit.u * values[j] + hit.v * values[k];
+        let (triangle, u, v) = self.locate(pixel)?;
+        let [i, j, k] = self.mesh.triangles[triangle].map(|k| k as usize);
+        let w = 1.0 - u - v;
+        let interpolate = |values: &[DVec3]| w * values[i] + u * values[j] + v * values[k];
         let direction = interpolate(&self.mesh.normals);
         if direction == DVec3::ZERO {
             return None;
@@ -161,6 +173,10 @@ impl Projection for Trilinear {
 
     fn has_inverse(&self) -> bool {
         true
+    }
+
+    fn as_trilinear(&self) -> Option<&Trilinear> {
+        Some(self)
     }
 
     /// Appends every image of `point`: per projection triangle, each solution of the cubic

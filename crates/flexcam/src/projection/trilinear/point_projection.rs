@@ -282,6 +282,21 @@ impl ProjectionTriangleCache {
         out
     }
 
+    /// The plane of the parametric triangle at depth `t`: a point on it (`r1(t)`) and its
+    /// (unnormalised) normal `E1(t) x E2(t) = N0 + t N1 + t^2 N2`, zero where the triangle is
+    /// degenerate at `t`.
+    pub fn plane_at(&self, t: f64) -> (DVec3, DVec3) {
+        let [n0, n1, n2] = self.cross;
+        (self.p1 + t * self.n1, n0 + t * (n1 + t * n2))
+    }
+
+    /// `(u, v)` of the scene point `ps` in the parametric triangle at depth `t` (meaningful
+    /// when `ps` lies in its plane), or `None` where that triangle is degenerate (the rule of
+    /// the module doc).
+    pub fn barycentrics_at(&self, ps: DVec3, t: f64) -> Option<(f64, f64)> {
+        self.barycentrics(ps - self.p1, t)
+    }
+
     /// `(u, v)` of `ps = p1 + w` in the parametric triangle at `t`, or `None` where that
     /// triangle is degenerate (module doc).
     fn barycentrics(&self, w: DVec3, t: f64) -> Option<(f64, f64)> {

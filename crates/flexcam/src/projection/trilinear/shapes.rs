@@ -297,7 +297,20 @@ pub fn project_triangle(
     if !scene.iter().all(|v| v.is_finite()) {
         return Err(Unprojectable::NonFinite);
     }
-    let solutions = scene.map(|v| cache.project_point(v));
+    project_solved_triangle(cache, scene, scene.map(|v| cache.project_point(v)))
+}
+
+/// [`project_triangle`] with the vertices already projected (`solutions[k]` is
+/// `cache.project_point(scene[k])`): a renderer projects each scene vertex once per projection
+/// triangle and reuses it for every scene triangle sharing the vertex.
+pub fn project_solved_triangle(
+    cache: &ProjectionTriangleCache,
+    scene: [DVec3; 3],
+    solutions: [Solutions; 3],
+) -> Result<TriangleShapes, Unprojectable> {
+    if !scene.iter().all(|v| v.is_finite()) {
+        return Err(Unprojectable::NonFinite);
+    }
     if let Some(vertex) = solutions.iter().position(Solutions::is_every_t) {
         return Err(Unprojectable::EveryDepth {
             vertex: vertex as u8,

@@ -86,7 +86,7 @@ impl Shader<'_> {
                     triangle,
                     barycentric,
                 };
-                caster.shade_hit(ray, hit, self.options)
+                caster.shade_hit(ray, hit, self.options).0
             }
             // Unreachable by construction (the caster exists whenever shading needs it and
             // resolved fragments have a ray); the base colour is the safe answer.

@@ -9,6 +9,9 @@
 //! - [`target`]: the z-buffered target and [`Fragment`]s;
 //! - [`stats`]: counters for `--stats`.
 //!
+//! A *stage* (see [`rasterize_parallel_staged`]) may rewrite each fragment before its z-test
+//! (an exact per-pixel depth instead of the interpolated one) or discard it.
+//!
 //! Determinism: a pixel keeps the fragment with the smallest `(depth, primitive)` pair, and
 //! every fragment's position and values depend only on its own shape, so the image does not
 //! depend on the band size or the number of threads, and with distinct primitive keys not on

@@ -58,8 +58,8 @@ impl RasterStats {
             ("raster_lines", self.lines),
             ("raster_skipped", self.skipped),
             ("raster_fragments", self.fragments),
-            ("raster_writes", self.writes),
             ("raster_discarded", self.discarded),
+            ("raster_writes", self.writes),
             ("raster_covered", self.covered),
         ] {
             stats.insert(name, Counter::Count(value));

@@ -693,3 +693,37 @@ fn raster_stats_and_frame() {
     );
     assert_eq!(frame.color[0], Vec3::ONE);
 }
+
+#[test]
+fn raster_stage_rewrites_depth_or_discards_before_the_z_test() {
+    // Two equal squares at depths 3 and 5; the stage moves the far one to depth 1 on its
+    // left half and discards it on its right half, so it wins only on the left.
+    let square = |depth| {
+        [(0.0, 0.0), (8.0, 0.0), (8.0, 4.0), (0.0, 4.0)].map(|(x, y)| Vertex::new(x, y, depth, []))
+    };
+    let mut batch = PolygonBatch::<0>::new();
+    batch.push(&square(3.0), 1, 0);
+    batch.push(&square(5.0), 2, 1);
+    let mut merged = PolygonBatch::<0>::new();
+    merged.append(&batch);
+    assert_eq!(merged.len(), 2);
+    let stage = |f: &mut Fragment<0>| {
+        if f.primitive == 0 {
+            return true;
+        }
+        f.varying.depth = 1.0;
+        f.x < 4
+    };
+    let mut target = Target::new(8, 4, Vec3::ZERO);
+    let stats =
+        rasterize_parallel_resolved(&mut target, &merged, FillRule::NonZero, 2, &stage, &|_| {
+            Vec3::ONE
+        });
+    assert_eq!((stats.fragments, stats.discarded), (64, 16));
+    for y in 0..4 {
+        for x in 0..8 {
+            let expected = if x < 4 { 2 } else { 1 };
+            assert_eq!(target.ids()[(y * 8 + x) as usize], expected, "({x}, {y})");
+        }
+    }
+}

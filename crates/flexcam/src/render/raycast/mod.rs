@@ -169,6 +169,16 @@ impl RayCaster {
         }
     }
 
+    /// The colour `options.shading` gives primary ray `ray` whose first hit is `hit` (found by
+    /// any means, e.g. rasterisation), exactly as [`RayCaster::render`] shades it: mirrors,
+    /// glass and shadows are traced from there with this caster. Also returns the number of
+    /// secondary and shadow rays that took.
+    pub fn shade_hit(&self, ray: &Ray, hit: Hit, options: &RenderOptions) -> (Vec3, u64) {
+        let mut tracer = shade::Tracer::new(self, options);
+        let color = tracer.shade_hit(ray, hit);
+        (color, tracer.counts.secondary + tracer.counts.shadow)
+    }
+
     /// Whether anything is hit within the ray's interval (the shadow-ray query).
     pub fn occluded(&self, ray: &Ray) -> bool {
         FastRay::new(ray).is_some_and(|r| self.bvh.occluded(&r))
@@ -189,14 +199,6 @@ impl RayCaster {
             crate::render::Counter::Count(self.triangle_count as u64),
         );
         (frame, stats)
-    }
-
-    /// The colour the reference shading gives primary ray `ray` whose first hit `hit` was
-    /// found by other means (a rasteriser that reconstructs the hit of each pixel's ray):
-    /// flat or lit by `options.shading`, with the same secondary and shadow rays as
-    /// [`RayCaster::render`], so that such a renderer shades exactly like the ray caster.
-    pub fn shade_hit(&self, ray: &Ray, hit: Hit, options: &RenderOptions) -> Vec3 {
-        shade::Tracer::new(self, options).shade_hit(ray, hit)
     }
 
     /// A ray leaving surface point `point` (geometric normal `normal`) along `direction`,

@@ -217,13 +217,9 @@ impl<'a> Tracer<'a> {
                 ),
                 found.t as f64,
             ),
-            Shading::Flat => {
+            _ => {
                 let hit = self.caster.refine(ray, found);
-                (self.flat(ray, hit), hit.t)
-            }
-            Shading::Lit => {
-                let hit = self.caster.refine(ray, found);
-                (self.lit(ray, hit, 0, 1.0), hit.t)
+                (self.shade_hit(ray, hit), hit.t)
             }
         };
         Sample {

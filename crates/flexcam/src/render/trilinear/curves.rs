@@ -1,0 +1,154 @@
+//! How the trilinear renderer follows the curved edges of projected scene triangles (seed 000,
+//! section 4.5): the image of a straight scene edge under a trilinear projection is a curve,
+//! and a shape's polygon of vertex images only approximates it.
+//!
+//! - [`CurveMode::Tessellate`]: cut each scene triangle into `steps^2` smaller triangles
+//!   (`steps` segments per scene edge) and project those with straight edges.
+//! - [`CurveMode::Slice`]: the thesis's parametric slicing: `steps` depths evenly spaced in
+//!   `[max(0, t_min), t_max]` of each shape; each polygon edge gets the exact image of its
+//!   scene edge at every slice depth within its own depth range.
+//! - [`CurveMode::Adaptive`] (the default): each polygon edge is bisected in depth while the
+//!   exact image at the middle depth lies more than [`ADAPTIVE_TOLERANCE_PX`] pixels off the
+//!   chord, up to `steps` segments per edge piece (see `edge_path::refine` for the rule).
+
+use std::fmt;
+use std::str::FromStr;
+
+use crate::error::{Error, Result};
+
+/// Largest distance, in pixels, between the exact image of a scene edge at a segment's middle
+/// depth and the chord drawn for it, before adaptive slicing splits the segment.
+///
+/// Why this value: the renderer tests every fragment exactly against its scene triangle (the
+/// pixel's ray is intersected with it), so a chord that bulges *outside* the true curve costs
+/// nothing, and one that cuts *inside* it loses the pixel centres in a sliver at most this
+/// wide. A quarter pixel keeps that sliver well below the half-pixel spacing at which a
+/// pixel centre is missed on average for a whole pixel column, and costs about
+/// `sqrt(2)` times the segments of a half-pixel bound (the deviation of a chord falls with
+/// the square of its length).
+pub const ADAPTIVE_TOLERANCE_PX: f64 = 0.25;
+
+/// The curve-following strategy (`--curves`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CurveMode {
+    /// Scene-triangle tessellation.
+    Tessellate,
+    /// Parametric slicing with a fixed number of slices per shape.
+    Slice,
+    /// Slicing refined per edge from a screen-space error bound.
+    #[default]
+    Adaptive,
+}
+
+impl CurveMode {
+    /// Every mode with its command-line name.
+    pub const ALL: [(&'static str, CurveMode); 3] = [
+        ("tessellate", CurveMode::Tessellate),
+        ("slice", CurveMode::Slice),
+        ("adaptive", CurveMode::Adaptive),
+    ];
+
+    /// The command-line name.
+    pub fn name(self) -> &'static str {
+        match self {
+            CurveMode::Tessellate => "tessellate",
+            CurveMode::Slice => "slice",
+            CurveMode::Adaptive => "adaptive",
+        }
+    }
+
+    /// The `steps` used when none is given: 8 segments per scene edge (64 sub-triangles), the
+    /// thesis's smallest slicing factor of 10, and at most 256 segments per edge piece.
+    pub fn default_steps(self) -> u32 {
+        match self {
+            CurveMode::Tessellate => 8,
+            CurveMode::Slice => 10,
+            CurveMode::Adaptive => 256,
+        }
+    }
+}
+
+impl FromStr for CurveMode {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<CurveMode> {
+        CurveMode::ALL
+            .iter()
+            .find(|(name, _)| *name == s)
+            .map(|(_, m)| *m)
+            .ok_or_else(|| {
+                Error::new(format!(
+                    "unknown curve mode \"{s}\" (available: tessellate, slice, adaptive)"
+                ))
+            })
+    }
+}
+
+impl fmt::Display for CurveMode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Largest accepted `steps`: tessellation makes `steps^2` triangles per scene triangle.
+pub const MAX_STEPS: u32 = 1024;
+
+/// The curve strategy and its step count.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CurveOptions {
+    pub mode: CurveMode,
+    /// Segments per scene edge (tessellate), slices per shape (slice) or the most segments
+    /// per edge piece (adaptive); 1 to [`MAX_STEPS`].
+    pub steps: u32,
+}
+
+impl CurveOptions {
+    /// Adaptive slicing with its default cap.
+    pub const ADAPTIVE: CurveOptions = CurveOptions {
+        mode: CurveMode::Adaptive,
+        steps: 256,
+    };
+
+    /// `mode` with `steps`, or the mode's default steps when `None`. Errors: `steps` outside
+    /// 1 to [`MAX_STEPS`].
+    pub fn new(mode: CurveMode, steps: Option<u32>) -> Result<CurveOptions> {
+        let steps = steps.unwrap_or(mode.default_steps());
+        if !(1..=MAX_STEPS).contains(&steps) {
+            return Err(Error::new(format!(
+                "curve steps must be between 1 and {MAX_STEPS}, got {steps}"
+            )));
+        }
+        Ok(CurveOptions { mode, steps })
+    }
+}
+
+impl Default for CurveOptions {
+    fn default() -> Self {
+        CurveOptions::ADAPTIVE
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_steps_are_checked() {
+        for (name, mode) in CurveMode::ALL {
+            assert_eq!(name.parse::<CurveMode>().unwrap(), mode);
+            assert_eq!(mode.to_string(), name);
+        }
+        assert!("bezier".parse::<CurveMode>().is_err());
+        assert_eq!(
+            CurveOptions::new(CurveMode::Adaptive, None).unwrap(),
+            CurveOptions::ADAPTIVE
+        );
+        assert_eq!(
+            CurveOptions::new(CurveMode::Slice, Some(50)).unwrap().steps,
+            50
+        );
+        let e = CurveOptions::new(CurveMode::Slice, Some(0)).unwrap_err();
+        assert!(e.to_string().contains("between 1 and 1024, got 0"), "{e}");
+        assert!(CurveOptions::new(CurveMode::Tessellate, Some(MAX_STEPS + 1)).is_err());
+    }
+}

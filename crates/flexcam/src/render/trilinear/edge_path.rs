@@ -1,0 +1,309 @@
+//! The exact image of a scene edge in one projection triangle, followed by depth (seed 000,
+//! sections 4.5 and 5).
+//!
+//! While a shape's polygon edge runs from an image of scene vertex `a` at depth `t_a` to the
+//! next image at `t_b`, the plane of the parametric triangle `r1(t), r2(t), r3(t)` cuts the
+//! scene segment `ab` in exactly one point for every `t` between them (a segment crosses a
+//! plane at most once, and the sweep argument of `shapes` says this edge is crossed there).
+//! [`EdgePath::at`] computes that point and its barycentrics in the parametric triangle: the
+//! exact image of the edge at depth `t`. A polygon edge is therefore a curve parametrised by
+//! `t`, and the renderer samples it:
+//!
+//! * **anchors**, computed exactly and always inserted: the depth `t = 0` (view-plane
+//!   clipping, 4.6: the crossing of the scene edge with the base triangle's plane) and the
+//!   depths where the scene edge crosses one of the three edge surfaces of the projection
+//!   triangle (scene-space clipping, chapter 5: [`EdgeSurface::crossing_depths`]). Between
+//!   two consecutive anchors the curve crosses neither `t = 0` nor any of the three
+//!   (extended) domain lines `u = 0`, `v = 0`, `u + v = 1`, so each piece is either wholly
+//!   visible or wholly clipped away;
+//! * **curve samples** inside visible pieces: fixed slices or adaptive bisection
+//!   ([`refine`]).
+//!
+//! Degenerate cases: where the plane at `t` is parallel to the segment, or the parametric
+//! triangle is degenerate at `t` (its plane is undefined), [`EdgePath::at`] gives `None` and
+//! the sample is skipped; the chord then spans it. A 2-vertex shape whose two images have the
+//! same `t` (a tangency) has no interior depth and stays a straight line.
+
+use glam::{DVec2, DVec3};
+
+use super::screen_map::ScreenMap;
+use crate::geometry::solve_quadratic;
+use crate::projection::ProjectionTriangleCache;
+
+/// A point of a shape's outline: barycentrics in the projection triangle and depth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OutlinePoint {
+    pub u: f64,
+    pub v: f64,
+    pub t: f64,
+}
+
+impl OutlinePoint {
+    /// Whether the point is on a ray (`t >= 0`) inside the projection triangle, up to `tol`
+    /// in barycentrics.
+    pub fn is_visible(&self, tol: f64) -> bool {
+        self.t >= 0.0 && self.u >= -tol && self.v >= -tol && self.u + self.v <= 1.0 + tol
+    }
+}
+
+/// The images of the scene segment from `a` to `b` in the projection triangle of `cache`.
+#[derive(Debug, Clone, Copy)]
+pub struct EdgePath<'a> {
+    pub cache: &'a ProjectionTriangleCache,
+    pub a: DVec3,
+    pub b: DVec3,
+}
+
+impl EdgePath<'_> {
+    /// Where the plane of the parametric triangle at depth `t` cuts the line through `a` and
+    /// `b`, as the parameter `s` of `a + s (b - a)`; `None` where the line is parallel to that
+    /// plane or the plane is undefined (zero normal).
+    pub fn segment_parameter(&self, t: f64) -> Option<f64> {
+        let (origin, normal) = self.cache.plane_at(t);
+        let denominator = normal.dot(self.b - self.a);
+        let s = normal.dot(origin - self.a) / denominator;
+        (denominator != 0.0 && s.is_finite()).then_some(s)
+    }
+
+    /// The image of the segment at depth `t` (module doc), the segment parameter clamped to
+    /// `[0, 1]` against rounding; `None` in the degenerate cases of the module doc.
+    pub fn at(&self, t: f64) -> Option<OutlinePoint> {
+        let s = self.segment_parameter(t)?.clamp(0.0, 1.0);
+        let point = self.a + s * (self.b - self.a);
+        let (u, v) = self.cache.barycentrics_at(point, t)?;
+        Some(OutlinePoint { u, v, t })
+    }
+}
+
+/// The surface swept by one edge of a projection triangle, `r_i(t) + s (r_j(t) - r_i(t))`
+/// (Eq. 5.1 corrected), in coordinates centred on `p_i` (the coplanarity test is invariant
+/// under translation; centring avoids cancellation far from the origin).
+#[derive(Debug, Clone, Copy)]
+pub struct EdgeSurface {
+    origin: DVec3,
+    /// `p_j - p_i`.
+    base: DVec3,
+    n_i: DVec3,
+    n_j: DVec3,
+}
+
+impl EdgeSurface {
+    /// The surface of the edge from vertex `(p_i, n_i)` to `(p_j, n_j)`.
+    pub fn new((p_i, n_i): (DVec3, DVec3), (p_j, n_j): (DVec3, DVec3)) -> EdgeSurface {
+        EdgeSurface {
+            origin: p_i,
+            base: p_j - p_i,
+            n_i,
+            n_j,
+        }
+    }
+
+    /// The depths at which the line through `s1` and `s2` is coplanar with the projection
+    /// edge, i.e. crosses its (extended) surface: the roots of `c2 t^2 + c1 t + c0` of the
+    /// notes, with `p_i = 0`, `p_j = base`:
+    /// `c2 = (s1 - s2).(n_i x n_j)`,
+    /// `c1 = (s1 - s2).(n_i x base) + s1.(s2 x (n_i - n_j))`,
+    /// `c0 = -s1.(s2 x base)`.
+    /// Degenerate cases: a line coplanar with the edge at every depth (all coefficients zero)
+    /// or never (a nonzero constant) gives no depth; a degree drop gives the remaining root.
+    pub fn crossing_depths(&self, s1: DVec3, s2: DVec3) -> impl Iterator<Item = f64> {
+        let (s1, s2) = (s1 - self.origin, s2 - self.origin);
+        let d = s1 - s2;
+        let c2 = d.dot(self.n_i.cross(self.n_j));
+        let c1 = d.dot(self.n_i.cross(self.base)) + s1.dot(s2.cross(self.n_i - self.n_j));
+        let c0 = -s1.dot(s2.cross(self.base));
+        solve_quadratic(c2, c1, c0).into_iter()
+    }
+}
+
+/// Appends to `out` the interior samples of the edge piece from `a` to `b` (both images on
+/// `path`, excluded), bisecting in depth while the exact image at the middle depth is more
+/// than `tolerance` pixels from the chord `a b` on screen, at most `levels` times (so at most
+/// `2^levels` segments). The test at the middle depth alone can miss a curve that crosses its
+/// chord there (an S shape); the images of straight edges under a trilinear projection are
+/// rational curves of low degree in `t`, and the first split already removes such a crossing
+/// unless it sits exactly at the middle.
+pub fn refine(
+    path: &EdgePath,
+    map: &ScreenMap,
+    (a, b): (OutlinePoint, OutlinePoint),
+    tolerance: f64,
+    levels: u32,
+    out: &mut Vec<OutlinePoint>,
+) {
+    if levels == 0 {
+        return;
+    }
+    let t = 0.5 * (a.t + b.t);
+    if t == a.t || t == b.t {
+        return;
+    }
+    let Some(middle) = path.at(t) else {
+        return;
+    };
+    let (pa, pb, pm) = (
+        map.pixel(a.u, a.v),
+        map.pixel(b.u, b.v),
+        map.pixel(middle.u, middle.v),
+    );
+    if distance_to_segment(pm, pa, pb) <= tolerance {
+        return;
+    }
+    refine(path, map, (a, middle), tolerance, levels - 1, out);
+    out.push(middle);
+    refine(path, map, (middle, b), tolerance, levels - 1, out);
+}
+
+/// Euclidean distance from `p` to the segment `a b` (to `a` when the segment is a point).
+fn distance_to_segment(p: DVec2, a: DVec2, b: DVec2) -> f64 {
+    let d = b - a;
+    let length_squared = d.length_squared();
+    let s = if length_squared > 0.0 {
+        ((p - a).dot(d) / length_squared).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    p.distance(a + s * d)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn triangle() -> ([DVec3; 3], [DVec3; 3]) {
+        (
+            [
+                DVec3::new(-1.0, -1.0, 0.0),
+                DVec3::new(1.0, -1.0, 0.1),
+                DVec3::new(0.0, 1.0, -0.1),
+            ],
+            [
+                DVec3::new(-0.4, -0.3, 1.0),
+                DVec3::new(0.5, -0.2, 1.2),
+                DVec3::new(0.1, 0.6, 0.9),
+            ],
+        )
+    }
+
+    proptest! {
+        /// Every sample lies on the ray of its own (u, v) at its own t: the exact image.
+        #[test]
+        fn samples_are_exact_images(
+            a in (-3.0..3.0f64, -3.0..3.0f64, 0.5..6.0f64),
+            b in (-3.0..3.0f64, -3.0..3.0f64, 0.5..6.0f64),
+            t in 0.0..8.0f64,
+        ) {
+            let (p, n) = triangle();
+            let cache = ProjectionTriangleCache::new(p, n);
+            let (a, b) = (DVec3::new(a.0, a.1, a.2), DVec3::new(b.0, b.1, b.2));
+            let path = EdgePath { cache: &cache, a, b };
+            if let Some(s) = path.segment_parameter(t) {
+                if (0.0..=1.0).contains(&s) {
+                    if let Some(x) = path.at(t) {
+                        let point = a + s * (b - a);
+                        let back = cache.ray_point(x.u, x.v, x.t);
+                        prop_assert!((back - point).length() < 1e-8 * (1.0 + point.length()));
+                    }
+                }
+            }
+        }
+
+        /// At every crossing depth the line's point is on the extended projection edge: the
+        /// barycentric of the opposite vertex is zero (scene-space clipping).
+        #[test]
+        fn crossing_depths_land_on_the_edge_line(
+            a in (-3.0..3.0f64, -3.0..3.0f64, 0.5..6.0f64),
+            b in (-3.0..3.0f64, -3.0..3.0f64, 0.5..6.0f64),
+        ) {
+            let (p, n) = triangle();
+            let cache = ProjectionTriangleCache::new(p, n);
+            let (a, b) = (DVec3::new(a.0, a.1, a.2), DVec3::new(b.0, b.1, b.2));
+            let path = EdgePath { cache: &cache, a, b };
+            // u = 0 is the edge from vertex 1 to vertex 3.
+            let surface = EdgeSurface::new((p[0], n[0]), (p[2], n[2]));
+            for t in surface.crossing_depths(a, b) {
+                let Some(s) = path.segment_parameter(t) else { continue };
+                let point = a + s * (b - a);
+                if let Some((u, _)) = cache.barycentrics_at(point, t) {
+                    prop_assert!(u.abs() < 1e-7, "t {t} u {u}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn crossing_of_a_known_point() {
+        // A segment through the point at (u, v, t) = (0, 0.4, 2) of the edge u = 0.
+        let (p, n) = triangle();
+        let cache = ProjectionTriangleCache::new(p, n);
+        let on_edge = cache.ray_point(0.0, 0.4, 2.0);
+        let (a, b) = (
+            on_edge + DVec3::new(0.7, 0.2, -0.3),
+            on_edge - DVec3::new(0.7, 0.2, -0.3) * 1.5,
+        );
+        let surface = EdgeSurface::new((p[0], n[0]), (p[2], n[2]));
+        let depths: Vec<f64> = surface.crossing_depths(a, b).collect();
+        assert!(depths.iter().any(|t| (t - 2.0).abs() < 1e-10), "{depths:?}");
+        let x = EdgePath {
+            cache: &cache,
+            a,
+            b,
+        }
+        .at(2.0)
+        .unwrap();
+        assert!(x.u.abs() < 1e-10 && (x.v - 0.4).abs() < 1e-10, "{x:?}");
+    }
+
+    #[test]
+    fn parallel_segment_has_no_image() {
+        // Orthographic along z: the plane at depth t is z = t, and a segment in the plane
+        // z = 2 is parallel to every one of them (no single crossing point, even at t = 2).
+        let p = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let cache = ProjectionTriangleCache::new(p, [DVec3::Z; 3]);
+        let path = EdgePath {
+            cache: &cache,
+            a: DVec3::new(0.1, 0.1, 2.0),
+            b: DVec3::new(0.5, 0.2, 2.0),
+        };
+        assert!(path.at(1.0).is_none());
+        assert_eq!(path.segment_parameter(2.0), None);
+    }
+
+    #[test]
+    fn refinement_follows_a_curve_to_the_tolerance() {
+        let (p, n) = triangle();
+        let cache = ProjectionTriangleCache::new(p, n);
+        let screen = [DVec2::ZERO, DVec2::X, DVec2::Y];
+        let map = ScreenMap::new(screen, DVec2::splat(400.0), cache);
+        let path = EdgePath {
+            cache: &cache,
+            a: cache.ray_point(0.1, 0.1, 0.5),
+            b: cache.ray_point(0.7, 0.2, 6.0),
+        };
+        let (a, b) = (path.at(0.5).unwrap(), path.at(6.0).unwrap());
+        let mut out = Vec::new();
+        refine(&path, &map, (a, b), 0.25, 10, &mut out);
+        assert!(!out.is_empty(), "the image of this edge is curved");
+        // Every chord is within the tolerance at densely sampled depths.
+        let mut points = vec![a];
+        points.extend(&out);
+        points.push(b);
+        for w in points.windows(2) {
+            for k in 1..8 {
+                let t = w[0].t + (w[1].t - w[0].t) * f64::from(k) / 8.0;
+                let x = path.at(t).unwrap();
+                let d = distance_to_segment(
+                    map.pixel(x.u, x.v),
+                    map.pixel(w[0].u, w[0].v),
+                    map.pixel(w[1].u, w[1].v),
+                );
+                assert!(d < 0.5, "chord off by {d} px");
+            }
+        }
+        // With no levels nothing is added; a straight image (orthographic) needs no sample.
+        out.clear();
+        refine(&path, &map, (a, b), 0.25, 0, &mut out);
+        assert!(out.is_empty());
+    }
+}

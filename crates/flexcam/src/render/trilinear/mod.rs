@@ -1,0 +1,169 @@
+//! `--method trilinear`: the fast renderer of trilinear projections (seed 000, chapters 4
+//! and 5). Instead of casting a ray per pixel it projects the scene into each projection
+//! triangle and rasterises the result; docs/trilinear.md has the design and measurements.
+//!
+//! Per projection triangle (in parallel), [`polygons`]: each scene vertex is projected once
+//! (its cubic), pairs that cannot be visible are culled, each scene triangle is cut into
+//! shapes (`projection::project_solved_triangle`), each shape's curved edges are sampled along
+//! the exact images of their scene edges ([`edge_path`], [`outline`], by the [`curves`]
+//! mode), with exact anchors at the view plane and at the projection triangle's edge surfaces,
+//! and the outline is clipped ([`clip`]) and mapped to pixels ([`screen_map`]). All polygons
+//! are then rasterised (`render::raster`, non-zero fill, z-buffer), every fragment refined
+//! to its exact hit before its z-test, and each pixel's winner shaded once ([`shade`]).
+//!
+//! Unprojectable pairs (see `projection::Unprojectable`) are counted and their projection
+//! triangle is ray cast instead, so they never silently vanish.
+
+pub mod clip;
+pub mod curves;
+pub mod edge_path;
+pub mod outline;
+pub mod polygons;
+pub mod scene_geometry;
+pub mod screen_map;
+pub mod shade;
+#[cfg(test)]
+mod tests;
+
+use std::time::Instant;
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+pub use curves::{CurveMode, CurveOptions};
+
+use self::outline::ProjectionTriangle;
+use self::polygons::{project_scene, PairCounts};
+use self::scene_geometry::SceneGeometry;
+use self::screen_map::ScreenMap;
+use self::shade::{Resolver, Shader};
+use crate::error::{Error, Result};
+use crate::projection::{Projection, Trilinear};
+use crate::render::raster::{
+    rasterize_parallel_resolved, FillRule, PolygonBatch, Target, BAND_ROWS,
+};
+use crate::render::raycast::RayCaster;
+use crate::render::{Counter, Frame, RenderOptions, Stats};
+use crate::scene::Scene;
+
+/// A scene prepared for trilinear rendering: its triangles in f64 and the ray caster used
+/// for shading (shadows, mirrors, glass) and for fallback pixels, built once.
+pub struct TrilinearRenderer {
+    scene: SceneGeometry,
+    caster: RayCaster,
+    background: Vec3,
+}
+
+impl TrilinearRenderer {
+    pub fn new(scene: &Scene) -> TrilinearRenderer {
+        TrilinearRenderer {
+            scene: SceneGeometry::new(scene),
+            caster: RayCaster::new(scene),
+            background: scene.image.background,
+        }
+    }
+
+    /// Renders the scene through `projection` with `curves`. Errors: more than one sample
+    /// per pixel (the rasteriser samples pixel centres only), a mesh of more than 2^32
+    /// projection triangles or a scene of more than 2^32 triangles (the fragment keys).
+    pub fn render(
+        &self,
+        projection: &Trilinear,
+        options: &RenderOptions,
+        curves: CurveOptions,
+    ) -> Result<(Frame, Stats)> {
+        if options.spp != 1 {
+            return Err(Error::new(format!(
+                "the trilinear method renders one sample per pixel, got --spp {}",
+                options.spp
+            )));
+        }
+        let mesh = projection.mesh();
+        if u32::try_from(mesh.triangles.len()).is_err()
+            || u32::try_from(self.scene.triangles.len()).is_err()
+        {
+            return Err(Error::new(
+                "the trilinear method handles at most 2^32 projection and scene triangles",
+            ));
+        }
+        let start = Instant::now();
+        let (width, height) = projection.resolution();
+        let size = glam::DVec2::new(f64::from(width), f64::from(height));
+        let triangles: Vec<ProjectionTriangle> = mesh
+            .triangles
+            .iter()
+            .zip(projection.triangle_caches())
+            .map(|(t, cache)| {
+                let [i, j, k] = t.map(|x| x as usize);
+                let pick = |values: &[glam::DVec3]| [values[i], values[j], values[k]];
+                let screen = [mesh.screen[i], mesh.screen[j], mesh.screen[k]];
+                let map = ScreenMap::new(screen, size, *cache);
+                ProjectionTriangle::new(pick(&mesh.points), pick(&mesh.normals), map)
+            })
+            .collect();
+        let projected: Vec<_> = triangles
+            .par_iter()
+            .enumerate()
+            .map(|(index, triangle)| project_scene(triangle, index as u32, &self.scene, curves))
+            .collect();
+        let mut polygons = PolygonBatch::new();
+        let mut counts = PairCounts::default();
+        let fallback: Vec<bool> = projected
+            .iter()
+            .map(|p| {
+                polygons.append(&p.polygons);
+                counts.add(&p.counts);
+                p.counts.unprojectable > 0
+            })
+            .collect();
+        let project_ms = start.elapsed().as_secs_f64() * 1e3;
+
+        let maps: Vec<ScreenMap> = triangles.iter().map(|t| t.map).collect();
+        let resolver = Resolver {
+            maps: &maps,
+            scene: &self.scene,
+        };
+        let mut target = Target::new(width, height, self.background);
+        let raster = rasterize_parallel_resolved(
+            &mut target,
+            &polygons,
+            FillRule::NonZero,
+            BAND_ROWS,
+            &|f| resolver.stage(f),
+            &|_| Vec3::ZERO,
+        );
+        let raster_ms = start.elapsed().as_secs_f64() * 1e3 - project_ms;
+
+        let shader = Shader {
+            resolver,
+            caster: &self.caster,
+            projection,
+            options,
+            fallback: &fallback,
+            background: self.background,
+        };
+        let (frame, shaded) = shader.frame(&target);
+        let total_ms = start.elapsed().as_secs_f64() * 1e3;
+
+        let mut stats = Stats::new();
+        counts.record(&mut stats);
+        raster.record(&mut stats);
+        let count = |n: usize| Counter::Count(n as u64);
+        stats.insert("triangles", count(self.scene.triangles.len()));
+        stats.insert("projection_triangles", count(triangles.len()));
+        stats.insert(
+            "fallback_triangles",
+            count(fallback.iter().filter(|&&f| f).count()),
+        );
+        stats.insert("fallback_rays", Counter::Count(shaded.fallback_rays));
+        stats.insert("shading_rays", Counter::Count(shaded.shading_rays));
+        stats.insert("curve_steps", Counter::Count(u64::from(curves.steps)));
+        stats.insert("project_ms", Counter::Value(project_ms));
+        stats.insert("raster_ms", Counter::Value(raster_ms));
+        stats.insert(
+            "shade_ms",
+            Counter::Value(total_ms - project_ms - raster_ms),
+        );
+        Ok((frame, stats))
+    }
+}

@@ -1,0 +1,258 @@
+//! From rasterised coverage to the final frame: the exact per-fragment hit (the stage run
+//! before the z-test) and the deferred shading of each pixel's winning fragment.
+//!
+//! A fragment's key names its projection triangle and scene triangle. Its depth and scene
+//! barycentrics are not interpolated over the polygon (the map from screen to scene is not
+//! affine, so interpolation would be wrong inside every curved shape): the pixel centre's
+//! projector is intersected with the scene triangle's plane, in f64 ([`Resolver::hit`]).
+//!
+//! - Inside the triangle at `t >= 0`: an **exact** fragment; the z-test compares exact ray
+//!   parameters `t`, and the frame's depth is `t |trinorm|`, the distance the ray caster
+//!   writes for the same projector.
+//! - Outside it across an edge no other triangle shares (a silhouette): discarded, so a
+//!   chord that bulges outside the true curved edge draws nothing wrong.
+//! - Outside it only across edges another triangle shares: a **crack filler**, shaded at the
+//!   nearest point of the triangle (barycentrics clamped) with its depth pushed behind every
+//!   exact fragment (`+ CRACK_FILL_DEPTH`). Where a chord cuts inside the curve, the pixels
+//!   between them belong to the neighbour, whose own chord bulges over them but whose exact
+//!   test rejects them; without fillers they would be cracks in a continuous surface. A
+//!   filler never hides an exact fragment.
+//! - Behind the view plane, or a projector parallel to the plane: discarded.
+//!
+//! Shading is deferred to one pass over the pixels, so that each pixel is shaded once: the
+//! hit is handed to [`RayCaster::shade_hit`], which shades it exactly as the ray caster
+//! does (flat: base colour, mirrors and glass passing the ray on; lit: lights, hard shadows,
+//! reflection and refraction, all traced by the ray caster from the rasterised first hit).
+//! Pixels of projection triangles with an unprojectable pair are ray cast entirely.
+
+use glam::{DVec2, DVec3, Vec3};
+use rayon::prelude::*;
+
+use super::scene_geometry::SceneGeometry;
+use super::screen_map::ScreenMap;
+use crate::geometry::Ray;
+use crate::projection::{Projection, Trilinear};
+use crate::render::raster::{Fragment, Target};
+use crate::render::raycast::{Hit, RayCaster};
+use crate::render::{Frame, RenderOptions};
+
+/// Added to the depth of crack fillers: behind any exact fragment (depths are ray
+/// parameters, far below this for any scene within the rasteriser's limits).
+const CRACK_FILL_DEPTH: f64 = 1e200;
+
+/// Finds the hit of a keyed fragment (module doc).
+pub struct Resolver<'a> {
+    pub maps: &'a [ScreenMap],
+    pub scene: &'a SceneGeometry,
+}
+
+/// A fragment's hit: the projector, the ray parameter, the barycentrics (clamped into the
+/// triangle for a crack filler) and whether it is exact.
+#[derive(Debug, Clone, Copy)]
+pub struct FragmentHit {
+    pub ray: Ray,
+    pub t: f64,
+    pub barycentric: DVec2,
+    pub exact: bool,
+}
+
+impl Resolver<'_> {
+    /// The hit of the projector through pixel position `pixel` of the projection triangle
+    /// named by `key` with the scene triangle named by `key`; `None` for a discarded
+    /// fragment (module doc).
+    pub fn hit(&self, key: u64, pixel: DVec2) -> Option<FragmentHit> {
+        let map = self.maps.get((key >> 32) as usize)?;
+        let k = (key & u64::from(u32::MAX)) as usize;
+        let ray = map.ray(pixel)?;
+        let (t, u, v) = plane_hit(&ray, self.scene.corners(k))?;
+        if t < 0.0 {
+            return None;
+        }
+        // Edges crossed: u < 0 is outside V1V3, v < 0 outside V1V2, u + v > 1 outside V2V3.
+        let outside = u8::from(v < 0.0) | (u8::from(u < 0.0) << 1) | (u8::from(u + v > 1.0) << 2);
+        if outside & !self.scene.shared_edges[k] != 0 {
+            return None;
+        }
+        let barycentric = if outside == 0 {
+            DVec2::new(u, v)
+        } else {
+            clamp_to_triangle(u, v)
+        };
+        Some(FragmentHit {
+            ray,
+            t,
+            barycentric,
+            exact: outside == 0,
+        })
+    }
+
+    /// The stage of the rasteriser: the fragment's depth, or `false` to discard it.
+    pub fn stage(&self, fragment: &mut Fragment<0>) -> bool {
+        let centre = pixel_centre(fragment.x, fragment.y);
+        match self.hit(fragment.primitive, centre) {
+            Some(hit) => {
+                let behind = if hit.exact { 0.0 } else { CRACK_FILL_DEPTH };
+                fragment.varying.depth = hit.t + behind;
+                true
+            }
+            None => false,
+        }
+    }
+}
+
+/// Where `ray` meets the plane of triangle `[a, b, c]`: `(t, u, v)` with `u`, `v` the
+/// barycentrics of `b` and `c`, unbounded (Moller-Trumbore without the inside tests).
+/// `None` for a projector parallel to the plane, a degenerate triangle or non-finite input.
+fn plane_hit(ray: &Ray, [a, b, c]: [DVec3; 3]) -> Option<(f64, f64, f64)> {
+    let (e1, e2) = (b - a, c - a);
+    let p = ray.direction.cross(e2);
+    let det = e1.dot(p);
+    let inv = 1.0 / det;
+    let s = ray.origin - a;
+    let q = s.cross(e1);
+    let (u, v, t) = (s.dot(p) * inv, ray.direction.dot(q) * inv, e2.dot(q) * inv);
+    (det != 0.0 && u.is_finite() && v.is_finite() && t.is_finite()).then_some((t, u, v))
+}
+
+/// The barycentrics of the point of the triangle nearest (in barycentric space) to `(u, v)`.
+fn clamp_to_triangle(u: f64, v: f64) -> DVec2 {
+    let (u, v) = (u.max(0.0), v.max(0.0));
+    let sum = u + v;
+    if sum > 1.0 {
+        DVec2::new(u / sum, v / sum)
+    } else {
+        DVec2::new(u, v)
+    }
+}
+
+fn pixel_centre(x: u32, y: u32) -> DVec2 {
+    DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5)
+}
+
+/// Rays cast while shading.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ShadeCounts {
+    /// Secondary and shadow rays of shading rasterised hits.
+    pub shading_rays: u64,
+    /// Primary rays cast for pixels of fallback projection triangles.
+    pub fallback_rays: u64,
+}
+
+impl ShadeCounts {
+    fn plus(self, o: ShadeCounts) -> ShadeCounts {
+        ShadeCounts {
+            shading_rays: self.shading_rays + o.shading_rays,
+            fallback_rays: self.fallback_rays + o.fallback_rays,
+        }
+    }
+}
+
+/// Everything the shading pass reads.
+pub struct Shader<'a> {
+    pub resolver: Resolver<'a>,
+    pub caster: &'a RayCaster,
+    pub projection: &'a Trilinear,
+    pub options: &'a RenderOptions<'a>,
+    /// Per projection triangle: ray cast its pixels instead.
+    pub fallback: &'a [bool],
+    pub background: Vec3,
+}
+
+/// One pixel's output.
+struct Pixel {
+    color: Vec3,
+    depth: f32,
+    id: u32,
+    counts: ShadeCounts,
+}
+
+impl Shader<'_> {
+    /// Shades every pixel of `target` into a frame, rows in parallel.
+    pub fn frame(&self, target: &Target) -> (Frame, ShadeCounts) {
+        let (width, height) = (target.width(), target.height());
+        let mut frame = Frame::new(width, height, self.background);
+        let any_fallback = self.fallback.iter().any(|&f| f);
+        let row = width as usize;
+        let counts = frame
+            .color
+            .par_chunks_mut(row)
+            .zip(frame.depth.par_chunks_mut(row))
+            .zip(frame.ids.par_chunks_mut(row))
+            .enumerate()
+            .map(|(y, ((color, depth), ids))| {
+                let mut counts = ShadeCounts::default();
+                for x in 0..width {
+                    let pixel = if any_fallback && self.in_fallback(x, y as u32) {
+                        self.cast(x, y as u32)
+                    } else {
+                        self.rasterised(target, x, y as u32)
+                    };
+                    if let Some(p) = pixel {
+                        let i = x as usize;
+                        (color[i], depth[i], ids[i]) = (p.color, p.depth, p.id);
+                        counts = counts.plus(p.counts);
+                    }
+                }
+                counts
+            })
+            .reduce(ShadeCounts::default, ShadeCounts::plus);
+        (frame, counts)
+    }
+
+    fn in_fallback(&self, x: u32, y: u32) -> bool {
+        self.projection
+            .locate(pixel_centre(x, y))
+            .is_some_and(|(triangle, _, _)| self.fallback[triangle])
+    }
+
+    /// The pixel's winning fragment, shaded; `None` where nothing was drawn.
+    fn rasterised(&self, target: &Target, x: u32, y: u32) -> Option<Pixel> {
+        let key = target.primitive(x, y)?;
+        let found = self.resolver.hit(key, pixel_centre(x, y))?;
+        let ray = found.ray;
+        let owner = self.resolver.scene.owners[(key & u64::from(u32::MAX)) as usize];
+        let hit = Hit {
+            t: found.t,
+            object: owner.object as usize,
+            triangle: owner.triangle as usize,
+            barycentric: found.barycentric.as_vec2(),
+        };
+        let (color, rays) = self.caster.shade_hit(&ray, hit, self.options);
+        Some(Pixel {
+            color,
+            depth: (hit.t * ray.direction.length()) as f32,
+            id: owner.id,
+            counts: ShadeCounts {
+                shading_rays: rays,
+                fallback_rays: 0,
+            },
+        })
+    }
+
+    /// The pixel ray cast like the reference renderer does it.
+    fn cast(&self, x: u32, y: u32) -> Option<Pixel> {
+        let ray = self.projection.ray(pixel_centre(x, y))?;
+        let counts = ShadeCounts {
+            shading_rays: 0,
+            fallback_rays: 1,
+        };
+        let Some(hit) = self.caster.intersect(&ray) else {
+            return Some(Pixel {
+                color: self.background,
+                depth: f32::INFINITY,
+                id: 0,
+                counts,
+            });
+        };
+        let (color, rays) = self.caster.shade_hit(&ray, hit, self.options);
+        Some(Pixel {
+            color,
+            depth: (hit.t * ray.direction.length()) as f32,
+            id: self.resolver.scene.object_ids[hit.object],
+            counts: ShadeCounts {
+                shading_rays: rays,
+                ..counts
+            },
+        })
+    }
+}

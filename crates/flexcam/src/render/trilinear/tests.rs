@@ -1,0 +1,379 @@
+//! The trilinear renderer against the reference ray caster on the same scene, projection and
+//! resolution, and its degenerate cases.
+
+use glam::{DVec2, DVec3, Vec3};
+
+use super::*;
+use crate::projection::TrilinearMesh;
+use crate::render::compare::{compare, Comparison};
+use crate::render::{Counter, Shading};
+use crate::scene::{self, Light, Material, Mesh, Object, Scene};
+
+/// A regular `cells x cells` screen grid (`2 cells^2` projection triangles) over a bent base
+/// patch near (0, 1, 5) whose ray directions fan out over 100 x 70 degrees looking along -z,
+/// with lengths growing to the right (trinorm is not renormalised: the depth scale varies).
+fn fan_mesh(cells: u32) -> TrilinearMesh {
+    let mut mesh = TrilinearMesh::default();
+    for j in 0..=cells {
+        for i in 0..=cells {
+            let s = DVec2::new(f64::from(i), f64::from(j)) / f64::from(cells);
+            let bend = 0.3 * (s.x - 0.5) * (s.x - 0.5) + 0.1 * s.y * s.y;
+            mesh.points
+                .push(DVec3::new(-0.2 + 0.4 * s.x, 0.85 + 0.3 * s.y, 5.0 + bend));
+            let (lon, lat) = (
+                (s.x - 0.5) * 100f64.to_radians(),
+                (s.y - 0.5) * 70f64.to_radians(),
+            );
+            let direction = DVec3::new(lon.sin() * lat.cos(), lat.sin(), -lon.cos() * lat.cos());
+            mesh.normals.push(direction * (1.0 + 0.3 * s.x));
+            mesh.screen.push(s);
+        }
+    }
+    let row = cells + 1;
+    for j in 0..cells {
+        for i in 0..cells {
+            let a = j * row + i;
+            mesh.triangles.push([a, a + 1, a + row + 1]);
+            mesh.triangles.push([a, a + row + 1, a + row]);
+        }
+    }
+    mesh
+}
+
+fn flat() -> RenderOptions<'static> {
+    RenderOptions {
+        shading: Shading::Flat,
+        ..RenderOptions::default()
+    }
+}
+
+/// Renders `scene` through `mesh` at `size` with both renderers; returns the comparison and
+/// the trilinear renderer's stats.
+fn against_raycast(
+    scene: &Scene,
+    mesh: &TrilinearMesh,
+    size: (u32, u32),
+    curves: CurveOptions,
+    options: &RenderOptions,
+) -> (Comparison, Stats) {
+    let projection = Trilinear::new(mesh, size.0, size.1).unwrap();
+    let (reference, _) = RayCaster::new(scene).render(&projection, options);
+    let (frame, stats) = TrilinearRenderer::new(scene)
+        .render(&projection, options, curves)
+        .unwrap();
+    (compare(&frame, &reference).unwrap(), stats)
+}
+
+fn count(stats: &Stats, name: &str) -> u64 {
+    match stats.get(name) {
+        Some(Counter::Count(n)) => *n,
+        other => panic!("{name}: {other:?}"),
+    }
+}
+
+#[test]
+fn cube_floor_matches_the_ray_caster_through_2_8_and_18_projections() {
+    let scene = scene::load("builtin:cube-floor").unwrap();
+    for cells in [1, 2, 3] {
+        let (c, stats) = against_raycast(
+            &scene,
+            &fan_mesh(cells),
+            (160, 120),
+            CurveOptions::ADAPTIVE,
+            &flat(),
+        );
+        println!(
+            "{} projections: ids {:.5}, rgb {:.5}, depth max {:.2e} mean {:.2e}",
+            2 * cells * cells,
+            c.id_agreement,
+            c.relative_rgb_error,
+            c.depth_max,
+            c.depth_mean
+        );
+        assert!(c.id_agreement >= 0.995, "{c:?}");
+        assert!(c.relative_rgb_error <= 0.02, "{c:?}");
+        assert!(c.depth_max < 1e-5, "{c:?}");
+        assert_eq!(count(&stats, "unprojectable"), 0);
+        assert!(count(&stats, "culled_outside") > 0);
+    }
+}
+
+#[test]
+fn every_curve_mode_renders_the_cube_floor() {
+    let scene = scene::load("builtin:cube-floor").unwrap();
+    for (mode, steps) in [
+        (CurveMode::Tessellate, 4),
+        (CurveMode::Slice, 10),
+        (CurveMode::Adaptive, 256),
+    ] {
+        let curves = CurveOptions::new(mode, Some(steps)).unwrap();
+        let (c, _) = against_raycast(&scene, &fan_mesh(2), (96, 72), curves, &flat());
+        println!(
+            "{mode} {steps}: ids {:.5}, rgb {:.5}",
+            c.id_agreement, c.relative_rgb_error
+        );
+        assert!(c.id_agreement >= 0.99, "{mode}: {c:?}");
+    }
+}
+
+#[test]
+fn lit_shading_matches_the_ray_caster() {
+    let scene = scene::load("builtin:cube-floor").unwrap();
+    let options = RenderOptions::default();
+    let (c, stats) = against_raycast(
+        &scene,
+        &fan_mesh(2),
+        (96, 72),
+        CurveOptions::ADAPTIVE,
+        &options,
+    );
+    assert!(c.id_agreement >= 0.995, "{c:?}");
+    assert!(c.relative_rgb_error <= 0.02, "{c:?}");
+    assert!(count(&stats, "shading_rays") > 0, "shadow rays are cast");
+}
+
+#[test]
+fn rendering_is_deterministic() {
+    let scene = scene::load("builtin:cube-floor").unwrap();
+    let projection = Trilinear::new(&fan_mesh(2), 80, 60).unwrap();
+    let renderer = TrilinearRenderer::new(&scene);
+    let (a, _) = renderer
+        .render(&projection, &flat(), CurveOptions::ADAPTIVE)
+        .unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let (b, _) = pool.install(|| {
+        renderer
+            .render(&projection, &flat(), CurveOptions::ADAPTIVE)
+            .unwrap()
+    });
+    assert_eq!(a, b);
+}
+
+/// One object made of the given triangles, flat colour `color`.
+fn object(id: u32, triangles: &[[DVec3; 3]], color: Vec3) -> Object {
+    let mut mesh = Mesh::default();
+    for (k, t) in triangles.iter().enumerate() {
+        mesh.positions.extend(t.iter().map(|p| p.as_vec3()));
+        let first = 3 * k as u32;
+        mesh.triangles.push([first, first + 1, first + 2]);
+    }
+    Object {
+        id,
+        name: format!("o{id}"),
+        mesh,
+        material: Material {
+            color,
+            ..Material::default()
+        },
+        world_to_object: glam::Affine3A::IDENTITY,
+    }
+}
+
+fn scene_of(objects: Vec<Object>) -> Scene {
+    let mut scene = scene::load("builtin:cube-floor").unwrap();
+    scene.objects = objects;
+    scene.lights = vec![Light::Directional {
+        direction: Vec3::new(-0.3, -1.0, -0.2).normalize(),
+        color: Vec3::ONE,
+        intensity: 1.0,
+    }];
+    scene
+}
+
+/// A mesh of two projection triangles over the unit square z = 0 looking along +z, with
+/// the given normal at each corner (bottom-left, bottom-right, top-left, top-right).
+fn square(normals: [DVec3; 4]) -> TrilinearMesh {
+    TrilinearMesh {
+        points: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)],
+        normals: normals.to_vec(),
+        screen: vec![DVec2::ZERO, DVec2::X, DVec2::Y, DVec2::ONE],
+        triangles: vec![[0, 1, 3], [0, 3, 2]],
+    }
+}
+
+fn diverging() -> TrilinearMesh {
+    square([
+        DVec3::new(-0.3, -0.3, 1.0),
+        DVec3::new(0.3, -0.3, 1.0),
+        DVec3::new(-0.3, 0.3, 1.0),
+        DVec3::new(0.25, 0.35, 1.1),
+    ])
+}
+
+#[test]
+fn degenerate_configurations_match_the_ray_caster() {
+    let red = Vec3::new(0.9, 0.1, 0.1);
+    let green = Vec3::new(0.1, 0.8, 0.2);
+    let cases: Vec<(&str, TrilinearMesh, Vec<[DVec3; 3]>)> = vec![
+        (
+            // A scene vertex exactly on the base triangle (t = 0), the others in front.
+            "vertex on the view plane",
+            diverging(),
+            vec![[
+                DVec3::new(0.5, 0.5, 0.0),
+                DVec3::new(-0.5, 0.2, 2.0),
+                DVec3::new(1.2, 1.0, 3.0),
+            ]],
+        ),
+        (
+            // Straddling the view plane: the part behind is clipped at t = 0 exactly.
+            "straddling the view plane",
+            diverging(),
+            vec![[
+                DVec3::new(0.2, 0.3, -1.0),
+                DVec3::new(-0.5, 0.2, 2.0),
+                DVec3::new(1.2, 1.0, 3.0),
+            ]],
+        ),
+        (
+            // A triangle seen edge-on by the central ray: nearly a line.
+            "edge-on",
+            diverging(),
+            vec![[
+                DVec3::new(0.5, 0.5, 1.0),
+                DVec3::new(0.5, 0.5, 3.0),
+                DVec3::new(0.9, 0.9, 2.0),
+            ]],
+        ),
+        (
+            // Its shape touches the shared diagonal of the two screen triangles.
+            "touching the screen-triangle edge",
+            diverging(),
+            vec![[
+                DVec3::new(0.5, 0.5, 1.5),
+                DVec3::new(1.0, 0.2, 1.5),
+                DVec3::new(1.1, 0.6, 2.5),
+            ]],
+        ),
+        (
+            // Orthographic-like: every normal the same.
+            "parallel normals",
+            square([DVec3::new(0.1, 0.05, 1.0); 4]),
+            vec![
+                [
+                    DVec3::new(0.1, 0.1, 1.0),
+                    DVec3::new(0.9, 0.2, 2.0),
+                    DVec3::new(0.4, 0.9, 3.0),
+                ],
+                [
+                    DVec3::new(-1.0, -1.0, 2.5),
+                    DVec3::new(2.0, -1.0, 2.5),
+                    DVec3::new(0.5, 2.0, 1.5),
+                ],
+            ],
+        ),
+    ];
+    for (name, mesh, triangles) in cases {
+        let objects = vec![
+            object(1, &triangles[..1], red),
+            object(2, &triangles[1..], green),
+        ];
+        let scene = scene_of(objects);
+        let (c, stats) = against_raycast(&scene, &mesh, (64, 64), CurveOptions::ADAPTIVE, &flat());
+        println!(
+            "{name}: ids {:.5} rgb {:.5}",
+            c.id_agreement, c.relative_rgb_error
+        );
+        assert!(c.id_agreement >= 0.995, "{name}: {c:?}");
+        // The reference's flat depths come from its f32 search: relative error about 1e-7
+        // times |origin| / distance, large right behind the view plane.
+        assert!(c.depth_mean < 1e-5 && c.depth_max < 1e-4, "{name}: {c:?}");
+        assert_eq!(count(&stats, "fallback_triangles"), 0, "{name}");
+    }
+}
+
+#[test]
+fn unprojectable_pairs_are_ray_cast_and_counted() {
+    // Coplanar, distinct normals (all parallel to the plane y = 0): a = 0 for every scene
+    // point, b = K2 - N2.ps with N2 along y, so a scene triangle straddling the plane
+    // y = K2 / N2.y is open at infinity: unprojectable.
+    let mesh = square([
+        DVec3::new(-0.4, 0.0, 1.0),
+        DVec3::new(0.4, 0.0, 1.2),
+        DVec3::new(-0.3, 0.0, 0.8),
+        DVec3::new(0.35, 0.0, 1.1),
+    ]);
+    let triangle = [
+        DVec3::new(-2.0, -3.0, 2.0),
+        DVec3::new(3.0, -3.0, 2.5),
+        // The plane where b changes sign is y = K2 / N2.y, about 12.6 for the first triangle.
+        DVec3::new(0.5, 30.0, 3.0),
+    ];
+    let scene = scene_of(vec![object(1, &[triangle], Vec3::new(0.9, 0.1, 0.1))]);
+    let (c, stats) = against_raycast(&scene, &mesh, (48, 48), CurveOptions::ADAPTIVE, &flat());
+    assert!(c.id_agreement >= 0.995, "{c:?}");
+    assert!(count(&stats, "unprojectable") > 0, "{stats:?}");
+    assert!(count(&stats, "fallback_rays") > 0, "{stats:?}");
+}
+
+#[test]
+fn no_cracks_between_adjacent_projection_triangles() {
+    // A wall far away covers the whole view: every pixel the ray caster covers along the
+    // shared edges must be covered, and the crossings of a scene edge with a shared
+    // projection edge computed from both triangles must coincide.
+    let wall = [
+        [
+            DVec3::new(-20.0, -20.0, -6.0),
+            DVec3::new(20.0, -20.0, -6.0),
+            DVec3::new(20.0, 20.0, -2.0),
+        ],
+        [
+            DVec3::new(-20.0, -20.0, -6.0),
+            DVec3::new(20.0, 20.0, -2.0),
+            DVec3::new(-20.0, 20.0, -2.0),
+        ],
+    ];
+    let scene = scene_of(vec![object(1, &wall, Vec3::new(0.5, 0.5, 0.5))]);
+    let mesh = fan_mesh(3);
+    let projection = Trilinear::new(&mesh, 90, 90).unwrap();
+    let (frame, _) = TrilinearRenderer::new(&scene)
+        .render(&projection, &flat(), CurveOptions::ADAPTIVE)
+        .unwrap();
+    let (reference, _) = RayCaster::new(&scene).render(&projection, &flat());
+    let uncovered: Vec<usize> = (0..frame.ids.len())
+        .filter(|&i| reference.ids[i] != 0 && frame.ids[i] == 0)
+        .collect();
+    assert!(uncovered.is_empty(), "cracks at {uncovered:?}");
+
+    // Crossing of a scene segment with the shared edge of triangles 0 and 1 (grid vertices
+    // 0 and 4, the first cell's diagonal), computed from both triangles.
+    let caches = projection.triangle_caches();
+    // Triangle 0 is [a, a+1, a+row+1]: the diagonal is its u = 0 line (vertices 1 and 3);
+    // triangle 1 is [a, a+row+1, a+row]: the diagonal is its vertices 1 and 2.
+    let on_edge = caches[0].ray_point(0.0, 0.5, 3.0);
+    let d = DVec3::new(0.5, -0.3, 0.2);
+    let (a, b) = (on_edge + d, on_edge - d);
+    let crossings = |t: usize, (i, j): (usize, usize)| {
+        let tri = mesh.triangles[t];
+        let vertex = |k: usize| (mesh.points[tri[k] as usize], mesh.normals[tri[k] as usize]);
+        let surface = edge_path::EdgeSurface::new(vertex(i), vertex(j));
+        let path = edge_path::EdgePath {
+            cache: &caches[t],
+            a,
+            b,
+        };
+        let map = ScreenMap::new(
+            tri.map(|k| mesh.screen[k as usize]),
+            DVec2::new(90.0, 90.0),
+            caches[t],
+        );
+        surface
+            .crossing_depths(a, b)
+            .filter(|&t| {
+                path.segment_parameter(t)
+                    .is_some_and(|s| (0.0..=1.0).contains(&s))
+            })
+            .filter_map(|t| path.at(t).map(|x| map.pixel(x.u, x.v)))
+            .collect::<Vec<_>>()
+    };
+    let (left, right) = (crossings(0, (0, 2)), crossings(1, (0, 1)));
+    assert_eq!(left.len(), 1, "{left:?}");
+    assert_eq!(right.len(), 1, "{right:?}");
+    assert!(
+        (left[0] - right[0]).length() < 1e-9,
+        "{left:?} vs {right:?}"
+    );
+}
