@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, StagedFile};
-use flexcam::render::{composite, Method, RenderOptions, Shading};
+use flexcam::render::{composite, Counter, Method, RenderOptions, Shading};
 use flexcam::{Error, Result};
 
 use super::scene_args::{MethodTuning, SceneArgs, ShadingArg};
@@ -73,7 +73,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     );
     let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
     progress.finish();
-    let (frame, counters) = rendered?;
+    let (frame, mut counters) = rendered?;
+    for (name, value) in loaded.projection.notes() {
+        counters.insert(name, Counter::Value(value));
+    }
 
     let encoding = match options.shading {
         Shading::Flat => ColorEncoding::Linear,

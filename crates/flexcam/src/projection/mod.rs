@@ -101,6 +101,12 @@ pub trait Projection: Send + Sync {
     fn as_trilinear(&self) -> Option<&Trilinear> {
         None
     }
+
+    /// Figures about how the projection was built that belong with a render's statistics
+    /// (the residual of a fitted projector grid), as (name, value) pairs.
+    fn notes(&self) -> Vec<(&'static str, f64)> {
+        Vec::new()
+    }
 }
 
 /// A camera placement shared by the single-viewpoint projections: an eye position, a point

@@ -40,6 +40,7 @@ pub use animation::{Animation, Easing, Keyframe};
 pub use blend::{BezierVolume, PiecewiseVolume};
 pub use interpolate::InterpolatedVolume;
 pub use presets::{Preset, PresetSpec};
+pub use projector_grid::{Aim, GridInterpolation, GridVolume, ProjectorGrid, ProjectorGridSpec};
 pub use reparam::Reparam;
 pub use surface::{
     BSplinePatch, BezierPatch, CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface,
@@ -71,6 +72,12 @@ pub enum VolumeSource {
         weight: f64,
         first: Box<FlexibleSpec>,
         second: Box<FlexibleSpec>,
+    },
+    /// A projector grid sampled from `base` (straight projectors), re-aimed and fitted
+    /// (module [`projector_grid`]); the re-parameterisation is `base`'s unless overridden.
+    ProjectorGrid {
+        base: Box<FlexibleSpec>,
+        grid: ProjectorGridSpec,
     },
 }
 
@@ -113,7 +120,10 @@ impl Flexible {
         let (volume, reparam) = build_volume(spec, aspect)?;
         let inverse = match &volume {
             Volume::Linear(v) => Inverse::classify(&v.near, &v.far),
-            Volume::Piecewise(_) | Volume::Bezier(_) | Volume::Interpolated(_) => None,
+            Volume::Piecewise(_)
+            | Volume::Bezier(_)
+            | Volume::Interpolated(_)
+            | Volume::Grid(_) => None,
         };
         Ok(Flexible {
             inverse,
@@ -185,6 +195,11 @@ fn build_volume(spec: &FlexibleSpec, aspect: f64) -> Result<(Volume, Reparam)> {
             }
             (interpolate::interpolate(*weight, a, b)?, map_a)
         }
+        VolumeSource::ProjectorGrid { base, grid } => {
+            let (base_volume, base_reparam) = build_volume(base, aspect)?;
+            let volume = GridVolume::build(grid, &base_volume)?;
+            (Volume::Grid(Box::new(volume)), base_reparam)
+        }
     };
     let reparam = spec.reparam.unwrap_or(default_reparam);
     reparam.validate()?;
@@ -206,6 +221,20 @@ fn describe(reparam: &Reparam) -> String {
 impl Projection for Flexible {
     fn kind(&self) -> &'static str {
         "flexible"
+    }
+
+    fn notes(&self) -> Vec<(&'static str, f64)> {
+        match &self.volume {
+            Volume::Grid(grid) => grid.fit.map_or_else(Vec::new, |r| {
+                vec![
+                    ("fit_correspondences", r.correspondences as f64),
+                    ("fit_unconstrained_nodes", r.unconstrained_nodes as f64),
+                    ("fit_max_angle_deg", r.max_angle_deg),
+                    ("fit_rms_angle_deg", r.rms_angle_deg),
+                ]
+            }),
+            _ => Vec::new(),
+        }
     }
 
     fn resolution(&self) -> (u32, u32) {

@@ -23,7 +23,8 @@
 
 use glam::{DVec2, DVec3};
 
-use super::volume::LinearVolume;
+use super::fit::{fit, Correspondence, FitReport};
+use super::volume::{LinearVolume, Volume};
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
 
@@ -253,6 +254,59 @@ impl ProjectorGrid {
             direction,
             t_min: 0.0,
             t_max: 1.0,
+        })
+    }
+}
+
+/// One node projector re-aimed through a scene point ([`ProjectorGrid::aim`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aim {
+    /// (column, row) of the node, (0, 0) at the bottom left.
+    pub node: (usize, usize),
+    pub at: DVec3,
+}
+
+/// A projector grid as a scene describes it: sampled from the projection's own volume, then
+/// re-aimed node by node, then fitted to correspondences (each step optional).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProjectorGridSpec {
+    /// Nodes per side: (columns, rows).
+    pub size: (usize, usize),
+    pub interpolation: GridInterpolation,
+    pub aims: Vec<Aim>,
+    pub correspondences: Vec<Correspondence>,
+}
+
+/// A projector grid in use as a viewing volume, with the residual of its fit if it had one.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GridVolume {
+    pub grid: ProjectorGrid,
+    pub fit: Option<FitReport>,
+}
+
+impl GridVolume {
+    /// Samples `base` (which must have straight projectors), applies the aims in order, then
+    /// fits the grid to the correspondences when there are any. Errors: a base with curved
+    /// projectors, and the errors of [`ProjectorGrid::sample`], [`ProjectorGrid::aim`] and
+    /// [`fit`].
+    pub fn build(spec: &ProjectorGridSpec, base: &Volume) -> Result<Self> {
+        let Volume::Linear(linear) = base else {
+            return Err(Error::new(
+                "a projector grid starts from a volume with straight projectors (a preset or \
+                 near and far surfaces), not from blended surfaces",
+            ));
+        };
+        let mut grid = ProjectorGrid::sample(linear, spec.size, spec.interpolation)?;
+        for aim in &spec.aims {
+            grid.aim(aim.node.0, aim.node.1, aim.at)?;
+        }
+        if spec.correspondences.is_empty() {
+            return Ok(GridVolume { grid, fit: None });
+        }
+        let (grid, report) = fit(&grid, &spec.correspondences)?;
+        Ok(GridVolume {
+            grid,
+            fit: Some(report),
         })
     }
 }

@@ -10,6 +10,7 @@ use glam::{DVec2, DVec3};
 
 use super::blend::{BezierVolume, PiecewiseVolume};
 use super::interpolate::InterpolatedVolume;
+use super::projector_grid::GridVolume;
 use super::surface::Surface;
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
@@ -82,6 +83,9 @@ pub enum Volume {
     /// a Q1 + (1 - a) Q2 of two volumes that do not blend into a simpler one (module
     /// `interpolate`).
     Interpolated(Box<InterpolatedVolume>),
+    /// Straight projectors interpolated from a grid of placed or fitted node projectors
+    /// (module `projector_grid`).
+    Grid(Box<GridVolume>),
 }
 
 impl Volume {
@@ -92,6 +96,7 @@ impl Volume {
             Volume::Piecewise(v) => v.point(uv, t),
             Volume::Bezier(v) => v.point(uv, t),
             Volume::Interpolated(v) => v.point(uv, t),
+            Volume::Grid(v) => v.grid.point(uv, t),
         }
     }
 
@@ -102,6 +107,7 @@ impl Volume {
             Volume::Piecewise(v) => v.tangent(uv, t),
             Volume::Bezier(v) => v.tangent(uv, t),
             Volume::Interpolated(v) => v.tangent(uv, t),
+            Volume::Grid(v) => v.grid.tangent(uv),
         }
     }
 
@@ -111,6 +117,7 @@ impl Volume {
         match self {
             Volume::Linear(v) => v.ray(uv),
             Volume::Interpolated(v) => v.ray(uv),
+            Volume::Grid(v) => v.grid.ray(uv),
             Volume::Piecewise(_) | Volume::Bezier(_) => None,
         }
     }
@@ -122,6 +129,7 @@ impl Volume {
             Volume::Piecewise(v) => v.projector(uv),
             Volume::Bezier(v) => v.projector(uv),
             Volume::Interpolated(v) => v.projector(uv),
+            Volume::Grid(v) => v.grid.ray(uv).map(Projector::Straight),
         }
     }
 

@@ -19,7 +19,7 @@ use crate::projection::flexible::{
 };
 
 /// Every key of a flexible table (besides `type`).
-pub(super) const KEYS: [&str; 24] = [
+pub(super) const KEYS: [&str; 25] = [
     "preset",
     "position",
     "look_at",
@@ -44,6 +44,7 @@ pub(super) const KEYS: [&str; 24] = [
     "azimuth",
     "elevation",
     "generators",
+    "projectors",
 ];
 
 /// Keys every preset accepts (but `up` for the axonometric one, which is always +y).
@@ -100,7 +101,13 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
     let src = required.src;
     let raw = required.raw();
     let reparam = reparam(src, raw)?;
-    let present = raw.present_keys();
+    // `projectors` goes with any volume of straight projectors; the checks below are for
+    // the keys of the volume itself.
+    let present: Vec<_> = raw
+        .present_keys()
+        .into_iter()
+        .filter(|(key, _)| *key != "projectors")
+        .collect();
     let source = match &raw.preset {
         Some(name) => {
             let own = preset_keys(name.get_ref());
@@ -173,6 +180,25 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
             ));
         }
     }
+    let source = match &raw.projectors {
+        None => source,
+        Some(table) => {
+            if matches!(source, VolumeSource::Blended { .. }) {
+                return Err(src.error(
+                    &table.span(),
+                    "a projector grid starts from a volume with straight projectors (a preset \
+                     or near and far surfaces), not from blended `surfaces`",
+                ));
+            }
+            VolumeSource::ProjectorGrid {
+                base: Box::new(FlexibleSpec {
+                    source,
+                    reparam: None,
+                }),
+                grid: super::projector_grid::convert(src, table)?,
+            }
+        }
+    };
     Ok(FlexibleSpec { source, reparam })
 }
 

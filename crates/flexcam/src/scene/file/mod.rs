@@ -9,6 +9,7 @@ mod flexible;
 mod light;
 mod object;
 mod projection;
+mod projector_grid;
 mod raw;
 mod shape;
 mod source;

@@ -99,6 +99,34 @@ pub struct RawProjection {
     pub azimuth: Option<Spanned<f64>>,
     pub elevation: Option<Spanned<f64>>,
     pub generators: Option<Spanned<Vec<[f64; 4]>>>,
+    pub projectors: Option<Spanned<RawProjectors>>,
+}
+
+/// `projectors = { ... }` of a flexible projection: a projector grid sampled from the
+/// projection's volume, re-aimed (`aim`) and fitted to correspondences (`fit`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawProjectors {
+    pub size: Option<Spanned<[i64; 2]>>,
+    pub interpolation: Option<Spanned<String>>,
+    pub aim: Option<Vec<Spanned<RawAim>>>,
+    pub fit: Option<Vec<Spanned<RawCorrespondence>>>,
+}
+
+/// `{ node = [column, row], at = [x, y, z] }`: re-aim one node projector through a point.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawAim {
+    pub node: Spanned<[i64; 2]>,
+    pub at: Vec3Value,
+}
+
+/// `{ uv = [u, v], point = [x, y, z] }`: the image position that must see a scene point.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawCorrespondence {
+    pub uv: Spanned<[f64; 2]>,
+    pub point: Vec3Value,
 }
 
 /// `camera = { ... }`, `first`, `second`: a camera of a trilinear grid's visualisation
@@ -223,6 +251,7 @@ impl RawProjection {
             ("azimuth", self.azimuth.as_ref().map(Spanned::span)),
             ("elevation", self.elevation.as_ref().map(Spanned::span)),
             ("generators", self.generators.as_ref().map(Spanned::span)),
+            ("projectors", self.projectors.as_ref().map(Spanned::span)),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))

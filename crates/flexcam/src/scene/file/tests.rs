@@ -1135,3 +1135,60 @@ fn animation_errors_have_positions() {
         "keys 0 and 1 cannot be interpolated",
     );
 }
+
+#[test]
+fn flexible_projector_grids_parse_and_fit() {
+    use crate::projection::flexible::{GridInterpolation, VolumeSource};
+    let head = "[projection]\ntype = \"flexible\"\npreset = \"perspective\"\n\
+                position = [0, 5, 7]\nlook_at = [0, 0, 0]\nfov = 60\n";
+    let text = format!(
+        "{head}projectors = {{ size = [3, 4], interpolation = \"bezier\", \
+         aim = [{{ node = [2, 3], at = [1, 0, 0] }}], \
+         fit = [{{ uv = [0.5, 0.5], point = [0, 0, 0] }}] }}\n"
+    );
+    let ProjectionSpec::Flexible(spec) = scene(&text).projection else {
+        panic!("not flexible");
+    };
+    let VolumeSource::ProjectorGrid { base, grid } = &spec.source else {
+        panic!("no grid: {spec:?}");
+    };
+    assert!(matches!(base.source, VolumeSource::Preset(_)));
+    assert_eq!(grid.size, (3, 4));
+    assert_eq!(grid.interpolation, GridInterpolation::Bezier);
+    assert_eq!(grid.aims[0].node, (2, 3));
+    assert_eq!(grid.correspondences.len(), 1);
+    // The fit's residual is reported with the projection.
+    let projection = ProjectionSpec::Flexible(spec).build(32, 24).unwrap();
+    let notes = projection.notes();
+    assert!(notes.contains(&("fit_correspondences", 1.0)), "{notes:?}");
+
+    let with = |projectors: &str| format!("{head}projectors = {projectors}\n");
+    assert_error_at(
+        &with("{ size = [1, 5] }"),
+        7,
+        23,
+        "projector grid `size` must be from 2 to 9 nodes per side, not [1, 5]",
+    );
+    assert_error_at(
+        &with("{ aim = [{ node = [5, 0], at = [0, 0, 0] }] }"),
+        7,
+        32,
+        "projector node [5, 0] is outside the 5 x 5 grid",
+    );
+    assert_error_at(
+        &with("{ fit = [{ uv = [0.5, 1.5], point = [0, 0, 0] }] }"),
+        7,
+        30,
+        "`uv` must lie in [0, 1] x [0, 1], not [0.5, 1.5]",
+    );
+    assert_error_at(
+        &with("{ interpolation = \"cubic\" }"),
+        7,
+        32,
+        "unknown interpolation \"cubic\"; expected one of: bilinear, bezier",
+    );
+    assert_error(
+        &with("{ fit = [{ uv = [0.5, 0.5], point = [0, 5, 7] }] }"),
+        "correspondence 1: the point",
+    );
+}

@@ -1,0 +1,104 @@
+//! `projectors = { ... }` in a flexible projection: a projector grid (seed 003, 5.2) sampled
+//! from the projection's own volume, re-aimed node by node and fitted to point
+//! correspondences. See scenes/README.md.
+
+use glam::{DVec2, DVec3};
+use toml::Spanned;
+
+use super::raw::RawProjectors;
+use super::source::Source;
+use crate::error::Result;
+use crate::projection::flexible::fit::Correspondence;
+use crate::projection::flexible::projector_grid::{MAX_NODES, MIN_NODES};
+use crate::projection::flexible::{Aim, GridInterpolation, ProjectorGridSpec};
+
+/// Nodes per side when `size` is not given: the thesis's 5 x 5.
+const DEFAULT_SIZE: usize = 5;
+
+/// Converts a `projectors` table; every value is checked here so that errors point at it.
+pub(super) fn convert(src: &Source, table: &Spanned<RawProjectors>) -> Result<ProjectorGridSpec> {
+    let raw = table.get_ref();
+    let size = match &raw.size {
+        Some(size) => {
+            let [cols, rows] = *size.get_ref();
+            let side = |n: i64| {
+                usize::try_from(n)
+                    .ok()
+                    .filter(|n| (MIN_NODES..=MAX_NODES).contains(n))
+            };
+            match (side(cols), side(rows)) {
+                (Some(c), Some(r)) => (c, r),
+                _ => {
+                    return Err(src.error(
+                        &size.span(),
+                        format!(
+                            "projector grid `size` must be from {MIN_NODES} to {MAX_NODES} \
+                             nodes per side, not [{cols}, {rows}]"
+                        ),
+                    ))
+                }
+            }
+        }
+        None => (DEFAULT_SIZE, DEFAULT_SIZE),
+    };
+    let interpolation = match &raw.interpolation {
+        None => GridInterpolation::Bilinear,
+        Some(name) => match name.get_ref().as_str() {
+            "bilinear" => GridInterpolation::Bilinear,
+            "bezier" => GridInterpolation::Bezier,
+            other => {
+                return Err(src.error(
+                    &name.span(),
+                    format!("unknown interpolation \"{other}\"; expected one of: bilinear, bezier"),
+                ))
+            }
+        },
+    };
+    let mut aims = Vec::new();
+    for aim in raw.aim.iter().flatten() {
+        let a = aim.get_ref();
+        let [c, r] = *a.node.get_ref();
+        let inside = |i: i64, n: usize| usize::try_from(i).ok().filter(|i| *i < n);
+        let (Some(col), Some(row)) = (inside(c, size.0), inside(r, size.1)) else {
+            return Err(src.error(
+                &a.node.span(),
+                format!(
+                    "projector node [{c}, {r}] is outside the {} x {} grid (columns and rows \
+                     count from 0)",
+                    size.0, size.1
+                ),
+            ));
+        };
+        let at = finite_point(src, &a.at, "at")?;
+        aims.push(Aim {
+            node: (col, row),
+            at,
+        });
+    }
+    let mut correspondences = Vec::new();
+    for pair in raw.fit.iter().flatten() {
+        let c = pair.get_ref();
+        let uv = DVec2::from(*c.uv.get_ref());
+        if !uv.is_finite() || uv.min_element() < 0.0 || uv.max_element() > 1.0 {
+            return Err(src.error(
+                &c.uv.span(),
+                format!("`uv` must lie in [0, 1] x [0, 1], not [{}, {}]", uv.x, uv.y),
+            ));
+        }
+        correspondences.push(Correspondence {
+            uv,
+            point: finite_point(src, &c.point, "point")?,
+        });
+    }
+    Ok(ProjectorGridSpec {
+        size,
+        interpolation,
+        aims,
+        correspondences,
+    })
+}
+
+fn finite_point(src: &Source, value: &Spanned<[f64; 3]>, name: &str) -> Result<DVec3> {
+    src.all_finite(value.get_ref(), value, name)?;
+    Ok(DVec3::from(*value.get_ref()))
+}
