@@ -262,25 +262,9 @@ fn residual(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::projection::flexible::presets::{Preset, PresetSpec};
+    use crate::projection::flexible::projector_grid::tests::perspective_volume as perspective;
     use crate::projection::flexible::projector_grid::GridInterpolation;
-    use crate::projection::flexible::volume::LinearVolume;
-    use crate::projection::CameraFrame;
     use proptest::prelude::*;
-
-    fn perspective(fov: f64, clip: [f64; 2]) -> LinearVolume {
-        let spec = PresetSpec {
-            preset: Preset::Perspective { fov },
-            frame: CameraFrame {
-                position: DVec3::new(0.0, 1.0, 5.0),
-                look_at: DVec3::new(0.0, 0.5, 0.0),
-                up: DVec3::Y,
-            },
-            clip: Some(clip),
-        };
-        let (near, far) = spec.surfaces(0.75).unwrap();
-        LinearVolume::new(near, far).unwrap()
-    }
 
     /// Correspondences seen by `truth`: one per cell of a `per_side x per_side` jittered
     /// grid of image positions (so every region of the image has data), each on its projector

@@ -342,12 +342,17 @@ fn bernstein(degree: usize, x: f64) -> Vec<f64> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::projection::flexible::presets::{Preset, PresetSpec};
     use crate::projection::CameraFrame;
 
-    pub(crate) fn perspective_volume(fov: f64) -> LinearVolume {
+    /// A perspective volume with horizontal field of view `fov` (degrees), aspect 3:4, its
+    /// control surfaces at the distances `clip`: the test fixture of grids and fits.
+    pub(in crate::projection::flexible) fn perspective_volume(
+        fov: f64,
+        clip: [f64; 2],
+    ) -> LinearVolume {
         let spec = PresetSpec {
             preset: Preset::Perspective { fov },
             frame: CameraFrame {
@@ -355,7 +360,7 @@ mod tests {
                 look_at: DVec3::new(0.0, 0.5, 0.0),
                 up: DVec3::Y,
             },
-            clip: Some([1.0, 50.0]),
+            clip: Some(clip),
         };
         let (near, far) = spec.surfaces(0.75).unwrap();
         LinearVolume::new(near, far).unwrap()
@@ -367,7 +372,7 @@ mod tests {
 
     #[test]
     fn a_bilinear_grid_reproduces_a_perspective_volume_exactly() {
-        let volume = perspective_volume(70.0);
+        let volume = perspective_volume(70.0, [1.0, 50.0]);
         let grid = ProjectorGrid::sample(&volume, (5, 5), GridInterpolation::Bilinear).unwrap();
         for uv in uv_samples() {
             for t in [0.0, 0.3, 1.0] {
@@ -381,7 +386,7 @@ mod tests {
     fn a_bezier_grid_of_a_bilinear_volume_is_that_volume_too() {
         // Degree elevation: control points sampled from a (bi)linear function on a uniform
         // grid are that function's Bezier control points, so the patch reproduces it.
-        let volume = perspective_volume(40.0);
+        let volume = perspective_volume(40.0, [1.0, 50.0]);
         let grid = ProjectorGrid::sample(&volume, (5, 4), GridInterpolation::Bezier).unwrap();
         for uv in uv_samples() {
             let (a, b) = (grid.point(uv, 1.0), volume.point(uv, 1.0));
@@ -391,7 +396,7 @@ mod tests {
 
     #[test]
     fn weights_are_a_partition_of_unity_and_bilinear_meets_every_node() {
-        let volume = perspective_volume(60.0);
+        let volume = perspective_volume(60.0, [1.0, 50.0]);
         for interpolation in [GridInterpolation::Bilinear, GridInterpolation::Bezier] {
             let grid = ProjectorGrid::sample(&volume, (4, 3), interpolation).unwrap();
             for uv in uv_samples().chain([DVec2::new(-0.5, 2.0)]) {
@@ -410,7 +415,7 @@ mod tests {
 
     #[test]
     fn bezier_meets_only_the_corner_projectors() {
-        let volume = perspective_volume(60.0);
+        let volume = perspective_volume(60.0, [1.0, 50.0]);
         let mut grid = ProjectorGrid::sample(&volume, (5, 5), GridInterpolation::Bezier).unwrap();
         let before = grid.point(grid.node_uv(2, 2), 1.0);
         grid.aim(2, 2, DVec3::new(4.0, 0.0, 0.0)).unwrap();
@@ -430,7 +435,7 @@ mod tests {
 
     #[test]
     fn aiming_keeps_the_length_unless_the_hit_is_farther() {
-        let volume = perspective_volume(60.0);
+        let volume = perspective_volume(60.0, [1.0, 50.0]);
         let mut grid = ProjectorGrid::sample(&volume, (3, 3), GridInterpolation::Bilinear).unwrap();
         let length = (grid.ends()[4] - grid.starts()[4]).length();
         let near_hit = grid.starts()[4] + DVec3::new(1.0, 0.0, 0.0);
@@ -444,7 +449,7 @@ mod tests {
 
     #[test]
     fn degenerate_grids_and_aims_are_errors() {
-        let volume = perspective_volume(60.0);
+        let volume = perspective_volume(60.0, [1.0, 50.0]);
         let bilinear = GridInterpolation::Bilinear;
         for size in [(1, 5), (5, 10), (0, 0)] {
             let e = ProjectorGrid::sample(&volume, size, bilinear).unwrap_err();
