@@ -39,6 +39,15 @@ color = [1.0, 0.0, 0.0]
 translate = [0.0, 1.0, 0.0]
 "#;
 
+/// Fails the test, showing the command's stderr, unless it exited successfully.
+fn assert_success(out: &std::process::Output) {
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
 fn write(dir: &TempDir, name: &str, text: &str) -> PathBuf {
     let path = dir.path().join(name);
     fs::write(&path, text).unwrap();
@@ -125,11 +134,7 @@ fn flat_render_with_all_outputs_and_stats_on_stdout() {
         ])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out);
     let json: serde_json::Value =
         serde_json::from_slice(&out.stdout).expect("stdout is one JSON object");
     for key in [
@@ -411,11 +416,7 @@ fn raster_method_renders_and_reports() {
             .args(&flags)
             .output()
             .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert_success(&out);
         let stats = String::from_utf8(out.stdout).unwrap();
         assert!(stats.contains("\"method\":\"raster\""), "{stats}");
         assert!(stats.contains("\"raster_pieces\""), "{stats}");
@@ -457,11 +458,7 @@ fn trilinear_reflector_renders_with_its_counters() {
         .args(["render", "r.toml", "--shading", "flat", "--stats", "-"])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out);
     let stats: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(stats["reflectors"], 1);
     assert!(
@@ -538,11 +535,7 @@ fn animate_writes_numbered_frames_and_a_gif() {
         .args(["--shading", "flat"])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out);
     let mut names: Vec<String> = fs::read_dir(dir.path().join("frames"))
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -575,11 +568,7 @@ fn animate_writes_numbered_frames_and_a_gif() {
         .args(["render", "k.toml", "-o", "k.png", "--shading", "flat"])
         .output()
         .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    assert_success(&out);
     assert_eq!(
         image::open(dir.path().join("k.png")).unwrap().to_rgb8(),
         frame(0).to_rgb8()
