@@ -96,6 +96,16 @@ pub fn quadratic_arc_length(p: &[DVec3; 3], s: f64) -> f64 {
 mod tests {
     use super::*;
 
+    /// The length of the curve's n-chord polyline: the reference for the closed form.
+    fn dense_length(p: &[DVec3; 3], n: usize) -> f64 {
+        (0..n)
+            .map(|k| {
+                let (a, b) = (k as f64 / n as f64, (k + 1) as f64 / n as f64);
+                (quadratic_point(p, b) - quadratic_point(p, a)).length()
+            })
+            .sum()
+    }
+
     #[test]
     fn arc_length_of_a_straight_curve_is_exact() {
         let p = [
@@ -115,13 +125,7 @@ mod tests {
             DVec3::new(1.0, 1.0, 0.0),
             DVec3::new(2.0, 0.0, 0.5),
         ];
-        let n = 200_000;
-        let dense: f64 = (0..n)
-            .map(|k| {
-                let (a, b) = (k as f64 / n as f64, (k + 1) as f64 / n as f64);
-                (quadratic_point(&p, b) - quadratic_point(&p, a)).length()
-            })
-            .sum();
+        let dense = dense_length(&p, 200_000);
         let exact = quadratic_arc_length(&p, 1.0);
         assert!((exact - dense).abs() < 1e-10 * exact, "{exact} {dense}");
     }
@@ -135,13 +139,7 @@ mod tests {
         assert!((got - exact).abs() < 1e-14, "{got} {exact}");
         // Nearly cusped: P1 slightly off the line.
         let near = [DVec3::ZERO, DVec3::new(2.0, 1e-4, 0.0), DVec3::X];
-        let n = 400_000;
-        let dense: f64 = (0..n)
-            .map(|k| {
-                let (a, b) = (k as f64 / n as f64, (k + 1) as f64 / n as f64);
-                (quadratic_point(&near, b) - quadratic_point(&near, a)).length()
-            })
-            .sum();
+        let dense = dense_length(&near, 400_000);
         let got = quadratic_arc_length(&near, 1.0);
         assert!((got - dense).abs() < 1e-6 * dense, "{got} {dense}");
         assert_eq!(quadratic_arc_length(&[DVec3::ONE; 3], 1.0), 0.0);
