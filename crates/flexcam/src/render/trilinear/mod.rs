@@ -24,6 +24,7 @@ pub mod screen_map;
 pub mod shade;
 #[cfg(test)]
 mod tests;
+pub mod workloads;
 
 use std::time::Instant;
 

@@ -266,7 +266,8 @@ impl Pair<'_> {
     ) {
         out.counts.shapes += 1;
         scratch.outline.clear();
-        trace_outline(self.triangle, shape, scene, sampling, &mut scratch.outline);
+        let mode = (sampling, self.curves.scene_clipping);
+        trace_outline(self.triangle, shape, scene, mode, &mut scratch.outline);
         clip_outline(&mut scratch.outline, &mut scratch.clipped);
         if scratch.outline.len() < 2 {
             out.counts.clipped_away += 1;
