@@ -6,6 +6,7 @@ use glam::DVec3;
 
 use super::edge_path::{refine, EdgePath, EdgeSurface, OutlinePoint};
 use super::screen_map::ScreenMap;
+use super::volume_bounds::VolumeBounds;
 use crate::projection::{Shape, ShapeVertex};
 
 /// How a polygon edge is sampled between its anchors.
@@ -26,6 +27,8 @@ pub struct ProjectionTriangle {
     /// The surfaces swept by the three edges, in the order of their domain lines `u = 0`
     /// (vertices 1-3), `v = 0` (vertices 1-2) and `u + v = 1` (vertices 2-3).
     pub surfaces: [EdgeSurface; 3],
+    /// Bounding planes of the volume its rays sweep at `t >= 0` (the cull).
+    pub bounds: VolumeBounds,
 }
 
 impl ProjectionTriangle {
@@ -39,6 +42,7 @@ impl ProjectionTriangle {
                 EdgeSurface::new(vertex(0), vertex(1)),
                 EdgeSurface::new(vertex(1), vertex(2)),
             ],
+            bounds: VolumeBounds::new(p, n),
         }
     }
 }
