@@ -1,6 +1,7 @@
 //! `flexcam bench`: the source documents' timing tables, rerun with flexcam's renderers.
 
 pub mod flexible;
+pub mod trilinear;
 
 use clap::Subcommand;
 use flexcam::Result;
@@ -10,11 +11,15 @@ use flexcam::Result;
 pub enum BenchCommand {
     /// Table 7.1 of seed 003: quadratic vs 2 to 6 segment projectors at 800 x 800.
     Flexible(flexible::FlexibleArgs),
+    /// Chapter 8 and appendix D of seed 000: ray casting vs trilinear rasterisation of random
+    /// scenes and of the cube-floor scene through 2 to 50 projection triangles.
+    Trilinear(trilinear::TrilinearArgs),
 }
 
 /// Runs `flexcam bench`.
 pub fn run(command: &BenchCommand) -> Result<()> {
     match command {
         BenchCommand::Flexible(args) => flexible::run(args),
+        BenchCommand::Trilinear(args) => trilinear::run(args),
     }
 }

@@ -100,6 +100,12 @@ pub struct CurveOptions {
     /// Segments per scene edge (tessellate), slices per shape (slice) or the most segments
     /// per edge piece (adaptive); 1 to [`MAX_STEPS`].
     pub steps: u32,
+    /// Scene-space clipping (seed 000, chapter 5; the default): outlines get exact anchors
+    /// where their scene edges cross the projection triangle's edge surfaces, so images are
+    /// continuous across projection edges. Without it (the thesis's cheaper variant, timed
+    /// by `flexcam bench trilinear`) outlines are clipped to the screen triangle by
+    /// interpolating their chords, which leaves cracks along curved projection edges.
+    pub scene_clipping: bool,
 }
 
 impl CurveOptions {
@@ -107,6 +113,7 @@ impl CurveOptions {
     pub const ADAPTIVE: CurveOptions = CurveOptions {
         mode: CurveMode::Adaptive,
         steps: 256,
+        scene_clipping: true,
     };
 
     /// `mode` with `steps`, or the mode's default steps when `None`. Errors: `steps` outside
@@ -118,7 +125,11 @@ impl CurveOptions {
                 "curve steps must be between 1 and {MAX_STEPS}, got {steps}"
             )));
         }
-        Ok(CurveOptions { mode, steps })
+        Ok(CurveOptions {
+            mode,
+            steps,
+            scene_clipping: true,
+        })
     }
 }
 

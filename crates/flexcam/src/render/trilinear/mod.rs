@@ -2,8 +2,9 @@
 //! and 5). Instead of casting a ray per pixel it projects the scene into each projection
 //! triangle and rasterises the result; docs/trilinear.md has the design and measurements.
 //!
-//! Per projection triangle (in parallel), [`polygons`]: each scene vertex is projected once
-//! (its cubic), pairs that cannot be visible are culled, each scene triangle is cut into
+//! Per projection triangle (in parallel), [`polygons`]: scene triangles beyond a bounding
+//! plane of the triangle's ray volume are culled ([`volume_bounds`]), each remaining scene
+//! vertex is projected once (its cubic), pairs whose images cannot be visible are culled, each scene triangle is cut into
 //! shapes (`projection::project_solved_triangle`), each shape's curved edges are sampled along
 //! the exact images of their scene edges ([`edge_path`], [`outline`], by the [`curves`]
 //! mode), with exact anchors at the view plane and at the projection triangle's edge surfaces,
@@ -24,6 +25,8 @@ pub mod screen_map;
 pub mod shade;
 #[cfg(test)]
 mod tests;
+pub mod volume_bounds;
+pub mod workloads;
 
 use std::time::Instant;
 

@@ -6,6 +6,7 @@ use glam::DVec3;
 
 use super::edge_path::{refine, EdgePath, EdgeSurface, OutlinePoint};
 use super::screen_map::ScreenMap;
+use super::volume_bounds::VolumeBounds;
 use crate::projection::{Shape, ShapeVertex};
 
 /// How a polygon edge is sampled between its anchors.
@@ -26,6 +27,8 @@ pub struct ProjectionTriangle {
     /// The surfaces swept by the three edges, in the order of their domain lines `u = 0`
     /// (vertices 1-3), `v = 0` (vertices 1-2) and `u + v = 1` (vertices 2-3).
     pub surfaces: [EdgeSurface; 3],
+    /// Bounding planes of the volume its rays sweep at `t >= 0` (the cull).
+    pub bounds: VolumeBounds,
 }
 
 impl ProjectionTriangle {
@@ -39,6 +42,7 @@ impl ProjectionTriangle {
                 EdgeSurface::new(vertex(0), vertex(1)),
                 EdgeSurface::new(vertex(1), vertex(2)),
             ],
+            bounds: VolumeBounds::new(p, n),
         }
     }
 }
@@ -48,11 +52,13 @@ const MAX_ANCHORS: usize = 7;
 
 /// Appends the outline of `shape` (of the scene triangle with vertices `scene`) to `out`:
 /// per polygon edge, its start image, then its anchors and curve samples in travel order.
+/// Without `scene_clipping` the only anchors are at `t = 0` (the edge-surface crossings are
+/// left to the clip's interpolation).
 pub fn trace_outline(
     triangle: &ProjectionTriangle,
     shape: &Shape,
     scene: [DVec3; 3],
-    sampling: Sampling,
+    (sampling, scene_clipping): (Sampling, bool),
     out: &mut Vec<OutlinePoint>,
 ) {
     let point = |x: &ShapeVertex| OutlinePoint {
@@ -74,20 +80,29 @@ pub fn trace_outline(
             b,
         };
         let mut previous = start;
-        for t in anchors(triangle, &path, start.t, end.t).iter().flatten() {
+        let surfaces: &[EdgeSurface] = if scene_clipping {
+            &triangle.surfaces
+        } else {
+            &[]
+        };
+        let piece = |out: &mut Vec<OutlinePoint>, ends| {
+            sample_piece(triangle, &path, ends, (sampling, scene_clipping), out)
+        };
+        for t in anchors(surfaces, &path, start.t, end.t).iter().flatten() {
             if let Some(anchor) = path.at(*t) {
-                sample_piece(triangle, &path, (previous, anchor), sampling, out);
+                piece(out, (previous, anchor));
                 out.push(anchor);
                 previous = anchor;
             }
         }
-        sample_piece(triangle, &path, (previous, end), sampling, out);
+        piece(out, (previous, end));
     }
 }
 
-/// The anchor depths strictly between `from` and `to`, in travel order (unused slots `None`).
+/// The anchor depths strictly between `from` and `to`, in travel order (unused slots `None`):
+/// `t = 0` and the crossings with `surfaces`.
 fn anchors(
-    triangle: &ProjectionTriangle,
+    surfaces: &[EdgeSurface],
     path: &EdgePath,
     from: f64,
     to: f64,
@@ -95,8 +110,7 @@ fn anchors(
     let (lo, hi) = (from.min(to), from.max(to));
     let mut found = [None; MAX_ANCHORS];
     let mut count = 0;
-    let candidates = triangle
-        .surfaces
+    let candidates = surfaces
         .iter()
         .flat_map(|s| s.crossing_depths(path.a, path.b))
         .chain(std::iter::once(0.0));
@@ -116,20 +130,25 @@ fn anchors(
 
 /// Appends the curve samples of the piece between two consecutive outline points (excluded)
 /// if the piece is visible: between anchors a piece is wholly visible or wholly clipped, so
-/// the image at its middle depth decides.
+/// the image at its middle depth decides. Without `scene_clipping` only the `t = 0` anchor
+/// separates pieces, so only a piece behind the view plane is skipped.
 fn sample_piece(
     triangle: &ProjectionTriangle,
     path: &EdgePath,
     (a, b): (OutlinePoint, OutlinePoint),
-    sampling: Sampling,
+    (sampling, scene_clipping): (Sampling, bool),
     out: &mut Vec<OutlinePoint>,
 ) {
     if matches!(sampling, Sampling::Anchors) {
         return;
     }
-    let visible = path
-        .at(0.5 * (a.t + b.t))
-        .is_some_and(|middle| middle.is_visible(0.0));
+    let visible = path.at(0.5 * (a.t + b.t)).is_some_and(|middle| {
+        if scene_clipping {
+            middle.is_visible(0.0)
+        } else {
+            middle.t >= 0.0
+        }
+    });
     if !visible {
         return;
     }

@@ -1,6 +1,7 @@
-//! Every scene triangle through one projection triangle, into clipped pixel polygons: project
-//! each scene vertex once (its cubic), cull pairs that cannot be visible, form the shapes,
-//! trace their curved outlines, clip them, and append them to a polygon batch.
+//! Every scene triangle through one projection triangle, into clipped pixel polygons: cull
+//! pairs outside the triangle's ray volume (`volume_bounds`), project each remaining scene
+//! vertex once (its cubic), cull pairs whose images cannot be visible, form the shapes, trace
+//! their curved outlines, clip them, and append them to a polygon batch.
 
 use glam::DVec3;
 
@@ -20,6 +21,9 @@ pub struct PairCounts {
     pub vertices_projected: u64,
     /// (projection triangle, scene triangle) pairs considered.
     pub pairs: u64,
+    /// Pairs culled because the scene triangle lies beyond one bounding plane of the
+    /// projection triangle's ray volume (no cubic solved).
+    pub culled_volume: u64,
     /// Pairs culled because every vertex image is behind the view plane.
     pub culled_behind: u64,
     /// Pairs culled because every vertex image is outside one domain line and no scene
@@ -40,6 +44,7 @@ impl PairCounts {
     pub fn add(&mut self, o: &PairCounts) {
         self.vertices_projected += o.vertices_projected;
         self.pairs += o.pairs;
+        self.culled_volume += o.culled_volume;
         self.culled_behind += o.culled_behind;
         self.culled_outside += o.culled_outside;
         self.unprojectable += o.unprojectable;
@@ -53,6 +58,7 @@ impl PairCounts {
         for (name, value) in [
             ("vertices_projected", self.vertices_projected),
             ("pairs", self.pairs),
+            ("culled_volume", self.culled_volume),
             ("culled_behind", self.culled_behind),
             ("culled_outside", self.culled_outside),
             ("unprojectable", self.unprojectable),
@@ -98,18 +104,32 @@ pub fn project_scene(
     curves: CurveOptions,
 ) -> Projected {
     let cache = triangle.map.cache();
-    let solutions: Vec<Solutions> = scene
+    let outside: Vec<u32> = scene
         .vertices
         .iter()
-        .map(|&v| cache.project_point(v))
+        .map(|&v| triangle.bounds.outside(v))
         .collect();
+    // Each vertex's cubic, solved when a pair first needs it.
+    let mut solutions: Vec<Option<Solutions>> = vec![None; scene.vertices.len()];
     let mut out = Projected::default();
-    out.counts.vertices_projected = solutions.len() as u64;
     let mut scratch = Scratch::default();
     for (k, corners) in scene.triangles.iter().enumerate() {
         out.counts.pairs += 1;
+        if corners
+            .iter()
+            .fold(u32::MAX, |m, &i| m & outside[i as usize])
+            != 0
+        {
+            out.counts.culled_volume += 1;
+            continue;
+        }
         let positions = scene.corners(k);
-        let solved = corners.map(|i| solutions[i as usize]);
+        let solved = corners.map(|i| {
+            *solutions[i as usize].get_or_insert_with(|| {
+                out.counts.vertices_projected += 1;
+                cache.project_point(scene.vertices[i as usize])
+            })
+        });
         match cull(triangle, positions, &solved) {
             Some(Cull::Behind) => out.counts.culled_behind += 1,
             Some(Cull::Outside) => out.counts.culled_outside += 1,
@@ -266,7 +286,8 @@ impl Pair<'_> {
     ) {
         out.counts.shapes += 1;
         scratch.outline.clear();
-        trace_outline(self.triangle, shape, scene, sampling, &mut scratch.outline);
+        let mode = (sampling, self.curves.scene_clipping);
+        trace_outline(self.triangle, shape, scene, mode, &mut scratch.outline);
         clip_outline(&mut scratch.outline, &mut scratch.clipped);
         if scratch.outline.len() < 2 {
             out.counts.clipped_away += 1;

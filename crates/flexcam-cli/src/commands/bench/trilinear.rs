@@ -1,0 +1,238 @@
+//! `flexcam bench trilinear`: the timing study of seed 000 (Vallance, Trilinear Projection,
+//! chapter 8 and appendix D) with flexcam's two renderers of the same trilinear projection:
+//! the BVH ray caster (`--method raycast`) and the rasteriser (`--method trilinear`, adaptive
+//! curves), with and without scene-space clipping.
+//!
+//! - Tables D.1 to D.3: random scenes of 1 to 640 disconnected vertex-coloured triangles
+//!   through random regular screen meshes of 2 to 50 projection triangles, square images of
+//!   1 to 640^2 pixels (`render::trilinear::workloads`).
+//! - Table 8.1, figure 7.4: the cube-floor scene (686 triangles) through 2, 8, 18, 32 and 50
+//!   projection triangles (the fan grid of the accuracy tests) at 800 x 800, with the
+//!   accuracy against the ray caster (item 9 of issue 3) and the trilinear stage times.
+//!
+//! Flat shading, as in the thesis ("no lighting or texture mapping"). Each cell is one
+//! warm-up render, then the median of `--repeat` timed renders; renderers (BVH, scene
+//! geometry) are built once per scene, outside the timing.
+
+use std::time::Instant;
+
+use clap::Args;
+use flexcam::projection::{Trilinear, TrilinearMesh};
+use flexcam::render::compare::compare;
+use flexcam::render::raycast::RayCaster;
+use flexcam::render::trilinear::workloads::{fan_grid, random_grid, random_triangles};
+use flexcam::render::trilinear::{CurveOptions, TrilinearRenderer};
+use flexcam::render::{Counter, RenderOptions, Shading};
+use flexcam::scene::{self, Scene};
+use flexcam::Result;
+
+/// Arguments of `flexcam bench trilinear`.
+#[derive(Args, Debug)]
+pub struct TrilinearArgs {
+    /// Timed renders per cell, after one warm-up render; the median is reported.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100))]
+    repeat: u32,
+    /// A fast subset: random scenes of 1 and 640 triangles through 2, 18 and 50 projections
+    /// at 1 and 256^2 pixels, and the cube-floor scene through 2, 18 and 50 projections.
+    #[arg(long)]
+    quick: bool,
+}
+
+/// Side lengths of the square images of appendix D (1 to 640^2 pixels).
+const SIDES: [u32; 6] = [1, 128, 256, 384, 512, 640];
+/// Scene triangle counts of appendix D.
+const SCENE_TRIANGLES: [u32; 6] = [1, 128, 256, 384, 512, 640];
+/// Screen cells per side of the projection meshes: 2, 8, 18, 32, 50 projection triangles.
+const CELLS: [u32; 5] = [1, 2, 3, 4, 5];
+/// The image side of Table 8.1's cube scene.
+const CUBE_SIDE: u32 = 800;
+/// Seed of the random data (fixed: every run times the same scenes).
+const SEED: u64 = 2005;
+
+/// The thesis's times (ms) at 640 triangles and 640^2 pixels through 2 to 50 projections:
+/// ray tracing (D.1), trilinear (D.2), with scene-space clipping (D.3).
+const THESIS_D: [[f64; 5]; 3] = [
+    [57913.0, 71352.0, 69250.0, 55970.0, 64122.0],
+    [62.56, 81.62, 242.40, 414.00, 696.00],
+    [90.92, 127.63, 501.00, 906.50, 1572.00],
+];
+/// Table 8.1, figure 7.4: the cube through 2 to 50 projections at 800 x 800 (ms); ray traced
+/// once (177926 ms).
+const THESIS_CUBE: [f64; 5] = [24.4, 70.1, 150.1, 230.2, 360.7];
+const THESIS_CUBE_RAY: f64 = 177926.0;
+
+/// One cell's medians (ms) and the trilinear stage times of its median render.
+struct Timing {
+    raycast: f64,
+    trilinear: f64,
+    clipped: f64,
+    stages: [f64; 3],
+}
+
+/// Runs the benchmark and prints both tables.
+pub fn run(args: &TrilinearArgs) -> Result<()> {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let (sides, counts, cells): (&[u32], &[u32], &[u32]) = if args.quick {
+        (&[1, 256], &[1, 640], &[1, 3, 5])
+    } else {
+        (&SIDES, &SCENE_TRIANGLES, &CELLS)
+    };
+    println!(
+        "seed 000 chapter 8 / appendix D: flat shading, {threads} threads, median of {} after \
+         one warm-up; raycast = BVH ray caster, trilinear = adaptive curves without / with \
+         scene-space clipping (clip); times in ms",
+        args.repeat
+    );
+    println!("\nTables D.1-D.3: random scenes through random regular screen meshes");
+    println!(
+        "{:>10}{:>7}{:>6}{:>11}{:>11}{:>9}{:>11}{:>9}",
+        "pixels", "tris", "proj", "raycast", "trilinear", "speedup", "clip", "speedup"
+    );
+    for &count in counts {
+        let scene = random_triangles(count, SEED + u64::from(count));
+        let renderers = Renderers::new(&scene);
+        for &side in sides {
+            for &n in cells {
+                let mesh = random_grid(n, SEED + u64::from(n))?;
+                let timing = renderers.time(&mesh, side, args.repeat)?.0;
+                println!(
+                    "{:>10}{count:>7}{:>6}{:>11.2}{:>11.2}{:>8.1}x{:>11.2}{:>8.1}x",
+                    side * side,
+                    mesh.triangles.len(),
+                    timing.raycast,
+                    timing.trilinear,
+                    timing.raycast / timing.trilinear,
+                    timing.clipped,
+                    timing.raycast / timing.clipped,
+                );
+            }
+        }
+    }
+    println!("thesis at 640 triangles, 640^2 pixels (800 MHz Athlon, no acceleration structure):");
+    for (k, n) in CELLS.iter().enumerate() {
+        println!(
+            "{:>10}{:>7}{:>6}{:>11.2}{:>11.2}{:>8.1}x{:>11.2}{:>8.1}x",
+            640 * 640,
+            640,
+            2 * n * n,
+            THESIS_D[0][k],
+            THESIS_D[1][k],
+            THESIS_D[0][k] / THESIS_D[1][k],
+            THESIS_D[2][k],
+            THESIS_D[0][k] / THESIS_D[2][k],
+        );
+    }
+
+    println!(
+        "\nTable 8.1 (figure 7.4): cube-floor, 686 triangles, {CUBE_SIDE} x {CUBE_SIDE}, fan \
+         projection; accuracy of trilinear with clipping against raycast"
+    );
+    println!(
+        "{:>5}{:>10}{:>11}{:>9}{:>10}{:>9}{:>9}{:>9}{:>9}{:>9}{:>11}{:>9}",
+        "proj",
+        "raycast",
+        "trilinear",
+        "speedup",
+        "clip",
+        "speedup",
+        "project",
+        "raster",
+        "shade",
+        "ids",
+        "rgb error",
+        "thesis"
+    );
+    let cube = scene::load("builtin:cube-floor")?;
+    let renderers = Renderers::new(&cube);
+    for &n in cells {
+        let mesh = fan_grid(n)?;
+        let (timing, accuracy) = renderers.time(&mesh, CUBE_SIDE, args.repeat)?;
+        let [project, raster, shade] = timing.stages;
+        let thesis = CELLS
+            .iter()
+            .position(|&c| c == n)
+            .map_or(f64::NAN, |k| THESIS_CUBE[k]);
+        println!(
+            "{:>5}{:>10.2}{:>11.2}{:>8.1}x{:>10.2}{:>8.1}x{project:>9.2}{raster:>9.2}{shade:>9.2}\
+             {:>9.5}{:>11.6}{thesis:>9.1}",
+            mesh.triangles.len(),
+            timing.raycast,
+            timing.trilinear,
+            timing.raycast / timing.trilinear,
+            timing.clipped,
+            timing.raycast / timing.clipped,
+            accuracy.0,
+            accuracy.1,
+        );
+    }
+    println!(
+        "thesis: ray traced {THESIS_CUBE_RAY} ms; stage times are those of the median clipped \
+         render"
+    );
+    Ok(())
+}
+
+/// Both renderers of one scene.
+struct Renderers {
+    caster: RayCaster,
+    trilinear: TrilinearRenderer,
+}
+
+impl Renderers {
+    fn new(scene: &Scene) -> Renderers {
+        Renderers {
+            caster: RayCaster::new(scene),
+            trilinear: TrilinearRenderer::new(scene),
+        }
+    }
+
+    /// Times the three renders of `mesh` at `side x side` pixels, and the id agreement and
+    /// relative RGB error of the clipped trilinear render against the ray caster.
+    fn time(&self, mesh: &TrilinearMesh, side: u32, repeat: u32) -> Result<(Timing, (f64, f64))> {
+        let projection = Trilinear::new(mesh, side, side)?;
+        let options = RenderOptions {
+            shading: Shading::Flat,
+            ..RenderOptions::default()
+        };
+        let (raycast, reference) =
+            median(repeat, || Ok(self.caster.render(&projection, &options).0))?;
+        let trilinear = |curves: CurveOptions| {
+            median(repeat, || {
+                self.trilinear.render(&projection, &options, curves)
+            })
+        };
+        let unclipped = CurveOptions {
+            scene_clipping: false,
+            ..CurveOptions::ADAPTIVE
+        };
+        let (plain, _) = trilinear(unclipped)?;
+        let (clipped, (frame, stats)) = trilinear(CurveOptions::ADAPTIVE)?;
+        let c = compare(&frame, &reference)?;
+        let stage = |name| match stats.get(name) {
+            Some(Counter::Value(ms)) => *ms,
+            _ => f64::NAN,
+        };
+        let timing = Timing {
+            raycast,
+            trilinear: plain,
+            clipped,
+            stages: ["project_ms", "raster_ms", "shade_ms"].map(stage),
+        };
+        Ok((timing, (c.id_agreement, c.relative_rgb_error)))
+    }
+}
+
+/// One warm-up call of `render`, then the median time (ms) of `repeat` timed calls and the
+/// output of the median call.
+fn median<T>(repeat: u32, mut render: impl FnMut() -> Result<T>) -> Result<(f64, T)> {
+    render()?;
+    let mut runs = Vec::with_capacity(repeat as usize);
+    for _ in 0..repeat {
+        let start = Instant::now();
+        let out = render()?;
+        runs.push((start.elapsed().as_secs_f64() * 1e3, out));
+    }
+    runs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let middle = runs.len() / 2;
+    Ok(runs.swap_remove(middle))
+}

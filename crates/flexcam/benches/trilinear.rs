@@ -1,0 +1,54 @@
+//! Trilinear rasterisation (`--method trilinear`) against the ray caster of the same
+//! projection: the cube-floor scene (686 triangles) through the 18-projection fan grid
+//! (`render::trilinear::workloads::fan_grid(3)`) at 800 x 800, flat shading: the speed target
+//! of issue 3 (at least 10x the ray caster, under 33 ms). Both renderers are prepared once
+//! (BVH, scene geometry); each iteration is one frame. `trilinear_frame` uses the default
+//! adaptive curves with scene-space clipping, `trilinear_unclipped` the thesis's cheaper
+//! screen-space clipping only.
+//!
+//! Run with `cargo bench -p flexcam --bench trilinear`. Figures are recorded in
+//! docs/trilinear.md (with `flexcam bench trilinear`, which prints the thesis's tables).
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use flexcam::projection::Trilinear;
+use flexcam::render::raycast::RayCaster;
+use flexcam::render::trilinear::workloads::fan_grid;
+use flexcam::render::trilinear::{CurveOptions, TrilinearRenderer};
+use flexcam::render::{RenderOptions, Shading};
+use flexcam::scene::builtin;
+
+const SIDE: u32 = 800;
+
+fn cube_floor_18(c: &mut Criterion) {
+    let scene = builtin::load("cube-floor").unwrap_or_else(|e| panic!("cube-floor: {e}"));
+    let mesh = fan_grid(3).unwrap_or_else(|e| panic!("fan grid: {e}"));
+    let projection =
+        Trilinear::new(&mesh, SIDE, SIDE).unwrap_or_else(|e| panic!("projection: {e}"));
+    let options = RenderOptions {
+        shading: Shading::Flat,
+        ..RenderOptions::default()
+    };
+    let mut group = c.benchmark_group("trilinear_cube-floor_18_800x800");
+    group.sample_size(10);
+    let renderer = TrilinearRenderer::new(&scene);
+    let unclipped = CurveOptions {
+        scene_clipping: false,
+        ..CurveOptions::ADAPTIVE
+    };
+    for (name, curves) in [
+        ("trilinear_frame", CurveOptions::ADAPTIVE),
+        ("trilinear_unclipped", unclipped),
+    ] {
+        group.bench_function(name, |b| {
+            b.iter(|| renderer.render(&projection, &options, curves))
+        });
+    }
+    let caster = RayCaster::new(&scene);
+    group.bench_function("raycast_frame", |b| {
+        b.iter(|| caster.render(&projection, &options))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, cube_floor_18);
+criterion_main!(benches);

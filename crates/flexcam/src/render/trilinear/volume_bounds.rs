@@ -1,0 +1,226 @@
+//! A safe, conservative cull of scene triangles per projection triangle: bounding planes of
+//! the volume its rays sweep in front of the view plane.
+//!
+//! Every point the renderer draws through a projection triangle is on a ray
+//! `tripoint(u, v) + t trinorm(u, v)` with barycentrics `w = (1 - u - v, u, v) >= 0` and
+//! `t >= 0`, i.e. the point `sum w_k p_k + t sum w_k n_k`. That is a point of the convex set
+//! `P = conv(p1, p2, p3) + cone(n1, n2, n3)`: the swept volume (whose sides are the bilinear
+//! edge surfaces between vertex rays) lies inside `P`. A plane `m . x = c` bounds `P` when
+//! `m . p_k <= c` and `m . n_k <= 0` for all three vertices. A scene triangle whose three
+//! vertices are all strictly beyond one such plane lies wholly outside `P` (a half-space is
+//! convex), so it has no point in the volume and nothing of it can be drawn: the pair is
+//! skipped before any cubic is solved.
+//!
+//! Candidate normals are those of `P`'s possible facets, both orientations: `n_i x n_j`
+//! (two directions), `n_k x (p_j - p_i)` (a direction and a base edge) and the base normal;
+//! each is kept only if it bounds `P` (its `m . n_k` are `<= 0`, up to the rounding of the
+//! terms that vanish analytically).
+//!
+//! Degenerate cases: directions that span more than a half-space (diverging over 180
+//! degrees), or coplanar directions in opposite senses, leave few or no valid planes: then
+//! fewer or no pairs are culled, never a wrong one. Zero or non-finite normals are skipped.
+//! A point is only called outside when beyond the plane by more than [`RELATIVE_MARGIN`]
+//! times its distance scale (so rounding, and the clip's `1e-9` domain margin, never cull a
+//! drawable pair).
+
+use glam::DVec3;
+
+/// How far beyond a plane, relative to the distance from the projection triangle plus the
+/// triangle's size, a point must lie to count as outside.
+pub const RELATIVE_MARGIN: f64 = 1e-7;
+
+/// Largest number of candidate planes: 3 direction pairs, 9 direction-edge pairs and the
+/// base normal, in both orientations.
+const MAX_PLANES: usize = 26;
+
+/// The bounding planes of one projection triangle's ray volume.
+#[derive(Debug, Clone, Copy)]
+pub struct VolumeBounds {
+    /// Unit normals `m` and offsets `c`: the volume is in `m . x <= c`.
+    planes: [(DVec3, f64); MAX_PLANES],
+    count: usize,
+    /// A base point (for the distance scale) and the size of the base triangle.
+    origin: DVec3,
+    size: f64,
+}
+
+impl VolumeBounds {
+    /// The bounds of the triangle with base points `p` and directions `n`.
+    pub fn new(p: [DVec3; 3], n: [DVec3; 3]) -> VolumeBounds {
+        let edges = [p[1] - p[0], p[2] - p[0], p[2] - p[1]];
+        let mut candidates = Vec::with_capacity(MAX_PLANES / 2);
+        for (i, j) in [(0, 1), (0, 2), (1, 2)] {
+            candidates.push(n[i].cross(n[j]));
+        }
+        for direction in n {
+            for edge in edges {
+                candidates.push(direction.cross(edge));
+            }
+        }
+        candidates.push(edges[0].cross(edges[1]));
+        let direction_scale = n.iter().map(|d| d.length()).fold(0.0, f64::max);
+        let mut bounds = VolumeBounds {
+            planes: [(DVec3::ZERO, 0.0); MAX_PLANES],
+            count: 0,
+            origin: p[0],
+            size: edges.iter().map(|e| e.length()).fold(0.0, f64::max),
+        };
+        for m in candidates.into_iter().filter_map(|m| m.try_normalize()) {
+            for m in [m, -m] {
+                // Terms zero in exact arithmetic come out at rounding level.
+                let bounded = n.iter().all(|d| m.dot(*d) <= 1e-12 * direction_scale);
+                if bounded && bounds.count < MAX_PLANES {
+                    let c = p
+                        .iter()
+                        .map(|x| m.dot(*x))
+                        .fold(f64::NEG_INFINITY, f64::max);
+                    bounds.planes[bounds.count] = (m, c);
+                    bounds.count += 1;
+                }
+            }
+        }
+        bounds
+    }
+
+    /// The planes (bit `k` for plane `k`) that `point` lies strictly beyond, by more than the
+    /// margin (module doc). A scene triangle whose vertices' masks have a common bit is
+    /// outside the volume.
+    pub fn outside(&self, point: DVec3) -> u32 {
+        let mut mask = 0;
+        for (k, (m, c)) in self.planes[..self.count].iter().enumerate() {
+            let beyond = m.dot(point) - c;
+            if beyond > 0.0 {
+                let scale = (point - self.origin).length() + self.size;
+                if beyond > RELATIVE_MARGIN * scale {
+                    mask |= 1 << k;
+                }
+            }
+        }
+        mask
+    }
+
+    /// The number of bounding planes found.
+    pub fn len(&self) -> usize {
+        self.count
+    }
+
+    /// Whether no bounding plane was found (nothing can be culled).
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::projection::ProjectionTriangleCache;
+    use proptest::prelude::*;
+
+    fn vec3() -> impl Strategy<Value = DVec3> {
+        (-3.0..3.0f64, -3.0..3.0f64, -3.0..3.0f64).prop_map(|(x, y, z)| DVec3::new(x, y, z))
+    }
+
+    /// A projection triangle: base points near the origin, directions around -z spread by
+    /// `spread` (up to folding and diverging beyond a half-space when large).
+    fn triangle(spread: f64) -> impl Strategy<Value = ([DVec3; 3], [DVec3; 3])> {
+        (
+            [vec3(), vec3(), vec3()],
+            [vec3(), vec3(), vec3()],
+            [0.3..2.0f64, 0.3..2.0f64, 0.3..2.0f64],
+        )
+            .prop_map(move |(p, d, len)| {
+                let p = p.map(|x| 0.3 * x);
+                let n = [0, 1, 2].map(|k| (-DVec3::Z + spread * 0.3 * d[k]) * len[k]);
+                (p, n)
+            })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(400))]
+
+        /// Every point of the swept volume is inside every bounding plane.
+        #[test]
+        fn volume_points_are_never_outside(
+            (p, n) in triangle(1.0),
+            u in 0.0..1.0f64, v in 0.0..1.0f64, t in 0.0..20.0f64,
+        ) {
+            let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
+            let cache = ProjectionTriangleCache::new(p, n);
+            let bounds = VolumeBounds::new(p, n);
+            prop_assert_eq!(bounds.outside(cache.ray_point(u, v, t)), 0);
+        }
+
+        /// The cull against full projection: whenever the three vertices of a random scene
+        /// triangle share an outside plane, no point of the triangle has an image inside the
+        /// projection triangle at `t >= 0` (projected by the cubic on a dense grid of the
+        /// scene triangle, its vertices included).
+        #[test]
+        fn culled_triangles_have_no_visible_image(
+            (p, n) in triangle(2.5),
+            scene in [vec3(), vec3(), vec3()],
+            shift in vec3(),
+        ) {
+            let scene = scene.map(|x| x + 2.0 * shift - 4.0 * DVec3::Z);
+            let bounds = VolumeBounds::new(p, n);
+            let common = scene.iter().fold(u32::MAX, |m, &x| m & bounds.outside(x));
+            if common != 0 {
+                let cache = ProjectionTriangleCache::new(p, n);
+                let steps = 12;
+                for i in 0..=steps {
+                    for j in 0..=steps - i {
+                        let (a, b) = (f64::from(i) / 12.0, f64::from(j) / 12.0);
+                        let x = scene[0] + a * (scene[1] - scene[0]) + b * (scene[2] - scene[0]);
+                        for s in cache.project_point(x).iter() {
+                            let inside = s.t >= 0.0
+                                && s.u >= -1e-9 && s.v >= -1e-9 && s.u + s.v <= 1.0 + 1e-9;
+                            prop_assert!(!inside, "culled point {x} images at {s:?}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_narrow_frustum_is_bounded_on_every_side() {
+        // A perspective-like triangle looking down -z from the origin: points far off to
+        // either side, behind the base or beyond a side are outside; points in front are not.
+        let p = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let n = [
+            DVec3::new(-0.1, -0.1, -1.0),
+            DVec3::new(0.1, -0.1, -1.0),
+            DVec3::new(-0.1, 0.1, -1.0),
+        ];
+        let bounds = VolumeBounds::new(p, n);
+        assert!(bounds.len() >= 4, "{bounds:?}");
+        assert_eq!(bounds.outside(DVec3::new(0.2, 0.2, -3.0)), 0);
+        for far in [
+            DVec3::new(5.0, 0.2, -3.0),
+            DVec3::new(-5.0, 0.2, -3.0),
+            DVec3::new(0.2, 5.0, -3.0),
+            DVec3::new(0.2, 0.2, 3.0),
+        ] {
+            assert_ne!(bounds.outside(far), 0, "{far}");
+        }
+    }
+
+    #[test]
+    fn directions_spanning_more_than_a_half_space_cull_nothing() {
+        // Normals along +x, +y and -x-y-ish (diverging over 180 degrees) with z mixed in:
+        // only planes containing all three directions' half-spaces survive, if any.
+        let p = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let n = [
+            DVec3::new(1.0, 0.0, 0.1),
+            DVec3::new(0.0, 1.0, 0.1),
+            DVec3::new(-1.0, -1.0, 0.1),
+        ];
+        let bounds = VolumeBounds::new(p, n);
+        let cache = ProjectionTriangleCache::new(p, n);
+        for (u, v, t) in [(0.1, 0.1, 50.0), (0.8, 0.1, 30.0), (0.1, 0.8, 70.0)] {
+            assert_eq!(bounds.outside(cache.ray_point(u, v, t)), 0);
+        }
+        // A zero direction gives no plane from it, never a wrong one.
+        let bounds = VolumeBounds::new(p, [DVec3::ZERO, -DVec3::Z, -DVec3::Z]);
+        assert_eq!(bounds.outside(DVec3::new(0.5, 0.2, -2.0)), 0);
+    }
+}
