@@ -11,17 +11,23 @@
 //!
 //! The renderer is a parameter ([`Renderer`]): any method that renders a scene through a
 //! projection, e.g. `|s, p, o| Method::Raycast.render(s, p, o)`, or a faster trilinear one.
-//! In `lit` shading the reflected or refracted colour is tinted by the reflector's base
-//! colour (no Fresnel mixing for glass); in `flat` shading it is taken as is, as the flat
-//! contract asks of mirrors and glass.
+//! In `lit` shading a mirror's reflected colour is tinted by its base colour, and glass mixes
+//! the images through its refraction surface and through a second, reflection surface by the
+//! exact Fresnel reflectance at each pixel, as the ray caster's glass does ([`FresnelSplit`],
+//! [`fresnel_mix`]); in `flat` shading the image through the surface is taken as is, as the
+//! flat contract asks of mirrors and glass (the refraction, or the reflection on total
+//! internal reflection, without Fresnel mixing).
 
 use std::time::Instant;
 
-use glam::Vec3;
+use glam::{DVec2, Vec3};
+use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::projection::surfaces::{reflector_surface, Optic, ReflectorSurface};
 use crate::projection::{Perspective, Projection, ProjectionSpec, Trilinear};
+use crate::render::raycast::{specular, RayCaster};
+use crate::render::surface::normals;
 use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
 use crate::scene::{Mesh, Object, Scene, Surface};
 
@@ -34,7 +40,9 @@ pub type Renderer<'a> =
 /// refractions of `scene.trilinear_reflectors` (none: exactly `renderer`'s image). The stats
 /// are the main render's, plus `reflectors`, `reflector_triangles` (in the surfaces),
 /// `reflector_dropped_triangles` (see [`reflector_surface`]), `reflector_pixels` (main-image
-/// pixels replaced) and `reflector_render_ms` (surface building and rendering).
+/// pixels replaced), `reflector_fresnel_rays` (lit glass: main-camera rays cast at the
+/// reflector alone for the Fresnel split) and `reflector_render_ms` (surface building and
+/// rendering).
 ///
 /// Errors: the renderer's; a scene projection that is not perspective (the main camera);
 /// a reflector id that no object has, or whose material is not mirror or glass.
@@ -56,7 +64,7 @@ pub fn render(
     }
     let (mut frame, mut stats) = renderer(&main_scene, main, options)?;
     let start = Instant::now();
-    let (mut triangles, mut dropped, mut pixels) = (0, 0, 0);
+    let (mut triangles, mut dropped, mut pixels, mut fresnel_rays) = (0, 0, 0, 0);
     for &id in &scene.trilinear_reflectors {
         let reflector = Reflector::of(scene, id)?;
         let surface = reflector_surface(&reflector.mesh, &camera, reflector.optic)?;
@@ -65,17 +73,28 @@ pub fn render(
         let Some(image) = render_through(scene, id, &surface, &camera, options, renderer)? else {
             continue;
         };
-        let tint = match options.shading {
-            Shading::Flat => Vec3::ONE,
-            Shading::Lit => reflector.tint,
+        pixels += match (options.shading, reflector.optic) {
+            (Shading::Flat, _) => paste(&mut frame, id, &image, Vec3::ONE)?,
+            (Shading::Lit, Optic::Reflect) => paste(&mut frame, id, &image, reflector.tint)?,
+            (Shading::Lit, Optic::Refract { .. }) => {
+                let mirror = reflector_surface(&reflector.mesh, &camera, Optic::Reflect)?;
+                let reflection = render_through(scene, id, &mirror, &camera, options, renderer)?
+                    .unwrap_or_else(|| {
+                        Frame::new(image.width, image.height, scene.image.background)
+                    });
+                let split = FresnelSplit::new(scene, id, camera.clone());
+                let mixed = fresnel_mix(&frame, id, &image, &reflection, &split, reflector.tint)?;
+                fresnel_rays += mixed.rays;
+                paste(&mut frame, id, &mixed.frame, Vec3::ONE)?
+            }
         };
-        pixels += paste(&mut frame, id, &image, tint)?;
     }
     let count = |n: usize| Counter::Count(n as u64);
     stats.insert("reflectors", count(scene.trilinear_reflectors.len()));
     stats.insert("reflector_triangles", count(triangles));
     stats.insert("reflector_dropped_triangles", count(dropped));
     stats.insert("reflector_pixels", Counter::Count(pixels));
+    stats.insert("reflector_fresnel_rays", Counter::Count(fresnel_rays));
     stats.insert(
         "reflector_render_ms",
         Counter::Value(start.elapsed().as_secs_f64() * 1e3),
@@ -168,12 +187,7 @@ pub fn render_through(
 /// triangle of the surface covers hold `reflection`'s background. Errors: frames of
 /// different sizes.
 pub fn paste(main: &mut Frame, id: u32, reflection: &Frame, tint: Vec3) -> Result<u64> {
-    if (main.width, main.height) != (reflection.width, reflection.height) {
-        return Err(Error::new(format!(
-            "cannot paste a {}x{} reflection into a {}x{} image",
-            reflection.width, reflection.height, main.width, main.height
-        )));
-    }
+    check_size(main, reflection)?;
     let mut replaced = 0;
     for (k, color) in main.color.iter_mut().enumerate() {
         if main.ids[k] == id {
@@ -182,6 +196,117 @@ pub fn paste(main: &mut Frame, id: u32, reflection: &Frame, tint: Vec3) -> Resul
         }
     }
     Ok(replaced)
+}
+
+/// How a lit glass reflector splits light at one main-image pixel, as the ray caster's glass
+/// does at the pixel's first hit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GlassSplit {
+    /// Refraction weighted `1 - R` (and tinted), reflection weighted `R`: the exact Fresnel
+    /// reflectance `R` at the hit.
+    Fresnel(f32),
+    /// Total internal reflection at the hit: the reflection alone, untinted.
+    TotalReflection,
+    /// The pixel's ray misses the reflector (the main view saw it at a grazing edge that the
+    /// f64 test rejects): the refraction alone, tinted, as without Fresnel.
+    Missed,
+}
+
+/// The Fresnel split of a glass reflector at main-image pixels: the main camera's pixel-centre
+/// ray is intersected exactly with the reflector alone (a ray caster over its parts only),
+/// and the ray caster's own [`specular`] gives the reflectance at the hit, from the
+/// interpolated shading normal and the side the ray arrives from. One primary ray per
+/// reflector pixel; no secondary rays.
+pub struct FresnelSplit {
+    caster: RayCaster,
+    parts: Vec<Object>,
+    camera: Perspective,
+}
+
+impl FresnelSplit {
+    /// The split of reflector `id` of `scene` seen by `camera`.
+    pub fn new(scene: &Scene, id: u32, camera: Perspective) -> FresnelSplit {
+        let mut only = scene.clone();
+        only.objects.retain(|o| o.id == id);
+        FresnelSplit {
+            caster: RayCaster::new(&only),
+            parts: only.objects,
+            camera,
+        }
+    }
+
+    /// The split at the centre of pixel `(x, y)`.
+    pub fn at(&self, x: u32, y: u32) -> GlassSplit {
+        let centre = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+        let Some(ray) = self.camera.ray(centre) else {
+            return GlassSplit::Missed;
+        };
+        let Some(hit) = self.caster.intersect(&ray) else {
+            return GlassSplit::Missed;
+        };
+        let part = &self.parts[hit.object];
+        let seen = normals(part, hit.triangle, hit.barycentric, ray.direction.as_vec3());
+        match specular(&ray, &seen, part.material.surface).fresnel {
+            Some((_, reflectance)) => GlassSplit::Fresnel(reflectance),
+            None => GlassSplit::TotalReflection,
+        }
+    }
+}
+
+/// A lit glass reflector's image in main-image coordinates, and the rays its split cast.
+pub struct FresnelMix {
+    pub frame: Frame,
+    pub rays: u64,
+}
+
+/// At every pixel of `main` that sees object `id`, the ray caster's glass colour made from
+/// the images through the refraction and reflection surfaces: `tint (1 - R) refraction +
+/// R reflection` by the pixel's [`GlassSplit`] (other pixels hold `refraction` unchanged).
+/// Errors: frames of different sizes.
+pub fn fresnel_mix(
+    main: &Frame,
+    id: u32,
+    refraction: &Frame,
+    reflection: &Frame,
+    split: &FresnelSplit,
+    tint: Vec3,
+) -> Result<FresnelMix> {
+    for other in [refraction, reflection] {
+        check_size(main, other)?;
+    }
+    let width = main.width as usize;
+    let mixed: Vec<(Vec3, u64)> = (0..main.ids.len())
+        .into_par_iter()
+        .map(|k| {
+            let (through, mirrored) = (refraction.color[k], reflection.color[k]);
+            if main.ids[k] != id {
+                return (through, 0);
+            }
+            let color = match split.at((k % width) as u32, (k / width) as u32) {
+                GlassSplit::Fresnel(r) => tint * (1.0 - r) * through + r * mirrored,
+                GlassSplit::TotalReflection => mirrored,
+                GlassSplit::Missed => tint * through,
+            };
+            (color, 1)
+        })
+        .collect();
+    let mut frame = refraction.clone();
+    frame.color = mixed.iter().map(|&(c, _)| c).collect();
+    Ok(FresnelMix {
+        frame,
+        rays: mixed.iter().map(|&(_, n)| n).sum(),
+    })
+}
+
+/// Fails unless `other` has `main`'s size.
+fn check_size(main: &Frame, other: &Frame) -> Result<()> {
+    if (main.width, main.height) != (other.width, other.height) {
+        return Err(Error::new(format!(
+            "cannot paste a {}x{} reflection into a {}x{} image",
+            other.width, other.height, main.width, main.height
+        )));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -3,46 +3,20 @@ use std::path::Path;
 use glam::{DVec3, Vec3};
 
 use super::*;
+use crate::projection::surfaces::test_scenes::{lens_plane, sphere_and_cube, BALL, BALL_CENTER};
 use crate::render::compare::{compare, Comparison};
 use crate::render::Method;
 use crate::scene::file;
 
 const SIZE: (u32, u32) = (160, 120);
-const BALL: u32 = 1;
 
-/// The thesis's sphere-reflects-cube (7.4): a mirror sphere, a cube with six face colours
-/// beside it, a checker floor, seen from close to the sphere.
-const SPHERE_AND_CUBE: &str = r#"
-    [image]
-    background = [0.3, 0.4, 0.6]
-    [projection]
-    type = "perspective"
-    position = [0.4, 1.4, 2.6]
-    look_at = [0.0, 1.0, 0.0]
-    fov = 60.0
-    [[object]]
-    name = "ball"
-    shape = "sphere"
-    size = 1.0
-    tessellation = 32
-    material = "mirror"
-    translate = [0.0, 1.0, 0.0]
-    [[object]]
-    shape = "box"
-    size = [1.2, 1.2, 1.2]
-    face_colors = [[0.9, 0.15, 0.1], [0.1, 0.75, 0.8], [0.2, 0.8, 0.2],
-                   [0.8, 0.2, 0.8], [0.15, 0.3, 0.9], [0.95, 0.8, 0.1]]
-    translate = [1.6, 0.6, 1.6]
-    rotate = [0.0, 30.0, 0.0]
-    [[object]]
-    shape = "plane"
-    size = [12.0, 12.0]
-    color = [0.9, 0.9, 0.9]
-    checker = { color = [0.1, 0.1, 0.1], size = 1.0 }
-"#;
-
+/// The shared sphere-and-cube fixture with the 32-segment sphere as a trilinear reflector.
 fn scene() -> Scene {
-    let mut scene = file::parse(SPHERE_AND_CUBE, Path::new("sphere-and-cube.toml")).unwrap();
+    sphere_and_cube_reflector(32)
+}
+
+fn sphere_and_cube_reflector(segments: u32) -> Scene {
+    let mut scene = sphere_and_cube(segments);
     scene.trilinear_reflectors = vec![BALL];
     scene
 }
@@ -94,9 +68,14 @@ fn agreement(frame: &Frame, reference: &Frame, id: u32) -> (Comparison, f64) {
 
 /// The plain ray-cast image with the reflector as a true mirror (or glass).
 fn reference(scene: &Scene, main: &dyn Projection) -> Frame {
+    reference_with(scene, main, &flat())
+}
+
+/// [`reference`] with other render options.
+fn reference_with(scene: &Scene, main: &dyn Projection, options: &RenderOptions) -> Frame {
     let mut plain = scene.clone();
     plain.trilinear_reflectors.clear();
-    raycast(&plain, main, &flat()).unwrap().0
+    raycast(&plain, main, options).unwrap().0
 }
 
 /// The composite made from `surface` (possibly broken on purpose).
@@ -174,7 +153,7 @@ fn broken_surfaces_fail_the_agreement() {
     assert!(good_same >= MIN_SAME_COLOUR);
 
     let eye = camera.basis().origin;
-    let center = DVec3::new(0.0, 1.0, 0.0);
+    let center = BALL_CENTER;
     let mut wrong_sign = good.clone();
     // The thesis's Eq. 7.6 as printed: r = 2 (n.i) n - i.
     wrong_sign.mesh.normals.iter_mut().for_each(|r| *r = -*r);
@@ -217,10 +196,10 @@ fn broken_surfaces_fail_the_agreement() {
     }
 }
 
-/// The thesis's lens (7.4, Figure 7.6): a 5 x 5-cell plane whose vertex normals radiate from
-/// a point below it, as glass (one refracting surface), over the checker floor.
-#[test]
-fn lens_composite_matches_ray_cast_glass() {
+/// The thesis's lens (7.4, Figure 7.6): the fixtures' 5 x 5-cell plane whose vertex normals
+/// radiate from a point below it, as glass (one refracting surface), over the checker floor;
+/// object id 1 is the lens, composited as a trilinear reflector.
+fn lens_scene() -> Scene {
     let text = r#"
         [image]
         background = [0.3, 0.4, 0.6]
@@ -248,24 +227,14 @@ fn lens_composite_matches_ray_cast_glass() {
     "#;
     let mut scene = file::parse(text, Path::new("lens.toml")).unwrap();
     // Replace the placeholder sphere by the lens plane at y = 1.2.
-    let mut lens = Mesh::default();
-    for j in 0..6 {
-        for i in 0..6 {
-            let p = Vec3::new(-1.0 + 0.4 * i as f32, 1.2, -1.0 + 0.4 * j as f32);
-            lens.positions.push(p);
-            lens.normals
-                .push((p - Vec3::new(0.0, -1.0, 0.0)).normalize());
-        }
-    }
-    for j in 0..5 {
-        for i in 0..5 {
-            let a = j * 6 + i;
-            lens.triangles.push([a, a + 6, a + 7]);
-            lens.triangles.push([a, a + 7, a + 1]);
-        }
-    }
-    scene.objects[0].mesh = lens;
+    scene.objects[0].mesh = lens_plane(1.2, 2.2);
     scene.trilinear_reflectors = vec![1];
+    scene
+}
+
+#[test]
+fn lens_composite_matches_ray_cast_glass() {
+    let scene = lens_scene();
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let reference = reference(&scene, main.as_ref());
     let (frame, _) = render(&scene, main.as_ref(), &flat(), &raycast).unwrap();
@@ -281,6 +250,82 @@ fn lens_composite_matches_ray_cast_glass() {
         "{}",
         c.relative_rgb_error
     );
+}
+
+/// Lit glass mixes reflection and refraction by the exact Fresnel reflectance, as the ray
+/// caster's glass does: on the lens's pixels the composite agrees with the ray-cast glass
+/// within the flat tests' RGB threshold, and clearly better than the tinted refraction alone
+/// (what the composite did before Fresnel mixing).
+#[test]
+fn lit_glass_mixes_reflection_and_refraction_by_fresnel() {
+    let scene = lens_scene();
+    let lit = RenderOptions::default();
+    let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
+    let reference = reference_with(&scene, main.as_ref(), &lit);
+    let (frame, stats) = render(&scene, main.as_ref(), &lit, &raycast).unwrap();
+    let (fresnel, _) = agreement(&frame, &reference, 1);
+
+    // Refraction alone, tinted: the main view with the lens diffuse, the refraction pasted.
+    let camera = main_camera(&scene, main.as_ref()).unwrap();
+    let lens = Reflector::of(&scene, 1).unwrap();
+    let refraction = reflector_surface(&lens.mesh, &camera, lens.optic).unwrap();
+    let mut plain = scene.clone();
+    plain.trilinear_reflectors.clear();
+    plain.objects[0].material.surface = Surface::Diffuse;
+    let mut alone = raycast(&plain, main.as_ref(), &lit).unwrap().0;
+    let image = render_through(&scene, 1, &refraction, &camera, &lit, &raycast)
+        .unwrap()
+        .unwrap();
+    paste(&mut alone, 1, &image, lens.tint).unwrap();
+    let (refraction_only, _) = agreement(&alone, &reference, 1);
+    println!(
+        "lit lens: {} pixels, relative RGB error {:.4} with Fresnel, {:.4} refraction only",
+        fresnel.pixels, fresnel.relative_rgb_error, refraction_only.relative_rgb_error
+    );
+    assert!(
+        fresnel.relative_rgb_error <= MAX_RGB_ERROR,
+        "{}",
+        fresnel.relative_rgb_error
+    );
+    assert!(
+        fresnel.relative_rgb_error < 0.5 * refraction_only.relative_rgb_error,
+        "{} vs {}",
+        fresnel.relative_rgb_error,
+        refraction_only.relative_rgb_error
+    );
+    assert_eq!(
+        stats.get("reflector_fresnel_rays"),
+        Some(&Counter::Count(fresnel.pixels))
+    );
+}
+
+/// The split is the ray caster's: at the pixel looking straight down the lens's central
+/// normal the reflectance is ((1.5 - 1) / (1.5 + 1))^2 = 0.04, larger at oblique pixels,
+/// and a pixel beside the lens misses it.
+#[test]
+fn fresnel_split_is_the_exact_reflectance_at_the_hit() {
+    let mut scene = lens_scene();
+    // Look straight down the lens's central normal (flat shading normal there: +y).
+    scene.projection = ProjectionSpec::Perspective {
+        frame: crate::projection::CameraFrame {
+            position: DVec3::new(0.0, 4.0, 0.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::NEG_Z,
+        },
+        fov: 60.0,
+    };
+    let main = scene.projection.build(101, 101).unwrap();
+    let camera = main_camera(&scene, main.as_ref()).unwrap();
+    let split = FresnelSplit::new(&scene, 1, camera);
+    let GlassSplit::Fresnel(centre) = split.at(50, 50) else {
+        panic!("the centre pixel sees the lens");
+    };
+    assert!((centre - 0.04).abs() < 1e-4, "{centre}");
+    let GlassSplit::Fresnel(oblique) = split.at(50, 70) else {
+        panic!("an oblique pixel sees the lens");
+    };
+    assert!(oblique > centre, "{oblique} vs {centre}");
+    assert_eq!(split.at(0, 0), GlassSplit::Missed);
 }
 
 #[test]
@@ -337,10 +382,7 @@ fn bad_reflectors_are_errors() {
 fn finer_reflectors_agree_better() {
     let mut errors = Vec::new();
     for segments in [8, 16, 64] {
-        let text =
-            SPHERE_AND_CUBE.replace("tessellation = 32", &format!("tessellation = {segments}"));
-        let mut scene = file::parse(&text, Path::new("sphere-and-cube.toml")).unwrap();
-        scene.trilinear_reflectors = vec![BALL];
+        let scene = sphere_and_cube_reflector(segments);
         let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
         let reference = reference(&scene, main.as_ref());
         let (frame, _) = render(&scene, main.as_ref(), &flat(), &raycast).unwrap();

@@ -159,6 +159,23 @@ impl<const N: usize> PolygonBatch<N> {
         }));
     }
 
+    /// The same shapes moved by `offset` pixels (depths and attributes unchanged): drawing
+    /// them samples the original shapes at pixel position `(x, y) + 0.5 - offset` instead of
+    /// the pixel centre, which is how a supersampling renderer places its samples.
+    pub fn translated(&self, offset: DVec2) -> PolygonBatch<N> {
+        PolygonBatch {
+            vertices: self
+                .vertices
+                .iter()
+                .map(|v| Vertex {
+                    position: v.position + offset,
+                    ..*v
+                })
+                .collect(),
+            shapes: self.shapes.clone(),
+        }
+    }
+
     pub fn len(&self) -> usize {
         self.shapes.len()
     }

@@ -18,6 +18,9 @@ use std::time::Instant;
 
 use glam::{DVec3, Vec2, Vec3};
 
+pub(crate) use self::sampling::SamplePattern;
+pub(crate) use self::shade::specular;
+
 use self::bvh::Bvh;
 use self::triangle::FastRay;
 use crate::geometry::{intersect_triangle, Ray};

@@ -87,12 +87,12 @@ pub(super) struct Tracer<'a> {
 }
 
 /// Where a specular surface sends a ray.
-struct Specular {
+pub(crate) struct Specular {
     /// The path flat shading follows: the mirror reflection, the refraction, or the
     /// reflection on total internal reflection.
-    main: DVec3,
+    pub main: DVec3,
     /// With a refraction: the reflected direction and the Fresnel reflectance.
-    fresnel: Option<(DVec3, f32)>,
+    pub fresnel: Option<(DVec3, f32)>,
 }
 
 /// The start of a secondary ray: a surface point, its geometric normal, and how many
@@ -264,7 +264,7 @@ impl<'a> Tracer<'a> {
                 break;
             }
             let normals = self.normals(&ray, &hit);
-            let direction = self.specular(&ray, &normals, object.material.surface).main;
+            let direction = specular(&ray, &normals, object.material.surface).main;
             ray = self
                 .caster
                 .spawn(ray.at(hit.t), normals.geometric.as_dvec3(), direction);
@@ -292,7 +292,7 @@ impl<'a> Tracer<'a> {
             Surface::Emissive => base,
             Surface::Diffuse => self.direct(ray, position, &normals, base),
             surface => {
-                let specular = self.specular(ray, &normals, surface);
+                let specular = specular(ray, &normals, surface);
                 let main_weight = match (surface, specular.fresnel) {
                     (Surface::Mirror, _) => base,
                     (_, Some((_, reflectance))) => base * (1.0 - reflectance),
@@ -377,30 +377,31 @@ impl<'a> Tracer<'a> {
             ray.direction.as_vec3(),
         )
     }
+}
 
-    /// Where `surface` sends `ray`: a mirror reflects; glass refracts and also reflects by
-    /// its Fresnel reflectance, or only reflects on total internal reflection.
-    fn specular(&self, ray: &Ray, normals: &Normals, surface: Surface) -> Specular {
-        let direction = ray.direction.normalize();
-        let normal = normals.shading.as_dvec3();
-        let reflected = reflect(direction, normal);
-        let refracted = match surface {
-            Surface::Glass { ior } => {
-                let ior = ior as f64;
-                let eta = if normals.front_face { 1.0 / ior } else { ior };
-                refract(direction, normal, eta)
-            }
-            _ => None,
-        };
-        match refracted {
-            Some(r) => Specular {
-                main: r.direction,
-                fresnel: Some((reflected, r.reflectance as f32)),
-            },
-            None => Specular {
-                main: reflected,
-                fresnel: None,
-            },
+/// Where `surface` sends `ray` (seen with `normals`): a mirror reflects; glass refracts and
+/// also reflects by its Fresnel reflectance, or only reflects on total internal reflection.
+/// Shared with the trilinear composites (`render::composite`), which mix the same way.
+pub(crate) fn specular(ray: &Ray, normals: &Normals, surface: Surface) -> Specular {
+    let direction = ray.direction.normalize();
+    let normal = normals.shading.as_dvec3();
+    let reflected = reflect(direction, normal);
+    let refracted = match surface {
+        Surface::Glass { ior } => {
+            let ior = ior as f64;
+            let eta = if normals.front_face { 1.0 / ior } else { ior };
+            refract(direction, normal, eta)
         }
+        _ => None,
+    };
+    match refracted {
+        Some(r) => Specular {
+            main: r.direction,
+            fresnel: Some((reflected, r.reflectance as f32)),
+        },
+        None => Specular {
+            main: reflected,
+            fresnel: None,
+        },
     }
 }

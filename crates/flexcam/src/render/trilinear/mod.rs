@@ -30,7 +30,7 @@ pub mod workloads;
 
 use std::time::Instant;
 
-use glam::Vec3;
+use glam::{DVec2, Vec3};
 use rayon::prelude::*;
 
 pub use curves::{CurveMode, CurveOptions};
@@ -39,13 +39,13 @@ use self::outline::ProjectionTriangle;
 use self::polygons::{project_scene, PairCounts};
 use self::scene_geometry::SceneGeometry;
 use self::screen_map::ScreenMap;
-use self::shade::{Resolver, Shader};
+use self::shade::{Resolver, ShadeCounts, Shader};
 use crate::error::{Error, Result};
 use crate::projection::{Projection, Trilinear};
 use crate::render::raster::{
-    rasterize_parallel_resolved, FillRule, PolygonBatch, Target, BAND_ROWS,
+    rasterize_parallel_resolved, FillRule, PolygonBatch, RasterStats, Target, BAND_ROWS,
 };
-use crate::render::raycast::RayCaster;
+use crate::render::raycast::{RayCaster, SamplePattern};
 use crate::render::{Counter, Frame, RenderOptions, Stats};
 use crate::scene::Scene;
 
@@ -66,21 +66,18 @@ impl TrilinearRenderer {
         }
     }
 
-    /// Renders the scene through `projection` with `curves`. Errors: more than one sample
-    /// per pixel (the rasteriser samples pixel centres only), a mesh of more than 2^32
-    /// projection triangles or a scene of more than 2^32 triangles (the fragment keys).
+    /// Renders the scene through `projection` with `curves`. With `options.spp` samples
+    /// per pixel (0 counts as 1) the polygons are projected once and rasterised, resolved
+    /// and shaded once per sample of the ray caster's pattern (`SamplePattern`): the pixel
+    /// averages its samples' colours and reports the depth and id of the sample nearest its
+    /// centre, as the ray caster does. Errors: a mesh of more than 2^32 projection triangles
+    /// or a scene of more than 2^32 triangles (the fragment keys).
     pub fn render(
         &self,
         projection: &Trilinear,
         options: &RenderOptions,
         curves: CurveOptions,
     ) -> Result<(Frame, Stats)> {
-        if options.spp != 1 {
-            return Err(Error::new(format!(
-                "the trilinear method renders one sample per pixel, got --spp {}",
-                options.spp
-            )));
-        }
         let mesh = projection.mesh();
         if u32::try_from(mesh.triangles.len()).is_err()
             || u32::try_from(self.scene.triangles.len()).is_err()
@@ -122,31 +119,51 @@ impl TrilinearRenderer {
         let project_ms = start.elapsed().as_secs_f64() * 1e3;
 
         let maps: Vec<ScreenMap> = triangles.iter().map(|t| t.map).collect();
-        let resolver = Resolver {
-            maps: &maps,
-            scene: &self.scene,
-        };
-        let mut target = Target::new(width, height, self.background);
-        let raster = rasterize_parallel_resolved(
-            &mut target,
-            &polygons,
-            FillRule::NonZero,
-            BAND_ROWS,
-            &|f| resolver.stage(f),
-            &|_| Vec3::ZERO,
-        );
-        let raster_ms = start.elapsed().as_secs_f64() * 1e3 - project_ms;
+        let pattern = SamplePattern::new(options.spp);
+        let mut samples = Samples::new(width, height, &pattern);
+        let mut raster = RasterStats::default();
+        let (mut raster_ms, mut shade_ms) = (0.0, 0.0);
+        for &sample in &pattern.offsets {
+            let pass = Instant::now();
+            let resolver = Resolver {
+                maps: &maps,
+                scene: &self.scene,
+                sample,
+            };
+            // Pixel centres of the moved polygons are the samples of the original ones.
+            let shift = DVec2::splat(0.5) - sample;
+            let moved;
+            let batch = if shift == DVec2::ZERO {
+                &polygons
+            } else {
+                moved = polygons.translated(shift);
+                &moved
+            };
+            let mut target = Target::new(width, height, self.background);
+            raster.add(&rasterize_parallel_resolved(
+                &mut target,
+                batch,
+                FillRule::NonZero,
+                BAND_ROWS,
+                &|f| resolver.stage(f),
+                &|_| Vec3::ZERO,
+            ));
+            let rasterised = pass.elapsed().as_secs_f64() * 1e3;
+            raster_ms += rasterised;
 
-        let shader = Shader {
-            resolver,
-            caster: &self.caster,
-            projection,
-            options,
-            fallback: &fallback,
-            background: self.background,
-        };
-        let (frame, shaded) = shader.frame(&target);
-        let total_ms = start.elapsed().as_secs_f64() * 1e3;
+            let shader = Shader {
+                resolver,
+                caster: &self.caster,
+                projection,
+                options,
+                fallback: &fallback,
+                background: self.background,
+            };
+            let (frame, counts) = shader.frame(&target);
+            samples.add(frame, counts);
+            shade_ms += pass.elapsed().as_secs_f64() * 1e3 - rasterised;
+        }
+        let (frame, shaded) = samples.finish();
 
         let mut stats = Stats::new();
         counts.record(&mut stats);
@@ -163,10 +180,55 @@ impl TrilinearRenderer {
         stats.insert("curve_steps", Counter::Count(u64::from(curves.steps)));
         stats.insert("project_ms", Counter::Value(project_ms));
         stats.insert("raster_ms", Counter::Value(raster_ms));
-        stats.insert(
-            "shade_ms",
-            Counter::Value(total_ms - project_ms - raster_ms),
-        );
+        stats.insert("shade_ms", Counter::Value(shade_ms));
         Ok((frame, stats))
+    }
+}
+
+/// The frames of the samples of one render, reduced as the ray caster reduces its samples:
+/// colours averaged, depth and id of the sample nearest the pixel centre.
+struct Samples {
+    color: Vec<Vec3>,
+    count: u32,
+    centre: usize,
+    kept: Option<Frame>,
+    counts: ShadeCounts,
+    size: (u32, u32),
+}
+
+impl Samples {
+    fn new(width: u32, height: u32, pattern: &SamplePattern) -> Samples {
+        Samples {
+            color: vec![Vec3::ZERO; width as usize * height as usize],
+            count: 0,
+            centre: pattern.centre,
+            kept: None,
+            counts: ShadeCounts::default(),
+            size: (width, height),
+        }
+    }
+
+    /// Adds the next sample's frame (samples come in pattern order).
+    fn add(&mut self, frame: Frame, counts: ShadeCounts) {
+        for (sum, c) in self.color.iter_mut().zip(&frame.color) {
+            *sum += *c;
+        }
+        if self.count as usize == self.centre {
+            self.kept = Some(frame);
+        }
+        self.count += 1;
+        self.counts = self.counts.plus(counts);
+    }
+
+    /// The pixel frame and the rays all samples cast.
+    fn finish(self) -> (Frame, ShadeCounts) {
+        let scale = 1.0 / self.count.max(1) as f32;
+        let mut frame = self
+            .kept
+            .unwrap_or_else(|| Frame::new(self.size.0, self.size.1, Vec3::ZERO));
+        if self.count > 1 {
+            frame.color = self.color.iter().map(|c| *c * scale).collect();
+        }
+        (frame, self.counts)
     }
 }

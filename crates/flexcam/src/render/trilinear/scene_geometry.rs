@@ -31,7 +31,13 @@ pub struct SceneGeometry {
     /// Per triangle, the edges `<V1V2, V1V3, V2V3>` (bits 0, 1, 2) that another triangle
     /// shares (same end positions, any object): the surface continues across them.
     pub shared_edges: Vec<u8>,
+    /// Per triangle and edge `<V1V2, V1V3, V2V3>`, a triangle across it ([`NO_NEIGHBOUR`]
+    /// where none shares the edge; where several do, the first in triangle order).
+    pub neighbours: Vec<[u32; 3]>,
 }
+
+/// The entry of [`SceneGeometry::neighbours`] for an edge no other triangle shares.
+pub const NO_NEIGHBOUR: u32 = u32::MAX;
 
 /// The edges `<V1V2, V1V3, V2V3>` as vertex pairs.
 const EDGES: [(usize, usize); 3] = [(0, 1), (0, 2), (1, 2)];
@@ -61,19 +67,40 @@ impl SceneGeometry {
                 });
             }
         }
-        let mut uses: HashMap<[u64; 6], u32> = HashMap::new();
+        // The first two triangles using each edge.
+        let mut users: HashMap<[u64; 6], [u32; 2]> = HashMap::new();
         for k in 0..out.triangles.len() {
             let c = out.corners(k);
             for (i, j) in EDGES {
-                *uses.entry(edge_key(c[i], c[j])).or_default() += 1;
+                let entry = users
+                    .entry(edge_key(c[i], c[j]))
+                    .or_insert([NO_NEIGHBOUR; 2]);
+                if entry[0] == NO_NEIGHBOUR {
+                    entry[0] = k as u32;
+                } else if entry[1] == NO_NEIGHBOUR {
+                    entry[1] = k as u32;
+                }
             }
         }
-        out.shared_edges = (0..out.triangles.len())
+        out.neighbours = (0..out.triangles.len())
             .map(|k| {
                 let c = out.corners(k);
-                EDGES.iter().enumerate().fold(0, |mask, (bit, &(i, j))| {
-                    let shared = uses[&edge_key(c[i], c[j])] > 1;
-                    mask | (u8::from(shared) << bit)
+                EDGES.map(|(i, j)| {
+                    let [a, b] = users[&edge_key(c[i], c[j])];
+                    if a == k as u32 {
+                        b
+                    } else {
+                        a
+                    }
+                })
+            })
+            .collect();
+        out.shared_edges = out
+            .neighbours
+            .iter()
+            .map(|across| {
+                (0..3).fold(0, |mask, bit| {
+                    mask | (u8::from(across[bit] != NO_NEIGHBOUR) << bit)
                 })
             })
             .collect();

@@ -3,7 +3,7 @@
 //!
 //! A fragment's key names its projection triangle and scene triangle. Its depth and scene
 //! barycentrics are not interpolated over the polygon (the map from screen to scene is not
-//! affine, so interpolation would be wrong inside every curved shape): the pixel centre's
+//! affine, so interpolation would be wrong inside every curved shape): the pixel sample's
 //! projector is intersected with the scene triangle's plane, in f64 ([`Resolver::hit`]).
 //!
 //! - Inside the triangle at `t >= 0`: an **exact** fragment; the z-test compares exact ray
@@ -11,12 +11,17 @@
 //!   writes for the same projector.
 //! - Outside it across an edge no other triangle shares (a silhouette): discarded, so a
 //!   chord that bulges outside the true curved edge draws nothing wrong.
-//! - Outside it only across edges another triangle shares: a **crack filler**, shaded at the
-//!   nearest point of the triangle (barycentrics clamped) with its depth pushed behind every
-//!   exact fragment (`+ CRACK_FILL_DEPTH`). Where a chord cuts inside the curve, the pixels
-//!   between them belong to the neighbour, whose own chord bulges over them but whose exact
-//!   test rejects them; without fillers they would be cracks in a continuous surface. A
-//!   filler never hides an exact fragment.
+//! - Outside it only across edges another triangle shares, inside the **neighbour** across
+//!   one of them: an exact fragment of the neighbour (its key is rewritten). Where a chord
+//!   cuts inside a curved edge, the pixels between chord and curve belong to the neighbour,
+//!   whose own polygon misses them, while this triangle's chord bulges over them.
+//! - Outside it only across shared edges and outside those neighbours too (a pixel near a
+//!   vertex where several triangles meet): a **crack filler**, shaded at the nearest point
+//!   of the triangle (barycentrics clamped) with its depth pushed behind every exact
+//!   fragment (`+ CRACK_FILL_DEPTH`), so that it never hides an exact fragment.
+//!   Before the neighbour step the fillers did all of this, and where the true surface's
+//!   pixel was left to a filler, a farther surface's exact fragment (the far side of the
+//!   same object) won it: 4 such pixels in scenes/trilinear-fan.toml.
 //! - Behind the view plane, or a projector parallel to the plane: discarded.
 //!
 //! Shading is deferred to one pass over the pixels, so that each pixel is shaded once: the
@@ -44,22 +49,33 @@ const CRACK_FILL_DEPTH: f64 = 1e200;
 pub struct Resolver<'a> {
     pub maps: &'a [ScreenMap],
     pub scene: &'a SceneGeometry,
+    /// Where in each pixel this pass samples, in `[0, 1)^2` (`(0.5, 0.5)`: the centre). The
+    /// polygons of the pass are drawn moved so that their pixel centres are these samples
+    /// (see `PolygonBatch::translated`).
+    pub sample: DVec2,
 }
 
-/// A fragment's hit: the projector, the ray parameter, the barycentrics (clamped into the
-/// triangle for a crack filler) and whether it is exact.
+/// A fragment's hit: the projector, the key of the triangle hit (the fragment's own, or a
+/// neighbour's), the ray parameter, the barycentrics (clamped into the triangle for a crack
+/// filler) and whether it is exact.
 #[derive(Debug, Clone, Copy)]
 pub struct FragmentHit {
     pub ray: Ray,
+    pub key: u64,
     pub t: f64,
     pub barycentric: DVec2,
     pub exact: bool,
 }
 
 impl Resolver<'_> {
+    /// The image position of pixel `(x, y)`'s sample.
+    pub fn position(&self, x: u32, y: u32) -> DVec2 {
+        DVec2::new(f64::from(x), f64::from(y)) + self.sample
+    }
+
     /// The hit of the projector through pixel position `pixel` of the projection triangle
-    /// named by `key` with the scene triangle named by `key`; `None` for a discarded
-    /// fragment (module doc).
+    /// named by `key` with the scene triangle named by `key`, or with a neighbour of it
+    /// (module doc); `None` for a discarded fragment.
     pub fn hit(&self, key: u64, pixel: DVec2) -> Option<FragmentHit> {
         let map = self.maps.get((key >> 32) as usize)?;
         let k = (key & u64::from(u32::MAX)) as usize;
@@ -68,31 +84,58 @@ impl Resolver<'_> {
         if t < 0.0 {
             return None;
         }
-        // Edges crossed: u < 0 is outside V1V3, v < 0 outside V1V2, u + v > 1 outside V2V3.
-        let outside = u8::from(v < 0.0) | (u8::from(u < 0.0) << 1) | (u8::from(u + v > 1.0) << 2);
+        let outside = outside_edges(u, v);
+        if outside == 0 {
+            return Some(FragmentHit {
+                ray,
+                key,
+                t,
+                barycentric: DVec2::new(u, v),
+                exact: true,
+            });
+        }
         if outside & !self.scene.shared_edges[k] != 0 {
             return None;
         }
-        let barycentric = if outside == 0 {
-            DVec2::new(u, v)
-        } else {
-            clamp_to_triangle(u, v)
-        };
+        // Across a shared edge: the pixel may be the neighbour's, missed by the neighbour's
+        // own polygon where its chord cuts inside the curved edge.
+        let across = self.scene.neighbours[k];
+        for edge in (0..3).filter(|e| outside & (1 << e) != 0) {
+            let n = across[edge] as usize;
+            let Some((t, u, v)) = plane_hit(&ray, self.scene.corners(n)) else {
+                continue;
+            };
+            if t >= 0.0 && outside_edges(u, v) == 0 {
+                return Some(FragmentHit {
+                    ray,
+                    key: (key & !u64::from(u32::MAX)) | n as u64,
+                    t,
+                    barycentric: DVec2::new(u, v),
+                    exact: true,
+                });
+            }
+        }
         Some(FragmentHit {
             ray,
+            key,
             t,
-            barycentric,
-            exact: outside == 0,
+            barycentric: clamp_to_triangle(u, v),
+            exact: false,
         })
     }
 
     /// The stage of the rasteriser: the fragment's depth, or `false` to discard it.
     pub fn stage(&self, fragment: &mut Fragment<0>) -> bool {
-        let centre = pixel_centre(fragment.x, fragment.y);
-        match self.hit(fragment.primitive, centre) {
+        let at = self.position(fragment.x, fragment.y);
+        match self.hit(fragment.primitive, at) {
             Some(hit) => {
                 let behind = if hit.exact { 0.0 } else { CRACK_FILL_DEPTH };
                 fragment.varying.depth = hit.t + behind;
+                if hit.key != fragment.primitive {
+                    fragment.primitive = hit.key;
+                    fragment.object =
+                        self.scene.owners[(hit.key & u64::from(u32::MAX)) as usize].id;
+                }
                 true
             }
             None => false,
@@ -114,6 +157,13 @@ fn plane_hit(ray: &Ray, [a, b, c]: [DVec3; 3]) -> Option<(f64, f64, f64)> {
     (det != 0.0 && u.is_finite() && v.is_finite() && t.is_finite()).then_some((t, u, v))
 }
 
+/// The edges of a triangle that a point with barycentrics `(u, v)` lies beyond, as bits of
+/// `<V1V2, V1V3, V2V3>`: `v < 0` is beyond V1V2, `u < 0` beyond V1V3, `u + v > 1` beyond
+/// V2V3. 0 for a point inside or on the boundary.
+fn outside_edges(u: f64, v: f64) -> u8 {
+    u8::from(v < 0.0) | (u8::from(u < 0.0) << 1) | (u8::from(u + v > 1.0) << 2)
+}
+
 /// The barycentrics of the point of the triangle nearest (in barycentric space) to `(u, v)`.
 fn clamp_to_triangle(u: f64, v: f64) -> DVec2 {
     let (u, v) = (u.max(0.0), v.max(0.0));
@@ -123,10 +173,6 @@ fn clamp_to_triangle(u: f64, v: f64) -> DVec2 {
     } else {
         DVec2::new(u, v)
     }
-}
-
-fn pixel_centre(x: u32, y: u32) -> DVec2 {
-    DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5)
 }
 
 /// Rays cast while shading.
@@ -139,7 +185,7 @@ pub struct ShadeCounts {
 }
 
 impl ShadeCounts {
-    fn plus(self, o: ShadeCounts) -> ShadeCounts {
+    pub fn plus(self, o: ShadeCounts) -> ShadeCounts {
         ShadeCounts {
             shading_rays: self.shading_rays + o.shading_rays,
             fallback_rays: self.fallback_rays + o.fallback_rays,
@@ -201,16 +247,16 @@ impl Shader<'_> {
 
     fn in_fallback(&self, x: u32, y: u32) -> bool {
         self.projection
-            .locate(pixel_centre(x, y))
+            .locate(self.resolver.position(x, y))
             .is_some_and(|(triangle, _, _)| self.fallback[triangle])
     }
 
     /// The pixel's winning fragment, shaded; `None` where nothing was drawn.
     fn rasterised(&self, target: &Target, x: u32, y: u32) -> Option<Pixel> {
         let key = target.primitive(x, y)?;
-        let found = self.resolver.hit(key, pixel_centre(x, y))?;
+        let found = self.resolver.hit(key, self.resolver.position(x, y))?;
         let ray = found.ray;
-        let owner = self.resolver.scene.owners[(key & u64::from(u32::MAX)) as usize];
+        let owner = self.resolver.scene.owners[(found.key & u64::from(u32::MAX)) as usize];
         let hit = Hit {
             t: found.t,
             object: owner.object as usize,
@@ -231,7 +277,7 @@ impl Shader<'_> {
 
     /// The pixel ray cast like the reference renderer does it.
     fn cast(&self, x: u32, y: u32) -> Option<Pixel> {
-        let ray = self.projection.ray(pixel_centre(x, y))?;
+        let ray = self.projection.ray(self.resolver.position(x, y))?;
         let counts = ShadeCounts {
             shading_rays: 0,
             fallback_rays: 1,

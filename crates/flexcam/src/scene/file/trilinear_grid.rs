@@ -59,7 +59,10 @@ pub(super) fn convert(required: &Required, cells: &Spanned<u32>) -> Result<Trili
             };
             src.reject_foreign_key(present, keys, &format!("view \"{name}\""))?;
             if name == "detail_in_context" {
-                let camera = camera(src, required.get(&raw.camera, "camera")?)?;
+                let table = required.get(&raw.camera, "camera")?;
+                let (camera, frame) = camera(src, table)?;
+                // The magnification holds at the camera's look-at distance.
+                let distance = frame.look_at.distance(frame.position);
                 let focus = match &raw.focus {
                     Some(f) => DVec2::from_array(src.vector(f, "focus")?),
                     None => DVec2::splat(0.5),
@@ -72,20 +75,22 @@ pub(super) fn convert(required: &Required, cells: &Spanned<u32>) -> Result<Trili
                     .magnification
                     .as_ref()
                     .map_or(Ok(3.0), |m| src.number(m, "magnification"))?;
-                let surface =
-                    DetailInContext::new(camera, focus, inset, magnification).map_err(|e| {
-                        let key = if e.message.contains("magnification") {
-                            raw.magnification.as_ref().map(Spanned::span)
-                        } else {
-                            raw.inset.as_ref().map(Spanned::span)
-                        };
-                        let at = key.unwrap_or_else(|| required.table.span());
-                        src.error(&at, e.message)
-                    })?;
+                let surface = DetailInContext::new(camera, focus, inset, magnification, distance)
+                    .map_err(|e| {
+                    let key = if e.message.contains("magnification") {
+                        raw.magnification.as_ref().map(Spanned::span)
+                    } else if e.message.contains("inset") {
+                        raw.inset.as_ref().map(Spanned::span)
+                    } else {
+                        Some(table.span())
+                    };
+                    let at = key.unwrap_or_else(|| required.table.span());
+                    src.error(&at, e.message)
+                })?;
                 screen_grid(*cells.get_ref(), |s| surface.vertex(s))
             } else {
-                let first = camera(src, required.get(&raw.first, "first")?)?;
-                let second = camera(src, required.get(&raw.second, "second")?)?;
+                let (first, _) = camera(src, required.get(&raw.first, "first")?)?;
+                let (second, _) = camera(src, required.get(&raw.second, "second")?)?;
                 let band = raw
                     .band
                     .as_ref()
@@ -111,8 +116,8 @@ pub(super) fn convert(required: &Required, cells: &Spanned<u32>) -> Result<Trili
 }
 
 /// A camera table: `position`, `look_at`, `up` (default +y) and either `h_fov` and `v_fov`
-/// (a pinhole) or `width` and `height` (parallel rays).
-fn camera(src: &Source, table: &Spanned<RawCamera>) -> Result<GridCamera> {
+/// (a pinhole) or `width` and `height` (parallel rays); with its frame.
+fn camera(src: &Source, table: &Spanned<RawCamera>) -> Result<(GridCamera, CameraFrame)> {
     let raw = table.get_ref();
     let frame = CameraFrame {
         position: src.dvec3(&raw.position, "position")?,
@@ -145,7 +150,8 @@ fn camera(src: &Source, table: &Spanned<RawCamera>) -> Result<GridCamera> {
             ))
         }
     };
-    camera.map_err(|e| src.error(&table.span(), e.message))
+    let camera = camera.map_err(|e| src.error(&table.span(), e.message))?;
+    Ok((camera, frame))
 }
 
 #[cfg(test)]
@@ -199,6 +205,13 @@ mod tests {
             "grid = 6\nview = \"detail_in_context\"\ncamera = {camera}\nmagnification = 2\n"
         ));
         assert_eq!(m.triangles.len(), 72);
+        // The focus (default: the screen centre, vertex 24 of the 7 x 7) looks along the
+        // camera's axis from the base plane at the look-at distance over the magnification.
+        let (eye, look_at) = (DVec3::new(0.0, 2.0, 6.0), DVec3::new(0.0, 1.0, 0.0));
+        let axis = (look_at - eye).normalize();
+        assert!((m.normals[24].normalize() - axis).length() < 1e-12);
+        let base = (m.points[24] - eye).length();
+        assert!((base - look_at.distance(eye) / 2.0).abs() < 1e-12, "{base}");
         let m = mesh(&format!(
             "grid = 2\nview = \"two_views\"\nfirst = {camera}\n\
              second = {{ position = [0, 9, 0], look_at = [0, 0, 0], up = [0, 0, -1], width = 8, height = 6 }}\n"
@@ -257,6 +270,7 @@ mod tests {
             "magnification must be positive",
         );
         error_at("grid = 2\nview = \"detail_in_context\"\ncamera = { position = [0, 2, 6], look_at = [0, 1, 0], h_fov = 60 }\n", 5, 10, "both `h_fov` and `v_fov`");
+        error_at("grid = 2\nview = \"detail_in_context\"\ncamera = { position = [0, 2, 6], look_at = [0, 1, 0], width = 4, height = 3 }\n", 5, 10, "needs a pinhole camera");
         error_at("grid = 2\nview = \"detail_in_context\"\ncamera = { position = [0, 2, 6], look_at = [0, 1, 0] }\n", 5, 10, "either `h_fov` and `v_fov`");
         error_at(&format!("grid = 2\nview = \"two_views\"\nfirst = {camera}\nsecond = {camera}\nband = [0.7, 0.2]\n"), 7, 8, "two_views band");
         // Rays of opposite views cancel in the middle of the band.

@@ -8,24 +8,45 @@ use super::grid::GridVertex;
 use crate::error::{Error, Result};
 use crate::projection::flexible::{PolarFrame, SpherePatch, Surface};
 
-/// A distortion-oriented display (6.1): a camera whose view is magnified by `magnification`
-/// inside a circle of screen radius `inner` around `focus` (the inset), unchanged beyond
-/// radius `outer` (the context), and compressed in the ring between so that the image is
-/// continuous everywhere (the surround).
+/// The distortion-oriented display of 6.1: "a projection surface whose outer rays tend
+/// toward a perspective projection but whose inner rays tend toward an orthographic" one.
 ///
-/// Screen position `s` at distance `r` from the focus is shown as the camera's view at
-/// `focus + (s - focus) rho(r) / r`, with `rho(r) = r / m` inside, `r` outside and linear in
-/// between. Radii are in screen units (the width and height of the image are both 1).
-/// Degenerate cases, all errors: `magnification` not finite or not positive; `inner` not
-/// positive; `outer <= inner`; and `inner / magnification >= outer` (a magnification below 1
-/// so strong that the ring would fold back over the inset).
+/// All base points lie on the plane at distance `d` in front of the eye of a pinhole
+/// `camera`, at the camera's own ray through each screen position: with `dir(s)` the
+/// camera's direction at screen `s` (unit forward component),
+///
+/// ```text
+/// ray(s, t) = eye + d dir(s) + t (dir(f) + w(r) (dir(s) - dir(f))),   r = |s - f|,
+/// ```
+///
+/// where `f` is the focus and `w` rises from 0 to 1 across the transition band `inner <= r
+/// <= outer` (a smoothstep, so the rays change continuously with a continuous slope):
+/// - **focus** (`r <= inner`): parallel rays along the camera's ray through the focus, an
+///   orthographic view of the base plane's patch. At forward distance `z` from the eye it
+///   shows objects `z / d` times larger than the perspective view does;
+///   `d = distance / magnification`, so at `distance` (the camera's look-at distance when
+///   built from a scene file) the focus magnifies exactly `magnification` times;
+/// - **context** (`r >= outer`): `eye + (d + t) dir(s)`, the camera's perspective rays, so
+///   the context is the unchanged perspective view (the checker "the same size at its
+///   edges" of Figure 6.4), seen from the base plane on;
+/// - **band**: between them. At forward distance `d + t` a screen offset from the focus is
+///   shown `(d + t w(r))` times its perspective offset at distance 1; that grows with `r`
+///   for every `t >= 0`, so the image never folds.
+///
+/// Radii are in screen units (the width and height of the image are both 1). Nothing
+/// nearer than the base plane (forward distance `d`) is seen, in the context too.
+/// Degenerate cases, all errors: an orthographic camera (there is no perspective context);
+/// `magnification` or `distance` not finite or not positive; `inner` not positive or
+/// `outer <= inner`; a focus that is not finite.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DetailInContext {
     camera: GridCamera,
+    eye: DVec3,
     focus: DVec2,
     inner: f64,
     outer: f64,
-    magnification: f64,
+    /// Forward distance of the base plane from the eye.
+    base: f64,
 }
 
 impl DetailInContext {
@@ -34,7 +55,14 @@ impl DetailInContext {
         focus: DVec2,
         [inner, outer]: [f64; 2],
         magnification: f64,
+        distance: f64,
     ) -> Result<Self> {
+        let GridCamera::Perspective { basis, .. } = camera else {
+            return Err(Error::new(
+                "detail_in_context needs a pinhole camera (h_fov and v_fov): its context is \
+                 the camera's perspective view",
+            ));
+        };
         if !magnification.is_finite() || magnification <= 0.0 {
             return Err(Error::new(format!(
                 "detail_in_context magnification must be positive, got {magnification}"
@@ -46,39 +74,42 @@ impl DetailInContext {
                  got [{inner}, {outer}]"
             )));
         }
-        if inner / magnification >= outer {
+        if !distance.is_finite() || distance <= 0.0 {
             return Err(Error::new(format!(
-                "detail_in_context magnification {magnification} is too small for the inset \
-                 [{inner}, {outer}]: the ring would fold back over the inset"
+                "detail_in_context reference distance must be positive, got {distance}"
             )));
         }
         Ok(DetailInContext {
             camera,
+            eye: basis.origin,
             focus,
             inner,
             outer,
-            magnification,
+            base: distance / magnification,
         })
     }
 
-    /// The screen position of the camera's view shown at `screen`.
-    pub fn source(&self, screen: DVec2) -> DVec2 {
-        let offset = screen - self.focus;
-        let r = offset.length();
-        if r <= self.inner {
-            return self.focus + offset / self.magnification;
-        }
-        if r >= self.outer {
-            return screen;
-        }
-        let start = self.inner / self.magnification;
-        let rho = start + (r - self.inner) * (self.outer - start) / (self.outer - self.inner);
-        self.focus + offset * (rho / r)
+    /// The weight of the perspective direction at screen distance `r` from the focus: 0 in
+    /// the focus, 1 in the context, smoothstep across the band.
+    pub fn weight(&self, r: f64) -> f64 {
+        let x = ((r - self.inner) / (self.outer - self.inner)).clamp(0.0, 1.0);
+        x * x * (3.0 - 2.0 * x)
     }
 
-    /// The base point and ray at `screen`.
+    /// Forward distance of the base plane from the eye.
+    pub fn base_distance(&self) -> f64 {
+        self.base
+    }
+
+    /// The base point and ray at `screen` (the formula of the type's doc).
     pub fn vertex(&self, screen: DVec2) -> GridVertex {
-        self.camera.vertex(self.source(screen))
+        let here = self.camera.vertex(screen).direction;
+        let axis = self.camera.vertex(self.focus).direction;
+        let w = self.weight((screen - self.focus).length());
+        GridVertex {
+            point: self.eye + self.base * here,
+            direction: axis + w * (here - axis),
+        }
     }
 }
 
@@ -172,45 +203,119 @@ mod tests {
         GridCamera::perspective(&frame, 60.0, 60.0).unwrap()
     }
 
+    const FOCUS: DVec2 = DVec2::new(0.4, 0.5);
+    const EYE: DVec3 = DVec3::new(0.0, 0.0, 5.0);
+
+    /// Focus radius 0.1, band to 0.3, magnified 2.5 times at the look-at distance 5: the
+    /// base plane at forward distance 2.
+    fn detail() -> DetailInContext {
+        DetailInContext::new(camera(), FOCUS, [0.1, 0.3], 2.5, 5.0).unwrap()
+    }
+
     #[test]
-    fn detail_in_context_magnifies_inside_and_keeps_the_context() {
-        let focus = DVec2::new(0.4, 0.5);
-        let view = DetailInContext::new(camera(), focus, [0.1, 0.3], 3.0).unwrap();
-        // Inside: distances from the focus shrink by 3 (the view is magnified 3x).
-        let s = focus + DVec2::new(0.06, -0.03);
-        assert!((view.source(s) - (focus + DVec2::new(0.02, -0.01))).length() < 1e-15);
-        assert_eq!(view.source(focus), focus);
-        // Outside the ring: unchanged; continuous at both radii.
-        let far = DVec2::new(0.95, 0.1);
-        assert_eq!(view.source(far), far);
-        for r in [0.1, 0.3] {
-            let dir = DVec2::new(0.6, 0.8);
-            let (a, b) = (focus + dir * (r - 1e-9), focus + dir * (r + 1e-9));
-            assert!((view.source(a) - view.source(b)).length() < 1e-8, "r {r}");
+    fn detail_in_context_focus_is_parallel_and_magnified() {
+        let view = detail();
+        assert_eq!(view.base_distance(), 2.0);
+        let axis = camera().vertex(FOCUS).direction;
+        for s in [
+            FOCUS,
+            FOCUS + DVec2::new(0.06, -0.03),
+            FOCUS + DVec2::new(0.0, 0.0999),
+        ] {
+            let v = view.vertex(s);
+            assert!((v.direction - axis).length() < 1e-15, "parallel at {s}");
+            let on_plane = EYE + 2.0 * camera().vertex(s).direction;
+            assert!((v.point - on_plane).length() < 1e-12, "base plane at {s}");
         }
-        // Monotone along a radius: no fold.
-        let mut last = 0.0;
-        for k in 1..100 {
-            let s = focus + DVec2::new(0.004 * f64::from(k), 0.0);
-            let r = (view.source(s) - focus).length();
-            assert!(r > last);
-            last = r;
+        // At the look-at distance (forward 5, t = 3 from the base plane) two focus rays are
+        // 1 / 2.5 as far apart as the camera's perspective rays through the same positions.
+        let (a, b) = (FOCUS, FOCUS + DVec2::new(0.05, 0.02));
+        let focus_at = |s: DVec2| {
+            let v = view.vertex(s);
+            v.point + 3.0 * v.direction
+        };
+        let perspective_at = |s: DVec2| EYE + 5.0 * camera().vertex(s).direction;
+        let ratio =
+            perspective_at(a).distance(perspective_at(b)) / focus_at(a).distance(focus_at(b));
+        assert!((ratio - 2.5).abs() < 1e-12, "{ratio}");
+    }
+
+    #[test]
+    fn detail_in_context_context_is_the_perspective_view() {
+        let view = detail();
+        for s in [
+            DVec2::new(0.95, 0.1),
+            DVec2::new(0.4, 0.8),
+            DVec2::new(0.0, 1.0),
+            FOCUS + DVec2::new(0.3, 0.0),
+        ] {
+            let (v, c) = (view.vertex(s), camera().vertex(s));
+            assert!((v.direction - c.direction).length() < 1e-15, "{s}");
+            // On the camera's ray: the line from the eye along its direction.
+            assert!((v.point - EYE).cross(c.direction).length() < 1e-12, "{s}");
+            assert!((v.point - EYE).dot(c.direction) > 0.0, "{s}");
+        }
+    }
+
+    #[test]
+    fn detail_in_context_is_continuous_across_the_band() {
+        let view = detail();
+        assert_eq!((view.weight(0.1), view.weight(0.3)), (0.0, 1.0));
+        assert!((view.weight(0.2) - 0.5).abs() < 1e-12);
+        // Along a radius through the band, steps of 1e-4 in screen change the ray by little
+        // (the two ends differ by about 0.3 in direction).
+        let dir = DVec2::new(0.6, -0.8);
+        let mut previous = view.vertex(FOCUS + 0.05 * dir);
+        for k in 1..=3000 {
+            let v = view.vertex(FOCUS + (0.05 + 1e-4 * f64::from(k)) * dir);
+            assert!(
+                (v.direction - previous.direction).length() < 1e-3,
+                "step {k}"
+            );
+            assert!((v.point - previous.point).length() < 1e-3, "step {k}");
+            previous = v;
+        }
+        // The grid of projection triangles over it is a valid, continuous trilinear mesh.
+        let mesh = screen_grid(16, |s| view.vertex(s)).unwrap();
+        let trilinear = Trilinear::new(&mesh, 64, 64).unwrap();
+        let mut previous = trilinear.ray(DVec2::new(0.05, 32.5)).unwrap();
+        for step in 1..640 {
+            let ray = trilinear
+                .ray(DVec2::new(0.05 + 0.1 * f64::from(step), 32.5))
+                .unwrap();
+            assert!(
+                (ray.direction - previous.direction).length() < 0.01,
+                "step {step}"
+            );
+            assert!(
+                (ray.origin - previous.origin).length() < 0.02,
+                "step {step}"
+            );
+            previous = ray;
         }
     }
 
     #[test]
     fn detail_in_context_degenerate_parameters_are_errors() {
-        let c = camera();
-        let f = DVec2::splat(0.5);
-        assert!(DetailInContext::new(c, f, [0.1, 0.3], 0.0).is_err());
-        assert!(DetailInContext::new(c, f, [0.1, 0.3], f64::NAN).is_err());
-        assert!(DetailInContext::new(c, f, [0.3, 0.3], 2.0).is_err());
-        assert!(DetailInContext::new(c, f, [0.0, 0.3], 2.0).is_err());
-        let e = DetailInContext::new(c, f, [0.2, 0.3], 0.5).unwrap_err();
-        assert!(e.message.contains("fold"), "{e}");
+        let (c, f) = (camera(), DVec2::splat(0.5));
+        assert!(DetailInContext::new(c, f, [0.1, 0.3], 0.0, 5.0).is_err());
+        assert!(DetailInContext::new(c, f, [0.1, 0.3], f64::NAN, 5.0).is_err());
+        assert!(DetailInContext::new(c, f, [0.3, 0.3], 2.0, 5.0).is_err());
+        assert!(DetailInContext::new(c, f, [0.0, 0.3], 2.0, 5.0).is_err());
+        assert!(DetailInContext::new(c, DVec2::NAN, [0.1, 0.3], 2.0, 5.0).is_err());
+        let e = DetailInContext::new(c, f, [0.1, 0.3], 2.0, 0.0).unwrap_err();
+        assert!(e.message.contains("distance"), "{e}");
+        let frame = CameraFrame {
+            position: DVec3::new(0.0, 8.0, 0.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::NEG_Z,
+        };
+        let parallel = GridCamera::orthographic(&frame, 8.0, 8.0).unwrap();
+        let e = DetailInContext::new(parallel, f, [0.1, 0.3], 2.0, 5.0).unwrap_err();
+        assert!(e.message.contains("pinhole"), "{e}");
         assert!(
-            DetailInContext::new(c, f, [0.2, 0.5], 0.5).is_ok(),
-            "a mild minifier"
+            DetailInContext::new(c, f, [0.2, 0.5], 0.5, 5.0).is_ok(),
+            "a minifier: the base plane beyond the look-at distance"
         );
     }
 
@@ -274,27 +379,56 @@ mod tests {
         use proptest::prelude::*;
 
         proptest! {
-            /// The detail-in-context map is invertible: it keeps the direction from the
-            /// focus and is strictly increasing in the distance, so no two screen positions
-            /// show the same view (no fold) for any valid inset.
+            /// The detail-in-context surface never folds: at every depth `t >= 0` from the
+            /// base plane, the image of a screen position lies on the focus ray's side of the
+            /// same direction and farther out the farther the position is from the focus.
             #[test]
-            fn detail_in_context_is_radially_monotone(
+            fn detail_in_context_does_not_fold(
                 inner in 0.01..0.4f64,
                 width in 0.01..0.4f64,
                 magnification in 0.3..8.0f64,
                 angle in 0.0..6.3f64,
                 (r1, r2) in (0.0..0.9f64, 0.0..0.9f64),
+                t in 0.0..20.0f64,
             ) {
-                let focus = DVec2::new(0.45, 0.55);
-                let outer = inner + width;
-                prop_assume!(inner / magnification < outer);
-                let view = DetailInContext::new(camera(), focus, [inner, outer], magnification).unwrap();
+                let view = DetailInContext::new(camera(), FOCUS, [inner, inner + width], magnification, 5.0).unwrap();
                 let dir = DVec2::from_angle(angle);
-                let (a, b) = (view.source(focus + r1 * dir) - focus, view.source(focus + r2 * dir) - focus);
-                prop_assert!(a.perp_dot(dir).abs() <= 1e-12 && b.perp_dot(dir).abs() <= 1e-12);
-                prop_assert!(a.dot(dir) >= 0.0 && b.dot(dir) >= 0.0);
+                let at = |r: f64| {
+                    let v = view.vertex(FOCUS + r * dir);
+                    v.point + t * v.direction
+                };
+                let centre = at(0.0);
+                let (a, b) = (at(r1) - centre, at(r2) - centre);
+                prop_assert!(a.dot(b) >= -1e-12);
                 if r1 < r2 {
                     prop_assert!(a.length() < b.length(), "{r1} {r2}: {a} {b}");
+                }
+            }
+
+            /// Project a point seen through the detail-in-context mesh, cast the ray at each
+            /// image position found: the ray reaches the point, and one of the images is the
+            /// pixel and depth the point was made from.
+            #[test]
+            fn detail_in_context_projection_round_trips(
+                sx in 1.0..63.0f64,
+                sy in 1.0..63.0f64,
+                t in 0.0..10.0f64,
+            ) {
+                let mesh = screen_grid(6, |s| detail().vertex(s)).unwrap();
+                let trilinear = Trilinear::new(&mesh, 64, 64).unwrap();
+                let pixel = DVec2::new(sx, sy);
+                let point = trilinear.ray(pixel).unwrap().at(t);
+                let mut images = Vec::new();
+                trilinear.project(point, &mut images);
+                prop_assert!(images
+                    .iter()
+                    .any(|i| i.pixel.distance(pixel) < 1e-6 && (i.t - t).abs() < 1e-6 * (1.0 + t)),
+                    "{pixel} {t}: {images:?}");
+                for image in images {
+                    if let Some(ray) = trilinear.ray(image.pixel) {
+                        prop_assert!(ray.at(image.t).distance(point) < 1e-6 * (1.0 + point.length()),
+                            "{point}: {image:?}");
+                    }
                 }
             }
         }

@@ -1,67 +1,32 @@
-use std::path::Path;
-
 use glam::{DVec2, DVec3, Vec2};
 
 use super::*;
 use crate::geometry::Ray;
-use crate::projection::{CameraFrame, Projection};
+use crate::projection::surfaces::test_scenes::{self, lens_plane, BALL_CENTER};
+use crate::projection::Projection;
 use crate::render::raycast::RayCaster;
 use crate::render::surface::normals;
-use crate::scene::{file, Scene};
+use crate::scene::Scene;
 
-const EYE: DVec3 = DVec3::new(0.3, 1.6, 4.0);
 const SIZE: (u32, u32) = (160, 120);
 
+/// The shared sphere-and-cube fixture (32-segment sphere, as in the compositing tests).
 fn scene() -> Scene {
-    let text = r#"
-        [projection]
-        type = "perspective"
-        position = [0.3, 1.6, 4.0]
-        look_at = [0.0, 1.0, 0.0]
-        fov = 50.0
-        [[object]]
-        name = "ball"
-        shape = "sphere"
-        size = 1.0
-        tessellation = 24
-        material = "mirror"
-        translate = [0.0, 1.0, 0.0]
-        [[object]]
-        shape = "box"
-        translate = [2.0, 0.5, 1.0]
-    "#;
-    file::parse(text, Path::new("reflector-test.toml")).unwrap()
+    test_scenes::sphere_and_cube(32)
 }
 
 fn camera() -> Perspective {
-    let frame = CameraFrame {
-        position: EYE,
-        look_at: DVec3::new(0.0, 1.0, 0.0),
-        up: DVec3::Y,
-    };
-    Perspective::new(&frame, 50.0, SIZE.0, SIZE.1).unwrap()
+    test_scenes::camera(&scene(), SIZE)
 }
 
-/// A 5 x 5-cell plane at y = 0 (x, z in [-1, 1]) with the vertex normals of a sphere centred
-/// at (0, -2, 0): the thesis's lens (7.4).
-fn lens_plane() -> Mesh {
-    let mut mesh = Mesh::default();
-    for j in 0..6 {
-        for i in 0..6 {
-            let p = glam::Vec3::new(-1.0 + 0.4 * i as f32, 0.0, -1.0 + 0.4 * j as f32);
-            mesh.positions.push(p);
-            mesh.normals
-                .push((p - glam::Vec3::new(0.0, -2.0, 0.0)).normalize());
-        }
-    }
-    for j in 0..5 {
-        for i in 0..5 {
-            let a = j * 6 + i;
-            mesh.triangles.push([a, a + 6, a + 7]);
-            mesh.triangles.push([a, a + 7, a + 1]);
-        }
-    }
-    mesh
+/// The main camera's eye.
+fn eye() -> DVec3 {
+    camera().basis().origin
+}
+
+/// The lens of the fixtures at y = 0, normals radiating from (0, -2, 0).
+fn lens() -> Mesh {
+    lens_plane(0.0, 2.0)
 }
 
 #[test]
@@ -74,7 +39,7 @@ fn vertex_rays_are_the_ray_casters_mirror_reflections() {
     let mut checked = 0;
     for k in 0..surface.mesh.points.len() {
         let p = surface.mesh.points[k];
-        let ray = Ray::new(EYE, p - EYE);
+        let ray = Ray::new(eye(), p - eye());
         let Some(hit) = caster.intersect(&ray) else {
             continue;
         };
@@ -115,20 +80,20 @@ fn back_and_hidden_triangles_are_left_out() {
     let surface = reflector_surface(ball, &camera(), Optic::Reflect).unwrap();
     let total = ball.triangles.len();
     assert_eq!(surface.dropped + surface.mesh.triangles.len(), total);
-    // Roughly the back half of the sphere is left out.
-    assert!(
-        surface.dropped > total / 3 && surface.dropped < 2 * total / 3,
-        "{surface:?}"
-    );
+    // The kept triangles are about the cap the eye sees: the fraction (1 - r / d) / 2 of a
+    // sphere of radius r = 1 seen from distance d.
+    let (center, eye) = (BALL_CENTER, eye());
+    let cap = 0.5 * (1.0 - 1.0 / eye.distance(center));
+    let kept = surface.mesh.triangles.len() as f64 / total as f64;
+    assert!((kept - cap).abs() < 0.05, "kept {kept}, cap {cap}");
     // Every kept triangle faces the eye (outward face normal towards it), nearer first.
-    let center = DVec3::new(0.0, 1.0, 0.0);
     let mut last = 0.0;
     for t in &surface.mesh.triangles {
         let [a, b, c] = t.map(|k| surface.mesh.points[k as usize]);
         let face = (b - a).cross(c - a);
         assert!(face.dot(a - center) > 0.0, "outward winding");
-        assert!(face.dot(EYE - a) > 0.0, "a back-facing triangle was kept");
-        let distance = ((a + b + c) / 3.0).distance(EYE);
+        assert!(face.dot(eye - a) > 0.0, "a back-facing triangle was kept");
+        let distance = ((a + b + c) / 3.0).distance(eye);
         assert!(distance >= last);
         last = distance;
     }
@@ -145,27 +110,28 @@ fn reflectors_behind_the_camera_give_an_empty_surface() {
     )));
     let surface = reflector_surface(&ball, &camera(), Optic::Reflect).unwrap();
     assert!(surface.mesh.triangles.is_empty() && surface.mesh.points.is_empty());
-    // Partly behind: the eye plane cuts the sphere, the triangles across it are left out.
+    // Partly behind: the eye plane cuts the sphere (centred on it, 1.5 to the right of the
+    // eye), the triangles across it are left out.
+    let basis = *camera().basis();
     let mut ball = scene.objects[0].mesh.clone();
-    ball.transform(&glam::Affine3A::from_translation(glam::Vec3::new(
-        0.0, 0.6, 4.0,
-    )));
+    let shift = basis.origin + 1.5 * basis.right - BALL_CENTER;
+    ball.transform(&glam::Affine3A::from_translation(shift.as_vec3()));
     let surface = reflector_surface(&ball, &camera(), Optic::Reflect).unwrap();
-    let forward = camera().basis().forward;
+    assert!(!surface.mesh.triangles.is_empty(), "the front half is seen");
     for p in &surface.mesh.points {
-        assert!((*p - EYE).dot(forward) > 0.0);
+        assert!((*p - basis.origin).dot(basis.forward) > 0.0);
     }
     assert!(surface.dropped > 0);
 }
 
 #[test]
 fn meshes_without_normals_use_face_normals() {
-    let mut plane = lens_plane();
+    let mut plane = lens();
     plane.normals.clear();
     let surface = reflector_surface(&plane, &camera(), Optic::Reflect).unwrap();
     assert_eq!(surface.mesh.triangles.len(), 50);
     for (p, r) in surface.mesh.points.iter().zip(&surface.mesh.normals) {
-        let i = (*p - EYE).normalize();
+        let i = (*p - eye()).normalize();
         let expected = DVec3::new(i.x, -i.y, i.z);
         assert!((*r - expected).length() < 1e-12, "a flat mirror flips y");
     }
@@ -174,7 +140,7 @@ fn meshes_without_normals_use_face_normals() {
 #[test]
 fn snell_at_the_vertices_of_a_lens() {
     let ior = 1.5;
-    let lens = lens_plane();
+    let lens = lens();
     let surface = reflector_surface(&lens, &camera(), Optic::Refract { ior }).unwrap();
     assert_eq!(surface.mesh.triangles.len(), 50);
     let mut checked = 0;
@@ -188,7 +154,7 @@ fn snell_at_the_vertices_of_a_lens() {
         assert!((q.length() - 1.0).abs() < 1e-9, "vertex {k}");
         assert!(q.y < 0.0, "vertex {k}: transmitted through the plane");
         let n = (*p - DVec3::new(0.0, -2.0, 0.0)).normalize();
-        let i = (*p - EYE).normalize();
+        let i = (*p - eye()).normalize();
         if i.dot(n) >= 0.0 {
             continue; // the bent normal faces away: grazing incidence, as in the ray caster
         }
