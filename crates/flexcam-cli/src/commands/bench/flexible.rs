@@ -8,14 +8,21 @@
 //! thesis's (64 n^2 - 8 n triangles for n x n quads per patch), and prints the count used.
 //! The volume is three rectangles (near, bent middle, far) placed around the model's bounding
 //! box; the polylines are the quadratic sampled at equal steps in t.
+//!
+//! The second table is item 9's panorama throughput: `builtin:teapot-dense` (123,554
+//! triangles) as a 1280 x 720 equirectangular panorama from the scene's camera, flat shading,
+//! by `--method raster` (the first frame of a new renderer, and a later frame of the same
+//! one, whose pixel projectors are then ready) and by the ray caster in the same run.
 
 use std::time::Instant;
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 use flexcam::projection::flexible::{Blend, Flexible, FlexibleSpec, Surface, VolumeSource};
+use flexcam::projection::{Projection, ProjectionSpec};
+use flexcam::render::inverse_raster::InverseRaster;
 use flexcam::render::raycast::RayCaster;
 use flexcam::render::{RenderOptions, Shading};
-use flexcam::scene::{shapes, ImageSettings, Material, Mesh, Object, Scene};
+use flexcam::scene::{builtin, shapes, ImageSettings, Material, Mesh, Object, Scene};
 use flexcam::{Error, Result};
 use glam::{Affine3A, DVec3, Vec3};
 
@@ -61,13 +68,41 @@ pub struct FlexibleArgs {
     /// Only the first N rows of the table (smallest models first).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=6))]
     rows: Option<u32>,
+    /// Which tables to measure.
+    #[arg(long, value_enum, default_value_t = Part::All)]
+    part: Part,
 }
+
+/// The tables of `flexcam bench flexible`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Part {
+    /// Both tables.
+    All,
+    /// Table 7.1 only.
+    Table,
+    /// The panorama throughput only.
+    Panorama,
+}
+
+/// The panorama table's image size.
+const PANORAMA: (u32, u32) = (1280, 720);
 
 /// The projector kinds of the table's columns: `None` is the analytic quadratic.
 const COLUMNS: [Option<u32>; 6] = [None, Some(2), Some(3), Some(4), Some(5), Some(6)];
 
-/// Runs the benchmark and prints the thesis's times, ours, and the speed-up.
+/// Runs the benchmarks `args.part` names.
 pub fn run(args: &FlexibleArgs) -> Result<()> {
+    if args.part != Part::Panorama {
+        table(args)?;
+    }
+    if args.part != Part::Table {
+        panorama(args.repeat)?;
+    }
+    Ok(())
+}
+
+/// Table 7.1: prints the thesis's times, ours, and the speed-up.
+fn table(args: &FlexibleArgs) -> Result<()> {
     let rows = args.rows.map_or(THESIS.len(), |r| r as usize);
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
@@ -79,21 +114,7 @@ pub fn run(args: &FlexibleArgs) -> Result<()> {
     let mut ours = Vec::with_capacity(rows);
     for (name, faces, _) in &THESIS[..rows] {
         let (scene, used) = teapot_scene(*faces);
-        let caster = RayCaster::new(&scene);
-        let (lo, hi) = bounds(&scene)?;
-        let mut times = [0.0; 6];
-        for (time, column) in times.iter_mut().zip(COLUMNS) {
-            let projection = volume(lo, hi, column)?;
-            *time = best_of(args.repeat, || {
-                caster.render(
-                    &projection,
-                    &RenderOptions {
-                        shading: Shading::Lit,
-                        ..RenderOptions::default()
-                    },
-                );
-            });
-        }
+        let times = row_times(&scene, args.repeat)?;
         eprintln!("{name}: {used} faces done");
         ours.push((*name, *faces, used, times));
     }
@@ -110,6 +131,85 @@ pub fn run(args: &FlexibleArgs) -> Result<()> {
     for (name, faces, used, _) in &ours {
         println!("  {name:<7} thesis {faces:>6}, teapot {used:>6}");
     }
+    Ok(())
+}
+
+/// One row of Table 7.1: the best time of one lit frame of `scene` through each column's
+/// projectors, the BVH built once for the row.
+fn row_times(scene: &Scene, repeat: u32) -> Result<[f64; 6]> {
+    let caster = RayCaster::new(scene);
+    let (lo, hi) = bounds(scene)?;
+    let options = RenderOptions {
+        shading: Shading::Lit,
+        ..RenderOptions::default()
+    };
+    let mut times = [0.0; 6];
+    for (time, column) in times.iter_mut().zip(COLUMNS) {
+        let projection = volume(lo, hi, column)?;
+        *time = best_of(repeat, || {
+            caster.render(&projection, &options);
+        });
+    }
+    Ok(times)
+}
+
+/// The panorama throughput table: raster (first and later frame) and ray caster, best of
+/// `repeat` frames each.
+fn panorama(repeat: u32) -> Result<()> {
+    let scene = builtin::load("teapot-dense")?;
+    let frame = match &scene.projection {
+        ProjectionSpec::Perspective { frame, .. } => *frame,
+        other => {
+            return Err(Error::new(format!(
+                "teapot-dense should have a perspective camera, not {}",
+                other.kind()
+            )))
+        }
+    };
+    let spec = ProjectionSpec::Equirectangular {
+        frame,
+        h_fov: 360.0,
+        v_fov: 180.0,
+    };
+    let (width, height) = PANORAMA;
+    let projection = spec.build(width, height)?;
+    let projection: &dyn Projection = projection.as_ref();
+    let options = RenderOptions {
+        shading: Shading::Flat,
+        ..RenderOptions::default()
+    };
+    // A new renderer per frame: the pixel projectors are computed during the frame.
+    let mut first = f64::INFINITY;
+    for _ in 0..repeat {
+        let start = Instant::now();
+        InverseRaster::new(&scene, projection, &options)?.render();
+        first = first.min(start.elapsed().as_secs_f64());
+    }
+    let raster = InverseRaster::new(&scene, projection, &options)?;
+    raster.render();
+    let later = best_of(repeat, || {
+        raster.render();
+    });
+    let start = Instant::now();
+    let caster = RayCaster::new(&scene);
+    let build = start.elapsed().as_secs_f64();
+    let cast = best_of(repeat, || {
+        caster.render(projection, &options);
+    });
+    println!(
+        "\npanorama: teapot-dense, {} triangles, {width}x{height} equirectangular (360 x 180), \
+         flat shading, best of {repeat}",
+        scene.triangle_count()
+    );
+    println!("{:<34}{:>10}{:>8}", "method", "ms/frame", "fps");
+    for (name, seconds) in [
+        ("raster, first frame", first),
+        ("raster, later frame", later),
+        ("raycast, frame (BVH prebuilt)", cast),
+    ] {
+        println!("{name:<34}{:>10.1}{:>8.1}", 1e3 * seconds, 1.0 / seconds);
+    }
+    println!("{:<34}{:>10.1}", "raycast, BVH build (once)", 1e3 * build);
     Ok(())
 }
 

@@ -55,6 +55,18 @@ fn control_points(surfaces: &[Surface], uv: DVec2) -> Option<Vec<DVec3>> {
     (moves && points.iter().all(|p| p.is_finite())).then_some(points)
 }
 
+/// Reduces the de Casteljau pyramid of `points` (at least two) at `t` in place down to its
+/// last two points and returns them.
+fn reduce_to_pair(points: &mut Vec<DVec3>, t: f64) -> (DVec3, DVec3) {
+    while points.len() > 2 {
+        for i in 0..points.len() - 1 {
+            points[i] = points[i].lerp(points[i + 1], t);
+        }
+        points.pop();
+    }
+    (points[0], points[1])
+}
+
 /// Piecewise-linear blending of surfaces at knots in t.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PiecewiseVolume {
@@ -161,13 +173,7 @@ impl BezierVolume {
     /// at `t`: their lerp is Q and their difference times the degree is dQ/dt.
     fn last_pair(&self, uv: DVec2, t: f64) -> (DVec3, DVec3) {
         let mut points: Vec<DVec3> = self.surfaces.iter().map(|s| s.point(uv)).collect();
-        while points.len() > 2 {
-            for i in 0..points.len() - 1 {
-                points[i] = points[i].lerp(points[i + 1], t);
-            }
-            points.pop();
-        }
-        (points[0], points[1])
+        reduce_to_pair(&mut points, t)
     }
 
     /// Q(u, v, t) by de Casteljau.
@@ -190,11 +196,21 @@ impl BezierVolume {
             None => Some(Projector::QuadraticBezier([
                 points[0], points[1], points[2],
             ])),
-            Some(n) => Some(Projector::Polyline(
-                (0..=n)
-                    .map(|k| self.point(uv, f64::from(k) / f64::from(n)))
-                    .collect(),
-            )),
+            // The control points are evaluated once per projector, not once per sample.
+            Some(n) => {
+                let mut pyramid = Vec::with_capacity(points.len());
+                Some(Projector::Polyline(
+                    (0..=n)
+                        .map(|k| {
+                            let t = f64::from(k) / f64::from(n);
+                            pyramid.clear();
+                            pyramid.extend_from_slice(&points);
+                            let (a, b) = reduce_to_pair(&mut pyramid, t);
+                            a.lerp(b, t)
+                        })
+                        .collect(),
+                ))
+            }
         }
     }
 }

@@ -1,26 +1,33 @@
-//! Per-fragment reconstruction and shading: a fragment is a pixel covered by the image of a
-//! piece of scene triangle; its scene point is where the pixel's projector meets the plane
-//! of that triangle, so its depth, barycentrics and colour are the ray caster's exactly, and
-//! only coverage (which triangle a pixel near a silhouette gets) depends on subdivision.
+//! Per-fragment reconstruction and per-pixel shading: a fragment is a pixel covered by the
+//! image of a piece of scene triangle; its scene point is where the pixel's projector meets
+//! the plane of that triangle, so its depth, barycentrics and colour are the ray caster's
+//! exactly, and only coverage (which triangle a pixel near a silhouette gets) depends on
+//! subdivision.
 //!
 //! The depth is the ray caster's: `t |direction|`, the distance along the projector from its
 //! origin. Fragments whose projector meets the plane outside the projector's range (behind a
 //! perspective eye, t outside [0, 1] of a flexible volume: the per-projector near and far
 //! clip), or runs parallel to it, are discarded. Barycentrics just outside the triangle (a
 //! silhouette pixel the polygon covers but the exact image does not) are clamped onto it.
+//!
+//! Shading is deferred: the rasteriser only resolves depths, and each pixel's visible
+//! fragment is shaded once afterwards ([`Shader::shade_visible`]), so hidden fragments cost
+//! no shading and no secondary rays.
 
 use glam::{DVec3, Vec2, Vec3};
+use rayon::prelude::*;
 
 use super::pixel_rays::PixelRays;
 use crate::geometry::Ray;
-use crate::render::raster::Fragment;
+use crate::render::raster::{Fragment, Target};
 use crate::render::raycast::{Hit, RayCaster};
 use crate::render::surface::{base_color, TextureFilter};
 use crate::render::{RenderOptions, Shading};
 use crate::scene::{Object, Surface};
 
-/// Attributes carried by a resolved fragment: barycentrics (u, v) and the ray parameter t.
-pub const ATTRIBUTES: usize = 3;
+/// Attributes carried by a fragment: none, depth only (everything else is reconstructed
+/// from the pixel's projector).
+pub const ATTRIBUTES: usize = 0;
 
 /// The primitive key of triangle `triangle` of object index `object`: objects in the high
 /// half, so keys order like (object, triangle).
@@ -36,7 +43,7 @@ fn unkey(key: u64) -> (usize, usize) {
 /// Reconstructs and shades fragments of one render.
 pub struct Shader<'a> {
     pub objects: &'a [Object],
-    pub rays: &'a PixelRays,
+    pub rays: &'a PixelRays<'a>,
     /// The ray caster, for what flat base colours cannot give: lit shading (lights,
     /// shadows) and mirrors and glass (secondary rays). `None` when neither is needed.
     pub caster: Option<&'a RayCaster>,
@@ -44,54 +51,77 @@ pub struct Shader<'a> {
 }
 
 impl Shader<'_> {
-    /// The resolve step: exact depth and attributes from the pixel's projector, or `false`
-    /// to discard.
+    /// The resolve step: the exact depth from the pixel's projector, or `false` to discard.
     pub fn resolve(&self, fragment: &mut Fragment<ATTRIBUTES>) -> bool {
-        let Some(ray) = self.rays.get(fragment.x, fragment.y) else {
-            return false;
-        };
-        let (object, triangle) = unkey(fragment.primitive);
-        let mesh = &self.objects[object].mesh;
-        let [a, b, c] = mesh.triangles[triangle].map(|i| mesh.positions[i as usize].as_dvec3());
-        let Some((t, u, v)) = plane_hit(ray, [a, b, c]) else {
+        let Some((ray, t, _)) = self.reconstruct(fragment.x, fragment.y, fragment.primitive) else {
             return false;
         };
         fragment.varying.depth = t * ray.direction.length();
-        fragment.varying.attributes = [u, v, t];
         true
     }
 
-    /// The colour of a resolved fragment.
-    pub fn shade(&self, fragment: &Fragment<ATTRIBUTES>) -> Vec3 {
-        let (object_index, triangle) = unkey(fragment.primitive);
+    /// The colours of `target` with every covered pixel's visible fragment shaded (rows in
+    /// parallel), and the number of rays that shading cast (secondary and shadow rays of
+    /// lit shading, mirrors and glass).
+    pub fn shade_visible(&self, target: &Target) -> (Vec<Vec3>, u64) {
+        let width = target.width() as usize;
+        let mut colors = target.color().to_vec();
+        let rays = colors
+            .par_chunks_mut(width.max(1))
+            .enumerate()
+            .map(|(y, row)| {
+                let mut rays = 0;
+                for (x, color) in row.iter_mut().enumerate() {
+                    let (x, y) = (x as u32, y as u32);
+                    if let Some((shaded, cast)) =
+                        target.primitive(x, y).and_then(|key| self.shade(x, y, key))
+                    {
+                        (*color, rays) = (shaded, rays + cast);
+                    }
+                }
+                rays
+            })
+            .sum();
+        (colors, rays)
+    }
+
+    /// Pixel `(x, y)`'s projector and where it meets the plane of primitive `key`: the ray
+    /// parameter and the clamped barycentrics (see [`plane_hit`]).
+    fn reconstruct(&self, x: u32, y: u32, key: u64) -> Option<(&Ray, f64, Vec2)> {
+        let ray = self.rays.get(x, y)?;
+        let (object, triangle) = unkey(key);
+        let mesh = &self.objects[object].mesh;
+        let corners = mesh.triangles[triangle].map(|i| mesh.positions[i as usize].as_dvec3());
+        let (t, u, v) = plane_hit(ray, corners)?;
+        Some((ray, t, Vec2::new(u as f32, v as f32)))
+    }
+
+    /// The colour of pixel `(x, y)` whose visible fragment belongs to primitive `key`, and
+    /// the rays its shading cast.
+    fn shade(&self, x: u32, y: u32, key: u64) -> Option<(Vec3, u64)> {
+        let (ray, t, barycentric) = self.reconstruct(x, y, key)?;
+        let (object_index, triangle) = unkey(key);
         let object = &self.objects[object_index];
-        let [u, v, t] = fragment.varying.attributes;
-        let barycentric = Vec2::new(u as f32, v as f32);
         let flat = matches!(
             object.material.surface,
             Surface::Diffuse | Surface::Emissive
         );
-        match (
-            self.options.shading,
-            self.caster,
-            self.rays.get(fragment.x, fragment.y),
-        ) {
-            (Shading::Flat, _, _) if flat => {
-                base_color(object, triangle, barycentric, TextureFilter::Nearest)
-            }
-            (_, Some(caster), Some(ray)) => {
+        let base = || base_color(object, triangle, barycentric, TextureFilter::Nearest);
+        Some(match (self.options.shading, self.caster) {
+            (Shading::Flat, _) if flat => (base(), 0),
+            (_, Some(caster)) => {
                 let hit = Hit {
                     t,
                     object: object_index,
                     triangle,
                     barycentric,
                 };
-                caster.shade_hit(ray, hit, self.options).0
+                caster.shade_hit(ray, hit, self.options)
             }
-            // Unreachable by construction (the caster exists whenever shading needs it and
-            // resolved fragments have a ray); the base colour is the safe answer.
-            _ => base_color(object, triangle, barycentric, TextureFilter::Nearest),
-        }
+            // Unreachable by construction (the caster exists whenever shading needs it); the
+            // base colour is the safe answer.
+            _ => (base(), 0),
+        })
     }
 }
 

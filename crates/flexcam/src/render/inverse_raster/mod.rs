@@ -9,16 +9,24 @@
 //!    piece's projected corners follows its curved image within the tolerance;
 //! 3. each piece is placed on the screen ([`seam`]): unwrapped across a panorama's seam and
 //!    drawn once more on the other side when it straddles it; pieces around a pole are
-//!    dropped (they cover no pixel centre);
+//!    dropped (they cover no pixel centre), and so are pieces whose screen box holds no
+//!    pixel centre (most pieces of a finely tessellated model);
 //! 4. the pieces are filled by the polygon rasteriser in parallel bands; each fragment
-//!    reconstructs its scene point exactly from its pixel's projector ([`fragment`]), so
-//!    depth and shading are the ray caster's and only coverage near silhouettes depends on
-//!    the subdivision.
+//!    reconstructs its exact depth from its pixel's projector ([`fragment`]; the projectors
+//!    are computed on first use and kept for later frames, [`pixel_rays`]);
+//! 5. each pixel's visible fragment is shaded once, from the same reconstruction, so depth
+//!    and shading are the ray caster's and only coverage near silhouettes depends on the
+//!    subdivision.
 //!
 //! Shading: flat base colours are computed here; lit shading (lights and shadows) and the
 //! secondary rays of mirrors and glass are delegated, per visible pixel, to the ray caster's
 //! own shading of the reconstructed hit ([`RayCaster::shade_hit`]), so a BVH is built when
-//! the render needs one. One sample per pixel (`--spp 1`).
+//! the render needs one; the rays it casts are counted (`shading_rays`). One sample per
+//! pixel (`--spp 1`).
+//!
+//! An [`InverseRaster`] is meant to render many frames of one projection (an animation of
+//! the scene, an interactive viewer): the pixel projectors and the BVH are kept between
+//! frames.
 //!
 //! Supported: every projection with an [`InverseChart`] (perspective, orthographic,
 //! fisheye, equirectangular, cylindrical, and the flexible volumes described in
@@ -37,7 +45,7 @@ use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 
 pub use subdivision::{Subdivision, DEFAULT_TOLERANCE, MAX_LEVEL, MAX_UNIFORM};
@@ -45,7 +53,7 @@ pub use subdivision::{Subdivision, DEFAULT_TOLERANCE, MAX_LEVEL, MAX_UNIFORM};
 use self::fragment::{key, Shader, ATTRIBUTES};
 use self::pixel_rays::PixelRays;
 use self::refine::{Node, Refiner};
-use self::seam::{place, Placement};
+use self::seam::{covers_a_centre, place, Placement};
 use crate::error::{Error, Result};
 use crate::projection::{InverseChart, Projection};
 use crate::render::raster::{
@@ -58,13 +66,13 @@ use crate::scene::{Scene, Surface};
 /// Scene triangles per parallel task when building pieces.
 const CHUNK: usize = 2048;
 
-/// A scene and a projection prepared for rasterisation: the chart, the pixel projectors and,
-/// when shading needs rays, the ray caster.
+/// A scene and a projection prepared for rasterisation: the chart, the pixel projectors
+/// (filled in as frames need them) and, when shading needs rays, the ray caster.
 pub struct InverseRaster<'a> {
     scene: &'a Scene,
     projection: &'a dyn Projection,
     chart: InverseChart,
-    rays: PixelRays,
+    rays: PixelRays<'a>,
     caster: Option<RayCaster>,
     options: RenderOptions<'a>,
     setup_ms: f64,
@@ -83,6 +91,8 @@ struct PieceCounts {
     singular: u64,
     /// Pieces whose outline winds around a pole, dropped.
     winding: u64,
+    /// Screen triangles whose box holds no pixel centre, dropped before the rasteriser.
+    empty: u64,
     /// Screen triangles handed to the rasteriser (a seam straddler counts twice).
     drawn: u64,
 }
@@ -94,6 +104,7 @@ impl std::ops::AddAssign for PieceCounts {
         self.pole_pieces += o.pole_pieces;
         self.singular += o.singular;
         self.winding += o.winding;
+        self.empty += o.empty;
         self.drawn += o.drawn;
     }
 }
@@ -178,8 +189,12 @@ impl<'a> InverseRaster<'a> {
             FillRule::NonZero,
             BAND_ROWS,
             &|f| shader.resolve(f),
-            &|f| shader.shade(f),
+            &|_| Vec3::ZERO,
         );
+        let fill_ms = start.elapsed().as_secs_f64() * 1e3 - pieces_ms;
+        let (colors, shading_rays) = shader.shade_visible(&target);
+        let mut frame = target.into_frame();
+        frame.color = colors;
         let mut stats = Stats::new();
         raster.record(&mut stats);
         let count = |n: u64| Counter::Count(n);
@@ -190,7 +205,10 @@ impl<'a> InverseRaster<'a> {
             ("raster_pole_pieces", counts.pole_pieces),
             ("raster_singular_pieces", counts.singular),
             ("raster_winding_pieces", counts.winding),
+            ("raster_empty_pieces", counts.empty),
             ("raster_screen_triangles", counts.drawn),
+            ("raster_ray_tiles", self.rays.computed_tiles()),
+            ("shading_rays", shading_rays),
             (
                 "raster_uniform",
                 u64::from(self.options.subdivision.uniform),
@@ -203,14 +221,15 @@ impl<'a> InverseRaster<'a> {
             ("raster_tolerance_px", tolerance),
             ("raster_setup_ms", self.setup_ms),
             ("raster_pieces_ms", pieces_ms),
+            ("raster_fill_ms", fill_ms),
             (
-                "raster_fill_ms",
-                start.elapsed().as_secs_f64() * 1e3 - pieces_ms,
+                "raster_shade_ms",
+                start.elapsed().as_secs_f64() * 1e3 - pieces_ms - fill_ms,
             ),
         ] {
             stats.insert(name, Counter::Value(value));
         }
-        (target.into_frame(), stats)
+        (frame, stats)
     }
 
     /// Steps 1 to 3 of the module documentation: the screen triangles of every scene
@@ -304,12 +323,20 @@ impl<'a> InverseRaster<'a> {
                 counts.singular += 1;
                 return;
             };
+            let mut empty = 0;
             let placed = place([a, b, c], size, period, |screen| {
-                let vertices = screen.map(|p| Vertex::new(p.x, p.y, 0.0, [0.0; ATTRIBUTES]));
-                batch.push(&vertices, id, key);
+                if covers_a_centre(screen) {
+                    let vertices = screen.map(|p| Vertex::new(p.x, p.y, 0.0, [0.0; ATTRIBUTES]));
+                    batch.push(&vertices, id, key);
+                } else {
+                    empty += 1;
+                }
             });
             match placed {
-                Placement::Copies(n) => counts.drawn += u64::from(n),
+                Placement::Copies(n) => {
+                    counts.drawn += u64::from(n) - empty;
+                    counts.empty += empty;
+                }
                 Placement::Winds => counts.winding += 1,
             }
         };

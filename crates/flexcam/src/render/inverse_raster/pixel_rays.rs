@@ -1,41 +1,109 @@
-//! The projector of every pixel centre, computed once per projection: each fragment of the
-//! rasteriser reconstructs its scene point exactly by intersecting its pixel's projector with
-//! the plane of its scene triangle (see the `fragment` module), and looking the projector up
-//! is much cheaper than evaluating a nonlinear projection per fragment.
+//! The projector of every pixel centre, computed lazily and kept for the life of the
+//! renderer: each fragment of the rasteriser reconstructs its scene point exactly by
+//! intersecting its pixel's projector with the plane of its scene triangle (see the
+//! `fragment` module), and looking the projector up is much cheaper than evaluating a
+//! nonlinear projection per fragment.
+//!
+//! The image is cut into square tiles of [`TILE`] pixels; a tile's rays are computed the first
+//! time a fragment needs one of them (by whichever thread gets there first), so pixels that no
+//! scene triangle covers (the sky of a panorama) never cost a ray, and every later frame of
+//! the same projection finds them ready.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::OnceLock;
 
 use glam::{DVec2, DVec3};
-use rayon::prelude::*;
 
 use crate::geometry::Ray;
 use crate::projection::Projection;
 
-/// The centre rays of a `width` x `height` image, row-major; `None` where the projection has
-/// no ray (outside a fisheye's circle).
-pub struct PixelRays {
-    width: u32,
-    rays: Vec<Option<Ray>>,
+/// Tile edge in pixels: one band of the rasteriser (16 rows) holds whole tiles, so a tile is
+/// usually computed and read by one thread.
+const TILE: u32 = 16;
+
+/// The centre rays of a projection's image, computed tile by tile on first use; `None` where
+/// the projection has no ray (outside a fisheye's circle).
+pub struct PixelRays<'a> {
+    projection: &'a dyn Projection,
+    size: (u32, u32),
+    tiles_x: u32,
+    tiles: Vec<OnceLock<Box<[Option<Ray>]>>>,
+    computed: AtomicU64,
 }
 
-impl PixelRays {
-    /// Evaluates `projection.ray` at every pixel centre, in parallel over rows.
-    pub fn new(projection: &dyn Projection) -> Self {
+impl<'a> PixelRays<'a> {
+    /// The (still empty) rays of `projection`'s image.
+    pub fn new(projection: &'a dyn Projection) -> Self {
         let (width, height) = projection.resolution();
-        let rays = (0..height)
-            .into_par_iter()
-            .flat_map_iter(|y| {
-                (0..width).map(move |x| {
-                    let centre = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-                    projection
-                        .ray(centre)
-                        .filter(|r| r.direction != DVec3::ZERO)
-                })
-            })
-            .collect();
-        PixelRays { width, rays }
+        let tiles_x = width.div_ceil(TILE);
+        let count = tiles_x as usize * height.div_ceil(TILE) as usize;
+        PixelRays {
+            projection,
+            size: (width, height),
+            tiles_x,
+            tiles: (0..count).map(|_| OnceLock::new()).collect(),
+            computed: AtomicU64::new(0),
+        }
     }
 
     /// The ray through the centre of pixel `(x, y)` (inside the image).
     pub fn get(&self, x: u32, y: u32) -> Option<&Ray> {
-        self.rays[y as usize * self.width as usize + x as usize].as_ref()
+        let (tx, ty) = (x / TILE, y / TILE);
+        let tile = self.tiles[(ty * self.tiles_x + tx) as usize].get_or_init(|| self.tile(tx, ty));
+        tile[((y % TILE) * TILE + x % TILE) as usize].as_ref()
+    }
+
+    /// How many tiles have been computed so far (over every frame).
+    pub fn computed_tiles(&self) -> u64 {
+        self.computed.load(Ordering::Relaxed)
+    }
+
+    /// The rays of tile `(tx, ty)`, row-major; `None` past the image's edge.
+    fn tile(&self, tx: u32, ty: u32) -> Box<[Option<Ray>]> {
+        self.computed.fetch_add(1, Ordering::Relaxed);
+        let (width, height) = self.size;
+        (0..TILE * TILE)
+            .map(|k| {
+                let (x, y) = (tx * TILE + k % TILE, ty * TILE + k / TILE);
+                if x >= width || y >= height {
+                    return None;
+                }
+                let centre = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                self.projection
+                    .ray(centre)
+                    .filter(|r| r.direction != DVec3::ZERO)
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::projection::{CameraFrame, ProjectionSpec};
+
+    #[test]
+    fn rays_are_the_projections_and_computed_only_where_asked() {
+        let frame = CameraFrame {
+            position: DVec3::new(0.5, 0.0, 2.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+        };
+        // 40 x 20: the last tile column and row are partial (degenerate edge tiles).
+        let projection = ProjectionSpec::Fisheye { frame, fov: 180.0 }
+            .build(40, 20)
+            .unwrap();
+        let rays = PixelRays::new(projection.as_ref());
+        assert_eq!(rays.computed_tiles(), 0);
+        for (x, y) in [(0, 0), (39, 19), (20, 10), (33, 2)] {
+            let want = projection.ray(DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5));
+            assert_eq!(rays.get(x, y), want.as_ref(), "({x}, {y})");
+        }
+        // Corners outside the fisheye's circle have no ray.
+        assert!(rays.get(0, 0).is_none() && rays.get(20, 10).is_some());
+        // Four distinct tiles were asked for; asking again computes nothing.
+        assert_eq!(rays.computed_tiles(), 4);
+        rays.get(1, 1);
+        assert_eq!(rays.computed_tiles(), 4);
     }
 }

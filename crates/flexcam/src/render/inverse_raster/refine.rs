@@ -10,7 +10,8 @@
 //!
 //! The adaptive rule halves an edge when
 //! - its projected midpoint lies more than `tolerance` pixels off the straight line between
-//!   its projected ends (unwrapped across a panorama's seam), or
+//!   its projected ends (unwrapped across a panorama's seam); the midpoint is not projected
+//!   for an edge whose image is too short to bend that far (see [`bends_at_most`]), or
 //! - it is longer, seen from a pole's centre, than the pole's clearance and lies within twice
 //!   its length of the pole: pieces containing a pole are thus brought within the clearance,
 //!   where they cover no pixel centre and are dropped (see [`Refiner::is_pole_piece`]).
@@ -18,6 +19,12 @@
 //! Degenerate cases: an edge whose ends coincide is never split; an edge with an end or a
 //! midpoint without image (on an eye or a pole) is not split by the midpoint rule (its
 //! pieces are dropped when drawn); edges stop splitting at [`MAX_LEVEL`] halvings.
+
+/// The smallest radius of curvature, in pixels, assumed for the image of a straight scene
+/// edge away from the singular set (the eye, clipped away, and the poles, handled by their
+/// own rule): an arc of radius R with a chord of c pixels lies at most c^2 / (8 R) off it.
+/// Images of lines bend that sharply only within a pixel or so of a pole or an eye.
+const MIN_BEND_RADIUS_PX: f64 = 1.0;
 
 use glam::{DVec2, DVec3};
 
@@ -88,14 +95,33 @@ impl<'a> Refiner<'a> {
         } else {
             (b, a)
         };
-        let mid = self.node(0.5 * (a.point + b.point));
-        let curved = match (self.tolerance, a.image, b.image, mid.image) {
-            (Some(tolerance), Some(pa), Some(pb), Some(pm)) => {
-                self.deviation(pa, pb, pm) > tolerance
-            }
+        // The midpoint rule applies to edges with both images whose image may bend by more
+        // than the tolerance; most edges of a finely tessellated model are too short to.
+        let bendable = match (self.tolerance, a.image, b.image) {
+            (Some(tolerance), Some(pa), Some(pb)) => !self.bends_at_most(pa, pb, tolerance),
             _ => false,
         };
-        (curved || self.near_pole(a.point, b.point)).then_some(mid)
+        let near_pole = self.near_pole(a.point, b.point);
+        if !bendable && !near_pole {
+            return None;
+        }
+        let mid = self.node(0.5 * (a.point + b.point));
+        let curved = bendable
+            && match (self.tolerance, a.image, b.image, mid.image) {
+                (Some(tolerance), Some(pa), Some(pb), Some(pm)) => {
+                    self.deviation(pa, pb, pm) > tolerance
+                }
+                _ => false,
+            };
+        (curved || near_pole).then_some(mid)
+    }
+
+    /// Whether the image of an edge whose ends project to `pa` and `pb` (unwrapped next to
+    /// `pa`) stays within `tolerance` pixels of its chord by the bend bound of
+    /// [`MIN_BEND_RADIUS_PX`]: chord^2 / (8 R) <= tolerance.
+    fn bends_at_most(&self, pa: DVec2, pb: DVec2, tolerance: f64) -> bool {
+        let pb = DVec2::new(unwrap(pb.x, pa.x, self.chart.period).0, pb.y);
+        pa.distance_squared(pb) <= 8.0 * MIN_BEND_RADIUS_PX * tolerance
     }
 
     /// How far `pm` is from the line through `pa` and `pb`, all unwrapped next to `pa`.
@@ -303,6 +329,20 @@ mod tests {
             node(DVec3::new(0.0, 0.1, -1.0)),
         );
         assert!(refiner.split(&c, &d, 0).is_none());
+        // A piece of the curved edge under a pixel long is too short to bend by the
+        // tolerance: not split (its midpoint is not even projected), and indeed its midpoint
+        // lies well within the tolerance of its chord. Its long parent edge is tested.
+        let (short, tiny) = (
+            node(DVec3::new(-0.01, 0.5, -1.0)),
+            node(DVec3::new(0.0, 0.5, -1.0)),
+        );
+        let image = |n: &Node| n.image.unwrap();
+        assert!(image(&short).distance(image(&tiny)) < 1.0);
+        assert!(refiner.bends_at_most(image(&short), image(&tiny), 0.5));
+        assert!(refiner.split(&short, &tiny, 0).is_none());
+        let mid = image(&node(DVec3::new(-0.005, 0.5, -1.0)));
+        assert!(refiner.deviation(image(&short), image(&tiny), mid) < 0.01);
+        assert!(!refiner.bends_at_most(image(&a), image(&b), 0.5));
         // Degenerate: an end on the eye has no image; the midpoint rule does not split.
         let eye = node(DVec3::ZERO);
         assert!(eye.image.is_none());

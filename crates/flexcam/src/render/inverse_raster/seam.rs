@@ -64,6 +64,24 @@ pub fn place(
     Placement::Copies(copies)
 }
 
+/// Widening of a screen triangle's box in [`covers_a_centre`], in pixels: far above the
+/// rounding of the rasteriser's edge crossings, far below a pixel.
+const BOX_SLACK: f64 = 1e-9;
+
+/// Whether the box of screen triangle `corners`, widened by [`BOX_SLACK`], holds a pixel
+/// centre `(i + 0.5, j + 0.5)` (any integers: the rasteriser clips to the image). A triangle
+/// whose box holds none covers none, so it need not reach the rasteriser: the rasteriser
+/// samples rows at centres in `[top, bottom)` and columns in `[left crossing, right
+/// crossing)`, all within the box. Degenerate (zero-area, or a box thinner than the gap
+/// between centres) triangles give `false` unless a centre lies in the box.
+pub fn covers_a_centre(corners: [DVec2; 3]) -> bool {
+    let [a, b, c] = corners;
+    let (lo, hi) = (a.min(b).min(c) - BOX_SLACK, a.max(b).max(c) + BOX_SLACK);
+    // The first centre at or after lo lies before hi.
+    let holds = |lo: f64, hi: f64| (lo - 0.5).ceil() + 0.5 < hi;
+    holds(lo.x, hi.x) && holds(lo.y, hi.y)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -108,6 +126,24 @@ mod tests {
         assert_eq!(rotated.len(), 2);
         assert!(rotated.iter().any(|r| r.contains(&DVec2::new(98.0, 10.0))));
         assert!(rotated.iter().any(|r| r.contains(&DVec2::new(103.0, 10.0))));
+    }
+
+    #[test]
+    fn only_boxes_holding_a_pixel_centre_are_kept() {
+        let at = |x: f64, y: f64, w: f64, h: f64| {
+            [DVec2::new(x, y), DVec2::new(x + w, y), DVec2::new(x, y + h)]
+        };
+        // A sliver between the centres 10.5 and 11.5 in x: nothing to cover.
+        assert!(!covers_a_centre(at(10.6, 3.0, 0.8, 2.0)));
+        // The same sliver reaching the centre (exactly at, or just past it) is kept.
+        assert!(covers_a_centre(at(10.6, 3.0, 0.9, 2.0)));
+        assert!(covers_a_centre(at(10.5, 3.0, 0.0, 2.0)));
+        // Thin in y likewise; negative coordinates (off the image) follow the same rule.
+        assert!(!covers_a_centre(at(3.0, -2.4, 2.0, 0.8)));
+        assert!(covers_a_centre(at(3.0, -2.4, 2.0, 1.0)));
+        // Degenerate: a point triangle on a centre is kept, one off it is not.
+        assert!(covers_a_centre(at(7.5, 7.5, 0.0, 0.0)));
+        assert!(!covers_a_centre(at(7.2, 7.5, 0.0, 0.0)));
     }
 
     /// Degenerate: an outline going once around a pole has no triangle image.

@@ -333,3 +333,42 @@ fn raster_converges_to_the_ray_caster() {
         }
     }
 }
+
+/// The count of `name` in `stats` (0 when absent).
+fn count(stats: &Stats, name: &str) -> u64 {
+    match stats.get(name) {
+        Some(Counter::Count(n)) => *n,
+        _ => 0,
+    }
+}
+
+/// Lit shading is delegated per visible pixel to the ray caster, whose shadow rays are
+/// counted in the stats like the ray caster's own; flat shading of diffuse surfaces casts
+/// none.
+#[test]
+fn delegated_shading_rays_are_counted() {
+    let scene = scene::load("builtin:cube-floor").unwrap();
+    let projection = scene.projection.build(64, 48).unwrap();
+    let options = |shading| RenderOptions {
+        shading,
+        ..RenderOptions::default()
+    };
+    let (_, lit) = Method::Raster
+        .render(&scene, projection.as_ref(), &options(Shading::Lit))
+        .unwrap();
+    let (_, cast) = Method::Raycast
+        .render(&scene, projection.as_ref(), &options(Shading::Lit))
+        .unwrap();
+    let reference = count(&cast, "secondary_rays") + count(&cast, "shadow_rays");
+    let rays = count(&lit, "shading_rays");
+    assert!(reference > 0);
+    // The same visible hits but at a few silhouette pixels: the same rays within 2 %.
+    assert!(
+        rays.abs_diff(reference) * 50 <= reference,
+        "raster {rays}, raycast {reference}"
+    );
+    let (_, flat) = Method::Raster
+        .render(&scene, projection.as_ref(), &options(Shading::Flat))
+        .unwrap();
+    assert_eq!(flat.get("shading_rays"), Some(&Counter::Count(0)));
+}

@@ -535,6 +535,12 @@ impl Bvh {
         }
     }
 
+    /// Whether `segment` meets the box of the whole tree enlarged by its pad (never for an
+    /// empty tree): a cheap first test for a query that would otherwise traverse.
+    pub fn near_root(&self, segment: &NearSegment) -> bool {
+        !self.triangles.is_empty() && segment.meets(self.root_bounds.min, self.root_bounds.max)
+    }
+
     /// Calls `visit` with the build-input index and the triangle of every stored triangle in
     /// every leaf whose box, enlarged by `segment.pad` on every side, the segment meets: a
     /// conservative cull for anything that lies within `pad` of the segment (a curve inside
@@ -545,12 +551,16 @@ impl Bvh {
         segment: &NearSegment,
         mut visit: impl FnMut(u32, &PackedTriangle),
     ) {
-        if self.triangles.is_empty() || !segment.meets(self.root_bounds.min, self.root_bounds.max) {
+        if !self.near_root(segment) {
             return;
         }
-        let mut stack = Vec::with_capacity(STACK_SIZE);
-        stack.push(self.root);
-        while let Some(current) = stack.pop() {
+        // A fixed stack, no allocation per call: it holds at most one pending sibling per
+        // level of the tree, fewer than STACK_SIZE.
+        let mut stack = [self.root; STACK_SIZE];
+        let mut depth = 1;
+        while depth > 0 {
+            depth -= 1;
+            let current = stack[depth];
             if current.count > 0 {
                 let first = current.index as usize;
                 let count = current.count as usize;
@@ -569,7 +579,8 @@ impl Bvh {
                     node.planes[2][k + 2],
                 );
                 if segment.meets(min, max) {
-                    stack.push(node.children[k]);
+                    stack[depth] = node.children[k];
+                    depth += 1;
                 }
             }
         }

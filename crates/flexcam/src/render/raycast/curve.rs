@@ -11,6 +11,7 @@
 //! s. A piece lies in the convex hull of its three control points, hence within
 //! `pad = dist(middle control point, chord)` of its chord; the BVH visits only leaves whose
 //! box, enlarged by `pad`, the chord meets, and the first piece with a hit ends the search.
+//! The whole curve is first tested the same way against the scene's box alone.
 //!
 //! Degenerate cases: a curve lying in a triangle's plane (the quadratic is identically zero)
 //! does not hit it, as a straight ray parallel to a triangle misses it; a double root (the
@@ -94,6 +95,12 @@ impl RayCaster {
     /// parameter and the hit in the f32 form of the straight search (`t` = 0: the shading
     /// ray starts at the hit). `None` when nothing is hit or a control point is not finite.
     pub(super) fn intersect_quadratic(&self, p: &[DVec3; 3]) -> Option<(f64, Hit32)> {
+        // The whole curve first (within its middle control point's distance of its chord):
+        // the projectors of many pixels pass by the scene's box altogether.
+        let whole = NearSegment::new(p[0], p[2] - p[0], distance_to_segment(p[1], p[0], p[2]))?;
+        if !self.bvh.near_root(&whole) {
+            return None;
+        }
         for k in 0..PIECES {
             let (a, b) = (k as f64 / PIECES as f64, (k + 1) as f64 / PIECES as f64);
             let q = piece(p, a, b);

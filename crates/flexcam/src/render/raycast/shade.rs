@@ -180,7 +180,8 @@ impl<'a> Tracer<'a> {
     }
 
     /// The samples of four projectors (a 2x2 pixel quad): [`Tracer::sample4`] when all are
-    /// straight (or absent), else one by one.
+    /// straight (or absent), [`Tracer::sample4_polylines`] when all are polylines (or
+    /// absent), else one by one.
     pub fn sample4_projectors(&mut self, projectors: &[Option<Projector>; 4]) -> [Sample; 4] {
         fn straight(p: &Option<Projector>) -> Option<Option<&Ray>> {
             match p {
@@ -189,12 +190,67 @@ impl<'a> Tracer<'a> {
                 Some(_) => None,
             }
         }
-        match projectors.each_ref().map(straight) {
-            [Some(a), Some(b), Some(c), Some(d)] => self.sample4([a, b, c, d]),
-            _ => projectors
-                .each_ref()
-                .map(|p| self.sample_projector(p.as_ref())),
+        fn polyline(p: &Option<Projector>) -> Option<Option<&[DVec3]>> {
+            match p {
+                Some(Projector::Polyline(points)) => Some(Some(points)),
+                None => Some(None),
+                Some(_) => None,
+            }
         }
+        if let [Some(a), Some(b), Some(c), Some(d)] = projectors.each_ref().map(straight) {
+            return self.sample4([a, b, c, d]);
+        }
+        if let [Some(a), Some(b), Some(c), Some(d)] = projectors.each_ref().map(polyline) {
+            return self.sample4_polylines([a, b, c, d]);
+        }
+        projectors
+            .each_ref()
+            .map(|p| self.sample_projector(p.as_ref()))
+    }
+
+    /// The samples of four polyline projectors (`None`: no projector), exactly those of
+    /// [`Tracer::sample_projector`] on each: segment k of the four is searched by one shared
+    /// BVH traversal ([`RayCaster::intersect4_f32`]), leaving out the polylines that have
+    /// hit something already or have fewer segments.
+    fn sample4_polylines(&mut self, polylines: [Option<&[DVec3]>; 4]) -> [Sample; 4] {
+        let mut hits: [Option<Sample>; 4] = [None; 4];
+        let mut before = [0.0; 4];
+        let segments = polylines
+            .iter()
+            .flatten()
+            .map(|p| p.len().saturating_sub(1))
+            .max()
+            .unwrap_or(0);
+        for k in 0..segments {
+            let rays: [Option<Ray>; 4] = std::array::from_fn(|i| match polylines[i] {
+                Some(p) if hits[i].is_none() && k + 1 < p.len() => Some(Ray {
+                    origin: p[k],
+                    direction: p[k + 1] - p[k],
+                    t_min: 0.0,
+                    t_max: 1.0,
+                }),
+                _ => None,
+            });
+            let found = self
+                .caster
+                .intersect4_f32(rays.each_ref().map(Option::as_ref));
+            for (i, (ray, found)) in rays.iter().zip(found).enumerate() {
+                match (ray, found) {
+                    (Some(ray), Some(hit)) => hits[i] = Some(self.shade(ray, Some(hit), before[i])),
+                    (Some(ray), None) => before[i] += ray.direction.length(),
+                    (None, _) => {}
+                }
+            }
+        }
+        let mut samples = [self.sample(None); 4];
+        for ((sample, hit), polyline) in samples.iter_mut().zip(hits).zip(polylines) {
+            *sample = match (hit, polyline) {
+                (Some(hit), _) => hit,
+                (None, Some(_)) => self.shade_miss(),
+                (None, None) => self.sample(None),
+            };
+        }
+        samples
     }
 
     /// The sample of primary ray `ray` whose first hit (the f32 search's) is `found`; the
