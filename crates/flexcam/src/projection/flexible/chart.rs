@@ -16,6 +16,8 @@
 //!   (the cylindrical preset): the image depends only on the direction from that point, with
 //!   poles along +-axis. Other cylinder volumes have no chart (their axis is singular at a
 //!   finite image row, which a chart cannot describe).
+//! - Shape-defined panoramas (linear map only): like the cylinder, only the direction from
+//!   the eye matters; see `panorama::lookup`.
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
@@ -49,6 +51,7 @@ impl Inverse {
                 (reparam == Reparam::Linear).then_some(())?;
                 cylinders_chart(near, far, resolution)
             }
+            Inverse::Panorama(lookup) => lookup.chart(reparam, resolution),
         }
     }
 }

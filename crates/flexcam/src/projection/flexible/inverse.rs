@@ -10,12 +10,16 @@
 //! - Coaxial cylinders: cylinder patches sharing the axis line, frame and angle range, with
 //!   different radii: t from the distance to the axis, u from the angle, v from the height.
 //!
+//! - Shape-defined panoramas with one outline and one profile: lookup tables of the curves'
+//!   angles (module `panorama::lookup`).
+//!
 //! Anything else has no inverse ([`Inverse::classify`] gives `None`).
 
 use std::f64::consts::PI;
 
 use glam::{DMat2, DVec2, DVec3};
 
+use super::panorama::lookup::PanoramaInverse;
 use super::surface::{CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface};
 
 /// Relative tolerance for "the same" centre, frame or range, and for the domain edges.
@@ -47,6 +51,8 @@ pub(super) enum Inverse {
         near: CylinderPatch,
         far: CylinderPatch,
     },
+    /// Shape-defined panoramas by lookup tables (module `panorama::lookup`).
+    Panorama(Box<PanoramaInverse>),
 }
 
 fn affine(s: &Surface) -> Option<Affine> {
@@ -88,9 +94,11 @@ fn affine(s: &Surface) -> Option<Affine> {
                 c: p01 - p00,
             })
         }
-        Surface::Sphere(_) | Surface::Cylinder(_) | Surface::Bezier(_) | Surface::BSpline(_) => {
-            None
-        }
+        Surface::Sphere(_)
+        | Surface::Cylinder(_)
+        | Surface::Bezier(_)
+        | Surface::BSpline(_)
+        | Surface::Panorama(_) => None,
     }
 }
 
@@ -120,6 +128,9 @@ fn as_sphere(s: &Surface, other: &Surface) -> Option<SpherePatch> {
 impl Inverse {
     /// The inverse of the volume between `near` and `far`, when it is in the analytic class.
     pub fn classify(near: &Surface, far: &Surface) -> Option<Inverse> {
+        if let (Surface::Panorama(n), Surface::Panorama(f)) = (near, far) {
+            return PanoramaInverse::new(n, f).map(|p| Inverse::Panorama(Box::new(p)));
+        }
         if let (Some(n), Some(f)) = (as_sphere(near, far), as_sphere(far, near)) {
             let ok = same(n.center, f.center, n.radius.max(f.radius))
                 && same_frame(&n.frame, &f.frame)
@@ -173,6 +184,7 @@ impl Inverse {
             Inverse::Planes { near, far, normal } => planes(near, far, *normal, p),
             Inverse::Spheres { near, far } => spheres(near, far, p),
             Inverse::Cylinders { near, far } => cylinders(near, far, p),
+            Inverse::Panorama(lookup) => lookup.solve(p),
         }
     }
 }

@@ -11,6 +11,7 @@
 //! - [`presets`]: named volumes from a camera frame (perspective, pushbroom, crossed slits, ...);
 //! - [`projector_grid`]: a volume interpolated from a grid of placed projectors (5.2), and
 //!   [`fit`]: aiming all of them by least squares from point correspondences;
+//! - [`panorama`]: shape-defined panoramas (ch. 9), outlines and profiles by arc length;
 //! - `inverse`: (u, v, t) from a scene point for the analytic class (parallel planes, nested
 //!   spheres, coaxial cylinders);
 //! - [`blend`]: Q = a Q1 + (1 - a) Q2, interpolation and extrapolation between volumes;
@@ -25,6 +26,7 @@ mod chart;
 pub mod fit;
 pub mod interpolate;
 mod inverse;
+pub mod panorama;
 mod patch;
 pub mod presets;
 pub mod projector_grid;
@@ -39,6 +41,7 @@ use glam::{DVec2, DVec3};
 pub use animation::{Animation, Easing, Keyframe};
 pub use blend::{BezierVolume, PiecewiseVolume};
 pub use interpolate::InterpolatedVolume;
+pub use panorama::{PanoramaShape, PanoramaSpec};
 pub use presets::{Preset, PresetSpec};
 pub use projector_grid::{Aim, GridInterpolation, GridVolume, ProjectorGrid, ProjectorGridSpec};
 pub use reparam::Reparam;
@@ -59,6 +62,8 @@ use crate::geometry::Ray;
 pub enum VolumeSource {
     /// A named volume placed by a camera frame.
     Preset(PresetSpec),
+    /// A shape-defined panorama (outlines and profiles) placed by a camera frame.
+    Panorama(PanoramaSpec),
     /// Two explicit control surfaces, straight projectors between them.
     Surfaces { near: Surface, far: Surface },
     /// Two or more explicit control surfaces blended in t: curved projectors.
@@ -162,6 +167,10 @@ fn build_volume(spec: &FlexibleSpec, aspect: f64) -> Result<(Volume, Reparam)> {
         VolumeSource::Preset(p) => {
             let (near, far) = p.surfaces(aspect)?;
             (linear(near, far)?, p.preset.default_reparam())
+        }
+        VolumeSource::Panorama(p) => {
+            let (near, far) = p.surfaces()?;
+            (linear(near, far)?, Reparam::Linear)
         }
         VolumeSource::Surfaces { near, far } => {
             (linear(near.clone(), far.clone())?, Reparam::Linear)

@@ -10,6 +10,7 @@ use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
 
+pub use super::panorama::PanoramaSurface;
 pub use super::patch::{BSplinePatch, BezierPatch};
 use crate::error::{Error, Result};
 
@@ -122,6 +123,9 @@ pub enum Surface {
     Bezier(Box<BezierPatch>),
     /// A uniform cubic B-spline patch.
     BSpline(BSplinePatch),
+    /// A shape-defined panorama surface: outlines and profiles by arc length (boxed: it
+    /// holds a camera basis).
+    Panorama(Box<PanoramaSurface>),
 }
 
 /// Linear interpolation of a parameter range at `s` in [0, 1].
@@ -176,6 +180,7 @@ impl Surface {
             }
             Surface::Bezier(b) => b.point(uv),
             Surface::BSpline(b) => b.point(uv),
+            Surface::Panorama(p) => p.point(uv),
         }
     }
 
@@ -190,6 +195,7 @@ impl Surface {
             Surface::Line { .. } => "line",
             Surface::Bezier(_) => "bezier",
             Surface::BSpline(_) => "bspline",
+            Surface::Panorama(_) => "panorama",
         }
     }
 
@@ -208,6 +214,10 @@ impl Surface {
             Surface::Line { start, end, .. } => finite(&[*start, *end]),
             Surface::Bezier(b) => finite(b.control.as_flattened()),
             Surface::BSpline(b) => finite(b.control()),
+            Surface::Panorama(p) => {
+                p.validate()?;
+                true
+            }
             Surface::Sphere(s) => {
                 check_radius(s.radius)?;
                 check_span("longitude", s.longitude)?;

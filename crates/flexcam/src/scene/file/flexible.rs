@@ -1,6 +1,7 @@
 //! `[projection] type = "flexible"`: a named preset placed by a camera frame, two explicit
 //! control surfaces `near` and `far`, or a list `surfaces` blended in t (`blend`, `knots`,
-//! `segments`), with an optional re-parameterisation.
+//! `segments`), a shape-defined panorama (`outline`/`outlines` and `profile`/`profiles`,
+//! module `panorama`), with an optional re-parameterisation.
 
 use std::ops::Range;
 
@@ -19,7 +20,7 @@ use crate::projection::flexible::{
 };
 
 /// Every key of a flexible table (besides `type`).
-pub(super) const KEYS: [&str; 25] = [
+pub(super) const KEYS: [&str; 30] = [
     "preset",
     "position",
     "look_at",
@@ -45,6 +46,11 @@ pub(super) const KEYS: [&str; 25] = [
     "elevation",
     "generators",
     "projectors",
+    "corner_radius",
+    "outline",
+    "outlines",
+    "profile",
+    "profiles",
 ];
 
 /// Keys every preset accepts (but `up` for the axonometric one, which is always +y).
@@ -92,6 +98,8 @@ fn preset_keys(name: &str) -> &'static [&'static str] {
         "oblique" => &["width", "shear"],
         "pushbroom" => &["width", "v_fov"],
         "crossed_slits" => &["fov", "v_fov", "slit_distance"],
+        "cubic" => &["v_fov"],
+        "rounded_cubic" => &["v_fov", "corner_radius"],
         _ => &["h_fov", "v_fov"],
     }
 }
@@ -138,6 +146,20 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
                 )
             })?;
             VolumeSource::Preset(preset(required, name.get_ref())?)
+        }
+        None if super::panorama::is_panorama(raw) => {
+            reject_keys(
+                src,
+                &present,
+                |key| super::panorama::KEYS.contains(&key),
+                || {
+                    format!(
+                        "panoramas given by outlines and profiles (they take: {})",
+                        super::panorama::KEYS.join(", ")
+                    )
+                },
+            )?;
+            VolumeSource::Panorama(super::panorama::convert(required)?)
         }
         None if raw.surfaces.is_some() || raw.blend.is_some() => {
             reject_keys(
@@ -338,6 +360,21 @@ fn reparam(src: &Source, raw: &RawProjection) -> Result<Option<Reparam>> {
     }))
 }
 
+/// `clip = [near, far]` with 0 <= near < far, when given.
+pub(super) fn clip(src: &Source, raw: &RawProjection) -> Result<Option<[f64; 2]>> {
+    let Some(c) = &raw.clip else {
+        return Ok(None);
+    };
+    let [near, far] = src.vector(c, "clip")?;
+    if !(0.0 <= near && near < far) {
+        return Err(src.error(
+            &c.span(),
+            format!("`clip` must be [near, far] with 0 <= near < far, got [{near}, {far}]"),
+        ));
+    }
+    Ok(Some([near, far]))
+}
+
 /// A preset with its camera frame and parameters (already checked to belong to it).
 fn preset(required: &Required, name: &str) -> Result<PresetSpec> {
     let src = required.src;
@@ -386,6 +423,23 @@ fn preset(required: &Required, name: &str) -> Result<PresetSpec> {
         "fisheye" => Preset::Fisheye {
             fov: number(&raw.fov, "fov")?,
         },
+        "cubic" => Preset::Cubic {
+            v_fov: optional(&raw.v_fov, "v_fov", 90.0)?,
+        },
+        "rounded_cubic" => Preset::RoundedCubic {
+            v_fov: optional(&raw.v_fov, "v_fov", 90.0)?,
+            corner_radius: {
+                let r = required.get(&raw.corner_radius, "corner_radius")?;
+                let x = src.number(r, "corner_radius")?;
+                if !(0.0..=1.0).contains(&x) {
+                    return Err(src.error(
+                        &r.span(),
+                        format!("`corner_radius` must lie in [0, 1], got {x}"),
+                    ));
+                }
+                x
+            },
+        },
         "off_axis" => Preset::OffAxis {
             fov: number(&raw.fov, "fov")?,
             shift: DVec2::from_array(src.vector(required.get(&raw.shift, "shift")?, "shift")?),
@@ -404,23 +458,10 @@ fn preset(required: &Required, name: &str) -> Result<PresetSpec> {
             generators: generators(src, required.get(&raw.generators, "generators")?)?,
         },
     };
-    let clip = match &raw.clip {
-        Some(c) => {
-            let [near, far] = src.vector(c, "clip")?;
-            if !(0.0 <= near && near < far) {
-                return Err(src.error(
-                    &c.span(),
-                    format!("`clip` must be [near, far] with 0 <= near < far, got [{near}, {far}]"),
-                ));
-            }
-            Some([near, far])
-        }
-        None => None,
-    };
     Ok(PresetSpec {
         preset,
         frame: camera_frame(src, required)?,
-        clip,
+        clip: clip(src, raw)?,
     })
 }
 

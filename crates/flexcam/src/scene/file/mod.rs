@@ -8,6 +8,7 @@ mod animation;
 mod flexible;
 mod light;
 mod object;
+mod panorama;
 mod projection;
 mod projector_grid;
 mod raw;

@@ -100,6 +100,38 @@ pub struct RawProjection {
     pub elevation: Option<Spanned<f64>>,
     pub generators: Option<Spanned<Vec<[f64; 4]>>>,
     pub projectors: Option<Spanned<RawProjectors>>,
+    pub corner_radius: Option<Spanned<f64>>,
+    pub outline: Option<Spanned<RawCurve>>,
+    pub outlines: Option<Spanned<Vec<Spanned<RawCurve>>>>,
+    pub profile: Option<Spanned<RawCurve>>,
+    pub profiles: Option<Spanned<Vec<Spanned<RawCurve>>>>,
+}
+
+/// `outline = { ... }`, `profile`, and the entries of `outlines` / `profiles` (with `at`): a
+/// panorama curve, named (`shape` with its parameter) or by `points`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawCurve {
+    pub at: Option<Spanned<f64>>,
+    pub shape: Option<Spanned<String>>,
+    pub points: Option<Spanned<Vec<[f64; 2]>>>,
+    pub radius: Option<Spanned<f64>>,
+    pub elevation: Option<Spanned<[f64; 2]>>,
+}
+
+impl RawCurve {
+    /// The keys present besides `at`, with their spans.
+    pub fn present_keys(&self) -> Vec<(&'static str, Range<usize>)> {
+        [
+            ("shape", self.shape.as_ref().map(Spanned::span)),
+            ("points", self.points.as_ref().map(Spanned::span)),
+            ("radius", self.radius.as_ref().map(Spanned::span)),
+            ("elevation", self.elevation.as_ref().map(Spanned::span)),
+        ]
+        .into_iter()
+        .filter_map(|(key, span)| Some((key, span?)))
+        .collect()
+    }
 }
 
 /// `projectors = { ... }` of a flexible projection: a projector grid sampled from the
@@ -252,6 +284,14 @@ impl RawProjection {
             ("elevation", self.elevation.as_ref().map(Spanned::span)),
             ("generators", self.generators.as_ref().map(Spanned::span)),
             ("projectors", self.projectors.as_ref().map(Spanned::span)),
+            (
+                "corner_radius",
+                self.corner_radius.as_ref().map(Spanned::span),
+            ),
+            ("outline", self.outline.as_ref().map(Spanned::span)),
+            ("outlines", self.outlines.as_ref().map(Spanned::span)),
+            ("profile", self.profile.as_ref().map(Spanned::span)),
+            ("profiles", self.profiles.as_ref().map(Spanned::span)),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))

@@ -15,6 +15,10 @@
 //! - cylindrical: cylinders about the up axis, radius d, angle U h_fov/2, height
 //!   V d tan(v_fov/2);
 //! - equirectangular: spheres of radius d, longitude U h_fov/2, latitude V v_fov/2;
+//! - cubic: the shape-defined panorama (module `panorama`) of the unit square outline and
+//!   the vertical segment between elevations +-v_fov/2, scaled by d: four 90-degree
+//!   perspective views side by side; rounded cubic: the square with corners rounded to
+//!   quarter circles of radius `corner_radius` (0: cubic, 1: cylindrical);
 //! - fisheye: spheres of radius d with the pole on the view axis, azimuth from u and angle
 //!   off the axis v fov/2, with the polar re-parameterisation.
 //!
@@ -33,12 +37,14 @@ mod axonometric;
 mod glc;
 
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
 
 use super::super::camera_basis::CameraBasis;
 use super::super::params::{angle_radians, positive_length, UpTo};
 use super::super::CameraFrame;
+use super::panorama::{OutlineShape, PanoramaShape, PanoramaSpec, ProfileShape};
 use super::reparam::Reparam;
 use super::surface::{CylinderPatch, PolarFrame, SpherePatch, Surface};
 use crate::error::{Error, Result};
@@ -84,6 +90,15 @@ pub enum Preset {
     Fisheye {
         fov: f64,
     },
+    /// The cubic panorama (360 degrees around, `v_fov` through the middle of each face).
+    Cubic {
+        v_fov: f64,
+    },
+    /// The cubic panorama with rounded corners: `corner_radius` in [0, 1] of the half-width.
+    RoundedCubic {
+        v_fov: f64,
+        corner_radius: f64,
+    },
     /// Perspective with the window shifted by `shift` half-widths and half-heights.
     OffAxis {
         fov: f64,
@@ -113,7 +128,7 @@ pub enum Preset {
 }
 
 /// The preset names of scene files, in order.
-pub const PRESET_NAMES: [&str; 13] = [
+pub const PRESET_NAMES: [&str; 15] = [
     "perspective",
     "inverse_perspective",
     "orthographic",
@@ -127,6 +142,8 @@ pub const PRESET_NAMES: [&str; 13] = [
     "twist",
     "axonometric",
     "glc",
+    "cubic",
+    "rounded_cubic",
 ];
 
 /// A preset placed in the scene.
@@ -156,6 +173,8 @@ impl Preset {
             Preset::Twist { .. } => "twist",
             Preset::Axonometric { .. } => "axonometric",
             Preset::Glc { .. } => "glc",
+            Preset::Cubic { .. } => "cubic",
+            Preset::RoundedCubic { .. } => "rounded_cubic",
         }
     }
 
@@ -273,6 +292,19 @@ impl PresetSpec {
                 let frame = PolarFrame::new(b.up, b.forward)?;
                 pair(&|d| sphere(b.origin, d, frame, [-h, h], [-v, v]))
             }
+            Preset::Cubic { v_fov } => cubic(p, frame, [near, far], v_fov, OutlineShape::Square)?,
+            Preset::RoundedCubic {
+                v_fov,
+                corner_radius,
+            } => cubic(
+                p,
+                frame,
+                [near, far],
+                v_fov,
+                OutlineShape::RoundedSquare {
+                    radius: corner_radius,
+                },
+            )?,
             Preset::Fisheye { fov } => {
                 let half = 0.5 * angle(p, "fov", fov, UpTo::Including(360.0))?;
                 // Pole on the view axis, longitude 0 to the right, +90 up: the polar map's
@@ -322,6 +354,31 @@ impl PresetSpec {
             }
         })
     }
+}
+
+/// The near and far surfaces of a cubic panorama with outline `outline` and the vertical
+/// segment profile between elevations +-`v_fov`/2.
+fn cubic(
+    preset: &Preset,
+    frame: CameraFrame,
+    clip: [f64; 2],
+    v_fov: f64,
+    outline: OutlineShape,
+) -> Result<(Surface, Surface)> {
+    let half = 0.5 * angle(preset, "v_fov", v_fov, UpTo::Below(180.0))?;
+    let outline = outline
+        .curve()
+        .map_err(|e| Error::new(format!("flexible {} {}", preset.name(), e.message)))?;
+    let profile = ProfileShape::Segment {
+        elevation: [-half, half],
+    }
+    .curve()?;
+    PanoramaSpec {
+        shape: Arc::new(PanoramaShape::single(outline, profile)?),
+        frame,
+        clip: Some(clip),
+    }
+    .surfaces()
 }
 
 fn sphere(

@@ -1,0 +1,287 @@
+//! Planar curves parameterised by arc length: the outlines and profiles of shape-defined
+//! panoramas (thesis 9.3).
+//!
+//! A curve is a chain of pieces, each a straight segment or a circular arc, so the arc length
+//! of every named shape (circle, square, rounded square, vertical segment, arc) is exact; a
+//! curve given by points is a chain of segments (the thesis's chord-length approximation of
+//! arc length, exact for the polyline itself).
+//!
+//! Degenerate cases: pieces of zero length (repeated points, a corner radius of 0 or 1) are
+//! dropped, as they take no arc length; a curve whose total length is zero, or with a
+//! non-finite coordinate, is an error.
+
+use glam::DVec2;
+
+use crate::error::{Error, Result};
+
+/// One piece of a curve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Piece {
+    /// The segment from `from` to `to`.
+    Line { from: DVec2, to: DVec2 },
+    /// The arc of the circle around `centre` of radius `radius` from angle `start` over the
+    /// signed angle `sweep` (radians, counter-clockwise positive).
+    Circular {
+        centre: DVec2,
+        radius: f64,
+        start: f64,
+        sweep: f64,
+    },
+}
+
+impl Piece {
+    /// The point at fraction `s` of the piece (outside [0, 1] the segment or circle
+    /// continues).
+    pub fn at(&self, s: f64) -> DVec2 {
+        match *self {
+            Piece::Line { from, to } => from + s * (to - from),
+            Piece::Circular {
+                centre,
+                radius,
+                start,
+                sweep,
+            } => {
+                let (sin, cos) = (start + s * sweep).sin_cos();
+                centre + radius * DVec2::new(cos, sin)
+            }
+        }
+    }
+
+    /// The piece's length.
+    pub fn length(&self) -> f64 {
+        match *self {
+            Piece::Line { from, to } => (to - from).length(),
+            Piece::Circular { radius, sweep, .. } => (radius * sweep).abs(),
+        }
+    }
+
+    /// The smallest and largest distance from the origin of a point of the piece.
+    fn distance_range(&self) -> (f64, f64) {
+        let ends = [self.at(0.0).length(), self.at(1.0).length()];
+        let (mut lo, mut hi) = (ends[0].min(ends[1]), ends[0].max(ends[1]));
+        match *self {
+            Piece::Line { from, to } => {
+                let d = to - from;
+                let s = (-from.dot(d) / d.length_squared()).clamp(0.0, 1.0);
+                lo = lo.min(self.at(s).length());
+            }
+            Piece::Circular {
+                centre,
+                start,
+                sweep,
+                ..
+            } => {
+                // The nearest and farthest points of the whole circle lie on the line through
+                // the origin and the centre; they count where the arc reaches them.
+                let toward = (-centre).to_angle();
+                for angle in [toward, toward + std::f64::consts::PI] {
+                    let turn = std::f64::consts::TAU;
+                    let s = ((angle - start) / sweep).rem_euclid(turn / sweep.abs());
+                    if s <= 1.0 {
+                        let r = self.at(s).length();
+                        lo = lo.min(r);
+                        hi = hi.max(r);
+                    }
+                }
+            }
+        }
+        (lo, hi)
+    }
+}
+
+/// A curve parameterised by arc-length fraction s in [0, 1].
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArcCurve {
+    pieces: Vec<Piece>,
+    /// The arc-length fraction at the end of each piece (the last is 1).
+    ends: Vec<f64>,
+    closed: bool,
+}
+
+/// Relative gap between the last and first points below which a curve counts as closed.
+const CLOSE: f64 = 1e-9;
+
+impl ArcCurve {
+    /// A curve through `pieces` in order. `closed` curves must end where they start (within
+    /// 1e-9 of their length). Errors: a non-finite number, zero total length, an open chain
+    /// of pieces that do not meet, a closed curve that does not close.
+    pub fn new(pieces: Vec<Piece>, closed: bool) -> Result<Self> {
+        let finite = |p: &Piece| match *p {
+            Piece::Line { from, to } => from.is_finite() && to.is_finite(),
+            Piece::Circular {
+                centre,
+                radius,
+                start,
+                sweep,
+            } => centre.is_finite() && radius.is_finite() && start.is_finite() && sweep.is_finite(),
+        };
+        if !pieces.iter().all(finite) {
+            return Err(Error::new("curve has a non-finite coordinate"));
+        }
+        let pieces: Vec<Piece> = pieces.into_iter().filter(|p| p.length() > 0.0).collect();
+        let total: f64 = pieces.iter().map(Piece::length).sum();
+        if !(total > 0.0 && total.is_finite()) {
+            return Err(Error::new(
+                "curve has zero length (all its points coincide)",
+            ));
+        }
+        let gap = |a: &Piece, b: &Piece| (a.at(1.0) - b.at(0.0)).length() > CLOSE * total;
+        if pieces.windows(2).any(|w| gap(&w[0], &w[1])) {
+            return Err(Error::new("curve pieces do not join"));
+        }
+        if closed && gap(&pieces[pieces.len() - 1], &pieces[0]) {
+            return Err(Error::new("closed curve does not end where it starts"));
+        }
+        let mut walked = 0.0;
+        let mut ends: Vec<f64> = pieces
+            .iter()
+            .map(|p| {
+                walked += p.length();
+                walked / total
+            })
+            .collect();
+        if let Some(last) = ends.last_mut() {
+            *last = 1.0;
+        }
+        Ok(ArcCurve {
+            pieces,
+            ends,
+            closed,
+        })
+    }
+
+    /// The polyline through `points` (closed: back to the first point). Errors as
+    /// [`ArcCurve::new`]; repeated points are allowed.
+    pub fn polyline(points: &[DVec2], closed: bool) -> Result<Self> {
+        let mut pieces: Vec<Piece> = points
+            .windows(2)
+            .map(|w| Piece::Line {
+                from: w[0],
+                to: w[1],
+            })
+            .collect();
+        if let (true, Some(first), Some(last)) = (closed, points.first(), points.last()) {
+            pieces.push(Piece::Line {
+                from: *last,
+                to: *first,
+            });
+        }
+        ArcCurve::new(pieces, closed)
+    }
+
+    /// Whether the curve is closed.
+    pub fn is_closed(&self) -> bool {
+        self.closed
+    }
+
+    /// The pieces of non-zero length.
+    pub fn pieces(&self) -> &[Piece] {
+        &self.pieces
+    }
+
+    /// The point at arc-length fraction `s`. A closed curve wraps (s modulo 1); an open one
+    /// continues its first and last pieces beyond s = 0 and s = 1.
+    pub fn at(&self, s: f64) -> DVec2 {
+        let s = if self.closed { s.rem_euclid(1.0) } else { s };
+        let i = self
+            .ends
+            .partition_point(|&end| end < s)
+            .min(self.pieces.len() - 1);
+        let start = if i == 0 { 0.0 } else { self.ends[i - 1] };
+        self.pieces[i].at((s - start) / (self.ends[i] - start))
+    }
+
+    /// The smallest and largest distance of a curve point from the origin.
+    pub fn distance_range(&self) -> (f64, f64) {
+        self.pieces
+            .iter()
+            .map(Piece::distance_range)
+            .fold((f64::INFINITY, 0.0), |(lo, hi), (a, b)| {
+                (lo.min(a), hi.max(b))
+            })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::{PI, TAU};
+
+    use super::*;
+
+    fn close(a: DVec2, b: DVec2) -> bool {
+        (a - b).length() < 1e-12
+    }
+
+    #[test]
+    fn polyline_is_parameterised_by_arc_length() {
+        // Lengths 1 and 3: the corner is at a quarter of the length.
+        let c = ArcCurve::polyline(&[DVec2::ZERO, DVec2::X, DVec2::new(1.0, 3.0)], false).unwrap();
+        assert!(close(c.at(0.25), DVec2::X));
+        assert!(close(c.at(0.125), DVec2::new(0.5, 0.0)));
+        assert!(close(c.at(1.0), DVec2::new(1.0, 3.0)));
+        // An open curve continues its end pieces.
+        assert!(close(c.at(-0.25), DVec2::new(-1.0, 0.0)));
+        assert!(close(c.at(1.25), DVec2::new(1.0, 4.0)));
+        assert!(!c.is_closed());
+    }
+
+    #[test]
+    fn closed_curves_wrap() {
+        let square = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y];
+        let c = ArcCurve::polyline(&square, true).unwrap();
+        assert_eq!(c.pieces().len(), 4);
+        assert!(close(c.at(0.875), DVec2::new(0.0, 0.5)));
+        assert!(close(c.at(1.125), DVec2::new(0.5, 0.0)));
+        assert!(close(c.at(-0.125), DVec2::new(0.0, 0.5)));
+    }
+
+    #[test]
+    fn arcs_have_exact_length() {
+        let arc = Piece::Circular {
+            centre: DVec2::new(1.0, 0.0),
+            radius: 2.0,
+            start: 0.0,
+            sweep: -PI,
+        };
+        assert!((arc.length() - TAU).abs() < 1e-15);
+        let c = ArcCurve::new(vec![arc], false).unwrap();
+        assert!(close(c.at(0.5), DVec2::new(1.0, -2.0)));
+        assert_eq!(c.distance_range(), (1.0, 3.0));
+    }
+
+    #[test]
+    fn repeated_points_take_no_length() {
+        let c = ArcCurve::polyline(&[DVec2::ZERO, DVec2::ZERO, DVec2::X, DVec2::X], false).unwrap();
+        assert_eq!(c.pieces().len(), 1);
+        assert!(close(c.at(0.5), DVec2::new(0.5, 0.0)));
+    }
+
+    #[test]
+    fn degenerate_curves_are_errors() {
+        let e = ArcCurve::polyline(&[DVec2::ONE, DVec2::ONE], false).unwrap_err();
+        assert!(e.message.contains("zero length"), "{e}");
+        assert!(ArcCurve::polyline(&[DVec2::ONE], true).is_err());
+        assert!(ArcCurve::polyline(&[], false).is_err());
+        let nan = DVec2::new(f64::NAN, 0.0);
+        assert!(ArcCurve::polyline(&[DVec2::ZERO, nan], false).is_err());
+        let apart = vec![
+            Piece::Line {
+                from: DVec2::ZERO,
+                to: DVec2::X,
+            },
+            Piece::Line {
+                from: DVec2::Y,
+                to: DVec2::ONE,
+            },
+        ];
+        assert!(ArcCurve::new(apart.clone(), false).is_err());
+        assert!(ArcCurve::new(apart[..1].to_vec(), true).is_err());
+    }
+
+    #[test]
+    fn distance_range_finds_interior_extremes() {
+        let c = ArcCurve::polyline(&[DVec2::new(-1.0, 2.0), DVec2::new(1.0, 2.0)], false).unwrap();
+        let (lo, hi) = c.distance_range();
+        assert!((lo - 2.0).abs() < 1e-15 && (hi - 5f64.sqrt()).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,264 @@
+//! A flexible projection given by outlines and profiles (a shape-defined panorama, module
+//! `projection::flexible::panorama`):
+//!
+//! ```toml
+//! [projection]
+//! type = "flexible"
+//! position = [0, 1, 0]
+//! look_at = [0, 1, -1]
+//! outline = { shape = "rounded_square", radius = 0.3 }     # or `outlines = [{ at = v, ... }]`
+//! profiles = [{ at = 0.5, shape = "segment", elevation = [-40, 40] },
+//!             { at = 0.0, shape = "arc" }]                  # or `profile = { ... }`
+//! blend = "smooth"                                          # or "linear" (the default)
+//! ```
+//!
+//! Outline shapes: `circle`, `square`, `rounded_square` (`radius`), or `points = [[x, y],
+//! ...]` in the (right, forward) plane. Profile shapes: `segment` (`elevation`, default
+//! [-45, 45] degrees), `arc` (`elevation`, default [-90, 90]), or `points = [[r, h], ...]`
+//! (distance from the up axis, height), bottom to top.
+
+use std::sync::Arc;
+
+use glam::DVec2;
+use toml::Spanned;
+
+use super::flexible::clip;
+use super::projection::{camera_frame, Required};
+use super::raw::{RawCurve, RawProjection};
+use super::source::Source;
+use crate::error::Result;
+use crate::projection::flexible::panorama::{
+    ArcCurve, Attached, CurveBlend, OutlineShape, PanoramaShape, PanoramaSpec, ProfileShape,
+};
+
+/// The keys of a panorama table (besides `type` and `projectors`).
+pub(super) const KEYS: [&str; 11] = [
+    "position",
+    "look_at",
+    "up",
+    "clip",
+    "reparam",
+    "max_latitude",
+    "outline",
+    "outlines",
+    "profile",
+    "profiles",
+    "blend",
+];
+
+const OUTLINE_NAMES: [&str; 3] = ["circle", "square", "rounded_square"];
+const PROFILE_NAMES: [&str; 2] = ["segment", "arc"];
+const BLEND_NAMES: [&str; 2] = ["linear", "smooth"];
+
+/// Whether the table describes a panorama by outlines and profiles.
+pub(super) fn is_panorama(raw: &RawProjection) -> bool {
+    raw.outline.is_some()
+        || raw.outlines.is_some()
+        || raw.profile.is_some()
+        || raw.profiles.is_some()
+}
+
+/// Which curve family a table belongs to.
+#[derive(Clone, Copy, PartialEq)]
+enum Family {
+    Outline,
+    Profile,
+}
+
+impl Family {
+    fn name(self) -> &'static str {
+        match self {
+            Family::Outline => "outline",
+            Family::Profile => "profile",
+        }
+    }
+}
+
+/// Converts a panorama table (its keys already checked).
+pub(super) fn convert(required: &Required) -> Result<PanoramaSpec> {
+    let src = required.src;
+    let raw = required.raw();
+    let outlines = family(required, Family::Outline, &raw.outline, &raw.outlines)?;
+    let profiles = family(required, Family::Profile, &raw.profile, &raw.profiles)?;
+    let blend = match &raw.blend {
+        None => CurveBlend::Linear,
+        Some(b) => match b.get_ref().as_str() {
+            "linear" => CurveBlend::Linear,
+            "smooth" => CurveBlend::Smooth,
+            other => {
+                return Err(src.error(
+                    &b.span(),
+                    format!(
+                        "unknown panorama blend \"{other}\"; expected one of: {}",
+                        BLEND_NAMES.join(", ")
+                    ),
+                ))
+            }
+        },
+    };
+    let at = raw
+        .outlines
+        .as_ref()
+        .map(Spanned::span)
+        .or(raw.profiles.as_ref().map(Spanned::span))
+        .unwrap_or(required.table.span());
+    let shape = PanoramaShape::new(outlines, profiles, blend).map_err(|e| {
+        let at = match (e.message.starts_with("profile"), &raw.profiles) {
+            (true, Some(p)) => p.span(),
+            _ => at,
+        };
+        src.error(&at, e.message)
+    })?;
+    Ok(PanoramaSpec {
+        shape: Arc::new(shape),
+        frame: camera_frame(src, required)?,
+        clip: clip(src, raw)?,
+    })
+}
+
+/// The curves of one family from its single key (`outline`) or its list (`outlines`).
+fn family(
+    required: &Required,
+    which: Family,
+    one: &Option<Spanned<RawCurve>>,
+    list: &Option<Spanned<Vec<Spanned<RawCurve>>>>,
+) -> Result<Vec<Attached>> {
+    let src = required.src;
+    let name = which.name();
+    match (one, list) {
+        (Some(_), Some(l)) => Err(src.error(
+            &l.span(),
+            format!("give either `{name}` or `{name}s`, not both"),
+        )),
+        (None, None) => Err(src.error(
+            &required.table.span(),
+            format!("a panorama needs `{name}` (or `{name}s`)"),
+        )),
+        (Some(table), None) => {
+            if let Some(at) = &table.get_ref().at {
+                return Err(src.error(
+                    &at.span(),
+                    format!("`at` belongs to the entries of `{name}s`"),
+                ));
+            }
+            Ok(vec![Attached {
+                at: 0.0,
+                curve: curve(src, table, which)?,
+            }])
+        }
+        (None, Some(l)) => {
+            if l.get_ref().is_empty() {
+                return Err(src.error(&l.span(), format!("`{name}s` must not be empty")));
+            }
+            l.get_ref()
+                .iter()
+                .map(|table| {
+                    let at = table.get_ref().at.as_ref().ok_or_else(|| {
+                        src.error(&table.span(), format!("each entry of `{name}s` needs `at`"))
+                    })?;
+                    let x = src.number(at, "at")?;
+                    if !(0.0..=1.0).contains(&x) {
+                        return Err(
+                            src.error(&at.span(), format!("`at` must lie in [0, 1], got {x}"))
+                        );
+                    }
+                    Ok(Attached {
+                        at: x,
+                        curve: curve(src, table, which)?,
+                    })
+                })
+                .collect()
+        }
+    }
+}
+
+/// One curve table: a named shape with its parameter, or `points`. Errors point at the key
+/// concerned (the shape's parameter, `points`) or at the table.
+fn curve(src: &Source, table: &Spanned<RawCurve>, which: Family) -> Result<ArcCurve> {
+    let raw = table.get_ref();
+    let family = which.name();
+    if let Some(points) = &raw.points {
+        src.reject_foreign_key(
+            raw.present_keys(),
+            &["points"],
+            &format!("{family}s by points"),
+        )?;
+        src.all_finite(points.get_ref().as_flattened(), points, "points")?;
+        let list: Vec<DVec2> = points
+            .get_ref()
+            .iter()
+            .map(|&p| DVec2::from_array(p))
+            .collect();
+        let built = match which {
+            Family::Outline => OutlineShape::Points(list).curve(),
+            Family::Profile => ProfileShape::Points(list).curve(),
+        };
+        return built.map_err(|e| src.error(&points.span(), e.message));
+    }
+    let names: &[&str] = match which {
+        Family::Outline => &OUTLINE_NAMES,
+        Family::Profile => &PROFILE_NAMES,
+    };
+    let name = raw.shape.as_ref().ok_or_else(|| {
+        src.error(
+            &table.span(),
+            format!(
+                "a {family} needs `shape` ({}) or `points`",
+                names.join(", ")
+            ),
+        )
+    })?;
+    let shape = name.get_ref().as_str();
+    if !names.contains(&shape) {
+        return Err(src.error(
+            &name.span(),
+            format!(
+                "unknown {family} shape \"{shape}\"; expected one of: {}",
+                names.join(", ")
+            ),
+        ));
+    }
+    let parameter = match shape {
+        "rounded_square" => Some("radius"),
+        "segment" | "arc" => Some("elevation"),
+        _ => None,
+    };
+    let allowed: Vec<&str> = std::iter::once("shape").chain(parameter).collect();
+    src.reject_foreign_key(raw.present_keys(), &allowed, &format!("{shape} {family}s"))?;
+    let elevation = |default: [f64; 2]| -> Result<[f64; 2]> {
+        let degrees = match &raw.elevation {
+            Some(e) => src.vector(e, "elevation")?,
+            None => default,
+        };
+        Ok(degrees.map(f64::to_radians))
+    };
+    let built = match shape {
+        "circle" => OutlineShape::Circle.curve(),
+        "square" => OutlineShape::Square.curve(),
+        "rounded_square" => {
+            let r = raw.radius.as_ref().ok_or_else(|| {
+                src.error(&table.span(), "a rounded_square outline needs `radius`")
+            })?;
+            OutlineShape::RoundedSquare {
+                radius: src.number(r, "radius")?,
+            }
+            .curve()
+        }
+        "segment" => ProfileShape::Segment {
+            elevation: elevation([-45.0, 45.0])?,
+        }
+        .curve(),
+        _ => ProfileShape::Arc {
+            elevation: elevation([-90.0, 90.0])?,
+        }
+        .curve(),
+    };
+    built.map_err(|e| {
+        let at = match parameter {
+            Some("radius") => raw.radius.as_ref().map(Spanned::span),
+            Some(_) => raw.elevation.as_ref().map(Spanned::span),
+            None => None,
+        };
+        src.error(&at.unwrap_or(table.span()), e.message)
+    })
+}
