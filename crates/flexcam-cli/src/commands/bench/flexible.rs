@@ -122,11 +122,16 @@ fn table(args: &FlexibleArgs) -> Result<()> {
         THESIS[r].2.map(|t| format!("{t:.2}"))
     });
     print_table("flexcam (seconds)", rows, |r| {
-        ours[r].3.map(|t| format!("{t:.4}"))
+        ours[r].3.map(|t| format!("{:.4}", t.wall))
     });
     print_table("speed-up (thesis / flexcam)", rows, |r| {
-        std::array::from_fn(|c| format!("{:.0}x", THESIS[r].2[c] / ours[r].3[c]))
+        std::array::from_fn(|c| format!("{:.0}x", THESIS[r].2[c] / ours[r].3[c].wall))
     });
+    print_table(
+        "flexcam CPU seconds per frame, all threads (independent of other load)",
+        rows,
+        |r| ours[r].3.map(|t| t.cpu_text(1.0, 4)),
+    );
     println!("faces used per row:");
     for (name, faces, used, _) in &ours {
         println!("  {name:<7} thesis {faces:>6}, teapot {used:>6}");
@@ -136,19 +141,20 @@ fn table(args: &FlexibleArgs) -> Result<()> {
 
 /// One row of Table 7.1: the best time of one lit frame of `scene` through each column's
 /// projectors, the BVH built once for the row.
-fn row_times(scene: &Scene, repeat: u32) -> Result<[f64; 6]> {
+fn row_times(scene: &Scene, repeat: u32) -> Result<[Timing; 6]> {
     let caster = RayCaster::new(scene);
     let (lo, hi) = bounds(scene)?;
     let options = RenderOptions {
         shading: Shading::Lit,
         ..RenderOptions::default()
     };
-    let mut times = [0.0; 6];
+    let mut times = [Timing::default(); 6];
     for (time, column) in times.iter_mut().zip(COLUMNS) {
         let projection = volume(lo, hi, column)?;
-        *time = best_of(repeat, || {
+        *time = measure(repeat, || {
             caster.render(&projection, &options);
-        });
+            Ok(())
+        })?;
     }
     Ok(times)
 }
@@ -179,35 +185,43 @@ fn panorama(repeat: u32) -> Result<()> {
         ..RenderOptions::default()
     };
     // A new renderer per frame: the pixel projectors are computed during the frame.
-    let mut first = f64::INFINITY;
-    for _ in 0..repeat {
-        let start = Instant::now();
+    let first = measure(repeat, || {
         InverseRaster::new(&scene, projection, &options)?.render();
-        first = first.min(start.elapsed().as_secs_f64());
-    }
+        Ok(())
+    })?;
     let raster = InverseRaster::new(&scene, projection, &options)?;
     raster.render();
-    let later = best_of(repeat, || {
+    let later = measure(repeat, || {
         raster.render();
-    });
+        Ok(())
+    })?;
     let start = Instant::now();
     let caster = RayCaster::new(&scene);
     let build = start.elapsed().as_secs_f64();
-    let cast = best_of(repeat, || {
+    let cast = measure(repeat, || {
         caster.render(projection, &options);
-    });
+        Ok(())
+    })?;
     println!(
         "\npanorama: teapot-dense, {} triangles, {width}x{height} equirectangular (360 x 180), \
          flat shading, best of {repeat}",
         scene.triangle_count()
     );
-    println!("{:<34}{:>10}{:>8}", "method", "ms/frame", "fps");
-    for (name, seconds) in [
+    println!(
+        "{:<34}{:>10}{:>8}{:>14}",
+        "method", "ms/frame", "fps", "CPU ms/frame"
+    );
+    for (name, t) in [
         ("raster, first frame", first),
         ("raster, later frame", later),
         ("raycast, frame (BVH prebuilt)", cast),
     ] {
-        println!("{name:<34}{:>10.1}{:>8.1}", 1e3 * seconds, 1.0 / seconds);
+        println!(
+            "{name:<34}{:>10.1}{:>8.1}{:>14}",
+            1e3 * t.wall,
+            1.0 / t.wall,
+            t.cpu_text(1e3, 1)
+        );
     }
     println!("{:<34}{:>10.1}", "raycast, BVH build (once)", 1e3 * build);
     Ok(())
@@ -229,15 +243,51 @@ fn print_table(title: &str, rows: usize, cell: impl Fn(usize) -> [String; 6]) {
     }
 }
 
-/// The fastest of `repeat` runs of `f`, in seconds.
-fn best_of(repeat: u32, mut f: impl FnMut()) -> f64 {
-    (0..repeat)
-        .map(|_| {
-            let start = Instant::now();
-            f();
-            start.elapsed().as_secs_f64()
-        })
-        .fold(f64::INFINITY, f64::min)
+/// What [`measure`] found: the fastest wall-clock time of one run, and the mean CPU time of
+/// one run over all threads (`None` where the system does not report it), in seconds.
+#[derive(Debug, Clone, Copy, Default)]
+struct Timing {
+    wall: f64,
+    cpu: Option<f64>,
+}
+
+impl Timing {
+    /// The CPU time times `scale` with `decimals` decimals, or "-" when unknown.
+    fn cpu_text(&self, scale: f64, decimals: usize) -> String {
+        self.cpu.map_or_else(
+            || "-".to_string(),
+            |c| format!("{:.*}", decimals, c * scale),
+        )
+    }
+}
+
+/// Runs `f` `repeat` times: the fastest wall-clock time and the mean CPU time per run. On a
+/// machine shared with other work the wall-clock time grows with the load; the CPU time
+/// does not, and over the two cores of an idle machine a frame would take about half of it.
+fn measure(repeat: u32, mut f: impl FnMut() -> Result<()>) -> Result<Timing> {
+    let cpu_start = process_cpu_seconds();
+    let mut wall = f64::INFINITY;
+    for _ in 0..repeat {
+        let start = Instant::now();
+        f()?;
+        wall = wall.min(start.elapsed().as_secs_f64());
+    }
+    let cpu = match (cpu_start, process_cpu_seconds()) {
+        (Some(a), Some(b)) => Some((b - a) / f64::from(repeat)),
+        _ => None,
+    };
+    Ok(Timing { wall, cpu })
+}
+
+/// The user and system CPU time of this process so far, all threads, from `/proc/self/stat`
+/// (fields 14 and 15, in clock ticks of 1/100 s: Linux's USER_HZ); `None` elsewhere.
+fn process_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // The command name (field 2) is parenthesised and may hold spaces: count from after it.
+    let rest = &stat[stat.rfind(')')? + 1..];
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i)?.parse::<u64>().ok();
+    Some((ticks(11)? + ticks(12)?) as f64 / 100.0)
 }
 
 /// A scene of one teapot whose triangle count is nearest `faces`, and that count.
