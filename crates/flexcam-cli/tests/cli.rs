@@ -400,6 +400,29 @@ fn compare_reports_agreement_and_enforces_thresholds() {
     assert!(e.contains("unknown method \"x\""), "{e}");
 }
 
+/// `compare --spp 4` supersamples both renders with the same pattern: trilinear against the
+/// ray caster on the fan example at a small size meets the accuracy targets, and the report
+/// names the sample count.
+#[test]
+fn compare_supersamples_trilinear_and_the_reference() {
+    let dir = TempDir::new().unwrap();
+    let fan = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/trilinear-fan.toml");
+    let out = flexcam(dir.path())
+        .args(["compare", fan.to_str().unwrap(), "--method", "trilinear"])
+        .args(["--width", "180", "--height", "120", "--spp", "4", "--json"])
+        .args(["--min-id-agreement", "99.5", "--max-rgb-error", "0.02"])
+        .output()
+        .unwrap();
+    assert_success(&out);
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["spp"], 4);
+    assert_eq!(report["method"], "trilinear");
+    expect_failure(
+        &dir,
+        &["compare", "s.toml", "--method", "raycast", "--spp", "0"],
+    );
+}
+
 /// `--method raster` renders from the command line, with both subdivision flags, and
 /// reports its counters.
 #[test]

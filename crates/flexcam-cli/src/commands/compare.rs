@@ -34,6 +34,10 @@ pub struct CompareArgs {
     /// targets are stated for.
     #[arg(long, value_enum, default_value_t = ShadingArg::Flat)]
     shading: ShadingArg,
+    /// Samples per pixel of both renders (the same pattern in every method that supports
+    /// supersampling): colours averaged, depth and id of the sample nearest the centre.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    spp: u32,
     /// Write a difference image (PNG): id mismatches red, colour differences amplified 4x.
     #[arg(long, value_name = "FILE")]
     diff: Option<PathBuf>,
@@ -58,6 +62,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let loaded = args.scene.load()?;
     let reference_options = RenderOptions {
         shading: args.shading.shading(),
+        spp: args.spp,
         ..RenderOptions::default()
     };
     let options = RenderOptions {
@@ -89,6 +94,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         reference,
         size: (loaded.width, loaded.height),
         shading: args.shading.name(),
+        spp: args.spp,
         times_ms: (method_ms, reference_ms),
     };
     if args.json {
@@ -107,13 +113,14 @@ struct Header<'a> {
     reference: Method,
     size: (u32, u32),
     shading: &'a str,
+    spp: u32,
     /// Render times of the method and the reference, in milliseconds.
     times_ms: (f64, f64),
 }
 
 fn report_text(h: &Header, c: &Comparison) -> String {
     format!(
-        "{} ({}), {} vs {}, {}x{}, {} shading\n\
+        "{} ({}), {} vs {}, {}x{}, {} shading, {} spp\n\
          id agreement        {:.3} %\n\
          relative RGB error  {:.5}\n\
          depth error         max {:.3e}, mean {:.3e} (relative, over {} pixels on the same object)\n\
@@ -125,6 +132,7 @@ fn report_text(h: &Header, c: &Comparison) -> String {
         h.size.0,
         h.size.1,
         h.shading,
+        h.spp,
         100.0 * c.id_agreement,
         c.relative_rgb_error,
         c.depth_max,
@@ -146,6 +154,7 @@ fn report_json(h: &Header, c: &Comparison) -> serde_json::Value {
         "width": h.size.0,
         "height": h.size.1,
         "shading": h.shading,
+        "spp": h.spp,
         "pixels": c.pixels,
         "id_agreement": number(c.id_agreement),
         "relative_rgb_error": number(c.relative_rgb_error),
