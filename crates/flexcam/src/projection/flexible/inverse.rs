@@ -88,9 +88,12 @@ fn affine(s: &Surface) -> Option<Affine> {
                 c: p01 - p00,
             })
         }
-        Surface::Sphere(_) | Surface::Cylinder(_) | Surface::Bezier(_) | Surface::BSpline(_) => {
-            None
-        }
+        Surface::Sphere(_)
+        | Surface::Cylinder(_)
+        | Surface::Bezier(_)
+        | Surface::BSpline(_)
+        | Surface::Pinched(_)
+        | Surface::Path(_) => None,
     }
 }
 

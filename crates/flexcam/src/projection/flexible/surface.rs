@@ -11,6 +11,7 @@ use std::f64::consts::PI;
 use glam::{DVec2, DVec3};
 
 pub use super::patch::{BSplinePatch, BezierPatch};
+pub use super::presets::{PathSurface, PinchedRectangle};
 use crate::error::{Error, Result};
 
 /// `axis` and `front` count as parallel when the sine of their angle is below this.
@@ -122,6 +123,12 @@ pub enum Surface {
     Bezier(Box<BezierPatch>),
     /// A uniform cubic B-spline patch.
     BSpline(BSplinePatch),
+    /// A rectangle with its parameters pulled towards a pole: the occlusion camera's far
+    /// surface (built by that preset only).
+    Pinched(Box<PinchedRectangle>),
+    /// The columns of a multiple-centre-of-projection camera path at one distance (built by
+    /// the `mcop` preset only).
+    Path(Box<PathSurface>),
 }
 
 /// Linear interpolation of a parameter range at `s` in [0, 1].
@@ -176,6 +183,8 @@ impl Surface {
             }
             Surface::Bezier(b) => b.point(uv),
             Surface::BSpline(b) => b.point(uv),
+            Surface::Pinched(p) => p.point(uv),
+            Surface::Path(p) => p.point(uv),
         }
     }
 
@@ -190,6 +199,8 @@ impl Surface {
             Surface::Line { .. } => "line",
             Surface::Bezier(_) => "bezier",
             Surface::BSpline(_) => "bspline",
+            Surface::Pinched(_) => "pinched",
+            Surface::Path(_) => "path",
         }
     }
 
@@ -208,6 +219,8 @@ impl Surface {
             Surface::Line { start, end, .. } => finite(&[*start, *end]),
             Surface::Bezier(b) => finite(b.control.as_flattened()),
             Surface::BSpline(b) => finite(b.control()),
+            Surface::Pinched(p) => p.is_finite(),
+            Surface::Path(p) => p.is_finite(),
             Surface::Sphere(s) => {
                 check_radius(s.radius)?;
                 check_span("longitude", s.longitude)?;

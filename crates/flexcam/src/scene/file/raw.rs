@@ -100,6 +100,16 @@ pub struct RawProjection {
     pub elevation: Option<Spanned<f64>>,
     pub generators: Option<Spanned<Vec<[f64; 4]>>>,
     pub projectors: Option<Spanned<RawProjectors>>,
+    pub transition: Option<Spanned<f64>>,
+    pub transitions: Option<Spanned<Vec<f64>>>,
+    pub fovs: Option<Spanned<Vec<f64>>>,
+    pub style: Option<Spanned<String>>,
+    pub pole: Option<Spanned<[f64; 2]>>,
+    pub strength: Option<Spanned<f64>>,
+    pub path: Option<Spanned<Vec<[f64; 3]>>>,
+    pub directions: Option<Spanned<Vec<[f64; 3]>>>,
+    pub center: Option<Spanned<[f64; 2]>>,
+    pub radius: Option<Spanned<f64>>,
 }
 
 /// `projectors = { ... }` of a flexible projection: a projector grid sampled from the
@@ -252,6 +262,16 @@ impl RawProjection {
             ("elevation", self.elevation.as_ref().map(Spanned::span)),
             ("generators", self.generators.as_ref().map(Spanned::span)),
             ("projectors", self.projectors.as_ref().map(Spanned::span)),
+            ("transition", self.transition.as_ref().map(Spanned::span)),
+            ("transitions", self.transitions.as_ref().map(Spanned::span)),
+            ("fovs", self.fovs.as_ref().map(Spanned::span)),
+            ("style", self.style.as_ref().map(Spanned::span)),
+            ("pole", self.pole.as_ref().map(Spanned::span)),
+            ("strength", self.strength.as_ref().map(Spanned::span)),
+            ("path", self.path.as_ref().map(Spanned::span)),
+            ("directions", self.directions.as_ref().map(Spanned::span)),
+            ("center", self.center.as_ref().map(Spanned::span)),
+            ("radius", self.radius.as_ref().map(Spanned::span)),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))
