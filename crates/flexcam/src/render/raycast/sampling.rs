@@ -5,7 +5,7 @@ use glam::DVec2;
 
 /// Sample offsets within a pixel (in `[0,1)^2`) and which of them is nearest the centre.
 #[derive(Debug, Clone, PartialEq)]
-pub(super) struct SamplePattern {
+pub(crate) struct SamplePattern {
     pub offsets: Vec<DVec2>,
     /// Index of the sample nearest the pixel centre (the lowest index on ties): the one whose
     /// depth and object id the pixel reports.
