@@ -6,7 +6,9 @@
 //! With c the circle's centre and R its radius in pixels, a pixel p at ρ = |p - c| / R < 1 is
 //! moved to p' = c + (p - c) s(ρ) / ρ before the linear map to (u, v), where
 //!
-//!     s(ρ) = a ρ + 2 (1 - a) ρ^2 + (a - 1) ρ^3,   a = 1 / magnification,
+//! ```text
+//! s(ρ) = a ρ + 2 (1 - a) ρ^2 + (a - 1) ρ^3,   a = 1 / magnification,
+//! ```
 //!
 //! the cubic with s(0) = 0, s'(0) = a, s(1) = 1 and s'(1) = 1: the image is magnified by
 //! 1 / s'(0) = `magnification` at the centre and joins the identity with a continuous

@@ -7,7 +7,9 @@
 //! fan F(s) + V tan(v_fov/2) U(s), V = 2v - 1, where U(s) is the scene's `up` made
 //! perpendicular to F(s). The control surface at distance d is
 //!
-//!     Q_d(u, v) = C(u L) + d (F(u L) + V tan(v_fov/2) U(u L)),
+//! ```text
+//! Q_d(u, v) = C(u L) + d (F(u L) + V tan(v_fov/2) U(u L)),
+//! ```
 //!
 //! so Q_0 is the path itself (Q_n of fig. 6.5) and Q_far the far surface assembled from the
 //! columns' far planes. A straight path with one direction is the pushbroom camera.

@@ -11,8 +11,10 @@
 //! the strength). The far surface holds, for each image position q', the far-plane point
 //! that the map sends there: its inverse
 //!
-//!     w(q') = q_0 + (q' - q_0) (1 - k / |q' - q_0|)   for |q' - q_0| >= k,
-//!     w(q') = q_0                                      inside the disc |q' - q_0| < k,
+//! ```text
+//! w(q') = q_0 + (q' - q_0) (1 - k / |q' - q_0|)   for |q' - q_0| >= k,
+//! w(q') = q_0                                      inside the disc |q' - q_0| < k,
+//! ```
 //!
 //! measured in units of the image width (isotropically, v scaled by H/W). Points on the far
 //! plane are seen k image widths further from the pole than in the perspective view, and

@@ -431,3 +431,30 @@ proptest! {
         prop_assert!((out[0].t - t).abs() < 1e-9);
     }
 }
+
+#[test]
+fn curved_presets_are_refused_by_method_raster() {
+    let curved = [
+        Preset::OrthoNearPerspFar {
+            fov: 50.0,
+            transition: 4.0,
+            style: DepthStyle::Quadratic,
+        },
+        Preset::DepthTransition {
+            fovs: vec![60.0, 30.0],
+            transitions: vec![5.0],
+            style: DepthStyle::Piecewise,
+        },
+        Preset::Occlusion {
+            fov: 60.0,
+            transition: 4.0,
+            pole: DVec2::splat(0.5),
+            strength: 0.1,
+        },
+    ];
+    for preset in curved {
+        let f = flexible(preset, [1.0, 20.0], 16, 12);
+        let e = supported_chart(&f).unwrap_err();
+        assert!(e.message.contains("has none (use --method raycast)"), "{e}");
+    }
+}
