@@ -24,6 +24,8 @@ struct Cli {
 enum Command {
     /// Render a scene file or built-in scene to a PNG (and optional depth / id images).
     Render(commands::render::RenderArgs),
+    /// Resample an equirectangular photo through a scene's projection into a PNG.
+    Reproject(commands::reproject::ReprojectArgs),
     /// Render a scene's keyframed flexible camera to numbered PNG frames and/or a GIF.
     Animate(commands::animate::AnimateArgs),
     /// List the built-in scenes: name, then a description.
@@ -44,6 +46,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => commands::render::run(&args),
         Command::Animate(args) => commands::animate::run(&args),
+        Command::Reproject(args) => commands::reproject::run(&args),
         Command::Scenes => commands::scenes::run(),
         Command::Compare(args) => commands::compare::run(&args),
         Command::Bench(command) => commands::bench::run(&command),

@@ -695,3 +695,119 @@ fn trilinear_method_renders_a_trilinear_scene_and_refuses_others() {
     );
     assert!(e.contains("curve steps"), "{e}");
 }
+
+/// A 16 x 8 equirectangular PNG photo: colour encodes the column and row.
+fn write_photo(dir: &TempDir, name: &str) -> PathBuf {
+    let path = dir.path().join(name);
+    let photo =
+        image::RgbImage::from_fn(16, 8, |x, y| image::Rgb([x as u8 * 16, y as u8 * 32, 128]));
+    photo.save(&path).unwrap();
+    path
+}
+
+#[test]
+fn reproject_through_an_equirectangular_camera_returns_the_photo() {
+    let dir = TempDir::new().unwrap();
+    write_photo(&dir, "photo.png");
+    write(
+        &dir,
+        "pano.toml",
+        "[image]\nwidth = 16\nheight = 8\n[projection]\ntype = \"equirectangular\"\n\
+         position = [0, 0, 0]\nlook_at = [0, 0, -1]\n",
+    );
+    let out = flexcam(dir.path())
+        .args([
+            "reproject",
+            "--input",
+            "photo.png",
+            "pano.toml",
+            "-o",
+            "out.png",
+        ])
+        .output()
+        .unwrap();
+    assert_success(&out);
+    let got = image::open(dir.path().join("out.png")).unwrap().to_rgb8();
+    let want = image::open(dir.path().join("photo.png")).unwrap().to_rgb8();
+    assert_eq!(got.dimensions(), (16, 8));
+    for (a, b) in got.pixels().zip(want.pixels()) {
+        for c in 0..3 {
+            assert!(
+                (i32::from(a[c]) - i32::from(b[c])).abs() <= 1,
+                "{a:?} {b:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn reproject_errors_are_one_line() {
+    let dir = TempDir::new().unwrap();
+    write(&dir, "scene.toml", GOOD_SCENE);
+    let missing = expect_failure(
+        &dir,
+        &[
+            "reproject",
+            "--input",
+            "none.png",
+            "scene.toml",
+            "-o",
+            "o.png",
+        ],
+    );
+    assert!(
+        missing.starts_with("flexcam: none.png: cannot read image"),
+        "{missing}"
+    );
+    let format = expect_failure(
+        &dir,
+        &[
+            "reproject",
+            "--input",
+            "photo.tif",
+            "scene.toml",
+            "-o",
+            "o.png",
+        ],
+    );
+    assert!(
+        format.contains("photo.tif: unsupported input format \"tif\""),
+        "{format}"
+    );
+    // A zero image size fails in one line and writes nothing.
+    let photo_dir = TempDir::new().unwrap();
+    write_photo(&photo_dir, "p.png");
+    write(&photo_dir, "scene.toml", GOOD_SCENE);
+    let out = flexcam(photo_dir.path())
+        .args([
+            "reproject",
+            "--input",
+            "p.png",
+            "scene.toml",
+            "-o",
+            "o.png",
+            "--width",
+            "0",
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        !out.status.success() && stderr.trim_end().lines().count() == 1,
+        "{stderr}"
+    );
+    assert!(stderr.contains("width"), "{stderr}");
+    assert!(!photo_dir.path().join("o.png").exists());
+    let output = expect_failure(
+        &dir,
+        &[
+            "reproject",
+            "--input",
+            "none.png",
+            "scene.toml",
+            "-o",
+            "o.jpg",
+        ],
+    );
+    assert!(output.contains("unsupported output extension"), "{output}");
+}

@@ -4,5 +4,6 @@ pub mod animate;
 pub mod bench;
 pub mod compare;
 pub mod render;
+pub mod reproject;
 pub mod scene_args;
 pub mod scenes;

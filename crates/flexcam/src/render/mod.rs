@@ -87,6 +87,7 @@ pub mod inverse_raster;
 mod method;
 pub mod raster;
 pub mod raycast;
+pub mod reproject;
 pub mod surface;
 pub mod trilinear;
 pub use method::Method;

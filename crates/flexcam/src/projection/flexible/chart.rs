@@ -43,7 +43,9 @@ impl Inverse {
     pub fn chart(&self, reparam: Reparam, resolution: &Resolution) -> Option<InverseChart> {
         match self {
             Inverse::Planes { near, far, normal } => {
-                (reparam == Reparam::Linear).then_some(())?;
+                // The magnifier is a homeomorphism of the image plane (the identity outside
+                // its circle): it keeps the extended inverse continuous.
+                matches!(reparam, Reparam::Linear | Reparam::Magnifier(_)).then_some(())?;
                 planes_chart(near, far, *normal)
             }
             Inverse::Spheres { near, .. } => spheres_chart(near, reparam, resolution),
@@ -120,6 +122,7 @@ fn spheres_chart(
             finite.then_some(())?;
             Some(period(near.longitude, resolution))
         }
+        Reparam::Magnifier(_) => return None,
         Reparam::Polar | Reparam::Lens => {
             let full = ((near.longitude[1] - near.longitude[0]).abs() - 2.0 * PI).abs() <= FLAT;
             let start = near.latitude[0];

@@ -98,7 +98,9 @@ fn affine(s: &Surface) -> Option<Affine> {
         | Surface::Cylinder(_)
         | Surface::Bezier(_)
         | Surface::BSpline(_)
-        | Surface::Panorama(_) => None,
+        | Surface::Panorama(_)
+        | Surface::Pinched(_)
+        | Surface::Path(_) => None,
     }
 }
 

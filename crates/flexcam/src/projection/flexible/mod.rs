@@ -42,7 +42,7 @@ pub use animation::{Animation, Easing, Keyframe};
 pub use blend::{BezierVolume, PiecewiseVolume};
 pub use interpolate::InterpolatedVolume;
 pub use panorama::{PanoramaShape, PanoramaSpec};
-pub use presets::{Preset, PresetSpec};
+pub use presets::{DepthStyle, Magnifier, McopPath, Preset, PresetSpec};
 pub use projector_grid::{Aim, GridInterpolation, GridVolume, ProjectorGrid, ProjectorGridSpec};
 pub use reparam::Reparam;
 pub use surface::{
@@ -164,10 +164,7 @@ impl Flexible {
 fn build_volume(spec: &FlexibleSpec, aspect: f64) -> Result<(Volume, Reparam)> {
     let linear = |near, far| LinearVolume::new(near, far).map(|v| Volume::Linear(Box::new(v)));
     let (volume, default_reparam) = match &spec.source {
-        VolumeSource::Preset(p) => {
-            let (near, far) = p.surfaces(aspect)?;
-            (linear(near, far)?, p.preset.default_reparam())
-        }
+        VolumeSource::Preset(p) => (p.volume(aspect)?, p.preset.default_reparam()),
         VolumeSource::Panorama(p) => {
             let (near, far) = p.surfaces()?;
             (linear(near, far)?, Reparam::Linear)

@@ -12,6 +12,7 @@ use std::f64::consts::{FRAC_PI_4, PI};
 use glam::DVec2;
 
 use super::super::image_coords::Resolution;
+use super::presets::Magnifier;
 use crate::error::{Error, Result};
 
 /// A pixel <-> (u, v) map.
@@ -36,6 +37,9 @@ pub enum Reparam {
     /// cover equal areas of the sphere. Surfaces as for `Mercator`; `max_latitude` in
     /// (0, pi/2] (the poles can be shown: sin stays finite there).
     EqualArea { max_latitude: f64 },
+    /// The linear map seen through a circular magnifying lens (the `magnifier` preset's
+    /// map; [`Magnifier`]): identity outside the circle.
+    Magnifier(Magnifier),
 }
 
 /// The names used in scene files, in order.
@@ -53,6 +57,7 @@ impl Reparam {
             Reparam::Lens => "lens",
             Reparam::Mercator { .. } => "mercator",
             Reparam::EqualArea { .. } => "equal_area",
+            Reparam::Magnifier(_) => "magnifier",
         }
     }
 
@@ -62,6 +67,7 @@ impl Reparam {
         let (latitude, pole_allowed) = match *self {
             Reparam::Mercator { max_latitude } => (max_latitude, false),
             Reparam::EqualArea { max_latitude } => (max_latitude, true),
+            Reparam::Magnifier(m) => return m.validate(),
             _ => return Ok(()),
         };
         let below_pole = latitude < 0.5 * PI || (pole_allowed && latitude == 0.5 * PI);
@@ -83,6 +89,10 @@ impl Reparam {
         let size = resolution.size();
         let uv = match self {
             Reparam::Linear => DVec2::new(pixel.x / size.x, 1.0 - pixel.y / size.y),
+            Reparam::Magnifier(m) => {
+                let p = m.sample_position(resolution, pixel);
+                DVec2::new(p.x / size.x, 1.0 - p.y / size.y)
+            }
             Reparam::Polar | Reparam::Lens => {
                 let p = resolution.centred(pixel) / circle_radius(resolution);
                 let r = p.length();
@@ -126,6 +136,9 @@ impl Reparam {
         let size = resolution.size();
         let pixel = match self {
             Reparam::Linear => DVec2::new(uv.x * size.x, (1.0 - uv.y) * size.y),
+            Reparam::Magnifier(m) => {
+                m.pixel_of(resolution, DVec2::new(uv.x * size.x, (1.0 - uv.y) * size.y))
+            }
             Reparam::Polar | Reparam::Lens => {
                 let r = if *self == Reparam::Lens {
                     // v = r/4 + 3 r^2/4  <=>  3 r^2 + r - 4 v = 0, the root in [0, 1].
@@ -161,7 +174,7 @@ impl Reparam {
     pub fn v_range(&self, resolution: &Resolution) -> Option<(f64, f64)> {
         let columns = match self {
             Reparam::Linear | Reparam::Mercator { .. } | Reparam::EqualArea { .. } => 1,
-            Reparam::Polar | Reparam::Lens => resolution.width,
+            Reparam::Polar | Reparam::Lens | Reparam::Magnifier(_) => resolution.width,
         };
         let mut range: Option<(f64, f64)> = None;
         for y in 0..resolution.height {

@@ -12,6 +12,7 @@ use glam::{DVec2, DVec3};
 
 pub use super::panorama::PanoramaSurface;
 pub use super::patch::{BSplinePatch, BezierPatch};
+pub use super::presets::{PathSurface, PinchedRectangle};
 use crate::error::{Error, Result};
 
 /// `axis` and `front` count as parallel when the sine of their angle is below this.
@@ -126,6 +127,12 @@ pub enum Surface {
     /// A shape-defined panorama surface: outlines and profiles by arc length (boxed: it
     /// holds a camera basis).
     Panorama(Box<PanoramaSurface>),
+    /// A rectangle with its parameters pulled towards a pole: the occlusion camera's far
+    /// surface (built by that preset only).
+    Pinched(Box<PinchedRectangle>),
+    /// The columns of a multiple-centre-of-projection camera path at one distance (built by
+    /// the `mcop` preset only).
+    Path(Box<PathSurface>),
 }
 
 /// Linear interpolation of a parameter range at `s` in [0, 1].
@@ -181,6 +188,8 @@ impl Surface {
             Surface::Bezier(b) => b.point(uv),
             Surface::BSpline(b) => b.point(uv),
             Surface::Panorama(p) => p.point(uv),
+            Surface::Pinched(p) => p.point(uv),
+            Surface::Path(p) => p.point(uv),
         }
     }
 
@@ -196,6 +205,8 @@ impl Surface {
             Surface::Bezier(_) => "bezier",
             Surface::BSpline(_) => "bspline",
             Surface::Panorama(_) => "panorama",
+            Surface::Pinched(_) => "pinched",
+            Surface::Path(_) => "path",
         }
     }
 
@@ -218,6 +229,8 @@ impl Surface {
                 p.validate()?;
                 true
             }
+            Surface::Pinched(p) => p.is_finite(),
+            Surface::Path(p) => p.is_finite(),
             Surface::Sphere(s) => {
                 check_radius(s.radius)?;
                 check_span("longitude", s.longitude)?;

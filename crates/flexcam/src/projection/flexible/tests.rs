@@ -231,7 +231,7 @@ fn angular_fisheye_radius_is_proportional_to_the_angle() {
 /// eye or the view plane) as the single-viewpoint projection at every pixel centre.
 fn check_same_rays(flexible: Preset, existing: ProjectionSpec, same_origin: bool) {
     let (w, h) = (9, 7);
-    let f = build(&preset(flexible, None), w, h);
+    let f = build(&preset(flexible.clone(), None), w, h);
     let e = existing.build(w, h).unwrap();
     for y in 0..h {
         for x in 0..w {

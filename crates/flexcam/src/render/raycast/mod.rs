@@ -9,7 +9,7 @@
 mod bvh;
 mod curve;
 pub(crate) mod optics;
-mod sampling;
+pub(crate) mod sampling;
 mod shade;
 mod tiles;
 mod triangle;

@@ -12,7 +12,9 @@ use super::projection::{camera_frame, Required};
 use super::raw::{RawProjection, RawSurface};
 use super::source::Source;
 use crate::error::{Error, Result};
-use crate::projection::flexible::presets::PRESET_NAMES;
+use crate::projection::flexible::presets::{
+    DepthStyle, Magnifier, DEPTH_STYLE_NAMES, PRESET_NAMES,
+};
 use crate::projection::flexible::reparam::{DEFAULT_MERCATOR_LATITUDE, REPARAM_NAMES};
 use crate::projection::flexible::{
     BSplinePatch, BezierPatch, BezierVolume, Blend, CylinderPatch, FlexibleSpec, LineParam,
@@ -20,7 +22,7 @@ use crate::projection::flexible::{
 };
 
 /// Every key of a flexible table (besides `type`).
-pub(super) const KEYS: [&str; 30] = [
+pub(super) const KEYS: [&str; 41] = [
     "preset",
     "position",
     "look_at",
@@ -51,6 +53,17 @@ pub(super) const KEYS: [&str; 30] = [
     "outlines",
     "profile",
     "profiles",
+    "transition",
+    "transitions",
+    "fovs",
+    "style",
+    "pole",
+    "strength",
+    "path",
+    "directions",
+    "center",
+    "radius",
+    "magnification",
 ];
 
 /// Keys every preset accepts (but `up` for the axonometric one, which is always +y).
@@ -100,6 +113,11 @@ fn preset_keys(name: &str) -> &'static [&'static str] {
         "crossed_slits" => &["fov", "v_fov", "slit_distance"],
         "cubic" => &["v_fov"],
         "rounded_cubic" => &["v_fov", "corner_radius"],
+        "ortho_near_persp_far" => &["fov", "transition", "style"],
+        "depth_transition" => &["fovs", "transitions", "style"],
+        "occlusion" => &["fov", "transition", "pole", "strength"],
+        "mcop" => &["directions", "path", "v_fov"],
+        "magnifier" => &["fov", "center", "radius", "magnification"],
         _ => &["h_fov", "v_fov"],
     }
 }
@@ -129,8 +147,11 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
                     ),
                 ));
             }
+            // The axonometric preset's up is always +y; the magnifier's map is its lens.
             let common = |key: &str| {
-                PRESET_COMMON.contains(&key) && !(key == "up" && name.get_ref() == "axonometric")
+                PRESET_COMMON.contains(&key)
+                    && !(key == "up" && name.get_ref() == "axonometric")
+                    && !(key == "reparam" && name.get_ref() == "magnifier")
             };
             let allowed = |key: &str| {
                 common(key)
@@ -138,11 +159,16 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
                     || (key == "max_latitude" && reparam.is_some_and(|r| has_latitude(&r)))
             };
             reject_keys(src, &present, allowed, || {
+                let takes: Vec<&str> = PRESET_COMMON
+                    .iter()
+                    .copied()
+                    .filter(|key| common(key))
+                    .chain(own.iter().copied())
+                    .collect();
                 format!(
-                    "preset \"{}\" (it takes: {}, {})",
+                    "preset \"{}\" (it takes: {})",
                     name.get_ref(),
-                    PRESET_COMMON.join(", "),
-                    own.join(", ")
+                    takes.join(", ")
                 )
             })?;
             VolumeSource::Preset(preset(required, name.get_ref())?)
@@ -453,16 +479,118 @@ fn preset(required: &Required, name: &str) -> Result<PresetSpec> {
             azimuth: number(&raw.azimuth, "azimuth")?,
             elevation: number(&raw.elevation, "elevation")?,
         },
-        _ => Preset::Glc {
+        "glc" => Preset::Glc {
             width: number(&raw.width, "width")?,
             generators: generators(src, required.get(&raw.generators, "generators")?)?,
         },
+        "ortho_near_persp_far" => Preset::OrthoNearPerspFar {
+            fov: number(&raw.fov, "fov")?,
+            transition: number(&raw.transition, "transition")?,
+            style: style(src, raw)?,
+        },
+        "depth_transition" => {
+            let list = |v: &Option<Spanned<Vec<f64>>>, key: &str| -> Result<Vec<f64>> {
+                let v = required.get(v, key)?;
+                src.all_finite(v.get_ref(), v, key)?;
+                Ok(v.get_ref().clone())
+            };
+            Preset::DepthTransition {
+                fovs: list(&raw.fovs, "fovs")?,
+                transitions: list(&raw.transitions, "transitions")?,
+                style: style(src, raw)?,
+            }
+        }
+        "occlusion" => Preset::Occlusion {
+            fov: number(&raw.fov, "fov")?,
+            transition: number(&raw.transition, "transition")?,
+            pole: DVec2::from_array(src.vector(required.get(&raw.pole, "pole")?, "pole")?),
+            strength: number(&raw.strength, "strength")?,
+        },
+        "mcop" => {
+            let points = |v: &Spanned<Vec<[f64; 3]>>, key: &str| -> Result<Vec<DVec3>> {
+                src.all_finite(v.get_ref().as_flattened(), v, key)?;
+                Ok(v.get_ref().iter().map(|p| DVec3::from_array(*p)).collect())
+            };
+            Preset::Mcop {
+                path: points(required.get(&raw.path, "path")?, "path")?,
+                directions: raw
+                    .directions
+                    .as_ref()
+                    .map(|d| points(d, "directions"))
+                    .transpose()?,
+                v_fov: optional(&raw.v_fov, "v_fov", 60.0)?,
+            }
+        }
+        _ => Preset::Magnifier {
+            fov: number(&raw.fov, "fov")?,
+            lens: Magnifier {
+                center: DVec2::from_array(
+                    src.vector(required.get(&raw.center, "center")?, "center")?,
+                ),
+                radius: number(&raw.radius, "radius")?,
+                magnification: number(&raw.magnification, "magnification")?,
+            },
+        },
     };
-    Ok(PresetSpec {
+    let spec = PresetSpec {
         preset,
         frame: camera_frame(src, required)?,
         clip: clip(src, raw)?,
-    })
+    };
+    check_preset(src, raw, &spec)?;
+    Ok(spec)
+}
+
+/// `style`: "piecewise" (the default) or "quadratic".
+fn style(src: &Source, raw: &RawProjection) -> Result<DepthStyle> {
+    let Some(name) = &raw.style else {
+        return Ok(DepthStyle::Piecewise);
+    };
+    match name.get_ref().as_str() {
+        "piecewise" => Ok(DepthStyle::Piecewise),
+        "quadratic" => Ok(DepthStyle::Quadratic),
+        other => Err(src.error(
+            &name.span(),
+            format!(
+                "unknown style \"{other}\"; expected one of: {}",
+                DEPTH_STYLE_NAMES.join(", ")
+            ),
+        )),
+    }
+}
+
+/// Builds the volume and map of the presets whose parameters are only checked then (the
+/// depth transitions, occlusion, mcop, magnifier) at a nominal aspect ratio, so that a bad value is
+/// reported at its key: the first present key (the preset's own, then `up`, `clip`,
+/// `position`, `look_at`) named in the message, else the preset name.
+fn check_preset(src: &Source, raw: &RawProjection, spec: &PresetSpec) -> Result<()> {
+    let checked_late = matches!(
+        spec.preset,
+        Preset::OrthoNearPerspFar { .. }
+            | Preset::DepthTransition { .. }
+            | Preset::Occlusion { .. }
+            | Preset::Mcop { .. }
+            | Preset::Magnifier { .. }
+    );
+    if !checked_late {
+        return Ok(());
+    }
+    let built = spec
+        .volume(0.75)
+        .and_then(|_| spec.preset.default_reparam().validate());
+    let Err(e) = built else {
+        return Ok(());
+    };
+    let name = spec.preset.name();
+    let present = raw.present_keys();
+    let at = preset_keys(name)
+        .iter()
+        .chain(&["up", "clip", "position", "look_at"])
+        .filter(|key| e.message.contains(*key))
+        .find_map(|key| present.iter().find(|(k, _)| k == key))
+        .map(|(_, span)| span.clone());
+    let fallback = raw.preset.as_ref().map_or(0..0, Spanned::span);
+    Err(src.error(&at.unwrap_or(fallback), e.message))
 }
 
 /// A bicubic Bezier surface from `control[row][column]`. Errors: not 4 rows of 4 points.

@@ -174,4 +174,6 @@ fn check_unique_names(src: &Source, objects: &[Spanned<raw::RawObject>]) -> Resu
 }
 
 #[cfg(test)]
+mod depth_preset_tests;
+#[cfg(test)]
 mod tests;

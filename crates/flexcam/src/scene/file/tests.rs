@@ -20,7 +20,7 @@ fn parse_text(text: &str) -> Result<Scene> {
     parse(text, Path::new("dir/s.toml"))
 }
 
-fn scene(text: &str) -> Scene {
+pub(super) fn scene(text: &str) -> Scene {
     parse_text(text).unwrap_or_else(|e| panic!("scene should parse: {e}"))
 }
 
@@ -33,7 +33,7 @@ fn error(text: &str) -> String {
 }
 
 /// Asserts the error starts with `dir/s.toml:LINE:COLUMN:` and mentions `needle`.
-fn assert_error_at(text: &str, line: usize, column: usize, needle: &str) {
+pub(super) fn assert_error_at(text: &str, line: usize, column: usize, needle: &str) {
     let message = error(text);
     let prefix = format!("dir/s.toml:{line}:{column}: ");
     assert!(

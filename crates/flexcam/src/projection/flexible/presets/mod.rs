@@ -30,11 +30,27 @@
 //!   `elevation` ([`axonometric`]);
 //! - general linear camera: the affine combinations of three generator rays ([`glc`]).
 //!
+//! Volumes that change with depth or are made of other surfaces (built by
+//! [`PresetSpec::volume`]):
+//! - ortho near / perspective far and perspective-to-perspective in depth: coaxial
+//!   rectangles joined piecewise-linearly or by a quadratic Bezier ([`depth_transition`]);
+//! - occlusion camera: perspective to the distortion plane, then bent towards a pole
+//!   ([`occlusion`]);
+//! - MCOP: the columns of a camera path ([`mcop`]);
+//! - magnifier: the perspective volume under a circular magnifying re-parameterisation
+//!   ([`lens`]).
+//!
 //! Near distance 0 puts the near surface at the eye (a point, or the slit): the rays then
 //! start where the single-viewpoint projections start theirs.
 
 mod axonometric;
+pub mod depth_transition;
 mod glc;
+pub mod lens;
+pub mod mcop;
+pub mod occlusion;
+#[cfg(test)]
+mod tests;
 
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -44,16 +60,23 @@ use glam::{DVec2, DVec3};
 use super::super::camera_basis::CameraBasis;
 use super::super::params::{angle_radians, positive_length, UpTo};
 use super::super::CameraFrame;
+use super::blend::PiecewiseVolume;
 use super::panorama::{OutlineShape, PanoramaShape, PanoramaSpec, ProfileShape};
 use super::reparam::Reparam;
 use super::surface::{CylinderPatch, PolarFrame, SpherePatch, Surface};
+use super::volume::{LinearVolume, Volume};
 use crate::error::{Error, Result};
+use depth_transition::Station;
+pub use depth_transition::{DepthStyle, DEPTH_STYLE_NAMES};
+pub use lens::Magnifier;
+pub use mcop::{McopPath, PathSurface};
+pub use occlusion::PinchedRectangle;
 
 /// The default far clip distance of the presets, in world units.
 pub const DEFAULT_FAR: f64 = 1000.0;
 
 /// A named volume and its own parameters (angles in degrees).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Preset {
     Perspective {
         fov: f64,
@@ -125,10 +148,46 @@ pub enum Preset {
         width: f64,
         generators: [[f64; 4]; 3],
     },
+    /// Orthographic in front of distance `transition`, the camera's perspective of `fov`
+    /// behind it (thesis fig. 4.10); see [`depth_transition`].
+    OrthoNearPerspFar {
+        fov: f64,
+        transition: f64,
+        style: DepthStyle,
+    },
+    /// Perspective views one after another in depth (figs. 7.7, 7.8): view k of `fovs[k]`
+    /// from `transitions[k - 1]` to `transitions[k]`; see [`depth_transition`].
+    DepthTransition {
+        fovs: Vec<f64>,
+        transitions: Vec<f64>,
+        style: DepthStyle,
+    },
+    /// The occlusion camera: perspective of `fov` up to distance `transition`, then bent
+    /// towards `pole` (image (u, v)) so that the far plane is seen `strength` image widths
+    /// further from the pole; see [`occlusion`].
+    Occlusion {
+        fov: f64,
+        transition: f64,
+        pole: DVec2,
+        strength: f64,
+    },
+    /// A multiple-centre-of-projection camera along the polyline `path` (world points),
+    /// looking along `directions` (one per point; `None`: look_at - position everywhere),
+    /// each column a vertical fan of `v_fov`; see [`mcop`].
+    Mcop {
+        path: Vec<DVec3>,
+        directions: Option<Vec<DVec3>>,
+        v_fov: f64,
+    },
+    /// The perspective of `fov` seen through a circular magnifying lens; see [`lens`].
+    Magnifier {
+        fov: f64,
+        lens: Magnifier,
+    },
 }
 
 /// The preset names of scene files, in order.
-pub const PRESET_NAMES: [&str; 15] = [
+pub const PRESET_NAMES: [&str; 20] = [
     "perspective",
     "inverse_perspective",
     "orthographic",
@@ -144,10 +203,15 @@ pub const PRESET_NAMES: [&str; 15] = [
     "glc",
     "cubic",
     "rounded_cubic",
+    "ortho_near_persp_far",
+    "depth_transition",
+    "occlusion",
+    "mcop",
+    "magnifier",
 ];
 
 /// A preset placed in the scene.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct PresetSpec {
     pub preset: Preset,
     pub frame: CameraFrame,
@@ -175,6 +239,11 @@ impl Preset {
             Preset::Glc { .. } => "glc",
             Preset::Cubic { .. } => "cubic",
             Preset::RoundedCubic { .. } => "rounded_cubic",
+            Preset::OrthoNearPerspFar { .. } => "ortho_near_persp_far",
+            Preset::DepthTransition { .. } => "depth_transition",
+            Preset::Occlusion { .. } => "occlusion",
+            Preset::Mcop { .. } => "mcop",
+            Preset::Magnifier { .. } => "magnifier",
         }
     }
 
@@ -182,6 +251,7 @@ impl Preset {
     pub fn default_reparam(&self) -> Reparam {
         match self {
             Preset::Fisheye { .. } => Reparam::Polar,
+            Preset::Magnifier { lens, .. } => Reparam::Magnifier(*lens),
             _ => Reparam::Linear,
         }
     }
@@ -192,21 +262,57 @@ fn angle(preset: &Preset, key: &str, degrees: f64, max: UpTo) -> Result<f64> {
     angle_radians(&format!("flexible {}", preset.name()), key, degrees, max)
 }
 
+/// Where a preset's surfaces go: the camera basis, the clip distances and the distance
+/// from the eye to `look_at`.
+struct Placement {
+    basis: CameraBasis,
+    near: f64,
+    far: f64,
+    focus: f64,
+}
+
+impl Placement {
+    /// The rectangle at distance `d` along the view axis with half-extents `half`, its
+    /// centre moved by `shift` (camera x, y).
+    fn rect(&self, d: f64, half: DVec2, shift: DVec2) -> Surface {
+        let [corner, u_edge, v_edge] = self.rect_edges(d, half, shift);
+        Surface::Rectangle {
+            corner,
+            u_edge,
+            v_edge,
+        }
+    }
+
+    /// [`Placement::rect`] as corner, u edge and v edge.
+    fn rect_edges(&self, d: f64, half: DVec2, shift: DVec2) -> [DVec3; 3] {
+        let b = &self.basis;
+        let centre = b.origin + d * b.forward + shift.x * b.right + shift.y * b.up;
+        let (u_axis, v_axis) = (half.x * b.right, half.y * b.up);
+        [centre - u_axis - v_axis, 2.0 * u_axis, 2.0 * v_axis]
+    }
+
+    /// The knots (fractions of the clip range) of surfaces at distances `depths`.
+    fn knots(&self, depths: &[f64]) -> Vec<f64> {
+        depths
+            .iter()
+            .map(|d| (d - self.near) / (self.far - self.near))
+            .collect()
+    }
+}
+
 impl PresetSpec {
-    /// The near and far surfaces for an image of aspect ratio `aspect` = height / width.
-    /// Errors: a degenerate frame, a parameter out of range (as the single-viewpoint types),
-    /// a clip range that is not 0 <= near < far (and far <= e for the inverse perspective).
-    pub fn surfaces(&self, aspect: f64) -> Result<(Surface, Surface)> {
-        let p = &self.preset;
-        let frame = match *p {
+    /// The camera basis and clip range. Errors: a degenerate frame, a clip range that is not
+    /// 0 <= near < far.
+    fn placement(&self) -> Result<Placement> {
+        let frame = match self.preset {
             Preset::Axonometric {
                 azimuth, elevation, ..
             } => axonometric::frame(&self.frame, azimuth, elevation)?,
             _ => self.frame,
         };
-        let b = CameraBasis::new(&frame)?;
+        let basis = CameraBasis::new(&frame)?;
         let focus = (frame.look_at - frame.position).length();
-        let [near, far] = self.clip.unwrap_or(match p {
+        let [near, far] = self.clip.unwrap_or(match self.preset {
             Preset::InversePerspective { .. } => [0.0, focus],
             _ => [0.0, DEFAULT_FAR],
         });
@@ -215,17 +321,133 @@ impl PresetSpec {
                 "flexible clip must be [near, far] with 0 <= near < far, got [{near}, {far}]"
             )));
         }
+        Ok(Placement {
+            basis,
+            near,
+            far,
+            focus,
+        })
+    }
+
+    /// The viewing volume for an image of aspect ratio `aspect` = height / width: two
+    /// surfaces with straight projectors ([`PresetSpec::surfaces`]), or the blended volumes
+    /// of the depth transitions and the occlusion camera. Errors: those of
+    /// [`PresetSpec::surfaces`], transitions outside (near, far), a bad pole, strength, path
+    /// or style (see the modules).
+    pub fn volume(&self, aspect: f64) -> Result<Volume> {
+        let p = &self.preset;
+        let half_tan =
+            |key: &str, fov: f64| Ok((0.5 * angle(p, key, fov, UpTo::Below(180.0))?).tan());
+        let place = self.placement()?;
+        let station = |s: Station| place.rect(s.d, DVec2::new(s.h, s.h * aspect), DVec2::ZERO);
+        match p {
+            Preset::OrthoNearPerspFar {
+                fov,
+                transition,
+                style,
+            } => {
+                let tan = half_tan("fov", *fov)?;
+                let stations = depth_transition::ortho_near_persp_far(
+                    tan,
+                    *transition,
+                    place.near,
+                    place.far,
+                )?;
+                depth_transition::volume(&stations, *style, station)
+            }
+            Preset::DepthTransition {
+                fovs,
+                transitions,
+                style,
+            } => {
+                let tans = fovs
+                    .iter()
+                    .map(|f| half_tan("fovs", *f))
+                    .collect::<Result<Vec<_>>>()?;
+                let stations =
+                    depth_transition::perspective_chain(&tans, transitions, place.near, place.far)?;
+                depth_transition::volume(&stations, *style, station)
+            }
+            Preset::Occlusion {
+                fov,
+                transition,
+                pole,
+                strength,
+            } => {
+                let tan = half_tan("fov", *fov)?;
+                let (near, far) = (place.near, place.far);
+                if !(near < *transition && *transition < far) {
+                    return Err(Error::new(format!(
+                        "flexible occlusion transition must lie strictly between the near and far clip distances ({near}, {far}), got {transition}"
+                    )));
+                }
+                let half = |d: f64| DVec2::new(d * tan, d * tan * aspect);
+                let far_edges = place.rect_edges(far, half(far), DVec2::ZERO);
+                let pinched = PinchedRectangle::new(far_edges, *pole, *strength, aspect)?;
+                let surfaces = vec![
+                    station(Station {
+                        d: near,
+                        h: near * tan,
+                    }),
+                    station(Station {
+                        d: *transition,
+                        h: transition * tan,
+                    }),
+                    Surface::Pinched(Box::new(pinched)),
+                ];
+                let knots = place.knots(&[near, *transition, far]);
+                Ok(Volume::Piecewise(PiecewiseVolume::new(
+                    surfaces,
+                    Some(knots),
+                )?))
+            }
+            _ => {
+                let (near, far) = self.surfaces(aspect)?;
+                Ok(Volume::Linear(Box::new(LinearVolume::new(near, far)?)))
+            }
+        }
+    }
+
+    /// The near and far surfaces for an image of aspect ratio `aspect` = height / width,
+    /// for the presets with straight projectors between two surfaces. Errors: a degenerate
+    /// frame, a parameter out of range (as the single-viewpoint types), a clip range that is
+    /// not 0 <= near < far (and far <= e for the inverse perspective), a preset made of more
+    /// than two surfaces (use [`PresetSpec::volume`]).
+    pub fn surfaces(&self, aspect: f64) -> Result<(Surface, Surface)> {
+        let p = &self.preset;
+        let place = self.placement()?;
+        let (b, near, far, focus) = (&place.basis, place.near, place.far, place.focus);
         let centre = |d: f64| b.origin + d * b.forward;
-        let rect = |d: f64, half: DVec2, shift: DVec2| {
-            Surface::rectangle_centred(
-                centre(d) + shift.x * b.right + shift.y * b.up,
-                half.x * b.right,
-                half.y * b.up,
-            )
-        };
+        let rect = |d: f64, half: DVec2, shift: DVec2| place.rect(d, half, shift);
         let pair = |f: &dyn Fn(f64) -> Surface| (f(near), f(far));
         Ok(match *p {
-            Preset::Perspective { fov } => {
+            Preset::OrthoNearPerspFar { .. }
+            | Preset::DepthTransition { .. }
+            | Preset::Occlusion { .. } => {
+                return Err(Error::new(format!(
+                    "flexible {} is made of more than two control surfaces",
+                    p.name()
+                )))
+            }
+            Preset::Mcop {
+                ref path,
+                ref directions,
+                v_fov,
+            } => {
+                let t = (0.5 * angle(p, "v_fov", v_fov, UpTo::Below(180.0))?).tan();
+                let looks = directions
+                    .clone()
+                    .unwrap_or_else(|| vec![b.forward; path.len()]);
+                let path = McopPath::new(path.clone(), looks, self.frame.up)?;
+                pair(&|d| {
+                    Surface::Path(Box::new(PathSurface {
+                        path: path.clone(),
+                        tan_half_v: t,
+                        depth: d,
+                    }))
+                })
+            }
+            Preset::Perspective { fov } | Preset::Magnifier { fov, .. } => {
                 let h = (0.5 * angle(p, "fov", fov, UpTo::Below(180.0))?).tan();
                 pair(&|d| rect(d, d * DVec2::new(h, h * aspect), DVec2::ZERO))
             }
@@ -292,13 +514,15 @@ impl PresetSpec {
                 let frame = PolarFrame::new(b.up, b.forward)?;
                 pair(&|d| sphere(b.origin, d, frame, [-h, h], [-v, v]))
             }
-            Preset::Cubic { v_fov } => cubic(p, frame, [near, far], v_fov, OutlineShape::Square)?,
+            Preset::Cubic { v_fov } => {
+                cubic(p, self.frame, [near, far], v_fov, OutlineShape::Square)?
+            }
             Preset::RoundedCubic {
                 v_fov,
                 corner_radius,
             } => cubic(
                 p,
-                frame,
+                self.frame,
                 [near, far],
                 v_fov,
                 OutlineShape::RoundedSquare {
