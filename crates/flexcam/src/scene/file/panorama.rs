@@ -262,3 +262,163 @@ fn curve(src: &Source, table: &Spanned<RawCurve>, which: Family) -> Result<ArcCu
         src.error(&at.unwrap_or(table.span()), e.message)
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use crate::projection::flexible::{Preset, VolumeSource};
+    use crate::projection::ProjectionSpec;
+    use crate::scene::file::parse;
+
+    const HEAD: &str =
+        "[projection]\ntype = \"flexible\"\nposition = [0, 1, 0]\nlook_at = [0, 1, -1]\n";
+
+    fn source(text: &str) -> VolumeSource {
+        let scene = parse(text, Path::new("p.toml")).unwrap_or_else(|e| panic!("{e}"));
+        match scene.projection {
+            ProjectionSpec::Flexible(spec) => spec.source,
+            other => panic!("not flexible: {}", other.kind()),
+        }
+    }
+
+    /// Asserts the one-line error `p.toml:LINE:COLUMN: ...needle...`.
+    fn error_at(text: &str, line: usize, column: usize, needle: &str) {
+        let e = parse(text, Path::new("p.toml")).err().unwrap().to_string();
+        assert!(
+            e.starts_with(&format!("p.toml:{line}:{column}: ")) && e.contains(needle),
+            "{e}"
+        );
+        assert!(!e.contains('\n'));
+    }
+
+    #[test]
+    fn cubic_presets_parse() {
+        let cubic = source("[projection]\ntype = \"flexible\"\npreset = \"cubic\"\nposition = [0, 1, 0]\nlook_at = [0, 1, -1]\n");
+        let VolumeSource::Preset(p) = cubic else {
+            panic!("not a preset")
+        };
+        assert_eq!(p.preset, Preset::Cubic { v_fov: 90.0 });
+        let rounded = source(
+            "[projection]\ntype = \"flexible\"\npreset = \"rounded_cubic\"\nposition = [0, 1, 0]\n\
+             look_at = [0, 1, -1]\nv_fov = 70\ncorner_radius = 0.25\n",
+        );
+        let VolumeSource::Preset(p) = rounded else {
+            panic!("not a preset")
+        };
+        assert_eq!(
+            p.preset,
+            Preset::RoundedCubic {
+                v_fov: 70.0,
+                corner_radius: 0.25
+            }
+        );
+    }
+
+    #[test]
+    fn outlines_and_profiles_parse() {
+        let text = format!(
+            "{HEAD}outlines = [{{ at = 0.2, shape = \"square\" }}, {{ at = 0.8, points = [[1, -1], [1, 1], [-1, 1], [-1, -1]] }}]\n\
+             profiles = [{{ at = 0.0, shape = \"arc\" }}, {{ at = 0.5, shape = \"segment\", elevation = [-30, 40] }}]\n\
+             blend = \"smooth\"\nclip = [0.5, 9]\n"
+        );
+        let VolumeSource::Panorama(p) = source(&text) else {
+            panic!("not a panorama")
+        };
+        assert_eq!(p.shape.outlines().len(), 2);
+        assert_eq!(p.shape.profiles()[1].at, 0.5);
+        assert_eq!(p.shape.blend(), super::CurveBlend::Smooth);
+        assert_eq!(p.clip, Some([0.5, 9.0]));
+        // The segment between -30 and 40 degrees at distance 1.
+        let top = p.shape.profiles()[1].curve.at(1.0);
+        assert!((top.y - 40f64.to_radians().tan()).abs() < 1e-12);
+        let one = format!(
+            "{HEAD}outline = {{ shape = \"rounded_square\", radius = 0.5 }}\nprofile = {{ points = [[1, -1], [1, 1]] }}\n"
+        );
+        assert!(matches!(source(&one), VolumeSource::Panorama(_)));
+    }
+
+    #[test]
+    fn bad_panoramas_are_refused_at_their_values() {
+        error_at(
+            &format!("{HEAD}outline = {{ shape = \"oval\" }}\nprofile = {{ shape = \"arc\" }}\n"),
+            5,
+            21,
+            "unknown outline shape \"oval\"; expected one of: circle, square, rounded_square",
+        );
+        error_at(
+            &format!("{HEAD}outline = {{ shape = \"circle\", radius = 2 }}\nprofile = {{ shape = \"arc\" }}\n"),
+            5,
+            40,
+            "`radius` is not a parameter of circle outlines",
+        );
+        error_at(
+            &format!("{HEAD}outline = {{ shape = \"rounded_square\", radius = 2 }}\nprofile = {{ shape = \"arc\" }}\n"),
+            5,
+            48,
+            "corner radius must lie in [0, 1]",
+        );
+        error_at(
+            &format!("{HEAD}outline = {{ points = [[1, 1], [2, 1], [2, 2]] }}\nprofile = {{ shape = \"arc\" }}\n"),
+            5,
+            22,
+            "outline must go once around the eye",
+        );
+        error_at(
+            &format!("{HEAD}outline = {{ shape = \"circle\" }}\nprofile = {{ shape = \"segment\", elevation = [-90, 10] }}\n"),
+            6,
+            44,
+            "segment profile elevations must increase within (-90, 90)",
+        );
+        error_at(
+            &format!("{HEAD}outline = {{ shape = \"circle\" }}\nprofile = {{ points = [[1, 1], [1, 1]] }}\n"),
+            6,
+            22,
+            "profile curve has zero length",
+        );
+        error_at(
+            &format!("{HEAD}outline = {{ shape = \"circle\" }}\n"),
+            1,
+            1,
+            "a panorama needs `profile` (or `profiles`)",
+        );
+        error_at(
+            &format!(
+                "{HEAD}outline = {{ shape = \"circle\" }}\nprofiles = [{{ shape = \"arc\" }}]\n"
+            ),
+            6,
+            13,
+            "each entry of `profiles` needs `at`",
+        );
+        error_at(
+            &format!("{HEAD}outline = {{ shape = \"circle\" }}\nprofiles = [{{ at = 0.5, shape = \"arc\" }}, {{ at = 0.2, shape = \"arc\" }}]\n"),
+            6,
+            12,
+            "profile attachment parameters `at` must increase strictly",
+        );
+        error_at(
+            &format!("{HEAD}outline = {{ at = 0.3, shape = \"circle\" }}\nprofile = {{ shape = \"arc\" }}\n"),
+            5,
+            18,
+            "`at` belongs to the entries of `outlines`",
+        );
+        error_at(
+            &format!("{HEAD}outline = {{ shape = \"circle\" }}\nprofile = {{ shape = \"arc\" }}\nblend = \"bezier\"\n"),
+            7,
+            9,
+            "unknown panorama blend \"bezier\"",
+        );
+        error_at(
+            &format!("{HEAD}outline = {{ shape = \"circle\" }}\nprofile = {{ shape = \"arc\" }}\nfov = 3\n"),
+            7,
+            7,
+            "`fov` is not a parameter of flexible panoramas given by outlines and profiles",
+        );
+        error_at(
+            "[projection]\ntype = \"flexible\"\npreset = \"rounded_cubic\"\nposition = [0, 1, 0]\nlook_at = [0, 1, -1]\ncorner_radius = 1.5\n",
+            6,
+            17,
+            "`corner_radius` must lie in [0, 1]",
+        );
+    }
+}
