@@ -23,7 +23,8 @@
 //! projector and settles directions the data leave open. lambda is 1e-11 of the data term's
 //! mean diagonal: it keeps the system positive definite, and the bias it adds to directions
 //! the data determine grows with it (measured: 1e-6 rad at 1e-8, 2e-9 rad at 1e-11 on
-//! exact data), so it is as small as double precision allows.
+//! exact data), so it is as small as double precision allows; a second solve centred on the
+//! first removes most of what bias remains (see [`fit`]).
 //!
 //! Unknowns are scaled by the prior's mean projector length, so lambda is dimensionless. After
 //! the solve, when some X_k would lie beyond its projector's end (t > 1), all directions are
@@ -67,7 +68,21 @@ pub struct FitReport {
 
 /// Fits the node directions of `prior` to `correspondences` (see the module docs); returns the
 /// fitted grid, with the prior's starts and interpolation, and its residual.
+///
+/// The solve runs twice, the second time with the first fit as its prior: the prior term pulls
+/// every direction towards the prior by about `PRIOR_WEIGHT` times their difference, which for
+/// a prior far from the answer (a 90-degree frustum fitted to a 20-degree camera) leaves
+/// errors near 2e-7 rad; centred on the first fit, the pull acts on that small residual only.
 pub fn fit(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+) -> Result<(ProjectorGrid, FitReport)> {
+    let (first, _) = fit_once(prior, correspondences)?;
+    fit_once(&first, correspondences)
+}
+
+/// One regularised least-squares solve around `prior` (see [`fit`]).
+fn fit_once(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport)> {
@@ -519,7 +534,8 @@ mod tests {
             ).unwrap();
             let data = correspondences_of(&truth, 8, seed);
             let (fitted, _) = fit(&prior, &data).unwrap();
-            prop_assert!(max_direction_error(&fitted, &truth) < 1e-7);
+            let error = max_direction_error(&fitted, &truth);
+            prop_assert!(error < 1e-7, "direction error {error}");
             // Casting the fitted projector through each correspondence's image position gives
             // back its scene point.
             for c in &data {
