@@ -19,7 +19,7 @@ use std::f64::consts::PI;
 
 use glam::{DMat2, DVec2, DVec3};
 
-use super::panorama::lookup::PanoramaInverse;
+use super::panorama::lookup::{self, PanoramaInverse};
 use super::surface::{CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface};
 
 /// Relative tolerance for "the same" centre, frame or range, and for the domain edges.
@@ -173,7 +173,11 @@ impl Inverse {
     /// spot (a point where the projectors meet, a polar axis outside the longitude range).
     pub fn solve(&self, p: DVec3) -> Option<(DVec2, f64)> {
         let (uv, t) = self.solve_unbounded(p)?;
-        let inside = |x: f64| (-EDGE..=1.0 + EDGE).contains(&x);
+        let edge = match self {
+            Inverse::Panorama(_) => lookup::ACCURACY,
+            _ => EDGE,
+        };
+        let inside = |x: f64| (-edge..=1.0 + edge).contains(&x);
         (inside(uv.x) && inside(uv.y) && inside(t))
             .then(|| (uv.clamp(DVec2::ZERO, DVec2::ONE), t.clamp(0.0, 1.0)))
     }

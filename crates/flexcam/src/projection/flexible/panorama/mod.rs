@@ -1,7 +1,9 @@
 //! Shape-defined panoramas (thesis ch. 9): a control surface built from an outline P_o(u)
 //! (closed, arc length) and a profile P_p(v) (open, arc length),
 //!
-//!     Q_d(u, v) = d (P_o(u)_x P_p(v)_x,  P_p(v)_y,  P_o(u)_y P_p(v)_x)
+//! ```text
+//! Q_d(u, v) = d (P_o(u)_x P_p(v)_x,  P_p(v)_y,  P_o(u)_y P_p(v)_x)
+//! ```
 //!
 //! in camera-local (right, up, forward) coordinates around the eye: the outline is drawn in
 //! the (right, forward) plane and the profile in the (distance from the up axis, height)

@@ -383,9 +383,8 @@ fn invertible_panoramas() -> Vec<(&'static str, FlexibleSpec)> {
     ]
 }
 
-/// The stated accuracy of the lookup: image positions within 1e-6 of the image size, depth
-/// t within 1e-6 (the tables' O(h^2) interpolation error, h = 1/4096).
-const LOOKUP_TOLERANCE: f64 = 1e-6;
+/// The stated accuracy of the lookup (image positions as a fraction of the image, and t).
+const LOOKUP_TOLERANCE: f64 = super::lookup::ACCURACY;
 
 mod round_trip {
     use proptest::prelude::*;
