@@ -361,6 +361,36 @@ mod tests {
     }
 
     #[test]
+    fn replace_keeps_the_other_fractions() {
+        // The unit square from the origin; replace fractions [0.125, 0.375] (from (0.5, 0)
+        // around the corner (1, 0) to (1, 0.5)) by the diagonal.
+        let square = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y];
+        let c = ArcCurve::polyline(&square, true).unwrap();
+        let diagonal = Piece::Line {
+            from: DVec2::new(0.5, 0.0),
+            to: DVec2::new(1.0, 0.5),
+        };
+        let r = c.replace([0.125, 0.375], diagonal).unwrap();
+        for s in [0.0, 0.1, 0.125, 0.375, 0.5, 0.9, 1.0] {
+            assert!(close(r.at(s), c.at(s)), "{s}");
+        }
+        assert!(close(r.at(0.25), DVec2::new(0.75, 0.25)));
+        assert!(r.is_closed());
+        // A central piece: the slope y / x is linear in the fraction.
+        let central = Piece::Central {
+            from: DVec2::new(1.0, 0.0),
+            to: DVec2::new(2.0, 2.0),
+        };
+        let mid = central.at(0.5);
+        assert!((mid.y / mid.x - 0.5).abs() < 1e-15 && close(central.part(0.0, 1.0).at(0.5), mid));
+        // Errors: a piece that misses the curve, an empty or outside range.
+        let e = c.replace([0.1, 0.375], diagonal).unwrap_err();
+        assert!(e.message.contains("does not join"), "{e}");
+        assert!(c.replace([0.3, 0.3], diagonal).is_err());
+        assert!(c.replace([0.5, 1.5], diagonal).is_err());
+    }
+
+    #[test]
     fn distance_range_finds_interior_extremes() {
         let c = ArcCurve::polyline(&[DVec2::new(-1.0, 2.0), DVec2::new(1.0, 2.0)], false).unwrap();
         let (lo, hi) = c.distance_range();
