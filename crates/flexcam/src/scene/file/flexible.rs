@@ -22,7 +22,7 @@ use crate::projection::flexible::{
 };
 
 /// Every key of a flexible table (besides `type`).
-pub(super) const KEYS: [&str; 41] = [
+pub(super) const KEYS: [&str; 42] = [
     "preset",
     "position",
     "look_at",
@@ -53,6 +53,7 @@ pub(super) const KEYS: [&str; 41] = [
     "outlines",
     "profile",
     "profiles",
+    "perspective_rect",
     "transition",
     "transitions",
     "fovs",

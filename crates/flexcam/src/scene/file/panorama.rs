@@ -10,6 +10,7 @@
 //! profiles = [{ at = 0.5, shape = "segment", elevation = [-40, 40] },
 //!             { at = 0.0, shape = "arc" }]                  # or `profile = { ... }`
 //! blend = "smooth"                                          # or "linear" (the default)
+//! perspective_rect = [0.4, 0.3, 0.6, 0.7]     # optional: [u0, v0, u1, v1] made perspective
 //! ```
 //!
 //! Outline shapes: `circle`, `square`, `rounded_square` (`radius`), or `points = [[x, y],
@@ -28,11 +29,12 @@ use super::raw::{RawCurve, RawProjection};
 use super::source::Source;
 use crate::error::Result;
 use crate::projection::flexible::panorama::{
-    ArcCurve, Attached, CurveBlend, OutlineShape, PanoramaShape, PanoramaSpec, ProfileShape,
+    make_perspective, ArcCurve, Attached, CurveBlend, OutlineShape, PanoramaShape, PanoramaSpec,
+    ProfileShape,
 };
 
 /// The keys of a panorama table (besides `type` and `projectors`).
-pub(super) const KEYS: [&str; 11] = [
+pub(super) const KEYS: [&str; 12] = [
     "position",
     "look_at",
     "up",
@@ -44,6 +46,7 @@ pub(super) const KEYS: [&str; 11] = [
     "profile",
     "profiles",
     "blend",
+    "perspective_rect",
 ];
 
 const OUTLINE_NAMES: [&str; 3] = ["circle", "square", "rounded_square"];
@@ -109,6 +112,14 @@ pub(super) fn convert(required: &Required) -> Result<PanoramaSpec> {
         };
         src.error(&at, e.message)
     })?;
+    let shape = match &raw.perspective_rect {
+        None => shape,
+        Some(rect) => {
+            src.all_finite(rect.get_ref(), rect, "perspective_rect")?;
+            make_perspective(&shape, *rect.get_ref())
+                .map_err(|e| src.error(&rect.span(), e.message))?
+        }
+    };
     Ok(PanoramaSpec {
         shape: Arc::new(shape),
         frame: camera_frame(src, required)?,
@@ -267,6 +278,7 @@ fn curve(src: &Source, table: &Spanned<RawCurve>, which: Family) -> Result<ArcCu
 mod tests {
     use std::path::Path;
 
+    use super::make_perspective;
     use crate::projection::flexible::{Preset, VolumeSource};
     use crate::projection::ProjectionSpec;
     use crate::scene::file::parse;
@@ -336,6 +348,39 @@ mod tests {
             "{HEAD}outline = {{ shape = \"rounded_square\", radius = 0.5 }}\nprofile = {{ points = [[1, -1], [1, 1]] }}\n"
         );
         assert!(matches!(source(&one), VolumeSource::Panorama(_)));
+    }
+
+    #[test]
+    fn perspective_rect_flattens_the_shape() {
+        let curves = "outline = { shape = \"circle\" }\nprofile = { shape = \"arc\" }\n";
+        let VolumeSource::Panorama(plain) = source(&format!("{HEAD}{curves}")) else {
+            panic!("not a panorama")
+        };
+        let text = format!("{HEAD}{curves}perspective_rect = [0.4, 0.3, 0.6, 0.7]\n");
+        let VolumeSource::Panorama(p) = source(&text) else {
+            panic!("not a panorama")
+        };
+        let edited = make_perspective(&plain.shape, [0.4, 0.3, 0.6, 0.7]).unwrap();
+        assert_eq!(*p.shape, edited);
+        assert_ne!(p.shape, plain.shape);
+        error_at(
+            &format!("{HEAD}{curves}perspective_rect = [0.6, 0.3, 0.4, 0.7]\n"),
+            7,
+            20,
+            "perspective rectangle [u0, v0, u1, v1] must satisfy 0 <= u0 < u1 <= 1",
+        );
+        error_at(
+            &format!("{HEAD}{curves}perspective_rect = [0.2, 0.3, 0.8, 0.7]\n"),
+            7,
+            20,
+            "turns 216.0 degrees around the eye",
+        );
+        error_at(
+            &format!("{HEAD}{curves}perspective_rect = [0.4, 0.0, 0.6, 0.7]\n"),
+            7,
+            20,
+            "lies on or behind the up axis",
+        );
     }
 
     #[test]

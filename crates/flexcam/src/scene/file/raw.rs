@@ -115,6 +115,7 @@ pub struct RawProjection {
     pub outlines: Option<Spanned<Vec<Spanned<RawCurve>>>>,
     pub profile: Option<Spanned<RawCurve>>,
     pub profiles: Option<Spanned<Vec<Spanned<RawCurve>>>>,
+    pub perspective_rect: Option<Spanned<[f64; 4]>>,
 }
 
 /// `outline = { ... }`, `profile`, and the entries of `outlines` / `profiles` (with `at`): a
@@ -302,6 +303,10 @@ impl RawProjection {
             ("outlines", self.outlines.as_ref().map(Spanned::span)),
             ("profile", self.profile.as_ref().map(Spanned::span)),
             ("profiles", self.profiles.as_ref().map(Spanned::span)),
+            (
+                "perspective_rect",
+                self.perspective_rect.as_ref().map(Spanned::span),
+            ),
             ("transition", self.transition.as_ref().map(Spanned::span)),
             ("transitions", self.transitions.as_ref().map(Spanned::span)),
             ("fovs", self.fovs.as_ref().map(Spanned::span)),

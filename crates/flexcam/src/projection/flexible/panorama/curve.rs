@@ -4,7 +4,9 @@
 //! A curve is a chain of pieces, each a straight segment or a circular arc, so the arc length
 //! of every named shape (circle, square, rounded square, vertical segment, arc) is exact; a
 //! curve given by points is a chain of segments (the thesis's chord-length approximation of
-//! arc length, exact for the polyline itself).
+//! arc length, exact for the polyline itself). [`ArcCurve::replace`] swaps a range of
+//! fractions for one piece (the perspective edit of module `edit`) and keeps every other
+//! fraction's point, so such a curve is arc-length parameterised outside that range only.
 //!
 //! Degenerate cases: pieces of zero length (repeated points, a corner radius of 0 or 1) are
 //! dropped, as they take no arc length; a curve whose total length is zero, or with a
@@ -27,6 +29,11 @@ pub enum Piece {
         start: f64,
         sweep: f64,
     },
+    /// The segment from `from` to `to` parameterised centrally: the slope y / x of the point
+    /// seen from the origin is linear in the fraction (a perspective, not an arc-length,
+    /// parameterisation; both ends must have x > 0). Outside [0, 1] the segment continues
+    /// linearly. Made by [`ArcCurve::replace`] for the perspective edit (module `edit`).
+    Central { from: DVec2, to: DVec2 },
 }
 
 impl Piece {
@@ -35,6 +42,11 @@ impl Piece {
     pub fn at(&self, s: f64) -> DVec2 {
         match *self {
             Piece::Line { from, to } => from + s * (to - from),
+            Piece::Central { from, to } if (0.0..=1.0).contains(&s) => {
+                // The point of the segment on the ray through (1-s) from/from.x + s to/to.x.
+                ((1.0 - s) * to.x * from + s * from.x * to) / ((1.0 - s) * to.x + s * from.x)
+            }
+            Piece::Central { from, to } => from + s * (to - from),
             Piece::Circular {
                 centre,
                 radius,
@@ -50,8 +62,34 @@ impl Piece {
     /// The piece's length.
     pub fn length(&self) -> f64 {
         match *self {
-            Piece::Line { from, to } => (to - from).length(),
+            Piece::Line { from, to } | Piece::Central { from, to } => (to - from).length(),
             Piece::Circular { radius, sweep, .. } => (radius * sweep).abs(),
+        }
+    }
+
+    /// The part of the piece between fractions `a` and `b`, re-parameterised over [0, 1]
+    /// (exact for every kind: a central parameterisation restricted stays central).
+    pub fn part(&self, a: f64, b: f64) -> Piece {
+        match *self {
+            Piece::Line { .. } => Piece::Line {
+                from: self.at(a),
+                to: self.at(b),
+            },
+            Piece::Central { .. } => Piece::Central {
+                from: self.at(a),
+                to: self.at(b),
+            },
+            Piece::Circular {
+                centre,
+                radius,
+                start,
+                sweep,
+            } => Piece::Circular {
+                centre,
+                radius,
+                start: start + a * sweep,
+                sweep: (b - a) * sweep,
+            },
         }
     }
 
@@ -60,7 +98,7 @@ impl Piece {
         let ends = [self.at(0.0).length(), self.at(1.0).length()];
         let (mut lo, mut hi) = (ends[0].min(ends[1]), ends[0].max(ends[1]));
         match *self {
-            Piece::Line { from, to } => {
+            Piece::Line { from, to } | Piece::Central { from, to } => {
                 let d = to - from;
                 let s = (-from.dot(d) / d.length_squared()).clamp(0.0, 1.0);
                 lo = lo.min(self.at(s).length());
@@ -107,7 +145,9 @@ impl ArcCurve {
     /// of pieces that do not meet, a closed curve that does not close.
     pub fn new(pieces: Vec<Piece>, closed: bool) -> Result<Self> {
         let finite = |p: &Piece| match *p {
-            Piece::Line { from, to } => from.is_finite() && to.is_finite(),
+            Piece::Line { from, to } | Piece::Central { from, to } => {
+                from.is_finite() && to.is_finite()
+            }
             Piece::Circular {
                 centre,
                 radius,
@@ -189,6 +229,48 @@ impl ArcCurve {
             .min(self.pieces.len() - 1);
         let start = if i == 0 { 0.0 } else { self.ends[i - 1] };
         self.pieces[i].at((s - start) / (self.ends[i] - start))
+    }
+
+    /// The curve with the part over fractions [`s0`, `s1`] (0 <= s0 < s1 <= 1) replaced by
+    /// `piece`, which must join the curve at both ends; every other fraction keeps its point,
+    /// so the parameterisation outside the range is unchanged (inside it is the piece's own,
+    /// not the arc length of the new curve). Errors: a range outside [0, 1] or empty, a
+    /// piece that does not meet the curve at both ends (within 1e-9 of the curve's length).
+    pub fn replace(&self, [s0, s1]: [f64; 2], piece: Piece) -> Result<ArcCurve> {
+        if !(0.0 <= s0 && s0 < s1 && s1 <= 1.0) {
+            return Err(Error::new(format!(
+                "curve range must satisfy 0 <= start < end <= 1, got [{s0}, {s1}]"
+            )));
+        }
+        let total: f64 = self.pieces.iter().map(Piece::length).sum();
+        let meets = |a: DVec2, b: DVec2| (a - b).length() <= CLOSE * total;
+        if !(meets(piece.at(0.0), self.at(s0)) && meets(piece.at(1.0), self.at(s1))) {
+            return Err(Error::new("replacement piece does not join the curve"));
+        }
+        let mut pieces = Vec::new();
+        let mut ends = Vec::new();
+        // The parts of the old pieces within [lo, hi], with their end fractions.
+        let keep = |lo: f64, hi: f64, pieces: &mut Vec<Piece>, ends: &mut Vec<f64>| {
+            let mut start: f64 = 0.0;
+            for (p, &end) in self.pieces.iter().zip(&self.ends) {
+                let (a, b) = (start.max(lo), end.min(hi));
+                if a < b {
+                    let span = end - start;
+                    pieces.push(p.part((a - start) / span, (b - start) / span));
+                    ends.push(b);
+                }
+                start = end;
+            }
+        };
+        keep(0.0, s0, &mut pieces, &mut ends);
+        pieces.push(piece);
+        ends.push(s1);
+        keep(s1, 1.0, &mut pieces, &mut ends);
+        Ok(ArcCurve {
+            pieces,
+            ends,
+            closed: self.closed,
+        })
     }
 
     /// The smallest and largest distance of a curve point from the origin.
@@ -276,6 +358,36 @@ mod tests {
         ];
         assert!(ArcCurve::new(apart.clone(), false).is_err());
         assert!(ArcCurve::new(apart[..1].to_vec(), true).is_err());
+    }
+
+    #[test]
+    fn replace_keeps_the_other_fractions() {
+        // The unit square from the origin; replace fractions [0.125, 0.375] (from (0.5, 0)
+        // around the corner (1, 0) to (1, 0.5)) by the diagonal.
+        let square = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y];
+        let c = ArcCurve::polyline(&square, true).unwrap();
+        let diagonal = Piece::Line {
+            from: DVec2::new(0.5, 0.0),
+            to: DVec2::new(1.0, 0.5),
+        };
+        let r = c.replace([0.125, 0.375], diagonal).unwrap();
+        for s in [0.0, 0.1, 0.125, 0.375, 0.5, 0.9, 1.0] {
+            assert!(close(r.at(s), c.at(s)), "{s}");
+        }
+        assert!(close(r.at(0.25), DVec2::new(0.75, 0.25)));
+        assert!(r.is_closed());
+        // A central piece: the slope y / x is linear in the fraction.
+        let central = Piece::Central {
+            from: DVec2::new(1.0, 0.0),
+            to: DVec2::new(2.0, 2.0),
+        };
+        let mid = central.at(0.5);
+        assert!((mid.y / mid.x - 0.5).abs() < 1e-15 && close(central.part(0.0, 1.0).at(0.5), mid));
+        // Errors: a piece that misses the curve, an empty or outside range.
+        let e = c.replace([0.1, 0.375], diagonal).unwrap_err();
+        assert!(e.message.contains("does not join"), "{e}");
+        assert!(c.replace([0.3, 0.3], diagonal).is_err());
+        assert!(c.replace([0.5, 1.5], diagonal).is_err());
     }
 
     #[test]

@@ -26,6 +26,7 @@
 //! [`lookup`]).
 
 pub mod curve;
+pub mod edit;
 pub mod lookup;
 pub mod shape;
 
@@ -34,6 +35,7 @@ use std::sync::Arc;
 use glam::{DVec2, DVec3};
 
 pub use self::curve::ArcCurve;
+pub use self::edit::make_perspective;
 pub use self::shape::{OutlineShape, ProfileShape};
 use super::super::camera_basis::CameraBasis;
 use super::super::CameraFrame;

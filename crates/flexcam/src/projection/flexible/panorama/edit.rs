@@ -1,0 +1,123 @@
+//! The local perspective edit of a shape-defined panorama (thesis 9.5): inside a chosen
+//! rectangle [u0, u1] x [v0, v1] of the image the panorama becomes a perspective image.
+//!
+//! The image direction of (u, v) is that of Q_1(u, v) = (O_x P_x, P_y, O_y P_x), that is of
+//! (O_x(u), P_y(v) / P_x(v), O_y(u)) when P_x > 0. It is a perspective (planar) image exactly
+//! when this direction is an affine function of (u, v): the image is then a linear map of a
+//! plane not through the eye, seen from the eye, so straight scene lines stay straight. The
+//! edit makes it so:
+//! - every outline over [u0, u1] becomes the chord from O(u0) to O(u1), parameterised
+//!   linearly (O affine in u);
+//! - every profile over [v0, v1] becomes the chord from P(v0) to P(v1), parameterised
+//!   centrally ([`Piece::Central`]: the slope P_y / P_x linear in v). A vertical chord is
+//!   then also linear; a slanted one is not, as its arc length would make the slope a
+//!   Moebius function of v and bend the image's lines.
+//!
+//! Exact: with one outline and one profile (the presets and most custom panoramas) the
+//! rectangle is an exact perspective image of the vertical plane through the outline's chord
+//! (up to floating point). Approximate: with several outlines or profiles each is flattened
+//! and the blend of their chords varies across the rectangle, so it is perspective only where
+//! the blend weight is constant.
+//!
+//! Outside the rectangle: the fractions outside [u0, u1] of every outline and outside
+//! [v0, v1] of every profile keep their points, so Q (and each ray) is unchanged wherever
+//! u lies outside [u0, u1] and v outside [v0, v1]. The column band u in [u0, u1] changes over
+//! the whole height (the outline there is the chord, which also changes its distance |O| and
+//! so the elevation of every row), and the row band v in [v0, v1] changes over the whole
+//! width (the elevations between the rectangle's top and bottom rows follow the chord). The
+//! surface stays continuous across the rectangle's borders, since the chords join the curves
+//! at their end points.
+//!
+//! Errors: a non-finite rectangle, one outside [0, 1]^2 or empty (u0 >= u1 or v0 >= v1);
+//! an outline range turning through 180 degrees or more around the eye (its chord would pass
+//! through or behind the eye; this includes ranges across the seam, which u0 < u1 excludes,
+//! so place the rectangle on one side of the seam); a profile end on or behind the up axis
+//! (P_x <= 0: the chord would meet the axis through the eye).
+
+use std::f64::consts::PI;
+
+use glam::DVec2;
+
+use super::curve::{ArcCurve, Piece};
+use super::{Attached, PanoramaShape};
+use crate::error::{Error, Result};
+
+/// Samples per outline range when measuring how far it turns around the eye.
+const TURN_SAMPLES: usize = 1024;
+
+/// The shape made perspective inside `rect` = [u0, v0, u1, v1] (module doc).
+pub fn make_perspective(shape: &PanoramaShape, rect: [f64; 4]) -> Result<PanoramaShape> {
+    let [u0, v0, u1, v1] = rect;
+    let ordered = |a: f64, b: f64| 0.0 <= a && a < b && b <= 1.0;
+    if !(ordered(u0, u1) && ordered(v0, v1)) {
+        return Err(Error::new(format!(
+            "perspective rectangle [u0, v0, u1, v1] must satisfy 0 <= u0 < u1 <= 1 and \
+             0 <= v0 < v1 <= 1, got [{u0}, {v0}, {u1}, {v1}]"
+        )));
+    }
+    let outlines = flatten(shape.outlines(), |c| outline_chord(c, [u0, u1]))?;
+    let profiles = flatten(shape.profiles(), |c| profile_chord(c, [v0, v1]))?;
+    PanoramaShape::new(outlines, profiles, shape.blend())
+}
+
+/// Each attached curve with `edit` applied.
+fn flatten(
+    list: &[Attached],
+    edit: impl Fn(&ArcCurve) -> Result<ArcCurve>,
+) -> Result<Vec<Attached>> {
+    list.iter()
+        .map(|a| {
+            Ok(Attached {
+                at: a.at,
+                curve: edit(&a.curve)?,
+            })
+        })
+        .collect()
+}
+
+/// The outline with [u0, u1] replaced by its linearly parameterised chord.
+fn outline_chord(curve: &ArcCurve, [u0, u1]: [f64; 2]) -> Result<ArcCurve> {
+    let turn = turning(curve, [u0, u1]);
+    if turn.abs() >= PI * (1.0 - 1e-9) {
+        return Err(Error::new(format!(
+            "perspective rectangle: the outline over u in [{u0}, {u1}] turns {:.1} degrees \
+             around the eye; a chord (a plane) needs less than 180",
+            turn.abs().to_degrees()
+        )));
+    }
+    let chord = Piece::Line {
+        from: curve.at(u0),
+        to: curve.at(u1),
+    };
+    curve.replace([u0, u1], chord)
+}
+
+/// The signed angle the curve turns around the origin between fractions `range`, summed
+/// over [`TURN_SAMPLES`] steps (outlines never pass through the eye).
+fn turning(curve: &ArcCurve, [a, b]: [f64; 2]) -> f64 {
+    let point = |k: usize| curve.at(a + (b - a) * k as f64 / TURN_SAMPLES as f64);
+    (0..TURN_SAMPLES)
+        .map(|k| {
+            let (p, q) = (point(k), point(k + 1));
+            p.perp_dot(q).atan2(p.dot(q))
+        })
+        .sum()
+}
+
+/// The profile with [v0, v1] replaced by its centrally parameterised chord.
+fn profile_chord(curve: &ArcCurve, [v0, v1]: [f64; 2]) -> Result<ArcCurve> {
+    let (from, to): (DVec2, DVec2) = (curve.at(v0), curve.at(v1));
+    // Ends within 1e-9 (relative) of the axis count as on it: the slope there is unbounded.
+    let ahead = |p: DVec2| p.x > 1e-9 * p.length();
+    if !(ahead(from) && ahead(to)) {
+        return Err(Error::new(format!(
+            "perspective rectangle: the profile at v = {v0} or {v1} lies on or behind the up \
+             axis through the eye (distance {} and {}); the chord must stay in front of it",
+            from.x, to.x
+        )));
+    }
+    curve.replace([v0, v1], Piece::Central { from, to })
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,187 @@
+//! The perspective edit: straight scene lines image straight inside the rectangle (measured
+//! in pixels through the lookup inverse), rays outside its u and v ranges are unchanged, bad
+//! rectangles are refused.
+
+use std::f64::consts::FRAC_PI_2;
+use std::sync::Arc;
+
+use glam::{DVec2, DVec3};
+
+use super::*;
+use crate::projection::camera_basis::CameraBasis;
+use crate::projection::flexible::panorama::lookup::PanoramaInverse;
+use crate::projection::flexible::panorama::{OutlineShape, PanoramaSurface, ProfileShape};
+use crate::projection::CameraFrame;
+
+/// Image size the deviations are measured in.
+const WIDTH: f64 = 1024.0;
+const HEIGHT: f64 = 512.0;
+
+/// A 90-degree-wide rectangle around the view direction, from -18 to 54 degrees of
+/// elevation on the equirectangular profile (a slanted profile chord).
+const RECT: [f64; 4] = [0.375, 0.4, 0.625, 0.8];
+
+/// The equirectangular shape: circle + semicircle.
+fn equirect() -> PanoramaShape {
+    let outline = OutlineShape::Circle.curve().unwrap();
+    let profile = ProfileShape::Arc {
+        elevation: [-FRAC_PI_2, FRAC_PI_2],
+    }
+    .curve()
+    .unwrap();
+    PanoramaShape::single(outline, profile).unwrap()
+}
+
+fn basis() -> CameraBasis {
+    CameraBasis::new(&CameraFrame {
+        position: DVec3::new(1.0, 2.0, 3.0),
+        look_at: DVec3::new(-2.0, 1.0, 0.0),
+        up: DVec3::Y,
+    })
+    .unwrap()
+}
+
+fn inverse(shape: PanoramaShape) -> PanoramaInverse {
+    let shape = Arc::new(shape);
+    let surface = |scale| PanoramaSurface {
+        basis: basis(),
+        scale,
+        shape: Arc::clone(&shape),
+    };
+    PanoramaInverse::new(&surface(0.0), &surface(1000.0)).unwrap()
+}
+
+/// The camera-local point at distance `r` in the direction of azimuth and elevation
+/// (degrees).
+fn local(az: f64, el: f64, r: f64) -> DVec3 {
+    let (az, el) = (az.to_radians(), el.to_radians());
+    r * DVec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos())
+}
+
+/// The largest distance in pixels of the image of the scene segment from `a` to `b`
+/// (camera-local) from the straight line between the images of its ends; every sample must
+/// image inside the rectangle.
+fn deviation(inv: &PanoramaInverse, a: DVec3, b: DVec3) -> f64 {
+    let b3 = basis();
+    let pixel = |p: DVec3| {
+        let (uv, _) = inv.solve(b3.origin + b3.to_world(p)).unwrap();
+        assert!(
+            (RECT[0]..=RECT[2]).contains(&uv.x) && (RECT[1]..=RECT[3]).contains(&uv.y),
+            "{uv} outside the rectangle"
+        );
+        DVec2::new(uv.x * WIDTH, uv.y * HEIGHT)
+    };
+    let (pa, pb) = (pixel(a), pixel(b));
+    let normal = (pb - pa).perp().normalize();
+    (0..=200)
+        .map(|k| (pixel(a.lerp(b, k as f64 / 200.0)) - pa).dot(normal).abs())
+        .fold(0.0, f64::max)
+}
+
+/// Scene segments whose images lie inside [`RECT`] before and after the edit: a diagonal, a
+/// horizontal line above the horizon, a slanted near-vertical one, each with ends at
+/// different distances.
+fn segments() -> [(DVec3, DVec3); 3] {
+    [
+        (local(-30.0, 5.0, 5.0), local(30.0, 35.0, 8.0)),
+        (local(-35.0, 30.0, 4.0), local(35.0, 30.0, 4.0)),
+        (local(-10.0, -10.0, 6.0), local(5.0, 45.0, 3.0)),
+    ]
+}
+
+#[test]
+fn straight_lines_image_straight_inside_the_rectangle() {
+    let before = inverse(equirect());
+    let after = inverse(make_perspective(&equirect(), RECT).unwrap());
+    for (a, b) in segments() {
+        let (bent, straight) = (deviation(&before, a, b), deviation(&after, a, b));
+        println!("deviation before {bent:.3} px, after {straight:.2e} px");
+        assert!(bent > 2.0, "before the edit the line bends: {bent} px");
+        assert!(
+            straight < 0.01,
+            "after the edit it is straight: {straight} px"
+        );
+    }
+}
+
+#[test]
+fn rays_outside_the_rectangles_ranges_are_unchanged() {
+    let old = equirect();
+    let new = make_perspective(&old, RECT).unwrap();
+    let (mut same, mut changed) = (0, 0);
+    for i in 0..=40 {
+        for j in 0..=40 {
+            let uv = DVec2::new(i as f64 / 40.0, j as f64 / 40.0);
+            let inside_u = (RECT[0]..=RECT[2]).contains(&uv.x);
+            let inside_v = (RECT[1]..=RECT[3]).contains(&uv.y);
+            let gap = (new.local(uv) - old.local(uv)).length();
+            if !inside_u && !inside_v {
+                assert!(gap < 1e-12, "{uv}: moved by {gap}");
+                same += 1;
+            } else if gap > 1e-3 {
+                changed += 1;
+            }
+        }
+    }
+    assert!(
+        same > 500 && changed > 300,
+        "{same} unchanged, {changed} changed"
+    );
+    // The surface stays continuous across the rectangle's corners.
+    for uv in [DVec2::new(RECT[0], RECT[1]), DVec2::new(RECT[2], RECT[3])] {
+        assert!((new.local(uv) - old.local(uv)).length() < 1e-12);
+    }
+}
+
+#[test]
+fn a_vertical_segment_profile_stays_linear() {
+    // The cubic panorama's front face is already perspective: the edit over exactly that
+    // face changes nothing.
+    let square = OutlineShape::Square.curve().unwrap();
+    let segment = ProfileShape::Segment {
+        elevation: [-0.7, 0.7],
+    }
+    .curve()
+    .unwrap();
+    let old = PanoramaShape::single(square, segment).unwrap();
+    let new = make_perspective(&old, [0.375, 0.1, 0.625, 0.9]).unwrap();
+    for k in 0..=20 {
+        let uv = DVec2::new(0.375 + 0.25 * k as f64 / 20.0, k as f64 / 20.0);
+        assert!((new.local(uv) - old.local(uv)).length() < 1e-12, "{uv}");
+    }
+}
+
+#[test]
+fn bad_rectangles_are_refused() {
+    let shape = equirect();
+    for rect in [
+        [-0.1, 0.4, 0.6, 0.8],
+        [0.4, 0.4, 0.6, 1.2],
+        [0.6, 0.4, 0.4, 0.8],
+        [0.4, 0.5, 0.6, 0.5],
+        [f64::NAN, 0.4, 0.6, 0.8],
+    ] {
+        let e = make_perspective(&shape, rect).unwrap_err();
+        assert!(e.message.contains("0 <= u0 < u1 <= 1"), "{e}");
+    }
+    // 216 degrees of the circle: the chord passes the eye.
+    let e = make_perspective(&shape, [0.2, 0.4, 0.8, 0.6]).unwrap_err();
+    assert!(e.message.contains("turns 216.0 degrees"), "{e}");
+    // Exactly half the circle: the chord runs through the eye.
+    assert!(make_perspective(&shape, [0.25, 0.4, 0.75, 0.6]).is_err());
+    // The whole height of the semicircle ends at the poles, on the axis.
+    let e = make_perspective(&shape, [0.4, 0.0, 0.6, 0.6]).unwrap_err();
+    assert!(e.message.contains("up axis"), "{e}");
+    let behind = ProfileShape::Points(vec![
+        DVec2::new(-0.5, -1.0),
+        DVec2::ONE,
+        DVec2::new(1.0, 2.0),
+    ]);
+    let shape = PanoramaShape::single(
+        OutlineShape::Circle.curve().unwrap(),
+        behind.curve().unwrap(),
+    )
+    .unwrap();
+    assert!(make_perspective(&shape, [0.4, 0.0, 0.6, 0.5]).is_err());
+    assert!(make_perspective(&shape, [0.4, 0.4, 0.6, 0.5]).is_ok());
+}
