@@ -10,7 +10,8 @@ use super::*;
 use crate::projection::camera_basis::CameraBasis;
 use crate::projection::{CameraFrame, ProjectionSpec};
 
-fn frame() -> CameraFrame {
+/// The camera frame every preset test uses (also the panorama tests').
+pub(super) fn frame() -> CameraFrame {
     CameraFrame {
         position: DVec3::new(1.0, 2.0, 3.0),
         look_at: DVec3::new(-2.0, 1.0, 0.0),
@@ -18,7 +19,8 @@ fn frame() -> CameraFrame {
     }
 }
 
-fn preset(preset: Preset, clip: Option<[f64; 2]>) -> FlexibleSpec {
+/// `preset` seen from [`frame`], with optional clip distances.
+pub(super) fn preset(preset: Preset, clip: Option<[f64; 2]>) -> FlexibleSpec {
     FlexibleSpec {
         source: VolumeSource::Preset(PresetSpec {
             preset,

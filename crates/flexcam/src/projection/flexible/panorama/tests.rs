@@ -8,16 +8,9 @@ use std::sync::Arc;
 use glam::{DVec2, DVec3};
 
 use super::*;
-use crate::projection::flexible::{Flexible, FlexibleSpec, Preset, PresetSpec, VolumeSource};
+use crate::projection::flexible::tests::{frame, preset};
+use crate::projection::flexible::{Flexible, FlexibleSpec, Preset, VolumeSource};
 use crate::projection::Projection;
-
-fn frame() -> CameraFrame {
-    CameraFrame {
-        position: DVec3::new(1.0, 2.0, 3.0),
-        look_at: DVec3::new(-2.0, 1.0, 0.0),
-        up: DVec3::Y,
-    }
-}
 
 fn single(outline: OutlineShape, profile: ProfileShape) -> PanoramaShape {
     PanoramaShape::single(outline.curve().unwrap(), profile.curve().unwrap()).unwrap()
@@ -27,17 +20,6 @@ fn panorama(shape: PanoramaShape, clip: Option<[f64; 2]>) -> FlexibleSpec {
     FlexibleSpec {
         source: VolumeSource::Panorama(PanoramaSpec {
             shape: Arc::new(shape),
-            frame: frame(),
-            clip,
-        }),
-        reparam: None,
-    }
-}
-
-fn preset(preset: Preset, clip: Option<[f64; 2]>) -> FlexibleSpec {
-    FlexibleSpec {
-        source: VolumeSource::Preset(PresetSpec {
-            preset,
             frame: frame(),
             clip,
         }),
