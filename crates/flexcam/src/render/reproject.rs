@@ -162,6 +162,36 @@ mod tests {
         }
     }
 
+    /// A `w` x `h` perspective camera of [`frame`]`(look)` with horizontal angle `fov`.
+    fn perspective(look: DVec3, fov: f64, (w, h): (u32, u32)) -> Box<dyn Projection> {
+        let frame = frame(look);
+        ProjectionSpec::Perspective { frame, fov }
+            .build(w, h)
+            .unwrap()
+    }
+
+    /// A `w` x `h` equirectangular camera of [`frame`]`(look)` seeing the whole sphere.
+    fn whole_sphere(look: DVec3, (w, h): (u32, u32)) -> Box<dyn Projection> {
+        let frame = frame(look);
+        ProjectionSpec::Equirectangular {
+            frame,
+            h_fov: 360.0,
+            v_fov: 180.0,
+        }
+        .build(w, h)
+        .unwrap()
+    }
+
+    /// A `w` x `h` photo of `pixels` (row by row from the top).
+    fn photo(w: u32, h: u32, pixels: Vec<Vec3>) -> EquirectPhoto {
+        EquirectPhoto::new(LinearImage {
+            width: w,
+            height: h,
+            pixels,
+        })
+        .unwrap()
+    }
+
     /// A photo whose colour is (longitude / 2 pi + 1/2, latitude / pi + 1/2, 0.5) at every
     /// pixel centre.
     fn direction_photo(w: u32, h: u32) -> EquirectPhoto {
@@ -174,12 +204,7 @@ mod tests {
                 })
             })
             .collect();
-        EquirectPhoto::new(LinearImage {
-            width: w,
-            height: h,
-            pixels,
-        })
-        .unwrap()
+        photo(w, h, pixels)
     }
 
     /// A photo of pseudo-random colours.
@@ -194,24 +219,14 @@ mod tests {
                 )
             })
             .collect();
-        EquirectPhoto::new(LinearImage {
-            width: w,
-            height: h,
-            pixels,
-        })
-        .unwrap()
+        photo(w, h, pixels)
     }
 
     #[test]
     fn an_equirectangular_camera_of_the_same_frame_returns_the_photo() {
         let (w, h) = (64, 32);
         let photo = noise_photo(w, h);
-        let spec = ProjectionSpec::Equirectangular {
-            frame: frame(DVec3::NEG_Z),
-            h_fov: 360.0,
-            v_fov: 180.0,
-        };
-        let camera = spec.build(w, h).unwrap();
+        let camera = whole_sphere(DVec3::NEG_Z, (w, h));
         let out = reproject(&photo, camera.as_ref(), 1, Vec3::ZERO);
         let worst = out
             .color
@@ -221,13 +236,7 @@ mod tests {
             .fold(0.0, f32::max);
         assert!(worst < 1e-4, "{worst}");
         // Turned by 90 degrees to +x: column x shows the photo's column x + W/4.
-        let turned = ProjectionSpec::Equirectangular {
-            frame: frame(DVec3::X),
-            h_fov: 360.0,
-            v_fov: 180.0,
-        }
-        .build(w, h)
-        .unwrap();
+        let turned = whole_sphere(DVec3::X, (w, h));
         let out = reproject(&photo, turned.as_ref(), 1, Vec3::ZERO);
         for (y, x) in [(3usize, 5usize), (20, 60)] {
             let want = photo.image.pixels[y * w as usize + (x + w as usize / 4) % w as usize];
@@ -241,12 +250,7 @@ mod tests {
         // Longitude 90 (+x), 90-degree perspective, square image: the centre looks along +x,
         // the top-left corner along (x, y, z) = (1, 1, -1) (left of +x is -z).
         let photo = direction_photo(720, 360);
-        let camera = ProjectionSpec::Perspective {
-            frame: frame(DVec3::X),
-            fov: 90.0,
-        }
-        .build(20, 20)
-        .unwrap();
+        let camera = perspective(DVec3::X, 90.0, (20, 20));
         let out = reproject(&photo, camera.as_ref(), 1, Vec3::ZERO);
         let colour = |lon: f64, lat: f64| {
             Vec3::new((lon / 360.0 + 0.5) as f32, (lat / 180.0 + 0.5) as f32, 0.5)
@@ -312,12 +316,7 @@ mod tests {
     #[test]
     fn supersampling_averages_the_pattern() {
         let photo = noise_photo(32, 16);
-        let camera = ProjectionSpec::Perspective {
-            frame: frame(DVec3::NEG_Z),
-            fov: 60.0,
-        }
-        .build(6, 4)
-        .unwrap();
+        let camera = perspective(DVec3::NEG_Z, 60.0, (6, 4));
         let one = reproject(&photo, camera.as_ref(), 1, Vec3::ZERO);
         let many = reproject(&photo, camera.as_ref(), 16, Vec3::ZERO);
         let pattern = SamplePattern::new(16);

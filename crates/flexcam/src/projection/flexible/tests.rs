@@ -87,18 +87,18 @@ fn centred_uv(f: &Flexible, pixel: DVec2) -> DVec2 {
     2.0 * f.uv(pixel).unwrap() - DVec2::ONE
 }
 
+/// [`check_oracle`] of the centred (U, V) for a spec clipped to depths [1, 2]: the ray
+/// parameter is also checked, as the depth beyond the near plane, z - 1.
+fn check_uv_clipped_to_1_2(spec: &FlexibleSpec, size: (u32, u32), oracle: impl Fn(DVec3) -> DVec2) {
+    check_oracle(spec, size, centred_uv, oracle, Some(&|p: DVec3| p.z - 1.0));
+}
+
 #[test]
 fn perspective_is_u_x_over_z() {
     // The thesis' squares: c_n = (0,0,1), l_n = 1; c_f = (0,0,2), l_f = 2.
     let spec = preset(Preset::Perspective { fov: 90.0 }, Some([1.0, 2.0]));
     let oracle = |p: DVec3| DVec2::new(p.x / p.z, p.y / p.z);
-    check_oracle(
-        &spec,
-        (8, 8),
-        centred_uv,
-        oracle,
-        Some(&|p: DVec3| p.z - 1.0),
-    );
+    check_uv_clipped_to_1_2(&spec, (8, 8), oracle);
 }
 
 #[test]
@@ -110,26 +110,14 @@ fn inverse_perspective_is_u_x_over_e_minus_z() {
         p.frame.look_at = p.frame.position + 3.0 * forward;
     }
     let oracle = |p: DVec3| DVec2::new(p.x, p.y) / (3.0 - p.z);
-    check_oracle(
-        &spec,
-        (8, 8),
-        centred_uv,
-        oracle,
-        Some(&|p: DVec3| p.z - 1.0),
-    );
+    check_uv_clipped_to_1_2(&spec, (8, 8), oracle);
 }
 
 #[test]
 fn orthographic_and_oblique_are_affine() {
     let spec = preset(Preset::Orthographic { width: 2.0 }, Some([1.0, 2.0]));
     let oracle = |p: DVec3| DVec2::new(p.x, p.y);
-    check_oracle(
-        &spec,
-        (6, 6),
-        centred_uv,
-        oracle,
-        Some(&|p: DVec3| p.z - 1.0),
-    );
+    check_uv_clipped_to_1_2(&spec, (6, 6), oracle);
     let shear = DVec2::new(0.5, -0.25);
     let spec = preset(Preset::Oblique { width: 2.0, shear }, Some([1.0, 2.0]));
     let oracle = |p: DVec3| DVec2::new(p.x + shear.x * p.z, p.y + shear.y * p.z);
@@ -147,13 +135,7 @@ fn pushbroom_is_x_and_y_over_z() {
         Some([1.0, 2.0]),
     );
     let oracle = |p: DVec3| DVec2::new(p.x, p.y / p.z);
-    check_oracle(
-        &spec,
-        (6, 6),
-        centred_uv,
-        oracle,
-        Some(&|p: DVec3| p.z - 1.0),
-    );
+    check_uv_clipped_to_1_2(&spec, (6, 6), oracle);
     // The notes' numbers (2,2,1) -> (2,2), (3,3,2) -> (3,1.5), (4,4,3) -> (4,4/3), through
     // the inverse: half width 4 and tan(v_fov/2) = 4 put them inside the image.
     let v_fov = 2.0 * 4f64.atan().to_degrees();
@@ -182,13 +164,7 @@ fn crossed_slits_meet_both_slits() {
     };
     let spec = preset(preset_, Some([1.0, 2.0]));
     let oracle = |p: DVec3| DVec2::new(p.x / p.z, p.y / (p.z + 1.0));
-    check_oracle(
-        &spec,
-        (8, 6),
-        centred_uv,
-        oracle,
-        Some(&|p: DVec3| p.z - 1.0),
-    );
+    check_uv_clipped_to_1_2(&spec, (8, 6), oracle);
 }
 
 #[test]
@@ -620,13 +596,7 @@ fn off_axis_matches_the_gl_frustum_matrix() {
             2.0 * n * p.y / ((t - b) * p.z) - (t + b) / (t - b),
         )
     };
-    check_oracle(
-        &spec,
-        (w, h),
-        centred_uv,
-        oracle,
-        Some(&|p: DVec3| p.z - 1.0),
-    );
+    check_uv_clipped_to_1_2(&spec, (w, h), oracle);
 }
 
 #[test]

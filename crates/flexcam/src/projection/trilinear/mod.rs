@@ -283,31 +283,22 @@ impl Trilinear {
 mod tests {
     use super::*;
     use crate::projection::linear::Perspective;
+    use crate::projection::surfaces::{screen_grid, GridVertex};
     use crate::projection::CameraFrame;
 
     /// A 2 x 2 quad grid (8 triangles) on the image plane at distance 1 in front of `eye`
     /// (looking down -z), with n_k = p_k - eye: a pinhole camera with horizontal half-angle
     /// tangent `half_w` and vertical `half_h`.
     fn pinhole_mesh(eye: DVec3, half_w: f64, half_h: f64) -> TrilinearMesh {
-        let mut mesh = TrilinearMesh::default();
-        for j in 0..3 {
-            for i in 0..3 {
-                let s = DVec2::new(i as f64, j as f64) / 2.0;
-                let p =
-                    eye + DVec3::new((2.0 * s.x - 1.0) * half_w, (2.0 * s.y - 1.0) * half_h, -1.0);
-                mesh.points.push(p);
-                mesh.normals.push(p - eye);
-                mesh.screen.push(s);
+        screen_grid(2, |s| {
+            let point =
+                eye + DVec3::new((2.0 * s.x - 1.0) * half_w, (2.0 * s.y - 1.0) * half_h, -1.0);
+            GridVertex {
+                point,
+                direction: point - eye,
             }
-        }
-        for j in 0..2u32 {
-            for i in 0..2u32 {
-                let a = j * 3 + i;
-                mesh.triangles.push([a, a + 1, a + 4]);
-                mesh.triangles.push([a, a + 4, a + 3]);
-            }
-        }
-        mesh
+        })
+        .unwrap()
     }
 
     /// The eye and image size of [`pinhole_and_perspective`].
@@ -609,30 +600,18 @@ mod tests {
                 -100.0..100.0f64,
             )
                 .prop_map(|(offsets, tilts, shift)| {
-                    let mut mesh = TrilinearMesh::default();
-                    for j in 0..4 {
-                        for i in 0..4 {
-                            let k = j * 4 + i;
-                            let s = DVec2::new(i as f64, j as f64) / 3.0;
-                            let (ox, oy, oz) = offsets[k];
-                            let (tx, ty, len) = tilts[k];
-                            mesh.points.push(DVec3::new(
-                                shift + s.x + ox / 3.0,
-                                s.y + oy / 3.0,
-                                oz / 3.0,
-                            ));
-                            mesh.normals.push(DVec3::new(tx, ty, 1.0) * len);
-                            mesh.screen.push(s);
+                    screen_grid(3, |s| {
+                        // The vertex's index, row by row from the bottom.
+                        let (i, j) = ((3.0 * s.x).round(), (3.0 * s.y).round());
+                        let k = (4.0 * j + i) as usize;
+                        let (ox, oy, oz) = offsets[k];
+                        let (tx, ty, len) = tilts[k];
+                        GridVertex {
+                            point: DVec3::new(shift + s.x + ox / 3.0, s.y + oy / 3.0, oz / 3.0),
+                            direction: DVec3::new(tx, ty, 1.0) * len,
                         }
-                    }
-                    for j in 0..3u32 {
-                        for i in 0..3u32 {
-                            let a = j * 4 + i;
-                            mesh.triangles.push([a, a + 1, a + 5]);
-                            mesh.triangles.push([a, a + 5, a + 4]);
-                        }
-                    }
-                    mesh
+                    })
+                    .unwrap()
                 })
         }
 

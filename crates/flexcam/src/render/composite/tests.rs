@@ -1,12 +1,11 @@
-use std::path::Path;
-
 use glam::{DVec3, Vec3};
 
 use super::*;
-use crate::projection::surfaces::test_scenes::{lens_plane, sphere_and_cube, BALL, BALL_CENTER};
+use crate::projection::surfaces::test_scenes::{
+    lens_plane, sphere_and_cube, ReflectorFixture, BALL, BALL_CENTER,
+};
 use crate::render::compare::{compare, Comparison};
 use crate::render::Method;
-use crate::scene::file;
 
 const SIZE: (u32, u32) = (160, 120);
 
@@ -200,32 +199,18 @@ fn broken_surfaces_fail_the_agreement() {
 /// radiate from a point below it, as glass (one refracting surface), over the checker floor;
 /// object id 1 is the lens, composited as a trilinear reflector.
 fn lens_scene() -> Scene {
-    let text = r#"
-        [image]
-        background = [0.3, 0.4, 0.6]
-        [projection]
-        type = "perspective"
-        position = [0.0, 3.0, 1.5]
-        look_at = [0.0, 0.0, 0.0]
-        fov = 60.0
-        [[object]]
-        name = "lens"
+    let mut scene = ReflectorFixture {
+        eye: [0.0, 3.0, 1.5],
+        look_at: [0.0, 0.0, 0.0],
+        reflector: r#"name = "lens"
         shape = "sphere"
         material = "glass"
-        ior = 1.5
-        [[object]]
-        shape = "box"
-        size = [0.8, 0.8, 0.8]
-        face_colors = [[0.9, 0.15, 0.1], [0.1, 0.75, 0.8], [0.2, 0.8, 0.2],
-                       [0.8, 0.2, 0.8], [0.15, 0.3, 0.9], [0.95, 0.8, 0.1]]
-        translate = [0.0, 0.4, 0.0]
-        [[object]]
-        shape = "plane"
-        size = [12.0, 12.0]
-        color = [0.9, 0.9, 0.9]
-        checker = { color = [0.1, 0.1, 0.1], size = 0.25 }
-    "#;
-    let mut scene = file::parse(text, Path::new("lens.toml")).unwrap();
+        ior = 1.5"#,
+        cube: r#"size = [0.8, 0.8, 0.8]
+        translate = [0.0, 0.4, 0.0]"#,
+        cell: 0.25,
+    }
+    .scene("lens.toml");
     // Replace the placeholder sphere by the lens plane at y = 1.2.
     scene.objects[0].mesh = lens_plane(1.2, 2.2);
     scene.trilinear_reflectors = vec![1];

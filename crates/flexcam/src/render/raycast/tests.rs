@@ -169,17 +169,16 @@ fn intersect_maps_hits_to_objects_and_agrees_with_f64_brute_force() {
     assert!(hits > 300);
 }
 
+/// A red diffuse 18 x 18 quad centred on the origin in the plane z = 0 (facing +z), object
+/// id `id`, and no lights.
+fn red_wall(id: u32) -> Scene {
+    let wall = quad(Vec3::ZERO, Vec3::X * 9.0, Vec3::Y * 9.0);
+    scene(vec![object(id, wall, RED, Surface::Diffuse)], vec![])
+}
+
 #[test]
 fn pixels_without_a_projector_get_the_background() {
-    let scene = scene(
-        vec![object(
-            1,
-            quad(Vec3::ZERO, Vec3::X * 9.0, Vec3::Y * 9.0),
-            RED,
-            Surface::Diffuse,
-        )],
-        vec![],
-    );
+    let scene = red_wall(1);
     let mut camera = Parallel::new(3, 1, (0.0, 0.0), DVec3::NEG_Z);
     camera.blind = 1.0;
     let (frame, stats) = RayCaster::new(&scene).render(&camera, &flat(8));
@@ -191,15 +190,7 @@ fn pixels_without_a_projector_get_the_background() {
 
 #[test]
 fn depth_is_euclidean_distance_along_an_unnormalised_projector() {
-    let scene = scene(
-        vec![object(
-            3,
-            quad(Vec3::ZERO, Vec3::X * 9.0, Vec3::Y * 9.0),
-            RED,
-            Surface::Diffuse,
-        )],
-        vec![],
-    );
+    let scene = red_wall(3);
     let (color, depth, id) = trace(
         &scene,
         DVec3::new(0.0, 0.0, 4.0),
