@@ -3,15 +3,10 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
+use std::process::Output;
 
 use assert_cmd::Command;
 use tempfile::TempDir;
-
-fn flexcam(dir: &Path) -> Command {
-    let mut cmd = Command::cargo_bin("flexcam").expect("flexcam binary");
-    cmd.current_dir(dir);
-    cmd
-}
 
 /// A small valid scene: a red sphere on a checker floor, perspective camera.
 const GOOD_SCENE: &str = r#"
@@ -39,25 +34,36 @@ color = [1.0, 0.0, 0.0]
 translate = [0.0, 1.0, 0.0]
 "#;
 
-/// Fails the test, showing the command's stderr, unless it exited successfully.
-fn assert_success(out: &std::process::Output) {
+/// Runs `flexcam ARGS` in `dir`.
+fn run(dir: &TempDir, args: &[&str]) -> Output {
+    Command::cargo_bin("flexcam")
+        .expect("flexcam binary")
+        .current_dir(dir.path())
+        .args(args)
+        .output()
+        .expect("flexcam runs")
+}
+
+/// Runs `flexcam ARGS` in `dir`; fails the test, showing the command's stderr, unless it
+/// exited successfully.
+fn run_ok(dir: &TempDir, args: &[&str]) -> Output {
+    let out = run(dir, args);
     assert!(
         out.status.success(),
-        "{}",
+        "flexcam {args:?}: {}",
         String::from_utf8_lossy(&out.stderr)
     );
+    out
 }
 
-fn write(dir: &TempDir, name: &str, text: &str) -> PathBuf {
-    let path = dir.path().join(name);
-    fs::write(&path, text).unwrap();
-    path
+/// [`run_ok`], returning the JSON object its standard output must be.
+fn run_json(dir: &TempDir, args: &[&str]) -> serde_json::Value {
+    serde_json::from_slice(&run_ok(dir, args).stdout).expect("stdout is one JSON object")
 }
 
-/// Runs a render expected to fail; returns its single stderr line and checks that no output
-/// file was left behind.
-fn expect_failure(dir: &TempDir, args: &[&str]) -> String {
-    let out = flexcam(dir.path()).args(args).output().unwrap();
+/// The single stderr line of a failed run; fails the test unless the run failed with
+/// exactly one line and no panic.
+fn error_line(out: Output, args: &[&str]) -> String {
     assert!(!out.status.success(), "expected failure for {args:?}");
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert_eq!(
@@ -66,22 +72,65 @@ fn expect_failure(dir: &TempDir, args: &[&str]) -> String {
         "expected exactly one error line, got: {stderr:?}"
     );
     assert!(!stderr.contains("panicked"), "{stderr}");
+    stderr.trim_end().to_string()
+}
+
+fn write(dir: &TempDir, name: &str, text: &str) -> PathBuf {
+    let path = dir.path().join(name);
+    fs::write(&path, text).unwrap();
+    path
+}
+
+/// A fresh folder holding [`GOOD_SCENE`] as the file `name`.
+fn good_scene_in(name: &str) -> TempDir {
+    let dir = TempDir::new().unwrap();
+    write(&dir, name, GOOD_SCENE);
+    dir
+}
+
+/// The folder of the example scenes.
+fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
+/// The path of example scene `name` in [`scenes_dir`].
+fn example_scene(name: &str) -> String {
+    let path = scenes_dir().join(name);
+    path.to_str().expect("a UTF-8 path").to_string()
+}
+
+/// The 1-based number of the first line of `text` containing `needle`.
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines()
+        .position(|l| l.contains(needle))
+        .expect("the needle is in the text")
+        + 1
+}
+
+/// Runs a command expected to fail; returns its single stderr line and checks that no
+/// output file was left behind.
+fn expect_failure(dir: &TempDir, args: &[&str]) -> String {
+    let line = error_line(run(dir, args), args);
     let leftovers: Vec<_> = fs::read_dir(dir.path())
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .filter(|n| !n.ends_with(".toml"))
         .collect();
     assert!(leftovers.is_empty(), "partial output left: {leftovers:?}");
-    stderr.trim_end().to_string()
+    line
+}
+
+/// Writes the scene file `name` with `text` and returns the single error line of rendering
+/// it (see [`expect_failure`]).
+fn render_fails(dir: &TempDir, name: &str, text: &str) -> String {
+    write(dir, name, text);
+    expect_failure(dir, &["render", name])
 }
 
 #[test]
 fn default_render_writes_a_real_image() {
     let dir = TempDir::new().unwrap();
-    flexcam(dir.path())
-        .args(["render", "--width", "160", "--height", "80"])
-        .assert()
-        .success();
+    run_ok(&dir, &["render", "--width", "160", "--height", "80"]);
     let img = image::open(dir.path().join("flexcam.png"))
         .unwrap()
         .to_rgb8();
@@ -97,9 +146,7 @@ fn default_render_writes_a_real_image() {
 #[test]
 fn scenes_lists_the_required_builtins() {
     let dir = TempDir::new().unwrap();
-    let out = flexcam(dir.path()).arg("scenes").output().unwrap();
-    assert!(out.status.success());
-    let text = String::from_utf8(out.stdout).unwrap();
+    let text = String::from_utf8(run_ok(&dir, &["scenes"]).stdout).unwrap();
     let names: Vec<&str> = text
         .lines()
         .filter_map(|l| l.split_whitespace().next())
@@ -115,10 +162,10 @@ fn scenes_lists_the_required_builtins() {
 
 #[test]
 fn flat_render_with_all_outputs_and_stats_on_stdout() {
-    let dir = TempDir::new().unwrap();
-    write(&dir, "s.toml", GOOD_SCENE);
-    let out = flexcam(dir.path())
-        .args([
+    let dir = good_scene_in("s.toml");
+    let json = run_json(
+        &dir,
+        &[
             "render",
             "s.toml",
             "-o",
@@ -131,12 +178,8 @@ fn flat_render_with_all_outputs_and_stats_on_stdout() {
             "i.png",
             "--stats",
             "-",
-        ])
-        .output()
-        .unwrap();
-    assert_success(&out);
-    let json: serde_json::Value =
-        serde_json::from_slice(&out.stdout).expect("stdout is one JSON object");
+        ],
+    );
     for key in [
         "method",
         "width",
@@ -181,15 +224,14 @@ fn flat_render_with_all_outputs_and_stats_on_stdout() {
 
 #[test]
 fn stats_and_depth_to_files() {
-    let dir = TempDir::new().unwrap();
-    write(&dir, "s.toml", GOOD_SCENE);
-    flexcam(dir.path())
-        .args([
+    let dir = good_scene_in("s.toml");
+    let out = run_ok(
+        &dir,
+        &[
             "render", "s.toml", "--depth", "d.pfm", "--stats", "st.json", "--spp", "4",
-        ])
-        .assert()
-        .success()
-        .stdout("");
+        ],
+    );
+    assert!(out.stdout.is_empty(), "{out:?}");
     let json: serde_json::Value =
         serde_json::from_str(&fs::read_to_string(dir.path().join("st.json")).unwrap()).unwrap();
     assert_eq!(json["spp"], 4);
@@ -217,8 +259,7 @@ fn unknown_builtin_scene() {
 #[test]
 fn toml_syntax_error_has_line_and_column() {
     let dir = TempDir::new().unwrap();
-    write(&dir, "bad.toml", "[image]\nwidth = 64\nheight = = 3\n");
-    let e = expect_failure(&dir, &["render", "bad.toml"]);
+    let e = render_fails(&dir, "bad.toml", "[image]\nwidth = 64\nheight = = 3\n");
     assert!(e.contains("bad.toml:3:"), "{e}");
 }
 
@@ -226,13 +267,8 @@ fn toml_syntax_error_has_line_and_column() {
 fn unknown_projection_type_is_located() {
     let dir = TempDir::new().unwrap();
     let text = GOOD_SCENE.replace("type = \"perspective\"", "type = \"perspektive\"");
-    write(&dir, "bad.toml", &text);
-    let e = expect_failure(&dir, &["render", "bad.toml"]);
-    let line = text
-        .lines()
-        .position(|l| l.contains("perspektive"))
-        .unwrap()
-        + 1;
+    let e = render_fails(&dir, "bad.toml", &text);
+    let line = line_of(&text, "perspektive");
     assert!(e.contains(&format!("bad.toml:{line}:")), "{e}");
     assert!(e.contains("perspektive"), "{e}");
 }
@@ -241,9 +277,8 @@ fn unknown_projection_type_is_located() {
 fn nan_value_is_located() {
     let dir = TempDir::new().unwrap();
     let text = GOOD_SCENE.replace("fov = 60.0", "fov = nan");
-    write(&dir, "bad.toml", &text);
-    let e = expect_failure(&dir, &["render", "bad.toml"]);
-    let line = text.lines().position(|l| l.contains("nan")).unwrap() + 1;
+    let e = render_fails(&dir, "bad.toml", &text);
+    let line = line_of(&text, "nan");
     assert!(e.contains(&format!("bad.toml:{line}:")), "{e}");
 }
 
@@ -251,27 +286,18 @@ fn nan_value_is_located() {
 fn degenerate_projection() {
     let dir = TempDir::new().unwrap();
     let text = GOOD_SCENE.replace("look_at = [0.0, 0.5, 0.0]", "look_at = [0.0, 1.0, 5.0]");
-    write(&dir, "bad.toml", &text);
-    let e = expect_failure(&dir, &["render", "bad.toml"]);
+    let e = render_fails(&dir, "bad.toml", &text);
     assert!(e.contains("bad.toml"), "{e}");
 }
 
 #[test]
 fn unknown_shape_and_key() {
     let dir = TempDir::new().unwrap();
-    write(
-        &dir,
-        "a.toml",
-        &GOOD_SCENE.replace("shape = \"sphere\"", "shape = \"spere\""),
-    );
-    let e = expect_failure(&dir, &["render", "a.toml"]);
+    let text = GOOD_SCENE.replace("shape = \"sphere\"", "shape = \"spere\"");
+    let e = render_fails(&dir, "a.toml", &text);
     assert!(e.contains("a.toml:") && e.contains("spere"), "{e}");
-    write(
-        &dir,
-        "b.toml",
-        &GOOD_SCENE.replace("translate =", "translat ="),
-    );
-    let e = expect_failure(&dir, &["render", "b.toml"]);
+    let text = GOOD_SCENE.replace("translate =", "translat =");
+    let e = render_fails(&dir, "b.toml", &text);
     assert!(e.contains("b.toml:") && e.contains("translat"), "{e}");
 }
 
@@ -280,34 +306,30 @@ fn missing_model_file_names_it() {
     let dir = TempDir::new().unwrap();
     let text =
         format!("{GOOD_SCENE}\n[[object]]\nshape = \"mesh\"\nfile = \"models/missing.obj\"\n");
-    write(&dir, "m.toml", &text);
-    let e = expect_failure(&dir, &["render", "m.toml"]);
+    let e = render_fails(&dir, "m.toml", &text);
     assert!(e.contains("missing.obj"), "{e}");
 }
 
 #[test]
 fn absurd_resolution() {
-    let dir = TempDir::new().unwrap();
-    write(&dir, "s.toml", GOOD_SCENE);
+    let dir = good_scene_in("s.toml");
     for args in [
         ["render", "s.toml", "--width", "0"],
         ["render", "s.toml", "--width", "1000000"],
     ] {
         expect_failure(&dir, &args);
     }
-    write(
+    let e = render_fails(
         &dir,
         "big.toml",
         &GOOD_SCENE.replace("width = 64", "width = 0"),
     );
-    let e = expect_failure(&dir, &["render", "big.toml"]);
     assert!(e.contains("big.toml:3:"), "{e}");
 }
 
 #[test]
 fn bad_flags() {
-    let dir = TempDir::new().unwrap();
-    write(&dir, "s.toml", GOOD_SCENE);
+    let dir = good_scene_in("s.toml");
     let e = expect_failure(&dir, &["render", "s.toml", "--method", "magic"]);
     assert!(e.contains("magic") && e.contains("raycast"), "{e}");
     expect_failure(&dir, &["render", "s.toml", "--spp", "0"]);
@@ -323,24 +345,14 @@ fn bad_flags() {
 /// Every example scene in scenes/ renders (flat, small), so the examples stay true.
 #[test]
 fn every_example_scene_renders() {
-    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     let mut rendered = 0;
-    for entry in fs::read_dir(&scenes).unwrap() {
+    for entry in fs::read_dir(scenes_dir()).unwrap() {
         let path = entry.unwrap().path();
         if path.extension().is_some_and(|e| e == "toml") {
             let dir = TempDir::new().unwrap();
-            let out = flexcam(dir.path())
-                .arg("render")
-                .arg(&path)
-                .args(["--width", "48", "--height", "32", "--shading", "flat"])
-                .output()
-                .unwrap();
-            assert!(
-                out.status.success(),
-                "{}: {}",
-                path.display(),
-                String::from_utf8_lossy(&out.stderr)
-            );
+            let path = path.to_str().expect("a UTF-8 path");
+            let size = ["--width", "48", "--height", "32", "--shading", "flat"];
+            run_ok(&dir, &[&["render", path][..], &size].concat());
             rendered += 1;
         }
     }
@@ -349,16 +361,23 @@ fn every_example_scene_renders() {
 
 #[test]
 fn compare_reports_agreement_and_enforces_thresholds() {
-    let dir = TempDir::new().unwrap();
-    write(&dir, "s.toml", GOOD_SCENE);
-    let out = flexcam(dir.path())
-        .args(["compare", "s.toml", "--method", "raycast", "--json"])
-        .args(["--min-id-agreement", "99.5", "--max-rgb-error", "0.02"])
-        .args(["--diff", "diff.png"])
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{out:?}");
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let dir = good_scene_in("s.toml");
+    let report = run_json(
+        &dir,
+        &[
+            "compare",
+            "s.toml",
+            "--method",
+            "raycast",
+            "--json",
+            "--min-id-agreement",
+            "99.5",
+            "--max-rgb-error",
+            "0.02",
+            "--diff",
+            "diff.png",
+        ],
+    );
     assert_eq!(report["id_agreement"], 1.0);
     assert_eq!(report["relative_rgb_error"], 0.0);
     assert_eq!(report["pixels"], 64 * 48);
@@ -371,21 +390,20 @@ fn compare_reports_agreement_and_enforces_thresholds() {
 
     // An unreachable threshold fails with one line naming the measure; the diff image of a
     // failed check is kept on purpose (it is what one looks at next).
-    let out = flexcam(dir.path())
-        .args(["compare", "s.toml", "--method", "raycast"])
-        .args(["--min-id-agreement", "100.5"])
-        .output()
-        .unwrap();
+    let args = [
+        "compare",
+        "s.toml",
+        "--method",
+        "raycast",
+        "--min-id-agreement",
+        "100.5",
+    ];
+    let out = run(&dir, &args);
     assert_eq!(out.status.code(), Some(1));
-    let stderr = String::from_utf8(out.stderr).unwrap();
-    assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
-    assert!(
-        stderr.contains("id agreement 100.000 % is below"),
-        "{stderr}"
-    );
+    let e = error_line(out, &args);
+    assert!(e.contains("id agreement 100.000 % is below"), "{e}");
 
-    let clean = TempDir::new().unwrap();
-    write(&clean, "s.toml", GOOD_SCENE);
+    let clean = good_scene_in("s.toml");
     let e = expect_failure(
         &clean,
         &[
@@ -406,15 +424,27 @@ fn compare_reports_agreement_and_enforces_thresholds() {
 #[test]
 fn compare_supersamples_trilinear_and_the_reference() {
     let dir = TempDir::new().unwrap();
-    let fan = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/trilinear-fan.toml");
-    let out = flexcam(dir.path())
-        .args(["compare", fan.to_str().unwrap(), "--method", "trilinear"])
-        .args(["--width", "180", "--height", "120", "--spp", "4", "--json"])
-        .args(["--min-id-agreement", "99.5", "--max-rgb-error", "0.02"])
-        .output()
-        .unwrap();
-    assert_success(&out);
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let fan = example_scene("trilinear-fan.toml");
+    let report = run_json(
+        &dir,
+        &[
+            "compare",
+            &fan,
+            "--method",
+            "trilinear",
+            "--width",
+            "180",
+            "--height",
+            "120",
+            "--spp",
+            "4",
+            "--json",
+            "--min-id-agreement",
+            "99.5",
+            "--max-rgb-error",
+            "0.02",
+        ],
+    );
     assert_eq!(report["spp"], 4);
     assert_eq!(report["method"], "trilinear");
     expect_failure(
@@ -427,19 +457,14 @@ fn compare_supersamples_trilinear_and_the_reference() {
 /// reports its counters.
 #[test]
 fn raster_method_renders_and_reports() {
-    let dir = TempDir::new().unwrap();
-    write(&dir, "s.toml", GOOD_SCENE);
+    let dir = good_scene_in("s.toml");
     for flags in [
         vec![],
         vec!["--subdiv", "4"],
         vec!["--raster-tolerance", "0.25"],
     ] {
-        let out = flexcam(dir.path())
-            .args(["render", "s.toml", "--method", "raster", "--stats", "-"])
-            .args(&flags)
-            .output()
-            .unwrap();
-        assert_success(&out);
+        let render = ["render", "s.toml", "--method", "raster", "--stats", "-"];
+        let out = run_ok(&dir, &[&render[..], &flags[..]].concat());
         let stats = String::from_utf8(out.stdout).unwrap();
         assert!(stats.contains("\"method\":\"raster\""), "{stats}");
         assert!(stats.contains("\"raster_pieces\""), "{stats}");
@@ -449,8 +474,7 @@ fn raster_method_renders_and_reports() {
 
 #[test]
 fn raster_bad_input_is_one_line() {
-    let dir = TempDir::new().unwrap();
-    write(&dir, "s.toml", GOOD_SCENE);
+    let dir = good_scene_in("s.toml");
     let raster = ["render", "s.toml", "--method", "raster"];
     let e = expect_failure(&dir, &[&raster[..], &["--subdiv", "0"]].concat());
     assert!(e.contains("subdivision must be between 1 and 64"), "{e}");
@@ -460,11 +484,8 @@ fn raster_bad_input_is_one_line() {
     assert!(e.contains("one sample per pixel"), "{e}");
     let e = expect_failure(&dir, &["render", "s.toml", "--subdiv", "2"]);
     assert!(e.contains("apply to --method raster"), "{e}");
-    let trilinear = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/trilinear-fan.toml");
-    let e = expect_failure(
-        &dir,
-        &["render", trilinear.to_str().unwrap(), "--method", "raster"],
-    );
+    let fan = example_scene("trilinear-fan.toml");
+    let e = expect_failure(&dir, &["render", &fan, "--method", "raster"]);
     assert!(e.contains("method raster needs a projection"), "{e}");
 }
 
@@ -477,12 +498,10 @@ fn trilinear_reflector_renders_with_its_counters() {
         "material = \"mirror\"\ntrilinear_reflector = true",
     );
     write(&dir, "r.toml", &text);
-    let out = flexcam(dir.path())
-        .args(["render", "r.toml", "--shading", "flat", "--stats", "-"])
-        .output()
-        .unwrap();
-    assert_success(&out);
-    let stats: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let stats = run_json(
+        &dir,
+        &["render", "r.toml", "--shading", "flat", "--stats", "-"],
+    );
     assert_eq!(stats["reflectors"], 1);
     assert!(
         stats["reflector_triangles"].as_u64().unwrap() > 100,
@@ -501,8 +520,7 @@ fn trilinear_reflector_errors_are_positioned() {
         "color = [1.0, 0.0, 0.0]",
         "color = [1.0, 0.0, 0.0]\ntrilinear_reflector = true",
     );
-    write(&dir, "d.toml", &text);
-    let e = expect_failure(&dir, &["render", "d.toml"]);
+    let e = render_fails(&dir, "d.toml", &text);
     assert!(
         e.contains("d.toml:23:23:") && e.contains("needs material"),
         "{e}"
@@ -513,8 +531,7 @@ fn trilinear_reflector_errors_are_positioned() {
             "material = \"mirror\"\ntrilinear_reflector = true",
         )
         .replace("type = \"perspective\"", "type = \"fisheye\"");
-    write(&dir, "f.toml", &text);
-    let e = expect_failure(&dir, &["render", "f.toml"]);
+    let e = render_fails(&dir, "f.toml", &text);
     assert!(
         e.contains("f.toml:23:23:") && e.contains("perspective"),
         "{e}"
@@ -546,19 +563,19 @@ fn animate_writes_numbered_frames_and_a_gif() {
     let dir = TempDir::new().unwrap();
     write(&dir, "a.toml", &animated_scene("1.0"));
     fs::create_dir(dir.path().join("frames")).unwrap();
-    let out = flexcam(dir.path())
-        .args([
+    run_ok(
+        &dir,
+        &[
             "animate",
             "a.toml",
             "-o",
             "frames/out_###.png",
             "--gif",
             "a.gif",
-        ])
-        .args(["--shading", "flat"])
-        .output()
-        .unwrap();
-    assert_success(&out);
+            "--shading",
+            "flat",
+        ],
+    );
     let mut names: Vec<String> = fs::read_dir(dir.path().join("frames"))
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -587,11 +604,10 @@ fn animate_writes_numbered_frames_and_a_gif() {
         "type = \"flexible\"\npreset = \"perspective\"\nclip = [0.0, 30.0]",
     );
     write(&dir, "k.toml", &single);
-    let out = flexcam(dir.path())
-        .args(["render", "k.toml", "-o", "k.png", "--shading", "flat"])
-        .output()
-        .unwrap();
-    assert_success(&out);
+    run_ok(
+        &dir,
+        &["render", "k.toml", "-o", "k.png", "--shading", "flat"],
+    );
     assert_eq!(
         image::open(dir.path().join("k.png")).unwrap().to_rgb8(),
         frame(0).to_rgb8()
@@ -611,11 +627,7 @@ fn animate_errors_are_one_line_and_write_nothing() {
         e.contains("bad.toml:") && e.contains("must be later than the key before it"),
         "{e}"
     );
-    let line = animated_scene("2.5")
-        .lines()
-        .position(|l| l == "time = 2.0")
-        .unwrap()
-        + 1;
+    let line = line_of(&animated_scene("2.5"), "time = 2.0");
     assert!(e.contains(&format!("bad.toml:{line}:8:")), "{e}");
     write(&dir, "nan.toml", &animated_scene("nan"));
     let e = expect_failure(&dir, &["animate", "nan.toml", "--gif", "a.gif"]);
@@ -636,38 +648,37 @@ fn animate_errors_are_one_line_and_write_nothing() {
 
 #[test]
 fn trilinear_method_renders_a_trilinear_scene_and_refuses_others() {
-    let fan = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/trilinear-fan.toml");
+    let fan = example_scene("trilinear-fan.toml");
     let dir = TempDir::new().unwrap();
     for curves in ["tessellate", "slice", "adaptive"] {
-        let out = flexcam(dir.path())
-            .arg("render")
-            .arg(&fan)
-            .args(["--width", "60", "--height", "40", "--shading", "flat"])
-            .args([
+        let json = run_json(
+            &dir,
+            &[
+                "render",
+                &fan,
+                "--width",
+                "60",
+                "--height",
+                "40",
+                "--shading",
+                "flat",
                 "--method",
                 "trilinear",
                 "--curves",
                 curves,
                 "--curve-steps",
                 "4",
-            ])
-            .args(["--stats", "-"])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{curves}: {}",
-            String::from_utf8_lossy(&out.stderr)
+                "--stats",
+                "-",
+            ],
         );
-        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         assert_eq!(json["method"], "trilinear");
         assert_eq!(json["curve_steps"], 4);
         assert!(json["shapes"].as_u64().unwrap() > 0, "{json}");
         assert!(json["raster_covered"].as_u64().unwrap() > 0, "{json}");
     }
     // A fresh folder: the renders above left flexcam.png, and failures must leave nothing.
-    let dir = TempDir::new().unwrap();
-    write(&dir, "s.toml", GOOD_SCENE);
+    let dir = good_scene_in("s.toml");
     let e = expect_failure(&dir, &["render", "s.toml", "--method", "trilinear"]);
     assert!(e.contains("only trilinear projections"), "{e}");
     let e = expect_failure(
@@ -715,18 +726,17 @@ fn reproject_through_an_equirectangular_camera_returns_the_photo() {
         "[image]\nwidth = 16\nheight = 8\n[projection]\ntype = \"equirectangular\"\n\
          position = [0, 0, 0]\nlook_at = [0, 0, -1]\n",
     );
-    let out = flexcam(dir.path())
-        .args([
+    run_ok(
+        &dir,
+        &[
             "reproject",
             "--input",
             "photo.png",
             "pano.toml",
             "-o",
             "out.png",
-        ])
-        .output()
-        .unwrap();
-    assert_success(&out);
+        ],
+    );
     let got = image::open(dir.path().join("out.png")).unwrap().to_rgb8();
     let want = image::open(dir.path().join("photo.png")).unwrap().to_rgb8();
     assert_eq!(got.dimensions(), (16, 8));
@@ -742,72 +752,64 @@ fn reproject_through_an_equirectangular_camera_returns_the_photo() {
 
 #[test]
 fn reproject_errors_are_one_line() {
-    let dir = TempDir::new().unwrap();
-    write(&dir, "scene.toml", GOOD_SCENE);
-    let missing = expect_failure(
-        &dir,
-        &[
-            "reproject",
-            "--input",
-            "none.png",
-            "scene.toml",
-            "-o",
-            "o.png",
-        ],
-    );
+    let dir = good_scene_in("scene.toml");
+    let reproject = |input: &str, output: &str| {
+        expect_failure(
+            &dir,
+            &["reproject", "--input", input, "scene.toml", "-o", output],
+        )
+    };
+    let missing = reproject("none.png", "o.png");
     assert!(
         missing.starts_with("flexcam: none.png: cannot read image"),
         "{missing}"
     );
-    let format = expect_failure(
-        &dir,
-        &[
-            "reproject",
-            "--input",
-            "photo.tif",
-            "scene.toml",
-            "-o",
-            "o.png",
-        ],
-    );
+    let format = reproject("photo.tif", "o.png");
     assert!(
         format.contains("photo.tif: unsupported input format \"tif\""),
         "{format}"
     );
     // A zero image size fails in one line and writes nothing.
-    let photo_dir = TempDir::new().unwrap();
+    let photo_dir = good_scene_in("scene.toml");
     write_photo(&photo_dir, "p.png");
-    write(&photo_dir, "scene.toml", GOOD_SCENE);
-    let out = flexcam(photo_dir.path())
-        .args([
-            "reproject",
-            "--input",
-            "p.png",
-            "scene.toml",
-            "-o",
-            "o.png",
-            "--width",
-            "0",
-        ])
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8(out.stderr).unwrap();
-    assert!(
-        !out.status.success() && stderr.trim_end().lines().count() == 1,
-        "{stderr}"
-    );
-    assert!(stderr.contains("width"), "{stderr}");
+    let args = [
+        "reproject",
+        "--input",
+        "p.png",
+        "scene.toml",
+        "-o",
+        "o.png",
+        "--width",
+        "0",
+    ];
+    let e = error_line(run(&photo_dir, &args), &args);
+    assert!(e.contains("width"), "{e}");
     assert!(!photo_dir.path().join("o.png").exists());
-    let output = expect_failure(
-        &dir,
-        &[
-            "reproject",
-            "--input",
-            "none.png",
-            "scene.toml",
-            "-o",
-            "o.jpg",
-        ],
-    );
+    let output = reproject("none.png", "o.jpg");
     assert!(output.contains("unsupported output extension"), "{output}");
+}
+
+/// `bench trilinear --quick` with one timed render per cell prints both of seed 000's tables
+/// with a row per cell of the quick subset; an out-of-range `--repeat` is one error line.
+#[test]
+fn bench_trilinear_quick_prints_both_tables() {
+    let dir = TempDir::new().unwrap();
+    let out = run_ok(&dir, &["bench", "trilinear", "--quick", "--repeat", "1"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    let (random, cube) = text.split_once("Table 8.1").expect("Table 8.1 is printed");
+    assert!(random.contains("Tables D.1-D.3"), "{text}");
+    // A row starts with a number: its first cell.
+    let rows = |table: &str| -> Vec<String> {
+        table
+            .lines()
+            .filter_map(|l| l.split_whitespace().next())
+            .filter(|cell| cell.parse::<f64>().is_ok())
+            .map(String::from)
+            .collect()
+    };
+    // 2 image sizes x 2 scene sizes x 3 projection meshes, then the thesis's 5 rows.
+    assert_eq!(rows(random).len(), 12 + 5, "{text}");
+    assert_eq!(rows(cube), ["2", "18", "50"], "{text}");
+    let e = expect_failure(&dir, &["bench", "trilinear", "--quick", "--repeat", "0"]);
+    assert!(e.contains("--repeat"), "{e}");
 }
