@@ -1,5 +1,6 @@
 //! The scene's triangles in one flat f64 list, numbered like the ray caster's BVH (objects in
-//! order, each object's triangles in order), with the owner of each.
+//! order, each object's triangles in order), with the owner of each and the triangles that
+//! meet at each edge.
 
 use std::collections::HashMap;
 
@@ -32,8 +33,66 @@ pub struct SceneGeometry {
     /// shares (same end positions, any object): the surface continues across them.
     pub shared_edges: Vec<u8>,
     /// Per triangle and edge `<V1V2, V1V3, V2V3>`, a triangle across it ([`NO_NEIGHBOUR`]
-    /// where none shares the edge; where several do, the first in triangle order).
+    /// where none shares the edge; where several do, the first in triangle order, and
+    /// [`SceneGeometry::across`] lists them all).
     pub neighbours: Vec<[u32; 3]>,
+    /// Per triangle, the numbers of its edges `<V1V2, V1V3, V2V3>` in `edge_users`.
+    edges: Vec<[u32; 3]>,
+    /// The triangles using each edge.
+    edge_users: EdgeUsers,
+}
+
+/// The triangles using each edge (by end positions), in triangle order, all lists in one
+/// vector: edge `e`'s are `users[start[e]..start[e + 1]]`. A triangle is listed once for
+/// each of its edges that is this edge (twice where two of its edges coincide: a degenerate
+/// triangle).
+#[derive(Debug, Clone, Default)]
+struct EdgeUsers {
+    start: Vec<u32>,
+    users: Vec<u32>,
+}
+
+impl EdgeUsers {
+    /// Numbers the edges of `triangles` (given by their corners) in order of first use;
+    /// returns the users of every edge and, per triangle, the numbers of its edges
+    /// `<V1V2, V1V3, V2V3>`.
+    fn new(triangles: impl Iterator<Item = [DVec3; 3]>) -> (EdgeUsers, Vec<[u32; 3]>) {
+        let mut numbers: HashMap<[u64; 6], u32> = HashMap::new();
+        let mut counts: Vec<u32> = Vec::new();
+        let edges: Vec<[u32; 3]> = triangles
+            .map(|c| {
+                EDGES.map(|(i, j)| {
+                    let next = numbers.len() as u32;
+                    let edge = *numbers.entry(edge_key(c[i], c[j])).or_insert(next);
+                    if edge == next {
+                        counts.push(0);
+                    }
+                    counts[edge as usize] += 1;
+                    edge
+                })
+            })
+            .collect();
+        let mut start = Vec::with_capacity(counts.len() + 1);
+        start.push(0);
+        for count in counts {
+            start.push(start[start.len() - 1] + count);
+        }
+        let mut free = start.clone();
+        let mut users = vec![0; start[start.len() - 1] as usize];
+        for (k, triangle_edges) in edges.iter().enumerate() {
+            for &edge in triangle_edges {
+                users[free[edge as usize] as usize] = k as u32;
+                free[edge as usize] += 1;
+            }
+        }
+        (EdgeUsers { start, users }, edges)
+    }
+
+    /// The users of edge `edge`, in triangle order.
+    fn of(&self, edge: u32) -> &[u32] {
+        let e = edge as usize;
+        &self.users[self.start[e] as usize..self.start[e + 1] as usize]
+    }
 }
 
 /// The entry of [`SceneGeometry::neighbours`] for an edge no other triangle shares.
@@ -67,31 +126,14 @@ impl SceneGeometry {
                 });
             }
         }
-        // The first two triangles using each edge.
-        let mut users: HashMap<[u64; 6], [u32; 2]> = HashMap::new();
-        for k in 0..out.triangles.len() {
-            let c = out.corners(k);
-            for (i, j) in EDGES {
-                let entry = users
-                    .entry(edge_key(c[i], c[j]))
-                    .or_insert([NO_NEIGHBOUR; 2]);
-                if entry[0] == NO_NEIGHBOUR {
-                    entry[0] = k as u32;
-                } else if entry[1] == NO_NEIGHBOUR {
-                    entry[1] = k as u32;
-                }
-            }
-        }
+        (out.edge_users, out.edges) =
+            EdgeUsers::new((0..out.triangles.len()).map(|k| out.corners(k)));
         out.neighbours = (0..out.triangles.len())
             .map(|k| {
-                let c = out.corners(k);
-                EDGES.map(|(i, j)| {
-                    let [a, b] = users[&edge_key(c[i], c[j])];
-                    if a == k as u32 {
-                        b
-                    } else {
-                        a
-                    }
+                [0, 1, 2].map(|edge| {
+                    out.across(k, edge)
+                        .next()
+                        .map_or(NO_NEIGHBOUR, |n| n as u32)
                 })
             })
             .collect();
@@ -107,8 +149,107 @@ impl SceneGeometry {
         out
     }
 
+    /// Every triangle across edge `edge` (0, 1, 2 for `<V1V2, V1V3, V2V3>`) of triangle `k`,
+    /// in triangle order: none on a boundary, one inside a manifold surface, several where
+    /// three or more triangles meet at the edge (non-manifold). These are the edge's users
+    /// but for this use of it, so a degenerate triangle with two coinciding edges is across
+    /// itself.
+    pub fn across(&self, k: usize, edge: usize) -> impl Iterator<Item = usize> + '_ {
+        let users = self.edge_users.of(self.edges[k][edge]);
+        let own = users.iter().position(|&n| n as usize == k);
+        users
+            .iter()
+            .enumerate()
+            .filter(move |&(i, _)| Some(i) != own)
+            .map(|(_, &n)| n as usize)
+    }
+
     /// The vertices of triangle `k`.
     pub fn corners(&self, k: usize) -> [DVec3; 3] {
         self.triangles[k].map(|i| self.vertices[i as usize])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Affine3A, Vec3};
+
+    use super::*;
+    use crate::scene::{self, Material, Mesh, Object};
+
+    /// A scene of one object per entry of `objects`, each a list of triangles by corners.
+    fn scene_of(objects: &[&[[Vec3; 3]]]) -> Scene {
+        let mut scene = scene::load("builtin:cube-floor").unwrap();
+        scene.objects = objects
+            .iter()
+            .enumerate()
+            .map(|(index, triangles)| {
+                let mut mesh = Mesh::default();
+                for (k, corners) in triangles.iter().enumerate() {
+                    mesh.positions.extend(corners);
+                    let first = 3 * k as u32;
+                    mesh.triangles.push([first, first + 1, first + 2]);
+                }
+                Object {
+                    id: index as u32 + 1,
+                    name: format!("o{index}"),
+                    mesh,
+                    material: Material::default(),
+                    world_to_object: Affine3A::IDENTITY,
+                }
+            })
+            .collect();
+        scene
+    }
+
+    fn across(geometry: &SceneGeometry, k: usize, edge: usize) -> Vec<usize> {
+        geometry.across(k, edge).collect()
+    }
+
+    /// Three triangles meeting at the edge from the origin to +x (a fin: not a manifold
+    /// surface), the third in another object: each edge user has the two others across it,
+    /// in triangle order; `neighbours` keeps the first; the outer edges have none.
+    #[test]
+    fn a_non_manifold_edge_lists_every_triangle_across_it() {
+        let (o, x) = (Vec3::ZERO, Vec3::X);
+        let scene = scene_of(&[&[[o, x, Vec3::Y], [x, o, Vec3::NEG_Y]], &[[o, x, Vec3::Z]]]);
+        let geometry = SceneGeometry::new(&scene);
+        // The shared edge is V1V2 (edge 0) of every triangle.
+        assert_eq!(across(&geometry, 0, 0), [1, 2]);
+        assert_eq!(across(&geometry, 1, 0), [0, 2]);
+        assert_eq!(across(&geometry, 2, 0), [0, 1]);
+        assert_eq!(
+            geometry.neighbours,
+            [
+                [1, NO_NEIGHBOUR, NO_NEIGHBOUR],
+                [0, NO_NEIGHBOUR, NO_NEIGHBOUR],
+                [0, NO_NEIGHBOUR, NO_NEIGHBOUR]
+            ]
+        );
+        assert_eq!(geometry.shared_edges, [0b001; 3]);
+        for k in 0..3 {
+            for edge in [1, 2] {
+                assert_eq!(across(&geometry, k, edge), Vec::<usize>::new());
+            }
+        }
+        assert_eq!(geometry.owners[2].id, 2);
+    }
+
+    /// Two triangles of a square share its diagonal (V1V3 of the first, V1V2 of the
+    /// second) and nothing else; a degenerate triangle whose edges V1V3 and V2V3 coincide
+    /// (V1 = V2) is across itself there, and its V1V2, of zero length, has nothing across.
+    #[test]
+    fn manifold_and_degenerate_edges() {
+        let (a, b, c, d) = (Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), Vec3::Y);
+        let e = Vec3::new(5.0, 0.0, 0.0);
+        let scene = scene_of(&[&[[a, b, c], [a, c, d], [e, e, b]]]);
+        let geometry = SceneGeometry::new(&scene);
+        assert_eq!(across(&geometry, 0, 1), [1]);
+        assert_eq!(across(&geometry, 1, 0), [0]);
+        assert_eq!(geometry.shared_edges[..2], [0b010, 0b001]);
+        assert_eq!(across(&geometry, 2, 0), Vec::<usize>::new());
+        assert_eq!(across(&geometry, 2, 1), [2]);
+        assert_eq!(across(&geometry, 2, 2), [2]);
+        assert_eq!(geometry.neighbours[2], [NO_NEIGHBOUR, 2, 2]);
     }
 }
