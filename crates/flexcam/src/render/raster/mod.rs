@@ -35,7 +35,7 @@ pub use scan::FillRule;
 pub use stats::RasterStats;
 
 use stats::FragmentCounts;
-pub use target::{Fragment, Target};
+pub use target::{Fragment, Layers, Target, NO_PRIMITIVE};
 
 use polygon::Kind;
 use scan::Scratch;

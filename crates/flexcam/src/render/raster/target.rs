@@ -19,7 +19,19 @@ pub struct Fragment<const N: usize> {
 }
 
 /// No primitive: the key of an empty pixel, beaten by any fragment.
-const NO_PRIMITIVE: u64 = u64::MAX;
+pub const NO_PRIMITIVE: u64 = u64::MAX;
+
+/// A drawn target taken apart for a deferred shading pass, which overwrites the frame in
+/// place (no second image allocated) while it reads each pixel's depth and key.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Layers {
+    /// Colour, depth rounded to `f32`, object ids.
+    pub frame: Frame,
+    /// Row-major depths in full precision; `f64::INFINITY` where nothing was drawn.
+    pub depth: Vec<f64>,
+    /// Row-major winning primitive keys; [`NO_PRIMITIVE`] where nothing was drawn.
+    pub primitives: Vec<u64>,
+}
 
 /// A framebuffer with an `f64` z-buffer and, per pixel, the primitive key that won it.
 #[derive(Debug, Clone, PartialEq)]
@@ -86,12 +98,22 @@ impl Target {
 
     /// The image as a [`Frame`] (depth rounded to `f32`).
     pub fn into_frame(self) -> Frame {
-        Frame {
+        self.into_layers().frame
+    }
+
+    /// The image as a [`Frame`], with the full-precision depths and the primitive keys.
+    pub fn into_layers(self) -> Layers {
+        let frame = Frame {
             width: self.width,
             height: self.height,
             color: self.color,
-            depth: self.depth.into_iter().map(|d| d as f32).collect(),
+            depth: self.depth.iter().map(|&d| d as f32).collect(),
             ids: self.ids,
+        };
+        Layers {
+            frame,
+            depth: self.depth,
+            primitives: self.primitives,
         }
     }
 

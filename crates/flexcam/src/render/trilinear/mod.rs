@@ -8,9 +8,11 @@
 //! shapes (`projection::project_solved_triangle`), each shape's curved edges are sampled along
 //! the exact images of their scene edges ([`edge_path`], [`outline`], by the [`curves`]
 //! mode), with exact anchors at the view plane and at the projection triangle's edge surfaces,
-//! and the outline is clipped ([`clip`]) and mapped to pixels ([`screen_map`]). All polygons
-//! are then rasterised (`render::raster`, non-zero fill, z-buffer), every fragment refined
-//! to its exact hit before its z-test, and each pixel's winner shaded once ([`shade`]).
+//! and the outline is clipped ([`clip`]) and mapped to pixels ([`screen_map`]), each vertex
+//! carrying the terms of its projector's hit with the scene triangle's plane that are affine
+//! in pixel position ([`hit_terms`]). All polygons are then rasterised (`render::raster`,
+//! non-zero fill, z-buffer), every fragment finished to its exact hit from its interpolated
+//! terms before its z-test, and each pixel's winner shaded once ([`shade`]).
 //!
 //! Unprojectable pairs (see `projection::Unprojectable`) are counted and their projection
 //! triangle is ray cast instead, so they never silently vanish.
@@ -18,6 +20,7 @@
 pub mod clip;
 pub mod curves;
 pub mod edge_path;
+pub mod hit_terms;
 pub mod outline;
 pub mod polygons;
 pub mod scene_geometry;
@@ -39,7 +42,7 @@ use self::outline::ProjectionTriangle;
 use self::polygons::{project_scene, PairCounts};
 use self::scene_geometry::SceneGeometry;
 use self::screen_map::ScreenMap;
-use self::shade::{Resolver, ShadeCounts, Shader};
+use self::shade::{stored_barycentrics, Resolver, ShadeCounts, Shader};
 use crate::error::{Error, Result};
 use crate::projection::{Projection, Trilinear};
 use crate::render::raster::{
@@ -146,7 +149,7 @@ impl TrilinearRenderer {
                 FillRule::NonZero,
                 BAND_ROWS,
                 &|f| resolver.stage(f),
-                &|_| Vec3::ZERO,
+                &stored_barycentrics,
             ));
             let rasterised = pass.elapsed().as_secs_f64() * 1e3;
             raster_ms += rasterised;
@@ -159,7 +162,7 @@ impl TrilinearRenderer {
                 fallback: &fallback,
                 background: self.background,
             };
-            let (frame, counts) = shader.frame(&target);
+            let (frame, counts) = shader.frame(target);
             samples.add(frame, counts);
             shade_ms += pass.elapsed().as_secs_f64() * 1e3 - rasterised;
         }
@@ -188,6 +191,8 @@ impl TrilinearRenderer {
 /// The frames of the samples of one render, reduced as the ray caster reduces its samples:
 /// colours averaged, depth and id of the sample nearest the pixel centre.
 struct Samples {
+    /// The sum of the samples' colours; empty with one sample per pixel, whose frame is
+    /// kept whole.
     color: Vec<Vec3>,
     count: u32,
     centre: usize,
@@ -198,8 +203,13 @@ struct Samples {
 
 impl Samples {
     fn new(width: u32, height: u32, pattern: &SamplePattern) -> Samples {
+        let summed = if pattern.offsets.len() > 1 {
+            width as usize * height as usize
+        } else {
+            0
+        };
         Samples {
-            color: vec![Vec3::ZERO; width as usize * height as usize],
+            color: vec![Vec3::ZERO; summed],
             count: 0,
             centre: pattern.centre,
             kept: None,

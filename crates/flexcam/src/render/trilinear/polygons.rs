@@ -8,6 +8,7 @@ use glam::DVec3;
 use super::clip::clip_outline;
 use super::curves::{CurveMode, CurveOptions, ADAPTIVE_TOLERANCE_PX};
 use super::edge_path::{EdgePath, OutlinePoint};
+use super::hit_terms::{HitTerms, TERMS};
 use super::outline::{slice_depths, trace_outline, ProjectionTriangle, Sampling};
 use super::scene_geometry::SceneGeometry;
 use crate::projection::{project_solved_triangle, Shape, Solutions};
@@ -29,6 +30,8 @@ pub struct PairCounts {
     /// Pairs culled because every vertex image is outside one domain line and no scene
     /// edge crosses that line's edge surface.
     pub culled_outside: u64,
+    /// Pairs skipped because the scene triangle has zero area: no plane, nothing to draw.
+    pub culled_zero_area: u64,
     /// Pairs (or tessellated sub-triangles) that could not be cut into shapes; their
     /// projection triangle is ray cast instead.
     pub unprojectable: u64,
@@ -47,6 +50,7 @@ impl PairCounts {
         self.culled_volume += o.culled_volume;
         self.culled_behind += o.culled_behind;
         self.culled_outside += o.culled_outside;
+        self.culled_zero_area += o.culled_zero_area;
         self.unprojectable += o.unprojectable;
         self.shapes += o.shapes;
         self.clipped_away += o.clipped_away;
@@ -61,6 +65,7 @@ impl PairCounts {
             ("culled_volume", self.culled_volume),
             ("culled_behind", self.culled_behind),
             ("culled_outside", self.culled_outside),
+            ("culled_zero_area", self.culled_zero_area),
             ("unprojectable", self.unprojectable),
             ("shapes", self.shapes),
             ("clipped_away", self.clipped_away),
@@ -71,10 +76,11 @@ impl PairCounts {
     }
 }
 
-/// The result for one projection triangle.
+/// The result for one projection triangle: polygons whose vertices carry the scene
+/// triangle's hit terms (`hit_terms`), and what was done.
 #[derive(Debug, Clone, Default)]
 pub struct Projected {
-    pub polygons: PolygonBatch<0>,
+    pub polygons: PolygonBatch<TERMS>,
     pub counts: PairCounts,
 }
 
@@ -90,7 +96,7 @@ struct Scratch {
     outline: Vec<OutlinePoint>,
     clipped: Vec<OutlinePoint>,
     slices: Vec<f64>,
-    pixels: Vec<Vertex<0>>,
+    pixels: Vec<Vertex<TERMS>>,
     grid: Vec<DVec3>,
     grid_solutions: Vec<Solutions>,
 }
@@ -124,6 +130,10 @@ pub fn project_scene(
             continue;
         }
         let positions = scene.corners(k);
+        let Some(terms) = HitTerms::new(positions) else {
+            out.counts.culled_zero_area += 1;
+            continue;
+        };
         let solved = corners.map(|i| {
             *solutions[i as usize].get_or_insert_with(|| {
                 out.counts.vertices_projected += 1;
@@ -141,6 +151,7 @@ pub fn project_scene(
                     key,
                     id,
                     curves,
+                    terms,
                 };
                 if curves.mode == CurveMode::Tessellate {
                     pair.tessellated(positions, &mut out, &mut scratch);
@@ -199,6 +210,8 @@ struct Pair<'a> {
     key: u64,
     id: u32,
     curves: CurveOptions,
+    /// The scene triangle's plane (of the whole triangle, also for tessellated pieces).
+    terms: HitTerms,
 }
 
 impl Pair<'_> {
@@ -275,7 +288,7 @@ impl Pair<'_> {
         }
     }
 
-    /// Traces, clips and appends one shape.
+    /// Traces, clips and appends one shape, each vertex with the hit terms of its projector.
     fn draw_shape(
         &self,
         shape: &Shape,
@@ -295,9 +308,10 @@ impl Pair<'_> {
         }
         out.counts.outline_points += scratch.outline.len() as u64;
         scratch.pixels.clear();
+        let cache = self.triangle.map.cache();
         scratch.pixels.extend(scratch.outline.iter().map(|p| {
             let pixel = self.triangle.map.pixel(p.u, p.v);
-            Vertex::new(pixel.x, pixel.y, p.t, [])
+            Vertex::new(pixel.x, pixel.y, p.t, self.terms.at(cache, p.u, p.v))
         }));
         out.polygons.push(&scratch.pixels, self.id, self.key);
     }

@@ -4,7 +4,11 @@
 //! A fragment's key names its projection triangle and scene triangle. Its depth and scene
 //! barycentrics are not interpolated over the polygon (the map from screen to scene is not
 //! affine, so interpolation would be wrong inside every curved shape): the pixel sample's
-//! projector is intersected with the scene triangle's plane, in f64 ([`Resolver::hit`]).
+//! projector is intersected with the scene triangle's plane, in f64. The polygon's vertices
+//! carry the terms of that intersection that are affine in pixel position ([`super::hit_terms`]),
+//! so the rasteriser hands each fragment the terms of its own projector and the stage finishes
+//! the hit with a division. Only a fragment outside its own triangle takes the general path,
+//! which builds the projector and intersects it with the neighbours ([`Resolver::hit`]).
 //!
 //! - Inside the triangle at `t >= 0`: an **exact** fragment; the z-test compares exact ray
 //!   parameters `t`, and the frame's depth is `t |trinorm|`, the distance the ray caster
@@ -24,8 +28,12 @@
 //!   same object) won it: 4 such pixels in scenes/trilinear-fan.toml.
 //! - Behind the view plane, or a projector parallel to the plane: discarded.
 //!
-//! Shading is deferred to one pass over the pixels, so that each pixel is shaded once: the
-//! hit is handed to [`RayCaster::shade_hit`], which shades it exactly as the ray caster
+//! Shading is deferred to one pass over the pixels, so that each pixel is shaded once. The
+//! rasteriser's target is the G-buffer: its depth is the winner's exact `t`, its key the
+//! triangle hit, and its colour channel holds the winner's scene barycentrics
+//! ([`stored_barycentrics`]), so an exact winner is shaded without intersecting again (a
+//! crack filler, whose depth was pushed back, is resolved again). The hit is handed to
+//! [`RayCaster::shade_hit`], which shades it exactly as the ray caster
 //! does (flat: base colour, mirrors and glass passing the ray on; lit: lights, hard shadows,
 //! reflection and refraction, all traced by the ray caster from the rasterised first hit).
 //! Pixels of projection triangles with an unprojectable pair are ray cast entirely.
@@ -33,11 +41,12 @@
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 
+use super::hit_terms::{self, TERMS};
 use super::scene_geometry::SceneGeometry;
 use super::screen_map::ScreenMap;
 use crate::geometry::Ray;
 use crate::projection::{Projection, Trilinear};
-use crate::render::raster::{Fragment, Target};
+use crate::render::raster::{Fragment, Layers, Target, NO_PRIMITIVE};
 use crate::render::raycast::{Hit, RayCaster};
 use crate::render::{Frame, RenderOptions};
 
@@ -124,23 +133,42 @@ impl Resolver<'_> {
         })
     }
 
-    /// The stage of the rasteriser: the fragment's depth, or `false` to discard it.
-    pub fn stage(&self, fragment: &mut Fragment<0>) -> bool {
-        let at = self.position(fragment.x, fragment.y);
-        match self.hit(fragment.primitive, at) {
-            Some(hit) => {
-                let behind = if hit.exact { 0.0 } else { CRACK_FILL_DEPTH };
-                fragment.varying.depth = hit.t + behind;
-                if hit.key != fragment.primitive {
-                    fragment.primitive = hit.key;
-                    fragment.object =
-                        self.scene.owners[(hit.key & u64::from(u32::MAX)) as usize].id;
-                }
-                true
+    /// The stage of the rasteriser: the fragment's depth (the exact `t`, pushed back for a
+    /// crack filler), key and object of the triangle hit, and in its first two attributes
+    /// the hit's barycentrics ([`stored_barycentrics`]); or `false` to discard it. The
+    /// fragment's attributes are the hit terms of its own triangle at its projector.
+    pub fn stage(&self, fragment: &mut Fragment<TERMS>) -> bool {
+        let (key, t, barycentric, exact) = match hit_terms::hit(&fragment.varying.attributes) {
+            None => return false,
+            Some((t, _, _)) if t < 0.0 => return false,
+            Some((t, u, v)) if outside_edges(u, v) == 0 => {
+                (fragment.primitive, t, DVec2::new(u, v), true)
             }
-            None => false,
+            Some(_) => {
+                let at = self.position(fragment.x, fragment.y);
+                match self.hit(fragment.primitive, at) {
+                    Some(hit) => (hit.key, hit.t, hit.barycentric, hit.exact),
+                    None => return false,
+                }
+            }
+        };
+        let behind = if exact { 0.0 } else { CRACK_FILL_DEPTH };
+        fragment.varying.depth = t + behind;
+        fragment.varying.attributes[0] = barycentric.x;
+        fragment.varying.attributes[1] = barycentric.y;
+        if key != fragment.primitive {
+            fragment.primitive = key;
+            fragment.object = self.scene.owners[(key & u64::from(u32::MAX)) as usize].id;
         }
+        true
     }
+}
+
+/// The rasteriser's "shader": a staged fragment's scene barycentrics, kept in the target's
+/// colour channel for the shading pass (f32, the precision `Hit` carries).
+pub fn stored_barycentrics(fragment: &Fragment<TERMS>) -> Vec3 {
+    let [u, v] = [0, 1].map(|i| fragment.varying.attributes[i] as f32);
+    Vec3::new(u, v, 0.0)
 }
 
 /// Where `ray` meets the plane of triangle `[a, b, c]`: `(t, u, v)` with `u`, `v` the
@@ -205,6 +233,7 @@ pub struct Shader<'a> {
 }
 
 /// One pixel's output.
+#[derive(Clone, Copy)]
 struct Pixel {
     color: Vec3,
     depth: f32,
@@ -213,31 +242,49 @@ struct Pixel {
 }
 
 impl Shader<'_> {
-    /// Shades every pixel of `target` into a frame, rows in parallel.
-    pub fn frame(&self, target: &Target) -> (Frame, ShadeCounts) {
-        let (width, height) = (target.width(), target.height());
-        let mut frame = Frame::new(width, height, self.background);
+    /// Shades every pixel of the drawn G-buffer `target` into a frame, rows in parallel. The
+    /// frame is the target's own (colour overwritten in place).
+    pub fn frame(&self, target: Target) -> (Frame, ShadeCounts) {
+        let width = target.width();
+        let Layers {
+            mut frame,
+            depth: gdepth,
+            primitives,
+        } = target.into_layers();
         let any_fallback = self.fallback.iter().any(|&f| f);
         let row = width as usize;
+        let empty = Pixel {
+            color: self.background,
+            depth: f32::INFINITY,
+            id: 0,
+            counts: ShadeCounts::default(),
+        };
         let counts = frame
             .color
             .par_chunks_mut(row)
             .zip(frame.depth.par_chunks_mut(row))
             .zip(frame.ids.par_chunks_mut(row))
+            .zip(gdepth.par_chunks(row).zip(primitives.par_chunks(row)))
             .enumerate()
-            .map(|(y, ((color, depth), ids))| {
+            .map(|(y, (((color, depth), ids), (gdepth, keys)))| {
                 let mut counts = ShadeCounts::default();
+                let y = y as u32;
                 for x in 0..width {
-                    let pixel = if any_fallback && self.in_fallback(x, y as u32) {
-                        self.cast(x, y as u32)
-                    } else {
-                        self.rasterised(target, x, y as u32)
-                    };
-                    if let Some(p) = pixel {
-                        let i = x as usize;
-                        (color[i], depth[i], ids[i]) = (p.color, p.depth, p.id);
-                        counts = counts.plus(p.counts);
+                    let i = x as usize;
+                    let key = keys[i];
+                    if key == NO_PRIMITIVE && !any_fallback {
+                        continue; // already the background
                     }
+                    let pixel = if any_fallback && self.in_fallback(x, y) {
+                        self.cast(x, y)
+                    } else if key == NO_PRIMITIVE {
+                        None
+                    } else {
+                        self.rasterised(key, gdepth[i], color[i], x, y)
+                    };
+                    let p = pixel.unwrap_or(empty);
+                    (color[i], depth[i], ids[i]) = (p.color, p.depth, p.id);
+                    counts = counts.plus(p.counts);
                 }
                 counts
             })
@@ -251,10 +298,22 @@ impl Shader<'_> {
             .is_some_and(|(triangle, _, _)| self.fallback[triangle])
     }
 
-    /// The pixel's winning fragment, shaded; `None` where nothing was drawn.
-    fn rasterised(&self, target: &Target, x: u32, y: u32) -> Option<Pixel> {
-        let key = target.primitive(x, y)?;
-        let found = self.resolver.hit(key, self.resolver.position(x, y))?;
+    /// Pixel `(x, y)`'s winning fragment (`key`, G-buffer depth and stored barycentrics),
+    /// shaded. An exact winner is read from the G-buffer (module doc); a crack filler is
+    /// resolved again. `None` where there is no hit after all (no projector).
+    fn rasterised(&self, key: u64, depth: f64, stored: Vec3, x: u32, y: u32) -> Option<Pixel> {
+        let position = self.resolver.position(x, y);
+        let found = if depth < CRACK_FILL_DEPTH {
+            FragmentHit {
+                ray: self.resolver.maps[(key >> 32) as usize].ray(position)?,
+                key,
+                t: depth,
+                barycentric: DVec2::new(f64::from(stored.x), f64::from(stored.y)),
+                exact: true,
+            }
+        } else {
+            self.resolver.hit(key, position)?
+        };
         let ray = found.ray;
         let owner = self.resolver.scene.owners[(found.key & u64::from(u32::MAX)) as usize];
         let hit = Hit {
