@@ -25,8 +25,8 @@
 //! pixel (`--spp 1`).
 //!
 //! An [`InverseRaster`] is meant to render many frames of one projection (an animation of
-//! the scene, an interactive viewer): the pixel projectors and the BVH are kept between
-//! frames.
+//! the scene, an interactive viewer): the pixel projectors, the BVH and the z-buffered target
+//! are kept between frames, and [`InverseRaster::render_into`] reuses the caller's frame.
 //!
 //! Supported: every projection with an [`InverseChart`] (perspective, orthographic,
 //! fisheye, equirectangular, cylindrical, and the flexible volumes described in
