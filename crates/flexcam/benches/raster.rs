@@ -1,41 +1,23 @@
 //! Panorama rasterisation throughput (`--method raster`) against the ray caster in the same
-//! run: `teapot-dense` (123,554 triangles) as a 1280 x 720 equirectangular (360 x 180)
-//! panorama from the scene's own camera position, flat shading. Throughput is frames per
-//! second. `raster_first_frame` is a new renderer and its first frame (the pixel projectors
-//! it needs are computed during the frame); `raster_frame` is a later frame of the same
-//! renderer (projectors kept, as the BVH is built once per scene); `raycast_frame` is one
-//! ray-cast frame with the BVH prebuilt. `flexcam bench flexible --part panorama` prints the
-//! same measurements as a table.
+//! run, on the workload of `render::inverse_raster::workloads` (`teapot-dense`, 123,554
+//! triangles, as a 1280 x 720 equirectangular panorama), flat shading. Throughput is frames
+//! per second. `raster_first_frame` is a new renderer and its first frame (the pixel
+//! projectors it needs are computed during the frame); `raster_frame` is a later frame of
+//! the same renderer into the same frame buffers (projectors and buffers kept, as the BVH is
+//! built once per scene); `raycast_frame` is one ray-cast frame with the BVH prebuilt.
+//! `flexcam bench flexible --part panorama` prints the same measurements as a table.
 //!
 //! Run with `cargo bench -p flexcam --bench raster`. Figures are recorded in docs/raster.md.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use flexcam::projection::ProjectionSpec;
+use flexcam::render::inverse_raster::workloads::{teapot_dense_panorama, PanoramaWorkload};
 use flexcam::render::inverse_raster::InverseRaster;
 use flexcam::render::raycast::RayCaster;
 use flexcam::render::{RenderOptions, Shading};
-use flexcam::scene::builtin;
-
-const WIDTH: u32 = 1280;
-const HEIGHT: u32 = 720;
 
 fn panorama(c: &mut Criterion) {
-    let scene = builtin::load("teapot-dense").unwrap_or_else(|e| panic!("teapot-dense: {e}"));
-    let frame = match &scene.projection {
-        ProjectionSpec::Perspective { frame, .. } => *frame,
-        other => panic!(
-            "teapot-dense should have a perspective camera, not {}",
-            other.kind()
-        ),
-    };
-    let spec = ProjectionSpec::Equirectangular {
-        frame,
-        h_fov: 360.0,
-        v_fov: 180.0,
-    };
-    let projection = spec
-        .build(WIDTH, HEIGHT)
-        .unwrap_or_else(|e| panic!("equirectangular: {e}"));
+    let PanoramaWorkload { scene, projection } =
+        teapot_dense_panorama().unwrap_or_else(|e| panic!("panorama workload: {e}"));
     let options = RenderOptions {
         shading: Shading::Flat,
         ..RenderOptions::default()
@@ -45,7 +27,10 @@ fn panorama(c: &mut Criterion) {
     group.throughput(Throughput::Elements(1));
     let raster = InverseRaster::new(&scene, projection.as_ref(), &options)
         .unwrap_or_else(|e| panic!("raster: {e}"));
-    group.bench_function("raster_frame", |b| b.iter(|| raster.render()));
+    let mut frame = raster.render().0;
+    group.bench_function("raster_frame", |b| {
+        b.iter(|| raster.render_into(&mut frame))
+    });
     group.bench_function("raster_first_frame", |b| {
         b.iter(|| {
             InverseRaster::new(&scene, projection.as_ref(), &options).map(|fresh| fresh.render())

@@ -10,19 +10,23 @@
 //! box; the polylines are the quadratic sampled at equal steps in t.
 //!
 //! The second table is item 9's panorama throughput: `builtin:teapot-dense` (123,554
-//! triangles) as a 1280 x 720 equirectangular panorama from the scene's camera, flat shading,
-//! by `--method raster` (the first frame of a new renderer, and a later frame of the same
-//! one, whose pixel projectors are then ready) and by the ray caster in the same run.
+//! triangles) as a 1280 x 720 equirectangular panorama from the scene's camera, by
+//! `--method raster` (the first frame of a new renderer; later frames of the same one,
+//! whose pixel projectors and buffers are then ready, with flat and with lit shading) and
+//! by the ray caster in the same run.
 
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use flexcam::projection::flexible::{Blend, Flexible, FlexibleSpec, Surface, VolumeSource};
-use flexcam::projection::{Projection, ProjectionSpec};
+use flexcam::projection::Projection;
+use flexcam::render::inverse_raster::workloads::{
+    teapot_dense_panorama, PanoramaWorkload, PANORAMA_SIZE,
+};
 use flexcam::render::inverse_raster::InverseRaster;
 use flexcam::render::raycast::RayCaster;
 use flexcam::render::{RenderOptions, Shading};
-use flexcam::scene::{builtin, shapes, ImageSettings, Material, Mesh, Object, Scene};
+use flexcam::scene::{shapes, ImageSettings, Material, Mesh, Object, Scene};
 use flexcam::{Error, Result};
 use glam::{Affine3A, DVec3, Vec3};
 
@@ -83,9 +87,6 @@ pub enum Part {
     /// The panorama throughput only.
     Panorama,
 }
-
-/// The panorama table's image size.
-const PANORAMA: (u32, u32) = (1280, 720);
 
 /// The projector kinds of the table's columns: `None` is the analytic quadratic.
 const COLUMNS: [Option<u32>; 6] = [None, Some(2), Some(3), Some(4), Some(5), Some(6)];
@@ -159,71 +160,63 @@ fn row_times(scene: &Scene, repeat: u32) -> Result<[Timing; 6]> {
     Ok(times)
 }
 
-/// The panorama throughput table: raster (first and later frame) and ray caster, best of
+/// The panorama throughput table (the workload of
+/// `flexcam::render::inverse_raster::workloads`): raster (first frame of a new renderer,
+/// later frames of one renderer into one kept frame, flat and lit) and ray caster, best of
 /// `repeat` frames each.
 fn panorama(repeat: u32) -> Result<()> {
-    let scene = builtin::load("teapot-dense")?;
-    let frame = match &scene.projection {
-        ProjectionSpec::Perspective { frame, .. } => *frame,
-        other => {
-            return Err(Error::new(format!(
-                "teapot-dense should have a perspective camera, not {}",
-                other.kind()
-            )))
-        }
-    };
-    let spec = ProjectionSpec::Equirectangular {
-        frame,
-        h_fov: 360.0,
-        v_fov: 180.0,
-    };
-    let (width, height) = PANORAMA;
-    let projection = spec.build(width, height)?;
+    let PanoramaWorkload { scene, projection } = teapot_dense_panorama()?;
     let projection: &dyn Projection = projection.as_ref();
-    let options = RenderOptions {
-        shading: Shading::Flat,
+    let options = |shading| RenderOptions {
+        shading,
         ..RenderOptions::default()
     };
+    let flat = options(Shading::Flat);
     // A new renderer per frame: the pixel projectors are computed during the frame.
     let first = measure(repeat, || {
-        InverseRaster::new(&scene, projection, &options)?.render();
+        InverseRaster::new(&scene, projection, &flat)?.render();
         Ok(())
     })?;
-    let raster = InverseRaster::new(&scene, projection, &options)?;
-    raster.render();
-    let later = measure(repeat, || {
-        raster.render();
-        Ok(())
-    })?;
+    let later = |options: &RenderOptions| {
+        let raster = InverseRaster::new(&scene, projection, options)?;
+        let mut frame = raster.render().0;
+        measure(repeat, || {
+            raster.render_into(&mut frame);
+            Ok(())
+        })
+    };
+    let (later_flat, later_lit) = (later(&flat)?, later(&options(Shading::Lit))?);
     let start = Instant::now();
     let caster = RayCaster::new(&scene);
     let build = start.elapsed().as_secs_f64();
     let cast = measure(repeat, || {
-        caster.render(projection, &options);
+        caster.render(projection, &flat);
         Ok(())
     })?;
+    let (width, height) = PANORAMA_SIZE;
     println!(
         "\npanorama: teapot-dense, {} triangles, {width}x{height} equirectangular (360 x 180), \
-         flat shading, best of {repeat}",
+         best of {repeat}",
         scene.triangle_count()
     );
     println!(
-        "{:<34}{:>10}{:>8}{:>14}",
+        "{:<40}{:>10}{:>8}{:>14}",
         "method", "ms/frame", "fps", "CPU ms/frame"
     );
     for (name, t) in [
-        ("raster, first frame", first),
-        ("raster, later frame", later),
-        ("raycast, frame (BVH prebuilt)", cast),
+        ("raster, first frame, flat", first),
+        ("raster, later frame, flat", later_flat),
+        ("raster, later frame, lit (shadow rays)", later_lit),
+        ("raycast, frame, flat (BVH prebuilt)", cast),
     ] {
         println!(
-            "{name:<34}{:>10.1}{:>8.1}{:>14}",
+            "{name:<40}{:>10.1}{:>8.1}{:>14}",
             1e3 * t.wall,
             1.0 / t.wall,
             t.cpu_text(1e3, 1)
         );
     }
-    println!("{:<34}{:>10.1}", "raycast, BVH build (once)", 1e3 * build);
+    println!("{:<40}{:>10.1}", "raycast, BVH build (once)", 1e3 * build);
     Ok(())
 }
 

@@ -22,7 +22,7 @@ use crate::geometry::Ray;
 use crate::render::raster::{Fragment, Target};
 use crate::render::raycast::{Hit, RayCaster};
 use crate::render::surface::{base_color, TextureFilter};
-use crate::render::{RenderOptions, Shading};
+use crate::render::{Frame, RenderOptions, Shading};
 use crate::scene::{Object, Surface};
 
 /// Attributes carried by a fragment: none, depth only (everything else is reconstructed
@@ -60,18 +60,32 @@ impl Shader<'_> {
         true
     }
 
-    /// The colours of `target` with every covered pixel's visible fragment shaded (rows in
-    /// parallel), and the number of rays that shading cast (secondary and shadow rays of
-    /// lit shading, mirrors and glass).
-    pub fn shade_visible(&self, target: &Target) -> (Vec<Vec3>, u64) {
-        let width = target.width() as usize;
-        let mut colors = target.color().to_vec();
-        let rays = colors
-            .par_chunks_mut(width.max(1))
+    /// Writes `target` into `frame` (resized to it) with every covered pixel's visible
+    /// fragment shaded (rows in parallel), and returns the number of rays that shading cast
+    /// (secondary and shadow rays of lit shading, mirrors and glass). Depths are rounded to
+    /// `f32`; pixels without a fragment keep the target's colour (the background).
+    pub fn shade_visible(&self, target: &Target, frame: &mut Frame) -> u64 {
+        let (width, height) = (target.width(), target.height());
+        let n = width as usize * height as usize;
+        (frame.width, frame.height) = (width, height);
+        frame.color.resize(n, Vec3::ZERO);
+        frame.depth.resize(n, f32::INFINITY);
+        frame.ids.resize(n, 0);
+        let row = (width as usize).max(1);
+        frame
+            .color
+            .par_chunks_mut(row)
+            .zip(frame.depth.par_chunks_mut(row))
+            .zip(frame.ids.par_chunks_mut(row))
             .enumerate()
-            .map(|(y, row)| {
+            .map(|(y, ((colors, depths), ids))| {
+                let first = y * row;
                 let mut rays = 0;
-                for (x, color) in row.iter_mut().enumerate() {
+                let pixels = colors.iter_mut().zip(depths).zip(ids).enumerate();
+                for (x, ((color, depth), id)) in pixels {
+                    let i = first + x;
+                    (*depth, *id) = (target.depth()[i] as f32, target.ids()[i]);
+                    *color = target.color()[i];
                     let (x, y) = (x as u32, y as u32);
                     if let Some((shaded, cast)) =
                         target.primitive(x, y).and_then(|key| self.shade(x, y, key))
@@ -81,8 +95,7 @@ impl Shader<'_> {
                 }
                 rays
             })
-            .sum();
-        (colors, rays)
+            .sum()
     }
 
     /// Pixel `(x, y)`'s projector and where it meets the plane of primitive `key`: the ray

@@ -25,8 +25,8 @@
 //! pixel (`--spp 1`).
 //!
 //! An [`InverseRaster`] is meant to render many frames of one projection (an animation of
-//! the scene, an interactive viewer): the pixel projectors and the BVH are kept between
-//! frames.
+//! the scene, an interactive viewer): the pixel projectors, the BVH and the z-buffered target
+//! are kept between frames, and [`InverseRaster::render_into`] reuses the caller's frame.
 //!
 //! Supported: every projection with an [`InverseChart`] (perspective, orthographic,
 //! fisheye, equirectangular, cylindrical, and the flexible volumes described in
@@ -40,9 +40,11 @@ mod seam;
 mod subdivision;
 #[cfg(test)]
 mod tests;
+pub mod workloads;
 
 use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
 use std::time::Instant;
 
 use glam::{DVec2, DVec3, Vec3};
@@ -76,6 +78,8 @@ pub struct InverseRaster<'a> {
     caster: Option<RayCaster>,
     options: RenderOptions<'a>,
     setup_ms: f64,
+    /// The z-buffered target, kept from frame to frame (cleared, not reallocated).
+    target: Mutex<Target>,
 }
 
 /// What piece building did, for `--stats`.
@@ -158,7 +162,10 @@ impl<'a> InverseRaster<'a> {
             .iter()
             .any(|o| !matches!(o.material.surface, Surface::Diffuse | Surface::Emissive));
         let caster = (options.shading == Shading::Lit || specular).then(|| RayCaster::new(scene));
+        let (width, height) = projection.resolution();
+        let target = Mutex::new(Target::new(width, height, scene.image.background));
         Ok(InverseRaster {
+            target,
             scene,
             projection,
             chart,
@@ -172,11 +179,26 @@ impl<'a> InverseRaster<'a> {
     /// Renders one frame: colour, depth (the ray caster's distance along the projector) and
     /// object ids, with the counters of every stage.
     pub fn render(&self) -> (Frame, Stats) {
+        let mut frame = Frame::new(0, 0, self.scene.image.background);
+        let stats = self.render_into(&mut frame);
+        (frame, stats)
+    }
+
+    /// [`InverseRaster::render`] into `frame`, whose buffers are resized to the image and
+    /// overwritten: a sequence of frames (an animation, a viewer, the throughput bench)
+    /// reusing one `frame` allocates no image buffer after the first.
+    pub fn render_into(&self, frame: &mut Frame) -> Stats {
         let start = Instant::now();
         let (batch, counts) = self.pieces();
         let pieces_ms = start.elapsed().as_secs_f64() * 1e3;
-        let (width, height) = self.projection.resolution();
-        let mut target = Target::new(width, height, self.scene.image.background);
+        let background = self.scene.image.background;
+        // Every frame clears the whole target first, so one left by a panicked frame is
+        // as good as any.
+        let mut target = self
+            .target
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        target.clear(background);
         let shader = Shader {
             objects: &self.scene.objects,
             rays: &self.rays,
@@ -192,9 +214,8 @@ impl<'a> InverseRaster<'a> {
             &|_| Vec3::ZERO,
         );
         let fill_ms = start.elapsed().as_secs_f64() * 1e3 - pieces_ms;
-        let (colors, shading_rays) = shader.shade_visible(&target);
-        let mut frame = target.into_frame();
-        frame.color = colors;
+        let shading_rays = shader.shade_visible(&target, frame);
+        drop(target);
         let mut stats = Stats::new();
         raster.record(&mut stats);
         let count = |n: u64| Counter::Count(n);
@@ -229,7 +250,7 @@ impl<'a> InverseRaster<'a> {
         ] {
             stats.insert(name, Counter::Value(value));
         }
-        (frame, stats)
+        stats
     }
 
     /// Steps 1 to 3 of the module documentation: the screen triangles of every scene
@@ -313,9 +334,10 @@ impl<'a> InverseRaster<'a> {
         if !inside {
             counts.clipped += 1;
         }
+        let poles = !refiner.far_from_poles(points);
         let mut draw = |nodes: [Node; 3]| {
             counts.pieces += 1;
-            if refiner.is_pole_piece(nodes.map(|n| n.point)) {
+            if poles && refiner.is_pole_piece(nodes.map(|n| n.point)) {
                 counts.pole_pieces += 1;
                 return;
             }
@@ -343,7 +365,7 @@ impl<'a> InverseRaster<'a> {
         let uniform = self.options.subdivision.uniform;
         let mut subdivide = |nodes: [Node; 3], grid: &mut Vec<Node>| {
             refiner.uniform(nodes, uniform, grid, &mut |piece| {
-                refiner.refine(piece, [0; 3], &mut draw)
+                refiner.refine(piece, [0; 3], poles, &mut draw)
             });
         };
         if inside {

@@ -52,7 +52,14 @@ pub struct Refiner<'a> {
 pub fn unwrap(x: f64, reference: f64, period: Option<f64>) -> (f64, i64) {
     match period {
         Some(p) => {
-            let k = ((reference - x) / p).round();
+            let periods = (reference - x) / p;
+            // Nearly every call is already within half a period: no rounding call then
+            // (`round` is a library call on this target); the result is `round`'s either way.
+            let k = if periods.abs() < 0.5 {
+                0.0
+            } else {
+                periods.round()
+            };
             (x + k * p, k as i64)
         }
         None => (x, 0),
@@ -85,8 +92,10 @@ impl<'a> Refiner<'a> {
         }
     }
 
-    /// The midpoint node of edge `a b` at `level` halvings if the edge must be split.
-    fn split(&self, a: &Node, b: &Node, level: u32) -> Option<Node> {
+    /// The midpoint node of edge `a b` at `level` halvings if the edge must be split;
+    /// `poles`: whether the pole rule applies (`false` only for edges of a triangle that
+    /// [`Refiner::far_from_poles`] clears, where it can never split).
+    fn split(&self, a: &Node, b: &Node, level: u32, poles: bool) -> Option<Node> {
         if level >= MAX_LEVEL || a.point == b.point {
             return None;
         }
@@ -101,7 +110,7 @@ impl<'a> Refiner<'a> {
             (Some(tolerance), Some(pa), Some(pb)) => !self.bends_at_most(pa, pb, tolerance),
             _ => false,
         };
-        let near_pole = self.near_pole(a.point, b.point);
+        let near_pole = poles && self.near_pole(a.point, b.point);
         if !bendable && !near_pole {
             return None;
         }
@@ -164,6 +173,41 @@ impl<'a> Refiner<'a> {
         })
     }
 
+    /// Whether no part of triangle `points` comes near a pole: then no edge of any piece
+    /// of it (pieces of the uniform grid, of adaptive refinement or of clipping all lie in
+    /// the triangle) is split by the pole rule of [`Refiner::near_pole`], and no piece is
+    /// crossed by a pole ray ([`Refiner::is_pole_piece`]), so neither need be tested piece
+    /// by piece. Most triangles of a scene are far from both poles.
+    ///
+    /// The bound: the triangle lies in the ball of radius r around its centroid c. Seen from
+    /// a pole's origin o at distance D = |c - o| > r, every point of the ball lies within
+    /// a = asin(r / D) of the direction of c, so every piece's edge is at most 2a long and
+    /// every point at least (theta - a) from the pole, theta being c's angle from the pole.
+    /// The pole rule needs an edge end within twice the edge's length, theta - a < 4a; a
+    /// pole crossing needs theta - a <= 0. Both are impossible when theta > 5a, which holds
+    /// when `chord * D > 5 (pi / 2) r`, chord = |unit(c - o) - direction| (theta >= chord
+    /// and a <= (pi / 2) r / D; the chord is at most 2, so this also implies D > r).
+    ///
+    /// Degenerate cases: a triangle around a pole's origin (D <= r), or whose centroid is
+    /// the origin (D = 0), is not far; neither is a zero-size triangle on a pole ray
+    /// (r = 0 and chord = 0: the inequality is strict); a non-finite point makes every
+    /// comparison false, so it is not far either (the exact tests decide).
+    pub fn far_from_poles(&self, points: [DVec3; 3]) -> bool {
+        let centre = (points[0] + points[1] + points[2]) / 3.0;
+        let radius = points
+            .iter()
+            .map(|&p| p.distance_squared(centre))
+            .fold(0.0, f64::max)
+            .sqrt();
+        self.chart.poles.iter().all(|pole| {
+            let offset = centre - pole.origin;
+            let distance = offset.length();
+            distance > 0.0
+                && (offset / distance - pole.direction).length() * distance
+                    > 2.5 * std::f64::consts::PI * radius
+        })
+    }
+
     /// Whether the piece `[a, b, c]` is crossed by a pole ray; such pieces are not drawn (by
     /// the edge rule they lie within the pole's clearance, unless the level limit stopped
     /// the splitting).
@@ -174,13 +218,20 @@ impl<'a> Refiner<'a> {
     }
 
     /// Calls `emit` with the pieces of triangle `nodes` whose edges have been halved
-    /// `levels` times, after adaptive refinement.
-    pub fn refine(&self, nodes: [Node; 3], levels: [u32; 3], emit: &mut impl FnMut([Node; 3])) {
+    /// `levels` times, after adaptive refinement; `poles`: whether the pole rule applies
+    /// (see [`Refiner::split`]).
+    pub fn refine(
+        &self,
+        nodes: [Node; 3],
+        levels: [u32; 3],
+        poles: bool,
+        emit: &mut impl FnMut([Node; 3]),
+    ) {
         let [a, b, c] = nodes;
         let splits = [
-            self.split(&a, &b, levels[0]),
-            self.split(&b, &c, levels[1]),
-            self.split(&c, &a, levels[2]),
+            self.split(&a, &b, levels[0], poles),
+            self.split(&b, &c, levels[1], poles),
+            self.split(&c, &a, levels[2], poles),
         ];
         // Rotate so that the split edges come first: ab, then bc, then ca.
         let count = splits.iter().filter(|s| s.is_some()).count();
@@ -199,21 +250,21 @@ impl<'a> Refiner<'a> {
         match count {
             1 => {
                 let ab = m(0);
-                self.refine([a, ab, c], [l(0) + 1, inner, l(2)], emit);
-                self.refine([ab, b, c], [l(0) + 1, l(1), inner], emit);
+                self.refine([a, ab, c], [l(0) + 1, inner, l(2)], poles, emit);
+                self.refine([ab, b, c], [l(0) + 1, l(1), inner], poles, emit);
             }
             2 => {
                 let (ab, bc) = (m(0), m(1));
-                self.refine([ab, b, bc], [l(0) + 1, l(1) + 1, inner], emit);
-                self.refine([a, ab, bc], [l(0) + 1, inner, inner], emit);
-                self.refine([a, bc, c], [inner, l(1) + 1, l(2)], emit);
+                self.refine([ab, b, bc], [l(0) + 1, l(1) + 1, inner], poles, emit);
+                self.refine([a, ab, bc], [l(0) + 1, inner, inner], poles, emit);
+                self.refine([a, bc, c], [inner, l(1) + 1, l(2)], poles, emit);
             }
             _ => {
                 let (ab, bc, ca) = (m(0), m(1), m(2));
-                self.refine([a, ab, ca], [l(0) + 1, inner, l(2) + 1], emit);
-                self.refine([ab, b, bc], [l(0) + 1, l(1) + 1, inner], emit);
-                self.refine([ca, bc, c], [inner, l(1) + 1, l(2) + 1], emit);
-                self.refine([ab, bc, ca], [inner, inner, inner], emit);
+                self.refine([a, ab, ca], [l(0) + 1, inner, l(2) + 1], poles, emit);
+                self.refine([ab, b, bc], [l(0) + 1, l(1) + 1, inner], poles, emit);
+                self.refine([ca, bc, c], [inner, l(1) + 1, l(2) + 1], poles, emit);
+                self.refine([ab, bc, ca], [inner, inner, inner], poles, emit);
             }
         }
     }
@@ -316,19 +367,22 @@ mod tests {
             node(DVec3::new(-1.0, 0.5, -1.0)),
             node(DVec3::new(1.0, 0.5, -1.0)),
         );
-        assert!(refiner.split(&a, &b, 0).is_some());
+        assert!(refiner.split(&a, &b, 0, true).is_some());
         // The same decision from either end, with the same midpoint.
-        assert_eq!(refiner.split(&a, &b, 0), refiner.split(&b, &a, 0));
+        assert_eq!(
+            refiner.split(&a, &b, 0, true),
+            refiner.split(&b, &a, 0, true)
+        );
         // Degenerate: the level limit, and an edge whose ends coincide.
-        assert!(refiner.split(&a, &b, MAX_LEVEL).is_none());
-        assert!(refiner.split(&a, &a, 0).is_none());
+        assert!(refiner.split(&a, &b, MAX_LEVEL, true).is_none());
+        assert!(refiner.split(&a, &a, 0, true).is_none());
         // A short vertical edge straight ahead, far from the poles, stays straight (a
         // column of the panorama).
         let (c, d) = (
             node(DVec3::new(0.0, -0.1, -1.0)),
             node(DVec3::new(0.0, 0.1, -1.0)),
         );
-        assert!(refiner.split(&c, &d, 0).is_none());
+        assert!(refiner.split(&c, &d, 0, true).is_none());
         // A piece of the curved edge under a pixel long is too short to bend by the
         // tolerance: not split (its midpoint is not even projected), and indeed its midpoint
         // lies well within the tolerance of its chord. Its long parent edge is tested.
@@ -339,14 +393,14 @@ mod tests {
         let image = |n: &Node| n.image.unwrap();
         assert!(image(&short).distance(image(&tiny)) < 1.0);
         assert!(refiner.bends_at_most(image(&short), image(&tiny), 0.5));
-        assert!(refiner.split(&short, &tiny, 0).is_none());
+        assert!(refiner.split(&short, &tiny, 0, true).is_none());
         let mid = image(&node(DVec3::new(-0.005, 0.5, -1.0)));
         assert!(refiner.deviation(image(&short), image(&tiny), mid) < 0.01);
         assert!(!refiner.bends_at_most(image(&a), image(&b), 0.5));
         // Degenerate: an end on the eye has no image; the midpoint rule does not split.
         let eye = node(DVec3::ZERO);
         assert!(eye.image.is_none());
-        assert!(refiner.split(&eye, &c, 0).is_none());
+        assert!(refiner.split(&eye, &c, 0, true).is_none());
     }
 
     #[test]
@@ -364,18 +418,100 @@ mod tests {
         // Refined, only pieces within the pole's clearance still contain the pole.
         let clearance = chart.poles[0].clearance;
         let mut pole_pieces = 0;
-        refiner.refine(ceiling.map(|p| refiner.node(p)), [0; 3], &mut |piece| {
-            let points = piece.map(|n| n.point);
-            if refiner.is_pole_piece(points) {
-                pole_pieces += 1;
-                let widest = points
-                    .iter()
-                    .map(|&p| angle_between(p, DVec3::Y))
-                    .fold(0.0, f64::max);
-                assert!(widest <= clearance, "{widest} > {clearance}");
-            }
-        });
+        refiner.refine(
+            ceiling.map(|p| refiner.node(p)),
+            [0; 3],
+            true,
+            &mut |piece| {
+                let points = piece.map(|n| n.point);
+                if refiner.is_pole_piece(points) {
+                    pole_pieces += 1;
+                    let widest = points
+                        .iter()
+                        .map(|&p| angle_between(p, DVec3::Y))
+                        .fold(0.0, f64::max);
+                    assert!(widest <= clearance, "{widest} > {clearance}");
+                }
+            },
+        );
         assert!(pole_pieces >= 1);
+    }
+
+    /// Pieces of triangles cleared by `far_from_poles` are refined the same with and without
+    /// the pole rule, and none is crossed by a pole; triangles at or around a pole are not
+    /// cleared, and neither are the degenerate cases of its documentation.
+    #[test]
+    fn triangles_far_from_the_poles_need_no_pole_tests() {
+        let projection = panorama();
+        let chart = projection.inverse_chart().unwrap();
+        let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
+        let pieces = |points: [DVec3; 3], poles: bool| {
+            let mut out = Vec::new();
+            refiner.refine(
+                points.map(|p| refiner.node(p)),
+                [0; 3],
+                poles,
+                &mut |piece| out.push(piece),
+            );
+            out
+        };
+        // Triangles of sizes 1e-3 to 1 (unit distance) at elevations from the horizon up to
+        // the pole: far ones refine identically without the pole rule and hold no pole
+        // piece; the bound clears the small ones well away from the pole and not the ones
+        // whose pieces the pole rule splits.
+        let (mut far, mut near) = (0, 0);
+        for size in [1e-3, 1e-2, 0.1, 1.0] {
+            for step in 0..=40 {
+                let elevation = f64::from(step) / 40.0 * std::f64::consts::FRAC_PI_2;
+                let centre = DVec3::new(0.0, elevation.sin(), -elevation.cos());
+                let points = [
+                    centre + DVec3::new(-size, 0.0, 0.0),
+                    centre + DVec3::new(size, 0.0, 0.3 * size),
+                    centre + DVec3::new(0.2 * size, size, -size),
+                ];
+                if refiner.far_from_poles(points) {
+                    far += 1;
+                    let with = pieces(points, true);
+                    assert_eq!(with, pieces(points, false), "{size} {elevation}");
+                    assert!(with
+                        .iter()
+                        .all(|p| !refiner.is_pole_piece(p.map(|n| n.point))));
+                } else {
+                    near += 1;
+                }
+            }
+        }
+        assert!(far >= 90 && near >= 40, "{far} far, {near} near");
+        let tiny = [
+            DVec3::new(0.0, 0.0, -1.0),
+            DVec3::new(1e-3, 0.0, -1.0),
+            DVec3::new(0.0, 1e-3, -1.0),
+        ];
+        assert!(refiner.far_from_poles(tiny));
+        // A triangle the pole crosses, and one with a corner on the pole ray, are not far.
+        let ceiling = [
+            DVec3::new(-1.0, 1.0, -1.0),
+            DVec3::new(1.0, 1.0, -1.0),
+            DVec3::new(0.0, 1.0, 1.0),
+        ];
+        assert!(refiner.is_pole_piece(ceiling) && !refiner.far_from_poles(ceiling));
+        assert!(!refiner.far_from_poles([
+            DVec3::Y,
+            DVec3::new(0.01, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.01)
+        ]));
+        // Degenerate: around the origin, centroid on the origin, a point on the pole ray, a
+        // non-finite corner. A point off the poles is far.
+        let around = [
+            DVec3::new(-1.0, 0.0, -1.0),
+            DVec3::new(1.0, 0.0, -1.0),
+            DVec3::new(0.0, 0.0, 2.0),
+        ];
+        assert!(!refiner.far_from_poles(around));
+        assert!(!refiner.far_from_poles([DVec3::X, -DVec3::X, DVec3::ZERO]));
+        assert!(!refiner.far_from_poles([DVec3::Y; 3]));
+        assert!(!refiner.far_from_poles([DVec3::NEG_Z, DVec3::NEG_Z, DVec3::splat(f64::NAN)]));
+        assert!(refiner.far_from_poles([DVec3::NEG_Z; 3]));
     }
 
     #[test]

@@ -2,6 +2,7 @@
 //! pixel, cut into horizontal bands that can be written in parallel.
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use super::interpolate::Varying;
 use crate::render::Frame;
@@ -56,6 +57,15 @@ impl Target {
             ids: vec![0; n],
             primitives: vec![NO_PRIMITIVE; n],
         }
+    }
+
+    /// Empties the target for another frame, as [`Target::new`] leaves it, keeping its
+    /// buffers (no allocation, no fresh pages to fault in); in parallel.
+    pub fn clear(&mut self, background: Vec3) {
+        fill(&mut self.color, background);
+        fill(&mut self.depth, f64::INFINITY);
+        fill(&mut self.ids, 0);
+        fill(&mut self.primitives, NO_PRIMITIVE);
     }
 
     pub fn width(&self) -> u32 {
@@ -152,6 +162,16 @@ impl Target {
             })
             .collect()
     }
+}
+
+/// Elements per parallel task of [`fill`].
+const FILL_CHUNK: usize = 1 << 15;
+
+/// Sets every element of `values` to `value`, in parallel chunks.
+fn fill<T: Copy + Send + Sync>(values: &mut [T], value: T) {
+    values
+        .par_chunks_mut(FILL_CHUNK)
+        .for_each(|chunk| chunk.fill(value));
 }
 
 /// Rows `[rows.0, rows.1)` of a [`Target`], borrowed mutably.
