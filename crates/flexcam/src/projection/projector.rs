@@ -65,11 +65,13 @@ pub fn quadratic_arc_length(p: &[DVec3; 3], s: f64) -> f64 {
     // B'(x) = 2 (b + x a): the speed is smallest at x = -a.b / a.a.
     let a2 = a.length_squared();
     let minimum = if a2 > 0.0 { -a.dot(b) / a2 } else { 0.0 };
-    let mut breaks = vec![0.0];
-    if minimum > 0.0 && minimum < s {
-        breaks.push(minimum);
-    }
-    breaks.push(s);
+    // The break points on the stack: this runs once per shaded pixel of a quadratic volume.
+    let (split, plain) = ([0.0, minimum, s], [0.0, s]);
+    let breaks: &[f64] = if minimum > 0.0 && minimum < s {
+        &split
+    } else {
+        &plain
+    };
     breaks
         .windows(2)
         .flat_map(|w| {

@@ -67,6 +67,31 @@ fn reduce_to_pair(points: &mut Vec<DVec3>, t: f64) -> (DVec3, DVec3) {
     (points[0], points[1])
 }
 
+/// The Bernstein weights C(n, i) t^i (1 - t)^(n - i), i = 0..=n, of the `n + 1` control
+/// points of a degree-n Bezier curve at `t`. For t in [0, 1] they are non-negative and sum to
+/// 1, so the weighted sum of the control points is as well conditioned as de Casteljau's
+/// lerps; at t = 0 and t = 1 one weight is exactly 1 and the others exactly 0, so the end
+/// points come out exactly. Degenerate case: n = 0 gives the single weight 1.
+fn bernstein_weights(n: u32, t: f64) -> Vec<f64> {
+    let n = n as i32;
+    let mut binomial = 1.0;
+    (0..=n)
+        .map(|i| {
+            let w = binomial * t.powi(i) * (1.0 - t).powi(n - i);
+            binomial = binomial * f64::from(n - i) / f64::from(i + 1);
+            w
+        })
+        .collect()
+}
+
+/// sum_i weights[i] points[i] (the shorter of the two decides the count).
+fn weighted_sum(weights: &[f64], points: &[DVec3]) -> DVec3 {
+    weights
+        .iter()
+        .zip(points)
+        .fold(DVec3::ZERO, |sum, (w, p)| sum + *w * *p)
+}
+
 /// Piecewise-linear blending of surfaces at knots in t.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PiecewiseVolume {
@@ -140,9 +165,10 @@ impl PiecewiseVolume {
 #[derive(Debug, Clone, PartialEq)]
 pub struct BezierVolume {
     surfaces: Vec<Surface>,
-    /// `None`: quadratic projectors, intersected analytically; `Some(n)`: projectors rendered
-    /// as polylines of `n` equal steps in t.
-    segments: Option<u32>,
+    /// `None`: quadratic projectors, intersected analytically; else projectors rendered as
+    /// polylines of `n` equal steps in t, through the samples at t = k / n, k = 0..=n, whose
+    /// Bernstein weights (`[k]`, one per surface) are computed here once for every projector.
+    polyline_weights: Option<Vec<Vec<f64>>>,
 }
 
 impl BezierVolume {
@@ -166,20 +192,29 @@ impl BezierVolume {
             (3, s) => s,
             (_, s) => Some(s.unwrap_or(DEFAULT_SEGMENTS)),
         };
-        Ok(BezierVolume { surfaces, segments })
+        let degree = n as u32 - 1;
+        let polyline_weights = segments.map(|steps| {
+            (0..=steps)
+                .map(|k| bernstein_weights(degree, f64::from(k) / f64::from(steps)))
+                .collect()
+        });
+        Ok(BezierVolume {
+            surfaces,
+            polyline_weights,
+        })
     }
 
     /// The de Casteljau pyramid of the control points at (u, v) down to its last two points,
-    /// at `t`: their lerp is Q and their difference times the degree is dQ/dt.
+    /// at `t`: their difference times the degree is dQ/dt.
     fn last_pair(&self, uv: DVec2, t: f64) -> (DVec3, DVec3) {
         let mut points: Vec<DVec3> = self.surfaces.iter().map(|s| s.point(uv)).collect();
         reduce_to_pair(&mut points, t)
     }
 
-    /// Q(u, v, t) by de Casteljau.
+    /// Q(u, v, t), the Bernstein sum of the surfaces' points.
     pub fn point(&self, uv: DVec2, t: f64) -> DVec3 {
-        let (a, b) = self.last_pair(uv, t);
-        a.lerp(b, t)
+        let points: Vec<DVec3> = self.surfaces.iter().map(|s| s.point(uv)).collect();
+        weighted_sum(&bernstein_weights(points.len() as u32 - 1, t), &points)
     }
 
     /// dQ/dt at (u, v, t): the degree times the difference of the last de Casteljau pair.
@@ -192,25 +227,15 @@ impl BezierVolume {
     /// `segments + 1` equally spaced t; `None` for a projector of zero length.
     pub fn projector(&self, uv: DVec2) -> Option<Projector> {
         let points = control_points(&self.surfaces, uv)?;
-        match self.segments {
+        match &self.polyline_weights {
             None => Some(Projector::QuadraticBezier([
                 points[0], points[1], points[2],
             ])),
-            // The control points are evaluated once per projector, not once per sample.
-            Some(n) => {
-                let mut pyramid = Vec::with_capacity(points.len());
-                Some(Projector::Polyline(
-                    (0..=n)
-                        .map(|k| {
-                            let t = f64::from(k) / f64::from(n);
-                            pyramid.clear();
-                            pyramid.extend_from_slice(&points);
-                            let (a, b) = reduce_to_pair(&mut pyramid, t);
-                            a.lerp(b, t)
-                        })
-                        .collect(),
-                ))
-            }
+            // The control points are evaluated once per projector, not once per sample, and
+            // each sample is a sum with the volume's precomputed weights.
+            Some(weights) => Some(Projector::Polyline(
+                weights.iter().map(|w| weighted_sum(w, &points)).collect(),
+            )),
         }
     }
 }
@@ -314,6 +339,31 @@ mod tests {
             v.projector(uv),
             Some(Projector::QuadraticBezier([p[0], p[1], p[2]]))
         );
+    }
+
+    #[test]
+    fn bernstein_points_match_de_casteljau_and_keep_the_end_points_exact() {
+        let points = [
+            DVec3::new(0.1, 0.2, 0.3),
+            DVec3::new(1.0, -2.0, 0.5),
+            DVec3::new(3.0, 1.0, -1.0),
+            DVec3::new(-0.7, 4.0, 2.0),
+        ];
+        let point = |points: &[DVec3], t: f64| {
+            weighted_sum(&bernstein_weights(points.len() as u32 - 1, t), points)
+        };
+        for t in [0.0, 0.1, 1.0 / 3.0, 0.5, 0.9, 1.0] {
+            let mut pyramid = points.to_vec();
+            let (a, b) = reduce_to_pair(&mut pyramid, t);
+            assert!(close(point(&points, t), a.lerp(b, t)), "t = {t}");
+            let sum: f64 = bernstein_weights(3, t).iter().sum();
+            assert!((sum - 1.0).abs() < 1e-15, "t = {t}");
+        }
+        assert_eq!(point(&points, 0.0), points[0]);
+        assert_eq!(point(&points, 1.0), points[3]);
+        // Degenerate case: a single control point is the whole curve.
+        assert_eq!(bernstein_weights(0, 0.4), vec![1.0]);
+        assert_eq!(point(&points[..1], 0.4), points[0]);
     }
 
     #[test]

@@ -247,6 +247,8 @@ const ROBUST_SLACK: f32 = 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::E
 /// Relative padding of stored boxes: covers the rounding of the triangles' precomputed edges,
 /// so that a hit the triangle test reports never lies outside its leaf's box.
 const BOX_PADDING: f32 = 1.0 / (1 << 20) as f32;
+/// Relative margin of [`Bvh::root_overlaps`]: 100 times the f32 rounding of a coordinate.
+const ROOT_MARGIN: f64 = 1e-5;
 /// Largest leaf the SAH may choose.
 const MAX_LEAF: usize = 4;
 /// Bins per axis of the SAH sweep.
@@ -273,6 +275,9 @@ pub(super) struct Bvh {
     root: Child,
     /// The padded box of everything (empty when nothing is stored).
     root_bounds: Aabb,
+    /// The largest coordinate magnitude of `root_bounds` (0 when empty), for
+    /// [`Bvh::root_overlaps`].
+    root_scale: f64,
     triangles: Vec<PackedTriangle>,
     /// Build-input index of each stored triangle.
     ids: Vec<u32>,
@@ -284,6 +289,7 @@ impl Default for Bvh {
             nodes: Vec::new(),
             root: Child { index: 0, count: 0 },
             root_bounds: Aabb::EMPTY,
+            root_scale: 0.0,
             triangles: Vec::new(),
             ids: Vec::new(),
         }
@@ -330,6 +336,11 @@ impl Bvh {
             nodes,
             root,
             root_bounds,
+            root_scale: root_bounds
+                .min
+                .abs()
+                .max(root_bounds.max.abs())
+                .max_element() as f64,
             triangles,
             ids: prims.iter().map(|p| p.id).collect(),
         }
@@ -539,6 +550,35 @@ impl Bvh {
     /// empty tree): a cheap first test for a query that would otherwise traverse.
     pub fn near_root(&self, segment: &NearSegment) -> bool {
         !self.triangles.is_empty() && segment.meets(self.root_bounds.min, self.root_bounds.max)
+    }
+
+    /// Every stored triangle, for tests that check a search against testing them all.
+    #[cfg(test)]
+    pub fn all_triangles(&self) -> &[PackedTriangle] {
+        &self.triangles
+    }
+
+    /// Whether the box `[min, max]` overlaps the box of the whole tree enlarged by
+    /// [`ROOT_MARGIN`] of the largest coordinate magnitude of either box (never for an empty
+    /// tree, always for non-finite input): a test without divisions for anything known to
+    /// lie inside `[min, max]`, such as a curve piece inside the box of its control points
+    /// or a ray's segment inside the box of its two ends. The margin, far above f32
+    /// rounding, keeps the test conservative for the f32 searches that follow it: what it
+    /// rejects, they could not hit.
+    #[inline]
+    pub fn root_overlaps(&self, min: glam::DVec3, max: glam::DVec3) -> bool {
+        if self.triangles.is_empty() {
+            return false;
+        }
+        let (lo, hi) = (
+            self.root_bounds.min.as_dvec3(),
+            self.root_bounds.max.as_dvec3(),
+        );
+        let scale = self.root_scale.max(min.abs().max(max.abs()).max_element());
+        let margin = glam::DVec3::splat(ROOT_MARGIN * scale);
+        // Written so that NaN anywhere fails a rejection and counts as an overlap.
+        let apart = (min - margin).cmpgt(hi).any() || (max + margin).cmplt(lo).any();
+        !apart
     }
 
     /// Calls `visit` with the build-input index and the triangle of every stored triangle in

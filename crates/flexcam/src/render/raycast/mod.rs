@@ -123,14 +123,32 @@ impl RayCaster {
     /// origin's magnitude to the hit distance). Enough for a flat colour and a depth stored
     /// as f32; everything that spawns rays from the hit refines it first.
     fn intersect_f32(&self, ray: &Ray) -> Option<Hit32> {
+        if self.misses_scene_box(ray) {
+            return None;
+        }
         let found = self.bvh.closest(&FastRay::new(ray)?)?;
         Some(self.hit32(found))
+    }
+
+    /// Whether `ray`'s segment (its points over `[t_min, t_max]`, both ends finite) lies
+    /// outside the scene's box: then it hits nothing, and costs this comparison instead of
+    /// the reciprocal directions and slab test of a traversal. Most segments of a polyline
+    /// projector pass in front of or behind a small model. Rays with an infinite end (every
+    /// straight camera ray, secondary rays) are never culled here.
+    #[inline]
+    fn misses_scene_box(&self, ray: &Ray) -> bool {
+        let (a, b) = (ray.at(ray.t_min), ray.at(ray.t_max));
+        a.is_finite() && b.is_finite() && !self.bvh.root_overlaps(a.min(b), a.max(b))
     }
 
     /// [`RayCaster::intersect_f32`] of four rays at once, with identical results: coherent
     /// rays (a 2x2 quad of primary rays) share one BVH traversal.
     fn intersect4_f32(&self, rays: [Option<&Ray>; 4]) -> [Option<Hit32>; 4] {
-        let fast = |i: usize| rays[i].and_then(FastRay::new);
+        let fast = |i: usize| {
+            rays[i]
+                .filter(|r| !self.misses_scene_box(r))
+                .and_then(FastRay::new)
+        };
         let (a, b, c, d) = (fast(0), fast(1), fast(2), fast(3));
         let [a, b, c, d] = self
             .bvh

@@ -188,3 +188,94 @@ fn polyline_quads_sample_exactly_like_single_projectors() {
         assert!(quad.counts.primary > 0);
     }
 }
+
+/// Segments of polyline projectors that pass in front of or behind a small model are culled
+/// by the scene's box before any traversal ([`RayCaster::misses_scene_box`]): on the layout
+/// of `flexcam bench flexible` (a teapot inside a bent perspective-to-perspective volume,
+/// six segments) most segments are culled, and every segment, culled or not, finds exactly
+/// the hit of an unculled BVH search; the rendered image is that of tracing each projector
+/// alone.
+#[test]
+fn segments_outside_the_scene_box_are_culled_without_changing_any_hit() {
+    let text = r#"
+        [projection]
+        type = "perspective"
+        position = [0.0, 2.0, 12.0]
+        look_at = [0.0, 1.5, 0.0]
+        fov = 60.0
+        [[object]]
+        shape = "teapot"
+        size = 1.0
+        tessellation = 8
+    "#;
+    let scene = crate::scene::file::parse(text, std::path::Path::new("teapot.toml")).unwrap();
+    let caster = RayCaster::new(&scene);
+    // The bench's volume around the teapot's box: centre c, half diagonal r.
+    let (c, r) = (DVec3::new(0.217, 1.575, 0.0), 4.1);
+    let square = |centre: DVec3, half: f64| {
+        Surface::rectangle_centred(centre, DVec3::X * half, DVec3::Y * half)
+    };
+    let spec = FlexibleSpec {
+        source: VolumeSource::Blended {
+            surfaces: vec![
+                square(c + DVec3::new(0.0, 0.0, 4.0 * r), 0.1 * r),
+                square(c + DVec3::new(0.4 * r, 0.3 * r, r), 0.9 * r),
+                square(c + DVec3::new(0.0, 0.0, -2.0 * r), 1.3 * r),
+            ],
+            blend: Blend::Bezier { segments: Some(6) },
+        },
+        reparam: None,
+    };
+    let (w, h) = (48, 48);
+    let projection = Flexible::new(&spec, w, h).unwrap();
+    let (mut culled, mut hits, mut segments) = (0, 0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let pixel = DVec2::new(x as f64, y as f64) + 0.5;
+            let Some(crate::projection::Projector::Polyline(points)) = projection.projector(pixel)
+            else {
+                panic!("pixel ({x}, {y}) has no polyline projector");
+            };
+            for pair in points.windows(2) {
+                let ray = crate::geometry::Ray {
+                    origin: pair[0],
+                    direction: pair[1] - pair[0],
+                    t_min: 0.0,
+                    t_max: 1.0,
+                };
+                let uncull = super::triangle::FastRay::new(&ray)
+                    .and_then(|fast| caster.bvh.closest(&fast))
+                    .map(|found| caster.hit32(found));
+                assert_eq!(caster.intersect_f32(&ray), uncull, "pixel ({x}, {y})");
+                segments += 1;
+                if caster.misses_scene_box(&ray) {
+                    culled += 1;
+                    assert_eq!(uncull, None);
+                }
+                hits += usize::from(uncull.is_some());
+            }
+        }
+    }
+    assert!(
+        hits > 0 && 2 * culled > segments,
+        "{culled} of {segments}, {hits} hits"
+    );
+    // The quads of the renderer against each projector alone.
+    let options = RenderOptions {
+        shading: Shading::Lit,
+        ..RenderOptions::default()
+    };
+    let frame = caster.render(&projection, &options).0;
+    let mut tracer = Tracer::new(&caster, &options);
+    for y in 0..h {
+        for x in 0..w {
+            let projector = projection.projector(DVec2::new(x as f64, y as f64) + 0.5);
+            let alone = tracer.sample_projector(projector.as_ref());
+            let i = (y * w + x) as usize;
+            assert_eq!(
+                (frame.color[i], frame.depth[i], frame.ids[i]),
+                (alone.color, alone.depth, alone.id)
+            );
+        }
+    }
+}
