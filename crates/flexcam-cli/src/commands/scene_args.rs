@@ -94,10 +94,10 @@ fn perspective_rect(projection: &ProjectionSpec, rect: &[f64]) -> Result<Project
         )));
     };
     let source = edit_source(&spec.source, rect).map_err(|e| refuse(e.message))?;
-    Ok(ProjectionSpec::Flexible(FlexibleSpec {
+    Ok(ProjectionSpec::Flexible(Box::new(FlexibleSpec {
         source,
         reparam: spec.reparam,
-    }))
+    })))
 }
 
 /// `--shading` on the command line.

@@ -384,7 +384,7 @@ fn coupled(step: impl Fn(f64) -> DVec2) -> Option<DVec2> {
         } else {
             uv.y
         };
-        if !(next.abs() <= COUPLED_RANGE) {
+        if next.is_nan() || next.abs() > COUPLED_RANGE {
             return None;
         }
         (x0, r0, x1) = (x1, r1, next);
