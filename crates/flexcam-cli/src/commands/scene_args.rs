@@ -32,7 +32,6 @@ pub struct SceneArgs {
         long,
         value_name = "U0,V0,U1,V1",
         value_delimiter = ',',
-        num_args = 4,
         allow_negative_numbers = true
     )]
     pub perspective_rect: Option<Vec<f64>>,
