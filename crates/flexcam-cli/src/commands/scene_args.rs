@@ -4,7 +4,9 @@
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
-use flexcam::projection::Projection;
+use flexcam::projection::flexible::panorama::edit_source;
+use flexcam::projection::flexible::FlexibleSpec;
+use flexcam::projection::{Projection, ProjectionSpec};
 use flexcam::render::inverse_raster::Subdivision;
 use flexcam::render::trilinear::CurveOptions;
 use flexcam::render::{Method, Shading};
@@ -22,6 +24,17 @@ pub struct SceneArgs {
     /// Image height in pixels (overrides the scene file).
     #[arg(long)]
     pub height: Option<u32>,
+    /// The local perspective edit of a shape-defined panorama (or the cubic and
+    /// rounded_cubic presets), as the scene key `perspective_rect`: the rectangle of the
+    /// image domain (u right, v up, in [0, 1]; U0 > U1 across the seam) becomes a perspective
+    /// view. Applied after the scene file's own rectangle, if any.
+    #[arg(
+        long,
+        value_name = "U0,V0,U1,V1",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
+    pub perspective_rect: Option<Vec<f64>>,
 }
 
 /// A loaded scene with its projection bound to the image size.
@@ -45,7 +58,10 @@ impl SceneArgs {
             .clone()
             .unwrap_or_else(|| format!("builtin:{}", scene::builtin::DEFAULT));
         let start = Instant::now();
-        let scene = scene::load(&source)?;
+        let mut scene = scene::load(&source)?;
+        if let Some(rect) = &self.perspective_rect {
+            scene.projection = perspective_rect(&scene.projection, rect)?;
+        }
         let width = self.width.unwrap_or(scene.image.width);
         let height = self.height.unwrap_or(scene.image.height);
         scene::file::validate_resolution(width, height)?;
@@ -62,6 +78,25 @@ impl SceneArgs {
             load_ms: start.elapsed().as_secs_f64() * 1e3,
         })
     }
+}
+
+/// `projection` with the perspective edit of `--perspective-rect` (clap gives four numbers).
+fn perspective_rect(projection: &ProjectionSpec, rect: &[f64]) -> Result<ProjectionSpec> {
+    let refuse = |why: String| Error::new(format!("--perspective-rect: {why}"));
+    let rect: [f64; 4] = rect
+        .try_into()
+        .map_err(|_| refuse(format!("needs 4 numbers, got {}", rect.len())))?;
+    let ProjectionSpec::Flexible(spec) = projection else {
+        return Err(refuse(format!(
+            "needs a flexible shape-defined panorama, the scene's projection is {}",
+            projection.kind()
+        )));
+    };
+    let source = edit_source(&spec.source, rect).map_err(|e| refuse(e.message))?;
+    Ok(ProjectionSpec::Flexible(Box::new(FlexibleSpec {
+        source,
+        reparam: spec.reparam,
+    })))
 }
 
 /// `--shading` on the command line.

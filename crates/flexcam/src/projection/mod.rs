@@ -75,6 +75,12 @@ pub trait Projection: Send + Sync {
         false
     }
 
+    /// Why this projection has no inverse where its kind may have one (a panorama shape
+    /// outside the lookup's class), for error messages; `None` otherwise.
+    fn inverse_refusal(&self) -> Option<String> {
+        None
+    }
+
     /// Appends to `out` every image position of scene point `point`, each with the ray
     /// parameter that reaches it. Projections without an inverse append nothing.
     fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {

@@ -10,10 +10,11 @@
 //! - Coaxial cylinders: cylinder patches sharing the axis line, frame and angle range, with
 //!   different radii: t from the distance to the axis, u from the angle, v from the height.
 //!
-//! - Shape-defined panoramas with one outline and one profile: lookup tables of the curves'
-//!   angles (module `panorama::lookup`).
+//! - Shape-defined panoramas whose outlines and profiles (and their blends) are star-shaped
+//!   around the eye: lookup tables of the curves' angles (module `panorama::lookup`).
 //!
-//! Anything else has no inverse ([`Inverse::classify`] gives `None`).
+//! Anything else has no inverse ([`Inverse::classify`] gives `None`, or for a panorama the
+//! reason).
 
 use std::f64::consts::PI;
 
@@ -21,6 +22,7 @@ use glam::{DMat2, DVec2, DVec3};
 
 use super::panorama::lookup::{self, PanoramaInverse};
 use super::surface::{CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface};
+use crate::error::Result;
 
 /// Relative tolerance for "the same" centre, frame or range, and for the domain edges.
 const SAME: f64 = 1e-12;
@@ -128,11 +130,17 @@ fn as_sphere(s: &Surface, other: &Surface) -> Option<SpherePatch> {
 }
 
 impl Inverse {
-    /// The inverse of the volume between `near` and `far`, when it is in the analytic class.
-    pub fn classify(near: &Surface, far: &Surface) -> Option<Inverse> {
+    /// The inverse of the volume between `near` and `far`, when it is in the analytic class
+    /// (`None` outside it). Errors: a panorama outside the lookup's class, with the reason.
+    pub fn classify(near: &Surface, far: &Surface) -> Result<Option<Inverse>> {
         if let (Surface::Panorama(n), Surface::Panorama(f)) = (near, far) {
-            return PanoramaInverse::new(n, f).map(|p| Inverse::Panorama(Box::new(p)));
+            return PanoramaInverse::new(n, f).map(|p| Some(Inverse::Panorama(Box::new(p))));
         }
+        Ok(Inverse::classify_analytic(near, far))
+    }
+
+    /// The closed-form cases: nested spheres, coaxial cylinders, parallel planes.
+    fn classify_analytic(near: &Surface, far: &Surface) -> Option<Inverse> {
         if let (Some(n), Some(f)) = (as_sphere(near, far), as_sphere(far, near)) {
             let ok = same(n.center, f.center, n.radius.max(f.radius))
                 && same_frame(&n.frame, &f.frame)

@@ -111,6 +111,8 @@ pub struct Flexible {
     reparam: Reparam,
     resolution: Resolution,
     inverse: Option<Inverse>,
+    /// Why a panorama has no inverse (for the refusal of `--method raster`).
+    inverse_refusal: Option<String>,
 }
 
 impl Flexible {
@@ -123,15 +125,20 @@ impl Flexible {
         let resolution = Resolution::new(width, height)?;
         let aspect = f64::from(height) / f64::from(width);
         let (volume, reparam) = build_volume(spec, aspect)?;
-        let inverse = match &volume {
+        let classified = match &volume {
             Volume::Linear(v) => Inverse::classify(&v.near, &v.far),
             Volume::Piecewise(_)
             | Volume::Bezier(_)
             | Volume::Interpolated(_)
-            | Volume::Grid(_) => None,
+            | Volume::Grid(_) => Ok(None),
+        };
+        let (inverse, inverse_refusal) = match classified {
+            Ok(inverse) => (inverse, None),
+            Err(e) => (None, Some(e.message)),
         };
         Ok(Flexible {
             inverse,
+            inverse_refusal,
             volume,
             reparam,
             resolution,
@@ -262,9 +269,13 @@ impl Projection for Flexible {
     }
 
     /// True for the analytic class: parallel planes sharing a normal, nested spheres,
-    /// coaxial cylinders (see the `inverse` module).
+    /// coaxial cylinders, star-shaped panoramas (see the `inverse` module).
     fn has_inverse(&self) -> bool {
         self.inverse.is_some()
+    }
+
+    fn inverse_refusal(&self) -> Option<String> {
+        self.inverse_refusal.clone()
     }
 
     /// Appends the one image of `point` when it lies inside the viewing volume (t and

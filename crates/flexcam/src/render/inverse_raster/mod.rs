@@ -117,8 +117,11 @@ impl std::ops::AddAssign for PieceCounts {
 pub fn supported_chart(projection: &dyn Projection) -> Result<InverseChart> {
     let kind = projection.kind();
     if !projection.has_inverse() {
+        let why = projection
+            .inverse_refusal()
+            .map_or_else(String::new, |reason| format!(": {reason}"));
         return Err(Error::new(format!(
-            "method raster needs a projection with an analytic inverse; {kind} has none \
+            "method raster needs a projection with an analytic inverse; {kind} has none{why} \
              (use --method raycast)"
         )));
     }

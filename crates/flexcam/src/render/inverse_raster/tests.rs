@@ -372,20 +372,40 @@ fn delegated_shading_rays_are_counted() {
         .unwrap();
     assert_eq!(flat.get("shading_rays"), Some(&Counter::Count(0)));
 }
-/// The shape-defined panoramas (lookup-table inverse): the example scene and the cubic and
-/// rounded cubic presets on a built-in scene reach the 99.5 % id agreement target with
-/// adaptive subdivision, and errors fall with uniform subdivision.
+/// The shape-defined panoramas (lookup-table inverse): the example scenes (the rounded
+/// cubic preset, blended profiles, the rounded cubic preset edited across the seam) and the
+/// cubic and rounded cubic presets on a built-in scene reach the 99.5 % id agreement target
+/// with adaptive subdivision, and errors fall with uniform subdivision.
 #[test]
 fn panoramas_by_lookup_converge_to_the_ray_caster() {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../scenes/flexible-panorama-cubic.toml"
-    );
-    let example = scene::load(path).unwrap();
+    let example = |name: &str| {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/");
+        scene::load(&format!("{dir}{name}")).unwrap()
+    };
+    let example_scene = example("flexible-panorama-cubic.toml");
+    let custom = example("flexible-panorama-custom.toml");
+    let edited = example("flexible-panorama-cubic-edit.toml");
     let teapot = scene::load("builtin:teapot-room").unwrap();
     let (frame, _) = scene_camera(&teapot);
     let cases = [
-        ("example", &example, example.projection.clone(), (320, 120)),
+        (
+            "example",
+            &example_scene,
+            example_scene.projection.clone(),
+            (320, 120),
+        ),
+        (
+            "custom example",
+            &custom,
+            custom.projection.clone(),
+            (320, 160),
+        ),
+        (
+            "edited across the seam",
+            &edited,
+            edited.projection.clone(),
+            (320, 120),
+        ),
         (
             "cubic",
             &teapot,

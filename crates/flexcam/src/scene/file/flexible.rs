@@ -112,8 +112,8 @@ fn preset_keys(name: &str) -> &'static [&'static str] {
         "oblique" => &["width", "shear"],
         "pushbroom" => &["width", "v_fov"],
         "crossed_slits" => &["fov", "v_fov", "slit_distance"],
-        "cubic" => &["v_fov"],
-        "rounded_cubic" => &["v_fov", "corner_radius"],
+        "cubic" => &["v_fov", "perspective_rect"],
+        "rounded_cubic" => &["v_fov", "corner_radius", "perspective_rect"],
         "ortho_near_persp_far" => &["fov", "transition", "style"],
         "depth_transition" => &["fovs", "transitions", "style"],
         "occlusion" => &["fov", "transition", "pole", "strength"],
@@ -172,7 +172,11 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
                     takes.join(", ")
                 )
             })?;
-            VolumeSource::Preset(preset(required, name.get_ref())?)
+            let source = VolumeSource::Preset(preset(required, name.get_ref())?);
+            match &raw.perspective_rect {
+                None => source,
+                Some(rect) => super::panorama::perspective_rect(src, &source, rect)?,
+            }
         }
         None if super::panorama::is_panorama(raw) => {
             reject_keys(
@@ -186,7 +190,7 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
                     )
                 },
             )?;
-            VolumeSource::Panorama(super::panorama::convert(required)?)
+            super::panorama::convert(required)?
         }
         None if raw.surfaces.is_some() || raw.blend.is_some() => {
             reject_keys(

@@ -29,9 +29,10 @@ use super::raw::{RawCurve, RawProjection};
 use super::source::Source;
 use crate::error::Result;
 use crate::projection::flexible::panorama::{
-    make_perspective, ArcCurve, Attached, CurveBlend, OutlineShape, PanoramaShape, PanoramaSpec,
+    edit_source, ArcCurve, Attached, CurveBlend, OutlineShape, PanoramaShape, PanoramaSpec,
     ProfileShape,
 };
+use crate::projection::flexible::VolumeSource;
 
 /// The keys of a panorama table (besides `type` and `projectors`).
 pub(super) const KEYS: [&str; 12] = [
@@ -77,8 +78,8 @@ impl Family {
     }
 }
 
-/// Converts a panorama table (its keys already checked).
-pub(super) fn convert(required: &Required) -> Result<PanoramaSpec> {
+/// Converts a panorama table (its keys already checked) to a panorama source.
+pub(super) fn convert(required: &Required) -> Result<VolumeSource> {
     let src = required.src;
     let raw = required.raw();
     let outlines = family(required, Family::Outline, &raw.outline, &raw.outlines)?;
@@ -112,19 +113,26 @@ pub(super) fn convert(required: &Required) -> Result<PanoramaSpec> {
         };
         src.error(&at, e.message)
     })?;
-    let shape = match &raw.perspective_rect {
-        None => shape,
-        Some(rect) => {
-            src.all_finite(rect.get_ref(), rect, "perspective_rect")?;
-            make_perspective(&shape, *rect.get_ref())
-                .map_err(|e| src.error(&rect.span(), e.message))?
-        }
-    };
-    Ok(PanoramaSpec {
+    let panorama = VolumeSource::Panorama(PanoramaSpec {
         shape: Arc::new(shape),
         frame: camera_frame(src, required)?,
         clip: clip(src, raw)?,
-    })
+    });
+    match &raw.perspective_rect {
+        None => Ok(panorama),
+        Some(rect) => perspective_rect(src, &panorama, rect),
+    }
+}
+
+/// `source` with the local perspective edit over `perspective_rect` (a panorama, or the
+/// `cubic` and `rounded_cubic` presets); errors point at the rectangle.
+pub(super) fn perspective_rect(
+    src: &Source,
+    source: &VolumeSource,
+    rect: &Spanned<[f64; 4]>,
+) -> Result<VolumeSource> {
+    src.all_finite(rect.get_ref(), rect, "perspective_rect")?;
+    edit_source(source, *rect.get_ref()).map_err(|e| src.error(&rect.span(), e.message))
 }
 
 /// The curves of one family from its single key (`outline`) or its list (`outlines`).
@@ -278,7 +286,7 @@ fn curve(src: &Source, table: &Spanned<RawCurve>, which: Family) -> Result<ArcCu
 mod tests {
     use std::path::Path;
 
-    use super::make_perspective;
+    use crate::projection::flexible::panorama::make_perspective;
     use crate::projection::flexible::{Preset, VolumeSource};
     use crate::projection::ProjectionSpec;
     use crate::scene::file::parse;
@@ -364,10 +372,16 @@ mod tests {
         assert_eq!(*p.shape, edited);
         assert_ne!(p.shape, plain.shape);
         error_at(
+            &format!("{HEAD}{curves}perspective_rect = [0.4, 0.7, 0.6, 0.3]\n"),
+            7,
+            20,
+            "perspective rectangle [u0, v0, u1, v1] needs u0, u1, v0, v1 in [0, 1]",
+        );
+        error_at(
             &format!("{HEAD}{curves}perspective_rect = [0.6, 0.3, 0.4, 0.7]\n"),
             7,
             20,
-            "perspective rectangle [u0, v0, u1, v1] must satisfy 0 <= u0 < u1 <= 1",
+            "turns 288.0 degrees around the eye",
         );
         error_at(
             &format!("{HEAD}{curves}perspective_rect = [0.2, 0.3, 0.8, 0.7]\n"),
@@ -380,6 +394,45 @@ mod tests {
             7,
             20,
             "lies on or behind the up axis",
+        );
+    }
+
+    #[test]
+    fn cubic_presets_take_perspective_rect() {
+        let preset = |name: &str, rest: &str| {
+            format!(
+                "[projection]\ntype = \"flexible\"\npreset = \"{name}\"\nposition = [0, 1, 0]\n\
+                 look_at = [0, 1, -1]\n{rest}"
+            )
+        };
+        let rect = "perspective_rect = [0.9, 0.3, 0.1, 0.7]\n";
+        let VolumeSource::Panorama(p) = source(&preset("cubic", rect)) else {
+            panic!("not a panorama")
+        };
+        let VolumeSource::Preset(plain) = source(&preset("cubic", "")) else {
+            panic!("not a preset")
+        };
+        let shape = plain.panorama().unwrap().unwrap().shape;
+        assert_eq!(
+            *p.shape,
+            make_perspective(&shape, [0.9, 0.3, 0.1, 0.7]).unwrap()
+        );
+        let rounded = preset("rounded_cubic", &format!("corner_radius = 0.5\n{rect}"));
+        assert!(matches!(source(&rounded), VolumeSource::Panorama(_)));
+        error_at(
+            &preset(
+                "rounded_cubic",
+                "corner_radius = 0.5\nperspective_rect = [0.1, 0.3, 0.9, 0.7]\n",
+            ),
+            7,
+            20,
+            "turns 286.9 degrees around the eye",
+        );
+        error_at(
+            &preset("perspective", &format!("fov = 60\n{rect}")),
+            7,
+            20,
+            "`perspective_rect` is not a parameter of flexible preset \"perspective\"",
         );
     }
 

@@ -231,15 +231,22 @@ impl ArcCurve {
         self.pieces[i].at((s - start) / (self.ends[i] - start))
     }
 
-    /// The curve with the part over fractions [`s0`, `s1`] (0 <= s0 < s1 <= 1) replaced by
-    /// `piece`, which must join the curve at both ends; every other fraction keeps its point,
-    /// so the parameterisation outside the range is unchanged (inside it is the piece's own,
-    /// not the arc length of the new curve). Errors: a range outside [0, 1] or empty, a
-    /// piece that does not meet the curve at both ends (within 1e-9 of the curve's length).
+    /// The curve with the part over fractions [`s0`, `s1`] (0 <= s0 < s1 <= 1; on a closed
+    /// curve also s0 > s1: the part [s0, 1] and [0, s1] across its start, less than the
+    /// whole curve) replaced by `piece`, which must join the curve at both ends; every other
+    /// fraction keeps its point, so the parameterisation outside the range is unchanged
+    /// (inside it is the piece's own, not the arc length of the new curve). Across the start
+    /// the piece is split where its fraction reaches the curve's start, (1 - s0) / (1 - s0 +
+    /// s1), so the piece is parameterised over the unwrapped range [s0, s1 + 1] and the
+    /// curve's start moves onto the piece. Errors: a range outside [0, 1] or empty, a piece
+    /// that does not meet the curve at both ends (within 1e-9 of the curve's length).
     pub fn replace(&self, [s0, s1]: [f64; 2], piece: Piece) -> Result<ArcCurve> {
-        if !(0.0 <= s0 && s0 < s1 && s1 <= 1.0) {
+        let unit = |s: f64| (0.0..=1.0).contains(&s);
+        let across = self.closed && s1 < s0 && s0 - s1 < 1.0;
+        if !(unit(s0) && unit(s1) && (s0 < s1 || across)) {
             return Err(Error::new(format!(
-                "curve range must satisfy 0 <= start < end <= 1, got [{s0}, {s1}]"
+                "curve range must satisfy 0 <= start < end <= 1 (or start > end across the \
+                 start of a closed curve), got [{s0}, {s1}]"
             )));
         }
         let total: f64 = self.pieces.iter().map(Piece::length).sum();
@@ -262,10 +269,23 @@ impl ArcCurve {
                 start = end;
             }
         };
-        keep(0.0, s0, &mut pieces, &mut ends);
-        pieces.push(piece);
-        ends.push(s1);
-        keep(s1, 1.0, &mut pieces, &mut ends);
+        if across {
+            let split = (1.0 - s0) / (1.0 - s0 + s1);
+            if s1 > 0.0 {
+                pieces.push(piece.part(split, 1.0));
+                ends.push(s1);
+            }
+            keep(s1, s0, &mut pieces, &mut ends);
+            if s0 < 1.0 {
+                pieces.push(piece.part(0.0, split));
+                ends.push(1.0);
+            }
+        } else {
+            keep(0.0, s0, &mut pieces, &mut ends);
+            pieces.push(piece);
+            ends.push(s1);
+            keep(s1, 1.0, &mut pieces, &mut ends);
+        }
         Ok(ArcCurve {
             pieces,
             ends,
@@ -388,6 +408,28 @@ mod tests {
         assert!(e.message.contains("does not join"), "{e}");
         assert!(c.replace([0.3, 0.3], diagonal).is_err());
         assert!(c.replace([0.5, 1.5], diagonal).is_err());
+    }
+
+    #[test]
+    fn replace_across_the_start_of_a_closed_curve() {
+        // The unit square from the origin; replace fractions [0.875, 1] + [0, 0.125] (from
+        // (0, 0.5) around the start corner (0, 0) to (0.5, 0)) by the diagonal, which is
+        // parameterised over the unwrapped range [0.875, 1.125]: the start moves to its
+        // middle.
+        let square = [DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y];
+        let c = ArcCurve::polyline(&square, true).unwrap();
+        let (from, to) = (DVec2::new(0.0, 0.5), DVec2::new(0.5, 0.0));
+        let r = c.replace([0.875, 0.125], Piece::Line { from, to }).unwrap();
+        for s in [0.125, 0.3, 0.5, 0.8, 0.875] {
+            assert!(close(r.at(s), c.at(s)), "{s}");
+        }
+        assert!(close(r.at(0.0), DVec2::splat(0.25)) && close(r.at(1.0), r.at(0.0)));
+        assert!(close(r.at(0.9375), from.lerp(to, 0.25)));
+        assert!(close(r.at(0.0625), from.lerp(to, 0.75)));
+        // An open curve has no start to cross; a range of the whole curve is empty.
+        let open = ArcCurve::polyline(&square, false).unwrap();
+        assert!(open.replace([0.9, 0.1], Piece::Line { from, to }).is_err());
+        assert!(c.replace([1.0, 0.0], Piece::Line { from, to }).is_err());
     }
 
     #[test]

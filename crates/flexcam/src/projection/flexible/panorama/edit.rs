@@ -28,36 +28,78 @@
 //! surface stays continuous across the rectangle's borders, since the chords join the curves
 //! at their end points.
 //!
-//! Errors: a non-finite rectangle, one outside [0, 1]^2 or empty (u0 >= u1 or v0 >= v1);
-//! an outline range turning through 180 degrees or more around the eye (its chord would pass
-//! through or behind the eye; this includes ranges across the seam, which u0 < u1 excludes,
-//! so place the rectangle on one side of the seam); a profile end on or behind the up axis
+//! Across the seam: u0 > u1 names the rectangle [u0, 1] + [0, u1] (the image's right and
+//! left edges joined). The outlines' chords are parameterised over the unwrapped range
+//! [u0, u1 + 1] and split at the seam ([`ArcCurve::replace`]), so the outline's start (the
+//! seam column) moves onto the chord, off the ray straight behind the eye; the image stays
+//! continuous across the seam as before.
+//!
+//! The `cubic` and `rounded_cubic` presets take the edit as the panoramas they are
+//! ([`edit_source`]).
+//!
+//! Errors: a non-finite rectangle, one outside [0, 1]^2, u0 = u1 (or u0 = 1, u1 = 0: no
+//! width) or v0 >= v1; an outline range turning through 180 degrees or more around the eye
+//! (its chord would pass through or behind the eye); a profile end on or behind the up axis
 //! (P_x <= 0: the chord would meet the axis through the eye).
 
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 use glam::DVec2;
 
+use super::super::VolumeSource;
 use super::curve::{ArcCurve, Piece};
-use super::{Attached, PanoramaShape};
+use super::{Attached, PanoramaShape, PanoramaSpec};
 use crate::error::{Error, Result};
 
 /// Samples per outline range when measuring how far it turns around the eye.
 const TURN_SAMPLES: usize = 1024;
 
-/// The shape made perspective inside `rect` = [u0, v0, u1, v1] (module doc).
+/// The shape made perspective inside `rect` = [u0, v0, u1, v1] (module doc; u0 > u1: across
+/// the seam).
 pub fn make_perspective(shape: &PanoramaShape, rect: [f64; 4]) -> Result<PanoramaShape> {
     let [u0, v0, u1, v1] = rect;
-    let ordered = |a: f64, b: f64| 0.0 <= a && a < b && b <= 1.0;
-    if !(ordered(u0, u1) && ordered(v0, v1)) {
+    let unit = |x: f64| (0.0..=1.0).contains(&x);
+    let width = if u0 < u1 { u1 - u0 } else { 1.0 - u0 + u1 };
+    let across = u0 != u1 && width > 0.0;
+    if !(unit(u0) && unit(u1) && across && unit(v0) && unit(v1) && v0 < v1) {
         return Err(Error::new(format!(
-            "perspective rectangle [u0, v0, u1, v1] must satisfy 0 <= u0 < u1 <= 1 and \
-             0 <= v0 < v1 <= 1, got [{u0}, {v0}, {u1}, {v1}]"
+            "perspective rectangle [u0, v0, u1, v1] needs u0, u1, v0, v1 in [0, 1], u0 != u1 \
+             (u0 > u1: across the seam) and v0 < v1, got [{u0}, {v0}, {u1}, {v1}]"
         )));
     }
     let outlines = flatten(shape.outlines(), |c| outline_chord(c, [u0, u1]))?;
     let profiles = flatten(shape.profiles(), |c| profile_chord(c, [v0, v1]))?;
     PanoramaShape::new(outlines, profiles, shape.blend())
+}
+
+/// `source` with the perspective edit over `rect`: the shape of a shape-defined panorama, or
+/// of the panorama that a `cubic` or `rounded_cubic` preset is. Errors: any other volume,
+/// and those of [`make_perspective`].
+pub fn edit_source(source: &VolumeSource, rect: [f64; 4]) -> Result<VolumeSource> {
+    let spec = match source {
+        VolumeSource::Panorama(spec) => spec.clone(),
+        VolumeSource::Preset(preset) => match preset.panorama() {
+            Some(spec) => spec?,
+            None => {
+                return Err(Error::new(format!(
+                    "a perspective rectangle needs a shape-defined panorama (outlines and \
+                     profiles, or the cubic and rounded_cubic presets), not the {} preset",
+                    preset.preset.name()
+                )))
+            }
+        },
+        _ => {
+            return Err(Error::new(
+                "a perspective rectangle needs a shape-defined panorama (outlines and \
+                 profiles, or the cubic and rounded_cubic presets)",
+            ))
+        }
+    };
+    Ok(VolumeSource::Panorama(PanoramaSpec {
+        shape: Arc::new(make_perspective(&spec.shape, rect)?),
+        ..spec
+    }))
 }
 
 /// Each attached curve with `edit` applied.
@@ -75,9 +117,11 @@ fn flatten(
         .collect()
 }
 
-/// The outline with [u0, u1] replaced by its linearly parameterised chord.
+/// The outline with [u0, u1] (across the seam when u0 > u1) replaced by its linearly
+/// parameterised chord.
 fn outline_chord(curve: &ArcCurve, [u0, u1]: [f64; 2]) -> Result<ArcCurve> {
-    let turn = turning(curve, [u0, u1]);
+    let unwrapped = if u1 < u0 { u1 + 1.0 } else { u1 };
+    let turn = turning(curve, [u0, unwrapped]);
     if turn.abs() >= PI * (1.0 - 1e-9) {
         return Err(Error::new(format!(
             "perspective rectangle: the outline over u in [{u0}, {u1}] turns {:.1} degrees \
@@ -92,8 +136,9 @@ fn outline_chord(curve: &ArcCurve, [u0, u1]: [f64; 2]) -> Result<ArcCurve> {
     curve.replace([u0, u1], chord)
 }
 
-/// The signed angle the curve turns around the origin between fractions `range`, summed
-/// over [`TURN_SAMPLES`] steps (outlines never pass through the eye).
+/// The signed angle the curve turns around the origin between fractions `range` (a closed
+/// curve wraps past 1), summed over [`TURN_SAMPLES`] steps (outlines never pass through the
+/// eye).
 fn turning(curve: &ArcCurve, [a, b]: [f64; 2]) -> f64 {
     let point = |k: usize| curve.at(a + (b - a) * k as f64 / TURN_SAMPLES as f64);
     (0..TURN_SAMPLES)

@@ -35,7 +35,7 @@ use std::sync::Arc;
 use glam::{DVec2, DVec3};
 
 pub use self::curve::ArcCurve;
-pub use self::edit::make_perspective;
+pub use self::edit::{edit_source, make_perspective};
 pub use self::shape::{OutlineShape, ProfileShape};
 use super::super::camera_basis::CameraBasis;
 use super::super::CameraFrame;
@@ -141,31 +141,29 @@ impl PanoramaShape {
         self.blend
     }
 
-    /// The blended outline point at (u, v).
-    pub fn outline(&self, uv: DVec2) -> DVec2 {
+    /// The outlines blended at row `v`: the indices of the two neighbours and the weight of
+    /// the second (below the first and above the last outline: that one twice, weight 0).
+    pub fn outline_blend(&self, v: f64) -> (usize, usize, f64) {
         let list = &self.outlines;
-        let at = |i: usize| list[i].curve.at(uv.x);
-        let v = uv.y;
         let next = list.partition_point(|a| a.at <= v);
         if next == 0 {
-            return at(0);
+            return (0, 0, 0.0);
         }
         if next == list.len() {
-            return at(list.len() - 1);
+            return (next - 1, next - 1, 0.0);
         }
         let (a, b) = (list[next - 1].at, list[next].at);
-        let w = self.blend.weight((v - a) / (b - a));
-        at(next - 1).lerp(at(next), w)
+        (next - 1, next, self.blend.weight((v - a) / (b - a)))
     }
 
-    /// The blended profile point at (u, v); profiles wrap across the seam.
-    pub fn profile(&self, uv: DVec2) -> DVec2 {
+    /// The profiles blended at column `u` (wrapping across the seam): the indices of the two
+    /// neighbours and the weight of the second (one profile: itself twice, weight 0).
+    pub fn profile_blend(&self, u: f64) -> (usize, usize, f64) {
         let list = &self.profiles;
-        let at = |i: usize| list[i].curve.at(uv.y);
         if list.len() == 1 {
-            return at(0);
+            return (0, 0, 0.0);
         }
-        let u = uv.x.rem_euclid(1.0);
+        let u = u.rem_euclid(1.0);
         let next = list.partition_point(|a| a.at <= u);
         let (i, j) = if next == 0 || next == list.len() {
             (list.len() - 1, 0)
@@ -174,7 +172,17 @@ impl PanoramaShape {
         };
         let span = (list[j].at - list[i].at).rem_euclid(1.0);
         let s = (u - list[i].at).rem_euclid(1.0) / span;
-        at(i).lerp(at(j), self.blend.weight(s))
+        (i, j, self.blend.weight(s))
+    }
+
+    /// The blended outline point at (u, v).
+    pub fn outline(&self, uv: DVec2) -> DVec2 {
+        blended(&self.outlines, self.outline_blend(uv.y), uv.x)
+    }
+
+    /// The blended profile point at (u, v); profiles wrap across the seam.
+    pub fn profile(&self, uv: DVec2) -> DVec2 {
+        blended(&self.profiles, self.profile_blend(uv.x), uv.y)
     }
 
     /// Q_1(u, v): the surface point at scale 1 in camera-local (right, up, forward)
@@ -183,6 +191,16 @@ impl PanoramaShape {
         let o = self.outline(uv);
         let p = self.profile(uv);
         DVec3::new(o.x * p.x, p.y, o.y * p.x)
+    }
+}
+
+/// The point at fraction `s` of the blend `(i, j, w)` of the curves of `list`.
+fn blended(list: &[Attached], (i, j, w): (usize, usize, f64), s: f64) -> DVec2 {
+    let a = list[i].curve.at(s);
+    if i == j || w == 0.0 {
+        a
+    } else {
+        a.lerp(list[j].curve.at(s), w)
     }
 }
 

@@ -324,10 +324,94 @@ fn surface_validation() {
     assert!(spec.surfaces().unwrap_err().message.contains("clip"));
 }
 
+/// The points `p` as a list of 2D points.
+fn points(p: &[[f64; 2]]) -> Vec<DVec2> {
+    p.iter().map(|&q| DVec2::from_array(q)).collect()
+}
+
+/// The shape of `scenes/flexible-panorama-custom.toml`: a flattened circle and two profiles
+/// blended smoothly, an arc at the seam and a segment in front.
+fn custom_example() -> PanoramaShape {
+    let outline = OutlineShape::Points(points(&[
+        [0.0, -1.0],
+        [-0.7, -0.7],
+        [-1.0, 0.0],
+        [-0.6, 0.8],
+        [0.6, 0.8],
+        [1.0, 0.0],
+        [0.7, -0.7],
+    ]));
+    let attach = |at, curve| Attached { at, curve };
+    let degrees = |a: f64, b: f64| [a.to_radians(), b.to_radians()];
+    PanoramaShape::new(
+        vec![attach(0.0, outline.curve().unwrap())],
+        vec![
+            attach(
+                0.0,
+                ProfileShape::Arc {
+                    elevation: degrees(-90.0, 90.0),
+                }
+                .curve()
+                .unwrap(),
+            ),
+            attach(
+                0.5,
+                ProfileShape::Segment {
+                    elevation: degrees(-50.0, 50.0),
+                }
+                .curve()
+                .unwrap(),
+            ),
+        ],
+        CurveBlend::Smooth,
+    )
+    .unwrap()
+}
+
+/// Two outlines (a square low, an off-centre polygon high) and three profiles, blended
+/// linearly: u and v are coupled.
+fn two_outlines_three_profiles() -> PanoramaShape {
+    let attach = |at, curve| Attached { at, curve };
+    let polygon = OutlineShape::Points(points(&[
+        [1.5, -1.0],
+        [2.0, 2.5],
+        [-1.0, 1.5],
+        [-1.2, -0.8],
+    ]));
+    let profile = |p: &[[f64; 2]]| ProfileShape::Points(points(p)).curve().unwrap();
+    PanoramaShape::new(
+        vec![
+            attach(0.25, OutlineShape::Square.curve().unwrap()),
+            attach(0.7, polygon.curve().unwrap()),
+        ],
+        vec![
+            attach(0.1, profile(&[[1.0, -1.5], [1.2, 0.0], [0.8, 1.2]])),
+            attach(
+                0.45,
+                ProfileShape::Arc {
+                    elevation: [-1.4, 1.4],
+                }
+                .curve()
+                .unwrap(),
+            ),
+            attach(
+                0.8,
+                ProfileShape::Segment {
+                    elevation: [-0.9, 1.0],
+                }
+                .curve()
+                .unwrap(),
+            ),
+        ],
+        CurveBlend::Linear,
+    )
+    .unwrap()
+}
+
 /// The panoramas of the lookup inverse's round-trip tests: exact shapes, a polyline outline
-/// off the eye's centre (non-unit rho) and a polyline profile.
+/// off the eye's centre (non-unit rho) and a polyline profile, blended profiles, blended
+/// outlines and profiles, and a perspective edit across the seam.
 fn invertible_panoramas() -> Vec<(&'static str, FlexibleSpec)> {
-    let points = |p: &[[f64; 2]]| p.iter().map(|&q| DVec2::from_array(q)).collect::<Vec<_>>();
     let custom = single(
         OutlineShape::Points(points(&[
             [2.0, -1.0],
@@ -337,6 +421,7 @@ fn invertible_panoramas() -> Vec<(&'static str, FlexibleSpec)> {
         ])),
         ProfileShape::Points(points(&[[1.0, -2.0], [1.5, 0.0], [1.0, 1.0], [0.2, 1.5]])),
     );
+    let across_seam = make_perspective(&two_outlines_three_profiles(), [0.9, 0.2, 0.1, 0.6]);
     vec![
         ("cubic", preset(Preset::Cubic { v_fov: 100.0 }, None)),
         (
@@ -362,6 +447,15 @@ fn invertible_panoramas() -> Vec<(&'static str, FlexibleSpec)> {
             ),
         ),
         ("custom", panorama(custom, Some([0.1, 50.0]))),
+        ("custom example", panorama(custom_example(), None)),
+        (
+            "two outlines",
+            panorama(two_outlines_three_profiles(), Some([0.2, 30.0])),
+        ),
+        (
+            "edited across the seam",
+            panorama(across_seam.unwrap(), None),
+        ),
     ]
 }
 
@@ -374,12 +468,12 @@ mod round_trip {
     use super::*;
 
     proptest! {
-        #![proptest_config(ProptestConfig::with_cases(256))]
+        #![proptest_config(ProptestConfig::with_cases(512))]
 
         /// A point on the projector of pixel q at depth t projects back to q and t, and the
         /// ray of the projected pixel reaches the point at the projected t.
         #[test]
-        fn project_then_cast(which in 0usize..4, x in 0.0f64..1.0, y in 0.02f64..0.98, t in 0.0f64..1.0) {
+        fn project_then_cast(which in 0usize..7, x in 0.0f64..1.0, y in 0.02f64..0.98, t in 0.0f64..1.0) {
             let (name, spec) = &invertible_panoramas()[which];
             let (w, h) = (360, 180);
             let f = Flexible::new(spec, w, h).unwrap();
@@ -406,39 +500,94 @@ mod round_trip {
 
 #[test]
 fn lookup_inverse_is_refused_outside_its_class() {
-    let profile = |points: &[[f64; 2]]| {
-        ProfileShape::Points(points.iter().map(|&p| DVec2::from_array(p)).collect())
-    };
+    let profile = |p: &[[f64; 2]]| ProfileShape::Points(points(p));
     let across = single(OutlineShape::Circle, profile(&[[1.0, 0.0], [-1.0, 2.0]]));
     let folded = single(
         OutlineShape::Circle,
         profile(&[[1.0, 0.0], [1.0, 2.0], [3.0, 1.0]]),
     );
     // Not star-shaped around the eye: a notch whose azimuth runs backwards.
-    let notch = OutlineShape::Points(
-        [
-            [0.0, -1.0],
-            [-1.0, 0.0],
-            [0.0, 1.0],
-            [0.2, 0.3],
-            [0.4, 1.0],
-            [1.0, 0.0],
-        ]
-        .iter()
-        .map(|&p| DVec2::from_array(p))
-        .collect(),
-    );
+    let notch = OutlineShape::Points(points(&[
+        [0.0, -1.0],
+        [-1.0, 0.0],
+        [0.0, 1.0],
+        [0.2, 0.3],
+        [0.4, 1.0],
+        [1.0, 0.0],
+    ]));
     let star = single(notch, profile(&[[1.0, -1.0], [1.0, 1.0]]));
-    for (name, shape) in [
-        ("across", across),
-        ("folded", folded),
-        ("notch", star),
-        ("blend", two_profiles(CurveBlend::Linear)),
+    // Two star-shaped outlines whose blend is not: the circle, and a circle with a long
+    // spike to the right (tip at x = 7.5), three times as long, so that by arc length its
+    // points near the start run up to 175 degrees ahead of the circle's, three times as
+    // fast: the blend turns back there.
+    let on_circle = |degrees: i32| {
+        let a = f64::from(degrees).to_radians();
+        DVec2::new(a.sin(), a.cos())
+    };
+    let mut spiked: Vec<DVec2> = (-18..=8).map(|k| on_circle(10 * k)).collect();
+    spiked.extend([DVec2::new(7.5, 0.1), DVec2::new(7.5, -0.1)]);
+    spiked.extend((10..=17).map(|k| on_circle(10 * k)));
+    let spiked = OutlineShape::Points(spiked);
+    let attach = |at, curve| Attached { at, curve };
+    let segment = || profile(&[[1.0, -1.0], [1.0, 1.0]]).curve().unwrap();
+    let outlines = PanoramaShape::new(
+        vec![
+            attach(0.2, OutlineShape::Circle.curve().unwrap()),
+            attach(0.8, spiked.curve().unwrap()),
+        ],
+        vec![attach(0.0, segment())],
+        CurveBlend::Smooth,
+    )
+    .unwrap();
+    // Two rising profiles whose blend dips: one rises early (then climbs far up near the
+    // axis), the other late (after coming up from far below): at one v their points are
+    // 160 degrees apart and the late one's is far from the eye.
+    let early = profile(&[[1.0, -1.0], [0.2, 5.0], [0.2, 50.0]]);
+    let late = profile(&[[0.2, -50.0], [0.2, -5.0], [1.0, 1.0]]);
+    let profiles = PanoramaShape::new(
+        vec![attach(0.0, OutlineShape::Circle.curve().unwrap())],
+        vec![
+            attach(0.2, early.curve().unwrap()),
+            attach(0.6, late.curve().unwrap()),
+        ],
+        CurveBlend::Linear,
+    )
+    .unwrap();
+    for (name, shape, reason) in [
+        ("across", across, "profile reaches behind the up axis"),
+        ("folded", folded, "profile does not rise strictly"),
+        ("notch", star, "outline is not star-shaped around the eye"),
+        (
+            "outline blend",
+            outlines,
+            "blend of the panorama's outlines at v = 0.2 and 0.8 is not star-shaped",
+        ),
+        (
+            "profile blend",
+            profiles,
+            "blend of the panorama's profiles at u = 0.2 and 0.6 does not rise strictly",
+        ),
     ] {
         let f = Flexible::new(&panorama(shape, None), 32, 16).unwrap();
         assert!(!f.has_inverse(), "{name}");
+        let why = f.inverse_refusal().unwrap();
+        assert!(why.contains(reason), "{name}: {why}");
         // Ray casting still works.
         assert!(f.ray(DVec2::new(16.0, 8.0)).is_some(), "{name}");
+    }
+}
+
+#[test]
+fn blended_panoramas_have_a_lookup_inverse() {
+    for shape in [
+        two_profiles(CurveBlend::Linear),
+        two_profiles(CurveBlend::Smooth),
+        custom_example(),
+        two_outlines_three_profiles(),
+    ] {
+        let f = Flexible::new(&panorama(shape, None), 32, 16).unwrap();
+        assert!(f.has_inverse() && f.inverse_refusal().is_none());
+        assert!(f.inverse_chart().is_some());
     }
 }
 

@@ -329,6 +329,33 @@ impl PresetSpec {
         })
     }
 
+    /// The `cubic` and `rounded_cubic` presets as the shape-defined panoramas they are: the
+    /// square (or rounded square) outline and the vertical segment profile between
+    /// elevations +-`v_fov`/2, with the preset's frame and clip; `None` for the other
+    /// presets. Errors: a bad `v_fov` or corner radius.
+    pub fn panorama(&self) -> Option<Result<PanoramaSpec>> {
+        let (v_fov, outline) = match self.preset {
+            Preset::Cubic { v_fov } => (v_fov, OutlineShape::Square),
+            Preset::RoundedCubic {
+                v_fov,
+                corner_radius,
+            } => (
+                v_fov,
+                OutlineShape::RoundedSquare {
+                    radius: corner_radius,
+                },
+            ),
+            _ => return None,
+        };
+        Some(
+            cubic_shape(&self.preset, v_fov, outline).map(|shape| PanoramaSpec {
+                shape: Arc::new(shape),
+                frame: self.frame,
+                clip: self.clip,
+            }),
+        )
+    }
+
     /// The viewing volume for an image of aspect ratio `aspect` = height / width: two
     /// surfaces with straight projectors ([`PresetSpec::surfaces`]), or the blended volumes
     /// of the depth transitions and the occlusion camera. Errors: those of
@@ -514,21 +541,10 @@ impl PresetSpec {
                 let frame = PolarFrame::new(b.up, b.forward)?;
                 pair(&|d| sphere(b.origin, d, frame, [-h, h], [-v, v]))
             }
-            Preset::Cubic { v_fov } => {
-                cubic(p, self.frame, [near, far], v_fov, OutlineShape::Square)?
-            }
-            Preset::RoundedCubic {
-                v_fov,
-                corner_radius,
-            } => cubic(
-                p,
-                self.frame,
-                [near, far],
-                v_fov,
-                OutlineShape::RoundedSquare {
-                    radius: corner_radius,
-                },
-            )?,
+            Preset::Cubic { .. } | Preset::RoundedCubic { .. } => match self.panorama() {
+                Some(panorama) => panorama?.surfaces()?,
+                None => return Err(Error::new("flexible cubic preset without its panorama")),
+            },
             Preset::Fisheye { fov } => {
                 let half = 0.5 * angle(p, "fov", fov, UpTo::Including(360.0))?;
                 // Pole on the view axis, longitude 0 to the right, +90 up: the polar map's
@@ -580,15 +596,9 @@ impl PresetSpec {
     }
 }
 
-/// The near and far surfaces of a cubic panorama with outline `outline` and the vertical
-/// segment profile between elevations +-`v_fov`/2.
-fn cubic(
-    preset: &Preset,
-    frame: CameraFrame,
-    clip: [f64; 2],
-    v_fov: f64,
-    outline: OutlineShape,
-) -> Result<(Surface, Surface)> {
+/// The shape of a cubic panorama with outline `outline` and the vertical segment profile
+/// between elevations +-`v_fov`/2. Errors: a bad `v_fov` or outline parameter.
+fn cubic_shape(preset: &Preset, v_fov: f64, outline: OutlineShape) -> Result<PanoramaShape> {
     let half = 0.5 * angle(preset, "v_fov", v_fov, UpTo::Below(180.0))?;
     let outline = outline
         .curve()
@@ -597,12 +607,7 @@ fn cubic(
         elevation: [-half, half],
     }
     .curve()?;
-    PanoramaSpec {
-        shape: Arc::new(PanoramaShape::single(outline, profile)?),
-        frame,
-        clip: Some(clip),
-    }
-    .surfaces()
+    PanoramaShape::single(outline, profile)
 }
 
 fn sphere(

@@ -11,6 +11,7 @@ use super::*;
 use crate::projection::camera_basis::CameraBasis;
 use crate::projection::flexible::panorama::lookup::PanoramaInverse;
 use crate::projection::flexible::panorama::{OutlineShape, PanoramaSurface, ProfileShape};
+use crate::projection::flexible::presets::{Preset, PresetSpec};
 use crate::projection::CameraFrame;
 
 /// Image size the deviations are measured in.
@@ -60,13 +61,18 @@ fn local(az: f64, el: f64, r: f64) -> DVec3 {
 
 /// The largest distance in pixels of the image of the scene segment from `a` to `b`
 /// (camera-local) from the straight line between the images of its ends; every sample must
-/// image inside the rectangle.
-fn deviation(inv: &PanoramaInverse, a: DVec3, b: DVec3) -> f64 {
+/// image inside `rect` (u0 > u1: across the seam, where u is unwrapped).
+fn deviation(inv: &PanoramaInverse, rect: [f64; 4], a: DVec3, b: DVec3) -> f64 {
     let b3 = basis();
+    let across = rect[0] > rect[2];
     let pixel = |p: DVec3| {
-        let (uv, _) = inv.solve(b3.origin + b3.to_world(p)).unwrap();
+        let (mut uv, _) = inv.solve(b3.origin + b3.to_world(p)).unwrap();
+        if across && uv.x < 0.5 {
+            uv.x += 1.0;
+        }
+        let u1 = if across { rect[2] + 1.0 } else { rect[2] };
         assert!(
-            (RECT[0]..=RECT[2]).contains(&uv.x) && (RECT[1]..=RECT[3]).contains(&uv.y),
+            (rect[0]..=u1).contains(&uv.x) && (rect[1]..=rect[3]).contains(&uv.y),
             "{uv} outside the rectangle"
         );
         DVec2::new(uv.x * WIDTH, uv.y * HEIGHT)
@@ -94,7 +100,10 @@ fn straight_lines_image_straight_inside_the_rectangle() {
     let before = inverse(equirect());
     let after = inverse(make_perspective(&equirect(), RECT).unwrap());
     for (a, b) in segments() {
-        let (bent, straight) = (deviation(&before, a, b), deviation(&after, a, b));
+        let (bent, straight) = (
+            deviation(&before, RECT, a, b),
+            deviation(&after, RECT, a, b),
+        );
         println!("deviation before {bent:.3} px, after {straight:.2e} px");
         assert!(bent > 2.0, "before the edit the line bends: {bent} px");
         assert!(
@@ -151,22 +160,132 @@ fn a_vertical_segment_profile_stays_linear() {
     }
 }
 
+/// Segments (camera-local) seen around azimuth `centre` degrees within +-30 degrees, at
+/// elevations within +-20 degrees, ends at different distances.
+fn segments_around(centre: f64) -> [(DVec3, DVec3); 3] {
+    [
+        (
+            local(centre - 28.0, 5.0, 5.0),
+            local(centre + 25.0, 18.0, 8.0),
+        ),
+        (
+            local(centre - 28.0, -15.0, 4.0),
+            local(centre + 28.0, -15.0, 4.0),
+        ),
+        (
+            local(centre - 10.0, -18.0, 6.0),
+            local(centre + 5.0, 18.0, 3.0),
+        ),
+    ]
+}
+
+/// Before and after the edit of `shape` over `rect`, the largest deviation of the segments.
+fn bent_and_straight(shape: &PanoramaShape, rect: [f64; 4], centre: f64) -> (f64, f64) {
+    let before = inverse(shape.clone());
+    let after = inverse(make_perspective(shape, rect).unwrap());
+    let worst = |inv: &PanoramaInverse| {
+        segments_around(centre)
+            .iter()
+            .map(|&(a, b)| deviation(inv, rect, a, b))
+            .fold(0.0, f64::max)
+    };
+    (worst(&before), worst(&after))
+}
+
+/// The cubic and rounded cubic presets take the edit as panoramas: a rectangle from the view
+/// direction to the right (u in [0.5, 0.75], azimuths 0 to 90 degrees) across the
+/// front-right corner makes the lines across the corner straight.
+#[test]
+fn cubic_presets_take_the_edit_across_a_corner() {
+    let spec = |preset| PresetSpec {
+        preset,
+        frame: CameraFrame {
+            position: DVec3::new(1.0, 2.0, 3.0),
+            look_at: DVec3::new(-2.0, 1.0, 0.0),
+            up: DVec3::Y,
+        },
+        clip: None,
+    };
+    let rect = [0.5, 0.2, 0.75, 0.8];
+    for preset in [
+        Preset::Cubic { v_fov: 100.0 },
+        Preset::RoundedCubic {
+            v_fov: 100.0,
+            corner_radius: 0.3,
+        },
+    ] {
+        let name = preset.name();
+        let source = edit_source(&VolumeSource::Preset(spec(preset.clone())), rect).unwrap();
+        let VolumeSource::Panorama(edited) = source else {
+            panic!("{name}: not a panorama");
+        };
+        let plain = spec(preset).panorama().unwrap().unwrap();
+        assert_eq!(
+            *edited.shape,
+            make_perspective(&plain.shape, rect).unwrap(),
+            "{name}"
+        );
+        let (bent, straight) = bent_and_straight(&plain.shape, rect, 45.0);
+        println!("{name}: deviation before {bent:.3} px, after {straight:.2e} px");
+        assert!(
+            bent > 2.0,
+            "{name}: before the edit the lines bend: {bent} px"
+        );
+        assert!(straight < 0.01, "{name}: after the edit: {straight} px");
+    }
+    // Other volumes are refused.
+    let perspective = VolumeSource::Preset(spec(Preset::Perspective { fov: 60.0 }));
+    let e = edit_source(&perspective, rect).unwrap_err();
+    assert!(e.message.contains("not the perspective preset"), "{e}");
+}
+
+/// A rectangle across the seam (u in [0.875, 1] + [0, 0.125]: 90 degrees behind the eye)
+/// is flattened as one chord: lines behind the eye image straight (in unwrapped u); rays
+/// outside its u and v ranges are unchanged.
+#[test]
+fn a_rectangle_across_the_seam_is_one_perspective_view() {
+    let rect = [0.875, 0.3, 0.125, 0.8];
+    let (bent, straight) = bent_and_straight(&equirect(), rect, 180.0);
+    println!("across the seam: deviation before {bent:.3} px, after {straight:.2e} px");
+    assert!(bent > 2.0, "{bent} px");
+    assert!(straight < 0.01, "{straight} px");
+    let old = equirect();
+    let new = make_perspective(&old, rect).unwrap();
+    for uv in [
+        DVec2::new(0.5, 0.1),
+        DVec2::new(0.3, 0.2),
+        DVec2::new(0.7, 0.9),
+    ] {
+        assert!((new.local(uv) - old.local(uv)).length() < 1e-12, "{uv}");
+    }
+    // The seam column moved onto the chord (the middle of the range: the chord's nearest
+    // point, straight behind the eye at distance cos 45 degrees), and u = 0 and 1 agree.
+    let seam = new.outline(DVec2::new(0.0, 0.5));
+    assert!((seam - DVec2::new(0.0, -(0.5f64.sqrt()))).length() < 1e-12);
+    assert!((new.local(DVec2::new(1.0, 0.3)) - new.local(DVec2::new(0.0, 0.3))).length() < 1e-12);
+}
+
 #[test]
 fn bad_rectangles_are_refused() {
     let shape = equirect();
     for rect in [
         [-0.1, 0.4, 0.6, 0.8],
         [0.4, 0.4, 0.6, 1.2],
-        [0.6, 0.4, 0.4, 0.8],
+        [0.4, 0.6, 0.6, 0.4],
         [0.4, 0.5, 0.6, 0.5],
+        [0.5, 0.4, 0.5, 0.8],
+        [1.0, 0.4, 0.0, 0.8],
         [f64::NAN, 0.4, 0.6, 0.8],
     ] {
         let e = make_perspective(&shape, rect).unwrap_err();
-        assert!(e.message.contains("0 <= u0 < u1 <= 1"), "{e}");
+        assert!(e.message.contains("needs u0, u1, v0, v1 in [0, 1]"), "{e}");
     }
     // 216 degrees of the circle: the chord passes the eye.
     let e = make_perspective(&shape, [0.2, 0.4, 0.8, 0.6]).unwrap_err();
     assert!(e.message.contains("turns 216.0 degrees"), "{e}");
+    // Across the seam likewise: [0.6, 1] + [0, 0.4] turns 288 degrees.
+    let e = make_perspective(&shape, [0.6, 0.4, 0.4, 0.8]).unwrap_err();
+    assert!(e.message.contains("turns 288.0 degrees"), "{e}");
     // Exactly half the circle: the chord runs through the eye.
     assert!(make_perspective(&shape, [0.25, 0.4, 0.75, 0.6]).is_err());
     // The whole height of the semicircle ends at the poles, on the axis.
