@@ -28,6 +28,9 @@ enum Command {
     Reproject(commands::reproject::ReprojectArgs),
     /// Render a scene's keyframed flexible camera to numbered PNG frames and/or a GIF.
     Animate(commands::animate::AnimateArgs),
+    /// Fit a scene's projector grid to its `fit` correspondences and write the scene with the
+    /// fitted node projectors explicit.
+    Fit(commands::fit::FitArgs),
     /// List the built-in scenes: name, then a description.
     Scenes,
     /// Render a scene with a method and with the reference ray caster, and report how closely
@@ -47,6 +50,7 @@ fn main() -> ExitCode {
         Command::Render(args) => commands::render::run(&args),
         Command::Animate(args) => commands::animate::run(&args),
         Command::Reproject(args) => commands::reproject::run(&args),
+        Command::Fit(args) => commands::fit::run(&args),
         Command::Scenes => commands::scenes::run(),
         Command::Compare(args) => commands::compare::run(&args),
         Command::Bench(command) => commands::bench::run(&command),

@@ -890,3 +890,89 @@ fn perspective_rect_option_edits_the_panorama() {
         &["render", scene, "--perspective-rect", "0.4,0.3,0.6"],
     );
 }
+
+/// Renders `scene` flat at its own size; returns the colour and id PNG files' bytes.
+fn flat_render_bytes(dir: &TempDir, scene: &str, name: &str) -> (Vec<u8>, Vec<u8>) {
+    let (color, ids) = (format!("{name}.png"), format!("{name}-ids.png"));
+    run_ok(
+        dir,
+        &[
+            "render",
+            scene,
+            "--shading",
+            "flat",
+            "-o",
+            &color,
+            "--ids",
+            &ids,
+        ],
+    );
+    (
+        fs::read(dir.path().join(&color)).unwrap(),
+        fs::read(dir.path().join(&ids)).unwrap(),
+    )
+}
+
+/// `flexcam fit` writes the fitted grid as explicit node projectors, keeping the file's
+/// comments, and the written scene renders bit for bit like the fitting scene.
+#[test]
+fn fit_writes_a_scene_that_renders_like_the_fitting_scene() {
+    let dir = TempDir::new().unwrap();
+    let example = example_scene("flexible-projector-fit.toml");
+    write(&dir, "fitting.toml", &fs::read_to_string(example).unwrap());
+    let out = run_ok(&dir, &["fit", "fitting.toml", "-o", "fitted.toml"]);
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        stdout.starts_with("fitted 5 correspondences (3 nodes unconstrained): residual max "),
+        "{stdout}"
+    );
+    let fitted = fs::read_to_string(dir.path().join("fitted.toml")).unwrap();
+    assert!(!fitted.contains("fit = ["), "{fitted}");
+    assert_eq!(fitted.matches("{ node = [").count(), 9, "{fitted}");
+    // The artist's comments survive.
+    assert!(
+        fitted.contains("# Extension: one colour per face"),
+        "{fitted}"
+    );
+    let original = flat_render_bytes(&dir, "fitting.toml", "original");
+    let written = flat_render_bytes(&dir, "fitted.toml", "written");
+    assert!(original.1.len() > 100);
+    assert!(original.0 == written.0, "colour images differ");
+    assert!(original.1 == written.1, "id images differ");
+}
+
+/// `flexcam fit` errors: nothing to fit, a missing file, writing over the input, a bad
+/// extension and a scene that does not load are one line each, and nothing is written.
+#[test]
+fn fit_errors_are_one_line_and_write_nothing() {
+    let dir = TempDir::new().unwrap();
+    write(&dir, "plain.toml", GOOD_SCENE);
+    let nothing = expect_failure(&dir, &["fit", "plain.toml", "-o", "out.toml"]);
+    assert!(
+        nothing.starts_with("flexcam: plain.toml: nothing to fit"),
+        "{nothing}"
+    );
+    let missing = expect_failure(&dir, &["fit", "none.toml", "-o", "out.toml"]);
+    assert!(
+        missing.starts_with("flexcam: none.toml: cannot read scene file"),
+        "{missing}"
+    );
+    let over = expect_failure(&dir, &["fit", "plain.toml", "-o", "plain.toml"]);
+    assert!(over.contains("would overwrite the fitting scene"), "{over}");
+    let extension = expect_failure(&dir, &["fit", "plain.toml", "-o", "out.txt"]);
+    assert!(
+        extension.contains("unsupported output extension"),
+        "{extension}"
+    );
+    // A correspondence at its own projector's start: the scene does not load, with the
+    // file named.
+    let bad = GOOD_SCENE.replace(
+        "type = \"perspective\"",
+        "type = \"flexible\"\npreset = \"perspective\"\nclip = [1.0, 40.0]\n\
+         projectors = { size = [3, 3], fit = [{ uv = [0.5, 0.5], point = [0.0, 1.0, 5.0] }] }",
+    );
+    write(&dir, "bad.toml", &bad);
+    let e = expect_failure(&dir, &["fit", "bad.toml", "-o", "out.toml"]);
+    assert!(e.starts_with("flexcam: bad.toml:"), "{e}");
+    assert!(!dir.path().join("out.toml").exists());
+}

@@ -67,7 +67,8 @@ pub struct FitReport {
 }
 
 /// Fits the node directions of `prior` to `correspondences` (see the module docs); returns the
-/// fitted grid, with the prior's starts and interpolation, and its residual.
+/// fitted grid, with the prior's starts and interpolation, and its residual. A prior with
+/// tangents (curved projectors) is refused: the fit solves for straight node projectors.
 ///
 /// The solve runs twice, the second time with the first fit as its prior: the prior term pulls
 /// every direction towards the prior by about `PRIOR_WEIGHT` times their difference, which for
@@ -77,6 +78,12 @@ pub fn fit(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport)> {
+    if prior.is_curved() {
+        return Err(Error::new(
+            "projector grid fit: the grid has node tangents (curved projectors), but the fit \
+             solves for straight ones; give tangents in a scene without `fit`",
+        ));
+    }
     let (first, _) = fit_once(prior, correspondences)?;
     fit_once(&first, correspondences)
 }
@@ -256,7 +263,7 @@ fn residual(
         .iter()
         .zip(targets)
         .map(|(c, a)| {
-            let d = grid.tangent(c.uv).normalize();
+            let d = grid.tangent(c.uv, 0.0).normalize();
             // atan2 of |cross| and dot: accurate for tiny angles, unlike acos.
             d.cross(*a).length().atan2(d.dot(*a)).to_degrees()
         })
@@ -277,8 +284,11 @@ fn residual(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::projection::flexible::presets::Preset;
     use crate::projection::flexible::projector_grid::tests::perspective_volume as perspective;
+    use crate::projection::flexible::projector_grid::tests::preset_volume;
     use crate::projection::flexible::projector_grid::GridInterpolation;
+    use crate::projection::flexible::volume::LinearVolume;
     use proptest::prelude::*;
 
     /// Correspondences seen by `truth`: one per cell of a `per_side x per_side` jittered
@@ -286,6 +296,15 @@ mod tests {
     /// at a depth t in (0.05, 0.9).
     fn correspondences_of(
         truth: &ProjectorGrid,
+        per_side: usize,
+        seed: u64,
+    ) -> Vec<Correspondence> {
+        correspondences_from(|uv, t| truth.point(uv, t), per_side, seed)
+    }
+
+    /// [`correspondences_of`] any volume, given as Q(u, v, t).
+    fn correspondences_from(
+        volume: impl Fn(DVec2, f64) -> DVec3,
         per_side: usize,
         seed: u64,
     ) -> Vec<Correspondence> {
@@ -306,7 +325,7 @@ mod tests {
                 let t = 0.05 + 0.85 * next();
                 out.push(Correspondence {
                     uv,
-                    point: truth.point(uv, t),
+                    point: volume(uv, t),
                 });
             }
         }
@@ -319,7 +338,10 @@ mod tests {
         for i in 0..=16 {
             for j in 0..=16 {
                 let uv = DVec2::new(f64::from(i), f64::from(j)) / 16.0;
-                let (da, db) = (a.tangent(uv).normalize(), b.tangent(uv).normalize());
+                let (da, db) = (
+                    a.tangent(uv, 0.0).normalize(),
+                    b.tangent(uv, 0.0).normalize(),
+                );
                 worst = worst.max(da.cross(db).length().atan2(da.dot(db)));
             }
         }
@@ -358,6 +380,61 @@ mod tests {
         // Every point is in view: reached at t in (0, 1].
         let reach = farthest_reach(&fitted, &data).unwrap();
         assert!(reach > 0.0 && reach <= 1.0, "{reach}");
+    }
+
+    /// Fits a 5 x 5 bilinear grid to `per_side`^2 correspondences seen by `truth` (a volume
+    /// whose surfaces are bilinear in (u, v), so that the grid can be it exactly), from a prior
+    /// with the truth's starts and a 90-degree perspective camera's directions; returns the
+    /// largest angle, in radians, between a fitted projector and the truth's over a 17 x 17
+    /// grid of (u, v), and the fit's residual.
+    fn recover(truth: &LinearVolume, per_side: usize, seed: u64) -> (f64, FitReport) {
+        let bilinear = GridInterpolation::Bilinear;
+        let sampled = ProjectorGrid::sample(truth, (5, 5), bilinear).unwrap();
+        let other =
+            ProjectorGrid::sample(&perspective(90.0, [1.0, 40.0]), (5, 5), bilinear).unwrap();
+        let prior = sampled
+            .with_ends(
+                (sampled.starts().iter())
+                    .zip(other.starts().iter().zip(other.ends()))
+                    .map(|(s, (os, oe))| *s + (*oe - *os))
+                    .collect(),
+            )
+            .unwrap();
+        let data = correspondences_from(|uv, t| truth.point(uv, t), per_side, seed);
+        let (fitted, report) = fit(&prior, &data).unwrap();
+        let mut worst = 0.0f64;
+        for i in 0..=16 {
+            for j in 0..=16 {
+                let uv = DVec2::new(f64::from(i), f64::from(j)) / 16.0;
+                let (a, b) = (
+                    fitted.tangent(uv, 0.0).normalize(),
+                    truth.tangent(uv).normalize(),
+                );
+                worst = worst.max(a.cross(b).length().atan2(a.dot(b)));
+            }
+        }
+        (worst, report)
+    }
+
+    #[test]
+    fn recovers_pushbroom_and_crossed_slits_cameras_from_their_own_correspondences() {
+        // Neither has a single centre of projection, and both have near and far rectangles:
+        // bilinear in (u, v), so a bilinear grid is each exactly.
+        let pushbroom = Preset::Pushbroom {
+            width: 6.0,
+            v_fov: 50.0,
+        };
+        let crossed_slits = Preset::CrossedSlits {
+            fov: 60.0,
+            v_fov: None,
+            slit_distance: -2.0,
+        };
+        for preset in [pushbroom, crossed_slits] {
+            let truth = preset_volume(preset.clone(), [1.0, 30.0]);
+            let (error, report) = recover(&truth, 12, 5);
+            assert!(error < 1e-7, "{preset:?}: {error} rad");
+            assert!(report.max_angle_deg < 1e-6, "{preset:?}: {report:?}");
+        }
     }
 
     #[test]
@@ -450,8 +527,8 @@ mod tests {
             DVec2::new(0.2, 0.4),
         ] {
             let (a, b) = (
-                fitted.tangent(uv).normalize(),
-                truth.tangent(uv).normalize(),
+                fitted.tangent(uv, 0.0).normalize(),
+                truth.tangent(uv, 0.0).normalize(),
             );
             assert!(a.dot(b) > (0.02f64).cos(), "{uv}: {a} vs {b}");
         }
@@ -517,6 +594,20 @@ mod tests {
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(32))]
+
+        /// Crossed-slits cameras of any field of view and slit distance (the horizontal slit
+        /// in front of or behind the vertical one) are recovered from 64 of their own
+        /// correspondences.
+        #[test]
+        fn crossed_slits_round_trip(
+            fov in 20.0f64..140.0,
+            slit_distance in prop_oneof![-8.0f64..-0.3, 0.3f64..0.9],
+            seed in 0u64..1000,
+        ) {
+            let preset = Preset::CrossedSlits { fov, v_fov: None, slit_distance };
+            let (error, _) = recover(&preset_volume(preset, [1.0, 30.0]), 8, seed);
+            prop_assert!(error < 1e-7, "direction error {error}");
+        }
 
         /// A perspective camera of any field of view is recovered from 64 of its own
         /// correspondences, starting from a 90-degree prior.

@@ -43,7 +43,9 @@ pub use blend::{BezierVolume, PiecewiseVolume};
 pub use interpolate::InterpolatedVolume;
 pub use panorama::{PanoramaShape, PanoramaSpec};
 pub use presets::{DepthStyle, Magnifier, McopPath, Preset, PresetSpec};
-pub use projector_grid::{Aim, GridInterpolation, GridVolume, ProjectorGrid, ProjectorGridSpec};
+pub use projector_grid::{
+    Aim, GridInterpolation, GridVolume, NodeProjector, ProjectorGrid, ProjectorGridSpec,
+};
 pub use reparam::Reparam;
 pub use surface::{
     BSplinePatch, BezierPatch, CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface,

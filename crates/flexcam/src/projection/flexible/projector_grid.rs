@@ -2,24 +2,41 @@
 //! small grid of explicitly placed projectors, the way the thesis reproduces a painting.
 //!
 //! Node (c, r) of a `cols x rows` grid sits at (u, v) = (c / (cols - 1), r / (rows - 1)): column
-//! 0 is the left edge of the image and row 0 the bottom. Every node holds a straight projector
-//! from a start point to an end point; the volume is
+//! 0 is the left edge of the image and row 0 the bottom. Every node holds a projector from a
+//! start point S_j to an end point E_j, straight, or curved by an optional tangent (below). The
+//! volume blends the nodes' quadratic Bezier control points,
 //!
-//! Q(u, v, t) = (1 - t) S(u, v) + t E(u, v),  S = sum_j w_j(u, v) S_j,  E = sum_j w_j(u, v) E_j,
+//! S(u, v) = sum_j w_j(u, v) S_j,  C(u, v) = sum_j w_j(u, v) C_j,  E(u, v) = sum_j w_j(u, v) E_j,
+//! Q(u, v, t) = (1 - t)^2 S + 2 t (1 - t) C + t^2 E,
 //!
 //! with the weights w_j of the chosen [`GridInterpolation`]: bilinear within each cell (every
 //! node's projector is met exactly; creases along cell edges) or one tensor-product Bezier
 //! patch of degree (cols - 1, rows - 1) over all nodes (smooth; only the four corner
-//! projectors are met exactly). Because the weights do not depend on t, the projector of every
-//! (u, v) is straight, and t in [0, 1] is its near/far clip like in every flexible volume.
+//! projectors are met exactly). t in [0, 1] is the near/far clip like in every flexible volume.
+//!
+//! # Tangents (the thesis's curved projectors, 5.2.1)
+//!
+//! A straight node has C_j = (S_j + E_j) / 2, which makes its quadratic the segment S_j E_j
+//! with t uniform along it. A node with a tangent T_j leaves its start along T_j: C_j = S_j +
+//! (|E_j - S_j| / 2) T_j / |T_j|, so the projector still runs from S_j to E_j, its direction at
+//! the start is T_j, and only the tangent's direction matters (as in the thesis, which takes
+//! the magnitude to be irrelevant). A tangent along the chord E_j - S_j gives C_j = the
+//! midpoint, the straight projector itself, so such a node is stored as straight. The thesis attaches the tangent where the projector meets the
+//! scene; here it is at the start, so that a node is defined by its start, end and tangent
+//! alone, independent of where the scene happens to be. A grid without tangents has
+//! straight projectors everywhere and is cast as rays; a grid with any tangent is cast as
+//! quadratic Bezier projectors ([`Projector::QuadraticBezier`], the representation of the
+//! three-surface Bezier volumes).
+//!
+//! Degenerate tangents: a zero tangent means "no tangent" (straight), and so does one along
+//! the chord (within rounding, [`ALONG_CHORD`]); a tangent opposite to
+//! the chord is an error (the projector would run backwards from its start and fold back over
+//! itself along one line, seeing what lies behind the image plane).
 //!
 //! A grid starts as a sample of any volume with straight projectors (the thesis fills it as a
-//! perspective frustum from the perspective preset); [`ProjectorGrid::aim`] then re-aims one
-//! projector through a scene point, and `fit` (module `fit`) aims all of them at once from
-//! point correspondences.
-//!
-//! Curved projectors through a hit point with a given tangent (the thesis's quadratic
-//! construction, 5.2.1) are not part of this grid yet: every projector here is straight.
+//! perspective frustum from the perspective preset); [`ProjectorGrid::set_projector`] places
+//! one node's projector explicitly, [`ProjectorGrid::aim`] re-aims one through a scene point,
+//! and `fit` (module `fit`) aims all of them at once from point correspondences.
 
 use glam::{DVec2, DVec3};
 
@@ -27,6 +44,8 @@ use super::fit::{fit, Correspondence, FitReport};
 use super::volume::{LinearVolume, Volume};
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
+use crate::projection::projector::{quadratic_point, quadratic_tangent};
+use crate::projection::Projector;
 
 /// Fewest nodes per side: a grid needs two to span the domain.
 pub const MIN_NODES: usize = 2;
@@ -53,7 +72,7 @@ impl GridInterpolation {
     }
 }
 
-/// A grid of straight node projectors and the volume they interpolate.
+/// A grid of node projectors and the volume they interpolate.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProjectorGrid {
     cols: usize,
@@ -61,6 +80,8 @@ pub struct ProjectorGrid {
     /// Row-major, row 0 (bottom) first.
     starts: Vec<DVec3>,
     ends: Vec<DVec3>,
+    /// Unit tangents at the starts; `None`: a straight node.
+    tangents: Vec<Option<DVec3>>,
     interpolation: GridInterpolation,
 }
 
@@ -91,23 +112,14 @@ impl ProjectorGrid {
             )));
         }
         for (j, (s, e)) in starts.iter().zip(&ends).enumerate() {
-            let (c, r) = (j % cols, j / cols);
-            if !s.is_finite() || !e.is_finite() {
-                return Err(Error::new(format!(
-                    "projector grid node ({c}, {r}) has a non-finite point"
-                )));
-            }
-            if s == e {
-                return Err(Error::new(format!(
-                    "projector grid node ({c}, {r}) has zero length (its start is its end)"
-                )));
-            }
+            node_tangent((j % cols, j / cols), *s, *e, None)?;
         }
         Ok(ProjectorGrid {
             cols,
             rows,
             starts,
             ends,
+            tangents: vec![None; count],
             interpolation,
         })
     }
@@ -154,19 +166,53 @@ impl ProjectorGrid {
         &self.ends
     }
 
-    /// Re-aims node (`col`, `row`) through scene point `hit` (the thesis's point-based
-    /// placement): the projector keeps its start and its length, unless `hit` lies beyond
-    /// that length, in which case it is lengthened to reach 1.01 times as far as `hit`, so the
-    /// hit is inside the t range. Errors: a node outside the grid, a non-finite `hit`, or
-    /// `hit` at the start point (no direction).
-    pub fn aim(&mut self, col: usize, row: usize, hit: DVec3) -> Result<()> {
+    /// Unit tangents at the node projectors' starts (`None`: straight), in the order of
+    /// [`ProjectorGrid::starts`].
+    pub fn tangents(&self) -> &[Option<DVec3>] {
+        &self.tangents
+    }
+
+    /// Whether some node has a tangent, making the volume's projectors quadratic curves.
+    pub fn is_curved(&self) -> bool {
+        self.tangents.iter().any(Option::is_some)
+    }
+
+    /// Places node (`col`, `row`)'s projector explicitly: from `start` to `end`, leaving the
+    /// start along `tangent` when one is given (a zero tangent is none; see the module docs).
+    /// Errors: a node outside the grid, a non-finite value, `start` equal to `end`, or a
+    /// tangent opposite to the chord `end - start`.
+    pub fn set_projector(
+        &mut self,
+        (col, row): (usize, usize),
+        start: DVec3,
+        end: DVec3,
+        tangent: Option<DVec3>,
+    ) -> Result<()> {
+        let j = self.index(col, row)?;
+        self.tangents[j] = node_tangent((col, row), start, end, tangent)?;
+        self.starts[j] = start;
+        self.ends[j] = end;
+        Ok(())
+    }
+
+    /// The index of node (`col`, `row`) in the node lists; an error outside the grid.
+    fn index(&self, col: usize, row: usize) -> Result<usize> {
         if col >= self.cols || row >= self.rows {
             return Err(Error::new(format!(
                 "projector ({col}, {row}) is outside the {} x {} grid",
                 self.cols, self.rows
             )));
         }
-        let j = row * self.cols + col;
+        Ok(row * self.cols + col)
+    }
+
+    /// Re-aims node (`col`, `row`) through scene point `hit` (the thesis's point-based
+    /// placement): the projector keeps its start and its length, unless `hit` lies beyond
+    /// that length, in which case it is lengthened to reach 1.01 times as far as `hit`, so the
+    /// hit is inside the t range. Errors: a node outside the grid, a non-finite `hit`, or
+    /// `hit` at the start point (no direction).
+    pub fn aim(&mut self, col: usize, row: usize, hit: DVec3) -> Result<()> {
+        let j = self.index(col, row)?;
         let start = self.starts[j];
         let direction = (hit - start).try_normalize().ok_or_else(|| {
             Error::new(format!(
@@ -177,14 +223,29 @@ impl ProjectorGrid {
         let length = (self.ends[j] - start)
             .length()
             .max(1.01 * (hit - start).length());
-        self.ends[j] = start + length * direction;
-        Ok(())
+        let tangent = self.tangents[j];
+        self.set_projector((col, row), start, start + length * direction, tangent)
     }
 
     /// Replaces every node's end point (same order as [`ProjectorGrid::ends`]), keeping the
-    /// starts; validated like [`ProjectorGrid::new`].
+    /// starts and tangents; validated like [`ProjectorGrid::set_projector`].
     pub fn with_ends(&self, ends: Vec<DVec3>) -> Result<Self> {
-        ProjectorGrid::new(self.size(), self.starts.clone(), ends, self.interpolation)
+        let mut grid =
+            ProjectorGrid::new(self.size(), self.starts.clone(), ends, self.interpolation)?;
+        for (j, tangent) in self.tangents.iter().enumerate() {
+            let node = (j % self.cols, j / self.cols);
+            grid.set_projector(node, grid.starts[j], grid.ends[j], *tangent)?;
+        }
+        Ok(grid)
+    }
+
+    /// The quadratic Bezier control point of node `j` (see the module docs).
+    fn control(&self, j: usize) -> DVec3 {
+        let (start, end) = (self.starts[j], self.ends[j]);
+        match self.tangents[j] {
+            Some(tangent) => start + 0.5 * (end - start).length() * tangent,
+            None => 0.5 * (start + end),
+        }
     }
 
     /// Calls `f(node index, weight)` for every node with a non-zero weight at (u, v); the
@@ -232,21 +293,43 @@ impl ProjectorGrid {
         (start, end)
     }
 
+    /// The interpolated quadratic Bezier control points of the projector of (u, v): start,
+    /// middle control point, end (the nodes' control points blended with the same weights).
+    pub fn control_points(&self, uv: DVec2) -> [DVec3; 3] {
+        let mut p = [DVec3::ZERO; 3];
+        self.for_each_weight(uv, |j, w| {
+            p[0] += w * self.starts[j];
+            p[1] += w * self.control(j);
+            p[2] += w * self.ends[j];
+        });
+        p
+    }
+
     /// Q(u, v, t).
     pub fn point(&self, uv: DVec2, t: f64) -> DVec3 {
+        if self.is_curved() {
+            return quadratic_point(&self.control_points(uv), t);
+        }
         let (start, end) = self.start_end(uv);
         start + t * (end - start)
     }
 
-    /// dQ/dt at (u, v): the same for every t.
-    pub fn tangent(&self, uv: DVec2) -> DVec3 {
+    /// dQ/dt at (u, v, t); for a grid without tangents the same for every t.
+    pub fn tangent(&self, uv: DVec2, t: f64) -> DVec3 {
+        if self.is_curved() {
+            return quadratic_tangent(&self.control_points(uv), t);
+        }
         let (start, end) = self.start_end(uv);
         end - start
     }
 
-    /// The projector of (u, v) as a ray with t in [0, 1]; `None` where the interpolated
-    /// projector has zero length (node projectors pointing at each other can cancel).
+    /// The projector of (u, v) as a ray with t in [0, 1]; `None` for a curved grid (see
+    /// [`ProjectorGrid::projector`]) and where the interpolated projector has zero length
+    /// (node projectors pointing at each other can cancel).
     pub fn ray(&self, uv: DVec2) -> Option<Ray> {
+        if self.is_curved() {
+            return None;
+        }
         let (origin, end) = self.start_end(uv);
         let direction = end - origin;
         (direction != DVec3::ZERO && direction.is_finite()).then_some(Ray {
@@ -256,6 +339,59 @@ impl ProjectorGrid {
             t_max: 1.0,
         })
     }
+
+    /// The projector of (u, v): a ray for a grid without tangents, else the quadratic Bezier
+    /// curve of [`ProjectorGrid::control_points`]; `None` where it has zero length.
+    pub fn projector(&self, uv: DVec2) -> Option<Projector> {
+        if !self.is_curved() {
+            return self.ray(uv).map(Projector::Straight);
+        }
+        let p = self.control_points(uv);
+        let moves = p[1] != p[0] || p[2] != p[0];
+        (moves && p.iter().all(|q| q.is_finite())).then_some(Projector::QuadraticBezier(p))
+    }
+}
+
+/// The sine of the angle below which a tangent counts as along the chord (or opposite to it):
+/// its control point is then off the chord by at most 1e-12 of the projector's length, which
+/// is rounding noise.
+const ALONG_CHORD: f64 = 1e-12;
+
+/// Validates node `node`'s projector from `start` to `end` and returns its unit tangent
+/// (`None` for no tangent, a zero one, or one along the chord: a straight node). Errors: a non-finite value, `start` equal to
+/// `end`, or a tangent opposite to the chord (see the module docs).
+fn node_tangent(
+    (c, r): (usize, usize),
+    start: DVec3,
+    end: DVec3,
+    tangent: Option<DVec3>,
+) -> Result<Option<DVec3>> {
+    let tangent = tangent.unwrap_or(DVec3::ZERO);
+    if !start.is_finite() || !end.is_finite() || !tangent.is_finite() {
+        return Err(Error::new(format!(
+            "projector grid node ({c}, {r}) has a non-finite point or tangent"
+        )));
+    }
+    if start == end {
+        return Err(Error::new(format!(
+            "projector grid node ({c}, {r}) has zero length (its start is its end)"
+        )));
+    }
+    let Some(unit) = tangent.try_normalize() else {
+        return Ok(None);
+    };
+    let chord = (end - start).normalize();
+    if unit.cross(chord).length() > ALONG_CHORD {
+        return Ok(Some(unit));
+    }
+    if unit.dot(chord) > 0.0 {
+        // Along the chord: the quadratic is the straight projector itself.
+        return Ok(None);
+    }
+    Err(Error::new(format!(
+        "projector grid node ({c}, {r}): the tangent {tangent} points back along the \
+         projector (from its end to its start), which would fold it over itself"
+    )))
 }
 
 /// One node projector re-aimed through a scene point ([`ProjectorGrid::aim`]).
@@ -266,13 +402,27 @@ pub struct Aim {
     pub at: DVec3,
 }
 
+/// One node projector placed explicitly ([`ProjectorGrid::set_projector`]); the start and
+/// end default to the sampled node's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NodeProjector {
+    /// (column, row) of the node, (0, 0) at the bottom left.
+    pub node: (usize, usize),
+    pub start: Option<DVec3>,
+    pub end: Option<DVec3>,
+    /// The direction the projector leaves its start in; `None`: straight.
+    pub tangent: Option<DVec3>,
+}
+
 /// A projector grid as a scene describes it: sampled from the projection's own volume, then
-/// re-aimed node by node, then fitted to correspondences (each step optional).
+/// nodes placed explicitly, then re-aimed node by node, then fitted to correspondences (each
+/// step optional).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ProjectorGridSpec {
     /// Nodes per side: (columns, rows).
     pub size: (usize, usize),
     pub interpolation: GridInterpolation,
+    pub projectors: Vec<NodeProjector>,
     pub aims: Vec<Aim>,
     pub correspondences: Vec<Correspondence>,
 }
@@ -285,10 +435,11 @@ pub struct GridVolume {
 }
 
 impl GridVolume {
-    /// Samples `base` (which must have straight projectors), applies the aims in order, then
-    /// fits the grid to the correspondences when there are any. Errors: a base with curved
-    /// projectors, and the errors of [`ProjectorGrid::sample`], [`ProjectorGrid::aim`] and
-    /// [`fit`].
+    /// Samples `base` (which must have straight projectors), places the explicit node
+    /// projectors, applies the aims in order, then fits the grid to the correspondences when
+    /// there are any. Errors: a base with curved projectors, and the errors of
+    /// [`ProjectorGrid::sample`], [`ProjectorGrid::set_projector`], [`ProjectorGrid::aim`] and
+    /// [`fit`] (which refuses grids with tangents).
     pub fn build(spec: &ProjectorGridSpec, base: &Volume) -> Result<Self> {
         let Volume::Linear(linear) = base else {
             return Err(Error::new(
@@ -297,6 +448,13 @@ impl GridVolume {
             ));
         };
         let mut grid = ProjectorGrid::sample(linear, spec.size, spec.interpolation)?;
+        for node in &spec.projectors {
+            let (col, row) = node.node;
+            let j = grid.index(col, row)?;
+            let start = node.start.unwrap_or(grid.starts[j]);
+            let end = node.end.unwrap_or(grid.ends[j]);
+            grid.set_projector(node.node, start, end, node.tangent)?;
+        }
         for aim in &spec.aims {
             grid.aim(aim.node.0, aim.node.1, aim.at)?;
         }
@@ -353,8 +511,17 @@ pub(super) mod tests {
         fov: f64,
         clip: [f64; 2],
     ) -> LinearVolume {
+        preset_volume(Preset::Perspective { fov }, clip)
+    }
+
+    /// `preset` seen from the fixture's camera, aspect 3:4, its control surfaces at the
+    /// distances `clip`.
+    pub(in crate::projection::flexible) fn preset_volume(
+        preset: Preset,
+        clip: [f64; 2],
+    ) -> LinearVolume {
         let spec = PresetSpec {
-            preset: Preset::Perspective { fov },
+            preset,
             frame: CameraFrame {
                 position: DVec3::new(0.0, 1.0, 5.0),
                 look_at: DVec3::new(0.0, 0.5, 0.0),
@@ -473,6 +640,99 @@ pub(super) mod tests {
         let start = grid.starts()[0];
         let e = grid.aim(0, 0, start).unwrap_err();
         assert!(e.message.contains("cannot be aimed"), "{e}");
+    }
+
+    /// A 3 x 3 bilinear grid of the test perspective with node (1, 1) curved sideways.
+    fn curved_grid(tangent: DVec3) -> ProjectorGrid {
+        let volume = perspective_volume(60.0, [1.0, 30.0]);
+        let mut grid = ProjectorGrid::sample(&volume, (3, 3), GridInterpolation::Bilinear).unwrap();
+        let (start, end) = (grid.starts()[4], grid.ends()[4]);
+        grid.set_projector((1, 1), start, end, Some(tangent))
+            .unwrap();
+        grid
+    }
+
+    #[test]
+    fn a_tangent_curves_its_node_projector_from_start_to_end() {
+        let tangent = DVec3::new(3.0, 1.0, -1.0);
+        let grid = curved_grid(tangent);
+        assert!(grid.is_curved());
+        let uv = grid.node_uv(1, 1);
+        let (start, end) = (grid.starts()[4], grid.ends()[4]);
+        assert!((grid.point(uv, 0.0) - start).length() < 1e-12 * start.length());
+        assert!((grid.point(uv, 1.0) - end).length() < 1e-12 * end.length());
+        let leaving = grid.tangent(uv, 0.0).normalize();
+        assert!(
+            leaving.cross(tangent.normalize()).length() < 1e-12,
+            "{leaving}"
+        );
+        assert!(leaving.dot(tangent) > 0.0);
+        // Halfway it is off the straight chord, and dQ/dt is the derivative of Q.
+        let mid = grid.point(uv, 0.5);
+        let off = (mid - start).cross((end - start).normalize()).length();
+        assert!(off > 0.1, "{off}");
+        let h = 1e-6;
+        for t in [0.0, 0.3, 1.0] {
+            let numeric = (grid.point(uv, t + h) - grid.point(uv, t - h)) / (2.0 * h);
+            let exact = grid.tangent(uv, t);
+            assert!((numeric - exact).length() < 1e-6 * exact.length(), "{t}");
+        }
+        // The projector is the quadratic of the blended control points; the neighbours'
+        // control points are their midpoints, so the curve fades out across the cells.
+        let p = grid.control_points(uv);
+        assert_eq!(grid.projector(uv), Some(Projector::QuadraticBezier(p)));
+        assert_eq!(grid.ray(uv), None);
+        let corner = grid.control_points(DVec2::ZERO);
+        assert!((corner[1] - 0.5 * (corner[0] + corner[2])).length() < 1e-12 * corner[1].length());
+        let between = grid.control_points(DVec2::new(0.25, 0.5));
+        let straight_between = 0.5 * (between[0] + between[2]);
+        assert!((between[1] - straight_between).length() > 1e-3);
+    }
+
+    #[test]
+    fn zero_and_along_the_chord_tangents_are_straight_and_opposite_ones_are_errors() {
+        let volume = perspective_volume(60.0, [1.0, 30.0]);
+        let straight = ProjectorGrid::sample(&volume, (3, 3), GridInterpolation::Bilinear).unwrap();
+        let (start, end) = (straight.starts()[4], straight.ends()[4]);
+        for tangent in [DVec3::ZERO, 3.7 * (end - start), (end - start) / 11.0] {
+            let mut grid = straight.clone();
+            grid.set_projector((1, 1), start, end, Some(tangent))
+                .unwrap();
+            assert_eq!(grid, straight, "{tangent}");
+        }
+        for tangent in [start - end, -0.01 * (end - start)] {
+            let mut grid = straight.clone();
+            let e = grid
+                .set_projector((1, 1), start, end, Some(tangent))
+                .unwrap_err();
+            assert!(e.message.contains("node (1, 1): the tangent"), "{e}");
+            assert!(e.message.contains("fold it over itself"), "{e}");
+        }
+        // Nearly opposite is a (sharp) curve, not an error.
+        let nearly = start - end + DVec3::new(0.0, 1e-3, 0.0);
+        assert!(curved_grid(nearly).is_curved());
+        let mut grid = straight.clone();
+        let e = grid
+            .set_projector((1, 1), start, end, Some(DVec3::new(f64::NAN, 0.0, 0.0)))
+            .unwrap_err();
+        assert!(e.message.contains("non-finite point or tangent"), "{e}");
+        assert!(grid.set_projector((3, 1), start, end, None).is_err());
+    }
+
+    #[test]
+    fn aiming_and_new_ends_keep_a_tangent_and_the_fit_refuses_it() {
+        let tangent = DVec3::new(1.0, 0.5, -1.0).normalize();
+        let mut grid = curved_grid(tangent);
+        grid.aim(1, 1, DVec3::new(2.0, 0.0, -3.0)).unwrap();
+        assert_eq!(grid.tangents()[4], Some(tangent));
+        let moved = grid.with_ends(grid.ends().to_vec()).unwrap();
+        assert_eq!(moved, grid);
+        let c = Correspondence {
+            uv: DVec2::splat(0.5),
+            point: DVec3::ZERO,
+        };
+        let e = fit(&grid, &[c]).unwrap_err();
+        assert!(e.message.contains("node tangents"), "{e}");
     }
 
     #[test]

@@ -83,8 +83,8 @@ pub enum Volume {
     /// a Q1 + (1 - a) Q2 of two volumes that do not blend into a simpler one (module
     /// `interpolate`).
     Interpolated(Box<InterpolatedVolume>),
-    /// Straight projectors interpolated from a grid of placed or fitted node projectors
-    /// (module `projector_grid`).
+    /// Straight or quadratic projectors interpolated from a grid of placed or fitted node
+    /// projectors (module `projector_grid`).
     Grid(Box<GridVolume>),
 }
 
@@ -107,7 +107,7 @@ impl Volume {
             Volume::Piecewise(v) => v.tangent(uv, t),
             Volume::Bezier(v) => v.tangent(uv, t),
             Volume::Interpolated(v) => v.tangent(uv, t),
-            Volume::Grid(v) => v.grid.tangent(uv),
+            Volume::Grid(v) => v.grid.tangent(uv, t),
         }
     }
 
@@ -129,7 +129,7 @@ impl Volume {
             Volume::Piecewise(v) => v.projector(uv),
             Volume::Bezier(v) => v.projector(uv),
             Volume::Interpolated(v) => v.projector(uv),
-            Volume::Grid(v) => v.grid.ray(uv).map(Projector::Straight),
+            Volume::Grid(v) => v.grid.projector(uv),
         }
     }
 

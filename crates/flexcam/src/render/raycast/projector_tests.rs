@@ -279,3 +279,77 @@ fn segments_outside_the_scene_box_are_culled_without_changing_any_hit() {
         }
     }
 }
+
+/// A 5 x 5 projector grid sampled from a perspective camera looking into the teapot room, with
+/// `tangents(start, end)` giving each node's tangent (all nodes set explicitly).
+fn grid_frame(tangents: impl Fn(DVec3, DVec3) -> Option<DVec3>) -> Frame {
+    use crate::projection::flexible::presets::{Preset, PresetSpec};
+    use crate::projection::flexible::{
+        GridInterpolation, NodeProjector, ProjectorGrid, ProjectorGridSpec, Volume,
+    };
+    use crate::projection::CameraFrame;
+    let base = FlexibleSpec {
+        source: VolumeSource::Preset(PresetSpec {
+            preset: Preset::Perspective { fov: 70.0 },
+            frame: CameraFrame {
+                position: DVec3::new(0.0, 2.6, 6.0),
+                look_at: DVec3::new(0.0, 0.5, 0.0),
+                up: DVec3::Y,
+            },
+            clip: Some([0.5, 30.0]),
+        }),
+        reparam: None,
+    };
+    let Volume::Linear(sampled) = Flexible::new(&base, W, H).unwrap().volume().clone() else {
+        panic!("a perspective preset has straight projectors");
+    };
+    let sample = ProjectorGrid::sample(&sampled, (5, 5), GridInterpolation::Bilinear).unwrap();
+    let projectors = sample
+        .starts()
+        .iter()
+        .zip(sample.ends())
+        .enumerate()
+        .map(|(j, (&start, &end))| NodeProjector {
+            node: (j % 5, j / 5),
+            start: None,
+            end: None,
+            tangent: tangents(start, end),
+        })
+        .collect();
+    render(
+        VolumeSource::ProjectorGrid {
+            base: Box::new(base),
+            grid: ProjectorGridSpec {
+                size: (5, 5),
+                interpolation: GridInterpolation::Bilinear,
+                projectors,
+                aims: Vec::new(),
+                correspondences: Vec::new(),
+            },
+        },
+        Shading::Flat,
+    )
+}
+
+#[test]
+fn grid_tangents_along_the_chords_give_the_straight_grid_image_and_others_bend_it() {
+    let straight = grid_frame(|_, _| None);
+    assert!(straight.ids.iter().any(|&id| id != 0));
+    let along = grid_frame(|start, end| Some(2.5 * (end - start)));
+    assert_eq!(along.ids, straight.ids);
+    assert_eq!(along.color, straight.color);
+    // Tangents a hair off the chords: every projector is a quadratic (the curve caster), still
+    // the same picture up to edge pixels.
+    let nearly = grid_frame(|start, end| {
+        let chord = end - start;
+        Some(chord + 1e-7 * chord.length() * chord.any_orthonormal_vector())
+    });
+    assert_same(compare(&nearly, &straight).unwrap(), "nearly straight grid");
+    // Tangents turned 20 degrees to the left bend the whole image.
+    let turned = grid_frame(|start, end| {
+        let chord = end - start;
+        Some(chord.normalize() + 0.36 * DVec3::X)
+    });
+    let bent = compare(&turned, &straight).unwrap();
+    assert!(bent.id_agreement < 0.9, "{bent:?}");
+}

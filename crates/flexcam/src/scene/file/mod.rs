@@ -5,6 +5,7 @@
 //! TOML syntax error to a degenerate projection, is one line `FILE:LINE:COLUMN: message`.
 
 mod animation;
+mod fitted_grid;
 mod flexible;
 mod light;
 mod object;
@@ -30,6 +31,7 @@ use crate::error::{Error, Result};
 use crate::projection::flexible::Animation;
 
 pub use self::animation::DEFAULT_FPS;
+pub use self::fitted_grid::{fit_scene, FittedScene};
 
 /// The largest accepted image side, in pixels. It keeps an image at or below 2^28 pixels, so
 /// that frame buffers (several values per pixel) fit in memory.

@@ -1,16 +1,17 @@
 //! `projectors = { ... }` in a flexible projection: a projector grid (seed 003, 5.2) sampled
-//! from the projection's own volume, re-aimed node by node and fitted to point
-//! correspondences. See scenes/README.md.
+//! from the projection's own volume, with node projectors placed explicitly (optionally
+//! curved by a tangent), re-aimed node by node and fitted to point correspondences. See
+//! scenes/README.md.
 
 use glam::{DVec2, DVec3};
 use toml::Spanned;
 
-use super::raw::RawProjectors;
+use super::raw::{RawNodeProjector, RawProjectors};
 use super::source::Source;
 use crate::error::Result;
 use crate::projection::flexible::fit::Correspondence;
 use crate::projection::flexible::projector_grid::{MAX_NODES, MIN_NODES};
-use crate::projection::flexible::{Aim, GridInterpolation, ProjectorGridSpec};
+use crate::projection::flexible::{Aim, GridInterpolation, NodeProjector, ProjectorGridSpec};
 
 /// Nodes per side when `size` is not given: the thesis's 5 x 5.
 const DEFAULT_SIZE: usize = 5;
@@ -54,25 +55,16 @@ pub(super) fn convert(src: &Source, table: &Spanned<RawProjectors>) -> Result<Pr
             }
         },
     };
+    let mut projectors = Vec::new();
+    for entry in raw.projector.iter().flatten() {
+        projectors.push(node_projector(src, entry.get_ref(), size)?);
+    }
     let mut aims = Vec::new();
     for aim in raw.aim.iter().flatten() {
         let a = aim.get_ref();
-        let [c, r] = *a.node.get_ref();
-        let inside = |i: i64, n: usize| usize::try_from(i).ok().filter(|i| *i < n);
-        let (Some(col), Some(row)) = (inside(c, size.0), inside(r, size.1)) else {
-            return Err(src.error(
-                &a.node.span(),
-                format!(
-                    "projector node [{c}, {r}] is outside the {} x {} grid (columns and rows \
-                     count from 0)",
-                    size.0, size.1
-                ),
-            ));
-        };
-        let at = finite_point(src, &a.at, "at")?;
         aims.push(Aim {
-            node: (col, row),
-            at,
+            node: node(src, &a.node, size)?,
+            at: finite_point(src, &a.at, "at")?,
         });
     }
     let mut correspondences = Vec::new();
@@ -90,12 +82,66 @@ pub(super) fn convert(src: &Source, table: &Spanned<RawProjectors>) -> Result<Pr
             point: finite_point(src, &c.point, "point")?,
         });
     }
+    let first_tangent = projectors_raw_tangent(raw);
+    if let (false, Some(tangent)) = (correspondences.is_empty(), first_tangent) {
+        return Err(src.error(
+            &tangent.span(),
+            "a projector `tangent` cannot be combined with `fit`: the fit solves for straight \
+             projectors; fit first (`flexcam fit` writes the fitted grid), then add tangents",
+        ));
+    }
     Ok(ProjectorGridSpec {
         size,
         interpolation,
+        projectors,
         aims,
         correspondences,
     })
+}
+
+/// The first `tangent` of the `projector` entries, if any.
+fn projectors_raw_tangent(raw: &RawProjectors) -> Option<&Spanned<[f64; 3]>> {
+    raw.projector
+        .iter()
+        .flatten()
+        .find_map(|p| p.get_ref().tangent.as_ref())
+}
+
+/// A `projector = [...]` entry; a zero `tangent` is allowed and means straight.
+fn node_projector(
+    src: &Source,
+    raw: &RawNodeProjector,
+    size: (usize, usize),
+) -> Result<NodeProjector> {
+    let optional = |value: &Option<Spanned<[f64; 3]>>, name| {
+        value
+            .as_ref()
+            .map(|v| finite_point(src, v, name))
+            .transpose()
+    };
+    Ok(NodeProjector {
+        node: node(src, &raw.node, size)?,
+        start: optional(&raw.start, "start")?,
+        end: optional(&raw.end, "end")?,
+        tangent: optional(&raw.tangent, "tangent")?,
+    })
+}
+
+/// A `node = [column, row]` value, checked to lie in the grid.
+fn node(src: &Source, value: &Spanned<[i64; 2]>, size: (usize, usize)) -> Result<(usize, usize)> {
+    let [c, r] = *value.get_ref();
+    let inside = |i: i64, n: usize| usize::try_from(i).ok().filter(|i| *i < n);
+    match (inside(c, size.0), inside(r, size.1)) {
+        (Some(col), Some(row)) => Ok((col, row)),
+        _ => Err(src.error(
+            &value.span(),
+            format!(
+                "projector node [{c}, {r}] is outside the {} x {} grid (columns and rows count \
+                 from 0)",
+                size.0, size.1
+            ),
+        )),
+    }
 }
 
 fn finite_point(src: &Source, value: &Spanned<[f64; 3]>, name: &str) -> Result<DVec3> {

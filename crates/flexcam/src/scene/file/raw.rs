@@ -146,14 +146,27 @@ impl RawCurve {
 }
 
 /// `projectors = { ... }` of a flexible projection: a projector grid sampled from the
-/// projection's volume, re-aimed (`aim`) and fitted to correspondences (`fit`).
+/// projection's volume, with node projectors placed explicitly (`projector`), re-aimed
+/// (`aim`) and fitted to correspondences (`fit`).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawProjectors {
     pub size: Option<Spanned<[i64; 2]>>,
     pub interpolation: Option<Spanned<String>>,
+    pub projector: Option<Vec<Spanned<RawNodeProjector>>>,
     pub aim: Option<Vec<Spanned<RawAim>>>,
     pub fit: Option<Vec<Spanned<RawCorrespondence>>>,
+}
+
+/// `{ node = [column, row], start = [x, y, z], end = [x, y, z], tangent = [x, y, z] }`: one
+/// node projector placed explicitly (each of start, end and tangent optional).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawNodeProjector {
+    pub node: Spanned<[i64; 2]>,
+    pub start: Option<Vec3Value>,
+    pub end: Option<Vec3Value>,
+    pub tangent: Option<Vec3Value>,
 }
 
 /// `{ node = [column, row], at = [x, y, z] }`: re-aim one node projector through a point.

@@ -1192,3 +1192,66 @@ fn flexible_projector_grids_parse_and_fit() {
         "correspondence 1: the point",
     );
 }
+
+#[test]
+fn flexible_projector_grid_nodes_with_tangents() {
+    use crate::projection::flexible::{NodeProjector, Volume, VolumeSource};
+    let head = "[projection]\ntype = \"flexible\"\npreset = \"perspective\"\n\
+                position = [0, 5, 7]\nlook_at = [0, 0, 0]\nfov = 60\n";
+    let text = format!(
+        "{head}[projection.projectors]\nsize = [3, 3]\nprojector = [\n\
+         {{ node = [1, 1], tangent = [1, -1, -2] }},\n\
+         {{ node = [0, 0], start = [-1, 4, 6], end = [-9, -3, -9] }},\n]\n"
+    );
+    let ProjectionSpec::Flexible(spec) = scene(&text).projection else {
+        panic!("not flexible");
+    };
+    let VolumeSource::ProjectorGrid { grid, .. } = &spec.source else {
+        panic!("no grid: {spec:?}");
+    };
+    assert_eq!(
+        grid.projectors[1],
+        NodeProjector {
+            node: (0, 0),
+            start: Some(DVec3::new(-1.0, 4.0, 6.0)),
+            end: Some(DVec3::new(-9.0, -3.0, -9.0)),
+            tangent: None,
+        }
+    );
+    let flexible = crate::projection::flexible::Flexible::new(&spec, 32, 24).unwrap();
+    let Volume::Grid(volume) = flexible.volume() else {
+        panic!("not a grid volume");
+    };
+    assert!(volume.grid.is_curved());
+    assert_eq!(volume.grid.starts()[0], DVec3::new(-1.0, 4.0, 6.0));
+    let tangent = DVec3::new(1.0, -1.0, -2.0).normalize();
+    assert_eq!(volume.grid.tangents()[4], Some(tangent));
+
+    let with = |projectors: &str| format!("{head}projectors = {projectors}\n");
+    assert_error_at(
+        &with("{ projector = [{ node = [0, 5], tangent = [1, 0, 0] }] }"),
+        7,
+        38,
+        "projector node [0, 5] is outside the 5 x 5 grid",
+    );
+    assert_error_at(
+        &with("{ projector = [{ node = [0, 0], tangent = [nan, 0, 0] }] }"),
+        7,
+        56,
+        "`tangent`",
+    );
+    assert_error_at(
+        &with(
+            "{ projector = [{ node = [0, 0], tangent = [1, 0, 0] }], \
+             fit = [{ uv = [0.5, 0.5], point = [0, 0, 0] }] }",
+        ),
+        7,
+        56,
+        "a projector `tangent` cannot be combined with `fit`",
+    );
+    // A tangent from the end back to the start: named by node, in the file.
+    assert_error(
+        &with("{ projector = [{ node = [2, 2], start = [0, 0, 0], end = [0, 0, -5], tangent = [0, 0, 3] }] }"),
+        "node (2, 2): the tangent",
+    );
+}

@@ -1,0 +1,161 @@
+//! `flexcam fit`: runs the projector-grid fit of a scene file and writes the scene back with
+//! the fitted node projectors explicit, so that an artist can go on editing them.
+//!
+//! The written file is the original text edited in place (comments and layout kept): in the
+//! projection's `projectors` table the `fit`, `aim` and `projector` keys are replaced by one
+//! `projector` entry per node with its fitted `start` and `end`. Floats are written in Rust's
+//! shortest round-trip form, so the written grid is the fitted one bit for bit, and rendering
+//! the written file gives the image of the fitting scene. The result is parsed back before
+//! it is returned (as if it were at its output path, whose folder then resolves its relative
+//! model paths) and its grid compared with the fitted one: a written scene that would not
+//! load, or load differently, is an error instead of a file.
+
+use std::path::Path;
+
+use toml_edit::{Array, DocumentMut, InlineTable, Item, TableLike, Value};
+
+use crate::error::{Error, Result};
+use crate::projection::flexible::fit::FitReport;
+use crate::projection::flexible::{Flexible, FlexibleSpec, ProjectorGrid, Volume, VolumeSource};
+use crate::projection::ProjectionSpec;
+
+/// A fitted scene: the text to write and the fit's residual.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FittedScene {
+    pub text: String,
+    pub report: FitReport,
+}
+
+/// Fits the projector grid of the scene file `text` (read from `path`) to its `fit`
+/// correspondences and returns the scene text with the fitted projectors explicit, checked
+/// to load back from `output` to the same grid. Errors (naming `path`): a scene that does
+/// not load, a projection that is not a flexible projector grid with `fit` correspondences,
+/// and a written scene that does not load back from `output` identically.
+pub fn fit_scene(text: &str, path: &Path, output: &Path) -> Result<FittedScene> {
+    let scene = super::parse(text, path)?;
+    let (width, height) = (scene.image.width, scene.image.height);
+    let (grid, report) = fitted_grid(&scene.projection, width, height)
+        .map_err(|e| e.or_in_file(path))?
+        .ok_or_else(|| {
+            Error::in_file(
+                path,
+                "nothing to fit: the projection is not a flexible projection with a \
+                 `projectors` table holding `fit` correspondences",
+            )
+        })?;
+    let mut document: DocumentMut = text
+        .parse()
+        .map_err(|e: toml_edit::TomlError| Error::in_file(path, e.message().to_string()))?;
+    let projectors = document
+        .get_mut("projection")
+        .and_then(|p| p.get_mut("projectors"))
+        .and_then(Item::as_table_like_mut)
+        .ok_or_else(|| Error::in_file(path, "the [projection] table has no `projectors`"))?;
+    replace_nodes(projectors, &grid);
+    let header = format!(
+        "# Written by `flexcam fit` from {}: {} correspondences, residual max {:e} and rms \
+         {:e} degrees.\n",
+        path.display(),
+        report.correspondences,
+        report.max_angle_deg,
+        report.rms_angle_deg
+    );
+    let written = format!("{header}{document}");
+    check_round_trip(&written, output, &grid, width, height)?;
+    Ok(FittedScene {
+        text: written,
+        report,
+    })
+}
+
+/// The fitted grid and its residual when `projection` is a projector grid with
+/// correspondences; `None` otherwise.
+fn fitted_grid(
+    projection: &ProjectionSpec,
+    width: u32,
+    height: u32,
+) -> Result<Option<(ProjectorGrid, FitReport)>> {
+    let ProjectionSpec::Flexible(spec) = projection else {
+        return Ok(None);
+    };
+    if !has_fit(spec) {
+        return Ok(None);
+    }
+    let flexible = Flexible::new(spec, width, height)?;
+    Ok(match flexible.volume() {
+        Volume::Grid(grid) => grid.fit.map(|report| (grid.grid.clone(), report)),
+        _ => None,
+    })
+}
+
+fn has_fit(spec: &FlexibleSpec) -> bool {
+    matches!(&spec.source, VolumeSource::ProjectorGrid { grid, .. } if !grid.correspondences.is_empty())
+}
+
+/// Replaces `fit`, `aim` and `projector` in `table` by one `projector` entry per node of
+/// `grid` (bottom row first), one per line.
+fn replace_nodes(table: &mut dyn TableLike, grid: &ProjectorGrid) {
+    for key in ["fit", "aim", "projector"] {
+        table.remove(key);
+    }
+    let cols = grid.size().0;
+    let mut nodes = Array::new();
+    for (j, (start, end)) in grid.starts().iter().zip(grid.ends()).enumerate() {
+        let mut node = InlineTable::new();
+        node.insert("node", pair([j % cols, j / cols]));
+        node.insert("start", point(start.to_array()));
+        node.insert("end", point(end.to_array()));
+        let mut value = Value::InlineTable(node);
+        value.decor_mut().set_prefix("\n    ");
+        nodes.push_formatted(value);
+    }
+    nodes.set_trailing_comma(true);
+    nodes.set_trailing("\n");
+    table.insert("projector", Item::Value(Value::Array(nodes)));
+}
+
+fn pair(values: [usize; 2]) -> Value {
+    // Node indices are below 10 (the grid's largest side is 9).
+    Value::Array(values.iter().map(|&i| i as i64).collect())
+}
+
+fn point(values: [f64; 3]) -> Value {
+    Value::Array(values.iter().copied().collect())
+}
+
+/// Parses `written` as if it were at `output` and checks that it holds exactly `grid`.
+fn check_round_trip(
+    written: &str,
+    output: &Path,
+    grid: &ProjectorGrid,
+    width: u32,
+    height: u32,
+) -> Result<()> {
+    let reloaded = super::parse(written, output).map_err(|e| {
+        Error::in_file(
+            output,
+            format!(
+                "the fitted scene would not load from here ({e}); write it next to the \
+                 original so its relative paths still resolve"
+            ),
+        )
+    })?;
+    let ProjectionSpec::Flexible(spec) = &reloaded.projection else {
+        return Err(Error::in_file(
+            output,
+            "the fitted scene lost its projection",
+        ));
+    };
+    let same = match Flexible::new(spec, width, height)?.volume() {
+        Volume::Grid(g) => g.grid == *grid,
+        _ => false,
+    };
+    if same {
+        Ok(())
+    } else {
+        Err(Error::in_file(
+            output,
+            "the fitted scene does not load back to the fitted grid",
+        ))
+    }
+}
