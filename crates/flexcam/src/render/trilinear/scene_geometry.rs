@@ -32,10 +32,6 @@ pub struct SceneGeometry {
     /// Per triangle, the edges `<V1V2, V1V3, V2V3>` (bits 0, 1, 2) that another triangle
     /// shares (same end positions, any object): the surface continues across them.
     pub shared_edges: Vec<u8>,
-    /// Per triangle and edge `<V1V2, V1V3, V2V3>`, a triangle across it ([`NO_NEIGHBOUR`]
-    /// where none shares the edge; where several do, the first in triangle order, and
-    /// [`SceneGeometry::across`] lists them all).
-    pub neighbours: Vec<[u32; 3]>,
     /// Per triangle, the numbers of its edges `<V1V2, V1V3, V2V3>` in `edge_users`.
     edges: Vec<[u32; 3]>,
     /// The triangles using each edge.
@@ -95,9 +91,6 @@ impl EdgeUsers {
     }
 }
 
-/// The entry of [`SceneGeometry::neighbours`] for an edge no other triangle shares.
-pub const NO_NEIGHBOUR: u32 = u32::MAX;
-
 /// The edges `<V1V2, V1V3, V2V3>` as vertex pairs.
 const EDGES: [(usize, usize); 3] = [(0, 1), (0, 2), (1, 2)];
 
@@ -128,21 +121,10 @@ impl SceneGeometry {
         }
         (out.edge_users, out.edges) =
             EdgeUsers::new((0..out.triangles.len()).map(|k| out.corners(k)));
-        out.neighbours = (0..out.triangles.len())
+        out.shared_edges = (0..out.triangles.len())
             .map(|k| {
-                [0, 1, 2].map(|edge| {
-                    out.across(k, edge)
-                        .next()
-                        .map_or(NO_NEIGHBOUR, |n| n as u32)
-                })
-            })
-            .collect();
-        out.shared_edges = out
-            .neighbours
-            .iter()
-            .map(|across| {
-                (0..3).fold(0, |mask, bit| {
-                    mask | (u8::from(across[bit] != NO_NEIGHBOUR) << bit)
+                (0..3).fold(0, |mask, edge| {
+                    mask | (u8::from(out.across(k, edge).next().is_some()) << edge)
                 })
             })
             .collect();
@@ -208,7 +190,7 @@ mod tests {
 
     /// Three triangles meeting at the edge from the origin to +x (a fin: not a manifold
     /// surface), the third in another object: each edge user has the two others across it,
-    /// in triangle order; `neighbours` keeps the first; the outer edges have none.
+    /// in triangle order; the outer edges have none.
     #[test]
     fn a_non_manifold_edge_lists_every_triangle_across_it() {
         let (o, x) = (Vec3::ZERO, Vec3::X);
@@ -218,14 +200,6 @@ mod tests {
         assert_eq!(across(&geometry, 0, 0), [1, 2]);
         assert_eq!(across(&geometry, 1, 0), [0, 2]);
         assert_eq!(across(&geometry, 2, 0), [0, 1]);
-        assert_eq!(
-            geometry.neighbours,
-            [
-                [1, NO_NEIGHBOUR, NO_NEIGHBOUR],
-                [0, NO_NEIGHBOUR, NO_NEIGHBOUR],
-                [0, NO_NEIGHBOUR, NO_NEIGHBOUR]
-            ]
-        );
         assert_eq!(geometry.shared_edges, [0b001; 3]);
         for k in 0..3 {
             for edge in [1, 2] {
@@ -250,6 +224,6 @@ mod tests {
         assert_eq!(across(&geometry, 2, 0), Vec::<usize>::new());
         assert_eq!(across(&geometry, 2, 1), [2]);
         assert_eq!(across(&geometry, 2, 2), [2]);
-        assert_eq!(geometry.neighbours[2], [NO_NEIGHBOUR, 2, 2]);
+        assert_eq!(geometry.shared_edges[2], 0b110);
     }
 }

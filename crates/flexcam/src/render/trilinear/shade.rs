@@ -108,20 +108,21 @@ impl Resolver<'_> {
         }
         // Across a shared edge: the pixel may be the neighbour's, missed by the neighbour's
         // own polygon where its chord cuts inside the curved edge.
-        let across = self.scene.neighbours[k];
+        // Where several triangles meet at the edge (non-manifold), each is tried in turn.
         for edge in (0..3).filter(|e| outside & (1 << e) != 0) {
-            let n = across[edge] as usize;
-            let Some((t, u, v)) = plane_hit(&ray, self.scene.corners(n)) else {
-                continue;
-            };
-            if t >= 0.0 && outside_edges(u, v) == 0 {
-                return Some(FragmentHit {
-                    ray,
-                    key: (key & !u64::from(u32::MAX)) | n as u64,
-                    t,
-                    barycentric: DVec2::new(u, v),
-                    exact: true,
-                });
+            for n in self.scene.across(k, edge) {
+                let Some((t, u, v)) = plane_hit(&ray, self.scene.corners(n)) else {
+                    continue;
+                };
+                if t >= 0.0 && outside_edges(u, v) == 0 {
+                    return Some(FragmentHit {
+                        ray,
+                        key: (key & !u64::from(u32::MAX)) | n as u64,
+                        t,
+                        barycentric: DVec2::new(u, v),
+                        exact: true,
+                    });
+                }
             }
         }
         Some(FragmentHit {

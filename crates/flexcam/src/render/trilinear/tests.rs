@@ -421,6 +421,50 @@ fn supersampling_matches_the_ray_caster_and_antialiases_edges() {
     assert_eq!(count(&stats, "raster_polygons") % 4, 0);
 }
 
+/// A square at z = 2 cut along its diagonal (shared): its lower (x > y) and upper triangles.
+fn diagonal_square() -> [[DVec3; 3]; 2] {
+    let (lo, hi) = (DVec3::new(0.25, 0.25, 2.0), DVec3::new(0.75, 0.75, 2.0));
+    [
+        [lo, DVec3::new(0.75, 0.25, 2.0), hi],
+        [lo, hi, DVec3::new(0.25, 0.75, 2.0)],
+    ]
+}
+
+/// The scene geometry of `triangles` (one red object, id 1) and the screen maps of an 8 x 8
+/// pixel view of it through parallel rays along +z over the unit square.
+fn parallel_rays_onto(triangles: &[[DVec3; 3]]) -> (SceneGeometry, Vec<ScreenMap>) {
+    let scene = scene_of(vec![object(1, triangles, Vec3::new(0.9, 0.1, 0.1))]);
+    let projection = Trilinear::new(&square([DVec3::Z; 4]), 8, 8).unwrap();
+    let size = DVec2::new(8.0, 8.0);
+    let mesh = projection.mesh();
+    let maps = mesh
+        .triangles
+        .iter()
+        .zip(projection.triangle_caches())
+        .map(|(t, cache)| ScreenMap::new(t.map(|i| mesh.screen[i as usize]), size, *cache))
+        .collect();
+    (SceneGeometry::new(&scene), maps)
+}
+
+/// Where several triangles meet at the edge a fragment crossed (non-manifold), each is
+/// tried: a fin along the square's diagonal, listed first, is not hit at pixel (3, 3), so
+/// the lower triangle's fragment there resolves to the upper triangle behind it in the list.
+#[test]
+fn fragments_across_a_non_manifold_edge_try_every_triangle_there() {
+    let [lower, upper] = diagonal_square();
+    let fin = [lower[0], lower[2], DVec3::new(0.75, 0.25, 3.0)];
+    let (geometry, maps) = parallel_rays_onto(&[lower, fin, upper]);
+    let resolver = Resolver {
+        maps: &maps,
+        scene: &geometry,
+        sample: DVec2::splat(0.5),
+    };
+    let key = |scene_triangle: u64| (1u64 << 32) | scene_triangle;
+    let redirected = resolver.hit(key(0), resolver.position(3, 3)).unwrap();
+    assert!(redirected.exact);
+    assert_eq!((redirected.key, redirected.t), (key(2), 2.0));
+}
+
 /// A fragment keyed to one scene triangle at a pixel just across an edge it shares, inside
 /// the neighbour, resolves to an exact hit of the neighbour: the pixel that the neighbour's
 /// own polygon left uncovered where its chord cuts inside its curved edge. Before, it became
@@ -428,30 +472,8 @@ fn supersampling_matches_the_ray_caster_and_antialiases_edges() {
 /// object won the pixel (the 4 pixels of `fan_scene_shows_the_nearest_surface_everywhere`).
 #[test]
 fn fragments_across_a_shared_edge_resolve_to_the_neighbour() {
-    let red = Vec3::new(0.9, 0.1, 0.1);
-    // A square at z = 2 cut along its diagonal (shared), seen through parallel rays along +z.
-    let (lo, hi) = (0.25, 0.75);
-    let lower = [
-        DVec3::new(lo, lo, 2.0),
-        DVec3::new(hi, lo, 2.0),
-        DVec3::new(hi, hi, 2.0),
-    ];
-    let upper = [
-        DVec3::new(lo, lo, 2.0),
-        DVec3::new(hi, hi, 2.0),
-        DVec3::new(lo, hi, 2.0),
-    ];
-    let scene = scene_of(vec![object(1, &[lower, upper], red)]);
-    let geometry = SceneGeometry::new(&scene);
-    let projection = Trilinear::new(&square([DVec3::Z; 4]), 8, 8).unwrap();
-    let size = DVec2::new(8.0, 8.0);
-    let mesh = projection.mesh();
-    let maps: Vec<ScreenMap> = mesh
-        .triangles
-        .iter()
-        .zip(projection.triangle_caches())
-        .map(|(t, cache)| ScreenMap::new(t.map(|i| mesh.screen[i as usize]), size, *cache))
-        .collect();
+    let [lower, upper] = diagonal_square();
+    let (geometry, maps) = parallel_rays_onto(&[lower, upper]);
     let resolver = Resolver {
         maps: &maps,
         scene: &geometry,
