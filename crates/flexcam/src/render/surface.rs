@@ -174,13 +174,33 @@ pub fn checker_parity(p: Vec3, size: f32) -> u32 {
     if !(size > 0.0 && size.is_finite()) {
         return 0;
     }
-    let cell = ((p + Vec3::splat(1e-4 * size)) / size).floor();
-    let sum = cell.x as i64 + cell.y as i64 + cell.z as i64;
+    let cell = (p + Vec3::splat(1e-4 * size)) / size;
+    let sum = floor_to_int(cell.x) + floor_to_int(cell.y) + floor_to_int(cell.z);
     sum.rem_euclid(2) as u32
+}
+
+/// `x.floor() as i64` without the libm call that `f32::floor` compiles to on baseline x86-64
+/// (no SSE4.1 `roundss`): truncate, then step down for negative non-integers. The same value
+/// for every `x` (saturating like `as` beyond the `i64` range; NaN gives 0).
+fn floor_to_int(x: f32) -> i64 {
+    let truncated = x as i64;
+    truncated.saturating_sub(i64::from(x < truncated as f32))
 }
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn floor_to_int_is_floor() {
+        for x in [
+            -2.5f32, -2.0, -1.0, -0.5, -1e-7, -0.0, 0.0, 1e-7, 0.5, 1.0, 2.5, 1e7, -1e7, 3e9,
+        ] {
+            assert_eq!(floor_to_int(x), x.floor() as i64, "{x}");
+        }
+        assert_eq!(floor_to_int(f32::NAN), 0);
+        assert_eq!(floor_to_int(f32::INFINITY), i64::MAX);
+        assert_eq!(floor_to_int(f32::NEG_INFINITY), i64::MIN);
+    }
+
     use std::sync::Arc;
 
     use glam::Affine3A;

@@ -142,10 +142,13 @@ pub(super) fn fill<const N: usize>(
                 continue;
             }
             let (x0, x1) = centre_range(left.x, right.x, width);
-            for x in x0..x1 {
-                // x1 > x0 implies right.x > left.x: the division is safe.
-                let u = ((f64::from(x) + 0.5 - left.x) / (right.x - left.x)).clamp(0.0, 1.0);
-                emit(x, y, left.varying.lerp(&right.varying, u));
+            if x1 > x0 {
+                // x1 > x0 implies right.x > left.x: the reciprocal is finite.
+                let per_x = 1.0 / (right.x - left.x);
+                for x in x0..x1 {
+                    let u = ((f64::from(x) + 0.5 - left.x) * per_x).clamp(0.0, 1.0);
+                    emit(x, y, left.varying.lerp(&right.varying, u));
+                }
             }
         }
     }
