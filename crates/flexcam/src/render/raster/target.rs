@@ -52,10 +52,10 @@ impl Target {
         Target {
             width,
             height,
-            color: vec![background; n],
-            depth: vec![f64::INFINITY; n],
-            ids: vec![0; n],
-            primitives: vec![NO_PRIMITIVE; n],
+            color: filled(n, background),
+            depth: filled(n, f64::INFINITY),
+            ids: filled(n, 0),
+            primitives: filled(n, NO_PRIMITIVE),
         }
     }
 
@@ -117,7 +117,7 @@ impl Target {
             width: self.width,
             height: self.height,
             color: self.color,
-            depth: self.depth.iter().map(|&d| d as f32).collect(),
+            depth: self.depth.par_iter().map(|&d| d as f32).collect(),
             ids: self.ids,
         };
         Layers {
@@ -168,6 +168,14 @@ impl Target {
 const FILL_CHUNK: usize = 1 << 15;
 
 /// Sets every element of `values` to `value`, in parallel chunks.
+/// `n` copies of `value`, written in parallel: a new frame-sized buffer's first touch (its
+/// page faults) is shared by the cores instead of serialised in `vec![value; n]`.
+fn filled<T: Copy + Send + Sync>(n: usize, value: T) -> Vec<T> {
+    let mut values = Vec::with_capacity(n);
+    values.par_extend(rayon::iter::repeat_n(value, n));
+    values
+}
+
 fn fill<T: Copy + Send + Sync>(values: &mut [T], value: T) {
     values
         .par_chunks_mut(FILL_CHUNK)
