@@ -1,5 +1,6 @@
 //! Every scene triangle through one projection triangle, into clipped pixel polygons: cull
-//! pairs outside the triangle's ray volume (`volume_bounds`), project each remaining scene
+//! pairs outside the triangle's ray volume (`volume_bounds`; first a whole cluster of
+//! scene triangles at once by its box, then triangle by triangle), project each remaining scene
 //! vertex once (its cubic), cull pairs whose images cannot be visible, form the shapes, trace
 //! their curved outlines, clip them, and append them to a polygon batch.
 
@@ -110,58 +111,76 @@ pub fn project_scene(
     curves: CurveOptions,
 ) -> Projected {
     let cache = triangle.map.cache();
-    let outside: Vec<u32> = scene
-        .vertices
-        .iter()
-        .map(|&v| triangle.bounds.outside(v))
-        .collect();
+    // Each vertex's mask of bounding planes it is beyond, computed when first needed.
+    let mut outside: Vec<u32> = vec![UNKNOWN_MASK; scene.vertices.len()];
     // Each vertex's cubic, solved when a pair first needs it.
     let mut solutions: Vec<Option<Solutions>> = vec![None; scene.vertices.len()];
     let mut out = Projected::default();
     let mut scratch = Scratch::default();
-    for (k, corners) in scene.triangles.iter().enumerate() {
-        out.counts.pairs += 1;
-        if corners
-            .iter()
-            .fold(u32::MAX, |m, &i| m & outside[i as usize])
-            != 0
-        {
-            out.counts.culled_volume += 1;
+    for cluster in &scene.clusters {
+        let run = cluster.triangles.len() as u64;
+        out.counts.pairs += run;
+        if beyond_one_plane(cluster.box_corners.map(|c| triangle.bounds.outside(c))) {
+            out.counts.culled_volume += run;
             continue;
         }
-        let positions = scene.corners(k);
-        let Some(terms) = HitTerms::new(positions) else {
-            out.counts.culled_zero_area += 1;
-            continue;
-        };
-        let solved = corners.map(|i| {
-            *solutions[i as usize].get_or_insert_with(|| {
-                out.counts.vertices_projected += 1;
-                cache.project_point(scene.vertices[i as usize])
-            })
-        });
-        match cull(triangle, positions, &solved) {
-            Some(Cull::Behind) => out.counts.culled_behind += 1,
-            Some(Cull::Outside) => out.counts.culled_outside += 1,
-            None => {
-                let key = (u64::from(index) << 32) | k as u64;
-                let id = scene.owners[k].id;
-                let pair = Pair {
-                    triangle,
-                    key,
-                    id,
-                    curves,
-                    terms,
-                };
-                if curves.mode == CurveMode::Tessellate {
-                    pair.tessellated(positions, &mut out, &mut scratch);
-                } else {
-                    pair.whole(positions, solved, &mut out, &mut scratch);
+        for k in cluster.triangles.clone() {
+            let corners = &scene.triangles[k];
+            let masks = corners.map(|i| {
+                let mask = &mut outside[i as usize];
+                if *mask == UNKNOWN_MASK {
+                    *mask = triangle.bounds.outside(scene.vertices[i as usize]);
+                }
+                *mask
+            });
+            if beyond_one_plane(masks) {
+                out.counts.culled_volume += 1;
+                continue;
+            }
+            let positions = scene.corners(k);
+            let Some(terms) = HitTerms::new(positions) else {
+                out.counts.culled_zero_area += 1;
+                continue;
+            };
+            let solved = corners.map(|i| {
+                *solutions[i as usize].get_or_insert_with(|| {
+                    out.counts.vertices_projected += 1;
+                    cache.project_point(scene.vertices[i as usize])
+                })
+            });
+            match cull(triangle, positions, &solved) {
+                Some(Cull::Behind) => out.counts.culled_behind += 1,
+                Some(Cull::Outside) => out.counts.culled_outside += 1,
+                None => {
+                    let key = (u64::from(index) << 32) | k as u64;
+                    let id = scene.owners[k].id;
+                    let pair = Pair {
+                        triangle,
+                        key,
+                        id,
+                        curves,
+                        terms,
+                    };
+                    if curves.mode == CurveMode::Tessellate {
+                        pair.tessellated(positions, &mut out, &mut scratch);
+                    } else {
+                        pair.whole(positions, solved, &mut out, &mut scratch);
+                    }
                 }
             }
         }
     }
     out
+}
+
+/// The entry of a vertex whose plane mask is not computed yet: no mask has all 32 bits, as a
+/// volume has at most 26 bounding planes.
+const UNKNOWN_MASK: u32 = u32::MAX;
+
+/// Whether points with plane masks `masks` ([`super::volume_bounds::VolumeBounds::outside`]) are all beyond one
+/// bounding plane, so that their convex hull is outside the projection triangle's volume.
+fn beyond_one_plane<const N: usize>(masks: [u32; N]) -> bool {
+    masks.iter().fold(u32::MAX, |common, &m| common & m) != 0
 }
 
 /// Whether a pair can be skipped. Only decided when every vertex's cubic kept all three

@@ -1,8 +1,9 @@
 //! The scene's triangles in one flat f64 list, numbered like the ray caster's BVH (objects in
-//! order, each object's triangles in order), with the owner of each and the triangles that
-//! meet at each edge.
+//! order, each object's triangles in order), with the owner of each, the triangles that
+//! meet at each edge, and clusters of consecutive triangles with their bounding boxes.
 
 use std::collections::HashMap;
+use std::ops::Range;
 
 use glam::DVec3;
 
@@ -32,6 +33,9 @@ pub struct SceneGeometry {
     /// Per triangle, the edges `<V1V2, V1V3, V2V3>` (bits 0, 1, 2) that another triangle
     /// shares (same end positions, any object): the surface continues across them.
     pub shared_edges: Vec<u8>,
+    /// Runs of at most [`CLUSTER_SIZE`] consecutive triangles of one object, each with the
+    /// corners of its bounding box: a projection triangle can cull a whole run at once.
+    pub clusters: Vec<Cluster>,
     /// Per triangle, the numbers of its edges `<V1V2, V1V3, V2V3>` in `edge_users`.
     edges: Vec<[u32; 3]>,
     /// The triangles using each edge.
@@ -91,6 +95,19 @@ impl EdgeUsers {
     }
 }
 
+/// Most triangles in a [`Cluster`]. Meshes list neighbouring triangles near each other (the
+/// built-in shapes and tessellations row by row), so consecutive runs are compact.
+pub const CLUSTER_SIZE: usize = 32;
+
+/// A run of consecutive scene triangles and the eight corners of the axis-aligned box
+/// around their vertices. A plane that all eight corners lie beyond has every point of the
+/// box, hence every vertex of the run, beyond it (the box is their convex hull).
+#[derive(Debug, Clone)]
+pub struct Cluster {
+    pub triangles: Range<usize>,
+    pub box_corners: [DVec3; 8],
+}
+
 /// The edges `<V1V2, V1V3, V2V3>` as vertex pairs.
 const EDGES: [(usize, usize); 3] = [(0, 1), (0, 2), (1, 2)];
 
@@ -121,6 +138,7 @@ impl SceneGeometry {
         }
         (out.edge_users, out.edges) =
             EdgeUsers::new((0..out.triangles.len()).map(|k| out.corners(k)));
+        out.clusters = out.clusters();
         out.shared_edges = (0..out.triangles.len())
             .map(|k| {
                 (0..3).fold(0, |mask, edge| {
@@ -144,6 +162,37 @@ impl SceneGeometry {
             .enumerate()
             .filter(move |&(i, _)| Some(i) != own)
             .map(|(_, &n)| n as usize)
+    }
+
+    /// The triangles cut into [`Cluster`]s: runs of [`CLUSTER_SIZE`] within each object.
+    fn clusters(&self) -> Vec<Cluster> {
+        let mut clusters = Vec::new();
+        let mut start = 0;
+        while start < self.triangles.len() {
+            let object = self.owners[start].object;
+            let end = (start..self.triangles.len().min(start + CLUSTER_SIZE))
+                .take_while(|&k| self.owners[k].object == object)
+                .last()
+                .map_or(start + 1, |k| k + 1);
+            let (lo, hi) = (start..end)
+                .flat_map(|k| self.corners(k))
+                .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| {
+                    (lo.min(v), hi.max(v))
+                });
+            let box_corners = std::array::from_fn(|c| {
+                DVec3::new(
+                    if c & 1 == 0 { lo.x } else { hi.x },
+                    if c & 2 == 0 { lo.y } else { hi.y },
+                    if c & 4 == 0 { lo.z } else { hi.z },
+                )
+            });
+            clusters.push(Cluster {
+                triangles: start..end,
+                box_corners,
+            });
+            start = end;
+        }
+        clusters
     }
 
     /// The vertices of triangle `k`.
@@ -225,5 +274,30 @@ mod tests {
         assert_eq!(across(&geometry, 2, 1), [2]);
         assert_eq!(across(&geometry, 2, 2), [2]);
         assert_eq!(geometry.shared_edges[2], 0b110);
+    }
+
+    /// The cube-floor scene's clusters: consecutive runs of at most `CLUSTER_SIZE`
+    /// triangles of one object each, covering every triangle once in order, each box
+    /// holding every vertex of its run.
+    #[test]
+    fn clusters_cover_the_triangles_in_order_within_objects() {
+        let geometry = SceneGeometry::new(&scene::load("builtin:cube-floor").unwrap());
+        let mut next = 0;
+        for cluster in &geometry.clusters {
+            let run = cluster.triangles.clone();
+            assert_eq!(run.start, next);
+            assert!(!run.is_empty() && run.len() <= CLUSTER_SIZE);
+            let object = geometry.owners[run.start].object;
+            let (lo, hi) = (cluster.box_corners[0], cluster.box_corners[7]);
+            for k in run.clone() {
+                assert_eq!(geometry.owners[k].object, object);
+                for v in geometry.corners(k) {
+                    assert!(v.cmpge(lo).all() && v.cmple(hi).all());
+                }
+            }
+            next = run.end;
+        }
+        assert_eq!(next, geometry.triangles.len());
+        assert!(geometry.clusters.len() >= 686 / CLUSTER_SIZE);
     }
 }
