@@ -90,25 +90,31 @@ impl Magnifier {
 
     /// p' of the module: where pixel position `pixel` samples the underlying image.
     pub fn sample_position(&self, resolution: &Resolution, pixel: DVec2) -> DVec2 {
-        let (c, r) = self.circle(resolution);
-        let d = pixel - c;
-        let rho = d.length() / r;
-        if rho >= 1.0 || rho == 0.0 {
-            return pixel;
-        }
-        c + d * (self.radial(rho) / rho)
+        self.remap_in_circle(resolution, pixel, |rho| self.radial(rho))
     }
 
     /// The pixel position whose sample position is `sampled` (inverse of
     /// [`Magnifier::sample_position`]).
     pub fn pixel_of(&self, resolution: &Resolution, sampled: DVec2) -> DVec2 {
+        self.remap_in_circle(resolution, sampled, |s| self.radial_inverse(s))
+    }
+
+    /// `point` moved along its ray from the lens centre to relative radius `radial(rho)`,
+    /// where `rho` is its own radius over the lens radius; unchanged at the centre and on or
+    /// outside the circle, where the map is the identity.
+    fn remap_in_circle(
+        &self,
+        resolution: &Resolution,
+        point: DVec2,
+        radial: impl Fn(f64) -> f64,
+    ) -> DVec2 {
         let (c, r) = self.circle(resolution);
-        let d = sampled - c;
-        let s = d.length() / r;
-        if s >= 1.0 || s == 0.0 {
-            return sampled;
+        let d = point - c;
+        let rho = d.length() / r;
+        if rho >= 1.0 || rho == 0.0 {
+            return point;
         }
-        c + d * (self.radial_inverse(s) / s)
+        c + d * (radial(rho) / rho)
     }
 }
 
