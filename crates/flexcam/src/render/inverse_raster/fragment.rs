@@ -10,24 +10,19 @@
 //! clip), or runs parallel to it, are discarded. Barycentrics just outside the triangle (a
 //! silhouette pixel the polygon covers but the exact image does not) are clamped onto it.
 //!
-//! Shading is deferred: the rasteriser only resolves depths, and each pixel's visible
-//! fragment is shaded once afterwards ([`Shader::shade_visible`]), so hidden fragments cost
-//! no shading and no secondary rays.
+//! Shading is deferred: fragments are only reconstructed and z-tested, and each pixel's
+//! visible fragment is shaded once afterwards ([`Shader::shade`]), from the values its one
+//! reconstruction gave, so hidden fragments cost no shading and no secondary rays.
 
 use glam::{DVec3, Vec2, Vec3};
-use rayon::prelude::*;
 
 use super::pixel_rays::PixelRays;
 use crate::geometry::Ray;
-use crate::render::raster::{Fragment, Target};
+use crate::render::raster::NO_PRIMITIVE;
 use crate::render::raycast::{Hit, RayCaster};
 use crate::render::surface::{base_color, TextureFilter};
-use crate::render::{Frame, RenderOptions, Shading};
+use crate::render::{RenderOptions, Shading};
 use crate::scene::{Object, Surface};
-
-/// Attributes carried by a fragment: none, depth only (everything else is reconstructed
-/// from the pixel's projector).
-pub const ATTRIBUTES: usize = 0;
 
 /// The primitive key of triangle `triangle` of object index `object`: objects in the high
 /// half, so keys order like (object, triangle).
@@ -50,91 +45,95 @@ pub struct Shader<'a> {
     pub options: &'a RenderOptions<'a>,
 }
 
+/// A pixel's nearest fragment so far: its exact depth (the ray caster's distance along the
+/// projector), ray parameter, primitive key and clamped barycentrics, all from the one
+/// reconstruction of the fragment ([`Shader::fragment`]), kept for shading.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Visible {
+    pub depth: f64,
+    pub t: f64,
+    pub key: u64,
+    pub barycentric: Vec2,
+}
+
+impl Visible {
+    /// No fragment: beaten by any.
+    pub const NONE: Visible = Visible {
+        depth: f64::INFINITY,
+        t: f64::INFINITY,
+        key: NO_PRIMITIVE,
+        barycentric: Vec2::ZERO,
+    };
+
+    /// The rasteriser's z-test: nearer, or as near with a smaller key, so the winner does
+    /// not depend on the order of the fragments.
+    pub fn beats(&self, other: &Visible) -> bool {
+        self.depth < other.depth || (self.depth == other.depth && self.key < other.key)
+    }
+
+    /// Whether this is [`Visible::NONE`] (no fragment reached the pixel).
+    pub fn is_empty(&self) -> bool {
+        self.key == NO_PRIMITIVE
+    }
+}
+
 impl Shader<'_> {
-    /// The resolve step: the exact depth from the pixel's projector, or `false` to discard.
-    pub fn resolve(&self, fragment: &mut Fragment<ATTRIBUTES>) -> bool {
-        let Some((ray, t, _)) = self.reconstruct(fragment.x, fragment.y, fragment.primitive) else {
-            return false;
-        };
-        fragment.varying.depth = t * ray.direction.length();
-        true
-    }
-
-    /// Writes `target` into `frame` (resized to it) with every covered pixel's visible
-    /// fragment shaded (rows in parallel), and returns the number of rays that shading cast
-    /// (secondary and shadow rays of lit shading, mirrors and glass). Depths are rounded to
-    /// `f32`; pixels without a fragment keep the target's colour (the background).
-    pub fn shade_visible(&self, target: &Target, frame: &mut Frame) -> u64 {
-        let (width, height) = (target.width(), target.height());
-        let n = width as usize * height as usize;
-        (frame.width, frame.height) = (width, height);
-        frame.color.resize(n, Vec3::ZERO);
-        frame.depth.resize(n, f32::INFINITY);
-        frame.ids.resize(n, 0);
-        let row = (width as usize).max(1);
-        frame
-            .color
-            .par_chunks_mut(row)
-            .zip(frame.depth.par_chunks_mut(row))
-            .zip(frame.ids.par_chunks_mut(row))
-            .enumerate()
-            .map(|(y, ((colors, depths), ids))| {
-                let first = y * row;
-                let mut rays = 0;
-                let pixels = colors.iter_mut().zip(depths).zip(ids).enumerate();
-                for (x, ((color, depth), id)) in pixels {
-                    let i = first + x;
-                    (*depth, *id) = (target.depth()[i] as f32, target.ids()[i]);
-                    *color = target.color()[i];
-                    let (x, y) = (x as u32, y as u32);
-                    if let Some((shaded, cast)) =
-                        target.primitive(x, y).and_then(|key| self.shade(x, y, key))
-                    {
-                        (*color, rays) = (shaded, rays + cast);
-                    }
-                }
-                rays
-            })
-            .sum()
-    }
-
-    /// Pixel `(x, y)`'s projector and where it meets the plane of primitive `key`: the ray
-    /// parameter and the clamped barycentrics (see [`plane_hit`]).
-    fn reconstruct(&self, x: u32, y: u32, key: u64) -> Option<(&Ray, f64, Vec2)> {
+    /// The fragment of primitive `key` at pixel `(x, y)`, reconstructed from the pixel's
+    /// projector, or `None` to discard it (see [`plane_hit`]; also a pixel without a
+    /// projector).
+    pub fn fragment(&self, x: u32, y: u32, key: u64) -> Option<Visible> {
         let ray = self.rays.get(x, y)?;
         let (object, triangle) = unkey(key);
         let mesh = &self.objects[object].mesh;
         let corners = mesh.triangles[triangle].map(|i| mesh.positions[i as usize].as_dvec3());
         let (t, u, v) = plane_hit(ray, corners)?;
-        Some((ray, t, Vec2::new(u as f32, v as f32)))
+        Some(Visible {
+            depth: t * ray.direction.length(),
+            t,
+            key,
+            barycentric: Vec2::new(u as f32, v as f32),
+        })
     }
 
-    /// The colour of pixel `(x, y)` whose visible fragment belongs to primitive `key`, and
-    /// the rays its shading cast.
-    fn shade(&self, x: u32, y: u32, key: u64) -> Option<(Vec3, u64)> {
-        let (ray, t, barycentric) = self.reconstruct(x, y, key)?;
-        let (object_index, triangle) = unkey(key);
+    /// The object id of primitive `key`.
+    pub fn id(&self, key: u64) -> u32 {
+        self.objects[unkey(key).0].id
+    }
+
+    /// The colour of pixel `(x, y)` whose visible fragment is `visible`, and the rays its
+    /// shading cast.
+    pub fn shade(&self, x: u32, y: u32, visible: &Visible) -> (Vec3, u64) {
+        let (object_index, triangle) = unkey(visible.key);
         let object = &self.objects[object_index];
         let flat = matches!(
             object.material.surface,
             Surface::Diffuse | Surface::Emissive
         );
-        let base = || base_color(object, triangle, barycentric, TextureFilter::Nearest);
-        Some(match (self.options.shading, self.caster) {
-            (Shading::Flat, _) if flat => (base(), 0),
-            (_, Some(caster)) => {
+        let base = || {
+            let color = base_color(
+                object,
+                triangle,
+                visible.barycentric,
+                TextureFilter::Nearest,
+            );
+            (color, 0)
+        };
+        match (self.options.shading, self.caster, self.rays.get(x, y)) {
+            (Shading::Flat, _, _) if flat => base(),
+            (_, Some(caster), Some(ray)) => {
                 let hit = Hit {
-                    t,
+                    t: visible.t,
                     object: object_index,
                     triangle,
-                    barycentric,
+                    barycentric: visible.barycentric,
                 };
                 caster.shade_hit(ray, hit, self.options)
             }
-            // Unreachable by construction (the caster exists whenever shading needs it); the
-            // base colour is the safe answer.
-            _ => (base(), 0),
-        })
+            // Unreachable by construction (the caster exists whenever shading needs it, and
+            // a visible fragment's pixel has a projector); the base colour is the safe
+            // answer.
+            _ => base(),
+        }
     }
 }
 

@@ -10,13 +10,15 @@
 //! 3. each piece is placed on the screen ([`seam`]): unwrapped across a panorama's seam and
 //!    drawn once more on the other side when it straddles it; pieces around a pole are
 //!    dropped (they cover no pixel centre), and so are pieces whose screen box holds no
-//!    pixel centre (most pieces of a finely tessellated model);
-//! 4. the pieces are filled by the polygon rasteriser in parallel bands; each fragment
-//!    reconstructs its exact depth from its pixel's projector ([`fragment`]; the projectors
+//!    pixel centre (most pieces of a finely tessellated model); the others are sorted into
+//!    bands of rows by the parallel job that built them ([`coverage::Bins`]);
+//! 4. the bands are filled in parallel by the polygon rasteriser's fill and tie rule
+//!    specialised to triangles ([`coverage::cover`]); each fragment reconstructs its exact
+//!    depth and barycentrics once from its pixel's projector ([`fragment`]; the projectors
 //!    are computed on first use and kept for later frames, [`pixel_rays`]);
-//! 5. each pixel's visible fragment is shaded once, from the same reconstruction, so depth
-//!    and shading are the ray caster's and only coverage near silhouettes depends on the
-//!    subdivision.
+//! 5. each band's visible fragments are shaded once, from that reconstruction, straight
+//!    into the frame ([`band_fill`]), so depth and shading are the ray caster's and only
+//!    coverage near silhouettes depends on the subdivision.
 //!
 //! Shading: flat base colours are computed here; lit shading (lights and shadows) and the
 //! secondary rays of mirrors and glass are delegated, per visible pixel, to the ray caster's
@@ -25,14 +27,17 @@
 //! pixel (`--spp 1`).
 //!
 //! An [`InverseRaster`] is meant to render many frames of one projection (an animation of
-//! the scene, an interactive viewer): the pixel projectors, the BVH and the z-buffered target
-//! are kept between frames, and [`InverseRaster::render_into`] reuses the caller's frame.
+//! the scene, an interactive viewer): the pixel projectors, the BVH, the bins and the
+//! z-buffer are kept between frames, and [`InverseRaster::render_into`] reuses the caller's
+//! frame.
 //!
 //! Supported: every projection with an [`InverseChart`] (perspective, orthographic,
 //! fisheye, equirectangular, cylindrical, and the flexible volumes described in
 //! `projection::flexible::chart`); others are refused with one line naming the projection.
 
+mod band_fill;
 mod clip;
+mod coverage;
 mod fragment;
 mod pixel_rays;
 mod refine;
@@ -47,20 +52,19 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
-use glam::{DVec2, DVec3, Vec3};
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 pub use subdivision::{Subdivision, DEFAULT_TOLERANCE, MAX_LEVEL, MAX_UNIFORM};
 
-use self::fragment::{key, Shader, ATTRIBUTES};
+use self::band_fill::{fill_and_shade, BAND_ROWS};
+use self::coverage::{Bins, ScreenTriangle};
+use self::fragment::{key, Shader, Visible};
 use self::pixel_rays::PixelRays;
 use self::refine::{Node, Refiner};
 use self::seam::{covers_a_centre, place, Placement};
 use crate::error::{Error, Result};
 use crate::projection::{InverseChart, Projection};
-use crate::render::raster::{
-    rasterize_parallel_resolved, FillRule, PolygonBatch, Target, Vertex, BAND_ROWS,
-};
 use crate::render::raycast::RayCaster;
 use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
 use crate::scene::{Scene, Surface};
@@ -69,7 +73,8 @@ use crate::scene::{Scene, Surface};
 const CHUNK: usize = 2048;
 
 /// A scene and a projection prepared for rasterisation: the chart, the pixel projectors
-/// (filled in as frames need them) and, when shading needs rays, the ray caster.
+/// (filled in as frames need them), the buffers frames reuse and, when shading needs rays,
+/// the ray caster.
 pub struct InverseRaster<'a> {
     scene: &'a Scene,
     projection: &'a dyn Projection,
@@ -78,8 +83,17 @@ pub struct InverseRaster<'a> {
     caster: Option<RayCaster>,
     options: RenderOptions<'a>,
     setup_ms: f64,
-    /// The z-buffered target, kept from frame to frame (cleared, not reallocated).
-    target: Mutex<Target>,
+    /// The buffers of a frame, kept from frame to frame (cleared, not reallocated).
+    buffers: Mutex<Buffers>,
+}
+
+/// What a frame writes besides the caller's frame, kept by the renderer.
+#[derive(Debug, Default)]
+struct Buffers {
+    /// The screen triangles of each piece-building job, sorted into bands.
+    bins: Vec<Bins>,
+    /// Each pixel's visible fragment.
+    zbuffer: Vec<Visible>,
 }
 
 /// What piece building did, for `--stats`.
@@ -97,8 +111,10 @@ struct PieceCounts {
     winding: u64,
     /// Screen triangles whose box holds no pixel centre, dropped before the rasteriser.
     empty: u64,
-    /// Screen triangles handed to the rasteriser (a seam straddler counts twice).
+    /// Screen triangles filled (a seam straddler counts twice).
     drawn: u64,
+    /// Screen triangles with a non-finite or huge coordinate, not filled.
+    invalid: u64,
 }
 
 impl std::ops::AddAssign for PieceCounts {
@@ -110,6 +126,7 @@ impl std::ops::AddAssign for PieceCounts {
         self.winding += o.winding;
         self.empty += o.empty;
         self.drawn += o.drawn;
+        self.invalid += o.invalid;
     }
 }
 
@@ -165,10 +182,8 @@ impl<'a> InverseRaster<'a> {
             .iter()
             .any(|o| !matches!(o.material.surface, Surface::Diffuse | Surface::Emissive));
         let caster = (options.shading == Shading::Lit || specular).then(|| RayCaster::new(scene));
-        let (width, height) = projection.resolution();
-        let target = Mutex::new(Target::new(width, height, scene.image.background));
         Ok(InverseRaster {
-            target,
+            buffers: Mutex::default(),
             scene,
             projection,
             chart,
@@ -192,35 +207,37 @@ impl<'a> InverseRaster<'a> {
     /// reusing one `frame` allocates no image buffer after the first.
     pub fn render_into(&self, frame: &mut Frame) -> Stats {
         let start = Instant::now();
-        let (batch, counts) = self.pieces();
-        let pieces_ms = start.elapsed().as_secs_f64() * 1e3;
-        let background = self.scene.image.background;
-        // Every frame clears the whole target first, so one left by a panicked frame is
-        // as good as any.
-        let mut target = self
-            .target
+        // Every frame overwrites the buffers, so ones left by a panicked frame are as good
+        // as any.
+        let mut buffers = self
+            .buffers
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
-        target.clear(background);
+        let Buffers { bins, zbuffer } = &mut *buffers;
+        let counts = self.pieces(bins);
+        let pieces_ms = start.elapsed().as_secs_f64() * 1e3;
         let shader = Shader {
             objects: &self.scene.objects,
             rays: &self.rays,
             caster: self.caster.as_ref(),
             options: &self.options,
         };
-        let raster = rasterize_parallel_resolved(
-            &mut target,
-            &batch,
-            FillRule::NonZero,
-            BAND_ROWS,
-            &|f| shader.resolve(f),
-            &|_| Vec3::ZERO,
+        let size = self.projection.resolution();
+        let filled = fill_and_shade(
+            &shader,
+            bins,
+            zbuffer,
+            frame,
+            size,
+            self.scene.image.background,
         );
+        drop(buffers);
         let fill_ms = start.elapsed().as_secs_f64() * 1e3 - pieces_ms;
-        let shading_rays = shader.shade_visible(&target, frame);
-        drop(target);
         let mut stats = Stats::new();
-        raster.record(&mut stats);
+        filled
+            .raster_stats(counts.drawn, counts.invalid)
+            .record(&mut stats);
+        let shading_rays = filled.shading_rays;
         let count = |n: u64| Counter::Count(n);
         for (name, value) in [
             ("triangles", self.scene.triangle_count() as u64),
@@ -246,10 +263,6 @@ impl<'a> InverseRaster<'a> {
             ("raster_setup_ms", self.setup_ms),
             ("raster_pieces_ms", pieces_ms),
             ("raster_fill_ms", fill_ms),
-            (
-                "raster_shade_ms",
-                start.elapsed().as_secs_f64() * 1e3 - pieces_ms - fill_ms,
-            ),
         ] {
             stats.insert(name, Counter::Value(value));
         }
@@ -257,8 +270,9 @@ impl<'a> InverseRaster<'a> {
     }
 
     /// Steps 1 to 3 of the module documentation: the screen triangles of every scene
-    /// triangle, in scene order (object, then triangle), with their counters.
-    fn pieces(&self) -> (PolygonBatch<ATTRIBUTES>, PieceCounts) {
+    /// triangle, sorted into bands by parallel jobs of [`CHUNK`] scene triangles, one
+    /// element of `bins` per job (resized), with their counters.
+    fn pieces(&self, bins: &mut Vec<Bins>) -> PieceCounts {
         let refiner = Refiner::new(
             self.projection,
             &self.chart,
@@ -287,47 +301,45 @@ impl<'a> InverseRaster<'a> {
             })
             .collect();
         let done = AtomicU64::new(0);
-        let parts: Vec<(PolygonBatch<ATTRIBUTES>, PieceCounts)> = jobs
-            .par_iter()
-            .map(|(o, range)| {
-                let mut part = (PolygonBatch::new(), PieceCounts::default());
+        let bands = self.projection.resolution().1.div_ceil(BAND_ROWS) as usize;
+        bins.resize_with(jobs.len(), Bins::default);
+        jobs.par_iter()
+            .zip(bins.par_iter_mut())
+            .map(|((o, range), bins)| {
+                bins.reset(bands);
+                let mut counts = PieceCounts::default();
                 let mut grid = Vec::new();
                 for triangle in range.clone() {
-                    self.triangle(&refiner, &images[*o], (*o, triangle), &mut grid, &mut part);
+                    let part = (&mut *bins, &mut counts);
+                    self.triangle(&refiner, &images[*o], (*o, triangle), &mut grid, part);
                 }
                 if let Some(progress) = self.options.progress {
                     progress(done.fetch_add(1, Ordering::Relaxed) + 1, jobs.len() as u64);
                 }
-                part
+                counts
             })
-            .collect();
-        let mut batch = PolygonBatch::new();
-        let mut counts = PieceCounts::default();
-        for (part, part_counts) in &parts {
-            batch.append(part);
-            counts += *part_counts;
-        }
-        (batch, counts)
+            .reduce(PieceCounts::default, |mut a, b| {
+                a += b;
+                a
+            })
     }
 
     /// Clips, subdivides and places triangle `triangle` of object index `object`, whose
-    /// vertex images are `images`.
+    /// vertex images are `images`, into `bins`.
     fn triangle(
         &self,
         refiner: &Refiner<'_>,
         images: &[Option<DVec2>],
         (object, triangle): (usize, usize),
         grid: &mut Vec<Node>,
-        (batch, counts): &mut (PolygonBatch<ATTRIBUTES>, PieceCounts),
+        (bins, counts): (&mut Bins, &mut PieceCounts),
     ) {
         let item = &self.scene.objects[object];
         let corners = item.mesh.triangles[triangle].map(|i| i as usize);
         let points: [DVec3; 3] = corners.map(|i| item.mesh.positions[i].as_dvec3());
-        let (id, key) = (item.id, key(object, triangle));
-        let size = DVec2::new(
-            f64::from(self.projection.resolution().0),
-            f64::from(self.projection.resolution().1),
-        );
+        let key = key(object, triangle);
+        let (width, height) = self.projection.resolution();
+        let size = DVec2::new(f64::from(width), f64::from(height));
         let period = self.chart.period;
         let inside = self
             .chart
@@ -348,19 +360,22 @@ impl<'a> InverseRaster<'a> {
                 counts.singular += 1;
                 return;
             };
-            let mut empty = 0;
-            let placed = place([a, b, c], size, period, |screen| {
-                if covers_a_centre(screen) {
-                    let vertices = screen.map(|p| Vertex::new(p.x, p.y, 0.0, [0.0; ATTRIBUTES]));
-                    batch.push(&vertices, id, key);
-                } else {
+            let (mut empty, mut invalid) = (0, 0);
+            let placed = place([a, b, c], size, period, |corners| {
+                let screen = ScreenTriangle { corners, key };
+                if !covers_a_centre(corners) {
                     empty += 1;
+                } else if screen.is_valid() {
+                    bins.push(screen, BAND_ROWS, height);
+                } else {
+                    invalid += 1;
                 }
             });
             match placed {
                 Placement::Copies(n) => {
-                    counts.drawn += u64::from(n) - empty;
+                    counts.drawn += u64::from(n) - empty - invalid;
                     counts.empty += empty;
+                    counts.invalid += invalid;
                 }
                 Placement::Winds => counts.winding += 1,
             }

@@ -1,0 +1,134 @@
+//! Steps 4 and 5 of the module documentation fused, band by band: the screen triangles of a
+//! band are filled into the band's part of a z-buffer of reconstructed fragments, and the
+//! band's visible fragments are shaded straight into the caller's frame while the band is
+//! still in cache. Bands are independent, so they run in parallel with no binning pass, no
+//! shared batch and no separate full-image clear or copy.
+//!
+//! Each covered pixel centre is reconstructed once ([`Shader::fragment`]: exact depth, ray
+//! parameter and barycentrics); the z-test keeps the nearest, ties going to the smaller
+//! primitive key, as the polygon rasteriser's does, so the image does not depend on the
+//! order of the triangles, the band size or the thread count.
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+use super::coverage::{cover, Bins};
+use super::fragment::{Shader, Visible};
+use crate::render::raster::RasterStats;
+use crate::render::Frame;
+
+/// Rows per band: small enough for many parallel tasks on the part of a panorama a model
+/// covers, large enough that few screen triangles (mostly one or two pixels) reach two.
+pub const BAND_ROWS: u32 = 8;
+
+/// What filling and shading did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct FillCounts {
+    /// Covered pixel centres, each reconstructed and z-tested.
+    pub fragments: u64,
+    /// Fragments whose projector misses the plane of their triangle within its range.
+    pub discarded: u64,
+    /// Fragments that won the z-test when tested.
+    pub writes: u64,
+    /// Pixels holding a visible fragment at the end.
+    pub covered: u64,
+    /// Rays cast by the shading of the visible fragments.
+    pub shading_rays: u64,
+}
+
+impl std::ops::Add for FillCounts {
+    type Output = FillCounts;
+
+    fn add(self, o: FillCounts) -> FillCounts {
+        FillCounts {
+            fragments: self.fragments + o.fragments,
+            discarded: self.discarded + o.discarded,
+            writes: self.writes + o.writes,
+            covered: self.covered + o.covered,
+            shading_rays: self.shading_rays + o.shading_rays,
+        }
+    }
+}
+
+impl FillCounts {
+    /// The rasteriser's counters for these fills of `polygons` screen triangles, `skipped`
+    /// more having been left out for invalid coordinates.
+    pub fn raster_stats(&self, polygons: u64, skipped: u64) -> RasterStats {
+        RasterStats {
+            polygons,
+            lines: 0,
+            skipped,
+            fragments: self.fragments,
+            writes: self.writes,
+            discarded: self.discarded,
+            covered: self.covered,
+        }
+    }
+}
+
+/// Fills the screen triangles of `bins` (those of every piece-building job, each sorted into
+/// bands of [`BAND_ROWS`]) into `zbuffer` (resized to the image and overwritten) and writes
+/// the image of `size` pixels into `frame` (resized): visible pixels shaded by `shader`,
+/// others `background` at infinite depth with id 0.
+pub fn fill_and_shade(
+    shader: &Shader<'_>,
+    bins: &[Bins],
+    zbuffer: &mut Vec<Visible>,
+    frame: &mut Frame,
+    size: (u32, u32),
+    background: Vec3,
+) -> FillCounts {
+    let (width, height) = size;
+    let n = width as usize * height as usize;
+    (frame.width, frame.height) = size;
+    frame.color.resize(n, background);
+    frame.depth.resize(n, f32::INFINITY);
+    frame.ids.resize(n, 0);
+    zbuffer.resize(n, Visible::NONE);
+    if n == 0 {
+        return FillCounts::default();
+    }
+    let row = width as usize;
+    let chunk = BAND_ROWS as usize * row;
+    frame
+        .color
+        .par_chunks_mut(chunk)
+        .zip(frame.depth.par_chunks_mut(chunk))
+        .zip(frame.ids.par_chunks_mut(chunk))
+        .zip(zbuffer.par_chunks_mut(chunk))
+        .enumerate()
+        .map(|(band, (((colors, depths), ids), visible))| {
+            let first = band as u32 * BAND_ROWS;
+            let rows = (first, first + (visible.len() / row) as u32);
+            visible.fill(Visible::NONE);
+            let mut counts = FillCounts::default();
+            for triangle in bins.iter().flat_map(|job| job.band(band)) {
+                cover(triangle, rows, width, |x, y| {
+                    counts.fragments += 1;
+                    let Some(fragment) = shader.fragment(x, y, triangle.key) else {
+                        counts.discarded += 1;
+                        return;
+                    };
+                    let slot = &mut visible[(y - first) as usize * row + x as usize];
+                    if fragment.beats(slot) {
+                        *slot = fragment;
+                        counts.writes += 1;
+                    }
+                });
+            }
+            let pixels = colors.iter_mut().zip(depths).zip(ids).zip(visible.iter());
+            for (i, (((color, depth), id), slot)) in pixels.enumerate() {
+                if slot.is_empty() {
+                    (*color, *depth, *id) = (background, f32::INFINITY, 0);
+                    continue;
+                }
+                let (x, y) = ((i % row) as u32, first + (i / row) as u32);
+                let (shaded, rays) = shader.shade(x, y, slot);
+                (*color, *depth, *id) = (shaded, slot.depth as f32, shader.id(slot.key));
+                counts.covered += 1;
+                counts.shading_rays += rays;
+            }
+            counts
+        })
+        .reduce(FillCounts::default, |a, b| a + b)
+}
