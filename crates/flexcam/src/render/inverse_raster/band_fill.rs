@@ -67,9 +67,10 @@ impl FillCounts {
 }
 
 /// Fills the screen triangles of `bins` (those of every piece-building job, each sorted into
-/// bands of [`BAND_ROWS`]) into `zbuffer` (resized to the image and overwritten) and writes
-/// the image of `size` pixels into `frame` (resized): visible pixels shaded by `shader`,
-/// others `background` at infinite depth with id 0.
+/// bands of [`BAND_ROWS`]) into `zbuffer` (resized to the image; the rows of bands that some
+/// triangle reaches are overwritten) and writes the image of `size` pixels into `frame`
+/// (resized): visible pixels shaded by `shader`, others `background` at infinite depth with
+/// id 0.
 pub fn fill_and_shade(
     shader: &Shader<'_>,
     bins: &[Bins],
@@ -100,12 +101,21 @@ pub fn fill_and_shade(
         .map(|(band, (((colors, depths), ids), visible))| {
             let first = band as u32 * BAND_ROWS;
             let rows = (first, first + (visible.len() / row) as u32);
-            visible.fill(Visible::NONE);
             let mut counts = FillCounts::default();
+            if bins.iter().all(|job| job.band(band).is_empty()) {
+                // Nothing reaches the band (the sky of a panorama): background only, and
+                // the z-buffer's rows are left as they are (not read).
+                colors.fill(background);
+                depths.fill(f32::INFINITY);
+                ids.fill(0);
+                return counts;
+            }
+            visible.fill(Visible::NONE);
             for triangle in bins.iter().flat_map(|job| job.band(band)) {
+                let corners = shader.corners(triangle.key);
                 cover(triangle, rows, width, |x, y| {
                     counts.fragments += 1;
-                    let Some(fragment) = shader.fragment(x, y, triangle.key) else {
+                    let Some(fragment) = shader.fragment(x, y, triangle.key, corners) else {
                         counts.discarded += 1;
                         return;
                     };

@@ -150,8 +150,11 @@ mod tests {
 
     const SIZE: (u32, u32) = (24, 16);
 
+    /// Pixels as `(x, y)`.
+    type Pixels = Vec<(u32, u32)>;
+
     /// The centres `cover` finds over the whole image, and those `render::raster` fills.
-    fn both(corners: [DVec2; 3]) -> (Vec<(u32, u32)>, Vec<(u32, u32)>) {
+    fn both(corners: [DVec2; 3]) -> (Pixels, Pixels) {
         let triangle = ScreenTriangle { corners, key: 7 };
         let mut ours = Vec::new();
         cover(&triangle, (0, SIZE.1), SIZE.0, |x, y| ours.push((x, y)));

@@ -78,14 +78,18 @@ impl Visible {
 }
 
 impl Shader<'_> {
-    /// The fragment of primitive `key` at pixel `(x, y)`, reconstructed from the pixel's
-    /// projector, or `None` to discard it (see [`plane_hit`]; also a pixel without a
-    /// projector).
-    pub fn fragment(&self, x: u32, y: u32, key: u64) -> Option<Visible> {
-        let ray = self.rays.get(x, y)?;
+    /// The scene corners of primitive `key`, looked up once per screen triangle.
+    pub fn corners(&self, key: u64) -> [DVec3; 3] {
         let (object, triangle) = unkey(key);
         let mesh = &self.objects[object].mesh;
-        let corners = mesh.triangles[triangle].map(|i| mesh.positions[i as usize].as_dvec3());
+        mesh.triangles[triangle].map(|i| mesh.positions[i as usize].as_dvec3())
+    }
+
+    /// The fragment of primitive `key`, whose scene corners are `corners`, at pixel
+    /// `(x, y)`, reconstructed from the pixel's projector, or `None` to discard it (see
+    /// [`plane_hit`]; also a pixel without a projector).
+    pub fn fragment(&self, x: u32, y: u32, key: u64, corners: [DVec3; 3]) -> Option<Visible> {
+        let ray = self.rays.get(x, y)?;
         let (t, u, v) = plane_hit(ray, corners)?;
         Some(Visible {
             depth: t * ray.direction.length(),

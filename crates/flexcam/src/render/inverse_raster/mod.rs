@@ -109,7 +109,7 @@ struct PieceCounts {
     singular: u64,
     /// Pieces whose outline winds around a pole, dropped.
     winding: u64,
-    /// Screen triangles whose box holds no pixel centre, dropped before the rasteriser.
+    /// Screen triangles whose box holds no pixel centre, dropped before the fill.
     empty: u64,
     /// Screen triangles filled (a seam straddler counts twice).
     drawn: u64,

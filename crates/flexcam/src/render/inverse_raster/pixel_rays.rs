@@ -17,8 +17,8 @@ use glam::{DVec2, DVec3};
 use crate::geometry::Ray;
 use crate::projection::Projection;
 
-/// Tile edge in pixels: one band of the rasteriser (16 rows) holds whole tiles, so a tile is
-/// usually computed and read by one thread.
+/// Tile edge in pixels: a tile spans two bands of the fill (`band_fill::BAND_ROWS`, 8 rows),
+/// so a tile is computed by one thread and read by at most two.
 const TILE: u32 = 16;
 
 /// The centre rays of a projection's image, computed tile by tile on first use; `None` where

@@ -186,25 +186,26 @@ impl<'a> Refiner<'a> {
     /// The pole rule needs an edge end within twice the edge's length, theta - a < 4a; a
     /// pole crossing needs theta - a <= 0. Both are impossible when theta > 5a, which holds
     /// when `chord * D > 5 (pi / 2) r`, chord = |unit(c - o) - direction| (theta >= chord
-    /// and a <= (pi / 2) r / D; the chord is at most 2, so this also implies D > r).
+    /// and a <= (pi / 2) r / D; the chord is at most 2, so this also implies D > r). It is
+    /// evaluated squared and without the division, as `|(c - o) - D direction|^2 >
+    /// (5 pi / 2)^2 r^2` (chord * D = |(c - o) - D direction|): one square root per pole and
+    /// none for r, as this runs once per scene triangle.
     ///
     /// Degenerate cases: a triangle around a pole's origin (D <= r), or whose centroid is
-    /// the origin (D = 0), is not far; neither is a zero-size triangle on a pole ray
-    /// (r = 0 and chord = 0: the inequality is strict); a non-finite point makes every
-    /// comparison false, so it is not far either (the exact tests decide).
+    /// the origin (D = 0, where the left side is 0), is not far; neither is a zero-size
+    /// triangle on a pole ray (r = 0 and chord = 0: the inequality is strict); a non-finite
+    /// point makes every comparison false, so it is not far either (the exact tests decide).
     pub fn far_from_poles(&self, points: [DVec3; 3]) -> bool {
+        const BOUND: f64 = 2.5 * std::f64::consts::PI;
         let centre = (points[0] + points[1] + points[2]) / 3.0;
-        let radius = points
+        let radius_squared = points
             .iter()
             .map(|&p| p.distance_squared(centre))
-            .fold(0.0, f64::max)
-            .sqrt();
+            .fold(0.0, f64::max);
         self.chart.poles.iter().all(|pole| {
             let offset = centre - pole.origin;
-            let distance = offset.length();
-            distance > 0.0
-                && (offset / distance - pole.direction).length() * distance
-                    > 2.5 * std::f64::consts::PI * radius
+            (offset - offset.length() * pole.direction).length_squared()
+                > BOUND * BOUND * radius_squared
         })
     }
 

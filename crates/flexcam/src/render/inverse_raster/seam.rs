@@ -47,10 +47,7 @@ pub fn place(
     let (x_lo, x_hi) = (a.x.min(xb).min(xc), a.x.max(xb).max(xc));
     let shifts = match period {
         // The shifts k with [x_lo + kP, x_hi + kP] meeting [0, width].
-        Some(p) => (
-            (-x_hi / p).ceil() as i64,
-            ((size.x - x_lo) / p).floor() as i64,
-        ),
+        Some(p) => (ceil(-x_hi / p) as i64, (-ceil(-(size.x - x_lo) / p)) as i64),
         None if x_hi < 0.0 || x_lo > size.x => return Placement::Copies(0),
         None => (0, 0),
     };
@@ -78,8 +75,28 @@ pub fn covers_a_centre(corners: [DVec2; 3]) -> bool {
     let [a, b, c] = corners;
     let (lo, hi) = (a.min(b).min(c) - BOX_SLACK, a.max(b).max(c) + BOX_SLACK);
     // The first centre at or after lo lies before hi.
-    let holds = |lo: f64, hi: f64| (lo - 0.5).ceil() + 0.5 < hi;
+    let holds = |lo: f64, hi: f64| ceil(lo - 0.5) + 0.5 < hi;
     holds(lo.x, hi.x) && holds(lo.y, hi.y)
+}
+
+/// Below this magnitude every `f64` converts to `i64` exactly, integral or not.
+const EXACT_I64: f64 = 4_503_599_627_370_496.0; // 2^52
+
+/// `v.ceil()`, computed inline by truncation below 2^52 in magnitude (on baseline x86-64
+/// `ceil` is a library call, and [`place`] and [`covers_a_centre`] run for every piece).
+/// Degenerate cases: -0.0 where `ceil` gives -0.0 for `v` in (-1, 0) gives +0.0 here
+/// (equal as numbers and as `i64`); large, infinite and NaN `v` take `ceil` itself.
+fn ceil(v: f64) -> f64 {
+    if v.abs() < EXACT_I64 {
+        let t = v as i64 as f64;
+        if t < v {
+            t + 1.0
+        } else {
+            t
+        }
+    } else {
+        v.ceil()
+    }
 }
 
 #[cfg(test)]
@@ -144,6 +161,46 @@ mod tests {
         // Degenerate: a point triangle on a centre is kept, one off it is not.
         assert!(covers_a_centre(at(7.5, 7.5, 0.0, 0.0)));
         assert!(!covers_a_centre(at(7.2, 7.5, 0.0, 0.0)));
+    }
+
+    /// `ceil` is `f64::ceil` (as a number) on both sides of every kind of boundary.
+    #[test]
+    fn inline_ceil_is_the_librarys() {
+        let big = EXACT_I64;
+        for v in [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            1.5,
+            -1.5,
+            2.0 - 1e-15,
+            -2.0 + 1e-15,
+            1e-300,
+            -1e-300,
+            123456.75,
+            -123456.75,
+            big - 0.5,
+            -(big - 0.5),
+            big,
+            -big,
+            big * 4.0,
+            1e300,
+            -1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::MAX,
+            f64::MIN,
+        ] {
+            assert_eq!(ceil(v), v.ceil(), "{v}");
+        }
+        assert!(ceil(f64::NAN).is_nan());
+        // floor(x) = -ceil(-x), as `place` uses it.
+        for v in [2.5, -2.5, 3.0, -0.25] {
+            assert_eq!(-ceil(-v), v.floor(), "{v}");
+        }
     }
 
     /// Degenerate: an outline going once around a pole has no triangle image.
