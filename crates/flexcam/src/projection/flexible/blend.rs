@@ -108,7 +108,7 @@ fn projector_hull(
         .iter()
         .map(Surface::bilinear_scale)
         .sum::<Option<f64>>()?;
-    if !(scale < f64::MAX / 64.0) {
+    if scale.is_nan() || scale >= f64::MAX / 64.0 {
         return None;
     }
     let pad = HULL_PAD * scale;

@@ -1,11 +1,12 @@
 //! Whole tiles culled at once: when a projection bounds the projectors of a tile by those of
-//! its corners ([`ProjectorHull`]), every part the per-projector searches test against the
-//! scene's box (a polyline's segment, a quadratic's piece of [`PIECES`]) is bounded for all
-//! of the tile's projectors by one box, built from the corners' corresponding parts. A part
-//! whose box misses the scene's box misses it for every projector of the tile, exactly as
-//! the projector's own search would find (its part's box lies inside the tile's, and the
-//! scene-box test is monotonic in the box): the searches skip it, and where every part
-//! misses the tile is background without generating a single projector.
+//! its corners ([`ProjectorHull`]), every part of the per-projector searches (a polyline's
+//! segment, a quadratic's piece of [`PIECES`]) is bounded for all of the tile's projectors
+//! by one box, built from the corners' corresponding parts. A part whose box overlaps no
+//! leaf box of the BVH (enlarged as the scene-box tests are, [`super::bvh::Bvh::leaves_overlap`])
+//! holds no hit for any projector of the tile: a hit lies on the part, inside its box, and
+//! in its leaf's box. The searches skip such parts, and where every part is skipped the tile
+//! is background without generating a single projector: exactly what each projector's own
+//! search would have found.
 
 use glam::DVec3;
 
@@ -20,7 +21,7 @@ use crate::projection::{Projector, ProjectorHull};
 const CASTER_ROUNDING: f64 = 1e-12;
 
 /// Which parts (polyline segments, quadratic pieces, in order) of the projectors a hull
-/// bounds may meet the scene's box: bit k for part k, the last bit for part 63 and all
+/// bounds may hold a hit: bit k for part k, the last bit for part 63 and all
 /// after it together.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) struct LiveParts(u64);
@@ -51,9 +52,10 @@ impl LiveParts {
 }
 
 impl RayCaster {
-    /// Which parts of the projectors bounded by `hull` may meet the scene's box, as their
-    /// own searches decide part by part ([`RayCaster::misses_scene_box`] for segments, the
-    /// control-point box for a quadratic's pieces). [`LiveParts::ALL`] when the corners are
+    /// Which parts of the projectors bounded by `hull` may hold a hit: those whose box over
+    /// the hull overlaps a leaf of the BVH (each projector's own search tests the scene's box
+    /// alone: [`RayCaster::misses_scene_box`] for segments, the control-point box for a
+    /// quadratic's pieces). [`LiveParts::ALL`] when the corners are
     /// of mixed kinds, polylines of different lengths, or straight.
     pub(super) fn live_parts(&self, hull: &ProjectorHull) -> LiveParts {
         match &hull.corners {
@@ -87,8 +89,8 @@ impl RayCaster {
         pad + CASTER_ROUNDING * largest
     }
 
-    /// Whether the box of `points` enlarged by `pad` misses the scene's box; a point or
-    /// pad that is not finite counts as an overlap.
+    /// Whether the box of `points` enlarged by `pad` misses every leaf box of the BVH; a
+    /// point or pad that is not finite counts as an overlap.
     fn box_misses_scene(&self, points: impl Iterator<Item = DVec3>, pad: f64) -> bool {
         let (mut lo, mut hi, mut finite) = (DVec3::INFINITY, DVec3::NEG_INFINITY, pad.is_finite());
         for p in points {
@@ -96,7 +98,7 @@ impl RayCaster {
             (lo, hi) = (lo.min(p), hi.max(p));
         }
         let pad = DVec3::splat(pad);
-        finite && !self.bvh.root_overlaps(lo - pad, hi + pad)
+        finite && !self.bvh.leaves_overlap(lo - pad, hi + pad)
     }
 }
 
