@@ -29,7 +29,7 @@ pub use flexible::{Flexible, FlexibleSpec};
 pub use image_coords::Resolution;
 pub use linear::{Orthographic, Perspective};
 pub use panoramic::{Cylindrical, Equirectangular};
-pub use projector::Projector;
+pub use projector::{Projector, ProjectorHull};
 pub use trilinear::{
     project_solved_triangle, project_triangle, surfaces, ProjectionTriangleCache, SceneEdge, Shape,
     ShapeVertex, Solutions, TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
@@ -68,6 +68,14 @@ pub trait Projection: Send + Sync {
     /// default, [`Projection::ray`] as a [`Projector::Straight`].
     fn projector(&self, pixel: DVec2) -> Option<Projector> {
         self.ray(pixel).map(Projector::Straight)
+    }
+
+    /// A bound on the projectors of every sample position in the closed pixel-space
+    /// rectangle `[lo, hi]`, each of which has a projector (see [`ProjectorHull`]): lets a
+    /// renderer cull a whole tile at once. `None` (the default) where the projection cannot
+    /// promise that.
+    fn projector_hull(&self, _lo: DVec2, _hi: DVec2) -> Option<ProjectorHull> {
+        None
     }
 
     /// Whether [`Projection::project`] is implemented.

@@ -22,6 +22,21 @@ pub enum Projector {
     QuadraticBezier([DVec3; 3]),
 }
 
+/// The projectors of a rectangle of sample positions, bounded by those of its four corners
+/// (see [`crate::projection::Projection::projector_hull`]): a renderer tests a whole tile
+/// against the scene with it instead of each of the tile's projectors.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProjectorHull {
+    /// The projectors of the rectangle's corners, all polylines with the same number of
+    /// vertices or all quadratic Bezier curves.
+    pub corners: [Projector; 4],
+    /// Rounding allowance, absolute, in every coordinate: each control point (polyline
+    /// vertex, Bezier control point) of the projector of any sample position in the
+    /// rectangle lies within `pad` of the convex hull of the corners' corresponding control
+    /// points.
+    pub pad: f64,
+}
+
 /// The point of quadratic Bezier curve `p` at `s`.
 pub fn quadratic_point(p: &[DVec3; 3], s: f64) -> DVec3 {
     let r = 1.0 - s;

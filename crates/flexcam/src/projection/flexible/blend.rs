@@ -12,7 +12,7 @@ use glam::{DVec2, DVec3};
 
 use super::surface::Surface;
 use crate::error::{Error, Result};
-use crate::projection::Projector;
+use crate::projection::{Projector, ProjectorHull};
 
 /// Segments of the polyline that renders a Bezier volume of degree above 2 when the scene does
 /// not say.
@@ -47,12 +47,89 @@ pub(super) fn check_surfaces(surfaces: &[Surface]) -> Result<()> {
     }
 }
 
+/// Whether `points` (the control points of a projector) describe a projector: they do not
+/// all coincide (a projector of zero length) and are finite.
+fn is_projector(points: &[DVec3]) -> bool {
+    let moves = points.iter().any(|p| *p != points[0]);
+    moves && points.iter().all(|p| p.is_finite())
+}
+
 /// The control points of the projector of (u, v): each surface's point. `None` when they
-/// all coincide (a projector of zero length) or one is not finite.
+/// are not a projector ([`is_projector`]).
 fn control_points(surfaces: &[Surface], uv: DVec2) -> Option<Vec<DVec3>> {
     let points: Vec<DVec3> = surfaces.iter().map(|s| s.point(uv)).collect();
-    let moves = points.iter().any(|p| *p != points[0]);
-    (moves && points.iter().all(|p| p.is_finite())).then_some(points)
+    is_projector(&points).then_some(points)
+}
+
+/// Surfaces whose control points [`with_control_points`] keeps on the stack.
+const STACK_SURFACES: usize = 8;
+
+/// `f` of the control points of the projector of (u, v), as [`control_points`] gives them,
+/// held on the stack for up to [`STACK_SURFACES`] surfaces (this runs once per pixel).
+fn with_control_points<R>(
+    surfaces: &[Surface],
+    uv: DVec2,
+    f: impl FnOnce(&[DVec3]) -> R,
+) -> Option<R> {
+    if surfaces.len() > STACK_SURFACES {
+        return control_points(surfaces, uv).map(|points| f(&points));
+    }
+    let mut stack = [DVec3::ZERO; STACK_SURFACES];
+    let points = &mut stack[..surfaces.len()];
+    for (point, surface) in points.iter_mut().zip(surfaces) {
+        *point = surface.point(uv);
+    }
+    is_projector(points).then(|| f(points))
+}
+
+/// [`ProjectorHull::pad`] relative to the sum of the surfaces' [`Surface::bilinear_scale`]s.
+/// A control point of a projector is a surface point, or a sum of surface points with
+/// non-negative weights summing to 1; either is rounded by a few ulps of that sum, below
+/// 1e-14 of it, so the pad is generous by four orders of magnitude.
+const HULL_PAD: f64 = 1e-10;
+
+/// The hull of the projectors (`projector(uv)`) of every (u, v) in the rectangle `[lo, hi]`
+/// of a volume whose control points are fixed linear combinations, with non-negative
+/// weights summing to 1, of the points of `surfaces` at (u, v) (each polyline vertex and
+/// each Bezier control point is). When every surface is bilinear in (u, v), so is every
+/// control point, and over the rectangle it is a convex combination of its values at the
+/// rectangle's corners. Degenerate cases, each giving `None`: a curved surface; a corner
+/// without a projector; coefficients so large that evaluating a point could overflow; and
+/// a rectangle where some (u, v) inside might have a projector of zero length (all
+/// surfaces meeting): unless some surface stays more than twice the pad away from the first
+/// one in one coordinate at all four corners, hence everywhere inside.
+fn projector_hull(
+    surfaces: &[Surface],
+    lo: DVec2,
+    hi: DVec2,
+    projector: impl Fn(DVec2) -> Option<Projector>,
+) -> Option<ProjectorHull> {
+    let scale: f64 = surfaces
+        .iter()
+        .map(Surface::bilinear_scale)
+        .sum::<Option<f64>>()?;
+    if scale.is_nan() || scale >= f64::MAX / 64.0 {
+        return None;
+    }
+    let pad = HULL_PAD * scale;
+    let corners = [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
+    let apart = surfaces[1..].iter().any(|surface| {
+        let gaps = corners.map(|uv| surface.point(uv) - surfaces[0].point(uv));
+        let (min, max) = gaps
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), g| {
+                (lo.min(*g), hi.max(*g))
+            });
+        min.cmpgt(DVec3::splat(2.0 * pad)).any() || max.cmplt(DVec3::splat(-2.0 * pad)).any()
+    });
+    if !apart {
+        return None;
+    }
+    let [a, b, c, d] = corners.map(projector);
+    Some(ProjectorHull {
+        corners: [a?, b?, c?, d?],
+        pad,
+    })
 }
 
 /// Reduces the de Casteljau pyramid of `points` (at least two) at `t` in place down to its
@@ -159,6 +236,12 @@ impl PiecewiseVolume {
     pub fn projector(&self, uv: DVec2) -> Option<Projector> {
         control_points(&self.surfaces, uv).map(Projector::Polyline)
     }
+
+    /// The hull of the projectors of the (u, v) rectangle `[lo, hi]`; see
+    /// [`projector_hull`] for when there is none.
+    pub fn projector_hull(&self, lo: DVec2, hi: DVec2) -> Option<ProjectorHull> {
+        projector_hull(&self.surfaces, lo, hi, |uv| self.projector(uv))
+    }
 }
 
 /// Bernstein blending of surfaces: Bezier projectors.
@@ -226,20 +309,26 @@ impl BezierVolume {
     /// The projector of (u, v): the analytic quadratic, or the polyline through Q at
     /// `segments + 1` equally spaced t; `None` for a projector of zero length.
     pub fn projector(&self, uv: DVec2) -> Option<Projector> {
-        let points = control_points(&self.surfaces, uv)?;
-        match &self.polyline_weights {
-            None => Some(Projector::QuadraticBezier([
-                points[0], points[1], points[2],
-            ])),
+        with_control_points(&self.surfaces, uv, |points| match &self.polyline_weights {
+            None => Projector::QuadraticBezier([points[0], points[1], points[2]]),
             // The control points are evaluated once per projector, not once per sample, and
             // each sample is a sum with the volume's precomputed weights.
-            Some(weights) => Some(Projector::Polyline(
-                weights.iter().map(|w| weighted_sum(w, &points)).collect(),
-            )),
-        }
+            Some(weights) => {
+                Projector::Polyline(weights.iter().map(|w| weighted_sum(w, points)).collect())
+            }
+        })
+    }
+
+    /// The hull of the projectors of the (u, v) rectangle `[lo, hi]` (polyline samples are
+    /// sums of the surfaces' points with Bernstein weights, non-negative and summing to 1);
+    /// see [`projector_hull`] for when there is none.
+    pub fn projector_hull(&self, lo: DVec2, hi: DVec2) -> Option<ProjectorHull> {
+        projector_hull(&self.surfaces, lo, hi, |uv| self.projector(uv))
     }
 }
 
+#[cfg(test)]
+mod hull_tests;
 #[cfg(test)]
 mod tests {
     use super::*;

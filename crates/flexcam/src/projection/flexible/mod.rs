@@ -55,7 +55,7 @@ pub use volume::{LinearVolume, Volume};
 use self::inverse::Inverse;
 use super::chart::InverseChart;
 use super::image_coords::Resolution;
-use super::{ImagePoint, Projection, Projector};
+use super::{ImagePoint, Projection, Projector, ProjectorHull};
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
 
@@ -268,6 +268,18 @@ impl Projection for Flexible {
     /// [0, 1]; `None` outside the re-parameterisation's domain and for zero-length projectors.
     fn projector(&self, pixel: DVec2) -> Option<Projector> {
         self.volume.projector(self.uv(pixel)?)
+    }
+
+    /// The volume's hull over the (u, v) rectangle of `[lo, hi]` (see
+    /// [`Volume::projector_hull`]), under the linear map only: its u = x / W and
+    /// v = 1 - y / H are monotonic also as rounded, so the (u, v) of every sample position
+    /// in `[lo, hi]` lies in the rectangle spanned by the corners' (u, v).
+    fn projector_hull(&self, lo: DVec2, hi: DVec2) -> Option<ProjectorHull> {
+        if self.reparam != Reparam::Linear {
+            return None;
+        }
+        let (a, b) = (self.uv(lo)?, self.uv(hi)?);
+        self.volume.projector_hull(a.min(b), a.max(b))
     }
 
     /// True for the analytic class: parallel planes sharing a normal, nested spheres,

@@ -210,6 +210,38 @@ impl Surface {
         }
     }
 
+    /// For a surface bilinear in (u, v) (rectangle, bilinear patch, point, line): a bound on
+    /// the magnitude of every coordinate of its coefficients and of the intermediates of
+    /// [`Surface::point`] over u, v in [0, 1], so that its rounding there is a few ulps of
+    /// this bound. Over any rectangle of (u, v) such a surface's points are convex
+    /// combinations of the rectangle's corner points (the bilinear weights). `None` for the
+    /// curved surfaces, which have no such property.
+    pub fn bilinear_scale(&self) -> Option<f64> {
+        let max = |points: &[DVec3]| {
+            points
+                .iter()
+                .fold(0.0f64, |m, p| m.max(p.abs().max_element()))
+        };
+        match self {
+            Surface::Rectangle {
+                corner,
+                u_edge,
+                v_edge,
+            } => Some((corner.abs() + u_edge.abs() + v_edge.abs()).max_element()),
+            // Each lerp a + (b - a) s has intermediates of up to twice its ends.
+            Surface::Bilinear { corners } => Some(2.0 * max(corners)),
+            Surface::Point(p) => Some(max(&[*p])),
+            Surface::Line { start, end, .. } => Some(2.0 * max(&[*start, *end])),
+            Surface::Sphere(_)
+            | Surface::Cylinder(_)
+            | Surface::Bezier(_)
+            | Surface::BSpline(_)
+            | Surface::Panorama(_)
+            | Surface::Pinched(_)
+            | Surface::Path(_) => None,
+        }
+    }
+
     /// Checks the numbers: every coordinate finite, radii at least 0, latitudes within
     /// [-90, 90] degrees and longitude / angle spans at most 360 degrees.
     pub fn validate(&self) -> Result<()> {

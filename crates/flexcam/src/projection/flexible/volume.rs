@@ -14,7 +14,7 @@ use super::projector_grid::GridVolume;
 use super::surface::Surface;
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
-use crate::projection::Projector;
+use crate::projection::{Projector, ProjectorHull};
 
 /// Samples per side of the grid on which [`Volume::check_projectors`] looks for a projector
 /// of non-zero length.
@@ -130,6 +130,18 @@ impl Volume {
             Volume::Bezier(v) => v.projector(uv),
             Volume::Interpolated(v) => v.projector(uv),
             Volume::Grid(v) => v.grid.projector(uv),
+        }
+    }
+
+    /// A bound on the projectors of every (u, v) in the rectangle `[lo, hi]`, each of which
+    /// has a projector (see [`ProjectorHull`]): for piecewise and Bezier volumes of surfaces
+    /// bilinear in (u, v) (see [`PiecewiseVolume::projector_hull`],
+    /// [`BezierVolume::projector_hull`]); `None` for the others.
+    pub fn projector_hull(&self, lo: DVec2, hi: DVec2) -> Option<ProjectorHull> {
+        match self {
+            Volume::Piecewise(v) => v.projector_hull(lo, hi),
+            Volume::Bezier(v) => v.projector_hull(lo, hi),
+            Volume::Linear(_) | Volume::Interpolated(_) | Volume::Grid(_) => None,
         }
     }
 

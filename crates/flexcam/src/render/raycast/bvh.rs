@@ -581,6 +581,45 @@ impl Bvh {
         !apart
     }
 
+    /// Whether the box `[min, max]`, enlarged as in [`Bvh::root_overlaps`], overlaps the box
+    /// of some leaf: the same test made tighter, since the leaves' boxes hug the triangles
+    /// where the root's box has empty corners. As conservative for the searches that follow:
+    /// a hit they report lies in its leaf's (padded) box, and on a path that the margin keeps
+    /// inside the enlarged box. Non-finite input counts as an overlap.
+    pub fn leaves_overlap(&self, min: glam::DVec3, max: glam::DVec3) -> bool {
+        if !self.root_overlaps(min, max) {
+            return false;
+        }
+        let scale = self.root_scale.max(min.abs().max(max.abs()).max_element());
+        let margin = glam::DVec3::splat(ROOT_MARGIN * scale);
+        let (lo, hi) = (min - margin, max + margin);
+        if !(lo.is_finite() && hi.is_finite()) {
+            return true;
+        }
+        // As in `visit_near_segment`: a fixed stack of pending children.
+        let mut stack = [self.root; STACK_SIZE];
+        let mut depth = 1;
+        while depth > 0 {
+            depth -= 1;
+            let current = stack[depth];
+            if current.count > 0 {
+                return true;
+            }
+            let node = &self.nodes[current.index as usize];
+            for k in [1, 0] {
+                let p = &node.planes;
+                let child_min = glam::DVec3::new(p[0][k] as f64, p[1][k] as f64, p[2][k] as f64);
+                let child_max =
+                    -glam::DVec3::new(p[0][k + 2] as f64, p[1][k + 2] as f64, p[2][k + 2] as f64);
+                if !(lo.cmpgt(child_max).any() || hi.cmplt(child_min).any()) {
+                    stack[depth] = node.children[k];
+                    depth += 1;
+                }
+            }
+        }
+        false
+    }
+
     /// Calls `visit` with the build-input index and the triangle of every stored triangle in
     /// every leaf whose box, enlarged by `segment.pad` on every side, the segment meets: a
     /// conservative cull for anything that lies within `pad` of the segment (a curve inside
@@ -1094,6 +1133,34 @@ mod tests {
             ids[0] < 300 && ids.iter().all(|&id| id == ids[0]),
             "{ids:?}"
         );
+    }
+
+    #[test]
+    fn boxes_apart_from_every_leaf_are_apart_from_every_triangle() {
+        let mut rng = Rng(7);
+        let triangles = soup(&mut rng, 300);
+        let bvh = Bvh::build(&triangles);
+        let (mut apart, mut root_only) = (0, 0);
+        for _ in 0..4000 {
+            let (c, half) = (rng.vec(12.0).as_dvec3(), rng.vec(1.0).abs().as_dvec3());
+            let (min, max) = (c - half, c + half);
+            let touched = triangles.iter().any(|t| {
+                let lo = t[0].min(t[1]).min(t[2]).as_dvec3();
+                let hi = t[0].max(t[1]).max(t[2]).as_dvec3();
+                lo.cmple(max).all() && hi.cmpge(min).all()
+            });
+            if !bvh.leaves_overlap(min, max) {
+                assert!(!touched, "box [{min}, {max}] touches a triangle");
+                apart += 1;
+                root_only += usize::from(bvh.root_overlaps(min, max));
+            } else {
+                assert!(bvh.root_overlaps(min, max));
+            }
+        }
+        // Both outcomes occur, and the leaves reject boxes inside the root's box.
+        assert!(apart > 100 && root_only > 10, "{apart} {root_only}");
+        assert!(bvh.leaves_overlap(DVec3::splat(f64::NAN), DVec3::ZERO));
+        assert!(!Bvh::build(&[]).leaves_overlap(DVec3::ZERO, DVec3::ONE));
     }
 
     #[test]

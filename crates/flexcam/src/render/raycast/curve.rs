@@ -24,6 +24,7 @@
 use glam::{DVec3, Vec2};
 
 use super::bvh::NearSegment;
+use super::hull_cull::LiveParts;
 use super::triangle::PackedTriangle;
 use super::{Hit32, RayCaster};
 use crate::geometry::solve_quadratic;
@@ -31,7 +32,12 @@ use crate::projection::projector::{quadratic_point, quadratic_tangent};
 
 /// Pieces the curve is cut into for the BVH search: more pieces give thinner fattened chords
 /// (the padding falls as 1/PIECES^2) but more traversals.
-const PIECES: usize = 8;
+pub(super) const PIECES: usize = 8;
+
+/// The parameter interval [a, b] of piece `k` of [`PIECES`].
+pub(super) fn piece_interval(k: usize) -> (f64, f64) {
+    (k as f64 / PIECES as f64, (k + 1) as f64 / PIECES as f64)
+}
 
 /// Where a curve hits a triangle: the curve parameter and the barycentric weights of the
 /// triangle's second and third vertices.
@@ -84,7 +90,7 @@ fn hull_misses_plane(hull: &[DVec3; 3], [v0, e1, e2]: [DVec3; 3]) -> bool {
 
 /// The control points of the piece of curve `p` over [a, b] (blossoming: the end points and
 /// the intersection of the end tangents).
-fn piece(p: &[DVec3; 3], a: f64, b: f64) -> [DVec3; 3] {
+pub(super) fn piece(p: &[DVec3; 3], a: f64, b: f64) -> [DVec3; 3] {
     let start = quadratic_point(p, a);
     [
         start,
@@ -109,7 +115,13 @@ impl RayCaster {
     /// The first hit (smallest s in [0, 1]) of quadratic Bezier curve `p`, as the curve
     /// parameter and the hit in the f32 form of the straight search (`t` = 0: the shading
     /// ray starts at the hit). `None` when nothing is hit or a control point is not finite.
-    pub(super) fn intersect_quadratic(&self, p: &[DVec3; 3]) -> Option<(f64, Hit32)> {
+    /// Pieces that `live` rules out (see `hull_cull`) are skipped: their control-point box
+    /// is known to miss the scene's box.
+    pub(super) fn intersect_quadratic(
+        &self,
+        p: &[DVec3; 3],
+        live: LiveParts,
+    ) -> Option<(f64, Hit32)> {
         // The whole curve first (within its middle control point's distance of its chord):
         // the projectors of many pixels pass by the scene's box altogether.
         let whole = NearSegment::new(p[0], p[2] - p[0], distance_to_segment(p[1], p[0], p[2]))?;
@@ -117,7 +129,10 @@ impl RayCaster {
             return None;
         }
         for k in 0..PIECES {
-            let (a, b) = (k as f64 / PIECES as f64, (k + 1) as f64 / PIECES as f64);
+            if !live.may_hit(k) {
+                continue;
+            }
+            let (a, b) = piece_interval(k);
             let q = piece(p, a, b);
             // The piece lies in the box of its control points: most pieces of a projector
             // that passes the scene are outside its box, and cost only this comparison.
@@ -374,7 +389,7 @@ mod tests {
         ) {
             let caster = room();
             let p = [p0, p1, p2].map(|q| q * DVec3::new(4.0, 2.0, 4.0) + DVec3::Y * 1.5);
-            let searched = caster.intersect_quadratic(&p).map(|(s, _)| s);
+            let searched = caster.intersect_quadratic(&p, LiveParts::ALL).map(|(s, _)| s);
             prop_assert_eq!(searched, brute_force_first_hit(caster, &p));
         }
 

@@ -8,6 +8,7 @@
 
 mod bvh;
 mod curve;
+mod hull_cull;
 pub(crate) mod optics;
 pub(crate) mod sampling;
 mod shade;

@@ -21,6 +21,7 @@
 
 use glam::{DVec3, Vec3};
 
+use super::hull_cull::LiveParts;
 use super::optics::{reflect, refract};
 use super::{Hit, Hit32, RayCaster};
 use crate::geometry::Ray;
@@ -84,6 +85,9 @@ pub(super) struct Tracer<'a> {
     pub shading: Shading,
     pub max_bounces: u32,
     pub counts: RayCounts,
+    /// Which parts (polyline segments, quadratic pieces) of the projectors now sampled
+    /// may meet the scene (see `hull_cull`); the others are not searched.
+    pub live: LiveParts,
 }
 
 /// Where a specular surface sends a ray.
@@ -110,6 +114,7 @@ impl<'a> Tracer<'a> {
             shading: options.shading,
             max_bounces: options.max_bounces,
             counts: RayCounts::default(),
+            live: LiveParts::ALL,
         }
     }
 
@@ -138,27 +143,34 @@ impl<'a> Tracer<'a> {
             Some(Projector::Straight(ray)) => self.sample(Some(ray)),
             Some(Projector::Polyline(points)) => {
                 let mut before = 0.0;
-                for pair in points.windows(2) {
+                for (k, pair) in points.windows(2).enumerate() {
                     let ray = Ray {
                         origin: pair[0],
                         direction: pair[1] - pair[0],
                         t_min: 0.0,
                         t_max: 1.0,
                     };
-                    if let Some(found) = self.caster.intersect_f32(&ray) {
+                    let found = if self.live.may_hit(k) {
+                        self.caster.intersect_f32(&ray)
+                    } else {
+                        None
+                    };
+                    if let Some(found) = found {
                         return self.shade(&ray, Some(found), before);
                     }
                     before += ray.direction.length();
                 }
                 self.shade_miss()
             }
-            Some(Projector::QuadraticBezier(p)) => match self.caster.intersect_quadratic(p) {
-                Some((s, found)) => {
-                    let ray = tangent_ray(p, s);
-                    self.shade(&ray, Some(found), quadratic_arc_length(p, s))
+            Some(Projector::QuadraticBezier(p)) => {
+                match self.caster.intersect_quadratic(p, self.live) {
+                    Some((s, found)) => {
+                        let ray = tangent_ray(p, s);
+                        self.shade(&ray, Some(found), quadratic_arc_length(p, s))
+                    }
+                    None => self.shade_miss(),
                 }
-                None => self.shade_miss(),
-            },
+            }
         }
     }
 
@@ -211,7 +223,8 @@ impl<'a> Tracer<'a> {
     /// The samples of four polyline projectors (`None`: no projector), exactly those of
     /// [`Tracer::sample_projector`] on each: segment k of the four is searched by one shared
     /// BVH traversal ([`RayCaster::intersect4_f32`]), leaving out the polylines that have
-    /// hit something already or have fewer segments.
+    /// hit something already or have fewer segments (and the segments `self.live` rules
+    /// out).
     fn sample4_polylines(&mut self, polylines: [Option<&[DVec3]>; 4]) -> [Sample; 4] {
         let mut hits: [Option<Sample>; 4] = [None; 4];
         let mut before = [0.0; 4];
@@ -231,9 +244,12 @@ impl<'a> Tracer<'a> {
                 }),
                 _ => None,
             });
-            let found = self
-                .caster
-                .intersect4_f32(rays.each_ref().map(Option::as_ref));
+            let found = if self.live.may_hit(k) {
+                self.caster
+                    .intersect4_f32(rays.each_ref().map(Option::as_ref))
+            } else {
+                [None; 4]
+            };
             for (i, (ray, found)) in rays.iter().zip(found).enumerate() {
                 match (ray, found) {
                     (Some(ray), Some(hit)) => hits[i] = Some(self.shade(ray, Some(hit), before[i])),
@@ -294,7 +310,7 @@ impl<'a> Tracer<'a> {
     }
 
     /// The sample of a primary projector that hits nothing: the background.
-    fn shade_miss(&mut self) -> Sample {
+    pub(super) fn shade_miss(&mut self) -> Sample {
         self.counts.primary += 1;
         Sample {
             color: self.caster.background,

@@ -7,6 +7,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use glam::{DVec2, Vec3};
 use rayon::prelude::*;
 
+use super::hull_cull::LiveParts;
 use super::sampling::SamplePattern;
 use super::shade::{RayCounts, Sample, Tracer};
 use super::RayCaster;
@@ -17,6 +18,14 @@ use crate::render::{Counter, Frame, RenderOptions, Stats};
 /// per-tile bookkeeping is negligible.
 const TILE: u32 = 16;
 
+/// Edge in pixels of the blocks whose projectors are culled together by their hull (module
+/// `hull_cull`): where a tile's hull does not cull all of it, each block's hull is tried,
+/// which also tells which parts (segments, pieces) of the block's projectors need searching.
+const BLOCK: u32 = 8;
+
+/// Blocks per tile side.
+const BLOCKS: usize = (TILE / BLOCK) as usize;
+
 /// One rendered tile: its rectangle and row-major pixels.
 struct Tile {
     x0: u32,
@@ -26,6 +35,8 @@ struct Tile {
     depth: Vec<f32>,
     ids: Vec<u32>,
     counts: RayCounts,
+    /// Blocks of the tile whose projectors were all culled by their hull (see `hull_cull`).
+    culled_blocks: u64,
 }
 
 /// Renders every pixel of `projection`'s image; see [`RayCaster::render`].
@@ -56,6 +67,7 @@ pub(super) fn render(
         .collect();
     let mut frame = Frame::new(width, height, caster.background);
     let mut counts = RayCounts::default();
+    let culled: u64 = tiles.iter().map(|tile| tile.culled_blocks).sum();
     for tile in &tiles {
         for (row, y) in (tile.y0..)
             .take(tile.color.len() / tile.width as usize)
@@ -80,8 +92,52 @@ pub(super) fn render(
             "rays_cast",
             Counter::Count(counts.primary + counts.secondary + counts.shadow),
         ),
+        ("blocks_culled", Counter::Count(culled)),
     ]);
     (frame, stats)
+}
+
+/// Which parts of the projectors of each block (`[row][column]`) of tile
+/// `(x0, y0, width, height)` may hit the scene ([`LiveParts::ALL`] where the projection
+/// gives no hull); blocks outside an edge tile are left at the tile's value.
+fn block_parts(
+    caster: &RayCaster,
+    projection: &dyn Projection,
+    pattern: &SamplePattern,
+    (x0, y0, width, height): (u32, u32, u32, u32),
+) -> [[LiveParts; BLOCKS]; BLOCKS] {
+    // Every sample position of a rectangle of pixels lies in the rectangle of its corner
+    // pixels' extreme sample offsets.
+    let (lo, hi) = pattern
+        .offsets
+        .iter()
+        .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), o| {
+            (lo.min(*o), hi.max(*o))
+        });
+    let parts = |x: u32, y: u32, w: u32, h: u32| {
+        let first = DVec2::new(x as f64, y as f64);
+        let last = first + DVec2::new((w - 1) as f64, (h - 1) as f64);
+        projection
+            .projector_hull(first + lo, last + hi)
+            .map(|hull| caster.live_parts(&hull))
+    };
+    let whole = parts(x0, y0, width, height);
+    let mut blocks = [[whole.unwrap_or(LiveParts::ALL); BLOCKS]; BLOCKS];
+    let Some(whole) = whole.filter(|w| !w.none()) else {
+        return blocks;
+    };
+    for (row, line) in blocks.iter_mut().enumerate() {
+        for (column, block) in line.iter_mut().enumerate() {
+            let (bx, by) = (column as u32 * BLOCK, row as u32 * BLOCK);
+            if bx < width && by < height {
+                let (w, h) = (BLOCK.min(width - bx), BLOCK.min(height - by));
+                // The tile's hull bounds the block too: it stands in where the block has
+                // none.
+                *block = parts(x0 + bx, y0 + by, w, h).unwrap_or(whole);
+            }
+        }
+    }
+    blocks
 }
 
 /// Renders the pixels of rectangle `(x0, y0, width, height)`: each averages its samples'
@@ -102,7 +158,20 @@ fn render_tile(
         depth: vec![f32::INFINITY; n],
         ids: vec![0; n],
         counts: RayCounts::default(),
+        culled_blocks: 0,
     };
+    let blocks = block_parts(caster, projection, pattern, (x0, y0, width, height));
+    let (rows, columns) = (
+        height.div_ceil(BLOCK) as usize,
+        width.div_ceil(BLOCK) as usize,
+    );
+    tile.culled_blocks = blocks[..rows]
+        .iter()
+        .flat_map(|line| &line[..columns])
+        .filter(|parts| parts.none())
+        .count() as u64;
+    let live =
+        |(x, y): (u32, u32)| blocks[((y - y0) / BLOCK) as usize][((x - x0) / BLOCK) as usize];
     let mut tracer = Tracer::new(caster, options);
     let store = |tile: &mut Tile, (x, y): (u32, u32), color: Vec3, sample: Sample| {
         let i = ((y - y0) * width + (x - x0)) as usize;
@@ -120,9 +189,16 @@ fn render_tile(
         for qx in (0..quad_w).step_by(2) {
             let (x, y) = (x0 + qx, y0 + qy);
             let pixels = [(x, y), (x + 1, y), (x, y + 1), (x + 1, y + 1)];
-            let projectors =
-                pixels.map(|(x, y)| projection.projector(DVec2::new(x as f64, y as f64) + offset));
-            let samples = tracer.sample4_projectors(&projectors);
+            // BLOCK is even: the quad lies in one block.
+            let parts = live((x, y));
+            let samples = if parts.none() {
+                [(); 4].map(|_| tracer.shade_miss())
+            } else {
+                tracer.live = parts;
+                let projectors = pixels
+                    .map(|(x, y)| projection.projector(DVec2::new(x as f64, y as f64) + offset));
+                tracer.sample4_projectors(&projectors)
+            };
             for (pixel, sample) in pixels.into_iter().zip(samples) {
                 store(&mut tile, pixel, Vec3::ZERO + sample.color, sample);
             }
@@ -136,9 +212,15 @@ fn render_tile(
             }
             let mut color = Vec3::ZERO;
             let mut centre = None;
+            let parts = live((x, y));
+            tracer.live = parts;
             for (k, offset) in pattern.offsets.iter().enumerate() {
                 let pixel = DVec2::new(x as f64, y as f64) + *offset;
-                let sample = tracer.sample_projector(projection.projector(pixel).as_ref());
+                let sample = if parts.none() {
+                    tracer.shade_miss()
+                } else {
+                    tracer.sample_projector(projection.projector(pixel).as_ref())
+                };
                 color += sample.color;
                 if k == pattern.centre {
                     centre = Some(sample);

@@ -1,0 +1,263 @@
+//! Whole tiles culled at once: when a projection bounds the projectors of a tile by those of
+//! its corners ([`ProjectorHull`]), every part of the per-projector searches (a polyline's
+//! segment, a quadratic's piece of [`PIECES`]) is bounded for all of the tile's projectors
+//! by one box, built from the corners' corresponding parts. A part whose box overlaps no
+//! leaf box of the BVH (enlarged as the scene-box tests are, [`super::bvh::Bvh::leaves_overlap`])
+//! holds no hit for any projector of the tile: a hit lies on the part, inside its box, and
+//! in its leaf's box. The searches skip such parts, and where every part is skipped the tile
+//! is background without generating a single projector: exactly what each projector's own
+//! search would have found.
+
+use glam::DVec3;
+
+use super::curve::{piece, piece_interval, PIECES};
+use super::RayCaster;
+use crate::projection::{Projector, ProjectorHull};
+
+/// Rounding allowance of the caster's own arithmetic on control points (a segment's end
+/// `origin + (end - origin)`, a piece's control points by de Casteljau), relative to the
+/// largest control-point coordinate: that arithmetic is rounded by a few ulps of it, below
+/// 1e-14; the allowance is generous by two orders of magnitude.
+const CASTER_ROUNDING: f64 = 1e-12;
+
+/// Which parts (polyline segments, quadratic pieces, in order) of the projectors a hull
+/// bounds may hold a hit: bit k for part k, the last bit for part 63 and all
+/// after it together.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct LiveParts(u64);
+
+impl LiveParts {
+    /// Every part may meet the scene (no hull, or one that bounds nothing).
+    pub const ALL: LiveParts = LiveParts(u64::MAX);
+
+    /// Whether part `k` may meet the scene.
+    #[inline]
+    pub fn may_hit(self, k: usize) -> bool {
+        self.0 >> k.min(63) & 1 == 1
+    }
+
+    /// Whether no part may: every projector misses everything.
+    pub fn none(self) -> bool {
+        self.0 == 0
+    }
+
+    /// The parts `live(k)` says of `count` parts.
+    fn of(count: usize, live: impl Fn(usize) -> bool) -> LiveParts {
+        LiveParts(
+            (0..count)
+                .filter(|&k| live(k))
+                .fold(0, |bits, k| bits | 1 << k.min(63)),
+        )
+    }
+}
+
+impl RayCaster {
+    /// Which parts of the projectors bounded by `hull` may hold a hit: those whose box over
+    /// the hull overlaps a leaf of the BVH (each projector's own search tests the scene's box
+    /// alone: [`RayCaster::misses_scene_box`] for segments, the control-point box for a
+    /// quadratic's pieces). [`LiveParts::ALL`] when the corners are
+    /// of mixed kinds, polylines of different lengths, or straight.
+    pub(super) fn live_parts(&self, hull: &ProjectorHull) -> LiveParts {
+        match &hull.corners {
+            [Projector::Polyline(a), Projector::Polyline(b), Projector::Polyline(c), Projector::Polyline(d)]
+                if [b, c, d].iter().all(|p| p.len() == a.len()) =>
+            {
+                let corners = [a, b, c, d];
+                let pad = self.hull_pad(hull.pad, corners.iter().flat_map(|p| p.iter()));
+                LiveParts::of(a.len().saturating_sub(1), |k| {
+                    let ends = corners.iter().flat_map(|p| [p[k], p[k + 1]]);
+                    !self.box_misses_scene(ends, pad)
+                })
+            }
+            [Projector::QuadraticBezier(a), Projector::QuadraticBezier(b), Projector::QuadraticBezier(c), Projector::QuadraticBezier(d)] =>
+            {
+                let corners = [a, b, c, d];
+                let pad = self.hull_pad(hull.pad, corners.iter().flat_map(|p| p.iter()));
+                LiveParts::of(PIECES, |k| {
+                    let (s0, s1) = piece_interval(k);
+                    let points = corners.iter().flat_map(|p| piece(p, s0, s1));
+                    !self.box_misses_scene(points, pad)
+                })
+            }
+            _ => LiveParts::ALL,
+        }
+    }
+
+    /// The projection's pad plus [`CASTER_ROUNDING`] of the largest coordinate of `points`.
+    fn hull_pad<'a>(&self, pad: f64, points: impl Iterator<Item = &'a DVec3>) -> f64 {
+        let largest = points.fold(0.0f64, |m, p| m.max(p.abs().max_element()));
+        pad + CASTER_ROUNDING * largest
+    }
+
+    /// Whether the box of `points` enlarged by `pad` misses every leaf box of the BVH; a
+    /// point or pad that is not finite counts as an overlap.
+    fn box_misses_scene(&self, points: impl Iterator<Item = DVec3>, pad: f64) -> bool {
+        let (mut lo, mut hi, mut finite) = (DVec3::INFINITY, DVec3::NEG_INFINITY, pad.is_finite());
+        for p in points {
+            finite &= p.is_finite();
+            (lo, hi) = (lo.min(p), hi.max(p));
+        }
+        let pad = DVec3::splat(pad);
+        finite && !self.bvh.leaves_overlap(lo - pad, hi + pad)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DVec2, DVec3};
+
+    use super::{LiveParts, RayCaster};
+    use crate::geometry::Ray;
+    use crate::projection::flexible::{Blend, Flexible, FlexibleSpec, Surface, VolumeSource};
+    use crate::projection::{Projection, Projector};
+    use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
+
+    /// `Flexible` without its hull: every tile is searched projector by projector.
+    struct NoHull<'a>(&'a Flexible);
+
+    impl Projection for NoHull<'_> {
+        fn kind(&self) -> &'static str {
+            self.0.kind()
+        }
+        fn resolution(&self) -> (u32, u32) {
+            self.0.resolution()
+        }
+        fn ray(&self, pixel: DVec2) -> Option<Ray> {
+            self.0.ray(pixel)
+        }
+        fn projector(&self, pixel: DVec2) -> Option<Projector> {
+            self.0.projector(pixel)
+        }
+    }
+
+    /// The teapot alone, as in `flexcam bench flexible`.
+    fn teapot() -> RayCaster {
+        let text = r#"
+            [projection]
+            type = "perspective"
+            position = [0.0, 2.0, 12.0]
+            look_at = [0.0, 1.5, 0.0]
+            fov = 60.0
+            [[object]]
+            shape = "teapot"
+            size = 1.0
+            tessellation = 4
+        "#;
+        let path = std::path::Path::new("teapot.toml");
+        RayCaster::new(&crate::scene::file::parse(text, path).unwrap())
+    }
+
+    /// The bench's three-rectangle volume around the teapot's box (centre c, half
+    /// diagonal r), with `segments` (`None`: quadratic), at `size` x `size`.
+    fn bench_volume(segments: Option<u32>, size: u32) -> Flexible {
+        let (c, r) = (DVec3::new(0.217, 1.575, 0.0), 4.1);
+        let square = |centre: DVec3, half: f64| {
+            Surface::rectangle_centred(centre, DVec3::X * half, DVec3::Y * half)
+        };
+        let spec = FlexibleSpec {
+            source: VolumeSource::Blended {
+                surfaces: vec![
+                    square(c + DVec3::new(0.0, 0.0, 4.0 * r), 0.1 * r),
+                    square(c + DVec3::new(0.4 * r, 0.3 * r, r), 0.9 * r),
+                    square(c + DVec3::new(0.0, 0.0, -2.0 * r), 1.3 * r),
+                ],
+                blend: Blend::Bezier { segments },
+            },
+            reparam: None,
+        };
+        Flexible::new(&spec, size, size).unwrap()
+    }
+
+    fn count(stats: &Stats, key: &str) -> u64 {
+        match stats[key] {
+            Counter::Count(n) => n,
+            Counter::Value(v) => panic!("{key} is a value: {v}"),
+        }
+    }
+
+    fn assert_frames_equal(a: &Frame, b: &Frame, what: &str) {
+        assert_eq!(a.color, b.color, "{what}: colours");
+        assert_eq!(a.depth, b.depth, "{what}: depths");
+        assert_eq!(a.ids, b.ids, "{what}: ids");
+    }
+
+    #[test]
+    fn culled_tiles_render_exactly_like_the_per_projector_searches() {
+        let caster = teapot();
+        // 104 = 6.5 tiles of 16: edge tiles of 8 pixels too.
+        let size = 104;
+        for segments in [None, Some(2), Some(5)] {
+            let projection = bench_volume(segments, size);
+            for spp in [1, 4] {
+                let options = RenderOptions {
+                    shading: Shading::Lit,
+                    spp,
+                    ..RenderOptions::default()
+                };
+                let (culled, stats) = caster.render(&projection, &options);
+                let (plain, plain_stats) = caster.render(&NoHull(&projection), &options);
+                let what = format!("segments {segments:?}, spp {spp}");
+                assert_frames_equal(&culled, &plain, &what);
+                for key in ["primary_rays", "secondary_rays", "shadow_rays"] {
+                    assert_eq!(
+                        count(&stats, key),
+                        count(&plain_stats, key),
+                        "{what}: {key}"
+                    );
+                }
+                // Some of the 13 x 13 blocks are culled, and some are not: the teapot is in
+                // view.
+                let blocks = count(&stats, "blocks_culled");
+                assert!(blocks > 0 && blocks < 169, "{what}: {blocks} blocks culled");
+                assert_eq!(count(&plain_stats, "blocks_culled"), 0);
+                assert!(culled.ids.iter().any(|&id| id != 0), "{what}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_hull_over_the_model_is_live_and_mixed_corners_are_never_culled() {
+        let caster = teapot();
+        let projection = bench_volume(None, 64);
+        // The whole image in one rectangle: it sees the teapot.
+        let whole = projection
+            .projector_hull(DVec2::splat(0.5), DVec2::splat(63.5))
+            .unwrap();
+        let live = caster.live_parts(&whole);
+        assert!(!live.none() && live != LiveParts::ALL, "{live:?}");
+        // A corner of the image far from the teapot is culled.
+        let corner = projection
+            .projector_hull(DVec2::splat(0.5), DVec2::splat(1.5))
+            .unwrap();
+        assert!(caster.live_parts(&corner).none());
+        // Polylines of different lengths, or kinds mixed, are not bounded: never culled.
+        let mut mixed = corner.clone();
+        let Projector::QuadraticBezier(p) = &corner.corners[0] else {
+            panic!("{:?}", corner.corners[0]);
+        };
+        mixed.corners[0] = Projector::Polyline(p.to_vec());
+        assert_eq!(caster.live_parts(&mixed), LiveParts::ALL);
+        let polylines = bench_volume(Some(3), 64)
+            .projector_hull(DVec2::splat(0.5), DVec2::splat(1.5))
+            .unwrap();
+        assert!(caster.live_parts(&polylines).none());
+        let mut uneven = polylines.clone();
+        uneven.corners[1] = Projector::Polyline(p.to_vec());
+        assert_eq!(caster.live_parts(&uneven), LiveParts::ALL);
+        // A pad that is not finite never culls.
+        let mut unbounded = polylines;
+        unbounded.pad = f64::INFINITY;
+        assert_eq!(caster.live_parts(&unbounded), LiveParts(0b111));
+    }
+
+    #[test]
+    fn live_parts_beyond_63_share_the_last_bit() {
+        let parts = LiveParts::of(70, |k| k == 2 || k == 65);
+        assert!(parts.may_hit(2) && !parts.may_hit(3) && !parts.may_hit(62));
+        assert!(parts.may_hit(63) && parts.may_hit(65) && parts.may_hit(69));
+        assert!(!parts.none());
+        assert!(LiveParts::of(70, |_| false).none());
+        assert!(LiveParts::of(0, |_| true).none());
+        assert!((0..100).all(|k| LiveParts::ALL.may_hit(k)));
+    }
+}
