@@ -114,12 +114,12 @@ pub fn base_color(
     let mesh = &object.mesh;
     let corners = corners(object, triangle);
     let w = weights(barycentric);
-    let pattern = pattern_color(object, filter, || {
-        (
-            interpolate(&mesh.positions, corners, w),
-            uv_at(mesh, corners, w),
-        )
-    });
+    let pattern = pattern_color(
+        object,
+        filter,
+        || interpolate(&mesh.positions, corners, w),
+        || uv_at(mesh, corners, w),
+    );
     if mesh.colors.is_empty() {
         pattern
     } else {
@@ -137,18 +137,21 @@ fn uv_at(mesh: &crate::scene::Mesh, corners: [usize; 3], w: Vec3) -> Vec2 {
 }
 
 /// `material.color` times the pattern: the checker alternates `color` and `other` by the cell
-/// parity of the object-space point, textures multiply `color`. `point_and_uv` gives the
-/// world-space point and texture coordinates, computed only for the patterns that need them.
+/// parity of the object-space point, textures multiply `color`. `point` and `uv` give the
+/// world-space point and the texture coordinates, each computed only for the pattern that
+/// needs it (the checker reads no texture coordinates, a texture no point).
+#[inline]
 fn pattern_color(
     object: &Object,
     filter: TextureFilter,
-    point_and_uv: impl Fn() -> (Vec3, Vec2),
+    point: impl Fn() -> Vec3,
+    uv: impl Fn() -> Vec2,
 ) -> Vec3 {
     let Material { color, pattern, .. } = &object.material;
     match pattern {
         Pattern::Solid => *color,
         Pattern::Checker { other, size } => {
-            let p = object.world_to_object.transform_point3(point_and_uv().0);
+            let p = object.world_to_object.transform_point3(point());
             if checker_parity(p, *size) == 0 {
                 *color
             } else {
@@ -156,7 +159,7 @@ fn pattern_color(
             }
         }
         Pattern::Texture(texture) => {
-            let uv = point_and_uv().1;
+            let uv = uv();
             *color
                 * match filter {
                     TextureFilter::Nearest => texture.nearest(uv),

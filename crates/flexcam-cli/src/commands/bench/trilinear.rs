@@ -12,7 +12,10 @@
 //!
 //! Flat shading, as in the thesis ("no lighting or texture mapping"). Each cell is one
 //! warm-up render, then the median of `--repeat` timed renders; renderers (BVH, scene
-//! geometry) are built once per scene, outside the timing.
+//! geometry) are built once per scene, outside the timing. The cube table also gives the
+//! mean CPU time (all threads, user + system) per render of the ray caster and of the
+//! clipped trilinear renderer, which load from other processes distorts far less than wall
+//! time (Linux only, in 10 ms ticks: use a `--repeat` of 10 or more).
 
 use std::time::Instant;
 
@@ -61,12 +64,14 @@ const THESIS_D: [[f64; 5]; 3] = [
 const THESIS_CUBE: [f64; 5] = [24.4, 70.1, 150.1, 230.2, 360.7];
 const THESIS_CUBE_RAY: f64 = 177926.0;
 
-/// One cell's medians (ms) and the trilinear stage times of its median render.
+/// One cell's medians (ms), the trilinear stage times of its median render, and the mean
+/// CPU times (ms) per render of the ray caster and of the clipped trilinear renderer.
 struct Timing {
     raycast: f64,
     trilinear: f64,
     clipped: f64,
     stages: [f64; 3],
+    cpu: [f64; 2],
 }
 
 /// Runs the benchmark and prints both tables.
@@ -128,7 +133,7 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
          projection; accuracy of trilinear with clipping against raycast"
     );
     println!(
-        "{:>5}{:>10}{:>11}{:>9}{:>10}{:>9}{:>9}{:>9}{:>9}{:>9}{:>11}{:>9}",
+        "{:>5}{:>10}{:>11}{:>9}{:>10}{:>9}{:>9}{:>9}{:>9}{:>9}{:>11}{:>9}{:>9}{:>10}{:>9}",
         "proj",
         "raycast",
         "trilinear",
@@ -140,7 +145,10 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
         "shade",
         "ids",
         "rgb error",
-        "thesis"
+        "thesis",
+        "rc cpu",
+        "clip cpu",
+        "cpu x"
     );
     let cube = scene::load("builtin:cube-floor")?;
     let renderers = Renderers::new(&cube);
@@ -148,13 +156,14 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
         let mesh = fan_grid(n)?;
         let (timing, accuracy) = renderers.time(&mesh, CUBE_SIDE, args.repeat)?;
         let [project, raster, shade] = timing.stages;
+        let [raycast_cpu, clipped_cpu] = timing.cpu;
         let thesis = CELLS
             .iter()
             .position(|&c| c == n)
             .map_or(f64::NAN, |k| THESIS_CUBE[k]);
         println!(
             "{:>5}{:>10.2}{:>11.2}{:>8.1}x{:>10.2}{:>8.1}x{project:>9.2}{raster:>9.2}{shade:>9.2}\
-             {:>9.5}{:>11.6}{thesis:>9.1}",
+             {:>9.5}{:>11.6}{thesis:>9.1}{raycast_cpu:>9.1}{clipped_cpu:>10.1}{:>8.1}x",
             mesh.triangles.len(),
             timing.raycast,
             timing.trilinear,
@@ -163,6 +172,7 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
             timing.raycast / timing.clipped,
             accuracy.0,
             accuracy.1,
+            raycast_cpu / clipped_cpu,
         );
     }
     println!(
@@ -194,7 +204,7 @@ impl Renderers {
             shading: Shading::Flat,
             ..RenderOptions::default()
         };
-        let (raycast, reference) =
+        let (raycast, raycast_cpu, reference) =
             median(repeat, || Ok(self.caster.render(&projection, &options).0))?;
         let trilinear = |curves: CurveOptions| {
             median(repeat, || {
@@ -205,8 +215,8 @@ impl Renderers {
             scene_clipping: false,
             ..CurveOptions::ADAPTIVE
         };
-        let (plain, _) = trilinear(unclipped)?;
-        let (clipped, (frame, stats)) = trilinear(CurveOptions::ADAPTIVE)?;
+        let (plain, _, _) = trilinear(unclipped)?;
+        let (clipped, clipped_cpu, (frame, stats)) = trilinear(CurveOptions::ADAPTIVE)?;
         let c = compare(&frame, &reference)?;
         let stage = |name| match stats.get(name) {
             Some(Counter::Value(ms)) => *ms,
@@ -217,22 +227,40 @@ impl Renderers {
             trilinear: plain,
             clipped,
             stages: ["project_ms", "raster_ms", "shade_ms"].map(stage),
+            cpu: [raycast_cpu, clipped_cpu],
         };
         Ok((timing, (c.id_agreement, c.relative_rgb_error)))
     }
 }
 
-/// One warm-up call of `render`, then the median time (ms) of `repeat` timed calls and the
-/// output of the median call.
-fn median<T>(repeat: u32, mut render: impl FnMut() -> Result<T>) -> Result<(f64, T)> {
+/// One warm-up call of `render`, then the median time (ms) of `repeat` timed calls, their
+/// mean CPU time (ms, NaN where unknown) and the output of the median call.
+fn median<T>(repeat: u32, mut render: impl FnMut() -> Result<T>) -> Result<(f64, f64, T)> {
     render()?;
     let mut runs = Vec::with_capacity(repeat as usize);
+    let cpu_start = cpu_ms();
     for _ in 0..repeat {
         let start = Instant::now();
         let out = render()?;
         runs.push((start.elapsed().as_secs_f64() * 1e3, out));
     }
+    let cpu = match (cpu_start, cpu_ms()) {
+        (Some(start), Some(end)) => (end - start) / f64::from(repeat),
+        _ => f64::NAN,
+    };
     runs.sort_by(|a, b| a.0.total_cmp(&b.0));
     let middle = runs.len() / 2;
-    Ok(runs.swap_remove(middle))
+    let (wall, out) = runs.swap_remove(middle);
+    Ok((wall, cpu, out))
+}
+
+/// The CPU time (ms) this process has used so far, all threads, user and system, from
+/// `/proc/self/stat` (its 14th and 15th fields, in ticks of 10 ms: Linux's fixed `USER_HZ`
+/// of 100); `None` where that file is missing or unreadable.
+fn cpu_ms() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // After the command name, which is in parentheses and may hold spaces: field 3 on.
+    let fields: Vec<&str> = stat.rsplit_once(')')?.1.split_whitespace().collect();
+    let ticks = |field: usize| fields.get(field - 3)?.parse::<f64>().ok();
+    Some((ticks(14)? + ticks(15)?) * 10.0)
 }

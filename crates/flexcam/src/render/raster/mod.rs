@@ -7,6 +7,8 @@
 //! - [`scan`]: polygon coverage, the fill and tie rules, and attribute interpolation;
 //! - [`line`](mod@line): one-pixel-wide lines for two-vertex shapes;
 //! - [`target`]: the z-buffered target and [`Fragment`]s;
+//! - [`fused`]: drawing band by band into small band-local targets, each finished into the
+//!   output [`crate::render::Frame`] at once (deferred shading without frame-sized buffers);
 //! - [`stats`]: counters for `--stats`.
 //!
 //! A *stage* (see [`rasterize_parallel_staged`]) may rewrite each fragment before its z-test
@@ -17,6 +19,7 @@
 //! depend on the band size or the number of threads, and with distinct primitive keys not on
 //! the order of the shapes either. Shaders must be pure functions of the fragment.
 
+pub mod fused;
 pub mod interpolate;
 pub mod line;
 pub mod polygon;
@@ -29,13 +32,14 @@ mod tests;
 use glam::Vec3;
 use rayon::prelude::*;
 
+pub use fused::{band_rows_for, rasterize_into_frame, BandTimes, DrawnRows, FrameRows};
 pub use interpolate::Varying;
 pub use polygon::{Polygon, PolygonBatch, Vertex, LIMIT};
 pub use scan::FillRule;
 pub use stats::RasterStats;
 
 use stats::FragmentCounts;
-pub use target::{Fragment, Layers, Target, NO_PRIMITIVE};
+pub use target::{new_frame, Fragment, Layers, Target, NO_PRIMITIVE};
 
 use polygon::Kind;
 use scan::Scratch;
@@ -97,20 +101,7 @@ pub fn rasterize_parallel_resolved<const N: usize>(
     shader: &(impl Fn(&Fragment<N>) -> Vec3 + Sync),
 ) -> RasterStats {
     let band_rows = band_rows.max(1);
-    let height = target.height();
-    // Bin: the shapes reaching each band, in input order.
-    let ranges: Vec<(u32, u32)> = (0..polygons.len())
-        .into_par_iter()
-        .map(|i| polygons.get(i).rows(height))
-        .collect();
-    let mut bins = vec![Vec::new(); height.div_ceil(band_rows) as usize];
-    for (i, &(first, end)) in ranges.iter().enumerate() {
-        if first < end {
-            for bin in &mut bins[(first / band_rows) as usize..=((end - 1) / band_rows) as usize] {
-                bin.push(i);
-            }
-        }
-    }
+    let bins = bins(polygons, target.height(), band_rows);
     let counts = target
         .bands(band_rows)
         .into_par_iter()
@@ -127,6 +118,28 @@ pub fn rasterize_parallel_resolved<const N: usize>(
     stats.add_fragments(counts);
     stats.covered = target.covered();
     stats
+}
+
+/// The shapes reaching each band of `band_rows` rows (at least 1) of an image `height` rows
+/// tall, in input order: their row ranges in parallel, then a serial pass over the ranges.
+fn bins<const N: usize>(
+    polygons: &PolygonBatch<N>,
+    height: u32,
+    band_rows: u32,
+) -> Vec<Vec<usize>> {
+    let ranges: Vec<(u32, u32)> = (0..polygons.len())
+        .into_par_iter()
+        .map(|i| polygons.get(i).rows(height))
+        .collect();
+    let mut bins = vec![Vec::new(); height.div_ceil(band_rows) as usize];
+    for (i, &(first, end)) in ranges.iter().enumerate() {
+        if first < end {
+            for bin in &mut bins[(first / band_rows) as usize..=((end - 1) / band_rows) as usize] {
+                bin.push(i);
+            }
+        }
+    }
+    bins
 }
 
 /// The shape counts of a batch (polygons, lines, skipped).

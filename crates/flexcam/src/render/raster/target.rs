@@ -127,6 +127,25 @@ impl Target {
         }
     }
 
+    /// This target's first `rows.1 - rows.0` rows (at most its height), emptied with
+    /// `background`, as rows `rows` of a larger image: a band-local buffer reused from band
+    /// to band (see [`super::fused`]).
+    pub(super) fn band_at(&mut self, rows: (u32, u32), background: Vec3) -> Band<'_> {
+        let n = (rows.1 - rows.0) as usize * self.width as usize;
+        self.color[..n].fill(background);
+        self.depth[..n].fill(f64::INFINITY);
+        self.ids[..n].fill(0);
+        self.primitives[..n].fill(NO_PRIMITIVE);
+        Band {
+            width: self.width,
+            rows,
+            color: &mut self.color[..n],
+            depth: &mut self.depth[..n],
+            ids: &mut self.ids[..n],
+            primitives: &mut self.primitives[..n],
+        }
+    }
+
     /// The whole target as one band.
     pub(super) fn band(&mut self) -> Band<'_> {
         Band {
@@ -164,10 +183,22 @@ impl Target {
     }
 }
 
+/// [`Frame::new`]'s empty frame (`background`, infinite depth, id 0), written in parallel so
+/// that the first touch of its pages is shared by the cores.
+pub fn new_frame(width: u32, height: u32, background: Vec3) -> Frame {
+    let n = width as usize * height as usize;
+    Frame {
+        width,
+        height,
+        color: filled(n, background),
+        depth: filled(n, f32::INFINITY),
+        ids: filled(n, 0),
+    }
+}
+
 /// Elements per parallel task of [`fill`].
 const FILL_CHUNK: usize = 1 << 15;
 
-/// Sets every element of `values` to `value`, in parallel chunks.
 /// `n` copies of `value`, written in parallel: a new frame-sized buffer's first touch (its
 /// page faults) is shared by the cores instead of serialised in `vec![value; n]`.
 fn filled<T: Copy + Send + Sync>(n: usize, value: T) -> Vec<T> {
@@ -176,6 +207,7 @@ fn filled<T: Copy + Send + Sync>(n: usize, value: T) -> Vec<T> {
     values
 }
 
+/// Sets every element of `values` to `value`, in parallel chunks.
 fn fill<T: Copy + Send + Sync>(values: &mut [T], value: T) {
     values
         .par_chunks_mut(FILL_CHUNK)
@@ -192,7 +224,19 @@ pub(super) struct Band<'a> {
     primitives: &'a mut [u64],
 }
 
-impl Band<'_> {
+impl<'a> Band<'a> {
+    /// The drawn rows, read-only.
+    pub(super) fn into_drawn(self) -> super::DrawnRows<'a> {
+        super::DrawnRows {
+            width: self.width,
+            rows: self.rows,
+            color: self.color,
+            depth: self.depth,
+            ids: self.ids,
+            primitives: self.primitives,
+        }
+    }
+
     /// The z-test: the fragment wins when `(depth, primitive)` is lexicographically smaller
     /// than the stored pair, so the result does not depend on the order of distinct shapes.
     /// On a win the shader is run and colour, depth, id and key are written. `fragment` must

@@ -732,3 +732,69 @@ fn raster_stage_rewrites_depth_or_discards_before_the_z_test() {
         }
     }
 }
+
+/// Drawing band by band into a frame hands the finish pass exactly the rows of the serial
+/// target, bit for bit, whatever the thread count or band size, and counts the same.
+#[test]
+fn raster_into_frame_finishes_the_rows_of_the_serial_target() {
+    let shapes = batch(&scene(23, 1500, 91.0, 77.0));
+    let background = Vec3::splat(0.25);
+    let mut serial = Target::new(91, 77, background);
+    let stage = |f: &mut Fragment<2>| {
+        f.varying.depth += f.varying.attributes[0];
+        f.x % 5 != 0
+    };
+    let serial_stats = rasterize_parallel_resolved(
+        &mut serial,
+        &shapes,
+        FillRule::NonZero,
+        1000,
+        &stage,
+        &shade,
+    );
+    // The finish pass copies the drawn rows into the frame, depth as f32, and checks the
+    // keys against the serial target's on the way.
+    let finish = |drawn: &DrawnRows<'_>, out: FrameRows<'_>| {
+        assert_eq!((drawn.width, drawn.rows), (out.width, out.rows));
+        let first = drawn.rows.0 as usize * 91;
+        let mut keys = 0u64;
+        for i in 0..drawn.primitives.len() {
+            let (x, y) = (((first + i) % 91) as u32, ((first + i) / 91) as u32);
+            assert_eq!(
+                serial.primitive(x, y),
+                (drawn.primitives[i] != NO_PRIMITIVE).then_some(drawn.primitives[i])
+            );
+            out.color[i] = drawn.color[i];
+            out.depth[i] = drawn.depth[i] as f32;
+            out.ids[i] = drawn.ids[i];
+            keys += u64::from(drawn.primitives[i] != NO_PRIMITIVE);
+        }
+        keys
+    };
+    let expected = serial.clone().into_frame();
+    for threads in [1, 3] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("thread pool");
+        for band_rows in [1, 7, band_rows_for(91), 1000] {
+            let mut frame = new_frame(91, 77, Vec3::ONE);
+            let (stats, keys, times) = pool.install(|| {
+                rasterize_into_frame(
+                    &mut frame,
+                    &shapes,
+                    FillRule::NonZero,
+                    band_rows,
+                    background,
+                    &stage,
+                    &shade,
+                    &finish,
+                )
+            });
+            assert!(frame == expected, "{threads} threads, {band_rows} rows");
+            assert_eq!(stats, serial_stats);
+            assert_eq!(keys, serial_stats.covered);
+            assert!(times.draw_s >= 0.0 && times.finish_s >= 0.0);
+        }
+    }
+}

@@ -45,6 +45,31 @@ fn shows_base_color(surface: Surface) -> bool {
     matches!(surface, Surface::Diffuse | Surface::Emissive)
 }
 
+impl RayCaster {
+    /// [`RayCaster::shade_hit`] for a caller that builds the primary ray only where shading
+    /// reads it: flat shading of a surface that shows its base colour reads only the hit (as
+    /// `Tracer::flat` does at its first hit), so `ray` is not called there. Same colour and
+    /// ray count as `shade_hit(&ray(), hit, options)`.
+    pub fn shade_hit_lazy(
+        &self,
+        ray: impl FnOnce() -> Ray,
+        hit: Hit,
+        options: &RenderOptions,
+    ) -> (Vec3, u64) {
+        let object = &self.objects[hit.object];
+        if options.shading == Shading::Flat && shows_base_color(object.material.surface) {
+            let color = base_color(
+                object,
+                hit.triangle,
+                hit.barycentric,
+                TextureFilter::Nearest,
+            );
+            return (color, 0);
+        }
+        self.shade_hit(&ray(), hit, options)
+    }
+}
+
 /// What one sample of a pixel reports.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct Sample {

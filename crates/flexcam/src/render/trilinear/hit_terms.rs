@@ -83,6 +83,7 @@ impl HitTerms {
 /// The hit the terms describe: `(t, b1, b2)`, the ray parameter and the barycentrics of
 /// the triangle's second and third corners (unbounded: outside the triangle too); `None`
 /// where the projector is parallel to the plane or a value is not finite.
+#[inline]
 pub fn hit(terms: &Terms) -> Option<(f64, f64, f64)> {
     let t = terms[NUMERATOR] / terms[DENOMINATOR];
     let b1 = terms[A1] + t * terms[C1];

@@ -46,7 +46,7 @@ use self::shade::{stored_barycentrics, Resolver, ShadeCounts, Shader};
 use crate::error::{Error, Result};
 use crate::projection::{Projection, Trilinear};
 use crate::render::raster::{
-    rasterize_parallel_resolved, FillRule, PolygonBatch, RasterStats, Target, BAND_ROWS,
+    band_rows_for, new_frame, rasterize_into_frame, FillRule, PolygonBatch, RasterStats,
 };
 use crate::render::raycast::{RayCaster, SamplePattern};
 use crate::render::{Counter, Frame, RenderOptions, Stats};
@@ -142,18 +142,6 @@ impl TrilinearRenderer {
                 moved = polygons.translated(shift);
                 &moved
             };
-            let mut target = Target::new(width, height, self.background);
-            raster.add(&rasterize_parallel_resolved(
-                &mut target,
-                batch,
-                FillRule::NonZero,
-                BAND_ROWS,
-                &|f| resolver.stage(f),
-                &stored_barycentrics,
-            ));
-            let rasterised = pass.elapsed().as_secs_f64() * 1e3;
-            raster_ms += rasterised;
-
             let shader = Shader {
                 resolver,
                 caster: &self.caster,
@@ -162,9 +150,26 @@ impl TrilinearRenderer {
                 fallback: &fallback,
                 background: self.background,
             };
-            let (frame, counts) = shader.frame(target);
+            // Drawn and shaded band by band, straight into the frame.
+            let mut frame = new_frame(width, height, self.background);
+            let (stats, counts, times) = rasterize_into_frame(
+                &mut frame,
+                batch,
+                FillRule::NonZero,
+                band_rows_for(width),
+                self.background,
+                &|f| shader.resolver.stage(f),
+                &stored_barycentrics,
+                &|drawn, rows| shader.rows(drawn, rows),
+            );
+            raster.add(&stats);
             samples.add(frame, counts);
-            shade_ms += pass.elapsed().as_secs_f64() * 1e3 - rasterised;
+            // The pass's wall time, split by the CPU time its bands spent drawing and shading.
+            let wall = pass.elapsed().as_secs_f64() * 1e3;
+            let busy = times.draw_s + times.finish_s;
+            let drawing = if busy > 0.0 { times.draw_s / busy } else { 1.0 };
+            raster_ms += wall * drawing;
+            shade_ms += wall * (1.0 - drawing);
         }
         let (frame, shaded) = samples.finish();
 
@@ -227,7 +232,7 @@ impl Samples {
             self.kept = Some(frame);
         }
         self.count += 1;
-        self.counts = self.counts.plus(counts);
+        self.counts = self.counts + counts;
     }
 
     /// The pixel frame and the rays all samples cast.

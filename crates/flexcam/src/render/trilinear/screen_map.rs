@@ -2,7 +2,7 @@
 //! positions, consistent with [`Trilinear::ray`](crate::projection::Trilinear): screen
 //! `s = (1 - u - v) S1 + u S2 + v S3` is pixel `(s_x W, (1 - s_y) H)`.
 
-use glam::{DMat2, DVec2};
+use glam::{DMat2, DVec2, DVec3};
 
 use crate::geometry::Ray;
 use crate::projection::ProjectionTriangleCache;
@@ -47,10 +47,20 @@ impl ScreenMap {
     /// The projector through pixel position `pixel` (extrapolated outside the triangle),
     /// `tripoint + t trinorm` as `Trilinear::ray` builds it; `None` where `trinorm` is zero.
     pub fn ray(&self, pixel: DVec2) -> Option<Ray> {
+        self.projector(pixel).map(|p| p.ray())
+    }
+
+    /// The projector through `pixel` as [`ScreenMap::ray`] gives it, with only its direction
+    /// computed: the origin is built by [`Projector::ray`] when needed. `None` where
+    /// `trinorm` is zero.
+    pub fn projector(&self, pixel: DVec2) -> Option<Projector<'_>> {
         let uv = self.barycentrics(pixel);
         let direction = self.cache.trinorm(uv.x, uv.y);
-        (direction != glam::DVec3::ZERO)
-            .then(|| Ray::new(self.cache.tripoint(uv.x, uv.y), direction))
+        (direction != DVec3::ZERO).then_some(Projector {
+            cache: &self.cache,
+            uv,
+            direction,
+        })
     }
 
     /// The projection triangle's point-projection cache.
@@ -59,10 +69,26 @@ impl ScreenMap {
     }
 }
 
+/// A projector through a pixel whose origin is not computed yet (see
+/// [`ScreenMap::projector`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Projector<'a> {
+    cache: &'a ProjectionTriangleCache,
+    uv: DVec2,
+    /// `trinorm` at the pixel: the ray's direction, non-zero.
+    pub direction: DVec3,
+}
+
+impl Projector<'_> {
+    /// The whole ray, `tripoint + t trinorm`.
+    pub fn ray(&self) -> Ray {
+        Ray::new(self.cache.tripoint(self.uv.x, self.uv.y), self.direction)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::DVec3;
     use proptest::prelude::*;
 
     fn map() -> ScreenMap {

@@ -39,16 +39,15 @@
 //! Pixels of projection triangles with an unprojectable pair are ray cast entirely.
 
 use glam::{DVec2, DVec3, Vec3};
-use rayon::prelude::*;
 
 use super::hit_terms::{self, TERMS};
 use super::scene_geometry::SceneGeometry;
 use super::screen_map::ScreenMap;
 use crate::geometry::Ray;
 use crate::projection::{Projection, Trilinear};
-use crate::render::raster::{Fragment, Layers, Target, NO_PRIMITIVE};
+use crate::render::raster::{DrawnRows, Fragment, FrameRows, NO_PRIMITIVE};
 use crate::render::raycast::{Hit, RayCaster};
-use crate::render::{Frame, RenderOptions};
+use crate::render::RenderOptions;
 
 /// Added to the depth of crack fillers: behind any exact fragment (depths are ray
 /// parameters, far below this for any scene within the rasteriser's limits).
@@ -138,6 +137,7 @@ impl Resolver<'_> {
     /// crack filler), key and object of the triangle hit, and in its first two attributes
     /// the hit's barycentrics ([`stored_barycentrics`]); or `false` to discard it. The
     /// fragment's attributes are the hit terms of its own triangle at its projector.
+    #[inline]
     pub fn stage(&self, fragment: &mut Fragment<TERMS>) -> bool {
         let (key, t, barycentric, exact) = match hit_terms::hit(&fragment.varying.attributes) {
             None => return false,
@@ -213,8 +213,10 @@ pub struct ShadeCounts {
     pub fallback_rays: u64,
 }
 
-impl ShadeCounts {
-    pub fn plus(self, o: ShadeCounts) -> ShadeCounts {
+impl std::ops::Add for ShadeCounts {
+    type Output = ShadeCounts;
+
+    fn add(self, o: ShadeCounts) -> ShadeCounts {
         ShadeCounts {
             shading_rays: self.shading_rays + o.shading_rays,
             fallback_rays: self.fallback_rays + o.fallback_rays,
@@ -243,54 +245,34 @@ struct Pixel {
 }
 
 impl Shader<'_> {
-    /// Shades every pixel of the drawn G-buffer `target` into a frame, rows in parallel. The
-    /// frame is the target's own (colour overwritten in place).
-    pub fn frame(&self, target: Target) -> (Frame, ShadeCounts) {
-        let width = target.width();
-        let Layers {
-            mut frame,
-            depth: gdepth,
-            primitives,
-        } = target.into_layers();
+    /// Shades the drawn G-buffer rows `drawn` into the same rows `out` of the frame, every
+    /// pixel of them written (a band of `render::raster::rasterize_into_frame`).
+    pub fn rows(&self, drawn: &DrawnRows<'_>, out: FrameRows<'_>) -> ShadeCounts {
         let any_fallback = self.fallback.iter().any(|&f| f);
-        let row = width as usize;
-        let empty = Pixel {
-            color: self.background,
-            depth: f32::INFINITY,
-            id: 0,
-            counts: ShadeCounts::default(),
-        };
-        let counts = frame
-            .color
-            .par_chunks_mut(row)
-            .zip(frame.depth.par_chunks_mut(row))
-            .zip(frame.ids.par_chunks_mut(row))
-            .zip(gdepth.par_chunks(row).zip(primitives.par_chunks(row)))
-            .enumerate()
-            .map(|(y, (((color, depth), ids), (gdepth, keys)))| {
-                let mut counts = ShadeCounts::default();
-                let y = y as u32;
-                for x in 0..width {
-                    let i = x as usize;
-                    let key = keys[i];
-                    if key == NO_PRIMITIVE && !any_fallback {
-                        continue; // already the background
-                    }
-                    let pixel = if any_fallback && self.in_fallback(x, y) {
-                        self.cast(x, y)
-                    } else if key == NO_PRIMITIVE {
-                        None
-                    } else {
-                        self.rasterised(key, gdepth[i], color[i], x, y)
-                    };
-                    let p = pixel.unwrap_or(empty);
-                    (color[i], depth[i], ids[i]) = (p.color, p.depth, p.id);
-                    counts = counts.plus(p.counts);
-                }
-                counts
-            })
-            .reduce(ShadeCounts::default, ShadeCounts::plus);
-        (frame, counts)
+        let width = drawn.width as usize;
+        let mut counts = ShadeCounts::default();
+        for (row, y) in (drawn.rows.0..drawn.rows.1).enumerate() {
+            for x in 0..drawn.width {
+                let i = row * width + x as usize;
+                let key = drawn.primitives[i];
+                let pixel = if any_fallback && self.in_fallback(x, y) {
+                    self.cast(x, y)
+                } else if key == NO_PRIMITIVE {
+                    None
+                } else {
+                    self.rasterised(key, drawn.depth[i], drawn.color[i], x, y)
+                };
+                let p = pixel.unwrap_or(Pixel {
+                    color: self.background,
+                    depth: f32::INFINITY,
+                    id: 0,
+                    counts: ShadeCounts::default(),
+                });
+                (out.color[i], out.depth[i], out.ids[i]) = (p.color, p.depth, p.id);
+                counts = counts + p.counts;
+            }
+        }
+        counts
     }
 
     fn in_fallback(&self, x: u32, y: u32) -> bool {
@@ -300,39 +282,53 @@ impl Shader<'_> {
     }
 
     /// Pixel `(x, y)`'s winning fragment (`key`, G-buffer depth and stored barycentrics),
-    /// shaded. An exact winner is read from the G-buffer (module doc); a crack filler is
-    /// resolved again. `None` where there is no hit after all (no projector).
+    /// shaded. An exact winner is read from the G-buffer (module doc) and its projector's
+    /// origin is built only if shading needs the ray (`RayCaster::shade_hit_lazy`); a crack
+    /// filler is resolved again. `None` where there is no hit after all (no projector).
     fn rasterised(&self, key: u64, depth: f64, stored: Vec3, x: u32, y: u32) -> Option<Pixel> {
         let position = self.resolver.position(x, y);
-        let found = if depth < CRACK_FILL_DEPTH {
-            FragmentHit {
-                ray: self.resolver.maps[(key >> 32) as usize].ray(position)?,
-                key,
-                t: depth,
-                barycentric: DVec2::new(f64::from(stored.x), f64::from(stored.y)),
-                exact: true,
-            }
+        if depth < CRACK_FILL_DEPTH {
+            let projector = self.resolver.maps[(key >> 32) as usize].projector(position)?;
+            let barycentric = DVec2::new(f64::from(stored.x), f64::from(stored.y));
+            Some(
+                self.shaded(key, depth, barycentric, projector.direction, || {
+                    projector.ray()
+                }),
+            )
         } else {
-            self.resolver.hit(key, position)?
-        };
-        let ray = found.ray;
-        let owner = self.resolver.scene.owners[(found.key & u64::from(u32::MAX)) as usize];
+            let found = self.resolver.hit(key, position)?;
+            let ray = found.ray;
+            Some(self.shaded(found.key, found.t, found.barycentric, ray.direction, || ray))
+        }
+    }
+
+    /// The hit at ray parameter `t` and `barycentric` of the scene triangle named by `key`
+    /// on the projector along `direction`, shaded; `ray` builds the whole projector.
+    fn shaded(
+        &self,
+        key: u64,
+        t: f64,
+        barycentric: DVec2,
+        direction: DVec3,
+        ray: impl FnOnce() -> Ray,
+    ) -> Pixel {
+        let owner = self.resolver.scene.owners[(key & u64::from(u32::MAX)) as usize];
         let hit = Hit {
-            t: found.t,
+            t,
             object: owner.object as usize,
             triangle: owner.triangle as usize,
-            barycentric: found.barycentric.as_vec2(),
+            barycentric: barycentric.as_vec2(),
         };
-        let (color, rays) = self.caster.shade_hit(&ray, hit, self.options);
-        Some(Pixel {
+        let (color, rays) = self.caster.shade_hit_lazy(ray, hit, self.options);
+        Pixel {
             color,
-            depth: (hit.t * ray.direction.length()) as f32,
+            depth: (t * direction.length()) as f32,
             id: owner.id,
             counts: ShadeCounts {
                 shading_rays: rays,
                 fallback_rays: 0,
             },
-        })
+        }
     }
 
     /// The pixel ray cast like the reference renderer does it.
