@@ -114,6 +114,7 @@ fn preset_keys(name: &str) -> &'static [&'static str] {
         "crossed_slits" => &["fov", "v_fov", "slit_distance"],
         "cubic" => &["v_fov", "perspective_rect"],
         "rounded_cubic" => &["v_fov", "corner_radius", "perspective_rect"],
+        "cylindrical" | "equirectangular" => &["h_fov", "v_fov", "perspective_rect"],
         "ortho_near_persp_far" => &["fov", "transition", "style"],
         "depth_transition" => &["fovs", "transitions", "style"],
         "occlusion" => &["fov", "transition", "pole", "strength"],

@@ -125,7 +125,8 @@ pub(super) fn convert(required: &Required) -> Result<VolumeSource> {
 }
 
 /// `source` with the local perspective edit over `perspective_rect` (a panorama, or the
-/// `cubic` and `rounded_cubic` presets); errors point at the rectangle.
+/// `cubic`, `rounded_cubic` and full `cylindrical` and `equirectangular` presets); errors
+/// point at the rectangle.
 pub(super) fn perspective_rect(
     src: &Source,
     source: &VolumeSource,
@@ -428,6 +429,26 @@ mod tests {
             20,
             "turns 286.9 degrees around the eye",
         );
+        // The full cylindrical and equirectangular presets as their panoramas; less than
+        // 360 degrees is refused at the rectangle.
+        for name in ["cylindrical", "equirectangular"] {
+            let text = preset(name, &format!("v_fov = 100\n{rect}"));
+            let VolumeSource::Panorama(p) = source(&text) else {
+                panic!("{name}: not a panorama")
+            };
+            let VolumeSource::Preset(plain) = source(&preset(name, "v_fov = 100\n")) else {
+                panic!("{name}: not a preset")
+            };
+            let shape = plain.panorama().unwrap().unwrap().shape;
+            let edited = make_perspective(&shape, [0.9, 0.3, 0.1, 0.7]).unwrap();
+            assert_eq!(*p.shape, edited, "{name}");
+            error_at(
+                &preset(name, &format!("h_fov = 180\n{rect}")),
+                7,
+                20,
+                &format!("flexible {name} is a shape-defined panorama only with h_fov = 360"),
+            );
+        }
         error_at(
             &preset("perspective", &format!("fov = 60\n{rect}")),
             7,

@@ -34,8 +34,12 @@
 //! seam column) moves onto the chord, off the ray straight behind the eye; the image stays
 //! continuous across the seam as before.
 //!
-//! The `cubic` and `rounded_cubic` presets take the edit as the panoramas they are
-//! ([`edit_source`]).
+//! The presets that are shape-defined panoramas take the edit as those panoramas
+//! ([`edit_source`]): `cubic` and `rounded_cubic`, and the full (h_fov = 360) `cylindrical`
+//! (circle and vertical segment) and `equirectangular` (circle and arc) presets, whose rays
+//! the panoramas repeat outside the edited bands (`PresetSpec::panorama`). The edited volume
+//! is a panorama, so `--method raster` draws it through the panorama's lookup inverse
+//! instead of the presets' own cylinder and sphere inverses.
 //!
 //! Errors: a non-finite rectangle, one outside [0, 1]^2, u0 = u1 (or u0 = 1, u1 = 0: no
 //! width) or v0 >= v1; an outline range turning through 180 degrees or more around the eye
@@ -74,8 +78,9 @@ pub fn make_perspective(shape: &PanoramaShape, rect: [f64; 4]) -> Result<Panoram
 }
 
 /// `source` with the perspective edit over `rect`: the shape of a shape-defined panorama, or
-/// of the panorama that a `cubic` or `rounded_cubic` preset is. Errors: any other volume,
-/// and those of [`make_perspective`].
+/// of the panorama that a `cubic`, `rounded_cubic`, `cylindrical` or `equirectangular`
+/// preset is. Errors: any other volume, a cylindrical or equirectangular preset of less than
+/// 360 degrees, and those of [`make_perspective`].
 pub fn edit_source(source: &VolumeSource, rect: [f64; 4]) -> Result<VolumeSource> {
     let spec = match source {
         VolumeSource::Panorama(spec) => spec.clone(),
@@ -84,7 +89,8 @@ pub fn edit_source(source: &VolumeSource, rect: [f64; 4]) -> Result<VolumeSource
             None => {
                 return Err(Error::new(format!(
                     "a perspective rectangle needs a shape-defined panorama (outlines and \
-                     profiles, or the cubic and rounded_cubic presets), not the {} preset",
+                     profiles, or the cubic, rounded_cubic, cylindrical and equirectangular \
+                     presets), not the {} preset",
                     preset.preset.name()
                 )))
             }
@@ -92,7 +98,8 @@ pub fn edit_source(source: &VolumeSource, rect: [f64; 4]) -> Result<VolumeSource
         _ => {
             return Err(Error::new(
                 "a perspective rectangle needs a shape-defined panorama (outlines and \
-                 profiles, or the cubic and rounded_cubic presets)",
+                 profiles, or the cubic, rounded_cubic, cylindrical and equirectangular \
+                 presets)",
             ))
         }
     };

@@ -329,31 +329,37 @@ impl PresetSpec {
         })
     }
 
-    /// The `cubic` and `rounded_cubic` presets as the shape-defined panoramas they are: the
-    /// square (or rounded square) outline and the vertical segment profile between
-    /// elevations +-`v_fov`/2, with the preset's frame and clip; `None` for the other
-    /// presets. Errors: a bad `v_fov` or corner radius.
+    /// The presets that are shape-defined panoramas, as those panoramas, with the preset's
+    /// frame and clip: `cubic` and `rounded_cubic` (the square or rounded-square outline and
+    /// the vertical segment profile between elevations +-`v_fov`/2), and the full
+    /// (`h_fov` = 360) `cylindrical` (circle and vertical segment) and `equirectangular`
+    /// (circle and the arc between elevations +-`v_fov`/2) presets, whose rays these
+    /// panoramas repeat (module `panorama`, tests `circle_and_*`). `None` for the other
+    /// presets. Errors: a bad `v_fov` or corner radius; a cylindrical or equirectangular
+    /// preset of less than 360 degrees (a panorama's outline goes once around the eye).
     pub fn panorama(&self) -> Option<Result<PanoramaSpec>> {
-        let (v_fov, outline) = match self.preset {
-            Preset::Cubic { v_fov } => (v_fov, OutlineShape::Square),
+        let shape = match self.preset {
+            Preset::Cubic { v_fov } => cubic_shape(&self.preset, v_fov, OutlineShape::Square),
             Preset::RoundedCubic {
                 v_fov,
                 corner_radius,
-            } => (
+            } => cubic_shape(
+                &self.preset,
                 v_fov,
                 OutlineShape::RoundedSquare {
                     radius: corner_radius,
                 },
             ),
+            Preset::Cylindrical { h_fov, v_fov } | Preset::Equirectangular { h_fov, v_fov } => {
+                round_shape(&self.preset, h_fov, v_fov)
+            }
             _ => return None,
         };
-        Some(
-            cubic_shape(&self.preset, v_fov, outline).map(|shape| PanoramaSpec {
-                shape: Arc::new(shape),
-                frame: self.frame,
-                clip: self.clip,
-            }),
-        )
+        Some(shape.map(|shape| PanoramaSpec {
+            shape: Arc::new(shape),
+            frame: self.frame,
+            clip: self.clip,
+        }))
     }
 
     /// The viewing volume for an image of aspect ratio `aspect` = height / width: two
@@ -608,6 +614,34 @@ fn cubic_shape(preset: &Preset, v_fov: f64, outline: OutlineShape) -> Result<Pan
     }
     .curve()?;
     PanoramaShape::single(outline, profile)
+}
+
+/// The shape of the full cylindrical (circle and vertical segment) or equirectangular
+/// (circle and arc) panorama between elevations +-`v_fov`/2. Errors: a bad `h_fov` or
+/// `v_fov`, or `h_fov` other than 360 degrees.
+fn round_shape(preset: &Preset, h_fov: f64, v_fov: f64) -> Result<PanoramaShape> {
+    let h = angle(preset, "h_fov", h_fov, UpTo::Including(360.0))?;
+    if (h - 2.0 * PI).abs() > 1e-12 {
+        return Err(Error::new(format!(
+            "flexible {} is a shape-defined panorama only with h_fov = 360 (its outline goes              once around the eye), got h_fov = {h_fov}",
+            preset.name()
+        )));
+    }
+    let profile = match preset {
+        Preset::Cylindrical { .. } => {
+            let half = 0.5 * angle(preset, "v_fov", v_fov, UpTo::Below(180.0))?;
+            ProfileShape::Segment {
+                elevation: [-half, half],
+            }
+        }
+        _ => {
+            let half = 0.5 * angle(preset, "v_fov", v_fov, UpTo::Including(180.0))?;
+            ProfileShape::Arc {
+                elevation: [-half, half],
+            }
+        }
+    };
+    PanoramaShape::single(OutlineShape::Circle.curve()?, profile.curve()?)
 }
 
 fn sphere(

@@ -12,7 +12,8 @@ use crate::projection::camera_basis::CameraBasis;
 use crate::projection::flexible::panorama::lookup::PanoramaInverse;
 use crate::projection::flexible::panorama::{OutlineShape, PanoramaSurface, ProfileShape};
 use crate::projection::flexible::presets::{Preset, PresetSpec};
-use crate::projection::CameraFrame;
+use crate::projection::flexible::{Flexible, FlexibleSpec};
+use crate::projection::{CameraFrame, Projection};
 
 /// Image size the deviations are measured in.
 const WIDTH: f64 = 1024.0;
@@ -303,4 +304,227 @@ fn bad_rectangles_are_refused() {
     .unwrap();
     assert!(make_perspective(&shape, [0.4, 0.0, 0.6, 0.5]).is_err());
     assert!(make_perspective(&shape, [0.4, 0.4, 0.6, 0.5]).is_ok());
+}
+
+/// The full cylindrical and equirectangular presets (camera frame of [`basis`]).
+fn round_presets() -> [PresetSpec; 2] {
+    let spec = |preset| PresetSpec {
+        preset,
+        frame: CameraFrame {
+            position: DVec3::new(1.0, 2.0, 3.0),
+            look_at: DVec3::new(-2.0, 1.0, 0.0),
+            up: DVec3::Y,
+        },
+        clip: Some([0.0, 50.0]),
+    };
+    [
+        spec(Preset::Cylindrical {
+            h_fov: 360.0,
+            v_fov: 100.0,
+        }),
+        spec(Preset::Equirectangular {
+            h_fov: 360.0,
+            v_fov: 180.0,
+        }),
+    ]
+}
+
+/// The preset edited over `rect`, as a flexible projection of `w` x `h` pixels.
+fn edited_flexible(spec: &PresetSpec, rect: [f64; 4], (w, h): (u32, u32)) -> Flexible {
+    let source = edit_source(&VolumeSource::Preset(spec.clone()), rect).unwrap();
+    let spec = FlexibleSpec {
+        source,
+        reparam: None,
+    };
+    Flexible::new(&spec, w, h).unwrap()
+}
+
+/// The cylindrical and equirectangular presets take the edit as the panoramas they are, in
+/// front of the eye and across the seam: lines inside the rectangle image straight.
+#[test]
+fn cylindrical_and_equirectangular_presets_take_the_edit() {
+    let cases = [
+        ([0.375, 0.3, 0.625, 0.7], 0.0),
+        ([0.875, 0.3, 0.125, 0.7], 180.0),
+    ];
+    for spec in round_presets() {
+        let name = spec.preset.name();
+        let plain = spec.panorama().unwrap().unwrap();
+        for (rect, centre) in cases {
+            let source = edit_source(&VolumeSource::Preset(spec.clone()), rect).unwrap();
+            let VolumeSource::Panorama(edited) = source else {
+                panic!("{name}: not a panorama");
+            };
+            assert_eq!(
+                *edited.shape,
+                make_perspective(&plain.shape, rect).unwrap(),
+                "{name}"
+            );
+            let (bent, straight) = bent_and_straight(&plain.shape, rect, centre);
+            println!("{name} {rect:?}: deviation before {bent:.3} px, after {straight:.2e} px");
+            assert!(
+                bent > 2.0,
+                "{name}: before the edit the lines bend: {bent} px"
+            );
+            assert!(straight < 0.01, "{name}: after the edit: {straight} px");
+        }
+    }
+}
+
+/// Outside the rectangle's u and v bands every pixel keeps the preset's own ray (the
+/// preset's cylinder or sphere surfaces, not its panorama form); inside, rays move.
+#[test]
+fn edited_round_presets_keep_their_rays_outside_the_rectangle() {
+    let (w, h) = (96, 48);
+    for spec in round_presets() {
+        let name = spec.preset.name();
+        let preset = FlexibleSpec {
+            source: VolumeSource::Preset(spec.clone()),
+            reparam: None,
+        };
+        let preset = Flexible::new(&preset, w, h).unwrap();
+        for rect in [[0.375, 0.3, 0.625, 0.7], [0.875, 0.3, 0.125, 0.7]] {
+            let edited = edited_flexible(&spec, rect, (w, h));
+            let across = rect[0] > rect[2];
+            let in_u = |u: f64| {
+                if across {
+                    u >= rect[0] || u <= rect[2]
+                } else {
+                    (rect[0]..=rect[2]).contains(&u)
+                }
+            };
+            let (mut same, mut moved) = (0, 0);
+            for y in 0..h {
+                for x in 0..w {
+                    let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                    let uv = preset.uv(pixel).unwrap();
+                    let (a, b) = (preset.ray(pixel).unwrap(), edited.ray(pixel).unwrap());
+                    let gap = (a.origin - b.origin).length() + (a.direction - b.direction).length();
+                    let scale = a.direction.length();
+                    if !in_u(uv.x) && !(rect[1]..=rect[3]).contains(&uv.y) {
+                        assert!(gap <= 1e-12 * scale, "{name} {rect:?} {pixel}: moved {gap}");
+                        same += 1;
+                    } else if gap > 1e-6 * scale {
+                        moved += 1;
+                    }
+                }
+            }
+            assert!(
+                same > 1000 && moved > 1000,
+                "{name}: {same} same, {moved} moved"
+            );
+        }
+    }
+}
+
+/// Less than 360 degrees is no panorama: the edit is refused in one line.
+#[test]
+fn partial_round_presets_refuse_the_edit() {
+    for mut spec in round_presets() {
+        match &mut spec.preset {
+            Preset::Cylindrical { h_fov, .. } | Preset::Equirectangular { h_fov, .. } => {
+                *h_fov = 200.0
+            }
+            _ => unreachable!(),
+        }
+        let e = edit_source(&VolumeSource::Preset(spec.clone()), RECT).unwrap_err();
+        assert!(e.message.contains("only with h_fov = 360"), "{e}");
+        assert!(e.message.contains(spec.preset.name()), "{e}");
+    }
+}
+
+mod round_trip {
+    use proptest::prelude::*;
+
+    use super::*;
+    use crate::projection::flexible::panorama::lookup::ACCURACY;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(256))]
+
+        /// Edited cylindrical and equirectangular presets (in front and across the seam): a
+        /// point at depth t on the ray of pixel q projects back to q and t, and the ray of
+        /// the projected pixel reaches the point.
+        #[test]
+        fn project_then_cast(
+            which in 0usize..2,
+            seam in any::<bool>(),
+            x in 0.0f64..1.0,
+            y in 0.02f64..0.98,
+            t in 0.0f64..1.0,
+        ) {
+            let rect = if seam { [0.8, 0.25, 0.15, 0.7] } else { [0.35, 0.25, 0.6, 0.7] };
+            let (w, h) = (360, 180);
+            let f = edited_flexible(&round_presets()[which], rect, (w, h));
+            prop_assert!(f.has_inverse());
+            let pixel = DVec2::new(x * f64::from(w), y * f64::from(h));
+            let ray = f.ray(pixel).unwrap();
+            let p = ray.at(t);
+            let mut images = Vec::new();
+            f.project(p, &mut images);
+            prop_assert_eq!(images.len(), 1);
+            let image = images[0];
+            let dx = (image.pixel.x - pixel.x).abs();
+            let dx = dx.min(f64::from(w) - dx);
+            prop_assert!(dx <= ACCURACY * f64::from(w), "x {} vs {}", image.pixel, pixel);
+            prop_assert!((image.pixel.y - pixel.y).abs() <= ACCURACY * f64::from(h));
+            prop_assert!((image.t - t).abs() <= ACCURACY, "t {} vs {}", image.t, t);
+            let back = f.ray(image.pixel).unwrap().at(image.t);
+            let reach = (p - ray.origin).length().max(ray.direction.length() * 1e-3);
+            prop_assert!((back - p).length() <= 10.0 * ACCURACY * reach, "{} vs {}", back, p);
+        }
+    }
+}
+
+/// The example scenes of the edited equirectangular (in front) and cylindrical (across the
+/// seam) presets: method raster with adaptive subdivision agrees with the ray caster on at
+/// least 99.5 % of the object ids, and uniform subdivision 8 on no fewer than 1.
+#[test]
+fn edited_round_presets_raster_like_the_ray_caster() {
+    use crate::render::compare::compare;
+    use crate::render::inverse_raster::Subdivision;
+    use crate::render::{Frame, Method, RenderOptions, Shading};
+    use crate::scene;
+
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/");
+    for name in [
+        "flexible-panorama-equirect-edit.toml",
+        "flexible-panorama-cylindrical-edit.toml",
+    ] {
+        let scene = scene::load(&format!("{dir}{name}")).unwrap();
+        let projection = scene
+            .projection
+            .build(scene.image.width, scene.image.height)
+            .unwrap();
+        let render = |method: Method, subdivision| -> Frame {
+            let options = RenderOptions {
+                shading: Shading::Flat,
+                subdivision,
+                ..RenderOptions::default()
+            };
+            method
+                .render(&scene, projection.as_ref(), &options)
+                .unwrap()
+                .0
+        };
+        let reference = render(Method::Raycast, Subdivision::default());
+        let agreement = |subdivision| {
+            compare(&render(Method::Raster, subdivision), &reference)
+                .unwrap()
+                .id_agreement
+        };
+        let (one, eight, adaptive) = (
+            agreement(Subdivision::uniform(1)),
+            agreement(Subdivision::uniform(8)),
+            agreement(Subdivision::default()),
+        );
+        println!(
+            "{name}: id disagreement uniform 1 {:.3} %, 8 {:.3} %, adaptive {:.3} %",
+            100.0 * (1.0 - one),
+            100.0 * (1.0 - eight),
+            100.0 * (1.0 - adaptive)
+        );
+        assert!(eight >= one, "{name}");
+        assert!(adaptive >= 0.995, "{name}: adaptive agreement {adaptive}");
+    }
 }
