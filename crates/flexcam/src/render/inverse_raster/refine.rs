@@ -52,13 +52,19 @@ pub struct Refiner<'a> {
 pub fn unwrap(x: f64, reference: f64, period: Option<f64>) -> (f64, i64) {
     match period {
         Some(p) => {
-            let periods = (reference - x) / p;
-            // Nearly every call is already within half a period: no rounding call then
-            // (`round` is a library call on this target); the result is `round`'s either way.
-            let k = if periods.abs() < 0.5 {
+            // Nearly every call is within a quarter period: no division then (|d| <= p/4
+            // gives |d / p| <= 1/4 after rounding, so k = 0 either way), and none within half
+            // a period calls `round` (a library call on this target); the result is the
+            // rounded quotient's in every case.
+            let k = if (reference - x).abs() <= 0.25 * p {
                 0.0
             } else {
-                periods.round()
+                let periods = (reference - x) / p;
+                if periods.abs() < 0.5 {
+                    0.0
+                } else {
+                    periods.round()
+                }
             };
             (x + k * p, k as i64)
         }

@@ -45,7 +45,14 @@ pub fn place(
         return Placement::Copies(0);
     }
     let (x_lo, x_hi) = (a.x.min(xb).min(xc), a.x.max(xb).max(xc));
+    // Within 0.999 P of the edges they are measured from, both quotients below lie in
+    // (-1, 0] after rounding: no shift, found without the divisions (most pieces).
+    let unshifted = |p: f64| {
+        let margin = 0.999 * p;
+        (0.0..=margin).contains(&x_hi) && (0.0..=margin).contains(&(size.x - x_lo))
+    };
     let shifts = match period {
+        Some(p) if unshifted(p) => (0, 0),
         // The shifts k with [x_lo + kP, x_hi + kP] meeting [0, width].
         Some(p) => (ceil(-x_hi / p) as i64, (-ceil(-(size.x - x_lo) / p)) as i64),
         None if x_hi < 0.0 || x_lo > size.x => return Placement::Copies(0),
