@@ -941,6 +941,54 @@ fn fit_writes_a_scene_that_renders_like_the_fitting_scene() {
     assert!(original.1 == written.1, "id images differ");
 }
 
+/// `flexcam fit` on a grid with tangents fits curved projectors and writes every node with
+/// its fitted tangent; the written scene renders bit for bit like the fitting scene, and the
+/// fitted nodes are the known curved grid the example's correspondences come from.
+#[test]
+fn curved_fit_writes_tangents_and_renders_like_the_fitting_scene() {
+    let dir = TempDir::new().unwrap();
+    let example = example_scene("flexible-projector-fit-curved.toml");
+    write(&dir, "fitting.toml", &fs::read_to_string(example).unwrap());
+    let out = run_ok(&dir, &["fit", "fitting.toml", "-o", "fitted.toml"]);
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        stdout.starts_with("fitted 25 correspondences (0 nodes unconstrained): residual max "),
+        "{stdout}"
+    );
+    let fitted = fs::read_to_string(dir.path().join("fitted.toml")).unwrap();
+    assert!(!fitted.contains("fit = ["), "{fitted}");
+    assert_eq!(fitted.matches("{ node = [").count(), 9, "{fitted}");
+    // The top row and the centre of the known grid are curved: their tangents are written
+    // and point like the known ones (normalised).
+    let tangent = |c: u32, r: u32| -> Vec<f64> {
+        let line = fitted
+            .lines()
+            .find(|l| l.trim_start().starts_with(&format!("{{ node = [{c}, {r}]")))
+            .unwrap();
+        let (_, after) = line.split_once("tangent = [").expect(line);
+        let (list, _) = after.split_once(']').unwrap();
+        list.split(',').map(|x| x.trim().parse().unwrap()).collect()
+    };
+    let close = |a: Vec<f64>, b: [f64; 3]| {
+        let n = (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt();
+        a.iter().zip(b).all(|(x, y)| (x - y / n).abs() < 1e-4)
+    };
+    let known = [
+        ((0, 2), [-0.47, -0.35, -0.86]),
+        ((1, 2), [0.0, -0.37, -0.98]),
+        ((2, 2), [0.47, -0.35, -0.86]),
+        ((1, 1), [0.15, -0.59, -0.81]),
+    ];
+    for ((c, r), t) in known {
+        assert!(close(tangent(c, r), t), "{:?}", tangent(c, r));
+    }
+    let original = flat_render_bytes(&dir, "fitting.toml", "original");
+    let written = flat_render_bytes(&dir, "fitted.toml", "written");
+    assert!(original.1.len() > 100);
+    assert!(original.0 == written.0, "colour images differ");
+    assert!(original.1 == written.1, "id images differ");
+}
+
 /// `flexcam fit` errors: nothing to fit, a missing file, writing over the input, a bad
 /// extension and a scene that does not load are one line each, and nothing is written.
 #[test]

@@ -3,7 +3,8 @@
 //!
 //! The written file is the original text edited in place (comments and layout kept): in the
 //! projection's `projectors` table the `fit`, `aim` and `projector` keys are replaced by one
-//! `projector` entry per node with its fitted `start` and `end`. Floats are written in Rust's
+//! `projector` entry per node with its fitted `start` and `end`, and its `tangent` when it is
+//! curved (a grid with tangents is fitted with curved projectors). Floats are written in Rust's
 //! shortest round-trip form, so the written grid is the fitted one bit for bit, and rendering
 //! the written file gives the image of the fitting scene. The result is parsed back before
 //! it is returned (as if it were at its output path, whose folder then resolves its relative
@@ -93,18 +94,23 @@ fn has_fit(spec: &FlexibleSpec) -> bool {
 }
 
 /// Replaces `fit`, `aim` and `projector` in `table` by one `projector` entry per node of
-/// `grid` (bottom row first), one per line.
+/// `grid` (bottom row first), one per line, with the tangents of curved nodes (unit vectors
+/// that normalising leaves unchanged, so they load back bit for bit).
 fn replace_nodes(table: &mut dyn TableLike, grid: &ProjectorGrid) {
     for key in ["fit", "aim", "projector"] {
         table.remove(key);
     }
     let cols = grid.size().0;
     let mut nodes = Array::new();
-    for (j, (start, end)) in grid.starts().iter().zip(grid.ends()).enumerate() {
+    let nodes_of = grid.starts().iter().zip(grid.ends()).zip(grid.tangents());
+    for (j, ((start, end), tangent)) in nodes_of.enumerate() {
         let mut node = InlineTable::new();
         node.insert("node", pair([j % cols, j / cols]));
         node.insert("start", point(start.to_array()));
         node.insert("end", point(end.to_array()));
+        if let Some(tangent) = tangent {
+            node.insert("tangent", point(tangent.to_array()));
+        }
         let mut value = Value::InlineTable(node);
         value.decor_mut().set_prefix("\n    ");
         nodes.push_formatted(value);

@@ -1,7 +1,7 @@
 //! `projectors = { ... }` in a flexible projection: a projector grid (seed 003, 5.2) sampled
 //! from the projection's own volume, with node projectors placed explicitly (optionally
-//! curved by a tangent), re-aimed node by node and fitted to point correspondences. See
-//! scenes/README.md.
+//! curved by a tangent), re-aimed node by node and fitted to point correspondences (with
+//! tangents: curved projectors fitted). See scenes/README.md.
 
 use glam::{DVec2, DVec3};
 use toml::Spanned;
@@ -82,14 +82,6 @@ pub(super) fn convert(src: &Source, table: &Spanned<RawProjectors>) -> Result<Pr
             point: finite_point(src, &c.point, "point")?,
         });
     }
-    let first_tangent = projectors_raw_tangent(raw);
-    if let (false, Some(tangent)) = (correspondences.is_empty(), first_tangent) {
-        return Err(src.error(
-            &tangent.span(),
-            "a projector `tangent` cannot be combined with `fit`: the fit solves for straight \
-             projectors; fit first (`flexcam fit` writes the fitted grid), then add tangents",
-        ));
-    }
     Ok(ProjectorGridSpec {
         size,
         interpolation,
@@ -97,14 +89,6 @@ pub(super) fn convert(src: &Source, table: &Spanned<RawProjectors>) -> Result<Pr
         aims,
         correspondences,
     })
-}
-
-/// The first `tangent` of the `projector` entries, if any.
-fn projectors_raw_tangent(raw: &RawProjectors) -> Option<&Spanned<[f64; 3]>> {
-    raw.projector
-        .iter()
-        .flatten()
-        .find_map(|p| p.get_ref().tangent.as_ref())
 }
 
 /// A `projector = [...]` entry; a zero `tangent` is allowed and means straight.

@@ -1240,15 +1240,24 @@ fn flexible_projector_grid_nodes_with_tangents() {
         56,
         "`tangent`",
     );
-    assert_error_at(
-        &with(
-            "{ projector = [{ node = [0, 0], tangent = [1, 0, 0] }], \
-             fit = [{ uv = [0.5, 0.5], point = [0, 0, 0] }] }",
-        ),
-        7,
-        56,
-        "a projector `tangent` cannot be combined with `fit`",
-    );
+    // Tangents with `fit`: a curved fit. The one correspondence, at the centre node, is on
+    // its straight projector already, so the fit keeps that node straight; the corner node
+    // that no correspondence constrains keeps its tangent.
+    let ProjectionSpec::Flexible(spec) = scene(&with(
+        "{ projector = [{ node = [0, 0], tangent = [1, 0, 0] }], \
+         fit = [{ uv = [0.5, 0.5], point = [0, 0, 0] }] }",
+    ))
+    .projection
+    else {
+        panic!("not flexible");
+    };
+    let flexible = crate::projection::flexible::Flexible::new(&spec, 32, 24).unwrap();
+    let Volume::Grid(volume) = flexible.volume() else {
+        panic!("not a grid volume");
+    };
+    assert_eq!(volume.grid.tangents()[0], Some(DVec3::X));
+    assert_eq!(volume.grid.tangents()[12], None);
+    assert!(volume.fit.is_some_and(|r| r.max_angle_deg < 1e-9));
     // A tangent from the end back to the start: named by node, in the file.
     assert_error(
         &with("{ projector = [{ node = [2, 2], start = [0, 0, 0], end = [0, 0, -5], tangent = [0, 0, 3] }] }"),
