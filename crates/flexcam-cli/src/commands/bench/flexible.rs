@@ -18,17 +18,16 @@
 use std::time::Instant;
 
 use clap::{Args, ValueEnum};
-use flexcam::projection::flexible::{Blend, Flexible, FlexibleSpec, Surface, VolumeSource};
 use flexcam::projection::Projection;
 use flexcam::render::inverse_raster::workloads::{
     teapot_dense_panorama, PanoramaWorkload, PANORAMA_SIZE,
 };
 use flexcam::render::inverse_raster::InverseRaster;
+use flexcam::render::raycast::workloads::{table_volume, teapot_scene, TABLE_SIZE};
 use flexcam::render::raycast::RayCaster;
 use flexcam::render::{Counter, RenderOptions, Shading};
-use flexcam::scene::{shapes, ImageSettings, Material, Mesh, Object, Scene};
+use flexcam::scene::Scene;
 use flexcam::{Error, Result};
-use glam::{Affine3A, DVec3, Vec3};
 
 /// Table 7.1's rows: model, faces, then seconds for quadratic and 2, 3, 4, 5, 6 segments.
 const THESIS: [(&str, u32, [f64; 6]); 6] = [
@@ -59,9 +58,6 @@ const THESIS: [(&str, u32, [f64; 6]); 6] = [
         [4642.61, 3235.35, 5075.96, 6175.63, 6810.99, 7239.51],
     ),
 ];
-
-/// The thesis's image size.
-const SIZE: u32 = 800;
 
 /// Arguments of `flexcam bench flexible`.
 #[derive(Args, Debug)]
@@ -107,7 +103,7 @@ fn table(args: &FlexibleArgs) -> Result<()> {
     let rows = args.rows.map_or(THESIS.len(), |r| r as usize);
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
-        "Table 7.1 (seed 003): {SIZE}x{SIZE}, lit shading (headlight), one frame per cell, best \
+        "Table 7.1 (seed 003): {TABLE_SIZE}x{TABLE_SIZE}, lit shading (headlight), one frame per cell, best \
          of {}, {threads} threads; models: the Utah teapot at the tessellation nearest each \
          face count",
         args.repeat
@@ -144,14 +140,13 @@ fn table(args: &FlexibleArgs) -> Result<()> {
 /// projectors, the BVH built once for the row.
 fn row_times(scene: &Scene, repeat: u32) -> Result<[Timing; 6]> {
     let caster = RayCaster::new(scene);
-    let (lo, hi) = bounds(scene)?;
     let options = RenderOptions {
         shading: Shading::Lit,
         ..RenderOptions::default()
     };
     let mut times = [Timing::default(); 6];
     for (time, column) in times.iter_mut().zip(COLUMNS) {
-        let projection = volume(lo, hi, column)?;
+        let projection = table_volume(scene, column, TABLE_SIZE)?;
         *time = measure(repeat, || {
             caster.render(&projection, &options);
             Ok(())
@@ -297,78 +292,4 @@ fn process_cpu_seconds() -> Option<f64> {
     let fields: Vec<&str> = rest.split_whitespace().collect();
     let ticks = |i: usize| fields.get(i)?.parse::<u64>().ok();
     Some((ticks(11)? + ticks(12)?) as f64 / 100.0)
-}
-
-/// A scene of one teapot whose triangle count is nearest `faces`, and that count.
-fn teapot_scene(faces: u32) -> (Scene, usize) {
-    let count = |n: u32| 64 * n * n - 8 * n;
-    let n = (1..=64)
-        .min_by_key(|&n| count(n).abs_diff(faces))
-        .unwrap_or(1);
-    let mesh: Mesh = shapes::teapot(1.0, 4 * n);
-    let used = mesh.triangle_count();
-    let object = Object {
-        id: 1,
-        name: "teapot".to_string(),
-        mesh,
-        material: Material {
-            color: Vec3::new(0.85, 0.3, 0.2),
-            ..Material::default()
-        },
-        world_to_object: Affine3A::IDENTITY,
-    };
-    let scene = Scene {
-        objects: vec![object],
-        lights: Vec::new(),
-        trilinear_reflectors: Vec::new(),
-        image: ImageSettings {
-            width: SIZE,
-            height: SIZE,
-            background: Vec3::new(0.55, 0.7, 0.9),
-        },
-        projection: flexcam::projection::ProjectionSpec::Perspective {
-            frame: flexcam::projection::CameraFrame {
-                position: DVec3::Z,
-                look_at: DVec3::ZERO,
-                up: DVec3::Y,
-            },
-            fov: 60.0,
-        },
-        base_dir: None,
-    };
-    (scene, used)
-}
-
-/// The bounding box of the scene's meshes.
-fn bounds(scene: &Scene) -> Result<(DVec3, DVec3)> {
-    scene
-        .objects
-        .iter()
-        .filter_map(|o| o.mesh.bounds())
-        .map(|(lo, hi)| (lo.as_dvec3(), hi.as_dvec3()))
-        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
-        .ok_or_else(|| Error::new("the benchmark scene is empty"))
-}
-
-/// The perspective-to-perspective volume around the box `[lo, hi]`: a small near square in
-/// front (+z), a middle square shifted up and to the right, a far square behind the model.
-/// `segments`: `None` for quadratic projectors, else polylines of that many segments.
-fn volume(lo: DVec3, hi: DVec3, segments: Option<u32>) -> Result<Flexible> {
-    let centre = 0.5 * (lo + hi);
-    let r = 0.5 * (hi - lo).length();
-    let square =
-        |c: DVec3, half: f64| Surface::rectangle_centred(c, DVec3::X * half, DVec3::Y * half);
-    let surfaces = vec![
-        square(centre + DVec3::new(0.0, 0.0, 4.0 * r), 0.1 * r),
-        square(centre + DVec3::new(0.4 * r, 0.3 * r, 1.0 * r), 0.9 * r),
-        square(centre + DVec3::new(0.0, 0.0, -2.0 * r), 1.3 * r),
-    ];
-    let spec = FlexibleSpec {
-        source: VolumeSource::Blended {
-            surfaces,
-            blend: Blend::Bezier { segments },
-        },
-        reparam: None,
-    };
-    Flexible::new(&spec, SIZE, SIZE)
 }

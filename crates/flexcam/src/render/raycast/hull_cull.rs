@@ -104,12 +104,13 @@ impl RayCaster {
 
 #[cfg(test)]
 mod tests {
-    use glam::{DVec2, DVec3};
+    use glam::DVec2;
 
     use super::{LiveParts, RayCaster};
     use crate::geometry::Ray;
-    use crate::projection::flexible::{Blend, Flexible, FlexibleSpec, Surface, VolumeSource};
+    use crate::projection::flexible::Flexible;
     use crate::projection::{Projection, Projector};
+    use crate::render::raycast::workloads::{table_volume, teapot_scene};
     use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
 
     /// `Flexible` without its hull: every tile is searched projector by projector.
@@ -130,42 +131,13 @@ mod tests {
         }
     }
 
-    /// The teapot alone, as in `flexcam bench flexible`.
-    fn teapot() -> RayCaster {
-        let text = r#"
-            [projection]
-            type = "perspective"
-            position = [0.0, 2.0, 12.0]
-            look_at = [0.0, 1.5, 0.0]
-            fov = 60.0
-            [[object]]
-            shape = "teapot"
-            size = 1.0
-            tessellation = 4
-        "#;
-        let path = std::path::Path::new("teapot.toml");
-        RayCaster::new(&crate::scene::file::parse(text, path).unwrap())
-    }
-
-    /// The bench's three-rectangle volume around the teapot's box (centre c, half
-    /// diagonal r), with `segments` (`None`: quadratic), at `size` x `size`.
-    fn bench_volume(segments: Option<u32>, size: u32) -> Flexible {
-        let (c, r) = (DVec3::new(0.217, 1.575, 0.0), 4.1);
-        let square = |centre: DVec3, half: f64| {
-            Surface::rectangle_centred(centre, DVec3::X * half, DVec3::Y * half)
-        };
-        let spec = FlexibleSpec {
-            source: VolumeSource::Blended {
-                surfaces: vec![
-                    square(c + DVec3::new(0.0, 0.0, 4.0 * r), 0.1 * r),
-                    square(c + DVec3::new(0.4 * r, 0.3 * r, r), 0.9 * r),
-                    square(c + DVec3::new(0.0, 0.0, -2.0 * r), 1.3 * r),
-                ],
-                blend: Blend::Bezier { segments },
-            },
-            reparam: None,
-        };
-        Flexible::new(&spec, size, size).unwrap()
+    /// The teapot of 56 triangles and the volume of `flexcam bench flexible` around it.
+    fn teapot_and_volume() -> (RayCaster, impl Fn(Option<u32>, u32) -> Flexible) {
+        let (scene, _) = teapot_scene(56);
+        let caster = RayCaster::new(&scene);
+        (caster, move |segments, size| {
+            table_volume(&scene, segments, size).unwrap()
+        })
     }
 
     fn count(stats: &Stats, key: &str) -> u64 {
@@ -183,7 +155,7 @@ mod tests {
 
     #[test]
     fn culled_tiles_render_exactly_like_the_per_projector_searches() {
-        let caster = teapot();
+        let (caster, bench_volume) = teapot_and_volume();
         // 104 = 6.5 tiles of 16: edge tiles of 8 pixels too.
         let size = 104;
         for segments in [None, Some(2), Some(5)] {
@@ -217,7 +189,7 @@ mod tests {
 
     #[test]
     fn a_hull_over_the_model_is_live_and_mixed_corners_are_never_culled() {
-        let caster = teapot();
+        let (caster, bench_volume) = teapot_and_volume();
         let projection = bench_volume(None, 64);
         // The whole image in one rectangle: it sees the teapot.
         let whole = projection

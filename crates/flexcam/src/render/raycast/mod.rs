@@ -14,6 +14,7 @@ pub(crate) mod sampling;
 mod shade;
 mod tiles;
 mod triangle;
+pub mod workloads;
 
 use std::time::Instant;
 

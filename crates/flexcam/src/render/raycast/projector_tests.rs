@@ -197,37 +197,10 @@ fn polyline_quads_sample_exactly_like_single_projectors() {
 /// alone.
 #[test]
 fn segments_outside_the_scene_box_are_culled_without_changing_any_hit() {
-    let text = r#"
-        [projection]
-        type = "perspective"
-        position = [0.0, 2.0, 12.0]
-        look_at = [0.0, 1.5, 0.0]
-        fov = 60.0
-        [[object]]
-        shape = "teapot"
-        size = 1.0
-        tessellation = 8
-    "#;
-    let scene = crate::scene::file::parse(text, std::path::Path::new("teapot.toml")).unwrap();
+    let (scene, _) = super::workloads::teapot_scene(240);
     let caster = RayCaster::new(&scene);
-    // The bench's volume around the teapot's box: centre c, half diagonal r.
-    let (c, r) = (DVec3::new(0.217, 1.575, 0.0), 4.1);
-    let square = |centre: DVec3, half: f64| {
-        Surface::rectangle_centred(centre, DVec3::X * half, DVec3::Y * half)
-    };
-    let spec = FlexibleSpec {
-        source: VolumeSource::Blended {
-            surfaces: vec![
-                square(c + DVec3::new(0.0, 0.0, 4.0 * r), 0.1 * r),
-                square(c + DVec3::new(0.4 * r, 0.3 * r, r), 0.9 * r),
-                square(c + DVec3::new(0.0, 0.0, -2.0 * r), 1.3 * r),
-            ],
-            blend: Blend::Bezier { segments: Some(6) },
-        },
-        reparam: None,
-    };
     let (w, h) = (48, 48);
-    let projection = Flexible::new(&spec, w, h).unwrap();
+    let projection = super::workloads::table_volume(&scene, Some(6), w).unwrap();
     let (mut culled, mut hits, mut segments) = (0, 0, 0);
     for y in 0..h {
         for x in 0..w {
