@@ -9,35 +9,11 @@ use crate::render::compare::{compare, Comparison};
 use crate::render::{Counter, Shading};
 use crate::scene::{self, Light, Material, Mesh, Object, Scene};
 
-/// A regular `cells x cells` screen grid (`2 cells^2` projection triangles) over a bent base
-/// patch near (0, 1, 5) whose ray directions fan out over 100 x 70 degrees looking along -z,
-/// with lengths growing to the right (trinorm is not renormalised: the depth scale varies).
+/// The fan screen grid of `cells x cells` cells of the bench and the accuracy tables
+/// ([`workloads::fan_grid`]: a bent base patch near (0, 1, 5) whose ray directions fan out
+/// over 100 x 70 degrees, lengths growing to the right).
 fn fan_mesh(cells: u32) -> TrilinearMesh {
-    let mut mesh = TrilinearMesh::default();
-    for j in 0..=cells {
-        for i in 0..=cells {
-            let s = DVec2::new(f64::from(i), f64::from(j)) / f64::from(cells);
-            let bend = 0.3 * (s.x - 0.5) * (s.x - 0.5) + 0.1 * s.y * s.y;
-            mesh.points
-                .push(DVec3::new(-0.2 + 0.4 * s.x, 0.85 + 0.3 * s.y, 5.0 + bend));
-            let (lon, lat) = (
-                (s.x - 0.5) * 100f64.to_radians(),
-                (s.y - 0.5) * 70f64.to_radians(),
-            );
-            let direction = DVec3::new(lon.sin() * lat.cos(), lat.sin(), -lon.cos() * lat.cos());
-            mesh.normals.push(direction * (1.0 + 0.3 * s.x));
-            mesh.screen.push(s);
-        }
-    }
-    let row = cells + 1;
-    for j in 0..cells {
-        for i in 0..cells {
-            let a = j * row + i;
-            mesh.triangles.push([a, a + 1, a + row + 1]);
-            mesh.triangles.push([a, a + row + 1, a + row]);
-        }
-    }
-    mesh
+    super::workloads::fan_grid(cells).unwrap()
 }
 
 fn flat() -> RenderOptions<'static> {
