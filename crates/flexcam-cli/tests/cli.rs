@@ -913,32 +913,51 @@ fn flat_render_bytes(dir: &TempDir, scene: &str, name: &str) -> (Vec<u8>, Vec<u8
     )
 }
 
+/// Copies example scene `name` into `dir` as fitting.toml and runs `flexcam fit` on it into
+/// fitted.toml; checks the summary line starts with `summary` and that the written 3 x 3
+/// grid has its 9 nodes as explicit projectors and no correspondences left. Returns the
+/// written text.
+fn fit_example(dir: &TempDir, name: &str, summary: &str) -> String {
+    write(
+        dir,
+        "fitting.toml",
+        &fs::read_to_string(example_scene(name)).unwrap(),
+    );
+    let out = run_ok(dir, &["fit", "fitting.toml", "-o", "fitted.toml"]);
+    let stdout = String::from_utf8(out.stdout).unwrap();
+    assert!(stdout.starts_with(summary), "{stdout}");
+    let fitted = fs::read_to_string(dir.path().join("fitted.toml")).unwrap();
+    assert!(!fitted.contains("fit = ["), "{fitted}");
+    assert_eq!(fitted.matches("{ node = [").count(), 9, "{fitted}");
+    fitted
+}
+
+/// The scene `flexcam fit` wrote (fitted.toml) renders bit for bit like the scene it was
+/// fitted from (fitting.toml): colours and ids, flat.
+fn assert_fitted_renders_like_fitting(dir: &TempDir) {
+    let original = flat_render_bytes(dir, "fitting.toml", "original");
+    let written = flat_render_bytes(dir, "fitted.toml", "written");
+    assert!(original.1.len() > 100);
+    assert!(original.0 == written.0, "colour images differ");
+    assert!(original.1 == written.1, "id images differ");
+}
+
 /// `flexcam fit` writes the fitted grid as explicit node projectors, keeping the file's
 /// comments, and the written scene renders bit for bit like the fitting scene.
 #[test]
 fn fit_writes_a_scene_that_renders_like_the_fitting_scene() {
     let dir = TempDir::new().unwrap();
-    let example = example_scene("flexible-projector-fit.toml");
-    write(&dir, "fitting.toml", &fs::read_to_string(example).unwrap());
-    let out = run_ok(&dir, &["fit", "fitting.toml", "-o", "fitted.toml"]);
-    let stdout = String::from_utf8(out.stdout).unwrap();
-    assert!(
-        stdout.starts_with("fitted 5 correspondences (3 nodes unconstrained): residual max "),
-        "{stdout}"
+    let fitted = fit_example(
+        &dir,
+        "flexible-projector-fit.toml",
+        "fitted 5 correspondences (3 nodes unconstrained): residual max ",
     );
-    let fitted = fs::read_to_string(dir.path().join("fitted.toml")).unwrap();
-    assert!(!fitted.contains("fit = ["), "{fitted}");
-    assert_eq!(fitted.matches("{ node = [").count(), 9, "{fitted}");
     // The artist's comments survive.
     assert!(
         fitted.contains("# Extension: one colour per face"),
         "{fitted}"
     );
-    let original = flat_render_bytes(&dir, "fitting.toml", "original");
-    let written = flat_render_bytes(&dir, "fitted.toml", "written");
-    assert!(original.1.len() > 100);
-    assert!(original.0 == written.0, "colour images differ");
-    assert!(original.1 == written.1, "id images differ");
+    assert_fitted_renders_like_fitting(&dir);
 }
 
 /// `flexcam fit` on a grid with tangents fits curved projectors and writes every node with
@@ -947,17 +966,11 @@ fn fit_writes_a_scene_that_renders_like_the_fitting_scene() {
 #[test]
 fn curved_fit_writes_tangents_and_renders_like_the_fitting_scene() {
     let dir = TempDir::new().unwrap();
-    let example = example_scene("flexible-projector-fit-curved.toml");
-    write(&dir, "fitting.toml", &fs::read_to_string(example).unwrap());
-    let out = run_ok(&dir, &["fit", "fitting.toml", "-o", "fitted.toml"]);
-    let stdout = String::from_utf8(out.stdout).unwrap();
-    assert!(
-        stdout.starts_with("fitted 25 correspondences (0 nodes unconstrained): residual max "),
-        "{stdout}"
+    let fitted = fit_example(
+        &dir,
+        "flexible-projector-fit-curved.toml",
+        "fitted 25 correspondences (0 nodes unconstrained): residual max ",
     );
-    let fitted = fs::read_to_string(dir.path().join("fitted.toml")).unwrap();
-    assert!(!fitted.contains("fit = ["), "{fitted}");
-    assert_eq!(fitted.matches("{ node = [").count(), 9, "{fitted}");
     // The top row and the centre of the known grid are curved: their tangents are written
     // and point like the known ones (normalised).
     let tangent = |c: u32, r: u32| -> Vec<f64> {
@@ -982,11 +995,7 @@ fn curved_fit_writes_tangents_and_renders_like_the_fitting_scene() {
     for ((c, r), t) in known {
         assert!(close(tangent(c, r), t), "{:?}", tangent(c, r));
     }
-    let original = flat_render_bytes(&dir, "fitting.toml", "original");
-    let written = flat_render_bytes(&dir, "fitted.toml", "written");
-    assert!(original.1.len() > 100);
-    assert!(original.0 == written.0, "colour images differ");
-    assert!(original.1 == written.1, "id images differ");
+    assert_fitted_renders_like_fitting(&dir);
 }
 
 /// `flexcam fit` errors: nothing to fit, a missing file, writing over the input, a bad

@@ -34,13 +34,26 @@ fn equirect() -> PanoramaShape {
     PanoramaShape::single(outline, profile).unwrap()
 }
 
-fn basis() -> CameraBasis {
-    CameraBasis::new(&CameraFrame {
+/// The camera frame of every test here: at (1, 2, 3) looking at (-2, 1, 0), y up.
+fn frame() -> CameraFrame {
+    CameraFrame {
         position: DVec3::new(1.0, 2.0, 3.0),
         look_at: DVec3::new(-2.0, 1.0, 0.0),
         up: DVec3::Y,
-    })
-    .unwrap()
+    }
+}
+
+fn basis() -> CameraBasis {
+    CameraBasis::new(&frame()).unwrap()
+}
+
+/// `preset` at the test [`frame`], with `clip`.
+fn preset_spec(preset: Preset, clip: Option<[f64; 2]>) -> PresetSpec {
+    PresetSpec {
+        preset,
+        frame: frame(),
+        clip,
+    }
 }
 
 fn inverse(shape: PanoramaShape) -> PanoramaInverse {
@@ -198,15 +211,7 @@ fn bent_and_straight(shape: &PanoramaShape, rect: [f64; 4], centre: f64) -> (f64
 /// front-right corner makes the lines across the corner straight.
 #[test]
 fn cubic_presets_take_the_edit_across_a_corner() {
-    let spec = |preset| PresetSpec {
-        preset,
-        frame: CameraFrame {
-            position: DVec3::new(1.0, 2.0, 3.0),
-            look_at: DVec3::new(-2.0, 1.0, 0.0),
-            up: DVec3::Y,
-        },
-        clip: None,
-    };
+    let spec = |preset| preset_spec(preset, None);
     let rect = [0.5, 0.2, 0.75, 0.8];
     for preset in [
         Preset::Cubic { v_fov: 100.0 },
@@ -306,17 +311,9 @@ fn bad_rectangles_are_refused() {
     assert!(make_perspective(&shape, [0.4, 0.4, 0.6, 0.5]).is_ok());
 }
 
-/// The full cylindrical and equirectangular presets (camera frame of [`basis`]).
+/// The full cylindrical and equirectangular presets (camera [`frame`]).
 fn round_presets() -> [PresetSpec; 2] {
-    let spec = |preset| PresetSpec {
-        preset,
-        frame: CameraFrame {
-            position: DVec3::new(1.0, 2.0, 3.0),
-            look_at: DVec3::new(-2.0, 1.0, 0.0),
-            up: DVec3::Y,
-        },
-        clip: Some([0.0, 50.0]),
-    };
+    let spec = |preset| preset_spec(preset, Some([0.0, 50.0]));
     [
         spec(Preset::Cylindrical {
             h_fov: 360.0,
