@@ -5,7 +5,8 @@
 //! shared batch and no separate full-image clear or copy.
 //!
 //! Each covered pixel centre is reconstructed once ([`Shader::fragment`]: exact depth, ray
-//! parameter and barycentrics); the z-test keeps the nearest, ties going to the smaller
+//! parameter and barycentrics, from its triangle's plane set up once per screen triangle,
+//! [`TrianglePlane`]); the z-test keeps the nearest, ties going to the smaller
 //! primitive key, as the polygon rasteriser's does, so the image does not depend on the
 //! order of the triangles, the band size or the thread count.
 
@@ -13,7 +14,7 @@ use glam::Vec3;
 use rayon::prelude::*;
 
 use super::coverage::{cover, Bins};
-use super::fragment::{Shader, Visible};
+use super::fragment::{Shader, TrianglePlane, Visible};
 use crate::render::raster::RasterStats;
 use crate::render::Frame;
 
@@ -66,9 +67,28 @@ impl FillCounts {
     }
 }
 
+/// One bit per pixel of a band: whether its z-buffer slot was written this frame.
+struct Written(Vec<u64>);
+
+impl Written {
+    /// `pixels` bits, all clear.
+    fn new(pixels: usize) -> Self {
+        Written(vec![0; pixels.div_ceil(64)])
+    }
+
+    fn get(&self, i: usize) -> bool {
+        self.0[i / 64] & (1 << (i % 64)) != 0
+    }
+
+    fn set(&mut self, i: usize) {
+        self.0[i / 64] |= 1 << (i % 64);
+    }
+}
+
 /// Fills the screen triangles of `bins` (those of every piece-building job, each sorted into
-/// bands of [`BAND_ROWS`]) into `zbuffer` (resized to the image; the rows of bands that some
-/// triangle reaches are overwritten) and writes the image of `size` pixels into `frame`
+/// bands of [`BAND_ROWS`]) into `zbuffer` (resized to the image; its slots are written
+/// where fragments land and read only where written this frame, so it needs no clearing)
+/// and writes the image of `size` pixels into `frame`
 /// (resized): visible pixels shaded by `shader`, others `background` at infinite depth with
 /// id 0.
 pub fn fill_and_shade(
@@ -110,28 +130,38 @@ pub fn fill_and_shade(
                 ids.fill(0);
                 return counts;
             }
-            visible.fill(Visible::NONE);
+            // Which slots hold a fragment of this frame: the others read as Visible::NONE
+            // without clearing the band's z-buffer rows (32 bytes a pixel) or reading them
+            // back where nothing was written (most of a band's width).
+            let mut written = Written::new(visible.len());
             for triangle in bins.iter().flat_map(|job| job.band(band)) {
-                let corners = shader.corners(triangle.key);
+                let mut plane = TrianglePlane::new(shader.corners(triangle.key));
                 cover(triangle, rows, width, |x, y| {
                     counts.fragments += 1;
-                    let Some(fragment) = shader.fragment(x, y, triangle.key, corners) else {
+                    let Some(fragment) = shader.fragment(x, y, triangle.key, &mut plane) else {
                         counts.discarded += 1;
                         return;
                     };
-                    let slot = &mut visible[(y - first) as usize * row + x as usize];
-                    if fragment.beats(slot) {
-                        *slot = fragment;
+                    let i = (y - first) as usize * row + x as usize;
+                    let current = if written.get(i) {
+                        &visible[i]
+                    } else {
+                        &Visible::NONE
+                    };
+                    if fragment.beats(current) {
+                        visible[i] = fragment;
+                        written.set(i);
                         counts.writes += 1;
                     }
                 });
             }
-            let pixels = colors.iter_mut().zip(depths).zip(ids).zip(visible.iter());
-            for (i, (((color, depth), id), slot)) in pixels.enumerate() {
-                if slot.is_empty() {
+            let pixels = colors.iter_mut().zip(depths).zip(ids).enumerate();
+            for (i, ((color, depth), id)) in pixels {
+                if !written.get(i) {
                     (*color, *depth, *id) = (background, f32::INFINITY, 0);
                     continue;
                 }
+                let slot = &visible[i];
                 let (x, y) = ((i % row) as u32, first + (i / row) as u32);
                 let (shaded, rays) = shader.shade(x, y, slot);
                 (*color, *depth, *id) = (shaded, slot.depth as f32, shader.id(slot.key));

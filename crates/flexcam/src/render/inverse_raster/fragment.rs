@@ -70,11 +70,6 @@ impl Visible {
     pub fn beats(&self, other: &Visible) -> bool {
         self.depth < other.depth || (self.depth == other.depth && self.key < other.key)
     }
-
-    /// Whether this is [`Visible::NONE`] (no fragment reached the pixel).
-    pub fn is_empty(&self) -> bool {
-        self.key == NO_PRIMITIVE
-    }
 }
 
 impl Shader<'_> {
@@ -85,12 +80,12 @@ impl Shader<'_> {
         mesh.triangles[triangle].map(|i| mesh.positions[i as usize].as_dvec3())
     }
 
-    /// The fragment of primitive `key`, whose scene corners are `corners`, at pixel
-    /// `(x, y)`, reconstructed from the pixel's projector, or `None` to discard it (see
-    /// [`plane_hit`]; also a pixel without a projector).
-    pub fn fragment(&self, x: u32, y: u32, key: u64, corners: [DVec3; 3]) -> Option<Visible> {
+    /// The fragment of primitive `key`, whose plane is `plane`, at pixel `(x, y)`,
+    /// reconstructed from the pixel's projector, or `None` to discard it (see
+    /// [`TrianglePlane::hit`]; also a pixel without a projector).
+    pub fn fragment(&self, x: u32, y: u32, key: u64, plane: &mut TrianglePlane) -> Option<Visible> {
         let ray = self.rays.get(x, y)?;
-        let (t, u, v) = plane_hit(ray, corners)?;
+        let (t, u, v) = plane.hit(ray)?;
         Some(Visible {
             depth: t * ray.direction.length(),
             t,
@@ -141,33 +136,83 @@ impl Shader<'_> {
     }
 }
 
-/// Where `ray` meets the plane of triangle `[a, b, c]`: its parameter t within the ray's
-/// range and the barycentrics (u, v) of the second and third vertices, clamped onto the
-/// triangle. `None` for a ray parallel to the plane (or a zero-area triangle) and for t
-/// outside `[t_min, t_max]`.
-pub fn plane_hit(ray: &Ray, [a, b, c]: [DVec3; 3]) -> Option<(f64, f64, f64)> {
-    let (e1, e2) = (b - a, c - a);
-    let p = ray.direction.cross(e2);
-    let det = e1.dot(p);
-    if det == 0.0 || !det.is_finite() {
-        return None;
+/// A scene triangle `[a, b, c]` set up for the fragments of its screen triangles: its
+/// edges, and the terms of the intersection that depend on the projector's origin only,
+/// kept for the last origin seen (every projector of a panorama, of a perspective camera
+/// and of a flexible volume with a point near surface leaves one eye, so they are computed
+/// once per screen triangle there). The arithmetic is that of the Moeller-Trumbore test
+/// term for term, so the results do not depend on what was kept.
+#[derive(Debug, Clone, Copy)]
+pub struct TrianglePlane {
+    a: DVec3,
+    e1: DVec3,
+    e2: DVec3,
+    from: Option<FromOrigin>,
+}
+
+/// The origin-dependent terms of [`TrianglePlane::hit`] for one projector origin.
+#[derive(Debug, Clone, Copy)]
+struct FromOrigin {
+    origin: DVec3,
+    /// origin - a.
+    s: DVec3,
+    /// s x e1.
+    q: DVec3,
+    /// e2 . q, the numerator of the ray parameter.
+    t_numerator: f64,
+}
+
+impl TrianglePlane {
+    pub fn new([a, b, c]: [DVec3; 3]) -> Self {
+        TrianglePlane {
+            a,
+            e1: b - a,
+            e2: c - a,
+            from: None,
+        }
     }
-    let inv = 1.0 / det;
-    let s = ray.origin - a;
-    let q = s.cross(e1);
-    let t = e2.dot(q) * inv;
-    if !(ray.t_min..=ray.t_max).contains(&t) {
-        return None;
+
+    /// Where `ray` meets the plane: its parameter t within the ray's range and the
+    /// barycentrics (u, v) of the second and third vertices, clamped onto the triangle.
+    /// `None` for a ray parallel to the plane (or a zero-area triangle) and for t outside
+    /// `[t_min, t_max]`.
+    pub fn hit(&mut self, ray: &Ray) -> Option<(f64, f64, f64)> {
+        let (e1, e2) = (self.e1, self.e2);
+        let p = ray.direction.cross(e2);
+        let det = e1.dot(p);
+        if det == 0.0 || !det.is_finite() {
+            return None;
+        }
+        let inv = 1.0 / det;
+        let from = match self.from {
+            Some(from) if from.origin == ray.origin => from,
+            _ => {
+                let s = ray.origin - self.a;
+                let q = s.cross(e1);
+                let from = FromOrigin {
+                    origin: ray.origin,
+                    s,
+                    q,
+                    t_numerator: e2.dot(q),
+                };
+                self.from = Some(from);
+                from
+            }
+        };
+        let t = from.t_numerator * inv;
+        if !(ray.t_min..=ray.t_max).contains(&t) {
+            return None;
+        }
+        let (mut u, mut v) = (
+            (from.s.dot(p) * inv).max(0.0),
+            (ray.direction.dot(from.q) * inv).max(0.0),
+        );
+        if u + v > 1.0 {
+            let sum = u + v;
+            (u, v) = (u / sum, v / sum);
+        }
+        Some((t, u, v))
     }
-    let (mut u, mut v) = (
-        (s.dot(p) * inv).max(0.0),
-        (ray.direction.dot(q) * inv).max(0.0),
-    );
-    if u + v > 1.0 {
-        let sum = u + v;
-        (u, v) = (u / sum, v / sum);
-    }
-    Some((t, u, v))
 }
 
 #[cfg(test)]
@@ -185,30 +230,52 @@ mod tests {
     #[test]
     fn plane_hit_inside_and_clamped_outside() {
         let ray = Ray::new(DVec3::ZERO, DVec3::new(0.25, 0.25, -1.0));
-        let (t, u, v) = plane_hit(&ray, triangle()).unwrap();
+        let (t, u, v) = TrianglePlane::new(triangle()).hit(&ray).unwrap();
         assert!((t - 2.0).abs() < 1e-15 && (u - 0.5).abs() < 1e-15 && (v - 0.5).abs() < 1e-15);
         // Outside the triangle (u + v = 2, u < 0 would be -): clamped onto it.
         let outside = Ray::new(DVec3::ZERO, DVec3::new(1.0, 1.0, -1.0));
-        let (_, u, v) = plane_hit(&outside, triangle()).unwrap();
+        let (_, u, v) = TrianglePlane::new(triangle()).hit(&outside).unwrap();
         assert!((u + v - 1.0).abs() < 1e-15);
         let left = Ray::new(DVec3::ZERO, DVec3::new(-0.5, 0.1, -1.0));
-        assert_eq!(plane_hit(&left, triangle()).unwrap().1, 0.0);
+        assert_eq!(TrianglePlane::new(triangle()).hit(&left).unwrap().1, 0.0);
     }
 
     /// Degenerate: parallel rays, zero-area triangles and hits outside the ray's range.
     #[test]
     fn plane_hit_misses() {
         let parallel = Ray::new(DVec3::ZERO, DVec3::X);
-        assert!(plane_hit(&parallel, triangle()).is_none());
+        assert!(TrianglePlane::new(triangle()).hit(&parallel).is_none());
         let flat = [DVec3::ZERO, DVec3::X, DVec3::X * 2.0];
-        assert!(plane_hit(&Ray::new(DVec3::Y, DVec3::NEG_Y), flat).is_none());
+        assert!(TrianglePlane::new(flat)
+            .hit(&Ray::new(DVec3::Y, DVec3::NEG_Y))
+            .is_none());
         let away = Ray::new(DVec3::ZERO, DVec3::Z);
-        assert!(plane_hit(&away, triangle()).is_none());
+        assert!(TrianglePlane::new(triangle()).hit(&away).is_none());
         let short = Ray {
             t_max: 1.0,
             ..Ray::new(DVec3::ZERO, DVec3::NEG_Z)
         };
-        assert!(plane_hit(&short, triangle()).is_none());
+        assert!(TrianglePlane::new(triangle()).hit(&short).is_none());
+    }
+
+    /// A plane kept across projectors of one origin, then of another and back, gives each
+    /// projector the result of a fresh set-up, bit for bit.
+    #[test]
+    fn kept_origin_terms_give_a_fresh_setups_hits() {
+        let mut kept = TrianglePlane::new(triangle());
+        let eye = DVec3::ZERO;
+        let other = DVec3::new(0.2, 0.1, 0.5);
+        for (origin, direction) in [
+            (eye, DVec3::new(0.25, 0.25, -1.0)),
+            (eye, DVec3::new(0.1, 0.3, -1.0)),
+            (other, DVec3::new(0.0, 0.1, -1.0)),
+            (other, DVec3::new(1.0, 1.0, -1.0)),
+            (eye, DVec3::new(0.3, 0.1, -1.0)),
+            (eye, DVec3::X),
+        ] {
+            let ray = Ray::new(origin, direction);
+            assert_eq!(kept.hit(&ray), TrianglePlane::new(triangle()).hit(&ray));
+        }
     }
 
     #[test]

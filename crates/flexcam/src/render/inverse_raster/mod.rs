@@ -90,6 +90,8 @@ pub struct InverseRaster<'a> {
 /// What a frame writes besides the caller's frame, kept by the renderer.
 #[derive(Debug, Default)]
 struct Buffers {
+    /// The image of every scene vertex, per object (`None` on the singular set).
+    images: Vec<Vec<Option<DVec2>>>,
     /// The screen triangles of each piece-building job, sorted into bands.
     bins: Vec<Bins>,
     /// Each pixel's visible fragment.
@@ -101,6 +103,9 @@ struct Buffers {
 struct PieceCounts {
     /// Scene triangles clipped by a chart half-space (partly or wholly outside).
     clipped: u64,
+    /// Scene triangles that `Refiner::far_from_poles` does not clear, refined and tested
+    /// with the pole rule (the others are proven to need neither).
+    near_poles: u64,
     /// Pieces after subdivision.
     pieces: u64,
     /// Pieces crossed by a pole, dropped.
@@ -120,6 +125,7 @@ struct PieceCounts {
 impl std::ops::AddAssign for PieceCounts {
     fn add_assign(&mut self, o: PieceCounts) {
         self.clipped += o.clipped;
+        self.near_poles += o.near_poles;
         self.pieces += o.pieces;
         self.pole_pieces += o.pole_pieces;
         self.singular += o.singular;
@@ -213,8 +219,12 @@ impl<'a> InverseRaster<'a> {
             .buffers
             .lock()
             .unwrap_or_else(std::sync::PoisonError::into_inner);
-        let Buffers { bins, zbuffer } = &mut *buffers;
-        let counts = self.pieces(bins);
+        let Buffers {
+            images,
+            bins,
+            zbuffer,
+        } = &mut *buffers;
+        let counts = self.pieces(images, bins);
         let pieces_ms = start.elapsed().as_secs_f64() * 1e3;
         let shader = Shader {
             objects: &self.scene.objects,
@@ -242,6 +252,7 @@ impl<'a> InverseRaster<'a> {
         for (name, value) in [
             ("triangles", self.scene.triangle_count() as u64),
             ("raster_clipped_triangles", counts.clipped),
+            ("raster_near_pole_triangles", counts.near_poles),
             ("raster_pieces", counts.pieces),
             ("raster_pole_pieces", counts.pole_pieces),
             ("raster_singular_pieces", counts.singular),
@@ -269,27 +280,26 @@ impl<'a> InverseRaster<'a> {
         stats
     }
 
-    /// Steps 1 to 3 of the module documentation: the screen triangles of every scene
-    /// triangle, sorted into bands by parallel jobs of [`CHUNK`] scene triangles, one
-    /// element of `bins` per job (resized), with their counters.
-    fn pieces(&self, bins: &mut Vec<Bins>) -> PieceCounts {
+    /// Steps 1 to 3 of the module documentation: the vertex images of every object into
+    /// `images`, then the screen triangles of every scene triangle, sorted into bands by
+    /// parallel jobs of [`CHUNK`] scene triangles, one element of `bins` per job, with their
+    /// counters (both buffers resized and overwritten).
+    fn pieces(&self, images: &mut Vec<Vec<Option<DVec2>>>, bins: &mut Vec<Bins>) -> PieceCounts {
         let refiner = Refiner::new(
             self.projection,
             &self.chart,
             self.options.subdivision.tolerance,
         );
-        let images: Vec<Vec<Option<DVec2>>> = self
-            .scene
-            .objects
-            .iter()
-            .map(|o| {
-                let positions = &o.mesh.positions;
-                positions
-                    .par_iter()
-                    .map(|p| refiner.node(p.as_dvec3()).image)
-                    .collect()
-            })
-            .collect();
+        images.resize_with(self.scene.objects.len(), Vec::new);
+        for (object, images) in self.scene.objects.iter().zip(images.iter_mut()) {
+            object
+                .mesh
+                .positions
+                .par_iter()
+                .map(|p| refiner.node(p.as_dvec3()).image)
+                .collect_into_vec(images);
+        }
+        let images = &*images;
         let jobs: Vec<(usize, Range<usize>)> = self
             .scene
             .objects
@@ -350,6 +360,7 @@ impl<'a> InverseRaster<'a> {
             counts.clipped += 1;
         }
         let poles = !refiner.far_from_poles(points);
+        counts.near_poles += u64::from(poles);
         let mut draw = |nodes: [Node; 3]| {
             counts.pieces += 1;
             if poles && refiner.is_pole_piece(nodes.map(|n| n.point)) {
@@ -382,6 +393,13 @@ impl<'a> InverseRaster<'a> {
         };
         let uniform = self.options.subdivision.uniform;
         let mut subdivide = |nodes: [Node; 3], grid: &mut Vec<Node>| {
+            // Most triangles of a finely tessellated model are far from the poles and too
+            // short to bend: refinement would emit them whole, so they are drawn at once
+            // (and most of those then cover no pixel centre and are dropped by the cull).
+            if uniform <= 1 && !poles && refiner.stays_whole(&nodes) {
+                draw(nodes);
+                return;
+            }
             refiner.uniform(nodes, uniform, grid, &mut |piece| {
                 refiner.refine(piece, [0; 3], poles, &mut draw)
             });

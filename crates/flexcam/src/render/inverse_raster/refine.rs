@@ -102,20 +102,7 @@ impl<'a> Refiner<'a> {
     /// `poles`: whether the pole rule applies (`false` only for edges of a triangle that
     /// [`Refiner::far_from_poles`] clears, where it can never split).
     fn split(&self, a: &Node, b: &Node, level: u32, poles: bool) -> Option<Node> {
-        if level >= MAX_LEVEL || a.point == b.point {
-            return None;
-        }
-        let (a, b) = if canonical(a.point, b.point) {
-            (a, b)
-        } else {
-            (b, a)
-        };
-        // The midpoint rule applies to edges with both images whose image may bend by more
-        // than the tolerance; most edges of a finely tessellated model are too short to.
-        let bendable = match (self.tolerance, a.image, b.image) {
-            (Some(tolerance), Some(pa), Some(pb)) => !self.bends_at_most(pa, pb, tolerance),
-            _ => false,
-        };
+        let (a, b, bendable) = self.candidate(a, b, level)?;
         let near_pole = poles && self.near_pole(a.point, b.point);
         if !bendable && !near_pole {
             return None;
@@ -129,6 +116,67 @@ impl<'a> Refiner<'a> {
                 _ => false,
             };
         (curved || near_pole).then_some(mid)
+    }
+
+    /// The ends of edge `a b` at `level` halvings in canonical order and whether the
+    /// midpoint rule may split it (both images, and an image long enough to bend by more
+    /// than the tolerance: most edges of a finely tessellated model are too short to), or
+    /// `None` for an edge that is never split (the level limit, coinciding ends).
+    fn candidate<'n>(
+        &self,
+        a: &'n Node,
+        b: &'n Node,
+        level: u32,
+    ) -> Option<(&'n Node, &'n Node, bool)> {
+        if level >= MAX_LEVEL || a.point == b.point {
+            return None;
+        }
+        let (a, b) = if canonical(a.point, b.point) {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        let bendable = match (self.tolerance, a.image, b.image) {
+            (Some(tolerance), Some(pa), Some(pb)) => !self.bends_at_most(pa, pb, tolerance),
+            _ => false,
+        };
+        Some((a, b, bendable))
+    }
+
+    /// Whether [`Refiner::refine`] emits the triangle `nodes` whole when the pole rule does
+    /// not apply (a triangle cleared by [`Refiner::far_from_poles`]): no edge's image is
+    /// long enough to bend by more than the tolerance, so no midpoint is even projected. A
+    /// `false` proves nothing (the edge may still turn out straight enough).
+    ///
+    /// Most edges are settled without ordering their ends: within a quarter period of each
+    /// other in x, [`unwrap`] moves neither end, so [`Refiner::bends_at_most`] gives the same
+    /// answer from either end ([`Refiner::short`]).
+    pub fn stays_whole(&self, nodes: &[Node; 3]) -> bool {
+        let Some(tolerance) = self.tolerance else {
+            return true;
+        };
+        let [a, b, c] = nodes;
+        [(a, b), (b, c), (c, a)].into_iter().all(|(p, q)| {
+            let (Some(pa), Some(pb)) = (p.image, q.image) else {
+                return true;
+            };
+            self.short(pa, pb, tolerance)
+                || self
+                    .candidate(p, q, 0)
+                    .is_none_or(|(_, _, bendable)| !bendable)
+        })
+    }
+
+    /// Whether images `pa` and `pb` lie within a quarter period of each other in x and
+    /// within the bend bound of each other: then `bends_at_most(pa, pb)` and
+    /// `bends_at_most(pb, pa)` both hold (neither end is unwrapped, and the distance is the
+    /// same both ways).
+    fn short(&self, pa: DVec2, pb: DVec2, tolerance: f64) -> bool {
+        let near = self
+            .chart
+            .period
+            .is_none_or(|p| (pa.x - pb.x).abs() <= 0.25 * p);
+        near && pa.distance_squared(pb) <= 8.0 * MIN_BEND_RADIUS_PX * tolerance
     }
 
     /// Whether the image of an edge whose ends project to `pa` and `pb` (unwrapped next to
@@ -194,8 +242,9 @@ impl<'a> Refiner<'a> {
     /// when `chord * D > 5 (pi / 2) r`, chord = |unit(c - o) - direction| (theta >= chord
     /// and a <= (pi / 2) r / D; the chord is at most 2, so this also implies D > r). It is
     /// evaluated squared and without the division, as `|(c - o) - D direction|^2 >
-    /// (5 pi / 2)^2 r^2` (chord * D = |(c - o) - D direction|): one square root per pole and
-    /// none for r, as this runs once per scene triangle.
+    /// (5 pi / 2)^2 r^2` (chord * D = |(c - o) - D direction|): one square root per pole
+    /// origin (the two poles of a panorama share the eye: one) and none for r, as this runs
+    /// once per scene triangle.
     ///
     /// Degenerate cases: a triangle around a pole's origin (D <= r), or whose centroid is
     /// the origin (D = 0, where the left side is 0), is not far; neither is a zero-size
@@ -208,10 +257,20 @@ impl<'a> Refiner<'a> {
             .iter()
             .map(|&p| p.distance_squared(centre))
             .fold(0.0, f64::max);
+        // The offset from the previous pole's origin and its length, reused by a pole with
+        // the same origin.
+        let mut seen: Option<(DVec3, DVec3, f64)> = None;
         self.chart.poles.iter().all(|pole| {
-            let offset = centre - pole.origin;
-            (offset - offset.length() * pole.direction).length_squared()
-                > BOUND * BOUND * radius_squared
+            let (offset, distance) = match seen {
+                Some((origin, offset, distance)) if origin == pole.origin => (offset, distance),
+                _ => {
+                    let offset = centre - pole.origin;
+                    let distance = offset.length();
+                    seen = Some((pole.origin, offset, distance));
+                    (offset, distance)
+                }
+            };
+            (offset - distance * pole.direction).length_squared() > BOUND * BOUND * radius_squared
         })
     }
 
@@ -519,6 +578,69 @@ mod tests {
         assert!(!refiner.far_from_poles([DVec3::Y; 3]));
         assert!(!refiner.far_from_poles([DVec3::NEG_Z, DVec3::NEG_Z, DVec3::splat(f64::NAN)]));
         assert!(refiner.far_from_poles([DVec3::NEG_Z; 3]));
+    }
+
+    proptest::proptest! {
+        /// A triangle `stays_whole` says refinement emits whole is emitted whole (without the
+        /// pole rule): small and large triangles in every direction, across the seam too;
+        /// both answers occur.
+        #[test]
+        fn triangles_that_stay_whole_are_emitted_whole(
+            centre in proptest::array::uniform3(-3.0f64..3.0),
+            offsets in proptest::array::uniform6(-1.0f64..1.0),
+            size in proptest::prop_oneof![0.001f64..0.01, 0.01f64..1.0],
+        ) {
+            let projection = panorama();
+            let chart = projection.inverse_chart().unwrap();
+            let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
+            let centre = DVec3::from_array(centre);
+            let corner = |k: usize| centre + size * DVec3::new(offsets[2 * k], offsets[2 * k + 1], 0.5);
+            let nodes = [0, 1, 2].map(|k| refiner.node(corner(k)));
+            let mut pieces = Vec::new();
+            refiner.refine(nodes, [0; 3], false, &mut |piece| pieces.push(piece));
+            if refiner.stays_whole(&nodes) {
+                proptest::prop_assert_eq!(pieces, vec![nodes]);
+            }
+        }
+    }
+
+    /// Both answers of `stays_whole`, and the degenerate cases: no tolerance (uniform
+    /// subdivision only), a corner without image, ends a quarter period apart.
+    #[test]
+    fn stays_whole_cases() {
+        let projection = panorama();
+        let chart = projection.inverse_chart().unwrap();
+        let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
+        let nodes = |points: [DVec3; 3]| points.map(|p| refiner.node(p));
+        let tiny = nodes([
+            DVec3::new(0.0, 0.0, -1.0),
+            DVec3::new(1e-3, 0.0, -1.0),
+            DVec3::new(0.0, 1e-3, -1.0),
+        ]);
+        assert!(refiner.stays_whole(&tiny));
+        // Behind the eye, across the seam (x near 0 and near 360): still whole.
+        let seam = nodes([
+            DVec3::new(-1e-3, 0.0, 1.0),
+            DVec3::new(1e-3, 0.0, 1.0),
+            DVec3::new(0.0, 1e-3, 1.0),
+        ]);
+        let xs = seam.map(|n| n.image.unwrap().x);
+        assert!(
+            xs.iter().any(|&x| x < 1.0) && xs.iter().any(|&x| x > 359.0),
+            "{xs:?}"
+        );
+        assert!(refiner.stays_whole(&seam));
+        let wide = nodes([
+            DVec3::new(-1.0, 0.5, -1.0),
+            DVec3::new(1.0, 0.5, -1.0),
+            DVec3::new(0.0, 1.0, -1.0),
+        ]);
+        assert!(!refiner.stays_whole(&wide));
+        let mut with_eye = tiny;
+        with_eye[0] = refiner.node(DVec3::ZERO);
+        assert!(with_eye[0].image.is_none() && refiner.stays_whole(&with_eye));
+        let uniform_only = Refiner::new(projection.as_ref(), &chart, None);
+        assert!(uniform_only.stays_whole(&wide));
     }
 
     #[test]
