@@ -429,8 +429,9 @@ mod tests {
             20,
             "turns 286.9 degrees around the eye",
         );
-        // The full cylindrical and equirectangular presets as their panoramas; less than
-        // 360 degrees is refused at the rectangle.
+        // The full cylindrical and equirectangular presets as their panoramas; with less
+        // than 360 degrees as windowed panoramas, which refuse a rectangle across the seam
+        // at the rectangle and take one inside the image.
         for name in ["cylindrical", "equirectangular"] {
             let text = preset(name, &format!("v_fov = 100\n{rect}"));
             let VolumeSource::Panorama(p) = source(&text) else {
@@ -446,8 +447,15 @@ mod tests {
                 &preset(name, &format!("h_fov = 180\n{rect}")),
                 7,
                 20,
-                &format!("flexible {name} is a shape-defined panorama only with h_fov = 360"),
+                "a perspective rectangle across the seam (u0 > u1",
             );
+            let inside = "perspective_rect = [0.2, 0.3, 0.8, 0.7]\n";
+            let VolumeSource::Panorama(p) =
+                source(&preset(name, &format!("h_fov = 180\n{inside}")))
+            else {
+                panic!("{name} 180: not a panorama")
+            };
+            assert_eq!(p.shape.window(), Some([0.25, 0.75]), "{name}");
         }
         error_at(
             &preset("perspective", &format!("fov = 60\n{rect}")),

@@ -35,16 +35,26 @@
 //! continuous across the seam as before.
 //!
 //! The presets that are shape-defined panoramas take the edit as those panoramas
-//! ([`edit_source`]): `cubic` and `rounded_cubic`, and the full (h_fov = 360) `cylindrical`
-//! (circle and vertical segment) and `equirectangular` (circle and arc) presets, whose rays
-//! the panoramas repeat outside the edited bands (`PresetSpec::panorama`). The edited volume
-//! is a panorama, so `--method raster` draws it through the panorama's lookup inverse
-//! instead of the presets' own cylinder and sphere inverses.
+//! ([`edit_source`]): `cubic` and `rounded_cubic`, and the `cylindrical` (circle and
+//! vertical segment) and `equirectangular` (circle and arc) presets, whose rays the
+//! panoramas repeat outside the edited bands (`PresetSpec::panorama`). The edited volume is
+//! a panorama, so `--method raster` draws it through the panorama's lookup inverse instead
+//! of the presets' own cylinder and sphere inverses.
+//!
+//! Less than a full turn: a cylindrical or equirectangular preset of `h_fov` < 360 is the
+//! circle windowed to its azimuths ([`PanoramaShape::windowed`]): the image's u maps onto the
+//! outline fractions [s0, s1], so the rectangle's columns [u0, u1] are the outline's
+//! fractions s0 + u (s1 - s0), which the chord replaces; the window is kept. Degenerate
+//! cases: a rectangle reaching the image's edge (u0 = 0 or u1 = 1) flattens the outline up
+//! to the window's end, and the edge column moves onto the chord like any other; a tiny
+//! `h_fov` gives a rectangle turning a tiny angle, whose chord is nearly the arc (the window
+//! itself is refused below [`super::MIN_WINDOW`] of a turn).
 //!
 //! Errors: a non-finite rectangle, one outside [0, 1]^2, u0 = u1 (or u0 = 1, u1 = 0: no
-//! width) or v0 >= v1; an outline range turning through 180 degrees or more around the eye
-//! (its chord would pass through or behind the eye); a profile end on or behind the up axis
-//! (P_x <= 0: the chord would meet the axis through the eye).
+//! width) or v0 >= v1; a rectangle across the seam (u0 > u1) of a windowed panorama, which
+//! has image edges instead of a seam; an outline range turning through 180 degrees or more
+//! around the eye (its chord would pass through or behind the eye); a profile end on or
+//! behind the up axis (P_x <= 0: the chord would meet the axis through the eye).
 
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -63,6 +73,14 @@ const TURN_SAMPLES: usize = 1024;
 /// the seam).
 pub fn make_perspective(shape: &PanoramaShape, rect: [f64; 4]) -> Result<PanoramaShape> {
     let [u0, v0, u1, v1] = rect;
+    if let (Some([s0, s1]), true) = (shape.window(), u0 > u1) {
+        return Err(Error::new(format!(
+            "a perspective rectangle across the seam (u0 > u1, got [{u0}, {v0}, {u1}, {v1}]) \
+             needs a panorama of the whole outline; this one spans {:.1} degrees of it and \
+             has image edges instead",
+            (s1 - s0) * 360.0
+        )));
+    }
     let unit = |x: f64| (0.0..=1.0).contains(&x);
     let width = if u0 < u1 { u1 - u0 } else { 1.0 - u0 + u1 };
     let across = u0 != u1 && width > 0.0;
@@ -72,15 +90,20 @@ pub fn make_perspective(shape: &PanoramaShape, rect: [f64; 4]) -> Result<Panoram
              (u0 > u1: across the seam) and v0 < v1, got [{u0}, {v0}, {u1}, {v1}]"
         )));
     }
-    let outlines = flatten(shape.outlines(), |c| outline_chord(c, [u0, u1]))?;
+    let range = [shape.fraction(u0), shape.fraction(u1)];
+    let outlines = flatten(shape.outlines(), |c| outline_chord(c, range))?;
     let profiles = flatten(shape.profiles(), |c| profile_chord(c, [v0, v1]))?;
-    PanoramaShape::new(outlines, profiles, shape.blend())
+    let edited = PanoramaShape::new(outlines, profiles, shape.blend())?;
+    match shape.window() {
+        Some(window) => edited.windowed(window),
+        None => Ok(edited),
+    }
 }
 
 /// `source` with the perspective edit over `rect`: the shape of a shape-defined panorama, or
 /// of the panorama that a `cubic`, `rounded_cubic`, `cylindrical` or `equirectangular`
-/// preset is. Errors: any other volume, a cylindrical or equirectangular preset of less than
-/// 360 degrees, and those of [`make_perspective`].
+/// preset is (windowed for less than 360 degrees). Errors: any other volume, and those of
+/// [`make_perspective`].
 pub fn edit_source(source: &VolumeSource, rect: [f64; 4]) -> Result<VolumeSource> {
     let spec = match source {
         VolumeSource::Panorama(spec) => spec.clone(),
@@ -124,15 +147,15 @@ fn flatten(
         .collect()
 }
 
-/// The outline with [u0, u1] (across the seam when u0 > u1) replaced by its linearly
-/// parameterised chord.
+/// The outline with its fractions [u0, u1] (across the seam when u0 > u1) replaced by its
+/// linearly parameterised chord.
 fn outline_chord(curve: &ArcCurve, [u0, u1]: [f64; 2]) -> Result<ArcCurve> {
     let unwrapped = if u1 < u0 { u1 + 1.0 } else { u1 };
     let turn = turning(curve, [u0, unwrapped]);
     if turn.abs() >= PI * (1.0 - 1e-9) {
         return Err(Error::new(format!(
-            "perspective rectangle: the outline over u in [{u0}, {u1}] turns {:.1} degrees \
-             around the eye; a chord (a plane) needs less than 180",
+            "perspective rectangle: the outline over its fractions [{u0}, {u1}] turns {:.1} \
+             degrees around the eye; a chord (a plane) needs less than 180",
             turn.abs().to_degrees()
         )));
     }

@@ -41,6 +41,13 @@
 //! Accuracy: the polished lookups are exact but for rounding; the stated [`ACCURACY`] is
 //! what the round-trip tests hold to.
 //!
+//! A shape windowed to the outline fractions [s0, s1] ([`PanoramaShape::windowed`], a
+//! panorama of less than a full turn) looks u up the same way, as the outline fraction s,
+//! and reports the image column (s - s0) / (s1 - s0) with s taken within half a turn of the
+//! window's middle: directions outside the window get u outside [0, 1] (clipped by the
+//! inverse's domain test), and u jumps by one turn, 1 / (s1 - s0), only straight opposite
+//! the window, which the chart gives the rasteriser as its period.
+//!
 //! Degenerate cases: points on the up axis through the eye (no azimuth) have no image (the
 //! chart's poles); elevations beyond the profile's ends continue the end intervals of the
 //! samples linearly (v outside [0, 1], clipped by [`super::super::inverse::Inverse::solve`]);
@@ -240,8 +247,8 @@ impl PanoramaInverse {
         })
     }
 
-    /// u at row `v` for the (unwrapped) azimuth `theta`, in [0, 1].
-    fn column(&self, theta: f64, v: f64) -> f64 {
+    /// The outline fraction at row `v` for the (unwrapped) azimuth `theta`, in [0, 1].
+    fn fraction(&self, theta: f64, v: f64) -> f64 {
         let (i, j, w) = self.shape.outline_blend(v);
         let blend = Blend {
             first: &self.outlines[i],
@@ -253,7 +260,7 @@ impl PanoramaInverse {
         // above it.
         let start = sample(0);
         let target = start + (theta - start).rem_euclid(TAU);
-        let exact = |s| unwrap_near(azimuth(self.shape.outline(DVec2::new(s, v))), target);
+        let exact = |s| unwrap_near(azimuth(self.shape.outline_at(s, v)), target);
         invert(sample, exact, target).clamp(0.0, 1.0)
     }
 
@@ -270,8 +277,10 @@ impl PanoramaInverse {
     }
 
     /// (u, v) and t of scene point `p`, extended beyond the volume (v and t outside [0, 1]
-    /// continue; u wraps into [0, 1]). `None` on the up axis through the eye, and where the
-    /// coupled iteration of several outlines does not converge.
+    /// continue; u wraps into [0, 1], or with a window, [`PanoramaShape::windowed`],
+    /// continues to within half a turn of the window's middle). `None` on the up axis
+    /// through the eye, and where the coupled iteration of several outlines does not
+    /// converge.
     pub fn solve(&self, p: DVec3) -> Option<(DVec2, f64)> {
         let local = self.basis.to_local(p - self.basis.origin);
         let horizontal = DVec2::new(local.x, local.z);
@@ -282,8 +291,9 @@ impl PanoramaInverse {
         let theta = azimuth(horizontal);
         // (u, v) from the column at row v and the row at that column.
         let step = |v: f64| {
-            let u = self.column(theta, v);
-            let rho = self.shape.outline(DVec2::new(u, v)).length();
+            let s = self.fraction(theta, v);
+            let u = self.shape.column(s);
+            let rho = self.shape.outline_at(s, v).length();
             DVec2::new(u, self.row(local.y.atan2(h / rho), u))
         };
         let uv = if self.outlines.len() == 1 {
@@ -299,9 +309,10 @@ impl PanoramaInverse {
         Some((uv, (d - self.near) / (self.far - self.near)))
     }
 
-    /// The chart under `reparam` (linear only: u wraps once across the image width): the
-    /// seam period and the poles up and down the axis through the eye, with the clearance
-    /// left by the highest and lowest pixel-centre rows.
+    /// The chart under `reparam` (linear only: u wraps once across the image width, or
+    /// once every 1 / (s1 - s0) widths for a window [s0, s1] of the outline): the seam
+    /// period and the poles up and down the axis through the eye, with the clearance left
+    /// by the highest and lowest pixel-centre rows.
     pub fn chart(&self, reparam: Reparam, resolution: &Resolution) -> Option<InverseChart> {
         (reparam == Reparam::Linear).then_some(())?;
         let (v_lo, v_hi) = reparam.v_range(resolution)?;
@@ -322,7 +333,9 @@ impl PanoramaInverse {
         let highest = elevations(v_hi).1;
         Some(InverseChart {
             clip: Vec::new(),
-            period: Some(f64::from(resolution.width)),
+            period: Some(
+                f64::from(resolution.width) / self.shape.window().map_or(1.0, |[a, b]| b - a),
+            ),
             poles: axis_poles(self.basis.origin, self.basis.up, lowest, highest),
         })
     }

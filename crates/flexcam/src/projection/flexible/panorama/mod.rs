@@ -8,7 +8,9 @@
 //! in camera-local (right, up, forward) coordinates around the eye: the outline is drawn in
 //! the (right, forward) plane and the profile in the (distance from the up axis, height)
 //! half-plane (module [`shape`]). u = 1/2 looks along the view direction, u = 0 and 1 are the
-//! seam behind the eye, v = 0 is the bottom of the image. Circle + vertical segment is the
+//! seam behind the eye, v = 0 is the bottom of the image. A windowed shape
+//! ([`PanoramaShape::windowed`]) spans only part of the outline across the image: a panorama
+//! of less than a full turn, with image edges instead of a seam. Circle + vertical segment is the
 //! cylindrical panorama, circle + semicircle the equirectangular one, square + segment the
 //! cubic one.
 //!
@@ -71,13 +73,23 @@ pub struct Attached {
     pub curve: ArcCurve,
 }
 
-/// The outlines and profiles of a panorama, with the blend between neighbours.
+/// The outlines and profiles of a panorama, with the blend between neighbours and the part
+/// of the outlines the image spans.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PanoramaShape {
     outlines: Vec<Attached>,
     profiles: Vec<Attached>,
     blend: CurveBlend,
+    /// The outline fractions [s0, s1] at the image's left and right edges (u = 0 and 1): the
+    /// image's u maps linearly onto them. `None`: the whole outline, [0, 1], with the seam
+    /// at the image's edges.
+    window: Option<[f64; 2]>,
 }
+
+/// The narrowest window, as a fraction of the outline (0.00036 degrees of a circle): u is
+/// found as (s - s0) / (s1 - s0) from an outline fraction s known to about 1e-16, so a
+/// narrower window would lose the lookup's accuracy in u.
+pub const MIN_WINDOW: f64 = 1e-6;
 
 impl PanoramaShape {
     /// Errors: no outline or no profile, an outline that is not closed or a profile that is,
@@ -116,7 +128,64 @@ impl PanoramaShape {
             outlines,
             profiles,
             blend,
+            window: None,
         })
+    }
+
+    /// The shape with its image spanning only the outline fractions `[s0, s1]` (u = 0 at
+    /// s0, u = 1 at s1; profiles stay attached at image columns u): a panorama of less than
+    /// a full turn, such as a cylindrical or equirectangular view of `h_fov` < 360 degrees
+    /// (the circle's fractions 1/2 -+ h_fov / 720). The image then has edges instead of a
+    /// seam: u outside [0, 1] continues around the outline, one turn every 1 / (s1 - s0).
+    /// Errors: fractions outside [0, 1], or a window narrower than [`MIN_WINDOW`]
+    /// (degenerate: u would lose its accuracy) or s0 >= s1; several profiles (they blend
+    /// across the image's edges, which a window makes two different columns).
+    pub fn windowed(self, [s0, s1]: [f64; 2]) -> Result<Self> {
+        if self.profiles.len() > 1 {
+            return Err(Error::new(
+                "a panorama windowed to part of its outline takes one profile",
+            ));
+        }
+        let unit = |s: f64| (0.0..=1.0).contains(&s);
+        if !(unit(s0) && unit(s1) && s1 - s0 >= MIN_WINDOW) {
+            return Err(Error::new(format!(
+                "a panorama's window of outline fractions [s0, s1] needs 0 <= s0 < s1 <= 1 and \
+                 s1 - s0 >= {MIN_WINDOW} (a horizontal field of view of at least {:.5} \
+                 degrees around a circle), got [{s0}, {s1}]",
+                MIN_WINDOW * 360.0
+            )));
+        }
+        Ok(PanoramaShape {
+            window: Some([s0, s1]),
+            ..self
+        })
+    }
+
+    /// The window of [`PanoramaShape::windowed`], `None` for the whole outline.
+    pub fn window(&self) -> Option<[f64; 2]> {
+        self.window
+    }
+
+    /// The outline fraction at image column `u`.
+    pub fn fraction(&self, u: f64) -> f64 {
+        match self.window {
+            Some([s0, s1]) => s0 + u * (s1 - s0),
+            None => u,
+        }
+    }
+
+    /// The image column of outline fraction `s` (the inverse of [`PanoramaShape::fraction`]):
+    /// with a window, `s` is first moved by whole turns to within half a turn of the
+    /// window's middle, so that u is continuous across the image and jumps by one turn
+    /// (1 / (s1 - s0)) only straight opposite it.
+    pub fn column(&self, s: f64) -> f64 {
+        match self.window {
+            Some([s0, s1]) => {
+                let s = s + (0.5 * (s0 + s1) - s).round();
+                (s - s0) / (s1 - s0)
+            }
+            None => s,
+        }
     }
 
     /// One outline and one profile.
@@ -177,7 +246,12 @@ impl PanoramaShape {
 
     /// The blended outline point at (u, v).
     pub fn outline(&self, uv: DVec2) -> DVec2 {
-        blended(&self.outlines, self.outline_blend(uv.y), uv.x)
+        self.outline_at(self.fraction(uv.x), uv.y)
+    }
+
+    /// The blended outline point at outline fraction `s` of row `v`.
+    pub fn outline_at(&self, s: f64, v: f64) -> DVec2 {
+        blended(&self.outlines, self.outline_blend(v), s)
     }
 
     /// The blended profile point at (u, v); profiles wrap across the seam.

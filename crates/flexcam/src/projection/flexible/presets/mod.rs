@@ -331,12 +331,12 @@ impl PresetSpec {
 
     /// The presets that are shape-defined panoramas, as those panoramas, with the preset's
     /// frame and clip: `cubic` and `rounded_cubic` (the square or rounded-square outline and
-    /// the vertical segment profile between elevations +-`v_fov`/2), and the full
-    /// (`h_fov` = 360) `cylindrical` (circle and vertical segment) and `equirectangular`
-    /// (circle and the arc between elevations +-`v_fov`/2) presets, whose rays these
-    /// panoramas repeat (module `panorama`, tests `circle_and_*`). `None` for the other
-    /// presets. Errors: a bad `v_fov` or corner radius; a cylindrical or equirectangular
-    /// preset of less than 360 degrees (a panorama's outline goes once around the eye).
+    /// the vertical segment profile between elevations +-`v_fov`/2), and the `cylindrical`
+    /// (circle and vertical segment) and `equirectangular` (circle and the arc between
+    /// elevations +-`v_fov`/2) presets, whose rays these
+    /// panoramas repeat (module `panorama`, tests `circle_and_*`), and with `h_fov` < 360
+    /// those panoramas windowed to the preset's azimuths ([`PanoramaShape::windowed`]).
+    /// `None` for the other presets. Errors: a bad `h_fov`, `v_fov` or corner radius.
     pub fn panorama(&self) -> Option<Result<PanoramaSpec>> {
         let shape = match self.preset {
             Preset::Cubic { v_fov } => cubic_shape(&self.preset, v_fov, OutlineShape::Square),
@@ -616,17 +616,15 @@ fn cubic_shape(preset: &Preset, v_fov: f64, outline: OutlineShape) -> Result<Pan
     PanoramaShape::single(outline, profile)
 }
 
-/// The shape of the full cylindrical (circle and vertical segment) or equirectangular
-/// (circle and arc) panorama between elevations +-`v_fov`/2. Errors: a bad `h_fov` or
-/// `v_fov`, or `h_fov` other than 360 degrees.
+/// The shape of the cylindrical (circle and vertical segment) or equirectangular (circle
+/// and arc) panorama between elevations +-`v_fov`/2: the whole circle for `h_fov` = 360,
+/// otherwise windowed to the circle's fractions 1/2 -+ `h_fov` / 720 (azimuths -+`h_fov`/2
+/// around the view direction, as the preset's own surfaces). Errors: a bad `h_fov` or
+/// `v_fov`; degenerate: an `h_fov` narrower than the window's minimum
+/// ([`super::panorama::MIN_WINDOW`] of a turn).
 fn round_shape(preset: &Preset, h_fov: f64, v_fov: f64) -> Result<PanoramaShape> {
     let h = angle(preset, "h_fov", h_fov, UpTo::Including(360.0))?;
-    if (h - 2.0 * PI).abs() > 1e-12 {
-        return Err(Error::new(format!(
-            "flexible {} is a shape-defined panorama only with h_fov = 360 (its outline goes              once around the eye), got h_fov = {h_fov}",
-            preset.name()
-        )));
-    }
+    let turn = h / (2.0 * PI);
     let profile = match preset {
         Preset::Cylindrical { .. } => {
             let half = 0.5 * angle(preset, "v_fov", v_fov, UpTo::Below(180.0))?;
@@ -641,7 +639,19 @@ fn round_shape(preset: &Preset, h_fov: f64, v_fov: f64) -> Result<PanoramaShape>
             }
         }
     };
-    PanoramaShape::single(OutlineShape::Circle.curve()?, profile.curve()?)
+    let whole = PanoramaShape::single(OutlineShape::Circle.curve()?, profile.curve()?)?;
+    if (turn - 1.0).abs() <= 1e-12 {
+        return Ok(whole);
+    }
+    whole
+        .windowed([0.5 - 0.5 * turn, 0.5 + 0.5 * turn])
+        .map_err(|e| {
+            Error::new(format!(
+                "flexible {} h_fov = {h_fov} as a panorama: {}",
+                preset.name(),
+                e.message
+            ))
+        })
 }
 
 fn sphere(

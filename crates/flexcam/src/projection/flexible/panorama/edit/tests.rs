@@ -368,65 +368,165 @@ fn cylindrical_and_equirectangular_presets_take_the_edit() {
     }
 }
 
-/// Outside the rectangle's u and v bands every pixel keeps the preset's own ray (the
-/// preset's cylinder or sphere surfaces, not its panorama form); inside, rays move.
+/// Outside the rectangle's u and v bands every pixel of the preset `spec` edited over
+/// `rect` keeps the preset's own ray (the preset's cylinder or sphere surfaces, not its
+/// panorama form); inside, rays move (at least `moved` pixels of 96 x 48 by over 1e-6).
+fn assert_rays_kept_outside(spec: &PresetSpec, rect: [f64; 4], moved_at_least: usize) {
+    let (w, h) = (96, 48);
+    let name = spec.preset.name();
+    let preset = FlexibleSpec {
+        source: VolumeSource::Preset(spec.clone()),
+        reparam: None,
+    };
+    let preset = Flexible::new(&preset, w, h).unwrap();
+    let edited = edited_flexible(spec, rect, (w, h));
+    let across = rect[0] > rect[2];
+    let in_u = |u: f64| {
+        if across {
+            u >= rect[0] || u <= rect[2]
+        } else {
+            (rect[0]..=rect[2]).contains(&u)
+        }
+    };
+    let (mut same, mut moved) = (0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let uv = preset.uv(pixel).unwrap();
+            let (a, b) = (preset.ray(pixel).unwrap(), edited.ray(pixel).unwrap());
+            let gap = (a.origin - b.origin).length() + (a.direction - b.direction).length();
+            let scale = a.direction.length();
+            if !in_u(uv.x) && !(rect[1]..=rect[3]).contains(&uv.y) {
+                assert!(gap <= 1e-12 * scale, "{name} {rect:?} {pixel}: moved {gap}");
+                same += 1;
+            } else if gap > 1e-6 * scale {
+                moved += 1;
+            }
+        }
+    }
+    assert!(
+        same > 1000 && moved >= moved_at_least,
+        "{name} {rect:?}: {same} same, {moved} moved"
+    );
+}
+
+/// Outside the rectangle's u and v bands every pixel keeps the preset's own ray; inside,
+/// rays move: full presets (in front and across the seam) and 200-degree ones (in front and
+/// up to the image's edge, where the windowed panorama repeats the partial preset).
 #[test]
 fn edited_round_presets_keep_their_rays_outside_the_rectangle() {
-    let (w, h) = (96, 48);
     for spec in round_presets() {
-        let name = spec.preset.name();
-        let preset = FlexibleSpec {
-            source: VolumeSource::Preset(spec.clone()),
-            reparam: None,
-        };
-        let preset = Flexible::new(&preset, w, h).unwrap();
         for rect in [[0.375, 0.3, 0.625, 0.7], [0.875, 0.3, 0.125, 0.7]] {
-            let edited = edited_flexible(&spec, rect, (w, h));
-            let across = rect[0] > rect[2];
-            let in_u = |u: f64| {
-                if across {
-                    u >= rect[0] || u <= rect[2]
-                } else {
-                    (rect[0]..=rect[2]).contains(&u)
-                }
-            };
-            let (mut same, mut moved) = (0, 0);
-            for y in 0..h {
-                for x in 0..w {
-                    let pixel = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-                    let uv = preset.uv(pixel).unwrap();
-                    let (a, b) = (preset.ray(pixel).unwrap(), edited.ray(pixel).unwrap());
-                    let gap = (a.origin - b.origin).length() + (a.direction - b.direction).length();
-                    let scale = a.direction.length();
-                    if !in_u(uv.x) && !(rect[1]..=rect[3]).contains(&uv.y) {
-                        assert!(gap <= 1e-12 * scale, "{name} {rect:?} {pixel}: moved {gap}");
-                        same += 1;
-                    } else if gap > 1e-6 * scale {
-                        moved += 1;
-                    }
-                }
-            }
-            assert!(
-                same > 1000 && moved > 1000,
-                "{name}: {same} same, {moved} moved"
-            );
+            assert_rays_kept_outside(&spec, rect, 1000);
+        }
+    }
+    for spec in partial_presets(200.0) {
+        for (rect, _) in PARTIAL_RECTS {
+            assert_rays_kept_outside(&spec, rect, 1000);
         }
     }
 }
 
-/// Less than 360 degrees is no panorama: the edit is refused in one line.
-#[test]
-fn partial_round_presets_refuse_the_edit() {
-    for mut spec in round_presets() {
+/// The cylindrical and equirectangular presets of `h_fov` degrees (camera [`frame`]).
+fn partial_presets(h_fov: f64) -> [PresetSpec; 2] {
+    round_presets().map(|mut spec| {
         match &mut spec.preset {
-            Preset::Cylindrical { h_fov, .. } | Preset::Equirectangular { h_fov, .. } => {
-                *h_fov = 200.0
+            Preset::Cylindrical { h_fov: h, .. } | Preset::Equirectangular { h_fov: h, .. } => {
+                *h = h_fov
             }
             _ => unreachable!(),
         }
+        spec
+    })
+}
+
+/// Rectangles of the 200-degree presets with the azimuth (degrees) of their middle: around
+/// the view direction, and reaching the image's left edge (degenerate: the window's end).
+const PARTIAL_RECTS: [([f64; 4], f64); 2] =
+    [([0.3, 0.3, 0.7, 0.7], 0.0), ([0.0, 0.3, 0.45, 0.7], -55.0)];
+
+/// Less than 360 degrees: the presets take the edit as the circle windowed to their
+/// azimuths, inside the image and up to its edge: lines inside the rectangle image straight
+/// (pixels of the windowed image, u measured across the 200 degrees).
+#[test]
+fn partial_round_presets_take_the_edit() {
+    for spec in partial_presets(200.0) {
+        let name = spec.preset.name();
+        let plain = spec.panorama().unwrap().unwrap();
+        assert_eq!(
+            plain.shape.window(),
+            Some([0.5 - 100.0 / 360.0, 0.5 + 100.0 / 360.0])
+        );
+        for (rect, centre) in PARTIAL_RECTS {
+            let source = edit_source(&VolumeSource::Preset(spec.clone()), rect).unwrap();
+            let VolumeSource::Panorama(edited) = source else {
+                panic!("{name}: not a panorama");
+            };
+            assert_eq!(
+                *edited.shape,
+                make_perspective(&plain.shape, rect).unwrap(),
+                "{name}"
+            );
+            assert_eq!(edited.shape.window(), plain.shape.window());
+            let (bent, straight) = bent_and_straight(&plain.shape, rect, centre);
+            println!("{name} 200 {rect:?}: deviation before {bent:.3} px, after {straight:.2e} px");
+            assert!(
+                bent > 2.0,
+                "{name}: before the edit the lines bend: {bent} px"
+            );
+            assert!(straight < 0.01, "{name}: after the edit: {straight} px");
+        }
+    }
+}
+
+/// Less than 360 degrees, refused in one line: a rectangle across the seam (the windowed
+/// image has edges instead), and a window narrower than `MIN_WINDOW` of a turn.
+#[test]
+fn partial_round_presets_refuse_what_has_no_meaning() {
+    for spec in partial_presets(200.0) {
+        let e = edit_source(&VolumeSource::Preset(spec), [0.8, 0.3, 0.2, 0.7]).unwrap_err();
+        assert!(
+            e.message.contains("across the seam") && e.message.contains("200.0 degrees"),
+            "{e}"
+        );
+    }
+    for spec in partial_presets(1e-4) {
         let e = edit_source(&VolumeSource::Preset(spec.clone()), RECT).unwrap_err();
-        assert!(e.message.contains("only with h_fov = 360"), "{e}");
-        assert!(e.message.contains(spec.preset.name()), "{e}");
+        assert!(
+            e.message.contains(spec.preset.name()) && e.message.contains("s1 - s0 >= "),
+            "{e}"
+        );
+    }
+}
+
+/// Degenerate: a tiny `h_fov` (half a degree, 0.0014 of a turn) still takes the edit: the
+/// chord is nearly the arc, rays outside the rectangle's bands are the preset's, and points
+/// project back to their pixels through the windowed lookup.
+#[test]
+fn a_tiny_h_fov_takes_the_edit() {
+    let rect = [0.4, 0.4, 0.6, 0.6];
+    for spec in partial_presets(0.5) {
+        let name = spec.preset.name();
+        assert_rays_kept_outside(&spec, rect, 0);
+        let f = edited_flexible(&spec, rect, (64, 32));
+        for (x, y, t) in [
+            (0.5, 0.5, 0.3),
+            (32.0, 16.0, 0.5),
+            (63.5, 31.5, 0.9),
+            (20.0, 5.0, 0.01),
+        ] {
+            let pixel = DVec2::new(x, y);
+            let p = f.ray(pixel).unwrap().at(t);
+            let mut images = Vec::new();
+            f.project(p, &mut images);
+            assert_eq!(images.len(), 1, "{name} {pixel}");
+            assert!(
+                (images[0].pixel - pixel).length() < 1e-6 * 64.0,
+                "{name} {pixel} {}",
+                images[0].pixel
+            );
+            assert!((images[0].t - t).abs() < 1e-6, "{name} {t} {}", images[0].t);
+        }
     }
 }
 
@@ -439,20 +539,28 @@ mod round_trip {
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(256))]
 
-        /// Edited cylindrical and equirectangular presets (in front and across the seam): a
-        /// point at depth t on the ray of pixel q projects back to q and t, and the ray of
-        /// the projected pixel reaches the point.
+        /// Edited cylindrical and equirectangular presets (full: in front and across the
+        /// seam; 200 degrees: in front and up to the image's edge): a point at depth t on
+        /// the ray of pixel q projects back to q and t, and the ray of the projected pixel
+        /// reaches the point.
         #[test]
         fn project_then_cast(
             which in 0usize..2,
             seam in any::<bool>(),
+            partial in any::<bool>(),
             x in 0.0f64..1.0,
             y in 0.02f64..0.98,
             t in 0.0f64..1.0,
         ) {
-            let rect = if seam { [0.8, 0.25, 0.15, 0.7] } else { [0.35, 0.25, 0.6, 0.7] };
+            // Partial (200 degrees): the rectangle reaching the left edge instead of the seam.
+            let rect = match (seam, partial) {
+                (true, false) => [0.8, 0.25, 0.15, 0.7],
+                (true, true) => [0.0, 0.25, 0.45, 0.7],
+                (false, _) => [0.35, 0.25, 0.6, 0.7],
+            };
             let (w, h) = (360, 180);
-            let f = edited_flexible(&round_presets()[which], rect, (w, h));
+            let spec = if partial { partial_presets(200.0) } else { round_presets() };
+            let f = edited_flexible(&spec[which], rect, (w, h));
             prop_assert!(f.has_inverse());
             let pixel = DVec2::new(x * f64::from(w), y * f64::from(h));
             let ray = f.ray(pixel).unwrap();
@@ -473,22 +581,44 @@ mod round_trip {
     }
 }
 
-/// The example scenes of the edited equirectangular (in front) and cylindrical (across the
-/// seam) presets: method raster with adaptive subdivision agrees with the ray caster on at
-/// least 99.5 % of the object ids, and uniform subdivision 8 on no fewer than 1.
+/// The example scenes of the edited equirectangular (in front), cylindrical (across the
+/// seam) and 200-degree cylindrical presets, and the last as a 200-degree equirectangular
+/// one (preset and `v_fov` replaced): method raster with adaptive subdivision agrees with
+/// the ray caster on at least 99.5 % of the object ids, and uniform subdivision 8 on no
+/// fewer than 1.
 #[test]
 fn edited_round_presets_raster_like_the_ray_caster() {
     use crate::render::compare::compare;
     use crate::render::inverse_raster::Subdivision;
     use crate::render::{Frame, Method, RenderOptions, Shading};
-    use crate::scene;
+    use crate::scene::file::parse;
 
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/");
-    for name in [
-        "flexible-panorama-equirect-edit.toml",
-        "flexible-panorama-cylindrical-edit.toml",
+    // The 200-degree scene once more as an equirectangular preset.
+    let as_equirect = |text: &str| {
+        let replaced = text
+            .replace("preset = \"cylindrical\"", "preset = \"equirectangular\"")
+            .replace("v_fov = 100.0", "v_fov = 120.0");
+        assert!(
+            replaced.contains("preset = \"equirectangular\"\n")
+                && replaced.contains("v_fov = 120.0")
+        );
+        replaced
+    };
+    for (file, equirect) in [
+        ("flexible-panorama-equirect-edit.toml", false),
+        ("flexible-panorama-cylindrical-edit.toml", false),
+        ("flexible-panorama-partial-edit.toml", false),
+        ("flexible-panorama-partial-edit.toml", true),
     ] {
-        let scene = scene::load(&format!("{dir}{name}")).unwrap();
+        let name = format!(
+            "{file}{}",
+            if equirect { " as equirectangular" } else { "" }
+        );
+        let path = format!("{dir}{file}");
+        let text = std::fs::read_to_string(&path).unwrap();
+        let text = if equirect { as_equirect(&text) } else { text };
+        let scene = parse(&text, std::path::Path::new(&path)).unwrap();
         let projection = scene
             .projection
             .build(scene.image.width, scene.image.height)
