@@ -70,6 +70,15 @@ pub trait Projection: Send + Sync {
         self.ray(pixel).map(Projector::Straight)
     }
 
+    /// Sets `out` to [`Projection::projector`] of `pixel`, reusing what `out` holds where the
+    /// projection can: a polyline refills the vertex buffer of a polyline already in `out`
+    /// instead of allocating one. Renderers that generate a projector per sample keep one
+    /// `out` per lane of their inner loop, so that loop allocates nothing. The default
+    /// replaces `out`.
+    fn projector_into(&self, pixel: DVec2, out: &mut Option<Projector>) {
+        *out = self.projector(pixel);
+    }
+
     /// A bound on the projectors of every sample position in the closed pixel-space
     /// rectangle `[lo, hi]`, each of which has a projector (see [`ProjectorHull`]): lets a
     /// renderer cull a whole tile at once. `None` (the default) where the projection cannot

@@ -61,6 +61,18 @@ fn control_points(surfaces: &[Surface], uv: DVec2) -> Option<Vec<DVec3>> {
     is_projector(&points).then_some(points)
 }
 
+/// Sets `out` to the polyline through `vertices`, refilling the vertex buffer of a
+/// polyline that `out` already holds instead of allocating one.
+fn set_polyline(out: &mut Option<Projector>, vertices: impl Iterator<Item = DVec3>) {
+    match out {
+        Some(Projector::Polyline(buffer)) => {
+            buffer.clear();
+            buffer.extend(vertices);
+        }
+        _ => *out = Some(Projector::Polyline(vertices.collect())),
+    }
+}
+
 /// Surfaces whose control points [`with_control_points`] keeps on the stack.
 const STACK_SURFACES: usize = 8;
 
@@ -237,6 +249,14 @@ impl PiecewiseVolume {
         control_points(&self.surfaces, uv).map(Projector::Polyline)
     }
 
+    /// [`PiecewiseVolume::projector`] written into `out` (see [`set_polyline`]).
+    pub fn projector_into(&self, uv: DVec2, out: &mut Option<Projector>) {
+        with_control_points(&self.surfaces, uv, |points| {
+            set_polyline(out, points.iter().copied())
+        })
+        .unwrap_or_else(|| *out = None)
+    }
+
     /// The hull of the projectors of the (u, v) rectangle `[lo, hi]`; see
     /// [`projector_hull`] for when there is none.
     pub fn projector_hull(&self, lo: DVec2, hi: DVec2) -> Option<ProjectorHull> {
@@ -317,6 +337,19 @@ impl BezierVolume {
                 Projector::Polyline(weights.iter().map(|w| weighted_sum(w, points)).collect())
             }
         })
+    }
+
+    /// [`BezierVolume::projector`] written into `out`: a polyline refills the vertex buffer
+    /// of a polyline already in `out` (see [`set_polyline`]).
+    pub fn projector_into(&self, uv: DVec2, out: &mut Option<Projector>) {
+        let Some(weights) = &self.polyline_weights else {
+            *out = self.projector(uv);
+            return;
+        };
+        with_control_points(&self.surfaces, uv, |points| {
+            set_polyline(out, weights.iter().map(|w| weighted_sum(w, points)))
+        })
+        .unwrap_or_else(|| *out = None)
     }
 
     /// The hull of the projectors of the (u, v) rectangle `[lo, hi]` (polyline samples are
@@ -410,6 +443,53 @@ mod tests {
         let b = BezierVolume::new(crossing, None).unwrap();
         assert_eq!(b.projector(DVec2::splat(0.5)), None);
         assert!(b.projector(DVec2::new(0.5, 0.9)).is_some());
+    }
+
+    /// Asserts that `write` sets any previous projector to what `projector` gives, at a few
+    /// (u, v).
+    fn assert_writes_new_projectors(
+        projector: impl Fn(DVec2) -> Option<Projector>,
+        write: impl Fn(DVec2, &mut Option<Projector>),
+    ) {
+        let previous = [
+            None,
+            Some(Projector::Polyline(vec![DVec3::X; 9])),
+            Some(Projector::Polyline(vec![DVec3::Y; 2])),
+            Some(Projector::QuadraticBezier([DVec3::Z; 3])),
+        ];
+        for uv in [
+            DVec2::splat(0.5),
+            DVec2::new(0.1, 0.8),
+            DVec2::new(1.0, 0.0),
+        ] {
+            for before in &previous {
+                let mut out = before.clone();
+                write(uv, &mut out);
+                assert_eq!(out, projector(uv), "{uv} after {before:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn projectors_written_into_any_previous_projector_equal_new_ones() {
+        let squares = vec![square(1.0, 1.0), square(3.0, 1.0), square(2.0, 4.0)];
+        // Three surfaces crossing at the centre: the projector of (1/2, 1/2) is a point.
+        let crossing = vec![
+            Surface::rectangle_centred(DVec3::ZERO, DVec3::X, DVec3::Y),
+            Surface::rectangle_centred(DVec3::ZERO, DVec3::X, DVec3::Z),
+            Surface::rectangle_centred(DVec3::ZERO, DVec3::Y, DVec3::Z),
+        ];
+        for surfaces in [squares, crossing] {
+            let v = PiecewiseVolume::new(surfaces.clone(), None).unwrap();
+            assert_writes_new_projectors(|uv| v.projector(uv), |uv, out| v.projector_into(uv, out));
+            for segments in [None, Some(2), Some(5), Some(12)] {
+                let v = BezierVolume::new(surfaces.clone(), segments).unwrap();
+                assert_writes_new_projectors(
+                    |uv| v.projector(uv),
+                    |uv, out| v.projector_into(uv, out),
+                );
+            }
+        }
     }
 
     #[test]

@@ -270,6 +270,15 @@ impl Projection for Flexible {
         self.volume.projector(self.uv(pixel)?)
     }
 
+    /// [`Flexible::projector`] written into `out`, reusing its polyline's vertex buffer
+    /// (see [`Volume::projector_into`]).
+    fn projector_into(&self, pixel: DVec2, out: &mut Option<Projector>) {
+        match self.uv(pixel) {
+            Some(uv) => self.volume.projector_into(uv, out),
+            None => *out = None,
+        }
+    }
+
     /// The volume's hull over the (u, v) rectangle of `[lo, hi]` (see
     /// [`Volume::projector_hull`]), under the linear map only: its u = x / W and
     /// v = 1 - y / H are monotonic also as rounded, so the (u, v) of every sample position

@@ -133,6 +133,19 @@ impl Volume {
         }
     }
 
+    /// Sets `out` to [`Volume::projector`] of (u, v); piecewise and Bezier volumes refill
+    /// the vertex buffer of a polyline already in `out` (no allocation once it is large
+    /// enough), the others replace `out`.
+    pub fn projector_into(&self, uv: DVec2, out: &mut Option<Projector>) {
+        match self {
+            Volume::Piecewise(v) => v.projector_into(uv, out),
+            Volume::Bezier(v) => v.projector_into(uv, out),
+            Volume::Linear(_) | Volume::Interpolated(_) | Volume::Grid(_) => {
+                *out = self.projector(uv)
+            }
+        }
+    }
+
     /// A bound on the projectors of every (u, v) in the rectangle `[lo, hi]`, each of which
     /// has a projector (see [`ProjectorHull`]): for piecewise and Bezier volumes of surfaces
     /// bilinear in (u, v) (see [`PiecewiseVolume::projector_hull`],

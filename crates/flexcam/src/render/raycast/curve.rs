@@ -13,8 +13,9 @@
 //! box, enlarged by `pad`, the chord meets, and the first piece with a hit ends the search.
 //! The whole curve is first tested the same way against the scene's box alone, and each
 //! piece against it by the box of the piece's control points before its chord is built; in
-//! a leaf, a triangle whose plane the piece's control points lie strictly on one side of is
-//! skipped without root finding (the piece cannot cross it).
+//! a leaf, a triangle whose box is apart from that box, or whose plane the piece's control
+//! points lie strictly on one side of, is skipped without root finding (the piece cannot
+//! meet it).
 //!
 //! Degenerate cases: a curve lying in a triangle's plane (the quadratic is identically zero)
 //! does not hit it, as a straight ray parallel to a triangle misses it; a double root (the
@@ -88,6 +89,36 @@ fn hull_misses_plane(hull: &[DVec3; 3], [v0, e1, e2]: [DVec3; 3]) -> bool {
     (x0 > 0.0 && x1 > 0.0 && x2 > 0.0) || (x0 < 0.0 && x1 < 0.0 && x2 < 0.0)
 }
 
+/// Margin of [`boxes_apart`], relative to the largest coordinate magnitude of either box.
+/// The hit the root finding would report is rounded off the exact piece and off the
+/// triangle by a few ulps of that magnitude (the piece's control points by de Casteljau, the
+/// hit point and its barycentric test): far below this margin, so that the test drops no hit
+/// that the root finding would accept. It stays far below any triangle of a model too, so
+/// the test keeps nearly all of its effect.
+const BOX_MARGIN: f64 = 1e-6;
+
+/// Whether the box `[lo, hi]` (of a curve piece's control points) and the box of triangle
+/// `[v0, e1, e2]` (its corners v0, v0 + e1, v0 + e2) are apart by more than [`BOX_MARGIN`]:
+/// a hit of the piece lies in both (on the piece, inside the hull of its control points,
+/// and on the triangle), so the root finding is skipped. Cheaper than
+/// [`hull_misses_plane`] (no cross product) and complementary to it: most triangles a piece's
+/// padded chord comes near lie beside the piece, their planes crossed by it. Degenerate
+/// cases: a triangle thinner than about 1e-9 radians, whose barycentric test rounds by more
+/// than the margin, may lose a hit that only that rounding gave; a NaN coordinate fails
+/// every comparison and never makes the boxes apart.
+fn boxes_apart(lo: DVec3, hi: DVec3, [v0, e1, e2]: [DVec3; 3]) -> bool {
+    let (a, b) = (v0 + e1, v0 + e2);
+    let (t_lo, t_hi) = (v0.min(a).min(b), v0.max(a).max(b));
+    let scale = lo
+        .abs()
+        .max(hi.abs())
+        .max(t_lo.abs())
+        .max(t_hi.abs())
+        .max_element();
+    let margin = DVec3::splat(BOX_MARGIN * scale);
+    (lo - margin).cmpgt(t_hi).any() || (hi + margin).cmplt(t_lo).any()
+}
+
 /// The control points of the piece of curve `p` over [a, b] (blossoming: the end points and
 /// the intersection of the end tangents).
 pub(super) fn piece(p: &[DVec3; 3], a: f64, b: f64) -> [DVec3; 3] {
@@ -146,7 +177,7 @@ impl RayCaster {
             self.bvh
                 .visit_near_segment(&segment, |id, tri: &PackedTriangle| {
                     let tri = [tri.v0, tri.e1, tri.e2].map(|v| glam::Vec3::from(v).as_dvec3());
-                    if hull_misses_plane(&q, tri) {
+                    if boxes_apart(lo, hi, tri) || hull_misses_plane(&q, tri) {
                         return;
                     }
                     let hi = best.map_or(b, |(_, h)| h.s);
@@ -309,6 +340,29 @@ mod tests {
     }
 
     #[test]
+    fn boxes_apart_only_beyond_the_margin() {
+        let t = unit();
+        // Just beyond x = 1 by more than the margin: apart; within it: not.
+        let x = |d: f64| DVec3::new(1.0 + d, 0.0, 0.0);
+        assert!(boxes_apart(x(1e-3), x(2.0), t));
+        assert!(!boxes_apart(x(1e-7), x(2.0), t));
+        // Below z = 0 or overlapping: apart only when separated.
+        assert!(boxes_apart(
+            DVec3::new(0.1, 0.1, -2.0),
+            DVec3::new(0.2, 0.2, -1.0),
+            t
+        ));
+        assert!(!boxes_apart(
+            DVec3::new(0.1, 0.1, -2.0),
+            DVec3::new(0.2, 0.2, 1.0),
+            t
+        ));
+        // Degenerate case: a coordinate that is not finite is never apart.
+        let nan = DVec3::new(f64::NAN, 0.1, 0.0);
+        assert!(!boxes_apart(nan, nan, t));
+    }
+
+    #[test]
     fn a_hull_on_one_side_of_the_plane_misses_and_a_crossing_one_does_not() {
         let above = [
             DVec3::new(0.2, 0.2, 0.1),
@@ -380,8 +434,31 @@ mod tests {
             }
         }
 
-        /// The BVH search with its culls (whole curve, piece boxes, piece chords, hull
-        /// planes) finds the first hit that testing every triangle finds, on curves through
+        /// A piece whose control points' box is apart from a triangle's box has no hit on
+        /// it; boxes that overlap or touch are never apart.
+        #[test]
+        fn a_piece_boxed_apart_has_no_hit(
+            p0 in point(), p1 in point(), p2 in point(),
+            a in point(), b in point(), c in point(),
+            lo in 0.0..1.0f64, width in 0.0..1.0f64,
+        ) {
+            let p = [p0, p1, p2];
+            let t = tri(a, b, c);
+            let hi = (lo + width).min(1.0);
+            let q = piece(&p, lo, hi);
+            let (q_lo, q_hi) = (q[0].min(q[1]).min(q[2]), q[0].max(q[1]).max(q[2]));
+            if boxes_apart(q_lo, q_hi, t) {
+                prop_assert_eq!(intersect_quadratic_triangle(&p, t, [lo, hi]), None);
+            }
+            // The triangle's own box is never apart from itself, nor from a box inside it.
+            let t_lo = a.min(b).min(c);
+            let t_hi = a.max(b).max(c);
+            prop_assert!(!boxes_apart(t_lo, t_hi, t));
+            prop_assert!(!boxes_apart(a, a, t));
+        }
+
+        /// The BVH search with its culls (whole curve, piece boxes, piece chords, triangle
+        /// boxes, hull planes) finds the first hit that testing every triangle finds, on curves through
         /// and past a room with a teapot (many pieces outside the scene's box).
         #[test]
         fn the_culled_search_finds_the_brute_force_first_hit(

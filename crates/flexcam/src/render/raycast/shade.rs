@@ -104,6 +104,15 @@ fn tangent_ray(p: &[DVec3; 3], s: f64) -> Ray {
     }
 }
 
+/// The length of polyline `points` before its segment `k`: the sum of the lengths of
+/// segments 0 to k - 1, in order. Computed only for the segment that hits, not as the search
+/// passes each segment (most projectors hit nothing).
+fn length_before(points: &[DVec3], k: usize) -> f64 {
+    points[..=k]
+        .windows(2)
+        .fold(0.0, |sum, pair| sum + (pair[1] - pair[0]).length())
+}
+
 /// Traces primary rays of one render; counts what it casts.
 pub(super) struct Tracer<'a> {
     pub caster: &'a RayCaster,
@@ -167,7 +176,6 @@ impl<'a> Tracer<'a> {
             None => self.sample(None),
             Some(Projector::Straight(ray)) => self.sample(Some(ray)),
             Some(Projector::Polyline(points)) => {
-                let mut before = 0.0;
                 for (k, pair) in points.windows(2).enumerate() {
                     let ray = Ray {
                         origin: pair[0],
@@ -181,9 +189,8 @@ impl<'a> Tracer<'a> {
                         None
                     };
                     if let Some(found) = found {
-                        return self.shade(&ray, Some(found), before);
+                        return self.shade(&ray, Some(found), length_before(points, k));
                     }
-                    before += ray.direction.length();
                 }
                 self.shade_miss()
             }
@@ -252,7 +259,6 @@ impl<'a> Tracer<'a> {
     /// out).
     fn sample4_polylines(&mut self, polylines: [Option<&[DVec3]>; 4]) -> [Sample; 4] {
         let mut hits: [Option<Sample>; 4] = [None; 4];
-        let mut before = [0.0; 4];
         let segments = polylines
             .iter()
             .flatten()
@@ -276,10 +282,8 @@ impl<'a> Tracer<'a> {
                 [None; 4]
             };
             for (i, (ray, found)) in rays.iter().zip(found).enumerate() {
-                match (ray, found) {
-                    (Some(ray), Some(hit)) => hits[i] = Some(self.shade(ray, Some(hit), before[i])),
-                    (Some(ray), None) => before[i] += ray.direction.length(),
-                    (None, _) => {}
+                if let (Some(ray), Some(hit), Some(points)) = (ray, found, polylines[i]) {
+                    hits[i] = Some(self.shade(ray, Some(hit), length_before(points, k)));
                 }
             }
         }

@@ -1,6 +1,8 @@
 //! The image cut into square tiles rendered in parallel (rayon); each tile is rendered into its
-//! own buffers and copied into the frame in tile order, so the result does not depend on the
-//! number of threads or the order tiles finish in.
+//! own buffers and copied into its place in the frame, so the result does not depend on the
+//! number of threads or the order tiles finish in. The frame is cut into bands of one row of
+//! tiles; the bands are filled in parallel too, each from its own tiles, so that no thread
+//! copies the whole frame after the tiles are rendered.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -11,7 +13,7 @@ use super::hull_cull::LiveParts;
 use super::sampling::SamplePattern;
 use super::shade::{RayCounts, Sample, Tracer};
 use super::RayCaster;
-use crate::projection::Projection;
+use crate::projection::{Projection, Projector};
 use crate::render::{Counter, Frame, RenderOptions, Stats};
 
 /// Tile edge in pixels: small enough to balance two to many cores, large enough that the
@@ -26,10 +28,9 @@ const BLOCK: u32 = 8;
 /// Blocks per tile side.
 const BLOCKS: usize = (TILE / BLOCK) as usize;
 
-/// One rendered tile: its rectangle and row-major pixels.
+/// One rendered tile: its rectangle's left column and width, and its row-major pixels.
 struct Tile {
     x0: u32,
-    y0: u32,
     width: u32,
     color: Vec<Vec3>,
     depth: Vec<f32>,
@@ -47,42 +48,57 @@ pub(super) fn render(
 ) -> (Frame, Stats) {
     let (width, height) = projection.resolution();
     let pattern = SamplePattern::new(options.spp);
-    let (tiles_x, tiles_y) = (width.div_ceil(TILE), height.div_ceil(TILE));
-    let total = tiles_x as u64 * tiles_y as u64;
+    let tiles_x = width.div_ceil(TILE);
+    let total = tiles_x as u64 * height.div_ceil(TILE) as u64;
     let done = AtomicU64::new(0);
-    let tiles: Vec<Tile> = (0..total)
-        .into_par_iter()
-        .map(|k| {
-            let (x0, y0) = (
-                (k % tiles_x as u64) as u32 * TILE,
-                (k / tiles_x as u64) as u32 * TILE,
-            );
-            let rect = (x0, y0, TILE.min(width - x0), TILE.min(height - y0));
-            let tile = render_tile(caster, projection, options, &pattern, rect);
-            if let Some(progress) = options.progress {
-                progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+    let mut frame = Frame::new(width, height, caster.background);
+    // One band of the frame per row of tiles.
+    let band = TILE as usize * width as usize;
+    let tallies: Vec<(RayCounts, u64)> = frame
+        .color
+        .par_chunks_mut(band)
+        .zip(frame.depth.par_chunks_mut(band))
+        .zip(frame.ids.par_chunks_mut(band))
+        .enumerate()
+        .map(|(row, ((color, depth), ids))| {
+            let y0 = row as u32 * TILE;
+            let tiles: Vec<Tile> = (0..tiles_x)
+                .into_par_iter()
+                .map(|column| {
+                    let x0 = column * TILE;
+                    let rect = (x0, y0, TILE.min(width - x0), TILE.min(height - y0));
+                    let tile = render_tile(caster, projection, options, &pattern, rect);
+                    if let Some(progress) = options.progress {
+                        progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+                    }
+                    tile
+                })
+                .collect();
+            let mut tally = (RayCounts::default(), 0);
+            for tile in &tiles {
+                let w = tile.width as usize;
+                for (r, src) in (0..tile.color.len() / w).map(|r| (r, r * w..(r + 1) * w)) {
+                    let start = r * width as usize + tile.x0 as usize;
+                    let dst = start..start + w;
+                    color[dst.clone()].copy_from_slice(&tile.color[src.clone()]);
+                    depth[dst.clone()].copy_from_slice(&tile.depth[src.clone()]);
+                    ids[dst].copy_from_slice(&tile.ids[src]);
+                }
+                tally.0.primary += tile.counts.primary;
+                tally.0.secondary += tile.counts.secondary;
+                tally.0.shadow += tile.counts.shadow;
+                tally.1 += tile.culled_blocks;
             }
-            tile
+            tally
         })
         .collect();
-    let mut frame = Frame::new(width, height, caster.background);
     let mut counts = RayCounts::default();
-    let culled: u64 = tiles.iter().map(|tile| tile.culled_blocks).sum();
-    for tile in &tiles {
-        for (row, y) in (tile.y0..)
-            .take(tile.color.len() / tile.width as usize)
-            .enumerate()
-        {
-            let src = row * tile.width as usize..(row + 1) * tile.width as usize;
-            let dst = (y as usize * width as usize + tile.x0 as usize)..;
-            let dst = dst.start..dst.start + tile.width as usize;
-            frame.color[dst.clone()].copy_from_slice(&tile.color[src.clone()]);
-            frame.depth[dst.clone()].copy_from_slice(&tile.depth[src.clone()]);
-            frame.ids[dst].copy_from_slice(&tile.ids[src]);
-        }
-        counts.primary += tile.counts.primary;
-        counts.secondary += tile.counts.secondary;
-        counts.shadow += tile.counts.shadow;
+    let mut culled = 0;
+    for (tally, blocks) in tallies {
+        counts.primary += tally.primary;
+        counts.secondary += tally.secondary;
+        counts.shadow += tally.shadow;
+        culled += blocks;
     }
     let stats = Stats::from([
         ("primary_rays", Counter::Count(counts.primary)),
@@ -152,7 +168,6 @@ fn render_tile(
     let n = (width * height) as usize;
     let mut tile = Tile {
         x0,
-        y0,
         width,
         color: vec![Vec3::ZERO; n],
         depth: vec![f32::INFINITY; n],
@@ -185,6 +200,9 @@ fn render_tile(
     let quads = if pattern.offsets.len() == 1 { 2 } else { 0 };
     let (quad_w, quad_h) = (width / 2 * quads, height / 2 * quads);
     let offset = pattern.offsets[0];
+    // The projectors are generated into these, reused from sample to sample (a polyline's
+    // vertex buffer is refilled, not allocated: `Projection::projector_into`).
+    let mut projectors: [Option<Projector>; 4] = Default::default();
     for qy in (0..quad_h).step_by(2) {
         for qx in (0..quad_w).step_by(2) {
             let (x, y) = (x0 + qx, y0 + qy);
@@ -195,8 +213,9 @@ fn render_tile(
                 [(); 4].map(|_| tracer.shade_miss())
             } else {
                 tracer.live = parts;
-                let projectors = pixels
-                    .map(|(x, y)| projection.projector(DVec2::new(x as f64, y as f64) + offset));
+                for (slot, (x, y)) in projectors.iter_mut().zip(pixels) {
+                    projection.projector_into(DVec2::new(x as f64, y as f64) + offset, slot);
+                }
                 tracer.sample4_projectors(&projectors)
             };
             for (pixel, sample) in pixels.into_iter().zip(samples) {
@@ -219,7 +238,9 @@ fn render_tile(
                 let sample = if parts.none() {
                     tracer.shade_miss()
                 } else {
-                    tracer.sample_projector(projection.projector(pixel).as_ref())
+                    let slot = &mut projectors[0];
+                    projection.projector_into(pixel, slot);
+                    tracer.sample_projector(slot.as_ref())
                 };
                 color += sample.color;
                 if k == pattern.centre {
