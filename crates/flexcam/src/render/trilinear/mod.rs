@@ -18,10 +18,14 @@
 //! triangle is ray cast instead, so they never silently vanish.
 
 pub mod clip;
+#[cfg(test)]
+mod cull_tests;
+pub mod cull_tree;
 pub mod curves;
 pub mod edge_path;
 pub mod hit_terms;
 pub mod outline;
+pub mod pair_cull;
 pub mod polygons;
 pub mod scene_geometry;
 pub mod screen_map;
@@ -34,19 +38,17 @@ pub mod workloads;
 use std::time::Instant;
 
 use glam::{DVec2, Vec3};
-use rayon::prelude::*;
 
 pub use curves::{CurveMode, CurveOptions};
 
-use self::outline::ProjectionTriangle;
-use self::polygons::{project_scene, PairCounts};
+use self::polygons::{project_all, projection_triangles, ProjectedScene};
 use self::scene_geometry::SceneGeometry;
 use self::screen_map::ScreenMap;
 use self::shade::{stored_barycentrics, Resolver, ShadeCounts, Shader};
 use crate::error::{Error, Result};
 use crate::projection::{Projection, Trilinear};
 use crate::render::raster::{
-    band_rows_for, new_frame, rasterize_into_frame, FillRule, PolygonBatch, RasterStats,
+    band_rows_for, new_frame, rasterize_into_frame, FillRule, RasterStats,
 };
 use crate::render::raycast::{RayCaster, SamplePattern};
 use crate::render::{Counter, Frame, RenderOptions, Stats};
@@ -91,34 +93,12 @@ impl TrilinearRenderer {
         }
         let start = Instant::now();
         let (width, height) = projection.resolution();
-        let size = glam::DVec2::new(f64::from(width), f64::from(height));
-        let triangles: Vec<ProjectionTriangle> = mesh
-            .triangles
-            .iter()
-            .zip(projection.triangle_caches())
-            .map(|(t, cache)| {
-                let [i, j, k] = t.map(|x| x as usize);
-                let pick = |values: &[glam::DVec3]| [values[i], values[j], values[k]];
-                let screen = [mesh.screen[i], mesh.screen[j], mesh.screen[k]];
-                let map = ScreenMap::new(screen, size, *cache);
-                ProjectionTriangle::new(pick(&mesh.points), pick(&mesh.normals), map)
-            })
-            .collect();
-        let projected: Vec<_> = triangles
-            .par_iter()
-            .enumerate()
-            .map(|(index, triangle)| project_scene(triangle, index as u32, &self.scene, curves))
-            .collect();
-        let mut polygons = PolygonBatch::new();
-        let mut counts = PairCounts::default();
-        let fallback: Vec<bool> = projected
-            .iter()
-            .map(|p| {
-                polygons.append(&p.polygons);
-                counts.add(&p.counts);
-                p.counts.unprojectable > 0
-            })
-            .collect();
+        let triangles = projection_triangles(projection);
+        let ProjectedScene {
+            polygons,
+            counts,
+            fallback,
+        } = project_all(&triangles, &self.scene, curves);
         let project_ms = start.elapsed().as_secs_f64() * 1e3;
 
         let maps: Vec<ScreenMap> = triangles.iter().map(|t| t.map).collect();

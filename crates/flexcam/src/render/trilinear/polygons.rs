@@ -1,18 +1,21 @@
-//! Every scene triangle through one projection triangle, into clipped pixel polygons: cull
-//! pairs outside the triangle's ray volume (`volume_bounds`; first a whole cluster of
-//! scene triangles at once by its box, then triangle by triangle), project each remaining scene
-//! vertex once (its cubic), cull pairs whose images cannot be visible, form the shapes, trace
-//! their curved outlines, clip them, and append them to a polygon batch.
+//! Every scene triangle through every projection triangle, into clipped pixel polygons: cull
+//! pairs outside each triangle's ray volume (`pair_cull`: whole subtrees of the scene's box
+//! tree at once, then triangle by triangle), project each remaining scene vertex once (its
+//! cubic), cull pairs whose images cannot be visible, form the shapes, trace their curved
+//! outlines, clip them, and append them to one polygon batch.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 
 use super::clip::clip_outline;
 use super::curves::{CurveMode, CurveOptions, ADAPTIVE_TOLERANCE_PX};
 use super::edge_path::{EdgePath, OutlinePoint};
 use super::hit_terms::{HitTerms, TERMS};
 use super::outline::{slice_depths, trace_outline, ProjectionTriangle, Sampling};
+use super::pair_cull::{live_pairs, LivePair, VertexCache};
 use super::scene_geometry::SceneGeometry;
-use crate::projection::{project_solved_triangle, Shape, Solutions};
+use super::screen_map::ScreenMap;
+use crate::projection::{project_solved_triangle, Projection, Shape, Solutions, Trilinear};
 use crate::render::raster::{PolygonBatch, Vertex};
 use crate::render::{Counter, Stats};
 
@@ -24,8 +27,11 @@ pub struct PairCounts {
     /// (projection triangle, scene triangle) pairs considered.
     pub pairs: u64,
     /// Pairs culled because the scene triangle lies beyond one bounding plane of the
-    /// projection triangle's ray volume (no cubic solved).
+    /// projection triangle's ray volume (no cubic solved), by the box tree or one by one.
     pub culled_volume: u64,
+    /// Of `culled_volume`, the pairs culled with a whole subtree of the box tree
+    /// (`cull_tree`), without a test of their own.
+    pub culled_tree: u64,
     /// Pairs culled because every vertex image is behind the view plane.
     pub culled_behind: u64,
     /// Pairs culled because every vertex image is outside one domain line and no scene
@@ -49,6 +55,7 @@ impl PairCounts {
         self.vertices_projected += o.vertices_projected;
         self.pairs += o.pairs;
         self.culled_volume += o.culled_volume;
+        self.culled_tree += o.culled_tree;
         self.culled_behind += o.culled_behind;
         self.culled_outside += o.culled_outside;
         self.culled_zero_area += o.culled_zero_area;
@@ -64,6 +71,7 @@ impl PairCounts {
             ("vertices_projected", self.vertices_projected),
             ("pairs", self.pairs),
             ("culled_volume", self.culled_volume),
+            ("culled_tree", self.culled_tree),
             ("culled_behind", self.culled_behind),
             ("culled_outside", self.culled_outside),
             ("culled_zero_area", self.culled_zero_area),
@@ -77,12 +85,111 @@ impl PairCounts {
     }
 }
 
-/// The result for one projection triangle: polygons whose vertices carry the scene
-/// triangle's hit terms (`hit_terms`), and what was done.
+/// The projection stage's result for the whole mesh: every polygon, in projection-triangle
+/// order and within it in scene-triangle order, keyed `projection << 32 | scene triangle`;
+/// the counts; and, per projection triangle, whether it had an unprojectable pair (its
+/// pixels are ray cast instead).
 #[derive(Debug, Clone, Default)]
-pub struct Projected {
+pub struct ProjectedScene {
     pub polygons: PolygonBatch<TERMS>,
     pub counts: PairCounts,
+    pub fallback: Vec<bool>,
+}
+
+/// The projection triangles of `projection`, each with its screen placement and the
+/// bounding planes of its ray volume.
+pub fn projection_triangles(projection: &Trilinear) -> Vec<ProjectionTriangle> {
+    let mesh = projection.mesh();
+    let (width, height) = projection.resolution();
+    let size = DVec2::new(f64::from(width), f64::from(height));
+    mesh.triangles
+        .iter()
+        .zip(projection.triangle_caches())
+        .map(|(t, cache)| {
+            let [i, j, k] = t.map(|x| x as usize);
+            let pick = |values: &[DVec3]| [values[i], values[j], values[k]];
+            let screen = [mesh.screen[i], mesh.screen[j], mesh.screen[k]];
+            let map = ScreenMap::new(screen, size, *cache);
+            ProjectionTriangle::new(pick(&mesh.points), pick(&mesh.normals), map)
+        })
+        .collect()
+}
+
+/// Live pairs per parallel work item of the drawing half. Pairs differ in cost by orders of
+/// magnitude (culled at once, or many curved shapes), so items are small and many: rayon
+/// balances them over the cores, where one item per projection triangle (18 on the cube
+/// bench) left one core idle at the end.
+const PAIRS_PER_ITEM: usize = 4;
+
+/// Projects every triangle of `scene` through every projection triangle (number `i` is
+/// `triangles[i]`), in two parallel passes: the cull per projection triangle
+/// (`pair_cull::live_pairs`, which also solves the cubics), then the shapes, outlines and
+/// clipping of the live pairs in small items. The result does not depend on the number of
+/// threads or on how the work was split.
+pub fn project_all(
+    triangles: &[ProjectionTriangle],
+    scene: &SceneGeometry,
+    curves: CurveOptions,
+) -> ProjectedScene {
+    let culled: Vec<(Vec<LivePair>, PairCounts)> = triangles
+        .par_iter()
+        .enumerate()
+        .map_init(
+            || VertexCache::new(scene.vertices.len()),
+            |cache, (index, triangle)| {
+                let mut live = Vec::new();
+                let counts = live_pairs(triangle, index as u32, scene, cache, &mut live);
+                (live, counts)
+            },
+        )
+        .collect();
+    let mut counts = PairCounts::default();
+    let mut live = Vec::with_capacity(culled.iter().map(|(l, _)| l.len()).sum());
+    for (pairs, c) in culled {
+        counts.add(&c);
+        live.extend(pairs);
+    }
+    draw_all(triangles, scene, &live, curves, counts)
+}
+
+/// The drawing half of [`project_all`]: the polygons of the live pairs `live` (in order,
+/// projection `live[i].projection` being `triangles[...]`), with `counts` of the cull added
+/// to those of drawing.
+pub(super) fn draw_all(
+    triangles: &[ProjectionTriangle],
+    scene: &SceneGeometry,
+    live: &[LivePair],
+    curves: CurveOptions,
+    counts: PairCounts,
+) -> ProjectedScene {
+    let drawn: Vec<Drawn> = live
+        .par_chunks(PAIRS_PER_ITEM)
+        .map_init(Scratch::default, |scratch, pairs| {
+            draw_pairs(triangles, scene, pairs, curves, scratch)
+        })
+        .collect();
+    let mut out = ProjectedScene {
+        counts,
+        fallback: vec![false; triangles.len()],
+        ..ProjectedScene::default()
+    };
+    for item in &drawn {
+        out.polygons.append(&item.polygons);
+        out.counts.add(&item.counts);
+        for &index in &item.fallback {
+            out.fallback[index as usize] = true;
+        }
+    }
+    out
+}
+
+/// What drawing some live pairs gave: their polygons (in pair order), the counts of the
+/// drawing half, and the projection triangles with an unprojectable pair among them.
+#[derive(Debug, Clone, Default)]
+struct Drawn {
+    polygons: PolygonBatch<TERMS>,
+    counts: PairCounts,
+    fallback: Vec<u32>,
 }
 
 /// Why a pair is skipped without forming its shapes.
@@ -102,85 +209,43 @@ struct Scratch {
     grid_solutions: Vec<Solutions>,
 }
 
-/// Projects every triangle of `scene` through `triangle` (number `index` in the mesh, which
-/// keys its polygons: `index << 32 | scene triangle`).
-pub fn project_scene(
-    triangle: &ProjectionTriangle,
-    index: u32,
+/// Culls (behind the view plane, outside a domain line) or draws each of `pairs` in order.
+fn draw_pairs(
+    triangles: &[ProjectionTriangle],
     scene: &SceneGeometry,
+    pairs: &[LivePair],
     curves: CurveOptions,
-) -> Projected {
-    let cache = triangle.map.cache();
-    // Each vertex's mask of bounding planes it is beyond, computed when first needed.
-    let mut outside: Vec<u32> = vec![UNKNOWN_MASK; scene.vertices.len()];
-    // Each vertex's cubic, solved when a pair first needs it.
-    let mut solutions: Vec<Option<Solutions>> = vec![None; scene.vertices.len()];
-    let mut out = Projected::default();
-    let mut scratch = Scratch::default();
-    for cluster in &scene.clusters {
-        let run = cluster.triangles.len() as u64;
-        out.counts.pairs += run;
-        if beyond_one_plane(cluster.box_corners.map(|c| triangle.bounds.outside(c))) {
-            out.counts.culled_volume += run;
-            continue;
-        }
-        for k in cluster.triangles.clone() {
-            let corners = &scene.triangles[k];
-            let masks = corners.map(|i| {
-                let mask = &mut outside[i as usize];
-                if *mask == UNKNOWN_MASK {
-                    *mask = triangle.bounds.outside(scene.vertices[i as usize]);
+    scratch: &mut Scratch,
+) -> Drawn {
+    let mut out = Drawn::default();
+    for live in pairs {
+        let triangle = &triangles[live.projection as usize];
+        let k = live.triangle as usize;
+        let positions = scene.corners(k);
+        match cull(triangle, positions, &live.solved) {
+            Some(Cull::Behind) => out.counts.culled_behind += 1,
+            Some(Cull::Outside) => out.counts.culled_outside += 1,
+            None => {
+                let pair = Pair {
+                    triangle,
+                    key: (u64::from(live.projection) << 32) | k as u64,
+                    id: scene.owners[k].id,
+                    curves,
+                    terms: live.terms,
+                };
+                let unprojectable = out.counts.unprojectable;
+                if curves.mode == CurveMode::Tessellate {
+                    pair.tessellated(positions, &mut out, scratch);
+                } else {
+                    pair.whole(positions, live.solved, &mut out, scratch);
                 }
-                *mask
-            });
-            if beyond_one_plane(masks) {
-                out.counts.culled_volume += 1;
-                continue;
-            }
-            let positions = scene.corners(k);
-            let Some(terms) = HitTerms::new(positions) else {
-                out.counts.culled_zero_area += 1;
-                continue;
-            };
-            let solved = corners.map(|i| {
-                *solutions[i as usize].get_or_insert_with(|| {
-                    out.counts.vertices_projected += 1;
-                    cache.project_point(scene.vertices[i as usize])
-                })
-            });
-            match cull(triangle, positions, &solved) {
-                Some(Cull::Behind) => out.counts.culled_behind += 1,
-                Some(Cull::Outside) => out.counts.culled_outside += 1,
-                None => {
-                    let key = (u64::from(index) << 32) | k as u64;
-                    let id = scene.owners[k].id;
-                    let pair = Pair {
-                        triangle,
-                        key,
-                        id,
-                        curves,
-                        terms,
-                    };
-                    if curves.mode == CurveMode::Tessellate {
-                        pair.tessellated(positions, &mut out, &mut scratch);
-                    } else {
-                        pair.whole(positions, solved, &mut out, &mut scratch);
-                    }
+                if out.counts.unprojectable > unprojectable {
+                    out.fallback.push(live.projection);
                 }
             }
         }
     }
     out
-}
-
-/// The entry of a vertex whose plane mask is not computed yet: no mask has all 32 bits, as a
-/// volume has at most 26 bounding planes.
-const UNKNOWN_MASK: u32 = u32::MAX;
-
-/// Whether points with plane masks `masks` ([`super::volume_bounds::VolumeBounds::outside`]) are all beyond one
-/// bounding plane, so that their convex hull is outside the projection triangle's volume.
-fn beyond_one_plane<const N: usize>(masks: [u32; N]) -> bool {
-    masks.iter().fold(u32::MAX, |common, &m| common & m) != 0
 }
 
 /// Whether a pair can be skipped. Only decided when every vertex's cubic kept all three
@@ -239,7 +304,7 @@ impl Pair<'_> {
         &self,
         scene: [DVec3; 3],
         solved: [Solutions; 3],
-        out: &mut Projected,
+        out: &mut Drawn,
         scratch: &mut Scratch,
     ) {
         let cache = self.triangle.map.cache();
@@ -267,7 +332,7 @@ impl Pair<'_> {
     /// Scene-triangle tessellation: `steps^2` sub-triangles on a barycentric grid, each
     /// vertex projected once, each sub-triangle's shapes drawn with straight edges between
     /// their anchors, under the whole triangle's key.
-    fn tessellated(&self, scene: [DVec3; 3], out: &mut Projected, scratch: &mut Scratch) {
+    fn tessellated(&self, scene: [DVec3; 3], out: &mut Drawn, scratch: &mut Scratch) {
         let n = self.curves.steps;
         let cache = self.triangle.map.cache();
         scratch.grid.clear();
@@ -313,7 +378,7 @@ impl Pair<'_> {
         shape: &Shape,
         scene: [DVec3; 3],
         sampling: Sampling,
-        out: &mut Projected,
+        out: &mut Drawn,
         scratch: &mut Scratch,
     ) {
         out.counts.shapes += 1;

@@ -1,12 +1,14 @@
 //! The scene's triangles in one flat f64 list, numbered like the ray caster's BVH (objects in
 //! order, each object's triangles in order), with the owner of each, the triangles that
-//! meet at each edge, and clusters of consecutive triangles with their bounding boxes.
+//! meet at each edge, and clusters of consecutive triangles with their bounding boxes under
+//! a box tree (`cull_tree`).
 
 use std::collections::HashMap;
 use std::ops::Range;
 
 use glam::DVec3;
 
+use super::cull_tree::CullTree;
 use crate::scene::Scene;
 
 /// Which object triangle a scene triangle is.
@@ -36,6 +38,8 @@ pub struct SceneGeometry {
     /// Runs of at most [`CLUSTER_SIZE`] consecutive triangles of one object, each with the
     /// corners of its bounding box: a projection triangle can cull a whole run at once.
     pub clusters: Vec<Cluster>,
+    /// The box tree over `clusters`: a projection triangle skips whole subtrees.
+    pub tree: CullTree,
     /// Per triangle, the numbers of its edges `<V1V2, V1V3, V2V3>` in `edge_users`.
     edges: Vec<[u32; 3]>,
     /// The triangles using each edge.
@@ -95,13 +99,17 @@ impl EdgeUsers {
     }
 }
 
-/// Most triangles in a [`Cluster`]. Meshes list neighbouring triangles near each other (the
-/// built-in shapes and tessellations row by row), so consecutive runs are compact.
-pub const CLUSTER_SIZE: usize = 32;
+/// Most triangles in a [`Cluster`], a leaf of the [`CullTree`]. Meshes list neighbouring
+/// triangles near each other (the built-in shapes and tessellations row by row), so
+/// consecutive runs are compact; short runs keep the triangle-by-triangle tests behind a
+/// visited leaf few (8 rather than 32: `project_ms` of the detail-in-context scene, see
+/// docs/trilinear.md).
+pub const CLUSTER_SIZE: usize = 8;
 
 /// A run of consecutive scene triangles and the eight corners of the axis-aligned box
 /// around their vertices. A plane that all eight corners lie beyond has every point of the
-/// box, hence every vertex of the run, beyond it (the box is their convex hull).
+/// box, hence every vertex of the run, beyond it (the box is their convex hull). A run with
+/// a non-finite vertex gets the infinite box (corners at infinity), never outside a plane.
 #[derive(Debug, Clone)]
 pub struct Cluster {
     pub triangles: Range<usize>,
@@ -139,6 +147,7 @@ impl SceneGeometry {
         (out.edge_users, out.edges) =
             EdgeUsers::new((0..out.triangles.len()).map(|k| out.corners(k)));
         out.clusters = out.clusters();
+        out.tree = CullTree::new(&out.clusters);
         out.shared_edges = (0..out.triangles.len())
             .map(|k| {
                 (0..3).fold(0, |mask, edge| {
@@ -174,11 +183,14 @@ impl SceneGeometry {
                 .take_while(|&k| self.owners[k].object == object)
                 .last()
                 .map_or(start + 1, |k| k + 1);
-            let (lo, hi) = (start..end)
-                .flat_map(|k| self.corners(k))
-                .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| {
+            let corners = || (start..end).flat_map(|k| self.corners(k));
+            let (lo, hi) = if corners().all(|v| v.is_finite()) {
+                corners().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), v| {
                     (lo.min(v), hi.max(v))
-                });
+                })
+            } else {
+                (DVec3::NEG_INFINITY, DVec3::INFINITY)
+            };
             let box_corners = std::array::from_fn(|c| {
                 DVec3::new(
                     if c & 1 == 0 { lo.x } else { hi.x },

@@ -129,7 +129,7 @@ fn rendering_is_deterministic() {
 }
 
 /// One object made of the given triangles, flat colour `color`.
-fn object(id: u32, triangles: &[[DVec3; 3]], color: Vec3) -> Object {
+pub(super) fn object(id: u32, triangles: &[[DVec3; 3]], color: Vec3) -> Object {
     let mut mesh = Mesh::default();
     for (k, t) in triangles.iter().enumerate() {
         mesh.positions.extend(t.iter().map(|p| p.as_vec3()));
@@ -148,7 +148,7 @@ fn object(id: u32, triangles: &[[DVec3; 3]], color: Vec3) -> Object {
     }
 }
 
-fn scene_of(objects: Vec<Object>) -> Scene {
+pub(super) fn scene_of(objects: Vec<Object>) -> Scene {
     let mut scene = scene::load("builtin:cube-floor").unwrap();
     scene.objects = objects;
     scene.lights = vec![Light::Directional {
@@ -161,7 +161,7 @@ fn scene_of(objects: Vec<Object>) -> Scene {
 
 /// A mesh of two projection triangles over the unit square z = 0 looking along +z, with
 /// the given normal at each corner (bottom-left, bottom-right, top-left, top-right).
-fn square(normals: [DVec3; 4]) -> TrilinearMesh {
+pub(super) fn square(normals: [DVec3; 4]) -> TrilinearMesh {
     TrilinearMesh {
         points: vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(1.0, 1.0, 0.0)],
         normals: normals.to_vec(),

@@ -33,6 +33,16 @@ pub const RELATIVE_MARGIN: f64 = 1e-7;
 /// base normal, in both orientations.
 const MAX_PLANES: usize = 26;
 
+/// Where a box lies against a projection triangle's bounding planes
+/// ([`VolumeBounds::box_side`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BoxSide {
+    /// Wholly beyond one plane: nothing in the box can be drawn.
+    Outside,
+    /// Not wholly beyond any plane; the planes (bit mask) that still cut the box.
+    Within(u32),
+}
+
 /// The bounding planes of one projection triangle's ray volume.
 #[derive(Debug, Clone, Copy)]
 pub struct VolumeBounds {
@@ -97,6 +107,45 @@ impl VolumeBounds {
             }
         }
         mask
+    }
+
+    /// Every bounding plane (bit `k` for plane `k`): where a box test starts.
+    pub fn all_planes(&self) -> u32 {
+        // At most MAX_PLANES = 26 planes: the shift never overflows.
+        (1 << self.count) - 1
+    }
+
+    /// Which side of the planes `active` the axis-aligned box with centre `centre` and
+    /// half-extents `half` lies on, for the hierarchical cull (`cull_tree`):
+    /// [`BoxSide::Outside`] only when every point `x` of the box is beyond one plane by more
+    /// than the margin [`VolumeBounds::outside`] requires of `x` (twice that margin, taken
+    /// at the box point farthest from the triangle, so that the rounding of the two tests
+    /// cannot disagree), hence every vertex in the box has that plane's bit in its mask and
+    /// every triangle in it would be culled one by one too. Otherwise
+    /// [`BoxSide::Within`] the planes of `active` that still cut the box: a plane with the
+    /// whole box on its inner side is dropped, as no point below can be beyond it.
+    ///
+    /// Degenerate boxes (zero extent: one point, a flat or thin cluster) are tested like any
+    /// other; a box with a non-finite coordinate is never outside (its comparisons fail).
+    pub fn box_side(&self, centre: DVec3, half: DVec3, active: u32) -> BoxSide {
+        let scale = (centre - self.origin).length() + half.length() + self.size;
+        let margin = 2.0 * RELATIVE_MARGIN * scale;
+        let mut within = active;
+        let mut remaining = active;
+        while remaining != 0 {
+            let k = remaining.trailing_zeros();
+            remaining &= remaining - 1;
+            let (m, c) = self.planes[k as usize];
+            let middle = m.dot(centre) - c;
+            let reach = m.abs().dot(half);
+            if middle - reach > margin {
+                return BoxSide::Outside;
+            }
+            if middle + reach <= 0.0 {
+                within &= !(1 << k);
+            }
+        }
+        BoxSide::Within(within)
     }
 
     /// The number of bounding planes found.
@@ -179,6 +228,94 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A random box: centre and half-extents (some of them zero: flat, thin and point boxes).
+    fn axis_box() -> impl Strategy<Value = (DVec3, DVec3)> {
+        (vec3(), vec3(), 0..8u32).prop_map(|(c, h, flat)| {
+            let h = DVec3::select(
+                glam::BVec3::new(flat & 1 != 0, flat & 2 != 0, flat & 4 != 0),
+                DVec3::ZERO,
+                h.abs(),
+            );
+            (c + DVec3::new(0.0, 0.0, -4.0), h)
+        })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(400))]
+
+        /// The box test agrees with the point test at every point of the box (its corners
+        /// and random points inside): a box outside has all of them beyond one common
+        /// plane; a plane dropped from the active set has none of them beyond it.
+        #[test]
+        fn the_box_test_is_implied_by_every_point_of_the_box(
+            (p, n) in triangle(2.5),
+            (centre, half) in axis_box(),
+            inner in prop::collection::vec((-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64), 8),
+        ) {
+            let bounds = VolumeBounds::new(p, n);
+            let corners = (0..8).map(|c| {
+                DVec3::new(
+                    if c & 1 == 0 { -1.0 } else { 1.0 },
+                    if c & 2 == 0 { -1.0 } else { 1.0 },
+                    if c & 4 == 0 { -1.0 } else { 1.0 },
+                )
+            });
+            let inner = inner.into_iter().map(|(x, y, z)| DVec3::new(x, y, z));
+            let masks: Vec<u32> = corners
+                .chain(inner)
+                .map(|s| bounds.outside(centre + s * half))
+                .collect();
+            match bounds.box_side(centre, half, bounds.all_planes()) {
+                BoxSide::Outside => {
+                    let common = masks.iter().fold(u32::MAX, |m, &x| m & x);
+                    prop_assert_ne!(common, 0);
+                }
+                BoxSide::Within(active) => {
+                    let dropped = bounds.all_planes() & !active;
+                    for m in masks {
+                        prop_assert_eq!(m & dropped, 0);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn boxes_beyond_a_side_are_outside_and_boxes_in_front_are_not() {
+        let p = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let n = [
+            DVec3::new(-0.1, -0.1, -1.0),
+            DVec3::new(0.1, -0.1, -1.0),
+            DVec3::new(-0.1, 0.1, -1.0),
+        ];
+        let bounds = VolumeBounds::new(p, n);
+        let all = bounds.all_planes();
+        assert_eq!(all.count_ones() as usize, bounds.len());
+        // A flat box far to the side, and one point (zero extent) behind the base.
+        for (centre, half) in [
+            (DVec3::new(6.0, 0.2, -3.0), DVec3::new(0.5, 0.5, 0.0)),
+            (DVec3::new(0.2, 0.2, 3.0), DVec3::ZERO),
+        ] {
+            assert_eq!(bounds.box_side(centre, half, all), BoxSide::Outside);
+        }
+        // A box in front: inside several planes entirely (dropped), cut by none or some.
+        match bounds.box_side(DVec3::new(0.3, 0.3, -3.0), DVec3::splat(0.05), all) {
+            BoxSide::Within(active) => assert_ne!(active, all),
+            BoxSide::Outside => panic!("a box inside the volume is outside"),
+        }
+        // A box with a non-finite corner (an infinite box) is never outside, nor is one
+        // tested against no plane.
+        let infinite = (DVec3::splat(f64::NAN), DVec3::splat(f64::INFINITY));
+        assert_eq!(
+            bounds.box_side(infinite.0, infinite.1, all),
+            BoxSide::Within(all)
+        );
+        assert_eq!(
+            bounds.box_side(DVec3::new(6.0, 0.2, -3.0), DVec3::ZERO, 0),
+            BoxSide::Within(0)
+        );
     }
 
     #[test]

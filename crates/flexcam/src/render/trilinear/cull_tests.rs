@@ -1,0 +1,374 @@
+//! The hierarchical cull of the projection stage (`cull_tree`, `pair_cull`) against the
+//! triangle-by-triangle volume test and against no cull at all: the same live pairs and
+//! polygons (every vertex, bit for bit) as the former; the same polygons as the latter on
+//! the example scenes but the inward sphere, the cube through the fan, randomised scenes and
+//! degenerate configurations.
+
+use glam::{DVec3, Vec3};
+use proptest::prelude::*;
+
+use super::curves::{CurveMode, CurveOptions};
+use super::hit_terms::HitTerms;
+use super::outline::ProjectionTriangle;
+use super::pair_cull::{live_pairs, LivePair, VertexCache};
+use super::polygons::{draw_all, project_all, projection_triangles, PairCounts, ProjectedScene};
+use super::scene_geometry::SceneGeometry;
+use super::tests::{object, scene_of, square};
+use super::workloads;
+use crate::projection::{Trilinear, TrilinearMesh};
+use crate::scene::{self, Scene};
+
+/// Every pair with a plane, with no volume cull, its cubics solved directly.
+fn unculled(triangles: &[ProjectionTriangle], scene: &SceneGeometry) -> Vec<LivePair> {
+    let mut live = Vec::new();
+    for (index, triangle) in triangles.iter().enumerate() {
+        for (k, corners) in scene.triangles.iter().enumerate() {
+            if let Some(terms) = HitTerms::new(scene.corners(k)) {
+                live.push(LivePair {
+                    projection: index as u32,
+                    triangle: k as u32,
+                    terms,
+                    solved: solve(triangle, scene, *corners),
+                });
+            }
+        }
+    }
+    live
+}
+
+fn solve(
+    triangle: &ProjectionTriangle,
+    scene: &SceneGeometry,
+    corners: [u32; 3],
+) -> [crate::projection::Solutions; 3] {
+    corners.map(|i| {
+        triangle
+            .map
+            .cache()
+            .project_point(scene.vertices[i as usize])
+    })
+}
+
+/// The pairs (projection, scene triangle) that the volume test alone keeps, triangle by
+/// triangle with no tree, among those with a plane.
+fn kept_one_by_one(triangles: &[ProjectionTriangle], scene: &SceneGeometry) -> Vec<(u32, u32)> {
+    let mut kept = Vec::new();
+    for (index, triangle) in triangles.iter().enumerate() {
+        for (k, corners) in scene.triangles.iter().enumerate() {
+            let common = corners.iter().fold(u32::MAX, |m, &i| {
+                m & triangle.bounds.outside(scene.vertices[i as usize])
+            });
+            if common == 0 && HitTerms::new(scene.corners(k)).is_some() {
+                kept.push((index as u32, k as u32));
+            }
+        }
+    }
+    kept
+}
+
+fn assert_same_polygons(a: &ProjectedScene, b: &ProjectedScene, what: &str) {
+    assert_eq!(a.polygons.len(), b.polygons.len(), "{what}: polygon count");
+    for (i, (p, q)) in a.polygons.iter().zip(b.polygons.iter()).enumerate() {
+        assert_eq!(
+            (p.object, p.primitive),
+            (q.object, q.primitive),
+            "{what}: polygon {i}"
+        );
+        assert_eq!(p.vertices, q.vertices, "{what}: polygon {i}");
+    }
+    assert_eq!(a.fallback, b.fallback, "{what}: fallback triangles");
+}
+
+/// Whether `a`'s polygons appear in `b` in the same order (all of them, bit for bit), every
+/// other polygon of `b` keyed to a pair outside `kept`; returns the number of those others.
+fn polygons_within(
+    a: &ProjectedScene,
+    b: &ProjectedScene,
+    kept: &[(u32, u32)],
+    what: &str,
+) -> usize {
+    let key = |p: u64| ((p >> 32) as u32, p as u32);
+    let mut mine = a.polygons.iter().peekable();
+    let mut others = 0;
+    for q in b.polygons.iter() {
+        match mine.peek() {
+            Some(p) if p.primitive == q.primitive && p.vertices == q.vertices => {
+                mine.next();
+            }
+            _ => {
+                assert!(
+                    kept.binary_search(&key(q.primitive)).is_err(),
+                    "{what}: polygon of kept pair {:?} missing",
+                    key(q.primitive)
+                );
+                others += 1;
+            }
+        }
+    }
+    assert!(
+        mine.next().is_none(),
+        "{what}: a polygon not drawn without the cull"
+    );
+    others
+}
+
+/// Checks the culled stage on `scene` through `projection`: its live pairs are exactly
+/// those of the one-by-one test, with the directly solved cubics, and its polygons exactly
+/// those of drawing them; its counts add up; drawing every pair (no cull) gives its
+/// polygons plus, possibly, polygons of pairs the volume test culls (returned: how many).
+fn check(
+    scene: &Scene,
+    projection: &Trilinear,
+    curves: CurveOptions,
+    what: &str,
+) -> (PairCounts, usize) {
+    let geometry = SceneGeometry::new(scene);
+    let triangles = projection_triangles(projection);
+    // One cache for all projection triangles, as one worker uses it.
+    let mut cache = VertexCache::new(geometry.vertices.len());
+    let mut live = Vec::new();
+    for (index, triangle) in triangles.iter().enumerate() {
+        live_pairs(triangle, index as u32, &geometry, &mut cache, &mut live);
+    }
+    let pairs: Vec<(u32, u32)> = live.iter().map(|p| (p.projection, p.triangle)).collect();
+    let kept = kept_one_by_one(&triangles, &geometry);
+    assert_eq!(pairs, kept, "{what}: live pairs");
+    let mut direct = Vec::new();
+    for p in &live {
+        let corners = geometry.triangles[p.triangle as usize];
+        let solved = solve(&triangles[p.projection as usize], &geometry, corners);
+        assert_eq!(p.solved, solved, "{what}: solutions");
+        direct.push(LivePair { solved, ..*p });
+    }
+    let culled = project_all(&triangles, &geometry, curves);
+    let one_by_one = draw_all(
+        &triangles,
+        &geometry,
+        &direct,
+        curves,
+        PairCounts::default(),
+    );
+    assert_same_polygons(&culled, &one_by_one, what);
+    let all = unculled(&triangles, &geometry);
+    let reference = draw_all(&triangles, &geometry, &all, curves, PairCounts::default());
+    let others = polygons_within(&culled, &reference, &kept, what);
+    if others == 0 {
+        assert_same_polygons(&culled, &reference, what);
+    }
+    let c = culled.counts;
+    assert_eq!(c.pairs, (triangles.len() * geometry.triangles.len()) as u64);
+    assert!(c.culled_tree <= c.culled_volume, "{what}: {c:?}");
+    assert_eq!(
+        c.pairs - c.culled_volume - c.culled_zero_area,
+        live.len() as u64,
+        "{what}: {c:?}"
+    );
+    (c, others)
+}
+
+fn trilinear(mesh: &TrilinearMesh, width: u32, height: u32) -> Trilinear {
+    Trilinear::new(mesh, width, height).unwrap()
+}
+
+/// Every example scene of a trilinear projection (the visualisation surfaces of chapter 6,
+/// the fan, the cylinder grid), at its own size; the detail-in-context surface culls most of
+/// its pairs by whole subtrees.
+#[test]
+fn the_tree_changes_no_polygon_of_the_example_scenes() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.starts_with("trilinear-") && n.ends_with(".toml"))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 5, "{names:?}");
+    for name in names {
+        let scene = scene::load(dir.join(&name).to_str().unwrap()).unwrap();
+        let (width, height) = (scene.image.width, scene.image.height);
+        let projection = scene.projection.build(width, height).unwrap();
+        let projection = projection.as_trilinear().unwrap();
+        let (c, others) = check(&scene, projection, CurveOptions::ADAPTIVE, &name);
+        println!(
+            "{name}: {} pairs, {} culled by the tree, {} one by one, {} live, {} shapes; \
+             {others} more polygons without the volume cull",
+            c.pairs,
+            c.culled_tree,
+            c.culled_volume - c.culled_tree,
+            c.pairs - c.culled_volume - c.culled_zero_area,
+            c.shapes
+        );
+        // The inward sphere's rays leave the volume test's culled pairs with chord
+        // polygons when drawn anyway (see docs/trilinear.md); every other scene draws
+        // nothing more without the cull.
+        if name != "trilinear-inward-sphere.toml" {
+            assert_eq!(others, 0, "{name}");
+        }
+        if name == "trilinear-detail-in-context.toml" {
+            assert!(c.culled_tree > c.pairs / 2, "{name}: {c:?}");
+        }
+    }
+}
+
+/// The bench's cube: cube-floor through the fan at 800 x 800 (18 projections), every curve
+/// mode, with and without scene-space clipping (tessellation through 8 projections at a
+/// smaller size, as it projects every grid point of every unculled pair).
+#[test]
+fn the_tree_changes_no_polygon_of_the_cube() {
+    let scene = scene::load("builtin:cube-floor").unwrap();
+    let fan = workloads::fan_grid(3).unwrap();
+    let unclipped = CurveOptions {
+        scene_clipping: false,
+        ..CurveOptions::ADAPTIVE
+    };
+    let slice = CurveOptions {
+        mode: CurveMode::Slice,
+        steps: 10,
+        scene_clipping: true,
+    };
+    for (curves, what) in [
+        (CurveOptions::ADAPTIVE, "adaptive"),
+        (unclipped, "adaptive, no scene-space clipping"),
+        (slice, "slice"),
+    ] {
+        let (c, others) = check(&scene, &trilinear(&fan, 800, 800), curves, what);
+        assert!(c.culled_volume > 0 && c.shapes > 0, "{what}: {c:?}");
+        assert_eq!(others, 0, "{what}");
+    }
+    let tessellate = CurveOptions {
+        mode: CurveMode::Tessellate,
+        steps: 4,
+        scene_clipping: true,
+    };
+    let fan = workloads::fan_grid(2).unwrap();
+    let (_, others) = check(&scene, &trilinear(&fan, 160, 120), tessellate, "tessellate");
+    assert_eq!(others, 0, "tessellate");
+}
+
+/// `count` random triangles of the bench's random data (`seed`), plus the same triangles
+/// mirrored behind the view plane (`z > 0`, the grids look along -z from `z = 0`), and the
+/// same triangles collapsed to their first vertex (zero area; clusters of zero extent).
+fn random_scene(count: u32, seed: u64) -> Scene {
+    let mut scene = workloads::random_triangles(count, seed);
+    let mut behind = scene.objects[0].clone();
+    behind.id = 2;
+    for p in &mut behind.mesh.positions {
+        p.z = -p.z;
+    }
+    let mut collapsed = scene.objects[0].clone();
+    collapsed.id = 3;
+    for triangle in &collapsed.mesh.triangles {
+        let first = collapsed.mesh.positions[triangle[0] as usize];
+        for &i in &triangle[1..] {
+            collapsed.mesh.positions[i as usize] = first;
+        }
+    }
+    scene.objects.extend([behind, collapsed]);
+    scene
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Random triangles (in front, behind, collapsed) through random screen meshes of 2 to
+    /// 32 projection triangles.
+    #[test]
+    fn the_tree_changes_no_polygon_of_random_scenes(
+        count in 1u32..48,
+        cells in 1u32..5,
+        seed in any::<u64>(),
+    ) {
+        let scene = random_scene(count, seed);
+        let mesh = workloads::random_grid(cells, seed ^ 0x5eed).unwrap();
+        let projection = trilinear(&mesh, 64, 64);
+        let (_, others) = check(&scene, &projection, CurveOptions::ADAPTIVE, "random");
+        prop_assert_eq!(others, 0);
+    }
+}
+
+/// Degenerate scenes and meshes: a triangle wholly behind the view plane, one straddling
+/// it, a triangle with an edge in the edge surface of a projection edge (the diagonal's
+/// plane `x = y` under parallel normals) and a vertex on it, a zero-area sliver, an object
+/// of zero extent (every vertex at one point), an object with a non-finite vertex (its
+/// cluster's box is infinite and never culled), and directions spanning more than a
+/// half-space (no bounding plane at all: nothing culled).
+#[test]
+fn the_tree_changes_no_polygon_in_degenerate_cases() {
+    let v = DVec3::new;
+    let scene = scene_of(vec![
+        object(
+            1,
+            &[
+                [v(0.2, 0.2, -3.0), v(0.8, 0.3, -2.0), v(0.4, 0.9, -1.0)],
+                [v(0.2, 0.3, -1.0), v(-0.5, 0.2, 2.0), v(1.2, 1.0, 3.0)],
+                [v(0.5, 0.5, 2.0), v(0.7, 0.7, 3.0), v(0.9, 0.2, 2.5)],
+                [v(0.1, 0.1, 2.0), v(0.5, 0.5, 2.0), v(0.9, 0.9, 2.0)],
+            ],
+            Vec3::new(0.9, 0.1, 0.1),
+        ),
+        object(2, &[[v(0.3, 0.6, 2.0); 3]; 4], Vec3::ONE),
+        object(
+            3,
+            &[
+                [v(f64::NAN, 0.5, 2.0), v(0.5, 0.5, 2.0), v(0.4, 0.6, 2.0)],
+                [v(0.3, 0.3, 4.0), v(0.6, 0.3, 4.0), v(0.3, 0.6, 4.0)],
+            ],
+            Vec3::ONE,
+        ),
+        // Far outside every volume below: culled wherever there are planes.
+        object(
+            4,
+            &[[v(50.0, 50.0, 2.0), v(51.0, 50.0, 2.0), v(50.0, 51.0, 2.0)]; 3],
+            Vec3::ONE,
+        ),
+    ]);
+    let meshes = [
+        ("parallel normals", square([v(0.0, 0.0, 1.0); 4])),
+        (
+            "diverging",
+            square([
+                v(-0.3, -0.3, 1.0),
+                v(0.3, -0.3, 1.0),
+                v(-0.3, 0.3, 1.0),
+                v(0.25, 0.35, 1.1),
+            ]),
+        ),
+        (
+            "beyond a half-space",
+            square([
+                v(1.0, 0.0, 0.1),
+                v(0.0, 1.0, 0.1),
+                v(-1.0, -1.0, 0.1),
+                v(0.3, 0.3, 1.0),
+            ]),
+        ),
+    ];
+    for (what, mesh) in meshes {
+        let projection = trilinear(&mesh, 48, 48);
+        let (c, others) = check(&scene, &projection, CurveOptions::ADAPTIVE, what);
+        println!("{what}: {c:?}");
+        assert_eq!(others, 0, "{what}");
+        assert!(c.culled_zero_area > 0, "{what}: {c:?}");
+        if what == "parallel normals" {
+            assert!(c.culled_tree > 0 && c.shapes > 0, "{what}: {c:?}");
+        }
+    }
+}
+
+/// The stage's result does not depend on the number of threads (its work items are
+/// concatenated in order).
+#[test]
+fn the_projection_stage_is_the_same_on_one_thread() {
+    let scene = scene::load("builtin:cube-floor").unwrap();
+    let geometry = SceneGeometry::new(&scene);
+    let projection = trilinear(&workloads::fan_grid(3).unwrap(), 400, 400);
+    let triangles = projection_triangles(&projection);
+    let many = project_all(&triangles, &geometry, CurveOptions::ADAPTIVE);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let one = pool.install(|| project_all(&triangles, &geometry, CurveOptions::ADAPTIVE));
+    assert_same_polygons(&many, &one, "one thread");
+    assert_eq!(many.counts, one.counts);
+}
