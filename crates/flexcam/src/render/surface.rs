@@ -4,6 +4,8 @@
 //! A hit is given as an object, a triangle index within its mesh and the barycentric weights
 //! `(u, v)` of the triangle's second and third vertices (the first has `1 - u - v`).
 
+pub mod triangle_color;
+
 use glam::{Vec2, Vec3};
 
 use crate::scene::{Material, Object, Pattern};
@@ -177,7 +179,16 @@ pub fn checker_parity(p: Vec3, size: f32) -> u32 {
     if !(size > 0.0 && size.is_finite()) {
         return 0;
     }
-    let cell = (p + Vec3::splat(1e-4 * size)) / size;
+    cell_parity((p + Vec3::splat(CHECKER_NUDGE * size)) / size)
+}
+
+/// The checker's nudge along every axis, in cells (see [`checker_parity`]).
+const CHECKER_NUDGE: f32 = 1e-4;
+
+/// Parity (0 or 1) of `floor(x) + floor(y) + floor(z)`: the checker cell at cell coordinates
+/// `cell` (the nudged object-space point divided by the cell size).
+#[inline]
+fn cell_parity(cell: Vec3) -> u32 {
     let sum = floor_to_int(cell.x) + floor_to_int(cell.y) + floor_to_int(cell.z);
     sum.rem_euclid(2) as u32
 }

@@ -16,6 +16,12 @@
 //! mean CPU time (all threads, user + system) per render of the ray caster and of the
 //! clipped trilinear renderer, which load from other processes distorts far less than wall
 //! time (Linux only, in 10 ms ticks: use a `--repeat` of 10 or more).
+//!
+//! Every render above returns a new frame, as the ray caster's does: its 12.8 MB at 800 x
+//! 800 are allocated and their pages first touched in each timed render. A second cube
+//! table times the later frames of a program that draws frame after frame into one frame it
+//! keeps (`TrilinearRenderer::render_into`), without and with clipping, against the same
+//! ray-caster times.
 
 use std::time::Instant;
 
@@ -25,7 +31,7 @@ use flexcam::render::compare::compare;
 use flexcam::render::raycast::RayCaster;
 use flexcam::render::trilinear::workloads::{fan_grid, random_grid, random_triangles};
 use flexcam::render::trilinear::{CurveOptions, TrilinearRenderer};
-use flexcam::render::{Counter, RenderOptions, Shading};
+use flexcam::render::{Counter, Frame, RenderOptions, Shading};
 use flexcam::scene::{self, Scene};
 use flexcam::Result;
 
@@ -65,12 +71,22 @@ const THESIS_CUBE: [f64; 5] = [24.4, 70.1, 150.1, 230.2, 360.7];
 const THESIS_CUBE_RAY: f64 = 177926.0;
 
 /// One cell's medians (ms), the trilinear stage times of its median render, and the mean
-/// CPU times (ms) per render of the ray caster and of the clipped trilinear renderer.
+/// CPU times (ms) per render.
 struct Timing {
     raycast: f64,
     trilinear: f64,
     clipped: f64,
     stages: [f64; 3],
+    /// The ray caster, trilinear and clipped trilinear, each returning a new frame.
+    cpu: [f64; 3],
+    /// Trilinear into a kept frame, without and with clipping (`None`: not timed).
+    kept: Option<Kept>,
+}
+
+/// Medians (ms) and mean CPU times (ms) of rendering into a kept frame.
+struct Kept {
+    trilinear: f64,
+    clipped: f64,
     cpu: [f64; 2],
 }
 
@@ -99,7 +115,7 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
         for &side in sides {
             for &n in cells {
                 let mesh = random_grid(n, SEED + u64::from(n))?;
-                let timing = renderers.time(&mesh, side, args.repeat)?.0;
+                let timing = renderers.time(&mesh, side, args.repeat, false)?.0;
                 println!(
                     "{:>10}{count:>7}{:>6}{:>11.2}{:>11.2}{:>8.1}x{:>11.2}{:>8.1}x",
                     side * side,
@@ -152,11 +168,12 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
     );
     let cube = scene::load("builtin:cube-floor")?;
     let renderers = Renderers::new(&cube);
+    let mut later = Vec::new();
     for &n in cells {
         let mesh = fan_grid(n)?;
-        let (timing, accuracy) = renderers.time(&mesh, CUBE_SIDE, args.repeat)?;
+        let (timing, accuracy) = renderers.time(&mesh, CUBE_SIDE, args.repeat, true)?;
         let [project, raster, shade] = timing.stages;
-        let [raycast_cpu, clipped_cpu] = timing.cpu;
+        let [raycast_cpu, _, clipped_cpu] = timing.cpu;
         let thesis = CELLS
             .iter()
             .position(|&c| c == n)
@@ -174,12 +191,55 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
             accuracy.1,
             raycast_cpu / clipped_cpu,
         );
+        later.push((mesh.triangles.len(), timing));
     }
     println!(
         "thesis: ray traced {THESIS_CUBE_RAY} ms; stage times are those of the median clipped \
          render"
     );
+    print_kept(&later);
     Ok(())
+}
+
+/// The cube table of later frames: trilinear into a kept frame, against the ray caster's
+/// times of the same cells; CPU times of the ray caster, of trilinear returning a new frame
+/// and into a kept frame (without clipping), and of clipped trilinear into a kept frame.
+fn print_kept(cells: &[(usize, Timing)]) {
+    println!(
+        "\ncube-floor, later frames: trilinear into a kept frame (render_into) without / with \
+         clipping; raycast as above"
+    );
+    println!(
+        "{:>5}{:>10}{:>10}{:>9}{:>11}{:>9}{:>9}{:>9}{:>10}{:>9}{:>11}{:>9}",
+        "proj",
+        "raycast",
+        "kept",
+        "speedup",
+        "clip kept",
+        "speedup",
+        "rc cpu",
+        "tri cpu",
+        "kept cpu",
+        "cpu x",
+        "ckept cpu",
+        "cpu x"
+    );
+    for (projections, timing) in cells {
+        let Some(kept) = &timing.kept else { continue };
+        let [raycast_cpu, trilinear_cpu, _] = timing.cpu;
+        let [kept_cpu, clipped_cpu] = kept.cpu;
+        println!(
+            "{projections:>5}{:>10.2}{:>10.2}{:>8.1}x{:>11.2}{:>8.1}x{raycast_cpu:>9.1}\
+             {trilinear_cpu:>9.1}{kept_cpu:>10.1}{:>8.1}x{clipped_cpu:>11.1}{:>8.1}x",
+            timing.raycast,
+            kept.trilinear,
+            timing.raycast / kept.trilinear,
+            kept.clipped,
+            timing.raycast / kept.clipped,
+            raycast_cpu / kept_cpu,
+            raycast_cpu / clipped_cpu,
+        );
+    }
 }
 
 /// Both renderers of one scene.
@@ -196,9 +256,16 @@ impl Renderers {
         }
     }
 
-    /// Times the three renders of `mesh` at `side x side` pixels, and the id agreement and
-    /// relative RGB error of the clipped trilinear render against the ray caster.
-    fn time(&self, mesh: &TrilinearMesh, side: u32, repeat: u32) -> Result<(Timing, (f64, f64))> {
+    /// Times the three renders of `mesh` at `side x side` pixels (and with `kept` the two
+    /// trilinear ones into a kept frame), and the id agreement and relative RGB error of the
+    /// clipped trilinear render against the ray caster.
+    fn time(
+        &self,
+        mesh: &TrilinearMesh,
+        side: u32,
+        repeat: u32,
+        kept: bool,
+    ) -> Result<(Timing, (f64, f64))> {
         let projection = Trilinear::new(mesh, side, side)?;
         let options = RenderOptions {
             shading: Shading::Flat,
@@ -215,8 +282,26 @@ impl Renderers {
             scene_clipping: false,
             ..CurveOptions::ADAPTIVE
         };
-        let (plain, _, _) = trilinear(unclipped)?;
+        let (plain, plain_cpu, _) = trilinear(unclipped)?;
         let (clipped, clipped_cpu, (frame, stats)) = trilinear(CurveOptions::ADAPTIVE)?;
+        let into_kept = |curves: CurveOptions| {
+            let mut kept = Frame::new(side, side, glam::Vec3::ZERO);
+            median(repeat, || {
+                self.trilinear
+                    .render_into(&mut kept, &projection, &options, curves)
+            })
+        };
+        let kept = if kept {
+            let (trilinear, kept_cpu, _) = into_kept(unclipped)?;
+            let (clipped, clipped_cpu, _) = into_kept(CurveOptions::ADAPTIVE)?;
+            Some(Kept {
+                trilinear,
+                clipped,
+                cpu: [kept_cpu, clipped_cpu],
+            })
+        } else {
+            None
+        };
         let c = compare(&frame, &reference)?;
         let stage = |name| match stats.get(name) {
             Some(Counter::Value(ms)) => *ms,
@@ -227,7 +312,8 @@ impl Renderers {
             trilinear: plain,
             clipped,
             stages: ["project_ms", "raster_ms", "shade_ms"].map(stage),
-            cpu: [raycast_cpu, clipped_cpu],
+            cpu: [raycast_cpu, plain_cpu, clipped_cpu],
+            kept,
         };
         Ok((timing, (c.id_agreement, c.relative_rgb_error)))
     }

@@ -46,6 +46,14 @@ fn shows_base_color(surface: Surface) -> bool {
 }
 
 impl RayCaster {
+    /// Whether flat shading shows the base colour of object `object` (an index into the
+    /// scene's objects) wherever it is hit, so that a hit's colour is the surface's base
+    /// colour at the hit ([`crate::render::surface::base_color`], nearest texels) and casts
+    /// no ray; `false` for a mirror or glass, which pass the ray on.
+    pub fn flat_shows_base_color(&self, object: usize) -> bool {
+        shows_base_color(self.objects[object].material.surface)
+    }
+
     /// [`RayCaster::shade_hit`] for a caller that builds the primary ray only where shading
     /// reads it: flat shading of a surface that shows its base colour reads only the hit (as
     /// `Tracer::flat` does at its first hit), so `ray` is not called there. Same colour and

@@ -35,7 +35,11 @@
 //! crack filler, whose depth was pushed back, is resolved again). The hit is handed to
 //! [`RayCaster::shade_hit`], which shades it exactly as the ray caster
 //! does (flat: base colour, mirrors and glass passing the ray on; lit: lights, hard shadows,
-//! reflection and refraction, all traced by the ray caster from the rasterised first hit).
+//! reflection and refraction, all traced by the ray caster from the rasterised first hit),
+//! except for flat shading of a surface that shows its base colour: that colour is read from
+//! the scene triangle's [`TriangleColor`], prepared once per renderer (a few multiply-adds a
+//! pixel instead of `base_color`'s transform and divisions; the same colours up to `f32`
+//! rounding, see `render::surface::triangle_color`).
 //! Pixels of projection triangles with an unprojectable pair are ray cast entirely.
 
 use glam::{DVec2, DVec3, Vec3};
@@ -47,6 +51,7 @@ use crate::geometry::Ray;
 use crate::projection::{Projection, Trilinear};
 use crate::render::raster::{DrawnRows, Fragment, FrameRows, NO_PRIMITIVE};
 use crate::render::raycast::{Hit, RayCaster};
+use crate::render::surface::triangle_color::TriangleColor;
 use crate::render::RenderOptions;
 
 /// Added to the depth of crack fillers: behind any exact fragment (depths are ray
@@ -233,6 +238,10 @@ pub struct Shader<'a> {
     /// Per projection triangle: ray cast its pixels instead.
     pub fallback: &'a [bool],
     pub background: Vec3,
+    /// With flat shading, per scene triangle, its base colour where flat shading shows it
+    /// (`None` for mirrors and glass, shaded by the ray caster): read instead of the ray
+    /// caster's per-hit `base_color`. `None` for lit shading.
+    pub flat_colors: Option<&'a [Option<TriangleColor>]>,
 }
 
 /// One pixel's output.
@@ -303,7 +312,8 @@ impl Shader<'_> {
     }
 
     /// The hit at ray parameter `t` and `barycentric` of the scene triangle named by `key`
-    /// on the projector along `direction`, shaded; `ray` builds the whole projector.
+    /// on the projector along `direction`, shaded (flat: from [`Shader::flat_colors`]
+    /// where it has the triangle); `ray` builds the whole projector.
     fn shaded(
         &self,
         key: u64,
@@ -312,14 +322,21 @@ impl Shader<'_> {
         direction: DVec3,
         ray: impl FnOnce() -> Ray,
     ) -> Pixel {
-        let owner = self.resolver.scene.owners[(key & u64::from(u32::MAX)) as usize];
-        let hit = Hit {
-            t,
-            object: owner.object as usize,
-            triangle: owner.triangle as usize,
-            barycentric: barycentric.as_vec2(),
+        let k = (key & u64::from(u32::MAX)) as usize;
+        let owner = self.resolver.scene.owners[k];
+        let flat = self.flat_colors.and_then(|colors| colors[k].as_ref());
+        let (color, rays) = match flat {
+            Some(color) => (color.at(barycentric.as_vec2()), 0),
+            None => {
+                let hit = Hit {
+                    t,
+                    object: owner.object as usize,
+                    triangle: owner.triangle as usize,
+                    barycentric: barycentric.as_vec2(),
+                };
+                self.caster.shade_hit_lazy(ray, hit, self.options)
+            }
         };
-        let (color, rays) = self.caster.shade_hit_lazy(ray, hit, self.options);
         Pixel {
             color,
             depth: (t * direction.length()) as f32,

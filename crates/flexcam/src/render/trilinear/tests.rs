@@ -128,6 +128,31 @@ fn rendering_is_deterministic() {
     assert_eq!(a, b);
 }
 
+/// `render_into` a kept frame gives `render`'s new frame, frame after frame, whatever the
+/// kept frame held (every pixel is overwritten), with one sample per pixel and with four; a
+/// kept frame of another size is replaced by one of the projection's size.
+#[test]
+fn rendering_into_a_kept_frame_matches_a_new_frame() {
+    let scene = scene::load("builtin:cube-floor").unwrap();
+    let projection = Trilinear::new(&fan_mesh(2), 80, 60).unwrap();
+    let renderer = TrilinearRenderer::new(&scene);
+    for options in [flat(), RenderOptions { spp: 4, ..flat() }] {
+        let (fresh, _) = renderer
+            .render(&projection, &options, CurveOptions::ADAPTIVE)
+            .unwrap();
+        let mut kept = Frame::new(3, 2, Vec3::ONE);
+        for _ in 0..2 {
+            renderer
+                .render_into(&mut kept, &projection, &options, CurveOptions::ADAPTIVE)
+                .unwrap();
+            assert_eq!(kept, fresh);
+            kept.color.fill(Vec3::splat(7.0));
+            kept.depth.fill(0.0);
+            kept.ids.fill(99);
+        }
+    }
+}
+
 /// One object made of the given triangles, flat colour `color`.
 pub(super) fn object(id: u32, triangles: &[[DVec3; 3]], color: Vec3) -> Object {
     let mut mesh = Mesh::default();
