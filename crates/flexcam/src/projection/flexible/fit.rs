@@ -90,11 +90,11 @@ pub fn fit(
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport)> {
     if prior.is_curved() {
-        return curved::fit(
-            prior,
-            &straight_start(prior, correspondences)?,
-            correspondences,
-        );
+        targets(prior, correspondences)?;
+        // Only a start: where curved data make the straight fit shrink a node to nothing,
+        // the prior's own straight projectors start the curved fit instead.
+        let start = straight_start(prior, correspondences).unwrap_or_else(|_| prior.straightened());
+        return curved::fit(prior, &start, correspondences);
     }
     let (first, _) = fit_once(prior, correspondences)?;
     fit_once(&first, correspondences)
@@ -668,26 +668,36 @@ mod tests {
 
     /// Fits `truth` (curved) from `per_side`^2 of its own correspondences, starting from the
     /// straight 60-degree perspective grid with one tangent (which marks it as curved).
-    /// Returns the fit, its report, and the largest relative error of a fitted node end
-    /// (over the node's projector length), of a fitted tangent (radians) and of Q(u, v, t)
-    /// over a 17 x 17 x 5 sample (over the projector length there).
-    fn recover_curved(truth: &ProjectorGrid, per_side: usize, seed: u64) -> (FitReport, [f64; 3]) {
+    /// Returns the fit's report and [`max_node_errors`].
+    fn recover_curved(
+        truth: &ProjectorGrid,
+        per_side: usize,
+        seed: u64,
+    ) -> Result<(FitReport, [f64; 3])> {
         let interpolation = truth.interpolation();
         let mut prior =
             ProjectorGrid::sample(&perspective(60.0, [1.0, 30.0]), (5, 5), interpolation).unwrap();
         let (s, e) = (prior.starts()[12], prior.ends()[12]);
         prior.set_projector((2, 2), s, e, Some(DVec3::X)).unwrap();
         let data = correspondences_of(truth, per_side, seed);
-        let (fitted, report) = fit(&prior, &data).unwrap();
+        let (fitted, report) = fit(&prior, &data)?;
+        Ok((report, max_node_errors(&fitted, truth)))
+    }
+
+    /// The largest relative error of a node end of `fitted` against `truth` (over the
+    /// node's projector length), of a node tangent (radians; a straight node's tangent is its
+    /// chord) and of Q(u, v, t) over a 17 x 17 x 5 sample (over the projector length there).
+    fn max_node_errors(fitted: &ProjectorGrid, truth: &ProjectorGrid) -> [f64; 3] {
         let mut worst = [0.0f64; 3];
         for j in 0..25 {
             let (start, end) = (truth.starts()[j], truth.ends()[j]);
             let length = (end - start).length();
             worst[0] = worst[0].max((fitted.ends()[j] - end).length() / length);
             let chord = (fitted.ends()[j] - fitted.starts()[j]).normalize();
+            let truth_chord = (end - start).normalize();
             let (a, b) = (
                 fitted.tangents()[j].unwrap_or(chord),
-                truth.tangents()[j].unwrap(),
+                truth.tangents()[j].unwrap_or(truth_chord),
             );
             worst[1] = worst[1].max(a.cross(b).length().atan2(a.dot(b)));
         }
@@ -701,7 +711,7 @@ mod tests {
                 }
             }
         }
-        (report, worst)
+        worst
     }
 
     #[test]
@@ -709,7 +719,7 @@ mod tests {
         // One grid: the iteration does not reach the known grid from every random one (it
         // can stop in a local minimum with a point at depth 0; docs/flexible.md).
         let truth = curved_truth(GridInterpolation::Bilinear, 0.3, 3);
-        let (report, [end, tangent, point]) = recover_curved(&truth, 12, 13);
+        let (report, [end, tangent, point]) = recover_curved(&truth, 12, 13).unwrap();
         eprintln!("{report:?}, errors end {end:e}, tangent {tangent:e} rad, Q {point:e}");
         assert_eq!(
             (report.correspondences, report.unconstrained_nodes),
@@ -719,6 +729,167 @@ mod tests {
         assert!(end < 1e-7, "end error {end}");
         assert!(tangent < 1e-7, "tangent error {tangent} rad");
         assert!(point < 1e-7, "Q error {point}");
+    }
+
+    /// Moves every point of `data` sideways, off the line from its projector's start in
+    /// `grid`, by up to `sigma` radians in each of two perpendicular directions (seeded).
+    fn with_noise(
+        grid: &ProjectorGrid,
+        data: &[Correspondence],
+        sigma: f64,
+        seed: u64,
+    ) -> Vec<Correspondence> {
+        let mut next = uniform(seed);
+        data.iter()
+            .map(|c| {
+                let (start, _) = grid.start_end(c.uv);
+                let (a, b) = (c.point - start).normalize().any_orthonormal_pair();
+                let off = sigma * (c.point - start).length();
+                let (x, y) = (2.0 * next() - 1.0, 2.0 * next() - 1.0);
+                Correspondence {
+                    point: c.point + off * (x * a + y * b),
+                    ..*c
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn recovers_random_straight_grids_and_reports_noise() {
+        // 24 random bilinear grids (every node's end turned up to about 6 degrees), fitted
+        // from the untouched 60-degree camera: all recovered. (Bezier grids are not: some
+        // random ones end with a projector pointing away from a point; docs/flexible.md.)
+        let sigma: f64 = 1e-3;
+        let interpolation = GridInterpolation::Bilinear;
+        let prior =
+            ProjectorGrid::sample(&perspective(60.0, [1.0, 30.0]), (5, 5), interpolation).unwrap();
+        let (mut exact_worst, mut noisy_worst) = (0.0f64, 0.0f64);
+        let mut rms_range = (f64::INFINITY, 0.0f64);
+        for seed in 0..24 {
+            let truth = curved_truth(interpolation, 0.0, seed).straightened();
+            let data = correspondences_of(&truth, 12, 200 + seed);
+            let (fitted, report) = fit(&prior, &data).unwrap();
+            assert!(report.max_angle_deg < 1e-6, "seed {seed}: {report:?}");
+            exact_worst = exact_worst.max(max_direction_error(&fitted, &truth));
+            // Noise: a residual of about its size is reported, no error.
+            let noisy = with_noise(&truth, &data, sigma, 300 + seed);
+            let (fitted, report) = fit(&prior, &noisy).unwrap();
+            noisy_worst = noisy_worst.max(max_direction_error(&fitted, &truth));
+            let rms = report.rms_angle_deg.to_radians();
+            rms_range = (rms_range.0.min(rms), rms_range.1.max(rms));
+        }
+        eprintln!(
+            "{interpolation:?}: exact {exact_worst:e} rad; noise {sigma}: direction error \
+             {noisy_worst:e} rad, rms residual {rms_range:?} rad"
+        );
+        assert!(exact_worst < 1e-7, "{interpolation:?}: {exact_worst}");
+        // Noise of up to sigma per axis has an rms angle of sigma * sqrt(2 / 3); the fit
+        // absorbs a part of it (75 unknowns for 288 equations).
+        assert!(
+            rms_range.0 > 0.4 * sigma && rms_range.1 < sigma,
+            "{interpolation:?}: {rms_range:?}"
+        );
+        assert!(
+            noisy_worst < 10.0 * sigma,
+            "{interpolation:?}: {noisy_worst}"
+        );
+    }
+
+    #[test]
+    fn a_point_behind_the_image_plane_is_named() {
+        // 144 exact correspondences and one more whose point lies behind its projector's
+        // start (t = -0.5): straight and curved fits refuse it by number.
+        let curved = curved_truth(GridInterpolation::Bilinear, 0.3, 3);
+        for truth in [curved.straightened(), curved] {
+            let mut data = correspondences_of(&truth, 12, 13);
+            let uv = DVec2::new(0.4, 0.7);
+            let (start, end) = truth.start_end(uv);
+            data.push(Correspondence {
+                uv,
+                point: start - 0.5 * (end - start),
+            });
+            let e = fit(&truth, &data).unwrap_err();
+            assert!(e.message.starts_with("correspondence 145: "), "{e}");
+        }
+    }
+
+    #[test]
+    fn curved_fits_with_too_few_or_uninformative_correspondences_are_refused() {
+        let truth = curved_truth(GridInterpolation::Bilinear, 0.3, 7);
+        let mut prior = ProjectorGrid::sample(
+            &perspective(60.0, [1.0, 30.0]),
+            (5, 5),
+            truth.interpolation(),
+        )
+        .unwrap();
+        let (s, e) = (prior.starts()[12], prior.ends()[12]);
+        prior.set_projector((2, 2), s, e, Some(DVec3::X)).unwrap();
+        // 25 nodes need 50 correspondences.
+        let few = correspondences_of(&truth, 7, 1);
+        let e = fit(&prior, &few).unwrap_err();
+        assert!(
+            e.message.contains("need at least 50 correspondences"),
+            "{e}"
+        );
+        assert!(e.message.contains("got 49, add 1 more"), "{e}");
+        // Points at the node positions only (each weights one node): three depths along
+        // every node's projector determine it, three copies of one point do not (a curve
+        // through one point can leave its start in any direction near it).
+        let at_nodes = |depths: [f64; 3]| -> Vec<Correspondence> {
+            (0..25)
+                .flat_map(|j| {
+                    let uv = truth.node_uv(j % 5, j / 5);
+                    depths.map(|t| Correspondence {
+                        uv,
+                        point: truth.point(uv, t),
+                    })
+                })
+                .collect()
+        };
+        let (fitted, report) = fit(&prior, &at_nodes([0.25, 0.55, 0.85])).unwrap();
+        assert!(report.max_angle_deg < 1e-6, "{report:?}");
+        assert!(max_node_errors(&fitted, &truth).iter().all(|e| *e < 1e-7));
+        let mut one_depth = at_nodes([0.25, 0.55, 0.85]);
+        let j = 3 * 17;
+        one_depth[j + 1] = one_depth[j];
+        one_depth[j + 2] = one_depth[j];
+        let e = fit(&prior, &one_depth).unwrap_err();
+        assert!(
+            e.message
+                .contains("do not determine the end and tangent of node (2, 3)"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn recovers_random_curved_grids_or_shows_the_miss() {
+        // 24 random grids of each interpolation (seeded; bend 0.03 to 0.43 rad, 144 exact
+        // correspondences): every fit either recovers its grid to 1e-7 or reports a residual
+        // above 1e-3 degrees (a wrong local minimum is never silent), and at least the
+        // measured 9 bilinear grids are recovered (docs/flexible.md: the rest is not solved).
+        for interpolation in [GridInterpolation::Bilinear, GridInterpolation::Bezier] {
+            let mut recovered = 0;
+            for seed in 0..24 {
+                let bend = 0.03
+                    + 0.4 * {
+                        let mut next = uniform(1000 + seed);
+                        next()
+                    };
+                let truth = curved_truth(interpolation, bend, seed);
+                match recover_curved(&truth, 12, 100 + seed) {
+                    Ok((_, errors)) if errors.iter().all(|e| *e < 1e-7) => recovered += 1,
+                    Ok((report, errors)) => assert!(
+                        report.max_angle_deg > 1e-3,
+                        "{interpolation:?} seed {seed}: {report:?} {errors:?}"
+                    ),
+                    Err(e) => eprintln!("{interpolation:?} seed {seed}: {e}"),
+                }
+            }
+            eprintln!("{interpolation:?}: {recovered} of 24 recovered");
+            if interpolation == GridInterpolation::Bilinear {
+                assert!(recovered >= 9, "{recovered} of 24");
+            }
+        }
     }
 
     /// The example scene's 25 correspondences of a known curved 3 x 3 grid: the fit meets

@@ -16,9 +16,10 @@
 //!
 //! with rho_k = |X_k - S_k| (so each term is about the squared angle the point is off its
 //! projector, seen from the start, as in the straight fit's report), D0, T0 the straight fit
-//! the iteration starts from (its directions, tangents along them), and lambda [`PRIOR_WEIGHT`] of the data term's mean curvature: it only settles what the
-//! data leave open (a grid with fewer correspondences than unknowns) and biases what they
-//! determine by about lambda (measured below 1e-9 on exact data).
+//! the iteration starts from (its directions, tangents along them), and lambda
+//! [`PRIOR_WEIGHT`] of the data term's mean curvature: it keeps the damped system positive
+//! definite and biases what the data determine by about lambda (measured below 1e-9 on
+//! exact data).
 //!
 //! Why the lengths are kept: a curved projector's shape depends on its length (C_j moves
 //! with L_j), but sliding its end along the curve (the depths rescaled) changes the cost
@@ -26,30 +27,47 @@
 //! the data barely fix the lengths (measured: the iteration wandered to ends that reach
 //! the points at t up to 2.9). Kept lengths remove that near-symmetry, as the straight
 //! fit's scale constraint removes its exact one; a known grid with the prior's lengths can
-//! then be recovered exactly (tests; but see the limits below). Points at a single depth per projector still leave the
-//! bend open (any projector reaching them fits); the prior term keeps the straight fit there.
+//! then be recovered exactly (tests).
 //!
 //! # The solver
 //!
-//! Levenberg-Marquardt on the node unknowns and the depths together, the depths kept in
-//! [0, 1] (each step's depths clamped to it): a quadratic continued beyond its ends bends
-//! back, and matching a point there (at a negative depth, say) is a wrong local minimum. Each depth t_k enters
-//! only residual k, so the depths are eliminated from the damped normal equations by their
-//! Schur complement (a 1 x 1 block per correspondence) and the system solved has 5 unknowns
-//! per node (the end's direction and the tangent, each as two angles about it). The
-//! iteration stops when no step lowers the cost any more (the damping exceeds
-//! [`MAX_DAMPING`]: converged to rounding), at a cost of 0, or after [`MAX_ITERATIONS`] steps.
+//! Levenberg-Marquardt on the node angles (the end's direction and the tangent, two angles
+//! each about their current value), every depth t_k the closest point of its projector to
+//! X_k over [0, 1] after each step (the global minimum of a quadratic's squared distance: a
+//! cubic's roots and the two ends, [`closest_depth`]): a point is never held at an end, such
+//! as the start, while the curve passes nearer further along (the trap of the first version,
+//! which stepped the depths with the nodes and clamped them). Each depth enters only its own
+//! residual and sits where the residual is perpendicular to the projector, so it is
+//! eliminated by projecting its three residual rows off B'(t_k) (the Schur complement of a
+//! depth strictly inside (0, 1); a depth at 0 or 1 is held). The iteration starts from the
+//! straight fit (tangents along its directions) and stops when no step lowers the cost (the
+//! damping exceeds [`MAX_DAMPING`]: converged to rounding), at a cost of 0, or after
+//! [`MAX_ITERATIONS`] steps. The Gauss-Newton matrix is formed from a dense Jacobian (three
+//! rows per correspondence, four columns per node) by one matrix product, so that Bezier
+//! grids, where every correspondence weights every node, take about a second, not minutes.
 //!
-//! Limits: the iteration starts from the straight fit and often ends in a wrong local
-//! minimum (a point held at depth 0, then an error): measured, most random bilinear 5 x 5
-//! grids bent 0.03 to 0.4 rad failed so; one (the test's) and the 3 x 3 example are
-//! recovered. With Bezier interpolation every correspondence weights every node and
-//! convergence is slow.
+//! Limits (measured, `recovers_random_curved_grids_or_shows_the_miss`): of 24 random
+//! bilinear 5 x 5 grids bent 0.03 to 0.43 rad, 9 are recovered to about 1e-11 and the rest
+//! end in a wrong local minimum (a tangent folded back), with a residual of degrees in the
+//! report, never a small one; no random Bezier grid is recovered (the straight start is
+//! already far off for them). A continuation in the data (from the straight start's own
+//! projectors to the points in 8 stages) with steps limited to 0.2 rad and folded tangents
+//! refused was tried and recovered the same 9 grids, the others stopping with a point at
+//! depth 0, so it is not kept.
+//!
+//! Identifiability: with fewer correspondences than twice the free nodes (each fixes two of a
+//! node's four angles) the fit is refused before it starts, naming how many are missing; at
+//! the fitted grid, a Gauss-Newton matrix whose smallest eigenvalue is below [`UNDETERMINED`]
+//! of its largest means the data leave some combination of angles open (say, one point per
+//! node: a curve through it can leave its start in any direction nearby), and the fit is
+//! refused naming the node that combination moves most, rather than returning the prior
+//! term's choice.
 //!
 //! Degenerate cases: no correspondences, or none weighting any node (the prior is returned
-//! with its tangents); a fitted depth t_k <= 0 or > 1 (the point would be reached behind the
-//! start or beyond the end: an error naming the correspondence); a fitted projector of zero
-//! length or a tangent pointing back along it (the errors of
+//! with its tangents); a point reached only at depth 0 (it lies behind the projector's
+//! start: an error naming the correspondence); a point beyond its projector's end is
+//! matched at t = 1 with the miss in the residual; too few or uninformative correspondences
+//! (above); a fitted projector of zero length (the errors of
 //! [`ProjectorGrid::set_projector`]).
 
 use glam::DVec3;
@@ -57,6 +75,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::{Correspondence, FitReport};
 use crate::error::{Error, Result};
+use crate::geometry::solve_cubic;
 use crate::projection::flexible::projector_grid::ProjectorGrid;
 use crate::projection::projector::{quadratic_point, quadratic_tangent};
 
@@ -69,6 +88,10 @@ const MAX_ITERATIONS: usize = 2000;
 /// The damping (relative to the curvature) beyond which no step lowers the cost: converged,
 /// to rounding.
 const MAX_DAMPING: f64 = 1e20;
+
+/// The smallest eigenvalue of the fitted Gauss-Newton matrix, relative to its largest, at
+/// which the data still determine every node angle (see [`Problem::check_determined`]).
+const UNDETERMINED: f64 = 1e-10;
 
 /// Unknowns per node: two angles of the end's direction, two of the tangent.
 const PER_NODE: usize = 4;
@@ -101,38 +124,30 @@ struct Problem<'a> {
     anchor: Vec<Node>,
 }
 
-/// One correspondence linearised: residual, d residual / d t and the columns over the node
-/// unknowns (index, column).
-struct Linear {
-    residual: DVec3,
-    along: DVec3,
-    columns: Vec<(usize, DVec3)>,
-}
-
 /// Fits the end directions and tangents of the nodes of `prior` that `data` constrain, their
 /// lengths kept, starting from the directions of `straight`, the straight fit of the same
-/// data (module docs). Returns the grid (the prior's
-/// starts, interpolation and unconstrained nodes) and its residual.
+/// data (module docs). Returns the grid (the prior's starts, interpolation and unconstrained
+/// nodes) and its residual.
 pub(super) fn fit(
     prior: &ProjectorGrid,
     straight: &ProjectorGrid,
     data: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport)> {
-    let (problem, start) = Problem::new(prior, straight, data);
-    let state = problem.solve(start);
-    for (k, &t) in state.depths.iter().enumerate() {
-        if !(t > 0.0 && t <= 1.0) {
-            let c = &data[k];
-            return Err(Error::new(format!(
-                "correspondence {}: the fitted curved projector of {} reaches {} at t = {t}, \
-                 outside its length (0, 1]; give the grid longer projectors or consistent \
-                 correspondences",
-                k + 1,
-                c.uv,
-                c.point
-            )));
-        }
+    let problem = Problem::new(prior, straight, data);
+    problem.check_count()?;
+    let state = problem.solve(problem.anchor.clone());
+    if let Some(k) = state.depths.iter().position(|t| *t <= 0.0) {
+        let c = &data[k];
+        return Err(Error::new(format!(
+            "correspondence {}: the fitted curved projector of {} comes nearest to {} at its \
+             start (t = 0): the point lies behind the image plane, or the correspondences \
+             contradict each other",
+            k + 1,
+            c.uv,
+            c.point
+        )));
     }
+    problem.check_determined(&state)?;
     let mut grid = prior.clone();
     let cols = prior.size().0;
     for (node, &(j, length)) in state.nodes.iter().zip(&problem.free) {
@@ -145,19 +160,14 @@ pub(super) fn fit(
 }
 
 impl<'a> Problem<'a> {
-    /// The problem and its starting state: the straight fit's directions, tangents along
-    /// them, depths by distance along the straight projectors.
-    fn new(
-        grid: &'a ProjectorGrid,
-        straight: &ProjectorGrid,
-        data: &'a [Correspondence],
-    ) -> (Self, State) {
+    /// The problem, its prior centred on the straight fit's directions with tangents along
+    /// them.
+    fn new(grid: &'a ProjectorGrid, straight: &ProjectorGrid, data: &'a [Correspondence]) -> Self {
         let nodes = grid.starts().len();
         let mut slot = vec![None; nodes];
         let mut free = Vec::new();
         let mut weights = Vec::with_capacity(data.len());
         let mut starts = Vec::with_capacity(data.len());
-        let mut depths = Vec::with_capacity(data.len());
         for c in data {
             let mut list = Vec::new();
             grid.for_each_weight(c.uv, |j, w| {
@@ -170,13 +180,8 @@ impl<'a> Problem<'a> {
             weights.push(list);
             let (start, _) = grid.start_end(c.uv);
             starts.push((start, 1.0 / (c.point - start).length()));
-            // The distance along the projector as a fraction of its length: positive even
-            // where the straight start points a little away from the point.
-            let (s, e) = straight.start_end(c.uv);
-            let depth = (c.point - s).length() / (e - s).length();
-            depths.push(depth.clamp(0.0, 1.0));
         }
-        let anchor: Vec<Node> = free
+        let anchor = free
             .iter()
             .map(|&(j, _)| {
                 let direction = (straight.ends()[j] - grid.starts()[j]).normalize();
@@ -186,26 +191,21 @@ impl<'a> Problem<'a> {
                 }
             })
             .collect();
-        let state = State {
-            nodes: anchor.clone(),
-            depths,
-        };
-        let problem = Problem {
+        Problem {
             grid,
             data,
             weights,
             starts,
             free,
             anchor,
-        };
-        (problem, state)
+        }
     }
 
-    /// The control points of correspondence `k`'s projector in `state`.
-    fn controls(&self, k: usize, state: &State) -> [DVec3; 3] {
+    /// The control points of correspondence `k`'s projector with node unknowns `nodes`.
+    fn controls(&self, k: usize, nodes: &[Node]) -> [DVec3; 3] {
         let mut p = [self.starts[k].0, DVec3::ZERO, DVec3::ZERO];
         for &(s, w) in &self.weights[k] {
-            let ((j, length), node) = (self.free[s], state.nodes[s]);
+            let ((j, length), node) = (self.free[s], nodes[s]);
             let start = self.grid.starts()[j];
             p[1] += w * (start + 0.5 * length * node.tangent);
             p[2] += w * (start + length * node.direction);
@@ -213,16 +213,22 @@ impl<'a> Problem<'a> {
         p
     }
 
-    /// The weighted residual of correspondence `k`.
-    fn residual(&self, k: usize, state: &State) -> DVec3 {
-        let point = quadratic_point(&self.controls(k, state), state.depths[k]);
-        (point - self.data[k].point) * self.starts[k].1
+    /// The state of node unknowns `nodes`: each depth at the point of its projector closest
+    /// to its scene point.
+    fn with_closest_depths(&self, nodes: Vec<Node>) -> State {
+        let depths = (0..self.data.len())
+            .map(|k| closest_depth(&self.controls(k, &nodes), self.data[k].point))
+            .collect();
+        State { nodes, depths }
     }
 
-    /// The cost: squared residuals plus the prior term.
+    /// The cost: squared weighted residuals plus the prior term.
     fn cost(&self, state: &State, lambda: f64) -> f64 {
         let data: f64 = (0..self.data.len())
-            .map(|k| self.residual(k, state).length_squared())
+            .map(|k| {
+                let point = quadratic_point(&self.controls(k, &state.nodes), state.depths[k]);
+                ((point - self.data[k].point) * self.starts[k].1).length_squared()
+            })
             .sum();
         let prior: f64 = state
             .nodes
@@ -236,35 +242,57 @@ impl<'a> Problem<'a> {
         data + lambda * prior
     }
 
-    /// Correspondence `k` linearised at `state` (columns of the end's three coordinates and
-    /// the tangent's two angles, about the planes of [`tangent_frame`]).
-    fn linearise(&self, k: usize, state: &State) -> Linear {
-        let p = self.controls(k, state);
-        let t = state.depths[k];
-        let scale = self.starts[k].1;
-        let mut columns = Vec::with_capacity(PER_NODE * self.weights[k].len());
-        for &(s, w) in &self.weights[k] {
-            let ((_, length), node) = (self.free[s], state.nodes[s]);
-            // dE/d angle = L e (the end turns), dC/d angle = (L / 2) e (the tangent turns).
-            let frames = [
-                (tangent_frame(node.direction), t * t * length),
-                (tangent_frame(node.tangent), t * (1.0 - t) * length),
-            ];
-            for (m, ((e1, e2), factor)) in frames.into_iter().enumerate() {
-                for (i, e) in [e1, e2].into_iter().enumerate() {
-                    columns.push((PER_NODE * s + 2 * m + i, w * scale * factor * e));
+    /// The weighted residuals (three rows per correspondence) and their Jacobian over the
+    /// node angles (about the planes of [`tangent_frame`]) at `state`, each depth strictly
+    /// inside (0, 1) eliminated: its rows are projected off the projector's tangent B'(t_k)
+    /// (the depth sits at the closest point, where the residual is perpendicular to the
+    /// projector, and follows the nodes to first order: the Schur complement of the depth);
+    /// a depth at 0 or 1 is held there.
+    fn linearise(&self, state: &State) -> (DMatrix<f64>, DVector<f64>) {
+        let rows = 3 * self.data.len();
+        let mut jacobian = DMatrix::<f64>::zeros(rows, PER_NODE * self.free.len());
+        let mut residuals = DVector::<f64>::zeros(rows);
+        for k in 0..self.data.len() {
+            let p = self.controls(k, &state.nodes);
+            let t = state.depths[k];
+            let scale = self.starts[k].1;
+            let along = quadratic_tangent(&p, t);
+            let interior = t > 0.0 && t < 1.0 && along != DVec3::ZERO;
+            // The part of a residual row-triple that the depth cannot absorb.
+            let kept = |v: DVec3| {
+                if interior {
+                    v - along * (v.dot(along) / along.length_squared())
+                } else {
+                    v
+                }
+            };
+            let r = kept((quadratic_point(&p, t) - self.data[k].point) * scale);
+            for axis in 0..3 {
+                residuals[3 * k + axis] = r[axis];
+            }
+            for &(s, w) in &self.weights[k] {
+                let ((_, length), node) = (self.free[s], state.nodes[s]);
+                // dE/d angle = L e (the end turns), dC/d angle = (L / 2) e (the tangent).
+                let frames = [
+                    (tangent_frame(node.direction), t * t * length),
+                    (tangent_frame(node.tangent), t * (1.0 - t) * length),
+                ];
+                for (m, ((e1, e2), factor)) in frames.into_iter().enumerate() {
+                    for (i, e) in [e1, e2].into_iter().enumerate() {
+                        let column = kept(w * scale * factor * e);
+                        for axis in 0..3 {
+                            jacobian[(3 * k + axis, PER_NODE * s + 2 * m + i)] = column[axis];
+                        }
+                    }
                 }
             }
         }
-        Linear {
-            residual: (quadratic_point(&p, t) - self.data[k].point) * scale,
-            along: quadratic_tangent(&p, t) * scale,
-            columns,
-        }
+        (jacobian, residuals)
     }
 
-    /// Levenberg-Marquardt from `state` (module docs).
-    fn solve(&self, mut state: State) -> State {
+    /// Levenberg-Marquardt on the node unknowns from `nodes` (module docs).
+    fn solve(&self, nodes: Vec<Node>) -> State {
+        let mut state = self.with_closest_depths(nodes);
         let n = PER_NODE * self.free.len();
         if n == 0 {
             return state;
@@ -273,19 +301,9 @@ impl<'a> Problem<'a> {
         let mut damping = 0.1;
         let mut cost = f64::INFINITY;
         for _ in 0..MAX_ITERATIONS {
-            let lines: Vec<Linear> = (0..self.data.len())
-                .map(|k| self.linearise(k, &state))
-                .collect();
-            let mut normal = DMatrix::<f64>::zeros(n, n);
-            let mut gradient = DVector::<f64>::zeros(n);
-            for line in &lines {
-                for &(i, a) in &line.columns {
-                    gradient[i] += a.dot(line.residual);
-                    for &(j, b) in &line.columns {
-                        normal[(i, j)] += a.dot(b);
-                    }
-                }
-            }
+            let (jacobian, residuals) = self.linearise(&state);
+            let mut normal = jacobian.tr_mul(&jacobian);
+            let mut gradient = jacobian.tr_mul(&residuals);
             let lambda = *lambda.get_or_insert_with(|| {
                 let mean = normal.trace() / n as f64;
                 PRIOR_WEIGHT * if mean > 0.0 { mean } else { 1.0 }
@@ -295,30 +313,74 @@ impl<'a> Problem<'a> {
             }
             self.add_prior(&state, lambda, &mut normal, &mut gradient);
             loop {
-                let Some(candidate) = self.step(&state, &lines, &normal, &gradient, damping) else {
-                    damping *= 10.0;
-                    if damping > MAX_DAMPING {
-                        return state;
+                let next = self.step(&state, &normal, &gradient, damping);
+                if let Some(next) = next {
+                    let next_cost = self.cost(&next, lambda);
+                    if next_cost < cost {
+                        state = next;
+                        cost = next_cost;
+                        damping = (damping / 10.0).max(1e-15);
+                        break;
                     }
-                    continue;
-                };
-                let next = self.cost(&candidate, lambda);
-                if next < cost {
-                    state = candidate;
-                    cost = next;
-                    damping = (damping / 10.0).max(1e-15);
-                    if cost == 0.0 {
-                        return state;
-                    }
-                    break;
                 }
                 damping *= 10.0;
                 if damping > MAX_DAMPING {
                     return state;
                 }
             }
+            if cost == 0.0 {
+                break;
+            }
         }
         state
+    }
+
+    /// Errors when the correspondences are fewer than the node unknowns: each fixes two
+    /// angles (three coordinates less its depth), each free node has four.
+    fn check_count(&self) -> Result<()> {
+        let needed = PER_NODE * self.free.len() / 2;
+        if self.data.len() >= needed {
+            return Ok(());
+        }
+        Err(Error::new(format!(
+            "curved projector grid fit: the correspondences weight {} node projectors, which \
+             need at least {needed} correspondences (each fixes 2 of a node's 4 angles: end \
+             direction and tangent); got {}, add {} more",
+            self.free.len(),
+            self.data.len(),
+            needed - self.data.len()
+        )))
+    }
+
+    /// Errors when the data leave some combination of node angles open at the fitted
+    /// `state` (the Gauss-Newton matrix, depths eliminated, is singular to [`UNDETERMINED`]),
+    /// naming the node that combination moves most: the prior term would then choose its
+    /// end and tangent, not the data.
+    fn check_determined(&self, state: &State) -> Result<()> {
+        let n = PER_NODE * self.free.len();
+        if n == 0 {
+            return Ok(());
+        }
+        let (jacobian, _) = self.linearise(state);
+        let eigen = jacobian.tr_mul(&jacobian).symmetric_eigen();
+        let (weakest, smallest) = eigen.eigenvalues.argmin();
+        if smallest > UNDETERMINED * eigen.eigenvalues.max() {
+            return Ok(());
+        }
+        let open = eigen.eigenvectors.column(weakest);
+        let moved =
+            |s: usize| -> f64 { (0..PER_NODE).map(|m| open[PER_NODE * s + m].powi(2)).sum() };
+        let slot = (0..self.free.len())
+            .max_by(|a, b| moved(*a).total_cmp(&moved(*b)))
+            .unwrap_or(0);
+        let cols = self.grid.size().0;
+        let (col, row) = (self.free[slot].0 % cols, self.free[slot].0 / cols);
+        Err(Error::new(format!(
+            "curved projector grid fit: the correspondences do not determine the end and \
+             tangent of node ({col}, {row}) (too few points near image position {}, or all at \
+             one depth along their projectors); add correspondences at several depths there",
+            self.grid.node_uv(col, row)
+        )))
     }
 
     /// Adds the prior term's curvature and gradient.
@@ -345,33 +407,22 @@ impl<'a> Problem<'a> {
         }
     }
 
-    /// The damped step from `state` (the depths eliminated by their Schur complement), or
-    /// `None` where the damped system is not positive definite.
+    /// The damped step from `state` on the node unknowns, its depths the closest points
+    /// again. `None` (a failed step: more damping) where the damped system is not positive
+    /// definite or a value would not be finite.
     fn step(
         &self,
         state: &State,
-        lines: &[Linear],
         normal: &DMatrix<f64>,
         gradient: &DVector<f64>,
         damping: f64,
     ) -> Option<State> {
-        let n = normal.nrows();
         let mut system = normal.clone();
-        for i in 0..n {
+        for i in 0..system.nrows() {
             system[(i, i)] += damping * normal[(i, i)].max(f64::MIN_POSITIVE);
         }
-        let mut rhs = -gradient.clone();
-        let eliminated: Vec<Depth> = lines.iter().map(|line| Depth::new(line, damping)).collect();
-        for Depth { u, h, g } in &eliminated {
-            for &(i, ui) in u {
-                rhs[i] += ui * g / h;
-                for &(j, uj) in u {
-                    system[(i, j)] -= ui * uj / h;
-                }
-            }
-        }
-        let delta = system.cholesky()?.solve(&rhs);
-        let nodes = state
+        let delta = system.cholesky()?.solve(&-gradient);
+        let nodes: Vec<Node> = state
             .nodes
             .iter()
             .enumerate()
@@ -387,22 +438,10 @@ impl<'a> Problem<'a> {
                 }
             })
             .collect();
-        let depths = state
-            .depths
+        let finite = nodes
             .iter()
-            .zip(&eliminated)
-            .map(|(t, Depth { u, h, g })| {
-                let coupled: f64 = u.iter().map(|&(i, ui)| ui * delta[i]).sum();
-                (t - (g + coupled) / h).clamp(0.0, 1.0)
-            })
-            .collect();
-        let next = State { nodes, depths };
-        let finite = next.depths.iter().all(|t| t.is_finite())
-            && next
-                .nodes
-                .iter()
-                .all(|n| n.direction.is_finite() && n.tangent.is_finite());
-        finite.then_some(next)
+            .all(|n| n.direction.is_finite() && n.tangent.is_finite());
+        finite.then(|| self.with_closest_depths(nodes))
     }
 
     /// The residual of the fitted `grid`: the angle, seen from the projector's start, between
@@ -434,28 +473,30 @@ impl<'a> Problem<'a> {
     }
 }
 
-/// One depth's row of the damped normal equations, eliminated: u = A^T b over the line's
-/// columns, h = |b|^2 (1 + damping) and g = b . r (b: d residual / d t).
-struct Depth {
-    u: Vec<(usize, f64)>,
-    h: f64,
-    g: f64,
-}
-
-impl Depth {
-    fn new(line: &Linear, damping: f64) -> Self {
-        let u = line
-            .columns
-            .iter()
-            .map(|&(i, a)| (i, a.dot(line.along)))
-            .collect();
-        let h = line.along.length_squared() * (1.0 + damping);
-        Depth {
-            u,
-            h: h.max(f64::MIN_POSITIVE),
-            g: line.along.dot(line.residual),
+/// The depth t in [0, 1] of the point of the quadratic Bezier curve `p` closest to `x`: an
+/// end, or a root in (0, 1) of the cubic (B(t) - x) . B'(t) / 2 (its global minimum, so that
+/// a point cannot be held at an end while the curve passes nearer further along).
+/// Degenerate cases: a curve that does not move (all control points equal: the cubic is
+/// identically zero) gives 0; equally near candidates give the smallest t.
+fn closest_depth(p: &[DVec3; 3], x: DVec3) -> f64 {
+    // B(t) - x = d + t b + t^2 a.
+    let (d, b, a) = (p[0] - x, 2.0 * (p[1] - p[0]), p[2] - 2.0 * p[1] + p[0]);
+    let roots = solve_cubic(
+        2.0 * a.length_squared(),
+        3.0 * a.dot(b),
+        b.length_squared() + 2.0 * a.dot(d),
+        b.dot(d),
+    );
+    let inside = roots.iter().filter(|t| *t > 0.0 && *t < 1.0);
+    let distance = |t: f64| (quadratic_point(p, t) - x).length_squared();
+    let mut best = (0.0, distance(0.0));
+    for t in inside.chain([1.0]) {
+        let d = distance(t);
+        if d < best.1 {
+            best = (t, d);
         }
     }
+    best.0
 }
 
 /// Two unit vectors perpendicular to the unit vector `v` and to each other: the directions
