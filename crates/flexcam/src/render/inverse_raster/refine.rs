@@ -594,7 +594,8 @@ mod tests {
             let chart = projection.inverse_chart().unwrap();
             let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
             let centre = DVec3::from_array(centre);
-            let corner = |k: usize| centre + size * DVec3::new(offsets[2 * k], offsets[2 * k + 1], 0.5);
+            let corner =
+                |k: usize| centre + size * DVec3::new(offsets[2 * k], offsets[2 * k + 1], 0.5);
             let nodes = [0, 1, 2].map(|k| refiner.node(corner(k)));
             let mut pieces = Vec::new();
             refiner.refine(nodes, [0; 3], false, &mut |piece| pieces.push(piece));

@@ -10,7 +10,9 @@ use glam::{DVec2, DVec3};
 use super::*;
 use crate::projection::camera_basis::CameraBasis;
 use crate::projection::flexible::panorama::lookup::PanoramaInverse;
-use crate::projection::flexible::panorama::{OutlineShape, PanoramaSurface, ProfileShape};
+use crate::projection::flexible::panorama::{
+    Attached, CurveBlend, OutlineShape, PanoramaSurface, ProfileShape,
+};
 use crate::projection::flexible::presets::{Preset, PresetSpec};
 use crate::projection::flexible::{Flexible, FlexibleSpec};
 use crate::projection::{CameraFrame, Projection};
@@ -497,6 +499,53 @@ fn partial_round_presets_refuse_what_has_no_meaning() {
             "{e}"
         );
     }
+}
+
+/// A window maps image columns onto outline fractions and back (across the turn opposite
+/// it too, where u jumps by one turn); bad windows are refused.
+#[test]
+fn windows_map_columns_to_outline_fractions() {
+    let quarter = equirect().windowed([0.375, 0.625]).unwrap();
+    for u in [-1.0, 0.0, 0.3, 1.0, 2.4] {
+        let s = quarter.fraction(u);
+        assert!((quarter.column(s) - u).abs() < 1e-12, "{u}");
+        // The same direction one turn on.
+        assert!((quarter.column(s + 1.0) - u).abs() < 1e-12, "{u}");
+    }
+    assert_eq!(quarter.fraction(0.5), 0.5);
+    // Straight behind (s = 0 or 1) is two turns' halves from the middle: u = -1.5 or 2.5.
+    assert!((quarter.column(0.0) - 2.5).abs() < 1e-12 || (quarter.column(0.0) + 1.5).abs() < 1e-12);
+    assert_eq!(equirect().column(0.3), 0.3);
+    for bad in [
+        [0.6, 0.4],
+        [-0.1, 0.5],
+        [0.5, 1.5],
+        [0.5, 0.5 + 1e-7],
+        [f64::NAN, 0.5],
+    ] {
+        let e = equirect().windowed(bad).unwrap_err();
+        assert!(e.message.contains("needs 0 <= s0 < s1 <= 1"), "{e}");
+    }
+    let two_profiles = PanoramaShape::new(
+        vec![Attached {
+            at: 0.0,
+            curve: OutlineShape::Circle.curve().unwrap(),
+        }],
+        [0.0, 0.5]
+            .map(|at| Attached {
+                at,
+                curve: ProfileShape::Segment {
+                    elevation: [-0.5, 0.5],
+                }
+                .curve()
+                .unwrap(),
+            })
+            .to_vec(),
+        CurveBlend::Linear,
+    )
+    .unwrap();
+    let e = two_profiles.windowed([0.25, 0.75]).unwrap_err();
+    assert!(e.message.contains("takes one profile"), "{e}");
 }
 
 /// Degenerate: a tiny `h_fov` (half a degree, 0.0014 of a turn) still takes the edit: the
