@@ -790,7 +790,8 @@ fn reproject_errors_are_one_line() {
 }
 
 /// `bench trilinear --quick` with one timed render per cell prints both of seed 000's tables
-/// with a row per cell of the quick subset; an out-of-range `--repeat` is one error line.
+/// and the cube's kept-frame table with a row per cell of the quick subset; an out-of-range
+/// `--repeat` is one error line.
 #[test]
 fn bench_trilinear_quick_prints_both_tables() {
     let dir = TempDir::new().unwrap();
@@ -809,7 +810,10 @@ fn bench_trilinear_quick_prints_both_tables() {
     };
     // 2 image sizes x 2 scene sizes x 3 projection meshes, then the thesis's 5 rows.
     assert_eq!(rows(random).len(), 12 + 5, "{text}");
+    // Then the cube's later frames into a kept frame, the same cells.
+    let (cube, kept) = cube.split_once("later frames").expect("kept-frame table");
     assert_eq!(rows(cube), ["2", "18", "50"], "{text}");
+    assert_eq!(rows(kept), ["2", "18", "50"], "{text}");
     let e = expect_failure(&dir, &["bench", "trilinear", "--quick", "--repeat", "0"]);
     assert!(e.contains("--repeat"), "{e}");
 }
