@@ -1240,12 +1240,13 @@ fn flexible_projector_grid_nodes_with_tangents() {
         56,
         "`tangent`",
     );
-    // Tangents with `fit`: a curved fit. The one correspondence, at the centre node, is on
-    // its straight projector already, so the fit keeps that node straight; the corner node
-    // that no correspondence constrains keeps its tangent.
+    // Tangents with `fit`: a curved fit. The two correspondences, at the centre node and
+    // two depths, lie on its straight projector already, so the fit keeps that node
+    // straight; the corner node that no correspondence constrains keeps its tangent.
     let ProjectionSpec::Flexible(spec) = scene(&with(
         "{ projector = [{ node = [0, 0], tangent = [1, 0, 0] }], \
-         fit = [{ uv = [0.5, 0.5], point = [0, 0, 0] }] }",
+         fit = [{ uv = [0.5, 0.5], point = [0, 0, 0] }, \
+         { uv = [0.5, 0.5], point = [0, 1, 1.4] }] }",
     ))
     .projection
     else {
@@ -1258,6 +1259,14 @@ fn flexible_projector_grid_nodes_with_tangents() {
     assert_eq!(volume.grid.tangents()[0], Some(DVec3::X));
     assert_eq!(volume.grid.tangents()[12], None);
     assert!(volume.fit.is_some_and(|r| r.max_angle_deg < 1e-9));
+    // One correspondence cannot fix a node's end direction and tangent (four angles).
+    assert_error(
+        &with(
+            "{ projector = [{ node = [0, 0], tangent = [1, 0, 0] }], \
+             fit = [{ uv = [0.5, 0.5], point = [0, 0, 0] }] }",
+        ),
+        "got 1, add 1 more",
+    );
     // A tangent from the end back to the start: named by node, in the file.
     assert_error(
         &with("{ projector = [{ node = [2, 2], start = [0, 0, 0], end = [0, 0, -5], tangent = [0, 0, 3] }] }"),
