@@ -165,6 +165,18 @@ mod tests {
     use crate::projection::ProjectionTriangleCache;
     use proptest::prelude::*;
 
+    /// A perspective-like projection triangle looking down -z from the unit triangle at the
+    /// origin, its directions spread by 0.1.
+    fn narrow_frustum() -> VolumeBounds {
+        let p = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let n = [
+            DVec3::new(-0.1, -0.1, -1.0),
+            DVec3::new(0.1, -0.1, -1.0),
+            DVec3::new(-0.1, 0.1, -1.0),
+        ];
+        VolumeBounds::new(p, n)
+    }
+
     fn vec3() -> impl Strategy<Value = DVec3> {
         (-3.0..3.0f64, -3.0..3.0f64, -3.0..3.0f64).prop_map(|(x, y, z)| DVec3::new(x, y, z))
     }
@@ -284,13 +296,7 @@ mod tests {
 
     #[test]
     fn boxes_beyond_a_side_are_outside_and_boxes_in_front_are_not() {
-        let p = [DVec3::ZERO, DVec3::X, DVec3::Y];
-        let n = [
-            DVec3::new(-0.1, -0.1, -1.0),
-            DVec3::new(0.1, -0.1, -1.0),
-            DVec3::new(-0.1, 0.1, -1.0),
-        ];
-        let bounds = VolumeBounds::new(p, n);
+        let bounds = narrow_frustum();
         let all = bounds.all_planes();
         assert_eq!(all.count_ones() as usize, bounds.len());
         // A flat box far to the side, and one point (zero extent) behind the base.
@@ -322,13 +328,7 @@ mod tests {
     fn a_narrow_frustum_is_bounded_on_every_side() {
         // A perspective-like triangle looking down -z from the origin: points far off to
         // either side, behind the base or beyond a side are outside; points in front are not.
-        let p = [DVec3::ZERO, DVec3::X, DVec3::Y];
-        let n = [
-            DVec3::new(-0.1, -0.1, -1.0),
-            DVec3::new(0.1, -0.1, -1.0),
-            DVec3::new(-0.1, 0.1, -1.0),
-        ];
-        let bounds = VolumeBounds::new(p, n);
+        let bounds = narrow_frustum();
         assert!(bounds.len() >= 4, "{bounds:?}");
         assert_eq!(bounds.outside(DVec3::new(0.2, 0.2, -3.0)), 0);
         for far in [
