@@ -398,6 +398,18 @@ mod tests {
         (-2.0..2.0f64, -2.0..2.0f64, -2.0..2.0f64).prop_map(|(x, y, z)| DVec3::new(x, y, z))
     }
 
+    /// A random curve's control points, a random triangle's corners, and a random piece
+    /// `[lo, hi]` of the curve's range (possibly empty at 1).
+    fn curve_triangle_range() -> impl Strategy<Value = ([DVec3; 3], [DVec3; 3], [f64; 2])> {
+        (
+            [point(), point(), point()],
+            [point(), point(), point()],
+            0.0..1.0f64,
+            0.0..1.0f64,
+        )
+            .prop_map(|(p, corners, lo, width)| (p, corners, [lo, (lo + width).min(1.0)]))
+    }
+
     /// The first s of a dense sampling of the curve at which it is on the other side of the
     /// plane from its start and the crossing lies inside the triangle, located to `1 / n`.
     fn dense_first_hit(p: &[DVec3; 3], t: [DVec3; 3], n: usize) -> Option<f64> {
@@ -421,14 +433,8 @@ mod tests {
         /// The hull test never rejects a piece that hits: wherever it says a piece misses
         /// the triangle's plane, the analytic search over that piece finds nothing.
         #[test]
-        fn a_rejected_piece_has_no_hit(
-            p0 in point(), p1 in point(), p2 in point(),
-            a in point(), b in point(), c in point(),
-            lo in 0.0..1.0f64, width in 0.0..1.0f64,
-        ) {
-            let p = [p0, p1, p2];
+        fn a_rejected_piece_has_no_hit((p, [a, b, c], [lo, hi]) in curve_triangle_range()) {
             let t = tri(a, b, c);
-            let hi = (lo + width).min(1.0);
             if hull_misses_plane(&piece(&p, lo, hi), t) {
                 prop_assert_eq!(intersect_quadratic_triangle(&p, t, [lo, hi]), None);
             }
@@ -437,14 +443,8 @@ mod tests {
         /// A piece whose control points' box is apart from a triangle's box has no hit on
         /// it; boxes that overlap or touch are never apart.
         #[test]
-        fn a_piece_boxed_apart_has_no_hit(
-            p0 in point(), p1 in point(), p2 in point(),
-            a in point(), b in point(), c in point(),
-            lo in 0.0..1.0f64, width in 0.0..1.0f64,
-        ) {
-            let p = [p0, p1, p2];
+        fn a_piece_boxed_apart_has_no_hit((p, [a, b, c], [lo, hi]) in curve_triangle_range()) {
             let t = tri(a, b, c);
-            let hi = (lo + width).min(1.0);
             let q = piece(&p, lo, hi);
             let (q_lo, q_hi) = (q[0].min(q[1]).min(q[2]), q[0].max(q[1]).max(q[2]));
             if boxes_apart(q_lo, q_hi, t) {
