@@ -596,28 +596,13 @@ impl Bvh {
         if !(lo.is_finite() && hi.is_finite()) {
             return true;
         }
-        // As in `visit_near_segment`: a fixed stack of pending children.
-        let mut stack = [self.root; STACK_SIZE];
-        let mut depth = 1;
-        while depth > 0 {
-            depth -= 1;
-            let current = stack[depth];
-            if current.count > 0 {
-                return true;
-            }
-            let node = &self.nodes[current.index as usize];
-            for k in [1, 0] {
-                let p = &node.planes;
-                let child_min = glam::DVec3::new(p[0][k] as f64, p[1][k] as f64, p[2][k] as f64);
-                let child_max =
-                    -glam::DVec3::new(p[0][k + 2] as f64, p[1][k + 2] as f64, p[2][k + 2] as f64);
-                if !(lo.cmpgt(child_max).any() || hi.cmplt(child_min).any()) {
-                    stack[depth] = node.children[k];
-                    depth += 1;
-                }
-            }
-        }
-        false
+        self.walk_leaves(
+            |child_min, child_max| {
+                let (child_min, child_max) = (child_min.as_dvec3(), child_max.as_dvec3());
+                !(lo.cmpgt(child_max).any() || hi.cmplt(child_min).any())
+            },
+            |_| true,
+        )
     }
 
     /// Calls `visit` with the build-input index and the triangle of every stored triangle in
@@ -633,18 +618,36 @@ impl Bvh {
         if !self.near_root(segment) {
             return;
         }
-        // A fixed stack, no allocation per call: it holds at most one pending sibling per
-        // level of the tree, fewer than STACK_SIZE.
+        self.walk_leaves(
+            |min, max| segment.meets(min, max),
+            |leaf| {
+                let first = leaf.index as usize;
+                for i in first..first + leaf.count as usize {
+                    visit(self.ids[i], &self.triangles[i]);
+                }
+                false
+            },
+        );
+    }
+
+    /// Walks the tree depth first, in tree order, into every child whose box (`min`, `max`)
+    /// `enter` accepts, calling `leaf` on each leaf reached (the root too, when it is one);
+    /// `leaf` returning true ends the walk. Returns whether a leaf ended it. A fixed stack,
+    /// no allocation per call: it holds at most one pending sibling per level of the tree,
+    /// fewer than STACK_SIZE.
+    fn walk_leaves(
+        &self,
+        mut enter: impl FnMut(Vec3, Vec3) -> bool,
+        mut leaf: impl FnMut(Child) -> bool,
+    ) -> bool {
         let mut stack = [self.root; STACK_SIZE];
         let mut depth = 1;
         while depth > 0 {
             depth -= 1;
             let current = stack[depth];
             if current.count > 0 {
-                let first = current.index as usize;
-                let count = current.count as usize;
-                for i in first..first + count {
-                    visit(self.ids[i], &self.triangles[i]);
+                if leaf(current) {
+                    return true;
                 }
                 continue;
             }
@@ -657,12 +660,13 @@ impl Bvh {
                     node.planes[1][k + 2],
                     node.planes[2][k + 2],
                 );
-                if segment.meets(min, max) {
+                if enter(min, max) {
                     stack[depth] = node.children[k];
                     depth += 1;
                 }
             }
         }
+        false
     }
 
     /// The hit at stored triangle `i`, known by its build-input index.
