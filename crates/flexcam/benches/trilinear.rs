@@ -4,7 +4,8 @@
 //! of issue 3 (at least 10x the ray caster, under 33 ms). Both renderers are prepared once
 //! (BVH, scene geometry); each iteration is one frame. `trilinear_frame` uses the default
 //! adaptive curves with scene-space clipping, `trilinear_unclipped` the thesis's cheaper
-//! screen-space clipping only.
+//! screen-space clipping only, `trilinear_kept_unclipped` the same into a frame kept from
+//! iteration to iteration (`TrilinearRenderer::render_into`, a program's later frames).
 //!
 //! Run with `cargo bench -p flexcam --bench trilinear`. Figures are recorded in
 //! docs/trilinear.md (with `flexcam bench trilinear`, which prints the thesis's tables).
@@ -43,6 +44,14 @@ fn cube_floor_18(c: &mut Criterion) {
             b.iter(|| renderer.render(&projection, &options, curves))
         });
     }
+    // Later frames of a program drawing frame after frame into one frame it keeps.
+    let mut kept = renderer
+        .render(&projection, &options, unclipped)
+        .unwrap_or_else(|e| panic!("render: {e}"))
+        .0;
+    group.bench_function("trilinear_kept_unclipped", |b| {
+        b.iter(|| renderer.render_into(&mut kept, &projection, &options, unclipped))
+    });
     let caster = RayCaster::new(&scene);
     group.bench_function("raycast_frame", |b| {
         b.iter(|| caster.render(&projection, &options))

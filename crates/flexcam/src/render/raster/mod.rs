@@ -7,8 +7,9 @@
 //! - [`scan`]: polygon coverage, the fill and tie rules, and attribute interpolation;
 //! - [`line`](mod@line): one-pixel-wide lines for two-vertex shapes;
 //! - [`target`]: the z-buffered target and [`Fragment`]s;
-//! - [`fused`]: drawing band by band into small band-local targets, each finished into the
-//!   output [`crate::render::Frame`] at once (deferred shading without frame-sized buffers);
+//! - [`fused`]: the image cut into bands drawn in parallel into small band-local buffers,
+//!   each shaded into the output [`crate::render::Frame`] at once (deferred shading without
+//!   frame-sized buffers);
 //! - [`stats`]: counters for `--stats`.
 //!
 //! A *stage* (see [`rasterize_parallel_staged`]) may rewrite each fragment before its z-test
@@ -32,17 +33,16 @@ mod tests;
 use glam::Vec3;
 use rayon::prelude::*;
 
-pub use fused::{band_rows_for, rasterize_into_frame, BandTimes, DrawnRows, FrameRows};
+pub use fused::{band_rows_for, for_each_band, FrameRows};
 pub use interpolate::Varying;
 pub use polygon::{Polygon, PolygonBatch, Vertex, LIMIT};
-pub use scan::FillRule;
+pub use scan::{FillRule, Scratch, Span};
 pub use stats::RasterStats;
 
 use stats::FragmentCounts;
 pub use target::{new_frame, Fragment, Layers, Target, NO_PRIMITIVE};
 
 use polygon::Kind;
-use scan::Scratch;
 use target::Band;
 
 /// Rows per band in [`rasterize_parallel`]: enough for little per-band overhead on small
@@ -58,7 +58,7 @@ pub fn rasterize<const N: usize>(
     rule: FillRule,
     shader: &impl Fn(&Fragment<N>) -> Vec3,
 ) -> RasterStats {
-    let mut stats = count_shapes(polygons);
+    let mut stats = RasterStats::of_shapes(polygons);
     let mut scratch = Scratch::default();
     let mut band = target.band();
     for polygon in polygons.iter() {
@@ -114,7 +114,7 @@ pub fn rasterize_parallel_resolved<const N: usize>(
             })
         })
         .reduce(FragmentCounts::default, |a, b| a + b);
-    let mut stats = count_shapes(polygons);
+    let mut stats = RasterStats::of_shapes(polygons);
     stats.add_fragments(counts);
     stats.covered = target.covered();
     stats
@@ -142,19 +142,6 @@ fn bins<const N: usize>(
     bins
 }
 
-/// The shape counts of a batch (polygons, lines, skipped).
-fn count_shapes<const N: usize>(polygons: &PolygonBatch<N>) -> RasterStats {
-    let mut stats = RasterStats::default();
-    for polygon in polygons.iter() {
-        match polygon.kind() {
-            Kind::Fill => stats.polygons += 1,
-            Kind::Line => stats.lines += 1,
-            Kind::Skip => stats.skipped += 1,
-        }
-    }
-    stats
-}
-
 /// Draws one shape into the rows of `band`, resolving each fragment before its z-test.
 fn draw<const N: usize>(
     band: &mut Band<'_>,
@@ -166,31 +153,48 @@ fn draw<const N: usize>(
 ) -> FragmentCounts {
     let mut counts = FragmentCounts::default();
     let (rows, width) = (band.rows, band.width);
-    let mut emit = |x, y, varying| {
-        let mut fragment = Fragment {
-            x,
-            y,
-            varying,
-            object: polygon.object,
-            primitive: polygon.primitive,
-        };
-        counts.fragments += 1;
-        if resolve(&mut fragment) {
-            counts.writes += u64::from(band.test_and_write(&fragment, shader));
-        } else {
-            counts.discarded += 1;
+    spans(polygon, rule, rows, width, scratch, |span| {
+        for x in span.x0..span.x1 {
+            let mut fragment = Fragment {
+                x,
+                y: span.y,
+                varying: span.at(x),
+                object: polygon.object,
+                primitive: polygon.primitive,
+            };
+            counts.fragments += 1;
+            if resolve(&mut fragment) {
+                counts.writes += u64::from(band.test_and_write(&fragment, shader));
+            } else {
+                counts.discarded += 1;
+            }
         }
-    };
+    });
+    counts
+}
+
+/// Calls `emit` with the runs of pixel centres that `polygon` covers in rows
+/// `rows.0..rows.1` and columns `0..width`, row by row, left to right, each pixel in at most
+/// one span: a polygon's by `rule` ([`scan`]), a line's pixels one by one ([`line`](mod@line)),
+/// none for a shape that is not drawn. For renderers that run their own stage and z-test
+/// along a span (see [`Span::start_and_step`]) instead of one fragment at a time.
+pub fn spans<const N: usize>(
+    polygon: &Polygon<'_, N>,
+    rule: FillRule,
+    rows: (u32, u32),
+    width: u32,
+    scratch: &mut Scratch<N>,
+    mut emit: impl FnMut(&Span<'_, N>),
+) {
     match polygon.kind() {
-        Kind::Fill => scan::fill(polygon, rule, rows, width, scratch, &mut emit),
+        Kind::Fill => scan::fill_spans(polygon, rule, rows, width, scratch, emit),
         Kind::Line => line::line(
             &polygon.vertices[0],
             &polygon.vertices[1],
             rows,
             width,
-            &mut emit,
+            |x, y, values| emit(&Span::pixel(x, y, &values)),
         ),
         Kind::Skip => {}
     }
-    counts
 }

@@ -72,21 +72,77 @@ struct Crossing<const N: usize> {
 
 /// Buffers reused from polygon to polygon.
 #[derive(Debug, Clone, Default)]
-pub(super) struct Scratch<const N: usize> {
+pub struct Scratch<const N: usize> {
     edges: Vec<Edge<N>>,
     crossings: Vec<Crossing<N>>,
 }
 
-/// Calls `emit(x, y, varying)` for every pixel centre in rows `rows.0..rows.1` and columns
-/// `0..width` that `polygon` covers by `rule`, row by row, left to right, each pixel at most
-/// once. The polygon must be of [`super::polygon::Kind::Fill`] (finite, bounded vertices).
-pub(super) fn fill<const N: usize>(
+/// A run of covered pixel centres `x0..x1` (non-empty) of row `y`, between two crossings of
+/// a shape's outline with the row, and the values interpolated along it.
+#[derive(Debug, Clone, Copy)]
+pub struct Span<'a, const N: usize> {
+    pub y: u32,
+    pub x0: u32,
+    pub x1: u32,
+    /// The left crossing's x and the reciprocal of the crossings' distance (0 for a single
+    /// pixel of a line, whose values are `left`'s).
+    left_x: f64,
+    per_x: f64,
+    left: &'a Varying<N>,
+    right: &'a Varying<N>,
+}
+
+impl<const N: usize> Span<'_, N> {
+    /// The values at pixel centre `x` (`x0 <= x < x1`): linear between the two crossings,
+    /// clamped to them.
+    #[inline]
+    pub fn at(&self, x: u32) -> Varying<N> {
+        let u = ((f64::from(x) + 0.5 - self.left_x) * self.per_x).clamp(0.0, 1.0);
+        self.left.lerp(self.right, u)
+    }
+
+    /// The values at pixel centre `x0` ([`Span::at`]) and their change from one pixel to the
+    /// next: the value at `x0 + k` is `start + k step` up to rounding, for callers stepping
+    /// along the span instead of interpolating each pixel on its own. The steps are finite
+    /// (the values are bounded by [`super::LIMIT`], the crossings at least a pixel centre
+    /// apart where the span has two pixels or more).
+    #[inline]
+    pub fn start_and_step(&self) -> (Varying<N>, Varying<N>) {
+        let start = self.at(self.x0);
+        let step = Varying {
+            depth: (self.right.depth - self.left.depth) * self.per_x,
+            attributes: std::array::from_fn(|i| {
+                (self.right.attributes[i] - self.left.attributes[i]) * self.per_x
+            }),
+        };
+        (start, step)
+    }
+
+    /// The one-pixel span of pixel `(x, y)` with `values`: a pixel of a line.
+    pub(super) fn pixel(x: u32, y: u32, values: &Varying<N>) -> Span<'_, N> {
+        Span {
+            y,
+            x0: x,
+            x1: x + 1,
+            left_x: f64::from(x) + 0.5,
+            per_x: 0.0,
+            left: values,
+            right: values,
+        }
+    }
+}
+
+/// Calls `emit` with the spans of pixel centres in rows `rows.0..rows.1` and columns
+/// `0..width` that `polygon` covers by `rule`, row by row, left to right, each pixel in at
+/// most one span. The polygon must be of
+/// [`super::polygon::Kind::Fill`] (finite, bounded vertices).
+pub(super) fn fill_spans<const N: usize>(
     polygon: &Polygon<'_, N>,
     rule: FillRule,
     rows: (u32, u32),
     width: u32,
     scratch: &mut Scratch<N>,
-    mut emit: impl FnMut(u32, u32, Varying<N>),
+    mut emit: impl FnMut(&Span<'_, N>),
 ) {
     let vertices = polygon.vertices;
     scratch.edges.clear();
@@ -144,11 +200,15 @@ pub(super) fn fill<const N: usize>(
             let (x0, x1) = centre_range(left.x, right.x, width);
             if x1 > x0 {
                 // x1 > x0 implies right.x > left.x: the reciprocal is finite.
-                let per_x = 1.0 / (right.x - left.x);
-                for x in x0..x1 {
-                    let u = ((f64::from(x) + 0.5 - left.x) * per_x).clamp(0.0, 1.0);
-                    emit(x, y, left.varying.lerp(&right.varying, u));
-                }
+                emit(&Span {
+                    y,
+                    x0,
+                    x1,
+                    left_x: left.x,
+                    per_x: 1.0 / (right.x - left.x),
+                    left: &left.varying,
+                    right: &right.varying,
+                });
             }
         }
     }

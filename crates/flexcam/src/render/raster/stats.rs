@@ -1,5 +1,6 @@
 //! What a rasterisation pass did, for `--stats`.
 
+use super::polygon::{Kind, PolygonBatch};
 use crate::render::{Counter, Stats};
 
 /// Counters of one or more rasterisation passes; they add up across bands and passes and do
@@ -24,6 +25,19 @@ pub struct RasterStats {
 }
 
 impl RasterStats {
+    /// The shape counts of a batch (polygons, lines, skipped), the other counts zero.
+    pub fn of_shapes<const N: usize>(polygons: &PolygonBatch<N>) -> RasterStats {
+        let mut stats = RasterStats::default();
+        for polygon in polygons.iter() {
+            match polygon.kind() {
+                Kind::Fill => stats.polygons += 1,
+                Kind::Line => stats.lines += 1,
+                Kind::Skip => stats.skipped += 1,
+            }
+        }
+        stats
+    }
+
     /// Adds `other`'s counts to these (`covered` too: callers set it once per pass).
     pub fn add(&mut self, other: &RasterStats) {
         self.polygons += other.polygons;

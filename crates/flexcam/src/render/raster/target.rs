@@ -127,25 +127,6 @@ impl Target {
         }
     }
 
-    /// This target's first `rows.1 - rows.0` rows (at most its height), emptied with
-    /// `background`, as rows `rows` of a larger image: a band-local buffer reused from band
-    /// to band (see [`super::fused`]).
-    pub(super) fn band_at(&mut self, rows: (u32, u32), background: Vec3) -> Band<'_> {
-        let n = (rows.1 - rows.0) as usize * self.width as usize;
-        self.color[..n].fill(background);
-        self.depth[..n].fill(f64::INFINITY);
-        self.ids[..n].fill(0);
-        self.primitives[..n].fill(NO_PRIMITIVE);
-        Band {
-            width: self.width,
-            rows,
-            color: &mut self.color[..n],
-            depth: &mut self.depth[..n],
-            ids: &mut self.ids[..n],
-            primitives: &mut self.primitives[..n],
-        }
-    }
-
     /// The whole target as one band.
     pub(super) fn band(&mut self) -> Band<'_> {
         Band {
@@ -225,18 +206,6 @@ pub(super) struct Band<'a> {
 }
 
 impl<'a> Band<'a> {
-    /// The drawn rows, read-only.
-    pub(super) fn into_drawn(self) -> super::DrawnRows<'a> {
-        super::DrawnRows {
-            width: self.width,
-            rows: self.rows,
-            color: self.color,
-            depth: self.depth,
-            ids: self.ids,
-            primitives: self.primitives,
-        }
-    }
-
     /// The z-test: the fragment wins when `(depth, primitive)` is lexicographically smaller
     /// than the stored pair, so the result does not depend on the order of distinct shapes.
     /// On a win the shader is run and colour, depth, id and key are written. `fragment` must

@@ -46,7 +46,7 @@ where
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn at(&self, barycentric: Vec2) -> T {
         self.origin + self.du * barycentric.x + self.dv * barycentric.y
     }
@@ -94,7 +94,7 @@ impl PatternMap {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn at(&self, barycentric: Vec2) -> Vec3 {
         match self {
             PatternMap::Uniform(c) => *c,
@@ -170,7 +170,7 @@ impl TriangleColor {
     /// The base colour at barycentrics `barycentric` (weights of the second and third
     /// corners), a point of the triangle. Outside it the affine parts extrapolate, except
     /// where the triangle was found to have one colour: that colour.
-    #[inline]
+    #[inline(always)]
     pub fn at(&self, barycentric: Vec2) -> Vec3 {
         let pattern = self.pattern.at(barycentric);
         match &self.vertex {

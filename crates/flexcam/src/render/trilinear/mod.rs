@@ -23,6 +23,7 @@ mod cull_tests;
 pub mod cull_tree;
 pub mod curves;
 pub mod edge_path;
+pub mod gbuffer;
 pub mod hit_terms;
 pub mod outline;
 pub mod pair_cull;
@@ -41,15 +42,14 @@ use glam::{DVec2, Vec3};
 
 pub use curves::{CurveMode, CurveOptions};
 
+use self::gbuffer::GBuffer;
 use self::polygons::{project_all, projection_triangles, ProjectedScene};
 use self::scene_geometry::SceneGeometry;
 use self::screen_map::ScreenMap;
-use self::shade::{stored_barycentrics, Resolver, ShadeCounts, Shader};
+use self::shade::{Resolver, ShadeCounts, Shader};
 use crate::error::{Error, Result};
 use crate::projection::{Projection, Trilinear};
-use crate::render::raster::{
-    band_rows_for, new_frame, rasterize_into_frame, FillRule, RasterStats,
-};
+use crate::render::raster::{band_rows_for, for_each_band, new_frame, RasterStats, Scratch};
 use crate::render::raycast::{RayCaster, SamplePattern};
 use crate::render::surface::triangle_color::TriangleColor;
 use crate::render::surface::TextureFilter;
@@ -179,22 +179,35 @@ impl TrilinearRenderer {
                 flat_colors,
             };
             // Drawn and shaded band by band, straight into the frame.
-            let (stats, counts, times) = rasterize_into_frame(
+            let band_rows = band_rows_for(width);
+            let done = for_each_band(
                 samples.target(),
                 batch,
-                FillRule::NonZero,
-                band_rows_for(width),
-                self.background,
-                &|f| shader.resolver.stage(f),
-                &stored_barycentrics,
-                &|drawn, rows| shader.rows(drawn, rows),
+                band_rows,
+                || (GBuffer::new(width, band_rows), Scratch::default()),
+                |(buffer, scratch), shapes, rows| {
+                    let start = Instant::now();
+                    buffer.start_band(rows.rows);
+                    let mut raster = RasterStats::default();
+                    for &k in shapes {
+                        raster.add(&buffer.draw(&batch.get(k), &shader.resolver, scratch));
+                    }
+                    let finishing = Instant::now();
+                    let counts = shader.rows(buffer, rows);
+                    BandWork {
+                        raster,
+                        counts,
+                        draw_s: (finishing - start).as_secs_f64(),
+                        shade_s: finishing.elapsed().as_secs_f64(),
+                    }
+                },
             );
-            raster.add(&stats);
-            samples.add(counts);
+            raster.add(&done.raster);
+            samples.add(done.counts);
             // The pass's wall time, split by the CPU time its bands spent drawing and shading.
             let wall = pass.elapsed().as_secs_f64() * 1e3;
-            let busy = times.draw_s + times.finish_s;
-            let drawing = if busy > 0.0 { times.draw_s / busy } else { 1.0 };
+            let busy = done.draw_s + done.shade_s;
+            let drawing = if busy > 0.0 { done.draw_s / busy } else { 1.0 };
             raster_ms += wall * drawing;
             shade_ms += wall * (1.0 - drawing);
         }
@@ -202,6 +215,10 @@ impl TrilinearRenderer {
 
         let mut stats = Stats::new();
         counts.record(&mut stats);
+        let shapes = RasterStats::of_shapes(&polygons);
+        raster.polygons = shapes.polygons * pattern.offsets.len() as u64;
+        raster.lines = shapes.lines * pattern.offsets.len() as u64;
+        raster.skipped = shapes.skipped * pattern.offsets.len() as u64;
         raster.record(&mut stats);
         let count = |n: usize| Counter::Count(n as u64);
         stats.insert("triangles", count(self.scene.triangles.len()));
@@ -217,6 +234,30 @@ impl TrilinearRenderer {
         stats.insert("raster_ms", Counter::Value(raster_ms));
         stats.insert("shade_ms", Counter::Value(shade_ms));
         Ok(stats)
+    }
+}
+
+/// What drawing and shading some bands did, and their CPU time (summed over threads).
+#[derive(Debug, Clone, Copy, Default)]
+struct BandWork {
+    raster: RasterStats,
+    counts: ShadeCounts,
+    draw_s: f64,
+    shade_s: f64,
+}
+
+impl std::ops::Add for BandWork {
+    type Output = BandWork;
+
+    fn add(self, o: BandWork) -> BandWork {
+        let mut raster = self.raster;
+        raster.add(&o.raster);
+        BandWork {
+            raster,
+            counts: self.counts + o.counts,
+            draw_s: self.draw_s + o.draw_s,
+            shade_s: self.shade_s + o.shade_s,
+        }
     }
 }
 

@@ -7,8 +7,9 @@
 //! projector is intersected with the scene triangle's plane, in f64. The polygon's vertices
 //! carry the terms of that intersection that are affine in pixel position ([`super::hit_terms`]),
 //! so the rasteriser hands each fragment the terms of its own projector and the stage finishes
-//! the hit with a division. Only a fragment outside its own triangle takes the general path,
-//! which builds the projector and intersects it with the neighbours ([`Resolver::hit`]).
+//! the hit with a division ([`super::gbuffer::GBuffer::draw`]). Only a fragment outside its
+//! own triangle takes the general path, which builds the projector and intersects it with
+//! the neighbours ([`Resolver::hit`]).
 //!
 //! - Inside the triangle at `t >= 0`: an **exact** fragment; the z-test compares exact ray
 //!   parameters `t`, and the frame's depth is `t |trinorm|`, the distance the ray caster
@@ -29,9 +30,9 @@
 //! - Behind the view plane, or a projector parallel to the plane: discarded.
 //!
 //! Shading is deferred to one pass over the pixels, so that each pixel is shaded once. The
-//! rasteriser's target is the G-buffer: its depth is the winner's exact `t`, its key the
-//! triangle hit, and its colour channel holds the winner's scene barycentrics
-//! ([`stored_barycentrics`]), so an exact winner is shaded without intersecting again (a
+//! rasteriser's target is the band's G-buffer ([`super::gbuffer`]): its depth is the winner's
+//! exact `t`, its key the triangle hit, and its barycentrics the winner's scene
+//! barycentrics, so an exact winner is shaded without intersecting again (a
 //! crack filler, whose depth was pushed back, is resolved again). The hit is handed to
 //! [`RayCaster::shade_hit`], which shades it exactly as the ray caster
 //! does (flat: base colour, mirrors and glass passing the ray on; lit: lights, hard shadows,
@@ -42,14 +43,15 @@
 //! rounding, see `render::surface::triangle_color`).
 //! Pixels of projection triangles with an unprojectable pair are ray cast entirely.
 
-use glam::{DVec2, DVec3, Vec3};
+use glam::{DVec2, DVec3, Vec2, Vec3};
 
-use super::hit_terms::{self, TERMS};
+use super::gbuffer::GBuffer;
+use super::hit_terms::{self, Terms, TERMS};
 use super::scene_geometry::SceneGeometry;
 use super::screen_map::ScreenMap;
 use crate::geometry::Ray;
 use crate::projection::{Projection, Trilinear};
-use crate::render::raster::{DrawnRows, Fragment, FrameRows, NO_PRIMITIVE};
+use crate::render::raster::{Fragment, FrameRows, NO_PRIMITIVE};
 use crate::render::raycast::{Hit, RayCaster};
 use crate::render::surface::triangle_color::TriangleColor;
 use crate::render::RenderOptions;
@@ -138,28 +140,37 @@ impl Resolver<'_> {
         })
     }
 
-    /// The stage of the rasteriser: the fragment's depth (the exact `t`, pushed back for a
-    /// crack filler), key and object of the triangle hit, and in its first two attributes
-    /// the hit's barycentrics ([`stored_barycentrics`]); or `false` to discard it. The
-    /// fragment's attributes are the hit terms of its own triangle at its projector.
+    /// The stage of the rasteriser for a fragment of the shape keyed `key` at pixel
+    /// `(x, y)` whose hit terms there are `terms`: the key of the triangle hit (its own, or
+    /// a neighbour's), its depth (the exact `t`, pushed back for a crack filler) and the
+    /// hit's barycentrics; `None` to discard it (module doc).
     #[inline]
+    pub fn staged(&self, key: u64, terms: &Terms, x: u32, y: u32) -> Option<(u64, f64, DVec2)> {
+        match hit_terms::hit(terms) {
+            Some((t, b1, b2)) if t >= 0.0 && outside_edges(b1, b2) == 0 => {
+                Some((key, t, DVec2::new(b1, b2)))
+            }
+            Some((t, _, _)) if t < 0.0 => None,
+            None => None,
+            Some(_) => self.hit(key, self.position(x, y)).map(|hit| {
+                let behind = if hit.exact { 0.0 } else { CRACK_FILL_DEPTH };
+                (hit.key, hit.t + behind, hit.barycentric)
+            }),
+        }
+    }
+
+    /// [`Resolver::staged`] as a stage of `render::raster`'s fragment API: rewrites the
+    /// fragment's depth, key and object to the hit's, its first two attributes to the hit's
+    /// barycentrics, or returns `false` to discard it. Its attributes are the hit terms of
+    /// its own triangle at its projector.
     pub fn stage(&self, fragment: &mut Fragment<TERMS>) -> bool {
-        let (key, t, barycentric, exact) = match hit_terms::hit(&fragment.varying.attributes) {
-            None => return false,
-            Some((t, _, _)) if t < 0.0 => return false,
-            Some((t, u, v)) if outside_edges(u, v) == 0 => {
-                (fragment.primitive, t, DVec2::new(u, v), true)
-            }
-            Some(_) => {
-                let at = self.position(fragment.x, fragment.y);
-                match self.hit(fragment.primitive, at) {
-                    Some(hit) => (hit.key, hit.t, hit.barycentric, hit.exact),
-                    None => return false,
-                }
-            }
+        let terms = fragment.varying.attributes;
+        let Some((key, depth, barycentric)) =
+            self.staged(fragment.primitive, &terms, fragment.x, fragment.y)
+        else {
+            return false;
         };
-        let behind = if exact { 0.0 } else { CRACK_FILL_DEPTH };
-        fragment.varying.depth = t + behind;
+        fragment.varying.depth = depth;
         fragment.varying.attributes[0] = barycentric.x;
         fragment.varying.attributes[1] = barycentric.y;
         if key != fragment.primitive {
@@ -168,13 +179,6 @@ impl Resolver<'_> {
         }
         true
     }
-}
-
-/// The rasteriser's "shader": a staged fragment's scene barycentrics, kept in the target's
-/// colour channel for the shading pass (f32, the precision `Hit` carries).
-pub fn stored_barycentrics(fragment: &Fragment<TERMS>) -> Vec3 {
-    let [u, v] = [0, 1].map(|i| fragment.varying.attributes[i] as f32);
-    Vec3::new(u, v, 0.0)
 }
 
 /// Where `ray` meets the plane of triangle `[a, b, c]`: `(t, u, v)` with `u`, `v` the
@@ -254,22 +258,23 @@ struct Pixel {
 }
 
 impl Shader<'_> {
-    /// Shades the drawn G-buffer rows `drawn` into the same rows `out` of the frame, every
-    /// pixel of them written (a band of `render::raster::rasterize_into_frame`).
-    pub fn rows(&self, drawn: &DrawnRows<'_>, out: FrameRows<'_>) -> ShadeCounts {
+    /// Shades the drawn band `drawn` into the same rows `out` of the frame, every pixel of
+    /// them written.
+    pub fn rows(&self, drawn: &GBuffer, out: FrameRows<'_>) -> ShadeCounts {
         let any_fallback = self.fallback.iter().any(|&f| f);
-        let width = drawn.width as usize;
+        let (width, rows) = (drawn.width(), drawn.rows());
         let mut counts = ShadeCounts::default();
-        for (row, y) in (drawn.rows.0..drawn.rows.1).enumerate() {
-            for x in 0..drawn.width {
-                let i = row * width + x as usize;
-                let key = drawn.primitives[i];
+        for (row, y) in (rows.0..rows.1).enumerate() {
+            for x in 0..width {
+                let i = row * width as usize + x as usize;
+                let key = drawn.keys[i];
                 let pixel = if any_fallback && self.in_fallback(x, y) {
                     self.cast(x, y)
                 } else if key == NO_PRIMITIVE {
                     None
                 } else {
-                    self.rasterised(key, drawn.depth[i], drawn.color[i], x, y)
+                    let barycentric = Vec2::from(drawn.barycentrics[i]);
+                    self.rasterised(key, drawn.depth[i], barycentric, x, y)
                 };
                 let p = pixel.unwrap_or(Pixel {
                     color: self.background,
@@ -290,15 +295,14 @@ impl Shader<'_> {
             .is_some_and(|(triangle, _, _)| self.fallback[triangle])
     }
 
-    /// Pixel `(x, y)`'s winning fragment (`key`, G-buffer depth and stored barycentrics),
-    /// shaded. An exact winner is read from the G-buffer (module doc) and its projector's
+    /// Pixel `(x, y)`'s winning fragment (`key`, G-buffer depth and barycentrics), shaded. An exact winner is read from the G-buffer (module doc) and its projector's
     /// origin is built only if shading needs the ray (`RayCaster::shade_hit_lazy`); a crack
     /// filler is resolved again. `None` where there is no hit after all (no projector).
-    fn rasterised(&self, key: u64, depth: f64, stored: Vec3, x: u32, y: u32) -> Option<Pixel> {
+    #[inline]
+    fn rasterised(&self, key: u64, depth: f64, barycentric: Vec2, x: u32, y: u32) -> Option<Pixel> {
         let position = self.resolver.position(x, y);
         if depth < CRACK_FILL_DEPTH {
             let projector = self.resolver.maps[(key >> 32) as usize].projector(position)?;
-            let barycentric = DVec2::new(f64::from(stored.x), f64::from(stored.y));
             Some(
                 self.shaded(key, depth, barycentric, projector.direction, || {
                     projector.ray()
@@ -307,18 +311,20 @@ impl Shader<'_> {
         } else {
             let found = self.resolver.hit(key, position)?;
             let ray = found.ray;
-            Some(self.shaded(found.key, found.t, found.barycentric, ray.direction, || ray))
+            let barycentric = found.barycentric.as_vec2();
+            Some(self.shaded(found.key, found.t, barycentric, ray.direction, || ray))
         }
     }
 
     /// The hit at ray parameter `t` and `barycentric` of the scene triangle named by `key`
     /// on the projector along `direction`, shaded (flat: from [`Shader::flat_colors`]
     /// where it has the triangle); `ray` builds the whole projector.
+    #[inline]
     fn shaded(
         &self,
         key: u64,
         t: f64,
-        barycentric: DVec2,
+        barycentric: Vec2,
         direction: DVec3,
         ray: impl FnOnce() -> Ray,
     ) -> Pixel {
@@ -326,13 +332,13 @@ impl Shader<'_> {
         let owner = self.resolver.scene.owners[k];
         let flat = self.flat_colors.and_then(|colors| colors[k].as_ref());
         let (color, rays) = match flat {
-            Some(color) => (color.at(barycentric.as_vec2()), 0),
+            Some(color) => (color.at(barycentric), 0),
             None => {
                 let hit = Hit {
                     t,
                     object: owner.object as usize,
                     triangle: owner.triangle as usize,
-                    barycentric: barycentric.as_vec2(),
+                    barycentric,
                 };
                 self.caster.shade_hit_lazy(ray, hit, self.options)
             }

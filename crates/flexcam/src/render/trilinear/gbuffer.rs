@@ -1,0 +1,136 @@
+//! The band-local G-buffer of trilinear rasterisation: the shapes of one band of rows are
+//! drawn span by span ([`crate::render::raster::spans`]), each fragment finished to its exact
+//! hit by the stage of [`Resolver`] and z-tested, and the band is then shaded from it
+//! ([`super::shade::Shader::rows`]).
+//!
+//! Along a span the hit terms are stepped (the value at the next pixel centre is the value
+//! here plus the span's per-pixel change, [`Span::start_and_step`]) instead of interpolated
+//! pixel by pixel, and the exact case (inside the fragment's own triangle, in front of the
+//! view plane) is z-tested and written without building a fragment; the general path
+//! ([`Resolver::hit`]) is taken only outside the triangle. Per pixel the buffer keeps what
+//! shading reads: the winner's depth (exact `t`, pushed back for a crack filler), its key,
+//! and its scene barycentrics (`f32`, the precision `Hit` carries). 24 bytes a pixel.
+//!
+//! The z-test is the rasteriser's: the fragment wins when `(depth, key)` is
+//! lexicographically smaller than the stored pair, so the result depends neither on the
+//! order of the shapes nor on the band size or thread count.
+
+use glam::DVec2;
+
+use super::hit_terms::{Terms, TERMS};
+use super::shade::Resolver;
+use crate::render::raster::{spans, FillRule, Polygon, RasterStats, Scratch, Span, NO_PRIMITIVE};
+
+/// The drawn state of one band of rows.
+#[derive(Debug, Clone)]
+pub struct GBuffer {
+    width: u32,
+    /// The rows `[rows.0, rows.1)` of the image the buffer holds now.
+    rows: (u32, u32),
+    /// The winner's depth; `f64::INFINITY` where nothing was drawn.
+    pub(super) depth: Vec<f64>,
+    /// The winner's key; [`NO_PRIMITIVE`] where nothing was drawn.
+    pub(super) keys: Vec<u64>,
+    /// The winner's scene barycentrics (weights of the second and third corners); only
+    /// meaningful where a key was written.
+    pub(super) barycentrics: Vec<[f32; 2]>,
+}
+
+impl GBuffer {
+    /// A buffer for bands of up to `rows` rows of an image `width` pixels wide.
+    pub fn new(width: u32, rows: u32) -> GBuffer {
+        let n = width as usize * rows as usize;
+        GBuffer {
+            width,
+            rows: (0, 0),
+            depth: vec![f64::INFINITY; n],
+            keys: vec![NO_PRIMITIVE; n],
+            barycentrics: vec![[0.0; 2]; n],
+        }
+    }
+
+    /// Empties the buffer for rows `rows` of the image (at most as many rows as it was made
+    /// for). The barycentrics are not cleared: they are read only where a key was written.
+    pub fn start_band(&mut self, rows: (u32, u32)) {
+        let n = (rows.1 - rows.0) as usize * self.width as usize;
+        self.rows = rows;
+        self.depth[..n].fill(f64::INFINITY);
+        self.keys[..n].fill(NO_PRIMITIVE);
+    }
+
+    /// Draws `polygon` (whose vertices carry the hit terms of its own scene triangle) into
+    /// the band by the non-zero rule, finishing each fragment with `resolver`'s stage before
+    /// the z-test. Returns the fragment counts (`covered`: pixels this shape was the first
+    /// to cover).
+    pub fn draw(
+        &mut self,
+        polygon: &Polygon<'_, TERMS>,
+        resolver: &Resolver<'_>,
+        scratch: &mut Scratch<TERMS>,
+    ) -> RasterStats {
+        let mut counts = RasterStats::default();
+        let (rows, width) = (self.rows, self.width);
+        spans(polygon, FillRule::NonZero, rows, width, scratch, |span| {
+            self.span(span, polygon.primitive, resolver, &mut counts);
+        });
+        counts
+    }
+
+    /// One span of a shape keyed `key`. Degenerate case: the step of a one-pixel span (a
+    /// line's pixel, a sliver's) may be huge or infinite where its crossings nearly
+    /// coincide; it is only added after the span's last pixel, never read.
+    #[inline]
+    fn span(
+        &mut self,
+        span: &Span<'_, TERMS>,
+        key: u64,
+        resolver: &Resolver<'_>,
+        counts: &mut RasterStats,
+    ) {
+        let (start, step) = span.start_and_step();
+        let mut terms: Terms = start.attributes;
+        let row = (span.y - self.rows.0) as usize * self.width as usize;
+        counts.fragments += u64::from(span.x1 - span.x0);
+        for x in span.x0..span.x1 {
+            let staged = resolver.staged(key, &terms, x, span.y);
+            match staged {
+                Some((key, depth, barycentric)) => {
+                    self.test_and_write(row + x as usize, key, depth, barycentric, counts)
+                }
+                None => counts.discarded += 1,
+            }
+            for (term, change) in terms.iter_mut().zip(&step.attributes) {
+                *term += change;
+            }
+        }
+    }
+
+    /// The z-test of a staged fragment at index `i` of the band, and its write on a win.
+    #[inline]
+    fn test_and_write(
+        &mut self,
+        i: usize,
+        key: u64,
+        depth: f64,
+        barycentric: DVec2,
+        counts: &mut RasterStats,
+    ) {
+        let (stored_depth, stored_key) = (self.depth[i], self.keys[i]);
+        if depth < stored_depth || (depth == stored_depth && key < stored_key) {
+            counts.writes += 1;
+            counts.covered += u64::from(stored_key == NO_PRIMITIVE);
+            self.depth[i] = depth;
+            self.keys[i] = key;
+            self.barycentrics[i] = [barycentric.x as f32, barycentric.y as f32];
+        }
+    }
+
+    /// The band's rows.
+    pub fn rows(&self) -> (u32, u32) {
+        self.rows
+    }
+
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+}
