@@ -77,24 +77,39 @@ impl EdgePath<'_> {
 
 /// The surface swept by one edge of a projection triangle, `r_i(t) + s (r_j(t) - r_i(t))`
 /// (Eq. 5.1 corrected), in coordinates centred on `p_i` (the coplanarity test is invariant
-/// under translation; centring avoids cancellation far from the origin).
+/// under translation; centring avoids cancellation far from the origin). The products of
+/// the edge's own vectors that every crossing needs are kept with it.
 #[derive(Debug, Clone, Copy)]
 pub struct EdgeSurface {
     origin: DVec3,
     /// `p_j - p_i`.
     base: DVec3,
-    n_i: DVec3,
-    n_j: DVec3,
+    /// `n_i x n_j`.
+    normals_cross: DVec3,
+    /// `n_i x base`.
+    normal_base_cross: DVec3,
+    /// `n_i - n_j`.
+    normals_difference: DVec3,
 }
+
+/// How far from zero, relative to the size of its terms (`|c2| t^2 + |c1| |t| + |c0|`),
+/// the crossing quadratic must stay over a depth range for
+/// [`EdgeSurface::crossing_depths_between`] to skip its roots. The root finder's estimates
+/// have residuals of a few `f64::EPSILON` of that size (its tangency window accepts
+/// `64 EPSILON` of the discriminant's), six orders of magnitude below this bound, so a
+/// range the bound clears holds no root the solver could return.
+const CLEAR_OF_ROOTS: f64 = 1e-9;
 
 impl EdgeSurface {
     /// The surface of the edge from vertex `(p_i, n_i)` to `(p_j, n_j)`.
     pub fn new((p_i, n_i): (DVec3, DVec3), (p_j, n_j): (DVec3, DVec3)) -> EdgeSurface {
+        let base = p_j - p_i;
         EdgeSurface {
             origin: p_i,
-            base: p_j - p_i,
-            n_i,
-            n_j,
+            base,
+            normals_cross: n_i.cross(n_j),
+            normal_base_cross: n_i.cross(base),
+            normals_difference: n_i - n_j,
         }
     }
 
@@ -107,13 +122,63 @@ impl EdgeSurface {
     /// Degenerate cases: a line coplanar with the edge at every depth (all coefficients zero)
     /// or never (a nonzero constant) gives no depth; a degree drop gives the remaining root.
     pub fn crossing_depths(&self, s1: DVec3, s2: DVec3) -> impl Iterator<Item = f64> {
-        let (s1, s2) = (s1 - self.origin, s2 - self.origin);
-        let d = s1 - s2;
-        let c2 = d.dot(self.n_i.cross(self.n_j));
-        let c1 = d.dot(self.n_i.cross(self.base)) + s1.dot(s2.cross(self.n_i - self.n_j));
-        let c0 = -s1.dot(s2.cross(self.base));
+        let [c2, c1, c0] = self.coefficients(s1, s2);
         solve_quadratic(c2, c1, c0).into_iter()
     }
+
+    /// [`EdgeSurface::crossing_depths`], except that none is given when the quadratic
+    /// provably has no root in `[lo, hi]` (then none of them lies strictly between `lo`
+    /// and `hi`, which is all an outline needs): its value at `lo`, at `hi` and at its
+    /// extremum (where that is inside) has one sign and is larger than [`CLEAR_OF_ROOTS`]
+    /// times the size of its terms at either end (that size is convex in `t`, so the
+    /// quadratic clears the bound over the whole range). Most polygon edges of a small
+    /// projection triangle cross no edge surface; this skips their root finding.
+    ///
+    /// Degenerate cases: an empty or reversed range (`lo >= hi`) has no depth strictly
+    /// inside and gives none; non-finite coefficients or bounds, a quadratic vanishing
+    /// identically or nearly touching zero in the range fail the test and go to the root
+    /// finder, as in [`EdgeSurface::crossing_depths`].
+    pub fn crossing_depths_between(
+        &self,
+        s1: DVec3,
+        s2: DVec3,
+        (lo, hi): (f64, f64),
+    ) -> impl Iterator<Item = f64> {
+        let [c2, c1, c0] = self.coefficients(s1, s2);
+        let has_inside = lo < hi;
+        let skip = !has_inside || clear_of_roots([c2, c1, c0], lo, hi);
+        let roots = (!skip).then(|| solve_quadratic(c2, c1, c0));
+        roots.into_iter().flatten()
+    }
+
+    /// `[c2, c1, c0]` of [`EdgeSurface::crossing_depths`] for the line through `s1`, `s2`.
+    fn coefficients(&self, s1: DVec3, s2: DVec3) -> [f64; 3] {
+        let (s1, s2) = (s1 - self.origin, s2 - self.origin);
+        let d = s1 - s2;
+        let c2 = d.dot(self.normals_cross);
+        let c1 = d.dot(self.normal_base_cross) + s1.dot(s2.cross(self.normals_difference));
+        let c0 = -s1.dot(s2.cross(self.base));
+        [c2, c1, c0]
+    }
+}
+
+/// Whether `c2 t^2 + c1 t + c0` keeps one sign over `[lo, hi]`, away from zero by more than
+/// [`CLEAR_OF_ROOTS`] times the size of its terms there (see
+/// [`EdgeSurface::crossing_depths_between`]); `false` for any non-finite input.
+fn clear_of_roots([c2, c1, c0]: [f64; 3], lo: f64, hi: f64) -> bool {
+    let value = |t: f64| (c2 * t + c1) * t + c0;
+    let size = |t: f64| (c2.abs() * t.abs() + c1.abs()) * t.abs() + c0.abs();
+    let bound = CLEAR_OF_ROOTS * size(lo).max(size(hi));
+    let (at_lo, at_hi) = (value(lo), value(hi));
+    // `c2 != 0` with the extremum strictly inside: its value must clear the bound too.
+    let extremum = -c1 / (2.0 * c2);
+    let at_extremum = if lo < extremum && extremum < hi {
+        value(extremum)
+    } else {
+        at_lo
+    };
+    let clear = |x: f64| x.abs() > bound && x.signum() == at_lo.signum();
+    bound.is_finite() && clear(at_lo) && clear(at_hi) && clear(at_extremum)
 }
 
 /// Appends to `out` the interior samples of the edge piece from `a` to `b` (both images on
@@ -131,16 +196,29 @@ pub fn refine(
     levels: u32,
     out: &mut Vec<OutlinePoint>,
 ) {
-    if levels == 0 {
-        return;
-    }
     let t = 0.5 * (a.t + b.t);
-    if t == a.t || t == b.t {
+    if levels == 0 || t == a.t || t == b.t {
         return;
     }
-    let Some(middle) = path.at(t) else {
+    if let Some(middle) = path.at(t) {
+        refine_around(path, map, (a, middle, b), tolerance, levels, out);
+    }
+}
+
+/// [`refine`] of the piece from `a` to `b` whose image at the middle depth,
+/// `path.at(0.5 (a.t + b.t))`, is `middle`, already computed by the caller (the outline
+/// tracer computes it to decide whether the piece is visible at all).
+pub fn refine_around(
+    path: &EdgePath,
+    map: &ScreenMap,
+    (a, middle, b): (OutlinePoint, OutlinePoint, OutlinePoint),
+    tolerance: f64,
+    levels: u32,
+    out: &mut Vec<OutlinePoint>,
+) {
+    if levels == 0 || middle.t == a.t || middle.t == b.t {
         return;
-    };
+    }
     let (pa, pb, pm) = (
         map.pixel(a.u, a.v),
         map.pixel(b.u, b.v),
@@ -229,6 +307,94 @@ mod tests {
                     prop_assert!(u.abs() < 1e-7, "t {t} u {u}");
                 }
             }
+        }
+    }
+
+    /// The roots strictly inside `(lo, hi)`, in the solver's order.
+    fn inside(depths: impl Iterator<Item = f64>, (lo, hi): (f64, f64)) -> Vec<f64> {
+        depths.filter(|&t| lo < t && t < hi).collect()
+    }
+
+    proptest! {
+        /// The filtered crossings are exactly the unfiltered ones inside the range, for
+        /// random ranges and for ranges ending at, just short of and just past each root.
+        #[test]
+        fn crossings_between_are_the_crossings_inside_the_range(
+            a in (-3.0..3.0f64, -3.0..3.0f64, 0.5..6.0f64),
+            b in (-3.0..3.0f64, -3.0..3.0f64, 0.5..6.0f64),
+            lo in -4.0..8.0f64,
+            length in 0.0..8.0f64,
+            edge in 0usize..3,
+        ) {
+            let (p, n) = triangle();
+            let [i, j] = [[0, 2], [0, 1], [1, 2]][edge];
+            let surface = EdgeSurface::new((p[i], n[i]), (p[j], n[j]));
+            let (a, b) = (DVec3::new(a.0, a.1, a.2), DVec3::new(b.0, b.1, b.2));
+            let mut ranges = vec![(lo, lo + length)];
+            for r in surface.crossing_depths(a, b) {
+                let tiny = 1e-12 * (1.0 + r.abs());
+                ranges.extend([
+                    (r - length, r),
+                    (r, r + length),
+                    (r - tiny, r + tiny),
+                    (r - length, r - tiny),
+                    (r + tiny, r + length),
+                    (r, r),
+                ]);
+            }
+            for range in ranges {
+                prop_assert_eq!(
+                    inside(surface.crossing_depths_between(a, b, range), range),
+                    inside(surface.crossing_depths(a, b), range),
+                    "range {:?}", range
+                );
+            }
+        }
+    }
+
+    /// The cases of `clear_of_roots`: a root or tangency in the range, a near-tangency (no
+    /// real root, but within rounding of one), a degree drop, an identically zero or
+    /// non-finite quadratic, and an empty range.
+    #[test]
+    fn clear_of_roots_only_where_no_root_can_be() {
+        // (t - 1)^2: clear of [0, 0.5] and [1.5, 3], not of ranges reaching 1.
+        assert!(clear_of_roots([1.0, -2.0, 1.0], 0.0, 0.5));
+        assert!(clear_of_roots([1.0, -2.0, 1.0], 1.5, 3.0));
+        assert!(!clear_of_roots([1.0, -2.0, 1.0], 0.0, 2.0));
+        assert!(!clear_of_roots([1.0, -2.0, 1.0], 0.5, 1.0));
+        // Complex roots 1e-7 off the axis: the solver's tangency window may still report
+        // a double root at 1, so the range around it is not clear; far from it, it is.
+        assert!(!clear_of_roots([1.0, -2.0, 1.0 + 1e-14], 0.0, 2.0));
+        assert!(clear_of_roots([1.0, -2.0, 1.0 + 1e-14], 2.0, 3.0));
+        // Two simple roots, 1 and 3, the extremum (2) between them: clear between the
+        // roots, not across either.
+        assert!(clear_of_roots([1.0, -4.0, 3.0], 1.5, 2.5));
+        assert!(!clear_of_roots([1.0, -4.0, 3.0], 0.5, 1.5));
+        assert!(!clear_of_roots([1.0, -4.0, 3.0], 2.5, 3.5));
+        assert!(!clear_of_roots([1.0, -4.0, 3.0], 0.0, 4.0));
+        // Linear (c2 = 0): root at 1.
+        assert!(clear_of_roots([0.0, 1.0, -1.0], 0.0, 0.5));
+        assert!(!clear_of_roots([0.0, 1.0, -1.0], 0.0, 2.0));
+        // A nonzero constant never crosses; zero everywhere, non-finite input: not clear.
+        assert!(clear_of_roots([0.0, 0.0, 2.0], -5.0, 5.0));
+        assert!(!clear_of_roots([0.0; 3], 0.0, 1.0));
+        assert!(!clear_of_roots([f64::NAN, 1.0, 1.0], 0.0, 1.0));
+        assert!(!clear_of_roots([1.0, 0.0, 1.0], 0.0, f64::INFINITY));
+        // The segment of `crossing_of_a_known_point`, crossing the edge surface at t = 2:
+        // found in a range around 2; an empty or reversed range gives no crossing at all.
+        let (p, n) = triangle();
+        let cache = ProjectionTriangleCache::new(p, n);
+        let surface = EdgeSurface::new((p[0], n[0]), (p[2], n[2]));
+        let on_edge = cache.ray_point(0.0, 0.4, 2.0);
+        let offset = DVec3::new(0.7, 0.2, -0.3);
+        let (a, b) = (on_edge + offset, on_edge - offset * 1.5);
+        let found = inside(
+            surface.crossing_depths_between(a, b, (1.0, 3.0)),
+            (1.0, 3.0),
+        );
+        assert!(found.iter().any(|t| (t - 2.0).abs() < 1e-10), "{found:?}");
+        for range in [(2.0, 2.0), (3.0, 1.0), (f64::NAN, 3.0)] {
+            assert_eq!(surface.crossing_depths_between(a, b, range).count(), 0);
         }
     }
 

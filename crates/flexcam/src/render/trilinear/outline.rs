@@ -4,7 +4,7 @@
 
 use glam::DVec3;
 
-use super::edge_path::{refine, EdgePath, EdgeSurface, OutlinePoint};
+use super::edge_path::{refine_around, EdgePath, EdgeSurface, OutlinePoint};
 use super::screen_map::ScreenMap;
 use super::volume_bounds::VolumeBounds;
 use crate::projection::{Shape, ShapeVertex};
@@ -112,7 +112,7 @@ fn anchors(
     let mut count = 0;
     let candidates = surfaces
         .iter()
-        .flat_map(|s| s.crossing_depths(path.a, path.b))
+        .flat_map(|s| s.crossing_depths_between(path.a, path.b, (lo, hi)))
         .chain(std::iter::once(0.0));
     for t in candidates {
         if lo < t && t < hi && count < MAX_ANCHORS {
@@ -130,7 +130,8 @@ fn anchors(
 
 /// Appends the curve samples of the piece between two consecutive outline points (excluded)
 /// if the piece is visible: between anchors a piece is wholly visible or wholly clipped, so
-/// the image at its middle depth decides. Without `scene_clipping` only the `t = 0` anchor
+/// the image at its middle depth decides (and is the first bisection point of adaptive
+/// sampling, not computed twice). Without `scene_clipping` only the `t = 0` anchor
 /// separates pieces, so only a piece behind the view plane is skipped.
 fn sample_piece(
     triangle: &ProjectionTriangle,
@@ -142,13 +143,14 @@ fn sample_piece(
     if matches!(sampling, Sampling::Anchors) {
         return;
     }
-    let visible = path.at(0.5 * (a.t + b.t)).is_some_and(|middle| {
-        if scene_clipping {
-            middle.is_visible(0.0)
-        } else {
-            middle.t >= 0.0
-        }
-    });
+    let Some(middle) = path.at(0.5 * (a.t + b.t)) else {
+        return;
+    };
+    let visible = if scene_clipping {
+        middle.is_visible(0.0)
+    } else {
+        middle.t >= 0.0
+    };
     if !visible {
         return;
     }
@@ -164,7 +166,7 @@ fn sample_piece(
             }
         }
         Sampling::Adaptive { tolerance, levels } => {
-            refine(path, &triangle.map, (a, b), tolerance, levels, out)
+            refine_around(path, &triangle.map, (a, middle, b), tolerance, levels, out)
         }
     }
 }
