@@ -60,7 +60,7 @@
 //! start's own projectors to the points in 8 stages) with steps limited to 0.2 rad (the same
 //! 9 grids), and an alternating start (depths fixed, the node control points and ends by
 //! linear least squares, put back on the constraint): for fixed depths the free problem is
-//! badly conditioned, its control points landing far off the constraint (up to 2,700 times
+//! badly conditioned, its control points landing far off the constraint (up to 2,750 times
 //! the half length on Bezier grids), and the start was no better.
 //!
 //! Identifiability: with fewer correspondences than twice the free nodes (each fixes two of a
