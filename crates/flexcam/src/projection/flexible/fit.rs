@@ -716,8 +716,7 @@ mod tests {
 
     #[test]
     fn recovers_curved_projector_grids_from_their_own_correspondences() {
-        // One grid: the iteration does not reach the known grid from every random one (it
-        // can stop in a local minimum with a point at depth 0; docs/flexible.md).
+        // One grid, with tight bounds (random ones: recovers_random_curved_grids_or_shows_the_miss).
         let truth = curved_truth(GridInterpolation::Bilinear, 0.3, 3);
         let (report, [end, tangent, point]) = recover_curved(&truth, 12, 13).unwrap();
         eprintln!("{report:?}, errors end {end:e}, tangent {tangent:e} rad, Q {point:e}");
@@ -756,43 +755,53 @@ mod tests {
 
     #[test]
     fn recovers_random_straight_grids_and_reports_noise() {
-        // 24 random bilinear grids (every node's end turned up to about 6 degrees), fitted
-        // from the untouched 60-degree camera: all recovered. (Bezier grids are not: some
-        // random ones end with a projector pointing away from a point; docs/flexible.md.)
+        // 24 random grids of each interpolation (every node's end turned up to about 6
+        // degrees), fitted from the untouched 60-degree camera: all recovered from exact
+        // data. Noise is checked on bilinear grids only: on Bezier grids noise of 1e-3 rad
+        // can turn a weakly determined node combination until a projector points away from
+        // its point (the fit then refuses; docs/flexible.md).
         let sigma: f64 = 1e-3;
-        let interpolation = GridInterpolation::Bilinear;
-        let prior =
-            ProjectorGrid::sample(&perspective(60.0, [1.0, 30.0]), (5, 5), interpolation).unwrap();
-        let (mut exact_worst, mut noisy_worst) = (0.0f64, 0.0f64);
-        let mut rms_range = (f64::INFINITY, 0.0f64);
-        for seed in 0..24 {
-            let truth = curved_truth(interpolation, 0.0, seed).straightened();
-            let data = correspondences_of(&truth, 12, 200 + seed);
-            let (fitted, report) = fit(&prior, &data).unwrap();
-            assert!(report.max_angle_deg < 1e-6, "seed {seed}: {report:?}");
-            exact_worst = exact_worst.max(max_direction_error(&fitted, &truth));
-            // Noise: a residual of about its size is reported, no error.
-            let noisy = with_noise(&truth, &data, sigma, 300 + seed);
-            let (fitted, report) = fit(&prior, &noisy).unwrap();
-            noisy_worst = noisy_worst.max(max_direction_error(&fitted, &truth));
-            let rms = report.rms_angle_deg.to_radians();
-            rms_range = (rms_range.0.min(rms), rms_range.1.max(rms));
+        for interpolation in [GridInterpolation::Bilinear, GridInterpolation::Bezier] {
+            let prior =
+                ProjectorGrid::sample(&perspective(60.0, [1.0, 30.0]), (5, 5), interpolation)
+                    .unwrap();
+            let (mut exact_worst, mut noisy_worst) = (0.0f64, 0.0f64);
+            let mut rms_range = (f64::INFINITY, 0.0f64);
+            for seed in 0..24 {
+                let truth = curved_truth(interpolation, 0.0, seed).straightened();
+                let data = correspondences_of(&truth, 12, 200 + seed);
+                let (fitted, report) = fit(&prior, &data).unwrap();
+                assert!(report.max_angle_deg < 1e-6, "seed {seed}: {report:?}");
+                exact_worst = exact_worst.max(max_direction_error(&fitted, &truth));
+                if interpolation == GridInterpolation::Bezier {
+                    continue;
+                }
+                // Noise: a residual of about its size is reported, no error.
+                let noisy = with_noise(&truth, &data, sigma, 300 + seed);
+                let (fitted, report) = fit(&prior, &noisy).unwrap();
+                noisy_worst = noisy_worst.max(max_direction_error(&fitted, &truth));
+                let rms = report.rms_angle_deg.to_radians();
+                rms_range = (rms_range.0.min(rms), rms_range.1.max(rms));
+            }
+            eprintln!("{interpolation:?}: exact {exact_worst:e} rad");
+            assert!(exact_worst < 1e-7, "{interpolation:?}: {exact_worst}");
+            if interpolation == GridInterpolation::Bezier {
+                continue;
+            }
+            eprintln!(
+                "noise {sigma}: direction error {noisy_worst:e} rad, rms residual {rms_range:?} rad"
+            );
+            // Noise of up to sigma per axis has an rms angle of sigma * sqrt(2 / 3); the fit
+            // absorbs a part of it (75 unknowns for 288 equations).
+            assert!(
+                rms_range.0 > 0.4 * sigma && rms_range.1 < sigma,
+                "{interpolation:?}: {rms_range:?}"
+            );
+            assert!(
+                noisy_worst < 10.0 * sigma,
+                "{interpolation:?}: {noisy_worst}"
+            );
         }
-        eprintln!(
-            "{interpolation:?}: exact {exact_worst:e} rad; noise {sigma}: direction error \
-             {noisy_worst:e} rad, rms residual {rms_range:?} rad"
-        );
-        assert!(exact_worst < 1e-7, "{interpolation:?}: {exact_worst}");
-        // Noise of up to sigma per axis has an rms angle of sigma * sqrt(2 / 3); the fit
-        // absorbs a part of it (75 unknowns for 288 equations).
-        assert!(
-            rms_range.0 > 0.4 * sigma && rms_range.1 < sigma,
-            "{interpolation:?}: {rms_range:?}"
-        );
-        assert!(
-            noisy_worst < 10.0 * sigma,
-            "{interpolation:?}: {noisy_worst}"
-        );
     }
 
     #[test]
@@ -863,13 +872,18 @@ mod tests {
 
     #[test]
     fn recovers_random_curved_grids_or_shows_the_miss() {
-        // 24 random grids of each interpolation (seeded; bend 0.03 to 0.43 rad, 144 exact
-        // correspondences): every fit either recovers its grid to 1e-7 or reports a residual
-        // above 1e-3 degrees (a wrong local minimum is never silent), and at least the
-        // measured 9 bilinear grids are recovered (docs/flexible.md: the rest is not solved).
-        for interpolation in [GridInterpolation::Bilinear, GridInterpolation::Bezier] {
+        // Random grids (seeded; bend 0.03 to 0.43 rad, 144 exact correspondences): 24
+        // bilinear and 8 Bezier ones (a Bezier fit takes about 2 s here, every point weighting
+        // every node). Every fit either recovers its grid to 1e-7 or reports a residual above
+        // 1e-3 degrees (a wrong local minimum is never silent); the counts are the measured
+        // ones (docs/flexible.md).
+        for (interpolation, grids, expected) in [
+            (GridInterpolation::Bilinear, 0..24, 24),
+            (GridInterpolation::Bezier, 0..8, 8),
+        ] {
             let mut recovered = 0;
-            for seed in 0..24 {
+            let mut worst = [0.0f64; 3];
+            for seed in grids {
                 let bend = 0.03
                     + 0.4 * {
                         let mut next = uniform(1000 + seed);
@@ -877,18 +891,28 @@ mod tests {
                     };
                 let truth = curved_truth(interpolation, bend, seed);
                 match recover_curved(&truth, 12, 100 + seed) {
-                    Ok((_, errors)) if errors.iter().all(|e| *e < 1e-7) => recovered += 1,
-                    Ok((report, errors)) => assert!(
-                        report.max_angle_deg > 1e-3,
-                        "{interpolation:?} seed {seed}: {report:?} {errors:?}"
-                    ),
+                    Ok((_, errors)) if errors.iter().all(|e| *e < 1e-7) => {
+                        recovered += 1;
+                        for (w, e) in worst.iter_mut().zip(errors) {
+                            *w = w.max(e);
+                        }
+                    }
+                    Ok((report, errors)) => {
+                        eprintln!("{interpolation:?} seed {seed}: {report:?} {errors:?}");
+                        assert!(
+                            report.max_angle_deg > 1e-3,
+                            "{interpolation:?} seed {seed}: {report:?} {errors:?}"
+                        );
+                    }
                     Err(e) => eprintln!("{interpolation:?} seed {seed}: {e}"),
                 }
             }
-            eprintln!("{interpolation:?}: {recovered} of 24 recovered");
-            if interpolation == GridInterpolation::Bilinear {
-                assert!(recovered >= 9, "{recovered} of 24");
-            }
+            eprintln!(
+                "{interpolation:?}: {recovered} recovered, worst end {:e}, tangent {:e} rad, \
+                 Q {:e}",
+                worst[0], worst[1], worst[2]
+            );
+            assert_eq!(recovered, expected, "{interpolation:?}");
         }
     }
 
