@@ -1278,11 +1278,11 @@ mod tests {
             for (i, lane) in lanes.iter().enumerate() {
                 let alone = present >> i & 1 == 1 && lane.meets(c - half, c + half);
                 assert_eq!(mask >> i & 1 == 1, alone, "lane {i}");
-                (met, missed) = if alone {
-                    (met + 1, missed)
+                if alone {
+                    met += 1;
                 } else {
-                    (met, missed + 1)
-                };
+                    missed += 1;
+                }
             }
         }
         // Both outcomes occur often (about 5 % of the present lanes meet their box).
