@@ -39,6 +39,15 @@ impl Node {
         }
     }
 
+    /// The box `(min, max)` of child `k` (0 or 1).
+    #[inline(always)]
+    fn child_box(&self, k: usize) -> (Vec3, Vec3) {
+        let p = &self.planes;
+        let min = Vec3::new(p[0][k], p[1][k], p[2][k]);
+        let max = -Vec3::new(p[0][k + 2], p[1][k + 2], p[2][k + 2]);
+        (min, max)
+    }
+
     /// Entry parameters of the ray into the two children's boxes (infinity for a box it
     /// misses within `[t_min, t_max]`), as [`box_entry`] computes them, bit for bit.
     #[inline(always)]
@@ -179,7 +188,7 @@ impl Packet {
 }
 
 /// The points within `pad` of the segment from `origin` to `origin + direction`, in f32, for
-/// [`Bvh::visit_near_segment`]. A zero direction is allowed (the segment is a point).
+/// [`Bvh::visit_near_segments4`]. A zero direction is allowed (the segment is a point).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct NearSegment {
     origin: Vec3A,
@@ -222,6 +231,61 @@ impl NearSegment {
         let near = t0.min(t1).max_element().max(0.0);
         let far = t0.max(t1).min_element().min(1.0);
         near <= far + far.abs() * ROBUST_SLACK
+    }
+}
+
+/// Up to four [`NearSegment`]s in SoA form, tested against a box at once for
+/// [`Bvh::visit_near_segments4`]: lane `i` is segment `i`, each lane's test bit for bit that
+/// of [`NearSegment::meets`] (the same operations in the same order, per lane).
+pub(super) struct NearSegments4 {
+    origin: [Vec4; 3],
+    inv_direction: [Vec4; 3],
+    pad: Vec4,
+    /// Bit `i` set when lane `i` holds a segment.
+    lanes: u32,
+}
+
+impl NearSegments4 {
+    /// The segments present (`None`: an empty lane, never reported).
+    pub fn new(segments: [Option<&NearSegment>; 4]) -> NearSegments4 {
+        let fill = segments.iter().flatten().next().copied();
+        let lane = |i: usize| segments[i].or(fill);
+        let get = |f: &dyn Fn(&NearSegment) -> f32| {
+            Vec4::from_array(std::array::from_fn(|i| lane(i).map_or(0.0, f)))
+        };
+        let axis = |f: fn(Vec3A) -> f32| {
+            [
+                get(&|s: &NearSegment| f(s.origin)),
+                get(&|s: &NearSegment| f(s.inv_direction)),
+            ]
+        };
+        let [ox, ix] = axis(|v| v.x);
+        let [oy, iy] = axis(|v| v.y);
+        let [oz, iz] = axis(|v| v.z);
+        NearSegments4 {
+            origin: [ox, oy, oz],
+            inv_direction: [ix, iy, iz],
+            pad: get(&|s: &NearSegment| s.pad),
+            lanes: (0..4)
+                .filter(|&i| segments[i].is_some())
+                .fold(0, |bits, i| bits | 1 << i),
+        }
+    }
+
+    /// The lanes whose segment meets the box `[min, max]` enlarged by its pad.
+    #[inline(always)]
+    fn meets(&self, min: Vec3, max: Vec3) -> u32 {
+        let t = |axis: usize| {
+            let o = self.origin[axis];
+            let inv = self.inv_direction[axis];
+            let t0 = (Vec4::splat(min[axis]) - self.pad - o) * inv;
+            let t1 = (Vec4::splat(max[axis]) + self.pad - o) * inv;
+            (t0.min(t1), t0.max(t1))
+        };
+        let ((n0, f0), (n1, f1), (n2, f2)) = (t(0), t(1), t(2));
+        let near = n0.max(n1).max(n2).max(Vec4::ZERO);
+        let far = f0.min(f1).min(f2).min(Vec4::ONE);
+        near.cmple(far + far.abs() * ROBUST_SLACK).bitmask() & self.lanes
     }
 }
 
@@ -552,10 +616,15 @@ impl Bvh {
         !self.triangles.is_empty() && segment.meets(self.root_bounds.min, self.root_bounds.max)
     }
 
-    /// Every stored triangle, for tests that check a search against testing them all.
-    #[cfg(test)]
+    /// Every stored triangle, in stored order (the indices [`Bvh::visit_near_segments4`]
+    /// reports).
     pub fn all_triangles(&self) -> &[PackedTriangle] {
         &self.triangles
+    }
+
+    /// The build-input index of stored triangle `stored`.
+    pub fn id(&self, stored: usize) -> u32 {
+        self.ids[stored]
     }
 
     /// Whether the box `[min, max]` overlaps the box of the whole tree enlarged by
@@ -605,29 +674,50 @@ impl Bvh {
         )
     }
 
-    /// Calls `visit` with the build-input index and the triangle of every stored triangle in
-    /// every leaf whose box, enlarged by `segment.pad` on every side, the segment meets: a
-    /// conservative cull for anything that lies within `pad` of the segment (a curve inside
-    /// the convex hull of its control points, see [`NearSegment`]). Leaves are visited in
-    /// tree order, not by distance.
-    pub fn visit_near_segment(
+    /// Calls `visit` with the lane and the stored index (see [`Bvh::all_triangles`],
+    /// [`Bvh::id`]) of every triangle in every leaf whose box, enlarged by the lane's pad on
+    /// every side, the lane's segment meets: a conservative cull for anything that lies within
+    /// `pad` of the segment (a curve inside the convex hull of its control points, see
+    /// [`NearSegment`]). A lane enters a node exactly when its own segment meets every box on
+    /// the way, so each lane sees the triangles a walk of its segment alone would, in tree
+    /// order (increasing stored index), whatever the other lanes hold; the node visits are
+    /// shared, and one 4-wide test serves the four lanes.
+    pub fn visit_near_segments4(
         &self,
-        segment: &NearSegment,
-        mut visit: impl FnMut(u32, &PackedTriangle),
+        segments: &NearSegments4,
+        mut visit: impl FnMut(usize, usize),
     ) {
-        if !self.near_root(segment) {
+        if self.triangles.is_empty() {
             return;
         }
-        self.walk_leaves(
-            |min, max| segment.meets(min, max),
-            |leaf| {
-                let first = leaf.index as usize;
-                for i in first..first + leaf.count as usize {
-                    visit(self.ids[i], &self.triangles[i]);
+        let root = segments.meets(self.root_bounds.min, self.root_bounds.max);
+        let mut stack = [(self.root, root); STACK_SIZE];
+        let mut depth = usize::from(root != 0);
+        while depth > 0 {
+            depth -= 1;
+            let (current, lanes) = stack[depth];
+            if current.count > 0 {
+                let first = current.index as usize;
+                for stored in first..first + current.count as usize {
+                    let mut left = lanes;
+                    while left != 0 {
+                        visit(left.trailing_zeros() as usize, stored);
+                        left &= left - 1;
+                    }
                 }
-                false
-            },
-        );
+                continue;
+            }
+            let node = &self.nodes[current.index as usize];
+            // Push the second child first, so that the first is visited first (tree order).
+            for k in [1, 0] {
+                let (min, max) = node.child_box(k);
+                let entered = segments.meets(min, max) & lanes;
+                if entered != 0 {
+                    stack[depth] = (node.children[k], entered);
+                    depth += 1;
+                }
+            }
+        }
     }
 
     /// Walks the tree depth first, in tree order, into every child whose box (`min`, `max`)
@@ -654,12 +744,7 @@ impl Bvh {
             let node = &self.nodes[current.index as usize];
             // Push the second child first, so that the first is visited first (tree order).
             for k in [1, 0] {
-                let min = Vec3::new(node.planes[0][k], node.planes[1][k], node.planes[2][k]);
-                let max = -Vec3::new(
-                    node.planes[0][k + 2],
-                    node.planes[1][k + 2],
-                    node.planes[2][k + 2],
-                );
+                let (min, max) = node.child_box(k);
                 if enter(min, max) {
                     stack[depth] = node.children[k];
                     depth += 1;
@@ -1165,6 +1250,43 @@ mod tests {
         assert!(apart > 100 && root_only > 10, "{apart} {root_only}");
         assert!(bvh.leaves_overlap(DVec3::splat(f64::NAN), DVec3::ZERO));
         assert!(!Bvh::build(&[]).leaves_overlap(DVec3::ZERO, DVec3::ONE));
+    }
+
+    #[test]
+    fn four_segments_meet_a_box_exactly_when_each_does_alone() {
+        let mut rng = Rng(11);
+        let segment = |rng: &mut Rng| {
+            let origin = rng.vec(6.0).as_dvec3();
+            // Some directions with a zero component, some segments of zero length.
+            let mut direction = rng.vec(4.0).as_dvec3();
+            match (rng.next() * 4.0) as u32 {
+                0 => direction.y = 0.0,
+                1 => direction = DVec3::ZERO,
+                _ => {}
+            }
+            NearSegment::new(origin, direction, f64::from(rng.next()) * 0.5).unwrap()
+        };
+        let (mut met, mut missed) = (0, 0);
+        for _ in 0..2000 {
+            let lanes: [NearSegment; 4] = std::array::from_fn(|_| segment(&mut rng));
+            let present = (rng.next() * 16.0) as u32;
+            let four = NearSegments4::new(std::array::from_fn(|i| {
+                (present >> i & 1 == 1).then_some(&lanes[i])
+            }));
+            let (c, half) = (rng.vec(3.0), rng.vec(3.0).abs());
+            let mask = four.meets(c - half, c + half);
+            for (i, lane) in lanes.iter().enumerate() {
+                let alone = present >> i & 1 == 1 && lane.meets(c - half, c + half);
+                assert_eq!(mask >> i & 1 == 1, alone, "lane {i}");
+                if alone {
+                    met += 1;
+                } else {
+                    missed += 1;
+                }
+            }
+        }
+        // Both outcomes occur often (about 5 % of the present lanes meet their box).
+        assert!(met > 100 && missed > 1000, "{met} {missed}");
     }
 
     #[test]

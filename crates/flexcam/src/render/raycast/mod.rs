@@ -8,6 +8,7 @@
 
 mod bvh;
 mod curve;
+mod curve_triangle;
 mod hull_cull;
 pub(crate) mod optics;
 pub(crate) mod sampling;
@@ -16,6 +17,7 @@ mod tiles;
 mod triangle;
 pub mod workloads;
 
+use std::sync::OnceLock;
 use std::time::Instant;
 
 use glam::{DVec3, Vec2, Vec3};
@@ -24,6 +26,7 @@ pub(crate) use self::sampling::SamplePattern;
 pub(crate) use self::shade::specular;
 
 use self::bvh::Bvh;
+use self::curve_triangle::CurveTriangle;
 use self::triangle::FastRay;
 use crate::geometry::{intersect_triangle, Ray};
 use crate::projection::Projection;
@@ -66,6 +69,10 @@ pub struct RayCaster {
     offset: f64,
     triangle_count: usize,
     build_ms: f64,
+    /// The BVH's triangles in stored order with the quadratic search's tests precomputed,
+    /// built on the first quadratic search ([`RayCaster::curve_triangles`]): renders without
+    /// curved projectors neither pay for it nor hold it.
+    curve_triangles: OnceLock<Vec<CurveTriangle>>,
 }
 
 /// Secondary-ray offset relative to the scene's largest coordinate magnitude: 2^-16, about
@@ -106,7 +113,20 @@ impl RayCaster {
             offset: (extent as f64 * OFFSET_SCALE).max(f64::MIN_POSITIVE),
             triangle_count: triangles.len(),
             build_ms: start.elapsed().as_secs_f64() * 1e3,
+            curve_triangles: OnceLock::new(),
         }
+    }
+
+    /// The BVH's triangles as the quadratic search reads them, in stored order; built once,
+    /// on the first call.
+    fn curve_triangles(&self) -> &[CurveTriangle] {
+        self.curve_triangles.get_or_init(|| {
+            self.bvh
+                .all_triangles()
+                .iter()
+                .map(CurveTriangle::from_packed)
+                .collect()
+        })
     }
 
     /// The closest hit of `ray` with `t` in `[ray.t_min, ray.t_max]`, from either side of any

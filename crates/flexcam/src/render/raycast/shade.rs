@@ -203,14 +203,21 @@ impl<'a> Tracer<'a> {
                 self.shade_miss()
             }
             Some(Projector::QuadraticBezier(p)) => {
-                match self.caster.intersect_quadratic(p, self.live) {
-                    Some((s, found)) => {
-                        let ray = tangent_ray(p, s);
-                        self.shade(&ray, Some(found), quadratic_arc_length(p, s))
-                    }
-                    None => self.shade_miss(),
-                }
+                let found = self.caster.intersect_quadratic(p, self.live);
+                self.shade_quadratic(p, found)
             }
+        }
+    }
+
+    /// The sample of quadratic projector `p` whose first hit (curve parameter and hit) is
+    /// `found`: shaded along the tangent ray there, at the arc length up to it.
+    fn shade_quadratic(&mut self, p: &[DVec3; 3], found: Option<(f64, Hit32)>) -> Sample {
+        match found {
+            Some((s, found)) => {
+                let ray = tangent_ray(p, s);
+                self.shade(&ray, Some(found), quadratic_arc_length(p, s))
+            }
+            None => self.shade_miss(),
         }
     }
 
@@ -233,7 +240,8 @@ impl<'a> Tracer<'a> {
 
     /// The samples of four projectors (a 2x2 pixel quad): [`Tracer::sample4`] when all are
     /// straight (or absent), [`Tracer::sample4_polylines`] when all are polylines (or
-    /// absent), else one by one.
+    /// absent), [`Tracer::sample4_quadratics`] when all are quadratic (or absent), else one
+    /// by one.
     pub fn sample4_projectors(&mut self, projectors: &[Option<Projector>; 4]) -> [Sample; 4] {
         fn straight(p: &Option<Projector>) -> Option<Option<&Ray>> {
             match p {
@@ -252,12 +260,36 @@ impl<'a> Tracer<'a> {
         if let [Some(a), Some(b), Some(c), Some(d)] = projectors.each_ref().map(straight) {
             return self.sample4([a, b, c, d]);
         }
+        fn quadratic(p: &Option<Projector>) -> Option<Option<&[DVec3; 3]>> {
+            match p {
+                Some(Projector::QuadraticBezier(points)) => Some(Some(points)),
+                None => Some(None),
+                Some(_) => None,
+            }
+        }
         if let [Some(a), Some(b), Some(c), Some(d)] = projectors.each_ref().map(polyline) {
             return self.sample4_polylines([a, b, c, d]);
+        }
+        if let [Some(a), Some(b), Some(c), Some(d)] = projectors.each_ref().map(quadratic) {
+            return self.sample4_quadratics([a, b, c, d]);
         }
         projectors
             .each_ref()
             .map(|p| self.sample_projector(p.as_ref()))
+    }
+
+    /// The samples of four quadratic projectors (`None`: no projector), exactly those of
+    /// [`Tracer::sample_projector`] on each: their pieces are searched by shared BVH walks
+    /// ([`RayCaster::intersect_quadratic4`]).
+    fn sample4_quadratics(&mut self, curves: [Option<&[DVec3; 3]>; 4]) -> [Sample; 4] {
+        let found = self.caster.intersect_quadratic4(curves, self.live);
+        let mut samples = [self.sample(None); 4];
+        for ((sample, curve), found) in samples.iter_mut().zip(curves).zip(found) {
+            if let Some(p) = curve {
+                *sample = self.shade_quadratic(p, found);
+            }
+        }
+        samples
     }
 
     /// The samples of four polyline projectors (`None`: no projector), exactly those of
