@@ -46,6 +46,17 @@ pub struct Hit {
     pub barycentric: Vec2,
 }
 
+/// Segment `k` of polyline projector `points` as a ray over `t` in `[0, 1]`, from vertex `k`
+/// to vertex `k + 1` (a zero direction where the two coincide).
+fn polyline_segment(points: &[DVec3], k: usize) -> Ray {
+    Ray {
+        origin: points[k],
+        direction: points[k + 1] - points[k],
+        t_min: 0.0,
+        t_max: 1.0,
+    }
+}
+
 /// A hit as the f32 search reports it (see [`RayCaster::intersect_f32`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Hit32 {
@@ -166,17 +177,54 @@ impl RayCaster {
     /// [`RayCaster::intersect_f32`] of four rays at once, with identical results: coherent
     /// rays (a 2x2 quad of primary rays) share one BVH traversal.
     fn intersect4_f32(&self, rays: [Option<&Ray>; 4]) -> [Option<Hit32>; 4] {
-        let fast = |i: usize| {
-            rays[i]
-                .filter(|r| !self.misses_scene_box(r))
-                .and_then(FastRay::new)
-        };
-        let (a, b, c, d) = (fast(0), fast(1), fast(2), fast(3));
-        let [a, b, c, d] = self
-            .bvh
-            .closest4([a.as_ref(), b.as_ref(), c.as_ref(), d.as_ref()]);
-        let hit = |f: Option<bvh::BvhHit>| f.map(|f| self.hit32(f));
-        [hit(a), hit(b), hit(c), hit(d)]
+        let fast = rays.map(|r| self.fast_unless_outside(r));
+        let found = self.bvh.closest4(fast.each_ref().map(Option::as_ref));
+        found.map(|f| f.map(|f| self.hit32(f)))
+    }
+
+    /// The f32 form of `ray` for a BVH search, or `None` where it cannot hit anything: no
+    /// ray, a segment outside the scene's box ([`RayCaster::misses_scene_box`]), or what
+    /// [`FastRay::new`] rejects (a zero direction, an empty interval).
+    #[inline]
+    fn fast_unless_outside(&self, ray: Option<&Ray>) -> Option<FastRay> {
+        ray.filter(|r| !self.misses_scene_box(r))
+            .and_then(FastRay::new)
+    }
+
+    /// The first hits of four polyline projectors (`None`: no projector) and the segments
+    /// they lie on: for each, the first segment with a hit wins, and on it the nearest hit,
+    /// exactly as searching the segments one by one with [`RayCaster::intersect_f32`] finds
+    /// it. Segment k of the four is searched by one shared BVH traversal
+    /// ([`Bvh::closest4`]), leaving out the polylines that have hit something already or have
+    /// fewer segments, and the segments that `live` rules out. Degenerate cases: a
+    /// zero-length segment sees nothing (and the next segment is searched); a hit exactly at
+    /// a joint, the end of segment k and the start of segment k + 1, is segment k's (both
+    /// ends of a segment's interval are closed); a joint on a triangle is such a hit.
+    fn intersect4_polylines(
+        &self,
+        polylines: [Option<&[DVec3]>; 4],
+        live: hull_cull::LiveParts,
+    ) -> [Option<(usize, Hit32)>; 4] {
+        let segments = polylines
+            .iter()
+            .flatten()
+            .map(|p| p.len().saturating_sub(1))
+            .max()
+            .unwrap_or(0);
+        let mut found: [Option<(usize, Hit32)>; 4] = [None; 4];
+        for k in (0..segments).filter(|&k| live.may_hit(k)) {
+            let rays: [Option<Ray>; 4] = std::array::from_fn(|i| match polylines[i] {
+                Some(p) if found[i].is_none() && k + 1 < p.len() => Some(polyline_segment(p, k)),
+                _ => None,
+            });
+            let hits = self.intersect4_f32(rays.each_ref().map(Option::as_ref));
+            for (slot, hit) in found.iter_mut().zip(hits) {
+                if let Some(hit) = hit {
+                    *slot = Some((k, hit));
+                }
+            }
+        }
+        found
     }
 
     /// The hit of BVH triangle `found`, known by object and triangle within its mesh.

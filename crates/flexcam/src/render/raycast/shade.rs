@@ -23,7 +23,7 @@ use glam::{DVec3, Vec3};
 
 use super::hull_cull::LiveParts;
 use super::optics::{reflect, refract};
-use super::{Hit, Hit32, RayCaster};
+use super::{polyline_segment, Hit, Hit32, RayCaster};
 use crate::geometry::Ray;
 use crate::projection::projector::{quadratic_arc_length, quadratic_point, quadratic_tangent};
 use crate::projection::Projector;
@@ -184,13 +184,8 @@ impl<'a> Tracer<'a> {
             None => self.sample(None),
             Some(Projector::Straight(ray)) => self.sample(Some(ray)),
             Some(Projector::Polyline(points)) => {
-                for (k, pair) in points.windows(2).enumerate() {
-                    let ray = Ray {
-                        origin: pair[0],
-                        direction: pair[1] - pair[0],
-                        t_min: 0.0,
-                        t_max: 1.0,
-                    };
+                for k in 0..points.len().saturating_sub(1) {
+                    let ray = polyline_segment(points, k);
                     let found = if self.live.may_hit(k) {
                         self.caster.intersect_f32(&ray)
                     } else {
@@ -294,45 +289,19 @@ impl<'a> Tracer<'a> {
 
     /// The samples of four polyline projectors (`None`: no projector), exactly those of
     /// [`Tracer::sample_projector`] on each: segment k of the four is searched by one shared
-    /// BVH traversal ([`RayCaster::intersect4_f32`]), leaving out the polylines that have
-    /// hit something already or have fewer segments (and the segments `self.live` rules
-    /// out).
+    /// BVH traversal ([`RayCaster::intersect4_polylines`]), leaving out the segments
+    /// `self.live` rules out.
     fn sample4_polylines(&mut self, polylines: [Option<&[DVec3]>; 4]) -> [Sample; 4] {
-        let mut hits: [Option<Sample>; 4] = [None; 4];
-        let segments = polylines
-            .iter()
-            .flatten()
-            .map(|p| p.len().saturating_sub(1))
-            .max()
-            .unwrap_or(0);
-        for k in 0..segments {
-            let rays: [Option<Ray>; 4] = std::array::from_fn(|i| match polylines[i] {
-                Some(p) if hits[i].is_none() && k + 1 < p.len() => Some(Ray {
-                    origin: p[k],
-                    direction: p[k + 1] - p[k],
-                    t_min: 0.0,
-                    t_max: 1.0,
-                }),
-                _ => None,
-            });
-            let found = if self.live.may_hit(k) {
-                self.caster
-                    .intersect4_f32(rays.each_ref().map(Option::as_ref))
-            } else {
-                [None; 4]
-            };
-            for (i, (ray, found)) in rays.iter().zip(found).enumerate() {
-                if let (Some(ray), Some(hit), Some(points)) = (ray, found, polylines[i]) {
-                    hits[i] = Some(self.shade(ray, Some(hit), length_before(points, k)));
-                }
-            }
-        }
+        let found = self.caster.intersect4_polylines(polylines, self.live);
         let mut samples = [self.sample(None); 4];
-        for ((sample, hit), polyline) in samples.iter_mut().zip(hits).zip(polylines) {
-            *sample = match (hit, polyline) {
-                (Some(hit), _) => hit,
-                (None, Some(_)) => self.shade_miss(),
-                (None, None) => self.sample(None),
+        for ((sample, polyline), found) in samples.iter_mut().zip(polylines).zip(found) {
+            *sample = match (polyline, found) {
+                (Some(points), Some((k, hit))) => {
+                    let ray = polyline_segment(points, k);
+                    self.shade(&ray, Some(hit), length_before(points, k))
+                }
+                (Some(_), None) => self.shade_miss(),
+                (None, _) => self.sample(None),
             };
         }
         samples

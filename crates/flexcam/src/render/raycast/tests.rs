@@ -579,3 +579,149 @@ fn packet_rendering_equals_single_ray_rendering() {
         }
     }
 }
+
+/// The first hit of polyline `points` by searching its segments one by one, each with an
+/// unculled BVH search (no scene-box or hull cull): the first segment with a hit wins.
+fn segment_by_segment(caster: &RayCaster, points: &[DVec3]) -> Option<(usize, Hit32)> {
+    (0..points.len().saturating_sub(1)).find_map(|k| {
+        FastRay::new(&polyline_segment(points, k))
+            .and_then(|fast| caster.bvh.closest(&fast))
+            .map(|found| (k, caster.hit32(found)))
+    })
+}
+
+/// Four polylines searched together, each against [`segment_by_segment`].
+fn assert_polylines_match(caster: &RayCaster, polylines: [Option<&[DVec3]>; 4]) {
+    let together = caster.intersect4_polylines(polylines, hull_cull::LiveParts::ALL);
+    let alone = polylines.map(|p| p.and_then(|p| segment_by_segment(caster, p)));
+    assert_eq!(together, alone, "{polylines:?}");
+}
+
+/// Degenerate case: a joint exactly on a triangle (the wall z = 0) is hit at the end of the
+/// earlier segment (t = 1, its interval is closed), which wins over the later segment's hit
+/// at its start, as searching segment by segment finds it; so is a polyline whose later
+/// segment runs along the wall's plane.
+#[test]
+fn a_joint_on_a_triangle_is_hit_by_the_earlier_segment() {
+    let caster = RayCaster::new(&red_wall(1));
+    let lane = |x: f64, bend: DVec3| {
+        vec![
+            DVec3::new(x, 0.25, 2.0),
+            DVec3::new(x, 0.25, 0.0),
+            DVec3::new(x, 0.25, 0.0) + bend,
+        ]
+    };
+    let polylines = [
+        lane(0.25, DVec3::new(0.0, 0.0, -2.0)),
+        lane(0.5, DVec3::new(1.0, 0.0, -2.0)),
+        lane(-0.25, DVec3::new(1.0, 0.0, 0.0)),
+        lane(0.75, DVec3::new(0.0, 0.0, -2.0)),
+    ];
+    let found = caster.intersect4_polylines(
+        polylines.each_ref().map(|p| Some(p.as_slice())),
+        hull_cull::LiveParts::ALL,
+    );
+    for (p, hit) in polylines.iter().zip(found) {
+        let (k, hit) = hit.expect("the joint lies on the wall");
+        assert_eq!((k, hit.t), (0, 1.0), "{p:?}");
+    }
+    assert_polylines_match(&caster, polylines.each_ref().map(|p| Some(p.as_slice())));
+}
+
+/// Degenerate case: a zero-length segment (a repeated vertex) sees nothing, even with its
+/// point on the wall, and the search goes on to the next segment (which finds the wall at
+/// its start when it starts there); a polyline of one point has no segment and finds
+/// nothing.
+#[test]
+fn a_zero_length_segment_sees_nothing_and_the_next_segment_is_searched() {
+    let caster = RayCaster::new(&red_wall(1));
+    let front = DVec3::new(0.5, 0.5, 1.0);
+    let on_wall = DVec3::new(0.5, 0.5, 0.0);
+    let behind = DVec3::new(0.5, 0.5, -1.0);
+    let repeated_in_front = [front + DVec3::Z, front, front, behind];
+    let repeated_on_wall = [on_wall, on_wall, front, behind];
+    let single = [front];
+    let found = caster.intersect4_polylines(
+        [
+            Some(&repeated_in_front[..]),
+            Some(&repeated_on_wall[..]),
+            Some(&single[..]),
+            None,
+        ],
+        hull_cull::LiveParts::ALL,
+    );
+    assert_eq!(found[0].map(|(k, hit)| (k, hit.t)), Some((2, 0.5)));
+    // The segment after the zero-length one starts on the wall: a hit at its start.
+    assert_eq!(found[1].map(|(k, hit)| (k, hit.t)), Some((1, 0.0)));
+    assert_eq!((found[2], found[3]), (None, None));
+    assert_polylines_match(
+        &caster,
+        [
+            Some(&repeated_in_front[..]),
+            Some(&repeated_on_wall[..]),
+            Some(&single[..]),
+            None,
+        ],
+    );
+}
+
+mod polyline_properties {
+    use proptest::prelude::*;
+
+    use super::*;
+
+    /// The caster of the built-in teapot room, built once for all cases.
+    fn room() -> &'static RayCaster {
+        static ROOM: std::sync::OnceLock<RayCaster> = std::sync::OnceLock::new();
+        ROOM.get_or_init(|| {
+            RayCaster::new(&crate::scene::builtin::load("teapot-room").expect("built-in scene"))
+        })
+    }
+
+    /// A point of the room (x and z in [-4, 4], y in [-0.5, 3.5]) and around it.
+    fn point() -> impl Strategy<Value = DVec3> {
+        (-1.2..1.2f64, -1.2..1.2f64, -1.2..1.2f64)
+            .prop_map(|(x, y, z)| DVec3::new(x * 4.0, y * 2.0 + 1.5, z * 4.0))
+    }
+
+    proptest! {
+        /// Four neighbouring polylines of 2 to 6 segments with joints inside the room (a
+        /// random polyline and three with every vertex moved by up to `spread`; large
+        /// spreads give lanes of disagreeing signs, which the packet search traces one by
+        /// one), some lanes empty, some with a repeated vertex (a zero-length segment): the
+        /// packet search with its scene-box cull finds for each exactly the first hit (segment, t, object, triangle, barycentrics) of searching its
+        /// segments one by one without any cull.
+        #[test]
+        fn polyline_packets_find_the_unculled_segment_by_segment_first_hit(
+            base in proptest::collection::vec(point(), 3..=7),
+            moves in proptest::collection::vec(point(), 21),
+            spread in prop_oneof![0.0..0.05f64, 0.0..2.0f64],
+            empty in 0..16u32,
+            repeat in 0..8usize,
+        ) {
+            let caster = room();
+            let polylines: Vec<Vec<DVec3>> = (0..4)
+                .map(|i| {
+                    let mut points: Vec<DVec3> = base
+                        .iter()
+                        .enumerate()
+                        .map(|(j, &q)| match i {
+                            0 => q,
+                            _ => q + moves[(i - 1) * 7 + j] * spread,
+                        })
+                        .collect();
+                    if repeat < points.len() && i == repeat % 4 {
+                        points.insert(repeat, points[repeat]);
+                    }
+                    points
+                })
+                .collect();
+            let lanes: [Option<&[DVec3]>; 4] = std::array::from_fn(|i| {
+                (empty >> i & 1 == 0).then_some(polylines[i].as_slice())
+            });
+            let together = caster.intersect4_polylines(lanes, hull_cull::LiveParts::ALL);
+            let alone = lanes.map(|p| p.and_then(|p| segment_by_segment(caster, p)));
+            prop_assert_eq!(together, alone);
+        }
+    }
+}
