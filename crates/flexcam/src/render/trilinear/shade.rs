@@ -46,12 +46,12 @@
 use glam::{DVec2, DVec3, Vec2, Vec3};
 
 use super::gbuffer::GBuffer;
-use super::hit_terms::{self, Terms, TERMS};
+use super::hit_terms::{self, Terms};
 use super::scene_geometry::SceneGeometry;
 use super::screen_map::ScreenMap;
 use crate::geometry::Ray;
 use crate::projection::{Projection, Trilinear};
-use crate::render::raster::{Fragment, FrameRows, NO_PRIMITIVE};
+use crate::render::raster::{FrameRows, NO_PRIMITIVE};
 use crate::render::raycast::{Hit, RayCaster};
 use crate::render::surface::triangle_color::TriangleColor;
 use crate::render::RenderOptions;
@@ -157,27 +157,6 @@ impl Resolver<'_> {
                 (hit.key, hit.t + behind, hit.barycentric)
             }),
         }
-    }
-
-    /// [`Resolver::staged`] as a stage of `render::raster`'s fragment API: rewrites the
-    /// fragment's depth, key and object to the hit's, its first two attributes to the hit's
-    /// barycentrics, or returns `false` to discard it. Its attributes are the hit terms of
-    /// its own triangle at its projector.
-    pub fn stage(&self, fragment: &mut Fragment<TERMS>) -> bool {
-        let terms = fragment.varying.attributes;
-        let Some((key, depth, barycentric)) =
-            self.staged(fragment.primitive, &terms, fragment.x, fragment.y)
-        else {
-            return false;
-        };
-        fragment.varying.depth = depth;
-        fragment.varying.attributes[0] = barycentric.x;
-        fragment.varying.attributes[1] = barycentric.y;
-        if key != fragment.primitive {
-            fragment.primitive = key;
-            fragment.object = self.scene.owners[(key & u64::from(u32::MAX)) as usize].id;
-        }
-        true
     }
 }
 

@@ -489,23 +489,14 @@ fn fragments_across_a_shared_edge_resolve_to_the_neighbour() {
     assert_eq!((redirected.key, redirected.t), (key(1), 2.0));
     assert_eq!(redirected.barycentric, own.barycentric);
     // The stage rewrites the fragment to the neighbour, at its exact depth, with the
-    // neighbour's barycentrics in place of the first two hit terms.
+    // neighbour's barycentrics, from the hit terms of the fragment's own triangle.
     let uv = maps[1].barycentrics(at);
     let terms = hit_terms::HitTerms::new(geometry.corners(0)).unwrap();
-    let mut fragment = crate::render::raster::Fragment {
-        x: 3,
-        y: 3,
-        varying: crate::render::raster::Varying {
-            depth: 0.0,
-            attributes: terms.at(maps[1].cache(), uv.x, uv.y),
-        },
-        object: 1,
-        primitive: key(0),
-    };
-    assert!(resolver.stage(&mut fragment));
-    assert_eq!((fragment.primitive, fragment.varying.depth), (key(1), 2.0));
-    let stored = &fragment.varying.attributes[..2];
-    assert_eq!(stored, &[own.barycentric.x, own.barycentric.y]);
+    let (staged_key, depth, stored) = resolver
+        .staged(key(0), &terms.at(maps[1].cache(), uv.x, uv.y), 3, 3)
+        .unwrap();
+    assert_eq!((staged_key, depth), (key(1), 2.0));
+    assert_eq!(stored, own.barycentric);
     // Beyond an edge nobody shares (left of the square): discarded.
     assert!(resolver.hit(key(1), resolver.position(1, 3)).is_none());
 }
