@@ -113,11 +113,16 @@ pub fn fit(
         let start = straight_start(prior, correspondences).unwrap_or_else(|_| prior.straightened());
         return curved::fit(prior, &start, correspondences);
     }
-    match noise_weight(prior, correspondences)? {
-        Some(weight) => fit_once(prior, correspondences, weight),
+    // The floor-weighted solve both measures the noise and, for exact data, is the first of
+    // the two solves.
+    let targets = targets(prior, correspondences)?;
+    let system = System::new(prior, correspondences, &targets);
+    let floor_dirs = system.solve(0.0)?;
+    match noise_weight(&system, correspondences, &targets, &floor_dirs) {
+        Some(weight) => in_view(prior, correspondences, &targets, system.solve(weight)?),
         None => {
-            let (first, _) = fit_once(prior, correspondences, 0.0)?;
-            fit_once(&first, correspondences, 0.0)
+            let (first, _) = in_view(prior, correspondences, &targets, floor_dirs)?;
+            fit_once(&first, correspondences)
         }
     }
 }
@@ -125,7 +130,7 @@ pub fn fit(
 /// The prior's weight for noisy correspondences, or `None` when the data show no noise above
 /// what the floor weight `PRIOR_WEIGHT` handles (see the module section "Noise").
 ///
-/// One solve at the floor weight measures the data term's residual sum of squares; divided by
+/// The solve at the floor weight, `floor_dirs`, measures the data term's residual sum of squares; divided by
 /// the degrees of freedom (two equations per correspondence less the unknowns of the
 /// constrained nodes, plus one for the scale constraint) it estimates the noise variance
 /// sigma^2 per equation, in the unknowns' scaled units (about radians squared). The weight is
@@ -136,29 +141,32 @@ pub fn fit(
 /// so that exact data are fitted as before); no more equations than unknowns (say one
 /// correspondence, or 30 points for a Bezier grid's 75 unknowns: the data can be met exactly,
 /// noise cannot be told from signal: `None`).
-fn noise_weight(prior: &ProjectorGrid, correspondences: &[Correspondence]) -> Result<Option<f64>> {
+fn noise_weight(
+    system: &System<'_>,
+    correspondences: &[Correspondence],
+    targets: &[DVec3],
+    floor_dirs: &[DVec3],
+) -> Option<f64> {
+    let prior = system.prior;
     let constrained = constrained_nodes(prior, correspondences);
     let unknowns = 3 * constrained.iter().filter(|c| **c).count();
     let equations = 2 * correspondences.len() + 1;
     if equations <= unknowns {
-        return Ok(None);
+        return None;
     }
-    let targets = targets(prior, correspondences)?;
-    let system = System::new(prior, correspondences, &targets);
-    let dirs = system.solve(0.0)?;
     let sum_of_squares: f64 = correspondences
         .iter()
-        .zip(&targets)
+        .zip(targets)
         .map(|(c, a)| {
             let mut d = DVec3::ZERO;
-            prior.for_each_weight(c.uv, |j, w| d += w * dirs[j]);
+            prior.for_each_weight(c.uv, |j, w| d += w * floor_dirs[j]);
             let d = d / system.scale;
             (d - d.dot(*a) * *a).length_squared()
         })
         .sum();
     let variance = sum_of_squares / (equations - unknowns) as f64;
     let weight = variance / (PRIOR_SPREAD * PRIOR_SPREAD);
-    Ok((weight > system.floor).then_some(weight))
+    (weight > system.floor).then_some(weight)
 }
 
 /// The start of the curved fit: the directions of the straight fit's two solves on `prior`
@@ -169,22 +177,30 @@ fn straight_start(
     correspondences: &[Correspondence],
 ) -> Result<ProjectorGrid> {
     let straight = prior.straightened();
-    let first = with_directions(
-        &straight,
-        &solve_directions(&straight, correspondences, 0.0)?,
-    )?;
-    with_directions(&first, &solve_directions(&first, correspondences, 0.0)?)
+    let first = with_directions(&straight, &solve_directions(&straight, correspondences)?)?;
+    with_directions(&first, &solve_directions(&first, correspondences)?)
 }
 
-/// One regularised least-squares solve around `prior` (see [`fit`]) with the prior weight
-/// `weight` (at least the floor), its projectors lengthened so that every point is in view.
+/// One least-squares solve around `prior` at the floor weight (see [`fit`]), its projectors
+/// lengthened so that every point is in view.
 fn fit_once(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
-    weight: f64,
 ) -> Result<(ProjectorGrid, FitReport)> {
     let targets = targets(prior, correspondences)?;
-    let mut dirs = solve_directions(prior, correspondences, weight)?;
+    let dirs = solve_directions(prior, correspondences)?;
+    in_view(prior, correspondences, &targets, dirs)
+}
+
+/// The grid of `prior` with the solved node directions `dirs`, all lengthened by one common
+/// factor where some point would lie beyond its projector's end (module docs), and its
+/// residual; `targets` are the correspondences' unit directions from their projectors' starts.
+fn in_view(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+    targets: &[DVec3],
+    mut dirs: Vec<DVec3>,
+) -> Result<(ProjectorGrid, FitReport)> {
     let fitted = with_directions(prior, &dirs)?;
     let reach = farthest_reach(&fitted, correspondences)?;
     if reach > 1.0 {
@@ -194,7 +210,7 @@ fn fit_once(
     }
     let fitted = with_directions(prior, &dirs)?;
     let constrained = constrained_nodes(prior, correspondences);
-    let report = residual(&fitted, correspondences, &targets, &constrained);
+    let report = residual(&fitted, correspondences, targets, &constrained);
     Ok((fitted, report))
 }
 
@@ -207,15 +223,13 @@ fn constrained_nodes(grid: &ProjectorGrid, correspondences: &[Correspondence]) -
     constrained
 }
 
-/// The node directions of one regularised least-squares solve around `prior` with the prior
-/// weight `weight` (raised to the floor where below it).
+/// The node directions of one least-squares solve around `prior` at the floor weight.
 fn solve_directions(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
-    weight: f64,
 ) -> Result<Vec<DVec3>> {
     let targets = targets(prior, correspondences)?;
-    System::new(prior, correspondences, &targets).solve(weight)
+    System::new(prior, correspondences, &targets).solve(0.0)
 }
 
 /// The least-squares system of one fit: the data term's normal matrix and the prior, in
@@ -956,6 +970,15 @@ mod tests {
         }
     }
 
+    /// [`noise_weight`] of `data` for `prior`, from the floor-weighted solve that [`fit`]
+    /// makes first.
+    fn noise_weight_of(prior: &ProjectorGrid, data: &[Correspondence]) -> Result<Option<f64>> {
+        let targets = targets(prior, data)?;
+        let system = System::new(prior, data, &targets);
+        let floor_dirs = system.solve(0.0)?;
+        Ok(noise_weight(&system, data, &targets, &floor_dirs))
+    }
+
     #[test]
     fn the_noise_weight_follows_the_data() {
         let bezier = GridInterpolation::Bezier;
@@ -963,12 +986,12 @@ mod tests {
         let truth = curved_truth(bezier, 0.0, 3).straightened();
         let data = correspondences_of(&truth, 12, 5);
         // No noise: no noise weight (exact data take the exact path).
-        assert_eq!(noise_weight(&prior, &data).unwrap(), None);
+        assert_eq!(noise_weight_of(&prior, &data).unwrap(), None);
         let noisy = with_noise(&truth, &data, 1e-3, 6);
         // Too few points: 37 give 75 equations for 75 unknowns, met exactly.
-        assert_eq!(noise_weight(&prior, &noisy[..37]).unwrap(), None);
+        assert_eq!(noise_weight_of(&prior, &noisy[..37]).unwrap(), None);
         // Uniform noise of up to 1e-3 on each of two axes: variance 1e-6 / 3 per equation.
-        let weight = noise_weight(&prior, &noisy).unwrap().unwrap();
+        let weight = noise_weight_of(&prior, &noisy).unwrap().unwrap();
         assert!((1e-7..1e-6).contains(&weight), "{weight}");
 
         // All noisy points in the bottom-left cell of a bilinear grid: that cell follows
@@ -984,7 +1007,7 @@ mod tests {
             })
             .collect();
         let cell = with_noise(&grid, &cell, 1e-3, 9);
-        assert!(noise_weight(&grid, &cell).unwrap().is_some());
+        assert!(noise_weight_of(&grid, &cell).unwrap().is_some());
         let (fitted, report) = fit(&grid, &cell).unwrap();
         assert_eq!(report.unconstrained_nodes, 21);
         assert!(report.rms_angle_deg.to_radians() < 1e-3, "{report:?}");
