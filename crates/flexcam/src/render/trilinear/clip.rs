@@ -33,6 +33,14 @@ const HALF_SPACES: [fn(&OutlinePoint) -> f64; 4] = [
 /// Consecutive equal points are merged, so the result has 0 points (clipped away), 1 (a
 /// single point on a clip line, to be dropped by the caller), 2 (a line) or more.
 pub fn clip_outline(points: &mut Vec<OutlinePoint>, scratch: &mut Vec<OutlinePoint>) {
+    // Most outlines lie wholly inside: one pass over the points settles that (the loop
+    // below would skip every half-space after testing them one by one).
+    if points
+        .iter()
+        .all(|p| HALF_SPACES.iter().all(|inside| inside(p) >= 0.0))
+    {
+        return;
+    }
     for inside in HALF_SPACES {
         if points.iter().all(|p| inside(p) >= 0.0) {
             continue;

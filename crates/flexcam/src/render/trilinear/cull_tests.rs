@@ -10,7 +10,7 @@ use proptest::prelude::*;
 use super::curves::{CurveMode, CurveOptions};
 use super::hit_terms::HitTerms;
 use super::outline::ProjectionTriangle;
-use super::pair_cull::{live_pairs, LivePair, VertexCache};
+use super::pair_cull::{live_pairs, LivePair, LivePairs, VertexCache};
 use super::polygons::{draw_all, project_all, projection_triangles, PairCounts, ProjectedScene};
 use super::scene_geometry::SceneGeometry;
 use super::tests::{object, scene_of, square};
@@ -19,21 +19,41 @@ use crate::projection::{Trilinear, TrilinearMesh};
 use crate::scene::{self, Scene};
 
 /// Every pair with a plane, with no volume cull, its cubics solved directly.
-fn unculled(triangles: &[ProjectionTriangle], scene: &SceneGeometry) -> Vec<LivePair> {
-    let mut live = Vec::new();
-    for (index, triangle) in triangles.iter().enumerate() {
-        for (k, corners) in scene.triangles.iter().enumerate() {
-            if let Some(terms) = HitTerms::new(scene.corners(k)) {
-                live.push(LivePair {
-                    projection: index as u32,
-                    triangle: k as u32,
-                    terms,
-                    solved: solve(triangle, scene, *corners),
-                });
-            }
-        }
+fn unculled(triangles: &[ProjectionTriangle], scene: &SceneGeometry) -> Vec<LivePairs> {
+    (0..triangles.len() as u32)
+        .map(|index| solved_directly(triangles, scene, index, 0..scene.triangles.len()))
+        .collect()
+}
+
+/// The pairs of projection triangle `index` with the scene triangles `live` (in order)
+/// that have a plane, each pair's vertices solved directly and stored on their own (no
+/// vertex cache, no sharing).
+fn solved_directly(
+    triangles: &[ProjectionTriangle],
+    scene: &SceneGeometry,
+    index: u32,
+    live: impl IntoIterator<Item = usize>,
+) -> LivePairs {
+    let mut group = LivePairs {
+        projection: index,
+        ..LivePairs::default()
+    };
+    for k in live {
+        let Some(terms) = HitTerms::new(scene.corners(k)) else {
+            continue;
+        };
+        let first = group.solutions.len() as u32;
+        let triangle = &triangles[index as usize];
+        group
+            .solutions
+            .extend(solve(triangle, scene, scene.triangles[k]));
+        group.pairs.push(LivePair {
+            triangle: k as u32,
+            terms,
+            solved: [first, first + 1, first + 2],
+        });
     }
-    live
+    group
 }
 
 fn solve(
@@ -126,19 +146,38 @@ fn check(
     let triangles = projection_triangles(projection);
     // One cache for all projection triangles, as one worker uses it.
     let mut cache = VertexCache::new(geometry.vertices.len());
-    let mut live = Vec::new();
-    for (index, triangle) in triangles.iter().enumerate() {
-        live_pairs(triangle, index as u32, &geometry, &mut cache, &mut live);
-    }
-    let pairs: Vec<(u32, u32)> = live.iter().map(|p| (p.projection, p.triangle)).collect();
+    let live: Vec<LivePairs> = triangles
+        .iter()
+        .enumerate()
+        .map(|(index, triangle)| live_pairs(triangle, index as u32, &geometry, &mut cache).0)
+        .collect();
+    let pairs: Vec<(u32, u32)> = live
+        .iter()
+        .flat_map(|g| g.pairs.iter().map(move |p| (g.projection, p.triangle)))
+        .collect();
     let kept = kept_one_by_one(&triangles, &geometry);
     assert_eq!(pairs, kept, "{what}: live pairs");
     let mut direct = Vec::new();
-    for p in &live {
-        let corners = geometry.triangles[p.triangle as usize];
-        let solved = solve(&triangles[p.projection as usize], &geometry, corners);
-        assert_eq!(p.solved, solved, "{what}: solutions");
-        direct.push(LivePair { solved, ..*p });
+    for group in &live {
+        let triangles_of = group.pairs.iter().map(|p| p.triangle as usize);
+        let d = solved_directly(&triangles, &geometry, group.projection, triangles_of);
+        for (p, q) in group.pairs.iter().zip(&d.pairs) {
+            assert_eq!(group.solved(p), d.solved(q), "{what}: solutions");
+        }
+        // Each live vertex is solved and stored once per projection triangle.
+        let mut vertices: Vec<u32> = group
+            .pairs
+            .iter()
+            .flat_map(|p| geometry.triangles[p.triangle as usize])
+            .collect();
+        vertices.sort_unstable();
+        vertices.dedup();
+        assert_eq!(
+            group.solutions.len(),
+            vertices.len(),
+            "{what}: solution pool"
+        );
+        direct.push(d);
     }
     let culled = project_all(&triangles, &geometry, curves);
     let one_by_one = draw_all(
@@ -160,7 +199,7 @@ fn check(
     assert!(c.culled_tree <= c.culled_volume, "{what}: {c:?}");
     assert_eq!(
         c.pairs - c.culled_volume - c.culled_zero_area,
-        live.len() as u64,
+        pairs.len() as u64,
         "{what}: {c:?}"
     );
     (c, others)

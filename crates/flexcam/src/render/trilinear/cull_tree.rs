@@ -116,9 +116,10 @@ impl CullTree {
     }
 
     /// Calls `keep` with every cluster whose box is not wholly beyond one plane of `bounds`
-    /// (no two boxes on the path to it were), in tree order; returns the number of scene
-    /// triangles in the subtrees skipped.
-    pub fn visit(&self, bounds: &VolumeBounds, mut keep: impl FnMut(u32)) -> u64 {
+    /// (no two boxes on the path to it were), in tree order, and with the planes that still
+    /// cut its box (`BoxSide::Within`: the box lies wholly inside the others); returns the
+    /// number of scene triangles in the subtrees skipped.
+    pub fn visit(&self, bounds: &VolumeBounds, mut keep: impl FnMut(u32, u32)) -> u64 {
         if self.nodes.is_empty() {
             return 0;
         }
@@ -139,7 +140,7 @@ impl CullTree {
                 BoxSide::Within(active) => active,
             };
             match node.content {
-                Content::Leaf(cluster) => keep(cluster),
+                Content::Leaf(cluster) => keep(cluster, active),
                 Content::Inner(second) => {
                     // The first child is visited first: pushed last.
                     stack[len] = (second, active);

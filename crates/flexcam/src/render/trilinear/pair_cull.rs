@@ -4,7 +4,8 @@
 //! The cull is hierarchical: the box tree over the scene's clusters (`cull_tree`) skips
 //! whole subtrees beyond one bounding plane of the triangle's ray volume
 //! (`volume_bounds`); the triangles of the clusters left are tested one by one by their
-//! vertices' plane masks, each vertex's mask computed once. Both levels cull exactly the
+//! vertices' plane masks, each vertex's mask computed once, against the planes that still
+//! cut its cluster's box only. Both levels cull exactly the
 //! pairs the triangle-by-triangle test alone culls (tested in `cull_tests`), so the images
 //! do not depend on the tree. The pairs left are listed in scene-triangle order, as the
 //! renderer's determinism requires.
@@ -15,18 +16,37 @@ use super::polygons::PairCounts;
 use super::scene_geometry::SceneGeometry;
 use crate::projection::Solutions;
 
-/// A (projection triangle, scene triangle) pair that survived the volume cull: what drawing
-/// it needs.
+/// A scene triangle that survived the volume cull of one projection triangle: what drawing
+/// the pair needs. Its vertices' solutions are kept once per vertex in the projection
+/// triangle's pool ([`LivePairs::solutions`]) and named here by index, so a pair is small
+/// (a vertex is shared by about six triangles) and nothing large is copied between the cull
+/// and the drawing.
 #[derive(Debug, Clone, Copy)]
 pub struct LivePair {
-    /// Index of the projection triangle in the mesh.
-    pub projection: u32,
     /// Index of the scene triangle.
     pub triangle: u32,
     /// The scene triangle's plane (it has one: zero-area triangles are not live).
     pub terms: HitTerms,
-    /// Its three vertices' solutions through the projection triangle.
-    pub solved: [Solutions; 3],
+    /// Where its three vertices' solutions are in [`LivePairs::solutions`].
+    pub solved: [u32; 3],
+}
+
+/// The live pairs of one projection triangle, in scene-triangle order, with the solutions
+/// of their vertices' cubics through it.
+#[derive(Debug, Clone, Default)]
+pub struct LivePairs {
+    /// Index of the projection triangle in the mesh.
+    pub projection: u32,
+    pub pairs: Vec<LivePair>,
+    /// The solutions [`LivePair::solved`] names.
+    pub solutions: Vec<Solutions>,
+}
+
+impl LivePairs {
+    /// The solutions of the three vertices of `pair` (one of `self.pairs`).
+    pub fn solved(&self, pair: &LivePair) -> [Solutions; 3] {
+        pair.solved.map(|i| self.solutions[i as usize])
+    }
 }
 
 /// Per-vertex state of the projection triangle being culled, reused from one projection
@@ -35,18 +55,23 @@ pub struct LivePair {
 pub struct VertexCache {
     states: Vec<VertexState>,
     generation: u32,
-    /// The clusters the tree kept, reused.
-    clusters: Vec<u32>,
+    /// The clusters the tree kept, each with the planes that still cut its box, reused.
+    clusters: Vec<(u32, u32)>,
 }
+
+/// [`VertexState::solved`] of a vertex whose cubic no live pair has needed yet.
+const NOT_SOLVED: u32 = u32::MAX;
 
 #[derive(Debug, Clone, Copy)]
 struct VertexState {
     /// The generation this entry belongs to.
     stamp: u32,
-    /// The bounding planes the vertex is beyond (`VolumeBounds::outside`).
+    /// The bounding planes the vertex is beyond (`VolumeBounds::outside`), computed among
+    /// the planes cutting the box of the first kept cluster that uses it (it is beyond none
+    /// of the others: `VolumeBounds::outside_of`).
     mask: u32,
-    /// Its cubic's solutions, once a live pair needed them.
-    solved: Option<Solutions>,
+    /// Index of its cubic's solutions in the pool of the live pairs, or [`NOT_SOLVED`].
+    solved: u32,
 }
 
 impl VertexCache {
@@ -55,7 +80,7 @@ impl VertexCache {
         let unused = VertexState {
             stamp: 0,
             mask: 0,
-            solved: None,
+            solved: NOT_SOLVED,
         };
         VertexCache {
             states: vec![unused; vertices],
@@ -75,16 +100,15 @@ impl VertexCache {
     }
 }
 
-/// Appends the live pairs of `triangle` (number `index` in the mesh) with every triangle of
-/// `scene` to `live`, in scene-triangle order; returns the counts of the cull (`pairs`,
-/// `culled_volume`, `culled_tree`, `culled_zero_area`, `vertices_projected`).
+/// The live pairs of `triangle` (number `index` in the mesh) with every triangle of `scene`,
+/// in scene-triangle order, and the counts of the cull (`pairs`, `culled_volume`,
+/// `culled_tree`, `culled_zero_area`, `vertices_projected`).
 pub fn live_pairs(
     triangle: &ProjectionTriangle,
     index: u32,
     scene: &SceneGeometry,
     cache: &mut VertexCache,
-    live: &mut Vec<LivePair>,
-) -> PairCounts {
+) -> (LivePairs, PairCounts) {
     let bounds = &triangle.bounds;
     let projector = triangle.map.cache();
     cache.next_generation();
@@ -92,13 +116,19 @@ pub fn live_pairs(
         pairs: scene.triangles.len() as u64,
         ..PairCounts::default()
     };
+    let mut live = LivePairs {
+        projection: index,
+        ..LivePairs::default()
+    };
     let mut kept = std::mem::take(&mut cache.clusters);
     kept.clear();
-    counts.culled_tree = scene.tree.visit(bounds, |cluster| kept.push(cluster));
+    counts.culled_tree = scene
+        .tree
+        .visit(bounds, |cluster, cutting| kept.push((cluster, cutting)));
     counts.culled_volume = counts.culled_tree;
     kept.sort_unstable();
     let generation = cache.generation;
-    for &cluster in &kept {
+    for &(cluster, cutting) in &kept {
         for k in scene.clusters[cluster as usize].triangles.clone() {
             let corners = scene.triangles[k];
             let masks = corners.map(|i| {
@@ -106,8 +136,8 @@ pub fn live_pairs(
                 if state.stamp != generation {
                     *state = VertexState {
                         stamp: generation,
-                        mask: bounds.outside(scene.vertices[i as usize]),
-                        solved: None,
+                        mask: bounds.outside_of(scene.vertices[i as usize], cutting),
+                        solved: NOT_SOLVED,
                     };
                 }
                 state.mask
@@ -116,18 +146,21 @@ pub fn live_pairs(
                 counts.culled_volume += 1;
                 continue;
             }
-            let Some(terms) = HitTerms::new(scene.corners(k)) else {
+            let Some(terms) = scene.hit_terms[k] else {
                 counts.culled_zero_area += 1;
                 continue;
             };
             let solved = corners.map(|i| {
-                *cache.states[i as usize].solved.get_or_insert_with(|| {
+                let state = &mut cache.states[i as usize];
+                if state.solved == NOT_SOLVED {
                     counts.vertices_projected += 1;
-                    projector.project_point(scene.vertices[i as usize])
-                })
+                    state.solved = live.solutions.len() as u32;
+                    live.solutions
+                        .push(projector.project_point(scene.vertices[i as usize]));
+                }
+                state.solved
             });
-            live.push(LivePair {
-                projection: index,
+            live.pairs.push(LivePair {
                 triangle: k as u32,
                 terms,
                 solved,
@@ -135,5 +168,5 @@ pub fn live_pairs(
         }
     }
     cache.clusters = kept;
-    counts
+    (live, counts)
 }

@@ -12,7 +12,7 @@ use super::curves::{CurveMode, CurveOptions, ADAPTIVE_TOLERANCE_PX};
 use super::edge_path::{EdgePath, OutlinePoint};
 use super::hit_terms::{HitTerms, TERMS};
 use super::outline::{slice_depths, trace_outline, ProjectionTriangle, Sampling};
-use super::pair_cull::{live_pairs, LivePair, VertexCache};
+use super::pair_cull::{live_pairs, LivePair, LivePairs, VertexCache};
 use super::scene_geometry::SceneGeometry;
 use super::screen_map::ScreenMap;
 use crate::projection::{project_solved_triangle, Projection, Shape, Solutions, Trilinear};
@@ -131,54 +131,71 @@ pub fn project_all(
     scene: &SceneGeometry,
     curves: CurveOptions,
 ) -> ProjectedScene {
-    let culled: Vec<(Vec<LivePair>, PairCounts)> = triangles
+    let culled: Vec<(LivePairs, PairCounts)> = triangles
         .par_iter()
         .enumerate()
         .map_init(
             || VertexCache::new(scene.vertices.len()),
-            |cache, (index, triangle)| {
-                let mut live = Vec::new();
-                let counts = live_pairs(triangle, index as u32, scene, cache, &mut live);
-                (live, counts)
-            },
+            |cache, (index, triangle)| live_pairs(triangle, index as u32, scene, cache),
         )
         .collect();
     let mut counts = PairCounts::default();
-    let mut live = Vec::with_capacity(culled.iter().map(|(l, _)| l.len()).sum());
-    for (pairs, c) in culled {
-        counts.add(&c);
-        live.extend(pairs);
+    for (_, c) in &culled {
+        counts.add(c);
     }
+    let live: Vec<LivePairs> = culled.into_iter().map(|(live, _)| live).collect();
     draw_all(triangles, scene, &live, curves, counts)
 }
 
 /// The drawing half of [`project_all`]: the polygons of the live pairs `live` (in order,
 /// projection `live[i].projection` being `triangles[...]`), with `counts` of the cull added
-/// to those of drawing.
+/// to those of drawing. The work items are runs of [`PAIRS_PER_ITEM`] pairs of one
+/// projection triangle (referring to its pairs in place); each worker draws a contiguous
+/// range of items into one batch of its own with one set of buffers, and the batches are
+/// joined in order.
 pub(super) fn draw_all(
     triangles: &[ProjectionTriangle],
     scene: &SceneGeometry,
-    live: &[LivePair],
+    live: &[LivePairs],
     curves: CurveOptions,
     counts: PairCounts,
 ) -> ProjectedScene {
-    let drawn: Vec<Drawn> = live
-        .par_chunks(PAIRS_PER_ITEM)
-        .map_init(Scratch::default, |scratch, pairs| {
-            draw_pairs(triangles, scene, pairs, curves, scratch)
+    let items: Vec<(&LivePairs, &[LivePair])> = live
+        .iter()
+        .flat_map(|group| {
+            group
+                .pairs
+                .chunks(PAIRS_PER_ITEM)
+                .map(move |run| (group, run))
         })
         .collect();
+    let drawn = items
+        .par_iter()
+        .fold(
+            || (Drawn::default(), Scratch::default()),
+            |(mut out, mut scratch), &(group, pairs)| {
+                draw_pairs(
+                    triangles,
+                    scene,
+                    group,
+                    pairs,
+                    curves,
+                    &mut out,
+                    &mut scratch,
+                );
+                (out, scratch)
+            },
+        )
+        .map(|(out, _)| out)
+        .reduce(Drawn::default, Drawn::followed_by);
     let mut out = ProjectedScene {
+        polygons: drawn.polygons,
         counts,
         fallback: vec![false; triangles.len()],
-        ..ProjectedScene::default()
     };
-    for item in &drawn {
-        out.polygons.append(&item.polygons);
-        out.counts.add(&item.counts);
-        for &index in &item.fallback {
-            out.fallback[index as usize] = true;
-        }
+    out.counts.add(&drawn.counts);
+    for &index in &drawn.fallback {
+        out.fallback[index as usize] = true;
     }
     out
 }
@@ -190,6 +207,16 @@ struct Drawn {
     polygons: PolygonBatch<TERMS>,
     counts: PairCounts,
     fallback: Vec<u32>,
+}
+
+impl Drawn {
+    /// What drawing these pairs and then `next`'s gave.
+    fn followed_by(mut self, next: Drawn) -> Drawn {
+        self.polygons.append(&next.polygons);
+        self.counts.add(&next.counts);
+        self.fallback.extend(next.fallback);
+        self
+    }
 }
 
 /// Why a pair is skipped without forming its shapes.
@@ -209,43 +236,45 @@ struct Scratch {
     grid_solutions: Vec<Solutions>,
 }
 
-/// Culls (behind the view plane, outside a domain line) or draws each of `pairs` in order.
+/// Culls (behind the view plane, outside a domain line) or draws each of `pairs` (live
+/// pairs of `group`) in order, into `out`.
 fn draw_pairs(
     triangles: &[ProjectionTriangle],
     scene: &SceneGeometry,
+    group: &LivePairs,
     pairs: &[LivePair],
     curves: CurveOptions,
+    out: &mut Drawn,
     scratch: &mut Scratch,
-) -> Drawn {
-    let mut out = Drawn::default();
+) {
+    let triangle = &triangles[group.projection as usize];
     for live in pairs {
-        let triangle = &triangles[live.projection as usize];
         let k = live.triangle as usize;
         let positions = scene.corners(k);
-        match cull(triangle, positions, &live.solved) {
+        let solved = group.solved(live);
+        match cull(triangle, positions, &solved) {
             Some(Cull::Behind) => out.counts.culled_behind += 1,
             Some(Cull::Outside) => out.counts.culled_outside += 1,
             None => {
                 let pair = Pair {
                     triangle,
-                    key: (u64::from(live.projection) << 32) | k as u64,
+                    key: (u64::from(group.projection) << 32) | k as u64,
                     id: scene.owners[k].id,
                     curves,
                     terms: live.terms,
                 };
                 let unprojectable = out.counts.unprojectable;
                 if curves.mode == CurveMode::Tessellate {
-                    pair.tessellated(positions, &mut out, scratch);
+                    pair.tessellated(positions, out, scratch);
                 } else {
-                    pair.whole(positions, live.solved, &mut out, scratch);
+                    pair.whole(positions, solved, out, scratch);
                 }
                 if out.counts.unprojectable > unprojectable {
-                    out.fallback.push(live.projection);
+                    out.fallback.push(group.projection);
                 }
             }
         }
     }
-    out
 }
 
 /// Whether a pair can be skipped. Only decided when every vertex's cubic kept all three

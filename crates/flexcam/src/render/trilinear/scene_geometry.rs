@@ -1,7 +1,7 @@
 //! The scene's triangles in one flat f64 list, numbered like the ray caster's BVH (objects in
-//! order, each object's triangles in order), with the owner of each, the triangles that
-//! meet at each edge, and clusters of consecutive triangles with their bounding boxes under
-//! a box tree (`cull_tree`).
+//! order, each object's triangles in order), with the owner and plane of each, the
+//! triangles that meet at each edge, and clusters of consecutive triangles with their
+//! bounding boxes under a box tree (`cull_tree`).
 
 use std::collections::HashMap;
 use std::ops::Range;
@@ -9,6 +9,7 @@ use std::ops::Range;
 use glam::DVec3;
 
 use super::cull_tree::CullTree;
+use super::hit_terms::HitTerms;
 use crate::scene::Scene;
 
 /// Which object triangle a scene triangle is.
@@ -40,6 +41,10 @@ pub struct SceneGeometry {
     pub clusters: Vec<Cluster>,
     /// The box tree over `clusters`: a projection triangle skips whole subtrees.
     pub tree: CullTree,
+    /// Per triangle, its plane as the terms of a projector's hit (`HitTerms::new`), built
+    /// once rather than for every projection triangle it is live in; `None` for a triangle
+    /// without a plane (zero area or a non-finite corner), which has nothing to draw.
+    pub hit_terms: Vec<Option<HitTerms>>,
     /// Per triangle, the numbers of its edges `<V1V2, V1V3, V2V3>` in `edge_users`.
     edges: Vec<[u32; 3]>,
     /// The triangles using each edge.
@@ -148,6 +153,9 @@ impl SceneGeometry {
             EdgeUsers::new((0..out.triangles.len()).map(|k| out.corners(k)));
         out.clusters = out.clusters();
         out.tree = CullTree::new(&out.clusters);
+        out.hit_terms = (0..out.triangles.len())
+            .map(|k| HitTerms::new(out.corners(k)))
+            .collect();
         out.shared_edges = (0..out.triangles.len())
             .map(|k| {
                 (0..3).fold(0, |mask, edge| {

@@ -98,10 +98,23 @@ impl VolumeBounds {
     /// margin (module doc). A scene triangle whose vertices' masks have a common bit is
     /// outside the volume.
     pub fn outside(&self, point: DVec3) -> u32 {
+        self.outside_of(point, self.all_planes())
+    }
+
+    /// [`VolumeBounds::outside`] among the planes `planes` only (the bits of the others are
+    /// zero). The cull passes the planes that still cut the box of the point's cluster
+    /// ([`VolumeBounds::box_side`]): the box lies wholly inside the others, so the point is
+    /// beyond none of them and the mask is the full one, at the cost of a few planes
+    /// instead of all.
+    pub fn outside_of(&self, point: DVec3, planes: u32) -> u32 {
         let mut mask = 0;
         // The distance scale, computed once and only for a point beyond some plane.
         let mut scale = None;
-        for (k, (m, c)) in self.planes[..self.count].iter().enumerate() {
+        let mut remaining = planes & self.all_planes();
+        while remaining != 0 {
+            let k = remaining.trailing_zeros();
+            remaining &= remaining - 1;
+            let (m, c) = self.planes[k as usize];
             let beyond = m.dot(point) - c;
             if beyond > 0.0 {
                 let scale =
@@ -280,10 +293,8 @@ mod tests {
                 )
             });
             let inner = inner.into_iter().map(|(x, y, z)| DVec3::new(x, y, z));
-            let masks: Vec<u32> = corners
-                .chain(inner)
-                .map(|s| bounds.outside(centre + s * half))
-                .collect();
+            let points: Vec<DVec3> = corners.chain(inner).map(|s| centre + s * half).collect();
+            let masks: Vec<u32> = points.iter().map(|&x| bounds.outside(x)).collect();
             match bounds.box_side(centre, half, bounds.all_planes()) {
                 BoxSide::Outside => {
                     let common = masks.iter().fold(u32::MAX, |m, &x| m & x);
@@ -291,11 +302,25 @@ mod tests {
                 }
                 BoxSide::Within(active) => {
                     let dropped = bounds.all_planes() & !active;
-                    for m in masks {
+                    for (&point, m) in points.iter().zip(masks) {
                         prop_assert_eq!(m & dropped, 0);
+                        // So the test among the planes still cutting the box is complete.
+                        prop_assert_eq!(bounds.outside_of(point, active), m);
                     }
                 }
             }
+        }
+
+        /// The test among some planes is the full test restricted to them.
+        #[test]
+        fn the_test_among_some_planes_is_the_full_test_restricted(
+            (p, n) in triangle(2.5),
+            point in vec3(),
+            planes in any::<u32>(),
+        ) {
+            let bounds = VolumeBounds::new(p, n);
+            let point = 2.0 * point;
+            prop_assert_eq!(bounds.outside_of(point, planes), bounds.outside(point) & planes);
         }
     }
 
