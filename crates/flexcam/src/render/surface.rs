@@ -186,11 +186,39 @@ pub fn checker_parity(p: Vec3, size: f32) -> u32 {
 const CHECKER_NUDGE: f32 = 1e-4;
 
 /// Parity (0 or 1) of `floor(x) + floor(y) + floor(z)`: the checker cell at cell coordinates
-/// `cell` (the nudged object-space point divided by the cell size).
+/// `cell` (the nudged object-space point divided by the cell size). The parity of a sum is
+/// the exclusive or of the parities; each is read by [`floor_parity`] (no float-to-integer
+/// conversion, the per-pixel cost of flat-shaded checkers) where all three coordinates are
+/// below [`ROUNDING_RANGE`] in magnitude, which every cell of a scene within the renderers'
+/// limits is. Degenerate cases: beyond that range, and for NaN or infinite coordinates, the
+/// parity of the wrapping sum of the three [`floor_to_int`] (NaN counts as 0, infinities
+/// as `i64::MAX` and `i64::MIN`); the result is that sum's parity for every input (tested).
 #[inline]
 fn cell_parity(cell: Vec3) -> u32 {
-    let sum = floor_to_int(cell.x) + floor_to_int(cell.y) + floor_to_int(cell.z);
-    sum.rem_euclid(2) as u32
+    if cell.abs().cmplt(Vec3::splat(ROUNDING_RANGE)).all() {
+        floor_parity(cell.x) ^ floor_parity(cell.y) ^ floor_parity(cell.z)
+    } else {
+        let sum = floor_to_int(cell.x)
+            .wrapping_add(floor_to_int(cell.y))
+            .wrapping_add(floor_to_int(cell.z));
+        (sum & 1) as u32
+    }
+}
+
+/// The magnitude below which [`floor_parity`] holds: `2^22`.
+const ROUNDING_RANGE: f32 = 4_194_304.0;
+
+/// Parity (0 or 1) of `floor(x)` for `|x| <` [`ROUNDING_RANGE`]: adding `1.5 * 2^23` rounds
+/// `x` to its nearest integer `r` (ties to even), exactly, because the sum lies in
+/// `[2^23, 2^24]` where `f32` steps by 1 (at most 2^24, where the step becomes 2, but that
+/// value is an integer); the sum's last mantissa bit is `r`'s parity, the constant being
+/// even, and `floor(x)` is `r - 1` where `r > x`.
+#[inline]
+fn floor_parity(x: f32) -> u32 {
+    const ROUNDER: f32 = 12_582_912.0;
+    let sum = x + ROUNDER;
+    let rounded = sum - ROUNDER;
+    (sum.to_bits() & 1) ^ u32::from(rounded > x)
 }
 
 /// `x.floor() as i64` without the libm call that `f32::floor` compiles to on baseline x86-64
@@ -213,6 +241,102 @@ mod tests {
         assert_eq!(floor_to_int(f32::NAN), 0);
         assert_eq!(floor_to_int(f32::INFINITY), i64::MAX);
         assert_eq!(floor_to_int(f32::NEG_INFINITY), i64::MIN);
+    }
+
+    /// The parity of the sum of the three `floor_to_int`, as `cell_parity` defines it.
+    fn parity_of_floors(cell: Vec3) -> u32 {
+        let sum = floor_to_int(cell.x) as i128
+            + floor_to_int(cell.y) as i128
+            + floor_to_int(cell.z) as i128;
+        sum.rem_euclid(2) as u32
+    }
+
+    #[test]
+    fn floor_parity_is_the_parity_of_floor_over_its_range() {
+        // Every 61st f32 bit pattern (about 70 million values), and the values around the
+        // range's ends, integers and half-integers.
+        let mut checked = 0;
+        for bits in (0..=u32::MAX).step_by(61) {
+            let x = f32::from_bits(bits);
+            if x.abs() < ROUNDING_RANGE {
+                assert_eq!(
+                    floor_parity(x),
+                    (x.floor() as i64).rem_euclid(2) as u32,
+                    "{x}"
+                );
+                checked += 1;
+            }
+        }
+        assert!(checked > 30_000_000, "{checked}");
+        let edge = ROUNDING_RANGE;
+        let below = f32::from_bits(edge.to_bits() - 1);
+        for x in [
+            below,
+            -below,
+            edge - 0.5,
+            -edge + 0.5,
+            edge - 0.25,
+            -edge + 0.25,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            -2.5,
+            -0.0,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            0.999_999_94,
+            -0.999_999_94,
+        ] {
+            assert_eq!(
+                floor_parity(x),
+                (x.floor() as i64).rem_euclid(2) as u32,
+                "{x}"
+            );
+        }
+    }
+
+    #[test]
+    fn cell_parity_is_the_parity_of_the_sum_of_floors_for_every_input() {
+        let special = [
+            0.0f32,
+            -0.0,
+            0.5,
+            -1.5,
+            ROUNDING_RANGE,
+            -ROUNDING_RANGE,
+            f32::from_bits(ROUNDING_RANGE.to_bits() - 1),
+            3e9,
+            -3e9,
+            1e19,
+            -1e19,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        for &x in &special {
+            for &y in &special {
+                for &z in &special {
+                    let cell = Vec3::new(x, y, z);
+                    assert_eq!(cell_parity(cell), parity_of_floors(cell), "{cell}");
+                }
+            }
+        }
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn cell_parity_matches_the_floors_on_random_cells(
+            x in -1e7f32..1e7,
+            y in -1e3f32..1e3,
+            z in -10.0f32..10.0,
+        ) {
+            let cell = Vec3::new(x, y, z);
+            proptest::prop_assert_eq!(cell_parity(cell), parity_of_floors(cell));
+        }
     }
 
     use std::sync::Arc;

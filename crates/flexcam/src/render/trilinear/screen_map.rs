@@ -16,6 +16,9 @@ pub struct ScreenMap {
     axes: DMat2,
     /// The inverse of `axes` (the screen triangle is validated non-degenerate).
     inverse: DMat2,
+    /// The change of `trinorm` from one pixel to the next along a row (`trinorm` is affine
+    /// in `(u, v)`, hence in pixel position).
+    direction_per_x: DVec3,
     cache: ProjectionTriangleCache,
 }
 
@@ -26,10 +29,15 @@ impl ScreenMap {
         let pixel = |s: DVec2| DVec2::new(s.x * size.x, (1.0 - s.y) * size.y);
         let [p0, p1, p2] = screen.map(pixel);
         let axes = DMat2::from_cols(p1 - p0, p2 - p0);
+        let inverse = axes.inverse();
+        // (u, v) changes by the inverse's first column per pixel along x.
+        let per_x = inverse.x_axis;
+        let direction_per_x = cache.trinorm(per_x.x, per_x.y) - cache.trinorm(0.0, 0.0);
         ScreenMap {
             origin: p0,
             axes,
-            inverse: axes.inverse(),
+            inverse,
+            direction_per_x,
             cache,
         }
     }
@@ -61,6 +69,17 @@ impl ScreenMap {
             uv,
             direction,
         })
+    }
+
+    /// The projector directions (`trinorm`, [`Projector::direction`]) along a row: the
+    /// direction at pixel position `pixel`, then the change from one pixel to the next, so
+    /// that the direction at `pixel + (k, 0)` is `start + k step` up to rounding, for
+    /// callers walking a run of pixels of this projection triangle (shading) instead of
+    /// mapping each pixel on its own. Unlike [`ScreenMap::projector`] it does not single out
+    /// a zero `trinorm`: the caller checks the directions it uses.
+    pub fn directions_along_row(&self, pixel: DVec2) -> (DVec3, DVec3) {
+        let uv = self.barycentrics(pixel);
+        (self.cache.trinorm(uv.x, uv.y), self.direction_per_x)
     }
 
     /// The projection triangle's point-projection cache.
@@ -125,6 +144,23 @@ mod tests {
             let m = map();
             let back = m.barycentrics(m.pixel(u, v));
             prop_assert!((back - DVec2::new(u, v)).length() < 1e-12);
+        }
+
+        #[test]
+        fn directions_along_a_row_are_the_projectors_directions(
+            x in -50.0..250.0f64,
+            y in -50.0..150.0f64,
+            k in 0u32..400,
+        ) {
+            let m = map();
+            let (start, step) = m.directions_along_row(DVec2::new(x, y));
+            let stepped = start + f64::from(k) * step;
+            let pixel = DVec2::new(x + f64::from(k), y);
+            let direction = m.projector(pixel).map_or(DVec3::ZERO, |p| p.direction);
+            prop_assert!(
+                (stepped - direction).length() < 1e-12 * (1.0 + direction.length()),
+                "{stepped} {direction}"
+            );
         }
     }
 }

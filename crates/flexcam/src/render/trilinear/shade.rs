@@ -236,32 +236,171 @@ struct Pixel {
     counts: ShadeCounts,
 }
 
+/// A run of pixels `x0..x0 + len` of row `y` won by the same `key`, starting at index
+/// `first` of the band (and of its rows of the frame).
+struct Run {
+    key: u64,
+    y: u32,
+    x0: u32,
+    first: usize,
+    len: usize,
+}
+
+impl Run {
+    /// The projection triangle of the key.
+    fn projection(&self) -> usize {
+        (self.key >> 32) as usize
+    }
+
+    /// The scene triangle of the key.
+    fn triangle(&self) -> usize {
+        (self.key & u64::from(u32::MAX)) as usize
+    }
+
+    /// Writes the background into every pixel of the run.
+    fn fill(&self, out: &mut FrameRows<'_>, background: Vec3) {
+        let cells = self.first..self.first + self.len;
+        out.color[cells.clone()].fill(background);
+        out.depth[cells.clone()].fill(f32::INFINITY);
+        out.ids[cells].fill(0);
+    }
+
+    /// Writes pixel `k` of the run; returns its ray counts.
+    fn write(&self, out: &mut FrameRows<'_>, k: usize, p: Pixel) -> ShadeCounts {
+        let i = self.first + k;
+        (out.color[i], out.depth[i], out.ids[i]) = (p.color, p.depth, p.id);
+        p.counts
+    }
+}
+
 impl Shader<'_> {
     /// Shades the drawn band `drawn` into the same rows `out` of the frame, every pixel of
     /// them written.
-    pub fn rows(&self, drawn: &GBuffer, out: FrameRows<'_>) -> ShadeCounts {
+    ///
+    /// Each row is walked in runs of pixels won by the same key: a run of background is
+    /// filled at once, and a run of one triangle seen through one projection triangle looks
+    /// up its map, owner and colour once and walks its projector directions along the row
+    /// ([`Shader::flat_run`]). With fallback projection triangles every pixel is shaded on
+    /// its own ([`Shader::pixel`]).
+    pub fn rows(&self, drawn: &GBuffer, mut out: FrameRows<'_>) -> ShadeCounts {
         let any_fallback = self.fallback.iter().any(|&f| f);
-        let (width, rows) = (drawn.width(), drawn.rows());
+        let (width, rows) = (drawn.width() as usize, drawn.rows());
         let mut counts = ShadeCounts::default();
         for (row, y) in (rows.0..rows.1).enumerate() {
-            for x in 0..width {
-                let i = row * width as usize + x as usize;
-                let key = drawn.keys[i];
-                let pixel = if any_fallback && self.in_fallback(x, y) {
-                    self.cast(x, y)
-                } else if key == NO_PRIMITIVE {
-                    None
-                } else {
-                    let barycentric = Vec2::from(drawn.barycentrics[i]);
-                    self.rasterised(key, drawn.depth[i], barycentric, x, y)
+            let keys = &drawn.keys[row * width..(row + 1) * width];
+            let mut x0 = 0;
+            while x0 < width {
+                let key = keys[x0];
+                let x1 = x0 + 1 + keys[x0 + 1..].iter().take_while(|&&k| k == key).count();
+                let run = Run {
+                    key,
+                    y,
+                    x0: x0 as u32,
+                    first: row * width + x0,
+                    len: x1 - x0,
                 };
-                let p = pixel.unwrap_or(Pixel {
-                    color: self.background,
-                    depth: f32::INFINITY,
-                    id: 0,
-                    counts: ShadeCounts::default(),
-                });
-                (out.color[i], out.depth[i], out.ids[i]) = (p.color, p.depth, p.id);
+                let flat = self
+                    .flat_colors
+                    .and_then(|colors| colors.get(run.triangle())?.as_ref());
+                counts = counts
+                    + match flat {
+                        _ if any_fallback => self.pixels(drawn, &run, &mut out, true),
+                        _ if key == NO_PRIMITIVE => {
+                            run.fill(&mut out, self.background);
+                            ShadeCounts::default()
+                        }
+                        Some(color) if color.is_uniform() => {
+                            let uniform = color.at(Vec2::ZERO);
+                            self.flat_run(drawn, &run, &mut out, |_| uniform)
+                        }
+                        Some(color) => self.flat_run(drawn, &run, &mut out, |b| color.at(b)),
+                        None => self.pixels(drawn, &run, &mut out, false),
+                    };
+                x0 = x1;
+            }
+        }
+        counts
+    }
+
+    /// The pixels of `run` shaded one by one ([`Shader::pixel`]); `any_fallback`: whether
+    /// any projection triangle is ray cast.
+    fn pixels(
+        &self,
+        drawn: &GBuffer,
+        run: &Run,
+        out: &mut FrameRows<'_>,
+        any_fallback: bool,
+    ) -> ShadeCounts {
+        let mut counts = ShadeCounts::default();
+        for k in 0..run.len {
+            let x = run.x0 + k as u32;
+            let pixel = self.pixel(drawn, run.first + k, x, run.y, any_fallback);
+            counts = counts + run.write(out, k, pixel);
+        }
+        counts
+    }
+
+    /// Pixel `(x, y)` at index `i` of the band `drawn`: ray cast in a fallback projection
+    /// triangle (looked up only if `any_fallback`), else its winning fragment shaded, else
+    /// background.
+    fn pixel(&self, drawn: &GBuffer, i: usize, x: u32, y: u32, any_fallback: bool) -> Pixel {
+        let key = drawn.keys[i];
+        let pixel = if any_fallback && self.in_fallback(x, y) {
+            self.cast(x, y)
+        } else if key == NO_PRIMITIVE {
+            None
+        } else {
+            let barycentric = Vec2::from(drawn.barycentrics[i]);
+            self.rasterised(key, drawn.depth[i], barycentric, x, y)
+        };
+        pixel.unwrap_or(Pixel {
+            color: self.background,
+            depth: f32::INFINITY,
+            id: 0,
+            counts: ShadeCounts::default(),
+        })
+    }
+
+    /// The pixels of `run` (a triangle whose flat colour at barycentrics `b` is `color(b)`,
+    /// no fallback) shaded as [`Shader::pixel`] shades them, with the map, owner and colour
+    /// looked up once and the projector's direction (for the depth `t |trinorm|`) stepped
+    /// along the row ([`ScreenMap::directions_along_row`]). A crack filler is resolved
+    /// again ([`Shader::rasterised`]). Degenerate case: where the stepped direction is zero
+    /// (a projector of zero `trinorm`, which [`ScreenMap::projector`] refuses), the pixel
+    /// is background, as [`Shader::pixel`] leaves it.
+    #[inline]
+    fn flat_run(
+        &self,
+        drawn: &GBuffer,
+        run: &Run,
+        out: &mut FrameRows<'_>,
+        color: impl Fn(Vec2) -> Vec3,
+    ) -> ShadeCounts {
+        let Some(map) = self.resolver.maps.get(run.projection()) else {
+            return self.pixels(drawn, run, out, false);
+        };
+        let id = self.resolver.scene.owners[run.triangle()].id;
+        let position = self.resolver.position(run.x0, run.y);
+        let (start, step) = map.directions_along_row(position);
+        let cells = run.first..run.first + run.len;
+        let exact = drawn.depth[cells.clone()]
+            .iter()
+            .zip(&drawn.barycentrics[cells])
+            .zip(&mut out.color[run.first..run.first + run.len])
+            .zip(&mut out.depth[run.first..run.first + run.len])
+            .zip(&mut out.ids[run.first..run.first + run.len])
+            .enumerate();
+        let mut counts = ShadeCounts::default();
+        for (k, ((((&t, &barycentric), out_color), out_depth), out_id)) in exact {
+            let direction = start + k as f64 * step;
+            if t < CRACK_FILL_DEPTH && direction != DVec3::ZERO {
+                *out_color = color(Vec2::from(barycentric));
+                *out_depth = (t * direction.length()) as f32;
+                *out_id = id;
+            } else {
+                let x = run.x0 + k as u32;
+                let p = self.pixel(drawn, run.first + k, x, run.y, false);
+                (*out_color, *out_depth, *out_id) = (p.color, p.depth, p.id);
                 counts = counts + p.counts;
             }
         }
