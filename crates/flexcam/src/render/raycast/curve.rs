@@ -31,8 +31,11 @@ use super::{Hit32, RayCaster};
 use crate::projection::projector::{quadratic_point, quadratic_tangent};
 
 /// Pieces the curve is cut into for the BVH search: more pieces give thinner fattened chords
-/// (the padding falls as 1/PIECES^2) but more traversals.
-pub(super) const PIECES: usize = 8;
+/// (the padding falls as 1/PIECES^2), boxes that fewer triangles overlap, and fewer triangles
+/// tested beyond the first hit, but more traversals and more piece boxes in the tile culls.
+/// 24 took the least CPU time on the Table 7.1 bench's smallest models (8, 12, 16, 20, 24,
+/// 28, 32, 48 and 64 tried; docs/flexible.md, change 7).
+pub(super) const PIECES: usize = 24;
 
 /// The parameter interval [a, b] of piece `k` of [`PIECES`].
 pub(super) fn piece_interval(k: usize) -> (f64, f64) {

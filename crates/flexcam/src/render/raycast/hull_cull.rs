@@ -55,9 +55,13 @@ impl RayCaster {
     /// Which parts of the projectors bounded by `hull` may hold a hit: those whose box over
     /// the hull overlaps a leaf of the BVH (each projector's own search tests the scene's box
     /// alone: [`RayCaster::misses_scene_box`] for segments, the control-point box for a
-    /// quadratic's pieces). [`LiveParts::ALL`] when the corners are
-    /// of mixed kinds, polylines of different lengths, or straight.
-    pub(super) fn live_parts(&self, hull: &ProjectorHull) -> LiveParts {
+    /// quadratic's pieces). Only the parts `within` leaves live are tested: the others stay
+    /// dead, as for a rectangle inside one whose parts `within` are (its projectors are among
+    /// that rectangle's, so a part that holds no hit for those holds none for these; the
+    /// tiles pass the tile's parts for its blocks, each of which would otherwise test every
+    /// part of every corner again). `within` itself when the corners are of mixed kinds,
+    /// polylines of different lengths, or straight.
+    pub(super) fn live_parts(&self, hull: &ProjectorHull, within: LiveParts) -> LiveParts {
         match &hull.corners {
             [Projector::Polyline(a), Projector::Polyline(b), Projector::Polyline(c), Projector::Polyline(d)]
                 if [b, c, d].iter().all(|p| p.len() == a.len()) =>
@@ -65,6 +69,9 @@ impl RayCaster {
                 let corners = [a, b, c, d];
                 let pad = self.hull_pad(hull.pad, corners.iter().flat_map(|p| p.iter()));
                 LiveParts::of(a.len().saturating_sub(1), |k| {
+                    if !within.may_hit(k) {
+                        return false;
+                    }
                     let ends = corners.iter().flat_map(|p| [p[k], p[k + 1]]);
                     !self.box_misses_scene(ends, pad)
                 })
@@ -74,12 +81,15 @@ impl RayCaster {
                 let corners = [a, b, c, d];
                 let pad = self.hull_pad(hull.pad, corners.iter().flat_map(|p| p.iter()));
                 LiveParts::of(PIECES, |k| {
+                    if !within.may_hit(k) {
+                        return false;
+                    }
                     let (s0, s1) = piece_interval(k);
                     let points = corners.iter().flat_map(|p| piece(p, s0, s1));
                     !self.box_misses_scene(points, pad)
                 })
             }
-            _ => LiveParts::ALL,
+            _ => within,
         }
     }
 
@@ -195,31 +205,40 @@ mod tests {
         let whole = projection
             .projector_hull(DVec2::splat(0.5), DVec2::splat(63.5))
             .unwrap();
-        let live = caster.live_parts(&whole);
+        let live = caster.live_parts(&whole, LiveParts::ALL);
         assert!(!live.none() && live != LiveParts::ALL, "{live:?}");
+        // Parts ruled out beforehand stay dead; the others are tested as before.
+        let first_live = (0..64).find(|&k| live.may_hit(k)).unwrap();
+        let all_but_first = LiveParts(!(1 << first_live));
+        let masked = caster.live_parts(&whole, all_but_first);
+        assert_eq!(masked, LiveParts(live.0 & all_but_first.0));
         // A corner of the image far from the teapot is culled.
         let corner = projection
             .projector_hull(DVec2::splat(0.5), DVec2::splat(1.5))
             .unwrap();
-        assert!(caster.live_parts(&corner).none());
+        assert!(caster.live_parts(&corner, LiveParts::ALL).none());
         // Polylines of different lengths, or kinds mixed, are not bounded: never culled.
         let mut mixed = corner.clone();
         let Projector::QuadraticBezier(p) = &corner.corners[0] else {
             panic!("{:?}", corner.corners[0]);
         };
         mixed.corners[0] = Projector::Polyline(p.to_vec());
-        assert_eq!(caster.live_parts(&mixed), LiveParts::ALL);
+        assert_eq!(caster.live_parts(&mixed, LiveParts::ALL), LiveParts::ALL);
+        assert_eq!(caster.live_parts(&mixed, LiveParts(0b10)), LiveParts(0b10));
         let polylines = bench_volume(Some(3), 64)
             .projector_hull(DVec2::splat(0.5), DVec2::splat(1.5))
             .unwrap();
-        assert!(caster.live_parts(&polylines).none());
+        assert!(caster.live_parts(&polylines, LiveParts::ALL).none());
         let mut uneven = polylines.clone();
         uneven.corners[1] = Projector::Polyline(p.to_vec());
-        assert_eq!(caster.live_parts(&uneven), LiveParts::ALL);
+        assert_eq!(caster.live_parts(&uneven, LiveParts::ALL), LiveParts::ALL);
         // A pad that is not finite never culls.
         let mut unbounded = polylines;
         unbounded.pad = f64::INFINITY;
-        assert_eq!(caster.live_parts(&unbounded), LiveParts(0b111));
+        assert_eq!(
+            caster.live_parts(&unbounded, LiveParts::ALL),
+            LiveParts(0b111)
+        );
     }
 
     #[test]

@@ -130,14 +130,14 @@ fn block_parts(
         .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(lo, hi), o| {
             (lo.min(*o), hi.max(*o))
         });
-    let parts = |x: u32, y: u32, w: u32, h: u32| {
+    let parts = |(x, y, w, h): (u32, u32, u32, u32), within: LiveParts| {
         let first = DVec2::new(x as f64, y as f64);
         let last = first + DVec2::new((w - 1) as f64, (h - 1) as f64);
         projection
             .projector_hull(first + lo, last + hi)
-            .map(|hull| caster.live_parts(&hull))
+            .map(|hull| caster.live_parts(&hull, within))
     };
-    let whole = parts(x0, y0, width, height);
+    let whole = parts((x0, y0, width, height), LiveParts::ALL);
     let mut blocks = [[whole.unwrap_or(LiveParts::ALL); BLOCKS]; BLOCKS];
     let Some(whole) = whole.filter(|w| !w.none()) else {
         return blocks;
@@ -147,9 +147,9 @@ fn block_parts(
             let (bx, by) = (column as u32 * BLOCK, row as u32 * BLOCK);
             if bx < width && by < height {
                 let (w, h) = (BLOCK.min(width - bx), BLOCK.min(height - by));
-                // The tile's hull bounds the block too: it stands in where the block has
-                // none.
-                *block = parts(x0 + bx, y0 + by, w, h).unwrap_or(whole);
+                // The tile's hull bounds the block too: only the tile's live parts are
+                // tested, and the tile's stand in where the block has no hull.
+                *block = parts((x0 + bx, y0 + by, w, h), whole).unwrap_or(whole);
             }
         }
     }
