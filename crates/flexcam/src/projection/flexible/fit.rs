@@ -895,7 +895,8 @@ mod tests {
 
     #[test]
     fn recovers_curved_projector_grids_from_their_own_correspondences() {
-        // One grid, with tight bounds (random ones: recovers_random_curved_grids_or_shows_the_miss).
+        // One grid, with tight bounds (random ones, with random lengths:
+        // recovers_random_bilinear_curved_grids_with_their_own_lengths).
         let truth = curved_truth(GridInterpolation::Bilinear, 0.3, 3);
         let (report, [end, tangent, point, _]) = recover_curved(&truth, 12, 13).unwrap();
         eprintln!("{report:?}, errors end {end:e}, tangent {tangent:e} rad, Q {point:e}");

@@ -6,10 +6,10 @@
 //! As in the straight fit, the starts S_j stay (the image plane); the unknowns of every node
 //! that some correspondence constrains are the direction D_j of its end, its unit tangent T_j
 //! and its length L_j = |E_j - S_j| (where the data determine it, below), which give
-//! E_j = S_j + L_j D_j and its control point C_j = S_j + (L_j / 2) T_j. The projector of (u, v) is the
-//! quadratic B(t) = (1 - t)^2 S + 2 t (1 - t) C + t^2 E of the blended S, C and E, and
-//! correspondence k asks that B_k(t_k) = X_k for some depth t_k, a further unknown. The fit
-//! minimises
+//! E_j = S_j + L_j D_j and its control point C_j = S_j + (L_j / 2) T_j. The projector of
+//! (u, v) is the quadratic B(t) = (1 - t)^2 S + 2 t (1 - t) C + t^2 E of the blended S, C
+//! and E, and correspondence k asks that B_k(t_k) = X_k for some depth t_k, a further
+//! unknown. The fit minimises
 //!
 //! sum_k |B_k(t_k) - X_k|^2 / rho_k^2
 //!     + lambda sum_j (|D_j - D0_j|^2 + |T_j - T0_j|^2 + ln(L_j / L0_j)^2)
@@ -63,13 +63,14 @@
 //! 24 of 24 bilinear and 8 of 8 Bezier random grids recovered; with each node's length 0.5 to
 //! 3 times the prior's and fitted, `recovers_random_bilinear_curved_grids_with_their_own_lengths`
 //! and `..._bezier_...`: 23 of 24 bilinear and 14 of 16 Bezier grids). A minimum without a
-//! folded node is not repaired, and is left to the report's residual (the three misses:
-//! max residuals 0.62, 0.0028 and 0.034 degrees). Tried and not kept: a continuation in the data (from the straight
-//! start's own projectors to the points in 8 stages) with steps limited to 0.2 rad (the same
-//! 9 grids), and an alternating start (depths fixed, the node control points and ends by
-//! linear least squares, put back on the constraint): for fixed depths the free problem is
-//! badly conditioned, its control points landing far off the constraint (up to 2,750 times
-//! the half length on Bezier grids), and the start was no better.
+//! folded node, or one whose mirror does not lower the cost, is not repaired, and is left to
+//! the report's residual (the three misses: max residuals 0.62, 0.0028 and 0.034 degrees).
+//! Tried and not kept: a continuation in the data (from the straight start's own projectors
+//! to the points in 8 stages) with steps limited to 0.2 rad (the same 9 grids), and an
+//! alternating start (depths fixed, the node control points and ends by linear least squares,
+//! put back on the constraint): for fixed depths the free problem is badly conditioned, its
+//! control points landing far off the constraint (up to 2,750 times the half length on
+//! Bezier grids), and the start was no better.
 //!
 //! Identifiability: with fewer correspondences than twice the free nodes (each fixes two of a
 //! node's four angles) the fit is refused before it starts, naming how many are missing; at
