@@ -860,6 +860,14 @@ mod tests {
         out
     }
 
+    /// The random curved grid of `seed` of the length tests: bent 0.03 to 0.43 rad, every
+    /// node's length 0.5 to 3 times the prior's.
+    fn random_curved_truth(interpolation: GridInterpolation, seed: u64) -> ProjectorGrid {
+        let bend = 0.03 + 0.4 * uniform(1000 + seed)();
+        let truth = curved_truth(interpolation, bend, seed);
+        with_random_lengths(&truth, 0.5..3.0, 2000 + seed)
+    }
+
     /// The largest relative error of a node end of `fitted` against `truth` (over the
     /// node's projector length), of a node tangent (radians; a straight node's tangent is its
     /// chord), of Q(u, v, t) over a 17 x 17 x 5 sample (over the projector length there) and
@@ -1153,13 +1161,7 @@ mod tests {
         let mut recovered = 0;
         let mut worst = [0.0f64; 4];
         for seed in seeds {
-            let bend = 0.03
-                + 0.4 * {
-                    let mut next = uniform(1000 + seed);
-                    next()
-                };
-            let truth = curved_truth(interpolation, bend, seed);
-            let truth = with_random_lengths(&truth, 0.5..3.0, 2000 + seed);
+            let truth = random_curved_truth(interpolation, seed);
             match recover_curved(&truth, 12, 100 + seed) {
                 Ok((report, errors)) if errors.iter().all(|e| *e < tolerance) => {
                     eprintln!("{interpolation:?} seed {seed}: {report:?} {errors:?}");
@@ -1304,13 +1306,7 @@ mod tests {
             let mut refused = 0;
             let mut worst_sight = 0.0f64;
             for seed in seeds {
-                let bend = 0.03
-                    + 0.4 * {
-                        let mut next = uniform(1000 + seed);
-                        next()
-                    };
-                let truth = curved_truth(interpolation, bend, seed);
-                let truth = with_random_lengths(&truth, 0.5..3.0, 2000 + seed);
+                let truth = random_curved_truth(interpolation, seed);
                 let data = correspondences_of(&truth, 12, 100 + seed);
                 let noisy = with_noise(&truth, &data, sigma, 300 + seed);
                 let mut prior =
