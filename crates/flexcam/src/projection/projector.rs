@@ -65,9 +65,10 @@ const GAUSS_WEIGHTS: [f64; 4] = [
 /// Equal sub-intervals each smooth piece of the arc-length integral is cut into.
 const ARC_PIECES: usize = 4;
 
-/// Largest ratio of the magnitudes of the two antiderivative values the closed form
-/// subtracts to their difference ([`arc_length_closed_form`]): each value carries a few ulps
-/// of relative rounding, so the result keeps about 1e-12 relative accuracy up to this ratio.
+/// Largest ratio of the sum of the magnitudes of the two terms that the closed form
+/// subtracts ([`arc_length_closed_form`]) to the antiderivative difference: each term carries
+/// a few ulps of relative rounding, so the result keeps about 1e-12 relative accuracy up to
+/// this ratio.
 const CANCELLATION_LIMIT: f64 = 1e3;
 
 /// The arc length of quadratic Bezier curve `p` from 0 to `s` (s in [0, 1]): in closed form
@@ -82,14 +83,18 @@ pub fn quadratic_arc_length(p: &[DVec3; 3], s: f64) -> f64 {
 
 /// The arc length of `p` from 0 to `s` by the antiderivative of the speed. With
 /// a = P0 - 2 P1 + P2 and b = P1 - P0, B'(x) = 2 (b + x a) and
-/// |B'(x)| = 2 |a| sqrt(u^2 + k^2), where u = x + a.b / |a|^2 and k^2 = |a x b|^2 / |a|^4 (Lagrange's identity, free of the
-/// cancellation of |a|^2 |b|^2 - (a.b)^2); the integral of sqrt(u^2 + k^2) is
-/// G(u) / 2, G(u) = u sqrt(u^2 + k^2) + k^2 asinh(u / k), so the length is
-/// |a| (G(u1) - G(u0)). Both terms of G have the sign of u, so G itself is computed without
-/// cancellation. `None` where the subtraction cancels more than [`CANCELLATION_LIMIT`]
+/// |B'(x)| = 2 |a| sqrt(u^2 + k^2), where u = x + a.b / |a|^2 and
+/// k^2 = |a x b|^2 / |a|^4 (Lagrange's identity, free of the cancellation of
+/// |a|^2 |b|^2 - (a.b)^2); the integral of sqrt(u^2 + k^2) is G(u) / 2,
+/// G(u) = u r(u) + k^2 asinh(u / k), r(u) = sqrt(u^2 + k^2), so the length is
+/// |a| (G(u1) - G(u0)) = |a| (u1 r1 - u0 r0 + k^2 D), D = asinh(u1 / k) - asinh(u0 / k)
+/// (both non-negative: u1 >= u0). D is one logarithm ([`asinh_difference`]) instead of two
+/// asinh calls: this runs once per pixel that a quadratic projector hits, for its depth.
+/// `None` where the subtraction u1 r1 - u0 r0 cancels more than [`CANCELLATION_LIMIT`]
 /// allows (nearly straight curves with a large shift a.b / |a|^2, and arcs short against
-/// it, including s = 0) or the result is not finite (overflow, or k so small that u / k
-/// overflows). Degenerate case: a = 0 (uniform speed 2 |b|) gives 2 |b| s exactly.
+/// it, including s = 0 away from the speed's minimum) or the result is not finite
+/// (overflow). Degenerate cases: a = 0 (uniform speed 2 |b|) gives 2 |b| s exactly; k = 0
+/// (collinear control points) has no asinh term.
 fn arc_length_closed_form(p: &[DVec3; 3], s: f64) -> Option<f64> {
     let a = p[0] - 2.0 * p[1] + p[2];
     let b = p[1] - p[0];
@@ -97,17 +102,37 @@ fn arc_length_closed_form(p: &[DVec3; 3], s: f64) -> Option<f64> {
     if a2 == 0.0 {
         return Some(2.0 * b.length() * s);
     }
-    let shift = a.dot(b) / a2;
     let k2 = a.cross(b).length_squared() / (a2 * a2);
-    let k = k2.sqrt();
-    let antiderivative = |u: f64| {
-        let tail = if k2 > 0.0 { k2 * (u / k).asinh() } else { 0.0 };
-        u * (u * u + k2).sqrt() + tail
+    let (u0, u1) = (a.dot(b) / a2, a.dot(b) / a2 + s);
+    let (r0, r1) = ((u0 * u0 + k2).sqrt(), (u1 * u1 + k2).sqrt());
+    let tail = if k2 > 0.0 {
+        k2 * asinh_difference(u0, u1, r0, r1, k2.sqrt(), s)
+    } else {
+        0.0
     };
-    let (g0, g1) = (antiderivative(shift), antiderivative(shift + s));
-    let length = a2.sqrt() * (g1 - g0);
-    (length.is_finite() && g0.abs() + g1.abs() <= CANCELLATION_LIMIT * (g1 - g0).abs())
+    let difference = u1 * r1 - u0 * r0 + tail;
+    let length = a2.sqrt() * difference;
+    (length.is_finite() && u0.abs() * r0 + u1.abs() * r1 <= CANCELLATION_LIMIT * difference)
         .then_some(length)
+}
+
+/// asinh(u1 / k) - asinh(u0 / k) for u0 <= u1 = u0 + s, k > 0, given r0 and r1 with
+/// ri = sqrt(ui^2 + k^2), as one `ln_1p`. With w(u) = |u| + r(u), asinh(|u| / k) = ln(w / k).
+/// Ends on the same side of 0 (the cancellation-prone case: w1 / w0 near 1 for short arcs)
+/// give ln(w_far / w_near) = ln_1p(s (1 + |u0 + u1| / (r0 + r1)) / w_near), because
+/// |w1 - w0| = s + |r1 - r0| and r1 - r0 = s (u0 + u1) / (r0 + r1): no subtraction. Ends on
+/// either side give ln((w0 / k) (w1 / k)) = ln_1p(e0 + e1 + e0 e1) with
+/// e = w / k - 1 = |u| (1 + |u| / (r + k)) / k, again without subtraction. Degenerate case:
+/// s = 0 gives 0.
+fn asinh_difference(u0: f64, u1: f64, r0: f64, r1: f64, k: f64, s: f64) -> f64 {
+    if u0 >= 0.0 || u1 <= 0.0 {
+        let near = (u0.abs() + r0).min(u1.abs() + r1);
+        (s * (1.0 + (u0 + u1).abs() / (r0 + r1)) / near).ln_1p()
+    } else {
+        let excess = |u: f64, r: f64| u.abs() * (1.0 + u.abs() / (r + k)) / k;
+        let (e0, e1) = (excess(u0, r0), excess(u1, r1));
+        (e0 + e1 + e0 * e1).ln_1p()
+    }
 }
 
 /// The arc length of quadratic Bezier curve `p` from 0 to `s` (s in [0, 1]), by 8-point
@@ -239,6 +264,46 @@ mod tests {
         // Overflowing coordinates are not finite in closed form: the quadrature decides.
         let huge = bent.map(|q| q * 1e300);
         assert_eq!(arc_length_closed_form(&huge, 1.0), None);
+    }
+
+    #[test]
+    fn a_short_arc_on_one_side_of_the_slowest_point_keeps_its_precision() {
+        // a = (1, 0, 0), b = (-2e-8, 1, 0): u runs from -2e-8 to -1e-8 and k = 1, so the
+        // two asinh values differ by about 1e-8 and the ratio w0 / w1 of their logarithms
+        // is 1 + 1e-8: taking ln of that ratio would lose about 8 digits of the tail.
+        let b = DVec3::new(-2e-8, 1.0, 0.0);
+        let p = [DVec3::ZERO, b, DVec3::X + 2.0 * b];
+        let s = 1e-8;
+        let closed = arc_length_closed_form(&p, s).expect("no cancellation in u r here");
+        let fine = gauss_arc_length(&p, s, 256);
+        assert!((closed - fine).abs() <= 1e-13 * fine, "{closed} {fine}");
+        // Mirrored: both ends on the positive side.
+        let b = DVec3::new(1e-8, 1.0, 0.0);
+        let p = [DVec3::ZERO, b, DVec3::X + 2.0 * b];
+        let closed = arc_length_closed_form(&p, s).expect("no cancellation in u r here");
+        let fine = gauss_arc_length(&p, s, 256);
+        assert!((closed - fine).abs() <= 1e-13 * fine, "{closed} {fine}");
+    }
+
+    #[test]
+    fn asinh_difference_matches_the_asinh_calls() {
+        let k: f64 = 0.7;
+        for (u0, s) in [
+            (-3.0, 1.0),
+            (-0.5, 1.0),
+            (0.25, 0.5),
+            (-1.0, 0.0),
+            (0.0, 2.0),
+        ] {
+            let u1 = u0 + s;
+            let (r0, r1) = ((u0 * u0 + k * k).sqrt(), (u1 * u1 + k * k).sqrt());
+            let got = asinh_difference(u0, u1, r0, r1, k, s);
+            let want = (u1 / k).asinh() - (u0 / k).asinh();
+            assert!(
+                (got - want).abs() <= 1e-15 * (1.0 + want),
+                "{u0} {s}: {got} {want}"
+            );
+        }
     }
 
     fn point() -> impl proptest::strategy::Strategy<Value = DVec3> {
