@@ -70,44 +70,6 @@ impl Frame {
             ids: vec![0; n],
         }
     }
-
-    /// A frame of zeros (black, depth 0, id 0) for a renderer that overwrites every pixel:
-    /// its buffers come zeroed from the allocator (`alloc_zeroed`, fresh pages from the
-    /// kernel for a large frame), so nothing is written here and each page is first touched
-    /// by the renderer's own (parallel) writes instead of by a fill that they overwrite.
-    /// Degenerate case: a width or height of 0 gives empty buffers (no allocation).
-    pub fn for_overwrite(width: u32, height: u32) -> Self {
-        let n = width as usize * height as usize;
-        Frame {
-            width,
-            height,
-            color: zeroed_colors(n),
-            depth: vec![0.0; n],
-            ids: vec![0; n],
-        }
-    }
-}
-
-/// `n` colours `Vec3::ZERO`, allocated zeroed: `vec![Vec3::ZERO; n]` writes every element
-/// (only primitive element types get a zeroed allocation), which for a frame means touching
-/// every page. Degenerate case: `n == 0` gives an empty vector without allocating (a
-/// zero-sized allocation is not allowed).
-fn zeroed_colors(n: usize) -> Vec<Vec3> {
-    let layout = std::alloc::Layout::array::<Vec3>(n).expect("frame size overflows");
-    if layout.size() == 0 {
-        return Vec::new();
-    }
-    // SAFETY: the layout has a non-zero size. `Vec3` is `#[repr(C)]` of three `f32`, for
-    // which all-zero bytes are the valid value 0.0, so the `n` elements are initialised;
-    // the pointer comes from the global allocator with `Vec3`'s alignment and a size of
-    // exactly `n * size_of::<Vec3>()` bytes, as `Vec::from_raw_parts` requires.
-    unsafe {
-        let ptr = std::alloc::alloc_zeroed(layout).cast::<Vec3>();
-        if ptr.is_null() {
-            std::alloc::handle_alloc_error(layout);
-        }
-        Vec::from_raw_parts(ptr, n, n)
-    }
 }
 
 /// One counter of a renderer's statistics.
@@ -129,23 +91,3 @@ pub mod reproject;
 pub mod surface;
 pub mod trilinear;
 pub use method::Method;
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `for_overwrite` gives buffers of the frame's size holding zeros, and empty buffers
-    /// (its degenerate case) for a width or height of 0.
-    #[test]
-    fn for_overwrite_is_zeroed_and_sized() {
-        let frame = Frame::for_overwrite(7, 5);
-        assert_eq!((frame.width, frame.height), (7, 5));
-        assert_eq!(frame.color, vec![Vec3::ZERO; 35]);
-        assert_eq!(frame.depth, vec![0.0; 35]);
-        assert_eq!(frame.ids, vec![0; 35]);
-        for (width, height) in [(0, 4), (4, 0), (0, 0)] {
-            let frame = Frame::for_overwrite(width, height);
-            assert!(frame.color.is_empty() && frame.depth.is_empty() && frame.ids.is_empty());
-        }
-    }
-}

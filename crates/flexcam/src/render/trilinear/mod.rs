@@ -100,8 +100,7 @@ impl TrilinearRenderer {
         curves: CurveOptions,
     ) -> Result<(Frame, Stats)> {
         let (width, height) = projection.resolution();
-        // Every pixel is overwritten below: no fill, the pages first touched by the shading.
-        let mut frame = Frame::for_overwrite(width, height);
+        let mut frame = new_frame(width, height, self.background);
         let stats = self.render_into(&mut frame, projection, options, curves)?;
         Ok((frame, stats))
     }
@@ -148,7 +147,7 @@ impl TrilinearRenderer {
         let fits = (frame.width, frame.height) == (width, height)
             && [frame.color.len(), frame.depth.len(), frame.ids.len()] == [n; 3];
         if !fits {
-            *frame = Frame::for_overwrite(width, height);
+            *frame = new_frame(width, height, self.background);
         }
         let mut samples = Samples::new(frame, &pattern, self.background);
         let flat_colors = (options.shading == Shading::Flat).then_some(&self.flat_colors[..]);
