@@ -41,8 +41,9 @@ pub type Renderer<'a> =
 /// are the main render's, plus `reflectors`, `reflector_triangles` (in the surfaces),
 /// `reflector_dropped_triangles` (see [`reflector_surface`]), `reflector_pixels` (main-image
 /// pixels replaced), `reflector_fresnel_rays` (lit glass: main-camera rays cast at the
-/// reflector alone for the Fresnel split) and `reflector_render_ms` (surface building and
-/// rendering).
+/// reflector alone for the Fresnel split), `reflector_exact_pixels` (reflector pixels that no
+/// triangle of the surface covers, ray cast exactly instead: [`ExactPixels`]) and
+/// `reflector_render_ms` (surface building and rendering).
 ///
 /// Errors: the renderer's; a scene projection that is not perspective (the main camera);
 /// a reflector id that no object has, or whose material is not mirror or glass.
@@ -65,29 +66,34 @@ pub fn render(
     let (mut frame, mut stats) = renderer(&main_scene, main, options)?;
     let start = Instant::now();
     let (mut triangles, mut dropped, mut pixels, mut fresnel_rays) = (0, 0, 0, 0);
+    let exact = ExactPixels::new(scene, &camera, options);
+    let mut exact_pixels = 0;
     for &id in &scene.trilinear_reflectors {
         let reflector = Reflector::of(scene, id)?;
         let surface = reflector_surface(&reflector.mesh, &camera, reflector.optic)?;
         triangles += surface.mesh.triangles.len();
         dropped += surface.dropped;
-        let Some(image) = render_through(scene, id, &surface, &camera, options, renderer)? else {
-            continue;
-        };
-        pixels += match (options.shading, reflector.optic) {
-            (Shading::Flat, _) => paste(&mut frame, id, &image, Vec3::ONE)?,
-            (Shading::Lit, Optic::Reflect) => paste(&mut frame, id, &image, reflector.tint)?,
-            (Shading::Lit, Optic::Refract { .. }) => {
-                let mirror = reflector_surface(&reflector.mesh, &camera, Optic::Reflect)?;
-                let reflection = render_through(scene, id, &mirror, &camera, options, renderer)?
-                    .unwrap_or_else(|| {
-                        Frame::new(image.width, image.height, scene.image.background)
-                    });
-                let split = FresnelSplit::new(scene, id, camera.clone());
-                let mixed = fresnel_mix(&frame, id, &image, &reflection, &split, reflector.tint)?;
-                fresnel_rays += mixed.rays;
-                paste(&mut frame, id, &mixed.frame, Vec3::ONE)?
-            }
-        };
+        if let Some(image) = render_through(scene, id, &surface, &camera, options, renderer)? {
+            pixels += match (options.shading, reflector.optic) {
+                (Shading::Flat, _) => paste(&mut frame, id, &image, Vec3::ONE)?,
+                (Shading::Lit, Optic::Reflect) => paste(&mut frame, id, &image, reflector.tint)?,
+                (Shading::Lit, Optic::Refract { .. }) => {
+                    let mirror = reflector_surface(&reflector.mesh, &camera, Optic::Reflect)?;
+                    let reflection =
+                        render_through(scene, id, &mirror, &camera, options, renderer)?
+                            .unwrap_or_else(|| {
+                                Frame::new(image.width, image.height, scene.image.background)
+                            });
+                    let split = FresnelSplit::new(scene, id, camera.clone());
+                    let mixed =
+                        fresnel_mix(&frame, id, &image, &reflection, &split, reflector.tint)?;
+                    fresnel_rays += mixed.rays;
+                    paste(&mut frame, id, &mixed.frame, Vec3::ONE)?
+                }
+            };
+        }
+        let covering = surface_projection(&surface, &camera)?;
+        exact_pixels += exact.cast_uncovered(&mut frame, id, covering.as_ref());
     }
     let count = |n: usize| Counter::Count(n as u64);
     stats.insert("reflectors", count(scene.trilinear_reflectors.len()));
@@ -95,6 +101,7 @@ pub fn render(
     stats.insert("reflector_dropped_triangles", count(dropped));
     stats.insert("reflector_pixels", Counter::Count(pixels));
     stats.insert("reflector_fresnel_rays", Counter::Count(fresnel_rays));
+    stats.insert("reflector_exact_pixels", Counter::Count(exact_pixels));
     stats.insert(
         "reflector_render_ms",
         Counter::Value(start.elapsed().as_secs_f64() * 1e3),
@@ -171,15 +178,83 @@ pub fn render_through(
     options: &RenderOptions,
     renderer: &Renderer,
 ) -> Result<Option<Frame>> {
-    if surface.mesh.triangles.is_empty() {
+    let Some(projection) = surface_projection(surface, camera)? else {
         return Ok(None);
-    }
-    let (width, height) = camera.resolution();
-    let projection = Trilinear::new(&surface.mesh, width, height)?;
+    };
     let mut others = scene.clone();
     others.objects.retain(|o| o.id != id);
     others.trilinear_reflectors.clear();
     Ok(Some(renderer(&others, &projection, options)?.0))
+}
+
+/// The trilinear projection of `surface` at the main camera's resolution; `None` when the
+/// surface has no triangles.
+fn surface_projection(
+    surface: &ReflectorSurface,
+    camera: &Perspective,
+) -> Result<Option<Trilinear>> {
+    if surface.mesh.triangles.is_empty() {
+        return Ok(None);
+    }
+    let (width, height) = camera.resolution();
+    Trilinear::new(&surface.mesh, width, height).map(Some)
+}
+
+/// Exact ray casting of the reflector pixels a surface does not cover: the ray caster's own
+/// mirror or glass (or, in flat shading, its passing on of the ray) at the main camera's
+/// pixel-centre ray. The ray caster (a BVH of the whole scene) is built on first use only.
+pub struct ExactPixels<'a> {
+    scene: &'a Scene,
+    camera: &'a Perspective,
+    options: &'a RenderOptions<'a>,
+    caster: std::sync::OnceLock<RayCaster>,
+}
+
+impl<'a> ExactPixels<'a> {
+    pub fn new(scene: &'a Scene, camera: &'a Perspective, options: &'a RenderOptions<'a>) -> Self {
+        ExactPixels {
+            scene,
+            camera,
+            options,
+            caster: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// Ray casts every pixel of `frame` that sees object `id` and whose centre no screen
+    /// triangle of `surface` covers (all of them when there is no surface): the back of an
+    /// open reflector, whose triangles are all left out (see [`reflector_surface`]), or a
+    /// silhouette pixel that the surface's screen triangles miss. Such a pixel would
+    /// otherwise keep the reflector's diffuse colour or show the background. Returns the
+    /// number of pixels cast. Degenerate case: a pixel whose ray misses the whole scene (the
+    /// main view saw the reflector at a grazing edge that the exact test rejects) takes the
+    /// background.
+    pub fn cast_uncovered(&self, frame: &mut Frame, id: u32, surface: Option<&Trilinear>) -> u64 {
+        let width = frame.width as usize;
+        let centre = |k: usize| DVec2::new((k % width) as f64 + 0.5, (k / width) as f64 + 0.5);
+        let uncovered: Vec<usize> = (0..frame.ids.len())
+            .filter(|&k| {
+                frame.ids[k] == id && surface.is_none_or(|s| s.locate(centre(k)).is_none())
+            })
+            .collect();
+        if uncovered.is_empty() {
+            return 0;
+        }
+        let caster = self.caster.get_or_init(|| RayCaster::new(self.scene));
+        let colors: Vec<Vec3> = uncovered
+            .par_iter()
+            .map(|&k| {
+                let ray = self.camera.ray(centre(k));
+                match ray.as_ref().and_then(|r| Some((r, caster.intersect(r)?))) {
+                    Some((ray, hit)) => caster.shade_hit(ray, hit, self.options).0,
+                    None => self.scene.image.background,
+                }
+            })
+            .collect();
+        for (&k, color) in uncovered.iter().zip(colors) {
+            frame.color[k] = color;
+        }
+        uncovered.len() as u64
+    }
 }
 
 /// Replaces the colour of every pixel of `main` that sees object `id` by `tint` times the

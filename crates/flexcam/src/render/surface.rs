@@ -119,7 +119,7 @@ pub fn base_color(
     let pattern = pattern_color(
         object,
         filter,
-        || interpolate(&mesh.positions, corners, w),
+        || object_point(object, corners, w),
         || uv_at(mesh, corners, w),
     );
     if mesh.colors.is_empty() {
@@ -127,6 +127,20 @@ pub fn base_color(
     } else {
         pattern * interpolate(&mesh.colors, corners, w)
     }
+}
+
+/// The object-space point at weights `w` of the triangle with vertices `corners`: the
+/// corners are taken to object space first and then interpolated (as
+/// [`triangle_color`] does), not the interpolated world point, whose rounding grows with the
+/// distance from the world origin: a floor at object y = 0 translated far away would
+/// otherwise flicker across the checker's cell boundary there.
+fn object_point(object: &Object, corners: [usize; 3], w: Vec3) -> Vec3 {
+    let local = corners.map(|i| {
+        object
+            .world_to_object
+            .transform_point3(object.mesh.positions[i])
+    });
+    interpolate(&local, [0, 1, 2], w)
 }
 
 /// Texture coordinates at weights `w` (zero when the mesh has none).
@@ -140,7 +154,7 @@ fn uv_at(mesh: &crate::scene::Mesh, corners: [usize; 3], w: Vec3) -> Vec2 {
 
 /// `material.color` times the pattern: the checker alternates `color` and `other` by the cell
 /// parity of the object-space point, textures multiply `color`. `point` and `uv` give the
-/// world-space point and the texture coordinates, each computed only for the pattern that
+/// object-space point and the texture coordinates, each computed only for the pattern that
 /// needs it (the checker reads no texture coordinates, a texture no point).
 #[inline]
 fn pattern_color(
@@ -153,8 +167,7 @@ fn pattern_color(
     match pattern {
         Pattern::Solid => *color,
         Pattern::Checker { other, size } => {
-            let p = object.world_to_object.transform_point3(point());
-            if checker_parity(p, *size) == 0 {
+            if checker_parity(point(), *size) == 0 {
                 *color
             } else {
                 *other
@@ -465,5 +478,41 @@ mod tests {
         );
         o.world_to_object = Affine3A::from_translation(Vec3::X);
         assert_eq!(base_color(&o, 0, b, TextureFilter::Nearest), Vec3::ZERO);
+    }
+
+    /// A floor triangle at object y = 0 (on a checker cell boundary) translated 1e4 from the
+    /// origin: the interpolated world point's rounding (about 1e-3 there) exceeds the
+    /// checker's nudge, the object-space corners' interpolation does not.
+    #[test]
+    fn checker_on_a_cell_boundary_is_stable_far_from_the_origin() {
+        let offset = Vec3::new(1.0e4, -3.0e3, 2.0e4);
+        let mut mesh = Mesh {
+            positions: vec![
+                Vec3::ZERO,
+                Vec3::new(0.0, 0.0, 0.9),
+                Vec3::new(0.9, 0.0, 0.0),
+            ],
+            triangles: vec![[0, 1, 2]],
+            ..Default::default()
+        };
+        mesh.positions.iter_mut().for_each(|p| *p += offset);
+        let mut o = object(
+            mesh,
+            Pattern::Checker {
+                other: Vec3::ZERO,
+                size: 1.0,
+            },
+        );
+        o.world_to_object = Affine3A::from_translation(-offset);
+        for i in 0..50 {
+            for j in 0..(50 - i) {
+                let b = Vec2::new(i as f32 / 50.0 + 0.003, j as f32 / 50.0 + 0.001);
+                assert_eq!(
+                    base_color(&o, 0, b, TextureFilter::Nearest),
+                    o.material.color,
+                    "barycentrics {b}"
+                );
+            }
+        }
     }
 }

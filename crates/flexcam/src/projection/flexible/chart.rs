@@ -34,6 +34,10 @@ use crate::projection::image_coords::Resolution;
 /// degenerates (a pinhole or a slit): the image of that end is at infinity.
 pub const END_MARGIN: f64 = 1e-9;
 
+/// Relative rounding allowed when a pole of a sphere volume maps to exactly +-90 degrees
+/// of a Mercator or equal-area map.
+const MAP_EDGE: f64 = 1e-9;
+
 /// Relative size below which a cross-section counts as degenerate.
 const FLAT: f64 = 1e-12;
 
@@ -113,11 +117,15 @@ fn spheres_chart(
     let period = match reparam {
         Reparam::Linear => Some(period(near.longitude, resolution)),
         Reparam::Mercator { max_latitude } | Reparam::EqualArea { max_latitude } => {
-            // Every latitude in [-90, 90] must stay on the finite (Mercator) and monotonic
-            // (equal area: sin) part of the map.
+            // Every latitude strictly between the poles must stay on the finite (Mercator)
+            // and monotonic (equal area: sin) part of the map, i.e. the poles may map at
+            // most to +-90 degrees: the poles themselves are singular anyway (their pieces
+            // are dropped), so the natural case, the map's own latitudes those of the
+            // patch (Mercator at `max_latitude` = `v_fov` / 2, equal area over the full
+            // sphere), is accepted (within rounding, `MAP_EDGE`).
             let finite = [-FRAC_PI_2, FRAC_PI_2].into_iter().all(|lat| {
                 let v = (lat - near.latitude[0]) / (near.latitude[1] - near.latitude[0]);
-                ((2.0 * v - 1.0) * max_latitude).abs() < FRAC_PI_2
+                ((2.0 * v - 1.0) * max_latitude).abs() <= FRAC_PI_2 * (1.0 + MAP_EDGE)
             });
             finite.then_some(())?;
             Some(period(near.longitude, resolution))

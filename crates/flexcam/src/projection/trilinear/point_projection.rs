@@ -297,6 +297,37 @@ impl ProjectionTriangleCache {
         self.barycentrics(ps - self.p1, t)
     }
 
+    /// Whether the triangle sweeps no volume: the Jacobian of `(u, v, t) -> ray(u, v, t)`,
+    /// `det[E1(t), E2(t), trinorm(u, v)] = N(t) . trinorm(u, v)` with
+    /// `N(t) = E1(t) x E2(t) = N0 + t N1 + t^2 N2`, vanishes identically, i.e. every
+    /// `N_k . n_i` is zero. Then the rays sweep a surface: either the parametric triangle
+    /// is degenerate at every `t` (`N = 0`: every `t` is a root for every scene point, e.g.
+    /// the pole rows of a grid over a sphere, where two vertices share base point and ray),
+    /// or every ray lies in one plane (a grid cell spanning longitudes 0 to 180 of a sphere
+    /// whose rays meet at its centre: points off that plane have no root). Either way no
+    /// scene point can be projected through it, yet a ray caster sees what crosses the
+    /// surface.
+    ///
+    /// The test is relative, as the degenerate-triangle rule: `|N_k . n_i|` is compared
+    /// with `|n_i|` times the bound on `|N_k|` from the lengths it is formed from (`|e|^2`,
+    /// `|e| |f|`, `|f|^2`, with `e` and `f` the largest base edge and direction difference)
+    /// and counts as zero below `sqrt(SLIVER_TOL)` of it (a volume thinner than `1e-5` of
+    /// its extent). Degenerate cases: a non-finite cache (a NaN or infinite vertex) is
+    /// never called degenerate here (the renderer rejects those elsewhere); an orthographic
+    /// triangle (`f = 0`) is degenerate only when its base is.
+    pub fn sweeps_no_volume(&self) -> bool {
+        let (e, f) = (self.base_size, self.spread);
+        let scales = [e * e, e * f, f * f];
+        let directions = [self.n1, self.n1 + self.f1, self.n1 + self.f2];
+        self.cross.iter().zip(scales).all(|(n, scale)| {
+            directions.iter().all(|d| {
+                let bound = scale * d.length();
+                let jacobian = n.dot(*d);
+                jacobian * jacobian <= SLIVER_TOL * bound * bound
+            })
+        })
+    }
+
     /// `(u, v)` of `ps = p1 + w` in the parametric triangle at `t`, or `None` where that
     /// triangle is degenerate (module doc).
     fn barycentrics(&self, w: DVec3, t: f64) -> Option<(f64, f64)> {
@@ -620,6 +651,51 @@ mod tests {
         assert!((us[0] - (2.6 - root) / 4.0).abs() < 1e-12);
         assert!((us[1] - (2.6 + root) / 4.0).abs() < 1e-12);
         assert!(s.iter().all(|x| (x.v - 0.02).abs() < 1e-12));
+    }
+
+    #[test]
+    fn sweeping_no_volume() {
+        let v = DVec3::new;
+        // Two vertices sharing base point and ray (a sphere grid's pole row): a surface.
+        let p = [v(0.0, 6.0, 0.0), v(0.0, 6.0, 0.0), v(0.8, 5.9, 0.1)];
+        let n = [v(0.0, -1.0, 0.0), v(0.0, -1.0, 0.0), v(-0.8, -0.9, -0.1)];
+        assert!(ProjectionTriangleCache::new(p, n).sweeps_no_volume());
+        // The same within rounding (longitude -180 and 180 on a sphere of radius 6).
+        let q = v(6.0 * std::f64::consts::PI.sin(), 0.0, -6.0);
+        let r = v(6.0 * (-std::f64::consts::PI).sin(), 0.0, -6.0);
+        assert_ne!(q, r);
+        let far = v(0.0, 1.0, 0.0);
+        let cache = ProjectionTriangleCache::new(
+            [q, r, v(0.0, 3.0, -5.0)],
+            [far - q, far - r, far - v(0.0, 3.0, -5.0)],
+        );
+        assert!(cache.sweeps_no_volume());
+        // Collinear base points with coplanar rays in one plane: a planar sweep.
+        let p = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(2.0, 0.0, 0.0)];
+        let n = [v(0.0, 1.0, 0.0), v(0.5, 1.0, 0.0), v(1.0, 1.0, 0.0)];
+        assert!(ProjectionTriangleCache::new(p, n).sweeps_no_volume());
+        // Base points and rays in one plane (x = 0), the parametric triangle never
+        // degenerate: rays from a sphere's longitudes 0 and 180 to its centre.
+        let centre = v(0.0, 1.0, 0.0);
+        let p = [v(0.0, -4.2, 3.0), v(0.0, -4.2, -3.0), v(0.0, 2.0, -5.9)];
+        let cache = ProjectionTriangleCache::new(p, p.map(|x| centre - x));
+        assert!(cache.plane_at(0.5).1.length() > 1.0);
+        assert!(cache.sweeps_no_volume());
+        // Not degenerate: a perspective triangle, an orthographic one, a base that is a
+        // point (a pinhole), two vertices sharing a base point only, and a thin but real one.
+        let (p, n) = perspective_triangle(v(0.0, 0.0, 5.0));
+        assert!(!ProjectionTriangleCache::new(p, n).sweeps_no_volume());
+        let p = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)];
+        assert!(!ProjectionTriangleCache::new(p, [v(0.0, 0.0, -1.0); 3]).sweeps_no_volume());
+        let n = [v(0.0, 0.0, -1.0), v(0.1, 0.0, -1.0), v(0.0, 0.1, -1.0)];
+        assert!(!ProjectionTriangleCache::new([DVec3::ZERO; 3], n).sweeps_no_volume());
+        let p = [v(0.0, 0.0, 0.0), v(0.0, 0.0, 0.0), v(0.0, 1.0, 0.0)];
+        assert!(!ProjectionTriangleCache::new(p, n).sweeps_no_volume());
+        let p = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.5, 1e-3, 0.0)];
+        assert!(!ProjectionTriangleCache::new(p, [v(0.0, 0.0, -1.0); 3]).sweeps_no_volume());
+        // A NaN vertex is left to the renderer's own checks.
+        let p = [v(f64::NAN, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.5, 1.0, 0.0)];
+        assert!(!ProjectionTriangleCache::new(p, [v(0.0, 0.0, -1.0); 3]).sweeps_no_volume());
     }
 
     #[test]

@@ -380,3 +380,53 @@ fn finer_reflectors_agree_better() {
     }
     assert!(errors[0] > errors[1] && errors[1] > errors[2], "{errors:?}");
 }
+
+/// An open mirror (a plane, one-sided by its winding) seen from behind: every triangle of the
+/// surface is left out, and the reflector's pixels, which kept the diffuse colour, are ray
+/// cast exactly: the composite is the true (two-sided) mirror, pixel for pixel. Seen from
+/// the front nothing is cast where the surface covers the mirror.
+#[test]
+fn uncovered_reflector_pixels_are_ray_cast_exactly() {
+    let behind = ReflectorFixture {
+        eye: [0.5, 1.2, -3.0],
+        look_at: [0.0, 1.0, 0.0],
+        reflector: "shape = \"plane\"\nsize = [2.0, 2.0]\nmaterial = \"mirror\"\n\
+                    rotate = [90.0, 0.0, 0.0]\ntranslate = [0.0, 1.2, 0.0]",
+        cube: "size = [0.6, 0.6, 0.6]\ntranslate = [0.8, 0.3, -1.5]",
+        cell: 0.5,
+    };
+    let mut scene = behind.scene("behind.toml");
+    scene.trilinear_reflectors = vec![BALL];
+    let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
+    let camera = main_camera(&scene, main.as_ref()).unwrap();
+    let mirror = Reflector::of(&scene, BALL).unwrap();
+    let surface = reflector_surface(&mirror.mesh, &camera, mirror.optic).unwrap();
+    assert!(surface.mesh.triangles.is_empty(), "seen from behind");
+    let reference = reference(&scene, main.as_ref());
+    let (frame, stats) = render(&scene, main.as_ref(), &flat(), &raycast).unwrap();
+    let (c, same) = agreement(&frame, &reference, BALL);
+    assert!(
+        c.pixels > 1000,
+        "the mirror fills part of the image: {}",
+        c.pixels
+    );
+    assert_eq!(same, 1.0, "{c:?}");
+    assert_eq!(
+        stats.get("reflector_exact_pixels"),
+        Some(&Counter::Count(c.pixels as u64))
+    );
+    // From the front, the surface covers the mirror: (almost) nothing is cast.
+    let front = ReflectorFixture {
+        eye: [0.5, 1.2, 3.0],
+        cube: "size = [0.6, 0.6, 0.6]\ntranslate = [0.8, 0.3, 1.5]",
+        ..behind
+    };
+    let mut scene = front.scene("front.toml");
+    scene.trilinear_reflectors = vec![BALL];
+    let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
+    let (_, stats) = render(&scene, main.as_ref(), &flat(), &raycast).unwrap();
+    let Some(Counter::Count(cast)) = stats.get("reflector_exact_pixels") else {
+        panic!("no counter: {stats:?}");
+    };
+    assert!(*cast < 50, "{cast} pixels cast from the front");
+}

@@ -108,7 +108,7 @@ struct PieceCounts {
     near_poles: u64,
     /// Pieces after subdivision.
     pieces: u64,
-    /// Pieces crossed by a pole, dropped.
+    /// Pieces crossed by a pole or lying within its clearance, dropped.
     pole_pieces: u64,
     /// Pieces with a corner on the singular set (an eye, a pole), dropped.
     singular: u64,
@@ -363,7 +363,8 @@ impl<'a> InverseRaster<'a> {
         counts.near_poles += u64::from(poles);
         let mut draw = |nodes: [Node; 3]| {
             counts.pieces += 1;
-            if poles && refiner.is_pole_piece(nodes.map(|n| n.point)) {
+            let points = nodes.map(|n| n.point);
+            if poles && (refiner.is_pole_piece(points) || refiner.is_within_clearance(points)) {
                 counts.pole_pieces += 1;
                 return;
             }

@@ -283,6 +283,27 @@ impl<'a> Refiner<'a> {
         })
     }
 
+    /// Whether the piece `[a, b, c]` lies wholly within some pole's clearance: every corner
+    /// strictly less than `min(clearance, pi / 2)` from the pole's direction, seen from its
+    /// origin. That cone is convex (at pi / 2 an open half-space), so the whole piece lies
+    /// in it, its exact image covers no pixel centre, and it is not drawn: the straight
+    /// polygon of its corner images would be no image of it at all, since near a pole a
+    /// small piece's image spans a wide arc (a fisheye's axis behind the eye maps to a whole
+    /// circle around the image), and its chords cut into the image (issue: an object
+    /// pierced by the axis behind a fisheye drew a ring inside the image circle).
+    ///
+    /// Degenerate cases: a corner on a pole's origin has no direction and keeps the piece
+    /// (for that pole); so does a non-finite corner (every comparison is false).
+    pub fn is_within_clearance(&self, points: [DVec3; 3]) -> bool {
+        self.chart.poles.iter().any(|pole| {
+            let cone = pole.clearance.min(std::f64::consts::FRAC_PI_2);
+            points.iter().all(|&p| {
+                let offset = p - pole.origin;
+                offset != DVec3::ZERO && angle_between(offset, pole.direction) < cone
+            })
+        })
+    }
+
     /// Calls `emit` with the pieces of triangle `nodes` whose edges have been halved
     /// `levels` times, after adaptive refinement; `poles`: whether the pole rule applies
     /// (see [`Refiner::split`]).
@@ -501,6 +522,59 @@ mod tests {
             },
         );
         assert!(pole_pieces >= 1);
+    }
+
+    /// A fisheye's pole is the axis behind the eye; pieces wholly within its clearance (no
+    /// pixel centre's projector comes that near the axis) are found, pieces reaching out of
+    /// it, or around the eye, are not; the cone is capped at 90 degrees (a half-space) where
+    /// the clearance is wider.
+    #[test]
+    fn pieces_within_a_poles_clearance_are_found() {
+        let fisheye = |fov: f64| {
+            let frame = CameraFrame {
+                position: DVec3::ZERO,
+                look_at: DVec3::NEG_Z,
+                up: DVec3::Y,
+            };
+            ProjectionSpec::Fisheye { frame, fov }
+                .build(80, 60)
+                .unwrap()
+        };
+        for fov in [220.0, 300.0, 360.0] {
+            let projection = fisheye(fov);
+            let chart = projection.inverse_chart().unwrap();
+            let clearance = chart.poles[0].clearance;
+            let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
+            // A small piece on the axis behind, and one beside it, both well within.
+            let r = 0.2 * clearance.tan();
+            let behind = [
+                DVec3::new(-r, -r, 1.0),
+                DVec3::new(r, -r, 1.0),
+                DVec3::new(0.0, r, 1.0),
+            ];
+            assert!(refiner.is_within_clearance(behind), "{fov}");
+            assert!(refiner.is_within_clearance(behind.map(|p| p + DVec3::X * r)));
+            // Reaching out of the clearance, in front, or with a corner on the eye: kept.
+            let wide = behind.map(|p| p * DVec3::new(10.0, 10.0, 1.0));
+            assert!(!refiner.is_within_clearance(wide), "{fov}");
+            assert!(!refiner.is_within_clearance(behind.map(|p| -p)));
+            assert!(!refiner.is_within_clearance([DVec3::ZERO, behind[1], behind[2]]));
+            let nan = [DVec3::NAN, behind[1], behind[2]];
+            assert!(!refiner.is_within_clearance(nan));
+        }
+        // Fisheye 180: the clearance is just over 90 degrees, the cone is the half-space
+        // behind the eye plane (strictly).
+        let projection = fisheye(180.0);
+        let chart = projection.inverse_chart().unwrap();
+        assert!(chart.poles[0].clearance > std::f64::consts::FRAC_PI_2);
+        let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
+        let side = [
+            DVec3::new(-5.0, 0.0, 0.1),
+            DVec3::new(5.0, 0.0, 0.1),
+            DVec3::new(0.0, 5.0, 0.1),
+        ];
+        assert!(refiner.is_within_clearance(side));
+        assert!(!refiner.is_within_clearance(side.map(|p| p * DVec3::new(1.0, 1.0, 0.0))));
     }
 
     /// Pieces of triangles cleared by `far_from_poles` are refined the same with and without

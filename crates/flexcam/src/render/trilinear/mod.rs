@@ -137,8 +137,13 @@ impl TrilinearRenderer {
         let ProjectedScene {
             polygons,
             counts,
-            fallback,
+            mut fallback,
         } = project_all(&triangles, &self.scene, curves);
+        // Projection triangles that sweep a surface, not a volume, project no scene point
+        // but still see the scene: their pixels are ray cast.
+        for (f, cache) in fallback.iter_mut().zip(projection.triangle_caches()) {
+            *f |= cache.sweeps_no_volume();
+        }
         let project_ms = start.elapsed().as_secs_f64() * 1e3;
 
         let maps: Vec<ScreenMap> = triangles.iter().map(|t| t.map).collect();

@@ -26,7 +26,7 @@ use crate::scene::{Material, Mesh, Pattern, Texture};
 /// Point and line primitives are skipped; a file without triangles is an error.
 pub(super) fn load_gltf(path: &Path) -> Result<Vec<ModelPart>> {
     let fail = |e: ::gltf::Error| Error::in_file(path, format!("malformed glTF: {e}"));
-    let ::gltf::Gltf { document, blob } = ::gltf::Gltf::open(path).map_err(fail)?;
+    let ::gltf::Gltf { document, blob } = open_validated(path).map_err(fail)?;
     let base = path.parent().unwrap_or(Path::new(""));
     let buffers = ::gltf::import_buffers(&document, Some(base), blob).map_err(fail)?;
     let mut loader = Loader {
@@ -51,6 +51,39 @@ pub(super) fn load_gltf(path: &Path) -> Result<Vec<ModelPart>> {
         return Err(Error::in_file(path, "contains no triangle meshes"));
     }
     Ok(loader.parts)
+}
+
+/// Reads and validates a glTF or GLB file as `gltf::Gltf::open` does, but checks first
+/// that every primitive's `POSITION` accessor exists: gltf-json's validation indexes the
+/// accessor list with it unchecked and panics on an index past its end.
+fn open_validated(path: &Path) -> std::result::Result<::gltf::Gltf, ::gltf::Error> {
+    use ::gltf::json::validation::{Checked, Error as Invalid};
+    use ::gltf::json::Path as JsonPath;
+    let reader = std::io::BufReader::new(std::fs::File::open(path)?);
+    let ::gltf::Gltf { document, blob } = ::gltf::Gltf::from_reader_without_validation(reader)?;
+    let json = document.into_json();
+    let positions = Checked::Valid(::gltf::json::mesh::Semantic::Positions);
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            if let Some(index) = primitive.attributes.get(&positions) {
+                if index.value() >= json.accessors.len() {
+                    let at = JsonPath::new()
+                        .field("meshes")
+                        .index(m)
+                        .field("primitives")
+                        .index(p)
+                        .field("attributes")
+                        .key("POSITION");
+                    return Err(::gltf::Error::Validation(vec![(
+                        at,
+                        Invalid::IndexOutOfBounds,
+                    )]));
+                }
+            }
+        }
+    }
+    let document = Document::from_json(json)?;
+    Ok(::gltf::Gltf { document, blob })
 }
 
 /// State of one glTF load.
@@ -418,6 +451,24 @@ mod tests {
         let json = write(&dir, "bad.gltf", "{ \"asset\": { \"version\": \"2.0\" }, ");
         let e = load_gltf(&json).unwrap_err().to_string();
         assert!(e.contains("bad.gltf") && e.contains("malformed"), "{e}");
+    }
+
+    /// gltf-json's own validation panics on this (an index into the accessor list it does
+    /// not check); the loader reports it.
+    #[test]
+    fn position_accessor_past_the_accessor_list_is_an_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = write(
+            &dir,
+            "bad-position.gltf",
+            r#"{"asset": {"version": "2.0"},
+                "meshes": [{"primitives": [{"attributes": {"POSITION": 5}}]}]}"#,
+        );
+        let e = load_gltf(&path).unwrap_err().to_string();
+        assert!(
+            e.contains("bad-position.gltf") && e.contains("POSITION") && !e.contains('\n'),
+            "{e}"
+        );
     }
 
     #[test]
