@@ -413,7 +413,7 @@ fn uncovered_reflector_pixels_are_ray_cast_exactly() {
     assert_eq!(same, 1.0, "{c:?}");
     assert_eq!(
         stats.get("reflector_exact_pixels"),
-        Some(&Counter::Count(c.pixels as u64))
+        Some(&Counter::Count(c.pixels))
     );
     // From the front, the surface covers the mirror: (almost) nothing is cast.
     let front = ReflectorFixture {
