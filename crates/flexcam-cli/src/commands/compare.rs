@@ -98,9 +98,9 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         times_ms: (method_ms, reference_ms),
     };
     if args.json {
-        println!("{}", report_json(&header, &result));
+        super::print_stdout(&format!("{}\n", report_json(&header, &result)))?;
     } else {
-        print!("{}", report_text(&header, &result));
+        super::print_stdout(&report_text(&header, &result))?;
     }
     check_thresholds(args, &result)
 }

@@ -39,14 +39,14 @@ pub fn run(args: &FitArgs) -> Result<()> {
     let fitted = fit_scene(&text, &args.scene, &args.output)?;
     image_io::write_bytes(&args.output, fitted.text.as_bytes())?.commit()?;
     let r = fitted.report;
-    println!(
+    super::print_stdout(&format!(
         "fitted {} correspondences ({} nodes unconstrained): residual max {:e} degrees, rms \
-         {:e} degrees; wrote {}",
+         {:e} degrees; wrote {}\n",
         r.correspondences,
         r.unconstrained_nodes,
         r.max_angle_deg,
         r.rms_angle_deg,
         args.output.display()
-    );
+    ))?;
     Ok(())
 }

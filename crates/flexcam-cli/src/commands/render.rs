@@ -110,7 +110,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         file.commit()?;
     }
     if let Some(OutputTarget::Stdout) = &args.stats {
-        println!("{json}");
+        super::print_stdout(&format!("{json}\n"))?;
     }
     Ok(())
 }

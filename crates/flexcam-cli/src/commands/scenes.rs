@@ -7,7 +7,7 @@ pub fn run() -> flexcam::Result<()> {
     let scenes = builtin::list();
     let width = scenes.iter().map(|(name, _)| name.len()).max().unwrap_or(0);
     for (name, description) in scenes {
-        println!("{name:width$}  {description}");
+        super::print_stdout(&format!("{name:width$}  {description}\n"))?;
     }
     Ok(())
 }
