@@ -11,13 +11,15 @@
 //! s. A piece lies in the convex hull of its three control points, hence within
 //! `pad = dist(middle control point, chord)` of its chord; the BVH visits only leaves whose
 //! box, enlarged by `pad`, the chord meets, and the first piece with a hit ends the search.
-//! The whole curve is first tested the same way against the scene's box alone, and each
-//! piece against it by the box of the piece's control points before its chord is built; in
-//! a leaf, a triangle whose box is apart from that box, whose plane the piece's control
-//! points lie strictly on one side of, or one of whose edge planes they lie outside, is
-//! skipped without root finding (the piece cannot meet it; see `curve_triangle`, whose
-//! precomputed form of every BVH triangle is built on the first quadratic search). The
-//! four projectors of a 2x2 pixel quad share the walks of their pieces.
+//! Where no projector hull culled the curve's pieces, the whole curve is first tested the
+//! same way against the scene's box alone; each piece is tested against it by the box of the
+//! piece's control points before its chord is built; in a leaf, a triangle whose box is
+//! apart from that box, whose plane the piece's control points lie strictly on one side of,
+//! or one of whose edge planes they, or the part of the piece's chord near the plane, lie
+//! outside, is skipped without root finding (the piece cannot meet it; see
+//! `curve_triangle`, whose precomputed form of every BVH triangle is built on the first
+//! quadratic search). The four projectors of a 2x2 pixel quad share the walks of their
+//! pieces.
 //!
 //! Degenerate cases: see `CurveTriangle::intersect`; a zero-area triangle is never stored
 //! in the BVH.
@@ -66,13 +68,15 @@ fn distance_to_segment(q: DVec3, a: DVec3, b: DVec3) -> f64 {
 }
 
 /// One curve's piece being searched in a packet walk: the curve, the piece's control
-/// points, their box and largest coordinate magnitude, and its padded chord.
+/// points, their box and largest coordinate magnitude, the piece's largest distance from its
+/// chord (the middle control point's), and its padded chord.
 struct PieceSearch<'a> {
     curve: &'a [DVec3; 3],
     hull: [DVec3; 3],
     lo: DVec3,
     hi: DVec3,
     scale: f64,
+    pad: f64,
     chord: NearSegment,
 }
 
@@ -102,11 +106,16 @@ impl RayCaster {
         live: LiveParts,
     ) -> [Option<(f64, Hit32)>; 4] {
         // The whole curve first (within its middle control point's distance of its chord):
-        // the projectors of many pixels pass by the scene's box altogether.
+        // the projectors of many pixels pass by the scene's box altogether. Not where a
+        // hull left only some parts live: the hull has culled the parts that miss the
+        // scene for the whole block, and each live piece's own box test below rejects a
+        // curve passing by it at less cost than this test made on every curve of the block.
+        let whole_curve_test = live == LiveParts::ALL;
         let mut searching = curves.map(|curve| {
             curve.filter(|p| {
-                NearSegment::new(p[0], p[2] - p[0], distance_to_segment(p[1], p[0], p[2]))
-                    .is_some_and(|whole| self.bvh.near_root(&whole))
+                !whole_curve_test
+                    || NearSegment::new(p[0], p[2] - p[0], distance_to_segment(p[1], p[0], p[2]))
+                        .is_some_and(|whole| self.bvh.near_root(&whole))
             })
         });
         let mut found: [Option<(usize, CurveHit)>; 4] = [None; 4];
@@ -143,6 +152,7 @@ impl RayCaster {
                             lo,
                             hi,
                             scale: lo.abs().max(hi.abs()).max_element(),
+                            pad,
                             chord,
                         })
                     }
@@ -166,8 +176,8 @@ impl RayCaster {
     /// The first hit (stored triangle and hit) of each of `pieces`, all over the curve
     /// parameter interval `(a, b)`, by one walk: in a leaf, a triangle whose box is apart
     /// from the piece's, whose plane the piece's control points lie strictly on one side of,
-    /// or one of whose edge planes they lie outside is skipped without root finding (see
-    /// `CurveTriangle`).
+    /// or one of whose edge planes the piece's chord (near the plane) or its control points
+    /// lie outside is skipped without root finding (see `CurveTriangle`).
     fn search_pieces(
         &self,
         pieces: &[Option<PieceSearch>; 4],
@@ -184,6 +194,7 @@ impl RayCaster {
             let margin = tri.margin(piece.scale);
             if tri.boxes_apart(piece.lo, piece.hi, margin)
                 || tri.plane_misses(&piece.hull)
+                || tri.chord_misses(&piece.hull, piece.pad, margin)
                 || tri.edges_miss(&piece.hull, margin)
             {
                 return;

@@ -14,10 +14,17 @@
 //!   plane through the edge along the normal): the piece crosses the triangle's plane, but
 //!   beside the triangle. The barycentric weights the search tests are linear functions of
 //!   the point, so a hit on the piece, a convex combination of its control points, would
-//!   have the weight negative too.
+//!   have the weight negative too;
+//! - [`CurveTriangle::chord_misses`]: the same edge test made on the part of the piece's
+//!   chord that comes within the piece's pad of the triangle's plane, allowing the pad: the
+//!   piece lies within its pad of its chord, so a hit lies within the pad of a chord point
+//!   that is itself within the pad of the plane and of the inside of every edge. A short
+//!   piece is nearly straight (its pad falls as the square of its length), so this narrows
+//!   where the piece can cross the plane to nearly a point, where the control points span
+//!   the whole piece: it leaves the root finding to little more than the triangles hit.
 //!
-//! The last two leave most triangles near a piece without root finding: the piece's padded
-//! chord meets their leaf's box, but the piece passes beside them.
+//! These leave most triangles near a piece without root finding: the piece's padded chord
+//! meets their leaf's box, but the piece passes beside them.
 
 use glam::DVec3;
 
@@ -51,6 +58,8 @@ pub(super) struct CurveTriangle {
     /// triangle, which is never hit.
     normal: DVec3,
     area2: f64,
+    /// |e1 x e2|: distances along `normal` divided by it are distances to the plane.
+    normal_length: f64,
     /// The triangle's box (its three corners) and its largest coordinate magnitude.
     lo: DVec3,
     hi: DVec3,
@@ -85,6 +94,7 @@ impl CurveTriangle {
             e2,
             normal,
             area2,
+            normal_length: area2.sqrt(),
             lo,
             hi,
             scale: lo.abs().max(hi.abs()).max_element(),
@@ -176,6 +186,54 @@ impl CurveTriangle {
         outside(&|w| -w.dot(self.inward_u))
             || outside(&|w| -w.dot(self.inward_v))
             || outside(&|w| w.dot(self.outward_w) - self.offset_w)
+    }
+
+    /// Whether a curve piece with control points `hull` misses the triangle by its chord
+    /// (from `hull[0]` to `hull[2]`): every point of the piece lies within `pad` (the middle
+    /// control point's distance from the chord) of a chord point, so a hit X, on the plane
+    /// and inside every edge plane, has a chord point C within `pad` of it, itself within
+    /// `pad` of the plane and at most `pad` outside each edge plane (the distances are
+    /// 1-Lipschitz). The chord points within `pad + margin` of the plane form one interval
+    /// of the chord; the distance outside an edge plane is linear along it, so if both ends
+    /// of that interval lie more than `pad + margin` outside one edge plane, no such C
+    /// exists and the piece has no hit. `margin` ([`CurveTriangle::margin`]) covers the
+    /// rounding of the control points, of this test and of the search's own hit point and
+    /// barycentric test, as in [`CurveTriangle::edges_miss`]. Degenerate cases: a chord of
+    /// zero length is a point (the whole chord is tested); a chord parallel to the plane
+    /// within `pad + margin` of it is tested whole; a zero-area triangle has zero normals
+    /// and gives `false`; a NaN coordinate or pad fails every rejection and gives `false`.
+    #[inline]
+    pub fn chord_misses(&self, hull: &[DVec3; 3], pad: f64, margin: f64) -> bool {
+        let slack = pad + margin;
+        let (w0, w2) = (hull[0] - self.v0, hull[2] - self.v0);
+        // Distances to the plane times |normal|, as in `plane_misses`.
+        let (d0, d2) = (self.normal.dot(w0), self.normal.dot(w2));
+        let reach = slack * self.normal_length;
+        if (d0 > reach && d2 > reach) || (d0 < -reach && d2 < -reach) {
+            return true;
+        }
+        // The chord parameters [lo, hi] where the chord is within `reach` of the plane: one
+        // end is inside the band or the chord crosses it (the case above is excluded). A
+        // NaN bound makes `min`/`max` keep the other operand, so [0, 1] at worst.
+        let step = d2 - d0;
+        let (lo, hi) = if step == 0.0 {
+            (0.0, 1.0)
+        } else {
+            let (ta, tb) = ((-reach - d0) / step, (reach - d0) / step);
+            (ta.min(tb).max(0.0), ta.max(tb).min(1.0))
+        };
+        // Whether the chord over [lo, hi] lies more than `slack` outside an edge plane, from
+        // the signed distances `e0`, `e2` of its ends inside it.
+        let outside = |e0: f64, e2: f64| {
+            let at = |t: f64| e0 + t * (e2 - e0);
+            at(lo) < -slack && at(hi) < -slack
+        };
+        outside(w0.dot(self.inward_u), w2.dot(self.inward_u))
+            || outside(w0.dot(self.inward_v), w2.dot(self.inward_v))
+            || outside(
+                self.offset_w - w0.dot(self.outward_w),
+                self.offset_w - w2.dot(self.outward_w),
+            )
     }
 }
 
@@ -368,6 +426,85 @@ mod tests {
         assert!(!t.edges_miss(&nan, margin));
     }
 
+    /// The piece's pad as the search computes it: the middle control point's distance from
+    /// the chord.
+    fn pad(q: &[DVec3; 3]) -> f64 {
+        let d = q[2] - q[0];
+        let s = if d.length_squared() > 0.0 {
+            ((q[1] - q[0]).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (q[1] - (q[0] + s * d)).length()
+    }
+
+    #[test]
+    fn a_chord_crossing_beside_the_triangle_misses_where_the_control_points_do_not() {
+        let t = unit();
+        let margin = t.margin(4.0);
+        // A straight oblique piece crossing z = 0 at (x, y): its control points straddle the
+        // edge planes x = 0 and x + y = 1, so only the chord test can reject it.
+        let oblique = |x: f64, y: f64| {
+            [
+                DVec3::new(x - 2.6, y, -1.0),
+                DVec3::new(x, y, 0.0),
+                DVec3::new(x + 2.6, y, 1.0),
+            ]
+        };
+        let beyond = oblique(0.6, 0.6);
+        assert!(!t.plane_misses(&beyond) && !t.edges_miss(&beyond, margin));
+        assert!(t.chord_misses(&beyond, pad(&beyond), margin));
+        assert_eq!(t.intersect(&beyond, FULL), None);
+        // Inside, and outside by less than the margin: kept (and the first hits).
+        let inside = oblique(0.3, 0.3);
+        assert!(!t.chord_misses(&inside, pad(&inside), margin));
+        assert!(t.intersect(&inside, FULL).is_some());
+        let grazing = oblique(0.5 + 1e-7, 0.5);
+        assert!(!t.chord_misses(&grazing, pad(&grazing), margin));
+        // The same chord with the middle control point pulled towards the triangle: the curve
+        // crosses at (0.4, 0.4), inside, and the pad keeps it.
+        let bent = [beyond[0], DVec3::new(0.2, 0.2, 0.0), beyond[2]];
+        assert!(t.intersect(&bent, FULL).is_some());
+        assert!(!t.chord_misses(&bent, pad(&bent), margin));
+    }
+
+    #[test]
+    fn degenerate_chords_and_triangles_in_the_chord_test() {
+        let t = unit();
+        let margin = t.margin(4.0);
+        // A chord of zero length (a closed curve crossing z = 0 twice at one point): tested
+        // as its point with the pad (2): kept over the triangle, missed far beside it.
+        let closed = |x: f64, y: f64| {
+            [
+                DVec3::new(x, y, -1.0),
+                DVec3::new(x, y, 1.0),
+                DVec3::new(x, y, -1.0),
+            ]
+        };
+        assert!(!t.chord_misses(&closed(0.3, 0.3), 2.0, margin));
+        assert!(t.intersect(&closed(0.3, 0.3), FULL).is_some());
+        assert!(t.chord_misses(&closed(5.0, 5.0), 2.0, margin));
+        assert_eq!(t.intersect(&closed(5.0, 5.0), FULL), None);
+        // A chord parallel to the plane within the pad of it: tested whole (missed only if
+        // all of it lies beside one edge).
+        let parallel = |y: f64| {
+            [
+                DVec3::new(-1.0, y, 1e-4),
+                DVec3::new(0.5, y, -1e-4),
+                DVec3::new(2.0, y, 1e-4),
+            ]
+        };
+        assert!(!t.chord_misses(&parallel(0.3), 2e-4, margin));
+        assert!(t.chord_misses(&parallel(-0.5), 2e-4, margin));
+        // A zero-area triangle, a NaN control point, a NaN pad.
+        let flat = tri(DVec3::ZERO, DVec3::X, DVec3::X * 2.0);
+        assert!(!flat.chord_misses(&closed(5.0, 5.0), 0.0, margin));
+        let mut nan = closed(5.0, 5.0);
+        nan[0].x = f64::NAN;
+        assert!(!t.chord_misses(&nan, 2.0, margin));
+        assert!(!t.chord_misses(&closed(5.0, 5.0), f64::NAN, margin));
+    }
+
     fn point() -> impl Strategy<Value = DVec3> {
         (-2.0..2.0f64, -2.0..2.0f64, -2.0..2.0f64).prop_map(|(x, y, z)| DVec3::new(x, y, z))
     }
@@ -449,6 +586,35 @@ mod tests {
             prop_assert!(rejected || !shifted, "a piece outside an edge plane is kept");
             if rejected {
                 prop_assert_eq!(t.intersect(&p, [lo, hi]), None);
+            }
+        }
+
+        /// The chord test never rejects a piece that hits: on random pieces, and on
+        /// triangles placed so that the piece crosses their plane at a random point of the
+        /// piece, at barycentric weights (u, v) around the triangle (inside, on, or just
+        /// outside an edge), where a piece crossing inside must be kept.
+        #[test]
+        fn a_piece_missed_by_its_chord_has_no_hit(
+            (p, [a, b, c], [lo, hi]) in curve_triangle_range(),
+            at in 0.0..1.0f64,
+            (u, v) in (-0.3..1.3f64, -0.3..1.3f64),
+            placed in any::<bool>(),
+        ) {
+            let q = piece(&p, lo, hi);
+            let (a, b, c) = if placed {
+                // Move the triangle so that its point at (u, v) is the curve's at `at`.
+                let crossing = quadratic_point(&p, lo + at * (hi - lo));
+                let shift = crossing - (a + u * (b - a) + v * (c - a));
+                (a + shift, b + shift, c + shift)
+            } else {
+                (a, b, c)
+            };
+            let t = tri(a, b, c);
+            let scale = q.iter().fold(0.0f64, |m, x| m.max(x.abs().max_element()));
+            if t.chord_misses(&q, pad(&q), t.margin(scale)) {
+                prop_assert_eq!(t.intersect(&p, [lo, hi]), None);
+                let inside = u > 1e-3 && v > 1e-3 && u + v < 1.0 - 1e-3;
+                prop_assert!(!(placed && inside), "a crossing inside is kept");
             }
         }
 

@@ -72,8 +72,8 @@ impl RayCaster {
                     if !within.may_hit(k) {
                         return false;
                     }
-                    let ends = corners.iter().flat_map(|p| [p[k], p[k + 1]]);
-                    !self.box_misses_scene(ends, pad)
+                    let ends = corners.map(|p| [p[k], p[k + 1]]);
+                    !self.box_misses_scene(ends.as_flattened(), pad)
                 })
             }
             [Projector::QuadraticBezier(a), Projector::QuadraticBezier(b), Projector::QuadraticBezier(c), Projector::QuadraticBezier(d)] =>
@@ -85,8 +85,8 @@ impl RayCaster {
                         return false;
                     }
                     let (s0, s1) = piece_interval(k);
-                    let points = corners.iter().flat_map(|p| piece(p, s0, s1));
-                    !self.box_misses_scene(points, pad)
+                    let points = corners.map(|p| piece(p, s0, s1));
+                    !self.box_misses_scene(points.as_flattened(), pad)
                 })
             }
             _ => within,
@@ -100,10 +100,11 @@ impl RayCaster {
     }
 
     /// Whether the box of `points` enlarged by `pad` misses every leaf box of the BVH; a
-    /// point or pad that is not finite counts as an overlap.
-    fn box_misses_scene(&self, points: impl Iterator<Item = DVec3>, pad: f64) -> bool {
+    /// point or pad that is not finite counts as an overlap. (A slice rather than an
+    /// iterator: flattening the corners' arrays lazily cost more than the test itself.)
+    fn box_misses_scene(&self, points: &[DVec3], pad: f64) -> bool {
         let (mut lo, mut hi, mut finite) = (DVec3::INFINITY, DVec3::NEG_INFINITY, pad.is_finite());
-        for p in points {
+        for &p in points {
             finite &= p.is_finite();
             (lo, hi) = (lo.min(p), hi.max(p));
         }
