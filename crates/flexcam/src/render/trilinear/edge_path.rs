@@ -27,7 +27,7 @@
 use glam::{DVec2, DVec3};
 
 use super::screen_map::ScreenMap;
-use crate::geometry::solve_quadratic;
+use crate::geometry::{solve_quadratic, Roots};
 use crate::projection::ProjectionTriangleCache;
 
 /// A point of a shape's outline: barycentrics in the projection triangle and depth.
@@ -126,29 +126,32 @@ impl EdgeSurface {
         solve_quadratic(c2, c1, c0).into_iter()
     }
 
-    /// [`EdgeSurface::crossing_depths`], except that none is given when the quadratic
-    /// provably has no root in `[lo, hi]` (then none of them lies strictly between `lo`
-    /// and `hi`, which is all an outline needs): its value at `lo`, at `hi` and at its
+    /// The roots of [`EdgeSurface::crossing_depths`], except that `None` is given when the
+    /// quadratic provably has no root in `[lo, hi]` (then none of them lies strictly between
+    /// `lo` and `hi`, which is all an outline needs): its value at `lo`, at `hi` and at its
     /// extremum (where that is inside) has one sign and is larger than [`CLEAR_OF_ROOTS`]
     /// times the size of its terms at either end (that size is convex in `t`, so the
     /// quadratic clears the bound over the whole range). Most polygon edges of a small
     /// projection triangle cross no edge surface; this skips their root finding.
     ///
     /// Degenerate cases: an empty or reversed range (`lo >= hi`) has no depth strictly
-    /// inside and gives none; non-finite coefficients or bounds, a quadratic vanishing
+    /// inside and gives `None`; non-finite coefficients or bounds, a quadratic vanishing
     /// identically or nearly touching zero in the range fail the test and go to the root
     /// finder, as in [`EdgeSurface::crossing_depths`].
+    ///
+    /// The solver's roots are returned as they are (not as an iterator): the outline tracer
+    /// calls this three times per polygon edge, and an iterator over an optional set of
+    /// roots was written out and read back through memory at every call.
     pub fn crossing_depths_between(
         &self,
         s1: DVec3,
         s2: DVec3,
         (lo, hi): (f64, f64),
-    ) -> impl Iterator<Item = f64> {
+    ) -> Option<Roots> {
         let [c2, c1, c0] = self.coefficients(s1, s2);
         let has_inside = lo < hi;
         let skip = !has_inside || clear_of_roots([c2, c1, c0], lo, hi);
-        let roots = (!skip).then(|| solve_quadratic(c2, c1, c0));
-        roots.into_iter().flatten()
+        (!skip).then(|| solve_quadratic(c2, c1, c0))
     }
 
     /// `[c2, c1, c0]` of [`EdgeSurface::crossing_depths`] for the line through `s1`, `s2`.
@@ -311,8 +314,8 @@ mod tests {
     }
 
     /// The roots strictly inside `(lo, hi)`, in the solver's order.
-    fn inside(depths: impl Iterator<Item = f64>, (lo, hi): (f64, f64)) -> Vec<f64> {
-        depths.filter(|&t| lo < t && t < hi).collect()
+    fn inside(depths: impl IntoIterator<Item = f64>, (lo, hi): (f64, f64)) -> Vec<f64> {
+        depths.into_iter().filter(|&t| lo < t && t < hi).collect()
     }
 
     proptest! {
@@ -344,7 +347,7 @@ mod tests {
             }
             for range in ranges {
                 prop_assert_eq!(
-                    inside(surface.crossing_depths_between(a, b, range), range),
+                    inside(surface.crossing_depths_between(a, b, range).into_iter().flatten(), range),
                     inside(surface.crossing_depths(a, b), range),
                     "range {:?}", range
                 );
@@ -389,12 +392,15 @@ mod tests {
         let offset = DVec3::new(0.7, 0.2, -0.3);
         let (a, b) = (on_edge + offset, on_edge - offset * 1.5);
         let found = inside(
-            surface.crossing_depths_between(a, b, (1.0, 3.0)),
+            surface
+                .crossing_depths_between(a, b, (1.0, 3.0))
+                .into_iter()
+                .flatten(),
             (1.0, 3.0),
         );
         assert!(found.iter().any(|t| (t - 2.0).abs() < 1e-10), "{found:?}");
         for range in [(2.0, 2.0), (3.0, 1.0), (f64::NAN, 3.0)] {
-            assert_eq!(surface.crossing_depths_between(a, b, range).count(), 0);
+            assert!(surface.crossing_depths_between(a, b, range).is_none());
         }
     }
 

@@ -110,16 +110,20 @@ fn anchors(
     let (lo, hi) = (from.min(to), from.max(to));
     let mut found = [None; MAX_ANCHORS];
     let mut count = 0;
-    let candidates = surfaces
-        .iter()
-        .flat_map(|s| s.crossing_depths_between(path.a, path.b, (lo, hi)))
-        .chain(std::iter::once(0.0));
-    for t in candidates {
+    let mut keep = |t: f64| {
         if lo < t && t < hi && count < MAX_ANCHORS {
             found[count] = Some(t);
             count += 1;
         }
+    };
+    // Plain loops rather than a chain of iterator adapters: the adapters' state (the
+    // solver's roots inside nested options) was copied through memory on every polygon edge.
+    for surface in surfaces {
+        if let Some(roots) = surface.crossing_depths_between(path.a, path.b, (lo, hi)) {
+            roots.as_slice().iter().for_each(|&t| keep(t));
+        }
     }
+    keep(0.0);
     let slots = &mut found[..count];
     slots.sort_by(|x, y| x.unwrap_or(0.0).total_cmp(&y.unwrap_or(0.0)));
     if from > to {

@@ -169,7 +169,7 @@ pub(super) fn draw_all(
                 .map(move |run| (group, run))
         })
         .collect();
-    let drawn = items
+    let jobs: Vec<Drawn> = items
         .par_iter()
         .fold(
             || (Drawn::default(), Scratch::default()),
@@ -187,7 +187,8 @@ pub(super) fn draw_all(
             },
         )
         .map(|(out, _)| out)
-        .reduce(Drawn::default, Drawn::followed_by);
+        .collect();
+    let drawn = Drawn::concatenated(jobs);
     let mut out = ProjectedScene {
         polygons: drawn.polygons,
         counts,
@@ -210,12 +211,18 @@ struct Drawn {
 }
 
 impl Drawn {
-    /// What drawing these pairs and then `next`'s gave.
-    fn followed_by(mut self, next: Drawn) -> Drawn {
-        self.polygons.append(&next.polygons);
-        self.counts.add(&next.counts);
-        self.fallback.extend(next.fallback);
-        self
+    /// What drawing the pairs of `parts`, one after the other, gave. Joined once, in order,
+    /// into the first part: a pairwise reduction would copy the early polygons again at
+    /// every level of its tree.
+    fn concatenated(parts: Vec<Drawn>) -> Drawn {
+        let mut parts = parts.into_iter();
+        let mut all = parts.next().unwrap_or_default();
+        for next in parts {
+            all.polygons.append(&next.polygons);
+            all.counts.add(&next.counts);
+            all.fallback.extend(next.fallback);
+        }
+        all
     }
 }
 
