@@ -364,13 +364,10 @@ impl Shader<'_> {
     /// The pixels of `run` (a triangle whose flat colour at barycentrics `b` is `color(b)`,
     /// no fallback) shaded as [`Shader::pixel`] shades them, with the map, owner and colour
     /// looked up once and the projector's direction (for the depth `t |trinorm|`) stepped
-    /// along the row ([`ScreenMap::directions_along_row`]). The pass over the run is split
-    /// so that each part is a simple loop: the depths (square roots without branches, which
-    /// the compiler vectorises), the colours, the ids, then the few pixels that need more. A
-    /// crack filler is resolved again ([`Shader::rasterised`]). Degenerate case: where the
-    /// stepped direction is zero (a projector of zero `trinorm`, which
-    /// [`ScreenMap::projector`] refuses), the pixel is background, as [`Shader::pixel`] leaves
-    /// it (its depth, colour and id written in the first passes are overwritten).
+    /// along the row ([`ScreenMap::directions_along_row`]). A crack filler is resolved
+    /// again ([`Shader::rasterised`]). Degenerate case: where the stepped direction is zero
+    /// (a projector of zero `trinorm`, which [`ScreenMap::projector`] refuses), the pixel
+    /// is background, as [`Shader::pixel`] leaves it.
     #[inline]
     fn flat_run(
         &self,
@@ -385,33 +382,25 @@ impl Shader<'_> {
         let id = self.resolver.scene.owners[run.triangle()].id;
         let position = self.resolver.position(run.x0, run.y);
         let (start, step) = map.directions_along_row(position);
-        let direction = |k: u32| start + f64::from(k) * step;
         let cells = run.first..run.first + run.len;
-        let depths = &drawn.depth[cells.clone()];
-        let out_depths = &mut out.depth[cells.clone()];
-        // Component by component, so that the loop is vectorised (`sqrtpd`).
-        for (k, (out_depth, &t)) in out_depths.iter_mut().zip(depths).enumerate() {
-            let k = k as f64;
-            let (x, y, z) = (
-                start.x + k * step.x,
-                start.y + k * step.y,
-                start.z + k * step.z,
-            );
-            *out_depth = (t * (x * x + y * y + z * z).sqrt()) as f32;
-        }
-        for (out_color, &barycentric) in out.color[cells.clone()]
-            .iter_mut()
-            .zip(&drawn.barycentrics[cells.clone()])
-        {
-            *out_color = color(Vec2::from(barycentric));
-        }
-        out.ids[cells.clone()].fill(id);
+        let exact = drawn.depth[cells.clone()]
+            .iter()
+            .zip(&drawn.barycentrics[cells])
+            .zip(&mut out.color[run.first..run.first + run.len])
+            .zip(&mut out.depth[run.first..run.first + run.len])
+            .zip(&mut out.ids[run.first..run.first + run.len])
+            .enumerate();
         let mut counts = ShadeCounts::default();
-        for (k, &t) in (0..).zip(depths) {
-            let i = run.first + k as usize;
-            if t >= CRACK_FILL_DEPTH || direction(k) == DVec3::ZERO {
-                let p = self.pixel(drawn, i, run.x0 + k, run.y, false);
-                (out.color[i], out.depth[i], out.ids[i]) = (p.color, p.depth, p.id);
+        for (k, ((((&t, &barycentric), out_color), out_depth), out_id)) in exact {
+            let direction = start + k as f64 * step;
+            if t < CRACK_FILL_DEPTH && direction != DVec3::ZERO {
+                *out_color = color(Vec2::from(barycentric));
+                *out_depth = (t * direction.length()) as f32;
+                *out_id = id;
+            } else {
+                let x = run.x0 + k as u32;
+                let p = self.pixel(drawn, run.first + k, x, run.y, false);
+                (*out_color, *out_depth, *out_id) = (p.color, p.depth, p.id);
                 counts = counts + p.counts;
             }
         }
