@@ -73,7 +73,9 @@ pub fn render(
         let surface = reflector_surface(&reflector.mesh, &camera, reflector.optic)?;
         triangles += surface.mesh.triangles.len();
         dropped += surface.dropped;
-        if let Some(image) = render_through(scene, id, &surface, &camera, options, renderer)? {
+        let projection = surface_projection(&surface, &camera)?;
+        if let Some(projection) = &projection {
+            let image = render_others(scene, id, projection, options, renderer)?;
             pixels += match (options.shading, reflector.optic) {
                 (Shading::Flat, _) => paste(&mut frame, id, &image, Vec3::ONE)?,
                 (Shading::Lit, Optic::Reflect) => paste(&mut frame, id, &image, reflector.tint)?,
@@ -92,8 +94,7 @@ pub fn render(
                 }
             };
         }
-        let covering = surface_projection(&surface, &camera)?;
-        exact_pixels += exact.cast_uncovered(&mut frame, id, covering.as_ref());
+        exact_pixels += exact.cast_uncovered(&mut frame, id, projection.as_ref());
     }
     let count = |n: usize| Counter::Count(n as u64);
     stats.insert("reflectors", count(scene.trilinear_reflectors.len()));
@@ -178,13 +179,23 @@ pub fn render_through(
     options: &RenderOptions,
     renderer: &Renderer,
 ) -> Result<Option<Frame>> {
-    let Some(projection) = surface_projection(surface, camera)? else {
-        return Ok(None);
-    };
+    surface_projection(surface, camera)?
+        .map(|projection| render_others(scene, id, &projection, options, renderer))
+        .transpose()
+}
+
+/// Renders `scene` without object `id` (and without reflectors) through `projection`.
+fn render_others(
+    scene: &Scene,
+    id: u32,
+    projection: &Trilinear,
+    options: &RenderOptions,
+    renderer: &Renderer,
+) -> Result<Frame> {
     let mut others = scene.clone();
     others.objects.retain(|o| o.id != id);
     others.trilinear_reflectors.clear();
-    Ok(Some(renderer(&others, &projection, options)?.0))
+    Ok(renderer(&others, projection, options)?.0)
 }
 
 /// The trilinear projection of `surface` at the main camera's resolution; `None` when the
