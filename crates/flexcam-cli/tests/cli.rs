@@ -1200,3 +1200,69 @@ fn closed_standard_output_is_no_panic() {
         );
     }
 }
+
+/// A raster tolerance far below a pixel split every edge, straight ones too (their midpoints
+/// are off the chord by rounding), to the deepest level: a 20 x 20 render of the test scene
+/// with `--raster-tolerance 1e-30` had not ended after 7 CPU minutes. It is refused now.
+#[test]
+fn raster_tolerance_below_a_thousandth_of_a_pixel_is_refused() {
+    let dir = good_scene_in("s.toml");
+    for tolerance in ["1e-30", "0.0009"] {
+        let args = [
+            "render",
+            "s.toml",
+            "--method",
+            "raster",
+            "--raster-tolerance",
+            tolerance,
+        ];
+        let e = expect_failure(&dir, &args);
+        assert!(
+            e.contains("raster tolerance must be a number of pixels of at least 0.001"),
+            "{e}"
+        );
+    }
+    run_ok(
+        &dir,
+        &[
+            "render",
+            "s.toml",
+            "--method",
+            "raster",
+            "--raster-tolerance",
+            "0.001",
+            "--width",
+            "16",
+            "--height",
+            "12",
+        ],
+    );
+}
+
+/// `compare` thresholds that no comparison can miss passed silently (`--min-id-agreement
+/// nan` and `--max-rgb-error nan` exited 0 whatever the result); these and thresholds
+/// outside their range are one error line before anything is rendered or written.
+#[test]
+fn compare_thresholds_that_cannot_be_checked_are_refused() {
+    let dir = good_scene_in("s.toml");
+    let compare = ["compare", "s.toml", "--method", "raster", "--diff", "d.png"];
+    for bad in [
+        "--min-id-agreement=nan",
+        "--min-id-agreement=150",
+        "--min-id-agreement=-1",
+        "--max-rgb-error=nan",
+        "--max-rgb-error=inf",
+        "--max-rgb-error=-0.5",
+    ] {
+        let e = expect_failure(&dir, &[&compare[..], &[bad]].concat());
+        let flag = bad.split('=').next().unwrap_or(bad);
+        assert!(e.contains(&format!("{flag} must be")), "{bad}: {e}");
+    }
+    let ok = [
+        "--min-id-agreement=0",
+        "--max-rgb-error=0.5",
+        "--width=16",
+        "--height=12",
+    ];
+    run_ok(&dir, &[&compare[..], &ok[..]].concat());
+}

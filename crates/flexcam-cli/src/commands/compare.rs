@@ -56,6 +56,7 @@ pub struct CompareArgs {
 pub fn run(args: &CompareArgs) -> Result<()> {
     let method: Method = args.method.parse()?;
     let reference: Method = args.reference.parse()?;
+    validate_thresholds(args)?;
     if let Some(path) = &args.diff {
         image_io::check_output_path(path, &["png"])?;
     }
@@ -164,6 +165,27 @@ fn report_json(h: &Header, c: &Comparison) -> serde_json::Value {
         "method_ms": number(h.times_ms.0),
         "reference_ms": number(h.times_ms.1),
     })
+}
+
+/// Errors: a `--min-id-agreement` outside [0, 100] percent or a `--max-rgb-error` that is
+/// negative or not finite. Checked before rendering: a NaN threshold would otherwise pass
+/// every comparison (every test against NaN is false), a check that cannot fail.
+fn validate_thresholds(args: &CompareArgs) -> Result<()> {
+    if let Some(min) = args.min_id_agreement {
+        if !(0.0..=100.0).contains(&min) {
+            return Err(Error::new(format!(
+                "--min-id-agreement must be a percentage in [0, 100], got {min}"
+            )));
+        }
+    }
+    if let Some(max) = args.max_rgb_error {
+        if !(max.is_finite() && max >= 0.0) {
+            return Err(Error::new(format!(
+                "--max-rgb-error must be a finite number of at least 0, got {max}"
+            )));
+        }
+    }
+    Ok(())
 }
 
 /// The thresholds given on the command line, as one error line naming the first one missed.

@@ -6,6 +6,14 @@ use crate::error::{Error, Result};
 /// The default adaptive tolerance: half a pixel.
 pub const DEFAULT_TOLERANCE: f64 = 0.5;
 
+/// The smallest adaptive tolerance accepted, in pixels. Below it the rule would split edges
+/// that are straight up to rounding (a perspective edge's midpoint is off its chord by about
+/// 1e-12 pixels) all the way to [`MAX_LEVEL`], up to 4^18 pieces per triangle: a render that
+/// never ends. A thousandth of a pixel is far below what one sample per pixel can show, and
+/// bounds the work (the default scene's panorama at 1024 x 512 takes about ten times the
+/// default's time there).
+pub const MIN_TOLERANCE: f64 = 1e-3;
+
 /// The largest uniform subdivision accepted (each triangle becomes its square pieces).
 pub const MAX_UNIFORM: u32 = 64;
 
@@ -53,8 +61,8 @@ impl Subdivision {
         }
     }
 
-    /// Errors: `uniform` outside [1, [`MAX_UNIFORM`]], a tolerance that is not a positive
-    /// finite number of pixels.
+    /// Errors: `uniform` outside [1, [`MAX_UNIFORM`]], a tolerance that is not a finite
+    /// number of pixels of at least [`MIN_TOLERANCE`].
     pub fn validate(&self) -> Result<()> {
         if !(1..=MAX_UNIFORM).contains(&self.uniform) {
             return Err(Error::new(format!(
@@ -63,9 +71,10 @@ impl Subdivision {
             )));
         }
         if let Some(tolerance) = self.tolerance {
-            if !(tolerance.is_finite() && tolerance > 0.0) {
+            if !(tolerance.is_finite() && tolerance >= MIN_TOLERANCE) {
                 return Err(Error::new(format!(
-                    "raster tolerance must be a positive number of pixels, got {tolerance}"
+                    "raster tolerance must be a number of pixels of at least {MIN_TOLERANCE}, \
+                     got {tolerance:e}"
                 )));
             }
         }
@@ -87,7 +96,17 @@ mod tests {
                 .message
                 .starts_with("subdivision must be between 1 and 64"));
         }
-        for t in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        assert!(Subdivision::adaptive(MIN_TOLERANCE).validate().is_ok());
+        // Tolerances below rounding would split every edge to the deepest level (a render
+        // that never ends): refused.
+        for t in [
+            0.0,
+            -1.0,
+            f64::NAN,
+            f64::INFINITY,
+            1e-30,
+            0.999 * MIN_TOLERANCE,
+        ] {
             let e = Subdivision::adaptive(t).validate().unwrap_err();
             assert!(e.message.starts_with("raster tolerance"), "{e}");
         }
