@@ -131,7 +131,7 @@ pub struct MethodTuning {
     #[arg(long, value_name = "N")]
     subdiv: Option<u32>,
     /// Method raster: halve edges whose projected midpoint is more than PX pixels off the
-    /// straight line (adaptive subdivision, the default, with 0.5).
+    /// straight line (adaptive subdivision, the default, with 0.5; at least 0.001).
     #[arg(long, value_name = "PX")]
     raster_tolerance: Option<f64>,
     /// Method trilinear: how curved edges are followed, `tessellate`, `slice` or `adaptive`
