@@ -167,21 +167,18 @@ fn report_json(h: &Header, c: &Comparison) -> serde_json::Value {
     })
 }
 
-/// Errors: a `--min-id-agreement` outside [0, 100] percent or a `--max-rgb-error` that is
-/// negative or not finite. Checked before rendering: a NaN threshold would otherwise pass
-/// every comparison (every test against NaN is false), a check that cannot fail.
+/// Errors: a `--min-id-agreement` or `--max-rgb-error` that is not a finite number.
+/// Checked before rendering: a NaN threshold would otherwise pass every comparison (every
+/// test against NaN is false), a check that cannot fail. Finite thresholds out of reach
+/// (above 100 %, a negative error) are kept: they fail with the measured value.
 fn validate_thresholds(args: &CompareArgs) -> Result<()> {
-    if let Some(min) = args.min_id_agreement {
-        if !(0.0..=100.0).contains(&min) {
+    for (flag, value) in [
+        ("--min-id-agreement", args.min_id_agreement),
+        ("--max-rgb-error", args.max_rgb_error),
+    ] {
+        if let Some(v) = value.filter(|v| !v.is_finite()) {
             return Err(Error::new(format!(
-                "--min-id-agreement must be a percentage in [0, 100], got {min}"
-            )));
-        }
-    }
-    if let Some(max) = args.max_rgb_error {
-        if !(max.is_finite() && max >= 0.0) {
-            return Err(Error::new(format!(
-                "--max-rgb-error must be a finite number of at least 0, got {max}"
+                "{flag} must be a finite number, got {v}"
             )));
         }
     }
