@@ -23,7 +23,9 @@
 //! the magnitude to be irrelevant). A tangent along the chord E_j - S_j gives C_j = the
 //! midpoint, the straight projector itself, so such a node is stored as straight. The thesis attaches the tangent where the projector meets the
 //! scene; here it is at the start, so that a node is defined by its start, end and tangent
-//! alone, independent of where the scene happens to be. A grid without tangents has
+//! alone, independent of where the scene happens to be; the thesis's form (through a scene
+//! point, the tangent there) is converted to this one by
+//! [`ProjectorGrid::set_projector_through`] (module `through`). A grid without tangents has
 //! straight projectors everywhere and is cast as rays; a grid with any tangent is cast as
 //! quadratic Bezier projectors ([`Projector::QuadraticBezier`], the representation of the
 //! three-surface Bezier volumes).
