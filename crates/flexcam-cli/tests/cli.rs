@@ -1002,6 +1002,69 @@ fn curved_fit_writes_tangents_and_renders_like_the_fitting_scene() {
     assert_fitted_renders_like_fitting(&dir);
 }
 
+/// Node projectors given the thesis's way (`point`, a tangent at the point, `length`) render
+/// from the CLI, their tangents bend the image (the same scene with the nodes straight through
+/// the same points differs), and bad entries are one error line naming the file, the line
+/// or the node, with nothing written.
+#[test]
+fn projectors_through_scene_points_render_and_bad_ones_are_one_line() {
+    let dir = TempDir::new().unwrap();
+    let scene = fs::read_to_string(example_scene("flexible-projector-through.toml")).unwrap();
+    write(&dir, "through.toml", &scene);
+    let straight = scene
+        .replace(", tangent = [0.35, -0.42, -0.84]", "")
+        .replace(", tangent = [0.0, -1.0, -1.0]", "");
+    assert_eq!(straight.matches("tangent = [").count(), 0, "{straight}");
+    write(&dir, "straight.toml", &straight);
+    let bent = flat_render_bytes(&dir, "through.toml", "bent");
+    let plain = flat_render_bytes(&dir, "straight.toml", "plain");
+    assert!(bent.1.len() > 100 && plain.1.len() > 100);
+    assert!(
+        bent.1 != plain.1,
+        "the tangents at the points change nothing"
+    );
+
+    let bad = TempDir::new().unwrap();
+    let both = scene.replace(
+        "point = [0.0, 2.0, 0.0]",
+        "end = [0.0, 0.0, -9.0], point = [0.0, 2.0, 0.0]",
+    );
+    let e = render_fails(&bad, "both.toml", &both);
+    let line = line_of(&both, "end = [0.0, 0.0, -9.0]");
+    assert!(e.starts_with(&format!("flexcam: both.toml:{line}:")), "{e}");
+    assert!(e.contains("`end` or `point`"), "{e}");
+    let length = scene.replace(
+        "{ node = [1, 4], point = [-2.0, 0.0, -3.0]",
+        "{ node = [1, 4], length = 5.0, end = [-2.0, 0.0, -3.0]",
+    );
+    let e = render_fails(&bad, "length.toml", &length);
+    assert!(e.starts_with("flexcam: length.toml:"), "{e}");
+    assert!(e.contains("`length` goes with `point`"), "{e}");
+    let bent_far = scene.replace(
+        "tangent = [0.35, -0.42, -0.84]",
+        "tangent = [1.0, -0.2, 0.0]",
+    );
+    let e = render_fails(&bad, "far.toml", &bent_far);
+    assert!(e.starts_with("flexcam: far.toml:"), "{e}");
+    assert!(
+        e.contains("node (2, 2)") && e.contains("bends at most"),
+        "{e}"
+    );
+    let short = scene.replace("length = 30.0", "length = 3.0");
+    let e = render_fails(&bad, "short.toml", &short);
+    assert!(
+        e.contains("node (2, 2)") && e.contains("does not reach past"),
+        "{e}"
+    );
+    let negative = scene.replace("length = 30.0", "length = -3.0");
+    let e = render_fails(&bad, "negative.toml", &negative);
+    let line = line_of(&negative, "length = -3.0");
+    assert!(
+        e.starts_with(&format!("flexcam: negative.toml:{line}:")),
+        "{e}"
+    );
+}
+
 /// `flexcam fit` errors: nothing to fit, a missing file, writing over the input, a bad
 /// extension and a scene that does not load are one line each, and nothing is written.
 #[test]

@@ -23,7 +23,9 @@
 //! the magnitude to be irrelevant). A tangent along the chord E_j - S_j gives C_j = the
 //! midpoint, the straight projector itself, so such a node is stored as straight. The thesis attaches the tangent where the projector meets the
 //! scene; here it is at the start, so that a node is defined by its start, end and tangent
-//! alone, independent of where the scene happens to be. A grid without tangents has
+//! alone, independent of where the scene happens to be; the thesis's form (through a scene
+//! point, the tangent there) is converted to this one by
+//! [`ProjectorGrid::set_projector_through`] (module `through`). A grid without tangents has
 //! straight projectors everywhere and is cast as rays; a grid with any tangent is cast as
 //! quadratic Bezier projectors ([`Projector::QuadraticBezier`], the representation of the
 //! three-surface Bezier volumes).
@@ -46,6 +48,9 @@ use crate::error::{Error, Result};
 use crate::geometry::Ray;
 use crate::projection::projector::{quadratic_point, quadratic_tangent};
 use crate::projection::Projector;
+
+mod through;
+pub use through::Through;
 
 /// Fewest nodes per side: a grid needs two to span the domain.
 pub const MIN_NODES: usize = 2;
@@ -201,6 +206,24 @@ impl ProjectorGrid {
         self.starts[j] = start;
         self.ends[j] = end;
         Ok(())
+    }
+
+    /// Places node (`col`, `row`)'s projector the thesis's way (5.2.1): from `start` through
+    /// the scene point `through.point`, with its direction there along `through.tangent`
+    /// when one is given, its end `through.length` from the start (default: the node's length,
+    /// lengthened like [`ProjectorGrid::aim`]'s when the point is farther) (see the `through` module's
+    /// docs for the construction and its errors). Without a tangent this is the straight node
+    /// `set_projector` gives from `start + length * (point - start) / |point - start|`.
+    pub fn set_projector_through(
+        &mut self,
+        (col, row): (usize, usize),
+        start: DVec3,
+        through: &Through,
+    ) -> Result<()> {
+        let j = self.index(col, row)?;
+        let current = (self.ends[j] - self.starts[j]).length();
+        let (end, tangent) = through::node_through((col, row), start, through, current)?;
+        self.set_projector((col, row), start, end, tangent)
     }
 
     /// The index of node (`col`, `row`) in the node lists; an error outside the grid.
@@ -423,7 +446,9 @@ pub struct Aim {
 }
 
 /// One node projector placed explicitly ([`ProjectorGrid::set_projector`]); the start and
-/// end default to the sampled node's.
+/// end default to the sampled node's. With `through`, the projector is placed through a scene
+/// point instead ([`ProjectorGrid::set_projector_through`]); `end` and `tangent` are then
+/// unused (the tangent at the point is `through`'s).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NodeProjector {
     /// (column, row) of the node, (0, 0) at the bottom left.
@@ -432,6 +457,8 @@ pub struct NodeProjector {
     pub end: Option<DVec3>,
     /// The direction the projector leaves its start in; `None`: straight.
     pub tangent: Option<DVec3>,
+    /// The thesis's form: through a scene point, the tangent there.
+    pub through: Option<Through>,
 }
 
 /// A projector grid as a scene describes it: sampled from the projection's own volume, then
@@ -472,6 +499,10 @@ impl GridVolume {
             let (col, row) = node.node;
             let j = grid.index(col, row)?;
             let start = node.start.unwrap_or(grid.starts[j]);
+            if let Some(through) = &node.through {
+                grid.set_projector_through(node.node, start, through)?;
+                continue;
+            }
             let end = node.end.unwrap_or(grid.ends[j]);
             grid.set_projector(node.node, start, end, node.tangent)?;
         }

@@ -287,6 +287,7 @@ fn grid_frame(tangents: impl Fn(DVec3, DVec3) -> Option<DVec3>) -> Frame {
             start: None,
             end: None,
             tangent: tangents(start, end),
+            through: None,
         })
         .collect();
     render(

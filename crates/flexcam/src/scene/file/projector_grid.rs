@@ -10,7 +10,7 @@ use super::raw::{RawNodeProjector, RawProjectors};
 use super::source::Source;
 use crate::error::Result;
 use crate::projection::flexible::fit::Correspondence;
-use crate::projection::flexible::projector_grid::{MAX_NODES, MIN_NODES};
+use crate::projection::flexible::projector_grid::{Through, MAX_NODES, MIN_NODES};
 use crate::projection::flexible::{Aim, GridInterpolation, NodeProjector, ProjectorGridSpec};
 
 /// Nodes per side when `size` is not given: the thesis's 5 x 5.
@@ -91,7 +91,9 @@ pub(super) fn convert(src: &Source, table: &Spanned<RawProjectors>) -> Result<Pr
     })
 }
 
-/// A `projector = [...]` entry; a zero `tangent` is allowed and means straight.
+/// A `projector = [...]` entry; a zero `tangent` is allowed and means straight. With `point`
+/// (the thesis's form, 5.2.1) the projector passes through it and `tangent` is its direction
+/// there; `end` then cannot be given, and `length` only goes with `point`.
 fn node_projector(
     src: &Source,
     raw: &RawNodeProjector,
@@ -103,12 +105,46 @@ fn node_projector(
             .map(|v| finite_point(src, v, name))
             .transpose()
     };
+    let tangent = optional(&raw.tangent, "tangent")?;
+    let through =
+        match (&raw.point, &raw.end, &raw.length) {
+            (Some(_), Some(end), _) => {
+                return Err(src.error(
+                    &end.span(),
+                    "a node projector takes `end` or `point` (through a scene point), not both",
+                ))
+            }
+            (None, _, Some(length)) => return Err(src.error(
+                &length.span(),
+                "`length` goes with `point` (a projector through a scene point); with `end` the \
+                 length is the distance from `start` to `end`",
+            )),
+            (Some(point), None, length) => Some(Through {
+                point: finite_point(src, point, "point")?,
+                tangent,
+                length: length.as_ref().map(|l| positive(src, l)).transpose()?,
+            }),
+            (None, _, None) => None,
+        };
     Ok(NodeProjector {
         node: node(src, &raw.node, size)?,
         start: optional(&raw.start, "start")?,
         end: optional(&raw.end, "end")?,
-        tangent: optional(&raw.tangent, "tangent")?,
+        tangent: if through.is_some() { None } else { tangent },
+        through,
     })
+}
+
+/// A `length` value: positive and finite.
+fn positive(src: &Source, value: &Spanned<f64>) -> Result<f64> {
+    let length = *value.get_ref();
+    if length.is_finite() && length > 0.0 {
+        return Ok(length);
+    }
+    Err(src.error(
+        &value.span(),
+        format!("`length` must be a positive number, not {length}"),
+    ))
 }
 
 /// A `node = [column, row]` value, checked to lie in the grid.

@@ -159,7 +159,9 @@ pub struct RawProjectors {
 }
 
 /// `{ node = [column, row], start = [x, y, z], end = [x, y, z], tangent = [x, y, z] }`: one
-/// node projector placed explicitly (each of start, end and tangent optional).
+/// node projector placed explicitly (each of start, end and tangent optional); or, the
+/// thesis's form, `point = [x, y, z]` (instead of `end`) with an optional `length`: the
+/// projector passes through `point`, with `tangent` its direction there.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawNodeProjector {
@@ -167,6 +169,8 @@ pub struct RawNodeProjector {
     pub start: Option<Vec3Value>,
     pub end: Option<Vec3Value>,
     pub tangent: Option<Vec3Value>,
+    pub point: Option<Vec3Value>,
+    pub length: Option<Spanned<f64>>,
 }
 
 /// `{ node = [column, row], at = [x, y, z] }`: re-aim one node projector through a point.

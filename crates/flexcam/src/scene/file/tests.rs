@@ -1216,6 +1216,7 @@ fn flexible_projector_grid_nodes_with_tangents() {
             start: Some(DVec3::new(-1.0, 4.0, 6.0)),
             end: Some(DVec3::new(-9.0, -3.0, -9.0)),
             tangent: None,
+            through: None,
         }
     );
     let flexible = crate::projection::flexible::Flexible::new(&spec, 32, 24).unwrap();

@@ -63,8 +63,12 @@
 //! 24 of 24 bilinear and 8 of 8 Bezier random grids recovered; with each node's length 0.5 to
 //! 3 times the prior's and fitted, `recovers_random_bilinear_curved_grids_with_their_own_lengths`
 //! and `..._bezier_...`: 23 of 24 bilinear and 14 of 16 Bezier grids). A minimum without a
-//! folded node, or one whose mirror does not lower the cost, is not repaired, and is left to
-//! the report's residual (the three misses: max residuals 0.62, 0.0028 and 0.034 degrees).
+//! folded node, or one whose mirror does not lower the cost, is left to [`Problem::reseat`]
+//! (where the residual is above rounding: restarts with every length scaled by 1.25 and 0.8,
+//! and with the three nodes carrying most of the residual put back on the straight fit,
+//! kept if the cost drops), which repaired Bezier seed 14 (two nodes turned 0.8 and 1.0
+//! rad, not folded); bilinear and Bezier seed 12 (lengths short together, a shallow valley)
+//! are not repaired and are left to the report's residual (0.62 and 0.0028 degrees).
 //! Tried and not kept: a continuation in the data (from the straight start's own projectors
 //! to the points in 8 stages) with steps limited to 0.2 rad (the same 9 grids), and an
 //! alternating start (depths fixed, the node control points and ends by linear least squares,
@@ -101,6 +105,20 @@ const PRIOR_WEIGHT: f64 = 1e-12;
 
 /// The most restarts with folded nodes mirrored ([`Problem::unfold`]).
 const MAX_UNFOLDS: usize = 8;
+
+/// The most rounds of [`Problem::reseat`].
+const MAX_RESEATS: usize = 3;
+
+/// Factors every free length is scaled by in the restarts of [`Problem::reseat`].
+const RESCALES: [f64; 2] = [1.25, 0.8];
+
+/// How many of the nodes carrying most of the residual [`Problem::reseat`] puts back on
+/// the straight fit.
+const RESEAT_NODES: usize = 3;
+
+/// The data cost per correspondence (squared angle, rad^2: an rms miss of 1e-8 rad) at or
+/// below which a fit counts as exact and [`Problem::reseat`] leaves it.
+const ROUNDING: f64 = 1e-16;
 
 /// The most Levenberg-Marquardt steps.
 const MAX_ITERATIONS: usize = 2000;
@@ -167,6 +185,7 @@ pub(super) fn fit(
     if problem.hold_open_lengths(&mut state) {
         state = problem.unfold(problem.solve(state.nodes));
     }
+    state = problem.reseat(state);
     // The prior term pulls each unknown towards its centre by about PRIOR_WEIGHT over the
     // data's curvature along it, which is small along a weakly bent node's length (measured:
     // lengths off by 2e-6); centred again on the fit, the pull acts on that residual only.
@@ -376,6 +395,78 @@ impl<'a> Problem<'a> {
             (state, cost) = better;
         }
         state
+    }
+
+    /// Repairs a wrong minimum that [`Problem::unfold`] leaves (module docs), only where the
+    /// data residual is above rounding: restarts from `state` with, in turn, every length
+    /// scaled by each of [`RESCALES`] (a minimum with the lengths off together: bilinear and
+    /// Bezier seed 12), and the [`RESEAT_NODES`] nodes that carry most of the residual put
+    /// back on the straight fit (a few nodes turned wrong: Bezier seed 14), each solved and
+    /// unfolded; keeps the lowest cost, repeats while the cost drops (at most
+    /// [`MAX_RESEATS`] rounds).
+    fn reseat(&self, mut state: State) -> State {
+        let mut cost = self.cost(&state, 0.0);
+        for _ in 0..MAX_RESEATS {
+            if cost <= ROUNDING * self.data.len() as f64 {
+                break;
+            }
+            let mut candidates: Vec<Vec<Node>> = RESCALES
+                .iter()
+                .map(|f| {
+                    let mut nodes = state.nodes.clone();
+                    for (s, n) in nodes.iter_mut().enumerate() {
+                        if !self.held[s] {
+                            n.length *= f;
+                        }
+                    }
+                    nodes
+                })
+                .collect();
+            let mut nodes = state.nodes.clone();
+            for s in self.worst_nodes(&state) {
+                nodes[s] = Node {
+                    length: if self.held[s] {
+                        nodes[s].length
+                    } else {
+                        self.anchor[s].length
+                    },
+                    ..self.anchor[s]
+                };
+            }
+            candidates.push(nodes);
+            let best = candidates
+                .into_iter()
+                .map(|nodes| {
+                    let candidate = self.unfold(self.solve(nodes));
+                    let c = self.cost(&candidate, 0.0);
+                    (candidate, c)
+                })
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            match best {
+                Some((candidate, c)) if c < cost => (state, cost) = (candidate, c),
+                _ => break,
+            }
+        }
+        state
+    }
+
+    /// The (at most [`RESEAT_NODES`]) free nodes carrying most of the data residual at
+    /// `state`: each correspondence's squared residual shared among its nodes by weight.
+    fn worst_nodes(&self, state: &State) -> Vec<usize> {
+        let mut share = vec![0.0; self.free.len()];
+        for k in 0..self.data.len() {
+            let p = self.controls(k, &state.nodes);
+            let miss = ((quadratic_point(&p, state.depths[k]) - self.data[k].point)
+                * self.starts[k].1)
+                .length_squared();
+            for &(s, w) in &self.weights[k] {
+                share[s] += w * miss;
+            }
+        }
+        let mut order: Vec<usize> = (0..share.len()).collect();
+        order.sort_by(|a, b| share[*b].total_cmp(&share[*a]));
+        order.truncate(RESEAT_NODES);
+        order
     }
 
     /// Levenberg-Marquardt on the node unknowns from `nodes` (module docs).
