@@ -25,7 +25,7 @@ use flexcam::render::inverse_raster::workloads::{
 use flexcam::render::inverse_raster::InverseRaster;
 use flexcam::render::raycast::workloads::{table_volume, teapot_scene, TABLE_SIZE};
 use flexcam::render::raycast::RayCaster;
-use flexcam::render::{Counter, RenderOptions, Shading};
+use flexcam::render::{Counter, Frame, RenderOptions, Shading};
 use flexcam::scene::Scene;
 use flexcam::{Error, Result};
 
@@ -71,6 +71,11 @@ pub struct FlexibleArgs {
     /// Which tables to measure.
     #[arg(long, value_enum, default_value_t = Part::All)]
     part: Part,
+    /// Also print a hash of each Table 7.1 cell's frame (the bits of every pixel's colour,
+    /// depth and id), to check that a change to the caster leaves every frame bit for bit
+    /// equal.
+    #[arg(long)]
+    hash: bool,
 }
 
 /// The tables of `flexcam bench flexible`.
@@ -111,9 +116,9 @@ fn table(args: &FlexibleArgs) -> Result<()> {
     let mut ours = Vec::with_capacity(rows);
     for (name, faces, _) in &THESIS[..rows] {
         let (scene, used) = teapot_scene(*faces);
-        let times = row_times(&scene, args.repeat)?;
+        let (times, hashes) = row_times(&scene, args.repeat)?;
         eprintln!("{name}: {used} faces done");
-        ours.push((*name, *faces, used, times));
+        ours.push((*name, *faces, used, times, hashes));
     }
     print_table("thesis (seconds, no acceleration structure)", rows, |r| {
         THESIS[r].2.map(|t| format!("{t:.2}"))
@@ -129,30 +134,59 @@ fn table(args: &FlexibleArgs) -> Result<()> {
         rows,
         |r| ours[r].3.map(|t| t.cpu_text(1.0, 4)),
     );
+    if args.hash {
+        println!("\nframe hashes (FNV-1a 64 of colour, depth and id bits)");
+        for (name, _, _, _, hashes) in &ours {
+            let cells: Vec<String> = hashes.iter().map(|h| format!("{h:016x}")).collect();
+            println!("{name:<8}{}", cells.join(" "));
+        }
+    }
     println!("faces used per row:");
-    for (name, faces, used, _) in &ours {
+    for (name, faces, used, _, _) in &ours {
         println!("  {name:<7} thesis {faces:>6}, teapot {used:>6}");
     }
     Ok(())
 }
 
 /// One row of Table 7.1: the best time of one lit frame of `scene` through each column's
-/// projectors, the BVH built once for the row.
-fn row_times(scene: &Scene, repeat: u32) -> Result<[Timing; 6]> {
+/// projectors, the BVH built once for the row, and the [`frame_hash`] of each column's last
+/// frame.
+fn row_times(scene: &Scene, repeat: u32) -> Result<([Timing; 6], [u64; 6])> {
     let caster = RayCaster::new(scene);
     let options = RenderOptions {
         shading: Shading::Lit,
         ..RenderOptions::default()
     };
     let mut times = [Timing::default(); 6];
-    for (time, column) in times.iter_mut().zip(COLUMNS) {
+    let mut hashes = [0; 6];
+    for ((time, hash), column) in times.iter_mut().zip(&mut hashes).zip(COLUMNS) {
         let projection = table_volume(scene, column, TABLE_SIZE)?;
+        let mut last = None;
         *time = measure(repeat, || {
-            caster.render(&projection, &options);
+            last = Some(caster.render(&projection, &options).0);
             Ok(())
         })?;
+        *hash = last.as_ref().map_or(0, frame_hash);
     }
-    Ok(times)
+    Ok((times, hashes))
+}
+
+/// FNV-1a (64 bits) of the bits of every pixel's colour, depth and id, in pixel order: equal
+/// frames give equal hashes, and a change in any bit almost surely changes it. Computed after
+/// the timed renders.
+fn frame_hash(frame: &Frame) -> u64 {
+    let words = frame
+        .color
+        .iter()
+        .flat_map(|c| c.to_array())
+        .map(f32::to_bits)
+        .chain(frame.depth.iter().map(|d| d.to_bits()))
+        .chain(frame.ids.iter().copied());
+    words
+        .flat_map(u32::to_le_bytes)
+        .fold(0xcbf2_9ce4_8422_2325, |h: u64, byte| {
+            (h ^ u64::from(byte)).wrapping_mul(0x0100_0000_01b3)
+        })
 }
 
 /// The panorama throughput table (the workload of
@@ -292,4 +326,32 @@ fn process_cpu_seconds() -> Option<f64> {
     let fields: Vec<&str> = rest.split_whitespace().collect();
     let ticks = |i: usize| fields.get(i)?.parse::<u64>().ok();
     Some((ticks(11)? + ticks(12)?) as f64 / 100.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+
+    /// Equal frames hash alike; one bit of a colour, a depth or an id changes the hash, and
+    /// so does a swap of two pixels.
+    #[test]
+    fn frame_hashes_see_every_bit_and_the_pixel_order() {
+        let mut frame = Frame::new(3, 2, Vec3::new(0.1, 0.2, 0.3));
+        frame.depth[4] = 2.5;
+        frame.ids[4] = 7;
+        let base = frame_hash(&frame);
+        assert_eq!(frame_hash(&frame.clone()), base);
+        let flipped = |edit: &dyn Fn(&mut Frame)| {
+            let mut f = frame.clone();
+            edit(&mut f);
+            frame_hash(&f)
+        };
+        let bit = |x: f32| f32::from_bits(x.to_bits() ^ 1);
+        assert_ne!(flipped(&|f| f.color[5].y = bit(f.color[5].y)), base);
+        assert_ne!(flipped(&|f| f.depth[0] = bit(f.depth[0])), base);
+        assert_ne!(flipped(&|f| f.ids[1] ^= 1), base);
+        assert_ne!(flipped(&|f| f.depth.swap(0, 4)), base);
+    }
 }

@@ -4,7 +4,7 @@
 
 use std::mem::MaybeUninit;
 
-use glam::{Vec3, Vec3A, Vec4, Vec4Swizzles};
+use glam::{BVec4A, Vec3, Vec3A, Vec4, Vec4Swizzles};
 
 use super::triangle::{FastHit, FastRay, PackedTriangle};
 use crate::geometry::Aabb;
@@ -241,8 +241,8 @@ pub(super) struct NearSegments4 {
     origin: [Vec4; 3],
     inv_direction: [Vec4; 3],
     pad: Vec4,
-    /// Bit `i` set when lane `i` holds a segment.
-    lanes: u32,
+    /// Set in lane `i` when lane `i` holds a segment.
+    lanes: BVec4A,
 }
 
 impl NearSegments4 {
@@ -266,15 +266,16 @@ impl NearSegments4 {
             origin: [ox, oy, oz],
             inv_direction: [ix, iy, iz],
             pad: get(&|s: &NearSegment| s.pad),
-            lanes: (0..4)
-                .filter(|&i| segments[i].is_some())
-                .fold(0, |bits, i| bits | 1 << i),
+            lanes: BVec4A::from_array(segments.map(|s| s.is_some())),
         }
     }
 
-    /// The lanes whose segment meets the box `[min, max]` enlarged by its pad.
+    /// Per lane, the parameter along the lane's segment (in [0, 1]) at which it enters the
+    /// box `[min, max]` enlarged by its pad, or infinity where it misses it or the lane is
+    /// empty. A lane's entry is finite exactly when [`NearSegment::meets`] accepts the box
+    /// (the same operations in the same order).
     #[inline(always)]
-    fn meets(&self, min: Vec3, max: Vec3) -> u32 {
+    fn entries(&self, min: Vec3, max: Vec3) -> Vec4 {
         let t = |axis: usize| {
             let o = self.origin[axis];
             let inv = self.inv_direction[axis];
@@ -285,7 +286,14 @@ impl NearSegments4 {
         let ((n0, f0), (n1, f1), (n2, f2)) = (t(0), t(1), t(2));
         let near = n0.max(n1).max(n2).max(Vec4::ZERO);
         let far = f0.min(f1).min(f2).min(Vec4::ONE);
-        near.cmple(far + far.abs() * ROBUST_SLACK).bitmask() & self.lanes
+        let inside = near.cmple(far + far.abs() * ROBUST_SLACK) & self.lanes;
+        Vec4::select(inside, near, Vec4::INFINITY)
+    }
+
+    /// The lanes whose segment meets the box `[min, max]` enlarged by its pad.
+    #[cfg(test)]
+    fn meets(&self, min: Vec3, max: Vec3) -> u32 {
+        self.entries(min, max).cmpne(Vec4::INFINITY).bitmask()
     }
 }
 
@@ -675,46 +683,82 @@ impl Bvh {
     }
 
     /// Calls `visit` with the lane and the stored index (see [`Bvh::all_triangles`],
-    /// [`Bvh::id`]) of every triangle in every leaf whose box, enlarged by the lane's pad on
+    /// [`Bvh::id`]) of the triangles in the leaves whose box, enlarged by the lane's pad on
     /// every side, the lane's segment meets: a conservative cull for anything that lies within
     /// `pad` of the segment (a curve inside the convex hull of its control points, see
-    /// [`NearSegment`]). A lane enters a node exactly when its own segment meets every box on
-    /// the way, so each lane sees the triangles a walk of its segment alone would, in tree
-    /// order (increasing stored index), whatever the other lanes hold; the node visits are
-    /// shared, and one 4-wide test serves the four lanes.
+    /// [`NearSegment`]). `visit` returns the lane's bound: from then on the lane skips every
+    /// node and triangle whose box its segment enters beyond that parameter (`f32::MAX`:
+    /// none), so a caller that knows nothing beyond some point of the segment can improve
+    /// its result ends the lane's walk there. The walk is ordered along the segments: at a
+    /// node, the child that some lane enters first is visited first, so that the bounds fall
+    /// early. A lane enters a node only when its own segment meets every box on the way
+    /// within its bound, so each lane sees a subset of the triangles a walk of its segment
+    /// alone would, whatever the other lanes hold, and every triangle of a box it enters
+    /// within its bound; the node visits are shared, and one 4-wide test serves the four
+    /// lanes.
     pub fn visit_near_segments4(
         &self,
         segments: &NearSegments4,
-        mut visit: impl FnMut(usize, usize),
+        mut visit: impl FnMut(usize, usize) -> f32,
     ) {
         if self.triangles.is_empty() {
             return;
         }
-        let root = segments.meets(self.root_bounds.min, self.root_bounds.max);
-        let mut stack = [(self.root, root); STACK_SIZE];
-        let mut depth = usize::from(root != 0);
-        while depth > 0 {
-            depth -= 1;
-            let (current, lanes) = stack[depth];
+        let mut bounds = Vec4::MAX;
+        // As in `traverse`: entries below `depth` are initialised.
+        let mut stack = [const { MaybeUninit::<(Child, Vec4)>::uninit() }; STACK_SIZE];
+        let mut depth = 0;
+        let mut current = self.root;
+        let mut entry = segments.entries(self.root_bounds.min, self.root_bounds.max);
+        loop {
+            // The lanes that enter `current` within their bounds.
+            let active = entry.cmple(bounds);
             if current.count > 0 {
                 let first = current.index as usize;
                 for stored in first..first + current.count as usize {
-                    let mut left = lanes;
+                    let mut left = entry.cmple(bounds).bitmask();
                     while left != 0 {
-                        visit(left.trailing_zeros() as usize, stored);
+                        let lane = left.trailing_zeros() as usize;
+                        bounds[lane] = visit(lane, stored);
                         left &= left - 1;
                     }
                 }
-                continue;
+            } else if active.any() {
+                let node = &self.nodes[current.index as usize];
+                let enter = |k: usize| {
+                    let (min, max) = node.child_box(k);
+                    let e = segments.entries(min, max);
+                    Vec4::select(active & e.cmple(bounds), e, Vec4::INFINITY)
+                };
+                let (e0, e1) = (enter(0), enter(1));
+                let (first0, first1) = (e0.min_element(), e1.min_element());
+                let [c0, c1] = node.children;
+                let (near, far, e_near, e_far, f_far) = if first1 < first0 {
+                    (c1, c0, e1, e0, first0)
+                } else {
+                    (c0, c1, e0, e1, first1)
+                };
+                if e_near.min_element() != f32::INFINITY {
+                    if f_far != f32::INFINITY {
+                        stack[depth].write((far, e_far));
+                        depth += 1;
+                    }
+                    (current, entry) = (near, e_near);
+                    continue;
+                }
             }
-            let node = &self.nodes[current.index as usize];
-            // Push the second child first, so that the first is visited first (tree order).
-            for k in [1, 0] {
-                let (min, max) = node.child_box(k);
-                let entered = segments.meets(min, max) & lanes;
-                if entered != 0 {
-                    stack[depth] = (node.children[k], entered);
-                    depth += 1;
+            // Pop the next pending node some lane enters within its bound.
+            loop {
+                if depth == 0 {
+                    return;
+                }
+                depth -= 1;
+                // SAFETY: `stack[depth]` was written by the push that made `depth` this large
+                // (pushes write `stack[depth]` and then increment it; pops decrement it).
+                let (child, e) = unsafe { stack[depth].assume_init() };
+                if e.cmple(bounds).any() {
+                    (current, entry) = (child, e);
+                    break;
                 }
             }
         }
@@ -1287,6 +1331,85 @@ mod tests {
         }
         // Both outcomes occur often (about 5 % of the present lanes meet their box).
         assert!(met > 100 && missed > 1000, "{met} {missed}");
+    }
+
+    /// Without a bound, the ordered walk of four segments visits each lane's triangles
+    /// exactly once each, and exactly those of the leaves a tree-order walk of the lane's
+    /// segment alone meets (empty lanes: none); with a bound, a lane visits no triangle
+    /// beyond it: after `visit` returns a bound of 0 for a lane, the lane sees only
+    /// triangles of leaves its segment enters at its start.
+    #[test]
+    fn ordered_walks_visit_each_lane_s_leaves_and_stop_at_the_bound() {
+        let mut rng = Rng(13);
+        let (mut visits, mut bounded) = (0, 0);
+        for n in [1, 40, 700] {
+            let triangles = soup(&mut rng, n);
+            let bvh = Bvh::build(&triangles);
+            // The box of each stored triangle's leaf.
+            let mut leaf_boxes =
+                vec![(bvh.root_bounds.min, bvh.root_bounds.max); bvh.triangles.len()];
+            for node in &bvh.nodes {
+                for (k, child) in node.children.iter().enumerate() {
+                    let first = child.index as usize;
+                    leaf_boxes[first..first + child.count as usize].fill(node.child_box(k));
+                }
+            }
+            for _ in 0..200 {
+                let base = rng.vec(12.0).as_dvec3();
+                let lanes: [NearSegment; 4] = std::array::from_fn(|_| {
+                    let origin = base + rng.vec(1.0).as_dvec3();
+                    NearSegment::new(origin, rng.vec(8.0).as_dvec3(), f64::from(rng.next()))
+                        .unwrap()
+                });
+                let present = (rng.next() * 16.0) as u32;
+                let four = NearSegments4::new(std::array::from_fn(|i| {
+                    (present >> i & 1 == 1).then_some(&lanes[i])
+                }));
+                let mut seen: Vec<(usize, usize)> = Vec::new();
+                bvh.visit_near_segments4(&four, |lane, stored| {
+                    seen.push((lane, stored));
+                    f32::MAX
+                });
+                seen.sort_unstable();
+                let mut alone: Vec<(usize, usize)> = Vec::new();
+                for (i, lane) in lanes
+                    .iter()
+                    .enumerate()
+                    .filter(|(i, _)| present >> i & 1 == 1)
+                {
+                    bvh.walk_leaves(
+                        |min, max| lane.meets(min, max),
+                        |leaf| {
+                            let first = leaf.index as usize;
+                            alone.extend((first..first + leaf.count as usize).map(|t| (i, t)));
+                            false
+                        },
+                    );
+                }
+                // The root leaf of a one-triangle tree is entered by `walk_leaves` unasked.
+                if bvh.root.count > 0 {
+                    let root = bvh.root_bounds;
+                    alone.retain(|&(i, _)| lanes[i].meets(root.min, root.max));
+                }
+                alone.sort_unstable();
+                assert_eq!(seen, alone);
+                visits += seen.len();
+                // A bound of 0 after the first visit of each lane: what the lane sees
+                // afterwards lies in leaves whose padded box its segment enters at its start.
+                let mut stopped = [false; 4];
+                bvh.visit_near_segments4(&four, |lane, stored| {
+                    if stopped[lane] {
+                        let (min, max) = leaf_boxes[stored];
+                        let alone = NearSegments4::new([Some(&lanes[lane]), None, None, None]);
+                        assert_eq!(alone.entries(min, max)[0], 0.0);
+                        bounded += 1;
+                    }
+                    stopped[lane] = true;
+                    0.0
+                });
+            }
+        }
+        assert!(visits > 1000 && bounded > 10, "{visits} {bounded}");
     }
 
     #[test]

@@ -69,7 +69,9 @@ fn distance_to_segment(q: DVec3, a: DVec3, b: DVec3) -> f64 {
 
 /// One curve's piece being searched in a packet walk: the curve, the piece's control
 /// points, their box and largest coordinate magnitude, the piece's largest distance from its
-/// chord (the middle control point's), and its padded chord.
+/// chord (the middle control point's), its padded chord, and where the chord parameter of
+/// the piece's points rises with the curve parameter, the middle control point's
+/// ([`chord_parameter`]).
 struct PieceSearch<'a> {
     curve: &'a [DVec3; 3],
     hull: [DVec3; 3],
@@ -78,6 +80,41 @@ struct PieceSearch<'a> {
     scale: f64,
     pad: f64,
     chord: NearSegment,
+    along: Option<f64>,
+}
+
+/// Slack of the walk's bound ([`PieceSearch::bound`]), in chord parameter units: the f32 slab
+/// test that computes a node's entry along the chord rounds it by a few f32 ulps relative
+/// (below 1e-6 for entries in [0, 1]), far below this.
+const BOUND_SLACK: f64 = 1e-5;
+
+/// Where the chord from `hull[0]` to `hull[2]` is passed by the piece: writing the middle
+/// control point as `hull[0] + alpha (hull[2] - hull[0]) + h` with `h` across the chord, the
+/// piece's point at local parameter `x` is `hull[0] + tau(x) (hull[2] - hull[0]) + 2 x (1 - x)
+/// h` with `tau(x) = x^2 + 2 alpha x (1 - x)`: within `|h| / 2` (less than the piece's pad) of
+/// the chord's point at `tau(x)`. Returns `alpha` where `tau` rises with `x` over [0, 1]
+/// (`alpha` in [0, 1]). Degenerate cases: a chord of zero length, a non-finite point or an
+/// `alpha` outside [0, 1] (the piece turns back along its chord) give `None`.
+fn chord_parameter(hull: &[DVec3; 3]) -> Option<f64> {
+    let d = hull[2] - hull[0];
+    let alpha = (hull[1] - hull[0]).dot(d) / d.length_squared();
+    (0.0..=1.0).contains(&alpha).then_some(alpha)
+}
+
+impl PieceSearch<'_> {
+    /// The bound of the walk ([`super::bvh::Bvh::visit_near_segments4`]) once the piece has a
+    /// hit at curve parameter `s` in the piece's interval `(a, b)`: a point of the piece in a
+    /// box whose padded box the chord enters beyond it has a larger curve parameter. Such a
+    /// point at local parameter `x` is within the pad of the chord's point at `tau(x)`
+    /// ([`chord_parameter`]), which is therefore in the padded box: `tau(x)` is at least the
+    /// entry, above `tau` at the hit by more than [`BOUND_SLACK`] covers the rounding of
+    /// the entry, and `tau` rises with `x`. `f32::MAX` (no bound) where `tau` does not rise.
+    fn bound(&self, s: f64, (a, b): (f64, f64)) -> f32 {
+        self.along.map_or(f32::MAX, |alpha| {
+            let x = (s - a) / (b - a);
+            (x * x + 2.0 * alpha * x * (1.0 - x) + BOUND_SLACK) as f32
+        })
+    }
 }
 
 impl RayCaster {
@@ -154,6 +191,7 @@ impl RayCaster {
                             scale: lo.abs().max(hi.abs()).max_element(),
                             pad,
                             chord,
+                            along: chord_parameter(&hull),
                         })
                     }
                     // A control point that is not finite: the curve hits nothing.
@@ -174,10 +212,13 @@ impl RayCaster {
     }
 
     /// The first hit (stored triangle and hit) of each of `pieces`, all over the curve
-    /// parameter interval `(a, b)`, by one walk: in a leaf, a triangle whose box is apart
-    /// from the piece's, whose plane the piece's control points lie strictly on one side of,
-    /// or one of whose edge planes the piece's chord (near the plane) or its control points
-    /// lie outside is skipped without root finding (see `CurveTriangle`).
+    /// parameter interval `(a, b)`: the smallest curve parameter, the first stored triangle
+    /// on a tie, whatever order the triangles are visited in. One walk, ordered along the
+    /// chords, that ends a lane's search beyond its best hit ([`PieceSearch::bound`]); in a
+    /// leaf, a triangle whose box is apart from the piece's, whose plane the piece's control
+    /// points lie strictly on one side of, or one of whose edge planes the piece's chord
+    /// (near the plane) or its control points lie outside is skipped without root finding
+    /// (see `CurveTriangle`).
     fn search_pieces(
         &self,
         pieces: &[Option<PieceSearch>; 4],
@@ -188,7 +229,10 @@ impl RayCaster {
         let mut best: [Option<(usize, CurveHit)>; 4] = [None; 4];
         self.bvh.visit_near_segments4(&chords, |lane, stored| {
             let (Some(piece), best) = (&pieces[lane], &mut best[lane]) else {
-                return;
+                return f32::MAX;
+            };
+            let bound = |best: &Option<(usize, CurveHit)>| {
+                best.map_or(f32::MAX, |(_, h)| piece.bound(h.s, (a, b)))
             };
             let tri = &triangles[stored];
             let margin = tri.margin(piece.scale);
@@ -197,14 +241,17 @@ impl RayCaster {
                 || tri.chord_misses(&piece.hull, piece.pad, margin)
                 || tri.edges_miss(&piece.hull, margin)
             {
-                return;
+                return bound(best);
             }
             let hi = best.map_or(b, |(_, h)| h.s);
             if let Some(hit) = tri.intersect(piece.curve, [a, hi]) {
-                if best.is_none_or(|(_, h)| hit.s < h.s) {
+                let first =
+                    best.is_none_or(|(was, h)| hit.s < h.s || (hit.s == h.s && stored < was));
+                if first {
                     *best = Some((stored, hit));
                 }
             }
+            bound(best)
         });
         best
     }
@@ -276,6 +323,31 @@ mod tests {
         (-2.0..2.0f64, -2.0..2.0f64, -2.0..2.0f64).prop_map(|(x, y, z)| DVec3::new(x, y, z))
     }
 
+    #[test]
+    fn chords_passed_backwards_or_of_zero_length_give_no_parameter() {
+        let x = DVec3::X;
+        assert_eq!(chord_parameter(&[DVec3::ZERO, x * 0.5, x]), Some(0.5));
+        assert_eq!(chord_parameter(&[DVec3::ZERO, DVec3::Y, DVec3::ZERO]), None);
+        assert_eq!(chord_parameter(&[DVec3::ZERO, x * 1.5, x]), None);
+        assert_eq!(chord_parameter(&[DVec3::ZERO, -x, x]), None);
+        assert_eq!(chord_parameter(&[DVec3::ZERO, DVec3::NAN, x]), None);
+        // The ends of the range: the piece's middle point at an end of its chord.
+        assert_eq!(chord_parameter(&[DVec3::ZERO, x + DVec3::Y, x]), Some(1.0));
+    }
+
+    /// The caster of `flexcam bench flexible`'s Kia row (the teapot of 552 triangles) and
+    /// its quadratic volume at 64 x 64 pixels, built once for all cases.
+    fn bench_row() -> &'static (RayCaster, crate::projection::flexible::Flexible) {
+        static ROW: std::sync::OnceLock<(RayCaster, crate::projection::flexible::Flexible)> =
+            std::sync::OnceLock::new();
+        ROW.get_or_init(|| {
+            let (scene, _) = super::super::workloads::teapot_scene(520);
+            let volume = super::super::workloads::table_volume(&scene, None, 64)
+                .expect("the bench's volume");
+            (RayCaster::new(&scene), volume)
+        })
+    }
+
     proptest! {
         /// The BVH search with its culls (whole curve, piece boxes, piece chords, triangle
         /// boxes, hull planes, edge planes) finds exactly the first hit (curve parameter,
@@ -289,6 +361,53 @@ mod tests {
             let p = [p0, p1, p2].map(|q| q * DVec3::new(4.0, 2.0, 4.0) + DVec3::Y * 1.5);
             let searched = caster.intersect_quadratic(&p, LiveParts::ALL);
             prop_assert_eq!(searched, brute_force_first_hit(caster, &p));
+        }
+
+        /// A piece whose chord parameter rises ([`chord_parameter`]) lies within half its
+        /// pad of the chord's point at `tau(x)`, and `tau` rises with `x`: what the walk's
+        /// bound ([`PieceSearch::bound`]) rests on.
+        #[test]
+        fn a_piece_stays_near_its_chord_point_and_that_point_moves_forward(
+            p0 in point(), p1 in point(), p2 in point(), x in 0.0..=1.0f64, step in 0.0..=1.0f64,
+        ) {
+            let hull = [p0, p1, p2];
+            if let Some(alpha) = chord_parameter(&hull) {
+                let tau = |x: f64| x * x + 2.0 * alpha * x * (1.0 - x);
+                let chord_point = hull[0] + tau(x) * (hull[2] - hull[0]);
+                let pad = distance_to_segment(hull[1], hull[0], hull[2]);
+                let off = (quadratic_point(&hull, x) - chord_point).length();
+                prop_assert!(off <= 0.5 * pad + 1e-12, "{} {}", off, pad);
+                let later = x + step * (1.0 - x);
+                prop_assert!(tau(later) >= tau(x), "{} {}", tau(later), tau(x));
+            }
+        }
+
+        /// On the bench's own layout (the Kia row's teapot, quadratic projectors of a random
+        /// 2x2 pixel quad), where the ordered walk ends most searches early, the packet
+        /// search finds each projector's brute-force first hit: the walk's bound drops
+        /// nothing that could win, ties included.
+        #[test]
+        fn the_ordered_walk_finds_the_brute_force_first_hit_on_the_bench_layout(
+            x in 0u32..63, y in 0u32..63, dx in 0.0..1.0f64, dy in 0.0..1.0f64,
+        ) {
+            use crate::projection::{Projection, Projector};
+            let (caster, volume) = bench_row();
+            let curves: [Option<[DVec3; 3]>; 4] = std::array::from_fn(|i| {
+                let pixel = glam::DVec2::new(
+                    f64::from(x + (i as u32 & 1)) + dx,
+                    f64::from(y + (i as u32 >> 1)) + dy,
+                );
+                match volume.projector(pixel) {
+                    Some(Projector::QuadraticBezier(p)) => Some(p),
+                    _ => None,
+                }
+            });
+            let lanes = curves.each_ref().map(Option::as_ref);
+            let searched = caster.intersect_quadratic4(lanes, LiveParts::ALL);
+            for (lane, found) in lanes.iter().zip(searched) {
+                let want = lane.and_then(|p| brute_force_first_hit(caster, p));
+                prop_assert_eq!(found, want);
+            }
         }
 
         /// The packet search finds for each of four curves exactly the first hit that
