@@ -120,6 +120,11 @@ impl SceneEdge {
         }
     }
 
+    /// Its position in `[V1V2, V1V3, V2V3]` (tables indexed by scene edge).
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
     /// The 0-based scene vertices at its ends, ascending.
     pub fn vertices(self) -> [u8; 2] {
         match self {

@@ -94,7 +94,7 @@ pub struct EdgeSurface {
 
 /// How far from zero, relative to the size of its terms (`|c2| t^2 + |c1| |t| + |c0|`),
 /// the crossing quadratic must stay over a depth range for
-/// [`EdgeSurface::crossing_depths_between`] to skip its roots. The root finder's estimates
+/// [`CrossingQuadratic::clear_between`] to let a caller skip its roots. The root finder's estimates
 /// have residuals of a few `f64::EPSILON` of that size (its tangency window accepts
 /// `64 EPSILON` of the discriminant's), six orders of magnitude below this bound, so a
 /// range the bound clears holds no root the solver could return.
@@ -122,52 +122,54 @@ impl EdgeSurface {
     /// Degenerate cases: a line coplanar with the edge at every depth (all coefficients zero)
     /// or never (a nonzero constant) gives no depth; a degree drop gives the remaining root.
     pub fn crossing_depths(&self, s1: DVec3, s2: DVec3) -> impl Iterator<Item = f64> {
-        let [c2, c1, c0] = self.coefficients(s1, s2);
-        solve_quadratic(c2, c1, c0).into_iter()
+        self.crossing_quadratic(s1, s2).roots().into_iter()
     }
 
-    /// The roots of [`EdgeSurface::crossing_depths`], except that `None` is given when the
-    /// quadratic provably has no root in `[lo, hi]` (then none of them lies strictly between
-    /// `lo` and `hi`, which is all an outline needs): its value at `lo`, at `hi` and at its
-    /// extremum (where that is inside) has one sign and is larger than [`CLEAR_OF_ROOTS`]
-    /// times the size of its terms at either end (that size is convex in `t`, so the
-    /// quadratic clears the bound over the whole range). Most polygon edges of a small
-    /// projection triangle cross no edge surface; this skips their root finding.
-    ///
-    /// Degenerate cases: an empty or reversed range (`lo >= hi`) has no depth strictly
-    /// inside and gives `None`; non-finite coefficients or bounds, a quadratic vanishing
-    /// identically or nearly touching zero in the range fail the test and go to the root
-    /// finder, as in [`EdgeSurface::crossing_depths`].
-    ///
-    /// The solver's roots are returned as they are (not as an iterator): the outline tracer
-    /// calls this three times per polygon edge, and an iterator over an optional set of
-    /// roots was written out and read back through memory at every call.
-    pub fn crossing_depths_between(
-        &self,
-        s1: DVec3,
-        s2: DVec3,
-        (lo, hi): (f64, f64),
-    ) -> Option<Roots> {
-        let [c2, c1, c0] = self.coefficients(s1, s2);
-        let has_inside = lo < hi;
-        let skip = !has_inside || clear_of_roots([c2, c1, c0], lo, hi);
-        (!skip).then(|| solve_quadratic(c2, c1, c0))
-    }
-
-    /// `[c2, c1, c0]` of [`EdgeSurface::crossing_depths`] for the line through `s1`, `s2`.
-    fn coefficients(&self, s1: DVec3, s2: DVec3) -> [f64; 3] {
+    /// The crossing quadratic of [`EdgeSurface::crossing_depths`] for the line through `s1`,
+    /// `s2`, kept so that a caller testing it over several depth ranges (the polygon edges
+    /// imaging one scene edge) computes its coefficients once.
+    pub fn crossing_quadratic(&self, s1: DVec3, s2: DVec3) -> CrossingQuadratic {
         let (s1, s2) = (s1 - self.origin, s2 - self.origin);
         let d = s1 - s2;
         let c2 = d.dot(self.normals_cross);
         let c1 = d.dot(self.normal_base_cross) + s1.dot(s2.cross(self.normals_difference));
         let c0 = -s1.dot(s2.cross(self.base));
-        [c2, c1, c0]
+        CrossingQuadratic([c2, c1, c0])
+    }
+}
+
+/// `[c2, c1, c0]` of [`EdgeSurface::crossing_depths`] for one line and one edge surface.
+#[derive(Debug, Clone, Copy)]
+pub struct CrossingQuadratic([f64; 3]);
+
+impl CrossingQuadratic {
+    /// Whether none of [`CrossingQuadratic::roots`] can lie strictly between `lo` and `hi`,
+    /// so that a caller may skip the root finding: the range has nothing strictly inside
+    /// (`lo >= hi`, or a bound NaN), or the quadratic provably has no root in `[lo, hi]`: its
+    /// value at `lo`, at `hi` and at its extremum (where that is inside) has one sign and is
+    /// larger than [`CLEAR_OF_ROOTS`] times the size of its terms at either end (that size
+    /// is convex in `t`, so the quadratic clears the bound over the whole range). A range
+    /// found clear is clear for every range inside it. Most polygon edges of a small
+    /// projection triangle cross no edge surface; this skips their root finding.
+    ///
+    /// Degenerate cases: non-finite coefficients or bounds, a quadratic vanishing
+    /// identically or nearly touching zero in the range fail the test (`false`), and the
+    /// caller goes to the root finder.
+    pub fn clear_between(&self, lo: f64, hi: f64) -> bool {
+        let has_inside = lo < hi;
+        !has_inside || clear_of_roots(self.0, lo, hi)
+    }
+
+    /// All its roots, as [`EdgeSurface::crossing_depths`] gives them.
+    pub fn roots(&self) -> Roots {
+        let [c2, c1, c0] = self.0;
+        solve_quadratic(c2, c1, c0)
     }
 }
 
 /// Whether `c2 t^2 + c1 t + c0` keeps one sign over `[lo, hi]`, away from zero by more than
 /// [`CLEAR_OF_ROOTS`] times the size of its terms there (see
-/// [`EdgeSurface::crossing_depths_between`]); `false` for any non-finite input.
+/// [`CrossingQuadratic::clear_between`]); `false` for any non-finite input.
 fn clear_of_roots([c2, c1, c0]: [f64; 3], lo: f64, hi: f64) -> bool {
     let value = |t: f64| (c2 * t + c1) * t + c0;
     let size = |t: f64| (c2.abs() * t.abs() + c1.abs()) * t.abs() + c0.abs();
@@ -345,12 +347,15 @@ mod tests {
                     (r, r),
                 ]);
             }
-            for range in ranges {
-                prop_assert_eq!(
-                    inside(surface.crossing_depths_between(a, b, range).into_iter().flatten(), range),
-                    inside(surface.crossing_depths(a, b), range),
-                    "range {:?}", range
-                );
+            let quadratic = surface.crossing_quadratic(a, b);
+            for (lo, hi) in ranges {
+                if quadratic.clear_between(lo, hi) {
+                    prop_assert_eq!(
+                        inside(surface.crossing_depths(a, b), (lo, hi)),
+                        Vec::<f64>::new(),
+                        "range {:?}", (lo, hi)
+                    );
+                }
             }
         }
     }
@@ -391,16 +396,12 @@ mod tests {
         let on_edge = cache.ray_point(0.0, 0.4, 2.0);
         let offset = DVec3::new(0.7, 0.2, -0.3);
         let (a, b) = (on_edge + offset, on_edge - offset * 1.5);
-        let found = inside(
-            surface
-                .crossing_depths_between(a, b, (1.0, 3.0))
-                .into_iter()
-                .flatten(),
-            (1.0, 3.0),
-        );
+        let quadratic = surface.crossing_quadratic(a, b);
+        assert!(!quadratic.clear_between(1.0, 3.0));
+        let found = inside(quadratic.roots().as_slice().iter().copied(), (1.0, 3.0));
         assert!(found.iter().any(|t| (t - 2.0).abs() < 1e-10), "{found:?}");
-        for range in [(2.0, 2.0), (3.0, 1.0), (f64::NAN, 3.0)] {
-            assert!(surface.crossing_depths_between(a, b, range).is_none());
+        for (lo, hi) in [(2.0, 2.0), (3.0, 1.0), (f64::NAN, 3.0)] {
+            assert!(quadratic.clear_between(lo, hi));
         }
     }
 

@@ -11,7 +11,9 @@ use super::clip::clip_outline;
 use super::curves::{CurveMode, CurveOptions, ADAPTIVE_TOLERANCE_PX};
 use super::edge_path::{EdgePath, OutlinePoint};
 use super::hit_terms::{HitTerms, TERMS};
-use super::outline::{slice_depths, trace_outline, ProjectionTriangle, Sampling};
+use super::outline::{
+    depth_range, slice_depths, trace_outline, EdgeCrossings, ProjectionTriangle, Sampling,
+};
 use super::pair_cull::{live_pairs, LivePair, LivePairs, VertexCache};
 use super::scene_geometry::SceneGeometry;
 use super::screen_map::ScreenMap;
@@ -348,6 +350,7 @@ impl Pair<'_> {
             out.counts.unprojectable += 1;
             return;
         };
+        let mut crossings = self.crossings(scene, || depth_range(shapes.iter()));
         for shape in shapes.iter() {
             let mut slices = std::mem::take(&mut scratch.slices);
             let sampling = match self.curves.mode {
@@ -360,7 +363,7 @@ impl Pair<'_> {
                     levels: self.curves.steps.next_power_of_two().trailing_zeros(),
                 },
             };
-            self.draw_shape(&shape, scene, sampling, out, scratch);
+            self.draw_shape(&shape, scene, sampling, &mut crossings, out, scratch);
             scratch.slices = slices;
         }
     }
@@ -397,8 +400,12 @@ impl Pair<'_> {
                     let solved = sub.map(|k| scratch.grid_solutions[k]);
                     match project_solved_triangle(cache, corners, solved) {
                         Ok(shapes) => {
+                            let mut crossings =
+                                self.crossings(corners, || depth_range(shapes.iter()));
                             for shape in shapes.iter() {
-                                self.draw_shape(&shape, corners, Sampling::Anchors, out, scratch);
+                                let sampling = Sampling::Anchors;
+                                let crossings = &mut crossings;
+                                self.draw_shape(&shape, corners, sampling, crossings, out, scratch);
                             }
                         }
                         Err(_) => out.counts.unprojectable += 1,
@@ -408,19 +415,32 @@ impl Pair<'_> {
         }
     }
 
-    /// Traces, clips and appends one shape, each vertex with the hit terms of its projector.
+    /// The edge-surface crossings of the scene triangle (or piece) `scene` for its shapes,
+    /// whose vertices' depth range `range` gives (computed only with scene-space clipping).
+    fn crossings(&self, scene: [DVec3; 3], range: impl FnOnce() -> (f64, f64)) -> EdgeCrossings {
+        if self.curves.scene_clipping {
+            EdgeCrossings::new(self.triangle, scene, range())
+        } else {
+            EdgeCrossings::none()
+        }
+    }
+
+    /// Traces, clips and appends one shape, each vertex with the hit terms of its projector;
+    /// `crossings` are those of [`Pair::crossings`] for the shapes of `scene`.
     fn draw_shape(
         &self,
         shape: &Shape,
         scene: [DVec3; 3],
         sampling: Sampling,
+        crossings: &mut EdgeCrossings,
         out: &mut Drawn,
         scratch: &mut Scratch,
     ) {
         out.counts.shapes += 1;
         scratch.outline.clear();
         let mode = (sampling, self.curves.scene_clipping);
-        trace_outline(self.triangle, shape, scene, mode, &mut scratch.outline);
+        let outline = &mut scratch.outline;
+        trace_outline(self.triangle, shape, scene, mode, crossings, outline);
         clip_outline(&mut scratch.outline, &mut scratch.clipped);
         if scratch.outline.len() < 2 {
             out.counts.clipped_away += 1;
