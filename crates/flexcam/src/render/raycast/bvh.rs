@@ -339,6 +339,49 @@ const STACK_SIZE: usize = SAH_DEPTH + 33;
 /// tree does not depend on the number of threads.
 const PARALLEL_BUILD: usize = 4096;
 
+/// The pending far children of a front-to-back walk, each with the entry distance (one ray's
+/// `f32`, or four lanes' `Vec4`) it was pushed with, so that a pop can skip nodes that
+/// closer hits found since have put out of reach. One stack shared by every ordered walk of
+/// [`Bvh`]; it holds at most one node per level of the tree, fewer than `STACK_SIZE`.
+struct Pending<E: Copy> {
+    /// Left uninitialised: filling 65 entries per ray would cost as much as a few node
+    /// tests. Entries below `depth` are always initialised (each push writes one).
+    stack: [MaybeUninit<(Child, E)>; STACK_SIZE],
+    depth: usize,
+}
+
+impl<E: Copy> Pending<E> {
+    #[inline(always)]
+    fn new() -> Pending<E> {
+        Pending {
+            stack: [const { MaybeUninit::uninit() }; STACK_SIZE],
+            depth: 0,
+        }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, child: Child, entry: E) {
+        self.stack[self.depth].write((child, entry));
+        self.depth += 1;
+    }
+
+    /// Pops nodes, most recently pushed first, until one whose entry `open` accepts; `None`
+    /// once the stack is empty.
+    #[inline(always)]
+    fn pop(&mut self, mut open: impl FnMut(E) -> bool) -> Option<(Child, E)> {
+        while self.depth > 0 {
+            self.depth -= 1;
+            // SAFETY: `stack[depth]` was written by the push that made `depth` this large
+            // (pushes write `stack[depth]` and then increment it; pops decrement it).
+            let (child, entry) = unsafe { self.stack[self.depth].assume_init() };
+            if open(entry) {
+                return Some((child, entry));
+            }
+        }
+        None
+    }
+}
+
 /// A BVH over a set of triangles, each known by its index in the build input.
 #[derive(Debug, Clone)]
 pub(super) struct Bvh {
@@ -452,10 +495,7 @@ impl Bvh {
         // index wins, so the result does not depend on the order leaves are visited in, and
         // packet traversal ([`Bvh::closest4`]) finds exactly the same hits.
         let mut best_index = usize::MAX;
-        // Left uninitialised: filling 65 entries per ray would cost as much as a few node
-        // tests. Entries below `depth` are always initialised (each push writes one).
-        let mut stack = [const { MaybeUninit::<(Child, f32)>::uninit() }; STACK_SIZE];
-        let mut depth = 0;
+        let mut pending = Pending::<f32>::new();
         let mut current = self.root;
         loop {
             if current.count > 0 {
@@ -484,26 +524,16 @@ impl Bvh {
                 };
                 if t_near != f32::INFINITY {
                     if t_far != f32::INFINITY {
-                        stack[depth].write((far, t_far));
-                        depth += 1;
+                        pending.push(far, t_far);
                     }
                     current = near;
                     continue;
                 }
             }
-            // Pop the nearest pending node still in front of the closest hit.
-            loop {
-                if depth == 0 {
-                    return self.finish(best);
-                }
-                depth -= 1;
-                // SAFETY: `stack[depth]` was written by the push that made `depth` this large
-                // (pushes write `stack[depth]` and then increment it; pops decrement it).
-                let (child, t_entry) = unsafe { stack[depth].assume_init() };
-                if t_entry <= t_max {
-                    current = child;
-                    break;
-                }
+            // The nearest pending node still in front of the closest hit.
+            match pending.pop(|t_entry| t_entry <= t_max) {
+                Some((child, _)) => current = child,
+                None => return self.finish(best),
             }
         }
     }
@@ -543,9 +573,7 @@ impl Bvh {
         let mut t_max = packet.t_max;
         let mut best: [Option<(usize, FastHit)>; 4] = [None; 4];
         let mut best_index = [usize::MAX; 4];
-        // As in `traverse`: entries below `depth` are initialised.
-        let mut stack = [const { MaybeUninit::<(Child, Vec4)>::uninit() }; STACK_SIZE];
-        let mut depth = 0;
+        let mut pending = Pending::<Vec4>::new();
         let (mut current, mut entry) = (self.root, root_entry);
         loop {
             if current.count > 0 {
@@ -588,32 +616,16 @@ impl Bvh {
                         (c0, c1, t0, t1, true)
                     };
                     if both {
-                        stack[depth].write((far, e_far));
-                        depth += 1;
+                        pending.push(far, e_far);
                     }
                     (current, entry) = (near, e_near);
                     continue;
                 }
             }
-            // Pop the next pending node some ray still enters in front of its closest hit.
-            loop {
-                if depth == 0 {
-                    let [a, b, c, d] = best;
-                    return [
-                        self.finish(a),
-                        self.finish(b),
-                        self.finish(c),
-                        self.finish(d),
-                    ];
-                }
-                depth -= 1;
-                // SAFETY: `stack[depth]` was written by the push that made `depth` this large
-                // (pushes write `stack[depth]` and then increment it; pops decrement it).
-                let (child, e) = unsafe { stack[depth].assume_init() };
-                if e.cmple(t_max).bitmask() != 0 {
-                    (current, entry) = (child, e);
-                    break;
-                }
+            // The next pending node some ray still enters in front of its closest hit.
+            match pending.pop(|e| e.cmple(t_max).bitmask() != 0) {
+                Some(next) => (current, entry) = next,
+                None => return best.map(|b| self.finish(b)),
             }
         }
     }
@@ -705,9 +717,7 @@ impl Bvh {
             return;
         }
         let mut bounds = Vec4::MAX;
-        // As in `traverse`: entries below `depth` are initialised.
-        let mut stack = [const { MaybeUninit::<(Child, Vec4)>::uninit() }; STACK_SIZE];
-        let mut depth = 0;
+        let mut pending = Pending::<Vec4>::new();
         let mut current = self.root;
         let mut entry = segments.entries(self.root_bounds.min, self.root_bounds.max);
         loop {
@@ -740,26 +750,16 @@ impl Bvh {
                 };
                 if e_near.min_element() != f32::INFINITY {
                     if f_far != f32::INFINITY {
-                        stack[depth].write((far, e_far));
-                        depth += 1;
+                        pending.push(far, e_far);
                     }
                     (current, entry) = (near, e_near);
                     continue;
                 }
             }
-            // Pop the next pending node some lane enters within its bound.
-            loop {
-                if depth == 0 {
-                    return;
-                }
-                depth -= 1;
-                // SAFETY: `stack[depth]` was written by the push that made `depth` this large
-                // (pushes write `stack[depth]` and then increment it; pops decrement it).
-                let (child, e) = unsafe { stack[depth].assume_init() };
-                if e.cmple(bounds).any() {
-                    (current, entry) = (child, e);
-                    break;
-                }
+            // The next pending node some lane enters within its bound.
+            match pending.pop(|e| e.cmple(bounds).any()) {
+                Some(next) => (current, entry) = next,
+                None => return,
             }
         }
     }
