@@ -82,6 +82,8 @@ use glam::DVec3;
 
 use crate::geometry::solve_cubic;
 
+mod fold;
+
 /// Rejection threshold for `d11 / s(t)^2` and `d22 / s(t)^2` (module doc).
 const COLLAPSE_TOL: f64 = 1e-10;
 
@@ -318,7 +320,7 @@ impl ProjectionTriangleCache {
     pub fn sweeps_no_volume(&self) -> bool {
         let (e, f) = (self.base_size, self.spread);
         let scales = [e * e, e * f, f * f];
-        let directions = [self.n1, self.n1 + self.f1, self.n1 + self.f2];
+        let directions = self.directions();
         self.cross.iter().zip(scales).all(|(n, scale)| {
             directions.iter().all(|d| {
                 let bound = scale * d.length();
@@ -326,6 +328,11 @@ impl ProjectionTriangleCache {
                 jacobian * jacobian <= SLIVER_TOL * bound * bound
             })
         })
+    }
+
+    /// The ray directions at the three vertices.
+    fn directions(&self) -> [DVec3; 3] {
+        [self.n1, self.n1 + self.f1, self.n1 + self.f2]
     }
 
     /// `(u, v)` of `ps = p1 + w` in the parametric triangle at `t`, or `None` where that

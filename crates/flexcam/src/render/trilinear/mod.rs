@@ -38,7 +38,7 @@ pub mod workloads;
 
 use std::time::Instant;
 
-use glam::{DVec2, Vec3};
+use glam::{DVec2, DVec3, Vec3};
 
 pub use curves::{CurveMode, CurveOptions};
 
@@ -66,6 +66,9 @@ pub struct TrilinearRenderer {
     /// Per scene triangle (numbered as `scene.triangles`), its base colour where flat
     /// shading shows it (see `Shader::flat_colors`).
     flat_colors: Vec<Option<TriangleColor>>,
+    /// A sphere (centre, radius) around every scene vertex, `None` for a scene without
+    /// vertices: how deep a projection triangle's rays can meet the scene.
+    bounding_sphere: Option<(DVec3, f64)>,
 }
 
 impl TrilinearRenderer {
@@ -83,7 +86,9 @@ impl TrilinearRenderer {
                 })
             })
             .collect();
+        let bounding_sphere = bounding_sphere(&geometry.vertices);
         TrilinearRenderer {
+            bounding_sphere,
             scene: geometry,
             caster,
             background: scene.image.background,
@@ -140,9 +145,14 @@ impl TrilinearRenderer {
             mut fallback,
         } = project_all(&triangles, &self.scene, curves);
         // Projection triangles that sweep a surface, not a volume, project no scene point
-        // but still see the scene: their pixels are ray cast.
+        // but still see the scene, and those whose rays cross (fold) at a depth the scene
+        // reaches see regions that no outline of scene-edge images bounds
+        // (`ProjectionTriangleCache::folds_before`): their pixels are ray cast.
         for (f, cache) in fallback.iter_mut().zip(projection.triangle_caches()) {
-            *f |= cache.sweeps_no_volume();
+            *f |= cache.sweeps_no_volume()
+                || self.bounding_sphere.is_some_and(|(center, radius)| {
+                    cache.folds_before(cache.depth_reaching(center, radius))
+                });
         }
         let project_ms = start.elapsed().as_secs_f64() * 1e3;
 
@@ -329,4 +339,14 @@ impl<'a> Samples<'a> {
         }
         self.counts
     }
+}
+
+/// The centre and half diagonal of the bounding box of the finite `vertices`, `None`
+/// without any.
+fn bounding_sphere(vertices: &[DVec3]) -> Option<(DVec3, f64)> {
+    let mut finite = vertices.iter().filter(|p| p.is_finite());
+    let first = *finite.next()?;
+    let (lo, hi) = finite.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let center = (lo + hi) / 2.0;
+    Some((center, (hi - center).length()))
 }
