@@ -47,7 +47,7 @@
 //! |P_k D|^2 is |D| sin(angle) squared: a projector pointing away meets it as well as one
 //! pointing towards X_k, and shortening D lowers it. Where no grid with the kept starts meets
 //! the data (a near surface off the camera's eye), the linear optimum shrank the nodes the
-//! residual gathers on to about 1e-3 of the others and past zero, and consistent data were
+//! residual gathers on to 1e-9 to 2e-7 of the longest and past zero, and consistent data were
 //! refused as contradictory. When the floor-weighted linear fit misses the data by more than
 //! `EXACT_CHORD`, the fit keeps the noise-weighted linear solution only where it reaches every
 //! point in front of its start; otherwise (no noise weight, or some point behind) it refines
