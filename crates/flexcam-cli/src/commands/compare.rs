@@ -9,7 +9,7 @@ use std::time::Instant;
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding};
 use flexcam::render::compare::{compare, Comparison};
-use flexcam::render::{Frame, Method, RenderOptions};
+use flexcam::render::{composite, Frame, Method, RenderOptions};
 use flexcam::{Error, Result};
 use glam::Vec3;
 use serde_json::json;
@@ -71,13 +71,21 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         curves: args.tuning.curves(method)?,
         ..reference_options
     };
-    let timed_render = |m: Method, options: &RenderOptions| -> Result<(Frame, f64)> {
+    // The method under test renders as `flexcam render` does (trilinear reflectors
+    // composited through their surfaces); the reference renders the scene as it is (a
+    // reflector is then the ray caster's exact mirror or glass).
+    let timed_render = |m: Method, options: &RenderOptions, composited: bool| {
         let start = Instant::now();
-        let (frame, _) = m.render(&loaded.scene, loaded.projection.as_ref(), options)?;
-        Ok((frame, start.elapsed().as_secs_f64() * 1e3))
+        let projection = loaded.projection.as_ref();
+        let (frame, _) = if composited {
+            composite::render_with_method(&loaded.scene, projection, options, m)?
+        } else {
+            m.render(&loaded.scene, projection, options)?
+        };
+        Ok::<_, Error>((frame, start.elapsed().as_secs_f64() * 1e3))
     };
-    let (frame, method_ms) = timed_render(method, &options)?;
-    let (reference_frame, reference_ms) = timed_render(reference, &reference_options)?;
+    let (frame, method_ms) = timed_render(method, &options, true)?;
+    let (reference_frame, reference_ms) = timed_render(reference, &reference_options, false)?;
     let result = compare(&frame, &reference_frame)?;
 
     if let Some(path) = &args.diff {

@@ -65,12 +65,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let render_start = Instant::now();
     // Trilinear reflectors (if the scene has any) are composited into the main view, each
     // rendered by the same method.
-    let rendered = composite::render(
-        &loaded.scene,
-        loaded.projection.as_ref(),
-        &options,
-        &|s, p, o| method.render(s, p, o),
-    );
+    let rendered =
+        composite::render_with_method(&loaded.scene, loaded.projection.as_ref(), &options, method);
     let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
     progress.finish();
     let (frame, mut counters) = rendered?;

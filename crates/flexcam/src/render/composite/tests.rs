@@ -430,3 +430,71 @@ fn uncovered_reflector_pixels_are_ray_cast_exactly() {
     };
     assert!(*cast < 50, "{cast} pixels cast from the front");
 }
+
+/// The main camera as two projection triangles is the same pinhole: at pixel centres (the
+/// corner pixels, one inside) its ray starts at the eye and runs along the camera's ray (unit
+/// directions agree to 1e-12), at odd image sizes too.
+#[test]
+fn perspective_as_trilinear_is_the_same_pinhole() {
+    let scene = scene();
+    for (width, height) in [(160, 120), (7, 5), (1, 1), (1000, 300)] {
+        let main = scene.projection.build(width, height).unwrap();
+        let camera = main_camera(&scene, main.as_ref()).unwrap();
+        let pinhole = perspective_as_trilinear(&camera).unwrap();
+        let (w, h) = (f64::from(width), f64::from(height));
+        for (x, y) in [
+            (0.5, 0.5),
+            (w - 0.5, h - 0.5),
+            (w * 0.37, h * 0.81),
+            (w - 0.5, 0.5),
+        ] {
+            let pixel = DVec2::new(x, y);
+            let (a, b) = (camera.ray(pixel).unwrap(), pinhole.ray(pixel).unwrap());
+            // The pinhole's ray starts on the plane 1e-6 (1 + |eye|) in front of the eye,
+            // on the camera's ray.
+            let offset = b.origin - a.origin;
+            assert!(
+                offset.length() > 0.0 && offset.length() < 1e-5,
+                "{width}x{height} {pixel}"
+            );
+            let along = offset.normalize().dot(a.direction.normalize());
+            assert!(
+                (along - 1.0).abs() < 1e-6,
+                "{width}x{height} {pixel}: {along}"
+            );
+            let (da, db) = (a.direction.normalize(), b.direction.normalize());
+            assert!(
+                (da - db).length() < 1e-12,
+                "{width}x{height} {pixel}: {da} {db}"
+            );
+        }
+    }
+}
+
+/// `--method trilinear` renders a scene with reflectors (before: refused, the main view
+/// being perspective): the main view through the pinhole's two projection triangles, the
+/// reflection through the reflector's surface, both by the trilinear rasteriser. It agrees
+/// with the ray-cast composite (same ids everywhere, colours but for rounding along edges)
+/// and, on the mirror, with the true mirror as the ray-cast composite does.
+#[test]
+fn trilinear_method_composites_reflectors() {
+    let scene = scene();
+    let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
+    let (trilinear, stats) =
+        render_with_method(&scene, main.as_ref(), &flat(), Method::Trilinear).unwrap();
+    let (raycast, _) = render(&scene, main.as_ref(), &flat(), &raycast).unwrap();
+    let c = compare(&trilinear, &raycast).unwrap();
+    assert!(c.id_agreement >= 0.9999, "{c:?}");
+    assert!(c.relative_rgb_error < 0.002, "{c:?}");
+    assert!(matches!(stats.get("reflector_pixels"), Some(Counter::Count(n)) if *n > 1000));
+    let reference = reference(&scene, main.as_ref());
+    let (c, same) = agreement(&trilinear, &reference, BALL);
+    assert!(
+        same >= MIN_SAME_COLOUR && c.relative_rgb_error <= MAX_RGB_ERROR,
+        "{c:?} {same}"
+    );
+    // Without reflectors the method is unchanged: a perspective scene is still refused.
+    let mut plain = scene.clone();
+    plain.trilinear_reflectors.clear();
+    assert!(render_with_method(&plain, main.as_ref(), &flat(), Method::Trilinear).is_err());
+}
