@@ -33,6 +33,7 @@ pub mod screen_map;
 pub mod shade;
 #[cfg(test)]
 mod tests;
+pub mod view_plane;
 pub mod volume_bounds;
 pub mod workloads;
 

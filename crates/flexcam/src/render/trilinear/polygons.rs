@@ -17,7 +17,10 @@ use super::outline::{
 use super::pair_cull::{live_pairs, LivePair, LivePairs, VertexCache};
 use super::scene_geometry::SceneGeometry;
 use super::screen_map::ScreenMap;
-use crate::projection::{project_solved_triangle, Projection, Shape, Solutions, Trilinear};
+use super::view_plane::clipping_base;
+use crate::projection::{
+    project_solved_triangle, Projection, ProjectionTriangleCache, Shape, Solutions, Trilinear,
+};
 use crate::render::raster::{PolygonBatch, Vertex};
 use crate::render::{Counter, Stats};
 
@@ -104,7 +107,8 @@ pub struct ProjectedScene {
 }
 
 /// The projection triangles of `projection`, each with its screen placement and the
-/// bounding planes of its ray volume.
+/// bounding planes of its ray volume; a collapsed base is moved along its rays first
+/// ([`clipping_base`]).
 pub fn projection_triangles(projection: &Trilinear) -> Vec<ProjectionTriangle> {
     let mesh = projection.mesh();
     let (width, height) = projection.resolution();
@@ -116,8 +120,16 @@ pub fn projection_triangles(projection: &Trilinear) -> Vec<ProjectionTriangle> {
             let [i, j, k] = t.map(|x| x as usize);
             let pick = |values: &[DVec3]| [values[i], values[j], values[k]];
             let screen = [mesh.screen[i], mesh.screen[j], mesh.screen[k]];
-            let map = ScreenMap::new(screen, size, *cache);
-            ProjectionTriangle::new(pick(&mesh.points), pick(&mesh.normals), map)
+            let normals = pick(&mesh.normals);
+            let base = clipping_base(pick(&mesh.points), normals);
+            // The projection's own cache unless the base collapsed (`view_plane`).
+            let cache = if base == pick(&mesh.points) {
+                *cache
+            } else {
+                ProjectionTriangleCache::new(base, normals)
+            };
+            let map = ScreenMap::new(screen, size, cache);
+            ProjectionTriangle::new(base, normals, map)
         })
         .collect()
 }
