@@ -146,13 +146,15 @@ impl TrilinearRenderer {
             mut fallback,
         } = project_all(&triangles, &self.scene, curves);
         // Projection triangles that sweep a surface, not a volume, project no scene point
-        // but still see the scene, and those whose rays cross (fold) at a depth the scene
-        // reaches see regions that no outline of scene-edge images bounds
-        // (`ProjectionTriangleCache::folds_before`): their pixels are ray cast.
+        // but still see the scene, and those whose rays cross (fold) or all meet in one
+        // point (collapse) at a depth the scene reaches see regions that no outline of
+        // scene-edge images bounds (`ProjectionTriangleCache::folds_before`,
+        // `collapses_before`): their pixels are ray cast.
         for (f, cache) in fallback.iter_mut().zip(projection.triangle_caches()) {
             *f |= cache.sweeps_no_volume()
                 || self.bounding_sphere.is_some_and(|(center, radius)| {
-                    cache.folds_before(cache.depth_reaching(center, radius))
+                    let reach = cache.depth_reaching(center, radius);
+                    cache.folds_before(reach) || cache.collapses_before(reach)
                 });
         }
         let project_ms = start.elapsed().as_secs_f64() * 1e3;

@@ -15,10 +15,12 @@
 //! same depth `t0` (a pinhole at `t0 < 0`, or the inward-looking sphere's centre at
 //! `t0 > 0`, where `r_i(t) = c + (t - t0) n_i`) give `E1(t) x E2(t) = (t - t0)^2 f1 x f2`:
 //! the Jacobian has a double root, keeps its sign, and the cones before and beyond the
-//! focus are disjoint (the image beyond it is turned by 180 degrees, not mirrored), so
-//! shapes stay exact. When the vertex rays meet the point at different depths (directions
-//! of different lengths), the interpolated rays miss it and cross each other near it: a
-//! real fold.
+//! focus are disjoint (the image beyond it is turned by 180 degrees, not mirrored): no fold.
+//! But the triangle collapses there, and a scene triangle reaching across the plane of the
+//! point has an unbounded image ([`ProjectionTriangleCache::collapses_before`]), which is
+//! another reason to treat the triangle another way when `t0 > 0`. When the vertex rays
+//! meet the point at different depths (directions of different lengths), the interpolated
+//! rays miss it and cross each other near it: a real fold.
 
 use glam::DVec3;
 
@@ -81,6 +83,49 @@ impl ProjectionTriangleCache {
             }
         }
         positive && negative
+    }
+
+    /// Whether the rays all meet in one point at some depth in `(0, t_max]`: there the
+    /// parametric triangle collapses to that point (`N(t) = 0`), and the Jacobian, though it
+    /// keeps its sign (a double root, see the module doc), vanishes on the whole triangle.
+    ///
+    /// The collapse makes the map from scene to screen a central projection from the point:
+    /// the depth surfaces are parallel planes, and the one through the point is imaged at
+    /// infinity, as a pinhole camera images the plane through its eye. A scene triangle that
+    /// reaches across that plane has an unbounded image, two pieces that go off to
+    /// infinity in opposite directions, which no outline of scene-edge images can enclose
+    /// (measured in audit 4 of docs/robustness.md: a floor seen through rays that converge
+    /// in front of it had none of its 1,930 pixels drawn). A renderer has to treat such
+    /// triangles another way (the trilinear renderer ray casts their pixels, as for folds).
+    /// A pinhole (the point behind the base, `t < 0`) does not collapse in this sense: the
+    /// view plane `t = 0` clips its eye plane away.
+    ///
+    /// Each vertex direction's quadratic `N(t) . n_i` must reach zero, within the tolerance
+    /// of [`ProjectionTriangleCache::folds_before`], at its vertex (its extremum), which
+    /// lies in `(0, t_max]`. Degenerate cases (each has a test):
+    ///
+    /// * the point beyond the scene (`t_max` before it) or behind the base: no collapse;
+    /// * directions of different lengths (the vertex rays meet the point at different
+    ///   depths): no collapse, since `N` does not vanish; that is a fold
+    ///   ([`ProjectionTriangleCache::folds_before`]);
+    /// * parallel rays and rays meeting only in a line (a cylinder's axis): no collapse
+    ///   (the line case has a simple root of the Jacobian: a fold);
+    /// * a triangle that sweeps no volume: the quadratics vanish identically, no vertex,
+    ///   no collapse (the renderer ray casts it for that reason already).
+    pub fn collapses_before(&self, t_max: f64) -> bool {
+        let (e, f) = (self.base_size, self.spread);
+        let tol = SLIVER_TOL.sqrt();
+        self.directions().iter().all(|d| {
+            let [c0, c1, c2] = self.cross.map(|n| n.dot(*d));
+            if c2 == 0.0 {
+                return false;
+            }
+            let vertex = -c1 / (2.0 * c2);
+            let value = c0 + vertex * (c1 + vertex * c2);
+            vertex > 0.0
+                && vertex <= t_max
+                && value.abs() <= tol * (e + vertex * f).powi(2) * d.length()
+        })
     }
 
     /// The largest depth `t >= 0` at which a ray of the triangle can be inside the sphere
@@ -175,6 +220,50 @@ mod tests {
         // Parallel rays: a constant Jacobian.
         let parallel = ProjectionTriangleCache::new(p, [V(0.1, 0.0, 1.0); 3]);
         assert!(!parallel.folds_before(f64::INFINITY));
+    }
+
+    /// Rays through one point at depth 1 (equal depths): a collapse once the scene reaches
+    /// that depth, at any scale; with unequal lengths, a pinhole behind the base, parallel
+    /// rays, rays through a line, or a triangle sweeping no volume: none.
+    #[test]
+    fn rays_meeting_in_front_collapse_there() {
+        let p = unit_base();
+        for (s, shift) in [
+            (1.0, DVec3::ZERO),
+            (1e-3, V(1e4, 0.0, -1e4)),
+            (1e3, DVec3::ZERO),
+        ] {
+            let base = p.map(|x| x * s + shift);
+            let centre = V(0.3, 0.2, 4.0) * s + shift;
+            let cache = ProjectionTriangleCache::new(base, base.map(|x| centre - x));
+            assert!(cache.collapses_before(1.01), "{s}");
+            assert!(cache.collapses_before(f64::INFINITY), "{s}");
+            assert!(
+                !cache.collapses_before(0.99),
+                "{s}: the scene ends before the point"
+            );
+        }
+        let centre = V(0.3, 0.2, 4.0);
+        let lengths = [1.0, 2.0, 0.5];
+        let unequal =
+            ProjectionTriangleCache::new(p, [0, 1, 2].map(|i| (centre - p[i]) * lengths[i]));
+        assert!(!unequal.collapses_before(f64::INFINITY));
+        assert!(unequal.folds_before(f64::INFINITY), "a fold instead");
+        let eye = V(0.2, -0.1, -3.0);
+        let pinhole = ProjectionTriangleCache::new(p, p.map(|x| x - eye));
+        assert!(!pinhole.collapses_before(f64::INFINITY));
+        let parallel = ProjectionTriangleCache::new(p, [V(0.1, 0.0, 1.0); 3]);
+        assert!(!parallel.collapses_before(f64::INFINITY));
+        // Rays from three points of a cylinder to its axis (the z axis), meeting it at depth
+        // 1: the parametric triangle becomes a segment of the axis, not a point.
+        let ring = [V(1.0, 0.0, 0.0), V(0.0, 1.0, 0.5), V(-1.0, 0.0, 1.0)];
+        let to_axis = ring.map(|x| V(-x.x, -x.y, 0.0));
+        let cylinder = ProjectionTriangleCache::new(ring, to_axis);
+        assert!(!cylinder.collapses_before(f64::INFINITY));
+        assert!(cylinder.folds_before(f64::INFINITY), "a fold instead");
+        let flat = [V(0.0, 0.0, 0.0), V(1.0, 0.0, 0.0), V(2.0, 0.0, 0.0)];
+        let sheet = ProjectionTriangleCache::new(flat, [V(0.0, 1.0, 0.0); 3]);
+        assert!(!sheet.collapses_before(f64::INFINITY));
     }
 
     #[test]
