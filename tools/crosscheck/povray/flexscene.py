@@ -3,7 +3,7 @@ scene objects as world-space triangle lists, each tagged with its object id (fil
 
 Independent of flexcam's code on purpose: this is the second opinion. Only what the crosscheck
 needs is read: `[image]`, a `trilinear` projection given as `surface = "x.obj"` or as inline
-`points`/`normals`/`screen`/`triangles`, and objects of shape `plane`, `box` and `mesh` (OBJ or
+`points`/`normals`/`screen`/`triangles` (any other projection is kept as its TOML table), and objects of shape `plane`, `box` and `mesh` (OBJ or
 ASCII PLY). Other shapes (sphere, cylinder, torus, teapot: tessellated by flexcam in its own way)
 and other model formats are skipped with a message, since a different tessellation would show up
 as disagreement at silhouettes; their pixels are reported, not compared blindly.
@@ -38,7 +38,7 @@ class Trilinear:
 class Scene:
     width: int
     height: int
-    projection: Trilinear
+    projection: Trilinear | dict  # a dict: a standard projection's TOML table (povcameras.py)
     objects: list[tuple[int, str, np.ndarray]] = field(default_factory=list)  # (id, name, (k,3,3))
     skipped: list[str] = field(default_factory=list)
 
@@ -51,9 +51,7 @@ def load(path: Path) -> Scene:
     image = raw.get("image", {})
     width, height = int(image.get("width", 800)), int(image.get("height", 600))
     proj = raw.get("projection", {})
-    if proj.get("type") != "trilinear":
-        raise SceneError(f"{path}: projection type is {proj.get('type')!r}, not 'trilinear'")
-    scene = Scene(width, height, _projection(path, proj))
+    scene = Scene(width, height, _projection(path, proj) if proj.get("type") == "trilinear" else proj)
     for index, obj in enumerate(raw.get("object", []), start=1):
         name = obj.get("name", f"object {index}")
         tris = _object_triangles(path, obj)

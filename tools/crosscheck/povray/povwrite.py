@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
+import povcameras
 from flexscene import Scene, Trilinear
 
 ID_STEP = 16  # 16-bit levels between consecutive ids: ids up to 4095 survive any rounding
@@ -75,13 +76,31 @@ def pov_uv(screen: np.ndarray, width: int, height: int) -> np.ndarray:
 
 
 def scene_source(scene: Scene, subdiv: int, base_shift: float) -> tuple[str, dict]:
-    p, n, s, n_sub, n_shift = camera_mesh(scene.projection, subdiv, base_shift)
-    uv = pov_uv(s, scene.width, scene.height)
-    m = len(p)
+    """The POV-Ray scene and facts about its camera. A trilinear projection becomes a mesh
+    camera (rendered one pixel larger each way, see the module doc); any other projection the
+    equivalent POV-Ray camera of povcameras.py (ValueError if there is none)."""
     lines = [
         "#version 3.7;",
         "global_settings { assumed_gamma 1.0 ambient_light 0 max_trace_level 1 }",
         "background { rgb 0 }",
+    ]
+    if isinstance(scene.projection, dict):
+        cam = povcameras.camera(scene.projection, scene.width, scene.height)
+        if cam is None:
+            raise ValueError(f"no POV-Ray camera for projection type {scene.projection.get('type')!r}")
+        lines.append(cam)
+        info = {"camera": scene.projection.get("type"), "padded": False}
+    else:
+        info = _mesh_camera(lines, scene, subdiv, base_shift)
+    _objects(lines, scene)
+    return "\n".join(lines) + "\n", info
+
+
+def _mesh_camera(lines: list[str], scene: Scene, subdiv: int, base_shift: float) -> dict:
+    p, n, s, n_sub, n_shift = camera_mesh(scene.projection, subdiv, base_shift)
+    uv = pov_uv(s, scene.width, scene.height)
+    m = len(p)
+    lines += [
         "#declare CamMesh = mesh2 {",
         _vectors("vertex_vectors", p.reshape(-1, 3)),
         _vectors("normal_vectors", n.reshape(-1, 3)),
@@ -92,6 +111,10 @@ def scene_source(scene: Scene, subdiv: int, base_shift: float) -> tuple[str, dic
         "}",
         "camera { mesh_camera { 1 3 mesh { CamMesh } smooth } location <0, 0, 0> direction <0, 0, 1> }",
     ]
+    return {"camera": "mesh", "padded": True, "camera_triangles": m, "subdivided": n_sub, "shifted": n_shift}
+
+
+def _objects(lines: list[str], scene: Scene) -> None:
     for oid, name, tris in scene.objects:
         lines += [
             f"// object {oid}: {name}",
@@ -102,8 +125,6 @@ def scene_source(scene: Scene, subdiv: int, base_shift: float) -> tuple[str, dic
             "  finish { ambient 0 diffuse 0 specular 0 phong 0 emission 1 }",
             "}",
         ]
-    info = {"camera_triangles": m, "subdivided": n_sub, "shifted": n_shift}
-    return "\n".join(lines) + "\n", info
 
 
 def decode_ids(red16: np.ndarray) -> np.ndarray:
