@@ -11,14 +11,20 @@
 //! adaptive curves) miss or add pieces of it. A renderer has to treat such triangles
 //! another way (the trilinear renderer ray casts their pixels).
 //!
-//! A sign change, not a zero, is what matters. Rays that all meet in one point at the
-//! same depth `t0` (a pinhole at `t0 < 0`, or the inward-looking sphere's centre at
-//! `t0 > 0`, where `r_i(t) = c + (t - t0) n_i`) give `E1(t) x E2(t) = (t - t0)^2 f1 x f2`:
-//! the Jacobian has a double root, keeps its sign, and the cones before and beyond the
-//! focus are disjoint (the image beyond it is turned by 180 degrees, not mirrored), so
-//! shapes stay exact. When the vertex rays meet the point at different depths (directions
-//! of different lengths), the interpolated rays miss it and cross each other near it: a
-//! real fold.
+//! A sign change is what makes a fold. Rays that all meet in one point at the same depth
+//! `t0` (a pinhole at `t0 < 0`, or the inward-looking sphere's centre at `t0 > 0`, where
+//! `r_i(t) = c + (t - t0) n_i`) give `E1(t) x E2(t) = (t - t0)^2 f1 x f2`: the Jacobian has
+//! a double root and keeps its sign; the cones before and beyond the focus are disjoint
+//! (the image beyond it is turned by 180 degrees, not mirrored). Behind the base
+//! (`t0 <= 0`, a pinhole) that is harmless. In front of it (`0 < t0`) it is not: the scene
+//! points of the focus plane (through `c`, parallel to the parametric triangles) other than
+//! `c` lie on no ray, so a scene triangle that crosses that plane has an unbounded image,
+//! and its outline, traced along the images of its edges, passes through infinity. Audit 4
+//! (docs/robustness.md) found `--method trilinear` drawing nothing of a floor seen through
+//! two such triangles (1930 px missing); so a focus in front of the base, within the depth
+//! range asked about, is reported as a fold too (its pixels are ray cast). When the vertex
+//! rays meet the point at different depths (directions of different lengths), the
+//! interpolated rays miss it and cross each other near it: a real fold.
 
 use glam::DVec3;
 
@@ -35,9 +41,15 @@ impl ProjectionTriangleCache {
     /// its size (`e`, `f`: the largest base edge and direction difference) and counts as a
     /// sign only beyond `sqrt(SLIVER_TOL)` (1e-5) of it: scale-free, and blind to rounding.
     ///
+    /// A focus in front of the base (module doc) counts as a fold when its depth `t0`, where
+    /// the parametric triangle collapses to a point, lies in `(0, t_max)`: `N(t)` is then
+    /// `(t - t0)^2 N2`, so `t0 = -N1.N2 / (2 N2.N2)` and `|N(t0)|` is zero, judged against
+    /// the bound `(e + t0 f)^2` as above.
+    ///
     /// Degenerate cases (each has a test):
     ///
-    /// * rays meeting in one point at one depth (module doc): a double root, no fold;
+    /// * rays meeting in one point at one depth (module doc): a double root; a fold only
+    ///   when that depth is in front of the base and before `t_max`;
     /// * the same rays with directions of different lengths: a real fold near the point;
     /// * parallel rays (`f = 0`): a constant Jacobian, no fold;
     /// * rays crossing the base triangle itself (both signs at `t = 0`): a fold;
@@ -80,7 +92,22 @@ impl ProjectionTriangleCache {
                 }
             }
         }
-        positive && negative
+        (positive && negative) || self.focus_before(t_max)
+    }
+
+    /// Whether all rays meet in one point at a depth `t0` in `(0, t_max)` (the doc of
+    /// [`Self::folds_before`]). `N2 = 0` (parallel direction differences: the triangle
+    /// cannot collapse to a point away from a constant `N`) is never a focus.
+    fn focus_before(&self, t_max: f64) -> bool {
+        let [n0, n1, n2] = self.cross;
+        let n2_squared = n2.length_squared();
+        if n2_squared == 0.0 {
+            return false;
+        }
+        let t0 = -n1.dot(n2) / (2.0 * n2_squared);
+        let (e, f) = (self.base_size, self.spread);
+        let residual = (n0 + t0 * (n1 + t0 * n2)).length();
+        t0 > 0.0 && t0 < t_max && residual <= SLIVER_TOL.sqrt() * (e + t0 * f).powi(2)
     }
 
     /// The largest depth `t >= 0` at which a ray of the triangle can be inside the sphere
@@ -147,8 +174,9 @@ mod tests {
         assert!(ProjectionTriangleCache::new(unit_base(), n).folds_before(1e-3));
     }
 
-    /// Rays through one point at one depth keep the Jacobian's sign (a double root); with
-    /// directions of different lengths the vertex rays still meet the point, at depths 1,
+    /// Rays through one point at one depth keep the Jacobian's sign (a double root), a fold
+    /// only for the focus in front of the base (module doc); with directions of different
+    /// lengths the vertex rays still meet the point, at depths 1,
     /// 0.5 and 2, but the rays between them miss it and cross: along the first vertex ray
     /// the Jacobian is `4 - 10 t + 4 t^2`, negative from t = 0.5 to 2.
     #[test]
@@ -156,9 +184,19 @@ mod tests {
         let centre = V(0.3, 0.2, 4.0);
         let p = unit_base();
         let equal = ProjectionTriangleCache::new(p, p.map(|x| centre - x));
-        for t_max in [0.5, 1.0, 1.5, 1e3, f64::INFINITY] {
+        // The focus at t = 1, in front of the base: a fold once the scene reaches it.
+        for t_max in [0.5, 0.99] {
             assert!(!equal.folds_before(t_max), "{t_max}");
         }
+        for t_max in [1.01, 1.5, 1e3, f64::INFINITY] {
+            assert!(equal.folds_before(t_max), "{t_max}");
+        }
+        // Scale-free: the same triangle scaled and moved far from the origin.
+        let far = ProjectionTriangleCache::new(
+            p.map(|x| x * 1e3 + V(1e5, -1e5, 1e5)),
+            p.map(|x| (centre - x) * 1e3),
+        );
+        assert!(!far.folds_before(0.99) && far.folds_before(1.01));
         let lengths = [1.0, 2.0, 0.5];
         let unequal =
             ProjectionTriangleCache::new(p, [0, 1, 2].map(|i| (centre - p[i]) * lengths[i]));
