@@ -74,6 +74,10 @@ def main() -> int:
     except flexscene.SceneError as e:
         print(f"crosscheck: {e}", file=sys.stderr)
         return 2
+    except (ValueError, KeyError, IndexError, TypeError) as e:
+        # Malformed values inside the scene or a file it names (a bad number, a missing key).
+        print(f"crosscheck: {args.scene} (or a file it names): {type(e).__name__}: {e}", file=sys.stderr)
+        return 2
     for skipped in scene.skipped:
         flexscene.warn(f"{args.scene}: skipped {skipped}: not a plane, box, OBJ or ASCII PLY mesh")
     args.out.mkdir(parents=True, exist_ok=True)
