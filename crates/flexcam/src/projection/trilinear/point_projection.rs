@@ -562,6 +562,41 @@ mod tests {
     }
 
     #[test]
+    fn converging_rays_collapse_in_front_and_image_beyond_the_crossing() {
+        // Rays through one point F (n_i = F - p_i): the perspective case with t negated. The
+        // parametric triangle collapses to F at t = +1, in front of the base (a rejected
+        // double root), and is point-reflected beyond it; every scene point, before or
+        // beyond F, keeps exactly one image, on its own ray. (Audit 4: POV-Ray and the ray
+        // caster agree on such projections; this pins the point projection's part.)
+        let p = [
+            DVec3::new(-1.45764322, 0.477759585, 5.5424479),
+            DVec3::new(1.54085543, 0.51293406, 6.46326127),
+            DVec3::new(-1.51028013, 2.4670385, 5.55334929),
+        ];
+        let f = DVec3::new(0.0, 1.8, 3.8);
+        let cache = ProjectionTriangleCache::new(p, p.map(|q| f - q));
+        for (u, v, t) in [
+            (0.2, 0.3, 0.5),
+            (0.2, 0.3, 3.5),
+            (-0.4, 1.2, 2.0),
+            (0.9, 0.05, 40.0),
+        ] {
+            let ps = cache.ray_point(u, v, t);
+            let s = cache.project_point(ps);
+            assert_eq!((s.len(), s.rejected()), (1, 2), "{s:?}");
+            let hit = s.as_slice()[0];
+            assert!((hit.t - t).abs() < 1e-12 * (1.0 + t.abs()), "{hit:?}");
+            assert!(
+                (hit.u - u).abs() < 1e-11 && (hit.v - v).abs() < 1e-11,
+                "{hit:?}"
+            );
+        }
+        // F itself: a triple root at 1, no image.
+        let s = cache.project_point(f);
+        assert!(s.is_empty() && s.rejected() == 3, "{s:?}");
+    }
+
+    #[test]
     fn collapse_to_a_segment_is_rejected() {
         // r2(t) and r3(t) meet at t = 1: the triangle is a segment there, f(1) = 0 for all ps.
         let p = [DVec3::ZERO, DVec3::X, DVec3::new(0.0, 1.0, 0.0)];
