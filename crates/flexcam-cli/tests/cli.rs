@@ -1389,7 +1389,8 @@ fn trilinear_projection_triangle_folding_inside_the_scene() {
 /// 4 of docs/robustness.md, found against POV-Ray's mesh_camera): the floor reaches across
 /// the plane through F, whose image is at infinity, and `--method trilinear` drew none of
 /// its 1,930 pixels in every curve mode (ids 92.95 %). Both projection triangles collapse at
-/// a depth the floor reaches, so their pixels are now ray cast.
+/// a depth the floor reaches, so their pixels are now ray cast, and nothing is projected into
+/// them.
 #[test]
 fn trilinear_rays_meeting_in_front_of_the_scene() {
     let dir = TempDir::new().unwrap();
@@ -1435,5 +1436,8 @@ fn trilinear_rays_meeting_in_front_of_the_scene() {
             ],
         );
         assert_eq!(stats["fallback_triangles"], 2, "{stats}");
+        // Ray cast triangles project nothing.
+        assert_eq!(stats["pairs"], 0, "{stats}");
+        assert_eq!(stats["shapes"], 0, "{stats}");
     }
 }

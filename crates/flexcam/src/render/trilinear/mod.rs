@@ -139,23 +139,27 @@ impl TrilinearRenderer {
         }
         let start = Instant::now();
         let (width, height) = projection.resolution();
-        let triangles = projection_triangles(projection);
+        let mut triangles = projection_triangles(projection);
+        // Projection triangles that sweep a surface, not a volume, project no scene point
+        // but still see the scene, and those whose rays cross (fold) or all meet in one
+        // point (collapse) at a depth the scene reaches see regions that no outline of
+        // scene-edge images bounds (`ProjectionTriangleCache::folds_before`,
+        // `collapses_before`): their pixels are ray cast, and their pairs are not projected.
+        for triangle in &mut triangles {
+            let cache = triangle.map.cache();
+            triangle.ray_cast = cache.sweeps_no_volume()
+                || self.bounding_sphere.is_some_and(|(center, radius)| {
+                    let reach = cache.depth_reaching(center, radius);
+                    cache.folds_before(reach) || cache.collapses_before(reach)
+                });
+        }
         let ProjectedScene {
             polygons,
             counts,
             mut fallback,
         } = project_all(&triangles, &self.scene, curves);
-        // Projection triangles that sweep a surface, not a volume, project no scene point
-        // but still see the scene, and those whose rays cross (fold) or all meet in one
-        // point (collapse) at a depth the scene reaches see regions that no outline of
-        // scene-edge images bounds (`ProjectionTriangleCache::folds_before`,
-        // `collapses_before`): their pixels are ray cast.
-        for (f, cache) in fallback.iter_mut().zip(projection.triangle_caches()) {
-            *f |= cache.sweeps_no_volume()
-                || self.bounding_sphere.is_some_and(|(center, radius)| {
-                    let reach = cache.depth_reaching(center, radius);
-                    cache.folds_before(reach) || cache.collapses_before(reach)
-                });
+        for (f, triangle) in fallback.iter_mut().zip(&triangles) {
+            *f |= triangle.ray_cast;
         }
         let project_ms = start.elapsed().as_secs_f64() * 1e3;
 

@@ -30,6 +30,10 @@ pub struct ProjectionTriangle {
     pub surfaces: [EdgeSurface; 3],
     /// Bounding planes of the volume its rays sweep at `t >= 0` (the cull).
     pub bounds: VolumeBounds,
+    /// Whether the renderer ray casts its pixels instead of projecting the scene into it
+    /// (set by the renderer, which knows the scene's depth; false from [`Self::new`]): it
+    /// then has no live pairs.
+    pub ray_cast: bool,
 }
 
 impl ProjectionTriangle {
@@ -44,6 +48,7 @@ impl ProjectionTriangle {
                 EdgeSurface::new(vertex(1), vertex(2)),
             ],
             bounds: VolumeBounds::new(p, n),
+            ray_cast: false,
         }
     }
 }

@@ -102,13 +102,21 @@ impl VertexCache {
 
 /// The live pairs of `triangle` (number `index` in the mesh) with every triangle of `scene`,
 /// in scene-triangle order, and the counts of the cull (`pairs`, `culled_volume`,
-/// `culled_tree`, `culled_zero_area`, `vertices_projected`).
+/// `culled_tree`, `culled_zero_area`, `vertices_projected`). None, and no pair counted, for
+/// a triangle the renderer ray casts ([`ProjectionTriangle::ray_cast`]).
 pub fn live_pairs(
     triangle: &ProjectionTriangle,
     index: u32,
     scene: &SceneGeometry,
     cache: &mut VertexCache,
 ) -> (LivePairs, PairCounts) {
+    if triangle.ray_cast {
+        let live = LivePairs {
+            projection: index,
+            ..LivePairs::default()
+        };
+        return (live, PairCounts::default());
+    }
     let bounds = &triangle.bounds;
     let projector = triangle.map.cache();
     cache.next_generation();
