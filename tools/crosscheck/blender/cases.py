@@ -25,6 +25,17 @@ intern/cycles/kernel/camera/projection.h and blender/camera.cpp):
   |theta| > `fisheye_fov` / 2; with R the inscribed circle's radius in mm, k1 = -(fov/2)/R
   is flexcam's fisheye (polar, v = r / R) and k1 = -(fov/2) / (4R), k2 = -3 (fov/2) / (4R^2)
   its `reparam = "lens"` (v = r/4 + 3 r^2/4), on any aspect;
+- fisheye equisolid: u, v scaled to mm on the sensor as above, theta = 2 asin(r / (2 lens)),
+  cut at r > 2 lens sin(fov / 4): with lens = R / (2 sin(fov / 4)) the rim is the inscribed
+  circle and theta = 2 asin((r / R) sin(fov / 4)), flexcam's fisheye with
+  `reparam = "equisolid"`, on any aspect;
+- mirror ball: u, v in [0, 1] over the whole image scaled to [-1, 1] each, the direction the
+  reflection of the view ray off a unit ball, i.e. 2 asin(r) off the view axis: the
+  360-degree equisolid fisheye, flexcam's fisheye with fov 360 and `reparam = "equisolid"`
+  on a square image (measured: the view direction is the image centre, the camera's right
+  at the image's right, up up; on other aspects Cycles' circle is an ellipse);
+- equiangular cubemap face: dir = (1, tan((1/2 - u) pi/2), tan((v - 1/2) pi/2)), angles
+  linear in u and v: no flexcam equivalent (the cubic preset's faces are perspective);
 - central cylindrical: longitude range (radians) and height range (height / radius, i.e.
   tan of the elevation), linear in u and v: flexcam's `cylindrical` with
   h_fov = u_max - u_min, tan(v_fov / 2) = v_max for symmetric ranges.
@@ -113,6 +124,22 @@ def _polynomial(fov, width, height, lens_like):
     return setup
 
 
+def _equisolid(fov, width, height):
+    def setup(cam, frame):
+        _pano(cam, "FISHEYE_EQUISOLID")
+        cam.sensor_fit = "HORIZONTAL"
+        cam.sensor_width = SENSOR_WIDTH
+        cam.fisheye_fov = math.radians(fov)
+        # Cycles' rim is at r = 2 lens sin(fov / 4) mm: put it on the inscribed circle.
+        r = _inscribed_radius_mm(width, height)
+        cam.fisheye_lens = r / (2.0 * math.sin(math.radians(fov) / 4.0))
+    return setup
+
+
+def _mirror_ball(cam, frame):
+    _pano(cam, "MIRRORBALL")
+
+
 def _central_cylindrical(h_fov, v_fov):
     def setup(cam, frame):
         _pano(cam, "CENTRAL_CYLINDRICAL")
@@ -177,6 +204,15 @@ def all_cases():
         ("polynomial_lens", "FISHEYE_LENS_POLYNOMIAL, fov 180, k1 = -(fov/2)/(4R), "
          "k2 = -3(fov/2)/(4R^2)", 'preset "fisheye", fov 180, reparam "lens"', w, h,
          _polynomial(180.0, w, h, True), _preset("fisheye", fov=180.0, reparam="lens")),
+        ("fisheye_equisolid_180", "FISHEYE_EQUISOLID, fov 180, lens = R / (2 sin(fov/4))",
+         'preset "fisheye", fov 180, reparam "equisolid"', w, h, _equisolid(180.0, w, h),
+         _preset("fisheye", fov=180.0, reparam="equisolid")),
+        ("fisheye_equisolid_300", "FISHEYE_EQUISOLID, fov 300, lens = R / (2 sin(fov/4))",
+         'preset "fisheye", fov 300, reparam "equisolid"', w, h, _equisolid(300.0, w, h),
+         _preset("fisheye", fov=300.0, reparam="equisolid")),
+        ("mirror_ball", "MIRRORBALL (square image)",
+         'preset "fisheye", fov 360, reparam "equisolid"', 256, 256, _mirror_ball,
+         _preset("fisheye", fov=360.0, reparam="equisolid")),
         ("central_cylindrical", "CENTRAL_CYLINDRICAL, u [-150, 150], v [-tan 50, tan 50]",
          'preset "cylindrical", h_fov 300, v_fov 100', 480, 240,
          _central_cylindrical(300.0, 100.0), _preset("cylindrical", h_fov=300.0, v_fov=100.0)),
