@@ -25,6 +25,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import blender_side  # noqa: E402
 import cases  # noqa: E402
+import closed_form  # noqa: E402
 import scene  # noqa: E402
 
 REPO = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
@@ -106,6 +107,10 @@ def main():
     ap.add_argument("--controls", action="store_true",
                     help="add negative controls: flexcam parameters slightly off, which "
                     "must disagree (shows the comparison can fail)")
+    ap.add_argument("--explain", action="store_true",
+                    help="judge every mismatched raycast pixel by its closed-form ray in "
+                    "double precision: whose id is right, and is an edge within Cycles' "
+                    "sample spread (0.005 px)")
     args = ap.parse_args()
     seeds = [int(s) for s in args.seeds.split(",")]
     chosen = cases.all_cases() + (cases.controls() if args.controls else [])
@@ -120,6 +125,7 @@ def main():
         folder = os.path.join(args.out, f"seed{seed}")
         objects = scene.random_scene(seed, frame["eye"], frame["forward"], args.objects)
         names = scene.write_objs(objects, os.path.join(folder, "obj"))
+        tris, tri_ids = closed_form.load_triangles(objects)
         for name, btext, ftext, width, height, setup, fkeys in chosen:
             blender_side.reset()
             blender_side.import_objects(os.path.join(folder, "obj"), names)
@@ -138,6 +144,8 @@ def main():
                     row[method] = {"error": err}
                     continue
                 row[method] = compare(ref, ids, os.path.join(folder, f"{name}-{method}-diff.png"))
+                if args.explain and method == "raycast":
+                    row["explained"] = closed_form.explain(name, frame, tris, tri_ids, ref, ids)
             results.append(row)
             print(format_row(row), flush=True)
     print()
@@ -155,7 +163,10 @@ def format_row(row):
     return (f"seed {row['seed']} {row['case']:26s} objects {row['objects_seen']:2d} "
             f"raycast {_cell(row['raycast'])}  raster {_cell(row['raster'])}"
             + (f"  non-id Cycles px {row['bad_cycles_px']}" if row["bad_cycles_px"] else "")
-            + ("" if "error" not in row["raster"] else f"  [{row['raster']['error']}]"))
+            + ("" if "error" not in row["raster"] else f"  [{row['raster']['error']}]")
+            + ("" if not row.get("explained") else
+               "  closed form: {} mismatched, flexcam right {}, Cycles right {}, "
+               "edge within 0.005 px {}".format(*row["explained"])))
 
 
 def summary(results):
