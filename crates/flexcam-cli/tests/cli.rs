@@ -1126,7 +1126,8 @@ fn meets_targets(dir: &TempDir, scene: &str, method: &str) -> serde_json::Value 
 /// An object pierced by the axis behind a fisheye: near that pole a piece's image spans a
 /// wide arc, and the straight polygons of the pieces next to the pole used to paint a ring
 /// inside the image circle (ids 89 % at 220 degrees, 87 % for the 270-degree lens-like
-/// preset, 77 % at 300). The fisheye type and the flexible preset, with a floor and a
+/// preset, 77 % at 300). The fisheye type and the flexible preset (also its equisolid map,
+/// added later), with a floor and a
 /// cylinder behind the eye. (At 360 degrees the pole lies within a pixel of the outermost
 /// pixel centres, where the adaptive rule's bend bound does not hold: 99.3 % here,
 /// docs/robustness.md.)
@@ -1143,6 +1144,10 @@ fn raster_fisheye_with_an_object_on_the_axis_behind() {
         (
             "preset300.toml",
             "type = \"flexible\"\npreset = \"fisheye\"\nfov = 300.0",
+        ),
+        (
+            "equisolid300.toml",
+            "type = \"flexible\"\npreset = \"fisheye\"\nfov = 300.0\nreparam = \"equisolid\"",
         ),
     ] {
         let scene = format!(

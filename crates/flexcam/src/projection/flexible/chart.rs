@@ -131,7 +131,7 @@ fn spheres_chart(
             Some(period(near.longitude, resolution))
         }
         Reparam::Magnifier(_) => return None,
-        Reparam::Polar | Reparam::Lens => {
+        Reparam::Polar | Reparam::Lens | Reparam::Equisolid { .. } => {
             let full = ((near.longitude[1] - near.longitude[0]).abs() - 2.0 * PI).abs() <= FLAT;
             let start = near.latitude[0];
             let at_pole = (start.abs() - FRAC_PI_2).abs() <= FLAT;

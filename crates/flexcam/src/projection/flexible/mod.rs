@@ -7,7 +7,7 @@
 //! - [`blend`]: volumes of two or more surfaces blended in t, piecewise-linear (polyline
 //!   projectors) or Bernstein (Bezier projectors);
 //! - `patch`: bicubic Bezier and uniform cubic B-spline control surfaces;
-//! - [`reparam`]: pixel <-> (u, v) (linear, polar fisheye, lens-like, Mercator);
+//! - [`reparam`]: pixel <-> (u, v) (linear, polar fisheye, lens-like, equisolid, Mercator);
 //! - [`presets`]: named volumes from a camera frame (perspective, pushbroom, crossed slits, ...);
 //! - [`projector_grid`]: a volume interpolated from a grid of placed projectors (5.2), and
 //!   [`fit`]: aiming all of them by least squares from point correspondences;

@@ -26,6 +26,13 @@ pub enum Reparam {
     /// Lens-like fisheye (thesis fig. 4.12): as `Polar` but v = r/4 + 3 r^2 / 4 with r = |p|,
     /// which magnifies the centre.
     Lens,
+    /// Equisolid-angle (equal-area) fisheye, the model of most real fisheye lenses and of a
+    /// photographed mirror ball (`max_angle` = pi): as `Polar`, but the image radius is
+    /// proportional to sin(theta / 2) of the angle theta off the axis, r = sin(theta / 2) /
+    /// sin(max_angle / 2), for volumes whose v is linear in that angle with v = 1 at
+    /// `max_angle` (the fisheye preset, max_angle = fov / 2): v = 2 asin(r sin(max_angle /
+    /// 2)) / max_angle. `max_angle` in radians, in (0, pi].
+    Equisolid { max_angle: f64 },
     /// Mercator map: u = x / W; the image row's Mercator ordinate y_m = py * M(max_latitude),
     /// M(phi) = ln tan(pi/4 + phi/2), gives the latitude phi = atan(sinh(y_m)) and
     /// v = (phi / max_latitude + 1) / 2. So it expects surfaces whose v spans the latitudes
@@ -43,7 +50,14 @@ pub enum Reparam {
 }
 
 /// The names used in scene files, in order.
-pub const REPARAM_NAMES: [&str; 5] = ["linear", "polar", "lens", "mercator", "equal_area"];
+pub const REPARAM_NAMES: [&str; 6] = [
+    "linear",
+    "polar",
+    "lens",
+    "mercator",
+    "equal_area",
+    "equisolid",
+];
 
 /// The default top latitude of the Mercator map, degrees.
 pub const DEFAULT_MERCATOR_LATITUDE: f64 = 85.0;
@@ -55,6 +69,7 @@ impl Reparam {
             Reparam::Linear => "linear",
             Reparam::Polar => "polar",
             Reparam::Lens => "lens",
+            Reparam::Equisolid { .. } => "equisolid",
             Reparam::Mercator { .. } => "mercator",
             Reparam::EqualArea { .. } => "equal_area",
             Reparam::Magnifier(_) => "magnifier",
@@ -62,8 +77,18 @@ impl Reparam {
     }
 
     /// Errors: a Mercator latitude outside (0, 90) degrees (the Mercator ordinate is
-    /// infinite at the pole), an equal-area one outside (0, 90].
+    /// infinite at the pole), an equal-area one outside (0, 90], an equisolid angle outside
+    /// (0, 180] (beyond 180 degrees off the axis sin(theta / 2) falls again: the map folds).
     pub fn validate(&self) -> Result<()> {
+        if let Reparam::Equisolid { max_angle } = *self {
+            if !(max_angle > 0.0 && max_angle <= PI) {
+                return Err(Error::new(format!(
+                    "flexible equisolid fisheye fov must be in (0, 360] degrees, got {}",
+                    2.0 * max_angle.to_degrees()
+                )));
+            }
+            return Ok(());
+        }
         let (latitude, pole_allowed) = match *self {
             Reparam::Mercator { max_latitude } => (max_latitude, false),
             Reparam::EqualArea { max_latitude } => (max_latitude, true),
@@ -93,16 +118,19 @@ impl Reparam {
                 let p = m.sample_position(resolution, pixel);
                 DVec2::new(p.x / size.x, 1.0 - p.y / size.y)
             }
-            Reparam::Polar | Reparam::Lens => {
+            Reparam::Polar | Reparam::Lens | Reparam::Equisolid { .. } => {
                 let p = resolution.centred(pixel) / circle_radius(resolution);
                 let r = p.length();
                 if r > 1.0 {
                     return None;
                 }
-                let v = if *self == Reparam::Lens {
-                    0.25 * r + 0.75 * r * r
-                } else {
-                    r
+                let v = match *self {
+                    Reparam::Lens => 0.25 * r + 0.75 * r * r,
+                    Reparam::Equisolid { max_angle } => {
+                        let s = (r * (0.5 * max_angle).sin()).min(1.0);
+                        2.0 * s.asin() / max_angle
+                    }
+                    _ => r,
                 };
                 DVec2::new((p.y.atan2(p.x) + PI) / (2.0 * PI), v)
             }
@@ -130,7 +158,8 @@ impl Reparam {
     }
 
     /// [`Reparam::to_pixel`] extended beyond [0, 1]^2 by the same formulas. `None` where
-    /// they are undefined: a lens-like v below -1/48 (no real radius), a Mercator latitude
+    /// they are undefined: a lens-like v below -1/48 (no real radius), an equisolid angle
+    /// |v| max_angle beyond 180 degrees (where the map folds back), a Mercator latitude
     /// (2v - 1) max_latitude of 90 degrees or more.
     pub fn to_pixel_unbounded(&self, resolution: &Resolution, uv: DVec2) -> Option<DVec2> {
         let size = resolution.size();
@@ -139,12 +168,18 @@ impl Reparam {
             Reparam::Magnifier(m) => {
                 m.pixel_of(resolution, DVec2::new(uv.x * size.x, (1.0 - uv.y) * size.y))
             }
-            Reparam::Polar | Reparam::Lens => {
-                let r = if *self == Reparam::Lens {
+            Reparam::Polar | Reparam::Lens | Reparam::Equisolid { .. } => {
+                let r = match *self {
                     // v = r/4 + 3 r^2/4  <=>  3 r^2 + r - 4 v = 0, the root in [0, 1].
-                    (-1.0 + (1.0 + 48.0 * uv.y).sqrt()) / 6.0
-                } else {
-                    uv.y
+                    Reparam::Lens => (-1.0 + (1.0 + 48.0 * uv.y).sqrt()) / 6.0,
+                    Reparam::Equisolid { max_angle } => {
+                        let theta = uv.y * max_angle;
+                        if theta.abs() > PI {
+                            return None;
+                        }
+                        (0.5 * theta).sin() / (0.5 * max_angle).sin()
+                    }
+                    _ => uv.y,
                 };
                 let azimuth = 2.0 * PI * uv.x - PI;
                 let p = r * DVec2::new(azimuth.cos(), azimuth.sin());
@@ -174,7 +209,9 @@ impl Reparam {
     pub fn v_range(&self, resolution: &Resolution) -> Option<(f64, f64)> {
         let columns = match self {
             Reparam::Linear | Reparam::Mercator { .. } | Reparam::EqualArea { .. } => 1,
-            Reparam::Polar | Reparam::Lens | Reparam::Magnifier(_) => resolution.width,
+            Reparam::Polar | Reparam::Lens | Reparam::Equisolid { .. } | Reparam::Magnifier(_) => {
+                resolution.width
+            }
         };
         let mut range: Option<(f64, f64)> = None;
         for y in 0..resolution.height {
@@ -252,6 +289,31 @@ mod tests {
     }
 
     #[test]
+    fn equisolid_radius_is_the_sine_of_half_the_angle() {
+        // The mirror ball (max angle 180 degrees): r = sin(theta / 2), so half way out
+        // (r = 1/2) is 60 degrees off the axis and r = sin(45) is 90 degrees.
+        let ball = Reparam::Equisolid { max_angle: PI };
+        assert!(ball.validate().is_ok());
+        for (x, degrees) in [(125.0, 60.0), (100.0 + 50.0 * FRAC_PI_4.sin(), 90.0)] {
+            let v = ball.to_uv(&res(), DVec2::new(x, 50.0)).unwrap().y;
+            assert!((v * 180.0 - degrees).abs() < 1e-9, "{x}: {v}");
+        }
+        // A 150-degree lens (max angle 75): the rim is 75 degrees, the centre 0.
+        let lens = Reparam::Equisolid {
+            max_angle: 75f64.to_radians(),
+        };
+        assert_eq!(lens.to_uv(&res(), DVec2::new(150.0, 50.0)).unwrap().y, 1.0);
+        assert_eq!(lens.to_uv(&res(), DVec2::new(100.0, 50.0)).unwrap().y, 0.0);
+        // Unlike the equidistant map, the centre is magnified: v(1/2) < 1/2.
+        assert!(lens.to_uv(&res(), DVec2::new(125.0, 50.0)).unwrap().y < 0.5);
+        // Beyond 180 degrees the map folds: refused, and no pixel for such angles.
+        for bad in [0.0, -1.0, PI + 1e-9, f64::NAN] {
+            assert!(Reparam::Equisolid { max_angle: bad }.validate().is_err());
+        }
+        assert_eq!(ball.to_pixel_unbounded(&res(), DVec2::new(0.5, 1.01)), None);
+    }
+
+    #[test]
     fn mercator_centre_row_is_the_equator_and_edges_are_max_latitude() {
         let r = Reparam::Mercator {
             max_latitude: 80f64.to_radians(),
@@ -300,6 +362,8 @@ mod tests {
             Reparam::Linear,
             Reparam::Polar,
             Reparam::Lens,
+            Reparam::Equisolid { max_angle: PI },
+            Reparam::Equisolid { max_angle: 0.7 },
             Reparam::Mercator { max_latitude: 1.2 },
             Reparam::EqualArea { max_latitude: 1.2 },
             Reparam::EqualArea {

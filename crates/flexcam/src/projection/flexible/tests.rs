@@ -503,6 +503,9 @@ fn invertible() -> Vec<Flexible> {
         u_edge: DVec3::new(5.0, 1.0, 0.0),
         v_edge: DVec3::new(-1.0, 4.0, 0.0),
     };
+    let mut ball = preset(Preset::Fisheye { fov: 360.0 }, Some([0.0, 20.0]));
+    ball.reparam = Some(Reparam::Equisolid { max_angle: PI });
+    all.push(build(&ball, 16, 12));
     all.push(custom(sphere(5.0), sphere(1.0)));
     all.push(custom(
         cylinder(DVec3::ZERO, 0.5, [-1.0, 1.0]),
@@ -788,6 +791,26 @@ fn lens_fisheye_angle_is_the_thesis_polynomial_of_the_radius() {
     let oracle = |p: DVec3| {
         let lateral = DVec2::new(p.x, p.y);
         lateral.normalize_or_zero() * lateral.length().atan2(p.z) / FRAC_PI_2
+    };
+    check_oracle(&spec, (9, 7), image, oracle, None);
+}
+
+#[test]
+fn equisolid_fisheye_radius_is_the_sine_of_half_the_angle() {
+    // The equisolid-angle lens: image radius proportional to sin(theta / 2), the rim at
+    // theta = fov / 2; here fov 250 (rim 125 degrees off the axis).
+    let half = 125f64.to_radians();
+    let mut spec = preset(Preset::Fisheye { fov: 250.0 }, Some([0.5, 2.0]));
+    spec.reparam = Some(Reparam::Equisolid { max_angle: half });
+    let image = |f: &Flexible, pixel: DVec2| {
+        let (w, h) = f.resolution();
+        let p = f.resolution.centred(pixel) / (0.5 * f64::from(w.min(h)));
+        let theta = 2.0 * (p.length() * (0.5 * half).sin()).asin();
+        p.normalize_or_zero() * theta / half
+    };
+    let oracle = |p: DVec3| {
+        let lateral = DVec2::new(p.x, p.y);
+        lateral.normalize_or_zero() * lateral.length().atan2(p.z) / half
     };
     check_oracle(&spec, (9, 7), image, oracle, None);
 }

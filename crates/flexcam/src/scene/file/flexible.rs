@@ -3,6 +3,7 @@
 //! `segments`), a shape-defined panorama (`outline`/`outlines` and `profile`/`profiles`,
 //! module `panorama`), with an optional re-parameterisation.
 
+use std::f64::consts::PI;
 use std::ops::Range;
 
 use glam::{DVec2, DVec3};
@@ -361,6 +362,7 @@ fn reparam(src: &Source, raw: &RawProjection) -> Result<Option<Reparam>> {
         "linear" => Reparam::Linear,
         "polar" => Reparam::Polar,
         "lens" => Reparam::Lens,
+        "equisolid" => equisolid(src, raw, name)?,
         map @ ("mercator" | "equal_area") => {
             let (default, make): (f64, fn(f64) -> Reparam) = if map == "mercator" {
                 (DEFAULT_MERCATOR_LATITUDE, |max_latitude| {
@@ -390,6 +392,33 @@ fn reparam(src: &Source, raw: &RawProjection) -> Result<Option<Reparam>> {
             ))
         }
     }))
+}
+
+/// `reparam = "equisolid"`: only with the fisheye preset, whose `fov` / 2 is the map's
+/// angle at the rim. A missing `fov` is left to the preset's own error (the map then has a
+/// placeholder that is never used).
+fn equisolid(src: &Source, raw: &RawProjection, name: &Spanned<String>) -> Result<Reparam> {
+    let fisheye = raw
+        .preset
+        .as_ref()
+        .is_some_and(|p| p.get_ref() == "fisheye");
+    if !fisheye {
+        return Err(src.error(
+            &name.span(),
+            "reparam \"equisolid\" belongs to the fisheye preset (its fov / 2 is the \
+             angle at the rim of the image circle)",
+        ));
+    }
+    let Some(fov) = &raw.fov else {
+        return Ok(Reparam::Equisolid { max_angle: PI });
+    };
+    let reparam = Reparam::Equisolid {
+        max_angle: 0.5 * src.number(fov, "fov")?.to_radians(),
+    };
+    reparam
+        .validate()
+        .map_err(|e| src.error(&fov.span(), e.message))?;
+    Ok(reparam)
 }
 
 /// `clip = [near, far]` with 0 <= near < far, when given.

@@ -320,6 +320,39 @@ fn new_flexible_presets_parse_with_their_keys() {
 }
 
 #[test]
+fn equisolid_fisheye_takes_its_angle_from_the_preset() {
+    let head = "[projection]\ntype = \"flexible\"\nposition = [0, 1, 5]\nlook_at = [0, 1, 0]\n";
+    let s = scene(&format!(
+        "{head}preset = \"fisheye\"\nfov = 360\nreparam = \"equisolid\"\n"
+    ));
+    let ProjectionSpec::Flexible(spec) = &s.projection else {
+        panic!("not flexible");
+    };
+    let Some(crate::projection::flexible::Reparam::Equisolid { max_angle }) = spec.reparam else {
+        panic!("not equisolid: {:?}", spec.reparam);
+    };
+    assert!((max_angle - std::f64::consts::PI).abs() < 1e-15);
+    assert_error_at(
+        &format!("{head}preset = \"perspective\"\nfov = 60\nreparam = \"equisolid\"\n"),
+        7,
+        11,
+        "reparam \"equisolid\" belongs to the fisheye preset",
+    );
+    assert_error_at(
+        &format!("{head}preset = \"fisheye\"\nfov = 400\nreparam = \"equisolid\"\n"),
+        6,
+        7,
+        "equisolid fisheye fov must be in (0, 360] degrees, got 400",
+    );
+    assert_error_at(
+        &format!("{head}preset = \"fisheye\"\nreparam = \"equisolid\"\n"),
+        1,
+        1,
+        "needs `fov`",
+    );
+}
+
+#[test]
 fn new_flexible_preset_errors_have_positions() {
     let head = "[projection]\ntype = \"flexible\"\nposition = [0, 1, 5]\nlook_at = [0, 1, 0]\n";
     assert_error_at(
