@@ -73,9 +73,10 @@ impl Frame {
 
     /// A frame of zero bits in every channel (black, depth 0, id 0), for a renderer that
     /// then overwrites every pixel. The buffers come zeroed from the allocator
-    /// (`alloc_zeroed`), so a frame-sized allocation is fresh zero pages that no clearing
-    /// pass writes: their first touch (page faults) is the renderer's own writes, in the
-    /// threads that make them, and the 20 bytes a pixel are written once, not twice.
+    /// (`alloc_zeroed`), so a frame-sized allocation of fresh memory is zero pages that no
+    /// clearing pass writes: their first touch (page faults) is the renderer's own writes,
+    /// in the threads that make them, and the 20 bytes a pixel are written once, not twice
+    /// (memory the allocator reuses is cleared by it, in the calling thread).
     /// Large buffers are mapped with transparent huge pages where the system allows
     /// ([`huge_pages::advise_huge_pages`]): far fewer page faults on that first touch.
     pub(crate) fn zeroed(width: u32, height: u32) -> Self {
