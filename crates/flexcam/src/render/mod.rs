@@ -70,6 +70,29 @@ impl Frame {
             ids: vec![0; n],
         }
     }
+
+    /// A frame of zero bits in every channel (black, depth 0, id 0), for a renderer that
+    /// then overwrites every pixel. The buffers come zeroed from the allocator
+    /// (`alloc_zeroed`), so a frame-sized allocation of fresh memory is zero pages that no
+    /// clearing pass writes: their first touch (page faults) is the renderer's own writes,
+    /// in the threads that make them, and the 20 bytes a pixel are written once, not twice
+    /// (memory the allocator reuses is cleared by it, in the calling thread).
+    /// Large buffers are mapped with transparent huge pages where the system allows
+    /// ([`huge_pages::advise_huge_pages`]): far fewer page faults on that first touch.
+    pub(crate) fn zeroed(width: u32, height: u32) -> Self {
+        let n = width as usize * height as usize;
+        let mut frame = Frame {
+            width,
+            height,
+            color: bytemuck::zeroed_vec(n),
+            depth: bytemuck::zeroed_vec(n),
+            ids: bytemuck::zeroed_vec(n),
+        };
+        huge_pages::advise_huge_pages(&mut frame.color);
+        huge_pages::advise_huge_pages(&mut frame.depth);
+        huge_pages::advise_huge_pages(&mut frame.ids);
+        frame
+    }
 }
 
 /// One counter of a renderer's statistics.
@@ -83,6 +106,7 @@ pub enum Counter {
 pub type Stats = BTreeMap<&'static str, Counter>;
 pub mod compare;
 pub mod composite;
+mod huge_pages;
 pub mod inverse_raster;
 mod method;
 pub mod raster;

@@ -40,7 +40,7 @@ pub use scan::{FillRule, Scratch, Span};
 pub use stats::RasterStats;
 
 use stats::FragmentCounts;
-pub use target::{new_frame, Fragment, Layers, Target, NO_PRIMITIVE};
+pub use target::{Fragment, Layers, Target, NO_PRIMITIVE};
 
 use polygon::Kind;
 use target::Band;

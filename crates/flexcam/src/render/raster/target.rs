@@ -164,19 +164,6 @@ impl Target {
     }
 }
 
-/// [`Frame::new`]'s empty frame (`background`, infinite depth, id 0), written in parallel so
-/// that the first touch of its pages is shared by the cores.
-pub fn new_frame(width: u32, height: u32, background: Vec3) -> Frame {
-    let n = width as usize * height as usize;
-    Frame {
-        width,
-        height,
-        color: filled(n, background),
-        depth: filled(n, f32::INFINITY),
-        ids: filled(n, 0),
-    }
-}
-
 /// Elements per parallel task of [`fill`].
 const FILL_CHUNK: usize = 1 << 15;
 

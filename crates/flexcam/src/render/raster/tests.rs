@@ -804,7 +804,7 @@ fn raster_bands_drawn_by_spans_are_the_rows_of_the_serial_target() {
             .build()
             .expect("thread pool");
         for band_rows in [1, 7, band_rows_for(91), 1000] {
-            let mut frame = new_frame(91, 77, Vec3::ONE);
+            let mut frame = crate::render::Frame::new(91, 77, Vec3::ONE);
             // Per band: a z-buffer of (depth, key) per pixel, written to the frame's rows.
             let band = |scratch: &mut Scratch<2>, bin: &[usize], out: FrameRows<'_>| {
                 let mut zbuffer = vec![(f64::INFINITY, NO_PRIMITIVE, 0, Vec3::ZERO); out.ids.len()];

@@ -50,7 +50,7 @@ use self::screen_map::ScreenMap;
 use self::shade::{Resolver, ShadeCounts, Shader};
 use crate::error::{Error, Result};
 use crate::projection::{Projection, Trilinear};
-use crate::render::raster::{band_rows_for, for_each_band, new_frame, RasterStats, Scratch};
+use crate::render::raster::{band_rows_for, for_each_band, RasterStats, Scratch};
 use crate::render::raycast::{RayCaster, SamplePattern};
 use crate::render::surface::triangle_color::TriangleColor;
 use crate::render::surface::TextureFilter;
@@ -98,7 +98,9 @@ impl TrilinearRenderer {
     }
 
     /// Renders the scene through `projection` with `curves` into a new frame (see
-    /// [`TrilinearRenderer::render_into`]).
+    /// [`TrilinearRenderer::render_into`]). The frame starts as zeroed memory
+    /// ([`Frame::zeroed`]), not cleared to the background: `render_into` writes every pixel,
+    /// so no clearing pass runs and each page is first touched by the shading that fills it.
     pub fn render(
         &self,
         projection: &Trilinear,
@@ -106,7 +108,7 @@ impl TrilinearRenderer {
         curves: CurveOptions,
     ) -> Result<(Frame, Stats)> {
         let (width, height) = projection.resolution();
-        let mut frame = new_frame(width, height, self.background);
+        let mut frame = Frame::zeroed(width, height);
         let stats = self.render_into(&mut frame, projection, options, curves)?;
         Ok((frame, stats))
     }
@@ -169,9 +171,9 @@ impl TrilinearRenderer {
         let fits = (frame.width, frame.height) == (width, height)
             && [frame.color.len(), frame.depth.len(), frame.ids.len()] == [n; 3];
         if !fits {
-            *frame = new_frame(width, height, self.background);
+            *frame = Frame::zeroed(width, height);
         }
-        let mut samples = Samples::new(frame, &pattern, self.background);
+        let mut samples = Samples::new(frame, &pattern);
         let flat_colors = (options.shading == Shading::Flat).then_some(&self.flat_colors[..]);
         let mut raster = RasterStats::default();
         let (mut raster_ms, mut shade_ms) = (0.0, 0.0);
@@ -298,11 +300,10 @@ struct Samples<'a> {
 }
 
 impl<'a> Samples<'a> {
-    fn new(out: &'a mut Frame, pattern: &SamplePattern, background: Vec3) -> Samples<'a> {
+    fn new(out: &'a mut Frame, pattern: &SamplePattern) -> Samples<'a> {
         let scratch = (pattern.offsets.len() > 1).then(|| {
-            let n = out.color.len();
-            let frame = new_frame(out.width, out.height, background);
-            (frame, vec![Vec3::ZERO; n])
+            let frame = Frame::zeroed(out.width, out.height);
+            (frame, bytemuck::zeroed_vec(out.color.len()))
         });
         Samples {
             out,

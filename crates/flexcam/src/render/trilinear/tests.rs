@@ -153,6 +153,42 @@ fn rendering_into_a_kept_frame_matches_a_new_frame() {
     }
 }
 
+/// A new frame starts as zeroed memory (`Frame::zeroed`), not the background: every pixel
+/// must still be written, so wherever nothing is hit the frame holds the background, infinite
+/// depth and id 0 (a pixel left unwritten would read black, depth 0), and every other pixel a
+/// positive finite depth; flat and lit, one sample per pixel and four (whose pixels on an
+/// object's outline average hit and missed samples: their colour is not checked).
+#[test]
+fn a_new_frame_holds_the_background_wherever_nothing_is_hit() {
+    let mut scene = scene::load("builtin:cube-floor").unwrap();
+    let background = Vec3::new(0.25, 0.5, 0.75);
+    scene.image.background = background;
+    let projection = Trilinear::new(&fan_mesh(2), 80, 60).unwrap();
+    let renderer = TrilinearRenderer::new(&scene);
+    for shading in [Shading::Flat, Shading::Lit] {
+        for spp in [1, 4] {
+            let options = RenderOptions {
+                shading,
+                spp,
+                ..RenderOptions::default()
+            };
+            let (frame, _) = renderer
+                .render(&projection, &options, CurveOptions::ADAPTIVE)
+                .unwrap();
+            let empty = frame.ids.iter().filter(|&&id| id == 0).count();
+            assert!(empty > 0 && empty < frame.ids.len(), "{empty} empty pixels");
+            for ((color, depth), id) in frame.color.iter().zip(&frame.depth).zip(&frame.ids) {
+                if *id == 0 {
+                    assert_eq!(*depth, f32::INFINITY);
+                    assert!(spp > 1 || *color == background, "colour {color}");
+                } else {
+                    assert!(depth.is_finite() && *depth > 0.0, "depth {depth}");
+                }
+            }
+        }
+    }
+}
+
 /// One object made of the given triangles, flat colour `color`.
 pub(super) fn object(id: u32, triangles: &[[DVec3; 3]], color: Vec3) -> Object {
     let mut mesh = Mesh::default();
