@@ -5,8 +5,10 @@ use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-use assert_cmd::Command;
 use tempfile::TempDir;
+
+mod common;
+use common::{run, run_json, run_ok};
 
 /// A small valid scene: a red sphere on a checker floor, perspective camera.
 const GOOD_SCENE: &str = r#"
@@ -33,33 +35,6 @@ size = 1.0
 color = [1.0, 0.0, 0.0]
 translate = [0.0, 1.0, 0.0]
 "#;
-
-/// Runs `flexcam ARGS` in `dir`.
-fn run(dir: &TempDir, args: &[&str]) -> Output {
-    Command::cargo_bin("flexcam")
-        .expect("flexcam binary")
-        .current_dir(dir.path())
-        .args(args)
-        .output()
-        .expect("flexcam runs")
-}
-
-/// Runs `flexcam ARGS` in `dir`; fails the test, showing the command's stderr, unless it
-/// exited successfully.
-fn run_ok(dir: &TempDir, args: &[&str]) -> Output {
-    let out = run(dir, args);
-    assert!(
-        out.status.success(),
-        "flexcam {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
-/// [`run_ok`], returning the JSON object its standard output must be.
-fn run_json(dir: &TempDir, args: &[&str]) -> serde_json::Value {
-    serde_json::from_slice(&run_ok(dir, args).stdout).expect("stdout is one JSON object")
-}
 
 /// The single stderr line of a failed run; fails the test unless the run failed with
 /// exactly one line and no panic.
@@ -1355,39 +1330,37 @@ fn trilinear_projection_triangle_folding_inside_the_scene() {
     );
     write(&dir, "fold.toml", &scene);
     for curves in ["adaptive", "slice"] {
-        let report = run_json(
-            &dir,
-            &[
-                "compare",
-                "fold.toml",
-                "--method",
-                "trilinear",
-                "--shading",
-                "flat",
-                "--curves",
-                curves,
-                "--json",
-            ],
-        );
+        let (report, stats) = trilinear_compare_and_stats(&dir, "fold.toml", curves);
         let rgb = report["relative_rgb_error"].as_f64().unwrap();
         assert!(rgb <= 1e-4, "{curves}: {report}");
-        let stats = run_json(
-            &dir,
-            &[
-                "render",
-                "fold.toml",
-                "--method",
-                "trilinear",
-                "--shading",
-                "flat",
-                "--curves",
-                curves,
-                "--stats",
-                "-",
-            ],
-        );
         assert_eq!(stats["fallback_triangles"], 1, "{stats}");
     }
+}
+
+/// `flexcam compare --method trilinear --json` and `flexcam render --method trilinear --stats
+/// -` of `scene` in `dir` with `--curves curves`, flat shading: the report and the stats.
+fn trilinear_compare_and_stats(
+    dir: &TempDir,
+    scene: &str,
+    curves: &str,
+) -> (serde_json::Value, serde_json::Value) {
+    let method = [
+        "--method",
+        "trilinear",
+        "--shading",
+        "flat",
+        "--curves",
+        curves,
+    ];
+    let report = run_json(
+        dir,
+        &[&["compare", scene][..], &method, &["--json"]].concat(),
+    );
+    let stats = run_json(
+        dir,
+        &[&["render", scene][..], &method, &["--stats", "-"]].concat(),
+    );
+    (report, stats)
 }
 
 /// Rays that all meet in one point in front of the scene (F = (0, 1.8, 3.8), at t = 1; audit
@@ -1408,37 +1381,11 @@ fn trilinear_rays_meeting_in_front_of_the_scene() {
         [[object]]\nshape = \"plane\"\nsize = [8.0, 8.0]\n";
     write(&dir, "converge.toml", scene);
     for curves in ["adaptive", "slice", "tessellate"] {
-        let report = run_json(
-            &dir,
-            &[
-                "compare",
-                "converge.toml",
-                "--method",
-                "trilinear",
-                "--shading",
-                "flat",
-                "--curves",
-                curves,
-                "--json",
-            ],
-        );
+        let (report, stats) = trilinear_compare_and_stats(&dir, "converge.toml", curves);
         assert_eq!(
             report["id_agreement"].as_f64().unwrap(),
             1.0,
             "{curves}: {report}"
-        );
-        let stats = run_json(
-            &dir,
-            &[
-                "render",
-                "converge.toml",
-                "--method",
-                "trilinear",
-                "--curves",
-                curves,
-                "--stats",
-                "-",
-            ],
         );
         assert_eq!(stats["fallback_triangles"], 2, "{stats}");
         // Ray cast triangles project nothing.

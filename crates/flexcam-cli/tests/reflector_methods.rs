@@ -4,10 +4,10 @@
 //! reflector's surface), and `flexcam compare` measures that composite against the ray
 //! caster's exact mirror.
 
-use std::process::Output;
-
-use assert_cmd::Command;
 use tempfile::TempDir;
+
+mod common;
+use common::run_json;
 
 /// A plane mirror (4 x 4 quads, facing +z) reflecting a cube and a checker floor; not one
 /// of the example scenes.
@@ -49,24 +49,6 @@ tessellation = 12
 checker = { color = [0.1, 0.1, 0.1], size = 0.5 }
 "#;
 
-fn run(dir: &TempDir, args: &[&str]) -> Output {
-    Command::cargo_bin("flexcam")
-        .expect("flexcam binary")
-        .current_dir(dir.path())
-        .args(args)
-        .output()
-        .expect("flexcam runs")
-}
-
-fn json(out: &Output, args: &[&str]) -> serde_json::Value {
-    assert!(
-        out.status.success(),
-        "flexcam {args:?}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("stdout is one JSON object")
-}
-
 fn mirror_scene() -> TempDir {
     let dir = TempDir::new().unwrap();
     std::fs::write(dir.path().join("mirror.toml"), PLANE_MIRROR).unwrap();
@@ -92,7 +74,7 @@ fn trilinear_method_renders_reflector_scenes() {
         "-o",
         "m.png",
     ];
-    let stats = json(&run(&dir, &args), &args);
+    let stats = run_json(&dir, &args);
     assert_eq!(stats["method"], "trilinear");
     assert_eq!(stats["reflectors"], 1);
     assert!(
@@ -113,7 +95,7 @@ fn compare_measures_the_composite_against_the_exact_mirror() {
     let mut measured = Vec::new();
     for method in ["trilinear", "raycast"] {
         let args = ["compare", "mirror.toml", "--method", method, "--json"];
-        let report = json(&run(&dir, &args), &args);
+        let report = run_json(&dir, &args);
         let ids = report["id_agreement"].as_f64().unwrap();
         let rgb = report["relative_rgb_error"].as_f64().unwrap();
         assert!(ids >= 0.995 && rgb <= 0.02, "{method}: {report}");

@@ -1,0 +1,34 @@
+//! Helpers shared by the CLI test files: run the `flexcam` binary in a folder and read its
+//! JSON output.
+
+use std::process::Output;
+
+use assert_cmd::Command;
+use tempfile::TempDir;
+
+/// Runs `flexcam ARGS` in `dir`.
+pub fn run(dir: &TempDir, args: &[&str]) -> Output {
+    Command::cargo_bin("flexcam")
+        .expect("flexcam binary")
+        .current_dir(dir.path())
+        .args(args)
+        .output()
+        .expect("flexcam runs")
+}
+
+/// Runs `flexcam ARGS` in `dir`; fails the test, showing the command's stderr, unless it
+/// exited successfully.
+pub fn run_ok(dir: &TempDir, args: &[&str]) -> Output {
+    let out = run(dir, args);
+    assert!(
+        out.status.success(),
+        "flexcam {args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// [`run_ok`], returning the JSON object its standard output must be.
+pub fn run_json(dir: &TempDir, args: &[&str]) -> serde_json::Value {
+    serde_json::from_slice(&run_ok(dir, args).stdout).expect("stdout is one JSON object")
+}
