@@ -358,7 +358,7 @@ impl ProjectionTriangleCache {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use proptest::prelude::*;
 
@@ -752,7 +752,9 @@ mod tests {
         }
     }
 
-    fn vec3(range: f64) -> impl Strategy<Value = DVec3> {
+    /// Points with each coordinate in `(-range, range)`: the strategy of the projection
+    /// tests' random triangles.
+    pub(in crate::projection::trilinear) fn vec3(range: f64) -> impl Strategy<Value = DVec3> {
         (-range..range, -range..range, -range..range).prop_map(|(x, y, z)| DVec3::new(x, y, z))
     }
 

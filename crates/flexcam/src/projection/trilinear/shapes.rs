@@ -480,6 +480,7 @@ fn connect(images: &[ShapeVertex]) -> Result<TriangleShapes, Unprojectable> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::projection::trilinear::point_projection::tests::vec3;
     use proptest::prelude::*;
 
     fn v(x: f64, y: f64, z: f64) -> DVec3 {
@@ -959,10 +960,6 @@ mod tests {
             image(2, 3.0),
         ]);
         assert_eq!(sizes(&shapes.unwrap()), [2, 3]);
-    }
-
-    fn vec3(range: f64) -> impl Strategy<Value = DVec3> {
-        (-range..range, -range..range, -range..range).prop_map(|(x, y, z)| DVec3::new(x, y, z))
     }
 
     proptest! {

@@ -270,6 +270,7 @@ pub fn slice_depths(shape: &Shape, count: u32, out: &mut Vec<f64>) {
 mod tests {
     use super::*;
     use crate::projection::{project_triangle, ProjectionTriangleCache};
+    use crate::render::trilinear::polygons::tests::test_triangle;
     use glam::DVec2;
     use proptest::prelude::*;
 
@@ -308,19 +309,7 @@ mod tests {
                 (-2.0..2.0f64, -2.0..2.0f64, -1.0..6.0f64)
             ),
         ) {
-            let p = [
-                DVec3::new(-1.0, -1.0, 0.0),
-                DVec3::new(1.0, -1.0, 0.1),
-                DVec3::new(0.0, 1.0, -0.1),
-            ];
-            let n = [
-                DVec3::new(-0.4, -0.3, 1.0),
-                DVec3::new(0.5, -0.2, 1.2),
-                DVec3::new(0.1, 0.6, 0.9),
-            ];
-            let cache = ProjectionTriangleCache::new(p, n);
-            let screen = [DVec2::ZERO, DVec2::X, DVec2::Y];
-            let triangle = ProjectionTriangle::new(p, n, ScreenMap::new(screen, DVec2::splat(400.0), cache));
+            let (triangle, cache) = test_triangle();
             let scene = corners.map(|(x, y, z)| DVec3::new(x, y, z));
             let Ok(shapes) = project_triangle(&cache, scene) else { return Ok(()) };
             let mut crossings = EdgeCrossings::new(&triangle, scene, depth_range(shapes.iter()));

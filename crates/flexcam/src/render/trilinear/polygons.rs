@@ -500,7 +500,7 @@ impl Pair<'_> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::projection::{project_triangle, ProjectionTriangleCache};
     use crate::render::trilinear::workloads::fan_grid;
@@ -553,7 +553,8 @@ mod tests {
 
     /// A projection triangle with directions of unequal slopes (rays that do not meet), so
     /// that scene vertices have one or three images.
-    fn test_triangle() -> (ProjectionTriangle, ProjectionTriangleCache) {
+    pub(in crate::render::trilinear) fn test_triangle(
+    ) -> (ProjectionTriangle, ProjectionTriangleCache) {
         let p = [
             DVec3::new(-1.0, -1.0, 0.0),
             DVec3::new(1.0, -1.0, 0.1),

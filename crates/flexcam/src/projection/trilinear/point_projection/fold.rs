@@ -56,30 +56,25 @@ impl ProjectionTriangleCache {
         let (e, f) = (self.base_size, self.spread);
         let tol = SLIVER_TOL.sqrt();
         let (mut positive, mut negative) = (false, false);
-        for d in self.directions() {
-            let size = d.length();
-            let [c0, c1, c2] = self.cross.map(|n| n.dot(d));
+        for q in self.jacobian_along_vertex_rays() {
+            let [_, c1, c2] = q.coefficients;
             let mut judge = |value: f64, bound: f64| {
                 positive |= value > tol * bound;
                 negative |= value < -tol * bound;
             };
-            let at = |t: f64| (c0 + t * (c1 + t * c2), (e + t * f).powi(2) * size);
-            let (start, bound) = at(0.0);
+            let (start, bound) = q.at(0.0);
             judge(start, bound);
             if t_max.is_finite() {
-                let (end, bound) = at(t_max);
+                let (end, bound) = q.at(t_max);
                 judge(end, bound);
-            } else if c2.abs() > tol * f * f * size {
-                judge(c2, f * f * size);
+            } else if c2.abs() > tol * f * f * q.size {
+                judge(c2, f * f * q.size);
             } else {
-                judge(c1, e * f * size);
+                judge(c1, e * f * q.size);
             }
-            if c2 != 0.0 {
-                let vertex = -c1 / (2.0 * c2);
-                if vertex > 0.0 && vertex < t_max {
-                    let (extreme, bound) = at(vertex);
-                    judge(extreme, bound);
-                }
+            if let Some(vertex) = q.vertex().filter(|&v| v > 0.0 && v < t_max) {
+                let (extreme, bound) = q.at(vertex);
+                judge(extreme, bound);
             }
         }
         positive && negative
@@ -113,18 +108,25 @@ impl ProjectionTriangleCache {
     /// * a triangle that sweeps no volume: the quadratics vanish identically, no vertex,
     ///   no collapse (the renderer ray casts it for that reason already).
     pub fn collapses_before(&self, t_max: f64) -> bool {
-        let (e, f) = (self.base_size, self.spread);
         let tol = SLIVER_TOL.sqrt();
-        self.directions().iter().all(|d| {
-            let [c0, c1, c2] = self.cross.map(|n| n.dot(*d));
-            if c2 == 0.0 {
-                return false;
-            }
-            let vertex = -c1 / (2.0 * c2);
-            let value = c0 + vertex * (c1 + vertex * c2);
-            vertex > 0.0
-                && vertex <= t_max
-                && value.abs() <= tol * (e + vertex * f).powi(2) * d.length()
+        self.jacobian_along_vertex_rays().iter().all(|q| {
+            q.vertex()
+                .filter(|&v| v > 0.0 && v <= t_max)
+                .is_some_and(|v| {
+                    let (value, bound) = q.at(v);
+                    value.abs() <= tol * bound
+                })
+        })
+    }
+
+    /// The Jacobian along each vertex ray, `N(t) . n_i`, with the size bound of the fold
+    /// rule ([`ProjectionTriangleCache::folds_before`]).
+    fn jacobian_along_vertex_rays(&self) -> [VertexRayJacobian; 3] {
+        self.directions().map(|d| VertexRayJacobian {
+            coefficients: self.cross.map(|n| n.dot(d)),
+            size: d.length(),
+            base_size: self.base_size,
+            spread: self.spread,
         })
     }
 
@@ -156,8 +158,33 @@ impl ProjectionTriangleCache {
     }
 }
 
+/// The quadratic `c0 + c1 t + c2 t^2 = N(t) . n_i` along one vertex ray, and what bounds its
+/// size: `(e + t f)^2 |n_i|` (`e`, `f`: the largest base edge and direction difference).
+struct VertexRayJacobian {
+    coefficients: [f64; 3],
+    size: f64,
+    base_size: f64,
+    spread: f64,
+}
+
+impl VertexRayJacobian {
+    /// The value at depth `t` and its size bound there.
+    fn at(&self, t: f64) -> (f64, f64) {
+        let [c0, c1, c2] = self.coefficients;
+        let scale = self.base_size + t * self.spread;
+        (c0 + t * (c1 + t * c2), scale.powi(2) * self.size)
+    }
+
+    /// The depth of the extremum; `None` for a quadratic with no `t^2` term.
+    fn vertex(&self) -> Option<f64> {
+        let [_, c1, c2] = self.coefficients;
+        (c2 != 0.0).then(|| -c1 / (2.0 * c2))
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    use super::super::tests::vec3;
     use super::*;
     use proptest::prelude::*;
 
@@ -327,10 +354,6 @@ mod tests {
         let away = [V(1.0, 0.0, 0.0), V(-1.0, 0.0, 0.0), V(0.0, 0.0, 1e-3)];
         let cache = ProjectionTriangleCache::new(unit_base(), away);
         assert_eq!(cache.depth_reaching(DVec3::ZERO, 1.0), f64::INFINITY);
-    }
-
-    fn vec3(range: f64) -> impl Strategy<Value = DVec3> {
-        (-range..range, -range..range, -range..range).prop_map(|(x, y, z)| DVec3::new(x, y, z))
     }
 
     proptest! {
