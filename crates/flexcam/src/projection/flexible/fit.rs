@@ -163,6 +163,14 @@ pub fn fit(
     in_view(prior, correspondences, &targets, dirs)
 }
 
+/// The direction of correspondence `c`'s projector in `prior`'s grid with node directions
+/// `dirs`: the nodes' directions blended with the grid's weights at its image position.
+fn blended(prior: &ProjectorGrid, c: &Correspondence, dirs: &[DVec3]) -> DVec3 {
+    let mut d = DVec3::ZERO;
+    prior.for_each_weight(c.uv, |j, w| d += w * dirs[j]);
+    d
+}
+
 /// Whether every correspondence's blended direction in `dirs` points towards its target
 /// (positive dot product: its point is reached at t > 0).
 fn all_in_front(
@@ -171,11 +179,10 @@ fn all_in_front(
     targets: &[DVec3],
     dirs: &[DVec3],
 ) -> bool {
-    correspondences.iter().zip(targets).all(|(c, a)| {
-        let mut d = DVec3::ZERO;
-        prior.for_each_weight(c.uv, |j, w| d += w * dirs[j]);
-        d.dot(*a) > 0.0
-    })
+    correspondences
+        .iter()
+        .zip(targets)
+        .all(|(c, a)| blended(prior, c, dirs).dot(*a) > 0.0)
 }
 
 /// Largest mean squared chord (2 sin(angle / 2)) per correspondence, in rad^2, at which the
@@ -195,8 +202,7 @@ fn nearly_exact(
         .iter()
         .zip(targets)
         .map(|(c, a)| {
-            let mut d = DVec3::ZERO;
-            prior.for_each_weight(c.uv, |j, w| d += w * dirs[j]);
+            let d = blended(prior, c, dirs);
             d.try_normalize().map_or(4.0, |n| (n - *a).length_squared())
         })
         .sum();
@@ -260,9 +266,7 @@ fn noise_weight(
         .iter()
         .zip(targets)
         .map(|(c, a)| {
-            let mut d = DVec3::ZERO;
-            prior.for_each_weight(c.uv, |j, w| d += w * floor_dirs[j]);
-            let d = d / system.scale;
+            let d = blended(prior, c, floor_dirs) / system.scale;
             (d - d.dot(*a) * *a).length_squared()
         })
         .sum();
