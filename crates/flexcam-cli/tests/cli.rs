@@ -1201,6 +1201,20 @@ fn raster_mercator_and_equal_area_maps() {
     }
 }
 
+/// An equi-angular cubemap face (`reparam = "equiangular"` on the perspective preset): the
+/// raster keeps the perspective volume's inverse, and its adaptive subdivision follows the
+/// edges that the map bends.
+#[test]
+fn raster_equiangular_cubemap_face() {
+    let dir = TempDir::new().unwrap();
+    let scene = GOOD_SCENE.replace(
+        "type = \"perspective\"",
+        "type = \"flexible\"\npreset = \"perspective\"\nreparam = \"equiangular\"",
+    );
+    write(&dir, "eac.toml", &scene.replace("fov = 60.0", "fov = 90.0"));
+    meets_targets(&dir, "eac.toml", "raster");
+}
+
 /// A glTF primitive whose POSITION accessor does not exist: gltf-json's validation panicked
 /// on it; now one error line naming the file.
 #[test]

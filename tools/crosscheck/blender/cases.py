@@ -35,7 +35,8 @@ intern/cycles/kernel/camera/projection.h and blender/camera.cpp):
   on a square image (measured: the view direction is the image centre, the camera's right
   at the image's right, up up; on other aspects Cycles' circle is an ellipse);
 - equiangular cubemap face: dir = (1, tan((1/2 - u) pi/2), tan((v - 1/2) pi/2)), angles
-  linear in u and v: no flexcam equivalent (the cubic preset's faces are perspective);
+  linear in u and v over 90 degrees: flexcam's perspective preset with fov 90 and
+  `reparam = "equiangular"` on a square image;
 - central cylindrical: longitude range (radians) and height range (height / radius, i.e.
   tan of the elevation), linear in u and v: flexcam's `cylindrical` with
   h_fov = u_max - u_min, tan(v_fov / 2) = v_max for symmetric ranges.
@@ -140,6 +141,10 @@ def _mirror_ball(cam, frame):
     _pano(cam, "MIRRORBALL")
 
 
+def _equiangular_face(cam, frame):
+    _pano(cam, "EQUIANGULAR_CUBEMAP_FACE")
+
+
 def _central_cylindrical(h_fov, v_fov):
     def setup(cam, frame):
         _pano(cam, "CENTRAL_CYLINDRICAL")
@@ -213,6 +218,9 @@ def all_cases():
         ("mirror_ball", "MIRRORBALL (square image)",
          'preset "fisheye", fov 360, reparam "equisolid"', 256, 256, _mirror_ball,
          _preset("fisheye", fov=360.0, reparam="equisolid")),
+        ("equiangular_face", "EQUIANGULAR_CUBEMAP_FACE (square image)",
+         'preset "perspective", fov 90, reparam "equiangular"', 256, 256, _equiangular_face,
+         _preset("perspective", fov=90.0, reparam="equiangular")),
         ("central_cylindrical", "CENTRAL_CYLINDRICAL, u [-150, 150], v [-tan 50, tan 50]",
          'preset "cylindrical", h_fov 300, v_fov 100', 480, 240,
          _central_cylindrical(300.0, 100.0), _preset("cylindrical", h_fov=300.0, v_fov=100.0)),
@@ -227,6 +235,9 @@ def controls():
     return [
         ("control_fov", "PERSP, angle 70", 'preset "perspective", fov 70.5 (wrong)', w, h,
          _perspective, _preset("perspective", fov=70.5)),
+        ("control_equiangular", "EQUIANGULAR_CUBEMAP_FACE (square image)",
+         'preset "perspective", fov 90 (tangents linear, wrong)', 256, 256, _equiangular_face,
+         _preset("perspective", fov=90.0)),
         ("control_mirrored", "EQUIRECTANGULAR, lon [-120, 60], lat [-30, 70]",
          "far sphere, longitude [60, -120] (mirrored, wrong)", 360, 200,
          _equirect((-120, 60), (-30, 70)), _sphere_far([60.0, -120.0], [-30.0, 70.0])),

@@ -81,6 +81,18 @@ def _cylindrical(h_fov, v_fov):
     return ray
 
 
+def _equiangular(fov):
+    """Angles off the axis linear in x and y (the vertical half angle the pinhole's)."""
+    half = math.radians(0.5 * fov)
+
+    def ray(X, Y, W, H):
+        u, v = _uv(X, Y, W, H)
+        half_y = math.atan(math.tan(half) * H / W)
+        return np.zeros(3), np.array([math.tan((2 * u - 1) * half),
+                                      math.tan((2 * v - 1) * half_y), 1.0])
+    return ray
+
+
 RAYS = {
     "perspective": _perspective(),
     "off_axis": _perspective((0.2, -0.16 * 320 / 240)),
@@ -95,6 +107,7 @@ RAYS = {
     "fisheye_equisolid_180": _fisheye(180.0, _equisolid),
     "fisheye_equisolid_300": _fisheye(300.0, _equisolid),
     "mirror_ball": _fisheye(360.0, _equisolid),
+    "equiangular_face": _equiangular(90.0),
     "central_cylindrical": _cylindrical(300.0, 100.0),
 }
 

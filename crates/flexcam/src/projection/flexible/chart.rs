@@ -47,9 +47,14 @@ impl Inverse {
     pub fn chart(&self, reparam: Reparam, resolution: &Resolution) -> Option<InverseChart> {
         match self {
             Inverse::Planes { near, far, normal } => {
-                // The magnifier is a homeomorphism of the image plane (the identity outside
-                // its circle): it keeps the extended inverse continuous.
-                matches!(reparam, Reparam::Linear | Reparam::Magnifier(_)).then_some(())?;
+                // The magnifier (the identity outside its circle) and the equiangular map
+                // (monotonic in x and in y) are homeomorphisms of the image plane onto their
+                // images: they keep the extended inverse continuous.
+                matches!(
+                    reparam,
+                    Reparam::Linear | Reparam::Magnifier(_) | Reparam::Equiangular { .. }
+                )
+                .then_some(())?;
                 planes_chart(near, far, *normal)
             }
             Inverse::Spheres { near, .. } => spheres_chart(near, reparam, resolution),
@@ -130,7 +135,7 @@ fn spheres_chart(
             finite.then_some(())?;
             Some(period(near.longitude, resolution))
         }
-        Reparam::Magnifier(_) => return None,
+        Reparam::Magnifier(_) | Reparam::Equiangular { .. } => return None,
         Reparam::Polar | Reparam::Lens | Reparam::Equisolid { .. } => {
             let full = ((near.longitude[1] - near.longitude[0]).abs() - 2.0 * PI).abs() <= FLAT;
             let start = near.latitude[0];

@@ -33,6 +33,15 @@ pub enum Reparam {
     /// `max_angle` (the fisheye preset, max_angle = fov / 2): v = 2 asin(r sin(max_angle /
     /// 2)) / max_angle. `max_angle` in radians, in (0, pi].
     Equisolid { max_angle: f64 },
+    /// Equiangular perspective, the map of an equi-angular cubemap face (EAC, as Blender
+    /// Cycles' `EQUIANGULAR_CUBEMAP_FACE` and YouTube's cubemaps): for volumes whose (u, v)
+    /// is linear on a pinhole's image plane (the perspective preset, horizontal field of
+    /// view 2 `half_fov`), the angle off the axis, not its tangent, is linear in each image
+    /// coordinate: x = (1/2 + a_x / (2 half_fov)) W with tan a_x = (2u - 1) tan(half_fov),
+    /// and likewise in y with the vertical half angle h_y, tan h_y = tan(half_fov) H / W, so
+    /// that the image frame sees what the perspective camera's frame sees. `half_fov` in
+    /// radians, in (0, pi/2).
+    Equiangular { half_fov: f64 },
     /// Mercator map: u = x / W; the image row's Mercator ordinate y_m = py * M(max_latitude),
     /// M(phi) = ln tan(pi/4 + phi/2), gives the latitude phi = atan(sinh(y_m)) and
     /// v = (phi / max_latitude + 1) / 2. So it expects surfaces whose v spans the latitudes
@@ -50,13 +59,14 @@ pub enum Reparam {
 }
 
 /// The names used in scene files, in order.
-pub const REPARAM_NAMES: [&str; 6] = [
+pub const REPARAM_NAMES: [&str; 7] = [
     "linear",
     "polar",
     "lens",
     "mercator",
     "equal_area",
     "equisolid",
+    "equiangular",
 ];
 
 /// The default top latitude of the Mercator map, degrees.
@@ -70,6 +80,7 @@ impl Reparam {
             Reparam::Polar => "polar",
             Reparam::Lens => "lens",
             Reparam::Equisolid { .. } => "equisolid",
+            Reparam::Equiangular { .. } => "equiangular",
             Reparam::Mercator { .. } => "mercator",
             Reparam::EqualArea { .. } => "equal_area",
             Reparam::Magnifier(_) => "magnifier",
@@ -78,8 +89,19 @@ impl Reparam {
 
     /// Errors: a Mercator latitude outside (0, 90) degrees (the Mercator ordinate is
     /// infinite at the pole), an equal-area one outside (0, 90], an equisolid angle outside
-    /// (0, 180] (beyond 180 degrees off the axis sin(theta / 2) falls again: the map folds).
+    /// (0, 180] (beyond 180 degrees off the axis sin(theta / 2) falls again: the map folds),
+    /// an equiangular field of view outside (0, 180) degrees (a pinhole's image plane ends
+    /// at 180).
     pub fn validate(&self) -> Result<()> {
+        if let Reparam::Equiangular { half_fov } = *self {
+            if !(half_fov > 0.0 && half_fov < 0.5 * PI) {
+                return Err(Error::new(format!(
+                    "flexible equiangular perspective fov must be in (0, 180) degrees, got {}",
+                    2.0 * half_fov.to_degrees()
+                )));
+            }
+            return Ok(());
+        }
         if let Reparam::Equisolid { max_angle } = *self {
             if !(max_angle > 0.0 && max_angle <= PI) {
                 return Err(Error::new(format!(
@@ -134,6 +156,16 @@ impl Reparam {
                 };
                 DVec2::new((p.y.atan2(p.x) + PI) / (2.0 * PI), v)
             }
+            Reparam::Equiangular { half_fov } => {
+                // Centred coordinates in [-1, 1] across the image, y up.
+                let p = resolution.centred(pixel) / (0.5 * size);
+                let half = half_angles(*half_fov, resolution);
+                let tan_ratio = |p: f64, half: f64| (p * half).tan() / half.tan();
+                DVec2::new(
+                    0.5 + 0.5 * tan_ratio(p.x, half.x),
+                    0.5 + 0.5 * tan_ratio(p.y, half.y),
+                )
+            }
             Reparam::Mercator { max_latitude } => {
                 let py = resolution.centred(pixel).y / (0.5 * size.y);
                 let latitude = (py * mercator(*max_latitude)).sinh().atan();
@@ -185,6 +217,12 @@ impl Reparam {
                 let p = r * DVec2::new(azimuth.cos(), azimuth.sin());
                 resolution.pixel(p * circle_radius(resolution))
             }
+            Reparam::Equiangular { half_fov } => {
+                let half = half_angles(*half_fov, resolution);
+                let angle_ratio = |u: f64, half: f64| ((2.0 * u - 1.0) * half.tan()).atan() / half;
+                let p = DVec2::new(angle_ratio(uv.x, half.x), angle_ratio(uv.y, half.y));
+                resolution.pixel(p * 0.5 * size)
+            }
             Reparam::Mercator { max_latitude } => {
                 let latitude = (2.0 * uv.y - 1.0) * max_latitude;
                 if latitude.abs() >= 0.5 * PI {
@@ -208,7 +246,10 @@ impl Reparam {
     /// no pixel centre is inside it. The linear and Mercator maps take v from the row alone.
     pub fn v_range(&self, resolution: &Resolution) -> Option<(f64, f64)> {
         let columns = match self {
-            Reparam::Linear | Reparam::Mercator { .. } | Reparam::EqualArea { .. } => 1,
+            Reparam::Linear
+            | Reparam::Mercator { .. }
+            | Reparam::EqualArea { .. }
+            | Reparam::Equiangular { .. } => 1,
             Reparam::Polar | Reparam::Lens | Reparam::Equisolid { .. } | Reparam::Magnifier(_) => {
                 resolution.width
             }
@@ -235,6 +276,14 @@ fn in_domain(uv: DVec2) -> bool {
 /// The radius in pixels of the circle inscribed in the shorter image side (as `Fisheye`).
 fn circle_radius(resolution: &Resolution) -> f64 {
     0.5 * f64::from(resolution.width.min(resolution.height))
+}
+
+/// The horizontal and vertical half angles of an equiangular map of horizontal half angle
+/// `half_fov` on an image of `resolution`: the vertical one is the perspective camera's,
+/// tan h_y = tan(half_fov) H / W.
+fn half_angles(half_fov: f64, resolution: &Resolution) -> DVec2 {
+    let size = resolution.size();
+    DVec2::new(half_fov, (half_fov.tan() * size.y / size.x).atan())
 }
 
 /// The Mercator ordinate of latitude `phi`.
@@ -314,6 +363,38 @@ mod tests {
     }
 
     #[test]
+    fn equiangular_angles_are_linear_in_the_image() {
+        // An equi-angular cubemap face: 90 degrees on a square image. A quarter of the width
+        // right of the centre is 22.5 degrees off the axis, so u = (1 + tan 22.5) / 2 on the
+        // image plane; the frame's edges stay the perspective camera's.
+        let square = Resolution::new(100, 100).unwrap();
+        let face = Reparam::Equiangular {
+            half_fov: FRAC_PI_4,
+        };
+        assert!(face.validate().is_ok());
+        let uv = face.to_uv(&square, DVec2::new(75.0, 25.0)).unwrap();
+        let want = 0.5 + 0.5 * (0.5 * FRAC_PI_4).tan();
+        assert!((uv - DVec2::splat(want)).length() < 1e-15, "{uv}");
+        assert_eq!(
+            face.to_uv(&square, DVec2::new(50.0, 50.0)),
+            Some(DVec2::splat(0.5))
+        );
+        let corner = face.to_uv(&square, DVec2::new(100.0, 0.0)).unwrap();
+        assert!((corner - DVec2::new(1.0, 1.0)).length() < 1e-15, "{corner}");
+        // On a 2:1 image the vertical half angle is the pinhole's: tan = tan(45) / 2, and the
+        // row a quarter of the height from the top is half that angle up.
+        let wide = Reparam::Equiangular {
+            half_fov: FRAC_PI_4,
+        };
+        let v = wide.to_uv(&res(), DVec2::new(100.0, 25.0)).unwrap().y;
+        let half_y = 0.5f64.atan();
+        assert!((v - (0.5 + 0.5 * (0.5 * half_y).tan() / half_y.tan())).abs() < 1e-15);
+        for bad in [0.0, -0.1, 0.5 * PI, f64::NAN] {
+            assert!(Reparam::Equiangular { half_fov: bad }.validate().is_err());
+        }
+    }
+
+    #[test]
     fn mercator_centre_row_is_the_equator_and_edges_are_max_latitude() {
         let r = Reparam::Mercator {
             max_latitude: 80f64.to_radians(),
@@ -364,6 +445,10 @@ mod tests {
             Reparam::Lens,
             Reparam::Equisolid { max_angle: PI },
             Reparam::Equisolid { max_angle: 0.7 },
+            Reparam::Equiangular {
+                half_fov: 0.25 * PI,
+            },
+            Reparam::Equiangular { half_fov: 1.5 },
             Reparam::Mercator { max_latitude: 1.2 },
             Reparam::EqualArea { max_latitude: 1.2 },
             Reparam::EqualArea {

@@ -1,7 +1,7 @@
 //! Presets against their closed forms (the notes' "Closed-form oracles"), against the
 //! single-viewpoint projections, and the inverse against the rays.
 
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 use glam::{DVec2, DVec3};
 use proptest::prelude::*;
@@ -506,6 +506,11 @@ fn invertible() -> Vec<Flexible> {
     let mut ball = preset(Preset::Fisheye { fov: 360.0 }, Some([0.0, 20.0]));
     ball.reparam = Some(Reparam::Equisolid { max_angle: PI });
     all.push(build(&ball, 16, 12));
+    let mut face = preset(Preset::Perspective { fov: 90.0 }, Some([0.5, 20.0]));
+    face.reparam = Some(Reparam::Equiangular {
+        half_fov: FRAC_PI_4,
+    });
+    all.push(build(&face, 16, 12));
     all.push(custom(sphere(5.0), sphere(1.0)));
     all.push(custom(
         cylinder(DVec3::ZERO, 0.5, [-1.0, 1.0]),
@@ -813,6 +818,26 @@ fn equisolid_fisheye_radius_is_the_sine_of_half_the_angle() {
         lateral.normalize_or_zero() * lateral.length().atan2(p.z) / half
     };
     check_oracle(&spec, (9, 7), image, oracle, None);
+}
+
+#[test]
+fn equiangular_perspective_has_angles_linear_in_the_image() {
+    // An equi-angular cubemap face (90 degrees, Cycles' EQUIANGULAR_CUBEMAP_FACE) and a
+    // 70-degree 9 x 7 image: atan(x / z) and atan(y / z) of every point on a pixel's ray are
+    // linear in the pixel's centred position, reaching the horizontal half angle at the
+    // frame's sides and the pinhole's vertical half angle at its top and bottom.
+    for (fov, size) in [(90.0, (8, 8)), (70.0, (9, 7))] {
+        let half = 0.5 * f64::to_radians(fov);
+        let mut spec = preset(Preset::Perspective { fov }, Some([0.5, 2.0]));
+        spec.reparam = Some(Reparam::Equiangular { half_fov: half });
+        let half_y = (half.tan() * f64::from(size.1) / f64::from(size.0)).atan();
+        let image = |f: &Flexible, pixel: DVec2| {
+            let (w, h) = f.resolution();
+            f.resolution.centred(pixel) / (0.5 * DVec2::new(f64::from(w), f64::from(h)))
+        };
+        let oracle = |p: DVec3| DVec2::new(p.x.atan2(p.z) / half, p.y.atan2(p.z) / half_y);
+        check_oracle(&spec, size, image, oracle, None);
+    }
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //! `segments`), a shape-defined panorama (`outline`/`outlines` and `profile`/`profiles`,
 //! module `panorama`), with an optional re-parameterisation.
 
-use std::f64::consts::PI;
+use std::f64::consts::{FRAC_PI_4, PI};
 use std::ops::Range;
 
 use glam::{DVec2, DVec3};
@@ -363,6 +363,7 @@ fn reparam(src: &Source, raw: &RawProjection) -> Result<Option<Reparam>> {
         "polar" => Reparam::Polar,
         "lens" => Reparam::Lens,
         "equisolid" => equisolid(src, raw, name)?,
+        "equiangular" => equiangular(src, raw, name)?,
         map @ ("mercator" | "equal_area") => {
             let (default, make): (f64, fn(f64) -> Reparam) = if map == "mercator" {
                 (DEFAULT_MERCATOR_LATITUDE, |max_latitude| {
@@ -414,6 +415,36 @@ fn equisolid(src: &Source, raw: &RawProjection, name: &Spanned<String>) -> Resul
     };
     let reparam = Reparam::Equisolid {
         max_angle: 0.5 * src.number(fov, "fov")?.to_radians(),
+    };
+    reparam
+        .validate()
+        .map_err(|e| src.error(&fov.span(), e.message))?;
+    Ok(reparam)
+}
+
+/// `reparam = "equiangular"`: only with the perspective preset, whose `fov` is the map's
+/// horizontal angle (an equi-angular cubemap face: fov 90 on a square image). A missing
+/// `fov` is left to the preset's own error (the map then has a placeholder that is never
+/// used).
+fn equiangular(src: &Source, raw: &RawProjection, name: &Spanned<String>) -> Result<Reparam> {
+    let perspective = raw
+        .preset
+        .as_ref()
+        .is_some_and(|p| p.get_ref() == "perspective");
+    if !perspective {
+        return Err(src.error(
+            &name.span(),
+            "reparam \"equiangular\" belongs to the perspective preset (its fov is the \
+             horizontal angle spread evenly across the image)",
+        ));
+    }
+    let Some(fov) = &raw.fov else {
+        return Ok(Reparam::Equiangular {
+            half_fov: FRAC_PI_4,
+        });
+    };
+    let reparam = Reparam::Equiangular {
+        half_fov: 0.5 * src.number(fov, "fov")?.to_radians(),
     };
     reparam
         .validate()

@@ -320,6 +320,33 @@ fn new_flexible_presets_parse_with_their_keys() {
 }
 
 #[test]
+fn equiangular_perspective_takes_its_angle_from_the_preset() {
+    let head = "[projection]\ntype = \"flexible\"\nposition = [0, 1, 5]\nlook_at = [0, 1, 0]\n";
+    let s = scene(&format!(
+        "{head}preset = \"perspective\"\nfov = 90\nreparam = \"equiangular\"\n"
+    ));
+    let ProjectionSpec::Flexible(spec) = &s.projection else {
+        panic!("not flexible");
+    };
+    let Some(crate::projection::flexible::Reparam::Equiangular { half_fov }) = spec.reparam else {
+        panic!("not equiangular: {:?}", spec.reparam);
+    };
+    assert!((half_fov - std::f64::consts::FRAC_PI_4).abs() < 1e-15);
+    assert_error_at(
+        &format!("{head}preset = \"fisheye\"\nfov = 180\nreparam = \"equiangular\"\n"),
+        7,
+        11,
+        "reparam \"equiangular\" belongs to the perspective preset",
+    );
+    assert_error_at(
+        &format!("{head}preset = \"perspective\"\nfov = 180\nreparam = \"equiangular\"\n"),
+        6,
+        7,
+        "equiangular perspective fov must be in (0, 180) degrees, got 180",
+    );
+}
+
+#[test]
 fn equisolid_fisheye_takes_its_angle_from_the_preset() {
     let head = "[projection]\ntype = \"flexible\"\nposition = [0, 1, 5]\nlook_at = [0, 1, 0]\n";
     let s = scene(&format!(
