@@ -46,7 +46,7 @@ pub(super) fn convert(
     let parts: Vec<(Mesh, Material)> = match (&raw.file, analytic(src, raw, shape)?) {
         (_, Some((mesh, base))) => vec![(mesh, overrides.apply(base))],
         (Some(file), None) => {
-            let path = base_dir.join(file.get_ref());
+            let path = src.existing_file(file, base_dir, "model file")?;
             load_model(&path)
                 .map_err(|e| e.or_in_file(&path))?
                 .into_iter()
@@ -260,7 +260,7 @@ impl MaterialOverrides {
                     as f32,
             })
         } else if let Some(texture) = &raw.texture {
-            let path = base_dir.join(texture.get_ref());
+            let path = src.existing_file(texture, base_dir, "texture")?;
             let texture = load_texture(&path).map_err(|e| e.or_in_file(&path))?;
             Some(Pattern::Texture(Arc::new(texture)))
         } else {

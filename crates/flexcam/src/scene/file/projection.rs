@@ -239,7 +239,7 @@ fn trilinear(src: &Source, required: &Required, base_dir: &Path) -> Result<Trili
                 format!("`{key}` cannot be combined with `surface`: give a surface file or inline arrays"),
             ));
         }
-        let path = base_dir.join(surface.get_ref());
+        let path = src.existing_file(surface, base_dir, "trilinear surface")?;
         return TrilinearMesh::load_obj(&path).map_err(|e| e.or_in_file(&path));
     }
     if raw.points.is_none() {

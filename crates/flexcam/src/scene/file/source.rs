@@ -2,9 +2,11 @@
 //! errors.
 
 use std::ops::Range;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use crate::error::Error;
+use toml::Spanned;
+
+use crate::error::{Error, Result};
 
 /// A scene file being parsed: its text and the path the user gave for it.
 pub(super) struct Source<'a> {
@@ -19,6 +21,31 @@ impl<'a> Source<'a> {
         Error::at(self.path, line, column, message)
     }
 
+    /// The file a scene value names (a model, texture or surface), resolved against
+    /// `base_dir`. Fails at the value when no regular file is there (an empty name, a
+    /// folder, a missing file), so that the error points into the scene rather than at a
+    /// path the user never wrote; the loader's own errors (a file it cannot parse) name the
+    /// file itself.
+    pub fn existing_file(
+        &self,
+        name: &Spanned<String>,
+        base_dir: &Path,
+        what: &str,
+    ) -> Result<PathBuf> {
+        let path = base_dir.join(name.get_ref());
+        if path.is_file() {
+            return Ok(path);
+        }
+        Err(self.error(
+            &name.span(),
+            format!(
+                "{what} \"{}\" is not a file (looked for {})",
+                name.get_ref(),
+                path.display()
+            ),
+        ))
+    }
+
     /// Fails at the first key of `present` (name, span) that is not in `allowed`, naming
     /// `what` takes instead (e.g. "fisheye projections"), so a key of another type is caught.
     pub fn reject_foreign_key(
@@ -26,7 +53,7 @@ impl<'a> Source<'a> {
         present: Vec<(&'static str, Range<usize>)>,
         allowed: &[&str],
         what: &str,
-    ) -> Result<(), Error> {
+    ) -> Result<()> {
         match present.into_iter().find(|(key, _)| !allowed.contains(key)) {
             Some((key, span)) => Err(self.error(
                 &span,

@@ -637,6 +637,12 @@ fn missing_model_and_texture_files_name_the_file() {
     assert!(message.contains("none.obj"), "{message}");
     let message = error(&object("shape = \"plane\"\ntexture = \"none.png\"\n"));
     assert!(message.contains("none.png"), "{message}");
+    // An empty name resolves to the scene's folder: refused at the value, not as a folder
+    // that cannot be read under an empty name.
+    let text = object("shape = \"plane\"\ntexture = \"\"\n");
+    let message = error(&text);
+    assert!(message.contains("texture \"\" is not a file"), "{message}");
+    assert!(message.starts_with("dir/s.toml:"), "{message}");
     assert_error(
         &object("shape = \"plane\"\ntexture = \"a.png\"\nchecker = { color = [0, 0, 0] }\n"),
         "`texture` and `checker` cannot be combined",
@@ -770,8 +776,13 @@ fn trilinear_surface_is_relative_to_the_scene_file() {
         ProjectionSpec::Trilinear(mesh) => assert_eq!(mesh.triangles.len(), 1),
         other => panic!("{other:?}"),
     }
-    let message = error("[projection]\ntype = \"trilinear\"\nsurface = \"missing.obj\"\n");
-    assert!(message.starts_with("dir/missing.obj: "), "{message}");
+    // A missing file is reported at the scene's value, with the path looked for.
+    assert_error_at(
+        "[projection]\ntype = \"trilinear\"\nsurface = \"missing.obj\"\n",
+        3,
+        11,
+        "trilinear surface \"missing.obj\" is not a file (looked for dir/missing.obj)",
+    );
 }
 
 #[test]
