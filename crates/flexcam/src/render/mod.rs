@@ -114,4 +114,5 @@ pub mod raycast;
 pub mod reproject;
 pub mod surface;
 pub mod trilinear;
+pub use huge_pages::HugePageAllocator;
 pub use method::Method;
