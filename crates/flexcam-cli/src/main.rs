@@ -11,13 +11,6 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use flexcam::render::HugePageAllocator;
-
-/// Blocks of 2 MiB and more (frames, above all) on transparent huge pages, zeroed by the
-/// kernel: a new frame's first touch costs a few faults instead of thousands (see
-/// `flexcam::render::HugePageAllocator`, docs/trilinear.md).
-#[global_allocator]
-static ALLOCATOR: HugePageAllocator = HugePageAllocator;
 
 /// Renders 3D scenes through nonlinear and multi-perspective projections.
 #[derive(Parser, Debug)]

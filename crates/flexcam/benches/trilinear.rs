@@ -15,14 +15,10 @@ use flexcam::projection::Trilinear;
 use flexcam::render::raycast::RayCaster;
 use flexcam::render::trilinear::workloads::fan_grid;
 use flexcam::render::trilinear::{CurveOptions, TrilinearRenderer};
-use flexcam::render::{HugePageAllocator, RenderOptions, Shading};
+use flexcam::render::{RenderOptions, Shading};
 use flexcam::scene::builtin;
 
 const SIDE: u32 = 800;
-
-/// The allocator the `flexcam` binary runs with, so that new frames cost what they cost there.
-#[global_allocator]
-static ALLOCATOR: HugePageAllocator = HugePageAllocator;
 
 fn cube_floor_18(c: &mut Criterion) {
     let scene = builtin::load("cube-floor").unwrap_or_else(|e| panic!("cube-floor: {e}"));

@@ -114,5 +114,4 @@ pub mod raycast;
 pub mod reproject;
 pub mod surface;
 pub mod trilinear;
-pub use huge_pages::HugePageAllocator;
 pub use method::Method;
