@@ -3,7 +3,7 @@
 //! `segments`), a shape-defined panorama (`outline`/`outlines` and `profile`/`profiles`,
 //! module `panorama`), with an optional re-parameterisation.
 
-use std::f64::consts::{FRAC_PI_4, PI};
+use std::f64::consts::PI;
 use std::ops::Range;
 
 use glam::{DVec2, DVec3};
@@ -362,8 +362,7 @@ fn reparam(src: &Source, raw: &RawProjection) -> Result<Option<Reparam>> {
         "linear" => Reparam::Linear,
         "polar" => Reparam::Polar,
         "lens" => Reparam::Lens,
-        "equisolid" => equisolid(src, raw, name)?,
-        "equiangular" => equiangular(src, raw, name)?,
+        "equisolid" | "equiangular" => preset_angle_map(src, raw, name)?,
         map @ ("mercator" | "equal_area") => {
             let (default, make): (f64, fn(f64) -> Reparam) = if map == "mercator" {
                 (DEFAULT_MERCATOR_LATITUDE, |max_latitude| {
@@ -395,57 +394,38 @@ fn reparam(src: &Source, raw: &RawProjection) -> Result<Option<Reparam>> {
     }))
 }
 
-/// `reparam = "equisolid"`: only with the fisheye preset, whose `fov` / 2 is the map's
-/// angle at the rim. A missing `fov` is left to the preset's own error (the map then has a
-/// placeholder that is never used).
-fn equisolid(src: &Source, raw: &RawProjection, name: &Spanned<String>) -> Result<Reparam> {
-    let fisheye = raw
-        .preset
-        .as_ref()
-        .is_some_and(|p| p.get_ref() == "fisheye");
-    if !fisheye {
+/// A re-parameterisation that takes its angle from its preset's `fov` (radians of half of
+/// it): `reparam = "equisolid"` belongs to the fisheye preset (fov / 2 is the angle at the
+/// rim of the image circle), `reparam = "equiangular"` to the perspective preset (fov / 2
+/// is the horizontal half angle, spread evenly across the image). Another preset is an
+/// error at the reparam's name, a bad angle at `fov`. A missing `fov` is left to the
+/// preset's own error (the map then gets a placeholder, 180 degrees, that is never used).
+fn preset_angle_map(src: &Source, raw: &RawProjection, name: &Spanned<String>) -> Result<Reparam> {
+    let (preset, why, make): (&str, &str, fn(f64) -> Reparam) = match name.get_ref().as_str() {
+        "equisolid" => (
+            "fisheye",
+            "its fov / 2 is the angle at the rim of the image circle",
+            |a| Reparam::Equisolid { max_angle: a },
+        ),
+        _ => (
+            "perspective",
+            "its fov is the horizontal angle spread evenly across the image",
+            |a| Reparam::Equiangular { half_fov: a },
+        ),
+    };
+    if !raw.preset.as_ref().is_some_and(|p| p.get_ref() == preset) {
         return Err(src.error(
             &name.span(),
-            "reparam \"equisolid\" belongs to the fisheye preset (its fov / 2 is the \
-             angle at the rim of the image circle)",
+            format!(
+                "reparam \"{}\" belongs to the {preset} preset ({why})",
+                name.get_ref()
+            ),
         ));
     }
     let Some(fov) = &raw.fov else {
-        return Ok(Reparam::Equisolid { max_angle: PI });
+        return Ok(make(0.5 * PI));
     };
-    let reparam = Reparam::Equisolid {
-        max_angle: 0.5 * src.number(fov, "fov")?.to_radians(),
-    };
-    reparam
-        .validate()
-        .map_err(|e| src.error(&fov.span(), e.message))?;
-    Ok(reparam)
-}
-
-/// `reparam = "equiangular"`: only with the perspective preset, whose `fov` is the map's
-/// horizontal angle (an equi-angular cubemap face: fov 90 on a square image). A missing
-/// `fov` is left to the preset's own error (the map then has a placeholder that is never
-/// used).
-fn equiangular(src: &Source, raw: &RawProjection, name: &Spanned<String>) -> Result<Reparam> {
-    let perspective = raw
-        .preset
-        .as_ref()
-        .is_some_and(|p| p.get_ref() == "perspective");
-    if !perspective {
-        return Err(src.error(
-            &name.span(),
-            "reparam \"equiangular\" belongs to the perspective preset (its fov is the \
-             horizontal angle spread evenly across the image)",
-        ));
-    }
-    let Some(fov) = &raw.fov else {
-        return Ok(Reparam::Equiangular {
-            half_fov: FRAC_PI_4,
-        });
-    };
-    let reparam = Reparam::Equiangular {
-        half_fov: 0.5 * src.number(fov, "fov")?.to_radians(),
-    };
+    let reparam = make(0.5 * src.number(fov, "fov")?.to_radians());
     reparam
         .validate()
         .map_err(|e| src.error(&fov.span(), e.message))?;
