@@ -413,7 +413,7 @@ fn preset_angle_map(src: &Source, raw: &RawProjection, name: &Spanned<String>) -
             |a| Reparam::Equiangular { half_fov: a },
         ),
     };
-    if !raw.preset.as_ref().is_some_and(|p| p.get_ref() == preset) {
+    if raw.preset.as_ref().is_none_or(|p| p.get_ref() != preset) {
         return Err(src.error(
             &name.span(),
             format!(
