@@ -27,8 +27,9 @@
 //! keeping the prior's starts): a prior with tangents (curved projectors have no common
 //! eye); fewer than `MIN_POINTS` correspondences; points that all coincide; an eye the data
 //! do not determine (the misses change by less than `FLAT` of the data's extent when E
-//! moves in some direction: points on one line through the eye, or so few that the node
-//! directions absorb any move of E); a descent that finds no eye at which the linear fit
+//! moves in some direction: points all on one plane, or so few that the node directions
+//! absorb any move of E); image positions all on one line (points on one line through the
+//! eye among them); a descent that finds no eye at which the linear fit
 //! solves.
 
 use glam::{DMat3, DVec3};
@@ -107,8 +108,9 @@ pub(super) fn fit(
 fn undetermined() -> Error {
     Error::new(
         "projector grid fit: the correspondences do not determine an eye (they are met as \
-         well from other eyes: image positions on one line, points on one line through the \
-         eye, or too few points for the grid's nodes); use `starts = \"kept\"` or more points",
+         well from other eyes: image positions on one line, points all on one plane, or too \
+         few points for the grid's nodes); use `starts = \"kept\"` or add points off that \
+         plane or line",
     )
 }
 
@@ -491,6 +493,21 @@ mod tests {
         // Twelve points for a 3 x 3 grid's 27 direction unknowns: the nodes absorb any move
         // of the eye.
         let e = fit(&prior, &seen_by(&truth, 12, 3)).unwrap_err();
+        assert!(e.message.contains("do not determine an eye"), "{e}");
+        // Twenty points on one plane (z = -5, across the view): from any eye the plane's
+        // points are affine in (u, v), which a bilinear grid meets exactly.
+        let plane: Vec<_> = seen_by(&truth, 20, 4)
+            .into_iter()
+            .map(|c| {
+                let (s, e) = truth.start_end(c.uv);
+                let t = (-5.0 - s.z) / (e.z - s.z);
+                Correspondence {
+                    point: s + t * (e - s),
+                    ..c
+                }
+            })
+            .collect();
+        let e = fit(&prior, &plane).unwrap_err();
         assert!(e.message.contains("do not determine an eye"), "{e}");
         // `auto` then keeps the prior's starts.
         let (_, report) = fit_with(&prior, &line, Starts::Auto).unwrap();
