@@ -39,13 +39,17 @@ pub fn run(args: &FitArgs) -> Result<()> {
     let fitted = fit_scene(&text, &args.scene, &args.output)?;
     image_io::write_bytes(&args.output, fitted.text.as_bytes())?.commit()?;
     let r = fitted.report;
+    if let Some(warning) = r.warning() {
+        eprintln!("flexcam: warning: {}: {warning}", args.scene.display());
+    }
     super::print_stdout(&format!(
         "fitted {} correspondences ({} nodes unconstrained): residual max {:e} degrees, rms \
-         {:e} degrees; wrote {}\n",
+         {:e} degrees, {}; wrote {}\n",
         r.correspondences,
         r.unconstrained_nodes,
         r.max_angle_deg,
         r.rms_angle_deg,
+        r.starts,
         args.output.display()
     ))?;
     Ok(())

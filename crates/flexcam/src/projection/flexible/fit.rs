@@ -62,6 +62,23 @@
 //! (an error: the fitted projector must reach X_k at t > 0); a fitted node direction of zero
 //! length (an error).
 //!
+//! # Starts
+//!
+//! Kept starts off a pinhole camera's eye meet no grid to its correspondences, and sparse
+//! data then bend the fit between the points (a small residual, a wrong image). [`fit_with`]
+//! takes the scene key `starts`: `Kept` is [`fit`]; `Eye` fits one common eye with the
+//! directions, every projector through it (module `central`); `Auto`, the default, keeps the
+//! starts when they meet the data exactly (bit for bit the old result) and takes the eye
+//! where it meets the data clearly better.
+//!
+//! # Warnings
+//!
+//! The residual is measured at the correspondences only. [`FitReport`] counts the
+//! constrained nodes that left the prior by far (`wild_nodes`: a length ratio to the prior's
+//! node beyond `WILD_LENGTH` times the median ratio, or a direction more than
+//! `WILD_ANGLE_DEG` off) and those with little data (`sparse_nodes`: summed grid weight
+//! below `SPARSE_WEIGHT`); [`FitReport::warning`] words them for the user.
+//!
 //! # Curved projectors
 //!
 //! A prior with node tangents (quadratic Bezier projectors) is fitted in two stages: the
@@ -79,6 +96,7 @@ use super::projector_grid::ProjectorGrid;
 use crate::error::{Error, Result};
 
 mod angular;
+mod central;
 mod curved;
 
 /// The prior's least weight, relative to the data term's mean diagonal (see the module docs).
@@ -95,8 +113,57 @@ pub struct Correspondence {
     pub point: DVec3,
 }
 
+/// Where the fitted grid's projectors start: the scene key `starts` (module section
+/// "Starts").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Starts {
+    /// The prior's starts are kept; only the node directions are fitted.
+    Kept,
+    /// One common eye is fitted with the directions; every projector passes through it.
+    Eye,
+    /// The kept starts where they meet the data exactly, else the eye where it meets the
+    /// data clearly better (see [`fit_with`]).
+    #[default]
+    Auto,
+}
+
+impl Starts {
+    /// The scene file's names, in the order of the error message.
+    pub const NAMES: [&'static str; 3] = ["auto", "kept", "eye"];
+
+    /// The model of a scene file name (`None` for any other).
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "auto" => Some(Starts::Auto),
+            "kept" => Some(Starts::Kept),
+            "eye" => Some(Starts::Eye),
+            _ => None,
+        }
+    }
+}
+
+/// The starts a fit used.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum FittedStarts {
+    /// The prior's starts.
+    #[default]
+    Kept,
+    /// Starts on projectors through this fitted eye.
+    Eye(DVec3),
+}
+
+/// In words, for the written scene's header and `flexcam fit`'s output.
+impl std::fmt::Display for FittedStarts {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FittedStarts::Kept => write!(f, "starts kept"),
+            FittedStarts::Eye(e) => write!(f, "starts on projectors through the fitted eye {e}"),
+        }
+    }
+}
+
 /// How well a fitted grid meets the correspondences.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct FitReport {
     /// Correspondences used.
     pub correspondences: usize,
@@ -107,6 +174,41 @@ pub struct FitReport {
     pub max_angle_deg: f64,
     /// Root mean square of those angles, in degrees.
     pub rms_angle_deg: f64,
+    /// The starts the fit used.
+    pub starts: FittedStarts,
+    /// Constrained nodes that left the prior by far (module section "Warnings").
+    pub wild_nodes: usize,
+    /// Constrained nodes with little data on them (module section "Warnings").
+    pub sparse_nodes: usize,
+}
+
+impl FitReport {
+    /// A warning for the user when some node left the prior by far or has little data:
+    /// the residual, measured at the correspondences only, may then hide a wrong image.
+    pub fn warning(&self) -> Option<String> {
+        let mut parts = Vec::new();
+        if self.wild_nodes > 0 {
+            parts.push(format!(
+                "{} fitted node(s) left the prior by far (length over {WILD_LENGTH} times or \
+                 under 1/{WILD_LENGTH} of the median length ratio, or direction over \
+                 {WILD_ANGLE_DEG} degrees off)",
+                self.wild_nodes
+            ));
+        }
+        if self.sparse_nodes > 0 {
+            parts.push(format!(
+                "{} node(s) have little data (summed weight below {SPARSE_WEIGHT})",
+                self.sparse_nodes
+            ));
+        }
+        (!parts.is_empty()).then(|| {
+            format!(
+                "{}: the residual is measured at the correspondences only; check the fitted \
+                 image",
+                parts.join(" and ")
+            )
+        })
+    }
 }
 
 /// Fits the node directions of `prior` to `correspondences` (see the module docs); returns the
@@ -161,6 +263,136 @@ pub fn fit(
         weight.unwrap_or(0.0),
     );
     in_view(prior, correspondences, &targets, dirs)
+}
+
+/// Fits `prior` to `correspondences` with the starts model `starts` (module section
+/// "Starts"): `Kept` is [`fit`]; `Eye` the central fit (module `central`, its errors
+/// included); `Auto` is [`fit`]'s result, bit for bit, when that meets the data exactly
+/// (rms below `EXACT_RMS_RAD`), when the grid is curved, or when the central fit fails, and
+/// otherwise the central fit when its sum of squared angles beats the kept one's by more than
+/// 4 noise variances per extra unknown (its 3 eye coordinates; the variance estimated from
+/// the central fit's own residual and degrees of freedom), or when [`fit`] fails where it
+/// does not. Then counts the wild and sparse nodes (module section "Warnings").
+pub fn fit_with(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+    starts: Starts,
+) -> Result<(ProjectorGrid, FitReport)> {
+    let (grid, mut report) = match starts {
+        Starts::Kept => fit(prior, correspondences)?,
+        Starts::Eye => central_fit(prior, correspondences)?,
+        Starts::Auto => auto_fit(prior, correspondences)?,
+    };
+    (report.wild_nodes, report.sparse_nodes) = node_warnings(prior, &grid, correspondences);
+    Ok((grid, report))
+}
+
+/// Largest rms angle, in radians, of a kept-starts fit that `Starts::Auto` keeps without
+/// trying the eye (the rms miss `EXACT_CHORD` allows).
+const EXACT_RMS_RAD: f64 = 1e-6;
+
+/// The central fit, its report saying which eye it found.
+fn central_fit(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+) -> Result<(ProjectorGrid, FitReport)> {
+    let (grid, report, eye) = central::fit(prior, correspondences)?;
+    Ok((
+        grid,
+        FitReport {
+            starts: FittedStarts::Eye(eye),
+            ..report
+        },
+    ))
+}
+
+/// `Starts::Auto` (see [`fit_with`]).
+fn auto_fit(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+) -> Result<(ProjectorGrid, FitReport)> {
+    let kept = fit(prior, correspondences);
+    let exact = |r: &FitReport| r.rms_angle_deg.to_radians() <= EXACT_RMS_RAD;
+    if prior.is_curved() || kept.as_ref().is_ok_and(|(_, r)| exact(r)) {
+        return kept;
+    }
+    let Ok(central) = central_fit(prior, correspondences) else {
+        return kept;
+    };
+    let Ok((_, kept_report)) = &kept else {
+        return Ok(central);
+    };
+    let count = correspondences.len() as f64;
+    let sum_of_squares = |r: &FitReport| r.rms_angle_deg.powi(2) * count;
+    let constrained = constrained_nodes(prior, correspondences);
+    let unknowns = 3 * constrained.iter().filter(|c| **c).count() + 3 - 1;
+    let freedom = 2 * correspondences.len();
+    if freedom <= unknowns {
+        return kept;
+    }
+    let freedom = (freedom - unknowns) as f64;
+    let central_ss = sum_of_squares(&central.1);
+    if sum_of_squares(kept_report) > central_ss * (1.0 + 4.0 * 3.0 / freedom) {
+        Ok(central)
+    } else {
+        kept
+    }
+}
+
+/// A fitted node is wild when its length ratio to the prior's node is more than this many
+/// times the median ratio of the constrained nodes, or less than its inverse.
+const WILD_LENGTH: f64 = 4.0;
+
+/// A fitted node is wild when its direction is more than this many degrees off the prior's.
+const WILD_ANGLE_DEG: f64 = 60.0;
+
+/// A constrained node has little data when the grid weights on it, summed over the
+/// correspondences, are below this: less than one correspondence's two equations for the
+/// node's three unknowns.
+const SPARSE_WEIGHT: f64 = 1.0;
+
+/// The numbers of wild and sparse constrained nodes of `fitted` against `prior` (module
+/// section "Warnings").
+fn node_warnings(
+    prior: &ProjectorGrid,
+    fitted: &ProjectorGrid,
+    correspondences: &[Correspondence],
+) -> (usize, usize) {
+    let mut weight = vec![0.0; prior.starts().len()];
+    for c in correspondences {
+        prior.for_each_weight(c.uv, |j, w| weight[j] += w);
+    }
+    let direction = |g: &ProjectorGrid, j: usize| g.ends()[j] - g.starts()[j];
+    let constrained: Vec<usize> = (0..weight.len()).filter(|j| weight[*j] > 0.0).collect();
+    let ratios: Vec<f64> = constrained
+        .iter()
+        .map(|&j| direction(fitted, j).length() / direction(prior, j).length())
+        .collect();
+    let mut sorted = ratios.clone();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted.get(sorted.len() / 2).copied().unwrap_or(1.0);
+    let wild = constrained
+        .iter()
+        .zip(&ratios)
+        .filter(|(&j, &ratio)| {
+            let (a, b) = (direction(fitted, j), direction(prior, j));
+            let angle = a.cross(b).length().atan2(a.dot(b)).to_degrees();
+            let relative = ratio / median;
+            angle > WILD_ANGLE_DEG || !(1.0 / WILD_LENGTH..=WILD_LENGTH).contains(&relative)
+        })
+        .count();
+    let sparse = constrained
+        .iter()
+        .filter(|&&j| weight[j] < SPARSE_WEIGHT)
+        .count();
+    (wild, sparse)
+}
+
+/// The residual of `grid` (straight) at `correspondences`, seen from its own starts.
+fn report_of(grid: &ProjectorGrid, correspondences: &[Correspondence]) -> Result<FitReport> {
+    let targets = targets(grid, correspondences)?;
+    let constrained = constrained_nodes(grid, correspondences);
+    Ok(residual(grid, correspondences, &targets, &constrained))
 }
 
 /// The direction of correspondence `c`'s projector in `prior`'s grid with node directions
@@ -560,6 +792,7 @@ fn residual(
         } else {
             (angles.iter().map(|a| a * a).sum::<f64>() / count as f64).sqrt()
         },
+        ..FitReport::default()
     }
 }
 

@@ -241,12 +241,28 @@ impl Projection for Flexible {
     fn notes(&self) -> Vec<(&'static str, f64)> {
         match &self.volume {
             Volume::Grid(grid) => grid.fit.map_or_else(Vec::new, |r| {
-                vec![
+                let mut notes = vec![
                     ("fit_correspondences", r.correspondences as f64),
                     ("fit_unconstrained_nodes", r.unconstrained_nodes as f64),
                     ("fit_max_angle_deg", r.max_angle_deg),
                     ("fit_rms_angle_deg", r.rms_angle_deg),
-                ]
+                    ("fit_wild_nodes", r.wild_nodes as f64),
+                    ("fit_sparse_nodes", r.sparse_nodes as f64),
+                ];
+                // 1 when the starts lie on projectors through a fitted eye (given next).
+                let eye = match r.starts {
+                    fit::FittedStarts::Eye(eye) => Some(eye),
+                    fit::FittedStarts::Kept => None,
+                };
+                notes.push(("fit_starts_eye", f64::from(u8::from(eye.is_some()))));
+                if let Some(eye) = eye {
+                    notes.extend([
+                        ("fit_eye_x", eye.x),
+                        ("fit_eye_y", eye.y),
+                        ("fit_eye_z", eye.z),
+                    ]);
+                }
+                notes
             }),
             _ => Vec::new(),
         }

@@ -42,7 +42,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::fit::{fit, Correspondence, FitReport};
+use super::fit::{fit_with, Correspondence, FitReport, Starts};
 use super::volume::{LinearVolume, Volume};
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
@@ -472,6 +472,8 @@ pub struct ProjectorGridSpec {
     pub projectors: Vec<NodeProjector>,
     pub aims: Vec<Aim>,
     pub correspondences: Vec<Correspondence>,
+    /// Where the fitted projectors start (scene key `starts`; unused without correspondences).
+    pub starts: Starts,
 }
 
 /// A projector grid in use as a viewing volume, with the residual of its fit if it had one.
@@ -486,7 +488,7 @@ impl GridVolume {
     /// projectors, applies the aims in order, then fits the grid to the correspondences when
     /// there are any. Errors: a base with curved projectors, and the errors of
     /// [`ProjectorGrid::sample`], [`ProjectorGrid::set_projector`], [`ProjectorGrid::aim`] and
-    /// [`fit`] (which fits curved projectors when the grid has tangents).
+    /// [`fit_with`] (which fits curved projectors when the grid has tangents).
     pub fn build(spec: &ProjectorGridSpec, base: &Volume) -> Result<Self> {
         let Volume::Linear(linear) = base else {
             return Err(Error::new(
@@ -512,7 +514,7 @@ impl GridVolume {
         if spec.correspondences.is_empty() {
             return Ok(GridVolume { grid, fit: None });
         }
-        let (grid, report) = fit(&grid, &spec.correspondences)?;
+        let (grid, report) = fit_with(&grid, &spec.correspondences, spec.starts)?;
         Ok(GridVolume {
             grid,
             fit: Some(report),

@@ -299,6 +299,7 @@ fn grid_frame(tangents: impl Fn(DVec3, DVec3) -> Option<DVec3>) -> Frame {
                 projectors,
                 aims: Vec::new(),
                 correspondences: Vec::new(),
+                starts: Default::default(),
             },
         },
         Shading::Flat,

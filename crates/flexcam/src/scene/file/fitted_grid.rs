@@ -2,7 +2,7 @@
 //! the fitted node projectors explicit, so that an artist can go on editing them.
 //!
 //! The written file is the original text edited in place (comments and layout kept): in the
-//! projection's `projectors` table the `fit`, `aim` and `projector` keys are replaced by one
+//! projection's `projectors` table the `fit`, `aim`, `projector` and `starts` keys are replaced by one
 //! `projector` entry per node with its fitted `start` and `end`, and its `tangent` when it is
 //! curved (a grid with tangents is fitted with curved projectors). Floats are written in Rust's
 //! shortest round-trip form, so the written grid is the fitted one bit for bit, and rendering
@@ -53,13 +53,17 @@ pub fn fit_scene(text: &str, path: &Path, output: &Path) -> Result<FittedScene> 
         .and_then(Item::as_table_like_mut)
         .ok_or_else(|| Error::in_file(path, "the [projection] table has no `projectors`"))?;
     replace_nodes(projectors, &grid);
+    let warning = report
+        .warning()
+        .map_or_else(String::new, |w| format!("# Warning: {w}.\n"));
     let header = format!(
         "# Written by `flexcam fit` from {}: {} correspondences, residual max {:e} and rms \
-         {:e} degrees.\n",
+         {:e} degrees, {}.\n{warning}",
         path.display(),
         report.correspondences,
         report.max_angle_deg,
-        report.rms_angle_deg
+        report.rms_angle_deg,
+        report.starts
     );
     let written = format!("{header}{document}");
     check_round_trip(&written, output, &grid, width, height)?;
@@ -93,11 +97,11 @@ fn has_fit(spec: &FlexibleSpec) -> bool {
     matches!(&spec.source, VolumeSource::ProjectorGrid { grid, .. } if !grid.correspondences.is_empty())
 }
 
-/// Replaces `fit`, `aim` and `projector` in `table` by one `projector` entry per node of
+/// Replaces `fit`, `aim`, `projector` and `starts` (which goes with `fit` only) in `table` by one `projector` entry per node of
 /// `grid` (bottom row first), one per line, with the tangents of curved nodes (unit vectors
 /// that normalising leaves unchanged, so they load back bit for bit).
 fn replace_nodes(table: &mut dyn TableLike, grid: &ProjectorGrid) {
-    for key in ["fit", "aim", "projector"] {
+    for key in ["fit", "aim", "projector", "starts"] {
         table.remove(key);
     }
     let cols = grid.size().0;

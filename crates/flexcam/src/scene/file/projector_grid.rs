@@ -9,7 +9,7 @@ use toml::Spanned;
 use super::raw::{RawNodeProjector, RawProjectors};
 use super::source::Source;
 use crate::error::Result;
-use crate::projection::flexible::fit::Correspondence;
+use crate::projection::flexible::fit::{Correspondence, Starts};
 use crate::projection::flexible::projector_grid::{Through, MAX_NODES, MIN_NODES};
 use crate::projection::flexible::{Aim, GridInterpolation, NodeProjector, ProjectorGridSpec};
 
@@ -82,12 +82,38 @@ pub(super) fn convert(src: &Source, table: &Spanned<RawProjectors>) -> Result<Pr
             point: finite_point(src, &c.point, "point")?,
         });
     }
+    let starts = starts(src, raw)?;
     Ok(ProjectorGridSpec {
         size,
         interpolation,
         projectors,
         aims,
         correspondences,
+        starts,
+    })
+}
+
+/// The `starts` key: where the fitted projectors start (see the `fit` module); it goes with
+/// `fit` only.
+fn starts(src: &Source, raw: &RawProjectors) -> Result<Starts> {
+    let Some(name) = &raw.starts else {
+        return Ok(Starts::default());
+    };
+    if raw.fit.is_none() {
+        return Err(src.error(
+            &name.span(),
+            "`starts` goes with `fit` (it says where the fitted projectors start)",
+        ));
+    }
+    Starts::from_name(name.get_ref()).ok_or_else(|| {
+        src.error(
+            &name.span(),
+            format!(
+                "unknown starts \"{}\"; expected one of: {}",
+                name.get_ref(),
+                Starts::NAMES.join(", ")
+            ),
+        )
     })
 }
 

@@ -156,6 +156,7 @@ pub struct RawProjectors {
     pub projector: Option<Vec<Spanned<RawNodeProjector>>>,
     pub aim: Option<Vec<Spanned<RawAim>>>,
     pub fit: Option<Vec<Spanned<RawCorrespondence>>>,
+    pub starts: Option<Spanned<String>>,
 }
 
 /// `{ node = [column, row], start = [x, y, z], end = [x, y, z], tangent = [x, y, z] }`: one

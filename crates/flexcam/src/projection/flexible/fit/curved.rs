@@ -732,6 +732,7 @@ impl<'a> Problem<'a> {
             } else {
                 (angles.iter().map(|a| a * a).sum::<f64>() / count as f64).sqrt()
             },
+            ..FitReport::default()
         }
     }
 }

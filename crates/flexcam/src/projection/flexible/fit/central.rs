@@ -1,0 +1,575 @@
+//! The central fit (`starts = "eye"`): one common eye E found together with the node
+//! directions, every projector a line through E, for correspondences taken from a pinhole
+//! camera whose eye is not where the prior's starts are (module section "Starts" of `fit`).
+//!
+//! With the starts kept off the camera's eye no grid meets such data: a projector from a
+//! start off the eye through two points at different depths at nearby (u, v) disagrees, and
+//! where the data are sparse the kept-starts fit bends between the points (docs/flexible.md,
+//! "A small residual is not a faithful image"). Here every node starts on its own projector
+//! at S_j = E + s D_j, with one s for all nodes: then S(u, v) = E + s D(u, v) for any
+//! weights that sum to 1, so every projector of the grid, not only the nodes', passes
+//! through E, and a bilinear grid is any pinhole camera exactly (its direction field is
+//! affine in (u, v)).
+//!
+//! E is found by variable projection: for a given E the directions are the linear fit's
+//! (module `fit`, starts at E, solved twice, the second centred on the first), and
+//! Levenberg-Marquardt moves E to minimise the chords 2 sin(angle / 2) between the blended
+//! directions and the points seen from E, with central-difference derivatives in E (three
+//! unknowns; each residual is two small linear solves). It starts from the point nearest to
+//! the prior's node projectors (the prior's own eye, for a perspective prior) and from the
+//! centre of the 3 x 4 camera matrix that the direct linear transform fits to the data
+//! (exact for pinhole data), and keeps the better. The grid at the found eye is then fitted
+//! by `fit` with its starts at E, and the starts are moved along their projectors to the
+//! prior's near distance s (the prior's mean start parameter seen from its own eye, 0 when
+//! the prior has none), less where a point lies nearer the eye than that.
+//!
+//! Degenerate cases (each an error naming the cause, which `starts = "auto"` answers by
+//! keeping the prior's starts): a prior with tangents (curved projectors have no common
+//! eye); fewer than `MIN_POINTS` correspondences; points that all coincide; an eye the data
+//! do not determine (the misses change by less than `FLAT` of the data's extent when E
+//! moves in some direction: points all on one plane, or so few that the node directions
+//! absorb any move of E); image positions all on one line (points on one line through the
+//! eye among them); a descent that finds no eye at which the linear fit
+//! solves.
+
+use glam::{DMat3, DVec3};
+use nalgebra::{DMatrix, Matrix3, SymmetricEigen};
+
+use super::{blended, targets, Correspondence, FitReport, System};
+use crate::error::{Error, Result};
+use crate::projection::flexible::projector_grid::ProjectorGrid;
+
+/// The fewest correspondences an eye is fitted from: the direct linear transform's 11
+/// unknowns need six points.
+pub(super) const MIN_POINTS: usize = 6;
+
+/// Levenberg-Marquardt iterations at most per starting eye.
+const MAX_ITERATIONS: usize = 40;
+
+/// The eye is taken as undetermined when moving it by the data's extent in some direction
+/// changes the misses (rad, root sum of squares) by less than this, or by less than this
+/// fraction of the most that any direction changes them.
+const FLAT: f64 = 1e-6;
+
+/// The central-difference step in E, as a fraction of the data's extent.
+const STEP: f64 = 1e-5;
+
+/// Fits `prior`'s node directions and one common eye to `correspondences` (module docs);
+/// returns the grid, its residual and the eye.
+pub(super) fn fit(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+) -> Result<(ProjectorGrid, FitReport, DVec3)> {
+    if prior.is_curved() {
+        return Err(Error::new(
+            "projector grid fit: `starts = \"eye\"` fits straight projectors through one eye; \
+             this grid has tangents",
+        ));
+    }
+    if correspondences.len() < MIN_POINTS {
+        return Err(Error::new(format!(
+            "projector grid fit: an eye needs at least {MIN_POINTS} correspondences, not {}",
+            correspondences.len()
+        )));
+    }
+    let extent = extent(correspondences);
+    if extent <= 0.0 || !extent.is_finite() {
+        return Err(Error::new(
+            "projector grid fit: the correspondences' points all coincide; they determine no eye",
+        ));
+    }
+    if on_one_image_line(correspondences) {
+        return Err(undetermined());
+    }
+    let problem = Problem {
+        prior,
+        correspondences,
+        step: STEP * extent,
+    };
+    let best = [prior_centre(prior), dlt_centre(correspondences)]
+        .into_iter()
+        .flatten()
+        .filter_map(|start| problem.descend(start))
+        .min_by(|a, b| a.1.total_cmp(&b.1));
+    let Some((eye, _)) = best else {
+        return Err(Error::new(
+            "projector grid fit: no eye found at which the node directions can be fitted",
+        ));
+    };
+    problem.check_determined(eye, extent)?;
+    let at_eye = problem.grid_at(eye, &prior_directions(prior))?;
+    let (fitted, _) = super::fit(&at_eye, correspondences)?;
+    let grid = starts_moved(&fitted, correspondences, eye, near_fraction(prior))?;
+    let report = super::report_of(&grid, correspondences)?;
+    Ok((grid, report, eye))
+}
+
+/// The error of an eye the correspondences do not determine.
+fn undetermined() -> Error {
+    Error::new(
+        "projector grid fit: the correspondences do not determine an eye (they are met as \
+         well from other eyes: image positions on one line, points all on one plane, or too \
+         few points for the grid's nodes); use `starts = \"kept\"` or add points off that \
+         plane or line",
+    )
+}
+
+/// Whether the image positions all lie on one line (or at one position): a pinhole's points
+/// then lie in one plane through its eye, and every eye in that plane sees them in one plane
+/// of directions too, which the node directions can follow.
+fn on_one_image_line(correspondences: &[Correspondence]) -> bool {
+    let n = correspondences.len() as f64;
+    let mean = correspondences.iter().map(|c| c.uv).sum::<glam::DVec2>() / n;
+    let (mut xx, mut xy, mut yy) = (0.0, 0.0, 0.0);
+    for c in correspondences {
+        let d = c.uv - mean;
+        (xx, xy, yy) = (xx + d.x * d.x, xy + d.x * d.y, yy + d.y * d.y);
+    }
+    // The covariance's least eigenvalue, against a spread of 1e-6 in the image.
+    let (half_trace, det) = (0.5 * (xx + yy) / n, (xx * yy - xy * xy) / (n * n));
+    let least = half_trace - (half_trace * half_trace - det).max(0.0).sqrt();
+    least < 1e-12
+}
+
+/// The prior's node directions E_j - S_j.
+fn prior_directions(prior: &ProjectorGrid) -> Vec<DVec3> {
+    prior
+        .starts()
+        .iter()
+        .zip(prior.ends())
+        .map(|(s, e)| *e - *s)
+        .collect()
+}
+
+/// The root mean square distance of the correspondences' points from their centroid.
+fn extent(correspondences: &[Correspondence]) -> f64 {
+    let n = correspondences.len() as f64;
+    let centroid = correspondences.iter().map(|c| c.point).sum::<DVec3>() / n;
+    let spread: f64 = correspondences
+        .iter()
+        .map(|c| (c.point - centroid).length_squared())
+        .sum();
+    (spread / n).sqrt()
+}
+
+/// The point nearest (least squares) to the lines of `grid`'s node projectors: the eye of a
+/// perspective grid. `None` when the lines are (nearly) parallel.
+fn prior_centre(grid: &ProjectorGrid) -> Option<DVec3> {
+    let mut matrix = DMat3::ZERO;
+    let mut rhs = DVec3::ZERO;
+    for (s, e) in grid.starts().iter().zip(grid.ends()) {
+        let d = (*e - *s).try_normalize()?;
+        let off = DMat3::IDENTITY - DMat3::from_cols(d * d.x, d * d.y, d * d.z);
+        matrix += off;
+        rhs += off * *s;
+    }
+    let scale = matrix.x_axis.x + matrix.y_axis.y + matrix.z_axis.z;
+    let det = matrix.determinant();
+    (det.abs() > 1e-9 * scale.powi(3))
+        .then(|| matrix.inverse() * rhs)
+        .filter(|c| c.is_finite())
+}
+
+/// The start parameter s of the prior's nodes seen from its own eye ([`prior_centre`]):
+/// the mean of (S_j - E0) . D_j / |D_j|^2, at least 0; 0 when the prior has no eye.
+fn near_fraction(prior: &ProjectorGrid) -> f64 {
+    let Some(eye) = prior_centre(prior) else {
+        return 0.0;
+    };
+    let n = prior.starts().len() as f64;
+    let sum: f64 = prior
+        .starts()
+        .iter()
+        .zip(prior.ends())
+        .map(|(s, e)| (*s - eye).dot(*e - *s) / (*e - *s).length_squared())
+        .sum();
+    (sum / n).max(0.0)
+}
+
+/// The centre of the 3 x 4 camera matrix that the direct linear transform fits to the
+/// correspondences (points centred and scaled first), or `None` where the fit is degenerate
+/// or the centre is at infinity (an affine camera).
+fn dlt_centre(correspondences: &[Correspondence]) -> Option<DVec3> {
+    let n = correspondences.len() as f64;
+    let centroid = correspondences.iter().map(|c| c.point).sum::<DVec3>() / n;
+    let scale = extent(correspondences);
+    let mut a = DMatrix::<f64>::zeros(2 * correspondences.len(), 12);
+    for (k, c) in correspondences.iter().enumerate() {
+        let x = (c.point - centroid) / scale;
+        let h = [x.x, x.y, x.z, 1.0];
+        let (u, v) = (c.uv.x - 0.5, c.uv.y - 0.5);
+        for i in 0..4 {
+            a[(2 * k, i)] = -h[i];
+            a[(2 * k, 8 + i)] = u * h[i];
+            a[(2 * k + 1, 4 + i)] = -h[i];
+            a[(2 * k + 1, 8 + i)] = v * h[i];
+        }
+    }
+    // The camera matrix: the eigenvector of A^T A with the least eigenvalue.
+    let eigen = SymmetricEigen::new(a.transpose() * &a);
+    let least = eigen.eigenvalues.imin();
+    let p = eigen.eigenvectors.column(least);
+    let m = |r: usize, c: usize| p[4 * r + c];
+    // The centre: the null vector of P, by cofactors.
+    let minor = |skip: usize| {
+        let cols: Vec<usize> = (0..4).filter(|c| *c != skip).collect();
+        Matrix3::from_fn(|r, c| m(r, cols[c])).determinant()
+    };
+    let w = -minor(3);
+    let centre = DVec3::new(minor(0), -minor(1), minor(2)) / w;
+    (w.abs() > 1e-12 && centre.is_finite()).then_some(centroid + scale * centre)
+}
+
+/// The variable-projection problem in the eye E.
+struct Problem<'a> {
+    prior: &'a ProjectorGrid,
+    correspondences: &'a [Correspondence],
+    /// The central-difference step in E.
+    step: f64,
+}
+
+impl Problem<'_> {
+    /// The prior's grid with every start at `eye` and the node directions `dirs`.
+    fn grid_at(&self, eye: DVec3, dirs: &[DVec3]) -> Result<ProjectorGrid> {
+        let starts = vec![eye; dirs.len()];
+        let ends = dirs.iter().map(|d| eye + *d).collect();
+        ProjectorGrid::new(self.prior.size(), starts, ends, self.prior.interpolation())
+    }
+
+    /// The chords n_k - a_k (3 per correspondence) between the blended directions of the
+    /// linear fit with every start at `eye` and the unit directions from `eye` to the points;
+    /// `None` where that fit fails (a point at the eye, a zero-length node).
+    fn misses(&self, eye: DVec3) -> Option<Vec<f64>> {
+        let first = self.grid_at(eye, &prior_directions(self.prior)).ok()?;
+        let targets = targets(&first, self.correspondences).ok()?;
+        let dirs = System::new(&first, self.correspondences, &targets)
+            .solve(0.0)
+            .ok()?;
+        // Centred on the first solve: the prior's pull acts on its small residual only.
+        let second = self.grid_at(eye, &dirs).ok()?;
+        let dirs = System::new(&second, self.correspondences, &targets)
+            .solve(0.0)
+            .ok()?;
+        let mut out = Vec::with_capacity(3 * self.correspondences.len());
+        for (c, a) in self.correspondences.iter().zip(&targets) {
+            let n = blended(&second, c, &dirs).try_normalize()?;
+            out.extend((n - *a).to_array());
+        }
+        Some(out)
+    }
+
+    /// The derivative of [`Problem::misses`] in E by central differences: 3 columns.
+    fn jacobian(&self, eye: DVec3) -> Option<Vec<[f64; 3]>> {
+        let mut rows = vec![[0.0; 3]; 3 * self.correspondences.len()];
+        for axis in 0..3 {
+            let mut h = DVec3::ZERO;
+            h[axis] = self.step;
+            let (plus, minus) = (self.misses(eye + h)?, self.misses(eye - h)?);
+            for (row, (p, m)) in rows.iter_mut().zip(plus.iter().zip(&minus)) {
+                row[axis] = (p - m) / (2.0 * self.step);
+            }
+        }
+        Some(rows)
+    }
+
+    /// J^T J and J^T r at `eye`.
+    fn normal(&self, eye: DVec3, r: &[f64]) -> Option<(DMat3, DVec3)> {
+        let jacobian = self.jacobian(eye)?;
+        let mut jtj = DMat3::ZERO;
+        let mut jtr = DVec3::ZERO;
+        for (row, value) in jacobian.iter().zip(r) {
+            let j = DVec3::from_array(*row);
+            jtj += DMat3::from_cols(j * j.x, j * j.y, j * j.z);
+            jtr += j * *value;
+        }
+        Some((jtj, jtr))
+    }
+
+    /// Levenberg-Marquardt on the sum of squared misses from the eye `start`: the eye found
+    /// and its cost, or `None` where the misses cannot be evaluated at `start`.
+    fn descend(&self, start: DVec3) -> Option<(DVec3, f64)> {
+        let cost_of = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>();
+        let mut eye = start;
+        let mut r = self.misses(eye)?;
+        let mut cost = cost_of(&r);
+        let mut damping = 1e-3;
+        for _ in 0..MAX_ITERATIONS {
+            if cost < 1e-30 {
+                break;
+            }
+            let Some((jtj, jtr)) = self.normal(eye, &r) else {
+                break;
+            };
+            let mut improved = false;
+            for _ in 0..12 {
+                let diagonal = DVec3::new(jtj.x_axis.x, jtj.y_axis.y, jtj.z_axis.z);
+                let damped =
+                    jtj + DMat3::from_diagonal(damping * diagonal.max(DVec3::splat(1e-30)));
+                let step = -(damped.inverse() * jtr);
+                let next = eye + step;
+                if let Some(r_next) = step.is_finite().then(|| self.misses(next)).flatten() {
+                    let next_cost = cost_of(&r_next);
+                    if next_cost < cost {
+                        let decrease = cost - next_cost;
+                        (eye, r, cost) = (next, r_next, next_cost);
+                        damping = (damping * 0.1).max(1e-12);
+                        improved = decrease > 1e-14 * cost;
+                        break;
+                    }
+                }
+                damping *= 10.0;
+            }
+            if !improved {
+                break;
+            }
+        }
+        Some((eye, cost))
+    }
+
+    /// An error when the misses at `eye` hardly change as E moves in some direction (module
+    /// docs, degenerate cases): the eye is then not determined by the data.
+    fn check_determined(&self, eye: DVec3, extent: f64) -> Result<()> {
+        let r = self.misses(eye).ok_or_else(undetermined)?;
+        let (jtj, _) = self.normal(eye, &r).ok_or_else(undetermined)?;
+        let symmetric = Matrix3::from_fn(|i, j| jtj.col(j)[i]);
+        let eigenvalues = SymmetricEigen::new(symmetric).eigenvalues;
+        let (least, most) = (eigenvalues.min().max(0.0).sqrt(), eigenvalues.max().sqrt());
+        if least * extent < FLAT || least < FLAT * most {
+            return Err(undetermined());
+        }
+        Ok(())
+    }
+}
+
+/// `fitted` (every start at `eye`) with its starts moved along their projectors to
+/// S_j = E + s D_j, the end D_j beyond, for the near fraction `s` less where a point lies
+/// nearer the eye than that (then half the nearest point's parameter).
+fn starts_moved(
+    fitted: &ProjectorGrid,
+    correspondences: &[Correspondence],
+    eye: DVec3,
+    near: f64,
+) -> Result<ProjectorGrid> {
+    let dirs = prior_directions(fitted);
+    let nearest = correspondences
+        .iter()
+        .map(|c| {
+            let d = blended(fitted, c, &dirs);
+            (c.point - eye).dot(d) / d.length_squared()
+        })
+        .fold(f64::INFINITY, f64::min);
+    let s = near.min(0.5 * nearest);
+    if s <= 0.0 {
+        return Ok(fitted.clone());
+    }
+    let starts = dirs.iter().map(|d| eye + s * *d).collect();
+    let ends = dirs.iter().map(|d| eye + (1.0 + s) * *d).collect();
+    ProjectorGrid::new(fitted.size(), starts, ends, fitted.interpolation())
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec2;
+    use proptest::prelude::*;
+
+    use super::super::{fit_with, FittedStarts, Starts};
+    use super::*;
+    use crate::projection::flexible::projector_grid::tests::perspective_volume as perspective;
+    use crate::projection::flexible::projector_grid::GridInterpolation;
+
+    /// The fixture camera's eye (`projector_grid::tests::preset_volume`).
+    const EYE: DVec3 = DVec3::new(0.0, 1.0, 5.0);
+
+    /// A 3 x 3 bilinear grid of a `fov`-degree perspective camera with near clip 1, every
+    /// point moved by `offset`.
+    fn camera_grid(fov: f64, offset: DVec3) -> ProjectorGrid {
+        let grid = ProjectorGrid::sample(
+            &perspective(fov, [1.0, 40.0]),
+            (3, 3),
+            GridInterpolation::Bilinear,
+        )
+        .unwrap();
+        let starts = grid.starts().iter().map(|s| *s + offset).collect();
+        let ends = grid.ends().iter().map(|e| *e + offset).collect();
+        ProjectorGrid::new((3, 3), starts, ends, GridInterpolation::Bilinear).unwrap()
+    }
+
+    /// `count` points seen by `truth` at seeded image positions and depths t in (0.1, 0.6).
+    fn seen_by(truth: &ProjectorGrid, count: usize, seed: u64) -> Vec<Correspondence> {
+        let mut state = seed;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (0..count)
+            .map(|_| {
+                let uv = DVec2::new(next(), next());
+                let t = 0.1 + 0.5 * next();
+                Correspondence {
+                    uv,
+                    point: truth.point(uv, t),
+                }
+            })
+            .collect()
+    }
+
+    /// The largest distance from `eye` to a projector line of `grid` over a 9 x 9 grid of
+    /// (u, v).
+    fn farthest_line(grid: &ProjectorGrid, eye: DVec3) -> f64 {
+        let mut worst = 0.0f64;
+        for i in 0..=8 {
+            for j in 0..=8 {
+                let uv = DVec2::new(f64::from(i), f64::from(j)) / 8.0;
+                let (s, e) = grid.start_end(uv);
+                let d = (e - s).normalize();
+                worst = worst.max((eye - s).cross(d).length());
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn recovers_a_pinhole_eye_from_a_prior_whose_starts_are_off_it() {
+        let truth = camera_grid(50.0, DVec3::ZERO);
+        // The prior: a wider camera 1.2 away, its starts on its own near plane.
+        let prior = camera_grid(70.0, DVec3::new(0.8, -0.5, 0.7));
+        let data = seen_by(&truth, 16, 3);
+        let (fitted, report, eye) = fit(&prior, &data).unwrap();
+        assert!((eye - EYE).length() < 1e-9, "{eye}");
+        assert!(report.max_angle_deg < 1e-6, "{report:?}");
+        assert!(farthest_line(&fitted, EYE) < 1e-8);
+        // The starts moved to the prior's near fraction 1 / 39 along the projectors.
+        let d = fitted.ends()[4] - fitted.starts()[4];
+        assert!((fitted.starts()[4] - (EYE + d / 39.0)).length() < 1e-8 * d.length());
+        // `auto` takes it (the kept starts miss by degrees), and says so.
+        let (kept, kept_report) = fit_with(&prior, &data, Starts::Kept).unwrap();
+        assert!(kept_report.max_angle_deg > 0.1, "{kept_report:?}");
+        assert_eq!(kept_report.starts, FittedStarts::Kept);
+        let (auto, auto_report) = fit_with(&prior, &data, Starts::Auto).unwrap();
+        assert_eq!(auto, fitted);
+        assert!(matches!(auto_report.starts, FittedStarts::Eye(e) if e == eye));
+        assert_ne!(kept, fitted);
+    }
+
+    #[test]
+    fn auto_keeps_exact_kept_starts_bit_for_bit() {
+        let truth = camera_grid(50.0, DVec3::ZERO);
+        // The prior has the truth's starts: the kept fit is exact, and `auto` is that fit.
+        let prior = truth
+            .with_ends(camera_grid(80.0, DVec3::ZERO).ends().to_vec())
+            .unwrap();
+        let data = seen_by(&truth, 30, 5);
+        let kept = super::super::fit(&prior, &data).unwrap();
+        assert!(kept.1.max_angle_deg < 1e-6);
+        let (grid, report) = fit_with(&prior, &data, Starts::Auto).unwrap();
+        assert_eq!(grid, kept.0);
+        assert_eq!(report.starts, FittedStarts::Kept);
+        assert_eq!(
+            (report.max_angle_deg, report.rms_angle_deg),
+            (kept.1.max_angle_deg, kept.1.rms_angle_deg)
+        );
+    }
+
+    #[test]
+    fn too_few_points_curved_priors_and_undetermined_eyes_are_refused() {
+        let truth = camera_grid(50.0, DVec3::ZERO);
+        let prior = camera_grid(70.0, DVec3::new(0.8, -0.5, 0.7));
+        let five = seen_by(&truth, 5, 3);
+        let e = fit(&prior, &five).unwrap_err();
+        assert!(e.message.contains("at least 6 correspondences"), "{e}");
+        // Eight points on one line through the eye, at one (u, v): any eye on that line
+        // meets them.
+        let uv = DVec2::new(0.3, 0.6);
+        let line: Vec<_> = (0..8)
+            .map(|k| Correspondence {
+                uv,
+                point: truth.point(uv, 0.1 + 0.1 * f64::from(k)),
+            })
+            .collect();
+        let e = fit(&prior, &line).unwrap_err();
+        assert!(e.message.contains("do not determine an eye"), "{e}");
+        // Twelve points for a 3 x 3 grid's 27 direction unknowns: the nodes absorb any move
+        // of the eye.
+        let e = fit(&prior, &seen_by(&truth, 12, 3)).unwrap_err();
+        assert!(e.message.contains("do not determine an eye"), "{e}");
+        // Twenty points on one plane (z = -5, across the view): from any eye the plane's
+        // points are affine in (u, v), which a bilinear grid meets exactly.
+        let plane: Vec<_> = seen_by(&truth, 20, 4)
+            .into_iter()
+            .map(|c| {
+                let (s, e) = truth.start_end(c.uv);
+                let t = (-5.0 - s.z) / (e.z - s.z);
+                Correspondence {
+                    point: s + t * (e - s),
+                    ..c
+                }
+            })
+            .collect();
+        let e = fit(&prior, &plane).unwrap_err();
+        assert!(e.message.contains("do not determine an eye"), "{e}");
+        // `auto` then keeps the prior's starts.
+        let (_, report) = fit_with(&prior, &line, Starts::Auto).unwrap();
+        assert_eq!(report.starts, FittedStarts::Kept);
+        // A curved prior has no common eye.
+        let mut curved = prior.clone();
+        let (s, end) = (curved.starts()[4], curved.ends()[4]);
+        curved
+            .set_projector((1, 1), s, end, Some((end - s).normalize() + DVec3::X * 0.1))
+            .unwrap();
+        let e = fit(&curved, &seen_by(&truth, 16, 3)).unwrap_err();
+        assert!(e.message.contains("has tangents"), "{e}");
+        // All points at one place.
+        let same = vec![five[0]; 8];
+        assert!(fit(&prior, &same).unwrap_err().message.contains("coincide"));
+    }
+
+    #[test]
+    fn a_wild_and_a_sparse_node_are_counted() {
+        let prior = camera_grid(60.0, DVec3::ZERO);
+        let data = seen_by(&prior, 40, 9);
+        let (grid, report) = fit_with(&prior, &data, Starts::Kept).unwrap();
+        assert_eq!(
+            (report.wild_nodes, report.sparse_nodes),
+            (0, 0),
+            "{report:?}"
+        );
+        assert!(report.warning().is_none());
+        // Node 0 ten times as long, node 8 turned by 90 degrees: both wild.
+        let mut ends = grid.ends().to_vec();
+        ends[0] = grid.starts()[0] + 10.0 * (ends[0] - grid.starts()[0]);
+        let d = ends[8] - grid.starts()[8];
+        ends[8] = grid.starts()[8] + d.cross(DVec3::Y).normalize() * d.length();
+        let wild = grid.with_ends(ends).unwrap();
+        assert_eq!(super::super::node_warnings(&prior, &wild, &data).0, 2);
+        // One point near the centre: the corner nodes carry weights below 1.
+        let one = [Correspondence {
+            uv: DVec2::new(0.4, 0.45),
+            point: prior.point(DVec2::new(0.4, 0.45), 0.3),
+        }];
+        let (_, sparse) = super::super::node_warnings(&prior, &prior, &one);
+        assert_eq!(sparse, 4);
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+
+        /// The central fit inverts a pinhole camera: its eye comes back from any 16 of its
+        /// points, whatever the prior's position.
+        #[test]
+        fn the_eye_of_any_pinhole_camera_comes_back(
+            fov in 20.0f64..120.0,
+            offset in prop::array::uniform3(-2.0f64..2.0),
+            moved in prop::array::uniform3(-1.5f64..1.5),
+            seed in 0u64..1000,
+        ) {
+            let truth = camera_grid(fov, DVec3::from(offset));
+            let prior = camera_grid(60.0, DVec3::from(moved));
+            let data = seen_by(&truth, 16, seed);
+            let (_, report, eye) = fit(&prior, &data).unwrap();
+            prop_assert!((eye - (EYE + DVec3::from(offset))).length() < 1e-7, "{eye}");
+            prop_assert!(report.max_angle_deg < 1e-5, "{report:?}");
+        }
+    }
+}
