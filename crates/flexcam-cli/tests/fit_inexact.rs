@@ -50,8 +50,11 @@ fn printed_residual(stdout: &str) -> (f64, f64) {
 #[test]
 fn the_audit_correspondences_fit_from_every_near_surface() {
     let dir = TempDir::new().unwrap();
-    // Bounds: about twice the measured residuals (docs/flexible.md, "Inexact data").
-    for (near, bound) in [("0", 2e-5), ("0.1", 0.04), ("0.5", 0.3), ("2", 3.0)] {
+    // Bounds: about twice the measured residuals (docs/flexible.md, "Inexact data"). Near 0
+    // (starts at the true eye): 12 points leave the free directions undetermined, so `auto`
+    // takes the pinhole through the fitted eye, exact up to the points' 6 decimals
+    // (2.5e-5 degrees, 4e-7 rad; the free directions had met them to 1e-5).
+    for (near, bound) in [("0", 5e-5), ("0.1", 0.04), ("0.5", 0.3), ("2", 3.0)] {
         let scene = dir.path().join(format!("audit-{near}.toml"));
         std::fs::write(&scene, audit_scene(near)).unwrap();
         let out = Command::cargo_bin("flexcam")

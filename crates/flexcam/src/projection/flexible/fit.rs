@@ -67,9 +67,12 @@
 //! Kept starts off a pinhole camera's eye meet no grid to its correspondences, and sparse
 //! data then bend the fit between the points (a small residual, a wrong image). [`fit_with`]
 //! takes the scene key `starts`: `Kept` is [`fit`]; `Eye` fits one common eye with the
-//! directions, every projector through it (module `central`); `Auto`, the default, keeps the
-//! starts when they meet the data exactly (bit for bit the old result) and takes the eye
-//! where it meets the data clearly better.
+//! directions, every projector through it (module `central`: a pinhole camera's affine
+//! direction field where that explains the data, else free node directions); `Auto`, the
+//! default, keeps the starts when they meet the data exactly and the data determine the
+//! free directions (bit for bit the old result), takes an exact eye fit where they do not
+//! (sparse data met exactly by many bent grids), and otherwise the eye where it meets the
+//! data clearly better.
 //!
 //! # Warnings
 //!
@@ -121,8 +124,8 @@ pub enum Starts {
     Kept,
     /// One common eye is fitted with the directions; every projector passes through it.
     Eye,
-    /// The kept starts where they meet the data exactly, else the eye where it meets the
-    /// data clearly better (see [`fit_with`]).
+    /// The kept starts where they meet the data exactly and determine the directions, else
+    /// the eye where it meets the data exactly or clearly better (see [`fit_with`]).
     #[default]
     Auto,
 }
@@ -313,19 +316,30 @@ fn auto_fit(
 ) -> Result<(ProjectorGrid, FitReport)> {
     let kept = fit(prior, correspondences);
     let exact = |r: &FitReport| r.rms_angle_deg.to_radians() <= EXACT_RMS_RAD;
-    if prior.is_curved() || kept.as_ref().is_ok_and(|(_, r)| exact(r)) {
+    // Fewer equations (2 a correspondence) than free node directions (3 a constrained
+    // node, less the scale): the kept fit meets the points exactly whatever lies between
+    // them, so its exactness says nothing; the eye is tried as well.
+    let constrained = constrained_nodes(prior, correspondences);
+    let node_unknowns = 3 * constrained.iter().filter(|c| **c).count();
+    let determined = 2 * correspondences.len() + 1 > node_unknowns;
+    if prior.is_curved() || (determined && kept.as_ref().is_ok_and(|(_, r)| exact(r))) {
         return kept;
     }
     let Ok(central) = central_fit(prior, correspondences) else {
         return kept;
     };
+    // An exact central fit where the kept starts are not: the data are a pinhole's (the
+    // central fit's pinhole field needs six points, where the counts below are those of
+    // free node directions, which sparse data leave undetermined).
+    if exact(&central.1) {
+        return Ok(central);
+    }
     let Ok((_, kept_report)) = &kept else {
         return Ok(central);
     };
     let count = correspondences.len() as f64;
     let sum_of_squares = |r: &FitReport| r.rms_angle_deg.powi(2) * count;
-    let constrained = constrained_nodes(prior, correspondences);
-    let unknowns = 3 * constrained.iter().filter(|c| **c).count() + 3 - 1;
+    let unknowns = node_unknowns + 3 - 1;
     let freedom = 2 * correspondences.len();
     if freedom <= unknowns {
         return kept;

@@ -81,25 +81,65 @@ pub(super) fn fit(
     if on_one_image_line(correspondences) {
         return Err(undetermined());
     }
-    let problem = Problem {
+    let problem = |model| Problem {
         prior,
         correspondences,
         step: STEP * extent,
+        model,
     };
-    let best = [prior_centre(prior), dlt_centre(correspondences)]
-        .into_iter()
-        .flatten()
-        .filter_map(|start| problem.descend(start))
-        .min_by(|a, b| a.1.total_cmp(&b.1));
-    let Some((eye, _)) = best else {
-        return Err(Error::new(
-            "projector grid fit: no eye found at which the node directions can be fitted",
-        ));
+    let (pinhole, free) = (problem(Model::Pinhole), problem(Model::Free));
+    let starts = [prior_centre(prior), dlt_centre(correspondences)];
+    let best = |problem: &Problem| {
+        starts
+            .into_iter()
+            .flatten()
+            .filter_map(|start| problem.descend(start))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(eye, _)| eye)
     };
-    problem.check_determined(eye, extent)?;
-    let at_eye = problem.grid_at(eye, &prior_directions(prior))?;
-    let (fitted, _) = super::fit(&at_eye, correspondences)?;
-    let grid = starts_moved(&fitted, correspondences, eye, near_fraction(prior))?;
+    // The pinhole first (8 unknowns and the eye): six points in general position determine
+    // it, where the free directions need points enough for every node.
+    let pinhole_fit = best(&pinhole)
+        .filter(|&eye| pinhole.check_determined(eye, extent).is_ok())
+        .and_then(|eye| Some((pinhole_grid(&pinhole, eye)?, eye)));
+    if let Some(((grid, report), eye)) = &pinhole_fit {
+        if report.rms_angle_deg.to_radians() <= PINHOLE_EXACT {
+            return finish(grid, correspondences, *eye, prior);
+        }
+    }
+    let free_fit = best(&free)
+        .ok_or_else(|| {
+            Error::new(
+                "projector grid fit: no eye found at which the node directions can be fitted",
+            )
+        })
+        .and_then(|eye| {
+            free.check_determined(eye, extent)?;
+            let at_eye = free.grid_at(eye, &prior_directions(prior))?;
+            Ok((super::fit(&at_eye, correspondences)?, eye))
+        });
+    let (fitted, eye) = match (pinhole_fit, free_fit) {
+        (Some(((grid, report), eye)), Ok(((_, free_report), _)))
+            if pinhole_suffices(&report, &free_report, prior.starts().len()) =>
+        {
+            (grid, eye)
+        }
+        (_, Ok(((grid, _), eye))) => (grid, eye),
+        (Some(((grid, _), eye)), Err(_)) => (grid, eye),
+        (None, Err(e)) => return Err(e),
+    };
+    finish(&fitted, correspondences, eye, prior)
+}
+
+/// `fitted` (every start at `eye`) with its starts moved to the prior's near distance, its
+/// report and the eye.
+fn finish(
+    fitted: &ProjectorGrid,
+    correspondences: &[Correspondence],
+    eye: DVec3,
+    prior: &ProjectorGrid,
+) -> Result<(ProjectorGrid, FitReport, DVec3)> {
+    let grid = starts_moved(fitted, correspondences, eye, near_fraction(prior))?;
     let report = super::report_of(&grid, correspondences)?;
     Ok((grid, report, eye))
 }
@@ -220,12 +260,118 @@ fn dlt_centre(correspondences: &[Correspondence]) -> Option<DVec3> {
     (w.abs() > 1e-12 && centre.is_finite()).then_some(centroid + scale * centre)
 }
 
+/// Rms miss (radians) at or below which the pinhole's direction field is taken as exact.
+const PINHOLE_EXACT: f64 = 1e-6;
+
+/// The grid at `eye` whose node directions sample the affine direction field
+/// D(u, v) = A (u - 1/2) + B (v - 1/2) + C that best meets the correspondences: the pinhole
+/// camera with its centre at `eye` (its 9 unknowns, 8 up to scale, against 3 a node for the
+/// free directions), by homogeneous least squares on P_k D(u_k, v_k) = 0, scaled to the
+/// prior's mean length and lengthened so that every point is in view. A bilinear or Bezier
+/// grid reproduces an affine field exactly (linear precision), so with pinhole data every
+/// projector between the correspondences is the camera's too, where the free directions
+/// fit the points and may bend between them (module docs). `None` where the field is
+/// degenerate or turns some point behind the eye.
+fn pinhole_grid(problem: &Problem, eye: DVec3) -> Option<(ProjectorGrid, FitReport)> {
+    let dirs = pinhole_directions(problem.prior, problem.correspondences, eye)?;
+    let at_eye = problem.grid_at(eye, &dirs).ok()?;
+    let targets = targets(&at_eye, problem.correspondences).ok()?;
+    super::in_view(&at_eye, problem.correspondences, &targets, dirs).ok()
+}
+
+/// The node directions of [`pinhole_grid`] before they are lengthened into view.
+fn pinhole_directions(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+    eye: DVec3,
+) -> Option<Vec<DVec3>> {
+    let mut normal = DMatrix::<f64>::zeros(9, 9);
+    for c in correspondences {
+        let a = (c.point - eye).try_normalize()?;
+        let off = DMat3::IDENTITY - DMat3::from_cols(a * a.x, a * a.y, a * a.z);
+        let (u, v) = (c.uv.x - 0.5, c.uv.y - 0.5);
+        // The 3 x 9 block P [u I, v I, I] of this correspondence.
+        let block = DMatrix::<f64>::from_fn(3, 9, |r, col| {
+            let factor = [u, v, 1.0][col / 3];
+            factor * off.col(col % 3)[r]
+        });
+        normal += block.transpose() * block;
+    }
+    let eigen = SymmetricEigen::new(normal);
+    let field = eigen
+        .eigenvectors
+        .column(eigen.eigenvalues.imin())
+        .into_owned();
+    let column = |i: usize| DVec3::new(field[3 * i], field[3 * i + 1], field[3 * i + 2]);
+    let (a, b, c) = (column(0), column(1), column(2));
+    let at = |uv: glam::DVec2| a * (uv.x - 0.5) + b * (uv.y - 0.5) + c;
+    let facing: Vec<f64> = correspondences
+        .iter()
+        .map(|k| at(k.uv).dot(k.point - eye))
+        .collect();
+    let sign = if facing.iter().sum::<f64>() < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    if facing.iter().any(|f| sign * f <= 0.0) {
+        return None;
+    }
+    let (cols, rows) = prior.size();
+    let mut dirs = Vec::with_capacity(cols * rows);
+    for row in 0..rows {
+        for col in 0..cols {
+            dirs.push(sign * at(prior.node_uv(col, row)));
+        }
+    }
+    let mean = |d: &[DVec3]| d.iter().map(|v| v.length()).sum::<f64>() / d.len() as f64;
+    let scale = mean(&prior_directions(prior)) / mean(&dirs);
+    if !(scale.is_finite() && scale > 0.0) {
+        return None;
+    }
+    dirs.iter_mut().for_each(|d| *d *= scale);
+    Some(dirs)
+}
+
+/// Whether the pinhole's direction field (8 unknowns) explains the data as well as the
+/// free directions of `nodes` nodes (3 a node less 1) do: its misses are at rounding level, or the
+/// free fit lowers the sum of squared misses by no more than 4 noise variances per extra
+/// unknown, the variance estimated from the pinhole's own misses (the simpler model's
+/// estimate, so that sparse data, where the free fit has few or no spare equations, keep
+/// the pinhole). The same rule as `starts = "auto"`'s between kept starts and the eye.
+fn pinhole_suffices(pinhole: &FitReport, free: &FitReport, nodes: usize) -> bool {
+    let rad = |deg: f64| deg.to_radians();
+    if rad(pinhole.rms_angle_deg) <= PINHOLE_EXACT {
+        return true;
+    }
+    let n = pinhole.correspondences as f64;
+    let sse = |r: &FitReport| n * rad(r.rms_angle_deg).powi(2);
+    let free_unknowns = 3.0 * nodes as f64 - 1.0;
+    let extra = free_unknowns - 8.0;
+    let spare = 2.0 * n - 8.0;
+    if spare <= 0.0 || extra <= 0.0 {
+        return true;
+    }
+    let variance = sse(pinhole) / spare;
+    sse(pinhole) - sse(free) <= 4.0 * extra * variance
+}
+
+/// The direction field fitted for a given eye.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Model {
+    /// Every node direction free (the linear fit of module `fit`).
+    Free,
+    /// The affine field of a pinhole camera at the eye ([`pinhole_directions`]).
+    Pinhole,
+}
+
 /// The variable-projection problem in the eye E.
 struct Problem<'a> {
     prior: &'a ProjectorGrid,
     correspondences: &'a [Correspondence],
     /// The central-difference step in E.
     step: f64,
+    model: Model,
 }
 
 impl Problem<'_> {
@@ -237,9 +383,16 @@ impl Problem<'_> {
     }
 
     /// The chords n_k - a_k (3 per correspondence) between the blended directions of the
-    /// linear fit with every start at `eye` and the unit directions from `eye` to the points;
-    /// `None` where that fit fails (a point at the eye, a zero-length node).
+    /// model's field at `eye` (the linear fit with every start at `eye`, or the pinhole's)
+    /// and the unit directions from `eye` to the points; `None` where that fit fails (a point
+    /// at the eye, a zero-length node, a pinhole field turning a point behind).
     fn misses(&self, eye: DVec3) -> Option<Vec<f64>> {
+        if self.model == Model::Pinhole {
+            let dirs = pinhole_directions(self.prior, self.correspondences, eye)?;
+            let grid = self.grid_at(eye, &dirs).ok()?;
+            let targets = targets(&grid, self.correspondences).ok()?;
+            return self.chords(&grid, &targets, &dirs);
+        }
         let first = self.grid_at(eye, &prior_directions(self.prior)).ok()?;
         let targets = targets(&first, self.correspondences).ok()?;
         let dirs = System::new(&first, self.correspondences, &targets)
@@ -250,9 +403,15 @@ impl Problem<'_> {
         let dirs = System::new(&second, self.correspondences, &targets)
             .solve(0.0)
             .ok()?;
+        self.chords(&second, &targets, &dirs)
+    }
+
+    /// The chords n_k - a_k between the blended unit directions of `grid`'s nodes `dirs`
+    /// and the unit directions `targets` from the starts to the points.
+    fn chords(&self, grid: &ProjectorGrid, targets: &[DVec3], dirs: &[DVec3]) -> Option<Vec<f64>> {
         let mut out = Vec::with_capacity(3 * self.correspondences.len());
-        for (c, a) in self.correspondences.iter().zip(&targets) {
-            let n = blended(&second, c, &dirs).try_normalize()?;
+        for (c, a) in self.correspondences.iter().zip(targets) {
+            let n = blended(grid, c, dirs).try_normalize()?;
             out.extend((n - *a).to_array());
         }
         Some(out)
@@ -490,10 +649,29 @@ mod tests {
             .collect();
         let e = fit(&prior, &line).unwrap_err();
         assert!(e.message.contains("do not determine an eye"), "{e}");
-        // Twelve points for a 3 x 3 grid's 27 direction unknowns: the nodes absorb any move
-        // of the eye.
-        let e = fit(&prior, &seen_by(&truth, 12, 3)).unwrap_err();
-        assert!(e.message.contains("do not determine an eye"), "{e}");
+        // Six and twelve points, fewer equations than a 3 x 3 grid's 27 free direction
+        // unknowns (the free directions absorb any move of the eye): the pinhole field's
+        // 8 unknowns still determine it, and every projector, not only the points', is the
+        // camera's.
+        for count in [6, 12] {
+            let (fitted, _, eye) = fit(&prior, &seen_by(&truth, count, 3)).unwrap();
+            assert!((eye - EYE).length() < 1e-8, "{count}: {eye}");
+            assert!(farthest_line(&fitted, EYE) < 1e-7, "{count}");
+            for uv in [
+                DVec2::new(0.9, 0.1),
+                DVec2::new(0.05, 0.95),
+                DVec2::splat(0.5),
+            ] {
+                let along = |g: &ProjectorGrid| {
+                    let (s, e) = g.start_end(uv);
+                    (e - s).normalize()
+                };
+                assert!(
+                    (along(&fitted) - along(&truth)).length() < 1e-8,
+                    "{count} {uv}"
+                );
+            }
+        }
         // Twenty points on one plane (z = -5, across the view): from any eye the plane's
         // points are affine in (u, v), which a bilinear grid meets exactly.
         let plane: Vec<_> = seen_by(&truth, 20, 4)
