@@ -31,8 +31,9 @@ pub use linear::{Orthographic, Perspective};
 pub use panoramic::{Cylindrical, Equirectangular};
 pub use projector::{Projector, ProjectorHull};
 pub use trilinear::{
-    project_solved_triangle, project_triangle, surfaces, ProjectionTriangleCache, SceneEdge, Shape,
-    ShapeVertex, Solutions, TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
+    project_solved_triangle, project_triangle, surfaces, ProjectionTriangleCache, ProjectiveMap,
+    SceneEdge, Shape, ShapeVertex, Solutions, TriangleShapes, TriangleSolution, Trilinear,
+    Unprojectable,
 };
 
 use glam::{DVec2, DVec3};

@@ -24,7 +24,7 @@ use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::projection::surfaces::{reflector_surface, Optic, ReflectorSurface};
+use crate::projection::surfaces::{reflector_surface, Optic, ReflectorSurface, SurfaceScreenMap};
 use crate::projection::{Perspective, Projection, ProjectionSpec, Trilinear, TrilinearMesh};
 use crate::render::raycast::{specular, RayCaster};
 use crate::render::surface::normals;
@@ -59,7 +59,7 @@ pub fn render(
     let camera = main_camera(scene, main)?;
     let mut main_scene = scene.clone();
     for object in &mut main_scene.objects {
-        if scene.trilinear_reflectors.contains(&object.id) {
+        if scene.trilinear_reflectors.iter().any(|r| r.id == object.id) {
             object.material.surface = Surface::Diffuse;
         }
     }
@@ -68,12 +68,13 @@ pub fn render(
     let (mut triangles, mut dropped, mut pixels, mut fresnel_rays) = (0, 0, 0, 0);
     let exact = ExactPixels::new(scene, &camera, options);
     let mut exact_pixels = 0;
-    for &id in &scene.trilinear_reflectors {
+    for entry in &scene.trilinear_reflectors {
+        let (id, map) = (entry.id, entry.screen_map);
         let reflector = Reflector::of(scene, id)?;
         let surface = reflector_surface(&reflector.mesh, &camera, reflector.optic)?;
         triangles += surface.mesh.triangles.len();
         dropped += surface.dropped;
-        let projection = surface_projection(&surface, &camera)?;
+        let projection = surface_projection(&surface, map, &camera)?;
         if let Some(projection) = &projection {
             let image = render_others(scene, id, projection, options, renderer)?;
             pixels += match (options.shading, reflector.optic) {
@@ -82,7 +83,7 @@ pub fn render(
                 (Shading::Lit, Optic::Refract { .. }) => {
                     let mirror = reflector_surface(&reflector.mesh, &camera, Optic::Reflect)?;
                     let reflection =
-                        render_through(scene, id, &mirror, &camera, options, renderer)?
+                        render_through(scene, id, &mirror, map, &camera, options, renderer)?
                             .unwrap_or_else(|| {
                                 Frame::new(image.width, image.height, scene.image.background)
                             });
@@ -244,18 +245,19 @@ impl Reflector {
     }
 }
 
-/// Renders `scene` without object `id` through `surface` at the main camera's resolution:
-/// the reflected or refracted view in main-image coordinates; `None` when the surface has no
-/// triangles (the main camera does not see the reflector).
+/// Renders `scene` without object `id` through `surface` with screen map `map` at the main
+/// camera's resolution: the reflected or refracted view in main-image coordinates; `None`
+/// when the surface has no triangles (the main camera does not see the reflector).
 pub fn render_through(
     scene: &Scene,
     id: u32,
     surface: &ReflectorSurface,
+    map: SurfaceScreenMap,
     camera: &Perspective,
     options: &RenderOptions,
     renderer: &Renderer,
 ) -> Result<Option<Frame>> {
-    surface_projection(surface, camera)?
+    surface_projection(surface, map, camera)?
         .map(|projection| render_others(scene, id, &projection, options, renderer))
         .transpose()
 }
@@ -274,17 +276,15 @@ fn render_others(
     Ok(renderer(&others, projection, options)?.0)
 }
 
-/// The trilinear projection of `surface` at the main camera's resolution; `None` when the
-/// surface has no triangles.
+/// The trilinear projection of `surface` with screen map `map` at the main camera's
+/// resolution; `None` when the surface has no triangles.
 fn surface_projection(
     surface: &ReflectorSurface,
+    map: SurfaceScreenMap,
     camera: &Perspective,
 ) -> Result<Option<Trilinear>> {
-    if surface.mesh.triangles.is_empty() {
-        return Ok(None);
-    }
     let (width, height) = camera.resolution();
-    Trilinear::new(&surface.mesh, width, height).map(Some)
+    surface.projection(map, width, height)
 }
 
 /// Exact ray casting of the reflector pixels a surface does not cover: the ray caster's own

@@ -14,6 +14,7 @@ use std::path::PathBuf;
 
 use glam::{Affine3A, Vec3};
 
+use crate::projection::surfaces::SurfaceScreenMap;
 use crate::projection::ProjectionSpec;
 
 /// One object of a scene. Its id (1-based, in file order; 0 is the background) is what the
@@ -58,10 +59,30 @@ pub struct Scene {
     /// The folder relative paths in the scene (models, textures, projection surfaces) are
     /// resolved against; `None` for built-in scenes.
     pub base_dir: Option<PathBuf>,
-    /// Ids of the mirror and glass objects whose reflection or refraction is rendered
-    /// through a trilinear surface and composited into the main image (scene-file key
+    /// The mirror and glass objects whose reflection or refraction is rendered through a
+    /// trilinear surface and composited into the main image (scene-file key
     /// `trilinear_reflector`; see [`crate::render::composite`]). Empty: plain rendering.
-    pub trilinear_reflectors: Vec<u32>,
+    pub trilinear_reflectors: Vec<TrilinearReflector>,
+}
+
+/// A mirror or glass object rendered through a trilinear surface (seed 000, chapter 7).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TrilinearReflector {
+    /// The object's id.
+    pub id: u32,
+    /// How the surface maps main-image pixels to its triangles (scene-file key
+    /// `trilinear_screen_map`).
+    pub screen_map: SurfaceScreenMap,
+}
+
+impl TrilinearReflector {
+    /// Object `id` with the default (projective) screen map.
+    pub fn new(id: u32) -> TrilinearReflector {
+        TrilinearReflector {
+            id,
+            screen_map: SurfaceScreenMap::default(),
+        }
+    }
 }
 
 impl Scene {

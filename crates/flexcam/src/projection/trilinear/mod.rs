@@ -7,9 +7,16 @@
 //! p_k and n_k linearly (trinorm is never renormalised: its length is the depth scale).
 //! The inverse solves a cubic per projection triangle ([`point_projection`], with the cached
 //! N/K form of each triangle): [`Projection::project`] returns every visible image.
+//!
+//! The map from screen position to `(u, v)` is affine (the thesis's screen-space
+//! interpolation) unless the projection has screen weights
+//! ([`Trilinear::with_screen_weights`]): then it is the projective map of
+//! [`projective_map`], which makes a surface whose screen positions are an eye's image of its
+//! base points send each screen point's ray from the base point that the eye sees there.
 
 mod obj;
 mod point_projection;
+mod projective_map;
 mod screen_locator;
 mod shapes;
 pub mod surfaces;
@@ -21,6 +28,7 @@ use super::{ImagePoint, Projection, TrilinearMesh};
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
 pub use point_projection::{ProjectionTriangleCache, Solutions, TriangleSolution};
+pub use projective_map::ProjectiveMap;
 use screen_locator::ScreenLocator;
 pub use shapes::{
     project_solved_triangle, project_triangle, SceneEdge, Shape, ShapeVertex, TriangleShapes,
@@ -39,6 +47,10 @@ pub struct Trilinear {
     resolution: Resolution,
     /// The point-projection cache of each triangle, same order as `mesh.triangles`.
     caches: Vec<ProjectionTriangleCache>,
+    /// The per-vertex screen weights, `None` for the affine screen map.
+    weights: Option<Vec<f64>>,
+    /// The projective screen map of each triangle (same order); empty for the affine map.
+    maps: Vec<ProjectiveMap>,
 }
 
 impl Trilinear {
@@ -71,7 +83,74 @@ impl Trilinear {
             locator: ScreenLocator::new(screen_triangles),
             resolution,
             caches,
+            weights: None,
+            maps: Vec::new(),
         })
+    }
+
+    /// As [`Trilinear::new`], with the projective screen map of per-vertex screen weights
+    /// `weights` (same order as the mesh's vertices; [`ProjectiveMap`]): the screen point
+    /// with affine barycentrics `l` in a screen triangle takes the ray at barycentrics
+    /// `b_i = l_i w_i / sum_j l_j w_j`. With `w_i = 1 / depth_i`, the forward depths of the
+    /// base points from an eye whose image of them the screen positions are, every screen
+    /// point gets the ray from the base point the eye sees there. Errors: those of
+    /// [`Trilinear::new`]; a weight count other than the vertex count; a weight that is not
+    /// finite and positive (a vertex at the eye or behind it, or a zero weight: the map
+    /// would be singular inside a triangle).
+    pub fn with_screen_weights(
+        mesh: &TrilinearMesh,
+        weights: &[f64],
+        width: u32,
+        height: u32,
+    ) -> Result<Self> {
+        let mut trilinear = Trilinear::new(mesh, width, height)?;
+        if weights.len() != mesh.points.len() {
+            return Err(Error::new(format!(
+                "trilinear screen weights: {} for {} vertices",
+                weights.len(),
+                mesh.points.len()
+            )));
+        }
+        trilinear.maps = mesh
+            .triangles
+            .iter()
+            .enumerate()
+            .map(|(index, t)| {
+                ProjectiveMap::new(t.map(|k| weights[k as usize])).ok_or_else(|| {
+                    Error::new(format!(
+                        "trilinear triangle {index} has screen weights {:?}: each must be \
+                         finite and positive",
+                        t.map(|k| weights[k as usize])
+                    ))
+                })
+            })
+            .collect::<Result<_>>()?;
+        trilinear.weights = Some(weights.to_vec());
+        Ok(trilinear)
+    }
+
+    /// The projective screen map of the triangle with vertices `vertices`; `None` for the
+    /// affine map (or a vertex index out of range).
+    pub fn projective_map(&self, vertices: [usize; 3]) -> Option<ProjectiveMap> {
+        let weights = self.weights.as_ref()?;
+        let [a, b, c] = vertices.map(|k| weights.get(k).copied());
+        ProjectiveMap::new([a?, b?, c?])
+    }
+
+    /// The barycentrics of triangle `index`'s ray at affine screen barycentrics `screen`.
+    fn barycentrics_at_screen(&self, index: usize, screen: DVec2) -> DVec2 {
+        match self.maps.get(index) {
+            Some(map) => map.barycentrics(screen),
+            None => screen,
+        }
+    }
+
+    /// The affine screen barycentrics of triangle `index`'s ray at barycentrics `b`.
+    fn screen_at_barycentrics(&self, index: usize, b: DVec2) -> DVec2 {
+        match self.maps.get(index) {
+            Some(map) => map.screen(b),
+            None => b,
+        }
     }
 
     /// The projection mesh.
@@ -85,9 +164,10 @@ impl Trilinear {
     pub fn locate(&self, pixel: DVec2) -> Option<(usize, f64, f64)> {
         let size = self.resolution.size();
         let screen = DVec2::new(pixel.x / size.x, 1.0 - pixel.y / size.y);
-        self.locator
-            .locate(screen)
-            .map(|hit| (hit.triangle, hit.u, hit.v))
+        self.locator.locate(screen).map(|hit| {
+            let b = self.barycentrics_at_screen(hit.triangle, DVec2::new(hit.u, hit.v));
+            (hit.triangle, b.x, b.y)
+        })
     }
 
     /// The point-projection cache of each projection triangle (same order as the mesh's
@@ -156,7 +236,8 @@ impl Projection for Trilinear {
         (self.resolution.width, self.resolution.height)
     }
 
-    /// Pixel (x, y) is screen (x / W, 1 - y / H). `None` where no screen triangle covers it,
+    /// Pixel (x, y) is screen (x / W, 1 - y / H); its barycentrics `(u, v)` are affine in the
+    /// screen position, or projective with screen weights. `None` where no screen triangle covers it,
     /// and where the interpolated direction trinorm is exactly zero (possible inside a
     /// triangle whose normals point in opposing directions: the projector is a single point).
     fn ray(&self, pixel: DVec2) -> Option<Ray> {
@@ -230,9 +311,10 @@ impl Projection for Trilinear {
                     }
                     0.0
                 };
-                let w = 1.0 - s.u - s.v;
-                let screen =
-                    w * self.mesh.screen[i] + s.u * self.mesh.screen[j] + s.v * self.mesh.screen[k];
+                let l = self.screen_at_barycentrics(index, DVec2::new(s.u, s.v));
+                let screen = (1.0 - l.x - l.y) * self.mesh.screen[i]
+                    + l.x * self.mesh.screen[j]
+                    + l.y * self.mesh.screen[k];
                 if !self.covers(index, screen, cache, s, t) {
                     continue;
                 }
@@ -270,11 +352,12 @@ impl Trilinear {
             return true;
         }
         let other = &self.caches[hit.triangle];
-        let theirs = other.ray_point(hit.u, hit.v, t);
+        let b = self.barycentrics_at_screen(hit.triangle, DVec2::new(hit.u, hit.v));
+        let theirs = other.ray_point(b.x, b.y, t);
         let ours = cache.ray_point(s.u, s.v, t);
         let scale = ours.abs().max_element()
-            + other.tripoint(hit.u, hit.v).abs().max_element()
-            + t * other.trinorm(hit.u, hit.v).length();
+            + other.tripoint(b.x, b.y).abs().max_element()
+            + t * other.trinorm(b.x, b.y).length();
         (theirs - ours).length() <= 1e-8 * scale
     }
 }
@@ -583,6 +666,85 @@ mod tests {
         trilinear.project(DVec3::new(0.2, 0.3, 3.0), &mut out);
         assert_eq!(out.len(), 1, "{out:?}");
         assert!((out[0].t - 3.0).abs() < 1e-12, "{out:?}");
+    }
+
+    /// A 3 x 3-cell surface seen by an eye at the origin looking down +z, whose screen
+    /// position `s` images `(4 s - 2) z` at depth `z` (the grid vertex's `depths` entry):
+    /// base points at varying depths, rays `(tilt, 1) length`, and weights `1 / z`.
+    fn eye_surface(depths: &[f64], tilts: &[(f64, f64, f64)]) -> (TrilinearMesh, Vec<f64>) {
+        let index = |s: DVec2| (4.0 * (3.0 * s.y).round() + (3.0 * s.x).round()) as usize;
+        let mesh = screen_grid(3, |s| {
+            let z = depths[index(s)];
+            let (tx, ty, len) = tilts[index(s)];
+            GridVertex {
+                point: DVec3::new((4.0 * s.x - 2.0) * z, (4.0 * s.y - 2.0) * z, z),
+                direction: DVec3::new(tx, ty, 1.0) * len,
+            }
+        })
+        .unwrap();
+        let weights = mesh.points.iter().map(|p| 1.0 / p.z).collect();
+        (mesh, weights)
+    }
+
+    #[test]
+    fn screen_weights_are_validated() {
+        let (mesh, mut weights) = eye_surface(&[2.0; 16], &[(0.0, 0.0, 1.0); 16]);
+        assert!(Trilinear::with_screen_weights(&mesh, &weights, 8, 8).is_ok());
+        let short = Trilinear::with_screen_weights(&mesh, &weights[1..], 8, 8);
+        assert!(short.unwrap_err().message.contains("15 for 16 vertices"));
+        for bad in [0.0, -0.5, f64::NAN, f64::INFINITY] {
+            weights[5] = bad;
+            let error = Trilinear::with_screen_weights(&mesh, &weights, 8, 8).unwrap_err();
+            assert!(error.message.contains("finite and positive"), "{bad}");
+        }
+        // The affine projection has no weights.
+        let affine = Trilinear::new(&mesh, 8, 8).unwrap();
+        assert!(affine.projective_map([0, 1, 2]).is_none());
+    }
+
+    mod projective_round_trip {
+        use super::*;
+        use proptest::prelude::*;
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(300))]
+
+            /// Pixel -> ray -> point -> project -> the pixel again (and every image's ray
+            /// reaches the point), and each pixel's ray starts on the eye's ray through the
+            /// pixel: the projective map is the eye's.
+            #[test]
+            fn pixel_to_point_to_pixel_through_an_eye_surface(
+                depths in proptest::collection::vec(2.0..6.0f64, 16),
+                tilts in proptest::collection::vec(
+                    (-0.01..0.01f64, -0.01..0.01f64, 0.5..2.0f64), 16),
+                (x, y) in (0.0..1.0f64, 0.0..1.0f64),
+                t in 0.0..10.0f64,
+            ) {
+                let (mesh, weights) = eye_surface(&depths, &tilts);
+                let (width, height) = (640, 480);
+                let trilinear =
+                    Trilinear::with_screen_weights(&mesh, &weights, width, height).unwrap();
+                let pixel = DVec2::new(x * f64::from(width), y * f64::from(height));
+                let ray = trilinear.ray(pixel).unwrap();
+                let eye_ray = DVec3::new(4.0 * x - 2.0, 4.0 * (1.0 - y) - 2.0, 1.0);
+                prop_assert!(
+                    ray.origin.cross(eye_ray).length() <= 1e-12 * ray.origin.length() * eye_ray.length(),
+                    "origin {} off the eye ray {}", ray.origin, eye_ray
+                );
+                let point = ray.at(t);
+                let mut out = Vec::new();
+                trilinear.project(point, &mut out);
+                let found = out.iter().any(|image| {
+                    (image.pixel - pixel).length() <= 1e-6
+                        && (image.t - t).abs() <= 1e-9 * t.max(1.0)
+                });
+                prop_assert!(found, "{pixel} t {t}: {out:?}");
+                for image in &out {
+                    let r = trilinear.ray(image.pixel).unwrap();
+                    prop_assert!((r.at(image.t) - point).length() <= 1e-9 * (1.0 + point.length()));
+                }
+            }
+        }
     }
 
     mod round_trip {

@@ -6,6 +6,7 @@ use crate::projection::surfaces::test_scenes::{
 };
 use crate::render::compare::{compare, Comparison};
 use crate::render::Method;
+use crate::scene::TrilinearReflector;
 
 const SIZE: (u32, u32) = (160, 120);
 
@@ -16,7 +17,7 @@ fn scene() -> Scene {
 
 fn sphere_and_cube_reflector(segments: u32) -> Scene {
     let mut scene = sphere_and_cube(segments);
-    scene.trilinear_reflectors = vec![BALL];
+    scene.trilinear_reflectors = vec![TrilinearReflector::new(BALL)];
     scene
 }
 
@@ -84,9 +85,17 @@ fn composite_from(scene: &Scene, main: &dyn Projection, surface: &ReflectorSurfa
     plain.trilinear_reflectors.clear();
     plain.objects[0].material.surface = Surface::Diffuse;
     let mut frame = raycast(&plain, main, &flat()).unwrap().0;
-    let image = render_through(scene, BALL, surface, &camera, &flat(), &raycast)
-        .unwrap()
-        .unwrap();
+    let image = render_through(
+        scene,
+        BALL,
+        surface,
+        SurfaceScreenMap::Projective,
+        &camera,
+        &flat(),
+        &raycast,
+    )
+    .unwrap()
+    .unwrap();
     paste(&mut frame, BALL, &image, Vec3::ONE).unwrap();
     frame
 }
@@ -213,7 +222,7 @@ fn lens_scene() -> Scene {
     .scene("lens.toml");
     // Replace the placeholder sphere by the lens plane at y = 1.2.
     scene.objects[0].mesh = lens_plane(1.2, 2.2);
-    scene.trilinear_reflectors = vec![1];
+    scene.trilinear_reflectors = vec![TrilinearReflector::new(1)];
     scene
 }
 
@@ -258,9 +267,17 @@ fn lit_glass_mixes_reflection_and_refraction_by_fresnel() {
     plain.trilinear_reflectors.clear();
     plain.objects[0].material.surface = Surface::Diffuse;
     let mut alone = raycast(&plain, main.as_ref(), &lit).unwrap().0;
-    let image = render_through(&scene, 1, &refraction, &camera, &lit, &raycast)
-        .unwrap()
-        .unwrap();
+    let image = render_through(
+        &scene,
+        1,
+        &refraction,
+        SurfaceScreenMap::Projective,
+        &camera,
+        &lit,
+        &raycast,
+    )
+    .unwrap()
+    .unwrap();
     paste(&mut alone, 1, &image, lens.tint).unwrap();
     let (refraction_only, _) = agreement(&alone, &reference, 1);
     println!(
@@ -339,11 +356,11 @@ fn paste_replaces_only_the_reflector_and_checks_sizes() {
 #[test]
 fn bad_reflectors_are_errors() {
     let mut scene = scene();
-    scene.trilinear_reflectors = vec![9];
+    scene.trilinear_reflectors = vec![TrilinearReflector::new(9)];
     let main = scene.projection.build(40, 30).unwrap();
     let e = render(&scene, main.as_ref(), &flat(), &raycast).unwrap_err();
     assert!(e.message.contains("no object has this id"), "{e}");
-    scene.trilinear_reflectors = vec![2];
+    scene.trilinear_reflectors = vec![TrilinearReflector::new(2)];
     let e = render(&scene, main.as_ref(), &flat(), &raycast).unwrap_err();
     assert!(e.message.contains("must be a mirror or glass"), "{e}");
     let mut scene = self::scene();
@@ -396,7 +413,7 @@ fn uncovered_reflector_pixels_are_ray_cast_exactly() {
         cell: 0.5,
     };
     let mut scene = behind.scene("behind.toml");
-    scene.trilinear_reflectors = vec![BALL];
+    scene.trilinear_reflectors = vec![TrilinearReflector::new(BALL)];
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let camera = main_camera(&scene, main.as_ref()).unwrap();
     let mirror = Reflector::of(&scene, BALL).unwrap();
@@ -422,7 +439,7 @@ fn uncovered_reflector_pixels_are_ray_cast_exactly() {
         ..behind
     };
     let mut scene = front.scene("front.toml");
-    scene.trilinear_reflectors = vec![BALL];
+    scene.trilinear_reflectors = vec![TrilinearReflector::new(BALL)];
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let (_, stats) = render(&scene, main.as_ref(), &flat(), &raycast).unwrap();
     let Some(Counter::Count(cast)) = stats.get("reflector_exact_pixels") else {
@@ -497,4 +514,88 @@ fn trilinear_method_composites_reflectors() {
     let mut plain = scene.clone();
     plain.trilinear_reflectors.clear();
     assert!(render_with_method(&plain, main.as_ref(), &flat(), Method::Trilinear).is_err());
+}
+
+/// [`lens_scene`] with index of refraction `ior` and the lens's screen map `map`; with
+/// `flat_normals` the plate's vertex normals are all +y (a flat plate, or with a mirror, a
+/// flat mirror).
+fn plate_scene(ior: f32, map: SurfaceScreenMap, flat_normals: bool) -> Scene {
+    let mut scene = lens_scene();
+    scene.objects[0].material.surface = Surface::Glass { ior };
+    if flat_normals {
+        scene.objects[0].mesh.normals.fill(Vec3::Y);
+    }
+    scene.trilinear_reflectors[0].screen_map = map;
+    scene
+}
+
+/// The composite of `scene` (the trilinear method or the ray caster) against the exact
+/// ray-cast image, over the whole frame and on the reflector's pixels.
+fn composite_error(scene: &Scene, method: Method) -> (Comparison, Comparison) {
+    let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
+    let reference = reference(scene, main.as_ref());
+    let (frame, _) = render_with_method(scene, main.as_ref(), &flat(), method).unwrap();
+    let whole = compare(&frame, &reference).unwrap();
+    (whole, agreement(&frame, &reference, 1).0)
+}
+
+/// A flat mirror (a 4 x 4-quad plane facing +z) in front of the checker floor and the cube,
+/// with screen map `map`.
+fn flat_mirror_scene(map: SurfaceScreenMap) -> Scene {
+    let mut scene = ReflectorFixture {
+        eye: [0.5, 1.2, 3.0],
+        look_at: [0.0, 1.0, 0.0],
+        reflector: "shape = \"plane\"\nsize = [2.0, 2.0]\nmaterial = \"mirror\"\n\
+                    tessellation = 4\nrotate = [90.0, 0.0, 0.0]\ntranslate = [0.0, 1.2, 0.0]",
+        cube: "size = [0.6, 0.6, 0.6]\ntranslate = [0.8, 0.3, 1.5]",
+        cell: 0.5,
+    }
+    .scene("flat-mirror.toml");
+    scene.trilinear_reflectors = vec![TrilinearReflector {
+        id: 1,
+        screen_map: map,
+    }];
+    scene
+}
+
+/// Straight vertex rays (ior 1) and a flat mirror: with the projective screen map every
+/// main-image pixel's surface ray is the exact ray (the eye ray from the point it meets the
+/// plate on, or its mirror image), so the composite is the exact image up to rounding at
+/// colour edges, for the ray-cast and the trilinear composite; the affine map of seed 000
+/// (7.2.2) misses by an order of magnitude more (docs/robustness.md, audit 3).
+#[test]
+fn projective_surfaces_are_exact_for_straight_rays_and_flat_mirrors() {
+    type Make = fn(SurfaceScreenMap) -> Scene;
+    let cases: [(&str, Make); 3] = [
+        ("ior 1 plate", |map| plate_scene(1.0, map, true)),
+        ("ior 1 lens", |map| plate_scene(1.0, map, false)),
+        ("flat mirror", flat_mirror_scene),
+    ];
+    for (name, make) in cases {
+        let projective = make(SurfaceScreenMap::Projective);
+        let affine = make(SurfaceScreenMap::Affine);
+        for method in [Method::Raycast, Method::Trilinear] {
+            let (whole, on_plate) = composite_error(&projective, method);
+            let (_, affine_on_plate) = composite_error(&affine, method);
+            println!(
+                "{name}, {method:?}: ids {:.5}, RGB {:.6} on {} reflector pixels (affine {:.6})",
+                whole.id_agreement,
+                on_plate.relative_rgb_error,
+                on_plate.pixels,
+                affine_on_plate.relative_rgb_error
+            );
+            assert!(on_plate.pixels > 2000, "{name}");
+            assert!(whole.id_agreement >= 0.9999, "{name} {method:?}: {whole:?}");
+            assert!(
+                on_plate.relative_rgb_error < 1e-3,
+                "{name} {method:?}: {on_plate:?}"
+            );
+            assert!(
+                affine_on_plate.relative_rgb_error > 5.0 * on_plate.relative_rgb_error,
+                "{name} {method:?}: affine {} vs {}",
+                affine_on_plate.relative_rgb_error,
+                on_plate.relative_rgb_error
+            );
+        }
+    }
 }

@@ -20,18 +20,26 @@
 //! interpolated linearly over the polygon, are their values at every pixel. The hit is the
 //! one `Resolver::hit`'s Moller-Trumbore gives, rounded differently.
 //!
+//! With a projective screen map (`Trilinear::with_screen_weights`), `(u, v)` is not affine in
+//! pixel position, but the homogeneous weight `W` is, and so is every term times `W`
+//! ([`crate::projection::ProjectiveMap`]). The terms are then carried multiplied by `W`, with
+//! `W` itself as a seventh term: `t = (W N) / (W D)` is unchanged and
+//! `b1 = (W a1 + t W c1) / W`. For the affine map `W` is exactly 1 at every vertex, hence
+//! at every pixel (the interpolation of a constant is exact), and the division by it changes
+//! nothing.
+//!
 //! Degenerate cases: a scene triangle of zero area has no plane ([`HitTerms::new`] gives
 //! `None`); a projector parallel to the plane has `D = 0` and a non-finite `t`, and
 //! [`Terms::hit`] gives `None` for it as for any non-finite value.
 
 use glam::DVec3;
 
-use crate::projection::ProjectionTriangleCache;
+use super::screen_map::ScreenMap;
 
 /// How many terms a vertex carries (the rasteriser's attribute count).
-pub const TERMS: usize = 6;
+pub const TERMS: usize = 7;
 
-/// The terms at one point, in the order `[a1, a2, c1, c2, N, D]`.
+/// The terms at one point, in the order `[a1, a2, c1, c2, N, D, W]` (module doc).
 pub type Terms = [f64; TERMS];
 
 /// Where the pieces of the hit are, as a fragment's attributes.
@@ -41,6 +49,7 @@ const C1: usize = 2;
 const C2: usize = 3;
 const NUMERATOR: usize = 4;
 const DENOMINATOR: usize = 5;
+const WEIGHT: usize = 6;
 
 /// One scene triangle's plane, ready to give the terms at any projector.
 #[derive(Debug, Clone, Copy)]
@@ -65,8 +74,10 @@ impl HitTerms {
         })
     }
 
-    /// The terms at barycentrics `(u, v)` of the projection triangle of `cache`.
-    pub fn at(&self, cache: &ProjectionTriangleCache, u: f64, v: f64) -> Terms {
+    /// The terms at barycentrics `(u, v)` of the projection triangle of `map`, multiplied
+    /// by its homogeneous weight there (module doc; 1 for the affine map).
+    pub fn at(&self, map: &ScreenMap, u: f64, v: f64) -> Terms {
+        let cache = map.cache();
         let offset = cache.tripoint(u, v) - self.corner;
         let direction = cache.trinorm(u, v);
         let mut terms = [0.0; TERMS];
@@ -76,25 +87,32 @@ impl HitTerms {
         terms[C2] = self.dual[1].dot(direction);
         terms[NUMERATOR] = -self.normal.dot(offset);
         terms[DENOMINATOR] = self.normal.dot(direction);
+        terms[WEIGHT] = 1.0;
+        if let Some(weight) = map.homogeneous_weight(u, v) {
+            terms.iter_mut().for_each(|term| *term *= weight);
+        }
         terms
     }
 }
 
 /// The hit the terms describe: `(t, b1, b2)`, the ray parameter and the barycentrics of
 /// the triangle's second and third corners (unbounded: outside the triangle too); `None`
-/// where the projector is parallel to the plane or a value is not finite.
+/// where the projector is parallel to the plane or a value is not finite (also a zero
+/// weight, which no pixel of a valid projective map has).
 #[inline]
 pub fn hit(terms: &Terms) -> Option<(f64, f64, f64)> {
     let t = terms[NUMERATOR] / terms[DENOMINATOR];
-    let b1 = terms[A1] + t * terms[C1];
-    let b2 = terms[A2] + t * terms[C2];
+    let b1 = (terms[A1] + t * terms[C1]) / terms[WEIGHT];
+    let b2 = (terms[A2] + t * terms[C2]) / terms[WEIGHT];
     (t.is_finite() && b1.is_finite() && b2.is_finite()).then_some((t, b1, b2))
 }
 
 #[cfg(test)]
 mod tests {
+    use glam::DVec2;
+
     use super::*;
-    use crate::projection::ProjectionTriangleCache;
+    use crate::projection::{ProjectionTriangleCache, ProjectiveMap};
 
     fn cache() -> ProjectionTriangleCache {
         ProjectionTriangleCache::new(
@@ -107,6 +125,20 @@ mod tests {
         )
     }
 
+    /// The affine map of [`cache`]'s triangle, and the projective one of weights 1, 0.5, 2.
+    fn maps() -> [ScreenMap; 2] {
+        let screen = [
+            DVec2::new(0.1, 0.2),
+            DVec2::new(0.9, 0.3),
+            DVec2::new(0.4, 0.95),
+        ];
+        let affine = ScreenMap::new(screen, DVec2::new(200.0, 100.0), cache());
+        [
+            affine,
+            affine.with_projective(ProjectiveMap::new([1.0, 0.5, 2.0])),
+        ]
+    }
+
     const TRIANGLE: [DVec3; 3] = [
         DVec3::new(-1.0, -1.0, 3.0),
         DVec3::new(2.0, -0.5, 4.0),
@@ -115,26 +147,37 @@ mod tests {
 
     #[test]
     fn terms_give_the_exact_hit() {
-        let cache = cache();
         let terms = HitTerms::new(TRIANGLE).unwrap();
-        for (u, v) in [(0.2, 0.3), (0.0, 0.0), (0.9, 0.05), (-0.3, 1.2)] {
-            let (t, b1, b2) = hit(&terms.at(&cache, u, v)).unwrap();
-            let on_ray = cache.ray_point(u, v, t);
-            let [a, b, c] = TRIANGLE;
-            let on_plane = a + b1 * (b - a) + b2 * (c - a);
-            assert!((on_ray - on_plane).length() < 1e-12, "{u} {v}");
+        for map in maps() {
+            for (u, v) in [(0.2, 0.3), (0.0, 0.0), (0.9, 0.05), (0.1, 0.85)] {
+                let (t, b1, b2) = hit(&terms.at(&map, u, v)).unwrap();
+                let on_ray = map.cache().ray_point(u, v, t);
+                let [a, b, c] = TRIANGLE;
+                let on_plane = a + b1 * (b - a) + b2 * (c - a);
+                assert!((on_ray - on_plane).length() < 1e-12, "{u} {v}");
+            }
         }
     }
 
     #[test]
-    fn interpolated_terms_are_the_terms_of_the_midpoint() {
-        // Affine in (u, v): the mean of the terms at two points is the terms at their middle.
-        let cache = cache();
+    fn affine_terms_carry_a_weight_of_exactly_one() {
         let terms = HitTerms::new(TRIANGLE).unwrap();
-        let (p, q) = (terms.at(&cache, 0.1, 0.7), terms.at(&cache, 0.6, 0.1));
-        let middle = terms.at(&cache, 0.35, 0.4);
-        for i in 0..TERMS {
-            assert!((0.5 * (p[i] + q[i]) - middle[i]).abs() < 1e-12, "term {i}");
+        assert_eq!(terms.at(&maps()[0], 0.3, 0.4)[WEIGHT], 1.0);
+    }
+
+    #[test]
+    fn interpolated_terms_are_the_terms_of_the_middle_pixel() {
+        // Affine in pixel position (for the projective map, the weighted terms): the mean
+        // of the terms at two points is the terms at the pixel halfway between them.
+        let terms = HitTerms::new(TRIANGLE).unwrap();
+        for map in maps() {
+            let (p, q) = (terms.at(&map, 0.1, 0.7), terms.at(&map, 0.6, 0.1));
+            let middle_pixel = 0.5 * (map.pixel(0.1, 0.7) + map.pixel(0.6, 0.1));
+            let uv = map.barycentrics(middle_pixel);
+            let middle = terms.at(&map, uv.x, uv.y);
+            for i in 0..TERMS {
+                assert!((0.5 * (p[i] + q[i]) - middle[i]).abs() < 1e-12, "term {i}");
+            }
         }
     }
 
@@ -147,15 +190,18 @@ mod tests {
     }
 
     #[test]
-    fn projector_parallel_to_the_plane_has_no_hit() {
+    fn projector_parallel_to_the_plane_or_zero_weight_has_no_hit() {
         // The plane x = 5 and the projector at (u, v) = (0, 1), direction (0, 0.25, 0.9).
         let plane = [
             DVec3::new(5.0, 0.0, 0.0),
             DVec3::new(5.0, 1.0, 0.0),
             DVec3::new(5.0, 0.0, 1.0),
         ];
-        let terms = HitTerms::new(plane).unwrap().at(&cache(), 0.0, 1.0);
+        let terms = HitTerms::new(plane).unwrap().at(&maps()[0], 0.0, 1.0);
         assert_eq!(terms[DENOMINATOR], 0.0);
         assert!(hit(&terms).is_none());
+        let mut weightless = HitTerms::new(TRIANGLE).unwrap().at(&maps()[1], 0.2, 0.2);
+        weightless[WEIGHT] = 0.0;
+        assert!(hit(&weightless).is_none());
     }
 }

@@ -128,7 +128,8 @@ pub fn projection_triangles(projection: &Trilinear) -> Vec<ProjectionTriangle> {
             } else {
                 ProjectionTriangleCache::new(base, normals)
             };
-            let map = ScreenMap::new(screen, size, cache);
+            let map = ScreenMap::new(screen, size, cache)
+                .with_projective(projection.projective_map([i, j, k]));
             ProjectionTriangle::new(base, normals, map)
         })
         .collect()
@@ -490,10 +491,14 @@ impl Pair<'_> {
         }
         out.counts.outline_points += scratch.outline.len() as u64;
         scratch.pixels.clear();
-        let cache = self.triangle.map.cache();
         scratch.pixels.extend(scratch.outline.iter().map(|p| {
             let pixel = self.triangle.map.pixel(p.u, p.v);
-            Vertex::new(pixel.x, pixel.y, p.t, self.terms.at(cache, p.u, p.v))
+            Vertex::new(
+                pixel.x,
+                pixel.y,
+                p.t,
+                self.terms.at(&self.triangle.map, p.u, p.v),
+            )
         }));
         out.polygons.push(&scratch.pixels, self.id, self.key);
     }

@@ -381,7 +381,7 @@ impl Shader<'_> {
         };
         let id = self.resolver.scene.owners[run.triangle()].id;
         let position = self.resolver.position(run.x0, run.y);
-        let (start, step) = map.directions_along_row(position);
+        let directions = map.directions_along_row(position);
         let cells = run.first..run.first + run.len;
         let exact = drawn.depth[cells.clone()]
             .iter()
@@ -392,7 +392,7 @@ impl Shader<'_> {
             .enumerate();
         let mut counts = ShadeCounts::default();
         for (k, ((((&t, &barycentric), out_color), out_depth), out_id)) in exact {
-            let direction = start + k as f64 * step;
+            let direction = directions.at(k);
             if t < CRACK_FILL_DEPTH && direction != DVec3::ZERO {
                 *out_color = color(Vec2::from(barycentric));
                 *out_depth = (t * direction.length()) as f32;

@@ -11,6 +11,7 @@ use super::raw::{Numbers, RawObject};
 use super::shape::{analytic_mesh, Shape, MAX_TESSELLATION};
 use super::source::Source;
 use crate::error::Result;
+use crate::projection::surfaces::SurfaceScreenMap;
 use crate::projection::ProjectionSpec;
 use crate::scene::loaders::{load_model, load_texture};
 use crate::scene::{Material, Mesh, Object, Pattern, Surface};
@@ -80,23 +81,48 @@ pub(super) fn convert(
         .collect())
 }
 
-/// Whether the object asks for `trilinear_reflector = true`: its reflection (mirror) or
-/// refraction (glass) is then rendered through a trilinear surface built from its mesh and
-/// composited into the main image. Errors, at the key: an object whose material is neither
-/// mirror nor glass, and a scene whose projection is not perspective (the surface's screen
-/// positions are the main camera's image of the reflector).
-pub(super) fn is_trilinear_reflector(
+/// The screen map of the object's trilinear surface if it asks for
+/// `trilinear_reflector = true` (`trilinear_screen_map`, default projective): its reflection
+/// (mirror) or refraction (glass) is then rendered through a trilinear surface built from its
+/// mesh and composited into the main image. Errors, at the key: an object whose material is
+/// neither mirror nor glass, a scene whose projection is not perspective (the surface's
+/// screen positions are the main camera's image of the reflector), a `trilinear_screen_map`
+/// other than "projective" or "affine", or one without `trilinear_reflector = true`.
+pub(super) fn trilinear_reflector(
     src: &Source,
     table: &Spanned<RawObject>,
     parts: &[Object],
     projection: &ProjectionSpec,
-) -> Result<bool> {
-    let Some(flag) = &table.get_ref().trilinear_reflector else {
-        return Ok(false);
+) -> Result<Option<SurfaceScreenMap>> {
+    let raw = table.get_ref();
+    let screen_map = match &raw.trilinear_screen_map {
+        None => SurfaceScreenMap::default(),
+        Some(name) => match name.get_ref().as_str() {
+            "projective" => SurfaceScreenMap::Projective,
+            "affine" => SurfaceScreenMap::Affine,
+            other => {
+                return Err(src.error(
+                    &name.span(),
+                    format!(
+                        "unknown trilinear_screen_map \"{other}\": expected \"projective\" or \"affine\""
+                    ),
+                ))
+            }
+        },
     };
-    if !*flag.get_ref() {
-        return Ok(false);
-    }
+    let enabled = raw
+        .trilinear_reflector
+        .as_ref()
+        .filter(|flag| *flag.get_ref());
+    let Some(flag) = enabled else {
+        if let Some(name) = &raw.trilinear_screen_map {
+            return Err(src.error(
+                &name.span(),
+                "`trilinear_screen_map` needs `trilinear_reflector = true`",
+            ));
+        }
+        return Ok(None);
+    };
     if let Some(part) = parts
         .iter()
         .find(|p| !matches!(p.material.surface, Surface::Mirror | Surface::Glass { .. }))
@@ -119,7 +145,7 @@ pub(super) fn is_trilinear_reflector(
             ),
         ));
     }
-    Ok(true)
+    Ok(Some(screen_map))
 }
 
 /// The scene-file name of a surface kind.

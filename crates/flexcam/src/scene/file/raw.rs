@@ -375,6 +375,7 @@ pub struct RawObject {
     pub tessellation: Option<Spanned<u32>>,
     pub face_colors: Option<Spanned<[[f64; 3]; 6]>>,
     pub trilinear_reflector: Option<Spanned<bool>>,
+    pub trilinear_screen_map: Option<Spanned<String>>,
 }
 
 /// `checker = { color = [...], size = ... }`.

@@ -1345,3 +1345,38 @@ fn flexible_projector_grid_nodes_with_tangents() {
         "node (2, 2): the tangent",
     );
 }
+
+#[test]
+fn trilinear_screen_map_key() {
+    use crate::projection::surfaces::SurfaceScreenMap;
+    use crate::scene::TrilinearReflector;
+    let mirror = |extra: &str| {
+        format!("{CAMERA}[[object]]\nshape = \"sphere\"\nmaterial = \"mirror\"\n{extra}\n")
+    };
+    let reflectors = |extra: &str| scene(&mirror(extra)).trilinear_reflectors;
+    let with = |screen_map| vec![TrilinearReflector { id: 1, screen_map }];
+    assert_eq!(
+        reflectors("trilinear_reflector = true"),
+        with(SurfaceScreenMap::Projective)
+    );
+    assert_eq!(
+        reflectors("trilinear_reflector = true\ntrilinear_screen_map = \"affine\""),
+        with(SurfaceScreenMap::Affine)
+    );
+    assert_eq!(
+        reflectors("trilinear_reflector = true\ntrilinear_screen_map = \"projective\""),
+        with(SurfaceScreenMap::Projective)
+    );
+    assert_error_at(
+        &mirror("trilinear_reflector = true\ntrilinear_screen_map = \"screen\""),
+        10,
+        24,
+        "unknown trilinear_screen_map \"screen\"",
+    );
+    assert_error_at(
+        &mirror("trilinear_screen_map = \"affine\""),
+        9,
+        24,
+        "needs `trilinear_reflector = true`",
+    );
+}

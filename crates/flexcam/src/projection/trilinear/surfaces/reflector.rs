@@ -6,12 +6,15 @@
 //! through the surface is already in the main image's coordinates: a pixel that sees the
 //! reflector in the main image sees, through the surface, the interpolated vertex rays of the
 //! reflector point under it (exact at the vertices, an approximation in between: 7.2.2).
+//! "Under it" is exact with the projective screen map ([`SurfaceScreenMap::Projective`],
+//! weights `1 / depth` of the vertices from the eye); the thesis's screen-space (affine)
+//! map meets the reflector at the eye ray's point only at the vertices.
 
 use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
 use crate::projection::trilinear::is_degenerate_screen_triangle;
-use crate::projection::{ImagePoint, Perspective, Projection, TrilinearMesh};
+use crate::projection::{ImagePoint, Perspective, Projection, Trilinear, TrilinearMesh};
 use crate::render::raycast::optics::{reflect, refract};
 use crate::scene::Mesh;
 
@@ -58,28 +61,77 @@ pub fn vertex_ray(incident: DVec3, normal: DVec3, face: DVec3, optic: Optic) -> 
     }
 }
 
+/// How a surface's screen positions map to barycentrics of its projection triangles.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum SurfaceScreenMap {
+    /// Perspective-correct: each main-image pixel takes the vertex rays interpolated at the
+    /// point of the reflector its eye ray meets (screen weights `1 / depth`,
+    /// [`Trilinear::with_screen_weights`]); with straight vertex rays (`ior` 1) or a flat
+    /// mirror the surface is exact.
+    #[default]
+    Projective,
+    /// Screen-space interpolation as in seed 000, 7.2.2, with unit vertex rays as in the
+    /// thesis: exact at the vertices only.
+    Affine,
+}
+
 /// A reflection or refraction surface and what was left out of it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReflectorSurface {
-    /// The projection mesh: used reflector vertices only, unit vertex rays, screen positions
-    /// in the main image; triangles ordered for visibility (see [`reflector_surface`]).
+    /// The projection mesh: used reflector vertices only, vertex rays as long as the
+    /// vertex's distance from the eye, screen positions in the main image; triangles ordered
+    /// for visibility (see [`reflector_surface`]).
     pub mesh: TrilinearMesh,
+    /// The screen weight of each mesh vertex: 1 / its forward depth from the eye (finite and
+    /// positive: vertices on or behind the eye's plane have no ray).
+    pub weights: Vec<f64>,
     /// Reflector triangles left out (see [`reflector_surface`]).
     pub dropped: usize,
+}
+
+impl ReflectorSurface {
+    /// The surface as a trilinear projection of `width` x `height` pixels with screen map
+    /// `map` (for [`SurfaceScreenMap::Affine`] with the vertex rays normalised, the thesis's
+    /// surface); `None` when it has no triangles. Errors: those of [`Trilinear::new`].
+    pub fn projection(
+        &self,
+        map: SurfaceScreenMap,
+        width: u32,
+        height: u32,
+    ) -> Result<Option<Trilinear>> {
+        if self.mesh.triangles.is_empty() {
+            return Ok(None);
+        }
+        match map {
+            SurfaceScreenMap::Affine => {
+                let mut unit = self.mesh.clone();
+                unit.normals.iter_mut().for_each(|r| *r = r.normalize());
+                Trilinear::new(&unit, width, height)
+            }
+            SurfaceScreenMap::Projective => {
+                Trilinear::with_screen_weights(&self.mesh, &self.weights, width, height)
+            }
+        }
+        .map(Some)
+    }
 }
 
 /// Builds the surface of `reflector` (a world-space mesh) seen by the main camera `camera`
 /// (whose eye is the eye of the first-hit reflections) with `optic`.
 ///
-/// Vertex `k` at `p` gets the ray `vertex_ray(i, n)` with `i = (p - eye) / |p - eye|` and `n`
-/// its unit vertex normal, and the screen position `(x / W, 1 - y / H)` of its pixel
-/// position `(x, y)` in the main image (outside [0, 1]^2 when it is outside the image).
+/// Vertex `k` at `p` gets the ray `|p - eye| vertex_ray(i, n)` with `i = (p - eye) / |p - eye|`
+/// and `n` its unit vertex normal (the length makes the interpolated direction at the point
+/// `P` the eye sees exact where the optic is linear: `P - eye` itself for straight rays, its
+/// mirror image for a flat mirror; unit rays would interpolate unit vectors, which bend), the screen position `(x / W, 1 - y / H)` of its pixel
+/// position `(x, y)` in the main image (outside [0, 1]^2 when it is outside the image), and
+/// the screen weight `1 / ((p - eye) . forward)` of the projective screen map.
 ///
 /// Degenerate cases:
 /// - a mesh without vertex normals, or a zero normal: the area-weighted mean of the adjacent
 ///   face normals is used; a vertex with no usable normal at all has no ray;
 /// - a vertex at the eye, or on or behind the plane of the eye (the main camera does not
-///   image it): no ray and no screen position;
+///   image it), or so near that plane that its screen weight is not finite: no ray and no
+///   screen position;
 /// - a triangle is left out when a vertex has no ray, when the eye is not on the side of its
 ///   plane that its vertex normals point to (the back of a closed reflector, hidden in the
 ///   main image, or the back of an open one; also when the normals lie in the plane), or
@@ -105,6 +157,7 @@ pub fn reflector_surface(
         }
     }
     let eye = camera.basis().origin;
+    let forward = camera.basis().forward;
     let normals = vertex_normals(reflector);
     let size = {
         let (w, h) = camera.resolution();
@@ -117,16 +170,19 @@ pub fn reflector_surface(
         .zip(&normals)
         .map(|(p, &(normal, face))| {
             let point = p.as_dvec3();
+            let distance = point.distance(eye);
             let incident = (point - eye).try_normalize()?;
             let normal = normal.try_normalize()?;
             images.clear();
             camera.project(point, &mut images);
             let &ImagePoint { pixel, .. } = images.first()?;
-            Some(SurfaceVertex {
+            let weight = 1.0 / (point - eye).dot(forward);
+            (weight.is_finite() && weight > 0.0).then_some(SurfaceVertex {
                 point,
                 normal,
-                direction: vertex_ray(incident, normal, face, optic),
+                direction: distance * vertex_ray(incident, normal, face, optic),
                 screen: DVec2::new(pixel.x / size.x, 1.0 - pixel.y / size.y),
+                weight,
             })
         })
         .collect();
@@ -150,6 +206,7 @@ pub fn reflector_surface(
     kept.sort_by(|x, y| x.0.total_cmp(&y.0));
 
     let mut mesh = TrilinearMesh::default();
+    let mut weights = Vec::new();
     let mut new_index = vec![u32::MAX; vertices.len()];
     for &(_, triangle) in &kept {
         let mapped = triangle.map(|k| {
@@ -161,6 +218,7 @@ pub fn reflector_surface(
                     mesh.points.push(v.point);
                     mesh.normals.push(v.direction);
                     mesh.screen.push(v.screen);
+                    weights.push(v.weight);
                 }
             }
             *slot
@@ -170,6 +228,7 @@ pub fn reflector_surface(
     Ok(ReflectorSurface {
         dropped: reflector.triangles.len() - mesh.triangles.len(),
         mesh,
+        weights,
     })
 }
 
@@ -181,6 +240,8 @@ struct SurfaceVertex {
     normal: DVec3,
     direction: DVec3,
     screen: DVec2,
+    /// 1 / forward depth from the eye.
+    weight: f64,
 }
 
 /// The shading and face normals of each vertex of `mesh` (not normalised): the face normal is

@@ -56,12 +56,19 @@ fn vertex_rays_are_the_ray_casters_mirror_reflections() {
         let at_vertex = [Vec2::ZERO, Vec2::X, Vec2::Y][corner];
         let n = normals(ball, hit.triangle, at_vertex, ray.direction.as_vec3());
         let exact = reflect(ray.direction.normalize(), n.shading.as_dvec3());
-        let got = surface.mesh.normals[k];
+        let distance = ray.direction.length();
+        let got = surface.mesh.normals[k] / distance;
         assert!(
             (got - exact).length() < 1e-6,
             "vertex {k}: {got} vs {exact}"
         );
-        assert!((got.length() - 1.0).abs() < 1e-12, "unit vertex rays");
+        assert!(
+            (got.length() - 1.0).abs() < 1e-12,
+            "rays as long as the eye's distance"
+        );
+        // The screen weight is 1 / the vertex's forward depth.
+        let depth = (surface.mesh.points[k] - eye()).dot(camera.basis().forward);
+        assert!((surface.weights[k] * depth - 1.0).abs() < 1e-12);
         // The screen position is the main image position of the vertex: the main camera's
         // ray through it points at the vertex.
         let s = surface.mesh.screen[k];
@@ -131,7 +138,8 @@ fn meshes_without_normals_use_face_normals() {
     let surface = reflector_surface(&plane, &camera(), Optic::Reflect).unwrap();
     assert_eq!(surface.mesh.triangles.len(), 50);
     for (p, r) in surface.mesh.points.iter().zip(&surface.mesh.normals) {
-        let i = (*p - eye()).normalize();
+        // The mirror image of the eye's ray to the vertex, as long as it.
+        let i = *p - eye();
         let expected = DVec3::new(i.x, -i.y, i.z);
         assert!((*r - expected).length() < 1e-12, "a flat mirror flips y");
     }
@@ -151,7 +159,8 @@ fn snell_at_the_vertices_of_a_lens() {
         .zip(&surface.mesh.normals)
         .enumerate()
     {
-        assert!((q.length() - 1.0).abs() < 1e-9, "vertex {k}");
+        assert!((q.length() - p.distance(eye())).abs() < 1e-9, "vertex {k}");
+        let q = &q.normalize();
         assert!(q.y < 0.0, "vertex {k}: transmitted through the plane");
         let n = (*p - DVec3::new(0.0, -2.0, 0.0)).normalize();
         let i = (*p - eye()).normalize();
