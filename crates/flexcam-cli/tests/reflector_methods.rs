@@ -86,20 +86,20 @@ fn trilinear_method_renders_reflector_scenes() {
 }
 
 /// `flexcam compare` composites the method under test (as `render` does) and compares it
-/// with the ray caster's exact mirror. A plane mirror's surface with the projective screen
-/// map (the default) is the exact mirror up to rounding at colour edges, for both methods;
-/// with `trilinear_screen_map = "affine"` (seed 000's screen-space interpolation) the
+/// with the ray caster's exact mirror. A plane mirror's surface with
+/// `trilinear_screen_map = "projective"` is the exact mirror up to rounding at colour edges,
+/// for both methods; with the default affine map (seed 000's screen-space interpolation) the
 /// interpolated rays move checker edges, still within issue 3's targets, and the trilinear
 /// composite is the ray-cast composite but for edge pixels.
 #[test]
 fn compare_measures_the_composite_against_the_exact_mirror() {
     let dir = mirror_scene();
-    let affine = PLANE_MIRROR.replace(
+    let projective = PLANE_MIRROR.replace(
         "trilinear_reflector = true",
-        "trilinear_reflector = true\ntrilinear_screen_map = \"affine\"",
+        "trilinear_reflector = true\ntrilinear_screen_map = \"projective\"",
     );
-    std::fs::write(dir.path().join("affine.toml"), affine).unwrap();
-    for (scene, largest) in [("mirror.toml", 1e-3), ("affine.toml", 0.02)] {
+    std::fs::write(dir.path().join("projective.toml"), projective).unwrap();
+    for (scene, largest) in [("projective.toml", 1e-3), ("mirror.toml", 0.02)] {
         let mut measured = Vec::new();
         for method in ["trilinear", "raycast"] {
             let args = ["compare", scene, "--method", method, "--json"];
@@ -110,7 +110,7 @@ fn compare_measures_the_composite_against_the_exact_mirror() {
             measured.push(rgb);
         }
         assert!((measured[0] - measured[1]).abs() < 0.002, "{measured:?}");
-        if scene == "affine.toml" {
+        if scene == "mirror.toml" {
             // Not the exact mirror: the interpolated rays move checker edges.
             assert!(measured[0] > 1e-4, "{measured:?}");
         }

@@ -82,7 +82,7 @@ pub(super) fn convert(
 }
 
 /// The screen map of the object's trilinear surface if it asks for
-/// `trilinear_reflector = true` (`trilinear_screen_map`, default projective): its reflection
+/// `trilinear_reflector = true` (`trilinear_screen_map`, default affine): its reflection
 /// (mirror) or refraction (glass) is then rendered through a trilinear surface built from its
 /// mesh and composited into the main image. Errors, at the key: an object whose material is
 /// neither mirror nor glass, a scene whose projection is not perspective (the surface's

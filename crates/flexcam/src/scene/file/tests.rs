@@ -1357,7 +1357,7 @@ fn trilinear_screen_map_key() {
     let with = |screen_map| vec![TrilinearReflector { id: 1, screen_map }];
     assert_eq!(
         reflectors("trilinear_reflector = true"),
-        with(SurfaceScreenMap::Projective)
+        with(SurfaceScreenMap::Affine)
     );
     assert_eq!(
         reflectors("trilinear_reflector = true\ntrilinear_screen_map = \"affine\""),

@@ -67,11 +67,13 @@ pub enum SurfaceScreenMap {
     /// Perspective-correct: each main-image pixel takes the vertex rays interpolated at the
     /// point of the reflector its eye ray meets (screen weights `1 / depth`,
     /// [`Trilinear::with_screen_weights`]); with straight vertex rays (`ior` 1) or a flat
-    /// mirror the surface is exact.
-    #[default]
+    /// mirror the surface is exact. Not the default: its longer vertex rays make curved
+    /// mirrors seen from close by and strong lenses worse than the affine map
+    /// (docs/trilinear-surfaces.md).
     Projective,
     /// Screen-space interpolation as in seed 000, 7.2.2, with unit vertex rays as in the
-    /// thesis: exact at the vertices only.
+    /// thesis: exact at the vertices only. The default.
+    #[default]
     Affine,
 }
 
