@@ -731,18 +731,7 @@ mod tests {
                     ray.origin.cross(eye_ray).length() <= 1e-12 * ray.origin.length() * eye_ray.length(),
                     "origin {} off the eye ray {}", ray.origin, eye_ray
                 );
-                let point = ray.at(t);
-                let mut out = Vec::new();
-                trilinear.project(point, &mut out);
-                let found = out.iter().any(|image| {
-                    (image.pixel - pixel).length() <= 1e-6
-                        && (image.t - t).abs() <= 1e-9 * t.max(1.0)
-                });
-                prop_assert!(found, "{pixel} t {t}: {out:?}");
-                for image in &out {
-                    let r = trilinear.ray(image.pixel).unwrap();
-                    prop_assert!((r.at(image.t) - point).length() <= 1e-9 * (1.0 + point.length()));
-                }
+                round_trip::check(&trilinear, pixel, ray.at(t), t)?;
             }
         }
     }
@@ -750,6 +739,28 @@ mod tests {
     mod round_trip {
         use super::*;
         use proptest::prelude::*;
+        use proptest::test_runner::TestCaseError;
+
+        /// `point`, at `t` on the ray of `pixel`, projects back to `pixel` at `t` among its
+        /// images, and every image's ray reaches it.
+        pub(super) fn check(
+            trilinear: &Trilinear,
+            pixel: DVec2,
+            point: DVec3,
+            t: f64,
+        ) -> std::result::Result<(), TestCaseError> {
+            let mut out = Vec::new();
+            trilinear.project(point, &mut out);
+            let found = out.iter().any(|image| {
+                (image.pixel - pixel).length() <= 1e-6 && (image.t - t).abs() <= 1e-9 * t.max(1.0)
+            });
+            prop_assert!(found, "{pixel} t {t}: {out:?}");
+            for image in &out {
+                let r = trilinear.ray(image.pixel).unwrap();
+                prop_assert!((r.at(image.t) - point).length() <= 1e-9 * (1.0 + point.length()));
+            }
+            Ok(())
+        }
 
         /// A 4 x 4 vertex grid on screen; points on a plane grid with offsets up to 0.1 of
         /// the spacing, normals (0, 0, 1) tilted by up to 0.01 per component (rays cross no
@@ -790,18 +801,7 @@ mod tests {
                 let trilinear = Trilinear::new(&mesh, width, height).unwrap();
                 let pixel = DVec2::new(x * f64::from(width), y * f64::from(height));
                 let ray = trilinear.ray(pixel).unwrap();
-                let point = ray.at(t);
-                let mut out = Vec::new();
-                trilinear.project(point, &mut out);
-                let found = out.iter().any(|image| {
-                    (image.pixel - pixel).length() <= 1e-6
-                        && (image.t - t).abs() <= 1e-9 * t.max(1.0)
-                });
-                prop_assert!(found, "{pixel} t {t}: {out:?}");
-                for image in &out {
-                    let r = trilinear.ray(image.pixel).unwrap();
-                    prop_assert!((r.at(image.t) - point).length() <= 1e-9 * (1.0 + point.length()));
-                }
+                round_trip::check(&trilinear, pixel, ray.at(t), t)?;
             }
         }
     }
