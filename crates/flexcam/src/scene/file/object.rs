@@ -100,14 +100,12 @@ pub(super) fn trilinear_reflector(
         Some(name) => match name.get_ref().as_str() {
             "projective" => SurfaceScreenMap::Projective,
             "affine" => SurfaceScreenMap::Affine,
-            other => {
-                return Err(src.error(
-                    &name.span(),
-                    format!(
-                        "unknown trilinear_screen_map \"{other}\": expected \"projective\" or \"affine\""
-                    ),
-                ))
-            }
+            other => return Err(src.error(
+                &name.span(),
+                format!(
+                    "unknown trilinear_screen_map \"{other}\"; expected one of: affine, projective"
+                ),
+            )),
         },
     };
     let enabled = raw

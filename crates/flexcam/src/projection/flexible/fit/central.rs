@@ -11,15 +11,23 @@
 //! through E, and a bilinear grid is any pinhole camera exactly (its direction field is
 //! affine in (u, v)).
 //!
-//! E is found by variable projection: for a given E the directions are the linear fit's
-//! (module `fit`, starts at E, solved twice, the second centred on the first), and
+//! Two direction fields are fitted for a given E: the pinhole's affine field
+//! D(u, v) = A (u - 1/2) + B (v - 1/2) + C (8 unknowns; [`pinhole_grid`]), tried first and
+//! kept when it is exact or explains the data nearly as well as the free field
+//! ([`pinhole_suffices`]), and the free node directions (3 a node). Free directions meet
+//! sparse data exactly in many ways, most of them bent between the points, so six points
+//! determine the pinhole where the free field needs points enough for every node.
+//!
+//! E is found by variable projection: for a given E the directions are the model's (the
+//! pinhole's least-squares field, or the linear fit's of module `fit`, starts at E, solved
+//! twice, the second centred on the first), and
 //! Levenberg-Marquardt moves E to minimise the chords 2 sin(angle / 2) between the blended
 //! directions and the points seen from E, with central-difference derivatives in E (three
 //! unknowns; each residual is two small linear solves). It starts from the point nearest to
 //! the prior's node projectors (the prior's own eye, for a perspective prior) and from the
 //! centre of the 3 x 4 camera matrix that the direct linear transform fits to the data
-//! (exact for pinhole data), and keeps the better. The grid at the found eye is then fitted
-//! by `fit` with its starts at E, and the starts are moved along their projectors to the
+//! (exact for pinhole data), and keeps the better. For the free field, the grid at the found
+//! eye is then fitted by `fit` with its starts at E. The starts are moved along their projectors to the
 //! prior's near distance s (the prior's mean start parameter seen from its own eye, 0 when
 //! the prior has none), less where a point lies nearer the eye than that.
 //!
@@ -27,10 +35,10 @@
 //! keeping the prior's starts): a prior with tangents (curved projectors have no common
 //! eye); fewer than `MIN_POINTS` correspondences; points that all coincide; an eye the data
 //! do not determine (the misses change by less than `FLAT` of the data's extent when E
-//! moves in some direction: points all on one plane, or so few that the node directions
-//! absorb any move of E); image positions all on one line (points on one line through the
-//! eye among them); a descent that finds no eye at which the linear fit
-//! solves.
+//! moves in some direction, for the pinhole and for the free directions alike: points all
+//! on one plane, or, for the free directions, so few that they absorb any move of E); image
+//! positions all on one line (points on one line through the eye among them); a descent
+//! that finds no eye at which either field solves.
 
 use glam::{DMat3, DVec3};
 use nalgebra::{DMatrix, Matrix3, SymmetricEigen};
