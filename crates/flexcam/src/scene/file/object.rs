@@ -100,12 +100,14 @@ pub(super) fn trilinear_reflector(
         Some(name) => match name.get_ref().as_str() {
             "projective" => SurfaceScreenMap::Projective,
             "affine" => SurfaceScreenMap::Affine,
-            other => return Err(src.error(
-                &name.span(),
-                format!(
+            other => {
+                return Err(src.error(
+                    &name.span(),
+                    format!(
                     "unknown trilinear_screen_map \"{other}\"; expected one of: affine, projective"
                 ),
-            )),
+                ))
+            }
         },
     };
     let enabled = raw
