@@ -42,9 +42,11 @@ pub(super) fn convert(
             "linear" => Easing::Linear,
             "smooth" => Easing::Smooth,
             other => {
-                return Err(src.error(
+                return Err(src.unknown(
                     &name.span(),
-                    format!("unknown interpolation \"{other}\"; expected one of: linear, smooth"),
+                    "interpolation",
+                    other,
+                    &["linear", "smooth"],
                 ))
             }
         },

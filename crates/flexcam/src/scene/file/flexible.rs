@@ -141,13 +141,11 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
         Some(name) => {
             let own = preset_keys(name.get_ref());
             if !PRESET_NAMES.contains(&name.get_ref().as_str()) {
-                return Err(src.error(
+                return Err(src.unknown(
                     &name.span(),
-                    format!(
-                        "unknown flexible preset \"{}\"; expected one of: {}",
-                        name.get_ref(),
-                        PRESET_NAMES.join(", ")
-                    ),
+                    "flexible preset",
+                    name.get_ref(),
+                    &PRESET_NAMES,
                 ));
             }
             // The axonometric preset's up is always +y; the magnifier's map is its lens.
@@ -298,15 +296,7 @@ fn blended(
                 segments: raw.segments.as_ref().map(|s| *s.get_ref()),
             }
         }
-        other => {
-            return Err(src.error(
-                &at_blend,
-                format!(
-                    "unknown blend \"{other}\"; expected one of: {}",
-                    BLEND_NAMES.join(", ")
-                ),
-            ))
-        }
+        other => return Err(src.unknown(&at_blend, "blend", other, &BLEND_NAMES)),
     };
     // Build the volume once here so that a bad count, knot list or segment count is
     // reported at its key, not later without a position.
@@ -382,15 +372,7 @@ fn reparam(src: &Source, raw: &RawProjection) -> Result<Option<Reparam>> {
             })?;
             reparam
         }
-        other => {
-            return Err(src.error(
-                &name.span(),
-                format!(
-                    "unknown reparam \"{other}\"; expected one of: {}",
-                    REPARAM_NAMES.join(", ")
-                ),
-            ))
-        }
+        other => return Err(src.unknown(&name.span(), "reparam", other, &REPARAM_NAMES)),
     }))
 }
 
@@ -595,13 +577,7 @@ fn style(src: &Source, raw: &RawProjection) -> Result<DepthStyle> {
     match name.get_ref().as_str() {
         "piecewise" => Ok(DepthStyle::Piecewise),
         "quadratic" => Ok(DepthStyle::Quadratic),
-        other => Err(src.error(
-            &name.span(),
-            format!(
-                "unknown style \"{other}\"; expected one of: {}",
-                DEPTH_STYLE_NAMES.join(", ")
-            ),
-        )),
+        other => Err(src.unknown(&name.span(), "style", other, &DEPTH_STYLE_NAMES)),
     }
 }
 
@@ -695,13 +671,7 @@ pub(super) fn surface(src: &Source, table: &Spanned<RawSurface>, which: &str) ->
     let raw = table.get_ref();
     let name = raw.surface.get_ref().as_str();
     if !SURFACE_NAMES.contains(&name) {
-        return Err(src.error(
-            &raw.surface.span(),
-            format!(
-                "unknown surface \"{name}\"; expected one of: {}",
-                SURFACE_NAMES.join(", ")
-            ),
-        ));
+        return Err(src.unknown(&raw.surface.span(), "surface", name, &SURFACE_NAMES));
     }
     src.reject_foreign_key(
         raw.present_keys(),

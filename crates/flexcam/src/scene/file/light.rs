@@ -36,15 +36,7 @@ pub(super) fn convert(src: &Source, table: &Spanned<RawLight>) -> Result<Light> 
     let (key, own, other) = match kind {
         "point" => ("position", &raw.position, ("direction", &raw.direction)),
         "directional" => ("direction", &raw.direction, ("position", &raw.position)),
-        _ => {
-            return Err(src.error(
-                &raw.kind.span(),
-                format!(
-                    "unknown light type \"{kind}\"; expected one of: {}",
-                    LIGHT_TYPES.join(", ")
-                ),
-            ))
-        }
+        _ => return Err(src.unknown(&raw.kind.span(), "light type", kind, &LIGHT_TYPES)),
     };
     if let (other_key, Some(value)) = other {
         return Err(src.error(

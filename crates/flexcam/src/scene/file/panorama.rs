@@ -89,15 +89,7 @@ pub(super) fn convert(required: &Required) -> Result<VolumeSource> {
         Some(b) => match b.get_ref().as_str() {
             "linear" => CurveBlend::Linear,
             "smooth" => CurveBlend::Smooth,
-            other => {
-                return Err(src.error(
-                    &b.span(),
-                    format!(
-                        "unknown panorama blend \"{other}\"; expected one of: {}",
-                        BLEND_NAMES.join(", ")
-                    ),
-                ))
-            }
+            other => return Err(src.unknown(&b.span(), "panorama blend", other, &BLEND_NAMES)),
         },
     };
     let at = raw
@@ -230,13 +222,7 @@ fn curve(src: &Source, table: &Spanned<RawCurve>, which: Family) -> Result<ArcCu
     })?;
     let shape = name.get_ref().as_str();
     if !names.contains(&shape) {
-        return Err(src.error(
-            &name.span(),
-            format!(
-                "unknown {family} shape \"{shape}\"; expected one of: {}",
-                names.join(", ")
-            ),
-        ));
+        return Err(src.unknown(&name.span(), &format!("{family} shape"), shape, names));
     }
     let parameter = match shape {
         "rounded_square" => Some("radius"),

@@ -90,13 +90,12 @@ impl Kind {
 }
 
 /// Every projection type name a scene file may use, for error messages.
-fn all_type_names() -> String {
+fn all_type_names() -> Vec<&'static str> {
     KINDS
         .iter()
         .map(|(name, _)| *name)
         .chain(UNSUPPORTED)
-        .collect::<Vec<_>>()
-        .join(", ")
+        .collect()
 }
 
 /// Fails with a clear message, at the `type` value, when the file asks for a projection type
@@ -128,15 +127,8 @@ pub(super) fn convert(
 ) -> Result<ProjectionSpec> {
     let raw = table.get_ref();
     let name = raw.kind.get_ref();
-    let kind = Kind::parse(name).ok_or_else(|| {
-        src.error(
-            &raw.kind.span(),
-            format!(
-                "unknown projection type \"{name}\"; expected one of: {}",
-                all_type_names()
-            ),
-        )
-    })?;
+    let kind = Kind::parse(name)
+        .ok_or_else(|| src.unknown(&raw.kind.span(), "projection type", name, &all_type_names()))?;
     src.reject_foreign_key(
         raw.present_keys(),
         &kind.keys(),

@@ -46,6 +46,25 @@ impl<'a> Source<'a> {
         ))
     }
 
+    /// The error for a value that names none of the choices a key takes: `unknown WHAT
+    /// "NAME"; expected one of: A, B, ...`, the one form every such key of a scene file uses.
+    pub fn unknown<S: AsRef<str>>(
+        &self,
+        span: &Range<usize>,
+        what: &str,
+        name: &str,
+        expected: &[S],
+    ) -> Error {
+        let expected: Vec<&str> = expected.iter().map(AsRef::as_ref).collect();
+        self.error(
+            span,
+            format!(
+                "unknown {what} \"{name}\"; expected one of: {}",
+                expected.join(", ")
+            ),
+        )
+    }
+
     /// Fails at the first key of `present` (name, span) that is not in `allowed`, naming
     /// `what` takes instead (e.g. "fisheye projections"), so a key of another type is caught.
     pub fn reject_foreign_key(

@@ -49,13 +49,7 @@ pub(super) fn convert(required: &Required, cells: &Spanned<u32>) -> Result<Trili
             let name = view.get_ref().as_str();
             let Some((_, keys)) = VIEWS.iter().find(|(n, _)| *n == name) else {
                 let names: Vec<_> = VIEWS.iter().map(|(n, _)| *n).collect();
-                return Err(src.error(
-                    &view.span(),
-                    format!(
-                        "unknown view \"{name}\"; expected one of: {}",
-                        names.join(", ")
-                    ),
-                ));
+                return Err(src.unknown(&view.span(), "view", name, &names));
             };
             src.reject_foreign_key(present, keys, &format!("view \"{name}\""))?;
             if name == "detail_in_context" {
