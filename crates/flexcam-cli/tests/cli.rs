@@ -1381,8 +1381,9 @@ fn trilinear_compare_and_stats(
 /// 4 of docs/robustness.md, found against POV-Ray's mesh_camera): the floor reaches across
 /// the plane through F, whose image is at infinity, and `--method trilinear` drew none of
 /// its 1,930 pixels in every curve mode (ids 92.95 %). Both projection triangles collapse at
-/// a depth the floor reaches, so their pixels are now ray cast, and nothing is projected into
-/// them.
+/// a depth the floor reaches; their rays meet in one point (to the 8 decimals written), so
+/// they are drawn as central projections (`render::trilinear::central`): no cubic, no
+/// fallback, every pixel the ray caster's.
 #[test]
 fn trilinear_rays_meeting_in_front_of_the_scene() {
     let dir = TempDir::new().unwrap();
@@ -1401,9 +1402,33 @@ fn trilinear_rays_meeting_in_front_of_the_scene() {
             1.0,
             "{curves}: {report}"
         );
-        assert_eq!(stats["fallback_triangles"], 2, "{stats}");
-        // Ray cast triangles project nothing.
-        assert_eq!(stats["pairs"], 0, "{stats}");
-        assert_eq!(stats["shapes"], 0, "{stats}");
+        assert!(
+            report["relative_rgb_error"].as_f64().unwrap() < 1e-6,
+            "{report}"
+        );
+        assert_eq!(stats["central_triangles"], 2, "{stats}");
+        assert_eq!(stats["fallback_triangles"], 0, "{stats}");
+        assert_eq!(stats["vertices_projected"], 0, "{stats}");
+        assert_eq!(stats["raster_covered"], 1930, "{stats}");
     }
+}
+
+/// The inward-looking sphere (seed 000, Figure 6.9): every ray passes through the centre,
+/// inside the cube, so every projection triangle but the 48 of the pole rows (which sweep no
+/// volume and are ray cast) is a central projection, drawn exactly: every pixel the ray
+/// caster's id and colour.
+#[test]
+fn trilinear_inward_sphere_is_drawn_as_central_projections() {
+    let dir = TempDir::new().unwrap();
+    let scene = fs::read_to_string(scenes_dir().join("trilinear-inward-sphere.toml")).unwrap();
+    write(&dir, "inward.toml", &scene);
+    let (report, stats) = trilinear_compare_and_stats(&dir, "inward.toml", "adaptive");
+    assert_eq!(report["id_agreement"].as_f64().unwrap(), 1.0, "{report}");
+    assert!(
+        report["relative_rgb_error"].as_f64().unwrap() < 1e-6,
+        "{report}"
+    );
+    assert_eq!(stats["central_triangles"], 1104, "{stats}");
+    assert_eq!(stats["fallback_triangles"], 48, "{stats}");
+    assert!(stats["shapes"].as_u64().unwrap() > 1104, "{stats}");
 }

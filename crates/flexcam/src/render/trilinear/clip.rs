@@ -18,7 +18,7 @@ use super::edge_path::OutlinePoint;
 /// so a zero margin could leave it to neither (a crack). With the margin both cover a strip
 /// about `1e-9` of the triangle wide (micro-pixels), and the z-test picks one; the projectors
 /// of the two triangles agree on the shared edge of a continuous mesh.
-const DOMAIN_MARGIN: f64 = 1e-9;
+pub(super) const DOMAIN_MARGIN: f64 = 1e-9;
 
 /// The half-spaces, in order: a point is kept where the function is `>= 0`.
 const HALF_SPACES: [fn(&OutlinePoint) -> f64; 4] = [

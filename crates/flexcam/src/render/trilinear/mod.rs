@@ -17,6 +17,7 @@
 //! Unprojectable pairs (see `projection::Unprojectable`) are counted and their projection
 //! triangle is ray cast instead, so they never silently vanish.
 
+pub mod central;
 pub mod clip;
 #[cfg(test)]
 mod cull_tests;
@@ -43,6 +44,7 @@ use glam::{DVec2, DVec3, Vec3};
 
 pub use curves::{CurveMode, CurveOptions};
 
+use self::central::CentralProjection;
 use self::gbuffer::GBuffer;
 use self::polygons::{project_all, projection_triangles, ProjectedScene};
 use self::scene_geometry::SceneGeometry;
@@ -146,14 +148,21 @@ impl TrilinearRenderer {
         // but still see the scene, and those whose rays cross (fold) or all meet in one
         // point (collapse) at a depth the scene reaches see regions that no outline of
         // scene-edge images bounds (`ProjectionTriangleCache::folds_before`,
-        // `collapses_before`): their pixels are ray cast, and their pairs are not projected.
+        // `collapses_before`). Where the rays meet exactly in one point the triangle is a
+        // central projection and is drawn as one (`central`); the pixels of the others are
+        // ray cast, and their pairs are not projected.
         for triangle in &mut triangles {
-            let cache = triangle.map.cache();
-            triangle.ray_cast = cache.sweeps_no_volume()
-                || self.bounding_sphere.is_some_and(|(center, radius)| {
-                    let reach = cache.depth_reaching(center, radius);
-                    cache.folds_before(reach) || cache.collapses_before(reach)
-                });
+            let cache = *triangle.map.cache();
+            let reach = self
+                .bounding_sphere
+                .map(|(center, radius)| cache.depth_reaching(center, radius));
+            let sweeps = cache.sweeps_no_volume();
+            let folds = reach.is_some_and(|reach| cache.folds_before(reach));
+            let collapses = reach.is_some_and(|reach| cache.collapses_before(reach));
+            triangle.central = (collapses && !folds && !sweeps)
+                .then(|| CentralProjection::of(&cache))
+                .flatten();
+            triangle.ray_cast = sweeps || folds || (collapses && triangle.central.is_none());
         }
         let ProjectedScene {
             polygons,
@@ -247,6 +256,10 @@ impl TrilinearRenderer {
         let count = |n: usize| Counter::Count(n as u64);
         stats.insert("triangles", count(self.scene.triangles.len()));
         stats.insert("projection_triangles", count(triangles.len()));
+        stats.insert(
+            "central_triangles",
+            count(triangles.iter().filter(|t| t.central.is_some()).count()),
+        );
         stats.insert(
             "fallback_triangles",
             count(fallback.iter().filter(|&&f| f).count()),

@@ -4,6 +4,7 @@
 
 use glam::DVec3;
 
+use super::central::CentralProjection;
 use super::edge_path::{refine_around, CrossingQuadratic, EdgePath, EdgeSurface, OutlinePoint};
 use super::screen_map::ScreenMap;
 use super::volume_bounds::VolumeBounds;
@@ -34,6 +35,10 @@ pub struct ProjectionTriangle {
     /// (set by the renderer, which knows the scene's depth; false from [`Self::new`]): it
     /// then has no live pairs.
     pub ray_cast: bool,
+    /// Where its rays all meet in one point inside the scene's reach: the central
+    /// projection its pairs are drawn with instead of their cubics and outlines (set by
+    /// the renderer; `None` from [`Self::new`]).
+    pub central: Option<CentralProjection>,
 }
 
 impl ProjectionTriangle {
@@ -49,6 +54,7 @@ impl ProjectionTriangle {
             ],
             bounds: VolumeBounds::new(p, n),
             ray_cast: false,
+            central: None,
         }
     }
 }

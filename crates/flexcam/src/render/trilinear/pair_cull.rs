@@ -10,6 +10,7 @@
 //! do not depend on the tree. The pairs left are listed in scene-triangle order, as the
 //! renderer's determinism requires.
 
+use super::central::CentralProjection;
 use super::hit_terms::HitTerms;
 use super::outline::ProjectionTriangle;
 use super::polygons::PairCounts;
@@ -27,7 +28,9 @@ pub struct LivePair {
     pub triangle: u32,
     /// The scene triangle's plane (it has one: zero-area triangles are not live).
     pub terms: HitTerms,
-    /// Where its three vertices' solutions are in [`LivePairs::solutions`].
+    /// Where its three vertices' solutions are in [`LivePairs::solutions`]; not solved
+    /// (`u32::MAX`) for a projection triangle drawn as a central projection
+    /// ([`ProjectionTriangle::central`]), which needs none.
     pub solved: [u32; 3],
 }
 
@@ -57,6 +60,8 @@ pub struct VertexCache {
     generation: u32,
     /// The clusters the tree kept, each with the planes that still cut its box, reused.
     clusters: Vec<(u32, u32)>,
+    /// Per vertex, the half-spaces of a central projection it is outside of, reused.
+    masks: Vec<u16>,
 }
 
 /// [`VertexState::solved`] of a vertex whose cubic no live pair has needed yet.
@@ -86,6 +91,7 @@ impl VertexCache {
             states: vec![unused; vertices],
             generation: 0,
             clusters: Vec::new(),
+            masks: Vec::new(),
         }
     }
 
@@ -116,6 +122,9 @@ pub fn live_pairs(
             ..LivePairs::default()
         };
         return (live, PairCounts::default());
+    }
+    if let Some(central) = &triangle.central {
+        return central_live_pairs(central, index, scene, cache);
     }
     let bounds = &triangle.bounds;
     let projector = triangle.map.cache();
@@ -176,5 +185,49 @@ pub fn live_pairs(
         }
     }
     cache.clusters = kept;
+    (live, counts)
+}
+
+/// [`live_pairs`] for a projection triangle drawn as the central projection `central`: its
+/// rays fill two cones from the focus, which the volume bounds of a triangle (one convex
+/// region) cover only loosely, so the scene's triangles are culled by the cones' own
+/// planes instead ([`CentralProjection::outside`]), each vertex tested once. No cubic is
+/// solved: the pairs' `solved` are [`NOT_SOLVED`].
+fn central_live_pairs(
+    central: &CentralProjection,
+    index: u32,
+    scene: &SceneGeometry,
+    cache: &mut VertexCache,
+) -> (LivePairs, PairCounts) {
+    let mut masks = std::mem::take(&mut cache.masks);
+    masks.clear();
+    masks.extend(scene.vertices.iter().map(|&x| central.outside(x)));
+    let mut counts = PairCounts {
+        pairs: scene.triangles.len() as u64,
+        ..PairCounts::default()
+    };
+    let mut live = LivePairs {
+        projection: index,
+        ..LivePairs::default()
+    };
+    for (k, corners) in scene.triangles.iter().enumerate() {
+        let common = corners
+            .iter()
+            .fold(u16::MAX, |common, &i| common & masks[i as usize]);
+        if CentralProjection::culled(common) {
+            counts.culled_volume += 1;
+            continue;
+        }
+        let Some(terms) = scene.hit_terms[k] else {
+            counts.culled_zero_area += 1;
+            continue;
+        };
+        live.pairs.push(LivePair {
+            triangle: k as u32,
+            terms,
+            solved: [NOT_SOLVED; 3],
+        });
+    }
+    cache.masks = masks;
     (live, counts)
 }

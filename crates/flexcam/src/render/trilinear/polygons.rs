@@ -7,6 +7,7 @@
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
+use super::central;
 use super::clip::clip_outline;
 use super::curves::{CurveMode, CurveOptions, ADAPTIVE_TOLERANCE_PX};
 use super::edge_path::{EdgePath, OutlinePoint};
@@ -261,6 +262,7 @@ struct Scratch {
     pixels: Vec<Vertex<TERMS>>,
     grid: Vec<DVec3>,
     grid_solutions: Vec<Solutions>,
+    central: central::Scratch,
 }
 
 /// Culls (behind the view plane, outside a domain line) or draws each of `pairs` (live
@@ -278,6 +280,25 @@ fn draw_pairs(
     for live in pairs {
         let k = live.triangle as usize;
         let positions = scene.corners(k);
+        if let Some(central) = &triangle.central {
+            let pair = Pair {
+                triangle,
+                key: (u64::from(group.projection) << 32) | k as u64,
+                id: scene.owners[k].id,
+                curves,
+                terms: live.terms,
+            };
+            let drawn = central.outlines(positions, &mut scratch.central, |outline| {
+                out.counts.shapes += 1;
+                pair.push_outline(outline, &mut scratch.pixels, &mut out.polygons);
+                out.counts.outline_points += outline.len() as u64;
+            });
+            if drawn.is_err() {
+                out.counts.unprojectable += 1;
+                out.fallback.push(group.projection);
+            }
+            continue;
+        }
         let solved = group.solved(live);
         match cull(triangle, positions, &solved) {
             Some(Cull::Behind) => out.counts.culled_behind += 1,
@@ -490,8 +511,19 @@ impl Pair<'_> {
             return;
         }
         out.counts.outline_points += scratch.outline.len() as u64;
-        scratch.pixels.clear();
-        scratch.pixels.extend(scratch.outline.iter().map(|p| {
+        self.push_outline(&scratch.outline, &mut scratch.pixels, &mut out.polygons);
+    }
+
+    /// Appends the clipped outline `outline` to `polygons` as one pixel polygon, each vertex
+    /// with the hit terms of its projector; `pixels` is reused storage.
+    fn push_outline(
+        &self,
+        outline: &[OutlinePoint],
+        pixels: &mut Vec<Vertex<TERMS>>,
+        polygons: &mut PolygonBatch<TERMS>,
+    ) {
+        pixels.clear();
+        pixels.extend(outline.iter().map(|p| {
             let pixel = self.triangle.map.pixel(p.u, p.v);
             Vertex::new(
                 pixel.x,
@@ -500,7 +532,7 @@ impl Pair<'_> {
                 self.terms.at(&self.triangle.map, p.u, p.v),
             )
         }));
-        out.polygons.push(&scratch.pixels, self.id, self.key);
+        polygons.push(pixels, self.id, self.key);
     }
 }
 

@@ -345,7 +345,13 @@ impl Shader<'_> {
     /// background.
     fn pixel(&self, drawn: &GBuffer, i: usize, x: u32, y: u32, any_fallback: bool) -> Pixel {
         let key = drawn.keys[i];
-        let pixel = if any_fallback && self.in_fallback(x, y) {
+        // An exact fragment comes from a polygon clipped to its projection triangle's
+        // domain, so the pixel lies in that triangle (up to the clipping margin, where a
+        // continuous mesh's neighbours share their rays): only where that triangle falls
+        // back, or where no exact fragment won, is the pixel's triangle looked up.
+        let exact = key != NO_PRIMITIVE && drawn.depth[i] < CRACK_FILL_DEPTH;
+        let lookup = any_fallback && (!exact || self.fallback[(key >> 32) as usize]);
+        let pixel = if lookup && self.in_fallback(x, y) {
             self.cast(x, y)
         } else if key == NO_PRIMITIVE {
             None
