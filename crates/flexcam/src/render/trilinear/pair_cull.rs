@@ -129,14 +129,7 @@ pub fn live_pairs(
     let bounds = &triangle.bounds;
     let projector = triangle.map.cache();
     cache.next_generation();
-    let mut counts = PairCounts {
-        pairs: scene.triangles.len() as u64,
-        ..PairCounts::default()
-    };
-    let mut live = LivePairs {
-        projection: index,
-        ..LivePairs::default()
-    };
+    let (mut live, mut counts) = no_pairs_yet(index, scene);
     let mut kept = std::mem::take(&mut cache.clusters);
     kept.clear();
     counts.culled_tree = scene
@@ -188,6 +181,20 @@ pub fn live_pairs(
     (live, counts)
 }
 
+/// The start of the cull of projection triangle `index`: no live pair, every pair of it
+/// with `scene` counted as considered.
+fn no_pairs_yet(index: u32, scene: &SceneGeometry) -> (LivePairs, PairCounts) {
+    let live = LivePairs {
+        projection: index,
+        ..LivePairs::default()
+    };
+    let counts = PairCounts {
+        pairs: scene.triangles.len() as u64,
+        ..PairCounts::default()
+    };
+    (live, counts)
+}
+
 /// [`live_pairs`] for a projection triangle drawn as the central projection `central`: its
 /// rays fill two cones from the focus, which the volume bounds of a triangle (one convex
 /// region) cover only loosely, so the scene's triangles are culled by the cones' own
@@ -202,14 +209,7 @@ fn central_live_pairs(
     let mut masks = std::mem::take(&mut cache.masks);
     masks.clear();
     masks.extend(scene.vertices.iter().map(|&x| central.outside(x)));
-    let mut counts = PairCounts {
-        pairs: scene.triangles.len() as u64,
-        ..PairCounts::default()
-    };
-    let mut live = LivePairs {
-        projection: index,
-        ..LivePairs::default()
-    };
+    let (mut live, mut counts) = no_pairs_yet(index, scene);
     for (k, corners) in scene.triangles.iter().enumerate() {
         let common = corners
             .iter()

@@ -280,14 +280,14 @@ fn draw_pairs(
     for live in pairs {
         let k = live.triangle as usize;
         let positions = scene.corners(k);
+        let pair = Pair {
+            triangle,
+            key: (u64::from(group.projection) << 32) | k as u64,
+            id: scene.owners[k].id,
+            curves,
+            terms: live.terms,
+        };
         if let Some(central) = &triangle.central {
-            let pair = Pair {
-                triangle,
-                key: (u64::from(group.projection) << 32) | k as u64,
-                id: scene.owners[k].id,
-                curves,
-                terms: live.terms,
-            };
             let drawn = central.outlines(positions, &mut scratch.central, |outline| {
                 out.counts.shapes += 1;
                 pair.push_outline(outline, &mut scratch.pixels, &mut out.polygons);
@@ -304,13 +304,6 @@ fn draw_pairs(
             Some(Cull::Behind) => out.counts.culled_behind += 1,
             Some(Cull::Outside) => out.counts.culled_outside += 1,
             None => {
-                let pair = Pair {
-                    triangle,
-                    key: (u64::from(group.projection) << 32) | k as u64,
-                    id: scene.owners[k].id,
-                    curves,
-                    terms: live.terms,
-                };
                 let unprojectable = out.counts.unprojectable;
                 if curves.mode == CurveMode::Tessellate {
                     pair.tessellated(positions, out, scratch);
