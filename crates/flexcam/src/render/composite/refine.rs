@@ -52,7 +52,11 @@
 //! - **total internal reflection** at a new vertex: its ray is the mirror reflection, as the
 //!   ray caster's (and [`vertex_ray`]'s) fallback; the edge error is measured against it;
 //! - **an edge end or midpoint without a ray** (on or behind the eye's plane, not imaged by
-//!   the main camera) or **an edge shorter than [`MIN_EDGE_PX`] on screen**: not split;
+//!   the main camera), **an edge beyond one side of the main image** (both ends left of it,
+//!   right of it, above or below it: no pixel sees it, and a large reflector reaching far
+//!   outside the view is not refined there) or **an edge shorter than [`MIN_EDGE_PX`] on
+//!   screen**: not split. A triangle that covers the image while all its edges lie outside
+//!   it on different sides therefore stays whole (the thesis's surface there);
 //! - **the depth cap** [`MAX_LEVEL`]: an edge of the input mesh is split into at most
 //!   `2^MAX_LEVEL` pieces and a triangle into at most `4^MAX_LEVEL` (a pathological mesh, or
 //!   a tolerance far below a pixel, cannot explode: at most 4,096 triangles per reflector
@@ -96,8 +100,8 @@ pub struct Refinement {
 
 /// Refines `reflector` (a world-space mesh) for the surface of `optic` seen by the main
 /// camera `camera` with screen map `map`, until every edge's error is within
-/// `tolerance_px` main-image pixels (see the module docs); `tolerance_px = 0` returns the
-/// mesh unchanged. Triangles keep their winding.
+/// `tolerance_px` main-image pixels (see the module docs); a tolerance of 0 (or NaN) returns
+/// the mesh unchanged. Triangles keep their winding.
 pub fn refine(
     reflector: &Mesh,
     camera: &Perspective,
@@ -105,7 +109,7 @@ pub fn refine(
     map: SurfaceScreenMap,
     tolerance_px: f64,
 ) -> Refinement {
-    if tolerance_px <= 0.0 {
+    if tolerance_px.is_nan() || tolerance_px <= 0.0 {
         return Refinement {
             mesh: reflector.clone(),
             unsplit: 0,
@@ -336,6 +340,9 @@ impl<'a> Refiner<'a> {
         if self.error_px(&sp, &sq, &sm) <= MIDPOINT_FRACTION * self.tolerance_px {
             return None;
         }
+        if self.off_image(sp.pixel, sq.pixel) {
+            return None;
+        }
         if level >= MAX_LEVEL || sp.pixel.distance(sq.pixel) < MIN_EDGE_PX {
             self.unsplit += 1;
             return None;
@@ -382,6 +389,17 @@ impl<'a> Refiner<'a> {
         } else {
             0.0
         }
+    }
+
+    /// Whether the screen segment from `a` to `b` lies beyond one side of the main image
+    /// (both ends left of it, right of it, above or below it): no pixel sees it.
+    fn off_image(&self, a: DVec2, b: DVec2) -> bool {
+        let (width, height) = self.camera.resolution();
+        let size = DVec2::new(f64::from(width), f64::from(height));
+        (a.x < 0.0 && b.x < 0.0)
+            || (a.y < 0.0 && b.y < 0.0)
+            || (a.x > size.x && b.x > size.x)
+            || (a.y > size.y && b.y > size.y)
     }
 
     /// The angle between the main camera's rays through `pixel` and its horizontal

@@ -357,3 +357,52 @@ fn grazing_vertex_rays_refine_finitely() {
     assert!(!surface.mesh.triangles.is_empty());
     assert!(finite(&surface));
 }
+
+/// Edges beyond one side of the main image are not split, however far their rays are from
+/// the exact ones: the pathological triangle of the depth-cap test moved out of view to the
+/// left (still in front of the eye) stays whole.
+#[test]
+fn edges_outside_the_image_are_not_split() {
+    let scene = sphere_and_cube(8);
+    let camera = camera(&scene, SIZE);
+    let mesh = Mesh {
+        positions: vec![
+            Vec3::new(-9.0, 0.8, 0.0),
+            Vec3::new(-7.0, 0.8, 0.0),
+            Vec3::new(-8.0, 2.0, 0.0),
+        ],
+        normals: vec![
+            Vec3::new(-1.0, 0.0, 0.1),
+            Vec3::new(1.0, 0.0, 0.1),
+            Vec3::new(0.0, 1.0, 0.1),
+        ],
+        triangles: vec![[0, 1, 2]],
+        ..Mesh::default()
+    };
+    for p in &mesh.positions {
+        let pixel = camera.project_continuous(p.as_dvec3()).unwrap().pixel;
+        assert!(pixel.x < 0.0, "{pixel}");
+    }
+    let refined = refine(
+        &mesh,
+        &camera,
+        Optic::Reflect,
+        SurfaceScreenMap::Affine,
+        1e-6,
+    );
+    assert_eq!(refined.mesh.triangles, mesh.triangles);
+    assert_eq!(refined.unsplit, 0);
+}
+
+#[test]
+fn a_nan_tolerance_is_no_refinement() {
+    let (mesh, camera) = sphere(8);
+    let refined = refine(
+        &mesh,
+        &camera,
+        Optic::Reflect,
+        SurfaceScreenMap::Affine,
+        f64::NAN,
+    );
+    assert_eq!(refined.mesh, mesh);
+}
