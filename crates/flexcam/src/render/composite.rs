@@ -5,7 +5,10 @@
 //! replaced, so no exact secondary rays are spent on them). Each reflector then gets a
 //! [`reflector_surface`] built from its mesh and the main camera, the scene without that
 //! reflector is rendered through it, and every main-image pixel that sees the reflector takes
-//! its colour from that image, which is already in main-image coordinates ([`paste`]).
+//! its colour from that image, which is already in main-image coordinates ([`paste`]). The
+//! reflector's mesh is first refined where the surface's interpolated rays would displace
+//! the reflected image by more than the reflector's tolerance in main-image pixels
+//! ([`refine`]; scene-file key `trilinear_refine_px`).
 //! Depth and object id stay those of the main view (the reflector's own, as for a mirror in
 //! the ray caster).
 //!
@@ -29,7 +32,7 @@ use crate::projection::{Perspective, Projection, ProjectionSpec, Trilinear, Tril
 use crate::render::raycast::{specular, RayCaster};
 use crate::render::surface::normals;
 use crate::render::{Counter, Frame, Method, RenderOptions, Shading, Stats};
-use crate::scene::{Mesh, Object, Scene, Surface};
+use crate::scene::{Mesh, Object, Scene, Surface, TrilinearReflector};
 
 /// A way of rendering a scene through a projection (a [`crate::render::Method`] or any
 /// other renderer).
@@ -42,8 +45,10 @@ pub type Renderer<'a> =
 /// `reflector_dropped_triangles` (see [`reflector_surface`]), `reflector_pixels` (main-image
 /// pixels replaced), `reflector_fresnel_rays` (lit glass: main-camera rays cast at the
 /// reflector alone for the Fresnel split), `reflector_exact_pixels` (reflector pixels that no
-/// triangle of the surface covers, ray cast exactly instead: [`ExactPixels`]) and
-/// `reflector_render_ms` (surface building and rendering).
+/// triangle of the surface covers, ray cast exactly instead: [`ExactPixels`]),
+/// `reflector_unsplit_edges` (edges the refinement left over its tolerance at its depth cap
+/// or below a pixel: [`refine`]) and `reflector_render_ms` (surface refinement, building and
+/// rendering).
 ///
 /// Errors: the renderer's; a scene projection that is not perspective (the main camera);
 /// a reflector id that no object has, or whose material is not mirror or glass.
@@ -67,11 +72,12 @@ pub fn render(
     let start = Instant::now();
     let (mut triangles, mut dropped, mut pixels, mut fresnel_rays) = (0, 0, 0, 0);
     let exact = ExactPixels::new(scene, &camera, options);
-    let mut exact_pixels = 0;
+    let (mut exact_pixels, mut unsplit) = (0, 0);
     for entry in &scene.trilinear_reflectors {
         let (id, map) = (entry.id, entry.screen_map);
         let reflector = Reflector::of(scene, id)?;
-        let surface = reflector_surface(&reflector.mesh, &camera, reflector.optic)?;
+        let (surface, left) = refined_surface(&reflector, reflector.optic, entry, &camera)?;
+        unsplit += left;
         triangles += surface.mesh.triangles.len();
         dropped += surface.dropped;
         let projection = surface_projection(&surface, map, &camera)?;
@@ -81,7 +87,9 @@ pub fn render(
                 (Shading::Flat, _) => paste(&mut frame, id, &image, Vec3::ONE)?,
                 (Shading::Lit, Optic::Reflect) => paste(&mut frame, id, &image, reflector.tint)?,
                 (Shading::Lit, Optic::Refract { .. }) => {
-                    let mirror = reflector_surface(&reflector.mesh, &camera, Optic::Reflect)?;
+                    let (mirror, left) =
+                        refined_surface(&reflector, Optic::Reflect, entry, &camera)?;
+                    unsplit += left;
                     let reflection =
                         render_through(scene, id, &mirror, map, &camera, options, renderer)?
                             .unwrap_or_else(|| {
@@ -104,6 +112,7 @@ pub fn render(
     stats.insert("reflector_pixels", Counter::Count(pixels));
     stats.insert("reflector_fresnel_rays", Counter::Count(fresnel_rays));
     stats.insert("reflector_exact_pixels", Counter::Count(exact_pixels));
+    stats.insert("reflector_unsplit_edges", count(unsplit));
     stats.insert(
         "reflector_render_ms",
         Counter::Value(start.elapsed().as_secs_f64() * 1e3),
@@ -243,6 +252,28 @@ impl Reflector {
             tint: first.material.color,
         })
     }
+}
+
+/// The surface of `reflector` for `optic` seen by `camera`, its mesh first refined with
+/// `entry`'s screen map and tolerance ([`refine`]), and the number of edges left over the
+/// tolerance (see [`refine::Refinement::unsplit`]).
+fn refined_surface(
+    reflector: &Reflector,
+    optic: Optic,
+    entry: &TrilinearReflector,
+    camera: &Perspective,
+) -> Result<(ReflectorSurface, usize)> {
+    let refined = refine::refine(
+        &reflector.mesh,
+        camera,
+        optic,
+        entry.screen_map,
+        entry.refine_px,
+    );
+    Ok((
+        reflector_surface(&refined.mesh, camera, optic)?,
+        refined.unsplit,
+    ))
 }
 
 /// Renders `scene` without object `id` through `surface` with screen map `map` at the main
@@ -471,5 +502,6 @@ fn check_size(main: &Frame, other: &Frame) -> Result<()> {
     Ok(())
 }
 
+pub mod refine;
 #[cfg(test)]
 mod tests;

@@ -66,21 +66,28 @@ pub struct Scene {
 }
 
 /// A mirror or glass object rendered through a trilinear surface (seed 000, chapter 7).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrilinearReflector {
     /// The object's id.
     pub id: u32,
     /// How the surface maps main-image pixels to its triangles (scene-file key
     /// `trilinear_screen_map`).
     pub screen_map: SurfaceScreenMap,
+    /// The surface's refinement tolerance in main-image pixels, 0 for none (scene-file key
+    /// `trilinear_refine_px`; see [`crate::render::composite::refine`]).
+    pub refine_px: f64,
 }
 
 impl TrilinearReflector {
-    /// Object `id` with the default (projective) screen map.
+    /// The default of [`TrilinearReflector::refine_px`] (docs/trilinear-surfaces.md).
+    pub const DEFAULT_REFINE_PX: f64 = 0.5;
+
+    /// Object `id` with the default screen map and refinement.
     pub fn new(id: u32) -> TrilinearReflector {
         TrilinearReflector {
             id,
             screen_map: SurfaceScreenMap::default(),
+            refine_px: Self::DEFAULT_REFINE_PX,
         }
     }
 }

@@ -26,7 +26,7 @@ use toml::Spanned;
 
 use self::raw::{RawImage, RawScene};
 use self::source::Source;
-use super::{ImageSettings, Scene, TrilinearReflector};
+use super::{ImageSettings, Scene};
 use crate::error::{Error, Result};
 use crate::projection::flexible::Animation;
 
@@ -91,8 +91,9 @@ pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animatio
         let id =
             u32::try_from(index + 1).map_err(|_| src.error(&table.span(), "too many objects"))?;
         let parts = object::convert(&src, table, id, &base_dir)?;
-        if let Some(screen_map) = object::trilinear_reflector(&src, table, &parts, &projection)? {
-            trilinear_reflectors.push(TrilinearReflector { id, screen_map });
+        if let Some(reflector) = object::trilinear_reflector(&src, table, id, &parts, &projection)?
+        {
+            trilinear_reflectors.push(reflector);
         }
         objects.extend(parts);
     }

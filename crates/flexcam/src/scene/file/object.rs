@@ -14,7 +14,7 @@ use crate::error::Result;
 use crate::projection::surfaces::SurfaceScreenMap;
 use crate::projection::ProjectionSpec;
 use crate::scene::loaders::{load_model, load_texture};
-use crate::scene::{Material, Mesh, Object, Pattern, Surface};
+use crate::scene::{Material, Mesh, Object, Pattern, Surface, TrilinearReflector};
 
 /// Surface names as written in scene files.
 const MATERIALS: [&str; 4] = ["diffuse", "mirror", "glass", "emissive"];
@@ -81,19 +81,23 @@ pub(super) fn convert(
         .collect())
 }
 
-/// The screen map of the object's trilinear surface if it asks for
-/// `trilinear_reflector = true` (`trilinear_screen_map`, default affine): its reflection
-/// (mirror) or refraction (glass) is then rendered through a trilinear surface built from its
-/// mesh and composited into the main image. Errors, at the key: an object whose material is
-/// neither mirror nor glass, a scene whose projection is not perspective (the surface's
-/// screen positions are the main camera's image of the reflector), a `trilinear_screen_map`
-/// other than "projective" or "affine", or one without `trilinear_reflector = true`.
+/// The object's trilinear reflector entry (object id `id`) if it asks for
+/// `trilinear_reflector = true`: its reflection (mirror) or refraction (glass) is then
+/// rendered through a trilinear surface built from its mesh and composited into the main
+/// image, with screen map `trilinear_screen_map` (default affine) and refinement tolerance
+/// `trilinear_refine_px` (main-image pixels, default
+/// [`TrilinearReflector::DEFAULT_REFINE_PX`], 0 for none). Errors, at the key: an object
+/// whose material is neither mirror nor glass, a scene whose projection is not perspective
+/// (the surface's screen positions are the main camera's image of the reflector), a
+/// `trilinear_screen_map` other than "projective" or "affine", a `trilinear_refine_px` that
+/// is negative or not finite, or either key without `trilinear_reflector = true`.
 pub(super) fn trilinear_reflector(
     src: &Source,
     table: &Spanned<RawObject>,
+    id: u32,
     parts: &[Object],
     projection: &ProjectionSpec,
-) -> Result<Option<SurfaceScreenMap>> {
+) -> Result<Option<TrilinearReflector>> {
     let raw = table.get_ref();
     let screen_map = match &raw.trilinear_screen_map {
         None => SurfaceScreenMap::default(),
@@ -110,6 +114,21 @@ pub(super) fn trilinear_reflector(
             }
         },
     };
+    let refine_px = match &raw.trilinear_refine_px {
+        None => TrilinearReflector::DEFAULT_REFINE_PX,
+        Some(value) => {
+            let px = src.number(value, "trilinear_refine_px")?;
+            if px < 0.0 {
+                return Err(src.error(
+                    &value.span(),
+                    format!(
+                        "`trilinear_refine_px` must be at least 0 (0: no refinement), not {px}"
+                    ),
+                ));
+            }
+            px
+        }
+    };
     let enabled = raw
         .trilinear_reflector
         .as_ref()
@@ -119,6 +138,12 @@ pub(super) fn trilinear_reflector(
             return Err(src.error(
                 &name.span(),
                 "`trilinear_screen_map` needs `trilinear_reflector = true`",
+            ));
+        }
+        if let Some(value) = &raw.trilinear_refine_px {
+            return Err(src.error(
+                &value.span(),
+                "`trilinear_refine_px` needs `trilinear_reflector = true`",
             ));
         }
         return Ok(None);
@@ -145,7 +170,11 @@ pub(super) fn trilinear_reflector(
             ),
         ));
     }
-    Ok(Some(screen_map))
+    Ok(Some(TrilinearReflector {
+        id,
+        screen_map,
+        refine_px,
+    }))
 }
 
 /// The scene-file name of a surface kind.

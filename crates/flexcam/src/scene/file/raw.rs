@@ -376,6 +376,7 @@ pub struct RawObject {
     pub face_colors: Option<Spanned<[[f64; 3]; 6]>>,
     pub trilinear_reflector: Option<Spanned<bool>>,
     pub trilinear_screen_map: Option<Spanned<String>>,
+    pub trilinear_refine_px: Option<Spanned<f64>>,
 }
 
 /// `checker = { color = [...], size = ... }`.

@@ -1354,7 +1354,12 @@ fn trilinear_screen_map_key() {
         format!("{CAMERA}[[object]]\nshape = \"sphere\"\nmaterial = \"mirror\"\n{extra}\n")
     };
     let reflectors = |extra: &str| scene(&mirror(extra)).trilinear_reflectors;
-    let with = |screen_map| vec![TrilinearReflector { id: 1, screen_map }];
+    let with = |screen_map| {
+        vec![TrilinearReflector {
+            screen_map,
+            ..TrilinearReflector::new(1)
+        }]
+    };
     assert_eq!(
         reflectors("trilinear_reflector = true"),
         with(SurfaceScreenMap::Affine)
@@ -1377,6 +1382,45 @@ fn trilinear_screen_map_key() {
         &mirror("trilinear_screen_map = \"affine\""),
         9,
         24,
+        "needs `trilinear_reflector = true`",
+    );
+}
+
+#[test]
+fn trilinear_refine_px_key() {
+    use crate::scene::TrilinearReflector;
+    let mirror = |extra: &str| {
+        format!("{CAMERA}[[object]]\nshape = \"sphere\"\nmaterial = \"mirror\"\n{extra}\n")
+    };
+    let refine_px = |extra: &str| {
+        scene(&mirror(&format!("trilinear_reflector = true\n{extra}"))).trilinear_reflectors[0]
+            .refine_px
+    };
+    assert_eq!(refine_px(""), TrilinearReflector::DEFAULT_REFINE_PX);
+    assert_eq!(refine_px("trilinear_refine_px = 0.25"), 0.25);
+    assert_eq!(refine_px("trilinear_refine_px = 0"), 0.0);
+    assert_error_at(
+        &mirror("trilinear_reflector = true\ntrilinear_refine_px = -1.0"),
+        10,
+        23,
+        "`trilinear_refine_px` must be at least 0 (0: no refinement), not -1",
+    );
+    assert_error_at(
+        &mirror("trilinear_reflector = true\ntrilinear_refine_px = nan"),
+        10,
+        23,
+        "trilinear_refine_px",
+    );
+    assert_error_at(
+        &mirror("trilinear_reflector = true\ntrilinear_refine_px = \"adaptive\""),
+        10,
+        23,
+        "invalid type",
+    );
+    assert_error_at(
+        &mirror("trilinear_refine_px = 0.5"),
+        9,
+        23,
         "needs `trilinear_reflector = true`",
     );
 }

@@ -249,8 +249,9 @@ struct SurfaceVertex {
 /// The shading and face normals of each vertex of `mesh` (not normalised): the face normal is
 /// the sum of the adjacent faces' normals weighted by area (outward for an outward winding);
 /// the shading normal is the mesh's own where present and non-zero, else the face normal.
-/// Both are zero for a vertex of no triangle.
-fn vertex_normals(mesh: &Mesh) -> Vec<(DVec3, DVec3)> {
+/// Both are zero for a vertex of no triangle. Also the normals that
+/// [`crate::render::composite`]'s refinement interpolates.
+pub(crate) fn vertex_normals(mesh: &Mesh) -> Vec<(DVec3, DVec3)> {
     let mut from_faces = vec![DVec3::ZERO; mesh.positions.len()];
     for t in &mesh.triangles {
         let [a, b, c] = t.map(|k| mesh.positions[k as usize].as_dvec3());
