@@ -32,14 +32,8 @@ pub(super) fn convert(
 ) -> Result<Vec<Object>> {
     let raw = table.get_ref();
     let shape = Shape::parse(raw.shape.get_ref()).ok_or_else(|| {
-        src.error(
-            &raw.shape.span(),
-            format!(
-                "unknown shape \"{}\"; expected one of: {}",
-                raw.shape.get_ref(),
-                Shape::all_names()
-            ),
-        )
+        let name = raw.shape.get_ref();
+        src.unknown(&raw.shape.span(), "shape", name, &Shape::all_names())
     })?;
     check_keys_fit_shape(src, table, shape)?;
     let overrides = MaterialOverrides::read(src, raw, base_dir)?;
@@ -105,12 +99,8 @@ pub(super) fn trilinear_reflector(
             "projective" => SurfaceScreenMap::Projective,
             "affine" => SurfaceScreenMap::Affine,
             other => {
-                return Err(src.error(
-                    &name.span(),
-                    format!(
-                    "unknown trilinear_screen_map \"{other}\"; expected one of: affine, projective"
-                ),
-                ))
+                let expected = ["affine", "projective"];
+                return Err(src.unknown(&name.span(), "trilinear_screen_map", other, &expected));
             }
         },
     };
@@ -359,15 +349,7 @@ fn surface(src: &Source, raw: &RawObject) -> Result<Option<Surface>> {
                 .as_ref()
                 .map_or(Ok(DEFAULT_IOR), |ior| src.positive(ior, "ior"))? as f32,
         },
-        other => {
-            return Err(src.error(
-                &material.span(),
-                format!(
-                    "unknown material \"{other}\"; expected one of: {}",
-                    MATERIALS.join(", ")
-                ),
-            ))
-        }
+        other => return Err(src.unknown(&material.span(), "material", other, &MATERIALS)),
     }))
 }
 

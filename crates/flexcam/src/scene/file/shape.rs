@@ -56,8 +56,8 @@ impl Shape {
     }
 
     /// Every shape name, for error messages.
-    pub fn all_names() -> String {
-        SHAPES.map(|(name, _)| name).join(", ")
+    pub fn all_names() -> [&'static str; SHAPES.len()] {
+        SHAPES.map(|(name, _)| name)
     }
 
     /// The form of `size`; `None` for model files, which take no size.
