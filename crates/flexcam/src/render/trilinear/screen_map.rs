@@ -158,6 +158,33 @@ impl RowDirections {
         let k = k as f64;
         (self.start + k * self.step) / (self.weight + k * self.weight_step)
     }
+
+    /// The same directions where the weight is exactly 1 all along the row (every row of
+    /// the affine map: a weight of 1 and a step of zero), `None` elsewhere.
+    pub fn unit_weight(&self) -> Option<UnitWeightDirections> {
+        (self.weight == 1.0 && self.weight_step == 0.0).then_some(UnitWeightDirections {
+            start: self.start,
+            step: self.step,
+        })
+    }
+}
+
+/// [`RowDirections`] whose weight is exactly 1 all along the row
+/// ([`RowDirections::unit_weight`]).
+#[derive(Debug, Clone, Copy)]
+pub struct UnitWeightDirections {
+    start: DVec3,
+    step: DVec3,
+}
+
+impl UnitWeightDirections {
+    /// [`RowDirections::at`] without dividing by the weight `1 + k 0 = 1`: the same bits
+    /// (IEEE 754 division by 1 returns its operand unchanged), and shading a pixel waits on
+    /// no division before its depth's square root.
+    #[inline]
+    pub fn at(&self, k: usize) -> DVec3 {
+        self.start + k as f64 * self.step
+    }
 }
 
 /// A projector through a pixel whose origin is not computed yet (see
@@ -262,6 +289,24 @@ mod tests {
                 (stepped - direction).length() < 1e-12 * (1.0 + direction.length()),
                 "{stepped} {direction}"
             );
+        }
+
+        #[test]
+        fn unit_weight_directions_are_the_same_bits(
+            bits in proptest::array::uniform6(proptest::num::u64::ANY),
+            weight in proptest::sample::select(vec![1.0, 0.5, 1.0 - f64::EPSILON / 2.0]),
+            weight_step in proptest::sample::select(vec![0.0, -0.0, 0.25, 1e-300]),
+            k in 0usize..1000,
+        ) {
+            // Arbitrary bit patterns (NaN and infinities included) for start and step.
+            let v = |i: usize| DVec3::from_array([0, 1, 2].map(|j| f64::from_bits(bits[i + j])));
+            let row = RowDirections { start: v(0), step: v(3), weight, weight_step };
+            let unit = row.unit_weight();
+            prop_assert_eq!(unit.is_some(), weight == 1.0 && weight_step == 0.0);
+            if let Some(unit) = unit {
+                let bits = |d: DVec3| d.to_array().map(f64::to_bits);
+                prop_assert_eq!(bits(unit.at(k)), bits(row.at(k)));
+            }
         }
 
         #[test]
