@@ -15,8 +15,6 @@
 //! lexicographically smaller than the stored pair, so the result depends neither on the
 //! order of the shapes nor on the band size or thread count.
 
-use glam::DVec2;
-
 use super::hit_terms::{self, Terms, TERMS};
 use super::shade::Resolver;
 use crate::render::raster::{spans, FillRule, Polygon, RasterStats, Scratch, Span, NO_PRIMITIVE};
@@ -108,8 +106,9 @@ impl GBuffer {
     }
 
     /// The pixels of `span` from the terms `start` stepped by `step`, each hit solved by
-    /// `solve`, staged ([`Resolver::staged`]) and z-tested. The counts are kept in locals
-    /// (registers) and added once.
+    /// `solve`, staged ([`Resolver::staged`]) and z-tested against the span's cells of the
+    /// buffer (sliced once: no bounds check a pixel), written where it wins. The counts are
+    /// kept in locals (registers) and added once.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn span_with(
@@ -124,15 +123,21 @@ impl GBuffer {
     ) {
         let mut terms: Terms = *start;
         let row = (span.y - self.rows.0) as usize * self.width as usize;
+        let cells = row + span.x0 as usize..row + span.x1 as usize;
+        let stored = self.depth[cells.clone()]
+            .iter_mut()
+            .zip(&mut self.keys[cells.clone()])
+            .zip(&mut self.barycentrics[cells]);
         let (mut discarded, mut writes, mut covered) = (0, 0, 0);
-        for x in span.x0..span.x1 {
+        for (x, ((stored_depth, stored_key), stored_barycentric)) in (span.x0..span.x1).zip(stored)
+        {
             match resolver.staged(key, solve(&terms), x, span.y) {
                 Some((key, depth, barycentric)) => {
-                    if let Some(first) =
-                        self.test_and_write(row + x as usize, key, depth, barycentric)
-                    {
+                    if depth < *stored_depth || (depth == *stored_depth && key < *stored_key) {
                         writes += 1;
-                        covered += u64::from(first);
+                        covered += u64::from(*stored_key == NO_PRIMITIVE);
+                        (*stored_depth, *stored_key) = (depth, key);
+                        *stored_barycentric = [barycentric.x as f32, barycentric.y as f32];
                     }
                 }
                 None => discarded += 1,
@@ -145,27 +150,6 @@ impl GBuffer {
         counts.discarded += discarded;
         counts.writes += writes;
         counts.covered += covered;
-    }
-
-    /// The z-test of a staged fragment at index `i` of the band, and its write on a win:
-    /// `Some(whether it is the pixel's first fragment)` where it wins, `None` where not.
-    #[inline]
-    fn test_and_write(
-        &mut self,
-        i: usize,
-        key: u64,
-        depth: f64,
-        barycentric: DVec2,
-    ) -> Option<bool> {
-        let (stored_depth, stored_key) = (self.depth[i], self.keys[i]);
-        if depth < stored_depth || (depth == stored_depth && key < stored_key) {
-            self.depth[i] = depth;
-            self.keys[i] = key;
-            self.barycentrics[i] = [barycentric.x as f32, barycentric.y as f32];
-            Some(stored_key == NO_PRIMITIVE)
-        } else {
-            None
-        }
     }
 
     /// The band's rows.

@@ -154,8 +154,8 @@ pub struct RowDirections {
 impl RowDirections {
     /// The direction `k` pixels along the row from the start.
     #[inline]
-    pub fn at(&self, k: usize) -> DVec3 {
-        let k = k as f64;
+    pub fn at(&self, k: u32) -> DVec3 {
+        let k = f64::from(k);
         (self.start + k * self.step) / (self.weight + k * self.weight_step)
     }
 
@@ -182,8 +182,8 @@ impl UnitWeightDirections {
     /// (IEEE 754 division by 1 returns its operand unchanged), and shading a pixel waits on
     /// no division before its depth's square root.
     #[inline]
-    pub fn at(&self, k: usize) -> DVec3 {
-        self.start + k as f64 * self.step
+    pub fn at(&self, k: u32) -> DVec3 {
+        self.start + f64::from(k) * self.step
     }
 }
 
@@ -282,7 +282,7 @@ mod tests {
             k in 0u32..400,
         ) {
             let m = map();
-            let stepped = m.directions_along_row(DVec2::new(x, y)).at(k as usize);
+            let stepped = m.directions_along_row(DVec2::new(x, y)).at(k);
             let pixel = DVec2::new(x + f64::from(k), y);
             let direction = m.projector(pixel).map_or(DVec3::ZERO, |p| p.direction);
             prop_assert!(
@@ -296,7 +296,7 @@ mod tests {
             bits in proptest::array::uniform6(proptest::num::u64::ANY),
             weight in proptest::sample::select(vec![1.0, 0.5, 1.0 - f64::EPSILON / 2.0]),
             weight_step in proptest::sample::select(vec![0.0, -0.0, 0.25, 1e-300]),
-            k in 0usize..1000,
+            k in 0u32..1000,
         ) {
             // Arbitrary bit patterns (NaN and infinities included) for start and step.
             let v = |i: usize| DVec3::from_array([0, 1, 2].map(|j| f64::from_bits(bits[i + j])));
@@ -318,7 +318,7 @@ mod tests {
             let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
             let m = projective();
             let start = m.pixel(u, v);
-            let stepped = m.directions_along_row(start).at(k as usize);
+            let stepped = m.directions_along_row(start).at(k);
             let pixel = start + DVec2::new(f64::from(k), 0.0);
             let uv = m.barycentrics(pixel);
             let direction = m.cache().trinorm(uv.x, uv.y);

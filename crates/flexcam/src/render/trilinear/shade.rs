@@ -446,7 +446,7 @@ impl Shader<'_> {
         run: &Run,
         out: &mut FrameRows<'_>,
         color: impl Fn(Vec2) -> Vec3,
-        direction: impl Fn(usize) -> DVec3,
+        direction: impl Fn(u32) -> DVec3,
     ) -> ShadeCounts {
         let id = self.resolver.scene.owners[run.triangle()].id;
         let mut counts = ShadeCounts::default();
@@ -465,7 +465,7 @@ impl Shader<'_> {
             for (k, ((((&t, &barycentric), out_color), out_id), length_squared)) in
                 pixels.enumerate()
             {
-                let direction = direction(chunk + k);
+                let direction = direction((chunk + k) as u32);
                 if t < CRACK_FILL_DEPTH && direction != DVec3::ZERO {
                     *out_color = color(Vec2::from(barycentric));
                     *out_id = id;
