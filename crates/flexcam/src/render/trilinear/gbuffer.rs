@@ -15,9 +15,7 @@
 //! lexicographically smaller than the stored pair, so the result depends neither on the
 //! order of the shapes nor on the band size or thread count.
 
-use glam::DVec2;
-
-use super::hit_terms::{Terms, TERMS};
+use super::hit_terms::{self, Terms, TERMS};
 use super::shade::Resolver;
 use crate::render::raster::{spans, FillRule, Polygon, RasterStats, Scratch, Span, NO_PRIMITIVE};
 
@@ -76,9 +74,12 @@ impl GBuffer {
         counts
     }
 
-    /// One span of a shape keyed `key`. Degenerate case: the step of a one-pixel span (a
-    /// line's pixel, a sliver's) may be huge or infinite where its crossings nearly
-    /// coincide; it is only added after the span's last pixel, never read.
+    /// One span of a shape keyed `key`. Where the terms' weight is exactly 1 along the
+    /// whole span (the affine screen map), each hit is solved without dividing by it
+    /// ([`hit_terms::solve_unit_weight`], the same bits). Degenerate case: the step of a
+    /// one-pixel span (a line's pixel, a sliver's) may be huge or infinite where its
+    /// crossings nearly coincide; it is only added after the span's last pixel, never read
+    /// (and a non-finite weight step takes the general [`hit_terms::solve`]).
     #[inline]
     fn span(
         &mut self,
@@ -88,41 +89,67 @@ impl GBuffer {
         counts: &mut RasterStats,
     ) {
         let (start, step) = span.start_and_step();
-        let mut terms: Terms = start.attributes;
-        let row = (span.y - self.rows.0) as usize * self.width as usize;
-        counts.fragments += u64::from(span.x1 - span.x0);
-        for x in span.x0..span.x1 {
-            let staged = resolver.staged(key, &terms, x, span.y);
-            match staged {
-                Some((key, depth, barycentric)) => {
-                    self.test_and_write(row + x as usize, key, depth, barycentric, counts)
-                }
-                None => counts.discarded += 1,
-            }
-            for (term, change) in terms.iter_mut().zip(&step.attributes) {
-                *term += change;
-            }
+        let (start, step) = (&start.attributes, &step.attributes);
+        if hit_terms::unit_weight_along(start, step) {
+            self.span_with(
+                span,
+                start,
+                step,
+                key,
+                resolver,
+                counts,
+                hit_terms::solve_unit_weight,
+            );
+        } else {
+            self.span_with(span, start, step, key, resolver, counts, hit_terms::solve);
         }
     }
 
-    /// The z-test of a staged fragment at index `i` of the band, and its write on a win.
-    #[inline]
-    fn test_and_write(
+    /// The pixels of `span` from the terms `start` stepped by `step`, each hit solved by
+    /// `solve`, staged ([`Resolver::staged`]) and z-tested against the span's cells of the
+    /// buffer (sliced once: no bounds check a pixel), written where it wins. The counts are
+    /// kept in locals (registers) and added once.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn span_with(
         &mut self,
-        i: usize,
+        span: &Span<'_, TERMS>,
+        start: &Terms,
+        step: &Terms,
         key: u64,
-        depth: f64,
-        barycentric: DVec2,
+        resolver: &Resolver<'_>,
         counts: &mut RasterStats,
+        solve: impl Fn(&Terms) -> (f64, f64, f64),
     ) {
-        let (stored_depth, stored_key) = (self.depth[i], self.keys[i]);
-        if depth < stored_depth || (depth == stored_depth && key < stored_key) {
-            counts.writes += 1;
-            counts.covered += u64::from(stored_key == NO_PRIMITIVE);
-            self.depth[i] = depth;
-            self.keys[i] = key;
-            self.barycentrics[i] = [barycentric.x as f32, barycentric.y as f32];
+        let mut terms: Terms = *start;
+        let row = (span.y - self.rows.0) as usize * self.width as usize;
+        let cells = row + span.x0 as usize..row + span.x1 as usize;
+        let stored = self.depth[cells.clone()]
+            .iter_mut()
+            .zip(&mut self.keys[cells.clone()])
+            .zip(&mut self.barycentrics[cells]);
+        let (mut discarded, mut writes, mut covered) = (0, 0, 0);
+        for (x, ((stored_depth, stored_key), stored_barycentric)) in (span.x0..span.x1).zip(stored)
+        {
+            match resolver.staged(key, solve(&terms), x, span.y) {
+                Some((key, depth, barycentric)) => {
+                    if depth < *stored_depth || (depth == *stored_depth && key < *stored_key) {
+                        writes += 1;
+                        covered += u64::from(*stored_key == NO_PRIMITIVE);
+                        (*stored_depth, *stored_key) = (depth, key);
+                        *stored_barycentric = [barycentric.x as f32, barycentric.y as f32];
+                    }
+                }
+                None => discarded += 1,
+            }
+            for (term, change) in terms.iter_mut().zip(step) {
+                *term += change;
+            }
         }
+        counts.fragments += u64::from(span.x1 - span.x0);
+        counts.discarded += discarded;
+        counts.writes += writes;
+        counts.covered += covered;
     }
 
     /// The band's rows.

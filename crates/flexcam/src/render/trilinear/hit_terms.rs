@@ -101,9 +101,46 @@ impl HitTerms {
 /// weight, which no pixel of a valid projective map has).
 #[inline]
 pub fn hit(terms: &Terms) -> Option<(f64, f64, f64)> {
+    finite(solve(terms))
+}
+
+/// [`hit`] before its test for finite values: `(t, b1, b2)`, any of them possibly
+/// infinite or NaN.
+#[inline]
+pub fn solve(terms: &Terms) -> (f64, f64, f64) {
+    let (t, b1, b2) = weighted(terms);
+    (t, b1 / terms[WEIGHT], b2 / terms[WEIGHT])
+}
+
+/// [`solve`] for terms whose weight is exactly 1 (every pixel of the affine map, the
+/// default): the same bits, without dividing by the weight, since IEEE 754 division by 1
+/// returns its operand unchanged (infinities and NaN included). A fragment's hit then waits
+/// on one division instead of two in a row, the span loop's longest dependency chain. Use
+/// it only where [`unit_weight_along`] holds; for another weight it is wrong.
+#[inline]
+pub fn solve_unit_weight(terms: &Terms) -> (f64, f64, f64) {
+    debug_assert_eq!(terms[WEIGHT], 1.0);
+    weighted(terms)
+}
+
+/// Whether every terms stepped from `start` by `step` (each the last plus `step`, as a span
+/// walks its pixels) have a weight of exactly 1, so that [`solve_unit_weight`] solves
+/// them: a start of 1 and a step of zero (`1 + 0` is exactly 1). A non-finite step is not
+/// zero, so a one-pixel span's huge step takes [`solve`].
+pub fn unit_weight_along(start: &Terms, step: &Terms) -> bool {
+    start[WEIGHT] == 1.0 && step[WEIGHT] == 0.0
+}
+
+/// The ray parameter and the barycentrics times the weight.
+#[inline(always)]
+fn weighted(terms: &Terms) -> (f64, f64, f64) {
     let t = terms[NUMERATOR] / terms[DENOMINATOR];
-    let b1 = (terms[A1] + t * terms[C1]) / terms[WEIGHT];
-    let b2 = (terms[A2] + t * terms[C2]) / terms[WEIGHT];
+    (t, terms[A1] + t * terms[C1], terms[A2] + t * terms[C2])
+}
+
+/// `Some(hit)` where all three of its values are finite.
+#[inline]
+pub fn finite((t, b1, b2): (f64, f64, f64)) -> Option<(f64, f64, f64)> {
     (t.is_finite() && b1.is_finite() && b2.is_finite()).then_some((t, b1, b2))
 }
 
@@ -178,6 +215,79 @@ mod tests {
             for i in 0..TERMS {
                 assert!((0.5 * (p[i] + q[i]) - middle[i]).abs() < 1e-12, "term {i}");
             }
+        }
+    }
+
+    /// The same bits from [`solve_unit_weight`] as from [`solve`].
+    fn same_hit(terms: &Terms) -> bool {
+        let bits = |(t, b1, b2): (f64, f64, f64)| [t, b1, b2].map(f64::to_bits);
+        bits(solve_unit_weight(terms)) == bits(solve(terms))
+    }
+
+    /// Values that stress the division: zeros of both signs, infinities, NaN, tiny and huge.
+    const SPECIAL: [f64; 10] = [
+        0.0,
+        -0.0,
+        1.0,
+        -3.5,
+        f64::MIN_POSITIVE,
+        5e-324,
+        f64::MAX,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+    ];
+
+    #[test]
+    fn unit_weight_hit_changes_no_bit_on_special_values() {
+        // Every pair of terms takes every pair of special values, the others ordinary;
+        // weight 1.
+        let base: Terms = [0.25, -0.5, 0.125, 2.0, 3.0, 1.5, 1.0];
+        for i in 0..TERMS - 1 {
+            for j in 0..TERMS - 1 {
+                for x in SPECIAL {
+                    for y in SPECIAL {
+                        let mut terms = base;
+                        (terms[i], terms[j]) = (x, y);
+                        assert!(same_hit(&terms), "{terms:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn unit_weight_hit_changes_no_bit(
+            bits in proptest::array::uniform6(proptest::num::u64::ANY),
+        ) {
+            // Arbitrary bit patterns (NaN and infinities included) for the six terms.
+            let mut terms = [1.0; TERMS];
+            for (term, b) in terms.iter_mut().zip(bits) {
+                *term = f64::from_bits(b);
+            }
+            proptest::prop_assert!(same_hit(&terms), "{:?}", terms);
+        }
+    }
+
+    #[test]
+    fn unit_weight_along_a_span_needs_a_start_of_one_and_a_zero_step() {
+        let with_weight = |w: f64| {
+            let mut terms = [0.5; TERMS];
+            terms[WEIGHT] = w;
+            terms
+        };
+        let one = with_weight(1.0);
+        assert!(unit_weight_along(&one, &with_weight(0.0)));
+        assert!(unit_weight_along(&one, &with_weight(-0.0)));
+        for step in [1e-300, -1e-300, f64::INFINITY, f64::NAN] {
+            assert!(!unit_weight_along(&one, &with_weight(step)), "{step}");
+        }
+        for start in [1.0 + f64::EPSILON, 1.0 - f64::EPSILON / 2.0, -1.0, f64::NAN] {
+            assert!(
+                !unit_weight_along(&with_weight(start), &with_weight(0.0)),
+                "{start}"
+            );
         }
     }
 

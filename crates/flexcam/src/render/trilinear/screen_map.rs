@@ -154,9 +154,36 @@ pub struct RowDirections {
 impl RowDirections {
     /// The direction `k` pixels along the row from the start.
     #[inline]
-    pub fn at(&self, k: usize) -> DVec3 {
-        let k = k as f64;
+    pub fn at(&self, k: u32) -> DVec3 {
+        let k = f64::from(k);
         (self.start + k * self.step) / (self.weight + k * self.weight_step)
+    }
+
+    /// The same directions where the weight is exactly 1 all along the row (every row of
+    /// the affine map: a weight of 1 and a step of zero), `None` elsewhere.
+    pub fn unit_weight(&self) -> Option<UnitWeightDirections> {
+        (self.weight == 1.0 && self.weight_step == 0.0).then_some(UnitWeightDirections {
+            start: self.start,
+            step: self.step,
+        })
+    }
+}
+
+/// [`RowDirections`] whose weight is exactly 1 all along the row
+/// ([`RowDirections::unit_weight`]).
+#[derive(Debug, Clone, Copy)]
+pub struct UnitWeightDirections {
+    start: DVec3,
+    step: DVec3,
+}
+
+impl UnitWeightDirections {
+    /// [`RowDirections::at`] without dividing by the weight `1 + k 0 = 1`: the same bits
+    /// (IEEE 754 division by 1 returns its operand unchanged), and shading a pixel waits on
+    /// no division before its depth's square root.
+    #[inline]
+    pub fn at(&self, k: u32) -> DVec3 {
+        self.start + f64::from(k) * self.step
     }
 }
 
@@ -255,13 +282,31 @@ mod tests {
             k in 0u32..400,
         ) {
             let m = map();
-            let stepped = m.directions_along_row(DVec2::new(x, y)).at(k as usize);
+            let stepped = m.directions_along_row(DVec2::new(x, y)).at(k);
             let pixel = DVec2::new(x + f64::from(k), y);
             let direction = m.projector(pixel).map_or(DVec3::ZERO, |p| p.direction);
             prop_assert!(
                 (stepped - direction).length() < 1e-12 * (1.0 + direction.length()),
                 "{stepped} {direction}"
             );
+        }
+
+        #[test]
+        fn unit_weight_directions_are_the_same_bits(
+            bits in proptest::array::uniform6(proptest::num::u64::ANY),
+            weight in proptest::sample::select(vec![1.0, 0.5, 1.0 - f64::EPSILON / 2.0]),
+            weight_step in proptest::sample::select(vec![0.0, -0.0, 0.25, 1e-300]),
+            k in 0u32..1000,
+        ) {
+            // Arbitrary bit patterns (NaN and infinities included) for start and step.
+            let v = |i: usize| DVec3::from_array([0, 1, 2].map(|j| f64::from_bits(bits[i + j])));
+            let row = RowDirections { start: v(0), step: v(3), weight, weight_step };
+            let unit = row.unit_weight();
+            prop_assert_eq!(unit.is_some(), weight == 1.0 && weight_step == 0.0);
+            if let Some(unit) = unit {
+                let bits = |d: DVec3| d.to_array().map(f64::to_bits);
+                prop_assert_eq!(bits(unit.at(k)), bits(row.at(k)));
+            }
         }
 
         #[test]
@@ -273,7 +318,7 @@ mod tests {
             let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
             let m = projective();
             let start = m.pixel(u, v);
-            let stepped = m.directions_along_row(start).at(k as usize);
+            let stepped = m.directions_along_row(start).at(k);
             let pixel = start + DVec2::new(f64::from(k), 0.0);
             let uv = m.barycentrics(pixel);
             let direction = m.cache().trinorm(uv.x, uv.y);

@@ -576,7 +576,12 @@ fn fragments_across_a_shared_edge_resolve_to_the_neighbour() {
     let uv = maps[1].barycentrics(at);
     let terms = hit_terms::HitTerms::new(geometry.corners(0)).unwrap();
     let (staged_key, depth, stored) = resolver
-        .staged(key(0), &terms.at(&maps[1], uv.x, uv.y), 3, 3)
+        .staged(
+            key(0),
+            hit_terms::solve(&terms.at(&maps[1], uv.x, uv.y)),
+            3,
+            3,
+        )
         .unwrap();
     assert_eq!((staged_key, depth), (key(1), 2.0));
     assert_eq!(stored, own.barycentric);
