@@ -72,15 +72,18 @@
 //! default, keeps the starts when they meet the data exactly and the data determine the
 //! free directions (bit for bit the old result), takes an exact eye fit where they do not
 //! (sparse data met exactly by many bent grids), and otherwise the eye where it meets the
-//! data clearly better.
+//! data clearly better. `Free` fits every node's start too (module `free`: projections with
+//! no common eye, such as pushbroom and crossed slits); `Auto` takes it where neither simpler
+//! model is exact and it is clearly better and determined ([`auto_fit`]).
 //!
 //! # Warnings
 //!
 //! The residual is measured at the correspondences only. [`FitReport`] counts the
 //! constrained nodes that left the prior by far (`wild_nodes`: a length ratio to the prior's
 //! node beyond `WILD_LENGTH` times the median ratio, or a direction more than
-//! `WILD_ANGLE_DEG` off) and those with little data (`sparse_nodes`: summed grid weight
-//! below `SPARSE_WEIGHT`); [`FitReport::warning`] words them for the user.
+//! `WILD_ANGLE_DEG` off) and those whose projectors the chosen model leaves undetermined
+//! (`sparse_nodes`, [`undetermined_nodes`]: none for a pinhole's field; for curved grids,
+//! summed grid weight below `SPARSE_WEIGHT`); [`FitReport::warning`] words them for the user.
 //!
 //! # Curved projectors
 //!
