@@ -51,6 +51,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     check_outputs(args)?;
 
     let loaded = args.scene.load()?;
+    warn_of_fit(&loaded.source, &loaded.projection.notes());
 
     let progress = RenderProgress::new();
     let report = |done: u64, total: u64| progress.update(done, total);
@@ -109,6 +110,24 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         super::print_stdout(&format!("{json}\n"))?;
     }
     Ok(())
+}
+
+/// Prints the warning of a fitted projector grid (as `flexcam fit` does) from the
+/// projection's notes, on stderr; the render goes on.
+fn warn_of_fit(source: &str, notes: &[(&'static str, f64)]) {
+    let count = |key: &str| {
+        notes
+            .iter()
+            .find(|(name, _)| *name == key)
+            .map_or(0, |(_, value)| *value as usize)
+    };
+    let warning = flexcam::projection::flexible::fit::node_warning(
+        count("fit_wild_nodes"),
+        count("fit_sparse_nodes"),
+    );
+    if let Some(warning) = warning {
+        eprintln!("flexcam: warning: {source}: {warning}");
+    }
 }
 
 /// Fails before rendering on output paths that could not be written afterwards.

@@ -72,15 +72,18 @@
 //! default, keeps the starts when they meet the data exactly and the data determine the
 //! free directions (bit for bit the old result), takes an exact eye fit where they do not
 //! (sparse data met exactly by many bent grids), and otherwise the eye where it meets the
-//! data clearly better.
+//! data clearly better. `Free` fits every node's start too (module `free`: projections with
+//! no common eye, such as pushbroom and crossed slits); `Auto` takes it where neither simpler
+//! model is exact and it is clearly better and determined ([`auto_fit`]).
 //!
 //! # Warnings
 //!
 //! The residual is measured at the correspondences only. [`FitReport`] counts the
 //! constrained nodes that left the prior by far (`wild_nodes`: a length ratio to the prior's
 //! node beyond `WILD_LENGTH` times the median ratio, or a direction more than
-//! `WILD_ANGLE_DEG` off) and those with little data (`sparse_nodes`: summed grid weight
-//! below `SPARSE_WEIGHT`); [`FitReport::warning`] words them for the user.
+//! `WILD_ANGLE_DEG` off) and those whose projectors the chosen model leaves undetermined
+//! (`sparse_nodes`, [`undetermined_nodes`]: none for a pinhole's field; for curved grids,
+//! summed grid weight below `SPARSE_WEIGHT`); [`FitReport::warning`] words them for the user.
 //!
 //! # Curved projectors
 //!
@@ -101,6 +104,7 @@ use crate::error::{Error, Result};
 mod angular;
 mod central;
 mod curved;
+mod free;
 
 /// The prior's least weight, relative to the data term's mean diagonal (see the module docs).
 const PRIOR_WEIGHT: f64 = 1e-11;
@@ -124,15 +128,18 @@ pub enum Starts {
     Kept,
     /// One common eye is fitted with the directions; every projector passes through it.
     Eye,
+    /// Every node's start is fitted with the directions (module `free`).
+    Free,
     /// The kept starts where they meet the data exactly and determine the directions, else
-    /// the eye where it meets the data exactly or clearly better (see [`fit_with`]).
+    /// the eye where it meets the data exactly or clearly better, else the free starts where
+    /// they meet the data clearly better (see [`fit_with`]).
     #[default]
     Auto,
 }
 
 impl Starts {
     /// The scene file's names, in the order of the error message.
-    pub const NAMES: [&'static str; 3] = ["auto", "kept", "eye"];
+    pub const NAMES: [&'static str; 4] = ["auto", "kept", "eye", "free"];
 
     /// The model of a scene file name (`None` for any other).
     pub fn from_name(name: &str) -> Option<Self> {
@@ -140,6 +147,7 @@ impl Starts {
             "auto" => Some(Starts::Auto),
             "kept" => Some(Starts::Kept),
             "eye" => Some(Starts::Eye),
+            "free" => Some(Starts::Free),
             _ => None,
         }
     }
@@ -153,6 +161,8 @@ pub enum FittedStarts {
     Kept,
     /// Starts on projectors through this fitted eye.
     Eye(DVec3),
+    /// Starts fitted per node, each in the plane across the prior's projector there.
+    Free,
 }
 
 /// In words, for the written scene's header and `flexcam fit`'s output.
@@ -161,6 +171,10 @@ impl std::fmt::Display for FittedStarts {
         match self {
             FittedStarts::Kept => write!(f, "starts kept"),
             FittedStarts::Eye(e) => write!(f, "starts on projectors through the fitted eye {e}"),
+            FittedStarts::Free => write!(
+                f,
+                "starts fitted per node (each across the prior's projector at its start)"
+            ),
         }
     }
 }
@@ -181,37 +195,43 @@ pub struct FitReport {
     pub starts: FittedStarts,
     /// Constrained nodes that left the prior by far (module section "Warnings").
     pub wild_nodes: usize,
-    /// Constrained nodes with little data on them (module section "Warnings").
+    /// Constrained nodes that the data leave undetermined under the fitted model (module
+    /// section "Warnings").
     pub sparse_nodes: usize,
 }
 
 impl FitReport {
-    /// A warning for the user when some node left the prior by far or has little data:
+    /// A warning for the user when some node left the prior by far or is undetermined:
     /// the residual, measured at the correspondences only, may then hide a wrong image.
     pub fn warning(&self) -> Option<String> {
-        let mut parts = Vec::new();
-        if self.wild_nodes > 0 {
-            parts.push(format!(
-                "{} fitted node(s) left the prior by far (length over {WILD_LENGTH} times or \
-                 under 1/{WILD_LENGTH} of the median length ratio, or direction over \
-                 {WILD_ANGLE_DEG} degrees off)",
-                self.wild_nodes
-            ));
-        }
-        if self.sparse_nodes > 0 {
-            parts.push(format!(
-                "{} node(s) have little data (summed weight below {SPARSE_WEIGHT})",
-                self.sparse_nodes
-            ));
-        }
-        (!parts.is_empty()).then(|| {
-            format!(
-                "{}: the residual is measured at the correspondences only; check the fitted \
-                 image",
-                parts.join(" and ")
-            )
-        })
+        node_warning(self.wild_nodes, self.sparse_nodes)
     }
+}
+
+/// [`FitReport::warning`] from its two counts (as `flexcam render`'s statistics carry them:
+/// `fit_wild_nodes`, `fit_sparse_nodes`).
+pub fn node_warning(wild_nodes: usize, sparse_nodes: usize) -> Option<String> {
+    let mut parts = Vec::new();
+    if wild_nodes > 0 {
+        parts.push(format!(
+            "{wild_nodes} fitted node(s) left the prior by far (length over {WILD_LENGTH} \
+                 times or under 1/{WILD_LENGTH} of the median length ratio, or direction over \
+                 {WILD_ANGLE_DEG} degrees off)"
+        ));
+    }
+    if sparse_nodes > 0 {
+        parts.push(format!(
+            "{sparse_nodes} node(s) are not determined by the correspondences under the \
+                 fitted model (too few points near them)"
+        ));
+    }
+    (!parts.is_empty()).then(|| {
+        format!(
+            "{}: the residual is measured at the correspondences only; check the fitted \
+                 image",
+            parts.join(" and ")
+        )
+    })
 }
 
 /// Fits the node directions of `prior` to `correspondences` (see the module docs); returns the
@@ -270,12 +290,9 @@ pub fn fit(
 
 /// Fits `prior` to `correspondences` with the starts model `starts` (module section
 /// "Starts"): `Kept` is [`fit`]; `Eye` the central fit (module `central`, its errors
-/// included); `Auto` is [`fit`]'s result, bit for bit, when that meets the data exactly
-/// (rms below `EXACT_RMS_RAD`), when the grid is curved, or when the central fit fails, and
-/// otherwise the central fit when its sum of squared angles beats the kept one's by more than
-/// 4 noise variances per extra unknown (its 3 eye coordinates; the variance estimated from
-/// the central fit's own residual and degrees of freedom), or when [`fit`] fails where it
-/// does not. Then counts the wild and sparse nodes (module section "Warnings").
+/// included); `Free` the free fit (module `free`); `Auto` the simplest model that explains the
+/// data ([`auto_fit`]). Then counts the wild nodes and, for kept starts, the undetermined ones
+/// (the other models count their own; module section "Warnings").
 pub fn fit_with(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
@@ -284,14 +301,33 @@ pub fn fit_with(
     let (grid, mut report) = match starts {
         Starts::Kept => fit(prior, correspondences)?,
         Starts::Eye => central_fit(prior, correspondences)?,
+        Starts::Free => {
+            let (kept, central) = (
+                fit(prior, correspondences),
+                central_fit(prior, correspondences),
+            );
+            let guesses: Vec<_> = [&kept, &central]
+                .into_iter()
+                .filter_map(|r| r.as_ref().ok().map(|(g, _)| g))
+                .collect();
+            let (grid, report, _) = free::fit(prior, correspondences, &guesses)?;
+            (grid, report)
+        }
         Starts::Auto => auto_fit(prior, correspondences)?,
     };
-    (report.wild_nodes, report.sparse_nodes) = node_warnings(prior, &grid, correspondences);
+    report.wild_nodes = wild_nodes(prior, &grid, correspondences);
+    if report.starts == FittedStarts::Kept {
+        report.sparse_nodes = if grid.is_curved() {
+            thinly_weighted_nodes(prior, correspondences)
+        } else {
+            straight_undetermined(&grid, correspondences)?
+        };
+    }
     Ok((grid, report))
 }
 
-/// Largest rms angle, in radians, of a kept-starts fit that `Starts::Auto` keeps without
-/// trying the eye (the rms miss `EXACT_CHORD` allows).
+/// Largest rms angle, in radians, of a fit that `Starts::Auto` takes as meeting the data
+/// exactly (the rms miss `EXACT_CHORD` allows).
 const EXACT_RMS_RAD: f64 = 1e-6;
 
 /// The central fit, its report saying which eye it found.
@@ -309,13 +345,102 @@ fn central_fit(
     ))
 }
 
-/// `Starts::Auto` (see [`fit_with`]).
+/// Whether a fit's rms miss is at most `EXACT_RMS_RAD`.
+fn exact(report: &FitReport) -> bool {
+    report.rms_angle_deg.to_radians() <= EXACT_RMS_RAD
+}
+
+/// Whether a model with `unknowns` and the sum of squared misses `fewer_ss` should replace
+/// one with fewer (`unknowns - extra`) and `more_ss`: it must lower the sum by more than 4
+/// noise variances per extra unknown, the variance estimated from its own residual and its
+/// degrees of freedom (2 equations a correspondence less `unknowns`); never where it has no
+/// spare equations.
+fn clearly_better(count: usize, unknowns: usize, extra: usize, ss: f64, simpler_ss: f64) -> bool {
+    let freedom = 2 * count;
+    if freedom <= unknowns {
+        return false;
+    }
+    simpler_ss > ss * (1.0 + 4.0 * extra as f64 / (freedom - unknowns) as f64)
+}
+
+/// `Starts::Auto`: [`fit`]'s result, bit for bit, when that meets the data exactly with the
+/// data determining the free directions (rms below `EXACT_RMS_RAD`), or when the grid is
+/// curved; else the central fit when it is exact, or when it beats the kept one
+/// ([`clearly_better`], its 3 eye coordinates extra), or when [`fit`] fails where it does
+/// not. That simpler model stands when it is exact; otherwise the free fit (module `free`),
+/// where it leaves no constrained node undetermined, replaces it when it is clearly better, counting 5 unknowns a constrained node less the
+/// scale, or, when it is exact with node values affine along every grid line (a bilinear
+/// grid: the smoothness term's own model), those of the grid's four corners (19); with no
+/// more unknowns than the simpler model it must only miss the data less. So pinhole data keep
+/// their eye, bit for bit, and bilinear non-central data from as few as 10 points may take
+/// the free starts.
 fn auto_fit(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport)> {
+    let (simple, central) = kept_or_eye(prior, correspondences);
+    if prior.is_curved() || simple.as_ref().is_ok_and(|(_, r)| exact(r)) {
+        return simple;
+    }
+    let kept = fit(prior, correspondences).ok();
+    let guesses: Vec<&ProjectorGrid> = [kept.as_ref(), central.as_ref()]
+        .into_iter()
+        .flatten()
+        .map(|(g, _)| g)
+        .collect();
+    // Free starts that the data leave undetermined somewhere are no evidence of anything.
+    let free = free::fit(prior, correspondences, &guesses)
+        .ok()
+        .filter(|(_, r, _)| r.sparse_nodes == 0);
+    let Some((free_grid, free_report, bilinear)) = free else {
+        return simple;
+    };
+    let Ok((_, simple_report)) = &simple else {
+        return Ok((free_grid, free_report));
+    };
+    let constrained = constrained_nodes(prior, correspondences)
+        .iter()
+        .filter(|c| **c)
+        .count();
+    let simple_unknowns = match simple_report.starts {
+        FittedStarts::Eye(_) => 3 * constrained + 2,
+        _ => 3 * constrained - 1,
+    };
+    let free_unknowns = if bilinear && exact(&free_report) {
+        4 * 5 - 1
+    } else {
+        5 * constrained - 1
+    };
+    let count = correspondences.len();
+    let ss = |r: &FitReport| r.rms_angle_deg.powi(2) * count as f64;
+    let better = if free_unknowns <= simple_unknowns {
+        2 * count > free_unknowns && ss(&free_report) < ss(simple_report)
+    } else {
+        clearly_better(
+            count,
+            free_unknowns,
+            free_unknowns - simple_unknowns,
+            ss(&free_report),
+            ss(simple_report),
+        )
+    };
+    if better {
+        Ok((free_grid, free_report))
+    } else {
+        simple
+    }
+}
+
+/// A fit result.
+type Fitted = Result<(ProjectorGrid, FitReport)>;
+
+/// The choice between kept starts and one eye of [`auto_fit`], with the central fit when it
+/// succeeded.
+fn kept_or_eye(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+) -> (Fitted, Option<(ProjectorGrid, FitReport)>) {
     let kept = fit(prior, correspondences);
-    let exact = |r: &FitReport| r.rms_angle_deg.to_radians() <= EXACT_RMS_RAD;
     // Fewer equations (2 a correspondence) than free node directions (3 a constrained
     // node, less the scale): the kept fit meets the points exactly whatever lies between
     // them, so its exactness says nothing; the eye is tried as well.
@@ -323,33 +448,27 @@ fn auto_fit(
     let node_unknowns = 3 * constrained.iter().filter(|c| **c).count();
     let determined = 2 * correspondences.len() + 1 > node_unknowns;
     if prior.is_curved() || (determined && kept.as_ref().is_ok_and(|(_, r)| exact(r))) {
-        return kept;
+        return (kept, None);
     }
     let Ok(central) = central_fit(prior, correspondences) else {
-        return kept;
+        return (kept, None);
     };
     // An exact central fit where the kept starts are not: the data are a pinhole's (the
     // central fit's pinhole field needs six points, where the counts below are those of
     // free node directions, which sparse data leave undetermined).
     if exact(&central.1) {
-        return Ok(central);
+        return (Ok(central.clone()), Some(central));
     }
     let Ok((_, kept_report)) = &kept else {
-        return Ok(central);
+        return (Ok(central.clone()), Some(central));
     };
-    let count = correspondences.len() as f64;
-    let sum_of_squares = |r: &FitReport| r.rms_angle_deg.powi(2) * count;
+    let count = correspondences.len();
+    let ss = |r: &FitReport| r.rms_angle_deg.powi(2) * count as f64;
     let unknowns = node_unknowns + 3 - 1;
-    let freedom = 2 * correspondences.len();
-    if freedom <= unknowns {
-        return kept;
-    }
-    let freedom = (freedom - unknowns) as f64;
-    let central_ss = sum_of_squares(&central.1);
-    if sum_of_squares(kept_report) > central_ss * (1.0 + 4.0 * 3.0 / freedom) {
-        Ok(central)
+    if clearly_better(count, unknowns, 3, ss(&central.1), ss(kept_report)) {
+        (Ok(central.clone()), Some(central))
     } else {
-        kept
+        (kept, Some(central))
     }
 }
 
@@ -360,22 +479,28 @@ const WILD_LENGTH: f64 = 4.0;
 /// A fitted node is wild when its direction is more than this many degrees off the prior's.
 const WILD_ANGLE_DEG: f64 = 60.0;
 
-/// A constrained node has little data when the grid weights on it, summed over the
-/// correspondences, are below this: less than one correspondence's two equations for the
-/// node's three unknowns.
+/// A constrained node of a curved grid has little data when the grid weights on it, summed
+/// over the correspondences, are below this: less than one correspondence's two equations
+/// for the node's three unknowns.
 const SPARSE_WEIGHT: f64 = 1.0;
 
-/// The numbers of wild and sparse constrained nodes of `fitted` against `prior` (module
-/// section "Warnings").
-fn node_warnings(
-    prior: &ProjectorGrid,
-    fitted: &ProjectorGrid,
-    correspondences: &[Correspondence],
-) -> (usize, usize) {
+/// The node weights summed over the correspondences.
+fn node_weights(prior: &ProjectorGrid, correspondences: &[Correspondence]) -> Vec<f64> {
     let mut weight = vec![0.0; prior.starts().len()];
     for c in correspondences {
         prior.for_each_weight(c.uv, |j, w| weight[j] += w);
     }
+    weight
+}
+
+/// The number of wild constrained nodes of `fitted` against `prior` (module section
+/// "Warnings").
+fn wild_nodes(
+    prior: &ProjectorGrid,
+    fitted: &ProjectorGrid,
+    correspondences: &[Correspondence],
+) -> usize {
+    let weight = node_weights(prior, correspondences);
     let direction = |g: &ProjectorGrid, j: usize| g.ends()[j] - g.starts()[j];
     let constrained: Vec<usize> = (0..weight.len()).filter(|j| weight[*j] > 0.0).collect();
     let ratios: Vec<f64> = constrained
@@ -385,7 +510,7 @@ fn node_warnings(
     let mut sorted = ratios.clone();
     sorted.sort_by(f64::total_cmp);
     let median = sorted.get(sorted.len() / 2).copied().unwrap_or(1.0);
-    let wild = constrained
+    constrained
         .iter()
         .zip(&ratios)
         .filter(|(&j, &ratio)| {
@@ -394,12 +519,131 @@ fn node_warnings(
             let relative = ratio / median;
             angle > WILD_ANGLE_DEG || !(1.0 / WILD_LENGTH..=WILD_LENGTH).contains(&relative)
         })
-        .count();
-    let sparse = constrained
+        .count()
+}
+
+/// The constrained nodes of a curved grid whose summed weight is below `SPARSE_WEIGHT`.
+fn thinly_weighted_nodes(prior: &ProjectorGrid, correspondences: &[Correspondence]) -> usize {
+    node_weights(prior, correspondences)
         .iter()
-        .filter(|&&j| weight[j] < SPARSE_WEIGHT)
-        .count();
-    (wild, sparse)
+        .filter(|w| **w > 0.0 && **w < SPARSE_WEIGHT)
+        .count()
+}
+
+/// A node is undetermined when the variance of some projector at or around it under the
+/// model, relative to the inverse mean diagonal of the model's matrix, exceeds this: the data
+/// (and the model's own terms) leave it free, and only the prior's weak pull settles it.
+const UNDETERMINED_VARIANCE: f64 = 1e6;
+
+/// The constrained nodes (`constrained`) of the fitted `grid` whose projectors the model
+/// leaves undetermined (module section "Warnings"). `matrix` is the model's Gauss-Newton
+/// matrix without the pull to the prior, in `per_node` unknowns a node: 3 (the direction over
+/// `scale`) or 6 (the start over a length near the points' distance, then the direction over
+/// `scale`); `grid` has the directions the unknowns describe; `gauge` is the
+/// scale constraint's row. The covariance is the inverse of matrix + g g^T (scaled to the
+/// mean diagonal) + 1e-10 of the mean diagonal; what is judged is the projectors' lines, not
+/// the unknowns: at the node's (u, v) and at the centres of its cells, the blended start's
+/// and direction's moves across the projector (about radians: the start in its units, the
+/// direction over its own length). A move that changes no line (a start sliding along its
+/// projector, a direction's length; a pushbroom's starts and lengths may change by any
+/// amount affine in u that way, its directions being the same along a row) is no doubt.
+fn undetermined_nodes(
+    grid: &ProjectorGrid,
+    matrix: &DMatrix<f64>,
+    per_node: usize,
+    gauge: &DVector<f64>,
+    constrained: &[bool],
+    scale: f64,
+) -> usize {
+    let n = matrix.nrows();
+    let mean = matrix.trace() / n as f64;
+    let all = constrained.iter().filter(|c| **c).count();
+    if mean <= 0.0 || !mean.is_finite() {
+        return all;
+    }
+    let mut fixed = matrix.clone();
+    let g2 = gauge.norm_squared();
+    if g2 > 0.0 {
+        fixed += (mean / g2) * gauge * gauge.transpose();
+    }
+    for i in 0..n {
+        fixed[(i, i)] += 1e-10 * mean;
+    }
+    let Some(covariance) = fixed.cholesky().map(|f| f.inverse()) else {
+        return all;
+    };
+    let dirs = prior_directions(grid);
+    let (cols, rows) = grid.size();
+    let doubtful = |uv: DVec2| {
+        let mut weights = Vec::new();
+        grid.for_each_weight(uv, |j, w| weights.push((j, w)));
+        let d: DVec3 = weights.iter().map(|&(j, w)| w * dirs[j]).sum();
+        let Some(unit) = d.try_normalize() else {
+            return true;
+        };
+        let off = projector_off(unit);
+        // Rows: the start's move across the projector (if fitted), then the direction's.
+        let parts = per_node / 3;
+        let mut jacobian = DMatrix::<f64>::zeros(3 * parts, n);
+        for &(j, w) in &weights {
+            for part in 0..parts {
+                let factor = if part + 1 == parts {
+                    w * scale / d.length()
+                } else {
+                    w
+                };
+                for r in 0..3 {
+                    for c in 0..3 {
+                        jacobian[(3 * part + r, per_node * j + 3 * part + c)] += factor * off[r][c];
+                    }
+                }
+            }
+        }
+        let variance = &jacobian * &covariance * jacobian.transpose();
+        (0..variance.nrows()).any(|i| variance[(i, i)] * mean > UNDETERMINED_VARIANCE)
+    };
+    (0..constrained.len())
+        .filter(|&j| {
+            let (col, row) = (j % cols, j / cols);
+            let here = grid.node_uv(col, row);
+            let mut samples = vec![here];
+            for (dc, dr) in [(-1, -1), (-1, 1), (1, -1), (1, 1)] {
+                let (c, r) = (col as isize + dc, row as isize + dr);
+                if (0..cols as isize).contains(&c) && (0..rows as isize).contains(&r) {
+                    samples.push(0.5 * (here + grid.node_uv(c as usize, r as usize)));
+                }
+            }
+            constrained[j] && samples.into_iter().any(&doubtful)
+        })
+        .count()
+}
+
+/// The constrained nodes of the straight `grid` whose directions (its starts kept) the data
+/// leave undetermined ([`undetermined_nodes`] of the linear fit's normal matrix).
+fn straight_undetermined(
+    grid: &ProjectorGrid,
+    correspondences: &[Correspondence],
+) -> Result<usize> {
+    let targets = targets(grid, correspondences)?;
+    let system = System::new(grid, correspondences, &targets);
+    let constrained = constrained_nodes(grid, correspondences);
+    Ok(undetermined_nodes(
+        grid,
+        &system.normal,
+        3,
+        &system.scale_row,
+        &constrained,
+        system.scale,
+    ))
+}
+
+/// The node directions E_j - S_j of `grid`.
+fn prior_directions(grid: &ProjectorGrid) -> Vec<DVec3> {
+    grid.starts()
+        .iter()
+        .zip(grid.ends())
+        .map(|(s, e)| *e - *s)
+        .collect()
 }
 
 /// The residual of `grid` (straight) at `correspondences`, seen from its own starts.

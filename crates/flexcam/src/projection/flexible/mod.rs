@@ -249,12 +249,15 @@ impl Projection for Flexible {
                     ("fit_wild_nodes", r.wild_nodes as f64),
                     ("fit_sparse_nodes", r.sparse_nodes as f64),
                 ];
-                // 1 when the starts lie on projectors through a fitted eye (given next).
+                // 1 when the starts lie on projectors through a fitted eye (given next), or
+                // were fitted per node.
                 let eye = match r.starts {
                     fit::FittedStarts::Eye(eye) => Some(eye),
-                    fit::FittedStarts::Kept => None,
+                    fit::FittedStarts::Kept | fit::FittedStarts::Free => None,
                 };
                 notes.push(("fit_starts_eye", f64::from(u8::from(eye.is_some()))));
+                let free = r.starts == fit::FittedStarts::Free;
+                notes.push(("fit_starts_free", f64::from(u8::from(free))));
                 if let Some(eye) = eye {
                     notes.extend([
                         ("fit_eye_x", eye.x),

@@ -63,7 +63,7 @@ pub(super) fn refine(
             }
             y *= wanted / along;
         }
-        let (cost, y) = problem.minimise(y);
+        let (cost, y) = minimise(&problem, y, &system.scale_row);
         if best.as_ref().is_none_or(|(c, _)| cost < *c) {
             best = Some((cost, y));
         }
@@ -86,6 +86,13 @@ struct Problem<'a> {
     lambda: f64,
 }
 
+/// A least-squares cost that Levenberg-Marquardt can minimise: its value and its
+/// Gauss-Newton matrix and gradient at given unknowns (shared with module `free`).
+pub(super) trait LeastSquares {
+    fn cost(&self, y: &DVector<f64>) -> f64;
+    fn linearise(&self, y: &DVector<f64>) -> (DMatrix<f64>, DVector<f64>);
+}
+
 impl Problem<'_> {
     /// The blended direction at correspondence `c` for unknowns `y`.
     fn direction(&self, c: &Correspondence, y: &DVector<f64>) -> DVec3 {
@@ -95,7 +102,9 @@ impl Problem<'_> {
         });
         d
     }
+}
 
+impl LeastSquares for Problem<'_> {
     fn cost(&self, y: &DVector<f64>) -> f64 {
         let data: f64 = self
             .correspondences
@@ -148,52 +157,56 @@ impl Problem<'_> {
         }
         (matrix, gradient)
     }
+}
 
-    /// Levenberg-Marquardt from `y` (on the scale constraint), keeping it there; returns the
-    /// final cost and unknowns.
-    fn minimise(&self, mut y: DVector<f64>) -> (f64, DVector<f64>) {
-        let row = &self.system.scale_row;
-        let constrained = row.norm_squared() > 0.0;
-        let mut cost = self.cost(&y);
-        let mut damping = 1e-3;
-        for _ in 0..MAX_ITERATIONS {
-            let (matrix, gradient) = self.linearise(&y);
-            let mut improved = None;
-            while damping < 1e12 {
-                let mut damped = matrix.clone();
-                for i in 0..damped.nrows() {
-                    damped[(i, i)] *= 1.0 + damping;
-                }
-                let Some(factor) = damped.cholesky() else {
-                    damping *= 10.0;
-                    continue;
-                };
-                let mut step = factor.solve(&(-&gradient));
-                if constrained {
-                    // Keep row . y fixed: remove the step's component along the constraint
-                    // in the damped metric (Lagrange multiplier).
-                    let along = factor.solve(row);
-                    step -= (row.dot(&step) / row.dot(&along)) * along;
-                }
-                let trial = &y + &step;
-                let trial_cost = self.cost(&trial);
-                if trial_cost < cost {
-                    improved = Some((trial_cost, trial));
-                    damping = (damping * 0.1).max(1e-12);
-                    break;
-                }
+/// Levenberg-Marquardt (Marquardt's diagonal damping) on `problem` from `y`, keeping the
+/// linear constraint `row . y` at its starting value (no constraint when `row` is zero);
+/// returns the final cost and unknowns.
+pub(super) fn minimise(
+    problem: &impl LeastSquares,
+    mut y: DVector<f64>,
+    row: &DVector<f64>,
+) -> (f64, DVector<f64>) {
+    let constrained = row.norm_squared() > 0.0;
+    let mut cost = problem.cost(&y);
+    let mut damping = 1e-3;
+    for _ in 0..MAX_ITERATIONS {
+        let (matrix, gradient) = problem.linearise(&y);
+        let mut improved = None;
+        while damping < 1e12 {
+            let mut damped = matrix.clone();
+            for i in 0..damped.nrows() {
+                damped[(i, i)] *= 1.0 + damping;
+            }
+            let Some(factor) = damped.cholesky() else {
                 damping *= 10.0;
-            }
-            let Some((trial_cost, trial)) = improved else {
-                break;
+                continue;
             };
-            let decrease = cost - trial_cost;
-            y = trial;
-            cost = trial_cost;
-            if decrease <= RELATIVE_DECREASE * cost {
+            let mut step = factor.solve(&(-&gradient));
+            if constrained {
+                // Keep row . y fixed: remove the step's component along the constraint
+                // in the damped metric (Lagrange multiplier).
+                let along = factor.solve(row);
+                step -= (row.dot(&step) / row.dot(&along)) * along;
+            }
+            let trial = &y + &step;
+            let trial_cost = problem.cost(&trial);
+            if trial_cost < cost {
+                improved = Some((trial_cost, trial));
+                damping = (damping * 0.1).max(1e-12);
                 break;
             }
+            damping *= 10.0;
         }
-        (cost, y)
+        let Some((trial_cost, trial)) = improved else {
+            break;
+        };
+        let decrease = cost - trial_cost;
+        y = trial;
+        cost = trial_cost;
+        if decrease <= RELATIVE_DECREASE * cost {
+            break;
+        }
     }
+    (cost, y)
 }

@@ -43,7 +43,7 @@
 use glam::{DMat3, DVec3};
 use nalgebra::{DMatrix, Matrix3, SymmetricEigen};
 
-use super::{blended, targets, Correspondence, FitReport, System};
+use super::{blended, prior_directions, targets, Correspondence, FitReport, System};
 use crate::error::{Error, Result};
 use crate::projection::flexible::projector_grid::ProjectorGrid;
 
@@ -112,7 +112,7 @@ pub(super) fn fit(
         .and_then(|eye| Some((pinhole_grid(&pinhole, eye)?, eye)));
     if let Some(((grid, report), eye)) = &pinhole_fit {
         if report.rms_angle_deg.to_radians() <= PINHOLE_EXACT {
-            return finish(grid, correspondences, *eye, prior);
+            return finish(grid, correspondences, *eye, prior, true);
         }
     }
     let free_fit = best(&free)
@@ -126,30 +126,45 @@ pub(super) fn fit(
             let at_eye = free.grid_at(eye, &prior_directions(prior))?;
             Ok((super::fit(&at_eye, correspondences)?, eye))
         });
-    let (fitted, eye) = match (pinhole_fit, free_fit) {
+    let (fitted, eye, pinhole) = match (pinhole_fit, free_fit) {
         (Some(((grid, report), eye)), Ok(((_, free_report), _)))
             if pinhole_suffices(&report, &free_report, prior.starts().len()) =>
         {
-            (grid, eye)
+            (grid, eye, true)
         }
-        (_, Ok(((grid, _), eye))) => (grid, eye),
-        (Some(((grid, _), eye)), Err(_)) => (grid, eye),
+        (_, Ok(((grid, _), eye))) => (grid, eye, false),
+        (Some(((grid, _), eye)), Err(_)) => (grid, eye, true),
         (None, Err(e)) => return Err(e),
     };
-    finish(&fitted, correspondences, eye, prior)
+    finish(&fitted, correspondences, eye, prior, pinhole)
 }
 
 /// `fitted` (every start at `eye`) with its starts moved to the prior's near distance, its
-/// report and the eye.
+/// report and the eye. The report's `sparse_nodes` counts the nodes the data leave
+/// undetermined: none under the `pinhole` field (its eye and 8 unknowns were found
+/// determined), else those of the free directions at the eye.
 fn finish(
     fitted: &ProjectorGrid,
     correspondences: &[Correspondence],
     eye: DVec3,
     prior: &ProjectorGrid,
+    pinhole: bool,
 ) -> Result<(ProjectorGrid, FitReport, DVec3)> {
     let grid = starts_moved(fitted, correspondences, eye, near_fraction(prior))?;
     let report = super::report_of(&grid, correspondences)?;
-    Ok((grid, report, eye))
+    let sparse_nodes = if pinhole {
+        0
+    } else {
+        super::straight_undetermined(&grid, correspondences)?
+    };
+    Ok((
+        grid,
+        FitReport {
+            sparse_nodes,
+            ..report
+        },
+        eye,
+    ))
 }
 
 /// The error of an eye the correspondences do not determine.
@@ -177,16 +192,6 @@ fn on_one_image_line(correspondences: &[Correspondence]) -> bool {
     let (half_trace, det) = (0.5 * (xx + yy) / n, (xx * yy - xy * xy) / (n * n));
     let least = half_trace - (half_trace * half_trace - det).max(0.0).sqrt();
     least < 1e-12
-}
-
-/// The prior's node directions E_j - S_j.
-fn prior_directions(prior: &ProjectorGrid) -> Vec<DVec3> {
-    prior
-        .starts()
-        .iter()
-        .zip(prior.ends())
-        .map(|(s, e)| *e - *s)
-        .collect()
 }
 
 /// The root mean square distance of the correspondences' points from their centroid.
@@ -712,7 +717,7 @@ mod tests {
     }
 
     #[test]
-    fn a_wild_and_a_sparse_node_are_counted() {
+    fn wild_nodes_are_counted_and_undetermined_ones_only_where_the_model_leaves_them_open() {
         let prior = camera_grid(60.0, DVec3::ZERO);
         let data = seen_by(&prior, 40, 9);
         let (grid, report) = fit_with(&prior, &data, Starts::Kept).unwrap();
@@ -728,14 +733,31 @@ mod tests {
         let d = ends[8] - grid.starts()[8];
         ends[8] = grid.starts()[8] + d.cross(DVec3::Y).normalize() * d.length();
         let wild = grid.with_ends(ends).unwrap();
-        assert_eq!(super::super::node_warnings(&prior, &wild, &data).0, 2);
-        // One point near the centre: the corner nodes carry weights below 1.
-        let one = [Correspondence {
-            uv: DVec2::new(0.4, 0.45),
-            point: prior.point(DVec2::new(0.4, 0.45), 0.3),
-        }];
-        let (_, sparse) = super::super::node_warnings(&prior, &prior, &one);
-        assert_eq!(sparse, 4);
+        assert_eq!(super::super::wild_nodes(&prior, &wild, &data), 2);
+        // Kept starts, three points in the lower left cell: its four nodes' 12 direction
+        // unknowns against 6 equations are undetermined, and the user is told.
+        let cell: Vec<_> = data
+            .iter()
+            .filter(|c| c.uv.max_element() < 0.5)
+            .take(3)
+            .copied()
+            .collect();
+        assert_eq!(cell.len(), 3);
+        let (_, report) = fit_with(&prior, &cell, Starts::Kept).unwrap();
+        assert_eq!(report.sparse_nodes, 4, "{report:?}");
+        assert!(report.warning().unwrap().contains("not determined"));
+        // A pinhole off the prior's eye recovered exactly from 8 points: some nodes carry
+        // little weight (the old summed-weight rule warned of them), but the pinhole's field
+        // determines every node: no warning.
+        let truth = camera_grid(50.0, DVec3::ZERO);
+        let off = camera_grid(70.0, DVec3::new(0.8, -0.5, 0.7));
+        let eight = seen_by(&truth, 8, 3);
+        assert!(super::super::thinly_weighted_nodes(&off, &eight) > 0);
+        let (fitted, report) = fit_with(&off, &eight, Starts::Auto).unwrap();
+        assert!(matches!(report.starts, FittedStarts::Eye(_)), "{report:?}");
+        assert!(farthest_line(&fitted, EYE) < 1e-7);
+        assert_eq!(report.sparse_nodes, 0, "{report:?}");
+        assert!(report.warning().is_none());
     }
 
     proptest! {

@@ -1,0 +1,612 @@
+//! The free fit (`starts = "free"`): every node's start fitted together with its direction,
+//! for correspondences from projections whose projectors pass through no common eye
+//! (pushbroom, crossed slits, any grid whose starts are off an eye; module section "Starts"
+//! of `fit`). Kept starts cannot meet such data, and one common eye cannot either.
+//!
+//! # Unknowns and gauge
+//!
+//! Node j has the start S_j = S0_j + L s_j and the direction D_j = l d_j (6 unknowns). Sliding
+//! every start along its own projector by one common fraction a of its direction changes no
+//! projector of the grid (S(u, v) + a D(u, v), for any weights that sum to 1), and scaling
+//! every direction by one factor changes none either. Sliding the starts by different
+//! fractions is no such freedom: the blended start then leaves the projector between the
+//! nodes (measured: holding each start in the plane across the prior's projector, one
+//! fraction per node, left a pushbroom 0.15 to 0.26 degrees off at the points). The common
+//! slide is fixed by a penalty on the starts' mean move along the prior's unit directions
+//! (weight: the data term's mean diagonal; on a true freedom it biases nothing), the scale by
+//! the fit's scale constraint (the prior's directions' component over the constrained nodes,
+//! as module `fit`'s). L is the rms distance from the prior's starts to the points (a start's
+//! move turns a projector by about its length over that distance) and l the prior's mean
+//! projector length, so the unknowns are dimensionless.
+//!
+//! # Cost
+//!
+//! sum_k |n_k - m_k|^2 + mu sum |second differences|^2 + pull, with n_k the unit blended
+//! direction D(u_k, v_k) and m_k the unit direction from the blended start S(u_k, v_k) to
+//! the point X_k: the chord 2 sin(angle / 2) of module `angular`, now moving with the starts
+//! too. The smoothness term takes the second differences of the starts (over L) and of the
+//! directions (over l) along every row and every column of nodes: zero for node values that
+//! are affine along the grid lines, so a bilinear truth (pushbroom, crossed slits, a bilinear
+//! grid off any eye, any pinhole) is not biased, while sparse data, which leave many grids
+//! exact, get the least bent one. mu is `SMOOTHNESS` of the data term's mean diagonal, a
+//! trade-off (docs/flexible.md, "Free starts"): it moves the fit of a 3 x 3 grid that is not
+//! bilinear across its nodes by up to 0.17 degrees at the points (measured), and it must be
+//! large enough that sparse fits of bilinear truths come out bilinear. Nodes that
+//! no correspondence weighs are pulled to the prior with `PULL` of that diagonal (the
+//! smoothness term extrapolates them otherwise); every unknown gets the floor weight of
+//! module `fit`, which keeps the matrix positive definite. Levenberg-Marquardt (module
+//! `angular`'s) from each given grid's projectors (the kept fit's, the eye fit's, the
+//! prior's); the lowest cost wins.
+//!
+//! # Degenerate cases
+//!
+//! - All points on one projector (one image position): that projector meets them, the others
+//!   are the smoothest continuation of the prior; every constrained node is reported as
+//!   undetermined (`sparse_nodes`), and `starts = "auto"` does not take it.
+//! - Points only in one cell: that cell's four nodes are fitted, the others unconstrained
+//!   (pulled to the prior, smoothed); with fewer than 10 points the cell's 20 unknowns are
+//!   undetermined and reported so.
+//! - Points all on one plane (whatever the projection): the plane's points at their image
+//!   positions are met, but nothing tells how the projectors run off the plane; `auto` keeps
+//!   the simpler kept starts, which meet such data as well, and the plane's image is right
+//!   either way.
+//! - A fitted projector that reaches its point only at t <= 0: the error of module `fit`.
+
+use glam::DVec3;
+use nalgebra::{DMatrix, DVector, SMatrix};
+
+use super::angular::{minimise, LeastSquares};
+use super::{
+    constrained_nodes, in_view, prior_directions, targets, undetermined_nodes, Correspondence,
+    FitReport, FittedStarts, PRIOR_WEIGHT,
+};
+use crate::error::{Error, Result};
+use crate::projection::flexible::projector_grid::ProjectorGrid;
+
+/// The smoothness weight, relative to the data term's mean diagonal (module docs).
+const SMOOTHNESS: f64 = 1e-3;
+
+/// The pull of unconstrained nodes to the prior, relative to the data term's mean diagonal.
+const PULL: f64 = 1e-6;
+
+/// Unknowns per node: three for the start, three for the direction.
+const PER_NODE: usize = 6;
+
+/// Largest second difference (in the unknowns' units) of a fit taken as bilinear.
+const BILINEAR: f64 = 1e-5;
+
+/// Fits `prior`'s node starts and directions to `correspondences` (module docs), starting
+/// from each of `guesses` (grids of the prior's size) and from the prior; returns the grid,
+/// its report (`sparse_nodes` counting the constrained nodes that data and smoothness leave
+/// undetermined) and whether its node values are affine along every grid line (all second
+/// differences below `BILINEAR`).
+pub(super) fn fit(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+    guesses: &[&ProjectorGrid],
+) -> Result<(ProjectorGrid, FitReport, bool)> {
+    if prior.is_curved() {
+        return Err(Error::new(
+            "projector grid fit: `starts = \"free\"` fits straight projectors; this grid has \
+             tangents",
+        ));
+    }
+    // The correspondences' errors (positions outside the image, a point at its start).
+    targets(prior, correspondences)?;
+    if correspondences.is_empty() {
+        let (grid, report) = super::fit(prior, correspondences)?;
+        return Ok((grid, report, false));
+    }
+    let problem = Problem::new(prior, correspondences);
+    let wanted = problem.scale_row.norm_squared();
+    let mut best: Option<(f64, DVector<f64>)> = None;
+    for guess in guesses.iter().copied().chain([prior]) {
+        let mut y = problem.unknowns_of(guess);
+        let along = problem.scale_row.dot(&y);
+        if !(along > 0.0 && along.is_finite()) {
+            continue;
+        }
+        problem.rescale(&mut y, wanted / along);
+        let (cost, y) = minimise(&problem, y, &problem.scale_row);
+        if best.as_ref().is_none_or(|(c, _)| cost < *c) {
+            best = Some((cost, y));
+        }
+    }
+    let (_, y) = best.ok_or_else(|| {
+        Error::new("projector grid fit: no starting grid for the free fit points at its data")
+    })?;
+    let starts: Vec<DVec3> = (0..problem.nodes()).map(|j| problem.start(j, &y)).collect();
+    let dirs: Vec<DVec3> = (0..problem.nodes()).map(|j| problem.dir(j, &y)).collect();
+    let ends = starts.iter().zip(&dirs).map(|(s, d)| *s + *d).collect();
+    let grid = ProjectorGrid::new(prior.size(), starts, ends, prior.interpolation())?;
+    let (matrix, _) = problem.linearise_model(&y);
+    let constrained = constrained_nodes(prior, correspondences);
+    let sparse_nodes = undetermined_nodes(
+        &grid,
+        &matrix,
+        PER_NODE,
+        &problem.scale_row,
+        &constrained,
+        problem.scale,
+    );
+    let grid_targets = targets(&grid, correspondences)?;
+    let (grid, report) = in_view(&grid, correspondences, &grid_targets, dirs)?;
+    let bilinear = (&problem.rows * &y + &problem.constant).amax() <= BILINEAR;
+    Ok((
+        grid,
+        FitReport {
+            starts: FittedStarts::Free,
+            sparse_nodes,
+            ..report
+        },
+        bilinear,
+    ))
+}
+
+/// The free fit's least-squares problem in its scaled unknowns (module docs).
+struct Problem<'a> {
+    prior: &'a ProjectorGrid,
+    correspondences: &'a [Correspondence],
+    /// The prior's starts S0_j.
+    origins: Vec<DVec3>,
+    /// The common slide's penalty row: the prior's unit directions on the start unknowns,
+    /// over the square root of the node count (unit length); and its weight.
+    slide: DVector<f64>,
+    slide_weight: f64,
+    /// L: the rms distance from the prior's starts to the points.
+    length: f64,
+    /// l: the prior's mean projector length.
+    scale: f64,
+    /// The smoothness term's matrix mu L^T L and gradient constant mu L^T c (below).
+    smooth: DMatrix<f64>,
+    smooth_c: DVector<f64>,
+    /// The second differences themselves (rows of L, constant c).
+    rows: DMatrix<f64>,
+    constant: DVector<f64>,
+    mu: f64,
+    /// The weight of each unknown's pull to `prior_y` (floor, or `PULL` on unconstrained
+    /// nodes).
+    pull: DVector<f64>,
+    prior_y: DVector<f64>,
+    /// The scale constraint's row: the prior's directions over the constrained nodes.
+    scale_row: DVector<f64>,
+}
+
+impl<'a> Problem<'a> {
+    fn new(prior: &'a ProjectorGrid, correspondences: &'a [Correspondence]) -> Self {
+        let dirs = prior_directions(prior);
+        let nodes = dirs.len();
+        let scale = dirs.iter().map(|d| d.length()).sum::<f64>() / nodes as f64;
+        let distance: f64 = correspondences
+            .iter()
+            .map(|c| (c.point - prior.start_end(c.uv).0).length_squared())
+            .sum();
+        let length = (distance / correspondences.len() as f64).sqrt();
+        let constrained = constrained_nodes(prior, correspondences);
+        let n = PER_NODE * nodes;
+        let mut prior_y = DVector::zeros(n);
+        let mut scale_row = DVector::zeros(n);
+        let mut slide = DVector::zeros(n);
+        for (j, d) in dirs.iter().enumerate() {
+            let along = d.normalize_or_zero() / (nodes as f64).sqrt();
+            for r in 0..3 {
+                prior_y[PER_NODE * j + 3 + r] = d[r] / scale;
+                slide[PER_NODE * j + r] = along[r];
+                if constrained[j] {
+                    scale_row[PER_NODE * j + 3 + r] = d[r] / scale;
+                }
+            }
+        }
+        let mut problem = Self {
+            prior,
+            correspondences,
+            origins: prior.starts().to_vec(),
+            slide,
+            slide_weight: 0.0,
+            length,
+            scale,
+            smooth: DMatrix::zeros(n, n),
+            smooth_c: DVector::zeros(n),
+            rows: DMatrix::zeros(0, n),
+            constant: DVector::zeros(0),
+            mu: 0.0,
+            pull: DVector::zeros(n),
+            prior_y,
+            scale_row,
+        };
+        // The weights follow the data term's mean diagonal at the prior (the chords'
+        // derivatives hardly depend on where they are taken).
+        let (data, _) = problem.data_term(&problem.prior_y);
+        let mean = (data.trace() / n as f64).max(f64::MIN_POSITIVE);
+        problem.mu = SMOOTHNESS * mean;
+        problem.slide_weight = mean;
+        (problem.rows, problem.constant) = problem.second_differences();
+        let (rows, constant, mu) = (&problem.rows, &problem.constant, problem.mu);
+        problem.smooth = mu * rows.transpose() * rows;
+        problem.smooth_c = mu * rows.transpose() * constant;
+        for (j, constrained) in constrained.iter().enumerate() {
+            let weight = if *constrained { PRIOR_WEIGHT } else { PULL };
+            for i in 0..PER_NODE {
+                problem.pull[PER_NODE * j + i] = weight * mean;
+            }
+        }
+        problem
+    }
+
+    fn nodes(&self) -> usize {
+        self.origins.len()
+    }
+
+    /// S_j for unknowns `y`.
+    fn start(&self, j: usize, y: &DVector<f64>) -> DVec3 {
+        let k = PER_NODE * j;
+        self.origins[j] + self.length * DVec3::new(y[k], y[k + 1], y[k + 2])
+    }
+
+    /// D_j for unknowns `y`.
+    fn dir(&self, j: usize, y: &DVector<f64>) -> DVec3 {
+        let k = PER_NODE * j + 3;
+        self.scale * DVec3::new(y[k], y[k + 1], y[k + 2])
+    }
+
+    /// Scales the directions in `y` by `factor`.
+    fn rescale(&self, y: &mut DVector<f64>, factor: f64) {
+        for j in 0..self.nodes() {
+            for r in 0..3 {
+                y[PER_NODE * j + 3 + r] *= factor;
+            }
+        }
+    }
+
+    /// The unknowns of `grid`'s node projectors.
+    fn unknowns_of(&self, grid: &ProjectorGrid) -> DVector<f64> {
+        let mut y = DVector::zeros(PER_NODE * self.nodes());
+        for (j, (s, e)) in grid.starts().iter().zip(grid.ends()).enumerate() {
+            let (offset, d) = ((*s - self.origins[j]) / self.length, *e - *s);
+            for r in 0..3 {
+                y[PER_NODE * j + r] = offset[r];
+                y[PER_NODE * j + 3 + r] = d[r] / self.scale;
+            }
+        }
+        y
+    }
+
+    /// The second differences of the starts (over L) and directions (over l) along every
+    /// row and column of nodes, as rows of L y + c.
+    fn second_differences(&self) -> (DMatrix<f64>, DVector<f64>) {
+        let (cols, rows) = self.prior.size();
+        let mut triples = Vec::new();
+        for r in 0..rows {
+            for c in 1..cols.saturating_sub(1) {
+                triples.push([r * cols + c - 1, r * cols + c, r * cols + c + 1]);
+            }
+        }
+        for c in 0..cols {
+            for r in 1..rows.saturating_sub(1) {
+                triples.push([(r - 1) * cols + c, r * cols + c, (r + 1) * cols + c]);
+            }
+        }
+        let n = PER_NODE * self.nodes();
+        let mut matrix = DMatrix::zeros(6 * triples.len(), n);
+        let mut constant = DVector::zeros(6 * triples.len());
+        for (t, triple) in triples.iter().enumerate() {
+            for (&j, weight) in triple.iter().zip([1.0, -2.0, 1.0]) {
+                for r in 0..3 {
+                    constant[6 * t + r] += weight * self.origins[j][r] / self.length;
+                }
+                for r in 0..PER_NODE {
+                    matrix[(6 * t + r, PER_NODE * j + r)] += weight;
+                }
+            }
+        }
+        (matrix, constant)
+    }
+
+    /// The data term's Gauss-Newton matrix and gradient at `y`.
+    fn data_term(&self, y: &DVector<f64>) -> (DMatrix<f64>, DVector<f64>) {
+        let n = y.len();
+        let mut matrix = DMatrix::<f64>::zeros(n, n);
+        let mut gradient = DVector::<f64>::zeros(n);
+        let mut weights = Vec::new();
+        for c in self.correspondences {
+            weights.clear();
+            self.prior
+                .for_each_weight(c.uv, |j, w| weights.push((j, w)));
+            let Some((n_unit, n_len, m_unit, m_len)) = self.blend(c, &weights, y) else {
+                continue;
+            };
+            let residual = n_unit - m_unit;
+            let off_n = glam::DMat3::IDENTITY - outer(n_unit);
+            let off_m = glam::DMat3::IDENTITY - outer(m_unit);
+            // d r / d s_j = w_j L (I - m m^T) / |X - S|; d r / d d_j = w_j l (I - n n^T) / |D|.
+            let blocks: Vec<(usize, SMatrix<f64, 3, 6>)> = weights
+                .iter()
+                .map(|&(j, w)| {
+                    let js = off_m * (w * self.length / m_len);
+                    let jd = off_n * (w * self.scale / n_len);
+                    let block = SMatrix::<f64, 3, 6>::from_fn(|r, col| {
+                        if col < 3 {
+                            js.col(col)[r]
+                        } else {
+                            jd.col(col - 3)[r]
+                        }
+                    });
+                    (j, block)
+                })
+                .collect();
+            let r = nalgebra::Vector3::new(residual.x, residual.y, residual.z);
+            for (j, bj) in &blocks {
+                let mut g = gradient.fixed_rows_mut::<6>(PER_NODE * j);
+                g += bj.transpose() * r;
+                for (l, bl) in &blocks {
+                    let mut m = matrix.fixed_view_mut::<6, 6>(PER_NODE * j, PER_NODE * l);
+                    m += bj.transpose() * bl;
+                }
+            }
+        }
+        (matrix, gradient)
+    }
+
+    /// The unit blended direction and its length, and the unit direction from the blended
+    /// start to the point and its length, at correspondence `c` (its grid `weights`); `None`
+    /// where either has no direction.
+    fn blend(
+        &self,
+        c: &Correspondence,
+        weights: &[(usize, f64)],
+        y: &DVector<f64>,
+    ) -> Option<(DVec3, f64, DVec3, f64)> {
+        let (mut s, mut d) = (DVec3::ZERO, DVec3::ZERO);
+        for &(j, w) in weights {
+            s += w * self.start(j, y);
+            d += w * self.dir(j, y);
+        }
+        let to = c.point - s;
+        Some((
+            d.try_normalize()?,
+            d.length(),
+            to.try_normalize()?,
+            to.length(),
+        ))
+    }
+
+    /// The model's Gauss-Newton matrix and gradient at `y`: data, smoothness and the common
+    /// slide's penalty, no pull (what the nodes are determined by).
+    fn linearise_model(&self, y: &DVector<f64>) -> (DMatrix<f64>, DVector<f64>) {
+        let (matrix, gradient) = self.data_term(y);
+        let slide = self.slide_weight * &self.slide;
+        (
+            matrix + &self.smooth + &slide * self.slide.transpose(),
+            gradient + &self.smooth * y + &self.smooth_c + slide * self.slide.dot(y),
+        )
+    }
+}
+
+impl LeastSquares for Problem<'_> {
+    fn cost(&self, y: &DVector<f64>) -> f64 {
+        let mut weights = Vec::new();
+        let data: f64 = self
+            .correspondences
+            .iter()
+            .map(|c| {
+                weights.clear();
+                self.prior
+                    .for_each_weight(c.uv, |j, w| weights.push((j, w)));
+                self.blend(c, &weights, y)
+                    .map_or(4.0, |(n, _, m, _)| (n - m).length_squared())
+            })
+            .sum();
+        let smooth = self.mu * (&self.rows * y + &self.constant).norm_squared();
+        let pull: f64 = (y - &self.prior_y)
+            .iter()
+            .zip(self.pull.iter())
+            .map(|(d, w)| w * d * d)
+            .sum();
+        data + smooth + pull + self.slide_weight * self.slide.dot(y).powi(2)
+    }
+
+    fn linearise(&self, y: &DVector<f64>) -> (DMatrix<f64>, DVector<f64>) {
+        let (mut matrix, mut gradient) = self.linearise_model(y);
+        for i in 0..y.len() {
+            matrix[(i, i)] += self.pull[i];
+            gradient[i] += self.pull[i] * (y[i] - self.prior_y[i]);
+        }
+        (matrix, gradient)
+    }
+}
+
+/// a a^T.
+fn outer(a: DVec3) -> glam::DMat3 {
+    glam::DMat3::from_cols(a * a.x, a * a.y, a * a.z)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec2;
+
+    use super::super::{fit_with, Starts};
+    use super::*;
+    use crate::projection::flexible::presets::Preset;
+    use crate::projection::flexible::projector_grid::tests::{
+        perspective_volume as perspective, preset_volume,
+    };
+    use crate::projection::flexible::projector_grid::GridInterpolation;
+    use crate::projection::flexible::volume::LinearVolume;
+
+    /// Deterministic uniform numbers in [0, 1) from `seed` (a linear congruential generator).
+    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut state = seed;
+        move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    /// `count` points of `truth` at seeded image positions in `[lo, hi]^2` and depths t in
+    /// (0.1, 0.6).
+    fn seen_by(
+        truth: &LinearVolume,
+        count: usize,
+        seed: u64,
+        lo: f64,
+        hi: f64,
+    ) -> Vec<Correspondence> {
+        let mut next = uniform(seed);
+        (0..count)
+            .map(|_| {
+                let uv = DVec2::new(lo + (hi - lo) * next(), lo + (hi - lo) * next());
+                Correspondence {
+                    uv,
+                    point: truth.point(uv, 0.1 + 0.5 * next()),
+                }
+            })
+            .collect()
+    }
+
+    /// The pushbroom and crossed-slits truths (bilinear in (u, v), no common eye).
+    fn truths() -> [LinearVolume; 2] {
+        [
+            preset_volume(
+                Preset::Pushbroom {
+                    width: 6.0,
+                    v_fov: 50.0,
+                },
+                [1.0, 30.0],
+            ),
+            preset_volume(
+                Preset::CrossedSlits {
+                    fov: 60.0,
+                    v_fov: None,
+                    slit_distance: -2.0,
+                },
+                [1.0, 30.0],
+            ),
+        ]
+    }
+
+    /// A 3 x 3 perspective prior with the fixture's eye.
+    fn prior() -> ProjectorGrid {
+        ProjectorGrid::sample(
+            &perspective(60.0, [1.0, 40.0]),
+            (3, 3),
+            GridInterpolation::Bilinear,
+        )
+        .unwrap()
+    }
+
+    /// The largest distance, over a 9 x 9 grid of (u, v), from the truth's points at
+    /// t = 0.1 and 0.6 to the fitted projector's line.
+    fn farthest_miss(fitted: &ProjectorGrid, truth: &LinearVolume, lo: f64, hi: f64) -> f64 {
+        let mut worst = 0.0f64;
+        for i in 0..=8 {
+            for j in 0..=8 {
+                let uv = DVec2::new(
+                    lo + (hi - lo) * f64::from(i) / 8.0,
+                    lo + (hi - lo) * f64::from(j) / 8.0,
+                );
+                let (s, e) = fitted.start_end(uv);
+                let d = (e - s).normalize();
+                for t in [0.1, 0.6] {
+                    worst = worst.max((truth.point(uv, t) - s).cross(d).length());
+                }
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn recovers_pushbroom_and_crossed_slits_from_a_perspective_prior() {
+        for truth in truths() {
+            for count in [12, 50] {
+                let data = seen_by(&truth, count, 3, 0.0, 1.0);
+                let (fitted, report) = fit_with(&prior(), &data, Starts::Free).unwrap();
+                assert!(
+                    farthest_miss(&fitted, &truth, 0.0, 1.0) < 1e-5,
+                    "{count} {report:?}"
+                );
+                assert!(report.max_angle_deg < 1e-6, "{report:?}");
+                assert_eq!(report.starts, FittedStarts::Free);
+                assert_eq!(report.sparse_nodes, 0, "{report:?}");
+                // `auto` takes it: kept starts and one eye miss these data.
+                let (auto, auto_report) = fit_with(&prior(), &data, Starts::Auto).unwrap();
+                assert_eq!(auto_report.starts, FittedStarts::Free);
+                assert_eq!(auto, fitted);
+            }
+        }
+    }
+
+    #[test]
+    fn points_on_one_projector_are_met_and_reported_undetermined() {
+        let [pushbroom, _] = truths();
+        let uv = DVec2::new(0.3, 0.6);
+        let line: Vec<_> = (0..8)
+            .map(|k| Correspondence {
+                uv,
+                point: pushbroom.point(uv, 0.1 + 0.07 * f64::from(k)),
+            })
+            .collect();
+        let (fitted, report) = fit_with(&prior(), &line, Starts::Free).unwrap();
+        // That projector meets them, but nothing says how the others run.
+        let (s, e) = fitted.start_end(uv);
+        for c in &line {
+            assert!((c.point - s).cross((e - s).normalize()).length() < 1e-6);
+        }
+        assert!(report.max_angle_deg < 1e-6, "{report:?}");
+        assert_eq!(report.sparse_nodes, 4, "{report:?}");
+        assert!(report.warning().unwrap().contains("not determined"));
+        // `auto` has no evidence for free starts (16 equations).
+        let (_, auto) = fit_with(&prior(), &line, Starts::Auto).unwrap();
+        assert_ne!(auto.starts, FittedStarts::Free, "{auto:?}");
+    }
+
+    #[test]
+    fn points_in_one_cell_fit_that_cell_and_the_smoothness_carries_a_bilinear_truth() {
+        for truth in truths() {
+            let data = seen_by(&truth, 40, 7, 0.0, 0.5);
+            let (fitted, report) = fit_with(&prior(), &data, Starts::Free).unwrap();
+            assert_eq!(report.unconstrained_nodes, 5, "{report:?}");
+            assert_eq!(report.sparse_nodes, 0, "{report:?}");
+            // Measured 4e-4 in the cell (points up to 18 away: 2e-5 rad) and 0.035 over
+            // the image: the unconstrained nodes continue the cell's affine fields, pulled
+            // weakly (not at all would leave them free) to the prior.
+            assert!(farthest_miss(&fitted, &truth, 0.0, 0.5) < 1e-3);
+            assert!(farthest_miss(&fitted, &truth, 0.0, 1.0) < 0.05);
+            // Too few points in the cell for its four nodes' 24 unknowns: reported.
+            let (_, few) = fit_with(&prior(), &data[..3], Starts::Free).unwrap();
+            assert!(few.sparse_nodes > 0, "{few:?}");
+        }
+    }
+
+    #[test]
+    fn coplanar_points_of_a_pushbroom_keep_the_simpler_model_and_the_planes_image() {
+        let [pushbroom, _] = truths();
+        // 40 points where the pushbroom's projectors meet the plane z = -4 (across the view).
+        let mut next = uniform(11);
+        let on_plane = |uv: DVec2| {
+            let (s, e) = (pushbroom.point(uv, 0.0), pushbroom.point(uv, 1.0));
+            s + (e - s) * ((-4.0 - s.z) / (e.z - s.z))
+        };
+        let data: Vec<_> = (0..40)
+            .map(|_| {
+                let uv = DVec2::new(next(), next());
+                Correspondence {
+                    uv,
+                    point: on_plane(uv),
+                }
+            })
+            .collect();
+        let (fitted, report) = fit_with(&prior(), &data, Starts::Auto).unwrap();
+        assert_ne!(report.starts, FittedStarts::Free, "{report:?}");
+        // The plane's image is right everywhere: every projector meets its plane point.
+        for i in 0..=8 {
+            for j in 0..=8 {
+                let uv = DVec2::new(f64::from(i), f64::from(j)) / 8.0;
+                let (s, e) = fitted.start_end(uv);
+                let miss = (on_plane(uv) - s).cross((e - s).normalize()).length();
+                assert!(miss < 1e-3, "{uv}: {miss}");
+            }
+        }
+    }
+}
