@@ -48,10 +48,8 @@ pub(super) fn convert(src: &Source, table: &Spanned<RawProjectors>) -> Result<Pr
             "bilinear" => GridInterpolation::Bilinear,
             "bezier" => GridInterpolation::Bezier,
             other => {
-                return Err(src.error(
-                    &name.span(),
-                    format!("unknown interpolation \"{other}\"; expected one of: bilinear, bezier"),
-                ))
+                let expected = ["bilinear", "bezier"];
+                return Err(src.unknown(&name.span(), "interpolation", other, &expected));
             }
         },
     };
@@ -105,16 +103,8 @@ fn starts(src: &Source, raw: &RawProjectors) -> Result<Starts> {
             "`starts` goes with `fit` (it says where the fitted projectors start)",
         ));
     }
-    Starts::from_name(name.get_ref()).ok_or_else(|| {
-        src.error(
-            &name.span(),
-            format!(
-                "unknown starts \"{}\"; expected one of: {}",
-                name.get_ref(),
-                Starts::NAMES.join(", ")
-            ),
-        )
-    })
+    Starts::from_name(name.get_ref())
+        .ok_or_else(|| src.unknown(&name.span(), "starts", name.get_ref(), &Starts::NAMES))
 }
 
 /// A `projector = [...]` entry; a zero `tangent` is allowed and means straight. With `point`
