@@ -58,6 +58,18 @@ fn lens_camera() -> Perspective {
     camera(&scene, SIZE)
 }
 
+/// `mesh` refined as a mirror seen by `camera` with the affine screen map (the default) to
+/// `tolerance_px`.
+fn mirror(mesh: &Mesh, camera: &Perspective, tolerance_px: f64) -> Refinement {
+    refine(
+        mesh,
+        camera,
+        Optic::Reflect,
+        SurfaceScreenMap::Affine,
+        tolerance_px,
+    )
+}
+
 /// Whether every vertex ray and screen position of `surface` is finite.
 fn finite(surface: &ReflectorSurface) -> bool {
     let mesh = &surface.mesh;
@@ -67,13 +79,7 @@ fn finite(surface: &ReflectorSurface) -> bool {
 #[test]
 fn refinement_is_crack_free() {
     let (mesh, camera) = sphere(24);
-    let refined = refine(
-        &mesh,
-        &camera,
-        Optic::Reflect,
-        SurfaceScreenMap::Affine,
-        0.5,
-    );
+    let refined = mirror(&mesh, &camera, 0.5);
     assert!(
         refined.mesh.triangles.len() > mesh.triangles.len(),
         "the close sphere is refined: {} triangles",
@@ -106,13 +112,7 @@ fn refinement_is_crack_free() {
 #[test]
 fn new_vertices_carry_the_ray_casters_interpolated_normals() {
     let (mesh, camera) = sphere(16);
-    let refined = refine(
-        &mesh,
-        &camera,
-        Optic::Reflect,
-        SurfaceScreenMap::Affine,
-        0.5,
-    );
+    let refined = mirror(&mesh, &camera, 0.5);
     let n = mesh.positions.len();
     assert!(refined.mesh.positions.len() > n);
     // The input vertices are unchanged.
@@ -151,13 +151,7 @@ fn refinement_stops_within_the_tolerance() {
     let (mesh, camera) = sphere(24);
     let mut counts = Vec::new();
     for tolerance in [0.0, 2.0, 0.5, 0.1] {
-        let refined = refine(
-            &mesh,
-            &camera,
-            Optic::Reflect,
-            SurfaceScreenMap::Affine,
-            tolerance,
-        );
+        let refined = mirror(&mesh, &camera, tolerance);
         counts.push(refined.mesh.triangles.len());
         assert_eq!(refined.unsplit, 0, "tolerance {tolerance}");
         // Every remaining edge is within the bound (decided again from scratch).
@@ -186,13 +180,7 @@ fn refinement_stops_within_the_tolerance() {
 #[test]
 fn zero_tolerance_is_the_mesh_unchanged() {
     let (mesh, camera) = sphere(8);
-    let refined = refine(
-        &mesh,
-        &camera,
-        Optic::Reflect,
-        SurfaceScreenMap::Affine,
-        0.0,
-    );
+    let refined = mirror(&mesh, &camera, 0.0);
     assert_eq!(refined.mesh, mesh);
 }
 
@@ -266,13 +254,7 @@ fn the_depth_cap_bounds_a_pathological_mesh() {
         triangles: vec![[0, 1, 2]],
         ..Mesh::default()
     };
-    let refined = refine(
-        &mesh,
-        &camera,
-        Optic::Reflect,
-        SurfaceScreenMap::Affine,
-        1e-6,
-    );
+    let refined = mirror(&mesh, &camera, 1e-6);
     let count = refined.mesh.triangles.len();
     println!("{count} triangles, {} edges left over", refined.unsplit);
     assert!(count <= 4usize.pow(MAX_LEVEL), "{count}");
@@ -344,13 +326,7 @@ fn grazing_vertex_rays_refine_finitely() {
         triangles: vec![[0, 1, 2]],
         ..Mesh::default()
     };
-    let refined = refine(
-        &mesh,
-        &camera,
-        Optic::Reflect,
-        SurfaceScreenMap::Affine,
-        0.5,
-    );
+    let refined = mirror(&mesh, &camera, 0.5);
     refined.mesh.validate().unwrap();
     assert!(refined.mesh.triangles.len() <= 4usize.pow(MAX_LEVEL));
     let surface = reflector_surface(&refined.mesh, &camera, Optic::Reflect).unwrap();
@@ -383,13 +359,7 @@ fn edges_outside_the_image_are_not_split() {
         let pixel = camera.project_continuous(p.as_dvec3()).unwrap().pixel;
         assert!(pixel.x < 0.0, "{pixel}");
     }
-    let refined = refine(
-        &mesh,
-        &camera,
-        Optic::Reflect,
-        SurfaceScreenMap::Affine,
-        1e-6,
-    );
+    let refined = mirror(&mesh, &camera, 1e-6);
     assert_eq!(refined.mesh.triangles, mesh.triangles);
     assert_eq!(refined.unsplit, 0);
 }
@@ -397,12 +367,6 @@ fn edges_outside_the_image_are_not_split() {
 #[test]
 fn a_nan_tolerance_is_no_refinement() {
     let (mesh, camera) = sphere(8);
-    let refined = refine(
-        &mesh,
-        &camera,
-        Optic::Reflect,
-        SurfaceScreenMap::Affine,
-        f64::NAN,
-    );
+    let refined = mirror(&mesh, &camera, f64::NAN);
     assert_eq!(refined.mesh, mesh);
 }
