@@ -70,6 +70,26 @@ fn mirror(mesh: &Mesh, camera: &Perspective, tolerance_px: f64) -> Refinement {
     )
 }
 
+/// One triangle centred on `x` whose normals splay apart by about 90 degrees: its mirror
+/// rays diverge so fast that no depth of refinement meets a fine tolerance (the depth-cap
+/// and off-image tests).
+fn splayed_triangle(x: f32) -> Mesh {
+    Mesh {
+        positions: vec![
+            Vec3::new(x - 1.0, 0.8, 0.0),
+            Vec3::new(x + 1.0, 0.8, 0.0),
+            Vec3::new(x, 2.0, 0.0),
+        ],
+        normals: vec![
+            Vec3::new(-1.0, 0.0, 0.1),
+            Vec3::new(1.0, 0.0, 0.1),
+            Vec3::new(0.0, 1.0, 0.1),
+        ],
+        triangles: vec![[0, 1, 2]],
+        ..Mesh::default()
+    }
+}
+
 /// Whether every vertex ray and screen position of `surface` is finite.
 fn finite(surface: &ReflectorSurface) -> bool {
     let mesh = &surface.mesh;
@@ -240,20 +260,7 @@ fn parallel_vertex_rays_have_a_finite_error() {
 fn the_depth_cap_bounds_a_pathological_mesh() {
     let scene = sphere_and_cube(8);
     let camera = camera(&scene, (1600, 1200));
-    let mesh = Mesh {
-        positions: vec![
-            Vec3::new(-1.0, 0.8, 0.0),
-            Vec3::new(1.0, 0.8, 0.0),
-            Vec3::new(0.0, 2.0, 0.0),
-        ],
-        normals: vec![
-            Vec3::new(-1.0, 0.0, 0.1),
-            Vec3::new(1.0, 0.0, 0.1),
-            Vec3::new(0.0, 1.0, 0.1),
-        ],
-        triangles: vec![[0, 1, 2]],
-        ..Mesh::default()
-    };
+    let mesh = splayed_triangle(0.0);
     let refined = mirror(&mesh, &camera, 1e-6);
     let count = refined.mesh.triangles.len();
     println!("{count} triangles, {} edges left over", refined.unsplit);
@@ -341,20 +348,7 @@ fn grazing_vertex_rays_refine_finitely() {
 fn edges_outside_the_image_are_not_split() {
     let scene = sphere_and_cube(8);
     let camera = camera(&scene, SIZE);
-    let mesh = Mesh {
-        positions: vec![
-            Vec3::new(-9.0, 0.8, 0.0),
-            Vec3::new(-7.0, 0.8, 0.0),
-            Vec3::new(-8.0, 2.0, 0.0),
-        ],
-        normals: vec![
-            Vec3::new(-1.0, 0.0, 0.1),
-            Vec3::new(1.0, 0.0, 0.1),
-            Vec3::new(0.0, 1.0, 0.1),
-        ],
-        triangles: vec![[0, 1, 2]],
-        ..Mesh::default()
-    };
+    let mesh = splayed_triangle(-8.0);
     for p in &mesh.positions {
         let pixel = camera.project_continuous(p.as_dvec3()).unwrap().pixel;
         assert!(pixel.x < 0.0, "{pixel}");
