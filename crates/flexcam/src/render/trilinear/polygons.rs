@@ -280,14 +280,17 @@ fn draw_pairs(
     for live in pairs {
         let k = live.triangle as usize;
         let positions = scene.corners(k);
-        let pair = Pair {
+        // Built only for a pair that is drawn.
+        let pair = || Pair {
             triangle,
             key: (u64::from(group.projection) << 32) | k as u64,
             id: scene.owners[k].id,
             curves,
             terms: live.terms,
         };
+        let unprojectable = out.counts.unprojectable;
         if let Some(central) = &triangle.central {
+            let pair = pair();
             let drawn = central.outlines(positions, &mut scratch.central, |outline| {
                 out.counts.shapes += 1;
                 pair.push_outline(outline, &mut scratch.pixels, &mut out.polygons);
@@ -295,25 +298,20 @@ fn draw_pairs(
             });
             if drawn.is_err() {
                 out.counts.unprojectable += 1;
-                out.fallback.push(group.projection);
             }
-            continue;
+        } else {
+            let solved = group.solved(live);
+            match cull(triangle, positions, &solved) {
+                Some(Cull::Behind) => out.counts.culled_behind += 1,
+                Some(Cull::Outside) => out.counts.culled_outside += 1,
+                None if curves.mode == CurveMode::Tessellate => {
+                    pair().tessellated(positions, out, scratch);
+                }
+                None => pair().whole(positions, solved, out, scratch),
+            }
         }
-        let solved = group.solved(live);
-        match cull(triangle, positions, &solved) {
-            Some(Cull::Behind) => out.counts.culled_behind += 1,
-            Some(Cull::Outside) => out.counts.culled_outside += 1,
-            None => {
-                let unprojectable = out.counts.unprojectable;
-                if curves.mode == CurveMode::Tessellate {
-                    pair.tessellated(positions, out, scratch);
-                } else {
-                    pair.whole(positions, solved, out, scratch);
-                }
-                if out.counts.unprojectable > unprojectable {
-                    out.fallback.push(group.projection);
-                }
-            }
+        if out.counts.unprojectable > unprojectable {
+            out.fallback.push(group.projection);
         }
     }
 }
