@@ -5,7 +5,8 @@
 //! (BVH, scene geometry); each iteration is one frame. `trilinear_frame` uses the default
 //! adaptive curves with scene-space clipping, `trilinear_unclipped` the thesis's cheaper
 //! screen-space clipping only, `trilinear_kept_unclipped` the same into a frame kept from
-//! iteration to iteration (`TrilinearRenderer::render_into`, a program's later frames).
+//! iteration to iteration (`TrilinearRenderer::render_into`, a program's later frames);
+//! `raycast_frame` and `raycast_kept` the ray caster into a new frame and into a kept one.
 //!
 //! Run with `cargo bench -p flexcam --bench trilinear`. Figures are recorded in
 //! docs/trilinear.md (with `flexcam bench trilinear`, which prints the thesis's tables).
@@ -55,6 +56,12 @@ fn cube_floor_18(c: &mut Criterion) {
     let caster = RayCaster::new(&scene);
     group.bench_function("raycast_frame", |b| {
         b.iter(|| caster.render(&projection, &options))
+    });
+    // The ray caster's later frames into a frame it keeps: like for like with
+    // `trilinear_kept_unclipped`.
+    let mut kept = caster.render(&projection, &options).0;
+    group.bench_function("raycast_kept", |b| {
+        b.iter(|| caster.render_into(&mut kept, &projection, &options))
     });
     group.finish();
 }

@@ -93,6 +93,20 @@ impl Frame {
         huge_pages::advise_huge_pages(&mut frame.ids);
         frame
     }
+
+    /// Makes this frame `width` x `height` for a renderer that overwrites every pixel: a
+    /// frame of that size (whose three buffers hold `width * height` pixels) is kept as it
+    /// is, contents and all, so a caller drawing frame after frame pays neither its
+    /// allocation nor the first touch of its pages again; any other is replaced by
+    /// [`Frame::zeroed`].
+    pub(crate) fn fit(&mut self, width: u32, height: u32) {
+        let n = width as usize * height as usize;
+        let fits = (self.width, self.height) == (width, height)
+            && [self.color.len(), self.depth.len(), self.ids.len()] == [n; 3];
+        if !fits {
+            *self = Frame::zeroed(width, height);
+        }
+    }
 }
 
 /// One counter of a renderer's statistics.

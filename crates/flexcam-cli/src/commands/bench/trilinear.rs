@@ -17,11 +17,12 @@
 //! clipped trilinear renderer, which load from other processes distorts far less than wall
 //! time (Linux only, in 10 ms ticks: use a `--repeat` of 10 or more).
 //!
-//! Every render above returns a new frame, as the ray caster's does: its 12.8 MB at 800 x
-//! 800 are allocated and their pages first touched in each timed render. A second cube
-//! table times the later frames of a program that draws frame after frame into one frame it
-//! keeps (`TrilinearRenderer::render_into`), without and with clipping, against the same
-//! ray-caster times.
+//! Every render above returns a new frame, the ray caster's and trilinear's alike
+//! (`RayCaster::render`, `TrilinearRenderer::render`): its 12.8 MB at 800 x 800 are allocated
+//! and their pages first touched in each timed render. A second cube table times the later
+//! frames of a program that draws frame after frame into one frame it keeps, both renderers
+//! alike (`RayCaster::render_into`, `TrilinearRenderer::render_into` without and with
+//! clipping), and compares them like for like.
 
 use std::time::Instant;
 
@@ -79,18 +80,21 @@ struct Timing {
     stages: [f64; 3],
     /// The ray caster, trilinear and clipped trilinear, each returning a new frame.
     cpu: [f64; 3],
-    /// Trilinear into a kept frame, without and with clipping (`None`: not timed).
+    /// The ray caster and trilinear without and with clipping, each into a frame it keeps
+    /// (`None`: not timed).
     kept: Option<Kept>,
     /// Id agreement and relative RGB error against the ray caster of trilinear without
     /// and with clipping.
     accuracy: [(f64, f64); 2],
 }
 
-/// Medians (ms) and mean CPU times (ms) of rendering into a kept frame.
+/// Medians (ms) and mean CPU times (ms) of rendering into a kept frame: the ray caster,
+/// trilinear, clipped trilinear.
 struct Kept {
+    raycast: f64,
     trilinear: f64,
     clipped: f64,
-    cpu: [f64; 2],
+    cpu: [f64; 3],
 }
 
 /// Runs the benchmark and prints both tables.
@@ -107,7 +111,10 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
          scene-space clipping (clip); times in ms",
         args.repeat
     );
-    println!("\nTables D.1-D.3: random scenes through random regular screen meshes");
+    println!(
+        "\nTables D.1-D.3: random scenes through random regular screen meshes; new frames (each \
+         render, ray cast and trilinear alike, returns a new frame)"
+    );
     println!(
         "{:>10}{:>7}{:>6}{:>11}{:>11}{:>9}{:>11}{:>9}",
         "pixels", "tris", "proj", "raycast", "trilinear", "speedup", "clip", "speedup"
@@ -149,15 +156,17 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
 
     println!(
         "\nTable 8.1 (figure 7.4): cube-floor, 686 triangles, {CUBE_SIDE} x {CUBE_SIDE}, fan \
-         projection; accuracy of trilinear with clipping against raycast"
+         projection; NEW FRAMES: every render, ray cast and trilinear alike, returns a new \
+         frame (its allocation and first touch timed); accuracy of trilinear with clipping \
+         against raycast; cpu = mean CPU ms per render, all threads"
     );
     println!(
-        "{:>5}{:>10}{:>11}{:>9}{:>10}{:>9}{:>9}{:>9}{:>9}{:>9}{:>11}{:>9}{:>9}{:>10}{:>9}",
+        "{:>5}{:>10}{:>11}{:>9}{:>10}{:>9}{:>9}{:>9}{:>9}{:>9}{:>11}{:>9}{:>9}{:>9}{:>9}{:>10}{:>9}",
         "proj",
-        "raycast",
-        "trilinear",
+        "rc new",
+        "tri new",
         "speedup",
-        "clip",
+        "clip new",
         "speedup",
         "project",
         "raster",
@@ -166,6 +175,8 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
         "rgb error",
         "thesis",
         "rc cpu",
+        "tri cpu",
+        "cpu x",
         "clip cpu",
         "cpu x"
     );
@@ -177,14 +188,15 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
         let timing = renderers.time(&mesh, CUBE_SIDE, args.repeat, true)?;
         let [_, accuracy] = timing.accuracy;
         let [project, raster, shade] = timing.stages;
-        let [raycast_cpu, _, clipped_cpu] = timing.cpu;
+        let [raycast_cpu, trilinear_cpu, clipped_cpu] = timing.cpu;
         let thesis = CELLS
             .iter()
             .position(|&c| c == n)
             .map_or(f64::NAN, |k| THESIS_CUBE[k]);
         println!(
             "{:>5}{:>10.2}{:>11.2}{:>8.1}x{:>10.2}{:>8.1}x{project:>9.2}{raster:>9.2}{shade:>9.2}\
-             {:>9.5}{:>11.6}{thesis:>9.1}{raycast_cpu:>9.1}{clipped_cpu:>10.1}{:>8.1}x",
+             {:>9.5}{:>11.6}{thesis:>9.1}{raycast_cpu:>9.1}{trilinear_cpu:>9.1}{:>8.1}x\
+             {clipped_cpu:>10.1}{:>8.1}x",
             mesh.triangles.len(),
             timing.raycast,
             timing.trilinear,
@@ -193,6 +205,7 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
             timing.raycast / timing.clipped,
             accuracy.0,
             accuracy.1,
+            raycast_cpu / trilinear_cpu,
             raycast_cpu / clipped_cpu,
         );
         later.push((mesh.triangles.len(), timing));
@@ -205,20 +218,22 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
     Ok(())
 }
 
-/// The cube table of later frames: trilinear into a kept frame, against the ray caster's
-/// times of the same cells; CPU times of the ray caster, of trilinear returning a new frame
-/// and into a kept frame (without clipping), and of clipped trilinear into a kept frame;
-/// the accuracy of trilinear without clipping (the clipped render's is in Table 8.1).
+/// The cube table of later frames, like for like: the ray caster and trilinear without and
+/// with clipping, each drawing into a frame it keeps (median ms, speed-up over the ray
+/// caster's kept frame, mean CPU ms per render and CPU ratios); the accuracy of trilinear
+/// without clipping against the ray caster (the clipped render's is in Table 8.1).
 fn print_kept(cells: &[(usize, Timing)]) {
     println!(
-        "\ncube-floor, later frames: trilinear into a kept frame (render_into) without / with \
-         clipping; raycast as above; accuracy of trilinear without clipping against raycast"
+        "\ncube-floor, later frames, KEPT FRAMES: the ray caster (RayCaster::render_into) and \
+         trilinear without / with clipping (TrilinearRenderer::render_into) each draw into a \
+         frame kept from render to render; accuracy of trilinear without clipping against \
+         raycast; cpu = mean CPU ms per render, all threads"
     );
     println!(
-        "{:>5}{:>10}{:>10}{:>9}{:>9}{:>11}{:>11}{:>9}{:>9}{:>9}{:>10}{:>9}{:>11}{:>9}",
+        "{:>5}{:>10}{:>10}{:>9}{:>9}{:>11}{:>11}{:>9}{:>9}{:>9}{:>9}{:>11}{:>9}",
         "proj",
-        "raycast",
-        "kept",
+        "rc kept",
+        "tri kept",
         "speedup",
         "ids",
         "rgb error",
@@ -226,26 +241,23 @@ fn print_kept(cells: &[(usize, Timing)]) {
         "speedup",
         "rc cpu",
         "tri cpu",
-        "kept cpu",
         "cpu x",
-        "ckept cpu",
+        "clip cpu",
         "cpu x"
     );
     for (projections, timing) in cells {
         let Some(kept) = &timing.kept else { continue };
-        let [raycast_cpu, trilinear_cpu, _] = timing.cpu;
-        let [kept_cpu, clipped_cpu] = kept.cpu;
+        let [raycast_cpu, trilinear_cpu, clipped_cpu] = kept.cpu;
         let [(ids, rgb_error), _] = timing.accuracy;
         println!(
             "{projections:>5}{:>10.2}{:>10.2}{:>8.1}x{ids:>9.5}{rgb_error:>11.6}{:>11.2}{:>8.1}x\
-             {raycast_cpu:>9.1}{trilinear_cpu:>9.1}{kept_cpu:>10.1}{:>8.1}x{clipped_cpu:>11.1}\
-             {:>8.1}x",
-            timing.raycast,
+             {raycast_cpu:>9.1}{trilinear_cpu:>9.1}{:>8.1}x{clipped_cpu:>11.1}{:>8.1}x",
+            kept.raycast,
             kept.trilinear,
-            timing.raycast / kept.trilinear,
+            kept.raycast / kept.trilinear,
             kept.clipped,
-            timing.raycast / kept.clipped,
-            raycast_cpu / kept_cpu,
+            kept.raycast / kept.clipped,
+            raycast_cpu / trilinear_cpu,
             raycast_cpu / clipped_cpu,
         );
     }
@@ -265,9 +277,9 @@ impl Renderers {
         }
     }
 
-    /// Times the three renders of `mesh` at `side x side` pixels (and with `kept` the two
-    /// trilinear ones into a kept frame), and the id agreement and relative RGB error of the
-    /// two trilinear renders against the ray caster.
+    /// Times the three renders of `mesh` at `side x side` pixels into new frames (and with
+    /// `kept` the same three into kept frames), and the id agreement and relative RGB error
+    /// of the two trilinear renders against the ray caster.
     fn time(&self, mesh: &TrilinearMesh, side: u32, repeat: u32, kept: bool) -> Result<Timing> {
         let projection = Trilinear::new(mesh, side, side)?;
         let options = RenderOptions {
@@ -287,20 +299,27 @@ impl Renderers {
         };
         let (plain, plain_cpu, (plain_frame, _)) = trilinear(unclipped)?;
         let (clipped, clipped_cpu, (frame, stats)) = trilinear(CurveOptions::ADAPTIVE)?;
+        // Each kept frame starts at the wrong size, so its first (warm-up) render allocates
+        // it, as a program's first frame would.
         let into_kept = |curves: CurveOptions| {
-            let mut kept = Frame::new(side, side, glam::Vec3::ZERO);
+            let mut kept = Frame::new(1, 1, glam::Vec3::ZERO);
             median(repeat, || {
                 self.trilinear
                     .render_into(&mut kept, &projection, &options, curves)
             })
         };
         let kept = if kept {
+            let mut frame = Frame::new(1, 1, glam::Vec3::ZERO);
+            let (raycast, raycast_cpu, _) = median(repeat, || {
+                Ok(self.caster.render_into(&mut frame, &projection, &options))
+            })?;
             let (trilinear, kept_cpu, _) = into_kept(unclipped)?;
             let (clipped, clipped_cpu, _) = into_kept(CurveOptions::ADAPTIVE)?;
             Some(Kept {
+                raycast,
                 trilinear,
                 clipped,
-                cpu: [kept_cpu, clipped_cpu],
+                cpu: [raycast_cpu, kept_cpu, clipped_cpu],
             })
         } else {
             None

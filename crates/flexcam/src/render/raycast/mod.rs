@@ -3,7 +3,8 @@
 //! [`RayCaster::new`] gathers every object's world-space triangles into one BVH (binned SAH,
 //! f32 traversal) and keeps what shading needs: the objects (meshes, materials,
 //! `world_to_object`), lights and background. [`RayCaster::intersect`] is the exact closest-hit
-//! query other renderers are checked against; [`RayCaster::render`] renders a projection.
+//! query other renderers are checked against; [`RayCaster::render`] renders a projection into
+//! a new frame, [`RayCaster::render_into`] into a frame the caller keeps.
 //! See docs/raycast.md for the design and the measurements.
 
 mod bvh;
@@ -275,11 +276,32 @@ impl RayCaster {
         FastRay::new(ray).is_some_and(|r| self.bvh.occluded(&r))
     }
 
-    /// Renders `projection` (colour, depth and object ids) with `options`, in parallel over
-    /// tiles; the image does not depend on the number of threads. `options.spp = 0` counts as
-    /// one sample. See [`shade`] for what the depth and id of a pixel are.
+    /// Renders `projection` (colour, depth and object ids) with `options` into a new frame
+    /// (see [`RayCaster::render_into`]). The frame starts as zeroed memory
+    /// ([`Frame::zeroed`]), not cleared to the background: every pixel is written.
     pub fn render(&self, projection: &dyn Projection, options: &RenderOptions) -> (Frame, Stats) {
-        let (frame, mut stats) = tiles::render(self, projection, options);
+        let (width, height) = projection.resolution();
+        let mut frame = Frame::zeroed(width, height);
+        let stats = self.render_into(&mut frame, projection, options);
+        (frame, stats)
+    }
+
+    /// Renders `projection` (colour, depth and object ids) with `options` into `frame`, every
+    /// pixel of it overwritten, in parallel over tiles; the image does not depend on the
+    /// number of threads, nor on what `frame` held. A caller drawing frame after frame keeps
+    /// one frame and pays neither its allocation nor the first touch of its pages again; a
+    /// frame of another size than the projection's resolution (or whose buffers do not match
+    /// its size) is replaced by one of the right size. `options.spp = 0` counts as one
+    /// sample. See [`shade`] for what the depth and id of a pixel are.
+    pub fn render_into(
+        &self,
+        frame: &mut Frame,
+        projection: &dyn Projection,
+        options: &RenderOptions,
+    ) -> Stats {
+        let (width, height) = projection.resolution();
+        frame.fit(width, height);
+        let mut stats = tiles::render(self, projection, options, frame);
         stats.insert("bvh_build_ms", crate::render::Counter::Value(self.build_ms));
         stats.insert(
             "bvh_nodes",
@@ -289,7 +311,7 @@ impl RayCaster {
             "triangles",
             crate::render::Counter::Count(self.triangle_count as u64),
         );
-        (frame, stats)
+        stats
     }
 
     /// A ray leaving surface point `point` (geometric normal `normal`) along `direction`,

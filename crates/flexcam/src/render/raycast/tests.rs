@@ -466,6 +466,44 @@ fn rendering_is_deterministic_across_thread_counts_and_reports_progress() {
     assert!(one.ids.contains(&3) && one.ids.contains(&4));
 }
 
+/// `render_into` a kept frame gives `render`'s new frame, frame after frame, whatever the
+/// kept frame held (every pixel is overwritten, edge tiles included: 37 x 29 pixels are
+/// not whole 16 x 16 tiles nor 2 x 2 quads), lit with one sample per pixel and with four; a
+/// kept frame of another size is replaced by one of the projection's size.
+#[test]
+fn rendering_into_a_kept_frame_matches_a_new_frame() {
+    let light = Light::Point {
+        position: Vec3::new(-1.0, 2.0, 5.0),
+        color: Vec3::ONE,
+        intensity: 0.7,
+    };
+    let scene = busy_scene(vec![light]);
+    let mut camera = Parallel {
+        direction: DVec3::new(0.1, -0.05, -1.0),
+        ..Parallel::new(37, 29, (-4.0, 4.0), DVec3::NEG_Z)
+    };
+    camera.blind = 3.0;
+    let caster = RayCaster::new(&scene);
+    for spp in [1, 4] {
+        let options = RenderOptions {
+            shading: Shading::Lit,
+            spp,
+            ..flat(8)
+        };
+        let (fresh, fresh_stats) = caster.render(&camera, &options);
+        assert!(fresh.ids.contains(&0) && fresh.ids.contains(&3));
+        let mut kept = Frame::new(3, 2, Vec3::ONE);
+        for _ in 0..2 {
+            let stats = caster.render_into(&mut kept, &camera, &options);
+            assert_eq!(kept, fresh);
+            assert_eq!(stats["rays_cast"], fresh_stats["rays_cast"]);
+            kept.color.fill(Vec3::splat(7.0));
+            kept.depth.fill(0.0);
+            kept.ids.fill(99);
+        }
+    }
+}
+
 #[test]
 fn supersampling_averages_colour_and_keeps_the_centre_sample_aov() {
     // Pixel 0 spans x in [0, 1]; red left of x = 0.49, blue behind and right of it.

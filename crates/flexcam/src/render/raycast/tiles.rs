@@ -40,18 +40,21 @@ struct Tile {
     culled_blocks: u64,
 }
 
-/// Renders every pixel of `projection`'s image; see [`RayCaster::render`].
+/// Renders every pixel of `projection`'s image into `frame`, which must already be of its
+/// resolution; see [`RayCaster::render_into`]. The bands and their tiles cover the frame, so
+/// every pixel is overwritten whatever the frame held.
 pub(super) fn render(
     caster: &RayCaster,
     projection: &dyn Projection,
     options: &RenderOptions,
-) -> (Frame, Stats) {
+    frame: &mut Frame,
+) -> Stats {
     let (width, height) = projection.resolution();
+    debug_assert_eq!((frame.width, frame.height), (width, height));
     let pattern = SamplePattern::new(options.spp);
     let tiles_x = width.div_ceil(TILE);
     let total = tiles_x as u64 * height.div_ceil(TILE) as u64;
     let done = AtomicU64::new(0);
-    let mut frame = Frame::new(width, height, caster.background);
     // One band of the frame per row of tiles.
     let band = TILE as usize * width as usize;
     let tallies: Vec<(RayCounts, u64)> = frame
@@ -100,7 +103,7 @@ pub(super) fn render(
         counts.shadow += tally.shadow;
         culled += blocks;
     }
-    let stats = Stats::from([
+    Stats::from([
         ("primary_rays", Counter::Count(counts.primary)),
         ("secondary_rays", Counter::Count(counts.secondary)),
         ("shadow_rays", Counter::Count(counts.shadow)),
@@ -109,8 +112,7 @@ pub(super) fn render(
             Counter::Count(counts.primary + counts.secondary + counts.shadow),
         ),
         ("blocks_culled", Counter::Count(culled)),
-    ]);
-    (frame, stats)
+    ])
 }
 
 /// Which parts of the projectors of each block (`[row][column]`) of tile

@@ -176,12 +176,7 @@ impl TrilinearRenderer {
 
         let maps: Vec<ScreenMap> = triangles.iter().map(|t| t.map).collect();
         let pattern = SamplePattern::new(options.spp);
-        let n = width as usize * height as usize;
-        let fits = (frame.width, frame.height) == (width, height)
-            && [frame.color.len(), frame.depth.len(), frame.ids.len()] == [n; 3];
-        if !fits {
-            *frame = Frame::zeroed(width, height);
-        }
+        frame.fit(width, height);
         let mut samples = Samples::new(frame, &pattern);
         let flat_colors = (options.shading == Shading::Flat).then_some(&self.flat_colors[..]);
         let mut raster = RasterStats::default();
