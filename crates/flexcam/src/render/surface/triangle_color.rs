@@ -179,9 +179,66 @@ impl TriangleColor {
         }
     }
 
+    /// [`TriangleColor::at`] of every barycentrics of `barycentrics`, into `out` (as many
+    /// colours as there are barycentrics; extra entries of `out` are left as they are), bit
+    /// for bit: for a rasteriser's run of pixels of one triangle. A checker without vertex
+    /// colours is evaluated several pixels at a time (`checker_lanes`).
+    pub fn fill(&self, barycentrics: &[[f32; 2]], out: &mut [Vec3]) {
+        match (&self.pattern, &self.vertex) {
+            (PatternMap::Uniform(color), None) => out[..barycentrics.len()].fill(*color),
+            (PatternMap::Checker { cell, colors }, None) => {
+                for (b, o) in barycentrics.chunks(LANES).zip(out.chunks_mut(LANES)) {
+                    checker_lanes(cell, colors, b, o);
+                }
+            }
+            _ => {
+                for (b, o) in barycentrics.iter().zip(out) {
+                    *o = self.at(Vec2::from(*b));
+                }
+            }
+        }
+    }
+
     /// Whether the colour is the same at every point of the triangle.
     pub fn is_uniform(&self) -> bool {
         matches!(self.pattern, PatternMap::Uniform(_)) && self.vertex.is_none()
+    }
+}
+
+/// Pixels whose checker colours [`checker_lanes`] computes together.
+const LANES: usize = 8;
+
+/// `colors[parity]` of the checker cell holding `cell.at(b)` for each of (at most [`LANES`])
+/// barycentrics `b`, into `out`: [`PatternMap::at`]'s values, bit for bit. Each axis's cell
+/// coordinate is `origin + du u + dv v`, the operations of [`Affine::at`] in its order, and
+/// its floor's parity is [`super::floor_parity`]'s, over all lanes at once (loops the
+/// compiler turns into vector instructions). Degenerate cases: a lane with a coordinate
+/// outside [`super::ROUNDING_RANGE`], or NaN, takes [`cell_parity`] of its point (the same
+/// function, whose slow path then decides); unused lanes compute from zeros and are
+/// dropped.
+#[inline]
+fn checker_lanes(cell: &Affine<Vec3>, colors: &[Vec3; 2], b: &[[f32; 2]], out: &mut [Vec3]) {
+    let (mut u, mut v) = ([0.0f32; LANES], [0.0f32; LANES]);
+    for ((u, v), b) in u.iter_mut().zip(&mut v).zip(b) {
+        (*u, *v) = (b[0], b[1]);
+    }
+    let mut parity = [0u32; LANES];
+    let mut in_range = [true; LANES];
+    for axis in 0..3 {
+        let (origin, du, dv) = (cell.origin[axis], cell.du[axis], cell.dv[axis]);
+        for k in 0..LANES {
+            let x = origin + du * u[k] + dv * v[k];
+            in_range[k] &= x.abs() < super::ROUNDING_RANGE;
+            parity[k] ^= super::floor_parity(x);
+        }
+    }
+    for (k, (o, b)) in out.iter_mut().zip(b).enumerate() {
+        let parity = if in_range[k] {
+            parity[k]
+        } else {
+            cell_parity(cell.at(Vec2::from(*b)))
+        };
+        *o = if parity == 0 { colors[0] } else { colors[1] };
     }
 }
 
@@ -287,7 +344,41 @@ mod tests {
         (0.0..1.0f32, 0.0..1.0f32, 0.0..1.0f32).prop_map(|(x, y, z)| Vec3::new(x, y, z))
     }
 
+    /// A barycentric coordinate: mostly around the triangle, sometimes any `f32` bits (NaN,
+    /// infinities, huge values).
+    fn coordinate() -> impl Strategy<Value = f32> {
+        prop_oneof![
+            3 => -0.5..1.5f32,
+            1 => any::<u32>().prop_map(f32::from_bits),
+        ]
+    }
+
     proptest! {
+        /// `fill` writes `at` of every barycentrics, bit for bit, and nothing past them: solid
+        /// and checker, with and without vertex colours, cell coordinates inside and beyond
+        /// the parity's fast range (corners scaled by 1e7), runs of 0 to 20 pixels (whole and
+        /// partial lanes).
+        #[test]
+        fn fill_is_at_bit_for_bit(
+            corners in [vec3(), vec3(), vec3()],
+            scale in prop_oneof![Just(1.0f32), Just(1e7f32)],
+            colors in proptest::option::of([color(), color(), color()]),
+            checker in any::<bool>(),
+            barycentrics in proptest::collection::vec([coordinate(), coordinate()], 0..20),
+        ) {
+            let pattern = if checker { CHECKER } else { Pattern::Solid };
+            let o = object(corners.map(|c| c * scale), colors, pattern);
+            let map = TriangleColor::new(&o, 0, TextureFilter::Nearest);
+            let sentinel = Vec3::splat(-7.0);
+            let mut out = vec![sentinel; barycentrics.len() + 3];
+            map.fill(&barycentrics, &mut out);
+            let bits = |c: Vec3| c.to_array().map(f32::to_bits);
+            for (b, o) in barycentrics.iter().zip(&out) {
+                prop_assert_eq!(bits(*o), bits(map.at(Vec2::from(*b))), "{:?}", b);
+            }
+            prop_assert!(out[barycentrics.len()..].iter().all(|&c| c == sentinel));
+        }
+
         /// Away from cell boundaries the map gives `base_color`'s checker colour, times the
         /// interpolated vertex colour within rounding.
         #[test]

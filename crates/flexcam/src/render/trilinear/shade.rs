@@ -353,11 +353,7 @@ impl Shader<'_> {
                             run.fill(&mut out, self.background);
                             ShadeCounts::default()
                         }
-                        Some(color) if color.is_uniform() => {
-                            let uniform = color.at(Vec2::ZERO);
-                            self.flat_run(drawn, &run, &mut out, |_| uniform)
-                        }
-                        Some(color) => self.flat_run(drawn, &run, &mut out, |b| color.at(b)),
+                        Some(color) => self.flat_run(drawn, &run, &mut out, color),
                         None => self.pixels(drawn, &run, &mut out, false),
                     };
                 x0 = x1;
@@ -411,10 +407,10 @@ impl Shader<'_> {
         })
     }
 
-    /// The pixels of `run` (a triangle whose flat colour at barycentrics `b` is `color(b)`,
-    /// no fallback) shaded as [`Shader::pixel`] shades them, with the map, owner and colour
-    /// looked up once and the projector's direction (for the depth `t |trinorm|`) stepped
-    /// along the row ([`ScreenMap::directions_along_row`]). A crack filler is resolved
+    /// The pixels of `run` (a triangle of flat colour `color`, no fallback) shaded as
+    /// [`Shader::pixel`] shades them, with the map, owner and colour looked up once and the
+    /// projector's direction (for the depth `t |trinorm|`) stepped along the row
+    /// ([`ScreenMap::directions_along_row`]). A crack filler is resolved
     /// again ([`Shader::rasterised`]). Degenerate case: where the stepped direction is zero
     /// (a projector of zero `trinorm`, which [`ScreenMap::projector`] refuses), the pixel
     /// is background, as [`Shader::pixel`] leaves it.
@@ -426,7 +422,7 @@ impl Shader<'_> {
         drawn: &GBuffer,
         run: &Run,
         out: &mut FrameRows<'_>,
-        color: impl Fn(Vec2) -> Vec3,
+        color: &TriangleColor,
     ) -> ShadeCounts {
         let Some(map) = self.resolver.maps.get(run.projection()) else {
             return self.pixels(drawn, run, out, false);
@@ -439,8 +435,9 @@ impl Shader<'_> {
     }
 
     /// [`Shader::flat_run`] with the projector direction of the run's pixel `k` given by
-    /// `direction(k)`. The run is shaded in chunks of [`CHUNK`] pixels: colours, ids and the
-    /// squared lengths of the directions first, then all the chunk's depths
+    /// `direction(k)`. The run is shaded in chunks of [`CHUNK`] pixels: colours
+    /// ([`TriangleColor::fill`], a chunk at once), ids and the squared lengths of the
+    /// directions first, then all the chunk's depths
     /// `t |direction|` in one loop without branches (compiled to two square roots an
     /// instruction: the square root is the shading's largest single cost), then the pixels
     /// that need more (crack fillers, a zero direction) through [`Shader::pixel`], which
@@ -451,7 +448,7 @@ impl Shader<'_> {
         drawn: &GBuffer,
         run: &Run,
         out: &mut FrameRows<'_>,
-        color: impl Fn(Vec2) -> Vec3,
+        color: &TriangleColor,
         direction: impl Fn(u32) -> DVec3,
     ) -> ShadeCounts {
         let id = self.resolver.scene.owners[run.triangle()].id;
@@ -462,18 +459,18 @@ impl Shader<'_> {
             let mut length_squared = [0.0; CHUNK];
             // Bit `k`: pixel `chunk + k` is shaded by `Shader::pixel`.
             let mut others = 0u64;
+            // Every colour of the chunk; `Shader::pixel` overwrites those of the others.
+            color.fill(
+                &drawn.barycentrics[cells.clone()],
+                &mut out.color[cells.clone()],
+            );
             let pixels = ts
                 .iter()
-                .zip(&drawn.barycentrics[cells.clone()])
-                .zip(&mut out.color[cells.clone()])
                 .zip(&mut out.ids[cells.clone()])
                 .zip(&mut length_squared);
-            for (k, ((((&t, &barycentric), out_color), out_id), length_squared)) in
-                pixels.enumerate()
-            {
+            for (k, ((&t, out_id), length_squared)) in pixels.enumerate() {
                 let direction = direction((chunk + k) as u32);
                 if t < CRACK_FILL_DEPTH && direction != DVec3::ZERO {
-                    *out_color = color(Vec2::from(barycentric));
                     *out_id = id;
                 } else {
                     others |= 1 << k;
