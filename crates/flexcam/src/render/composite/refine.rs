@@ -41,6 +41,11 @@
 //!   same new vertex. A triangle with one, two or three split edges becomes two, three or four
 //!   triangles (red-green refinement), so no vertex ever lies inside another triangle's edge
 //!   (no T-junction, which would open a crack in the surface image).
+//! - **Back-facing triangles stay whole** (mirrors): a triangle whose vertex normals all
+//!   point clearly away from the eye (the far side of a sphere) is dropped by the surface,
+//!   and so would every piece of it be ([`Refiner::back_facing`]), so it is not split; an
+//!   edge it shares with a split neighbour leaves a T-junction only on its side, which the
+//!   surface drops. The surface is the same as when every triangle is refined.
 //!
 //! Degenerate cases:
 //! - **parallel vertex rays** (a triangle whose rays are all parallel, e.g. a flat mirror
@@ -83,6 +88,13 @@ pub const MAX_LEVEL: u32 = 6;
 /// composite samples too few pixel centres for a split to matter.
 pub const MIN_EDGE_PX: f64 = 1.0;
 
+/// How clearly a triangle must face away for [`Refiner::back_facing`]: the cosines between
+/// its face normal and each vertex normal, and between its face normal and the direction to
+/// the eye, at least this far from zero. Far above the rounding of the `f32` midpoints (its
+/// descendants' planes and normals are the parent's up to about `1e-4` of a cosine even at
+/// the depth cap), so the surface's test on every descendant has the parent's sign.
+const BACK_FACING_COSINE: f64 = 1e-2;
+
 /// The edge-midpoint bound as a fraction of the tolerance (see the module docs: the error
 /// inside a triangle is at most 4/3 of its largest edge-midpoint error).
 const MIDPOINT_FRACTION: f64 = 0.75;
@@ -115,11 +127,29 @@ pub fn refine(
             unsplit: 0,
         };
     }
-    let mut refiner = Refiner::new(reflector, camera, optic, map, tolerance_px);
+    refine_where(
+        reflector,
+        Refiner::new(reflector, camera, optic, map, tolerance_px),
+        |refiner, triangle| refiner.back_facing(triangle),
+    )
+}
+
+/// The refinement loop of [`refine`] with `refiner`, leaving whole the triangles `whole`
+/// holds for (their edges are decided only where a neighbour needs them).
+fn refine_where(
+    reflector: &Mesh,
+    mut refiner: Refiner<'_>,
+    whole: impl Fn(&Refiner<'_>, [u32; 3]) -> bool,
+) -> Refinement {
     let mut stack: Vec<[u32; 3]> = reflector.triangles.iter().rev().copied().collect();
     let mut triangles = Vec::with_capacity(reflector.triangles.len());
     while let Some(triangle) = stack.pop() {
-        match refiner.split_triangle(triangle) {
+        let split = if whole(&refiner, triangle) {
+            None
+        } else {
+            refiner.split_triangle(triangle)
+        };
+        match split {
             None => triangles.push(triangle),
             // Reversed so that the children come out in order.
             Some(children) => stack.extend(children.into_iter().rev()),
@@ -224,6 +254,40 @@ impl<'a> Refiner<'a> {
             unit,
             interpolated,
             pixel,
+        })
+    }
+
+    /// Whether the surface ([`reflector_surface`](crate::projection::surfaces::reflector_surface))
+    /// drops `[a, b, c]` and every triangle its refinement could make, so that splitting
+    /// it is wasted: its vertex normals all lie clearly on the side of its plane away from
+    /// the eye ([`BACK_FACING_COSINE`]). Its descendants lie in its plane with its winding,
+    /// and their vertices' raw normals are averages of its own (midpoints), so each has
+    /// every vertex normal on that side too, and the surface's test (the face normal
+    /// against the sum of the vertex normals, times the eye's side) drops it. On the
+    /// example sphere about half the refined triangles were such (the far hemisphere).
+    ///
+    /// Mirrors only: a glass surface's vertex ray depends on whether the ray enters or
+    /// leaves, which it decides by the face normals of the triangles around the vertex,
+    /// weighted by their areas (`vertex_normals`), so a whole back-facing triangle next to a
+    /// split front-facing one could turn a silhouette vertex's ray; a mirror's ray is the
+    /// same for either side.
+    fn back_facing(&self, corners: [u32; 3]) -> bool {
+        if self.optic != Optic::Reflect {
+            return false;
+        }
+        let [a, b, c] = corners.map(|k| self.positions[k as usize].as_dvec3());
+        let face = (b - a).cross(c - a);
+        let to_eye = self.camera.basis().origin - a;
+        let eye_side = face.dot(to_eye);
+        let clear = BACK_FACING_COSINE * face.length();
+        // False for NaN too: such a triangle is refined as before.
+        let off_the_plane = eye_side.abs() > clear * to_eye.length();
+        if !off_the_plane {
+            return false;
+        }
+        corners.iter().all(|&k| {
+            let normal = self.normals[k as usize].as_dvec3();
+            face.dot(normal) * eye_side.signum() < -clear * normal.length()
         })
     }
 

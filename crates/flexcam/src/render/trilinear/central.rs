@@ -40,6 +40,7 @@ use glam::DVec3;
 
 use super::clip::DOMAIN_MARGIN;
 use super::edge_path::OutlinePoint;
+use super::volume_bounds::BoxSide;
 use crate::projection::ProjectionTriangleCache;
 
 /// How close (relative to the largest distance from a base point to the focus) the three
@@ -47,6 +48,17 @@ use crate::projection::ProjectionTriangleCache;
 /// central projection: far above the rounding of coordinates computed in `f64`, far below
 /// anything a pixel resolves.
 pub const MEETING_TOL: f64 = 1e-9;
+
+/// How far (relative to the scale of its terms) a box's least or greatest value of a
+/// half-space must be from zero for [`CentralProjection::box_side`] to decide for every
+/// point in the box: far above the rounding of the two ways the value is computed (per
+/// vertex and per box), so the box test never contradicts the vertices' own.
+const BOX_MARGIN: f64 = 1e-9;
+
+/// The half-spaces of [`CentralProjection::sides`] the points seen in each cone must be
+/// in: before the focus (bits 0 to 4), beyond it (bits 5 to 8).
+const NEAR_CONE: u32 = 0x1f;
+const FAR_CONE: u32 = 0x1e0;
 
 /// A projection triangle's rays as a central projection from their common point.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,6 +71,10 @@ pub struct CentralProjection {
     u: DVec3,
     v: DVec3,
     w: DVec3,
+    /// The scale of the half-spaces' terms for [`Self::box_side`]'s margin: `(2 + m)` (the
+    /// largest coefficient sum in `sides`) times the sum of the absolute values of the
+    /// components of `u`, `v` and `w` (at least their lengths).
+    box_scale: f64,
 }
 
 /// A scene triangle reaching the focus: its image through a central projection is not a
@@ -98,12 +114,15 @@ impl CentralProjection {
         let area2 = normal.length_squared();
         let (gu, gv) = (e2.cross(normal) / area2, normal.cross(e1) / area2);
         let to_focus = focus - p[0];
+        let (u, v) = (gu + gu.dot(to_focus) * w, gv + gv.dot(to_focus) * w);
+        let terms = [u, v, w].map(|a| a.abs().element_sum());
         Some(CentralProjection {
             focus,
             depth,
-            u: gu + gu.dot(to_focus) * w,
-            v: gv + gv.dot(to_focus) * w,
+            u,
+            v,
             w,
+            box_scale: (2.0 + DOMAIN_MARGIN) * (terms[0] + terms[1] + terms[2]),
         })
     }
 
@@ -120,7 +139,67 @@ impl CentralProjection {
     /// `common` (the `&` of their [`Self::outside`]) has no image: it is outside one
     /// half-space of each cone.
     pub fn culled(common: u16) -> bool {
-        common & 0x1f != 0 && common & 0x1e0 != 0
+        let common = u32::from(common);
+        common & NEAR_CONE != 0 && common & FAR_CONE != 0
+    }
+
+    /// Every half-space of [`Self::sides`] (bit `k` for half-space `k`): where a box test
+    /// starts.
+    pub const ALL_SIDES: u32 = NEAR_CONE | FAR_CONE;
+
+    /// The hierarchical form of [`Self::culled`] for `cull_tree`: [`BoxSide::Outside`] only
+    /// when every point of the axis-aligned box (centre and half-extents) is outside one
+    /// half-space of each cone by more than [`BOX_MARGIN`] of the scale, so that every
+    /// scene vertex in it has those bits in its [`Self::outside`] mask and every triangle
+    /// in it would be culled one by one too (the tree culls no pair the vertices keep).
+    /// Otherwise [`BoxSide::Within`] the half-spaces of `active` that do not hold the whole
+    /// box by that margin (no point below can be outside the others). Degenerate boxes: a
+    /// box of zero extent is tested like any other; one with a non-finite coordinate is
+    /// never outside (its comparisons fail).
+    pub fn box_side(&self, centre: DVec3, half: DVec3, active: u32) -> BoxSide {
+        let y = centre - self.focus;
+        // The sums of absolute values bound the lengths (no square root per node).
+        let margin =
+            BOX_MARGIN * (self.box_scale * (y.abs().element_sum() + half.element_sum()) + 1.0);
+        let (mut outside, mut inside) = (0, 0);
+        for (k, (normal, offset)) in self.near_half_spaces().into_iter().enumerate() {
+            let middle = normal.dot(y) + offset;
+            let reach = normal.abs().dot(half);
+            // The near cone's half-space `k`, and the far cone's that is its negation
+            // (`k + 5` for the domain planes, 8 for `w >= 0`; none for the view plane).
+            let far = match k {
+                0..=2 => 1 << (k + 5),
+                4 => 1 << 8,
+                _ => 0,
+            };
+            if middle + reach < -margin {
+                outside |= 1 << k;
+                inside |= far;
+            }
+            if middle - reach > margin {
+                inside |= 1 << k;
+                outside |= far;
+            }
+        }
+        let outside = outside & active;
+        if outside & NEAR_CONE != 0 && outside & FAR_CONE != 0 {
+            BoxSide::Outside
+        } else {
+            BoxSide::Within(active & !inside)
+        }
+    }
+
+    /// The near cone's half-spaces of [`Self::sides`] (bits 0 to 4) as `normal . y +
+    /// offset >= 0`; the far cone's are the first three and the last turned round.
+    fn near_half_spaces(&self) -> [(DVec3, f64); 5] {
+        let m = DOMAIN_MARGIN;
+        [
+            (self.u + m * self.w, 0.0),
+            (self.v + m * self.w, 0.0),
+            ((1.0 + m) * self.w - self.u - self.v, 0.0),
+            (-self.w, 1.0),
+            (self.w, 0.0),
+        ]
     }
 
     /// The values at `y = X - F` of the half-spaces a point must be in (`>= 0`) to be seen,
@@ -129,7 +208,8 @@ impl CentralProjection {
     /// which culls a scene triangle beyond the focus as a whole) and in the cone beyond it
     /// (bits 5 to 8: the domain's planes turned round, and `w <= 0`).
     fn sides(&self, y: DVec3) -> [f64; 9] {
-        let [u, v, w] = [self.u, self.v, self.w].map(|a| a.dot(y));
+        // Spelled out (no array maps): called per scene vertex and clipped point.
+        let (u, v, w) = (self.u.dot(y), self.v.dot(y), self.w.dot(y));
         let m = DOMAIN_MARGIN;
         let [a, b, c] = [u + m * w, v + m * w, (1.0 + m) * w - u - v];
         [a, b, c, 1.0 - w, w, -a, -b, -c, -w]
@@ -152,23 +232,45 @@ impl CentralProjection {
         mut draw: impl FnMut(&[OutlinePoint]),
     ) -> Result<(), ThroughFocus> {
         let corners = scene.map(|x| x - self.focus);
-        let reach = corners.iter().map(|y| y.length()).fold(0.0, f64::max);
+        // The corners' sides, for the tests that need no clipping: computed as the clipping
+        // computes them, so the tests agree with it bit for bit.
+        let sides = [0, 1, 2].map(|i| self.sides(corners[i]));
+        let mut reach = None;
         let Scratch {
             polygon,
             clipped,
             pieces,
         } = scratch;
-        let cones: [(f64, &[usize]); 2] = [(1.0, &[0, 1, 2, 3]), (-1.0, &[5, 6, 7])];
-        for ((side, half_spaces), piece) in cones.into_iter().zip(pieces.iter_mut()) {
+        // Per cone: the side `w` is on, where `side * w` is in `sides`, and the half-spaces
+        // clipped to.
+        let cones: [(f64, usize, &[usize]); 2] = [(1.0, 4, &[0, 1, 2, 3]), (-1.0, 8, &[5, 6, 7])];
+        for ((side, w_at, half_spaces), piece) in cones.into_iter().zip(pieces.iter_mut()) {
             piece.clear();
-            if corners.iter().all(|y| side * self.w.dot(*y) <= 0.0) {
+            // No corner on this cone's side of the plane through the focus (`side * w`
+            // is `sides[w_at]`, exactly: a sign change), or all corners outside one of its
+            // half-spaces: no image in it. Clipping would give no polygon either (the
+            // half-spaces are linear, their cut points convex combinations of the corners).
+            let all = |k: usize, inside: fn(f64) -> bool| sides.iter().all(|s| inside(s[k]));
+            if all(w_at, |s| s <= 0.0) || half_spaces.iter().any(|&k| all(k, |s| s < 0.0)) {
                 continue;
             }
             polygon.clear();
             polygon.extend_from_slice(&corners);
+            // While the polygon is still the scene triangle, its corners' sides decide
+            // whether a half-space cuts it (most live pairs lie wholly inside the cone).
+            let mut whole = true;
             for &k in half_spaces {
+                if whole && all(k, |s| s >= 0.0) {
+                    continue;
+                }
+                whole = false;
                 clip_polygon(polygon, clipped, |y| self.sides(y)[k]);
             }
+            if polygon.is_empty() {
+                continue;
+            }
+            let reach = *reach
+                .get_or_insert_with(|| corners.iter().map(|y| y.length()).fold(0.0, f64::max));
             for y in polygon.iter() {
                 let w = self.w.dot(*y);
                 // Away from the focus `side * w` is positive (module doc); at it the image
@@ -308,6 +410,37 @@ mod tests {
         assert_eq!((result, drawn), (Err(ThroughFocus), 0));
     }
 
+    /// The box test decides both ways on clear cases: a box beside the focus but off the
+    /// cones is outside, one around the focus (which every half-space through it cuts) and
+    /// one with an infinite extent (degenerate) are not, a box of zero extent (a point) is
+    /// tested as its point.
+    #[test]
+    fn boxes_off_the_cones_are_outside_and_others_not() {
+        let focus = V(0.3, 0.2, 3.0);
+        let (p, n) = converging(focus, 1.0);
+        let c = central(p, n).expect("central");
+        let all = CentralProjection::ALL_SIDES;
+        // The cones open along the base's normal (z): a box far to the side of the focus.
+        let side = focus + V(20.0, 0.0, 0.0);
+        assert_eq!(c.box_side(side, V(1.0, 1.0, 1.0), all), BoxSide::Outside);
+        let BoxSide::Within(active) = c.box_side(focus, V(0.5, 0.5, 0.5), all) else {
+            panic!("a box around the focus is culled");
+        };
+        assert_eq!(
+            active & 0x1f7,
+            0x1f7,
+            "every plane through the focus cuts it"
+        );
+        let infinite = V(f64::INFINITY, 1.0, 1.0);
+        assert!(matches!(
+            c.box_side(side, infinite, all),
+            BoxSide::Within(_)
+        ));
+        let point = c.box_side(side, DVec3::ZERO, all) == BoxSide::Outside;
+        assert_eq!(point, CentralProjection::culled(c.outside(side)));
+        assert!(point);
+    }
+
     /// Where `point` is against the convex polygon `polygon`: `Some(true)` inside by more
     /// than `margin`, `Some(false)` outside by more than it, `None` near its boundary.
     fn inside_convex(polygon: &[OutlinePoint], u: f64, v: f64, margin: f64) -> Option<bool> {
@@ -388,6 +521,43 @@ mod tests {
                     }
                     if unseen {
                         prop_assert!(!found.contains(&Some(true)), "({u}, {v}) t {t} {outlines:?}");
+                    }
+                }
+            }
+        }
+
+        /// The box test is sound against the vertices' own masks: every point of a box it
+        /// calls outside (its corners and random points) is outside one half-space of each
+        /// cone, so the tree culls no scene triangle the vertices keep; and no point of a
+        /// box is outside a half-space it drops.
+        #[test]
+        fn box_side_agrees_with_the_points_in_the_box(
+            focus in (-1.0..1.0f64, -1.0..1.0f64, 1.0..4.0f64),
+            depth in 0.5..2.0f64,
+            centre in (-8.0..8.0f64, -8.0..8.0f64, -6.0..12.0f64),
+            half in (0.0..3.0f64, 0.0..3.0f64, 0.0..3.0f64),
+            inside in proptest::collection::vec((-1.0..=1.0f64, -1.0..=1.0f64, -1.0..=1.0f64), 8),
+        ) {
+            let (p, n) = converging(V(focus.0, focus.1, focus.2), depth);
+            let c = central(p, n).expect("central");
+            let (centre, half) = (V(centre.0, centre.1, centre.2), V(half.0, half.1, half.2));
+            let corners = (0..8).map(|k| {
+                V([-1.0, 1.0][k & 1], [-1.0, 1.0][(k >> 1) & 1], [-1.0, 1.0][k >> 2])
+            });
+            let points: Vec<DVec3> = corners
+                .chain(inside.iter().map(|&(x, y, z)| V(x, y, z)))
+                .map(|f| centre + f * half)
+                .collect();
+            let masks: Vec<u16> = points.iter().map(|&x| c.outside(x)).collect();
+            match c.box_side(centre, half, CentralProjection::ALL_SIDES) {
+                BoxSide::Outside => {
+                    let common = masks.iter().fold(u16::MAX, |m, &x| m & x);
+                    prop_assert!(CentralProjection::culled(common), "{masks:?}");
+                }
+                BoxSide::Within(active) => {
+                    let dropped = CentralProjection::ALL_SIDES & !active;
+                    for m in masks {
+                        prop_assert_eq!(u32::from(m) & dropped, 0, "{:b}", dropped);
                     }
                 }
             }

@@ -7,6 +7,7 @@
 use glam::{DVec3, Vec3};
 use proptest::prelude::*;
 
+use super::central::CentralProjection;
 use super::curves::{CurveMode, CurveOptions};
 use super::hit_terms::HitTerms;
 use super::outline::ProjectionTriangle;
@@ -39,9 +40,9 @@ fn solved_directly(
         ..LivePairs::default()
     };
     for k in live {
-        let Some(terms) = HitTerms::new(scene.corners(k)) else {
+        if HitTerms::new(scene.corners(k)).is_none() {
             continue;
-        };
+        }
         let first = group.solutions.len() as u32;
         let triangle = &triangles[index as usize];
         group
@@ -49,7 +50,6 @@ fn solved_directly(
             .extend(solve(triangle, scene, scene.triangles[k]));
         group.pairs.push(LivePair {
             triangle: k as u32,
-            terms,
             solved: [first, first + 1, first + 2],
         });
     }
@@ -70,15 +70,31 @@ fn solve(
 }
 
 /// The pairs (projection, scene triangle) that the volume test alone keeps, triangle by
-/// triangle with no tree, among those with a plane.
+/// triangle with no tree, among those with a plane; for a central projection, those its
+/// cones' test alone keeps (`CentralProjection::culled`); none of a ray cast triangle.
 fn kept_one_by_one(triangles: &[ProjectionTriangle], scene: &SceneGeometry) -> Vec<(u32, u32)> {
     let mut kept = Vec::new();
     for (index, triangle) in triangles.iter().enumerate() {
+        if triangle.ray_cast {
+            continue;
+        }
         for (k, corners) in scene.triangles.iter().enumerate() {
-            let common = corners.iter().fold(u32::MAX, |m, &i| {
-                m & triangle.bounds.outside(scene.vertices[i as usize])
-            });
-            if common == 0 && HitTerms::new(scene.corners(k)).is_some() {
+            let vertices = corners.map(|i| scene.vertices[i as usize]);
+            let culled = match &triangle.central {
+                Some(central) => {
+                    let common = vertices
+                        .iter()
+                        .fold(u16::MAX, |m, &x| m & central.outside(x));
+                    CentralProjection::culled(common)
+                }
+                None => {
+                    let common = vertices
+                        .iter()
+                        .fold(u32::MAX, |m, &x| m & triangle.bounds.outside(x));
+                    common != 0
+                }
+            };
+            if !culled && HitTerms::new(scene.corners(k)).is_some() {
                 kept.push((index as u32, k as u32));
             }
         }
@@ -282,6 +298,79 @@ fn the_tree_changes_no_polygon_of_the_cube() {
     let fan = workloads::fan_grid(2).unwrap();
     let (_, others) = check(&scene, &trilinear(&fan, 160, 120), tessellate, "tessellate");
     assert_eq!(others, 0, "tessellate");
+}
+
+/// The cull of projection triangles drawn as central projections, set as the renderer sets
+/// them (`render_into`: central where the rays meet in one point, ray cast where they sweep
+/// no volume): through the tree, exactly the pairs the cones' test keeps one by one; drawing
+/// every pair instead (no cull) gives the same polygons and fallback triangles, so the
+/// culled pairs had no image. Returns the counts.
+fn check_central(scene: &Scene, projection: &Trilinear, what: &str) -> PairCounts {
+    let geometry = SceneGeometry::new(scene);
+    let mut triangles = projection_triangles(projection);
+    for triangle in &mut triangles {
+        let cache = *triangle.map.cache();
+        triangle.ray_cast = cache.sweeps_no_volume();
+        triangle.central = (!triangle.ray_cast)
+            .then(|| CentralProjection::of(&cache))
+            .flatten();
+    }
+    let central = triangles.iter().filter(|t| t.central.is_some()).count();
+    assert!(central > triangles.len() / 2, "{what}: {central} central");
+    let mut cache = VertexCache::new(geometry.vertices.len());
+    let pairs: Vec<(u32, u32)> = triangles
+        .iter()
+        .enumerate()
+        .flat_map(|(index, triangle)| {
+            let (live, _) = live_pairs(triangle, index as u32, &geometry, &mut cache);
+            live.pairs
+                .into_iter()
+                .map(move |p| (index as u32, p.triangle))
+        })
+        .collect();
+    let kept = kept_one_by_one(&triangles, &geometry);
+    assert_eq!(pairs, kept, "{what}: live pairs");
+    let culled = project_all(&triangles, &geometry, CurveOptions::ADAPTIVE);
+    let all = unculled(&triangles, &geometry);
+    let reference = draw_all(
+        &triangles,
+        &geometry,
+        &all,
+        CurveOptions::ADAPTIVE,
+        PairCounts::default(),
+    );
+    let others = polygons_within(&culled, &reference, &kept, what);
+    assert_eq!(others, 0, "{what}");
+    assert_same_polygons(&culled, &reference, what);
+    culled.counts
+}
+
+/// The inward-looking sphere (its central projections), with its own scene and with random
+/// triangles (in front of it, behind it, collapsed) around its centre: the tree culls most
+/// pairs by whole subtrees, and changes no pair and no polygon.
+#[test]
+fn the_tree_changes_no_polygon_of_central_projections() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/trilinear-inward-sphere.toml"
+    );
+    let mut scene = scene::load(path).unwrap();
+    let built = scene.projection.build(64, 32).unwrap();
+    let projection = built.as_trilinear().unwrap();
+    let c = check_central(&scene, projection, "inward sphere");
+    assert!(c.culled_tree > c.pairs / 2 && c.shapes > 0, "{c:?}");
+    for (count, seed) in [(40, 1), (200, 7)] {
+        let random = random_scene(count, seed);
+        scene.objects = random.objects;
+        for object in &mut scene.objects {
+            for p in &mut object.mesh.positions {
+                *p += Vec3::new(0.0, 1.5, 4.0);
+            }
+        }
+        let what = format!("inward sphere, {count} random triangles");
+        let c = check_central(&scene, projection, &what);
+        assert!(c.culled_tree > 0 && c.shapes > 0, "{what}: {c:?}");
+    }
 }
 
 /// `count` random triangles of the bench's random data (`seed`), plus the same triangles

@@ -119,20 +119,37 @@ impl CullTree {
     /// (no two boxes on the path to it were), in tree order, and with the planes that still
     /// cut its box (`BoxSide::Within`: the box lies wholly inside the others); returns the
     /// number of scene triangles in the subtrees skipped.
-    pub fn visit(&self, bounds: &VolumeBounds, mut keep: impl FnMut(u32, u32)) -> u64 {
+    pub fn visit(&self, bounds: &VolumeBounds, keep: impl FnMut(u32, u32)) -> u64 {
+        self.visit_boxes(
+            bounds.all_planes(),
+            |centre, half, active| bounds.box_side(centre, half, active),
+            keep,
+        )
+    }
+
+    /// [`Self::visit`] with any box test: `side` tells of a node's box (centre and
+    /// half-extents) whether everything in it is culled, given the planes (bit mask) that
+    /// still cut its parent's box, `all` at the root. For the central projections' cones
+    /// (`CentralProjection::box_side`), which are no volume bounds.
+    pub fn visit_boxes(
+        &self,
+        all: u32,
+        mut side: impl FnMut(DVec3, DVec3, u32) -> BoxSide,
+        mut keep: impl FnMut(u32, u32),
+    ) -> u64 {
         if self.nodes.is_empty() {
             return 0;
         }
         let mut culled = 0;
         // Nodes still to visit, each with the planes that still cut its parent's box.
         let mut stack = [(0u32, 0u32); MAX_DEPTH];
-        stack[0] = (0, bounds.all_planes());
+        stack[0] = (0, all);
         let mut len = 1;
         while len > 0 {
             len -= 1;
             let (index, active) = stack[len];
             let node = &self.nodes[index as usize];
-            let active = match bounds.box_side(node.centre, node.half, active) {
+            let active = match side(node.centre, node.half, active) {
                 BoxSide::Outside => {
                     culled += node.triangles;
                     continue;

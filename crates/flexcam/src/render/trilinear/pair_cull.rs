@@ -11,7 +11,6 @@
 //! renderer's determinism requires.
 
 use super::central::CentralProjection;
-use super::hit_terms::HitTerms;
 use super::outline::ProjectionTriangle;
 use super::polygons::PairCounts;
 use super::scene_geometry::SceneGeometry;
@@ -24,10 +23,10 @@ use crate::projection::Solutions;
 /// and the drawing.
 #[derive(Debug, Clone, Copy)]
 pub struct LivePair {
-    /// Index of the scene triangle.
+    /// Index of the scene triangle; it has a plane (`SceneGeometry::hit_terms`: zero-area
+    /// triangles are not live), looked up where the pair is drawn, so that a pair stays
+    /// 16 bytes (the live pairs of a frame are written once and read once).
     pub triangle: u32,
-    /// The scene triangle's plane (it has one: zero-area triangles are not live).
-    pub terms: HitTerms,
     /// Where its three vertices' solutions are in [`LivePairs::solutions`]; not solved
     /// (`u32::MAX`) for a projection triangle drawn as a central projection
     /// ([`ProjectionTriangle::central`]), which needs none.
@@ -60,8 +59,8 @@ pub struct VertexCache {
     generation: u32,
     /// The clusters the tree kept, each with the planes that still cut its box, reused.
     clusters: Vec<(u32, u32)>,
-    /// Per vertex, the half-spaces of a central projection it is outside of, reused.
-    masks: Vec<u16>,
+    /// The live pairs of a central projection as they are found, reused.
+    pairs: Vec<LivePair>,
 }
 
 /// [`VertexState::solved`] of a vertex whose cubic no live pair has needed yet.
@@ -73,7 +72,8 @@ struct VertexState {
     stamp: u32,
     /// The bounding planes the vertex is beyond (`VolumeBounds::outside`), computed among
     /// the planes cutting the box of the first kept cluster that uses it (it is beyond none
-    /// of the others: `VolumeBounds::outside_of`).
+    /// of the others: `VolumeBounds::outside_of`); for a central projection, the
+    /// half-spaces of its cones the vertex is outside of (`CentralProjection::outside`).
     mask: u32,
     /// Index of its cubic's solutions in the pool of the live pairs, or [`NOT_SOLVED`].
     solved: u32,
@@ -91,7 +91,7 @@ impl VertexCache {
             states: vec![unused; vertices],
             generation: 0,
             clusters: Vec::new(),
-            masks: Vec::new(),
+            pairs: Vec::new(),
         }
     }
 
@@ -156,10 +156,10 @@ pub fn live_pairs(
                 counts.culled_volume += 1;
                 continue;
             }
-            let Some(terms) = scene.hit_terms[k] else {
+            if scene.hit_terms[k].is_none() {
                 counts.culled_zero_area += 1;
                 continue;
-            };
+            }
             let solved = corners.map(|i| {
                 let state = &mut cache.states[i as usize];
                 if state.solved == NOT_SOLVED {
@@ -172,7 +172,6 @@ pub fn live_pairs(
             });
             live.pairs.push(LivePair {
                 triangle: k as u32,
-                terms,
                 solved,
             });
         }
@@ -198,36 +197,64 @@ fn no_pairs_yet(index: u32, scene: &SceneGeometry) -> (LivePairs, PairCounts) {
 /// [`live_pairs`] for a projection triangle drawn as the central projection `central`: its
 /// rays fill two cones from the focus, which the volume bounds of a triangle (one convex
 /// region) cover only loosely, so the scene's triangles are culled by the cones' own
-/// planes instead ([`CentralProjection::outside`]), each vertex tested once. No cubic is
-/// solved: the pairs' `solved` are [`NOT_SOLVED`].
+/// planes instead ([`CentralProjection::culled`]), hierarchically as the volume cull: the
+/// tree skips the subtrees whose boxes are outside one plane of each cone
+/// ([`CentralProjection::box_side`], which culls no pair the vertices keep), and the
+/// triangles of the clusters left are tested by their vertices' masks, each computed once.
+/// No cubic is solved: the pairs' `solved` are [`NOT_SOLVED`].
 fn central_live_pairs(
     central: &CentralProjection,
     index: u32,
     scene: &SceneGeometry,
     cache: &mut VertexCache,
 ) -> (LivePairs, PairCounts) {
-    let mut masks = std::mem::take(&mut cache.masks);
-    masks.clear();
-    masks.extend(scene.vertices.iter().map(|&x| central.outside(x)));
+    cache.next_generation();
     let (mut live, mut counts) = no_pairs_yet(index, scene);
-    for (k, corners) in scene.triangles.iter().enumerate() {
-        let common = corners
-            .iter()
-            .fold(u16::MAX, |common, &i| common & masks[i as usize]);
-        if CentralProjection::culled(common) {
-            counts.culled_volume += 1;
-            continue;
+    let mut kept = std::mem::take(&mut cache.clusters);
+    kept.clear();
+    counts.culled_tree = scene.tree.visit_boxes(
+        CentralProjection::ALL_SIDES,
+        |centre, half, active| central.box_side(centre, half, active),
+        |cluster, _| kept.push((cluster, 0)),
+    );
+    counts.culled_volume = counts.culled_tree;
+    kept.sort_unstable();
+    // Gathered in reused storage and copied out at their exact size: one small allocation
+    // per projection triangle, not a growing vector's several (every projection
+    // triangle's pairs are kept until they are drawn).
+    let mut pairs = std::mem::take(&mut cache.pairs);
+    pairs.clear();
+    let generation = cache.generation;
+    for &(cluster, _) in &kept {
+        for k in scene.clusters[cluster as usize].triangles.clone() {
+            let common = scene.triangles[k].iter().fold(u16::MAX, |common, &i| {
+                let state = &mut cache.states[i as usize];
+                if state.stamp != generation {
+                    *state = VertexState {
+                        stamp: generation,
+                        mask: u32::from(central.outside(scene.vertices[i as usize])),
+                        solved: NOT_SOLVED,
+                    };
+                }
+                // The mask of a central projection has 9 bits.
+                common & state.mask as u16
+            });
+            if CentralProjection::culled(common) {
+                counts.culled_volume += 1;
+                continue;
+            }
+            if scene.hit_terms[k].is_none() {
+                counts.culled_zero_area += 1;
+                continue;
+            }
+            pairs.push(LivePair {
+                triangle: k as u32,
+                solved: [NOT_SOLVED; 3],
+            });
         }
-        let Some(terms) = scene.hit_terms[k] else {
-            counts.culled_zero_area += 1;
-            continue;
-        };
-        live.pairs.push(LivePair {
-            triangle: k as u32,
-            terms,
-            solved: [NOT_SOLVED; 3],
-        });
     }
-    cache.masks = masks;
+    live.pairs = pairs.clone();
+    cache.pairs = pairs;
+    cache.clusters = kept;
     (live, counts)
 }

@@ -279,6 +279,10 @@ fn draw_pairs(
     let triangle = &triangles[group.projection as usize];
     for live in pairs {
         let k = live.triangle as usize;
+        // Live pairs have a plane (the cull skips the others).
+        let Some(terms) = scene.hit_terms[k] else {
+            continue;
+        };
         let positions = scene.corners(k);
         // Built only for a pair that is drawn.
         let pair = || Pair {
@@ -286,7 +290,7 @@ fn draw_pairs(
             key: (u64::from(group.projection) << 32) | k as u64,
             id: scene.owners[k].id,
             curves,
-            terms: live.terms,
+            terms,
         };
         let unprojectable = out.counts.unprojectable;
         if let Some(central) = &triangle.central {
