@@ -161,7 +161,7 @@ pub enum FittedStarts {
     Kept,
     /// Starts on projectors through this fitted eye.
     Eye(DVec3),
-    /// Starts fitted per node, each in the plane across the prior's projector there.
+    /// Starts fitted per node (module `free`).
     Free,
 }
 
@@ -171,10 +171,7 @@ impl std::fmt::Display for FittedStarts {
         match self {
             FittedStarts::Kept => write!(f, "starts kept"),
             FittedStarts::Eye(e) => write!(f, "starts on projectors through the fitted eye {e}"),
-            FittedStarts::Free => write!(
-                f,
-                "starts fitted per node (each across the prior's projector at its start)"
-            ),
+            FittedStarts::Free => write!(f, "starts fitted per node"),
         }
     }
 }
@@ -198,9 +195,21 @@ pub struct FitReport {
     /// Constrained nodes that the data leave undetermined under the fitted model (module
     /// section "Warnings").
     pub sparse_nodes: usize,
+    /// The free fit's smoothness weight, relative to its data term's mean diagonal, as the
+    /// data chose it (module `free::weight`); `None` for the other models.
+    pub smoothness: Option<f64>,
 }
 
 impl FitReport {
+    /// The model in words, for `flexcam fit`'s line and the written header: the starts, and
+    /// for the free fit the smoothness weight the data chose.
+    pub fn model(&self) -> String {
+        match self.smoothness {
+            Some(weight) => format!("{}, smoothness {weight:e}", self.starts),
+            None => self.starts.to_string(),
+        }
+    }
+
     /// A warning for the user when some node left the prior by far or is undetermined:
     /// the residual, measured at the correspondences only, may then hide a wrong image.
     pub fn warning(&self) -> Option<String> {

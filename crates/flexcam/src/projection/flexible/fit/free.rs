@@ -28,15 +28,18 @@
 //! directions (over l) along every row and every column of nodes: zero for node values that
 //! are affine along the grid lines, so a bilinear truth (pushbroom, crossed slits, a bilinear
 //! grid off any eye, any pinhole) is not biased, while sparse data, which leave many grids
-//! exact, get the least bent one. mu is `SMOOTHNESS` of the data term's mean diagonal, a
-//! trade-off (docs/flexible.md, "Free starts"): it moves the fit of a 3 x 3 grid that is not
-//! bilinear across its nodes by up to 0.17 degrees at the points (measured), and it must be
-//! large enough that sparse fits of bilinear truths come out bilinear. Nodes that
-//! no correspondence weighs are pulled to the prior with `PULL` of that diagonal (the
+//! exact, get the least bent one. mu is a weight of the ladder `weight::LADDER` (1e-3 to
+//! 1e-6) times the data term's mean diagonal, chosen from the data by cross-validation
+//! (module `weight`): the largest where the data are sparse or exact, so that sparse fits of
+//! bilinear truths come out bilinear; smaller where many points show the grid bent across
+//! its nodes, which the largest would bias (by up to 0.17 degrees at the points of a 3 x 3
+//! grid, measured).
+//! Nodes that no correspondence weighs are pulled to the prior with `PULL` of that diagonal (the
 //! smoothness term extrapolates them otherwise); every unknown gets the floor weight of
 //! module `fit`, which keeps the matrix positive definite. Levenberg-Marquardt (module
 //! `angular`'s) from each given grid's projectors (the kept fit's, the eye fit's, the
-//! prior's); the lowest cost wins.
+//! prior's); the lowest cost wins (for the largest weight; each smaller one starts from the
+//! previous weight's fit).
 //!
 //! # Degenerate cases
 //!
@@ -52,6 +55,8 @@
 //!   either way.
 //! - A fitted projector that reaches its point only at t <= 0: the error of module `fit`.
 
+mod weight;
+
 use glam::DVec3;
 use nalgebra::{DMatrix, DVector, SMatrix};
 
@@ -62,9 +67,6 @@ use super::{
 };
 use crate::error::{Error, Result};
 use crate::projection::flexible::projector_grid::ProjectorGrid;
-
-/// The smoothness weight, relative to the data term's mean diagonal (module docs).
-const SMOOTHNESS: f64 = 1e-3;
 
 /// The pull of unconstrained nodes to the prior, relative to the data term's mean diagonal.
 const PULL: f64 = 1e-6;
@@ -97,46 +99,24 @@ pub(super) fn fit(
         let (grid, report) = super::fit(prior, correspondences)?;
         return Ok((grid, report, false));
     }
-    let problem = Problem::new(prior, correspondences);
-    let wanted = problem.scale_row.norm_squared();
-    let mut best: Option<(f64, DVector<f64>)> = None;
-    for guess in guesses.iter().copied().chain([prior]) {
-        let mut y = problem.unknowns_of(guess);
-        let along = problem.scale_row.dot(&y);
-        if !(along > 0.0 && along.is_finite()) {
-            continue;
-        }
-        problem.rescale(&mut y, wanted / along);
-        let (cost, y) = minimise(&problem, y, &problem.scale_row);
-        if best.as_ref().is_none_or(|(c, _)| cost < *c) {
-            best = Some((cost, y));
-        }
-    }
-    let (_, y) = best.ok_or_else(|| {
-        Error::new("projector grid fit: no starting grid for the free fit points at its data")
-    })?;
-    let starts: Vec<DVec3> = (0..problem.nodes()).map(|j| problem.start(j, &y)).collect();
-    let dirs: Vec<DVec3> = (0..problem.nodes()).map(|j| problem.dir(j, &y)).collect();
-    let ends = starts.iter().zip(&dirs).map(|(s, d)| *s + *d).collect();
-    let grid = ProjectorGrid::new(prior.size(), starts, ends, prior.interpolation())?;
-    let (matrix, _) = problem.linearise_model(&y);
-    let constrained = constrained_nodes(prior, correspondences);
-    let sparse_nodes = undetermined_nodes(
-        &grid,
-        &matrix,
-        PER_NODE,
-        &problem.scale_row,
-        &constrained,
-        problem.scale,
-    );
-    let grid_targets = targets(&grid, correspondences)?;
-    let (grid, report) = in_view(&grid, correspondences, &grid_targets, dirs)?;
-    let bilinear = (&problem.rows * &y + &problem.constant).amax() <= BILINEAR;
+    let rungs = weight::fit_ladder(prior, correspondences, guesses)?;
+    let chosen = weight::choose(prior, correspondences, &rungs);
+    let weight::Rung {
+        problem,
+        y,
+        grid,
+        sparse_nodes,
+    } = &rungs[chosen];
+    let dirs: Vec<DVec3> = (0..problem.nodes()).map(|j| problem.dir(j, y)).collect();
+    let grid_targets = targets(grid, correspondences)?;
+    let (grid, report) = in_view(grid, correspondences, &grid_targets, dirs)?;
+    let bilinear = (&problem.rows * y + &problem.constant).amax() <= BILINEAR;
     Ok((
         grid,
         FitReport {
             starts: FittedStarts::Free,
-            sparse_nodes,
+            sparse_nodes: *sparse_nodes,
+            smoothness: Some(problem.smoothness),
             ..report
         },
         bilinear,
@@ -164,6 +144,8 @@ struct Problem<'a> {
     rows: DMatrix<f64>,
     constant: DVector<f64>,
     mu: f64,
+    /// mu relative to the data term's mean diagonal (the ladder's rung, module `weight`).
+    smoothness: f64,
     /// The weight of each unknown's pull to `prior_y` (floor, or `PULL` on unconstrained
     /// nodes).
     pull: DVector<f64>,
@@ -173,7 +155,13 @@ struct Problem<'a> {
 }
 
 impl<'a> Problem<'a> {
-    fn new(prior: &'a ProjectorGrid, correspondences: &'a [Correspondence]) -> Self {
+    /// The problem of fitting `prior` to `correspondences` with the smoothness weight
+    /// `smoothness` (relative to the data term's mean diagonal).
+    fn new(
+        prior: &'a ProjectorGrid,
+        correspondences: &'a [Correspondence],
+        smoothness: f64,
+    ) -> Self {
         let dirs = prior_directions(prior);
         let nodes = dirs.len();
         let scale = dirs.iter().map(|d| d.length()).sum::<f64>() / nodes as f64;
@@ -210,6 +198,7 @@ impl<'a> Problem<'a> {
             rows: DMatrix::zeros(0, n),
             constant: DVector::zeros(0),
             mu: 0.0,
+            smoothness,
             pull: DVector::zeros(n),
             prior_y,
             scale_row,
@@ -218,7 +207,7 @@ impl<'a> Problem<'a> {
         // derivatives hardly depend on where they are taken).
         let (data, _) = problem.data_term(&problem.prior_y);
         let mean = (data.trace() / n as f64).max(f64::MIN_POSITIVE);
-        problem.mu = SMOOTHNESS * mean;
+        problem.mu = smoothness * mean;
         problem.slide_weight = mean;
         (problem.rows, problem.constant) = problem.second_differences();
         let (rows, constant, mu) = (&problem.rows, &problem.constant, problem.mu);
@@ -231,6 +220,54 @@ impl<'a> Problem<'a> {
             }
         }
         problem
+    }
+
+    /// Levenberg-Marquardt (module `angular`'s) from each of `starts` (grids of the prior's
+    /// size, their directions scaled onto the scale constraint; one whose directions have no
+    /// positive component along it is skipped): the unknowns of the lowest cost, `None` when
+    /// every start was skipped.
+    fn solve(&self, starts: &[&ProjectorGrid]) -> Option<DVector<f64>> {
+        let wanted = self.scale_row.norm_squared();
+        let mut best: Option<(f64, DVector<f64>)> = None;
+        for start in starts {
+            let mut y = self.unknowns_of(start);
+            let along = self.scale_row.dot(&y);
+            if !(along > 0.0 && along.is_finite()) {
+                continue;
+            }
+            self.rescale(&mut y, wanted / along);
+            let (cost, y) = minimise(self, y, &self.scale_row);
+            if best.as_ref().is_none_or(|(c, _)| cost < *c) {
+                best = Some((cost, y));
+            }
+        }
+        best.map(|(_, y)| y)
+    }
+
+    /// The grid of the node projectors `y` (ends one direction from the starts).
+    fn grid_of(&self, y: &DVector<f64>) -> Result<ProjectorGrid> {
+        let starts: Vec<DVec3> = (0..self.nodes()).map(|j| self.start(j, y)).collect();
+        let ends = starts
+            .iter()
+            .enumerate()
+            .map(|(j, s)| *s + self.dir(j, y))
+            .collect();
+        ProjectorGrid::new(self.prior.size(), starts, ends, self.prior.interpolation())
+    }
+
+    /// The constrained nodes that the model (data, smoothness, slide penalty; no pull)
+    /// leaves undetermined at `y`, whose grid is `grid` (`undetermined_nodes` of `fit`).
+    fn undetermined(&self, y: &DVector<f64>, grid: &ProjectorGrid) -> usize {
+        let (matrix, _) = self.linearise_model(y);
+        let constrained = constrained_nodes(self.prior, self.correspondences);
+        undetermined_nodes(
+            grid,
+            &matrix,
+            PER_NODE,
+            &self.scale_row,
+            &constrained,
+            self.scale,
+        )
     }
 
     fn nodes(&self) -> usize {
@@ -434,7 +471,7 @@ mod tests {
     use crate::projection::flexible::volume::LinearVolume;
 
     /// Deterministic uniform numbers in [0, 1) from `seed` (a linear congruential generator).
-    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+    pub(super) fn uniform(seed: u64) -> impl FnMut() -> f64 {
         let mut state = seed;
         move || {
             state = state
@@ -444,10 +481,27 @@ mod tests {
         }
     }
 
+    /// A known projection the tests take points from: (u, v) and t to a point.
+    pub(super) trait Truth {
+        fn point(&self, uv: DVec2, t: f64) -> DVec3;
+    }
+
+    impl Truth for LinearVolume {
+        fn point(&self, uv: DVec2, t: f64) -> DVec3 {
+            LinearVolume::point(self, uv, t)
+        }
+    }
+
+    impl Truth for ProjectorGrid {
+        fn point(&self, uv: DVec2, t: f64) -> DVec3 {
+            ProjectorGrid::point(self, uv, t)
+        }
+    }
+
     /// `count` points of `truth` at seeded image positions in `[lo, hi]^2` and depths t in
     /// (0.1, 0.6).
-    fn seen_by(
-        truth: &LinearVolume,
+    pub(super) fn seen_by(
+        truth: &impl Truth,
         count: usize,
         seed: u64,
         lo: f64,
@@ -466,7 +520,7 @@ mod tests {
     }
 
     /// The pushbroom and crossed-slits truths (bilinear in (u, v), no common eye).
-    fn truths() -> [LinearVolume; 2] {
+    pub(super) fn truths() -> [LinearVolume; 2] {
         [
             preset_volume(
                 Preset::Pushbroom {
@@ -487,7 +541,7 @@ mod tests {
     }
 
     /// A 3 x 3 perspective prior with the fixture's eye.
-    fn prior() -> ProjectorGrid {
+    pub(super) fn prior() -> ProjectorGrid {
         ProjectorGrid::sample(
             &perspective(60.0, [1.0, 40.0]),
             (3, 3),
@@ -498,7 +552,12 @@ mod tests {
 
     /// The largest distance, over a 9 x 9 grid of (u, v), from the truth's points at
     /// t = 0.1 and 0.6 to the fitted projector's line.
-    fn farthest_miss(fitted: &ProjectorGrid, truth: &LinearVolume, lo: f64, hi: f64) -> f64 {
+    pub(super) fn farthest_miss(
+        fitted: &ProjectorGrid,
+        truth: &impl Truth,
+        lo: f64,
+        hi: f64,
+    ) -> f64 {
         let mut worst = 0.0f64;
         for i in 0..=8 {
             for j in 0..=8 {
