@@ -41,7 +41,7 @@
 use nalgebra::DVector;
 
 use super::super::{constrained_nodes, Correspondence, EXACT_RMS_RAD};
-use super::Problem;
+use super::{Problem, REVERSED};
 use crate::error::{Error, Result};
 use crate::projection::flexible::projector_grid::ProjectorGrid;
 
@@ -53,9 +53,6 @@ const FOLDS: usize = 5;
 
 /// Fewest correspondences each fold must hold out for the rungs to be ranked.
 const MIN_HELD_OUT: usize = 4;
-
-/// The squared chord a held-out point counts when its refit or blend has no direction.
-const REVERSED: f64 = 4.0;
 
 /// One rung of the ladder: its problem, the fit's unknowns and grid, and the constrained
 /// nodes it leaves undetermined.
@@ -169,9 +166,7 @@ fn held_out_squares(
             }
             weights.clear();
             prior.for_each_weight(c.uv, |j, w| weights.push((j, w)));
-            if let Some((n, _, m, _)) = problem.blend(c, &weights, &y) {
-                squares[k] = (n - m).length_squared();
-            }
+            squares[k] = problem.miss_squared(c, &weights, &y);
         }
     }
     squares
