@@ -479,7 +479,8 @@ const SLIT_CAMERA: Camera = Camera {
 #[test]
 #[ignore = "a few minutes: prints the table of docs/flexible.md, \"Fitted starts\"; \
             FIT_TABLE_STARTS=kept,auto picks the columns (the default adds free), \
-            FIT_TABLE_NOISE=1 adds image noise in pixels, FIT_TABLE_ROWS=0.5:3:50 picks rows"]
+            FIT_TABLE_NOISE=1 adds image noise in pixels, FIT_TABLE_ROWS=0.5:3:50 picks rows, \
+            FIT_TABLE_KEEP=DIR keeps each case's fitting scene"]
 fn fitted_images_against_their_truths() {
     let moved = |d: V3| {
         Truth::Pinhole(Camera {
@@ -564,6 +565,14 @@ fn fitted_images_against_their_truths() {
                             noise,
                         },
                     );
+                    if let Ok(keep) = std::env::var("FIT_TABLE_KEEP") {
+                        let name = format!(
+                            "{}-{n}x{n}-{count}-s{seed}-{starts}.toml",
+                            name.replace([' ', '\''], "-")
+                        );
+                        std::fs::copy(dir.path().join("fitting.toml"), Path::new(&keep).join(name))
+                            .unwrap();
+                    }
                     let residual = outcome
                         .stdout
                         .split("residual max ")
