@@ -377,9 +377,11 @@ fn clearly_better(count: usize, unknowns: usize, extra: usize, ss: f64, simpler_
 /// curved; else the central fit when it is exact, or when it beats the kept one
 /// ([`clearly_better`], its 3 eye coordinates extra), or when [`fit`] fails where it does
 /// not. That simpler model stands when it is exact; otherwise the free fit (module `free`),
-/// where it leaves no constrained node undetermined, replaces it when it is clearly better, counting 5 unknowns a constrained node less the
-/// scale, or, when it is exact with node values affine along every grid line (a bilinear
-/// grid: the smoothness term's own model), those of the grid's four corners (19); with no
+/// where it leaves no constrained node undetermined, replaces it when it is clearly better, counting its effective unknowns (the trace
+/// of its hat matrix, `free::Shape::freedom`; at most 5 a constrained node less the scale:
+/// the smoothness spends fewer where the data are sparse), or, when it is exact with node
+/// values affine along every grid line (a bilinear grid: the smoothness term's own model),
+/// those of the grid's four corners (19); with no
 /// more unknowns than the simpler model it must only miss the data less. Misses are compared
 /// as [`misses_seen_from`] the prior's starts (here and between kept and eye starts), not as
 /// each model's own residual. So pinhole data keep
@@ -403,7 +405,7 @@ fn auto_fit(
     let free = free::fit(prior, correspondences, &guesses)
         .ok()
         .filter(|(_, r, _)| r.sparse_nodes == 0);
-    let Some((free_grid, free_report, bilinear)) = free else {
+    let Some((free_grid, free_report, shape)) = free else {
         return simple;
     };
     let Ok((simple_grid, simple_report)) = &simple else {
@@ -417,10 +419,16 @@ fn auto_fit(
         FittedStarts::Eye(_) => 3 * constrained + 2,
         _ => 3 * constrained - 1,
     };
-    let free_unknowns = if bilinear && exact(&free_report) {
+    let free_unknowns = if shape.bilinear && exact(&free_report) {
         4 * 5 - 1
     } else {
-        5 * constrained - 1
+        // The effective count, rounded up (finite and below the nominal one).
+        let nominal = 5 * constrained - 1;
+        if shape.freedom < nominal as f64 {
+            shape.freedom.ceil() as usize
+        } else {
+            nominal
+        }
     };
     let count = correspondences.len();
     let ss = |grid: &ProjectorGrid| misses_seen_from(prior, grid, correspondences);

@@ -88,16 +88,31 @@ const PER_NODE: usize = 6;
 /// Largest second difference (in the unknowns' units) of a fit taken as bilinear.
 const BILINEAR: f64 = 1e-5;
 
+/// What `Starts::Auto` judges a free fit by besides its misses.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Shape {
+    /// Node values affine along every grid line (all second differences below `BILINEAR`).
+    pub(super) bilinear: bool,
+    /// The fit's effective number of unknowns: the trace of its hat matrix,
+    /// trace((data + smoothness + slide + pull)^-1 data) of the Gauss-Newton matrices at the
+    /// fit (the count a penalised least-squares fit spends; at most the 6 unknowns a node
+    /// less the gauge, and at most the data's 2 equations a correspondence); infinite where
+    /// the matrix does not factor, and where the weight was not cross-validated (fewer than
+    /// 20 points or a node without data, module `weight`: the count would then measure the
+    /// fixed weight, not what the data support; measured: 16 points of an off-eye 3 x 3 grid
+    /// took free starts at 91.5 to 97.2 % ids against 94.2 to 97.1 % kept).
+    pub(super) freedom: f64,
+}
+
 /// Fits `prior`'s node starts and directions to `correspondences` (module docs), starting
 /// from each of `guesses` (grids of the prior's size) and from the prior; returns the grid,
 /// its report (`sparse_nodes` counting the constrained nodes that data and smoothness leave
-/// undetermined) and whether its node values are affine along every grid line (all second
-/// differences below `BILINEAR`).
+/// undetermined) and its [`Shape`].
 pub(super) fn fit(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
     guesses: &[&ProjectorGrid],
-) -> Result<(ProjectorGrid, FitReport, bool)> {
+) -> Result<(ProjectorGrid, FitReport, Shape)> {
     if prior.is_curved() {
         return Err(Error::new(
             "projector grid fit: `starts = \"free\"` fits straight projectors; this grid has \
@@ -108,7 +123,11 @@ pub(super) fn fit(
     targets(prior, correspondences)?;
     if correspondences.is_empty() {
         let (grid, report) = super::fit(prior, correspondences)?;
-        return Ok((grid, report, false));
+        let shape = Shape {
+            bilinear: false,
+            freedom: f64::INFINITY,
+        };
+        return Ok((grid, report, shape));
     }
     let rungs = weight::fit_ladder(prior, correspondences, guesses)?;
     let chosen = weight::choose(prior, correspondences, &rungs);
@@ -121,7 +140,14 @@ pub(super) fn fit(
     let dirs: Vec<DVec3> = (0..problem.nodes()).map(|j| problem.dir(j, y)).collect();
     let grid_targets = targets(grid, correspondences)?;
     let (grid, report) = in_view(grid, correspondences, &grid_targets, dirs)?;
-    let bilinear = (&problem.rows * y + &problem.constant).amax() <= BILINEAR;
+    let shape = Shape {
+        bilinear: (&problem.rows * y + &problem.constant).amax() <= BILINEAR,
+        freedom: if rungs.len() > 1 {
+            problem.freedom(y)
+        } else {
+            f64::INFINITY
+        },
+    };
     Ok((
         grid,
         FitReport {
@@ -130,7 +156,7 @@ pub(super) fn fit(
             smoothness: Some(problem.smoothness),
             ..report
         },
-        bilinear,
+        shape,
     ))
 }
 
@@ -279,6 +305,15 @@ impl<'a> Problem<'a> {
             &constrained,
             self.scale,
         )
+    }
+
+    /// [`Shape::freedom`] at `y`.
+    fn freedom(&self, y: &DVector<f64>) -> f64 {
+        let (data, _) = self.data_term(y);
+        let (model, _) = self.linearise(y);
+        model
+            .cholesky()
+            .map_or(f64::INFINITY, |factor| factor.solve(&data).trace())
     }
 
     fn nodes(&self) -> usize {
