@@ -246,14 +246,32 @@ fn uniform(seed: u64) -> impl FnMut() -> f64 {
     }
 }
 
+/// The example scene's image size in pixels (`[image]` of `flexible-projector-fit.toml`).
+const IMAGE_PIXELS: [f64; 2] = [320.0, 240.0];
+
 /// `count` correspondences of `truth` at random image positions, 4 to 12 from their
-/// projectors' starts, written to 6 decimals (the lead's audit).
-fn fit_array(truth: &Truth, count: usize, seed: u64) -> String {
+/// projectors' starts, written to 6 decimals (the lead's audit); with `noise` > 0 each
+/// image position is then moved by normal noise of `noise` pixels' standard deviation on
+/// each axis (Box-Muller from its own seeded sequence, so the points are the noiseless
+/// case's) and kept inside the image.
+fn fit_array(truth: &Truth, count: usize, seed: u64, noise: f64) -> String {
     let mut next = uniform(seed);
+    let mut jitter = uniform(seed + 1000);
+    let mut normal = move || {
+        let (a, b) = (jitter().max(1e-300), jitter());
+        (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+    };
     let mut text = String::from("fit = [\n");
     for _ in 0..count {
         let (u, v, d) = (next(), next(), 4.0 + 8.0 * next());
         let p = truth.point(u, v, d);
+        let (u, v) = if noise > 0.0 {
+            let moved = |x: f64, pixels: f64, z: f64| (x + noise * z / pixels).clamp(0.0, 1.0);
+            let (zu, zv) = (normal(), normal());
+            (moved(u, IMAGE_PIXELS[0], zu), moved(v, IMAGE_PIXELS[1], zv))
+        } else {
+            (u, v)
+        };
         text += &format!(
             "    {{ uv = [{u:.6}, {v:.6}], point = [{:.6}, {:.6}, {:.6}] }},\n",
             p[0], p[1], p[2]
@@ -284,6 +302,8 @@ struct Case<'a> {
     count: usize,
     seed: u64,
     starts: Option<&'a str>,
+    /// Image noise of the correspondences, in pixels ([`fit_array`]).
+    noise: f64,
 }
 
 /// What a case gave: the id agreement in percent (NaN where `flexcam fit` failed), `flexcam
@@ -308,7 +328,7 @@ fn run_case(dir: &TempDir, case: &Case<'_>) -> Outcome {
         "{image}{}\n[projection.projectors]\nsize = [{n}, {n}]\ninterpolation = \"bilinear\"\n\
          {starts}{}\n{objects}",
         prior.projection([case.near, 40.0]),
-        fit_array(case.truth, case.count, case.seed),
+        fit_array(case.truth, case.count, case.seed, case.noise),
         n = case.n,
     );
     let truth = format!("{image}{}\n{objects}", case.truth.projection());
@@ -363,6 +383,7 @@ fn moved_camera_case(dir: &TempDir, starts: Option<&str>) -> Outcome {
             count: 16,
             seed: 2,
             starts,
+            noise: 0.0,
         },
     )
 }
@@ -457,7 +478,9 @@ const SLIT_CAMERA: Camera = Camera {
 
 #[test]
 #[ignore = "a few minutes: prints the table of docs/flexible.md, \"Fitted starts\"; \
-            FIT_TABLE_STARTS=kept,auto picks the columns (the default adds free)"]
+            FIT_TABLE_STARTS=kept,auto picks the columns (the default adds free), \
+            FIT_TABLE_NOISE=1 adds image noise in pixels, FIT_TABLE_ROWS=0.5:3:50 picks rows, \
+            FIT_TABLE_KEEP=DIR keeps each case's fitting scene"]
 fn fitted_images_against_their_truths() {
     let moved = |d: V3| {
         Truth::Pinhole(Camera {
@@ -490,6 +513,34 @@ fn fitted_images_against_their_truths() {
     ];
     let columns = std::env::var("FIT_TABLE_STARTS").unwrap_or_else(|_| "kept,auto,free".into());
     let only = std::env::var("FIT_TABLE_TRUTHS").unwrap_or_default();
+    // FIT_TABLE_NOISE: image noise in pixels (standard deviation per axis, [`fit_array`]);
+    // FIT_TABLE_ROWS: `near:n:count` rows, comma-separated (default: the docs' rows).
+    let noise: f64 = std::env::var("FIT_TABLE_NOISE").map_or(0.0, |v| v.parse().unwrap());
+    let rows: Vec<(f64, usize, usize)> = std::env::var("FIT_TABLE_ROWS").map_or_else(
+        |_| {
+            vec![
+                (0.5, 3, 16),
+                (0.5, 3, 50),
+                (0.5, 3, 200),
+                (0.0, 3, 16),
+                (0.0, 3, 50),
+                (0.5, 5, 50),
+                (0.5, 5, 200),
+            ]
+        },
+        |v| {
+            v.split(',')
+                .map(|row| {
+                    let parts: Vec<&str> = row.split(':').collect();
+                    (
+                        parts[0].parse().unwrap(),
+                        parts[1].parse().unwrap(),
+                        parts[2].parse().unwrap(),
+                    )
+                })
+                .collect()
+        },
+    );
     let dir = TempDir::new().unwrap();
     println!("| truth | near | grid | points | starts | seed 1 | seed 2 | seed 3 |");
     println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
@@ -497,15 +548,7 @@ fn fitted_images_against_their_truths() {
         .iter()
         .filter(|(name, _)| name.contains(only.as_str()))
     {
-        for (near, n, count) in [
-            (0.5, 3, 16),
-            (0.5, 3, 50),
-            (0.5, 3, 200),
-            (0.0, 3, 16),
-            (0.0, 3, 50),
-            (0.5, 5, 50),
-            (0.5, 5, 200),
-        ] {
+        for &(near, n, count) in &rows {
             for starts in columns.split(',') {
                 let mut row = format!("| {name} | {near} | {n}x{n} | {count} | {starts} |");
                 for seed in 1..=3 {
@@ -519,8 +562,17 @@ fn fitted_images_against_their_truths() {
                             count,
                             seed,
                             starts: Some(starts),
+                            noise,
                         },
                     );
+                    if let Ok(keep) = std::env::var("FIT_TABLE_KEEP") {
+                        let name = format!(
+                            "{}-{n}x{n}-{count}-s{seed}-{starts}.toml",
+                            name.replace([' ', '\''], "-")
+                        );
+                        std::fs::copy(dir.path().join("fitting.toml"), Path::new(&keep).join(name))
+                            .unwrap();
+                    }
                     let residual = outcome
                         .stdout
                         .split("residual max ")
@@ -568,6 +620,7 @@ fn the_fitted_eye_is_in_the_stats_and_bad_starts_keys_are_located() {
         count: 20,
         seed: 4,
         starts: Some("eye"),
+        noise: 0.0,
     };
     run_case(&dir, &case);
     let stats = run_json(
@@ -628,6 +681,7 @@ fn a_pushbroom_is_recovered_with_free_starts_image_for_image() {
         count: 50,
         seed: 1,
         starts: None,
+        noise: 0.0,
     };
     let outcome = run_case(&dir, &case);
     assert_recovered(&dir, &outcome, "starts fitted per node");
@@ -637,5 +691,12 @@ fn a_pushbroom_is_recovered_with_free_starts_image_for_image() {
         &["render", "fitting.toml", "-o", "out.png", "--stats", "-"],
     );
     assert_eq!(stats["fit_starts_free"].as_f64(), Some(1.0), "{stats}");
+    // Exact bilinear data: every smoothness weight meets them, the largest is kept.
+    assert_eq!(stats["fit_smoothness"].as_f64(), Some(1e-3), "{stats}");
+    assert!(
+        outcome.stdout.contains("smoothness 1e-3"),
+        "{}",
+        outcome.stdout
+    );
     assert_eq!(stats["fit_starts_eye"].as_f64(), Some(0.0), "{stats}");
 }

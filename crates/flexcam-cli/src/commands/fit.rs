@@ -49,7 +49,7 @@ pub fn run(args: &FitArgs) -> Result<()> {
         r.unconstrained_nodes,
         r.max_angle_deg,
         r.rms_angle_deg,
-        r.starts,
+        r.model(),
         args.output.display()
     ))?;
     Ok(())

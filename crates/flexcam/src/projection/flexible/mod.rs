@@ -258,6 +258,9 @@ impl Projection for Flexible {
                 notes.push(("fit_starts_eye", f64::from(u8::from(eye.is_some()))));
                 let free = r.starts == fit::FittedStarts::Free;
                 notes.push(("fit_starts_free", f64::from(u8::from(free))));
+                if let Some(smoothness) = r.smoothness {
+                    notes.push(("fit_smoothness", smoothness));
+                }
                 if let Some(eye) = eye {
                     notes.extend([
                         ("fit_eye_x", eye.x),

@@ -63,7 +63,7 @@ pub fn fit_scene(text: &str, path: &Path, output: &Path) -> Result<FittedScene> 
         report.correspondences,
         report.max_angle_deg,
         report.rms_angle_deg,
-        report.starts
+        report.model()
     );
     let written = format!("{header}{document}");
     check_round_trip(&written, output, &grid, width, height)?;
