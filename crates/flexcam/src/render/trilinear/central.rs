@@ -55,7 +55,7 @@ pub const MEETING_TOL: f64 = 1e-9;
 /// vertex and per box), so the box test never contradicts the vertices' own.
 const BOX_MARGIN: f64 = 1e-9;
 
-/// The half-spaces of [`CentralProjection::sides`] the points seen in each cone must be
+/// The half-spaces of [`ClipPoint::sides`] the points seen in each cone must be
 /// in: before the focus (bits 0 to 4), beyond it (bits 5 to 8).
 const NEAR_CONE: u32 = 0x1f;
 const FAR_CONE: u32 = 0x1e0;
@@ -127,11 +127,11 @@ impl CentralProjection {
     }
 
     /// The half-spaces of the two cones the rays fill that the scene point `x` is strictly
-    /// outside of, as the bits of [`Self::sides`] (0 to 4 the cone before the focus, 5 to
+    /// outside of, as the bits of [`ClipPoint::sides`] (0 to 4 the cone before the focus, 5 to
     /// 8 the one beyond it). The planes are those [`Self::outlines`] clips to, so a scene
     /// triangle whose corners share a bit of each cone ([`Self::culled`]) has no image.
     pub fn outside(&self, x: DVec3) -> u16 {
-        let sides = self.sides(x - self.focus);
+        let sides = self.point(x - self.focus).sides();
         (0..9).fold(0, |mask, k| mask | u16::from(sides[k] < 0.0) << k)
     }
 
@@ -143,7 +143,7 @@ impl CentralProjection {
         common & NEAR_CONE != 0 && common & FAR_CONE != 0
     }
 
-    /// Every half-space of [`Self::sides`] (bit `k` for half-space `k`): where a box test
+    /// Every half-space of [`ClipPoint::sides`] (bit `k` for half-space `k`): where a box test
     /// starts.
     pub const ALL_SIDES: u32 = NEAR_CONE | FAR_CONE;
 
@@ -189,7 +189,7 @@ impl CentralProjection {
         }
     }
 
-    /// The near cone's half-spaces of [`Self::sides`] (bits 0 to 4) as `normal . y +
+    /// The near cone's half-spaces of [`ClipPoint::sides`] (bits 0 to 4) as `normal . y +
     /// offset >= 0`; the far cone's are the first three and the last turned round.
     fn near_half_spaces(&self) -> [(DVec3, f64); 5] {
         let m = DOMAIN_MARGIN;
@@ -202,17 +202,15 @@ impl CentralProjection {
         ]
     }
 
-    /// The values at `y = X - F` of the half-spaces a point must be in (`>= 0`) to be seen,
-    /// in the cone before the focus (bits 0 to 4: the domain's three planes with the
-    /// clipping margin, the view plane `w <= 1`, and `w >= 0`, which the three imply but
-    /// which culls a scene triangle beyond the focus as a whole) and in the cone beyond it
-    /// (bits 5 to 8: the domain's planes turned round, and `w <= 0`).
-    fn sides(&self, y: DVec3) -> [f64; 9] {
-        // Spelled out (no array maps): called per scene vertex and clipped point.
-        let (u, v, w) = (self.u.dot(y), self.v.dot(y), self.w.dot(y));
-        let m = DOMAIN_MARGIN;
-        let [a, b, c] = [u + m * w, v + m * w, (1.0 + m) * w - u - v];
-        [a, b, c, 1.0 - w, w, -a, -b, -c, -w]
+    /// The point `y = X - F` with its homogeneous coordinates `u w`, `v w` and `w` (module
+    /// doc), from which its [`ClipPoint::sides`] and image follow.
+    fn point(&self, y: DVec3) -> ClipPoint {
+        ClipPoint {
+            y,
+            u: self.u.dot(y),
+            v: self.v.dot(y),
+            w: self.w.dot(y),
+        }
     }
 
     /// The depth `t0` at which the rays meet.
@@ -231,10 +229,10 @@ impl CentralProjection {
         scratch: &mut Scratch,
         mut draw: impl FnMut(&[OutlinePoint]),
     ) -> Result<(), ThroughFocus> {
-        let corners = scene.map(|x| x - self.focus);
+        let corners = scene.map(|x| self.point(x - self.focus));
         // The corners' sides, for the tests that need no clipping: computed as the clipping
         // computes them, so the tests agree with it bit for bit.
-        let sides = [0, 1, 2].map(|i| self.sides(corners[i]));
+        let sides = [0, 1, 2].map(|i| corners[i].sides());
         let mut reach = None;
         let Scratch {
             polygon,
@@ -264,23 +262,22 @@ impl CentralProjection {
                     continue;
                 }
                 whole = false;
-                clip_polygon(polygon, clipped, |y| self.sides(y)[k]);
+                clip_polygon(polygon, clipped, |y| self.point(y), |p| p.sides()[k]);
             }
             if polygon.is_empty() {
                 continue;
             }
             let reach = *reach
-                .get_or_insert_with(|| corners.iter().map(|y| y.length()).fold(0.0, f64::max));
-            for y in polygon.iter() {
-                let w = self.w.dot(*y);
+                .get_or_insert_with(|| corners.iter().map(|c| c.y.length()).fold(0.0, f64::max));
+            for &ClipPoint { u, v, w, .. } in polygon.iter() {
                 // Away from the focus `side * w` is positive (module doc); at it the image
                 // is undefined.
                 if w.is_nan() || side * w <= MEETING_TOL * self.w.length() * reach {
                     return Err(ThroughFocus);
                 }
                 piece.push(OutlinePoint {
-                    u: self.u.dot(*y) / w,
-                    v: self.v.dot(*y) / w,
+                    u: u / w,
+                    v: v / w,
                     t: self.depth * (1.0 - w),
                 });
             }
@@ -292,47 +289,82 @@ impl CentralProjection {
     }
 }
 
+/// A point of a polygon clipped in scene space: its offset `y = X - F` from the focus and
+/// its dot products with the projection's `u`, `v` and `w` ([`CentralProjection::point`]),
+/// computed once per point, since every half-space it is tested against and its image are
+/// made of these three (the clipping tests a point against up to four half-spaces).
+#[derive(Debug, Clone, Copy)]
+struct ClipPoint {
+    y: DVec3,
+    u: f64,
+    v: f64,
+    w: f64,
+}
+
+impl ClipPoint {
+    /// The values of the half-spaces the point must be in (`>= 0`) to be seen, in the cone
+    /// before the focus (bits 0 to 4: the domain's three planes with the clipping margin,
+    /// the view plane `w <= 1`, and `w >= 0`, which the three imply but which culls a scene
+    /// triangle beyond the focus as a whole) and in the cone beyond it (bits 5 to 8: the
+    /// domain's planes turned round, and `w <= 0`).
+    fn sides(&self) -> [f64; 9] {
+        // Spelled out (no array maps): called per scene vertex and clipped point.
+        let (u, v, w) = (self.u, self.v, self.w);
+        let m = DOMAIN_MARGIN;
+        let [a, b, c] = [u + m * w, v + m * w, (1.0 + m) * w - u - v];
+        [a, b, c, 1.0 - w, w, -a, -b, -c, -w]
+    }
+}
+
 /// Reused buffers of [`CentralProjection::outlines`].
 #[derive(Debug, Default)]
 pub struct Scratch {
-    polygon: Vec<DVec3>,
-    clipped: Vec<DVec3>,
+    polygon: Vec<ClipPoint>,
+    clipped: Vec<ClipPoint>,
     /// The parts before and beyond the focus.
     pieces: [Vec<OutlinePoint>; 2],
 }
 
 /// One Sutherland-Hodgman pass in scene space: `polygon` becomes its part where `inside >=
-/// 0` (`inside` linear, so the cut points are exact up to rounding); `scratch` is reused
-/// storage. Consecutive equal points are merged.
-fn clip_polygon(polygon: &mut Vec<DVec3>, scratch: &mut Vec<DVec3>, inside: impl Fn(DVec3) -> f64) {
-    if polygon.iter().all(|&y| inside(y) >= 0.0) {
+/// 0` (`inside` linear in the points' offsets, so the cut points are exact up to rounding);
+/// a cut point is made from its offset by `point`; `scratch` is reused storage.
+/// Consecutive equal points are merged.
+fn clip_polygon(
+    polygon: &mut Vec<ClipPoint>,
+    scratch: &mut Vec<ClipPoint>,
+    point: impl Fn(DVec3) -> ClipPoint,
+    inside: impl Fn(&ClipPoint) -> f64,
+) {
+    if polygon.iter().all(|p| inside(p) >= 0.0) {
         return;
     }
     scratch.clear();
     let Some(&last) = polygon.last() else {
         return;
     };
-    let (mut previous, mut previous_side) = (last, inside(last));
+    let (mut previous, mut previous_side) = (last, inside(&last));
     for &current in polygon.iter() {
-        let side = inside(current);
+        let side = inside(&current);
         if (side >= 0.0) != (previous_side >= 0.0) {
             let s = previous_side / (previous_side - side);
-            push_distinct(scratch, previous + s * (current - previous));
+            push_distinct(scratch, point(previous.y + s * (current.y - previous.y)));
         }
         if side >= 0.0 {
             push_distinct(scratch, current);
         }
         (previous, previous_side) = (current, side);
     }
-    if scratch.len() > 1 && scratch.first() == scratch.last() {
+    if scratch.len() > 1 && scratch.first().map(|p| p.y) == scratch.last().map(|p| p.y) {
         scratch.pop();
     }
     std::mem::swap(polygon, scratch);
 }
 
-fn push_distinct(out: &mut Vec<DVec3>, y: DVec3) {
-    if out.last() != Some(&y) {
-        out.push(y);
+/// Appends `p` unless its offset equals the last point's (equal offsets have equal
+/// products).
+fn push_distinct(out: &mut Vec<ClipPoint>, p: ClipPoint) {
+    if out.last().map(|q| q.y) != Some(p.y) {
+        out.push(p);
     }
 }
 
