@@ -61,23 +61,40 @@ impl ScreenLocator {
             bin_triangles: Vec::new(),
             triangles: Vec::new(),
         };
-        let mut lists = vec![Vec::new(); bins_per_axis * bins_per_axis];
+        // A counting sort into the bins (how many per bin, where each bin starts, then the
+        // triangles in index order): no list per bin to grow, which cost more than the
+        // queries on meshes of a thousand triangles.
+        let bins = bins_per_axis * bins_per_axis;
+        let mut bin_start = vec![0; bins + 1];
+        for tri in &triangles {
+            locator.for_each_bin(tri, |bin| bin_start[bin + 1] += 1);
+        }
+        for bin in 0..bins {
+            bin_start[bin + 1] += bin_start[bin];
+        }
+        let mut next = bin_start[..bins].to_vec();
+        let mut bin_triangles = vec![0; bin_start[bins]];
         for (index, tri) in triangles.iter().enumerate() {
-            let lo = tri[0].min(tri[1]).min(tri[2]);
-            let hi = tri[0].max(tri[1]).max(tri[2]);
-            for by in locator.bin(lo.y, 1)..=locator.bin(hi.y, 1) {
-                for bx in locator.bin(lo.x, 0)..=locator.bin(hi.x, 0) {
-                    lists[by * bins_per_axis + bx].push(index as u32);
-                }
-            }
+            locator.for_each_bin(tri, |bin| {
+                bin_triangles[next[bin]] = index as u32;
+                next[bin] += 1;
+            });
         }
-        locator.bin_start.push(0);
-        for list in lists {
-            locator.bin_triangles.extend(list);
-            locator.bin_start.push(locator.bin_triangles.len());
-        }
+        locator.bin_start = bin_start;
+        locator.bin_triangles = bin_triangles;
         locator.triangles = triangles;
         locator
+    }
+
+    /// Calls `f` with every bin that the bounding box of `tri` overlaps, row by row.
+    fn for_each_bin(&self, tri: &[DVec2; 3], mut f: impl FnMut(usize)) {
+        let lo = tri[0].min(tri[1]).min(tri[2]);
+        let hi = tri[0].max(tri[1]).max(tri[2]);
+        for by in self.bin(lo.y, 1)..=self.bin(hi.y, 1) {
+            for bx in self.bin(lo.x, 0)..=self.bin(hi.x, 0) {
+                f(by * self.bins_per_axis + bx);
+            }
+        }
     }
 
     /// The bin index of coordinate `c` along `axis`, clamped to the grid. Monotone in `c`,
@@ -268,5 +285,48 @@ mod tests {
         assert!(locator.locate(DVec2::new(0.25, 0.7)).is_none()); // inside bounds, outside
         assert!(locator.locate(DVec2::new(0.5, 0.4)).is_some());
         assert!(locator.locate(DVec2::new(f64::NAN, 0.4)).is_none());
+    }
+
+    /// Each bin lists exactly the triangles whose bounding boxes overlap it (by the bin
+    /// indices of their corners' extremes), in ascending order, and the bins follow each
+    /// other without gaps: the counting sort against the definition, on the grid mesh and
+    /// on overlapping triangles of many sizes (some covering many bins, some one).
+    #[test]
+    fn bins_list_the_overlapping_triangles_in_index_order() {
+        let mut scattered = Vec::new();
+        for k in 0..200 {
+            let (x, y) = ((k * 37 % 101) as f64 / 101.0, (k * 53 % 97) as f64 / 97.0);
+            let size = 0.01 + (k % 7) as f64 * 0.06;
+            scattered.push([
+                DVec2::new(x, y),
+                DVec2::new(x + size, y + 0.3 * size),
+                DVec2::new(x - 0.5 * size, y + size),
+            ]);
+        }
+        for tris in [grid(6), scattered] {
+            let locator = ScreenLocator::new(tris.clone());
+            let n = locator.bins_per_axis;
+            assert_eq!(locator.bin_start.len(), n * n + 1);
+            assert_eq!(locator.bin_start[0], 0);
+            assert_eq!(locator.bin_start[n * n], locator.bin_triangles.len());
+            for by in 0..n {
+                for bx in 0..n {
+                    let expected: Vec<u32> = (0..tris.len())
+                        .filter(|&k| {
+                            let t = &tris[k];
+                            let (lo, hi) = (t[0].min(t[1]).min(t[2]), t[0].max(t[1]).max(t[2]));
+                            (locator.bin(lo.x, 0)..=locator.bin(hi.x, 0)).contains(&bx)
+                                && (locator.bin(lo.y, 1)..=locator.bin(hi.y, 1)).contains(&by)
+                        })
+                        .map(|k| k as u32)
+                        .collect();
+                    let b = by * n + bx;
+                    let listed =
+                        &locator.bin_triangles[locator.bin_start[b]..locator.bin_start[b + 1]];
+                    assert_eq!(listed, &expected[..], "bin ({bx}, {by})");
+                }
+            }
+        }
+        assert!(ScreenLocator::new(Vec::new()).locate(DVec2::ZERO).is_none());
     }
 }
