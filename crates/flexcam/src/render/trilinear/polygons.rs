@@ -11,7 +11,7 @@ use super::central;
 use super::clip::clip_outline;
 use super::curves::{CurveMode, CurveOptions, ADAPTIVE_TOLERANCE_PX};
 use super::edge_path::{EdgePath, OutlinePoint};
-use super::hit_terms::{HitTerms, TERMS};
+use super::hit_terms::TERMS;
 use super::outline::{
     depth_range, slice_depths, trace_outline, EdgeCrossings, ProjectionTriangle, Sampling,
 };
@@ -172,8 +172,9 @@ pub fn project_all(
 /// projection `live[i].projection` being `triangles[...]`), with `counts` of the cull added
 /// to those of drawing. The work items are runs of [`PAIRS_PER_ITEM`] pairs of one
 /// projection triangle (referring to its pairs in place); each worker draws a contiguous
-/// range of items into one batch of its own with one set of buffers, and the batches are
-/// joined in order.
+/// range of items into one part of its own with one set of buffers (the shapes' clipped
+/// outlines), and the parts are then turned into one polygon batch in order
+/// ([`Drawn::polygons`]).
 pub(super) fn draw_all(
     triangles: &[ProjectionTriangle],
     scene: &SceneGeometry,
@@ -209,41 +210,86 @@ pub(super) fn draw_all(
         )
         .map(|(out, _)| out)
         .collect();
-    let drawn = Drawn::concatenated(jobs);
     let mut out = ProjectedScene {
-        polygons: drawn.polygons,
+        polygons: Drawn::polygons(&jobs, triangles, scene),
         counts,
         fallback: vec![false; triangles.len()],
     };
-    out.counts.add(&drawn.counts);
-    for &index in &drawn.fallback {
-        out.fallback[index as usize] = true;
+    for part in &jobs {
+        out.counts.add(&part.counts);
+        for &index in &part.fallback {
+            out.fallback[index as usize] = true;
+        }
     }
     out
 }
 
-/// What drawing some live pairs gave: their polygons (in pair order), the counts of the
-/// drawing half, and the projection triangles with an unprojectable pair among them.
+/// What drawing some live pairs gave: the clipped outline of each shape (in pair order),
+/// the counts of the drawing half, and the projection triangles with an unprojectable pair
+/// among them. The outlines are kept as barycentrics and depth (24 bytes a point) and turned
+/// into pixel vertices (80 bytes) only once the parts are joined ([`Drawn::polygons`]): each
+/// part's storage is fresh memory, and building the vertices in the parts and then copying
+/// them into one batch wrote them twice, which cost more in page faults and copies than
+/// computing them (mostly the inward sphere's 36,000 outline points).
 #[derive(Debug, Clone, Default)]
 struct Drawn {
-    polygons: PolygonBatch<TERMS>,
+    points: Vec<OutlinePoint>,
+    shapes: Vec<DrawnShape>,
     counts: PairCounts,
     fallback: Vec<u32>,
 }
 
+/// A shape in [`Drawn`]: its outline is `points[previous shape's end..end]`, of the pair of
+/// projection triangle `projection` and scene triangle `triangle`.
+#[derive(Debug, Clone, Copy)]
+struct DrawnShape {
+    end: usize,
+    projection: u32,
+    triangle: u32,
+}
+
 impl Drawn {
-    /// What drawing the pairs of `parts`, one after the other, gave. Joined once, in order,
-    /// into the first part: a pairwise reduction would copy the early polygons again at
-    /// every level of its tree.
-    fn concatenated(parts: Vec<Drawn>) -> Drawn {
-        let mut parts = parts.into_iter();
-        let mut all = parts.next().unwrap_or_default();
-        for next in parts {
-            all.polygons.append(&next.polygons);
-            all.counts.add(&next.counts);
-            all.fallback.extend(next.fallback);
+    /// Records the clipped outline `outline` of a shape of the pair (`projection`,
+    /// `triangle`).
+    fn push(&mut self, outline: &[OutlinePoint], projection: u32, triangle: u32) {
+        self.points.extend_from_slice(outline);
+        self.shapes.push(DrawnShape {
+            end: self.points.len(),
+            projection,
+            triangle,
+        });
+    }
+
+    /// The pixel polygons of the shapes of `parts`, one after the other, in one batch: each
+    /// vertex at its pixel with the hit terms of its projector through the scene
+    /// triangle's plane (of the whole triangle, also for tessellated pieces), keyed
+    /// `projection << 32 | scene triangle`, with the scene triangle's object id.
+    fn polygons(
+        parts: &[Drawn],
+        triangles: &[ProjectionTriangle],
+        scene: &SceneGeometry,
+    ) -> PolygonBatch<TERMS> {
+        let mut polygons = PolygonBatch::new();
+        let mut pixels = Vec::new();
+        for part in parts {
+            let mut start = 0;
+            for shape in &part.shapes {
+                let outline = &part.points[start..shape.end];
+                start = shape.end;
+                let k = shape.triangle as usize;
+                let map = &triangles[shape.projection as usize].map;
+                // Only pairs with a plane are drawn (`draw_pairs`).
+                let terms = scene.hit_terms[k].expect("a drawn scene triangle has a plane");
+                pixels.clear();
+                pixels.extend(outline.iter().map(|p| {
+                    let pixel = map.pixel(p.u, p.v);
+                    Vertex::new(pixel.x, pixel.y, p.t, terms.at(map, p.u, p.v))
+                }));
+                let key = (u64::from(shape.projection) << 32) | k as u64;
+                polygons.push(&pixels, scene.owners[k].id, key);
+            }
         }
-        all
+        polygons
     }
 }
 
@@ -259,7 +305,6 @@ struct Scratch {
     outline: Vec<OutlinePoint>,
     clipped: Vec<OutlinePoint>,
     slices: Vec<f64>,
-    pixels: Vec<Vertex<TERMS>>,
     grid: Vec<DVec3>,
     grid_solutions: Vec<Solutions>,
     central: central::Scratch,
@@ -280,24 +325,21 @@ fn draw_pairs(
     for live in pairs {
         let k = live.triangle as usize;
         // Live pairs have a plane (the cull skips the others).
-        let Some(terms) = scene.hit_terms[k] else {
+        if scene.hit_terms[k].is_none() {
             continue;
-        };
+        }
         let positions = scene.corners(k);
-        // Built only for a pair that is drawn.
         let pair = || Pair {
             triangle,
-            key: (u64::from(group.projection) << 32) | k as u64,
-            id: scene.owners[k].id,
+            projection: group.projection,
+            scene_triangle: live.triangle,
             curves,
-            terms,
         };
         let unprojectable = out.counts.unprojectable;
         if let Some(central) = &triangle.central {
-            let pair = pair();
             let drawn = central.outlines(positions, &mut scratch.central, |outline| {
                 out.counts.shapes += 1;
-                pair.push_outline(outline, &mut scratch.pixels, &mut out.polygons);
+                out.push(outline, group.projection, live.triangle);
                 out.counts.outline_points += outline.len() as u64;
             });
             if drawn.is_err() {
@@ -381,11 +423,10 @@ fn is_drawn(shape: &Shape) -> bool {
 /// One (projection triangle, scene triangle) pair being drawn.
 struct Pair<'a> {
     triangle: &'a ProjectionTriangle,
-    key: u64,
-    id: u32,
+    /// Its index in the mesh, and the scene triangle's: the shapes' keys.
+    projection: u32,
+    scene_triangle: u32,
     curves: CurveOptions,
-    /// The scene triangle's plane (of the whole triangle, also for tessellated pieces).
-    terms: HitTerms,
 }
 
 impl Pair<'_> {
@@ -506,28 +547,7 @@ impl Pair<'_> {
             return;
         }
         out.counts.outline_points += scratch.outline.len() as u64;
-        self.push_outline(&scratch.outline, &mut scratch.pixels, &mut out.polygons);
-    }
-
-    /// Appends the clipped outline `outline` to `polygons` as one pixel polygon, each vertex
-    /// with the hit terms of its projector; `pixels` is reused storage.
-    fn push_outline(
-        &self,
-        outline: &[OutlinePoint],
-        pixels: &mut Vec<Vertex<TERMS>>,
-        polygons: &mut PolygonBatch<TERMS>,
-    ) {
-        pixels.clear();
-        pixels.extend(outline.iter().map(|p| {
-            let pixel = self.triangle.map.pixel(p.u, p.v);
-            Vertex::new(
-                pixel.x,
-                pixel.y,
-                p.t,
-                self.terms.at(&self.triangle.map, p.u, p.v),
-            )
-        }));
-        polygons.push(pixels, self.id, self.key);
+        out.push(&scratch.outline, self.projection, self.scene_triangle);
     }
 }
 
