@@ -377,8 +377,10 @@ fn clearly_better(count: usize, unknowns: usize, extra: usize, ss: f64, simpler_
 /// data determining the free directions (rms below `EXACT_RMS_RAD`), or when the grid is
 /// curved; else the central fit when it is exact, or when it beats the kept one
 /// ([`clearly_better`], its 3 eye coordinates extra), or when [`fit`] fails where it does
-/// not. That simpler model stands when it is exact; otherwise the free fit (module `free`),
-/// where it leaves no constrained node undetermined, replaces it when it is clearly better, counting its effective unknowns (the trace
+/// not. That simpler model stands when it is exact; otherwise the free fit (module `free`)
+/// replaces it where it leaves no constrained node undetermined and the simpler model does
+/// ([`undetermined_nodes`]: the same criterion for both), is never taken where it leaves one
+/// and the simpler model none, and otherwise replaces it when it is clearly better, counting its effective unknowns (the trace
 /// of its hat matrix, `free::Shape::freedom`; at most 5 a constrained node less the scale:
 /// the smoothness spends fewer where the data are sparse), or, when it is exact with node
 /// values affine along every grid line (a bilinear grid: the smoothness term's own model),
@@ -402,16 +404,24 @@ fn auto_fit(
         .flatten()
         .map(|(g, _)| g)
         .collect();
-    // Free starts that the data leave undetermined somewhere are no evidence of anything.
-    let free = free::fit(prior, correspondences, &guesses)
-        .ok()
-        .filter(|(_, r, _)| r.sparse_nodes == 0);
-    let Some((free_grid, free_report, shape)) = free else {
+    let Ok((free_grid, free_report, shape)) = free::fit(prior, correspondences, &guesses) else {
         return simple;
     };
     let Ok((simple_grid, simple_report)) = &simple else {
         return Ok((free_grid, free_report));
     };
+    // Every model is judged by the same undetermined-node criterion: a model that the data
+    // leave undetermined somewhere is no evidence against one they determine, and only two
+    // determined (or two undetermined) models are compared by their misses.
+    let simple_open = match simple_report.starts {
+        FittedStarts::Kept => straight_undetermined(simple_grid, correspondences).unwrap_or(0),
+        _ => simple_report.sparse_nodes,
+    } > 0;
+    match (simple_open, free_report.sparse_nodes > 0) {
+        (false, true) => return simple,
+        (true, false) => return Ok((free_grid, free_report)),
+        _ => {}
+    }
     let constrained = constrained_nodes(prior, correspondences)
         .iter()
         .filter(|c| **c)
