@@ -718,6 +718,50 @@ mod tests {
     }
 
     #[test]
+    fn a_pushbroom_length_pattern_is_no_wild_node_but_a_stretched_or_turned_node_is() {
+        // Noisy pushbroom data (as above, seed 1) fitted with free starts, then the node
+        // lengths set affine in u from 0.02 to 2.02 times the fit's: a pushbroom's nodes along
+        // a row share one direction, so no blended line moves (the lengths noisy fits drift
+        // to; docs/flexible.md, "Wild nodes"), though the u = 0 column is 50 times shorter
+        // than the median node and the length bar alone (4 times) counts it wild.
+        let [pushbroom, _] = truths();
+        let mut next = uniform(101);
+        let data: Vec<_> = seen_by(&pushbroom, 200, 1, 0.0, 1.0)
+            .into_iter()
+            .map(|c| Correspondence {
+                uv: (c.uv + 3e-3 * DVec2::new(next() - 0.5, next() - 0.5))
+                    .clamp(DVec2::ZERO, DVec2::ONE),
+                ..c
+            })
+            .collect();
+        let (fitted, report) = fit_with(&prior(), &data, Starts::Free).unwrap();
+        assert_eq!(report.wild_nodes, 0, "{report:?}");
+        let starts = fitted.starts();
+        let scaled = |factor: &dyn Fn(usize) -> f64| {
+            let ends = (0..9)
+                .map(|j| starts[j] + (fitted.ends()[j] - starts[j]) * factor(j))
+                .collect();
+            fitted.with_ends(ends).unwrap()
+        };
+        let affine = |j: usize| 0.02 + (j % 3) as f64;
+        let gauge = scaled(&affine);
+        assert!(farthest_miss(&gauge, &pushbroom, 0.0, 1.0) < 0.15);
+        assert_eq!(super::super::wild_nodes(&prior(), &gauge, &data), 0);
+        // The same fit with every node as long as the centre one, then the centre node 10
+        // times as long: the lines around it move, wild. Or a node turned by 90 degrees.
+        let length = |j: usize| (fitted.ends()[j] - starts[j]).length();
+        let even = |j: usize| length(4) / length(j);
+        assert_eq!(super::super::wild_nodes(&prior(), &scaled(&even), &data), 0);
+        let stretched = scaled(&|j| even(j) * if j == 4 { 10.0 } else { 1.0 });
+        assert_eq!(super::super::wild_nodes(&prior(), &stretched, &data), 1);
+        let mut ends = scaled(&even).ends().to_vec();
+        let d = ends[8] - starts[8];
+        ends[8] = starts[8] + d.cross(DVec3::X).normalize() * d.length();
+        let turned = fitted.with_ends(ends).unwrap();
+        assert_eq!(super::super::wild_nodes(&prior(), &turned, &data), 1);
+    }
+
+    #[test]
     fn points_on_one_projector_are_met_and_reported_undetermined() {
         let [pushbroom, _] = truths();
         let uv = DVec2::new(0.3, 0.6);
