@@ -689,25 +689,31 @@ mod tests {
         }
     }
 
+    /// 200 correspondences of `truth` (drawn with `seed`) whose image positions carry noise
+    /// of up to 1.5e-3 in u and v (about half a pixel of a 320-pixel image), kept in the
+    /// image.
+    fn noisy(truth: &impl Truth, seed: u64) -> Vec<Correspondence> {
+        let mut next = uniform(100 + seed);
+        seen_by(truth, 200, seed, 0.0, 1.0)
+            .into_iter()
+            .map(|c| Correspondence {
+                uv: (c.uv + 3e-3 * DVec2::new(next() - 0.5, next() - 0.5))
+                    .clamp(DVec2::ZERO, DVec2::ONE),
+                ..c
+            })
+            .collect()
+    }
+
     #[test]
     fn noisy_pushbroom_data_take_free_starts_near_the_truth() {
-        // 200 points with image noise of up to 1.5e-3 in u and v (about half a pixel of a
-        // 320-pixel image). Before the residual was scaled by max(|X - S| / R, 1) and `auto`
+        // Before the residual was scaled by max(|X - S| / R, 1) and `auto`
         // compared misses seen from the prior's starts (module section "Cost",
         // `fit::misses_seen_from`), noisy pushbroom data in the CLI table (docs/flexible.md,
         // "Noisy non-central data") gave free fits with receding starts and `auto` an eye
         // far behind the points.
         let [pushbroom, _] = truths();
         for seed in [1, 2] {
-            let mut next = uniform(100 + seed);
-            let data: Vec<_> = seen_by(&pushbroom, 200, seed, 0.0, 1.0)
-                .into_iter()
-                .map(|c| Correspondence {
-                    uv: (c.uv + 3e-3 * DVec2::new(next() - 0.5, next() - 0.5))
-                        .clamp(DVec2::ZERO, DVec2::ONE),
-                    ..c
-                })
-                .collect();
+            let data = noisy(&pushbroom, seed);
             let (fitted, report) = fit_with(&prior(), &data, Starts::Auto).unwrap();
             let miss = farthest_miss(&fitted, &pushbroom, 0.0, 1.0);
             assert_eq!(report.starts, FittedStarts::Free, "{report:?}");
@@ -719,21 +725,13 @@ mod tests {
 
     #[test]
     fn a_pushbroom_length_pattern_is_no_wild_node_but_a_stretched_or_turned_node_is() {
-        // Noisy pushbroom data (as above, seed 1) fitted with free starts, then the node
+        // Noisy pushbroom data (`noisy`, seed 1) fitted with free starts, then the node
         // lengths set affine in u from 0.02 to 2.02 times the fit's: a pushbroom's nodes along
         // a row share one direction, so no blended line moves (the lengths noisy fits drift
         // to; docs/flexible.md, "Wild nodes"), though the u = 0 column is 50 times shorter
         // than the median node and the length bar alone (4 times) counts it wild.
         let [pushbroom, _] = truths();
-        let mut next = uniform(101);
-        let data: Vec<_> = seen_by(&pushbroom, 200, 1, 0.0, 1.0)
-            .into_iter()
-            .map(|c| Correspondence {
-                uv: (c.uv + 3e-3 * DVec2::new(next() - 0.5, next() - 0.5))
-                    .clamp(DVec2::ZERO, DVec2::ONE),
-                ..c
-            })
-            .collect();
+        let data = noisy(&pushbroom, 1);
         let (fitted, report) = fit_with(&prior(), &data, Starts::Free).unwrap();
         assert_eq!(report.wild_nodes, 0, "{report:?}");
         let starts = fitted.starts();
