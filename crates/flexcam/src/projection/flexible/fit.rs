@@ -408,7 +408,14 @@ fn auto_fit(
         return simple;
     };
     let Ok((simple_grid, simple_report)) = &simple else {
-        return Ok((free_grid, free_report));
+        // Where the simpler models fail (a point at its projector's start, say), free starts
+        // that the data leave undetermined somewhere are no evidence of anything: the
+        // simpler model's error stands.
+        return if free_report.sparse_nodes == 0 {
+            Ok((free_grid, free_report))
+        } else {
+            simple
+        };
     };
     // Every model is judged by the same undetermined-node criterion: a model that the data
     // leave undetermined somewhere is no evidence against one they determine, and only two
