@@ -1,5 +1,5 @@
 //! Panorama rasterisation throughput (`--method raster`) against the ray caster in the same
-//! run, on the workload of `render::inverse_raster::workloads` (`teapot-dense`, 123,554
+//! run, on the workload of `render::raster::workloads` (`teapot-dense`, 123,554
 //! triangles, as a 1280 x 720 equirectangular panorama), flat shading. Throughput is frames
 //! per second. `raster_first_frame` is a new renderer and its first frame (the pixel
 //! projectors it needs are computed during the frame); `raster_frame` is a later frame of
@@ -10,8 +10,8 @@
 //! Run with `cargo bench -p flexcam --bench raster`. Figures are recorded in docs/raster.md.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use flexcam::render::inverse_raster::workloads::{teapot_dense_panorama, PanoramaWorkload};
-use flexcam::render::inverse_raster::InverseRaster;
+use flexcam::render::raster::workloads::{teapot_dense_panorama, PanoramaWorkload};
+use flexcam::render::raster::InverseRaster;
 use flexcam::render::raycast::RayCaster;
 use flexcam::render::{RenderOptions, Shading};
 

@@ -7,7 +7,7 @@ use clap::{Args, ValueEnum};
 use flexcam::projection::flexible::panorama::edit_source;
 use flexcam::projection::flexible::FlexibleSpec;
 use flexcam::projection::{Projection, ProjectionSpec};
-use flexcam::render::inverse_raster::Subdivision;
+use flexcam::render::raster::Subdivision;
 use flexcam::render::trilinear::CurveOptions;
 use flexcam::render::{Method, Shading};
 use flexcam::scene::{self, Scene};

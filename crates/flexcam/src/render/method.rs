@@ -5,7 +5,7 @@ use std::str::FromStr;
 
 use crate::error::{Error, Result};
 use crate::projection::Projection;
-use crate::render::inverse_raster::InverseRaster;
+use crate::render::raster::InverseRaster;
 use crate::render::raycast::RayCaster;
 use crate::render::trilinear::TrilinearRenderer;
 use crate::render::{Frame, RenderOptions, Stats};
@@ -18,7 +18,7 @@ pub enum Method {
     #[default]
     Raycast,
     /// Rasterisation by the analytic inverse with subdivision (see
-    /// [`crate::render::inverse_raster`]); projections with a continuous inverse only.
+    /// [`crate::render::raster`]); projections with a continuous inverse only.
     Raster,
     /// Trilinear rasterisation (seed 000), curved edges followed as `options.curves` says;
     /// renders trilinear projections only.

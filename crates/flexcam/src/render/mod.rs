@@ -24,7 +24,7 @@ pub struct RenderOptions<'a> {
     /// Maximum number of specular bounces.
     pub max_bounces: u32,
     /// How method `raster` subdivides triangles (other methods ignore it).
-    pub subdivision: inverse_raster::Subdivision,
+    pub subdivision: raster::Subdivision,
     /// How method trilinear follows curved edges.
     pub curves: trilinear::CurveOptions,
     /// Called from worker threads with (work units done, total) as rendering progresses.
@@ -37,7 +37,7 @@ impl Default for RenderOptions<'_> {
             shading: Shading::Lit,
             spp: 1,
             max_bounces: 8,
-            subdivision: inverse_raster::Subdivision::default(),
+            subdivision: raster::Subdivision::default(),
             curves: trilinear::CurveOptions::ADAPTIVE,
             progress: None,
         }
@@ -121,11 +121,11 @@ pub type Stats = BTreeMap<&'static str, Counter>;
 pub mod compare;
 pub mod composite;
 mod huge_pages;
-pub mod inverse_raster;
 mod method;
 pub mod raster;
 pub mod raycast;
 pub mod reproject;
+pub mod scan;
 pub mod surface;
 pub mod trilinear;
 pub use method::Method;

@@ -19,10 +19,8 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use flexcam::projection::Projection;
-use flexcam::render::inverse_raster::workloads::{
-    teapot_dense_panorama, PanoramaWorkload, PANORAMA_SIZE,
-};
-use flexcam::render::inverse_raster::InverseRaster;
+use flexcam::render::raster::workloads::{teapot_dense_panorama, PanoramaWorkload, PANORAMA_SIZE};
+use flexcam::render::raster::InverseRaster;
 use flexcam::render::raycast::workloads::{table_volume, teapot_scene, TABLE_SIZE};
 use flexcam::render::raycast::RayCaster;
 use flexcam::render::{Counter, Frame, RenderOptions, Shading};
@@ -190,7 +188,7 @@ fn frame_hash(frame: &Frame) -> u64 {
 }
 
 /// The panorama throughput table (the workload of
-/// `flexcam::render::inverse_raster::workloads`): raster (first frame of a new renderer,
+/// `flexcam::render::raster::workloads`): raster (first frame of a new renderer,
 /// later frames of one renderer into one kept frame, flat and lit) and ray caster, best of
 /// `repeat` frames each.
 fn panorama(repeat: u32) -> Result<()> {

@@ -1,200 +1,421 @@
-//! The software polygon rasteriser shared by the fast renderers: shapes in continuous pixel
-//! coordinates (polygons of any shape, or two-vertex lines) with a depth and `N` attributes
-//! per vertex, scan-converted at pixel centres by an explicit [`FillRule`] with a top-left tie
-//! rule, z-tested and shaded into a [`Target`].
+//! `--method raster`: rasterisation of nonlinear projections by their analytic inverse
+//! (seed 003, 7.3 and 9.4).
 //!
-//! - [`polygon`]: the input ([`Vertex`], [`Polygon`], [`PolygonBatch`]);
-//! - [`scan`]: polygon coverage, the fill and tie rules, and attribute interpolation;
-//! - [`line`](mod@line): one-pixel-wide lines for two-vertex shapes;
-//! - [`target`]: the z-buffered target and [`Fragment`]s;
-//! - [`fused`]: the image cut into bands drawn in parallel into small band-local buffers,
-//!   each shaded into the output [`crate::render::Frame`] at once (deferred shading without
-//!   frame-sized buffers);
-//! - [`stats`]: counters for `--stats`.
+//! Per frame:
+//! 1. every scene vertex is projected once through [`Projection::project_continuous`] (the
+//!    per-vertex cache shared by the triangles around it);
+//! 2. each triangle is clipped in 3D to the chart's half-spaces ([`clip`]), cut by the
+//!    uniform grid and refined adaptively ([`refine`]) until the straight polygon of each
+//!    piece's projected corners follows its curved image within the tolerance;
+//! 3. each piece is placed on the screen ([`seam`]): unwrapped across a panorama's seam and
+//!    drawn once more on the other side when it straddles it; pieces around a pole are
+//!    dropped (they cover no pixel centre), and so are pieces whose screen box holds no
+//!    pixel centre (most pieces of a finely tessellated model); the others are sorted into
+//!    bands of rows by the parallel job that built them ([`coverage::Bins`]);
+//! 4. the bands are filled in parallel by the polygon rasteriser's fill and tie rule
+//!    specialised to triangles ([`coverage::cover`]); each fragment reconstructs its exact
+//!    depth and barycentrics once from its pixel's projector ([`fragment`]; the projectors
+//!    are computed on first use and kept for later frames, [`pixel_rays`]);
+//! 5. each band's visible fragments are shaded once, from that reconstruction, straight
+//!    into the frame ([`band_fill`]), so depth and shading are the ray caster's and only
+//!    coverage near silhouettes depends on the subdivision.
 //!
-//! A *stage* (see [`rasterize_parallel_staged`]) may rewrite each fragment before its z-test
-//! (an exact per-pixel depth instead of the interpolated one) or discard it.
+//! Shading: flat base colours are computed here; lit shading (lights and shadows) and the
+//! secondary rays of mirrors and glass are delegated, per visible pixel, to the ray caster's
+//! own shading of the reconstructed hit ([`RayCaster::shade_hit`]), so a BVH is built when
+//! the render needs one; the rays it casts are counted (`shading_rays`). One sample per
+//! pixel (`--spp 1`).
 //!
-//! Determinism: a pixel keeps the fragment with the smallest `(depth, primitive)` pair, and
-//! every fragment's position and values depend only on its own shape, so the image does not
-//! depend on the band size or the number of threads, and with distinct primitive keys not on
-//! the order of the shapes either. Shaders must be pure functions of the fragment.
+//! An [`InverseRaster`] is meant to render many frames of one projection (an animation of
+//! the scene, an interactive viewer): the pixel projectors, the BVH, the bins and the
+//! z-buffer are kept between frames, and [`InverseRaster::render_into`] reuses the caller's
+//! frame.
+//!
+//! Supported: every projection with an [`InverseChart`] (perspective, orthographic,
+//! fisheye, equirectangular, cylindrical, and the flexible volumes described in
+//! `projection::flexible::chart`); others are refused with one line naming the projection.
 
-pub mod fused;
-pub mod interpolate;
-pub mod line;
-pub mod polygon;
-pub mod scan;
-pub mod stats;
-pub mod target;
+mod band_fill;
+mod clip;
+mod coverage;
+mod fragment;
+mod pixel_rays;
+mod refine;
+mod seam;
+mod subdivision;
 #[cfg(test)]
 mod tests;
+pub mod workloads;
 
-use glam::Vec3;
+use std::ops::Range;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Mutex;
+use std::time::Instant;
+
+use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-pub use fused::{band_rows_for, for_each_band, FrameRows};
-pub use interpolate::Varying;
-pub use polygon::{Polygon, PolygonBatch, Vertex, LIMIT};
-pub use scan::{FillRule, Scratch, Span};
-pub use stats::RasterStats;
+pub use subdivision::{Subdivision, DEFAULT_TOLERANCE, MAX_LEVEL, MAX_UNIFORM};
 
-use stats::FragmentCounts;
-pub use target::{Fragment, Layers, Target, NO_PRIMITIVE};
+use self::band_fill::{fill_and_shade, BAND_ROWS};
+use self::coverage::{Bins, ScreenTriangle};
+use self::fragment::{key, Shader, Visible};
+use self::pixel_rays::PixelRays;
+use self::refine::{Node, Refiner};
+use self::seam::{covers_a_centre, place, Placement};
+use crate::error::{Error, Result};
+use crate::projection::{InverseChart, Projection};
+use crate::render::raycast::RayCaster;
+use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
+use crate::scene::{Scene, Surface};
 
-use polygon::Kind;
-use target::Band;
+/// Scene triangles per parallel task when building pieces.
+const CHUNK: usize = 2048;
 
-/// Rows per band in [`rasterize_parallel`]: enough for little per-band overhead on small
-/// shapes, few enough for many tasks on typical images.
-pub const BAND_ROWS: u32 = 16;
+/// A scene and a projection prepared for rasterisation: the chart, the pixel projectors
+/// (filled in as frames need them), the buffers frames reuse and, when shading needs rays,
+/// the ray caster.
+pub struct InverseRaster<'a> {
+    scene: &'a Scene,
+    projection: &'a dyn Projection,
+    chart: InverseChart,
+    rays: PixelRays<'a>,
+    caster: Option<RayCaster>,
+    options: RenderOptions<'a>,
+    setup_ms: f64,
+    /// The buffers of a frame, kept from frame to frame (cleared, not reallocated).
+    buffers: Mutex<Buffers>,
+}
 
-/// Draws `polygons` into `target` in order on the calling thread, shading each fragment that
-/// passes the z-test with `shader`. Returns what was done (`covered` counts the whole
-/// target after the pass).
-pub fn rasterize<const N: usize>(
-    target: &mut Target,
-    polygons: &PolygonBatch<N>,
-    rule: FillRule,
-    shader: &impl Fn(&Fragment<N>) -> Vec3,
-) -> RasterStats {
-    let mut stats = RasterStats::of_shapes(polygons);
-    let mut scratch = Scratch::default();
-    let mut band = target.band();
-    for polygon in polygons.iter() {
-        let counts = draw(&mut band, &polygon, rule, &mut scratch, &keep, shader);
-        stats.add_fragments(counts);
+/// What a frame writes besides the caller's frame, kept by the renderer.
+#[derive(Debug, Default)]
+struct Buffers {
+    /// The image of every scene vertex, per object (`None` on the singular set).
+    images: Vec<Vec<Option<DVec2>>>,
+    /// The screen triangles of each piece-building job, sorted into bands.
+    bins: Vec<Bins>,
+    /// Each pixel's visible fragment.
+    zbuffer: Vec<Visible>,
+}
+
+/// What piece building did, for `--stats`.
+#[derive(Debug, Clone, Copy, Default)]
+struct PieceCounts {
+    /// Scene triangles clipped by a chart half-space (partly or wholly outside).
+    clipped: u64,
+    /// Scene triangles that `Refiner::far_from_poles` does not clear, refined and tested
+    /// with the pole rule (the others are proven to need neither).
+    near_poles: u64,
+    /// Pieces after subdivision.
+    pieces: u64,
+    /// Pieces crossed by a pole or lying within its clearance, dropped.
+    pole_pieces: u64,
+    /// Pieces with a corner on the singular set (an eye, a pole), dropped.
+    singular: u64,
+    /// Pieces whose outline winds around a pole, dropped.
+    winding: u64,
+    /// Screen triangles whose box holds no pixel centre, dropped before the fill.
+    empty: u64,
+    /// Screen triangles filled (a seam straddler counts twice).
+    drawn: u64,
+    /// Screen triangles with a non-finite or huge coordinate, not filled.
+    invalid: u64,
+}
+
+impl std::ops::AddAssign for PieceCounts {
+    fn add_assign(&mut self, o: PieceCounts) {
+        self.clipped += o.clipped;
+        self.near_poles += o.near_poles;
+        self.pieces += o.pieces;
+        self.pole_pieces += o.pole_pieces;
+        self.singular += o.singular;
+        self.winding += o.winding;
+        self.empty += o.empty;
+        self.drawn += o.drawn;
+        self.invalid += o.invalid;
     }
-    stats.covered = target.covered();
-    stats
 }
 
-/// Like [`rasterize`], with the target cut into bands of `band_rows` rows drawn in parallel
-/// (rayon), each band by one task drawing the shapes that reach it in input order. The result
-/// is bit for bit that of [`rasterize`], whatever the thread count or band size.
-pub fn rasterize_parallel<const N: usize>(
-    target: &mut Target,
-    polygons: &PolygonBatch<N>,
-    rule: FillRule,
-    band_rows: u32,
-    shader: &(impl Fn(&Fragment<N>) -> Vec3 + Sync),
-) -> RasterStats {
-    rasterize_parallel_resolved(target, polygons, rule, band_rows, &keep, shader)
+/// The projection's chart, or the one-line refusal of method raster.
+pub fn supported_chart(projection: &dyn Projection) -> Result<InverseChart> {
+    let kind = projection.kind();
+    if !projection.has_inverse() {
+        let why = projection
+            .inverse_refusal()
+            .map_or_else(String::new, |reason| format!(": {reason}"));
+        return Err(Error::new(format!(
+            "method raster needs a projection with an analytic inverse; {kind} has none{why} \
+             (use --method raycast)"
+        )));
+    }
+    let chart = projection.inverse_chart().ok_or_else(|| {
+        Error::new(format!(
+            "method raster needs a projection with an analytic inverse it can fill triangles \
+             by; this {kind} projection's inverse is not continuous in a way it handles \
+             (see docs/raster.md; use --method raycast)"
+        ))
+    })?;
+    if chart.clip.len() > clip::MAX_PLANES {
+        return Err(Error::new(format!(
+            "method raster: {kind} projection clips by {} planes, at most {} are supported",
+            chart.clip.len(),
+            clip::MAX_PLANES
+        )));
+    }
+    Ok(chart)
 }
 
-/// Keeps every fragment as interpolated (the resolve step of plain rasterisation).
-fn keep<const N: usize>(_: &mut Fragment<N>) -> bool {
-    true
-}
-
-/// [`rasterize_parallel`] with a resolve step run on every covered fragment before its
-/// z-test: `resolve` may replace the interpolated depth and attributes (a renderer that
-/// computes exact per-pixel values from the fragment's primitive) or discard the fragment by
-/// returning `false` (counted in [`RasterStats::discarded`]). It must be a pure function of
-/// the fragment, like the shader, for the result to stay deterministic.
-pub fn rasterize_parallel_resolved<const N: usize>(
-    target: &mut Target,
-    polygons: &PolygonBatch<N>,
-    rule: FillRule,
-    band_rows: u32,
-    resolve: &(impl Fn(&mut Fragment<N>) -> bool + Sync),
-    shader: &(impl Fn(&Fragment<N>) -> Vec3 + Sync),
-) -> RasterStats {
-    let band_rows = band_rows.max(1);
-    let bins = bins(polygons, target.height(), band_rows);
-    let counts = target
-        .bands(band_rows)
-        .into_par_iter()
-        .zip(bins)
-        .map(|(mut band, bin)| {
-            let mut scratch = Scratch::default();
-            bin.iter().fold(FragmentCounts::default(), |sum, &i| {
-                let polygon = polygons.get(i);
-                sum + draw(&mut band, &polygon, rule, &mut scratch, resolve, shader)
-            })
+impl<'a> InverseRaster<'a> {
+    /// Prepares `scene` and `projection` with `options`. Errors: a projection outside the
+    /// supported class, an invalid subdivision, more than one sample per pixel.
+    pub fn new(
+        scene: &'a Scene,
+        projection: &'a dyn Projection,
+        options: &RenderOptions<'a>,
+    ) -> Result<Self> {
+        let chart = supported_chart(projection)?;
+        options.subdivision.validate()?;
+        if options.spp != 1 {
+            return Err(Error::new(format!(
+                "method raster renders one sample per pixel; got --spp {}",
+                options.spp
+            )));
+        }
+        let start = Instant::now();
+        let rays = PixelRays::new(projection);
+        let specular = scene
+            .objects
+            .iter()
+            .any(|o| !matches!(o.material.surface, Surface::Diffuse | Surface::Emissive));
+        let caster = (options.shading == Shading::Lit || specular).then(|| RayCaster::new(scene));
+        Ok(InverseRaster {
+            buffers: Mutex::default(),
+            scene,
+            projection,
+            chart,
+            rays,
+            caster,
+            options: *options,
+            setup_ms: start.elapsed().as_secs_f64() * 1e3,
         })
-        .reduce(FragmentCounts::default, |a, b| a + b);
-    let mut stats = RasterStats::of_shapes(polygons);
-    stats.add_fragments(counts);
-    stats.covered = target.covered();
-    stats
-}
-
-/// The shapes reaching each band of `band_rows` rows (at least 1) of an image `height` rows
-/// tall, in input order: their row ranges in parallel, then a serial pass over the ranges.
-fn bins<const N: usize>(
-    polygons: &PolygonBatch<N>,
-    height: u32,
-    band_rows: u32,
-) -> Vec<Vec<usize>> {
-    let ranges: Vec<(u32, u32)> = (0..polygons.len())
-        .into_par_iter()
-        .map(|i| polygons.get(i).rows(height))
-        .collect();
-    let mut bins = vec![Vec::new(); height.div_ceil(band_rows) as usize];
-    for (i, &(first, end)) in ranges.iter().enumerate() {
-        if first < end {
-            for bin in &mut bins[(first / band_rows) as usize..=((end - 1) / band_rows) as usize] {
-                bin.push(i);
-            }
-        }
     }
-    bins
-}
 
-/// Draws one shape into the rows of `band`, resolving each fragment before its z-test.
-fn draw<const N: usize>(
-    band: &mut Band<'_>,
-    polygon: &Polygon<'_, N>,
-    rule: FillRule,
-    scratch: &mut Scratch<N>,
-    resolve: &impl Fn(&mut Fragment<N>) -> bool,
-    shader: &impl Fn(&Fragment<N>) -> Vec3,
-) -> FragmentCounts {
-    let mut counts = FragmentCounts::default();
-    let (rows, width) = (band.rows, band.width);
-    spans(polygon, rule, rows, width, scratch, |span| {
-        for x in span.x0..span.x1 {
-            let mut fragment = Fragment {
-                x,
-                y: span.y,
-                varying: span.at(x),
-                object: polygon.object,
-                primitive: polygon.primitive,
+    /// Renders one frame: colour, depth (the ray caster's distance along the projector) and
+    /// object ids, with the counters of every stage.
+    pub fn render(&self) -> (Frame, Stats) {
+        let mut frame = Frame::new(0, 0, self.scene.image.background);
+        let stats = self.render_into(&mut frame);
+        (frame, stats)
+    }
+
+    /// [`InverseRaster::render`] into `frame`, whose buffers are resized to the image and
+    /// overwritten: a sequence of frames (an animation, a viewer, the throughput bench)
+    /// reusing one `frame` allocates no image buffer after the first.
+    pub fn render_into(&self, frame: &mut Frame) -> Stats {
+        let start = Instant::now();
+        // Every frame overwrites the buffers, so ones left by a panicked frame are as good
+        // as any.
+        let mut buffers = self
+            .buffers
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let Buffers {
+            images,
+            bins,
+            zbuffer,
+        } = &mut *buffers;
+        let counts = self.pieces(images, bins);
+        let pieces_ms = start.elapsed().as_secs_f64() * 1e3;
+        let shader = Shader {
+            objects: &self.scene.objects,
+            rays: &self.rays,
+            caster: self.caster.as_ref(),
+            options: &self.options,
+        };
+        let size = self.projection.resolution();
+        let filled = fill_and_shade(
+            &shader,
+            bins,
+            zbuffer,
+            frame,
+            size,
+            self.scene.image.background,
+        );
+        drop(buffers);
+        let fill_ms = start.elapsed().as_secs_f64() * 1e3 - pieces_ms;
+        let mut stats = Stats::new();
+        filled
+            .raster_stats(counts.drawn, counts.invalid)
+            .record(&mut stats);
+        let shading_rays = filled.shading_rays;
+        let count = |n: u64| Counter::Count(n);
+        for (name, value) in [
+            ("triangles", self.scene.triangle_count() as u64),
+            ("raster_clipped_triangles", counts.clipped),
+            ("raster_near_pole_triangles", counts.near_poles),
+            ("raster_pieces", counts.pieces),
+            ("raster_pole_pieces", counts.pole_pieces),
+            ("raster_singular_pieces", counts.singular),
+            ("raster_winding_pieces", counts.winding),
+            ("raster_empty_pieces", counts.empty),
+            ("raster_screen_triangles", counts.drawn),
+            ("raster_ray_tiles", self.rays.computed_tiles()),
+            ("shading_rays", shading_rays),
+            (
+                "raster_uniform",
+                u64::from(self.options.subdivision.uniform),
+            ),
+        ] {
+            stats.insert(name, count(value));
+        }
+        let tolerance = self.options.subdivision.tolerance.unwrap_or(0.0);
+        for (name, value) in [
+            ("raster_tolerance_px", tolerance),
+            ("raster_setup_ms", self.setup_ms),
+            ("raster_pieces_ms", pieces_ms),
+            ("raster_fill_ms", fill_ms),
+        ] {
+            stats.insert(name, Counter::Value(value));
+        }
+        stats
+    }
+
+    /// Steps 1 to 3 of the module documentation: the vertex images of every object into
+    /// `images`, then the screen triangles of every scene triangle, sorted into bands by
+    /// parallel jobs of [`CHUNK`] scene triangles, one element of `bins` per job, with their
+    /// counters (both buffers resized and overwritten).
+    fn pieces(&self, images: &mut Vec<Vec<Option<DVec2>>>, bins: &mut Vec<Bins>) -> PieceCounts {
+        let refiner = Refiner::new(
+            self.projection,
+            &self.chart,
+            self.options.subdivision.tolerance,
+        );
+        images.resize_with(self.scene.objects.len(), Vec::new);
+        for (object, images) in self.scene.objects.iter().zip(images.iter_mut()) {
+            object
+                .mesh
+                .positions
+                .par_iter()
+                .map(|p| refiner.node(p.as_dvec3()).image)
+                .collect_into_vec(images);
+        }
+        let images = &*images;
+        let jobs: Vec<(usize, Range<usize>)> = self
+            .scene
+            .objects
+            .iter()
+            .enumerate()
+            .flat_map(|(o, object)| {
+                let n = object.mesh.triangles.len();
+                (0..n.div_ceil(CHUNK)).map(move |k| (o, k * CHUNK..((k + 1) * CHUNK).min(n)))
+            })
+            .collect();
+        let done = AtomicU64::new(0);
+        let bands = self.projection.resolution().1.div_ceil(BAND_ROWS) as usize;
+        bins.resize_with(jobs.len(), Bins::default);
+        jobs.par_iter()
+            .zip(bins.par_iter_mut())
+            .map(|((o, range), bins)| {
+                bins.reset(bands);
+                let mut counts = PieceCounts::default();
+                let mut grid = Vec::new();
+                for triangle in range.clone() {
+                    let part = (&mut *bins, &mut counts);
+                    self.triangle(&refiner, &images[*o], (*o, triangle), &mut grid, part);
+                }
+                if let Some(progress) = self.options.progress {
+                    progress(done.fetch_add(1, Ordering::Relaxed) + 1, jobs.len() as u64);
+                }
+                counts
+            })
+            .reduce(PieceCounts::default, |mut a, b| {
+                a += b;
+                a
+            })
+    }
+
+    /// Clips, subdivides and places triangle `triangle` of object index `object`, whose
+    /// vertex images are `images`, into `bins`.
+    fn triangle(
+        &self,
+        refiner: &Refiner<'_>,
+        images: &[Option<DVec2>],
+        (object, triangle): (usize, usize),
+        grid: &mut Vec<Node>,
+        (bins, counts): (&mut Bins, &mut PieceCounts),
+    ) {
+        let item = &self.scene.objects[object];
+        let corners = item.mesh.triangles[triangle].map(|i| i as usize);
+        let points: [DVec3; 3] = corners.map(|i| item.mesh.positions[i].as_dvec3());
+        let key = key(object, triangle);
+        let (width, height) = self.projection.resolution();
+        let size = DVec2::new(f64::from(width), f64::from(height));
+        let period = self.chart.period;
+        let inside = self
+            .chart
+            .clip
+            .iter()
+            .all(|h| points.iter().all(|&p| h.signed_distance(p) >= 0.0));
+        if !inside {
+            counts.clipped += 1;
+        }
+        let poles = !refiner.far_from_poles(points);
+        counts.near_poles += u64::from(poles);
+        let mut draw = |nodes: [Node; 3]| {
+            counts.pieces += 1;
+            let points = nodes.map(|n| n.point);
+            if poles && (refiner.is_pole_piece(points) || refiner.is_within_clearance(points)) {
+                counts.pole_pieces += 1;
+                return;
+            }
+            let [Some(a), Some(b), Some(c)] = nodes.map(|n| n.image) else {
+                counts.singular += 1;
+                return;
             };
-            counts.fragments += 1;
-            if resolve(&mut fragment) {
-                counts.writes += u64::from(band.test_and_write(&fragment, shader));
-            } else {
-                counts.discarded += 1;
+            let (mut empty, mut invalid) = (0, 0);
+            let placed = place([a, b, c], size, period, |corners| {
+                let screen = ScreenTriangle { corners, key };
+                if !covers_a_centre(corners) {
+                    empty += 1;
+                } else if screen.is_valid() {
+                    bins.push(screen, BAND_ROWS, height);
+                } else {
+                    invalid += 1;
+                }
+            });
+            match placed {
+                Placement::Copies(n) => {
+                    counts.drawn += u64::from(n) - empty - invalid;
+                    counts.empty += empty;
+                    counts.invalid += invalid;
+                }
+                Placement::Winds => counts.winding += 1,
+            }
+        };
+        let uniform = self.options.subdivision.uniform;
+        let mut subdivide = |nodes: [Node; 3], grid: &mut Vec<Node>| {
+            // Most triangles of a finely tessellated model are far from the poles and too
+            // short to bend: refinement would emit them whole, so they are drawn at once
+            // (and most of those then cover no pixel centre and are dropped by the cull).
+            if uniform <= 1 && !poles && refiner.stays_whole(&nodes) {
+                draw(nodes);
+                return;
+            }
+            refiner.uniform(nodes, uniform, grid, &mut |piece| {
+                refiner.refine(piece, [0; 3], poles, &mut draw)
+            });
+        };
+        if inside {
+            let nodes = [0, 1, 2].map(|k| Node {
+                point: points[k],
+                image: images[corners[k]],
+            });
+            subdivide(nodes, grid);
+        } else {
+            let clipped = clip::clip(points, &self.chart.clip);
+            for fan in clipped.fan() {
+                subdivide(fan.map(|p| refiner.node(p)), grid);
             }
         }
-    });
-    counts
-}
-
-/// Calls `emit` with the runs of pixel centres that `polygon` covers in rows
-/// `rows.0..rows.1` and columns `0..width`, row by row, left to right, each pixel in at most
-/// one span: a polygon's by `rule` ([`scan`]), a line's pixels one by one ([`line`](mod@line)),
-/// none for a shape that is not drawn. For renderers that run their own stage and z-test
-/// along a span (see [`Span::start_and_step`]) instead of one fragment at a time.
-pub fn spans<const N: usize>(
-    polygon: &Polygon<'_, N>,
-    rule: FillRule,
-    rows: (u32, u32),
-    width: u32,
-    scratch: &mut Scratch<N>,
-    mut emit: impl FnMut(&Span<'_, N>),
-) {
-    match polygon.kind() {
-        Kind::Fill => scan::fill_spans(polygon, rule, rows, width, scratch, emit),
-        Kind::Line => line::line(
-            &polygon.vertices[0],
-            &polygon.vertices[1],
-            rows,
-            width,
-            |x, y, values| emit(&Span::pixel(x, y, &values)),
-        ),
-        Kind::Skip => {}
     }
 }

@@ -1,5 +1,5 @@
 //! The band-local G-buffer of trilinear rasterisation: the shapes of one band of rows are
-//! drawn span by span ([`crate::render::raster::spans`]), each fragment finished to its exact
+//! drawn span by span ([`crate::render::scan::spans`]), each fragment finished to its exact
 //! hit by the stage of [`Resolver`] and z-tested, and the band is then shaded from it
 //! ([`super::shade::Shader::rows`]).
 //!
@@ -17,7 +17,7 @@
 
 use super::hit_terms::{self, Terms, TERMS};
 use super::shade::Resolver;
-use crate::render::raster::{spans, FillRule, Polygon, RasterStats, Scratch, Span, NO_PRIMITIVE};
+use crate::render::scan::{spans, FillRule, Polygon, RasterStats, Scratch, Span, NO_PRIMITIVE};
 
 /// The drawn state of one band of rows.
 #[derive(Debug, Clone)]

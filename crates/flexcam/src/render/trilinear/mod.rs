@@ -10,7 +10,7 @@
 //! mode), with exact anchors at the view plane and at the projection triangle's edge surfaces,
 //! and the outline is clipped ([`clip`]) and mapped to pixels ([`screen_map`]), each vertex
 //! carrying the terms of its projector's hit with the scene triangle's plane that are affine
-//! in pixel position ([`hit_terms`]). All polygons are then rasterised (`render::raster`,
+//! in pixel position ([`hit_terms`]). All polygons are then rasterised (`render::scan`,
 //! non-zero fill, z-buffer), every fragment finished to its exact hit from its interpolated
 //! terms before its z-test, and each pixel's winner shaded once ([`shade`]).
 //!
@@ -52,8 +52,8 @@ use self::screen_map::ScreenMap;
 use self::shade::{Resolver, ShadeCounts, Shader};
 use crate::error::{Error, Result};
 use crate::projection::{Projection, Trilinear};
-use crate::render::raster::{band_rows_for, for_each_band, RasterStats, Scratch};
 use crate::render::raycast::{RayCaster, SamplePattern};
+use crate::render::scan::{band_rows_for, for_each_band, RasterStats, Scratch};
 use crate::render::surface::triangle_color::TriangleColor;
 use crate::render::surface::TextureFilter;
 use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};

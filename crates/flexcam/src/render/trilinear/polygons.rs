@@ -22,7 +22,7 @@ use super::view_plane::clipping_base;
 use crate::projection::{
     project_solved_triangle, Projection, ProjectionTriangleCache, Shape, Solutions, Trilinear,
 };
-use crate::render::raster::{PolygonBatch, Vertex};
+use crate::render::scan::{PolygonBatch, Vertex};
 use crate::render::{Counter, Stats};
 
 /// What projecting the scene through projection triangles did.

@@ -51,8 +51,8 @@ use super::scene_geometry::SceneGeometry;
 use super::screen_map::ScreenMap;
 use crate::geometry::Ray;
 use crate::projection::{Projection, Trilinear};
-use crate::render::raster::{FrameRows, NO_PRIMITIVE};
 use crate::render::raycast::{Hit, RayCaster};
+use crate::render::scan::{FrameRows, NO_PRIMITIVE};
 use crate::render::surface::triangle_color::TriangleColor;
 use crate::render::RenderOptions;
 

@@ -634,7 +634,7 @@ mod round_trip {
 #[test]
 fn edited_round_presets_raster_like_the_ray_caster() {
     use crate::render::compare::compare;
-    use crate::render::inverse_raster::Subdivision;
+    use crate::render::raster::Subdivision;
     use crate::render::{Frame, Method, RenderOptions, Shading};
     use crate::scene::file::parse;
 

@@ -18,8 +18,8 @@ use glam::{DVec3, Vec2, Vec3};
 
 use super::pixel_rays::PixelRays;
 use crate::geometry::Ray;
-use crate::render::raster::NO_PRIMITIVE;
 use crate::render::raycast::{Hit, RayCaster};
+use crate::render::scan::NO_PRIMITIVE;
 use crate::render::surface::{base_color, TextureFilter};
 use crate::render::{RenderOptions, Shading};
 use crate::scene::{Object, Surface};

@@ -3,7 +3,7 @@
 //!
 //! Nearly every piece of a finely tessellated model covers one or two pixel centres (the
 //! panorama workload's 31,730 screen triangles cover about as many pixels), so the general
-//! polygon scan of `render::raster` (edge list, crossing list, sort, interpolated
+//! polygon scan of `render::scan` (edge list, crossing list, sort, interpolated
 //! attributes, one shared bin list) costs far more than the centres themselves. [`cover`]
 //! is that scan specialised to one triangle without attributes: the same fill and tie rule
 //! computed by the same floating-point expressions, so it covers exactly the centres the
@@ -11,7 +11,7 @@
 
 use glam::DVec2;
 
-use crate::render::raster::LIMIT;
+use crate::render::scan::LIMIT;
 
 /// One screen triangle to fill: its corners in continuous pixel coordinates and the
 /// primitive key of its scene triangle (`fragment::key`).
@@ -49,7 +49,7 @@ fn centre_range(lo: f64, hi: f64, max: u32) -> (u32, u32) {
 /// Calls `emit(x, y)` for every pixel centre of rows `rows.0..rows.1` and columns
 /// `0..width` that `triangle` covers, row by row, left to right.
 ///
-/// The rule is the rasteriser's (`render::raster::scan`, which a triangle's fill and tie
+/// The rule is the rasteriser's (`render::scan::fill`, which a triangle's fill and tie
 /// rules reduce to): an edge takes part in row `y` when `top.y <= y + 0.5 < bottom.y`, its
 /// crossing is interpolated from its top end, and the centres in `[left crossing, right
 /// crossing)` are covered. A row through a triangle meets exactly two of its
@@ -146,14 +146,14 @@ mod tests {
     use proptest::prelude::*;
 
     use super::*;
-    use crate::render::raster::{rasterize, FillRule, PolygonBatch, Target, Vertex};
+    use crate::render::scan::{rasterize, FillRule, PolygonBatch, Target, Vertex};
 
     const SIZE: (u32, u32) = (24, 16);
 
     /// Pixels as `(x, y)`.
     type Pixels = Vec<(u32, u32)>;
 
-    /// The centres `cover` finds over the whole image, and those `render::raster` fills.
+    /// The centres `cover` finds over the whole image, and those `render::scan` fills.
     fn both(corners: [DVec2; 3]) -> (Pixels, Pixels) {
         let triangle = ScreenTriangle { corners, key: 7 };
         let mut ours = Vec::new();

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 use super::coverage::{cover, Bins};
 use super::fragment::{Shader, TrianglePlane, Visible};
-use crate::render::raster::RasterStats;
+use crate::render::scan::RasterStats;
 use crate::render::Frame;
 
 /// Rows per band: small enough for many parallel tasks on the part of a panorama a model

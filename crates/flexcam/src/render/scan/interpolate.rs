@@ -12,7 +12,7 @@ pub struct Varying<const N: usize> {
 
 impl<const N: usize> Varying<N> {
     /// `self + s (other - self)`: exactly `self` at `s = 0`. Written as an offset from `self`
-    /// so that, for `s` in `[0, 1]` and components bounded by [`crate::render::raster::LIMIT`],
+    /// so that, for `s` in `[0, 1]` and components bounded by [`crate::render::scan::LIMIT`],
     /// the result is finite and lies between the two values.
     pub fn lerp(&self, other: &Self, s: f64) -> Self {
         Varying {
