@@ -25,15 +25,18 @@ impl FileIdentity {
         Some(FileIdentity { canonical, inode })
     }
 
-    /// The identity of a file about to be written at `path`, which may not exist yet, and
-    /// the folders that writing it will create (outermost first). Errors: a path without a
-    /// file name, or whose nearest existing ancestor is not a folder.
-    pub fn of_target(path: &Path) -> Result<(FileIdentity, Vec<PathBuf>)> {
-        if path.file_name().is_none() {
+    /// Where a file about to be written at `path` goes: see [`Target`]. Errors: a path
+    /// without a file name, or whose nearest existing ancestor is not a folder.
+    pub fn of_target(path: &Path) -> Result<Target> {
+        let Some(name) = path.file_name() else {
             return Err(Error::in_file(path, "an output needs a file name"));
-        }
+        };
         if let Some(identity) = FileIdentity::of_existing(path) {
-            return Ok((identity, Vec::new()));
+            return Ok(Target {
+                identity,
+                folders: Vec::new(),
+                path: path.to_path_buf(),
+            });
         }
         let folder = match path.parent() {
             Some(p) if !p.as_os_str().is_empty() => p,
@@ -66,14 +69,15 @@ impl FileIdentity {
             to_create.push(created.clone());
             canonical.push(name);
         }
-        canonical.push(path.file_name().unwrap_or_default());
-        Ok((
-            FileIdentity {
+        canonical.push(name);
+        Ok(Target {
+            identity: FileIdentity {
                 canonical,
                 inode: None,
             },
-            to_create,
-        ))
+            path: created.join(name),
+            folders: to_create,
+        })
     }
 
     /// Whether `self` and `other` are the same file.
@@ -81,6 +85,18 @@ impl FileIdentity {
         self.canonical == other.canonical
             || matches!((self.inode, other.inode), (Some(a), Some(b)) if a == b)
     }
+}
+
+/// Where an output goes.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Target {
+    pub identity: FileIdentity,
+    /// The folders writing it creates, outermost first.
+    pub folders: Vec<PathBuf>,
+    /// The path to write: the path as given for a file that exists; for a new one, the path
+    /// through its nearest existing folder with `.` and `..` applied to the rest
+    /// (`new/x/../a.png` is written as `new/a.png`: the folder `new/x` is never made).
+    pub path: PathBuf,
 }
 
 /// `folder` split into its longest existing prefix (as written, empty for none) and the names of the
@@ -131,34 +147,37 @@ mod tests {
         std::fs::write(root.join("a/x.png"), b"x").unwrap();
         let x = FileIdentity::of_existing(&root.join("a/x.png")).unwrap();
         for spelling in ["a/./x.png", "a/../a/x.png", "a//x.png", "a/./../a/x.png"] {
-            let (other, created) = FileIdentity::of_target(&root.join(spelling)).unwrap();
-            assert!(other.same_file(&x), "{spelling}");
-            assert!(created.is_empty());
+            let target = FileIdentity::of_target(&root.join(spelling)).unwrap();
+            assert!(target.identity.same_file(&x), "{spelling}");
+            assert!(target.folders.is_empty());
         }
         #[cfg(unix)]
         {
             std::os::unix::fs::symlink(root.join("a/x.png"), root.join("link.png")).unwrap();
             std::fs::hard_link(root.join("a/x.png"), root.join("hard.png")).unwrap();
             for other in ["link.png", "hard.png"] {
-                let (other, _) = FileIdentity::of_target(&root.join(other)).unwrap();
-                assert!(other.same_file(&x));
+                let target = FileIdentity::of_target(&root.join(other)).unwrap();
+                assert!(target.identity.same_file(&x));
             }
         }
-        let (new, _) = FileIdentity::of_target(&root.join("a/y.png")).unwrap();
-        assert!(!new.same_file(&x));
+        let new = FileIdentity::of_target(&root.join("a/y.png")).unwrap();
+        assert!(!new.identity.same_file(&x));
     }
 
     #[test]
     fn missing_folders_are_listed_and_normalised() {
         let dir = tempfile::tempdir().unwrap();
         let root = dir.path().canonicalize().unwrap();
-        let (deep, created) = FileIdentity::of_target(&root.join("n/m/./x.png")).unwrap();
-        assert_eq!(created, vec![root.join("n"), root.join("n/m")]);
-        let (_, created) = FileIdentity::of_target(&root.join("n/k/../m/x.png")).unwrap();
-        assert_eq!(created, vec![root.join("n"), root.join("n/m")]);
-        assert_eq!(deep.canonical, root.join("n/m/x.png"));
-        let (back, _) = FileIdentity::of_target(&root.join("n/../x.png")).unwrap();
-        assert_eq!(back.canonical, root.join("x.png"));
+        let deep = FileIdentity::of_target(&root.join("n/m/./x.png")).unwrap();
+        assert_eq!(deep.folders, [root.join("n"), root.join("n/m")]);
+        assert_eq!(deep.identity.canonical, root.join("n/m/x.png"));
+        let back = FileIdentity::of_target(&root.join("n/k/../m/x.png")).unwrap();
+        assert_eq!(back.folders, [root.join("n"), root.join("n/m")]);
+        assert_eq!(back.path, root.join("n/m/x.png"));
+        let up = FileIdentity::of_target(&root.join("n/../x.png")).unwrap();
+        assert_eq!(up.identity.canonical, root.join("x.png"));
+        assert!(up.folders.is_empty());
+        assert_eq!(up.path, root.join("x.png"));
         std::fs::write(root.join("file"), b"").unwrap();
         let e = FileIdentity::of_target(&root.join("file/x.png")).unwrap_err();
         assert!(e.to_string().contains("is not a folder"), "{e}");

@@ -20,7 +20,7 @@ use crate::render::Frame;
 
 pub use depth::{write_depth, DepthFormat};
 pub use gif::GifFrames;
-pub use identity::FileIdentity;
+pub use identity::{FileIdentity, Target};
 pub use outputs::{check_extension, write_bytes, OutputId, OutputSet};
 pub use png::{write_color_png, write_ids_png};
 pub use read::{read_linear_image, LinearImage, INPUT_EXTENSIONS};

@@ -33,6 +33,9 @@ struct Declared {
 /// An output: where it goes, the folders its commit creates, its temporary once staged.
 #[derive(Debug)]
 struct Output {
+    /// The path as the user gave it, for messages.
+    shown: PathBuf,
+    /// The path written (see [`super::identity::Target::path`]).
     path: PathBuf,
     folders: Vec<PathBuf>,
     temporary: Option<PathBuf>,
@@ -89,11 +92,12 @@ impl OutputSet {
     /// declared input or output that is the same file.
     pub fn output(&mut self, role: &str, path: &Path, extensions: &[&str]) -> Result<OutputId> {
         check_extension(path, extensions)?;
-        let (identity, folders) = FileIdentity::of_target(path)?;
-        self.declare(role, path, identity, true)?;
+        let target = FileIdentity::of_target(path)?;
+        self.declare(role, path, target.identity, true)?;
         self.outputs.push(Output {
-            path: path.to_path_buf(),
-            folders,
+            shown: path.to_path_buf(),
+            path: target.path,
+            folders: target.folders,
             temporary: None,
         });
         Ok(OutputId(self.outputs.len() - 1))
@@ -161,7 +165,7 @@ impl OutputSet {
         };
         let temporary = folder.join(format!(".{name}.{}-{}.partial", std::process::id(), id.0));
         output.temporary = Some(temporary.clone());
-        write(&temporary).map_err(|e| Error::in_file(&output.path, e.message))
+        write(&temporary).map_err(|e| Error::in_file(&output.shown, e.message))
     }
 
     /// Moves every staged output into place, or none: see the module documentation. Errors:
@@ -220,10 +224,11 @@ pub fn write_bytes(path: &Path, bytes: &[u8]) -> Result<()> {
 /// its temporary into place, recording each step in `steps`.
 fn place(index: usize, output: &mut Output, steps: &mut Vec<Step>) -> Result<()> {
     let target = &output.path;
+    let shown = &output.shown;
     let temporary = output
         .temporary
         .clone()
-        .ok_or_else(|| Error::in_file(target, "the output was never written"))?;
+        .ok_or_else(|| Error::in_file(shown, "the output was never written"))?;
     for folder in &output.folders {
         match fs::create_dir(folder) {
             Ok(()) => steps.push(Step::Folder(folder.clone())),
@@ -231,7 +236,7 @@ fn place(index: usize, output: &mut Output, steps: &mut Vec<Step>) -> Result<()>
             Err(_) if folder.is_dir() => {}
             Err(e) => {
                 return Err(Error::in_file(
-                    target,
+                    shown,
                     format!("cannot create the folder {}: {e}", folder.display()),
                 ))
             }
@@ -247,7 +252,7 @@ fn place(index: usize, output: &mut Output, steps: &mut Vec<Step>) -> Result<()>
         // a copy where the file system has no hard links.
         fs::hard_link(target, &backup)
             .or_else(|_| fs::copy(target, &backup).map(|_| ()))
-            .map_err(|e| Error::in_file(target, format!("cannot keep a backup: {e}")))?;
+            .map_err(|e| Error::in_file(shown, format!("cannot keep a backup: {e}")))?;
         Some(backup)
     } else {
         None
@@ -256,7 +261,7 @@ fn place(index: usize, output: &mut Output, steps: &mut Vec<Step>) -> Result<()>
         if let Some(backup) = backup {
             let _ = fs::remove_file(backup);
         }
-        return Err(Error::in_file(target, format!("cannot write: {e}")));
+        return Err(Error::in_file(shown, format!("cannot write: {e}")));
     }
     output.temporary = None;
     steps.push(Step::Placed {
