@@ -413,6 +413,68 @@ mod tests {
     }
 
     #[test]
+    fn uris_name_files_as_the_gltf_crate_reads_them() {
+        let base = Path::new("m");
+        assert_eq!(uri_file(base, "a%20b.bin"), Some(base.join("a b.bin")));
+        assert_eq!(uri_file(base, "t/x%2.png"), Some(base.join("t/x%2.png")));
+        assert_eq!(
+            uri_file(base, "file:///abs/t.png"),
+            Some(PathBuf::from("/abs/t.png"))
+        );
+        assert_eq!(
+            uri_file(base, "data:application/octet-stream;base64,AA"),
+            None
+        );
+        assert_eq!(uri_file(base, "https://example.org/t.png"), None);
+        assert_eq!(uri_file(base, "%ff.bin"), None);
+    }
+
+    /// A glTF with its buffer and image in files of their own names both as inputs.
+    #[test]
+    fn external_buffers_and_images_are_listed() {
+        let dir = tempfile::tempdir().unwrap();
+        let triangle: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .chain(
+                [0.0f32, 0.0, 1.0, 0.0, 0.0, 1.0]
+                    .iter()
+                    .flat_map(|v| v.to_le_bytes()),
+            )
+            .collect();
+        write(&dir, "tri angle.bin", &triangle);
+        std::fs::copy(example("checker.png"), dir.path().join("tex.png")).unwrap();
+        let gltf = r#"{
+            "asset": {"version": "2.0"},
+            "buffers": [{"byteLength": 60, "uri": "tri%20angle.bin"}],
+            "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24}],
+            "accessors": [
+                {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                 "min": [0, 0, 0], "max": [1, 1, 0]},
+                {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}],
+            "images": [{"uri": "tex.png"}],
+            "textures": [{"source": 0}],
+            "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 0}]}]
+        }"#;
+        let path = write(&dir, "m.gltf", gltf);
+        let model = load_gltf(&path).unwrap();
+        let files: Vec<(&str, PathBuf)> = model
+            .files
+            .iter()
+            .map(|f| (f.what, f.path.clone()))
+            .collect();
+        assert_eq!(
+            files,
+            [
+                ("model file", path.clone()),
+                ("model buffer", dir.path().join("tri angle.bin")),
+                ("texture", dir.path().join("tex.png")),
+            ]
+        );
+    }
+
+    #[test]
     fn loads_gltf_and_glb_alike() {
         for name in ["tetra-quad.gltf", "tetra-quad.glb"] {
             let parts = load_gltf(&example(name)).unwrap().parts;

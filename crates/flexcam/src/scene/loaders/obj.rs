@@ -254,7 +254,21 @@ mod tests {
 
     #[test]
     fn loads_the_textured_octahedron() {
-        let parts = load_obj(&example("octahedron.obj")).unwrap().parts;
+        let model = load_obj(&example("octahedron.obj")).unwrap();
+        let files: Vec<(&str, PathBuf)> = model
+            .files
+            .iter()
+            .map(|f| (f.what, f.path.clone()))
+            .collect();
+        assert_eq!(
+            files,
+            [
+                ("model file", example("octahedron.obj")),
+                ("material library", example("octahedron.mtl")),
+                ("texture", example("checker.png")),
+            ]
+        );
+        let parts = model.parts;
         let triangles: usize = parts.iter().map(|p| p.mesh.triangle_count()).sum();
         assert_eq!(triangles, 8);
         assert_eq!(parts.len(), 2, "one part per material");
