@@ -105,6 +105,13 @@ impl Setup {
     }
 }
 
+/// Runs `flexcam ARGS` in `folder`, which must succeed.
+fn succeeds(folder: &Path, args: &[&str]) {
+    let out = run_in(folder, args);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{args:?}: {stderr}");
+}
+
 /// Runs `flexcam ARGS` in `folder`.
 fn run_in(folder: &Path, args: &[&str]) -> std::process::Output {
     assert_cmd::Command::cargo_bin("flexcam")
@@ -274,7 +281,7 @@ fn two_outputs_aimed_at_each_other_are_refused() {
 fn missing_output_folders_are_created() {
     let s = Setup::new();
     let work = s.work();
-    let out = run_in(
+    succeeds(
         &work,
         &render(
             "scene.png",
@@ -290,16 +297,11 @@ fn missing_output_folders_are_created() {
             ],
         ),
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     for made in ["a/b/c.png", "a/d/depth.exr", "e/ids.png", "f/stats.json"] {
         assert!(work.join(made).is_file(), "{made}");
     }
     assert!(!work.join("f/g").exists(), "f/g/.. needs no folder g");
-    let out = run_in(
+    succeeds(
         &work,
         &[
             &[
@@ -314,14 +316,9 @@ fn missing_output_folders_are_created() {
         ]
         .concat(),
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     assert!(work.join("frames/x/f_0000.png").is_file());
     assert!(work.join("gif/a.gif").is_file());
-    let out = run_in(
+    succeeds(
         &work,
         &[
             "reproject",
@@ -335,13 +332,8 @@ fn missing_output_folders_are_created() {
             "4",
         ],
     );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
     assert!(work.join("re/p.png").is_file());
-    let out = run_in(
+    succeeds(
         &work,
         &[
             &[
@@ -355,11 +347,6 @@ fn missing_output_folders_are_created() {
             &SMALL,
         ]
         .concat(),
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     assert!(work.join("diff/d.png").is_file());
     // Nothing but the outputs: no temporary, no backup.
@@ -404,12 +391,7 @@ fn a_failed_commit_leaves_the_old_outputs() {
 
     // The same outputs with the folder gone: all written, the old ones replaced.
     fs::remove_dir_all(work.join("ids.png")).unwrap();
-    let out = run_in(&work, &args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    succeeds(&work, &args);
     assert_ne!(fs::read(work.join("old.png")).unwrap(), b"old image");
     assert!(fs::read_to_string(work.join("stats.json"))
         .unwrap()

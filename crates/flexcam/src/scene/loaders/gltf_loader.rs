@@ -405,7 +405,7 @@ fn texture_from_gltf_image(data: &::gltf::image::Data) -> Result<Texture> {
 mod tests {
     use glam::Vec2;
 
-    use super::super::test_files::{example, write};
+    use super::super::test_files::{example, listed, write};
     use super::*;
 
     fn bounds(part: &ModelPart) -> (Vec3, Vec3) {
@@ -459,13 +459,8 @@ mod tests {
         }"#;
         let path = write(&dir, "m.gltf", gltf);
         let model = load_gltf(&path).unwrap();
-        let files: Vec<(&str, PathBuf)> = model
-            .files
-            .iter()
-            .map(|f| (f.what, f.path.clone()))
-            .collect();
         assert_eq!(
-            files,
+            listed(&model),
             [
                 ("model file", path.clone()),
                 ("model buffer", dir.path().join("tri angle.bin")),

@@ -88,6 +88,15 @@ pub(super) mod test_files {
             .join(name)
     }
 
+    /// What each file `model` was read from is, and its path.
+    pub fn listed(model: &super::Model) -> Vec<(&'static str, PathBuf)> {
+        model
+            .files
+            .iter()
+            .map(|f| (f.what, f.path.clone()))
+            .collect()
+    }
+
     /// Writes `contents` to `name` in `dir` and returns its path.
     pub fn write(dir: &tempfile::TempDir, name: &str, contents: impl AsRef<[u8]>) -> PathBuf {
         let path = dir.path().join(name);

@@ -249,19 +249,14 @@ fn convert_material(
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_files::{example, write};
+    use super::super::test_files::{example, listed, write};
     use super::*;
 
     #[test]
     fn loads_the_textured_octahedron() {
         let model = load_obj(&example("octahedron.obj")).unwrap();
-        let files: Vec<(&str, PathBuf)> = model
-            .files
-            .iter()
-            .map(|f| (f.what, f.path.clone()))
-            .collect();
         assert_eq!(
-            files,
+            listed(&model),
             [
                 ("model file", example("octahedron.obj")),
                 ("material library", example("octahedron.mtl")),
