@@ -99,7 +99,50 @@ position = [0.0, 1.5, 0.0]
 look_at = [0.0, 1.5, -1.0]
 fov = 90.0')" "${small[@]}" -o "$out/panorama-edit-perspective.png"
 
-# The sample equirectangular photo for `flexcam reproject`: the default scene, 512 x 256.
-"$flexcam" render --width 512 --height 256 -o scenes/photos/default-pano.png >/dev/null
+# The user guide's pictures (docs/*.md), each at a small size.
+# Cameras: the teapot-room objects through each single-viewpoint type.
+room_eye='position = [0.0, 2.6, 6.5]
+look_at = [0.0, 0.6, 0.0]'
+render builtin:teapot-room "${small[@]}" -o "$out/teapot-perspective.png"
+render scenes/cameras/teapot-fisheye.toml --width 240 --height 240 -o "$out/teapot-fisheye.png"
+render "$(variant scenes/teapot-room.toml room-ortho "type = \"orthographic\"
+$room_eye
+width = 7.0")" "${small[@]}" -o "$out/teapot-orthographic.png"
+pano_eye='position = [0.0, 1.0, 1.8]
+look_at = [0.0, 0.6, 0.0]'
+render "$(variant scenes/teapot-room.toml room-equirect "type = \"equirectangular\"
+$pano_eye")" --width 320 --height 160 -o "$out/teapot-equirectangular.png"
+render "$(variant scenes/teapot-room.toml room-cylindrical "type = \"cylindrical\"
+$pano_eye")" --width 320 --height 120 -o "$out/teapot-cylindrical.png"
 
-ls -l "$out" scenes/photos
+# The cube-floor scene from its own camera: the perspective view beside the trilinear and
+# flexible examples that share its objects.
+render builtin:cube-floor --width 240 --height 240 -o "$out/cube-floor-perspective.png"
+for scene in trilinear-fan trilinear-grid-cylinder trilinear-two-views reflect-sphere-cube \
+  flexible-isometric flexible-magnifier flexible-occlusion flexible-ortho-near-persp-far \
+  flexible-depth-transition flexible-mcop flexible-bent flexible-quadratic flexible-patches \
+  flexible-panorama-cubic flexible-panorama-custom flexible-panorama-cylindrical-edit \
+  flexible-projector-fit flexible-projector-fit-curved; do
+  size=()
+  case $scene in
+    trilinear-fan | flexible-bent) size=(--width 300 --height 200) ;;
+  esac
+  render "scenes/$scene.toml" "${size[@]}" -o "$out/$scene.png"
+done
+"$flexcam" animate scenes/flexible-animation.toml --gif "$out/flexible-animation.gif" >/dev/null
+
+# Renderers: the difference images of `flexcam compare` (id mismatches red).
+"$flexcam" compare scenes/trilinear-fan.toml --method trilinear --width 300 --height 200 \
+  --diff "$out/diff-trilinear-fan.png" >/dev/null
+"$flexcam" compare scenes/cameras/teapot-fisheye.toml --method raster --width 240 --height 240 \
+  --diff "$out/diff-raster-fisheye.png" >/dev/null
+
+# The sample equirectangular photo for `flexcam reproject`: the default scene, 512 x 256, and
+# what the reprojection examples of the guide make of it.
+"$flexcam" render --width 512 --height 256 -o scenes/photos/default-pano.png >/dev/null
+"$flexcam" reproject --input scenes/photos/default-pano.png scenes/flexible-mcop.toml \
+  -o "$out/reproject-mcop.png" >/dev/null
+"$flexcam" reproject --input scenes/photos/default-pano.png scenes/cameras/teapot-fisheye.toml \
+  --width 240 --height 240 -o "$out/reproject-fisheye.png" >/dev/null
+
+du -ch "$out"/* scenes/photos/* | tail -1
