@@ -159,6 +159,8 @@ impl OutputSet {
             .file_name()
             .unwrap_or_default()
             .to_string_lossy();
+        // The nearest existing folder: the output's own, or the one its first missing folder
+        // will be made in (same file system, so the final rename is atomic).
         let folder = match output.folders.first().and_then(|f| f.parent()) {
             Some(existing) => existing.to_path_buf(),
             None => output.path.parent().unwrap_or(Path::new("")).to_path_buf(),
