@@ -102,6 +102,8 @@ impl Scene {
 pub mod builtin;
 pub mod file;
 pub mod loaders;
+#[cfg(test)]
+pub(crate) mod reflector_fixtures;
 pub mod shapes;
 
 pub use file::validate_resolution;

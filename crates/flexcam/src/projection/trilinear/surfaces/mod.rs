@@ -17,8 +17,6 @@
 mod camera;
 mod grid;
 mod reflector;
-#[cfg(test)]
-pub(crate) mod test_scenes;
 mod visualisation;
 
 pub use camera::GridCamera;
