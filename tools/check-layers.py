@@ -8,7 +8,9 @@ Nodes are file modules (src/a/b.rs and src/a/b/mod.rs are `a::b`). An edge A -> 
 A names an item of B: a `use crate::...`, `use super::...`, `use self::...` item or an inline
 path `crate::x::y` / `super::y`. Paths are resolved through `pub use` re-exports to the module
 that defines the item, so a facade mod.rs that re-exports its children does not by itself tie
-them into a cycle (a re-export is not a use). Test code is left out: modules declared under
+them into a cycle (a re-export is not a use). A module's uses of its own submodules are
+ownership, not edges: a parent is made of its children, and a child may use its parent's
+items (that edge counts). Test code is left out: modules declared under
 `#[cfg(test)]` and inline `#[cfg(test)] mod ... { }` blocks.
 
 Reports
@@ -231,8 +233,8 @@ class Crate:
                 if absolute is None:
                     continue
                 target = self.resolve(absolute)
-                if target is None or target == mod:
-                    continue
+                if target is None or target[: len(mod)] == mod:
+                    continue  # itself, or a module it owns
                 # A module naming its own ancestor's item through `super` reaches a facade;
                 # resolve() already followed re-exports, so what is left is a real use.
                 graph[mod].add(target)
