@@ -6,8 +6,8 @@ Usage: tools/check-layers.py [SRC_DIR] [--cycles-under PREFIX ...]
 
 Nodes are file modules (src/a/b.rs and src/a/b/mod.rs are `a::b`). An edge A -> B means code of
 A names an item of B: a `use crate::...`, `use super::...`, `use self::...` item or an inline
-path `crate::x::y` / `super::y`. Paths are resolved through `pub use` re-exports to the module
-that defines the item, so a facade mod.rs that re-exports its children does not by itself tie
+path `crate::x::y` / `super::y`. Paths are resolved through `use` items (re-exports and private imports) to the
+module that defines the item, so a facade mod.rs that re-exports its children does not by itself tie
 them into a cycle (a re-export is not a use). A module's uses of its own submodules are
 ownership, not edges: a parent is made of its children, and a child may use its parent's
 items (that edge counts). Test code is left out: modules declared under
@@ -168,8 +168,6 @@ class Crate:
         for mod, code in self.code.items():
             table = {}
             for m in USE_RE.finditer(code):
-                if not m.group(1):
-                    continue
                 for segs, alias in expand_use_tree(m.group(2)):
                     absolute = self.absolute(mod, segs)
                     if absolute is None or not segs:
