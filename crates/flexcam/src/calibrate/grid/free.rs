@@ -561,7 +561,7 @@ mod tests {
         perspective_volume as perspective, preset_volume,
     };
     use crate::projection::flexible::projector_grid::GridInterpolation;
-    use crate::projection::flexible::volume::LinearVolume;
+    use crate::projection::flexible::LinearVolume;
 
     /// Deterministic uniform numbers in [0, 1) from `seed` (a linear congruential generator).
     pub(super) fn uniform(seed: u64) -> impl FnMut() -> f64 {

@@ -6,7 +6,7 @@ use crate::projection::flexible::presets::Preset;
 use crate::projection::flexible::projector_grid::tests::perspective_volume as perspective;
 use crate::projection::flexible::projector_grid::tests::preset_volume;
 use crate::projection::flexible::projector_grid::GridInterpolation;
-use crate::projection::flexible::volume::LinearVolume;
+use crate::projection::flexible::LinearVolume;
 use crate::projection::projector::quadratic_point;
 use proptest::prelude::*;
 

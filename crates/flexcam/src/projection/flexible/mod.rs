@@ -3,7 +3,8 @@
 //!
 //! - [`surface`]: control surfaces Q_i(u, v) on the shared domain (u, v) in [0, 1]^2, u to the
 //!   right of the image, v up;
-//! - [`volume`]: Q(u, v, t) = (1 - t) Q_near + t Q_far and dQ/dt (straight projectors);
+//! - [`volume`]: the volume Q(u, v, t) and dQ/dt over every kind of projector, and
+//!   `linear_volume`: Q(u, v, t) = (1 - t) Q_near + t Q_far (straight projectors);
 //! - [`blend`]: volumes of two or more surfaces blended in t, piecewise-linear (polyline
 //!   projectors) or Bernstein (Bezier projectors);
 //! - `patch`: bicubic Bezier and uniform cubic B-spline control surfaces;
@@ -25,6 +26,7 @@ pub mod blend;
 mod chart;
 pub mod interpolate;
 mod inverse;
+mod linear_volume;
 pub mod panorama;
 mod patch;
 pub mod presets;
@@ -39,7 +41,7 @@ use glam::{DVec2, DVec3};
 
 pub use animation::{Animation, Easing, Keyframe};
 pub use blend::{BezierVolume, PiecewiseVolume};
-pub use interpolate::InterpolatedVolume;
+pub use linear_volume::LinearVolume;
 pub use panorama::{PanoramaShape, PanoramaSpec};
 pub use presets::{DepthStyle, Magnifier, McopPath, Preset, PresetSpec};
 pub use projector_grid::{
@@ -50,7 +52,7 @@ pub use reparam::Reparam;
 pub use surface::{
     BSplinePatch, BezierPatch, CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface,
 };
-pub use volume::{LinearVolume, Volume};
+pub use volume::{InterpolatedVolume, Volume};
 
 use self::inverse::Inverse;
 use super::chart::InverseChart;
@@ -230,7 +232,13 @@ fn build_volume(
         }
         VolumeSource::ProjectorGrid { base, grid } => {
             let (base_volume, base_reparam) = build_volume(base, aspect, fitter, report)?;
-            let volume = GridVolume::build(grid, &base_volume, fitter, report)?;
+            let Volume::Linear(linear) = &base_volume else {
+                return Err(Error::new(
+                    "a projector grid starts from a volume with straight projectors (a preset \
+                     or near and far surfaces), not from blended surfaces",
+                ));
+            };
+            let volume = GridVolume::build(grid, linear, fitter, report)?;
             (Volume::Grid(Box::new(volume)), base_reparam)
         }
     };

@@ -43,7 +43,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::volume::{LinearVolume, Volume};
+use super::linear_volume::LinearVolume;
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
 use crate::projection::projector::{quadratic_point, quadratic_tangent};
@@ -485,25 +485,18 @@ pub struct GridVolume {
 }
 
 impl GridVolume {
-    /// Samples `base` (which must have straight projectors), places the explicit node
+    /// Samples `base`, places the explicit node
     /// projectors, applies the aims in order, then, when there are correspondences, has
-    /// `fitter` fit the grid to them and adds what it reports to `report`. Errors: a base with
-    /// curved projectors; correspondences without a fitter; the errors of
+    /// `fitter` fit the grid to them and adds what it reports to `report`. Errors: correspondences without a fitter; the errors of
     /// [`ProjectorGrid::sample`], [`ProjectorGrid::set_projector`], [`ProjectorGrid::aim`] and
     /// of the fitter.
     pub fn build(
         spec: &ProjectorGridSpec,
-        base: &Volume,
+        base: &LinearVolume,
         fitter: Option<&dyn GridFitter>,
         report: &mut BuildReport,
     ) -> Result<Self> {
-        let Volume::Linear(linear) = base else {
-            return Err(Error::new(
-                "a projector grid starts from a volume with straight projectors (a preset or \
-                 near and far surfaces), not from blended surfaces",
-            ));
-        };
-        let mut grid = ProjectorGrid::sample(linear, spec.size, spec.interpolation)?;
+        let mut grid = ProjectorGrid::sample(base, spec.size, spec.interpolation)?;
         for node in &spec.projectors {
             let (col, row) = node.node;
             let j = grid.index(col, row)?;
