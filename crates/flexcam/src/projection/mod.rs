@@ -32,10 +32,10 @@ pub use image_coords::Resolution;
 pub use linear::{Orthographic, Perspective};
 pub use panoramic::{Cylindrical, Equirectangular};
 pub use projector::{Projector, ProjectorHull};
+pub use trilinear::mesh_builders as trilinear_builders;
 pub use trilinear::{
-    project_solved_triangle, project_triangle, surfaces, ProjectionTriangleCache, ProjectiveMap,
-    SceneEdge, Shape, ShapeVertex, Solutions, TriangleShapes, TriangleSolution, Trilinear,
-    Unprojectable,
+    project_solved_triangle, project_triangle, ProjectionTriangleCache, ProjectiveMap, SceneEdge,
+    Shape, ShapeVertex, Solutions, TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
 };
 
 use glam::{DVec2, DVec3};

@@ -11,8 +11,8 @@
 
 use glam::{DVec2, DVec3};
 
+use super::control_surface::{lerp_range, CylinderPatch, SpherePatch, Surface};
 use super::linear_volume::LinearVolume;
-use super::surface::{lerp_range, CylinderPatch, SpherePatch, Surface};
 use super::volume::{mix, InterpolatedVolume, Volume};
 use crate::error::{Error, Result};
 

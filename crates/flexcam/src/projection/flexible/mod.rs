@@ -1,7 +1,7 @@
 //! The flexible projection (seed 003, Flexible Projection): a parametric viewing volume
 //! Q(u, v, t) between control surfaces, mapped to the image by a re-parameterisation.
 //!
-//! - [`surface`]: control surfaces Q_i(u, v) on the shared domain (u, v) in [0, 1]^2, u to the
+//! - [`control_surface`]: control surfaces Q_i(u, v) on the shared domain (u, v) in [0, 1]^2, u to the
 //!   right of the image, v up;
 //! - [`volume`]: the volume Q(u, v, t) and dQ/dt over every kind of projector, and
 //!   `linear_volume`: Q(u, v, t) = (1 - t) Q_near + t Q_far (straight projectors);
@@ -24,6 +24,7 @@
 pub mod animation;
 pub mod blend;
 mod chart;
+pub mod control_surface;
 pub mod interpolate;
 mod inverse;
 mod linear_volume;
@@ -32,7 +33,6 @@ mod patch;
 pub mod presets;
 pub mod projector_grid;
 pub mod reparam;
-pub mod surface;
 #[cfg(test)]
 mod tests;
 pub mod volume;
@@ -41,6 +41,9 @@ use glam::{DVec2, DVec3};
 
 pub use animation::{Animation, Easing, Keyframe};
 pub use blend::{BezierVolume, PiecewiseVolume};
+pub use control_surface::{
+    BSplinePatch, BezierPatch, CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface,
+};
 pub use linear_volume::LinearVolume;
 pub use panorama::{PanoramaShape, PanoramaSpec};
 pub use presets::{DepthStyle, Magnifier, McopPath, Preset, PresetSpec};
@@ -49,9 +52,6 @@ pub use projector_grid::{
     ProjectorGridSpec, Starts,
 };
 pub use reparam::Reparam;
-pub use surface::{
-    BSplinePatch, BezierPatch, CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface,
-};
 pub use volume::{InterpolatedVolume, Volume};
 
 use self::inverse::Inverse;

@@ -1351,7 +1351,7 @@ fn flexible_projector_grid_nodes_with_tangents() {
 
 #[test]
 fn trilinear_screen_map_key() {
-    use crate::projection::surfaces::SurfaceScreenMap;
+    use crate::projection::trilinear_builders::SurfaceScreenMap;
     use crate::scene::TrilinearReflector;
     let mirror = |extra: &str| {
         format!("{CAMERA}[[object]]\nshape = \"sphere\"\nmaterial = \"mirror\"\n{extra}\n")

@@ -41,7 +41,7 @@ pub use self::edit::{edit_source, make_perspective};
 pub use self::shape::{OutlineShape, ProfileShape};
 use super::super::camera_basis::CameraBasis;
 use super::super::CameraFrame;
-use super::surface::Surface;
+use super::control_surface::Surface;
 use crate::error::{Error, Result};
 
 /// The default far clip distance of the presets and shape-defined panoramas, in world units.
