@@ -147,7 +147,7 @@ pub(super) fn thinly_weighted_nodes(
 pub(super) const UNDETERMINED_VARIANCE: f64 = 1e6;
 
 /// The constrained nodes (`constrained`) of the fitted `grid` whose projectors the model
-/// leaves undetermined (module section "Warnings"). `matrix` is the model's Gauss-Newton
+/// leaves undetermined (module docs of `grid`, "Warnings"). `matrix` is the model's Gauss-Newton
 /// matrix without the pull to the prior, in `per_node` unknowns a node: 3 (the direction over
 /// `scale`) or 6 (the start over a length near the points' distance, then the direction over
 /// `scale`); `grid` has the directions the unknowns describe; `gauge` is the

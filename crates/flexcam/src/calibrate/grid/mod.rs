@@ -1,60 +1,41 @@
-//! Fitting a projector grid to point correspondences by linear least squares: given scene
-//! points and the image positions where they must appear, aim every node projector at once.
-//! The thesis placed its 25 projectors by hand, about three hours per attempt, with no error
-//! measure (8.3); this does it in milliseconds and reports the residual.
+//! Fitting a projector grid to point correspondences: given scene points and the image
+//! positions (u, v) where they must appear, aim every node projector at once and report the
+//! residual. The history of measurements behind the constants here is in
+//! docs/log/calibrate.md.
 //!
-//! # The problem
+//! # The straight fit (starts kept)
 //!
-//! The starts S_j of the node projectors are kept (they are the image plane: where each part of
-//! the image begins); the unknowns are the node directions D_j = E_j - S_j. Correspondence k
-//! says that scene point X_k lies on the projector of (u_k, v_k), i.e. that
-//! D(u_k, v_k) = sum_j w_j(u_k, v_k) D_j is parallel to a_k = (X_k - S(u_k, v_k)) / |...|.
-//! With P_k = I - a_k a_k^T (the projection off a_k), `P_k D(u_k, v_k) = 0` is linear in the
-//! D_j, so the fit minimises
+//! The starts S_j of the node projectors are kept (they are the image plane); the unknowns
+//! are the node directions D_j = E_j - S_j. Correspondence k says that X_k lies on the
+//! projector of (u_k, v_k): D(u_k, v_k) = sum_j w_j(u_k, v_k) D_j is parallel to
+//! a_k = (X_k - S(u_k, v_k)) / |...|. With P_k = I - a_k a_k^T, `P_k D(u_k, v_k) = 0` is
+//! linear in the D_j, so the fit minimises
 //!
 //! sum_k |P_k sum_j w_kj D_j|^2 + lambda sum_j |D_j - D0_j|^2
 //!
-//! where D0 are the prior grid's directions, subject to one linear constraint that fixes the
-//! overall scale: sum_j D0_j . D_j = sum_j |D0_j|^2 over the nodes that some correspondence
-//! constrains. The data term alone is homogeneous (D = 0 and any overall scale fit it): the
-//! constraint removes that freedom without shrinking the solution towards zero (a pure prior
-//! term would shrink it, badly so when the data are noisy), and the small prior term gives
-//! nodes that no correspondence constrains (no weight at any (u_k, v_k)) the prior's
-//! projector and settles directions the data leave open. lambda is 1e-11 of the data term's
-//! mean diagonal: it keeps the system positive definite, and the bias it adds to directions
-//! the data determine grows with it (measured: 1e-6 rad at 1e-8, 2e-9 rad at 1e-11 on
-//! exact data), so it is as small as double precision allows; a second solve centred on the
-//! first removes most of what bias remains (see [`fit`]).
+//! (D0: the prior grid's directions) subject to one scale constraint, sum_j D0_j . D_j =
+//! sum_j |D0_j|^2 over the constrained nodes: the data term is homogeneous, and the
+//! constraint removes the scale freedom without shrinking the solution towards zero.
+//! lambda (`PRIOR_WEIGHT` of the data term's mean diagonal, unknowns scaled by the prior's
+//! mean projector length so that it is dimensionless) keeps the system positive definite and
+//! gives nodes no correspondence constrains the prior's projector; its bias on determined
+//! directions grows with it, so it is as small as double precision allows, and a second
+//! solve centred on the first removes most of what remains ([`fit`]). After the solve, when
+//! some X_k would lie beyond its projector's end (t > 1), all directions are lengthened by
+//! one common factor so that every X_k is in view.
 //!
-//! Unknowns are scaled by the prior's mean projector length, so lambda is dimensionless. After
-//! the solve, when some X_k would lie beyond its projector's end (t > 1), all directions are
-//! lengthened by one common factor (which changes no direction) so that every X_k is in view.
+//! Noisy data (module `system`): one floor-weighted solve measures the noise; above rounding
+//! level the fit solves again with the prior's weight set to the noise variance over
+//! `PRIOR_SPREAD`^2 (the maximum a posteriori weight for a Gaussian prior around the prior
+//! grid), centred on the prior, so that weakly determined node combinations do not turn
+//! until projectors point away from their points.
 //!
-//! # Noise
-//!
-//! The floor weight holds only against exact data: a Bezier grid's inner control nodes are
-//! weakly determined by scattered points, and with 1e-3 rad of noise the floor-weighted fit
-//! turned such node combinations until projectors pointed away from their points (21 of 100
-//! random fits from 144 points and 89 of 100 from 64 were refused, two more turned a
-//! projector by 3.1 rad). [`fit`] therefore first measures the data's noise with one
-//! floor-weighted solve and, where it is above rounding level, solves once more with the
-//! prior's weight set to the estimated noise variance over `PRIOR_SPREAD`^2 (the maximum a
-//! posteriori weight for a Gaussian prior around the prior grid), centred on the prior. Exact
-//! data take the floor weight and the two solves as before, unchanged.
-//!
-//! # Inexact data
-//!
-//! |P_k D|^2 is |D| sin(angle) squared: a projector pointing away meets it as well as one
-//! pointing towards X_k, and shortening D lowers it. Where no grid with the kept starts meets
-//! the data (a near surface off the camera's eye), the linear optimum shrank the nodes the
-//! residual gathers on to 1e-9 to 2e-7 of the longest and past zero, and consistent data were
-//! refused as contradictory. When the floor-weighted linear fit misses the data by more than
-//! `EXACT_CHORD`, the fit keeps the noise-weighted linear solution only where it reaches every
-//! point in front of its start; otherwise (no noise weight, or some point behind) it refines
-//! on the chord 2 sin(angle / 2) between fitted and wanted unit directions, which no length
-//! changes and a reversed projector maximises, from the linear solution and from the prior
-//! (module `angular`). Refining noisy Bezier fits as well was measured worse (see
-//! docs/flexible.md) and is not done.
+//! Inexact data: |P_k D|^2 is |D| sin(angle) squared, met as well by a projector pointing
+//! away and lowered by shortening D. When the floor-weighted fit misses by more than
+//! `EXACT_CHORD`, the noise-weighted linear solution is kept only where it reaches every
+//! point in front of its start; otherwise the fit is refined on the chord 2 sin(angle / 2)
+//! between fitted and wanted unit directions (module `angular`), from the linear solution
+//! and from the prior.
 //!
 //! Degenerate cases: no correspondences (the prior is returned unchanged); a point at its
 //! projector's start (no direction: an error naming it); (u, v) outside [0, 1]^2 or
@@ -62,39 +43,35 @@
 //! (an error: the fitted projector must reach X_k at t > 0); a fitted node direction of zero
 //! length (an error).
 //!
-//! # Starts
+//! # Starts (model selection, module `select`)
 //!
-//! Kept starts off a pinhole camera's eye meet no grid to its correspondences, and sparse
-//! data then bend the fit between the points (a small residual, a wrong image). [`fit_with`]
-//! takes the scene key `starts`: `Kept` is [`fit`]; `Eye` fits one common eye with the
-//! directions, every projector through it (module `central`: a pinhole camera's affine
-//! direction field where that explains the data, else free node directions); `Auto`, the
-//! default, keeps the starts when they meet the data exactly and the data determine the
-//! free directions (bit for bit the old result), takes an exact eye fit where they do not
-//! (sparse data met exactly by many bent grids), and otherwise the eye where it meets the
-//! data clearly better. `Free` fits every node's start too (module `free`: projections with
-//! no common eye, such as pushbroom and crossed slits); `Auto` takes it where neither simpler
-//! model is exact and it is clearly better and determined ([`auto_fit`]).
+//! [`fit_with`] takes the scene key `starts`: `Kept` is [`fit`]; `Eye` fits one common eye
+//! with the directions, every projector through it (module `central`: a pinhole camera's
+//! affine direction field where that explains the data, else free node directions); `Free`
+//! fits every node's start too (module `free`: projections with no common eye, such as
+//! pushbroom and crossed slits). `Auto`, the default, keeps the starts when they meet the
+//! data exactly and the data determine the free directions, takes an exact eye fit where they
+//! do not, otherwise the eye where it meets the data clearly better, and the free starts
+//! where neither simpler model is exact and the free fit is clearly better and determined.
 //!
-//! # Warnings
+//! # Warnings (module `checks`)
 //!
 //! The residual is measured at the correspondences only. [`FitReport`] counts the
 //! constrained nodes that left the prior by far (`wild_nodes`: a length ratio to the prior's
 //! node beyond `WILD_LENGTH` times the median ratio, judged only where the lengths move the
-//! projectors at the points by more than the fit's noise ([`lengths_move_lines`]), or a
-//! direction more than `WILD_ANGLE_DEG` off) and those whose projectors the chosen model leaves undetermined
-//! (`sparse_nodes`, [`undetermined_nodes`]: none for a pinhole's field; for curved grids,
-//! summed grid weight below `SPARSE_WEIGHT`); [`FitReport::warning`] words them for the user.
+//! projectors at the points by more than the fit's noise, or a direction more than
+//! `WILD_ANGLE_DEG` off) and those the chosen model leaves undetermined (`sparse_nodes`:
+//! none for a pinhole's field; for curved grids, summed grid weight below `SPARSE_WEIGHT`);
+//! [`FitReport::warning`] words them for the user.
 //!
-//! # Curved projectors
+//! # Curved projectors (module `curved`)
 //!
 //! A prior with node tangents (quadratic Bezier projectors) is fitted in two stages: the
-//! straight fit above (its tangents dropped; with the noise's prior weight where its residual
-//! is above rounding, as it always is for curved data), then the end directions, tangents and
-//! lengths (where the data determine them; else the prior's) of every node that some
-//! correspondence constrains by nonlinear least squares from there (module `curved`).
-//! The prior's tangents mark the grid as curved and stay on the nodes no correspondence
-//! constrains; a fitted tangent along its chord makes a straight node.
+//! straight fit above (tangents dropped, with the noise's prior weight where its residual is
+//! above rounding), then the end directions, tangents and lengths (where the data determine
+//! them; else the prior's) of every constrained node by nonlinear least squares. The prior's
+//! tangents stay on the nodes no correspondence constrains; a fitted tangent along its chord
+//! makes a straight node.
 
 use glam::DVec3;
 
@@ -126,7 +103,7 @@ mod tests;
 const PRIOR_WEIGHT: f64 = 1e-11;
 
 /// How far, as a fraction of their length, the prior's node directions are taken to be off
-/// the truth when its weight follows the noise (module section "Noise").
+/// the truth when its weight follows the noise (module docs, "Noisy data").
 const PRIOR_SPREAD: f64 = 1.0;
 
 /// The starts a fit used.
@@ -223,7 +200,7 @@ pub fn node_warning(wild_nodes: usize, sparse_nodes: usize) -> Option<String> {
 /// fitted grid, with the prior's starts and interpolation, and its residual. A prior with
 /// tangents is fitted with curved projectors (section "Curved projectors").
 ///
-/// Noisy data (module section "Noise") are solved once with the noise's prior weight. Exact
+/// Noisy data (module docs of `grid`, "Noisy data") are solved once with the noise's prior weight. Exact
 /// data: the solve runs twice, the second time with the first fit as its prior: the prior term pulls
 /// every direction towards the prior by about `PRIOR_WEIGHT` times their difference, which for
 /// a prior far from the answer (a 90-degree frustum fitted to a 20-degree camera) leaves
@@ -246,7 +223,7 @@ pub fn fit(
         let (first, _) = in_view(prior, correspondences, &targets, floor_dirs)?;
         return fit_once(&first, correspondences);
     }
-    // Inexact data (module section "Inexact data"): the linear solution with the noise's
+    // Inexact data (module docs of `grid`, "Inexact data"): the linear solution with the noise's
     // prior weight is kept where it reaches every point in front of its start; otherwise
     // (no weight, or a node shrunk past zero) it and the prior start the angular refinement.
     let weight = noise_weight(&system, correspondences, &targets, &floor_dirs);

@@ -29,7 +29,7 @@ pub(super) fn all_in_front(
 
 /// Largest mean squared chord (2 sin(angle / 2)) per correspondence, in rad^2, at which the
 /// linear fit is taken as meeting the data (rms miss 1e-6 rad): below it the linear optimum
-/// cannot have shrunk or reversed a node (module section "Inexact data").
+/// cannot have shrunk or reversed a node (module docs of `grid`, "Inexact data").
 pub(super) const EXACT_CHORD: f64 = 1e-12;
 
 /// Whether the floor-weighted linear directions `dirs` meet every correspondence to within
@@ -78,7 +78,7 @@ pub(super) fn first_solve(
 }
 
 /// The prior's weight for noisy correspondences, or `None` when the data show no noise above
-/// what the floor weight `PRIOR_WEIGHT` handles (see the module section "Noise").
+/// what the floor weight `PRIOR_WEIGHT` handles (see the module docs of `grid`, "Noisy data").
 ///
 /// The solve at the floor weight, `floor_dirs`, measures the data term's residual sum of squares; divided by
 /// the degrees of freedom (two equations per correspondence less the unknowns of the
