@@ -102,3 +102,55 @@ fn build_report(fit: &FitReport) -> BuildReport {
         warnings: fit.warning().into_iter().collect(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The example scene whose projector grid has five `fit` correspondences.
+    fn fitted_example() -> ProjectionSpec {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../scenes/flexible-projector-fit.toml"
+        );
+        crate::scene::load(path).unwrap().projection
+    }
+
+    /// The projection layer does not fit: without the fitter a grid with correspondences is
+    /// an error, never an unfitted grid; with it the fit's residual and warning come back as
+    /// the typed report.
+    #[test]
+    fn grids_with_correspondences_are_built_only_through_calibrate() {
+        let spec = fitted_example();
+        let e = spec.build(64, 48).err().expect("built without the fit");
+        assert!(e.message.contains("calibrate::build"), "{}", e.message);
+        let (projection, report) = build(&spec, 64, 48).unwrap();
+        assert_eq!(projection.kind(), "flexible");
+        assert!(
+            report.counters.contains(&("fit_correspondences", 5.0)),
+            "{report:?}"
+        );
+        let rms = report
+            .counters
+            .iter()
+            .find(|(name, _)| *name == "fit_rms_angle_deg");
+        assert!(rms.is_some_and(|&(_, deg)| deg < 1e-9), "{report:?}");
+        assert_eq!(report.warnings.len(), 1, "{report:?}");
+        assert!(report.warnings[0].contains("not determined"), "{report:?}");
+    }
+
+    /// Projections without grids report nothing.
+    #[test]
+    fn explicit_projections_report_nothing() {
+        let spec = ProjectionSpec::Perspective {
+            frame: crate::projection::CameraFrame {
+                position: glam::DVec3::Z,
+                look_at: glam::DVec3::ZERO,
+                up: glam::DVec3::Y,
+            },
+            fov: 60.0,
+        };
+        let (_, report) = build(&spec, 8, 8).unwrap();
+        assert_eq!(report, BuildReport::default());
+    }
+}
