@@ -75,7 +75,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
     let loaded = args.scene.load()?;
     super::declare_scene_inputs(&mut outputs, &loaded.scene.inputs)?;
-    warn_of_fit(&loaded.source, &loaded.projection.notes());
+    for warning in &loaded.build_report.warnings {
+        eprintln!("flexcam: warning: {}: {warning}", loaded.source);
+    }
 
     let progress = RenderProgress::new();
     let report = |done: u64, total: u64| progress.update(done, total);
@@ -95,7 +97,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
     progress.finish();
     let (frame, mut counters) = rendered?;
-    for (name, value) in loaded.projection.notes() {
+    for &(name, value) in &loaded.build_report.counters {
         counters.insert(name, Counter::Value(value));
     }
 
@@ -135,22 +137,4 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         super::print_stdout(&format!("{json}\n"))?;
     }
     Ok(())
-}
-
-/// Prints the warning of a fitted projector grid (as `flexcam fit` does) from the
-/// projection's notes, on stderr; the render goes on.
-fn warn_of_fit(source: &str, notes: &[(&'static str, f64)]) {
-    let count = |key: &str| {
-        notes
-            .iter()
-            .find(|(name, _)| *name == key)
-            .map_or(0, |(_, value)| *value as usize)
-    };
-    let warning = flexcam::projection::flexible::fit::node_warning(
-        count("fit_wild_nodes"),
-        count("fit_sparse_nodes"),
-    );
-    if let Some(warning) = warning {
-        eprintln!("flexcam: warning: {source}: {warning}");
-    }
 }

@@ -14,7 +14,7 @@ use std::path::PathBuf;
 
 use glam::{Affine3A, Vec3};
 
-use crate::projection::surfaces::SurfaceScreenMap;
+use crate::projection::trilinear_builders::SurfaceScreenMap;
 use crate::projection::ProjectionSpec;
 
 /// One object of a scene. Its id (1-based, in file order; 0 is the background) is what the
@@ -115,6 +115,8 @@ impl Scene {
 pub mod builtin;
 pub mod file;
 pub mod loaders;
+#[cfg(test)]
+pub(crate) mod reflector_fixtures;
 pub mod shapes;
 
 pub use file::validate_resolution;
