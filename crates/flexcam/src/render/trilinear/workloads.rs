@@ -108,6 +108,7 @@ pub fn random_triangles(count: u32, seed: u64) -> Scene {
         },
         base_dir: None,
         trilinear_reflectors: Vec::new(),
+        inputs: Vec::new(),
     }
 }
 

@@ -19,12 +19,15 @@ use crate::calibrate::{self, FitReport};
 use crate::error::{Error, Result};
 use crate::projection::flexible::{Flexible, FlexibleSpec, ProjectorGrid, Volume, VolumeSource};
 use crate::projection::ProjectionSpec;
+use crate::scene::InputFile;
 
-/// A fitted scene: the text to write and the fit's residual.
+/// A fitted scene: the text to write, the fit's residual, and the files the fitting scene's
+/// values named (models, textures, surfaces; see [`crate::scene::Scene::inputs`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FittedScene {
     pub text: String,
     pub report: FitReport,
+    pub inputs: Vec<InputFile>,
 }
 
 /// Fits the projector grid of the scene file `text` (read from `path`) to its `fit`
@@ -70,6 +73,7 @@ pub fn fit_scene(text: &str, path: &Path, output: &Path) -> Result<FittedScene> 
     Ok(FittedScene {
         text: written,
         report,
+        inputs: scene.inputs,
     })
 }
 

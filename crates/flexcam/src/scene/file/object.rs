@@ -42,8 +42,10 @@ pub(super) fn convert(
         (_, Some((mesh, base))) => vec![(mesh, overrides.apply(base))],
         (Some(file), None) => {
             let path = src.existing_file(file, base_dir, "model file")?;
-            load_model(&path)
-                .map_err(|e| e.or_in_file(&path))?
+            let model = load_model(&path).map_err(|e| e.or_in_file(&path))?;
+            src.read_files(model.files);
+            model
+                .parts
                 .into_iter()
                 .map(|part| {
                     (

@@ -1427,3 +1427,44 @@ fn trilinear_refine_px_key() {
         "needs `trilinear_reflector = true`",
     );
 }
+
+/// A scene lists every file it was read from: itself, its models with the files they name,
+/// its textures and its trilinear surface.
+#[test]
+fn scenes_list_the_files_they_were_read_from() {
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let inputs = |name: &str| -> Vec<(&'static str, String)> {
+        let scene = load(&scenes.join(name)).unwrap();
+        let mut files: Vec<_> = scene
+            .inputs
+            .iter()
+            .map(|f| {
+                let path = f.path.strip_prefix(&scenes).unwrap();
+                (f.what, path.to_string_lossy().into_owned())
+            })
+            .collect();
+        files.dedup();
+        files
+    };
+    assert_eq!(
+        inputs("models.toml"),
+        [
+            ("scene file", "models.toml"),
+            ("model file", "models/octahedron.obj"),
+            ("material library", "models/octahedron.mtl"),
+            ("texture", "models/checker.png"),
+            ("model file", "models/pyramid.ply"),
+            ("model file", "models/tetra-quad.glb"),
+            ("texture", "models/checker.png"),
+        ]
+        .map(|(what, path)| (what, path.to_string()))
+    );
+    assert_eq!(
+        inputs("trilinear-fan.toml"),
+        [
+            ("scene file", "trilinear-fan.toml".to_string()),
+            ("trilinear surface", "surfaces/fan18.obj".to_string())
+        ]
+    );
+    assert!(scene(CAMERA).inputs.is_empty());
+}
