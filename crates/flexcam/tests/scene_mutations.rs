@@ -45,7 +45,12 @@ fn exercise(text: &str, path: &Path) -> bool {
         methods.push(Method::Trilinear);
     }
     for method in methods {
-        let _ = composite::render_with_method(&scene, projection.as_ref(), &options, method);
+        let _ = composite::render_with_method(
+            &flexcam::render::PreparedScene::new(&scene),
+            projection.as_ref(),
+            &options,
+            method,
+        );
     }
     true
 }

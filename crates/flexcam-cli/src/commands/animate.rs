@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, GifFrames, StagedFile};
 use flexcam::projection::ProjectionSpec;
-use flexcam::render::{Method, RenderOptions, Shading};
+use flexcam::render::{Method, PreparedScene, RenderOptions, Shading};
 use flexcam::scene;
 use flexcam::{Error, Result};
 
@@ -132,6 +132,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         Shading::Flat => ColorEncoding::Linear,
         Shading::Lit => ColorEncoding::Srgb,
     };
+    let prepared = PreparedScene::new(&scene);
     let progress = RenderProgress::new();
     let mut staged: Vec<StagedFile> = Vec::new();
     let mut gif = args.gif.as_ref().map(|_| GifFrames::default());
@@ -150,7 +151,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
             progress: Some(&report),
             ..RenderOptions::default()
         };
-        let (frame, _) = method.render(&scene, projection.as_ref(), &options)?;
+        let (frame, _) = method.render(&prepared, projection.as_ref(), &options)?;
         if let Some(pattern) = &pattern {
             staged.push(image_io::write_color_png(
                 &frame,

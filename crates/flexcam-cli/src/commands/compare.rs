@@ -9,7 +9,7 @@ use std::time::Instant;
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding};
 use flexcam::render::compare::{compare, Comparison};
-use flexcam::render::{composite, Frame, Method, RenderOptions};
+use flexcam::render::{composite, Frame, Method, PreparedScene, RenderOptions};
 use flexcam::{Error, Result};
 use glam::Vec3;
 use serde_json::json;
@@ -61,6 +61,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         image_io::check_output_path(path, &["png"])?;
     }
     let loaded = args.scene.load()?;
+    let prepared = PreparedScene::new(&loaded.scene);
     let reference_options = RenderOptions {
         shading: args.shading.shading(),
         spp: args.spp,
@@ -78,9 +79,9 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         let start = Instant::now();
         let projection = loaded.projection.as_ref();
         let (frame, _) = if composited {
-            composite::render_with_method(&loaded.scene, projection, options, m)?
+            composite::render_with_method(&prepared, projection, options, m)?
         } else {
-            m.render(&loaded.scene, projection, options)?
+            m.render(&prepared, projection, options)?
         };
         Ok::<_, Error>((frame, start.elapsed().as_secs_f64() * 1e3))
     };

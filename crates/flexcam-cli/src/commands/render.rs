@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, StagedFile};
-use flexcam::render::{composite, Counter, Method, RenderOptions, Shading};
+use flexcam::render::{composite, Counter, Method, PreparedScene, RenderOptions, Shading};
 use flexcam::{Error, Result};
 
 use super::scene_args::{MethodTuning, SceneArgs, ShadingArg};
@@ -64,16 +64,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ..RenderOptions::default()
     };
     let render_start = Instant::now();
+    let prepared = PreparedScene::new(&loaded.scene);
     // Trilinear reflectors (if the scene has any) are composited into the main view, each
     // rendered by the same method.
     let rendered =
-        composite::render_with_method(&loaded.scene, loaded.projection.as_ref(), &options, method);
+        composite::render_with_method(&prepared, loaded.projection.as_ref(), &options, method);
     let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
     progress.finish();
     let (frame, mut counters) = rendered?;
     for (name, value) in loaded.projection.notes() {
         counters.insert(name, Counter::Value(value));
     }
+    counters.insert("bvh_builds", Counter::Count(prepared.bvh_builds()));
 
     let encoding = match options.shading {
         Shading::Flat => ColorEncoding::Linear,

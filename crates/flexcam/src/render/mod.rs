@@ -118,10 +118,12 @@ pub enum Counter {
 
 /// Named counters a renderer reports (rays cast, build times, ...), for `--stats`.
 pub type Stats = BTreeMap<&'static str, Counter>;
+pub(crate) mod bvh;
 pub mod compare;
 pub mod composite;
 mod huge_pages;
 mod method;
+pub mod prepared;
 pub mod raster;
 pub mod raycast;
 pub mod reproject;
@@ -129,3 +131,4 @@ pub mod scan;
 pub mod surface;
 pub mod trilinear;
 pub use method::Method;
+pub use prepared::PreparedScene;

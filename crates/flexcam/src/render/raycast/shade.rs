@@ -23,10 +23,11 @@ use glam::{DVec3, Vec3};
 
 use super::hull_cull::LiveParts;
 use super::optics::{reflect, refract};
-use super::{polyline_segment, Hit, Hit32, RayCaster};
+use super::polyline_segment;
 use crate::geometry::Ray;
 use crate::projection::projector::{quadratic_arc_length, quadratic_point, quadratic_tangent};
 use crate::projection::Projector;
+use crate::render::prepared::{Hit, Hit32, PreparedScene};
 use crate::render::surface::{base_color, normals, Normals, TextureFilter};
 use crate::render::{RenderOptions, Shading};
 use crate::scene::{Light, Surface};
@@ -45,16 +46,16 @@ fn shows_base_color(surface: Surface) -> bool {
     matches!(surface, Surface::Diffuse | Surface::Emissive)
 }
 
-impl RayCaster {
+impl PreparedScene {
     /// Whether flat shading shows the base colour of object `object` (an index into the
     /// scene's objects) wherever it is hit, so that a hit's colour is the surface's base
     /// colour at the hit ([`crate::render::surface::base_color`], nearest texels) and casts
     /// no ray; `false` for a mirror or glass, which pass the ray on.
     pub fn flat_shows_base_color(&self, object: usize) -> bool {
-        shows_base_color(self.objects[object].material.surface)
+        shows_base_color(self.scene.objects[object].material.surface)
     }
 
-    /// [`RayCaster::shade_hit`] for a caller that builds the primary ray only where shading
+    /// [`PreparedScene::shade_hit`] for a caller that builds the primary ray only where shading
     /// reads it: flat shading of a surface that shows its base colour reads only the hit (as
     /// `Tracer::flat` does at its first hit), so `ray` is not called there. Same colour and
     /// ray count as `shade_hit(&ray(), hit, options)`.
@@ -64,7 +65,7 @@ impl RayCaster {
         hit: Hit,
         options: &RenderOptions,
     ) -> (Vec3, u64) {
-        let object = &self.objects[hit.object];
+        let object = &self.scene.objects[hit.object];
         if options.shading == Shading::Flat && shows_base_color(object.material.surface) {
             let color = base_color(
                 object,
@@ -123,7 +124,7 @@ fn length_before(points: &[DVec3], k: usize) -> f64 {
 
 /// Traces primary rays of one render; counts what it casts.
 pub(super) struct Tracer<'a> {
-    pub caster: &'a RayCaster,
+    pub caster: &'a PreparedScene,
     pub shading: Shading,
     pub max_bounces: u32,
     pub counts: RayCounts,
@@ -150,7 +151,7 @@ struct Segment {
 }
 
 impl<'a> Tracer<'a> {
-    pub fn new(caster: &'a RayCaster, options: &RenderOptions) -> Tracer<'a> {
+    pub fn new(caster: &'a PreparedScene, options: &RenderOptions) -> Tracer<'a> {
         Tracer {
             caster,
             shading: options.shading,
@@ -163,7 +164,7 @@ impl<'a> Tracer<'a> {
     /// The sample a pixel gets for `primary` (`None`: no projector there, the background).
     pub fn sample(&mut self, primary: Option<&Ray>) -> Sample {
         let background = Sample {
-            color: self.caster.background,
+            color: self.caster.scene.image.background,
             depth: f32::INFINITY,
             id: 0,
         };
@@ -221,7 +222,7 @@ impl<'a> Tracer<'a> {
     pub fn sample4(&mut self, primary: [Option<&Ray>; 4]) -> [Sample; 4] {
         let found = self.caster.intersect4_f32(primary);
         let mut samples = [Sample {
-            color: self.caster.background,
+            color: self.caster.scene.image.background,
             depth: f32::INFINITY,
             id: 0,
         }; 4];
@@ -275,7 +276,7 @@ impl<'a> Tracer<'a> {
 
     /// The samples of four quadratic projectors (`None`: no projector), exactly those of
     /// [`Tracer::sample_projector`] on each: their pieces are searched by shared BVH walks
-    /// ([`RayCaster::intersect_quadratic4`]).
+    /// ([`PreparedScene::intersect_quadratic4`]).
     fn sample4_quadratics(&mut self, curves: [Option<&[DVec3; 3]>; 4]) -> [Sample; 4] {
         let found = self.caster.intersect_quadratic4(curves, self.live);
         let mut samples = [self.sample(None); 4];
@@ -289,7 +290,7 @@ impl<'a> Tracer<'a> {
 
     /// The samples of four polyline projectors (`None`: no projector), exactly those of
     /// [`Tracer::sample_projector`] on each: segment k of the four is searched by one shared
-    /// BVH traversal ([`RayCaster::intersect4_polylines`]), leaving out the segments
+    /// BVH traversal ([`PreparedScene::intersect4_polylines`]), leaving out the segments
     /// `self.live` rules out.
     fn sample4_polylines(&mut self, polylines: [Option<&[DVec3]>; 4]) -> [Sample; 4] {
         let found = self.caster.intersect4_polylines(polylines, self.live);
@@ -314,7 +315,7 @@ impl<'a> Tracer<'a> {
             return self.shade_miss();
         };
         self.counts.primary += 1;
-        let object = &self.caster.objects[found.object];
+        let object = &self.caster.scene.objects[found.object];
         let (color, t) = match self.shading {
             // The common flat case, a diffuse or emissive first hit, needs neither an exact
             // hit point nor normals: the f32 hit gives the colour and the depth.
@@ -351,7 +352,7 @@ impl<'a> Tracer<'a> {
     pub(super) fn shade_miss(&mut self) -> Sample {
         self.counts.primary += 1;
         Sample {
-            color: self.caster.background,
+            color: self.caster.scene.image.background,
             depth: f32::INFINITY,
             id: 0,
         }
@@ -361,7 +362,7 @@ impl<'a> Tracer<'a> {
     fn flat(&mut self, ray: &Ray, hit: Hit) -> Vec3 {
         let (mut ray, mut hit) = (*ray, hit);
         for bounce in 0.. {
-            let object = &self.caster.objects[hit.object];
+            let object = &self.caster.scene.objects[hit.object];
             if shows_base_color(object.material.surface) {
                 return base_color(
                     object,
@@ -384,12 +385,12 @@ impl<'a> Tracer<'a> {
                 None => break,
             }
         }
-        self.caster.background
+        self.caster.scene.image.background
     }
 
     /// Lit shading of `hit` on `ray`, which has bounced `bounce` times and weighs `weight`.
     fn lit(&mut self, ray: &Ray, hit: Hit, bounce: u32, weight: f32) -> Vec3 {
-        let object = &self.caster.objects[hit.object];
+        let object = &self.caster.scene.objects[hit.object];
         let normals = self.normals(ray, &hit);
         let base = base_color(
             object,
@@ -426,13 +427,13 @@ impl<'a> Tracer<'a> {
     /// Light arriving at `from.position` along `direction`, for a branch weighing `weight`.
     fn radiance(&mut self, from: &Segment, direction: DVec3, weight: f32) -> Vec3 {
         if from.bounce > self.max_bounces || weight < MIN_WEIGHT {
-            return self.caster.background;
+            return self.caster.scene.image.background;
         }
         let ray = self.caster.spawn(from.position, from.normal, direction);
         self.counts.secondary += 1;
         match self.caster.intersect(&ray) {
             Some(hit) => self.lit(&ray, hit, from.bounce, weight),
-            None => self.caster.background,
+            None => self.caster.scene.image.background,
         }
     }
 
@@ -446,11 +447,11 @@ impl<'a> Tracer<'a> {
             let highlight = reflect(-to_light, normal).dot(-view).max(0.0) as f32;
             base * cos + Vec3::splat(SPECULAR * highlight.powi(SHININESS))
         };
-        if self.caster.lights.is_empty() {
+        if self.caster.scene.lights.is_empty() {
             return base * AMBIENT + shade(-view);
         }
         let mut color = base * AMBIENT;
-        for light in &self.caster.lights {
+        for light in &self.caster.scene.lights {
             let (to_light, t_max, radiance) = match *light {
                 Light::Point {
                     position: p,
@@ -479,7 +480,7 @@ impl<'a> Tracer<'a> {
 
     /// The normals at `hit` as seen along `ray`.
     fn normals(&self, ray: &Ray, hit: &Hit) -> Normals {
-        let object = &self.caster.objects[hit.object];
+        let object = &self.caster.scene.objects[hit.object];
         normals(
             object,
             hit.triangle,

@@ -34,7 +34,7 @@
 //! exact `t`, its key the triangle hit, and its barycentrics the winner's scene
 //! barycentrics, so an exact winner is shaded without intersecting again (a
 //! crack filler, whose depth was pushed back, is resolved again). The hit is handed to
-//! [`RayCaster::shade_hit`], which shades it exactly as the ray caster
+//! [`PreparedScene::shade_hit`], which shades it exactly as the ray caster
 //! does (flat: base colour, mirrors and glass passing the ray on; lit: lights, hard shadows,
 //! reflection and refraction, all traced by the ray caster from the rasterised first hit),
 //! except for flat shading of a surface that shows its base colour: that colour is read from
@@ -51,7 +51,7 @@ use super::scene_geometry::SceneGeometry;
 use super::screen_map::ScreenMap;
 use crate::geometry::Ray;
 use crate::projection::{Projection, Trilinear};
-use crate::render::raycast::{Hit, RayCaster};
+use crate::render::prepared::{Hit, PreparedScene};
 use crate::render::scan::{FrameRows, NO_PRIMITIVE};
 use crate::render::surface::triangle_color::TriangleColor;
 use crate::render::RenderOptions;
@@ -253,7 +253,7 @@ impl std::ops::Add for ShadeCounts {
 /// Everything the shading pass reads.
 pub struct Shader<'a> {
     pub resolver: Resolver<'a>,
-    pub caster: &'a RayCaster,
+    pub prepared: &'a PreparedScene,
     pub projection: &'a Trilinear,
     pub options: &'a RenderOptions<'a>,
     /// Per projection triangle: ray cast its pixels instead.
@@ -501,7 +501,7 @@ impl Shader<'_> {
     }
 
     /// Pixel `(x, y)`'s winning fragment (`key`, G-buffer depth and barycentrics), shaded. An exact winner is read from the G-buffer (module doc) and its projector's
-    /// origin is built only if shading needs the ray (`RayCaster::shade_hit_lazy`); a crack
+    /// origin is built only if shading needs the ray (`PreparedScene::shade_hit_lazy`); a crack
     /// filler is resolved again. `None` where there is no hit after all (no projector).
     #[inline]
     fn rasterised(&self, key: u64, depth: f64, barycentric: Vec2, x: u32, y: u32) -> Option<Pixel> {
@@ -545,7 +545,7 @@ impl Shader<'_> {
                     triangle: owner.triangle as usize,
                     barycentric,
                 };
-                self.caster.shade_hit_lazy(ray, hit, self.options)
+                self.prepared.shade_hit_lazy(ray, hit, self.options)
             }
         };
         Pixel {
@@ -566,7 +566,7 @@ impl Shader<'_> {
             shading_rays: 0,
             fallback_rays: 1,
         };
-        let Some(hit) = self.caster.intersect(&ray) else {
+        let Some(hit) = self.prepared.intersect(&ray) else {
             return Some(Pixel {
                 color: self.background,
                 depth: f32::INFINITY,
@@ -574,7 +574,7 @@ impl Shader<'_> {
                 counts,
             });
         };
-        let (color, rays) = self.caster.shade_hit(&ray, hit, self.options);
+        let (color, rays) = self.prepared.shade_hit(&ray, hit, self.options);
         Some(Pixel {
             color,
             depth: (hit.t * ray.direction.length()) as f32,
