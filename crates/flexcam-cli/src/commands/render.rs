@@ -5,10 +5,10 @@ use std::time::Instant;
 
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, StagedFile};
-use flexcam::render::{composite, Counter, Method, PreparedScene, RenderOptions, Shading};
+use flexcam::render::{self, Counter, Method, PreparedScene, RenderOptions, Shading};
 use flexcam::{Error, Result};
 
-use super::scene_args::{MethodTuning, SceneArgs, ShadingArg};
+use super::scene_args::{print_warnings, MethodTuning, SceneArgs, ShadingArg};
 use crate::progress::RenderProgress;
 use crate::stats_json::{self, RunFacts};
 use crate::OutputTarget;
@@ -51,11 +51,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     check_outputs(args)?;
 
     let loaded = args.scene.load()?;
-    warn_of_fit(&loaded.source, &loaded.projection.notes());
+    print_warnings(&loaded);
 
     let progress = RenderProgress::new();
     let report = |done: u64, total: u64| progress.update(done, total);
     let options = RenderOptions {
+        method,
         shading: args.shading.shading(),
         spp: args.spp,
         subdivision: args.tuning.subdivision(method)?,
@@ -66,13 +67,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let render_start = Instant::now();
     let prepared = PreparedScene::new(&loaded.scene);
     // Trilinear reflectors (if the scene has any) are composited into the main view, each
-    // rendered by the same method.
-    let rendered =
-        composite::render_with_method(&prepared, loaded.projection.as_ref(), &options, method);
+    // rendered by the same method (the options' default).
+    let rendered = render::render(&prepared, loaded.projection.as_ref(), &options);
     let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
     progress.finish();
-    let (frame, mut counters) = rendered?;
-    for (name, value) in loaded.projection.notes() {
+    let render::Rendered {
+        frame,
+        mut counters,
+    } = rendered?;
+    for &(name, value) in &loaded.projection_counters {
         counters.insert(name, Counter::Value(value));
     }
     counters.insert("bvh_builds", Counter::Count(prepared.bvh_builds()));
@@ -112,24 +115,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         super::print_stdout(&format!("{json}\n"))?;
     }
     Ok(())
-}
-
-/// Prints the warning of a fitted projector grid (as `flexcam fit` does) from the
-/// projection's notes, on stderr; the render goes on.
-fn warn_of_fit(source: &str, notes: &[(&'static str, f64)]) {
-    let count = |key: &str| {
-        notes
-            .iter()
-            .find(|(name, _)| *name == key)
-            .map_or(0, |(_, value)| *value as usize)
-    };
-    let warning = flexcam::projection::flexible::fit::node_warning(
-        count("fit_wild_nodes"),
-        count("fit_sparse_nodes"),
-    );
-    if let Some(warning) = warning {
-        eprintln!("flexcam: warning: {source}: {warning}");
-    }
 }
 
 /// Fails before rendering on output paths that could not be written afterwards.

@@ -1,4 +1,5 @@
-//! Rendering methods by name (`--method`), and the one entry point that dispatches to them.
+//! Rendering methods by name (`--method`), and the dispatch to them that
+//! [`crate::render::render`] and reflector compositing share.
 
 use std::fmt;
 use std::str::FromStr;
@@ -40,10 +41,10 @@ impl Method {
         }
     }
 
-    /// Renders `prepared` through `projection`. Fails, rather than producing a wrong image, when
-    /// the method cannot render that projection. The returned stats hold the method's own
-    /// counters.
-    pub fn render(
+    /// Renders `prepared` through `projection` by this method alone (no reflector
+    /// compositing). Fails, rather than producing a wrong image, when the method cannot
+    /// render that projection. The returned stats hold the method's own counters.
+    pub(crate) fn render(
         self,
         prepared: &PreparedScene,
         projection: &dyn Projection,

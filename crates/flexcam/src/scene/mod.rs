@@ -101,10 +101,12 @@ impl Scene {
 
 pub mod builtin;
 pub mod file;
+mod loaded;
 pub mod loaders;
 pub mod shapes;
 
 pub use file::validate_resolution;
+pub use loaded::{load_with, LoadWarning, LoadedScene, Overrides};
 
 /// Loads a scene from `source`: `builtin:NAME` names a built-in scene, anything else is the
 /// path of a scene file. This is the SCENE argument of `flexcam render`.
