@@ -267,13 +267,7 @@ fn write_depth_pfm(frame: &Frame, path: &Path) -> Result<()> {
     out.flush().map_err(io)
 }
 
-/// A colour image read from a file, in linear RGB, rows from the top.
-#[derive(Debug, Clone, PartialEq)]
-pub struct LinearImage {
-    pub width: u32,
-    pub height: u32,
-    pub pixels: Vec<Vec3>,
-}
+pub use crate::render::LinearImage;
 
 /// The input extensions [`read_linear_image`] accepts.
 pub const INPUT_EXTENSIONS: [&str; 4] = ["png", "jpg", "jpeg", "exr"];

@@ -35,7 +35,7 @@ use crate::projection::surfaces::{reflector_surface, Optic, ReflectorSurface, Su
 use crate::projection::{Perspective, Projection, ProjectionSpec, Trilinear, TrilinearMesh};
 use crate::render::prepared::PreparedScene;
 use crate::render::raycast::specular;
-use crate::render::surface::normals;
+use crate::render::shading::normals;
 use crate::render::{Counter, Frame, Method, RenderOptions, Shading, Stats};
 use crate::scene::{Mesh, Object, Scene, Surface, TrilinearReflector};
 

@@ -149,6 +149,15 @@ pub fn render(
     Ok(Rendered { frame, counters })
 }
 
+/// A colour image in linear RGB, rows from the top: a photo to reproject
+/// ([`reproject::EquirectPhoto`]), as `image_io` reads it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearImage {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<Vec3>,
+}
+
 /// One counter of a renderer's statistics.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Counter {
@@ -168,7 +177,7 @@ pub mod raster;
 pub mod raycast;
 pub mod reproject;
 pub mod scan;
-pub mod surface;
+pub mod shading;
 pub mod trilinear;
 pub use method::Method;
 pub use prepared::PreparedScene;

@@ -242,7 +242,7 @@ mod tests {
     use proptest::prelude::*;
 
     use super::*;
-    use crate::render::raycast::curve::piece;
+    use crate::render::raycast::pieces::piece;
 
     fn tri(a: DVec3, b: DVec3, c: DVec3) -> CurveTriangle {
         CurveTriangle::new([a, b - a, c - a])

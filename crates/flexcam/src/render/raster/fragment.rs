@@ -20,7 +20,7 @@ use super::pixel_rays::PixelRays;
 use crate::geometry::Ray;
 use crate::render::prepared::{Hit, PreparedScene};
 use crate::render::scan::NO_PRIMITIVE;
-use crate::render::surface::{base_color, TextureFilter};
+use crate::render::shading::{base_color, TextureFilter};
 use crate::render::{RenderOptions, Shading};
 use crate::scene::{Object, Surface};
 

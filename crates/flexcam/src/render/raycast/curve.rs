@@ -27,33 +27,10 @@
 use glam::{DVec3, Vec2};
 
 use super::hull_cull::LiveParts;
-use crate::projection::projector::{quadratic_point, quadratic_tangent};
+use super::pieces::{piece, piece_interval, PIECES};
 use crate::render::bvh::curve_triangle::CurveHit;
 use crate::render::bvh::{NearSegment, NearSegments4};
 use crate::render::prepared::{Hit32, PreparedScene};
-
-/// Pieces the curve is cut into for the BVH search: more pieces give thinner fattened chords
-/// (the padding falls as 1/PIECES^2), boxes that fewer triangles overlap, and fewer triangles
-/// tested beyond the first hit, but more traversals and more piece boxes in the tile culls.
-/// 24 took the least CPU time on the Table 7.1 bench's smallest models (8, 12, 16, 20, 24,
-/// 28, 32, 48 and 64 tried; docs/flexible.md, change 7).
-pub(super) const PIECES: usize = 24;
-
-/// The parameter interval [a, b] of piece `k` of [`PIECES`].
-pub(super) fn piece_interval(k: usize) -> (f64, f64) {
-    (k as f64 / PIECES as f64, (k + 1) as f64 / PIECES as f64)
-}
-
-/// The control points of the piece of curve `p` over [a, b] (blossoming: the end points and
-/// the intersection of the end tangents).
-pub(in crate::render) fn piece(p: &[DVec3; 3], a: f64, b: f64) -> [DVec3; 3] {
-    let start = quadratic_point(p, a);
-    [
-        start,
-        start + 0.5 * (b - a) * quadratic_tangent(p, a),
-        quadratic_point(p, b),
-    ]
-}
 
 /// The distance from `q` to the segment from `a` to `b`.
 fn distance_to_segment(q: DVec3, a: DVec3, b: DVec3) -> f64 {
@@ -279,6 +256,7 @@ mod tests {
     use proptest::prelude::*;
 
     use super::*;
+    use crate::projection::projector::quadratic_point;
     use crate::render::bvh::curve_triangle::CurveTriangle;
 
     #[test]

@@ -10,7 +10,7 @@
 
 use glam::DVec3;
 
-use super::curve::{piece, piece_interval, PIECES};
+use super::pieces::{piece, piece_interval, PIECES};
 use crate::projection::{Projector, ProjectorHull};
 use crate::render::prepared::PreparedScene;
 

@@ -3,9 +3,10 @@
 //! a projection into a new frame, [`render_into`] into a frame the caller keeps.
 //! See docs/raycast.md for the design and the measurements.
 
-pub(in crate::render) mod curve;
+mod curve;
 mod hull_cull;
 pub(crate) mod optics;
+pub(in crate::render) mod pieces;
 pub(crate) mod sampling;
 mod shade;
 mod tiles;
@@ -16,21 +17,11 @@ use glam::{DVec3, Vec3};
 pub(crate) use self::sampling::SamplePattern;
 pub(crate) use self::shade::specular;
 
+use self::pieces::polyline_segment;
 use crate::geometry::Ray;
 use crate::projection::Projection;
 use crate::render::prepared::{Hit, Hit32, PreparedScene};
 use crate::render::{Frame, RenderOptions, Stats};
-
-/// Segment `k` of polyline projector `points` as a ray over `t` in `[0, 1]`, from vertex `k`
-/// to vertex `k + 1` (a zero direction where the two coincide).
-fn polyline_segment(points: &[DVec3], k: usize) -> Ray {
-    Ray {
-        origin: points[k],
-        direction: points[k + 1] - points[k],
-        t_min: 0.0,
-        t_max: 1.0,
-    }
-}
 
 impl PreparedScene {
     /// The first hits of four polyline projectors (`None`: no projector) and the segments

@@ -23,12 +23,12 @@ use glam::{DVec3, Vec3};
 
 use super::hull_cull::LiveParts;
 use super::optics::{reflect, refract};
-use super::polyline_segment;
+use super::pieces::polyline_segment;
 use crate::geometry::Ray;
 use crate::projection::projector::{quadratic_arc_length, quadratic_point, quadratic_tangent};
 use crate::projection::Projector;
 use crate::render::prepared::{Hit, Hit32, PreparedScene};
-use crate::render::surface::{base_color, normals, Normals, TextureFilter};
+use crate::render::shading::{base_color, normals, Normals, TextureFilter};
 use crate::render::{RenderOptions, Shading};
 use crate::scene::{Light, Surface};
 
@@ -49,7 +49,7 @@ fn shows_base_color(surface: Surface) -> bool {
 impl PreparedScene {
     /// Whether flat shading shows the base colour of object `object` (an index into the
     /// scene's objects) wherever it is hit, so that a hit's colour is the surface's base
-    /// colour at the hit ([`crate::render::surface::base_color`], nearest texels) and casts
+    /// colour at the hit ([`crate::render::shading::base_color`], nearest texels) and casts
     /// no ray; `false` for a mirror or glass, which pass the ray on.
     pub fn flat_shows_base_color(&self, object: usize) -> bool {
         shows_base_color(self.scene.objects[object].material.surface)

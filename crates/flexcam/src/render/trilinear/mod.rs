@@ -29,6 +29,7 @@ pub mod hit_terms;
 pub mod outline;
 pub mod pair_cull;
 pub mod polygons;
+pub mod resolve;
 pub mod scene_geometry;
 pub mod screen_map;
 pub mod shade;
@@ -47,16 +48,17 @@ pub use curves::{CurveMode, CurveOptions};
 use self::central::CentralProjection;
 use self::gbuffer::GBuffer;
 use self::polygons::{project_all, projection_triangles, ProjectedScene};
+use self::resolve::Resolver;
 use self::scene_geometry::SceneGeometry;
 use self::screen_map::ScreenMap;
-use self::shade::{Resolver, ShadeCounts, Shader};
+use self::shade::{ShadeCounts, Shader};
 use crate::error::{Error, Result};
 use crate::projection::{Projection, Trilinear};
 use crate::render::prepared::PreparedScene;
 use crate::render::raycast::SamplePattern;
 use crate::render::scan::{band_rows_for, for_each_band, RasterStats, Scratch};
-use crate::render::surface::triangle_color::TriangleColor;
-use crate::render::surface::TextureFilter;
+use crate::render::shading::triangle_color::TriangleColor;
+use crate::render::shading::TextureFilter;
 use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
 
 /// A prepared scene made ready for trilinear rendering: its triangles in f64 and the flat base

@@ -4,7 +4,7 @@ use super::*;
 use crate::geometry::Ray;
 use crate::projection::surfaces::test_scenes::{self, lens_plane, BALL_CENTER};
 use crate::projection::Projection;
-use crate::render::surface::normals;
+use crate::render::shading::normals;
 use crate::render::PreparedScene;
 use crate::scene::Scene;
 
