@@ -34,8 +34,8 @@ use crate::error::{Error, Result};
 use crate::projection::surfaces::{reflector_surface, Optic, ReflectorSurface, SurfaceScreenMap};
 use crate::projection::{Perspective, Projection, ProjectionSpec, Trilinear, TrilinearMesh};
 use crate::render::prepared::PreparedScene;
-use crate::render::raycast::specular;
 use crate::render::shading::normals;
+use crate::render::shading::trace::specular;
 use crate::render::{Counter, Frame, Method, RenderOptions, Shading, Stats};
 use crate::scene::{Mesh, Object, Scene, Surface, TrilinearReflector};
 

@@ -12,15 +12,14 @@ mod shade;
 mod tiles;
 pub mod workloads;
 
-use glam::{DVec3, Vec3};
+use glam::DVec3;
 
 pub(crate) use self::sampling::SamplePattern;
-pub(crate) use self::shade::specular;
 
 use self::pieces::polyline_segment;
 use crate::geometry::Ray;
 use crate::projection::Projection;
-use crate::render::prepared::{Hit, Hit32, PreparedScene};
+use crate::render::prepared::{Hit32, PreparedScene};
 use crate::render::{Frame, RenderOptions, Stats};
 
 impl PreparedScene {
@@ -58,16 +57,6 @@ impl PreparedScene {
             }
         }
         found
-    }
-
-    /// The colour `options.shading` gives primary ray `ray` whose first hit is `hit` (found by
-    /// any means, e.g. rasterisation), exactly as [`raycast::render`] shades it: mirrors,
-    /// glass and shadows are traced from there with this caster. Also returns the number of
-    /// secondary and shadow rays that took.
-    pub fn shade_hit(&self, ray: &Ray, hit: Hit, options: &RenderOptions) -> (Vec3, u64) {
-        let mut tracer = shade::Tracer::new(self, options);
-        let color = tracer.shade_hit(ray, hit);
-        (color, tracer.counts.secondary + tracer.counts.shadow)
     }
 }
 

@@ -184,8 +184,8 @@ fn polyline_quads_sample_exactly_like_single_projectors() {
                 assert_eq!(together, alone, "quad at ({x}, {y}), {shading:?}");
             }
         }
-        assert_eq!(quad.counts, single.counts);
-        assert!(quad.counts.primary > 0);
+        assert_eq!(quad.shader.counts, single.shader.counts);
+        assert!(quad.shader.counts.primary > 0);
     }
 }
 

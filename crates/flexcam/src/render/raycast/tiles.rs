@@ -11,9 +11,10 @@ use rayon::prelude::*;
 
 use super::hull_cull::LiveParts;
 use super::sampling::SamplePattern;
-use super::shade::{RayCounts, Sample, Tracer};
+use super::shade::{Sample, Tracer};
 use crate::projection::{Projection, Projector};
 use crate::render::prepared::PreparedScene;
+use crate::render::shading::trace::RayCounts;
 use crate::render::{Counter, Frame, RenderOptions, Stats};
 
 /// Tile edge in pixels: small enough to balance two to many cores, large enough that the
@@ -253,6 +254,6 @@ fn render_tile(
             store(&mut tile, (x, y), color * scale, centre);
         }
     }
-    tile.counts = tracer.counts;
+    tile.counts = tracer.shader.counts;
     tile
 }
