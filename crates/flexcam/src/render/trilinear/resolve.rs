@@ -24,9 +24,6 @@
 //!   vertex where several triangles meet): a **crack filler**, shaded at the nearest point
 //!   of the triangle (barycentrics clamped) with its depth pushed behind every exact
 //!   fragment (`+ CRACK_FILL_DEPTH`), so that it never hides an exact fragment.
-//!   Before the neighbour step the fillers did all of this, and where the true surface's
-//!   pixel was left to a filler, a farther surface's exact fragment (the far side of the
-//!   same object) won it: 4 such pixels in scenes/trilinear-fan.toml.
 //! - Behind the view plane, or a projector parallel to the plane: discarded.
 //!
 
