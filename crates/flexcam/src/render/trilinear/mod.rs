@@ -17,26 +17,26 @@
 //! Unprojectable pairs (see `projection::Unprojectable`) are counted and their projection
 //! triangle is ray cast instead, so they never silently vanish.
 
-pub mod central;
-pub mod clip;
+mod central;
+mod clip;
 #[cfg(test)]
 mod cull_tests;
-pub mod cull_tree;
-pub mod curves;
-pub mod edge_path;
-pub mod gbuffer;
-pub mod hit_terms;
-pub mod outline;
-pub mod pair_cull;
-pub mod polygons;
-pub mod resolve;
-pub mod scene_geometry;
-pub mod screen_map;
-pub mod shade;
+mod cull_tree;
+mod curves;
+mod edge_path;
+mod gbuffer;
+mod hit_terms;
+mod outline;
+mod pair_cull;
+mod polygons;
+mod resolve;
+mod scene_geometry;
+mod screen_map;
+mod shade;
 #[cfg(test)]
 mod tests;
-pub mod view_plane;
-pub mod volume_bounds;
+mod view_plane;
+mod volume_bounds;
 pub mod workloads;
 
 use std::time::Instant;
@@ -44,12 +44,13 @@ use std::time::Instant;
 use glam::{DVec2, DVec3, Vec3};
 
 pub use curves::{CurveMode, CurveOptions};
+pub use polygons::{project_all, projection_triangles};
+pub use scene_geometry::SceneGeometry;
 
 use self::central::CentralProjection;
 use self::gbuffer::GBuffer;
-use self::polygons::{project_all, projection_triangles, ProjectedScene};
+use self::polygons::ProjectedScene;
 use self::resolve::Resolver;
-use self::scene_geometry::SceneGeometry;
 use self::screen_map::ScreenMap;
 use self::shade::{ShadeCounts, Shader};
 use crate::error::{Error, Result};
