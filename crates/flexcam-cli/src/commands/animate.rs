@@ -152,8 +152,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     let mut gif = args.gif.as_ref().map(|_| GifFrames::default());
     for frame_number in 0..frames {
         let spec = ProjectionSpec::Flexible(Box::new(animation.projection(frame_number)));
-        let projection = spec
-            .build(width, height)
+        let (projection, _) = flexcam::calibrate::build(&spec, width, height)
             .map_err(|e| e.or_in_file(&args.scene))?;
         let done_before = u64::from(frame_number);
         let report = |done: u64, total: u64| {

@@ -75,7 +75,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         frame,
         mut counters,
     } = rendered?;
-    for &(name, value) in &loaded.projection_counters {
+    for &(name, value) in &loaded.build_report.counters {
         counters.insert(name, Counter::Value(value));
     }
     counters.insert("bvh_builds", Counter::Count(prepared.bvh_builds()));

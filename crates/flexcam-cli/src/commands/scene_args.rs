@@ -62,7 +62,7 @@ impl SceneArgs {
 
 /// Prints the warnings of a scene's load on stderr (the command goes on).
 pub fn print_warnings(loaded: &LoadedScene) {
-    for warning in &loaded.warnings {
+    for warning in &loaded.build_report.warnings {
         eprintln!("flexcam: warning: {}: {warning}", loaded.source);
     }
 }

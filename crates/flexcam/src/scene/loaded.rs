@@ -1,15 +1,13 @@
 //! Loading a scene with the caller's overrides (image size, the perspective edit of a
 //! panorama, ...) and building its projection: what a command needs before rendering, with
-//! the warnings of the build as values the caller prints or ignores.
+//! the projection build's report (counters, warnings) for the caller to print or ignore.
 
-use std::fmt;
 use std::time::Instant;
 
 use crate::error::{Error, Result};
-use crate::projection::flexible::fit::node_warning;
 use crate::projection::flexible::panorama::edit_source;
 use crate::projection::flexible::FlexibleSpec;
-use crate::projection::{Projection, ProjectionSpec};
+use crate::projection::{BuildReport, Projection, ProjectionSpec};
 use crate::scene::{self, Scene};
 
 /// What a caller changes in a scene file's settings. `None` keeps the file's value.
@@ -25,25 +23,6 @@ pub struct Overrides {
     pub perspective_rect: Option<[f64; 4]>,
 }
 
-/// Something the build of a scene's projection found doubtful; the scene still renders.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum LoadWarning {
-    /// A fitted projector grid (a flexible projection fitted to correspondences) has nodes
-    /// that left the prior by far (`wild`) or that the correspondences do not determine
-    /// (`sparse`): its residual, measured at the correspondences only, does not show them.
-    FitNodes { wild: usize, sparse: usize },
-}
-
-impl fmt::Display for LoadWarning {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match *self {
-            LoadWarning::FitNodes { wild, sparse } => {
-                f.write_str(&node_warning(wild, sparse).unwrap_or_default())
-            }
-        }
-    }
-}
-
 /// A scene loaded with overrides and its projection built at the image size.
 pub struct LoadedScene {
     /// The scene as named by the caller (`builtin:NAME` for built-ins).
@@ -52,10 +31,9 @@ pub struct LoadedScene {
     pub projection: Box<dyn Projection>,
     pub width: u32,
     pub height: u32,
-    /// The projection build's counters by name (fit residuals, node counts, ...), for
-    /// `--stats`.
-    pub projection_counters: Vec<(&'static str, f64)>,
-    pub warnings: Vec<LoadWarning>,
+    /// What building the projection reported: counters for `--stats` (a fitted grid's
+    /// residual, ...) and warnings (a fitted grid's doubtful nodes).
+    pub build_report: BuildReport,
     /// Time spent loading and building, in milliseconds.
     pub load_ms: f64,
 }
@@ -72,39 +50,17 @@ pub fn load_with(source: &str, overrides: &Overrides) -> Result<LoadedScene> {
     let width = overrides.width.unwrap_or(scene.image.width);
     let height = overrides.height.unwrap_or(scene.image.height);
     scene::validate_resolution(width, height)?;
-    let projection = scene
-        .projection
-        .build(width, height)
+    let (projection, build_report) = crate::calibrate::build(&scene.projection, width, height)
         .map_err(|e: Error| e.or_in_file(source))?;
-    let (projection_counters, warnings) = build_report(projection.as_ref());
     Ok(LoadedScene {
         source: source.to_string(),
         scene,
         projection,
         width,
         height,
-        projection_counters,
-        warnings,
+        build_report,
         load_ms: start.elapsed().as_secs_f64() * 1e3,
     })
-}
-
-/// The counters and warnings of `projection`'s build, from its notes.
-fn build_report(projection: &dyn Projection) -> (Vec<(&'static str, f64)>, Vec<LoadWarning>) {
-    let notes = projection.notes();
-    let count = |key: &str| {
-        notes
-            .iter()
-            .find(|(name, _)| *name == key)
-            .map_or(0, |(_, value)| *value as usize)
-    };
-    let (wild, sparse) = (count("fit_wild_nodes"), count("fit_sparse_nodes"));
-    let warnings = if wild + sparse > 0 {
-        vec![LoadWarning::FitNodes { wild, sparse }]
-    } else {
-        Vec::new()
-    };
-    (notes, warnings)
 }
 
 /// `projection` with the perspective edit `rect`.

@@ -14,7 +14,7 @@ use std::path::PathBuf;
 
 use glam::{Affine3A, Vec3};
 
-use crate::projection::surfaces::SurfaceScreenMap;
+use crate::projection::trilinear_builders::SurfaceScreenMap;
 use crate::projection::ProjectionSpec;
 
 /// One object of a scene. Its id (1-based, in file order; 0 is the background) is what the
@@ -103,10 +103,12 @@ pub mod builtin;
 pub mod file;
 mod loaded;
 pub mod loaders;
+#[cfg(test)]
+pub(crate) mod reflector_fixtures;
 pub mod shapes;
 
 pub use file::validate_resolution;
-pub use loaded::{load_with, LoadWarning, LoadedScene, Overrides};
+pub use loaded::{load_with, LoadedScene, Overrides};
 
 /// Loads a scene from `source`: `builtin:NAME` names a built-in scene, anything else is the
 /// path of a scene file. This is the SCENE argument of `flexcam render`.

@@ -5,7 +5,6 @@
 
 mod curve;
 mod hull_cull;
-pub(crate) mod optics;
 pub(in crate::render) mod pieces;
 pub(crate) mod sampling;
 mod shade;

@@ -19,9 +19,9 @@
 
 use glam::{DVec3, Vec3};
 
+use crate::geometry::optics::{reflect, refract};
 use crate::geometry::Ray;
 use crate::render::prepared::{Hit, PreparedScene};
-use crate::render::raycast::optics::{reflect, refract};
 use crate::render::shading::{base_color, normals, Normals, TextureFilter};
 use crate::render::{RenderOptions, Shading};
 use crate::scene::{Light, Surface};

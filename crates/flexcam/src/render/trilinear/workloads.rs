@@ -14,7 +14,7 @@
 use glam::{Affine3A, DVec2, DVec3, Vec3};
 
 use crate::error::Result;
-use crate::projection::surfaces::{screen_grid, GridVertex};
+use crate::projection::trilinear_builders::{screen_grid, GridVertex};
 use crate::projection::{CameraFrame, ProjectionSpec, TrilinearMesh};
 use crate::scene::{ImageSettings, Material, Mesh, Object, Scene};
 

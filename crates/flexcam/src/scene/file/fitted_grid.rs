@@ -15,8 +15,8 @@ use std::path::Path;
 
 use toml_edit::{Array, DocumentMut, InlineTable, Item, TableLike, Value};
 
+use crate::calibrate::{self, FitReport};
 use crate::error::{Error, Result};
-use crate::projection::flexible::fit::FitReport;
 use crate::projection::flexible::{Flexible, FlexibleSpec, ProjectorGrid, Volume, VolumeSource};
 use crate::projection::ProjectionSpec;
 
@@ -86,9 +86,10 @@ fn fitted_grid(
     if !has_fit(spec) {
         return Ok(None);
     }
-    let flexible = Flexible::new(spec, width, height)?;
-    Ok(match flexible.volume() {
-        Volume::Grid(grid) => grid.fit.map(|report| (grid.grid.clone(), report)),
+    // The top-level grid is fitted last (after any grids of its base).
+    let (flexible, mut reports) = calibrate::build_flexible(spec, width, height)?;
+    Ok(match (flexible.volume(), reports.pop()) {
+        (Volume::Grid(grid), Some(report)) => Some((grid.grid.clone(), report)),
         _ => None,
     })
 }

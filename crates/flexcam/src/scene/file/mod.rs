@@ -103,12 +103,12 @@ pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animatio
         .map(|table| light::convert(&src, table))
         .collect::<Result<Vec<_>>>()?;
     // Building the projection is what detects degenerate parameters.
-    projection
-        .build(image.width, image.height)
-        .map_err(|e| match e.location {
+    crate::calibrate::build(&projection, image.width, image.height).map_err(|e| {
+        match e.location {
             Some(_) => e,
             None => src.error(&projection_table.span(), e.message),
-        })?;
+        }
+    })?;
     let animation = raw
         .animation
         .as_ref()

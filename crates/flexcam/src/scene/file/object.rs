@@ -11,7 +11,7 @@ use super::raw::{Numbers, RawObject};
 use super::shape::{analytic_mesh, Shape, MAX_TESSELLATION};
 use super::source::Source;
 use crate::error::Result;
-use crate::projection::surfaces::SurfaceScreenMap;
+use crate::projection::trilinear_builders::SurfaceScreenMap;
 use crate::projection::ProjectionSpec;
 use crate::scene::loaders::{load_model, load_texture};
 use crate::scene::{Material, Mesh, Object, Pattern, Surface, TrilinearReflector};

@@ -1229,9 +1229,12 @@ fn flexible_projector_grids_parse_and_fit() {
     assert_eq!(grid.aims[0].node, (2, 3));
     assert_eq!(grid.correspondences.len(), 1);
     // The fit's residual is reported with the projection.
-    let projection = ProjectionSpec::Flexible(spec).build(32, 24).unwrap();
-    let notes = projection.notes();
-    assert!(notes.contains(&("fit_correspondences", 1.0)), "{notes:?}");
+    let (_, report) = crate::calibrate::build(&ProjectionSpec::Flexible(spec), 32, 24).unwrap();
+    let counters = report.counters;
+    assert!(
+        counters.contains(&("fit_correspondences", 1.0)),
+        "{counters:?}"
+    );
 
     let with = |projectors: &str| format!("{head}projectors = {projectors}\n");
     assert_error_at(
@@ -1324,13 +1327,13 @@ fn flexible_projector_grid_nodes_with_tangents() {
     else {
         panic!("not flexible");
     };
-    let flexible = crate::projection::flexible::Flexible::new(&spec, 32, 24).unwrap();
+    let (flexible, reports) = crate::calibrate::build_flexible(&spec, 32, 24).unwrap();
     let Volume::Grid(volume) = flexible.volume() else {
         panic!("not a grid volume");
     };
     assert_eq!(volume.grid.tangents()[0], Some(DVec3::X));
     assert_eq!(volume.grid.tangents()[12], None);
-    assert!(volume.fit.is_some_and(|r| r.max_angle_deg < 1e-9));
+    assert!(reports[0].max_angle_deg < 1e-9);
     // One correspondence cannot fix a node's end direction and tangent (four angles).
     assert_error(
         &with(
@@ -1348,7 +1351,7 @@ fn flexible_projector_grid_nodes_with_tangents() {
 
 #[test]
 fn trilinear_screen_map_key() {
-    use crate::projection::surfaces::SurfaceScreenMap;
+    use crate::projection::trilinear_builders::SurfaceScreenMap;
     use crate::scene::TrilinearReflector;
     let mirror = |extra: &str| {
         format!("{CAMERA}[[object]]\nshape = \"sphere\"\nmaterial = \"mirror\"\n{extra}\n")

@@ -1,5 +1,7 @@
-//! Surfaces to project through (seed 000, chapters 6 and 7): trilinear projection meshes
-//! built from a description instead of listed vertex by vertex.
+//! Builders of trilinear projection meshes from a description instead of vertex by vertex:
+//! from reflector and lens meshes, visualisation surfaces and grids over control surfaces
+//! (Vallance 2005, chapters 6 and 7, calls the results surfaces to project through; re-exported
+//! as `projection::trilinear_builders`).
 //!
 //! - [`screen_grid`]: a regular n x n grid of screen cells (two projection triangles each,
 //!   shared vertices and ray directions) over any base given as a function from screen
@@ -17,8 +19,6 @@
 mod camera;
 mod grid;
 mod reflector;
-#[cfg(test)]
-pub(crate) mod test_scenes;
 mod visualisation;
 
 pub use camera::GridCamera;

@@ -13,10 +13,10 @@
 use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
+use crate::geometry::optics::{reflect, refract};
+use crate::geometry::MeshView;
 use crate::projection::trilinear::is_degenerate_screen_triangle;
 use crate::projection::{ImagePoint, Perspective, Projection, Trilinear, TrilinearMesh};
-use crate::render::raycast::optics::{reflect, refract};
-use crate::scene::Mesh;
 
 /// What the reflector does to the eye's rays.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -146,11 +146,12 @@ impl ReflectorSurface {
 ///
 /// A reflector that the camera does not see gives a surface without triangles. Errors: a
 /// refractive index that is not finite and positive.
-pub fn reflector_surface(
-    reflector: &Mesh,
+pub fn reflector_surface<'a>(
+    reflector: impl Into<MeshView<'a>>,
     camera: &Perspective,
     optic: Optic,
 ) -> Result<ReflectorSurface> {
+    let reflector = reflector.into();
     if let Optic::Refract { ior } = optic {
         if !ior.is_finite() || ior <= 0.0 {
             return Err(Error::new(format!(
@@ -190,7 +191,7 @@ pub fn reflector_surface(
         .collect();
 
     let mut kept: Vec<(f64, [u32; 3])> = Vec::new();
-    for triangle in &reflector.triangles {
+    for triangle in reflector.triangles {
         let [Some(a), Some(b), Some(c)] = triangle.map(|k| vertices[k as usize]) else {
             continue;
         };
@@ -251,9 +252,10 @@ struct SurfaceVertex {
 /// the shading normal is the mesh's own where present and non-zero, else the face normal.
 /// Both are zero for a vertex of no triangle. Also the normals that
 /// [`crate::render::composite`]'s refinement interpolates.
-pub(crate) fn vertex_normals(mesh: &Mesh) -> Vec<(DVec3, DVec3)> {
+pub(crate) fn vertex_normals<'a>(mesh: impl Into<MeshView<'a>>) -> Vec<(DVec3, DVec3)> {
+    let mesh = mesh.into();
     let mut from_faces = vec![DVec3::ZERO; mesh.positions.len()];
-    for t in &mesh.triangles {
+    for t in mesh.triangles {
         let [a, b, c] = t.map(|k| mesh.positions[k as usize].as_dvec3());
         let area_normal = (b - a).cross(c - a);
         for &k in t {

@@ -68,7 +68,7 @@ impl GridCamera {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::projection::trilinear::surfaces::screen_grid;
+    use crate::projection::trilinear::mesh_builders::screen_grid;
     use crate::projection::{Perspective, Projection, Trilinear};
 
     fn frame() -> CameraFrame {

@@ -191,7 +191,7 @@ mod tests {
     use std::f64::consts::PI;
 
     use super::*;
-    use crate::projection::trilinear::surfaces::{between_surfaces, screen_grid};
+    use crate::projection::trilinear::mesh_builders::{between_surfaces, screen_grid};
     use crate::projection::{CameraFrame, Projection, Trilinear};
 
     fn camera() -> GridCamera {

@@ -28,7 +28,7 @@
 //! # Degenerate cases
 //!
 //! - Fewer than `FOLDS * MIN_HELD_OUT` correspondences: too few to hold any out and still
-//!   rank the rungs; the largest weight (the committed 1e-3), fitted as before.
+//!   rank the rungs; the largest weight (1e-3).
 //! - A node that no correspondence weighs (all points in one cell, say): the smoothness
 //!   carries the fit to it, which no held-out point can check; the largest weight.
 //! - Exact data that every weight meets (a bilinear truth, where no rung bends the grid):

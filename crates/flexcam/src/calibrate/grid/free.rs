@@ -1,7 +1,7 @@
 //! The free fit (`starts = "free"`): every node's start fitted together with its direction,
 //! for correspondences from projections whose projectors pass through no common eye
 //! (pushbroom, crossed slits, any grid whose starts are off an eye; module section "Starts"
-//! of `fit`). Kept starts cannot meet such data, and one common eye cannot either.
+//! of `grid`). Kept starts cannot meet such data, and one common eye cannot either.
 //!
 //! # Unknowns and gauge
 //!
@@ -15,7 +15,7 @@
 //! slide is fixed by a penalty on the starts' mean move along the prior's unit directions
 //! (weight: the data term's mean diagonal; on a true freedom it biases nothing), the scale by
 //! the fit's scale constraint (the prior's directions' component over the constrained nodes,
-//! as module `fit`'s). L is the rms distance from the prior's starts to the points (a start's
+//! as module `grid`'s). L is the rms distance from the prior's starts to the points (a start's
 //! move turns a projector by about its length over that distance) and l the prior's mean
 //! projector length, so the unknowns are dimensionless.
 //!
@@ -47,7 +47,7 @@
 //! grid, measured).
 //! Nodes that no correspondence weighs are pulled to the prior with `PULL` of that diagonal (the
 //! smoothness term extrapolates them otherwise); every unknown gets the floor weight of
-//! module `fit`, which keeps the matrix positive definite. Levenberg-Marquardt (module
+//! module `grid`, which keeps the matrix positive definite. Levenberg-Marquardt (module
 //! `angular`'s) from each given grid's projectors (the kept fit's, the eye fit's, the
 //! prior's); the lowest cost wins (for the largest weight; each smaller one starts from the
 //! previous weight's fit).
@@ -64,7 +64,7 @@
 //!   positions are met, but nothing tells how the projectors run off the plane; `auto` keeps
 //!   the simpler kept starts, which meet such data as well, and the plane's image is right
 //!   either way.
-//! - A fitted projector that reaches its point only at t <= 0: the error of module `fit`.
+//! - A fitted projector that reaches its point only at t <= 0: the error of module `grid`.
 
 mod weight;
 
@@ -293,7 +293,7 @@ impl<'a> Problem<'a> {
     }
 
     /// The constrained nodes that the model (data, smoothness, slide penalty; no pull)
-    /// leaves undetermined at `y`, whose grid is `grid` (`undetermined_nodes` of `fit`).
+    /// leaves undetermined at `y`, whose grid is `grid` (`undetermined_nodes` of module `checks`).
     fn undetermined(&self, y: &DVector<f64>, grid: &ProjectorGrid) -> usize {
         let (matrix, _) = self.linearise_model(y);
         let constrained = constrained_nodes(self.prior, self.correspondences);
@@ -561,7 +561,7 @@ mod tests {
         perspective_volume as perspective, preset_volume,
     };
     use crate::projection::flexible::projector_grid::GridInterpolation;
-    use crate::projection::flexible::volume::LinearVolume;
+    use crate::projection::flexible::LinearVolume;
 
     /// Deterministic uniform numbers in [0, 1) from `seed` (a linear congruential generator).
     pub(super) fn uniform(seed: u64) -> impl FnMut() -> f64 {

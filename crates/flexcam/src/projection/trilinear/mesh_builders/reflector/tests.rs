@@ -2,11 +2,11 @@ use glam::{DVec2, DVec3, Vec2};
 
 use super::*;
 use crate::geometry::Ray;
-use crate::projection::surfaces::test_scenes::{self, lens_plane, BALL_CENTER};
 use crate::projection::Projection;
 use crate::render::shading::normals;
 use crate::render::PreparedScene;
-use crate::scene::Scene;
+use crate::scene::reflector_fixtures::{self as test_scenes, lens_plane, BALL_CENTER};
+use crate::scene::{Mesh, Scene};
 
 const SIZE: (u32, u32) = (160, 120);
 

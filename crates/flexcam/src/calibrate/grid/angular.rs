@@ -1,11 +1,11 @@
 //! Refinement of a straight fit on the angle each projector misses its point by, for data
-//! that no grid with the kept starts meets exactly (module section "Inexact data" of `fit`).
+//! that no grid with the kept starts meets exactly (section "The straight fit" of module `grid`).
 //!
 //! The linear data term |P_k D(u_k, v_k)|^2 is |D| sin(angle) squared: it is met by a
 //! projector pointing away from its point as well as towards it, and it is made small by
 //! making D short. Where the starts leave every grid a residual (a near surface off the
 //! camera's eye), the linear optimum shrinks the nodes the residual concentrates on towards
-//! zero and past it: measured on the audit's 12 points (3 x 3 grid, starts 0.5 off the eye),
+//! zero and past it: measured on 12 points (3 x 3 grid, starts 0.5 off the eye),
 //! six of nine nodes came out 1e-8 to 2e-7 of the longest's length and two pointed away
 //! (86 and 170 degrees off the prior), which `fit` refused as contradictory data.
 //!

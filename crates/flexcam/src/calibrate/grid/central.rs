@@ -1,6 +1,6 @@
 //! The central fit (`starts = "eye"`): one common eye E found together with the node
 //! directions, every projector a line through E, for correspondences taken from a pinhole
-//! camera whose eye is not where the prior's starts are (module section "Starts" of `fit`).
+//! camera whose eye is not where the prior's starts are (module section "Starts" of `grid`).
 //!
 //! With the starts kept off the camera's eye no grid meets such data: a projector from a
 //! start off the eye through two points at different depths at nearby (u, v) disagrees, and
@@ -19,7 +19,7 @@
 //! determine the pinhole where the free field needs points enough for every node.
 //!
 //! E is found by variable projection: for a given E the directions are the model's (the
-//! pinhole's least-squares field, or the linear fit's of module `fit`, starts at E, solved
+//! pinhole's least-squares field, or the linear fit's of module `grid`, starts at E, solved
 //! twice, the second centred on the first), and
 //! Levenberg-Marquardt moves E to minimise the chords 2 sin(angle / 2) between the blended
 //! directions and the points seen from E, with central-difference derivatives in E (three
@@ -372,7 +372,7 @@ fn pinhole_suffices(pinhole: &FitReport, free: &FitReport, nodes: usize) -> bool
 /// The direction field fitted for a given eye.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Model {
-    /// Every node direction free (the linear fit of module `fit`).
+    /// Every node direction free (the linear fit of module `grid`).
     Free,
     /// The affine field of a pinhole camera at the eye ([`pinhole_directions`]).
     Pinhole,
