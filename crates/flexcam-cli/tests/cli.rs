@@ -590,6 +590,53 @@ fn animate_writes_numbered_frames_and_a_gif() {
     );
 }
 
+/// An animation of a static scene prepares it once: `animate --stats` reports one BVH build
+/// for its 5 frames (to a file, and on standard output with `-`), and the frame count.
+#[test]
+fn animate_stats_report_one_bvh_build_for_all_frames() {
+    let dir = TempDir::new().unwrap();
+    write(&dir, "a.toml", &animated_scene("1.0"));
+    let args = [
+        "animate",
+        "a.toml",
+        "--gif",
+        "a.gif",
+        "--shading",
+        "flat",
+        "--width",
+        "16",
+        "--height",
+        "12",
+    ];
+    let mut with_file = args.to_vec();
+    with_file.extend(["--stats", "stats.json"]);
+    run_ok(&dir, &with_file);
+    let text = fs::read_to_string(dir.path().join("stats.json")).unwrap();
+    let stats: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(stats["frames"], 5);
+    assert_eq!(stats["bvh_builds"], 1);
+    assert_eq!(stats["method"], "raycast");
+    assert_eq!(stats["width"], 16);
+    let mut to_stdout = args.to_vec();
+    to_stdout.extend(["--stats", "-"]);
+    let stats = run_json(&dir, &to_stdout);
+    assert_eq!(
+        (stats["frames"].clone(), stats["bvh_builds"].clone()),
+        (5.into(), 1.into())
+    );
+}
+
+/// `compare` renders both methods from one prepared scene (one BVH build), and `render
+/// --stats` reports the build too.
+#[test]
+fn compare_and_render_build_the_bvh_once() {
+    let dir = good_scene_in("s.toml");
+    let report = run_json(&dir, &["compare", "s.toml", "--method", "raster", "--json"]);
+    assert_eq!(report["bvh_builds"], 1);
+    let stats = run_json(&dir, &["render", "s.toml", "-o", "a.png", "--stats", "-"]);
+    assert_eq!(stats["bvh_builds"], 1);
+}
+
 #[test]
 fn animate_errors_are_one_line_and_write_nothing() {
     let dir = TempDir::new().unwrap();

@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use flexcam::geometry::Ray;
-use flexcam::render::raycast::RayCaster;
+use flexcam::render::PreparedScene;
 use flexcam::scene::{builtin, Scene};
 use glam::DVec2;
 use obvhs::cwbvh::builder::build_cwbvh_from_tris;
@@ -60,7 +60,7 @@ fn compare(c: &mut Criterion) {
     let scene = scene();
     let rays = primary_rays(&scene);
     let tris = obvhs_triangles(&scene);
-    let ours = RayCaster::new(&scene);
+    let ours = PreparedScene::new(&scene);
     let theirs = build_cwbvh_from_tris(
         &tris,
         BvhBuildParams::medium_build(),
@@ -99,7 +99,9 @@ fn compare(c: &mut Criterion) {
     let mut group = c.benchmark_group("bvh_build_teapot_dense");
     group.sample_size(10);
     group.throughput(Throughput::Elements(tris.len() as u64));
-    group.bench_function("flexcam", |b| b.iter(|| RayCaster::new(black_box(&scene))));
+    group.bench_function("flexcam", |b| {
+        b.iter(|| PreparedScene::new(black_box(&scene)))
+    });
     group.bench_function("obvhs_cwbvh_medium", |b| {
         b.iter(|| {
             build_cwbvh_from_tris(

@@ -12,7 +12,7 @@
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use flexcam::render::raster::workloads::{teapot_dense_panorama, PanoramaWorkload};
 use flexcam::render::raster::InverseRaster;
-use flexcam::render::raycast::RayCaster;
+use flexcam::render::{raycast, PreparedScene};
 use flexcam::render::{RenderOptions, Shading};
 
 fn panorama(c: &mut Criterion) {
@@ -25,7 +25,9 @@ fn panorama(c: &mut Criterion) {
     let mut group = c.benchmark_group("panorama_teapot-dense_1280x720");
     group.sample_size(10);
     group.throughput(Throughput::Elements(1));
-    let raster = InverseRaster::new(&scene, projection.as_ref(), &options)
+    // The scene is prepared once for every renderer of the group.
+    let prepared = PreparedScene::new(&scene);
+    let raster = InverseRaster::new(&prepared, projection.as_ref(), &options)
         .unwrap_or_else(|e| panic!("raster: {e}"));
     let mut frame = raster.render().0;
     group.bench_function("raster_frame", |b| {
@@ -33,12 +35,11 @@ fn panorama(c: &mut Criterion) {
     });
     group.bench_function("raster_first_frame", |b| {
         b.iter(|| {
-            InverseRaster::new(&scene, projection.as_ref(), &options).map(|fresh| fresh.render())
+            InverseRaster::new(&prepared, projection.as_ref(), &options).map(|fresh| fresh.render())
         })
     });
-    let caster = RayCaster::new(&scene);
     group.bench_function("raycast_frame", |b| {
-        b.iter(|| caster.render(projection.as_ref(), &options))
+        b.iter(|| raycast::render(&prepared, projection.as_ref(), &options))
     });
     group.finish();
 }

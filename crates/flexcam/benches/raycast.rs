@@ -6,7 +6,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use flexcam::projection::{CameraFrame, ProjectionSpec};
-use flexcam::render::raycast::RayCaster;
+use flexcam::render::{raycast, PreparedScene};
 use flexcam::render::{RenderOptions, Shading};
 use flexcam::scene::{builtin, Scene};
 
@@ -39,7 +39,7 @@ fn primary_rays(c: &mut Criterion) {
     group.throughput(Throughput::Elements(u64::from(SIZE * SIZE)));
     for name in SCENES {
         let scene = load(name);
-        let caster = RayCaster::new(&scene);
+        let caster = PreparedScene::new(&scene);
         let (frame, fov) = camera(&scene);
         let specs = [
             ("perspective", ProjectionSpec::Perspective { frame, fov }),
@@ -50,7 +50,7 @@ fn primary_rays(c: &mut Criterion) {
                 .build(SIZE, SIZE)
                 .unwrap_or_else(|e| panic!("{name} {label}: {e}"));
             group.bench_function(format!("{name}/{label}"), |b| {
-                b.iter(|| caster.render(projection.as_ref(), &options))
+                b.iter(|| raycast::render(&caster, projection.as_ref(), &options))
             });
         }
     }
@@ -63,7 +63,7 @@ fn bvh_build(c: &mut Criterion) {
     for name in SCENES {
         let scene = load(name);
         group.throughput(Throughput::Elements(scene.triangle_count() as u64));
-        group.bench_function(name, |b| b.iter(|| RayCaster::new(&scene)));
+        group.bench_function(name, |b| b.iter(|| PreparedScene::new(&scene)));
     }
     group.finish();
 }

@@ -13,9 +13,9 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use flexcam::projection::Trilinear;
-use flexcam::render::raycast::RayCaster;
 use flexcam::render::trilinear::workloads::fan_grid;
 use flexcam::render::trilinear::{CurveOptions, TrilinearRenderer};
+use flexcam::render::{raycast, PreparedScene};
 use flexcam::render::{RenderOptions, Shading};
 use flexcam::scene::builtin;
 
@@ -32,7 +32,9 @@ fn cube_floor_18(c: &mut Criterion) {
     };
     let mut group = c.benchmark_group("trilinear_cube-floor_18_800x800");
     group.sample_size(10);
-    let renderer = TrilinearRenderer::new(&scene);
+    // The scene is prepared once for both renderers.
+    let caster = PreparedScene::new(&scene);
+    let renderer = TrilinearRenderer::new(&caster);
     let unclipped = CurveOptions {
         scene_clipping: false,
         ..CurveOptions::ADAPTIVE
@@ -53,15 +55,14 @@ fn cube_floor_18(c: &mut Criterion) {
     group.bench_function("trilinear_kept_unclipped", |b| {
         b.iter(|| renderer.render_into(&mut kept, &projection, &options, unclipped))
     });
-    let caster = RayCaster::new(&scene);
     group.bench_function("raycast_frame", |b| {
-        b.iter(|| caster.render(&projection, &options))
+        b.iter(|| raycast::render(&caster, &projection, &options))
     });
     // The ray caster's later frames into a frame it keeps: like for like with
     // `trilinear_kept_unclipped`.
-    let mut kept = caster.render(&projection, &options).0;
+    let mut kept = raycast::render(&caster, &projection, &options).0;
     group.bench_function("raycast_kept", |b| {
-        b.iter(|| caster.render_into(&mut kept, &projection, &options))
+        b.iter(|| raycast::render_into(&caster, &mut kept, &projection, &options))
     });
     group.finish();
 }

@@ -11,10 +11,10 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use flexcam::projection::Trilinear;
-use flexcam::render::trilinear::polygons::{project_all, projection_triangles};
-use flexcam::render::trilinear::scene_geometry::SceneGeometry;
 use flexcam::render::trilinear::workloads::fan_grid;
 use flexcam::render::trilinear::CurveOptions;
+use flexcam::render::trilinear::SceneGeometry;
+use flexcam::render::trilinear::{project_all, projection_triangles};
 use flexcam::scene::{self, builtin, Scene};
 
 /// Times `project_all` of `scene` through `projection` with `curves` as `name`.

@@ -14,7 +14,7 @@
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
-use flexcam::render::{composite, Method, RenderOptions, Shading};
+use flexcam::render::{self, Method, PreparedScene, RenderOptions, Shading};
 use flexcam::scene::file;
 
 mod mutations;
@@ -44,8 +44,10 @@ fn exercise(text: &str, path: &Path) -> bool {
     if projection.as_trilinear().is_some() {
         methods.push(Method::Trilinear);
     }
+    let prepared = PreparedScene::new(&scene);
     for method in methods {
-        let _ = composite::render_with_method(&scene, projection.as_ref(), &options, method);
+        let options = RenderOptions { method, ..options };
+        let _ = render::render(&prepared, projection.as_ref(), &options);
     }
     true
 }

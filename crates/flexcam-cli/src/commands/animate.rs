@@ -3,16 +3,19 @@
 //! unless every frame renders.
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, GifFrames, OutputSet};
 use flexcam::projection::ProjectionSpec;
-use flexcam::render::{Method, RenderOptions, Shading};
+use flexcam::render::{self, Counter, Method, PreparedScene, RenderOptions, Shading, Stats};
 use flexcam::scene;
 use flexcam::{Error, Result};
 
 use super::scene_args::ShadingArg;
 use crate::progress::RenderProgress;
+use crate::stats_json::{self, RunFacts};
+use crate::OutputTarget;
 
 /// Arguments of `flexcam animate`.
 #[derive(Args, Debug)]
@@ -41,6 +44,10 @@ pub struct AnimateArgs {
     /// Samples per pixel.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
     spp: u32,
+    /// Write statistics of the whole animation as one JSON object to FILE, or to standard
+    /// output with `-` (as `flexcam render --stats`; `frames`, `bvh_builds`).
+    #[arg(long, value_name = "FILE|-")]
+    stats: Option<OutputTarget>,
 }
 
 /// A file name with one run of `#` to be replaced by the frame number.
@@ -119,6 +126,13 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         .as_deref()
         .map(|gif| outputs.output("the GIF output", gif, &["gif"]))
         .transpose()?;
+    let stats_output = match &args.stats {
+        Some(OutputTarget::File(path)) => {
+            Some(outputs.output("the stats output", path, &["json", "txt", ""])?)
+        }
+        _ => None,
+    };
+    let load_start = Instant::now();
     let (scene, animation) = scene::file::load_animated(&args.scene)?;
     super::declare_scene_inputs(&mut outputs, &scene.inputs)?;
     let animation = animation.ok_or_else(|| {
@@ -150,6 +164,10 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         Shading::Flat => ColorEncoding::Linear,
         Shading::Lit => ColorEncoding::Srgb,
     };
+    // The scene is static: one prepared scene (one BVH) for every frame.
+    let prepared = PreparedScene::new(&scene);
+    let load_ms = load_start.elapsed().as_secs_f64() * 1e3;
+    let render_start = Instant::now();
     let progress = RenderProgress::new();
     let mut gif = args.gif.as_ref().map(|_| GifFrames::default());
     for frame_number in 0..frames {
@@ -161,12 +179,13 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
             progress.update(done_before * total + done, u64::from(frames) * total)
         };
         let options = RenderOptions {
+            method,
             shading: args.shading.shading(),
             spp: args.spp,
             progress: Some(&report),
             ..RenderOptions::default()
         };
-        let (frame, _) = method.render(&scene, projection.as_ref(), &options)?;
+        let frame = render::render(&prepared, projection.as_ref(), &options)?.frame;
         if let Some(&id) = frame_outputs.get(frame_number as usize) {
             outputs.stage(id, |tmp| image_io::write_color_png(&frame, tmp, encoding))?;
         }
@@ -175,8 +194,33 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         }
     }
     progress.finish();
+    let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
     if let (Some(gif), Some(id)) = (gif, gif_output) {
         outputs.stage(id, |tmp| gif.write(tmp, animation.fps()))?;
     }
-    outputs.commit()
+    let mut counters = Stats::new();
+    counters.insert("frames", Counter::Count(u64::from(frames)));
+    counters.insert("bvh_builds", Counter::Count(prepared.bvh_builds()));
+    counters.insert("bvh_build_ms", Counter::Value(prepared.bvh_build_ms()));
+    let facts = RunFacts {
+        method: method.name(),
+        scene: &args.scene.to_string_lossy(),
+        projection: "flexible",
+        shading: args.shading.name(),
+        width,
+        height,
+        spp: args.spp,
+        triangles: scene.triangle_count(),
+        load_ms,
+        render_ms,
+    };
+    let json = format!("{}\n", stats_json::to_json(&facts, &counters));
+    if let Some(id) = stats_output {
+        outputs.stage(id, |tmp| image_io::write_bytes(tmp, json.as_bytes()))?;
+    }
+    outputs.commit()?;
+    if let Some(OutputTarget::Stdout) = &args.stats {
+        super::print_stdout(&json)?;
+    }
+    Ok(())
 }

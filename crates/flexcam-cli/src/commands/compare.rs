@@ -9,7 +9,7 @@ use std::time::Instant;
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, OutputSet};
 use flexcam::render::compare::{compare, Comparison};
-use flexcam::render::{composite, Frame, Method, RenderOptions};
+use flexcam::render::{self, Frame, Method, PreparedScene, RenderOptions};
 use flexcam::{Error, Result};
 use glam::Vec3;
 use serde_json::json;
@@ -68,31 +68,31 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         .transpose()?;
     let loaded = args.scene.load()?;
     super::declare_scene_inputs(&mut outputs, &loaded.scene.inputs)?;
+    let prepared = PreparedScene::new(&loaded.scene);
+    // The method under test renders as `flexcam render` does (trilinear reflectors
+    // composited through their surfaces); the reference renders the scene as it is (a
+    // reflector is then the ray caster's exact mirror or glass).
     let reference_options = RenderOptions {
+        method: reference,
+        composite_reflectors: false,
         shading: args.shading.shading(),
         spp: args.spp,
         ..RenderOptions::default()
     };
     let options = RenderOptions {
+        method,
+        composite_reflectors: true,
         subdivision: args.tuning.subdivision(method)?,
         curves: args.tuning.curves(method)?,
         ..reference_options
     };
-    // The method under test renders as `flexcam render` does (trilinear reflectors
-    // composited through their surfaces); the reference renders the scene as it is (a
-    // reflector is then the ray caster's exact mirror or glass).
-    let timed_render = |m: Method, options: &RenderOptions, composited: bool| {
+    let timed_render = |options: &RenderOptions| {
         let start = Instant::now();
-        let projection = loaded.projection.as_ref();
-        let (frame, _) = if composited {
-            composite::render_with_method(&loaded.scene, projection, options, m)?
-        } else {
-            m.render(&loaded.scene, projection, options)?
-        };
-        Ok::<_, Error>((frame, start.elapsed().as_secs_f64() * 1e3))
+        let rendered = render::render(&prepared, loaded.projection.as_ref(), options)?;
+        Ok::<_, Error>((rendered.frame, start.elapsed().as_secs_f64() * 1e3))
     };
-    let (frame, method_ms) = timed_render(method, &options, true)?;
-    let (reference_frame, reference_ms) = timed_render(reference, &reference_options, false)?;
+    let (frame, method_ms) = timed_render(&options)?;
+    let (reference_frame, reference_ms) = timed_render(&reference_options)?;
     let result = compare(&frame, &reference_frame)?;
 
     if let Some(id) = diff {
@@ -111,6 +111,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         shading: args.shading.name(),
         spp: args.spp,
         times_ms: (method_ms, reference_ms),
+        bvh_builds: prepared.bvh_builds(),
     };
     if args.json {
         super::print_stdout(&format!("{}\n", report_json(&header, &result)))?;
@@ -131,6 +132,8 @@ struct Header<'a> {
     spp: u32,
     /// Render times of the method and the reference, in milliseconds.
     times_ms: (f64, f64),
+    /// BVH builds of the scene prepared once for both renders.
+    bvh_builds: u64,
 }
 
 fn report_text(h: &Header, c: &Comparison) -> String {
@@ -178,6 +181,7 @@ fn report_json(h: &Header, c: &Comparison) -> serde_json::Value {
         "depth_mean": number(c.depth_mean),
         "method_ms": number(h.times_ms.0),
         "reference_ms": number(h.times_ms.1),
+        "bvh_builds": h.bvh_builds,
     })
 }
 

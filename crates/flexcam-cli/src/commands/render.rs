@@ -5,10 +5,10 @@ use std::time::Instant;
 
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, DepthFormat, OutputSet};
-use flexcam::render::{composite, Counter, Method, RenderOptions, Shading};
+use flexcam::render::{self, Counter, Method, PreparedScene, RenderOptions, Shading};
 use flexcam::Result;
 
-use super::scene_args::{MethodTuning, SceneArgs, ShadingArg};
+use super::scene_args::{print_warnings, MethodTuning, SceneArgs, ShadingArg};
 use crate::progress::RenderProgress;
 use crate::stats_json::{self, RunFacts};
 use crate::OutputTarget;
@@ -75,13 +75,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
     let loaded = args.scene.load()?;
     super::declare_scene_inputs(&mut outputs, &loaded.scene.inputs)?;
-    for warning in &loaded.build_report.warnings {
-        eprintln!("flexcam: warning: {}: {warning}", loaded.source);
-    }
+    print_warnings(&loaded);
 
     let progress = RenderProgress::new();
     let report = |done: u64, total: u64| progress.update(done, total);
     let options = RenderOptions {
+        method,
         shading: args.shading.shading(),
         spp: args.spp,
         subdivision: args.tuning.subdivision(method)?,
@@ -90,16 +89,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         ..RenderOptions::default()
     };
     let render_start = Instant::now();
+    let prepared = PreparedScene::new(&loaded.scene);
     // Trilinear reflectors (if the scene has any) are composited into the main view, each
-    // rendered by the same method.
-    let rendered =
-        composite::render_with_method(&loaded.scene, loaded.projection.as_ref(), &options, method);
+    // rendered by the same method (the options' default).
+    let rendered = render::render(&prepared, loaded.projection.as_ref(), &options);
     let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
     progress.finish();
-    let (frame, mut counters) = rendered?;
+    let render::Rendered {
+        frame,
+        mut counters,
+    } = rendered?;
     for &(name, value) in &loaded.build_report.counters {
         counters.insert(name, Counter::Value(value));
     }
+    counters.insert("bvh_builds", Counter::Count(prepared.bvh_builds()));
 
     let encoding = match options.shading {
         Shading::Flat => ColorEncoding::Linear,

@@ -1,16 +1,12 @@
-//! What `render` and `compare` share: the scene argument, the size overrides, shading and the
-//! methods' tuning options, and loading a scene and building its projection from them.
-
-use std::time::Instant;
+//! What `render`, `compare` and `reproject` share: the scene argument and its overrides,
+//! shading and the methods' tuning options, turned into the library's load and render
+//! options.
 
 use clap::{Args, ValueEnum};
-use flexcam::projection::flexible::panorama::edit_source;
-use flexcam::projection::flexible::FlexibleSpec;
-use flexcam::projection::{BuildReport, Projection, ProjectionSpec};
 use flexcam::render::raster::Subdivision;
 use flexcam::render::trilinear::CurveOptions;
 use flexcam::render::{Method, Shading};
-use flexcam::scene::{self, Scene};
+use flexcam::scene::{self, LoadedScene, Overrides};
 use flexcam::{Error, Result};
 
 /// The scene to render and its image size.
@@ -38,68 +34,37 @@ pub struct SceneArgs {
     pub perspective_rect: Option<Vec<f64>>,
 }
 
-/// A loaded scene with its projection bound to the image size.
-pub struct LoadedScene {
-    /// The scene as named on the command line (`builtin:NAME` for built-ins).
-    pub source: String,
-    pub scene: Scene,
-    pub projection: Box<dyn Projection>,
-    /// What building the projection reported (a fitted grid's residual and warnings).
-    pub build_report: BuildReport,
-    pub width: u32,
-    pub height: u32,
-    /// Time spent loading and building, in milliseconds.
-    pub load_ms: f64,
-}
-
 impl SceneArgs {
-    /// Loads the scene, applies the size overrides and builds the projection. Errors name the
-    /// scene file.
+    /// Loads the scene with the size and perspective-rect overrides and builds the
+    /// projection ([`scene::load_with`]). Errors name the scene file.
     pub fn load(&self) -> Result<LoadedScene> {
         let source = self
             .scene
             .clone()
             .unwrap_or_else(|| format!("builtin:{}", scene::builtin::DEFAULT));
-        let start = Instant::now();
-        let mut scene = scene::load(&source)?;
-        if let Some(rect) = &self.perspective_rect {
-            scene.projection = perspective_rect(&scene.projection, rect)?;
-        }
-        let width = self.width.unwrap_or(scene.image.width);
-        let height = self.height.unwrap_or(scene.image.height);
-        scene::file::validate_resolution(width, height)?;
-        let (projection, build_report) =
-            flexcam::calibrate::build(&scene.projection, width, height)
-                .map_err(|e: Error| e.or_in_file(&source))?;
-        Ok(LoadedScene {
-            source,
-            scene,
-            projection,
-            build_report,
-            width,
-            height,
-            load_ms: start.elapsed().as_secs_f64() * 1e3,
-        })
+        let perspective_rect = match &self.perspective_rect {
+            Some(rect) => Some(<[f64; 4]>::try_from(rect.as_slice()).map_err(|_| {
+                Error::new(format!(
+                    "--perspective-rect: needs 4 numbers, got {}",
+                    rect.len()
+                ))
+            })?),
+            None => None,
+        };
+        let overrides = Overrides {
+            width: self.width,
+            height: self.height,
+            perspective_rect,
+        };
+        scene::load_with(&source, &overrides)
     }
 }
 
-/// `projection` with the perspective edit of `--perspective-rect` (clap gives four numbers).
-fn perspective_rect(projection: &ProjectionSpec, rect: &[f64]) -> Result<ProjectionSpec> {
-    let refuse = |why: String| Error::new(format!("--perspective-rect: {why}"));
-    let rect: [f64; 4] = rect
-        .try_into()
-        .map_err(|_| refuse(format!("needs 4 numbers, got {}", rect.len())))?;
-    let ProjectionSpec::Flexible(spec) = projection else {
-        return Err(refuse(format!(
-            "needs a flexible shape-defined panorama, the scene's projection is {}",
-            projection.kind()
-        )));
-    };
-    let source = edit_source(&spec.source, rect).map_err(|e| refuse(e.message))?;
-    Ok(ProjectionSpec::Flexible(Box::new(FlexibleSpec {
-        source,
-        reparam: spec.reparam,
-    })))
+/// Prints the warnings of a scene's load on stderr (the command goes on).
+pub fn print_warnings(loaded: &LoadedScene) {
+    for warning in &loaded.build_report.warnings {
+        eprintln!("flexcam: warning: {}: {warning}", loaded.source);
+    }
 }
 
 /// `--shading` on the command line.

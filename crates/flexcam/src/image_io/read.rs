@@ -8,13 +8,7 @@ use glam::Vec3;
 use super::{extension, srgb_decode};
 use crate::error::{Error, Result};
 
-/// A colour image read from a file, in linear RGB, rows from the top.
-#[derive(Debug, Clone, PartialEq)]
-pub struct LinearImage {
-    pub width: u32,
-    pub height: u32,
-    pub pixels: Vec<Vec3>,
-}
+pub use crate::render::LinearImage;
 
 /// The input extensions [`read_linear_image`] accepts.
 pub const INPUT_EXTENSIONS: [&str; 4] = ["png", "jpg", "jpeg", "exr"];

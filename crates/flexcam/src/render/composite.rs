@@ -12,8 +12,12 @@
 //! Depth and object id stay those of the main view (the reflector's own, as for a mirror in
 //! the ray caster).
 //!
-//! The renderer is a parameter ([`Renderer`]): any method that renders a scene through a
-//! projection, e.g. `|s, p, o| Method::Raycast.render(s, p, o)`, or a faster trilinear one.
+//! The renderer is a parameter ([`Renderer`]): any method that renders a prepared scene
+//! through a projection, e.g. `|s, p, o| Method::Raycast.render(s, p, o)`, or a faster
+//! trilinear one. The main view shares the prepared scene's BVH (only materials differ);
+//! the scene without a reflector, rendered through that reflector's surfaces, and the
+//! reflector alone (the Fresnel split) are variants with BVHs of their own, counted in
+//! [`PreparedScene::bvh_builds`].
 //! In `lit` shading a mirror's reflected colour is tinted by its base colour, and glass mixes
 //! the images through its refraction surface and through a second, reflection surface by the
 //! exact Fresnel reflectance at each pixel, as the ray caster's glass does ([`FresnelSplit`],
@@ -31,17 +35,18 @@ use crate::projection::trilinear_builders::{
     reflector_surface, Optic, ReflectorSurface, SurfaceScreenMap,
 };
 use crate::projection::{Perspective, Projection, ProjectionSpec, Trilinear, TrilinearMesh};
-use crate::render::raycast::{specular, RayCaster};
-use crate::render::surface::normals;
+use crate::render::prepared::PreparedScene;
+use crate::render::shading::normals;
+use crate::render::shading::trace::specular;
 use crate::render::{Counter, Frame, Method, RenderOptions, Shading, Stats};
 use crate::scene::{Mesh, Object, Scene, Surface, TrilinearReflector};
 
 /// A way of rendering a scene through a projection (a [`crate::render::Method`] or any
 /// other renderer).
 pub type Renderer<'a> =
-    dyn Fn(&Scene, &dyn Projection, &RenderOptions) -> Result<(Frame, Stats)> + 'a;
+    dyn Fn(&PreparedScene, &dyn Projection, &RenderOptions) -> Result<(Frame, Stats)> + 'a;
 
-/// Renders `scene` through `main` with `renderer`, compositing the reflections and
+/// Renders `prepared` through `main` with `renderer`, compositing the reflections and
 /// refractions of `scene.trilinear_reflectors` (none: exactly `renderer`'s image). The stats
 /// are the main render's, plus `reflectors`, `reflector_triangles` (in the surfaces),
 /// `reflector_dropped_triangles` (see [`reflector_surface`]), `reflector_pixels` (main-image
@@ -55,13 +60,14 @@ pub type Renderer<'a> =
 /// Errors: the renderer's; a scene projection that is not perspective (the main camera);
 /// a reflector id that no object has, or whose material is not mirror or glass.
 pub fn render(
-    scene: &Scene,
+    prepared: &PreparedScene,
     main: &dyn Projection,
     options: &RenderOptions,
     renderer: &Renderer,
 ) -> Result<(Frame, Stats)> {
+    let scene = prepared.scene();
     if scene.trilinear_reflectors.is_empty() {
-        return renderer(scene, main, options);
+        return renderer(prepared, main, options);
     }
     let camera = main_camera(scene, main)?;
     let mut main_scene = scene.clone();
@@ -70,10 +76,10 @@ pub fn render(
             object.material.surface = Surface::Diffuse;
         }
     }
-    let (mut frame, mut stats) = renderer(&main_scene, main, options)?;
+    let (mut frame, mut stats) = renderer(&prepared.with_materials(&main_scene), main, options)?;
     let start = Instant::now();
     let (mut triangles, mut dropped, mut pixels, mut fresnel_rays) = (0, 0, 0, 0);
-    let exact = ExactPixels::new(scene, &camera, options);
+    let exact = ExactPixels::new(prepared, &camera, options);
     let (mut exact_pixels, mut unsplit) = (0, 0);
     for entry in &scene.trilinear_reflectors {
         let (id, map) = (entry.id, entry.screen_map);
@@ -84,7 +90,8 @@ pub fn render(
         dropped += surface.dropped;
         let projection = surface_projection(&surface, map, &camera)?;
         if let Some(projection) = &projection {
-            let image = render_others(scene, id, projection, options, renderer)?;
+            let others = prepared.variant(&without(scene, id));
+            let image = renderer(&others, projection, options)?.0;
             pixels += match (options.shading, reflector.optic) {
                 (Shading::Flat, _) => paste(&mut frame, id, &image, Vec3::ONE)?,
                 (Shading::Lit, Optic::Reflect) => paste(&mut frame, id, &image, reflector.tint)?,
@@ -93,11 +100,11 @@ pub fn render(
                         refined_surface(&reflector, Optic::Reflect, entry, &camera)?;
                     unsplit += left;
                     let reflection =
-                        render_through(scene, id, &mirror, map, &camera, options, renderer)?
+                        render_through(&others, &mirror, map, &camera, options, renderer)?
                             .unwrap_or_else(|| {
                                 Frame::new(image.width, image.height, scene.image.background)
                             });
-                    let split = FresnelSplit::new(scene, id, camera.clone());
+                    let split = FresnelSplit::new(prepared, id, camera.clone());
                     let mixed =
                         fresnel_mix(&frame, id, &image, &reflection, &split, reflector.tint)?;
                     fresnel_rays += mixed.rays;
@@ -131,17 +138,19 @@ pub fn render(
 /// this is `method.render` unchanged (a perspective scene is still refused by the trilinear
 /// method). Errors: as [`render`].
 pub fn render_with_method(
-    scene: &Scene,
+    prepared: &PreparedScene,
     main: &dyn Projection,
     options: &RenderOptions,
     method: Method,
 ) -> Result<(Frame, Stats)> {
-    let renderer = |s: &Scene, p: &dyn Projection, o: &RenderOptions| method.render(s, p, o);
+    let renderer =
+        |s: &PreparedScene, p: &dyn Projection, o: &RenderOptions| method.render(s, p, o);
+    let scene = prepared.scene();
     if method != Method::Trilinear || scene.trilinear_reflectors.is_empty() {
-        return render(scene, main, options, &renderer);
+        return render(prepared, main, options, &renderer);
     }
     let pinhole = perspective_as_trilinear(&main_camera(scene, main)?)?;
-    let main_as_trilinear = |s: &Scene, p: &dyn Projection, o: &RenderOptions| {
+    let main_as_trilinear = |s: &PreparedScene, p: &dyn Projection, o: &RenderOptions| {
         // The main pass is the only one through a projection that is not trilinear.
         if p.as_trilinear().is_none() {
             method.render(s, &pinhole, o)
@@ -149,7 +158,7 @@ pub fn render_with_method(
             method.render(s, p, o)
         }
     };
-    render(scene, main, options, &main_as_trilinear)
+    render(prepared, main, options, &main_as_trilinear)
 }
 
 /// The perspective camera `camera` as an exact trilinear projection: two projection
@@ -278,12 +287,12 @@ fn refined_surface(
     ))
 }
 
-/// Renders `scene` without object `id` through `surface` with screen map `map` at the main
-/// camera's resolution: the reflected or refracted view in main-image coordinates; `None`
-/// when the surface has no triangles (the main camera does not see the reflector).
+/// Renders `others` (the scene without a reflector: [`without`]) through `surface` with
+/// screen map `map` at the main camera's resolution: the reflected or refracted view in
+/// main-image coordinates; `None` when the surface has no triangles (the main camera does
+/// not see the reflector).
 pub fn render_through(
-    scene: &Scene,
-    id: u32,
+    others: &PreparedScene,
     surface: &ReflectorSurface,
     map: SurfaceScreenMap,
     camera: &Perspective,
@@ -291,22 +300,16 @@ pub fn render_through(
     renderer: &Renderer,
 ) -> Result<Option<Frame>> {
     surface_projection(surface, map, camera)?
-        .map(|projection| render_others(scene, id, &projection, options, renderer))
+        .map(|projection| Ok(renderer(others, &projection, options)?.0))
         .transpose()
 }
 
-/// Renders `scene` without object `id` (and without reflectors) through `projection`.
-fn render_others(
-    scene: &Scene,
-    id: u32,
-    projection: &Trilinear,
-    options: &RenderOptions,
-    renderer: &Renderer,
-) -> Result<Frame> {
+/// `scene` without object `id` and without reflectors: what a reflector's surface sees.
+pub fn without(scene: &Scene, id: u32) -> Scene {
     let mut others = scene.clone();
     others.objects.retain(|o| o.id != id);
     others.trilinear_reflectors.clear();
-    Ok(renderer(&others, projection, options)?.0)
+    others
 }
 
 /// The trilinear projection of `surface` with screen map `map` at the main camera's
@@ -322,21 +325,23 @@ fn surface_projection(
 
 /// Exact ray casting of the reflector pixels a surface does not cover: the ray caster's own
 /// mirror or glass (or, in flat shading, its passing on of the ray) at the main camera's
-/// pixel-centre ray. The ray caster (a BVH of the whole scene) is built on first use only.
+/// pixel-centre ray, traced through the whole prepared scene.
 pub struct ExactPixels<'a> {
-    scene: &'a Scene,
+    prepared: &'a PreparedScene,
     camera: &'a Perspective,
     options: &'a RenderOptions<'a>,
-    caster: std::sync::OnceLock<RayCaster>,
 }
 
 impl<'a> ExactPixels<'a> {
-    pub fn new(scene: &'a Scene, camera: &'a Perspective, options: &'a RenderOptions<'a>) -> Self {
+    pub fn new(
+        prepared: &'a PreparedScene,
+        camera: &'a Perspective,
+        options: &'a RenderOptions<'a>,
+    ) -> Self {
         ExactPixels {
-            scene,
+            prepared,
             camera,
             options,
-            caster: std::sync::OnceLock::new(),
         }
     }
 
@@ -359,14 +364,14 @@ impl<'a> ExactPixels<'a> {
         if uncovered.is_empty() {
             return 0;
         }
-        let caster = self.caster.get_or_init(|| RayCaster::new(self.scene));
+        let caster = self.prepared;
         let colors: Vec<Vec3> = uncovered
             .par_iter()
             .map(|&k| {
                 let ray = self.camera.ray(centre(k));
                 match ray.as_ref().and_then(|r| Some((r, caster.intersect(r)?))) {
                     Some((ray, hit)) => caster.shade_hit(ray, hit, self.options).0,
-                    None => self.scene.image.background,
+                    None => caster.scene.image.background,
                 }
             })
             .collect();
@@ -408,24 +413,22 @@ pub enum GlassSplit {
 }
 
 /// The Fresnel split of a glass reflector at main-image pixels: the main camera's pixel-centre
-/// ray is intersected exactly with the reflector alone (a ray caster over its parts only),
+/// ray is intersected exactly with the reflector alone (a prepared scene of its parts only),
 /// and the ray caster's own [`specular`] gives the reflectance at the hit, from the
 /// interpolated shading normal and the side the ray arrives from. One primary ray per
 /// reflector pixel; no secondary rays.
 pub struct FresnelSplit {
-    caster: RayCaster,
-    parts: Vec<Object>,
+    caster: PreparedScene,
     camera: Perspective,
 }
 
 impl FresnelSplit {
-    /// The split of reflector `id` of `scene` seen by `camera`.
-    pub fn new(scene: &Scene, id: u32, camera: Perspective) -> FresnelSplit {
-        let mut only = scene.clone();
+    /// The split of reflector `id` of `prepared` seen by `camera`.
+    pub fn new(prepared: &PreparedScene, id: u32, camera: Perspective) -> FresnelSplit {
+        let mut only = prepared.scene().clone();
         only.objects.retain(|o| o.id == id);
         FresnelSplit {
-            caster: RayCaster::new(&only),
-            parts: only.objects,
+            caster: prepared.variant(&only),
             camera,
         }
     }
@@ -439,7 +442,7 @@ impl FresnelSplit {
         let Some(hit) = self.caster.intersect(&ray) else {
             return GlassSplit::Missed;
         };
-        let part = &self.parts[hit.object];
+        let part = &self.caster.scene.objects[hit.object];
         let seen = normals(part, hit.triangle, hit.barycentric, ray.direction.as_vec3());
         match specular(&ray, &seen, part.material.surface).fresnel {
             Some((_, reflectance)) => GlassSplit::Fresnel(reflectance),

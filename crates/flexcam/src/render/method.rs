@@ -1,4 +1,5 @@
-//! Rendering methods by name (`--method`), and the one entry point that dispatches to them.
+//! Rendering methods by name (`--method`), and the dispatch to them that
+//! [`crate::render::render`] and reflector compositing share.
 
 use std::fmt;
 use std::str::FromStr;
@@ -6,10 +7,8 @@ use std::str::FromStr;
 use crate::error::{Error, Result};
 use crate::projection::Projection;
 use crate::render::raster::InverseRaster;
-use crate::render::raycast::RayCaster;
 use crate::render::trilinear::TrilinearRenderer;
-use crate::render::{Frame, RenderOptions, Stats};
-use crate::scene::Scene;
+use crate::render::{raycast, Frame, PreparedScene, RenderOptions, Stats};
 
 /// A way of rendering a projection.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -42,12 +41,12 @@ impl Method {
         }
     }
 
-    /// Renders `scene` through `projection`. Fails, rather than producing a wrong image, when
-    /// the method cannot render that projection. The returned stats hold the method's own
-    /// counters.
-    pub fn render(
+    /// Renders `prepared` through `projection` by this method alone (no reflector
+    /// compositing). Fails, rather than producing a wrong image, when the method cannot
+    /// render that projection. The returned stats hold the method's own counters.
+    pub(crate) fn render(
         self,
-        scene: &Scene,
+        prepared: &PreparedScene,
         projection: &dyn Projection,
         options: &RenderOptions,
     ) -> Result<(Frame, Stats)> {
@@ -55,8 +54,8 @@ impl Method {
             return Err(Error::new("samples per pixel must be at least 1"));
         }
         match self {
-            Method::Raycast => Ok(RayCaster::new(scene).render(projection, options)),
-            Method::Raster => Ok(InverseRaster::new(scene, projection, options)?.render()),
+            Method::Raycast => Ok(raycast::render(prepared, projection, options)),
+            Method::Raster => Ok(InverseRaster::new(prepared, projection, options)?.render()),
             Method::Trilinear => {
                 let trilinear = projection.as_trilinear().ok_or_else(|| {
                     Error::new(format!(
@@ -65,7 +64,7 @@ impl Method {
                         projection.kind()
                     ))
                 })?;
-                TrilinearRenderer::new(scene).render(trilinear, options, options.curves)
+                TrilinearRenderer::new(prepared).render(trilinear, options, options.curves)
             }
         }
     }
@@ -118,7 +117,11 @@ mod tests {
         let scene = crate::scene::load("builtin:cube-floor").unwrap();
         let projection = scene.projection.build(8, 8).unwrap();
         let e = Method::Trilinear
-            .render(&scene, projection.as_ref(), &RenderOptions::default())
+            .render(
+                &PreparedScene::new(&scene),
+                projection.as_ref(),
+                &RenderOptions::default(),
+            )
             .unwrap_err();
         assert_eq!(
             e.to_string(),

@@ -1,8 +1,15 @@
 //! Renderers and what they produce: a [`Frame`] (colour, depth, object ids) and counters.
+//!
+//! The one entry point is [`render`]: a [`PreparedScene`] (built once per scene and command)
+//! through a projection with [`RenderOptions`] (method, shading, samples, the methods'
+//! tunings, reflector compositing, progress) gives a [`Rendered`] frame and its report.
 
 use std::collections::BTreeMap;
 
 use glam::Vec3;
+
+use crate::error::Result;
+use crate::projection::Projection;
 
 /// How surfaces are shaded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -15,9 +22,15 @@ pub enum Shading {
     Lit,
 }
 
-/// Options shared by all renderers.
+/// What [`render`] does: the method and everything that tunes it.
 #[derive(Clone, Copy)]
 pub struct RenderOptions<'a> {
+    /// The renderer (`--method`).
+    pub method: Method,
+    /// Composite the scene's trilinear reflectors (scene key `trilinear_reflector`) into the
+    /// main view, each reflection rendered by `method` ([`composite`]); `false` renders them
+    /// as the method's own mirrors and glass (the reference of a comparison).
+    pub composite_reflectors: bool,
     pub shading: Shading,
     /// Samples per pixel (1 = one ray through each pixel centre).
     pub spp: u32,
@@ -34,6 +47,8 @@ pub struct RenderOptions<'a> {
 impl Default for RenderOptions<'_> {
     fn default() -> Self {
         RenderOptions {
+            method: Method::Raycast,
+            composite_reflectors: true,
             shading: Shading::Lit,
             spp: 1,
             max_bounces: 8,
@@ -109,6 +124,40 @@ impl Frame {
     }
 }
 
+/// A rendered frame and what rendering it counted.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rendered {
+    pub frame: Frame,
+    /// The method's counters (rays cast, build times, ...), for `--stats`; with reflectors
+    /// composited, also the compositing's (see [`composite::render`]).
+    pub counters: Stats,
+}
+
+/// Renders `prepared` through `projection` as `options` say: the one entry point of every
+/// method. Fails, rather than producing a wrong image, when the method cannot render that
+/// projection (with one line naming why), or on zero samples per pixel.
+pub fn render(
+    prepared: &PreparedScene,
+    projection: &dyn Projection,
+    options: &RenderOptions,
+) -> Result<Rendered> {
+    let (frame, counters) = if options.composite_reflectors {
+        composite::render_with_method(prepared, projection, options, options.method)?
+    } else {
+        options.method.render(prepared, projection, options)?
+    };
+    Ok(Rendered { frame, counters })
+}
+
+/// A colour image in linear RGB, rows from the top: a photo to reproject
+/// ([`reproject::EquirectPhoto`]), as `image_io` reads it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearImage {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<Vec3>,
+}
+
 /// One counter of a renderer's statistics.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Counter {
@@ -118,14 +167,123 @@ pub enum Counter {
 
 /// Named counters a renderer reports (rays cast, build times, ...), for `--stats`.
 pub type Stats = BTreeMap<&'static str, Counter>;
+pub(crate) mod bvh;
 pub mod compare;
 pub mod composite;
 mod huge_pages;
 mod method;
+pub mod prepared;
 pub mod raster;
 pub mod raycast;
 pub mod reproject;
 pub mod scan;
-pub mod surface;
+pub mod shading;
 pub mod trilinear;
 pub use method::Method;
+pub use prepared::PreparedScene;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene;
+
+    fn flat(method: Method) -> RenderOptions<'static> {
+        RenderOptions {
+            method,
+            shading: Shading::Flat,
+            ..RenderOptions::default()
+        }
+    }
+
+    /// The entry point refuses what a method cannot render with the method's own line, and
+    /// zero samples per pixel, composited or not.
+    #[test]
+    fn refuses_what_the_method_cannot_render() {
+        let scene = scene::load("builtin:cube-floor").unwrap();
+        let projection = scene.projection.build(8, 8).unwrap();
+        let prepared = PreparedScene::new(&scene);
+        for composite_reflectors in [true, false] {
+            let render = |options: RenderOptions| {
+                let options = RenderOptions {
+                    composite_reflectors,
+                    ..options
+                };
+                render(&prepared, projection.as_ref(), &options)
+                    .unwrap_err()
+                    .to_string()
+            };
+            assert_eq!(
+                render(flat(Method::Trilinear)),
+                format!(
+                    "the trilinear method renders only trilinear projections, not a {} \
+                     projection",
+                    projection.kind()
+                )
+            );
+            assert_eq!(
+                render(RenderOptions {
+                    spp: 4,
+                    ..flat(Method::Raster)
+                }),
+                "method raster renders one sample per pixel; got --spp 4"
+            );
+            assert_eq!(
+                render(RenderOptions {
+                    spp: 0,
+                    ..flat(Method::Raycast)
+                }),
+                "samples per pixel must be at least 1"
+            );
+        }
+    }
+
+    /// Reflector compositing as an option of the entry point is [`composite::render`] with
+    /// the method as renderer, frame and counters; without it the reflector is the method's
+    /// own mirror. Both renders share one prepared scene, whose count holds the builds of
+    /// the compositing's variant (the scene without the reflector).
+    #[test]
+    fn compositing_is_an_option_giving_the_composite_frame() {
+        let scene = scene::load(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../scenes/reflect-sphere-cube.toml"
+        ))
+        .unwrap();
+        assert!(!scene.trilinear_reflectors.is_empty());
+        let main = scene.projection.build(48, 36).unwrap();
+        let prepared = PreparedScene::new(&scene);
+        let options = flat(Method::Raycast);
+        let composited = render(&prepared, main.as_ref(), &options).unwrap();
+        let renderer = |s: &PreparedScene, p: &dyn Projection, o: &RenderOptions| {
+            Method::Raycast.render(s, p, o)
+        };
+        let (frame, counters) =
+            composite::render(&prepared, main.as_ref(), &options, &renderer).unwrap();
+        assert_eq!(composited.frame, frame);
+        assert_eq!(composited.counters.len(), counters.len());
+        assert_eq!(
+            composited.counters["reflector_pixels"],
+            counters["reflector_pixels"]
+        );
+        let builds = prepared.bvh_builds();
+        assert!(builds > 1, "{builds}");
+        let plain = RenderOptions {
+            composite_reflectors: false,
+            ..options
+        };
+        let mirror = render(&prepared, main.as_ref(), &plain).unwrap();
+        assert_eq!(
+            mirror.frame,
+            Method::Raycast
+                .render(&prepared, main.as_ref(), &plain)
+                .unwrap()
+                .0
+        );
+        assert_ne!(mirror.frame.color, frame.color);
+        assert!(!mirror.counters.contains_key("reflectors"));
+        assert_eq!(
+            prepared.bvh_builds(),
+            builds,
+            "no build without compositing"
+        );
+    }
+}

@@ -21,9 +21,8 @@ use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 
 use super::raycast::sampling::SamplePattern;
-use super::Frame;
+use super::{Frame, LinearImage};
 use crate::error::{Error, Result};
-use crate::image_io::LinearImage;
 use crate::projection::projector::quadratic_tangent;
 use crate::projection::{Projection, Projector};
 

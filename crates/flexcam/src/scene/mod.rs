@@ -114,12 +114,14 @@ impl Scene {
 
 pub mod builtin;
 pub mod file;
+mod loaded;
 pub mod loaders;
 #[cfg(test)]
 pub(crate) mod reflector_fixtures;
 pub mod shapes;
 
 pub use file::validate_resolution;
+pub use loaded::{load_with, LoadedScene, Overrides};
 
 /// Loads a scene from `source`: `builtin:NAME` names a built-in scene, anything else is the
 /// path of a scene file. This is the SCENE argument of `flexcam render`.

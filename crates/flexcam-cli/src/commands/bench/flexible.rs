@@ -22,7 +22,7 @@ use flexcam::projection::Projection;
 use flexcam::render::raster::workloads::{teapot_dense_panorama, PanoramaWorkload, PANORAMA_SIZE};
 use flexcam::render::raster::InverseRaster;
 use flexcam::render::raycast::workloads::{table_volume, teapot_scene, TABLE_SIZE};
-use flexcam::render::raycast::RayCaster;
+use flexcam::render::{raycast, PreparedScene};
 use flexcam::render::{Counter, Frame, RenderOptions, Shading};
 use flexcam::scene::Scene;
 use flexcam::{Error, Result};
@@ -150,7 +150,7 @@ fn table(args: &FlexibleArgs) -> Result<()> {
 /// projectors, the BVH built once for the row, and the [`frame_hash`] of each column's last
 /// frame.
 fn row_times(scene: &Scene, repeat: u32) -> Result<([Timing; 6], [u64; 6])> {
-    let caster = RayCaster::new(scene);
+    let caster = PreparedScene::new(scene);
     let options = RenderOptions {
         shading: Shading::Lit,
         ..RenderOptions::default()
@@ -161,7 +161,7 @@ fn row_times(scene: &Scene, repeat: u32) -> Result<([Timing; 6], [u64; 6])> {
         let projection = table_volume(scene, column, TABLE_SIZE)?;
         let mut last = None;
         *time = measure(repeat, || {
-            last = Some(caster.render(&projection, &options).0);
+            last = Some(raycast::render(&caster, &projection, &options).0);
             Ok(())
         })?;
         *hash = last.as_ref().map_or(0, frame_hash);
@@ -199,15 +199,19 @@ fn panorama(repeat: u32) -> Result<()> {
         ..RenderOptions::default()
     };
     let flat = options(Shading::Flat);
+    // The scene is prepared once (BVH built and timed here) for every renderer below.
+    let start = Instant::now();
+    let prepared = PreparedScene::new(&scene);
+    let build = start.elapsed().as_secs_f64();
     // A new renderer per frame: the pixel projectors are computed during the frame.
     let first = measure(repeat, || {
-        InverseRaster::new(&scene, projection, &flat)?.render();
+        InverseRaster::new(&prepared, projection, &flat)?.render();
         Ok(())
     })?;
     // Later frames, and the mean wall-clock milliseconds of their two stages (building the
     // pieces; filling and shading them) from the renderer's own counters.
     let later = |options: &RenderOptions| {
-        let raster = InverseRaster::new(&scene, projection, options)?;
+        let raster = InverseRaster::new(&prepared, projection, options)?;
         let mut frame = raster.render().0;
         let mut stages = [0.0; 2];
         let timing = measure(repeat, || {
@@ -225,11 +229,8 @@ fn panorama(repeat: u32) -> Result<()> {
         Ok::<_, Error>((timing, stages))
     };
     let ((later_flat, stages), (later_lit, _)) = (later(&flat)?, later(&options(Shading::Lit))?);
-    let start = Instant::now();
-    let caster = RayCaster::new(&scene);
-    let build = start.elapsed().as_secs_f64();
     let cast = measure(repeat, || {
-        caster.render(projection, &flat);
+        raycast::render(&prepared, projection, &flat);
         Ok(())
     })?;
     let (width, height) = PANORAMA_SIZE;

@@ -18,10 +18,10 @@
 //! time (Linux only, in 10 ms ticks: use a `--repeat` of 10 or more).
 //!
 //! Every render above returns a new frame, the ray caster's and trilinear's alike
-//! (`RayCaster::render`, `TrilinearRenderer::render`): its 12.8 MB at 800 x 800 are allocated
+//! (`raycast::render`, `TrilinearRenderer::render`): its 12.8 MB at 800 x 800 are allocated
 //! and their pages first touched in each timed render. A second cube table times the later
 //! frames of a program that draws frame after frame into one frame it keeps, both renderers
-//! alike (`RayCaster::render_into`, `TrilinearRenderer::render_into` without and with
+//! alike (`raycast::render_into`, `TrilinearRenderer::render_into` without and with
 //! clipping), and compares them like for like.
 
 use std::time::Instant;
@@ -29,11 +29,11 @@ use std::time::Instant;
 use clap::Args;
 use flexcam::projection::{Trilinear, TrilinearMesh};
 use flexcam::render::compare::compare;
-use flexcam::render::raycast::RayCaster;
 use flexcam::render::trilinear::workloads::{fan_grid, random_grid, random_triangles};
 use flexcam::render::trilinear::{CurveOptions, TrilinearRenderer};
+use flexcam::render::{raycast, PreparedScene};
 use flexcam::render::{Counter, Frame, RenderOptions, Shading};
-use flexcam::scene::{self, Scene};
+use flexcam::scene;
 use flexcam::Result;
 
 /// Arguments of `flexcam bench trilinear`.
@@ -121,7 +121,8 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
     );
     for &count in counts {
         let scene = random_triangles(count, SEED + u64::from(count));
-        let renderers = Renderers::new(&scene);
+        let prepared = PreparedScene::new(&scene);
+        let renderers = Renderers::new(&prepared);
         for &side in sides {
             for &n in cells {
                 let mesh = random_grid(n, SEED + u64::from(n))?;
@@ -181,7 +182,8 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
         "cpu x"
     );
     let cube = scene::load("builtin:cube-floor")?;
-    let renderers = Renderers::new(&cube);
+    let prepared = PreparedScene::new(&cube);
+    let renderers = Renderers::new(&prepared);
     let mut later = Vec::new();
     for &n in cells {
         let mesh = fan_grid(n)?;
@@ -224,7 +226,7 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
 /// without clipping against the ray caster (the clipped render's is in Table 8.1).
 fn print_kept(cells: &[(usize, Timing)]) {
     println!(
-        "\ncube-floor, later frames, KEPT FRAMES: the ray caster (RayCaster::render_into) and \
+        "\ncube-floor, later frames, KEPT FRAMES: the ray caster (raycast::render_into) and \
          trilinear without / with clipping (TrilinearRenderer::render_into) each draw into a \
          frame kept from render to render; accuracy of trilinear without clipping against \
          raycast; cpu = mean CPU ms per render, all threads"
@@ -263,17 +265,17 @@ fn print_kept(cells: &[(usize, Timing)]) {
     }
 }
 
-/// Both renderers of one scene.
-struct Renderers {
-    caster: RayCaster,
-    trilinear: TrilinearRenderer,
+/// Both renderers of one prepared scene.
+struct Renderers<'a> {
+    caster: &'a PreparedScene,
+    trilinear: TrilinearRenderer<'a>,
 }
 
-impl Renderers {
-    fn new(scene: &Scene) -> Renderers {
+impl<'a> Renderers<'a> {
+    fn new(prepared: &'a PreparedScene) -> Renderers<'a> {
         Renderers {
-            caster: RayCaster::new(scene),
-            trilinear: TrilinearRenderer::new(scene),
+            caster: prepared,
+            trilinear: TrilinearRenderer::new(prepared),
         }
     }
 
@@ -286,8 +288,9 @@ impl Renderers {
             shading: Shading::Flat,
             ..RenderOptions::default()
         };
-        let (raycast, raycast_cpu, reference) =
-            median(repeat, || Ok(self.caster.render(&projection, &options).0))?;
+        let (raycast, raycast_cpu, reference) = median(repeat, || {
+            Ok(raycast::render(self.caster, &projection, &options).0)
+        })?;
         let trilinear = |curves: CurveOptions| {
             median(repeat, || {
                 self.trilinear.render(&projection, &options, curves)
@@ -311,7 +314,12 @@ impl Renderers {
         let kept = if kept {
             let mut frame = Frame::new(1, 1, glam::Vec3::ZERO);
             let (raycast, raycast_cpu, _) = median(repeat, || {
-                Ok(self.caster.render_into(&mut frame, &projection, &options))
+                Ok(raycast::render_into(
+                    self.caster,
+                    &mut frame,
+                    &projection,
+                    &options,
+                ))
             })?;
             let (trilinear, kept_cpu, _) = into_kept(unclipped)?;
             let (clipped, clipped_cpu, _) = into_kept(CurveOptions::ADAPTIVE)?;

@@ -22,7 +22,7 @@ fn sphere_and_cube_reflector(segments: u32) -> Scene {
 }
 
 fn raycast(
-    scene: &Scene,
+    scene: &PreparedScene,
     projection: &dyn Projection,
     options: &RenderOptions,
 ) -> Result<(Frame, Stats)> {
@@ -75,7 +75,9 @@ fn reference(scene: &Scene, main: &dyn Projection) -> Frame {
 fn reference_with(scene: &Scene, main: &dyn Projection, options: &RenderOptions) -> Frame {
     let mut plain = scene.clone();
     plain.trilinear_reflectors.clear();
-    raycast(&plain, main, options).unwrap().0
+    raycast(&PreparedScene::new(&plain), main, options)
+        .unwrap()
+        .0
 }
 
 /// The composite made from `surface` (possibly broken on purpose).
@@ -84,10 +86,11 @@ fn composite_from(scene: &Scene, main: &dyn Projection, surface: &ReflectorSurfa
     let mut plain = scene.clone();
     plain.trilinear_reflectors.clear();
     plain.objects[0].material.surface = Surface::Diffuse;
-    let mut frame = raycast(&plain, main, &flat()).unwrap().0;
+    let mut frame = raycast(&PreparedScene::new(&plain), main, &flat())
+        .unwrap()
+        .0;
     let image = render_through(
-        scene,
-        BALL,
+        &PreparedScene::new(&without(scene, BALL)),
         surface,
         SurfaceScreenMap::Projective,
         &camera,
@@ -110,7 +113,13 @@ fn sphere_composite_matches_the_true_mirror() {
     let scene = scene();
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let reference = reference(&scene, main.as_ref());
-    let (frame, stats) = render(&scene, main.as_ref(), &flat(), &raycast).unwrap();
+    let (frame, stats) = render(
+        &PreparedScene::new(&scene),
+        main.as_ref(),
+        &flat(),
+        &raycast,
+    )
+    .unwrap();
     assert_eq!(frame.ids, reference.ids, "ids are the main view's");
     // Depth is the reflector's own (to f32 rounding: the diffuse path reports the f32 hit).
     let depth_ok = frame
@@ -231,7 +240,13 @@ fn lens_composite_matches_ray_cast_glass() {
     let scene = lens_scene();
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let reference = reference(&scene, main.as_ref());
-    let (frame, _) = render(&scene, main.as_ref(), &flat(), &raycast).unwrap();
+    let (frame, _) = render(
+        &PreparedScene::new(&scene),
+        main.as_ref(),
+        &flat(),
+        &raycast,
+    )
+    .unwrap();
     let (c, same) = agreement(&frame, &reference, 1);
     println!(
         "lens composite: {} pixels, same colour {same:.4}, relative RGB error {:.4}",
@@ -256,7 +271,8 @@ fn lit_glass_mixes_reflection_and_refraction_by_fresnel() {
     let lit = RenderOptions::default();
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let reference = reference_with(&scene, main.as_ref(), &lit);
-    let (frame, stats) = render(&scene, main.as_ref(), &lit, &raycast).unwrap();
+    let (frame, stats) =
+        render(&PreparedScene::new(&scene), main.as_ref(), &lit, &raycast).unwrap();
     let (fresnel, _) = agreement(&frame, &reference, 1);
 
     // Refraction alone, tinted: the main view with the lens diffuse, the refraction pasted.
@@ -266,10 +282,11 @@ fn lit_glass_mixes_reflection_and_refraction_by_fresnel() {
     let mut plain = scene.clone();
     plain.trilinear_reflectors.clear();
     plain.objects[0].material.surface = Surface::Diffuse;
-    let mut alone = raycast(&plain, main.as_ref(), &lit).unwrap().0;
+    let mut alone = raycast(&PreparedScene::new(&plain), main.as_ref(), &lit)
+        .unwrap()
+        .0;
     let image = render_through(
-        &scene,
-        1,
+        &PreparedScene::new(&without(&scene, 1)),
         &refraction,
         SurfaceScreenMap::Projective,
         &camera,
@@ -318,7 +335,7 @@ fn fresnel_split_is_the_exact_reflectance_at_the_hit() {
     };
     let main = scene.projection.build(101, 101).unwrap();
     let camera = main_camera(&scene, main.as_ref()).unwrap();
-    let split = FresnelSplit::new(&scene, 1, camera);
+    let split = FresnelSplit::new(&PreparedScene::new(&scene), 1, camera);
     let GlassSplit::Fresnel(centre) = split.at(50, 50) else {
         panic!("the centre pixel sees the lens");
     };
@@ -335,8 +352,19 @@ fn without_reflectors_the_renderer_runs_once_and_unchanged() {
     let mut scene = scene();
     scene.trilinear_reflectors.clear();
     let main = scene.projection.build(40, 30).unwrap();
-    let (frame, stats) = render(&scene, main.as_ref(), &flat(), &raycast).unwrap();
-    assert_eq!(frame, raycast(&scene, main.as_ref(), &flat()).unwrap().0);
+    let (frame, stats) = render(
+        &PreparedScene::new(&scene),
+        main.as_ref(),
+        &flat(),
+        &raycast,
+    )
+    .unwrap();
+    assert_eq!(
+        frame,
+        raycast(&PreparedScene::new(&scene), main.as_ref(), &flat())
+            .unwrap()
+            .0
+    );
     assert!(!stats.contains_key("reflectors"));
 }
 
@@ -358,10 +386,22 @@ fn bad_reflectors_are_errors() {
     let mut scene = scene();
     scene.trilinear_reflectors = vec![TrilinearReflector::new(9)];
     let main = scene.projection.build(40, 30).unwrap();
-    let e = render(&scene, main.as_ref(), &flat(), &raycast).unwrap_err();
+    let e = render(
+        &PreparedScene::new(&scene),
+        main.as_ref(),
+        &flat(),
+        &raycast,
+    )
+    .unwrap_err();
     assert!(e.message.contains("no object has this id"), "{e}");
     scene.trilinear_reflectors = vec![TrilinearReflector::new(2)];
-    let e = render(&scene, main.as_ref(), &flat(), &raycast).unwrap_err();
+    let e = render(
+        &PreparedScene::new(&scene),
+        main.as_ref(),
+        &flat(),
+        &raycast,
+    )
+    .unwrap_err();
     assert!(e.message.contains("must be a mirror or glass"), "{e}");
     let mut scene = self::scene();
     scene.projection = ProjectionSpec::Orthographic {
@@ -373,7 +413,13 @@ fn bad_reflectors_are_errors() {
         width: 4.0,
     };
     let main = scene.projection.build(40, 30).unwrap();
-    let e = render(&scene, main.as_ref(), &flat(), &raycast).unwrap_err();
+    let e = render(
+        &PreparedScene::new(&scene),
+        main.as_ref(),
+        &flat(),
+        &raycast,
+    )
+    .unwrap_err();
     assert!(e.message.contains("need a perspective projection"), "{e}");
 }
 
@@ -389,7 +435,13 @@ fn finer_reflectors_agree_better() {
         scene.trilinear_reflectors[0].refine_px = 0.0;
         let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
         let reference = reference(&scene, main.as_ref());
-        let (frame, _) = render(&scene, main.as_ref(), &flat(), &raycast).unwrap();
+        let (frame, _) = render(
+            &PreparedScene::new(&scene),
+            main.as_ref(),
+            &flat(),
+            &raycast,
+        )
+        .unwrap();
         let (c, same) = agreement(&frame, &reference, BALL);
         println!(
             "{segments} segments: same colour {same:.4}, relative RGB error {:.4}",
@@ -422,7 +474,13 @@ fn uncovered_reflector_pixels_are_ray_cast_exactly() {
     let surface = reflector_surface(&mirror.mesh, &camera, mirror.optic).unwrap();
     assert!(surface.mesh.triangles.is_empty(), "seen from behind");
     let reference = reference(&scene, main.as_ref());
-    let (frame, stats) = render(&scene, main.as_ref(), &flat(), &raycast).unwrap();
+    let (frame, stats) = render(
+        &PreparedScene::new(&scene),
+        main.as_ref(),
+        &flat(),
+        &raycast,
+    )
+    .unwrap();
     let (c, same) = agreement(&frame, &reference, BALL);
     assert!(
         c.pixels > 1000,
@@ -443,7 +501,13 @@ fn uncovered_reflector_pixels_are_ray_cast_exactly() {
     let mut scene = front.scene("front.toml");
     scene.trilinear_reflectors = vec![TrilinearReflector::new(BALL)];
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
-    let (_, stats) = render(&scene, main.as_ref(), &flat(), &raycast).unwrap();
+    let (_, stats) = render(
+        &PreparedScene::new(&scene),
+        main.as_ref(),
+        &flat(),
+        &raycast,
+    )
+    .unwrap();
     let Some(Counter::Count(cast)) = stats.get("reflector_exact_pixels") else {
         panic!("no counter: {stats:?}");
     };
@@ -499,9 +563,20 @@ fn perspective_as_trilinear_is_the_same_pinhole() {
 fn trilinear_method_composites_reflectors() {
     let scene = scene();
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
-    let (trilinear, stats) =
-        render_with_method(&scene, main.as_ref(), &flat(), Method::Trilinear).unwrap();
-    let (raycast, _) = render(&scene, main.as_ref(), &flat(), &raycast).unwrap();
+    let (trilinear, stats) = render_with_method(
+        &PreparedScene::new(&scene),
+        main.as_ref(),
+        &flat(),
+        Method::Trilinear,
+    )
+    .unwrap();
+    let (raycast, _) = render(
+        &PreparedScene::new(&scene),
+        main.as_ref(),
+        &flat(),
+        &raycast,
+    )
+    .unwrap();
     let c = compare(&trilinear, &raycast).unwrap();
     assert!(c.id_agreement >= 0.9999, "{c:?}");
     assert!(c.relative_rgb_error < 0.002, "{c:?}");
@@ -515,7 +590,13 @@ fn trilinear_method_composites_reflectors() {
     // Without reflectors the method is unchanged: a perspective scene is still refused.
     let mut plain = scene.clone();
     plain.trilinear_reflectors.clear();
-    assert!(render_with_method(&plain, main.as_ref(), &flat(), Method::Trilinear).is_err());
+    assert!(render_with_method(
+        &PreparedScene::new(&plain),
+        main.as_ref(),
+        &flat(),
+        Method::Trilinear
+    )
+    .is_err());
 }
 
 /// [`lens_scene`] with index of refraction `ior` and the lens's screen map `map`; with
@@ -536,7 +617,8 @@ fn plate_scene(ior: f32, map: SurfaceScreenMap, flat_normals: bool) -> Scene {
 fn composite_error(scene: &Scene, method: Method) -> (Comparison, Comparison) {
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let reference = reference(scene, main.as_ref());
-    let (frame, _) = render_with_method(scene, main.as_ref(), &flat(), method).unwrap();
+    let (frame, _) =
+        render_with_method(&PreparedScene::new(scene), main.as_ref(), &flat(), method).unwrap();
     let whole = compare(&frame, &reference).unwrap();
     (whole, agreement(&frame, &reference, 1).0)
 }
@@ -610,7 +692,13 @@ fn refined_error(scene: &Scene, id: u32, refine_px: f64) -> (Comparison, f64, St
     scene.trilinear_reflectors[0].refine_px = refine_px;
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let reference = reference(&scene, main.as_ref());
-    let (frame, stats) = render(&scene, main.as_ref(), &flat(), &raycast).unwrap();
+    let (frame, stats) = render(
+        &PreparedScene::new(&scene),
+        main.as_ref(),
+        &flat(),
+        &raycast,
+    )
+    .unwrap();
     let (c, same) = agreement(&frame, &reference, id);
     (c, same, stats)
 }

@@ -18,9 +18,9 @@ use glam::{DVec3, Vec2, Vec3};
 
 use super::pixel_rays::PixelRays;
 use crate::geometry::Ray;
-use crate::render::raycast::{Hit, RayCaster};
+use crate::render::prepared::{Hit, PreparedScene};
 use crate::render::scan::NO_PRIMITIVE;
-use crate::render::surface::{base_color, TextureFilter};
+use crate::render::shading::{base_color, TextureFilter};
 use crate::render::{RenderOptions, Shading};
 use crate::scene::{Object, Surface};
 
@@ -41,7 +41,7 @@ pub struct Shader<'a> {
     pub rays: &'a PixelRays<'a>,
     /// The ray caster, for what flat base colours cannot give: lit shading (lights,
     /// shadows) and mirrors and glass (secondary rays). `None` when neither is needed.
-    pub caster: Option<&'a RayCaster>,
+    pub caster: Option<&'a PreparedScene>,
     pub options: &'a RenderOptions<'a>,
 }
 

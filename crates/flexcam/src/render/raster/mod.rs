@@ -22,7 +22,7 @@
 //!
 //! Shading: flat base colours are computed here; lit shading (lights and shadows) and the
 //! secondary rays of mirrors and glass are delegated, per visible pixel, to the ray caster's
-//! own shading of the reconstructed hit ([`RayCaster::shade_hit`]), so a BVH is built when
+//! own shading of the reconstructed hit ([`PreparedScene::shade_hit`]), so a BVH is built when
 //! the render needs one; the rays it casts are counted (`shading_rays`). One sample per
 //! pixel (`--spp 1`).
 //!
@@ -65,7 +65,7 @@ use self::refine::{Node, Refiner};
 use self::seam::{covers_a_centre, place, Placement};
 use crate::error::{Error, Result};
 use crate::projection::{InverseChart, Projection};
-use crate::render::raycast::RayCaster;
+use crate::render::prepared::PreparedScene;
 use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
 use crate::scene::{Scene, Surface};
 
@@ -74,13 +74,13 @@ const CHUNK: usize = 2048;
 
 /// A scene and a projection prepared for rasterisation: the chart, the pixel projectors
 /// (filled in as frames need them), the buffers frames reuse and, when shading needs rays,
-/// the ray caster.
+/// the prepared scene they are traced through.
 pub struct InverseRaster<'a> {
     scene: &'a Scene,
     projection: &'a dyn Projection,
     chart: InverseChart,
     rays: PixelRays<'a>,
-    caster: Option<RayCaster>,
+    caster: Option<&'a PreparedScene>,
     options: RenderOptions<'a>,
     setup_ms: f64,
     /// The buffers of a frame, kept from frame to frame (cleared, not reallocated).
@@ -166,10 +166,10 @@ pub fn supported_chart(projection: &dyn Projection) -> Result<InverseChart> {
 }
 
 impl<'a> InverseRaster<'a> {
-    /// Prepares `scene` and `projection` with `options`. Errors: a projection outside the
-    /// supported class, an invalid subdivision, more than one sample per pixel.
+    /// Prepares `prepared` and `projection` with `options`. Errors: a projection outside
+    /// the supported class, an invalid subdivision, more than one sample per pixel.
     pub fn new(
-        scene: &'a Scene,
+        prepared: &'a PreparedScene,
         projection: &'a dyn Projection,
         options: &RenderOptions<'a>,
     ) -> Result<Self> {
@@ -182,12 +182,13 @@ impl<'a> InverseRaster<'a> {
             )));
         }
         let start = Instant::now();
+        let scene = prepared.scene();
         let rays = PixelRays::new(projection);
         let specular = scene
             .objects
             .iter()
             .any(|o| !matches!(o.material.surface, Surface::Diffuse | Surface::Emissive));
-        let caster = (options.shading == Shading::Lit || specular).then(|| RayCaster::new(scene));
+        let caster = (options.shading == Shading::Lit || specular).then_some(prepared);
         Ok(InverseRaster {
             buffers: Mutex::default(),
             scene,
@@ -229,7 +230,7 @@ impl<'a> InverseRaster<'a> {
         let shader = Shader {
             objects: &self.scene.objects,
             rays: &self.rays,
-            caster: self.caster.as_ref(),
+            caster: self.caster,
             options: &self.options,
         };
         let size = self.projection.resolution();

@@ -9,7 +9,7 @@ use super::*;
 use crate::projection::flexible::{FlexibleSpec, Preset, PresetSpec, VolumeSource};
 use crate::projection::{CameraFrame, ProjectionSpec, TrilinearMesh};
 use crate::render::compare::{compare, Comparison};
-use crate::render::Method;
+use crate::render::{Method, PreparedScene};
 use crate::scene::{self, file};
 
 fn flat(subdivision: Subdivision) -> RenderOptions<'static> {
@@ -141,7 +141,7 @@ fn render(
 ) -> Frame {
     let projection = spec.build(size.0, size.1).unwrap();
     method
-        .render(scene, projection.as_ref(), options)
+        .render(&PreparedScene::new(scene), projection.as_ref(), options)
         .unwrap_or_else(|e| panic!("{}: {e}", spec.kind()))
         .0
 }
@@ -168,7 +168,11 @@ fn projections_without_a_chart_are_refused_in_one_line() {
     for spec in [trilinear, inside_slit] {
         let projection = spec.build(16, 16).unwrap();
         let e = Method::Raster
-            .render(&scene, projection.as_ref(), &flat(Subdivision::default()))
+            .render(
+                &PreparedScene::new(&scene),
+                projection.as_ref(),
+                &flat(Subdivision::default()),
+            )
             .unwrap_err();
         assert!(
             e.message.starts_with("method raster needs a projection"),
@@ -193,9 +197,13 @@ fn projections_without_a_chart_are_refused_in_one_line() {
     }));
     let projection = twisted.build(8, 8).unwrap();
     assert!(!projection.has_inverse());
-    let e = InverseRaster::new(&scene, projection.as_ref(), &flat(Subdivision::default()))
-        .err()
-        .unwrap();
+    let e = InverseRaster::new(
+        &PreparedScene::new(&scene),
+        projection.as_ref(),
+        &flat(Subdivision::default()),
+    )
+    .err()
+    .unwrap();
     assert_eq!(
         e.message,
         "method raster needs a projection with an analytic inverse; flexible has none \
@@ -211,12 +219,12 @@ fn bad_options_are_refused() {
         spp: 4,
         ..flat(Subdivision::default())
     };
-    let e = InverseRaster::new(&scene, projection.as_ref(), &four)
+    let e = InverseRaster::new(&PreparedScene::new(&scene), projection.as_ref(), &four)
         .err()
         .unwrap();
     assert!(e.message.contains("one sample per pixel"), "{e}");
     let bad = flat(Subdivision::uniform(0));
-    assert!(InverseRaster::new(&scene, projection.as_ref(), &bad).is_err());
+    assert!(InverseRaster::new(&PreparedScene::new(&scene), projection.as_ref(), &bad).is_err());
 }
 
 /// A closed box around the eye, finely enough tessellated that its triangles share edges
@@ -354,10 +362,18 @@ fn delegated_shading_rays_are_counted() {
         ..RenderOptions::default()
     };
     let (_, lit) = Method::Raster
-        .render(&scene, projection.as_ref(), &options(Shading::Lit))
+        .render(
+            &PreparedScene::new(&scene),
+            projection.as_ref(),
+            &options(Shading::Lit),
+        )
         .unwrap();
     let (_, cast) = Method::Raycast
-        .render(&scene, projection.as_ref(), &options(Shading::Lit))
+        .render(
+            &PreparedScene::new(&scene),
+            projection.as_ref(),
+            &options(Shading::Lit),
+        )
         .unwrap();
     let reference = count(&cast, "secondary_rays") + count(&cast, "shadow_rays");
     let rays = count(&lit, "shading_rays");
@@ -368,7 +384,11 @@ fn delegated_shading_rays_are_counted() {
         "raster {rays}, raycast {reference}"
     );
     let (_, flat) = Method::Raster
-        .render(&scene, projection.as_ref(), &options(Shading::Flat))
+        .render(
+            &PreparedScene::new(&scene),
+            projection.as_ref(),
+            &options(Shading::Flat),
+        )
         .unwrap();
     assert_eq!(flat.get("shading_rays"), Some(&Counter::Count(0)));
 }

@@ -26,34 +26,11 @@
 
 use glam::{DVec3, Vec2};
 
-use super::bvh::{NearSegment, NearSegments4};
-use super::curve_triangle::CurveHit;
 use super::hull_cull::LiveParts;
-use super::{Hit32, RayCaster};
-use crate::projection::projector::{quadratic_point, quadratic_tangent};
-
-/// Pieces the curve is cut into for the BVH search: more pieces give thinner fattened chords
-/// (the padding falls as 1/PIECES^2), boxes that fewer triangles overlap, and fewer triangles
-/// tested beyond the first hit, but more traversals and more piece boxes in the tile culls.
-/// 24 took the least CPU time on the Table 7.1 bench's smallest models (8, 12, 16, 20, 24,
-/// 28, 32, 48 and 64 tried; docs/flexible.md, change 7).
-pub(super) const PIECES: usize = 24;
-
-/// The parameter interval [a, b] of piece `k` of [`PIECES`].
-pub(super) fn piece_interval(k: usize) -> (f64, f64) {
-    (k as f64 / PIECES as f64, (k + 1) as f64 / PIECES as f64)
-}
-
-/// The control points of the piece of curve `p` over [a, b] (blossoming: the end points and
-/// the intersection of the end tangents).
-pub(super) fn piece(p: &[DVec3; 3], a: f64, b: f64) -> [DVec3; 3] {
-    let start = quadratic_point(p, a);
-    [
-        start,
-        start + 0.5 * (b - a) * quadratic_tangent(p, a),
-        quadratic_point(p, b),
-    ]
-}
+use super::pieces::{piece, piece_interval, PIECES};
+use crate::render::bvh::curve_triangle::CurveHit;
+use crate::render::bvh::{NearSegment, NearSegments4};
+use crate::render::prepared::{Hit32, PreparedScene};
 
 /// The distance from `q` to the segment from `a` to `b`.
 fn distance_to_segment(q: DVec3, a: DVec3, b: DVec3) -> f64 {
@@ -117,7 +94,7 @@ impl PieceSearch<'_> {
     }
 }
 
-impl RayCaster {
+impl PreparedScene {
     /// The first hit (smallest s in [0, 1]) of quadratic Bezier curve `p`, as the curve
     /// parameter and the hit in the f32 form of the straight search (`t` = 0: the shading
     /// ray starts at the hit). `None` when nothing is hit or a control point is not finite.
@@ -132,7 +109,7 @@ impl RayCaster {
         first
     }
 
-    /// [`RayCaster::intersect_quadratic`] of up to four curves (`None`: no curve, no hit),
+    /// [`PreparedScene::intersect_quadratic`] of up to four curves (`None`: no curve, no hit),
     /// with identical results: piece k of the curves still searching is searched by one
     /// shared BVH walk ([`super::bvh::Bvh::visit_near_segments4`], which gives each curve
     /// exactly the triangles of its own walk, in the same order). Pays for the coherent
@@ -258,9 +235,9 @@ impl RayCaster {
 
     /// The f32 form of curve hit `hit` on stored triangle `stored`.
     fn curve_hit32(&self, stored: usize, hit: CurveHit) -> Hit32 {
-        let found = self.hit32(super::bvh::BvhHit {
+        let found = self.hit32(crate::render::bvh::BvhHit {
             id: self.bvh.id(stored),
-            hit: super::triangle::FastHit {
+            hit: crate::render::bvh::triangle::FastHit {
                 t: 0.0,
                 u: hit.barycentric[0] as f32,
                 v: hit.barycentric[1] as f32,
@@ -278,8 +255,9 @@ impl RayCaster {
 mod tests {
     use proptest::prelude::*;
 
-    use super::super::curve_triangle::CurveTriangle;
     use super::*;
+    use crate::projection::projector::quadratic_point;
+    use crate::render::bvh::curve_triangle::CurveTriangle;
 
     #[test]
     fn pieces_reproduce_the_curve() {
@@ -296,10 +274,10 @@ mod tests {
     }
 
     /// The caster of the built-in teapot room, built once for all cases.
-    fn room() -> &'static RayCaster {
-        static ROOM: std::sync::OnceLock<RayCaster> = std::sync::OnceLock::new();
+    fn room() -> &'static PreparedScene {
+        static ROOM: std::sync::OnceLock<PreparedScene> = std::sync::OnceLock::new();
         ROOM.get_or_init(|| {
-            RayCaster::new(&crate::scene::builtin::load("teapot-room").expect("built-in scene"))
+            PreparedScene::new(&crate::scene::builtin::load("teapot-room").expect("built-in scene"))
         })
     }
 
@@ -307,7 +285,7 @@ mod tests {
     /// without any cull, with the triangles as the BVH stores them (f32 vertex and edges):
     /// the smallest s, the first stored triangle on a tie (as the search's walk in tree
     /// order finds it).
-    fn brute_force_first_hit(caster: &RayCaster, p: &[DVec3; 3]) -> Option<(f64, Hit32)> {
+    fn brute_force_first_hit(caster: &PreparedScene, p: &[DVec3; 3]) -> Option<(f64, Hit32)> {
         let mut best: Option<(usize, CurveHit)> = None;
         for (stored, t) in caster.bvh.all_triangles().iter().enumerate() {
             if let Some(hit) = CurveTriangle::from_packed(t).intersect(p, [0.0, 1.0]) {
@@ -337,14 +315,14 @@ mod tests {
 
     /// The caster of `flexcam bench flexible`'s Kia row (the teapot of 552 triangles) and
     /// its quadratic volume at 64 x 64 pixels, built once for all cases.
-    fn bench_row() -> &'static (RayCaster, crate::projection::flexible::Flexible) {
-        static ROW: std::sync::OnceLock<(RayCaster, crate::projection::flexible::Flexible)> =
+    fn bench_row() -> &'static (PreparedScene, crate::projection::flexible::Flexible) {
+        static ROW: std::sync::OnceLock<(PreparedScene, crate::projection::flexible::Flexible)> =
             std::sync::OnceLock::new();
         ROW.get_or_init(|| {
             let (scene, _) = super::super::workloads::teapot_scene(520);
             let volume = super::super::workloads::table_volume(&scene, None, 64)
                 .expect("the bench's volume");
-            (RayCaster::new(&scene), volume)
+            (PreparedScene::new(&scene), volume)
         })
     }
 

@@ -10,9 +10,9 @@
 
 use glam::DVec3;
 
-use super::curve::{piece, piece_interval, PIECES};
-use super::RayCaster;
+use super::pieces::{piece, piece_interval, PIECES};
 use crate::projection::{Projector, ProjectorHull};
+use crate::render::prepared::PreparedScene;
 
 /// Rounding allowance of the caster's own arithmetic on control points (a segment's end
 /// `origin + (end - origin)`, a piece's control points by de Casteljau), relative to the
@@ -51,10 +51,10 @@ impl LiveParts {
     }
 }
 
-impl RayCaster {
+impl PreparedScene {
     /// Which parts of the projectors bounded by `hull` may hold a hit: those whose box over
     /// the hull overlaps a leaf of the BVH (each projector's own search tests the scene's box
-    /// alone: [`RayCaster::misses_scene_box`] for segments, the control-point box for a
+    /// alone: [`PreparedScene::misses_scene_box`] for segments, the control-point box for a
     /// quadratic's pieces). Only the parts `within` leaves live are tested: the others stay
     /// dead, as for a rectangle inside one whose parts `within` are (its projectors are among
     /// that rectangle's, so a part that holds no hit for those holds none for these; the
@@ -117,12 +117,12 @@ impl RayCaster {
 mod tests {
     use glam::DVec2;
 
-    use super::{LiveParts, RayCaster};
+    use super::{LiveParts, PreparedScene};
     use crate::geometry::Ray;
     use crate::projection::flexible::Flexible;
     use crate::projection::{Projection, Projector};
     use crate::render::raycast::workloads::{table_volume, teapot_scene};
-    use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
+    use crate::render::{raycast, Counter, Frame, RenderOptions, Shading, Stats};
 
     /// `Flexible` without its hull: every tile is searched projector by projector.
     struct NoHull<'a>(&'a Flexible);
@@ -143,9 +143,9 @@ mod tests {
     }
 
     /// The teapot of 56 triangles and the volume of `flexcam bench flexible` around it.
-    fn teapot_and_volume() -> (RayCaster, impl Fn(Option<u32>, u32) -> Flexible) {
+    fn teapot_and_volume() -> (PreparedScene, impl Fn(Option<u32>, u32) -> Flexible) {
         let (scene, _) = teapot_scene(56);
-        let caster = RayCaster::new(&scene);
+        let caster = PreparedScene::new(&scene);
         (caster, move |segments, size| {
             table_volume(&scene, segments, size).unwrap()
         })
@@ -177,8 +177,8 @@ mod tests {
                     spp,
                     ..RenderOptions::default()
                 };
-                let (culled, stats) = caster.render(&projection, &options);
-                let (plain, plain_stats) = caster.render(&NoHull(&projection), &options);
+                let (culled, stats) = raycast::render(&caster, &projection, &options);
+                let (plain, plain_stats) = raycast::render(&caster, &NoHull(&projection), &options);
                 let what = format!("segments {segments:?}, spp {spp}");
                 assert_frames_equal(&culled, &plain, &what);
                 for key in ["primary_rays", "secondary_rays", "shadow_rays"] {

@@ -4,11 +4,11 @@
 use glam::{DVec2, DVec3};
 
 use super::shade::Tracer;
-use super::RayCaster;
 use crate::projection::flexible::{Blend, Flexible, FlexibleSpec, Surface, VolumeSource};
 use crate::projection::Projection;
 use crate::render::compare::{compare, Comparison};
-use crate::render::{Frame, RenderOptions, Shading};
+use crate::render::prepared::PreparedScene;
+use crate::render::{raycast, Frame, RenderOptions, Shading};
 use crate::scene::builtin;
 
 const W: u32 = 96;
@@ -48,7 +48,7 @@ fn render(source: VolumeSource, shading: Shading) -> Frame {
         shading,
         ..RenderOptions::default()
     };
-    RayCaster::new(&scene).render(&projection, &options).0
+    raycast::render(&PreparedScene::new(&scene), &projection, &options).0
 }
 
 fn straight(shading: Shading) -> Frame {
@@ -163,7 +163,7 @@ fn polyline_quads_sample_exactly_like_single_projectors() {
     };
     let projection = Flexible::new(&spec, W, H).unwrap();
     let scene = builtin::load("teapot-room").unwrap();
-    let caster = RayCaster::new(&scene);
+    let caster = PreparedScene::new(&scene);
     for shading in [Shading::Flat, Shading::Lit] {
         let options = RenderOptions {
             shading,
@@ -184,13 +184,13 @@ fn polyline_quads_sample_exactly_like_single_projectors() {
                 assert_eq!(together, alone, "quad at ({x}, {y}), {shading:?}");
             }
         }
-        assert_eq!(quad.counts, single.counts);
-        assert!(quad.counts.primary > 0);
+        assert_eq!(quad.shader.counts, single.shader.counts);
+        assert!(quad.shader.counts.primary > 0);
     }
 }
 
 /// Segments of polyline projectors that pass in front of or behind a small model are culled
-/// by the scene's box before any traversal ([`RayCaster::misses_scene_box`]): on the layout
+/// by the scene's box before any traversal ([`PreparedScene::misses_scene_box`]): on the layout
 /// of `flexcam bench flexible` (a teapot inside a bent perspective-to-perspective volume,
 /// six segments) most segments are culled, and every segment, culled or not, finds exactly
 /// the hit of an unculled BVH search; the rendered image is that of tracing each projector
@@ -198,7 +198,7 @@ fn polyline_quads_sample_exactly_like_single_projectors() {
 #[test]
 fn segments_outside_the_scene_box_are_culled_without_changing_any_hit() {
     let (scene, _) = super::workloads::teapot_scene(240);
-    let caster = RayCaster::new(&scene);
+    let caster = PreparedScene::new(&scene);
     let (w, h) = (48, 48);
     let projection = super::workloads::table_volume(&scene, Some(6), w).unwrap();
     let (mut culled, mut hits, mut segments) = (0, 0, 0);
@@ -216,7 +216,7 @@ fn segments_outside_the_scene_box_are_culled_without_changing_any_hit() {
                     t_min: 0.0,
                     t_max: 1.0,
                 };
-                let uncull = super::triangle::FastRay::new(&ray)
+                let uncull = crate::render::bvh::triangle::FastRay::new(&ray)
                     .and_then(|fast| caster.bvh.closest(&fast))
                     .map(|found| caster.hit32(found));
                 assert_eq!(caster.intersect_f32(&ray), uncull, "pixel ({x}, {y})");
@@ -238,7 +238,7 @@ fn segments_outside_the_scene_box_are_culled_without_changing_any_hit() {
         shading: Shading::Lit,
         ..RenderOptions::default()
     };
-    let frame = caster.render(&projection, &options).0;
+    let frame = raycast::render(&caster, &projection, &options).0;
     let mut tracer = Tracer::new(&caster, &options);
     for y in 0..h {
         for x in 0..w {

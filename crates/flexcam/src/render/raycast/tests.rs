@@ -5,8 +5,8 @@ use glam::{Affine3A, DVec2, DVec3, Vec3};
 use super::*;
 use crate::geometry::intersect_triangle;
 use crate::projection::{CameraFrame, ProjectionSpec};
-use crate::render::{Counter, Shading};
-use crate::scene::{ImageSettings, Material, Mesh, Pattern, Surface};
+use crate::render::{raycast, Counter, Shading};
+use crate::scene::{ImageSettings, Light, Material, Mesh, Object, Pattern, Scene, Surface};
 
 /// Parallel rays along `direction` from a grid of origins: pixel (x, y) starts at
 /// `corner + x * right - y * up` (continuous pixel coordinates). Columns left of `blind`
@@ -120,7 +120,7 @@ fn trace(
 ) -> (Vec3, f32, u32) {
     let mut camera = Parallel::new(1, 1, (0.0, 0.0), direction);
     camera.corner = origin - DVec3::new(0.5, -0.5, 0.0);
-    let (frame, _) = RayCaster::new(scene).render(&camera, options);
+    let (frame, _) = raycast::render(&PreparedScene::new(scene), &camera, options);
     (frame.color[0], frame.depth[0], frame.ids[0])
 }
 
@@ -138,7 +138,7 @@ fn intersect_maps_hits_to_objects_and_agrees_with_f64_brute_force() {
         ));
     }
     let scene = scene(objects, vec![]);
-    let caster = RayCaster::new(&scene);
+    let caster = PreparedScene::new(&scene);
     let mut hits = 0;
     for i in 0..40 {
         for j in 0..40 {
@@ -182,7 +182,7 @@ fn pixels_without_a_projector_get_the_background() {
     let scene = red_wall(1);
     let mut camera = Parallel::new(3, 1, (0.0, 0.0), DVec3::NEG_Z);
     camera.blind = 1.0;
-    let (frame, stats) = RayCaster::new(&scene).render(&camera, &flat(8));
+    let (frame, stats) = raycast::render(&PreparedScene::new(&scene), &camera, &flat(8));
     assert_eq!(frame.color, vec![scene.image.background, RED, RED]);
     assert_eq!(frame.depth[0], f32::INFINITY);
     assert_eq!(frame.ids, vec![0, 1, 1]);
@@ -267,7 +267,7 @@ fn facing_mirrors_run_out_of_bounces() {
     assert_eq!(color, scene.image.background);
     let mut camera = Parallel::new(1, 1, (0.0, 0.0), DVec3::new(0.1, 0.0, -1.0));
     camera.corner.z = 0.5;
-    let (frame, stats) = RayCaster::new(&scene).render(&camera, &options);
+    let (frame, stats) = raycast::render(&PreparedScene::new(&scene), &camera, &options);
     assert_eq!(frame.color[0], scene.image.background);
     assert_eq!(stats["secondary_rays"], Counter::Count(8));
 }
@@ -411,8 +411,11 @@ fn lit_shadows_cost_shadow_rays_and_darken() {
     let dark = busy_scene(vec![]);
     let (head, _, _) = trace(&dark, DVec3::new(-5.0, 5.0, -1.5), DVec3::NEG_Z, &lit);
     assert!(head.x > 0.5, "{head}");
-    let (_, stats) =
-        RayCaster::new(&scene).render(&Parallel::new(8, 8, (-4.0, 4.0), DVec3::NEG_Z), &lit);
+    let (_, stats) = raycast::render(
+        &PreparedScene::new(&scene),
+        &Parallel::new(8, 8, (-4.0, 4.0), DVec3::NEG_Z),
+        &lit,
+    );
     let Counter::Count(shadow) = stats["shadow_rays"] else {
         panic!()
     };
@@ -438,7 +441,7 @@ fn rendering_is_deterministic_across_thread_counts_and_reports_progress() {
         direction: DVec3::new(0.1, -0.05, -1.0),
         ..Parallel::new(37, 29, (-4.0, 4.0), DVec3::NEG_Z)
     };
-    let caster = RayCaster::new(&scene);
+    let caster = PreparedScene::new(&scene);
     let calls = std::sync::Mutex::new(Vec::new());
     let progress = |done: u64, total: u64| calls.lock().unwrap().push((done, total));
     let options = RenderOptions {
@@ -453,7 +456,7 @@ fn rendering_is_deterministic_across_thread_counts_and_reports_progress() {
             .num_threads(threads)
             .build()
             .unwrap();
-        pool.install(|| caster.render(&camera, &options))
+        pool.install(|| raycast::render(&caster, &camera, &options))
     };
     let (one, stats_one) = render_with(1);
     let (many, stats_many) = render_with(4);
@@ -484,18 +487,18 @@ fn rendering_into_a_kept_frame_matches_a_new_frame() {
         ..Parallel::new(37, 29, (-4.0, 4.0), DVec3::NEG_Z)
     };
     camera.blind = 3.0;
-    let caster = RayCaster::new(&scene);
+    let caster = PreparedScene::new(&scene);
     for spp in [1, 4] {
         let options = RenderOptions {
             shading: Shading::Lit,
             spp,
             ..flat(8)
         };
-        let (fresh, fresh_stats) = caster.render(&camera, &options);
+        let (fresh, fresh_stats) = raycast::render(&caster, &camera, &options);
         assert!(fresh.ids.contains(&0) && fresh.ids.contains(&3));
         let mut kept = Frame::new(3, 2, Vec3::ONE);
         for _ in 0..2 {
-            let stats = caster.render_into(&mut kept, &camera, &options);
+            let stats = raycast::render_into(&caster, &mut kept, &camera, &options);
             assert_eq!(kept, fresh);
             assert_eq!(stats["rays_cast"], fresh_stats["rays_cast"]);
             kept.color.fill(Vec3::splat(7.0));
@@ -521,14 +524,14 @@ fn supersampling_averages_colour_and_keeps_the_centre_sample_aov() {
         Surface::Diffuse,
     );
     let scene = scene(vec![left, right], vec![]);
-    let caster = RayCaster::new(&scene);
+    let caster = PreparedScene::new(&scene);
     let camera = Parallel::new(1, 1, (0.0, 0.0), DVec3::NEG_Z);
-    let (one, _) = caster.render(&camera, &flat(8));
+    let (one, _) = raycast::render(&caster, &camera, &flat(8));
     assert_eq!(
         one.color[0], BLUE,
         "spp 1 samples exactly the centre x = 0.5"
     );
-    let (four, stats) = caster.render(&camera, &RenderOptions { spp: 4, ..flat(8) });
+    let (four, stats) = raycast::render(&caster, &camera, &RenderOptions { spp: 4, ..flat(8) });
     assert!((four.color[0] - Vec3::new(0.5, 0.0, 0.5)).length() < 1e-6);
     // The two samples nearest the centre tie; the lower index (x = 0.375) is red.
     assert_eq!((four.ids[0], four.depth[0]), (1, 10.0));
@@ -538,8 +541,11 @@ fn supersampling_averages_colour_and_keeps_the_centre_sample_aov() {
 #[test]
 fn empty_scene_renders_background_and_reports_build_stats() {
     let scene = scene(vec![], vec![]);
-    let (frame, stats) =
-        RayCaster::new(&scene).render(&Parallel::new(2, 2, (0.0, 0.0), DVec3::NEG_Z), &flat(8));
+    let (frame, stats) = raycast::render(
+        &PreparedScene::new(&scene),
+        &Parallel::new(2, 2, (0.0, 0.0), DVec3::NEG_Z),
+        &flat(8),
+    );
     assert!(frame.color.iter().all(|&c| c == scene.image.background));
     assert_eq!(stats["bvh_nodes"], Counter::Count(0));
     assert_eq!(stats["triangles"], Counter::Count(0));
@@ -548,12 +554,12 @@ fn empty_scene_renders_background_and_reports_build_stats() {
 
 /// The image rendered pixel by pixel with single rays, as before packets.
 fn render_single_rays(
-    caster: &RayCaster,
+    caster: &PreparedScene,
     camera: &dyn Projection,
     options: &RenderOptions,
 ) -> Frame {
     let (w, h) = camera.resolution();
-    let mut frame = Frame::new(w, h, caster.background);
+    let mut frame = Frame::new(w, h, caster.scene.image.background);
     let mut tracer = shade::Tracer::new(caster, options);
     for y in 0..h {
         for x in 0..w {
@@ -574,7 +580,7 @@ fn packet_rendering_equals_single_ray_rendering() {
         intensity: 0.7,
     };
     let scene = busy_scene(vec![light]);
-    let caster = RayCaster::new(&scene);
+    let caster = PreparedScene::new(&scene);
     let frame = |position: DVec3, look_at: DVec3| CameraFrame {
         position,
         look_at,
@@ -602,7 +608,7 @@ fn packet_rendering_equals_single_ray_rendering() {
     for camera in &cameras {
         for shading in [Shading::Flat, Shading::Lit] {
             let options = RenderOptions { shading, ..flat(8) };
-            let (packets, _) = caster.render(camera.as_ref(), &options);
+            let (packets, _) = raycast::render(&caster, camera.as_ref(), &options);
             let single = render_single_rays(&caster, camera.as_ref(), &options);
             assert_eq!(packets.ids, single.ids, "{}", camera.kind());
             let bits = |f: &Frame| {
@@ -621,16 +627,16 @@ fn packet_rendering_equals_single_ray_rendering() {
 
 /// The first hit of polyline `points` by searching its segments one by one, each with an
 /// unculled BVH search (no scene-box or hull cull): the first segment with a hit wins.
-fn segment_by_segment(caster: &RayCaster, points: &[DVec3]) -> Option<(usize, Hit32)> {
+fn segment_by_segment(caster: &PreparedScene, points: &[DVec3]) -> Option<(usize, Hit32)> {
     (0..points.len().saturating_sub(1)).find_map(|k| {
-        FastRay::new(&polyline_segment(points, k))
+        crate::render::bvh::triangle::FastRay::new(&polyline_segment(points, k))
             .and_then(|fast| caster.bvh.closest(&fast))
             .map(|found| (k, caster.hit32(found)))
     })
 }
 
 /// Four polylines searched together, each against [`segment_by_segment`].
-fn assert_polylines_match(caster: &RayCaster, polylines: [Option<&[DVec3]>; 4]) {
+fn assert_polylines_match(caster: &PreparedScene, polylines: [Option<&[DVec3]>; 4]) {
     let together = caster.intersect4_polylines(polylines, hull_cull::LiveParts::ALL);
     let alone = polylines.map(|p| p.and_then(|p| segment_by_segment(caster, p)));
     assert_eq!(together, alone, "{polylines:?}");
@@ -642,7 +648,7 @@ fn assert_polylines_match(caster: &RayCaster, polylines: [Option<&[DVec3]>; 4]) 
 /// segment runs along the wall's plane.
 #[test]
 fn a_joint_on_a_triangle_is_hit_by_the_earlier_segment() {
-    let caster = RayCaster::new(&red_wall(1));
+    let caster = PreparedScene::new(&red_wall(1));
     let lane = |x: f64, bend: DVec3| {
         vec![
             DVec3::new(x, 0.25, 2.0),
@@ -673,7 +679,7 @@ fn a_joint_on_a_triangle_is_hit_by_the_earlier_segment() {
 /// nothing.
 #[test]
 fn a_zero_length_segment_sees_nothing_and_the_next_segment_is_searched() {
-    let caster = RayCaster::new(&red_wall(1));
+    let caster = PreparedScene::new(&red_wall(1));
     let front = DVec3::new(0.5, 0.5, 1.0);
     let on_wall = DVec3::new(0.5, 0.5, 0.0);
     let behind = DVec3::new(0.5, 0.5, -1.0);
@@ -710,10 +716,10 @@ mod polyline_properties {
     use super::*;
 
     /// The caster of the built-in teapot room, built once for all cases.
-    fn room() -> &'static RayCaster {
-        static ROOM: std::sync::OnceLock<RayCaster> = std::sync::OnceLock::new();
+    fn room() -> &'static PreparedScene {
+        static ROOM: std::sync::OnceLock<PreparedScene> = std::sync::OnceLock::new();
         ROOM.get_or_init(|| {
-            RayCaster::new(&crate::scene::builtin::load("teapot-room").expect("built-in scene"))
+            PreparedScene::new(&crate::scene::builtin::load("teapot-room").expect("built-in scene"))
         })
     }
 

@@ -11,9 +11,10 @@ use rayon::prelude::*;
 
 use super::hull_cull::LiveParts;
 use super::sampling::SamplePattern;
-use super::shade::{RayCounts, Sample, Tracer};
-use super::RayCaster;
+use super::shade::{Sample, Tracer};
 use crate::projection::{Projection, Projector};
+use crate::render::prepared::PreparedScene;
+use crate::render::shading::trace::RayCounts;
 use crate::render::{Counter, Frame, RenderOptions, Stats};
 
 /// Tile edge in pixels: small enough to balance two to many cores, large enough that the
@@ -41,10 +42,10 @@ struct Tile {
 }
 
 /// Renders every pixel of `projection`'s image into `frame`, which must already be of its
-/// resolution; see [`RayCaster::render_into`]. The bands and their tiles cover the frame, so
+/// resolution; see [`raycast::render_into`]. The bands and their tiles cover the frame, so
 /// every pixel is overwritten whatever the frame held.
 pub(super) fn render(
-    caster: &RayCaster,
+    caster: &PreparedScene,
     projection: &dyn Projection,
     options: &RenderOptions,
     frame: &mut Frame,
@@ -119,7 +120,7 @@ pub(super) fn render(
 /// `(x0, y0, width, height)` may hit the scene ([`LiveParts::ALL`] where the projection
 /// gives no hull); blocks outside an edge tile are left at the tile's value.
 fn block_parts(
-    caster: &RayCaster,
+    caster: &PreparedScene,
     projection: &dyn Projection,
     pattern: &SamplePattern,
     (x0, y0, width, height): (u32, u32, u32, u32),
@@ -161,7 +162,7 @@ fn block_parts(
 /// Renders the pixels of rectangle `(x0, y0, width, height)`: each averages its samples'
 /// colours and reports the depth and id of the sample nearest its centre.
 fn render_tile(
-    caster: &RayCaster,
+    caster: &PreparedScene,
     projection: &dyn Projection,
     options: &RenderOptions,
     pattern: &SamplePattern,
@@ -253,6 +254,6 @@ fn render_tile(
             store(&mut tile, (x, y), color * scale, centre);
         }
     }
-    tile.counts = tracer.counts;
+    tile.counts = tracer.shader.counts;
     tile
 }

@@ -17,10 +17,21 @@
 //! (`SceneGeometry`), which no plane can have outside, so it and its ancestors are always
 //! visited.
 
+use std::ops::Range;
+
 use glam::DVec3;
 
-use super::scene_geometry::Cluster;
 use super::volume_bounds::{BoxSide, VolumeBounds};
+
+/// A run of consecutive scene triangles and the eight corners of the axis-aligned box
+/// around their vertices. A plane that all eight corners lie beyond has every point of the
+/// box, hence every vertex of the run, beyond it (the box is their convex hull). A run with
+/// a non-finite vertex gets the infinite box (corners at infinity), never outside a plane.
+#[derive(Debug, Clone)]
+pub struct Cluster {
+    pub triangles: Range<usize>,
+    pub box_corners: [DVec3; 8],
+}
 
 /// Deeper than any balanced tree over at most 2^32 clusters (`log2 + 2`).
 const MAX_DEPTH: usize = 40;

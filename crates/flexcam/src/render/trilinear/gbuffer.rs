@@ -16,7 +16,7 @@
 //! order of the shapes nor on the band size or thread count.
 
 use super::hit_terms::{self, Terms, TERMS};
-use super::shade::Resolver;
+use super::resolve::Resolver;
 use crate::render::scan::{spans, FillRule, Polygon, RasterStats, Scratch, Span, NO_PRIMITIVE};
 
 /// The drawn state of one band of rows.

@@ -99,12 +99,13 @@ impl HitTerms {
 /// the triangle's second and third corners (unbounded: outside the triangle too); `None`
 /// where the projector is parallel to the plane or a value is not finite (also a zero
 /// weight, which no pixel of a valid projective map has).
-#[inline]
+/// (The stage itself runs [`solve`] and tests in its own order; the tests check against this.)
+#[cfg(test)]
 pub fn hit(terms: &Terms) -> Option<(f64, f64, f64)> {
     finite(solve(terms))
 }
 
-/// [`hit`] before its test for finite values: `(t, b1, b2)`, any of them possibly
+/// `hit` before its test for finite values: `(t, b1, b2)`, any of them possibly
 /// infinite or NaN.
 #[inline]
 pub fn solve(terms: &Terms) -> (f64, f64, f64) {

@@ -17,25 +17,26 @@
 //! Unprojectable pairs (see `projection::Unprojectable`) are counted and their projection
 //! triangle is ray cast instead, so they never silently vanish.
 
-pub mod central;
-pub mod clip;
+mod central;
+mod clip;
 #[cfg(test)]
 mod cull_tests;
-pub mod cull_tree;
-pub mod curves;
-pub mod edge_path;
-pub mod gbuffer;
-pub mod hit_terms;
-pub mod outline;
-pub mod pair_cull;
-pub mod polygons;
-pub mod scene_geometry;
-pub mod screen_map;
-pub mod shade;
+mod cull_tree;
+mod curves;
+mod edge_path;
+mod gbuffer;
+mod hit_terms;
+mod outline;
+mod pair_cull;
+mod polygons;
+mod resolve;
+mod scene_geometry;
+mod screen_map;
+mod shade;
 #[cfg(test)]
 mod tests;
-pub mod view_plane;
-pub mod volume_bounds;
+mod view_plane;
+mod volume_bounds;
 pub mod workloads;
 
 use std::time::Instant;
@@ -43,29 +44,30 @@ use std::time::Instant;
 use glam::{DVec2, DVec3, Vec3};
 
 pub use curves::{CurveMode, CurveOptions};
+pub use polygons::{project_all, projection_triangles};
+pub use scene_geometry::SceneGeometry;
 
 use self::central::CentralProjection;
 use self::gbuffer::GBuffer;
-use self::polygons::{project_all, projection_triangles, ProjectedScene};
-use self::scene_geometry::SceneGeometry;
+use self::polygons::ProjectedScene;
+use self::resolve::Resolver;
 use self::screen_map::ScreenMap;
-use self::shade::{Resolver, ShadeCounts, Shader};
+use self::shade::{ShadeCounts, Shader};
 use crate::error::{Error, Result};
 use crate::projection::{Projection, Trilinear};
-use crate::render::raycast::{RayCaster, SamplePattern};
+use crate::render::prepared::PreparedScene;
+use crate::render::raycast::SamplePattern;
 use crate::render::scan::{band_rows_for, for_each_band, RasterStats, Scratch};
-use crate::render::surface::triangle_color::TriangleColor;
-use crate::render::surface::TextureFilter;
+use crate::render::shading::triangle_color::TriangleColor;
+use crate::render::shading::TextureFilter;
 use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
-use crate::scene::Scene;
 
-/// A scene prepared for trilinear rendering: its triangles in f64, the ray caster used for
-/// shading (shadows, mirrors, glass) and for fallback pixels, and the flat base colour of
-/// each scene triangle, built once.
-pub struct TrilinearRenderer {
+/// A prepared scene made ready for trilinear rendering: its triangles in f64 and the flat base
+/// colour of each, built once for any number of renders; shading (shadows, mirrors, glass)
+/// and fallback pixels trace through the prepared scene's BVH.
+pub struct TrilinearRenderer<'a> {
+    prepared: &'a PreparedScene,
     scene: SceneGeometry,
-    caster: RayCaster,
-    background: Vec3,
     /// Per scene triangle (numbered as `scene.triangles`), its base colour where flat
     /// shading shows it (see `Shader::flat_colors`).
     flat_colors: Vec<Option<TriangleColor>>,
@@ -74,16 +76,16 @@ pub struct TrilinearRenderer {
     bounding_sphere: Option<(DVec3, f64)>,
 }
 
-impl TrilinearRenderer {
-    pub fn new(scene: &Scene) -> TrilinearRenderer {
+impl<'a> TrilinearRenderer<'a> {
+    pub fn new(prepared: &'a PreparedScene) -> TrilinearRenderer<'a> {
+        let scene = prepared.scene();
         let geometry = SceneGeometry::new(scene);
-        let caster = RayCaster::new(scene);
         let flat_colors = geometry
             .owners
             .iter()
             .map(|owner| {
                 let object = owner.object as usize;
-                caster.flat_shows_base_color(object).then(|| {
+                prepared.flat_shows_base_color(object).then(|| {
                     let triangle = owner.triangle as usize;
                     TriangleColor::new(&scene.objects[object], triangle, TextureFilter::Nearest)
                 })
@@ -91,10 +93,9 @@ impl TrilinearRenderer {
             .collect();
         let bounding_sphere = bounding_sphere(&geometry.vertices);
         TrilinearRenderer {
+            prepared,
             bounding_sphere,
             scene: geometry,
-            caster,
-            background: scene.image.background,
             flat_colors,
         }
     }
@@ -199,11 +200,11 @@ impl TrilinearRenderer {
             };
             let shader = Shader {
                 resolver,
-                caster: &self.caster,
+                prepared: self.prepared,
                 projection,
                 options,
                 fallback: &fallback,
-                background: self.background,
+                background: self.prepared.scene.image.background,
                 flat_colors,
             };
             // Drawn and shaded band by band, straight into the frame.

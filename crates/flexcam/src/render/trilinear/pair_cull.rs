@@ -12,9 +12,80 @@
 
 use super::central::CentralProjection;
 use super::outline::ProjectionTriangle;
-use super::polygons::PairCounts;
 use super::scene_geometry::SceneGeometry;
 use crate::projection::Solutions;
+use crate::render::{Counter, Stats};
+
+/// What projecting the scene through projection triangles did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct PairCounts {
+    /// Scene vertices projected (one cubic each).
+    pub vertices_projected: u64,
+    /// (projection triangle, scene triangle) pairs considered.
+    pub pairs: u64,
+    /// Pairs culled because the scene triangle lies beyond one bounding plane of the
+    /// projection triangle's ray volume (no cubic solved), by the box tree or one by one.
+    pub culled_volume: u64,
+    /// Of `culled_volume`, the pairs culled with a whole subtree of the box tree
+    /// (`cull_tree`), without a test of their own.
+    pub culled_tree: u64,
+    /// Pairs culled because every vertex image is behind the view plane.
+    pub culled_behind: u64,
+    /// Pairs culled because every vertex image is outside one domain line and no scene
+    /// edge crosses that line's edge surface.
+    pub culled_outside: u64,
+    /// Pairs skipped because the scene triangle has zero area: no plane, nothing to draw.
+    pub culled_zero_area: u64,
+    /// Pairs (or tessellated sub-triangles) that could not be cut into shapes; their
+    /// projection triangle is ray cast instead.
+    pub unprojectable: u64,
+    /// Shapes formed.
+    pub shapes: u64,
+    /// Shapes with nothing left after clipping.
+    pub clipped_away: u64,
+    /// Of `clipped_away`, the shapes known to be clipped away before their outline was
+    /// traced: every vertex behind the view plane (`polygons::is_behind`).
+    pub skipped_behind: u64,
+    /// Outline points of the shapes drawn (after clipping).
+    pub outline_points: u64,
+}
+
+impl PairCounts {
+    pub fn add(&mut self, o: &PairCounts) {
+        self.vertices_projected += o.vertices_projected;
+        self.pairs += o.pairs;
+        self.culled_volume += o.culled_volume;
+        self.culled_tree += o.culled_tree;
+        self.culled_behind += o.culled_behind;
+        self.culled_outside += o.culled_outside;
+        self.culled_zero_area += o.culled_zero_area;
+        self.unprojectable += o.unprojectable;
+        self.shapes += o.shapes;
+        self.clipped_away += o.clipped_away;
+        self.skipped_behind += o.skipped_behind;
+        self.outline_points += o.outline_points;
+    }
+
+    /// Inserts the counters into `stats`.
+    pub fn record(&self, stats: &mut Stats) {
+        for (name, value) in [
+            ("vertices_projected", self.vertices_projected),
+            ("pairs", self.pairs),
+            ("culled_volume", self.culled_volume),
+            ("culled_tree", self.culled_tree),
+            ("culled_behind", self.culled_behind),
+            ("culled_outside", self.culled_outside),
+            ("culled_zero_area", self.culled_zero_area),
+            ("unprojectable", self.unprojectable),
+            ("shapes", self.shapes),
+            ("clipped_away", self.clipped_away),
+            ("skipped_behind", self.skipped_behind),
+            ("outline_points", self.outline_points),
+        ] {
+            stats.insert(name, Counter::Count(value));
+        }
+    }
+}
 
 /// A scene triangle that survived the volume cull of one projection triangle: what drawing
 /// the pair needs. Its vertices' solutions are kept once per vertex in the projection

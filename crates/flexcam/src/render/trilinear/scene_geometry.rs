@@ -4,11 +4,10 @@
 //! bounding boxes under a box tree (`cull_tree`).
 
 use std::collections::HashMap;
-use std::ops::Range;
 
 use glam::DVec3;
 
-use super::cull_tree::CullTree;
+use super::cull_tree::{Cluster, CullTree};
 use super::hit_terms::HitTerms;
 use crate::scene::Scene;
 
@@ -110,16 +109,6 @@ impl EdgeUsers {
 /// visited leaf few (8 rather than 32: `project_ms` of the detail-in-context scene, see
 /// docs/trilinear.md).
 pub const CLUSTER_SIZE: usize = 8;
-
-/// A run of consecutive scene triangles and the eight corners of the axis-aligned box
-/// around their vertices. A plane that all eight corners lie beyond has every point of the
-/// box, hence every vertex of the run, beyond it (the box is their convex hull). A run with
-/// a non-finite vertex gets the infinite box (corners at infinity), never outside a plane.
-#[derive(Debug, Clone)]
-pub struct Cluster {
-    pub triangles: Range<usize>,
-    pub box_corners: [DVec3; 8],
-}
 
 /// The edges `<V1V2, V1V3, V2V3>` as vertex pairs.
 const EDGES: [(usize, usize); 3] = [(0, 1), (0, 2), (1, 2)];

@@ -6,7 +6,7 @@ use glam::{DVec2, DVec3, Vec3};
 use super::*;
 use crate::projection::TrilinearMesh;
 use crate::render::compare::{compare, Comparison};
-use crate::render::{Counter, Shading};
+use crate::render::{raycast, Counter, Shading};
 use crate::scene::{self, Light, Material, Mesh, Object, Scene};
 
 /// The fan screen grid of `cells x cells` cells of the bench and the accuracy tables
@@ -33,8 +33,9 @@ fn against_raycast(
     options: &RenderOptions,
 ) -> (Comparison, Stats) {
     let projection = Trilinear::new(mesh, size.0, size.1).unwrap();
-    let (reference, _) = RayCaster::new(scene).render(&projection, options);
-    let (frame, stats) = TrilinearRenderer::new(scene)
+    let prepared = PreparedScene::new(scene);
+    let (reference, _) = raycast::render(&prepared, &projection, options);
+    let (frame, stats) = TrilinearRenderer::new(&prepared)
         .render(&projection, options, curves)
         .unwrap();
     (compare(&frame, &reference).unwrap(), stats)
@@ -112,7 +113,8 @@ fn lit_shading_matches_the_ray_caster() {
 fn rendering_is_deterministic() {
     let scene = scene::load("builtin:cube-floor").unwrap();
     let projection = Trilinear::new(&fan_mesh(2), 80, 60).unwrap();
-    let renderer = TrilinearRenderer::new(&scene);
+    let prepared = PreparedScene::new(&scene);
+    let renderer = TrilinearRenderer::new(&prepared);
     let (a, _) = renderer
         .render(&projection, &flat(), CurveOptions::ADAPTIVE)
         .unwrap();
@@ -135,7 +137,8 @@ fn rendering_is_deterministic() {
 fn rendering_into_a_kept_frame_matches_a_new_frame() {
     let scene = scene::load("builtin:cube-floor").unwrap();
     let projection = Trilinear::new(&fan_mesh(2), 80, 60).unwrap();
-    let renderer = TrilinearRenderer::new(&scene);
+    let prepared = PreparedScene::new(&scene);
+    let renderer = TrilinearRenderer::new(&prepared);
     for options in [flat(), RenderOptions { spp: 4, ..flat() }] {
         let (fresh, _) = renderer
             .render(&projection, &options, CurveOptions::ADAPTIVE)
@@ -164,7 +167,8 @@ fn a_new_frame_holds_the_background_wherever_nothing_is_hit() {
     let background = Vec3::new(0.25, 0.5, 0.75);
     scene.image.background = background;
     let projection = Trilinear::new(&fan_mesh(2), 80, 60).unwrap();
-    let renderer = TrilinearRenderer::new(&scene);
+    let prepared = PreparedScene::new(&scene);
+    let renderer = TrilinearRenderer::new(&prepared);
     for shading in [Shading::Flat, Shading::Lit] {
         for spp in [1, 4] {
             let options = RenderOptions {
@@ -413,10 +417,11 @@ fn no_cracks_between_adjacent_projection_triangles() {
     let scene = scene_of(vec![object(1, &wall, Vec3::new(0.5, 0.5, 0.5))]);
     let mesh = fan_mesh(3);
     let projection = Trilinear::new(&mesh, 90, 90).unwrap();
-    let (frame, _) = TrilinearRenderer::new(&scene)
+    let prepared = PreparedScene::new(&scene);
+    let (frame, _) = TrilinearRenderer::new(&prepared)
         .render(&projection, &flat(), CurveOptions::ADAPTIVE)
         .unwrap();
-    let (reference, _) = RayCaster::new(&scene).render(&projection, &flat());
+    let (reference, _) = raycast::render(&prepared, &projection, &flat());
     let uncovered: Vec<usize> = (0..frame.ids.len())
         .filter(|&i| reference.ids[i] != 0 && frame.ids[i] == 0)
         .collect();
@@ -481,7 +486,8 @@ fn supersampling_matches_the_ray_caster_and_antialiases_edges() {
     assert!(c.depth_max < 1e-5, "{c:?}");
 
     let projection = Trilinear::new(&mesh, 160, 120).unwrap();
-    let renderer = TrilinearRenderer::new(&scene);
+    let prepared = PreparedScene::new(&scene);
+    let renderer = TrilinearRenderer::new(&prepared);
     let (one, _) = renderer
         .render(&projection, &flat(), CurveOptions::ADAPTIVE)
         .unwrap();

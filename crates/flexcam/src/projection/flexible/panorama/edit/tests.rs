@@ -668,6 +668,7 @@ fn edited_round_presets_raster_like_the_ray_caster() {
             .projection
             .build(scene.image.width, scene.image.height)
             .unwrap();
+        let prepared = crate::render::PreparedScene::new(&scene);
         let render = |method: Method, subdivision| -> Frame {
             let options = RenderOptions {
                 shading: Shading::Flat,
@@ -675,7 +676,7 @@ fn edited_round_presets_raster_like_the_ray_caster() {
                 ..RenderOptions::default()
             };
             method
-                .render(&scene, projection.as_ref(), &options)
+                .render(&prepared, projection.as_ref(), &options)
                 .unwrap()
                 .0
         };

@@ -3,8 +3,8 @@ use glam::{DVec2, DVec3, Vec2};
 use super::*;
 use crate::geometry::Ray;
 use crate::projection::Projection;
-use crate::render::raycast::RayCaster;
-use crate::render::surface::normals;
+use crate::render::shading::normals;
+use crate::render::PreparedScene;
 use crate::scene::reflector_fixtures::{self as test_scenes, lens_plane, BALL_CENTER};
 use crate::scene::{Mesh, Scene};
 
@@ -32,7 +32,7 @@ fn lens() -> Mesh {
 #[test]
 fn vertex_rays_are_the_ray_casters_mirror_reflections() {
     let scene = scene();
-    let caster = RayCaster::new(&scene);
+    let caster = PreparedScene::new(&scene);
     let ball = &scene.objects[0];
     let camera = camera();
     let surface = reflector_surface(&ball.mesh, &camera, Optic::Reflect).unwrap();

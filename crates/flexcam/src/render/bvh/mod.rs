@@ -2,11 +2,14 @@
 //! 64-byte interior nodes holding both children's boxes for a 4-wide slab test of the pair,
 //! and near-first f32 traversal for closest-hit and any-hit queries.
 
+pub(in crate::render) mod curve_triangle;
+pub(in crate::render) mod triangle;
+
 use std::mem::MaybeUninit;
 
 use glam::{BVec4A, Vec3, Vec3A, Vec4, Vec4Swizzles};
 
-use super::triangle::{FastHit, FastRay, PackedTriangle};
+use self::triangle::{FastHit, FastRay, PackedTriangle};
 use crate::geometry::Aabb;
 
 /// What a node's child slot, or the root, refers to: interior node `index` when `count == 0`,
@@ -190,7 +193,7 @@ impl Packet {
 /// The points within `pad` of the segment from `origin` to `origin + direction`, in f32, for
 /// [`Bvh::visit_near_segments4`]. A zero direction is allowed (the segment is a point).
 #[derive(Debug, Clone, Copy)]
-pub(super) struct NearSegment {
+pub(in crate::render) struct NearSegment {
     origin: Vec3A,
     inv_direction: Vec3A,
     pad: f32,
@@ -237,7 +240,7 @@ impl NearSegment {
 /// Up to four [`NearSegment`]s in SoA form, tested against a box at once for
 /// [`Bvh::visit_near_segments4`]: lane `i` is segment `i`, each lane's test bit for bit that
 /// of [`NearSegment::meets`] (the same operations in the same order, per lane).
-pub(super) struct NearSegments4 {
+pub(in crate::render) struct NearSegments4 {
     origin: [Vec4; 3],
     inv_direction: [Vec4; 3],
     pad: Vec4,
@@ -384,7 +387,7 @@ impl<E: Copy> Pending<E> {
 
 /// A BVH over a set of triangles, each known by its index in the build input.
 #[derive(Debug, Clone)]
-pub(super) struct Bvh {
+pub(in crate::render) struct Bvh {
     /// Interior nodes in depth-first order (a node, its left subtree, its right subtree).
     nodes: Vec<Node>,
     root: Child,
@@ -413,7 +416,7 @@ impl Default for Bvh {
 
 /// A closest or any hit: the build-input index of the triangle and where it was hit.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct BvhHit {
+pub(in crate::render) struct BvhHit {
     pub id: u32,
     pub hit: FastHit,
 }

@@ -7,7 +7,7 @@ use crate::geometry::Ray;
 
 /// A triangle as the inner loop reads it: one vertex and the two edges from it.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct PackedTriangle {
+pub(in crate::render) struct PackedTriangle {
     pub v0: Vec3A,
     pub e1: Vec3A,
     pub e2: Vec3A,
@@ -20,7 +20,7 @@ const MIN_COMPONENT: f32 = 1e-30;
 
 /// A ray in f32 with what every box and triangle test needs precomputed.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct FastRay {
+pub(in crate::render) struct FastRay {
     pub origin: Vec3A,
     pub direction: Vec3A,
     pub inv_direction: Vec3A,
@@ -65,7 +65,7 @@ impl FastRay {
 
 /// A hit found by the f32 inner loop: ray parameter and barycentrics of vertices 1 and 2.
 #[derive(Debug, Clone, Copy)]
-pub(super) struct FastHit {
+pub(in crate::render) struct FastHit {
     pub t: f32,
     pub u: f32,
     pub v: f32,

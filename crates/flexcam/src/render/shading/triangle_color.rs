@@ -296,7 +296,7 @@ mod tests {
     use proptest::prelude::*;
 
     use super::*;
-    use crate::render::surface::base_color;
+    use crate::render::shading::base_color;
     use crate::scene::{Mesh, Surface};
 
     fn object(positions: [Vec3; 3], colors: Option<[Vec3; 3]>, pattern: Pattern) -> Object {

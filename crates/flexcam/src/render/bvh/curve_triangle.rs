@@ -38,19 +38,19 @@ use crate::projection::projector::quadratic_point;
 /// piece's control points by de Casteljau, the hit point and its barycentric test): far
 /// below this margin, so that the tests drop no hit that the root finding would accept. It
 /// stays far below any triangle of a model too, so the tests keep nearly all of their effect.
-pub(super) const MARGIN: f64 = 1e-6;
+pub(in crate::render) const MARGIN: f64 = 1e-6;
 
 /// Where a curve hits a triangle: the curve parameter and the barycentric weights of the
 /// triangle's second and third vertices.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct CurveHit {
+pub(in crate::render) struct CurveHit {
     pub s: f64,
     pub barycentric: [f64; 2],
 }
 
 /// A triangle (first vertex, then the two edges from it) with its precomputed tests.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct CurveTriangle {
+pub(in crate::render) struct CurveTriangle {
     v0: DVec3,
     e1: DVec3,
     e2: DVec3,
@@ -241,8 +241,8 @@ impl CurveTriangle {
 mod tests {
     use proptest::prelude::*;
 
-    use super::super::curve::piece;
     use super::*;
+    use crate::render::raycast::pieces::piece;
 
     fn tri(a: DVec3, b: DVec3, c: DVec3) -> CurveTriangle {
         CurveTriangle::new([a, b - a, c - a])

@@ -1,0 +1,41 @@
+//! The parts of a curved projector that the ray caster searches one by one: the segments of
+//! a polyline and the pieces a quadratic curve is cut into.
+
+use glam::DVec3;
+
+use crate::geometry::Ray;
+use crate::projection::projector::{quadratic_point, quadratic_tangent};
+
+/// Segment `k` of polyline projector `points` as a ray over `t` in `[0, 1]`, from vertex `k`
+/// to vertex `k + 1` (a zero direction where the two coincide).
+pub(in crate::render) fn polyline_segment(points: &[DVec3], k: usize) -> Ray {
+    Ray {
+        origin: points[k],
+        direction: points[k + 1] - points[k],
+        t_min: 0.0,
+        t_max: 1.0,
+    }
+}
+
+/// Pieces the curve is cut into for the BVH search: more pieces give thinner fattened chords
+/// (the padding falls as 1/PIECES^2), boxes that fewer triangles overlap, and fewer triangles
+/// tested beyond the first hit, but more traversals and more piece boxes in the tile culls.
+/// 24 took the least CPU time on the Table 7.1 bench's smallest models (8, 12, 16, 20, 24,
+/// 28, 32, 48 and 64 tried; docs/flexible.md, change 7).
+pub(in crate::render) const PIECES: usize = 24;
+
+/// The parameter interval [a, b] of piece `k` of [`PIECES`].
+pub(in crate::render) fn piece_interval(k: usize) -> (f64, f64) {
+    (k as f64 / PIECES as f64, (k + 1) as f64 / PIECES as f64)
+}
+
+/// The control points of the piece of curve `p` over [a, b] (blossoming: the end points and
+/// the intersection of the end tangents).
+pub(in crate::render) fn piece(p: &[DVec3; 3], a: f64, b: f64) -> [DVec3; 3] {
+    let start = quadratic_point(p, a);
+    [
+        start,
+        start + 0.5 * (b - a) * quadratic_tangent(p, a),
+        quadratic_point(p, b),
+    ]
+}

@@ -1,0 +1,292 @@
+//! Shading of a surface hit, `flat` or `lit`, the same for every renderer: the ray caster
+//! shades its primary hits with it, the rasterising renderers the hits they reconstruct, and
+//! secondary rays (mirrors, glass, shadows) are traced through the prepared scene's BVH.
+//!
+//! Specular materials take the same paths in both modes: a mirror reflects about the shading
+//! normal; glass enters when the ray opposes the triangle's face normal (eta = 1/ior), else
+//! leaves (eta = ior), and reflects on total internal reflection. A ray may bounce at most
+//! `max_bounces` times: a specular surface reached after that yields the background.
+//!
+//! - `flat`: the base colour of the first non-specular surface (nearest texel), untinted by
+//!   the mirrors and glass on the way; no Fresnel mixing.
+//! - `lit`: emissive shows its base colour; diffuse is an ambient term plus, per light,
+//!   Lambert + a white Phong highlight if a shadow ray reaches the light (any surface, glass
+//!   included, casts a hard shadow); a scene without lights gets an unshadowed headlight along
+//!   the ray. Mirrors reflect tinted by their base colour; glass mixes reflection and
+//!   refraction by the exact Fresnel reflectance, its transmission tinted by the base colour.
+//!   Branches whose weight in the pixel drops below [`MIN_WEIGHT`] yield the background, as
+//!   at the depth limit, so that nested glass costs at most a few hundred rays.
+
+use glam::{DVec3, Vec3};
+
+use crate::geometry::optics::{reflect, refract};
+use crate::geometry::Ray;
+use crate::render::prepared::{Hit, PreparedScene};
+use crate::render::shading::{base_color, normals, Normals, TextureFilter};
+use crate::render::{RenderOptions, Shading};
+use crate::scene::{Light, Surface};
+
+/// Ambient fraction of the base colour in `lit` shading.
+const AMBIENT: f32 = 0.1;
+/// Strength and Phong exponent of the highlight.
+const SPECULAR: f32 = 0.3;
+const SHININESS: i32 = 32;
+/// Lit branches weighing less than this in the final pixel are not traced.
+const MIN_WEIGHT: f32 = 1.0 / 1024.0;
+
+/// Whether flat shading shows the base colour of `surface` (else it is specular and passes
+/// the ray on).
+pub(in crate::render) fn shows_base_color(surface: Surface) -> bool {
+    matches!(surface, Surface::Diffuse | Surface::Emissive)
+}
+
+impl PreparedScene {
+    /// Whether flat shading shows the base colour of object `object` (an index into the
+    /// scene's objects) wherever it is hit, so that a hit's colour is the surface's base
+    /// colour at the hit ([`crate::render::shading::base_color`], nearest texels) and casts
+    /// no ray; `false` for a mirror or glass, which pass the ray on.
+    pub fn flat_shows_base_color(&self, object: usize) -> bool {
+        shows_base_color(self.scene.objects[object].material.surface)
+    }
+
+    /// [`PreparedScene::shade_hit`] for a caller that builds the primary ray only where shading
+    /// reads it: flat shading of a surface that shows its base colour reads only the hit (as
+    /// `Tracer::flat` does at its first hit), so `ray` is not called there. Same colour and
+    /// ray count as `shade_hit(&ray(), hit, options)`.
+    pub fn shade_hit_lazy(
+        &self,
+        ray: impl FnOnce() -> Ray,
+        hit: Hit,
+        options: &RenderOptions,
+    ) -> (Vec3, u64) {
+        let object = &self.scene.objects[hit.object];
+        if options.shading == Shading::Flat && shows_base_color(object.material.surface) {
+            let color = base_color(
+                object,
+                hit.triangle,
+                hit.barycentric,
+                TextureFilter::Nearest,
+            );
+            return (color, 0);
+        }
+        self.shade_hit(&ray(), hit, options)
+    }
+
+    /// The colour `options.shading` gives primary ray `ray` whose first hit is `hit` (found by
+    /// any means: a ray cast, a rasterised fragment), exactly as the ray caster shades its own
+    /// hits: mirrors, glass and shadows are traced from there through this scene. Also returns
+    /// the number of secondary and shadow rays that took.
+    pub fn shade_hit(&self, ray: &Ray, hit: Hit, options: &RenderOptions) -> (Vec3, u64) {
+        let mut shader = HitShader::new(self, options);
+        let color = shader.shade_hit(ray, hit);
+        (color, shader.counts.secondary + shader.counts.shadow)
+    }
+}
+
+/// Rays cast so far, by kind.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub(in crate::render) struct RayCounts {
+    pub primary: u64,
+    pub secondary: u64,
+    pub shadow: u64,
+}
+/// Shades hits of one render and traces their secondary rays; counts what it casts.
+pub(in crate::render) struct HitShader<'a> {
+    pub caster: &'a PreparedScene,
+    pub shading: Shading,
+    pub max_bounces: u32,
+    pub counts: RayCounts,
+}
+
+/// Where a specular surface sends a ray.
+pub(crate) struct Specular {
+    /// The path flat shading follows: the mirror reflection, the refraction, or the
+    /// reflection on total internal reflection.
+    pub main: DVec3,
+    /// With a refraction: the reflected direction and the Fresnel reflectance.
+    pub fresnel: Option<(DVec3, f32)>,
+}
+
+/// The start of a secondary ray: a surface point, its geometric normal, and how many
+/// bounces the ray will have made.
+struct Segment {
+    position: DVec3,
+    normal: DVec3,
+    bounce: u32,
+}
+impl<'a> HitShader<'a> {
+    pub fn new(caster: &'a PreparedScene, options: &RenderOptions) -> HitShader<'a> {
+        HitShader {
+            caster,
+            shading: options.shading,
+            max_bounces: options.max_bounces,
+            counts: RayCounts::default(),
+        }
+    }
+
+    /// The colour of primary ray `ray` whose first hit is `hit` (exact, f64).
+    pub fn shade_hit(&mut self, ray: &Ray, hit: Hit) -> Vec3 {
+        match self.shading {
+            Shading::Flat => self.flat(ray, hit),
+            Shading::Lit => self.lit(ray, hit, 0, 1.0),
+        }
+    }
+
+    /// Flat shading from the first hit on: follow mirrors and glass, show a base colour.
+    fn flat(&mut self, ray: &Ray, hit: Hit) -> Vec3 {
+        let (mut ray, mut hit) = (*ray, hit);
+        for bounce in 0.. {
+            let object = &self.caster.scene.objects[hit.object];
+            if shows_base_color(object.material.surface) {
+                return base_color(
+                    object,
+                    hit.triangle,
+                    hit.barycentric,
+                    TextureFilter::Nearest,
+                );
+            }
+            if bounce >= self.max_bounces {
+                break;
+            }
+            let normals = self.normals(&ray, &hit);
+            let direction = specular(&ray, &normals, object.material.surface).main;
+            ray = self
+                .caster
+                .spawn(ray.at(hit.t), normals.geometric.as_dvec3(), direction);
+            self.counts.secondary += 1;
+            match self.caster.intersect(&ray) {
+                Some(next) => hit = next,
+                None => break,
+            }
+        }
+        self.caster.scene.image.background
+    }
+
+    /// Lit shading of `hit` on `ray`, which has bounced `bounce` times and weighs `weight`.
+    fn lit(&mut self, ray: &Ray, hit: Hit, bounce: u32, weight: f32) -> Vec3 {
+        let object = &self.caster.scene.objects[hit.object];
+        let normals = self.normals(ray, &hit);
+        let base = base_color(
+            object,
+            hit.triangle,
+            hit.barycentric,
+            TextureFilter::Bilinear,
+        );
+        let position = ray.at(hit.t);
+        match object.material.surface {
+            Surface::Emissive => base,
+            Surface::Diffuse => self.direct(ray, position, &normals, base),
+            surface => {
+                let specular = specular(ray, &normals, surface);
+                let main_weight = match (surface, specular.fresnel) {
+                    (Surface::Mirror, _) => base,
+                    (_, Some((_, reflectance))) => base * (1.0 - reflectance),
+                    (_, None) => Vec3::ONE,
+                };
+                let next = Segment {
+                    position,
+                    normal: normals.geometric.as_dvec3(),
+                    bounce: bounce + 1,
+                };
+                let mut color = main_weight
+                    * self.radiance(&next, specular.main, weight * main_weight.max_element());
+                if let Some((direction, reflectance)) = specular.fresnel {
+                    color += reflectance * self.radiance(&next, direction, weight * reflectance);
+                }
+                color
+            }
+        }
+    }
+
+    /// Light arriving at `from.position` along `direction`, for a branch weighing `weight`.
+    fn radiance(&mut self, from: &Segment, direction: DVec3, weight: f32) -> Vec3 {
+        if from.bounce > self.max_bounces || weight < MIN_WEIGHT {
+            return self.caster.scene.image.background;
+        }
+        let ray = self.caster.spawn(from.position, from.normal, direction);
+        self.counts.secondary += 1;
+        match self.caster.intersect(&ray) {
+            Some(hit) => self.lit(&ray, hit, from.bounce, weight),
+            None => self.caster.scene.image.background,
+        }
+    }
+
+    /// Ambient plus Lambert and Phong from each light that a shadow ray reaches.
+    fn direct(&mut self, ray: &Ray, position: DVec3, normals: &Normals, base: Vec3) -> Vec3 {
+        let view = ray.direction.normalize();
+        let normal = normals.shading.as_dvec3();
+        let geometric = normals.geometric.as_dvec3();
+        let shade = |to_light: DVec3| {
+            let cos = normal.dot(to_light) as f32;
+            let highlight = reflect(-to_light, normal).dot(-view).max(0.0) as f32;
+            base * cos + Vec3::splat(SPECULAR * highlight.powi(SHININESS))
+        };
+        if self.caster.scene.lights.is_empty() {
+            return base * AMBIENT + shade(-view);
+        }
+        let mut color = base * AMBIENT;
+        for light in &self.caster.scene.lights {
+            let (to_light, t_max, radiance) = match *light {
+                Light::Point {
+                    position: p,
+                    color,
+                    intensity,
+                } => (p.as_dvec3() - position, 1.0, color * intensity),
+                Light::Directional {
+                    direction,
+                    color,
+                    intensity,
+                } => (-direction.as_dvec3(), f64::INFINITY, color * intensity),
+            };
+            let unit = to_light.normalize_or_zero();
+            if normal.dot(unit) <= 0.0 {
+                continue;
+            }
+            let mut shadow = self.caster.spawn(position, geometric, to_light);
+            shadow.t_max = t_max;
+            self.counts.shadow += 1;
+            if !self.caster.occluded(&shadow) {
+                color += radiance * shade(unit);
+            }
+        }
+        color
+    }
+
+    /// The normals at `hit` as seen along `ray`.
+    fn normals(&self, ray: &Ray, hit: &Hit) -> Normals {
+        let object = &self.caster.scene.objects[hit.object];
+        normals(
+            object,
+            hit.triangle,
+            hit.barycentric,
+            ray.direction.as_vec3(),
+        )
+    }
+}
+
+/// Where `surface` sends `ray` (seen with `normals`): a mirror reflects; glass refracts and
+/// also reflects by its Fresnel reflectance, or only reflects on total internal reflection.
+/// Shared with the trilinear composites (`render::composite`), which mix the same way.
+pub(crate) fn specular(ray: &Ray, normals: &Normals, surface: Surface) -> Specular {
+    let direction = ray.direction.normalize();
+    let normal = normals.shading.as_dvec3();
+    let reflected = reflect(direction, normal);
+    let refracted = match surface {
+        Surface::Glass { ior } => {
+            let ior = ior as f64;
+            let eta = if normals.front_face { 1.0 / ior } else { ior };
+            refract(direction, normal, eta)
+        }
+        _ => None,
+    };
+    match refracted {
+        Some(r) => Specular {
+            main: r.direction,
+            fresnel: Some((reflected, r.reflectance as f32)),
+        },
+        None => Specular {
+            main: reflected,
+            fresnel: None,
+        },
+    }
+}

@@ -1,0 +1,80 @@
+//! Loading a scene with the caller's overrides (image size, the perspective edit of a
+//! panorama, ...) and building its projection: what a command needs before rendering, with
+//! the projection build's report (counters, warnings) for the caller to print or ignore.
+
+use std::time::Instant;
+
+use crate::error::{Error, Result};
+use crate::projection::flexible::panorama::edit_source;
+use crate::projection::flexible::FlexibleSpec;
+use crate::projection::{BuildReport, Projection, ProjectionSpec};
+use crate::scene::{self, Scene};
+
+/// What a caller changes in a scene file's settings. `None` keeps the file's value.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Overrides {
+    /// Image width in pixels.
+    pub width: Option<u32>,
+    /// Image height in pixels.
+    pub height: Option<u32>,
+    /// The local perspective edit of a shape-defined panorama (the scene key
+    /// `perspective_rect`: `[u0, v0, u1, v1]` of the image domain), applied after the scene
+    /// file's own rectangle, if any.
+    pub perspective_rect: Option<[f64; 4]>,
+}
+
+/// A scene loaded with overrides and its projection built at the image size.
+pub struct LoadedScene {
+    /// The scene as named by the caller (`builtin:NAME` for built-ins).
+    pub source: String,
+    pub scene: Scene,
+    pub projection: Box<dyn Projection>,
+    pub width: u32,
+    pub height: u32,
+    /// What building the projection reported: counters for `--stats` (a fitted grid's
+    /// residual, ...) and warnings (a fitted grid's doubtful nodes).
+    pub build_report: BuildReport,
+    /// Time spent loading and building, in milliseconds.
+    pub load_ms: f64,
+}
+
+/// Loads `source` (a scene file or `builtin:NAME`), applies `overrides` and builds the
+/// projection. Errors name the scene file; an override that does not apply names the
+/// command-line flag that sets it (`--perspective-rect`), the spelling users see.
+pub fn load_with(source: &str, overrides: &Overrides) -> Result<LoadedScene> {
+    let start = Instant::now();
+    let mut scene = scene::load(source)?;
+    if let Some(rect) = overrides.perspective_rect {
+        scene.projection = perspective_rect(&scene.projection, rect)?;
+    }
+    let width = overrides.width.unwrap_or(scene.image.width);
+    let height = overrides.height.unwrap_or(scene.image.height);
+    scene::validate_resolution(width, height)?;
+    let (projection, build_report) = crate::calibrate::build(&scene.projection, width, height)
+        .map_err(|e: Error| e.or_in_file(source))?;
+    Ok(LoadedScene {
+        source: source.to_string(),
+        scene,
+        projection,
+        width,
+        height,
+        build_report,
+        load_ms: start.elapsed().as_secs_f64() * 1e3,
+    })
+}
+
+/// `projection` with the perspective edit `rect`.
+fn perspective_rect(projection: &ProjectionSpec, rect: [f64; 4]) -> Result<ProjectionSpec> {
+    let refuse = |why: String| Error::new(format!("--perspective-rect: {why}"));
+    let ProjectionSpec::Flexible(spec) = projection else {
+        return Err(refuse(format!(
+            "needs a flexible shape-defined panorama, the scene's projection is {}",
+            projection.kind()
+        )));
+    };
+    let source = edit_source(&spec.source, rect).map_err(|e| refuse(e.message))?;
+    Ok(ProjectionSpec::Flexible(Box::new(FlexibleSpec {
+        source,
+        reparam: spec.reparam,
+    })))
+}
