@@ -4,11 +4,13 @@
 //! use f32 ([`glam::Vec3`]) where precision has been shown to suffice.
 
 mod aabb;
+mod bilinear_patch;
 mod ray;
 mod roots;
 mod triangle;
 
 pub use aabb::Aabb;
+pub use bilinear_patch::{BilinearPatch, PatchHit};
 pub use ray::Ray;
 pub use roots::{solve_cubic, solve_quadratic, Roots};
 pub use triangle::{intersect_triangle, TriangleHit};
