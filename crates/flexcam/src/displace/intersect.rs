@@ -270,7 +270,7 @@ fn normal_range(n: [DVec3; 3]) -> [DVec3; 2] {
     let longest = n[0].length().max(n[1].length()).max(n[2].length());
     let m = (n[0] + n[1] + n[2]).normalize_or_zero();
     let nearest = n[0].dot(m).min(n[1].dot(m)).min(n[2].dot(m));
-    if !(nearest > 0.0) || longest == 0.0 {
+    if nearest.is_nan() || nearest <= 0.0 || longest == 0.0 {
         let r = DVec3::splat(longest.max(1.0) * (1.0 + 1e-12));
         return [-r, r];
     }

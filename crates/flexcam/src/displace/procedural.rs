@@ -160,7 +160,7 @@ fn wave_angle(w: &Wave, uv: DVec2) -> f64 {
 
 /// The range of `cos` over `[a, b]`.
 fn cos_range(a: f64, b: f64) -> [f64; 2] {
-    if !(b - a < TAU) {
+    if (b - a).is_nan() || b - a >= TAU {
         return [-1.0, 1.0];
     }
     let (ca, cb) = (a.cos(), b.cos());
