@@ -20,21 +20,31 @@ struct Cli {
     command: Command,
 }
 
+/// How every command that writes files writes them (shown after its options in `--help`).
+const OUTPUTS_HELP: &str = "Outputs are written all together or not at all, never over an \
+input (scene file, model, texture, photo) or another output, compared by file identity; \
+missing output folders are created.";
+
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Render a scene file or built-in scene to a PNG (and optional depth / id images).
+    #[command(after_help = OUTPUTS_HELP)]
     Render(commands::render::RenderArgs),
     /// Resample an equirectangular photo through a scene's projection into a PNG.
+    #[command(after_help = OUTPUTS_HELP)]
     Reproject(commands::reproject::ReprojectArgs),
     /// Render a scene's keyframed flexible camera to numbered PNG frames and/or a GIF.
+    #[command(after_help = OUTPUTS_HELP)]
     Animate(commands::animate::AnimateArgs),
     /// Fit a scene's projector grid to its `fit` correspondences and write the scene with the
     /// fitted node projectors explicit.
+    #[command(after_help = OUTPUTS_HELP)]
     Fit(commands::fit::FitArgs),
     /// List the built-in scenes: name, then a description.
     Scenes,
     /// Render a scene with a method and with the reference ray caster, and report how closely
     /// they agree (object ids, depth, relative RGB error).
+    #[command(after_help = OUTPUTS_HELP)]
     Compare(commands::compare::CompareArgs),
     /// Rerun a source document's timing table with flexcam's renderers.
     #[command(subcommand)]

@@ -6,6 +6,7 @@
 //! from the TOML scene format, model files or the built-in scenes. Renderers ([`render`]) turn
 //! a scene and a projection into a [`render::Frame`]; the ray caster is the exact reference.
 
+pub mod calibrate;
 pub mod displace;
 pub mod error;
 pub mod geometry;

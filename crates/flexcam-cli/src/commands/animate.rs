@@ -5,7 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::Args;
-use flexcam::image_io::{self, ColorEncoding, GifFrames, StagedFile};
+use flexcam::image_io::{self, ColorEncoding, GifFrames, OutputSet};
 use flexcam::projection::ProjectionSpec;
 use flexcam::render::{Method, RenderOptions, Shading};
 use flexcam::scene;
@@ -53,9 +53,9 @@ struct FramePattern {
 
 impl FramePattern {
     /// Errors: no `#` in the file name, two separate runs of them, an extension other than
-    /// .png, a missing folder, or fewer `#` than the last frame number has digits.
+    /// .png, or fewer `#` than the last frame number has digits.
     fn new(path: &Path, frames: u32) -> Result<Self> {
-        image_io::check_output_path(path, &["png"])?;
+        image_io::check_extension(path, &["png"])?;
         let name = path
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
@@ -103,7 +103,8 @@ impl FramePattern {
     }
 }
 
-/// Runs `flexcam animate`.
+/// Runs `flexcam animate`. Every frame and the GIF are written only once all frames have
+/// rendered, all together, and never over an input.
 pub fn run(args: &AnimateArgs) -> Result<()> {
     let method: Method = args.method.parse()?;
     if args.output.is_none() && args.gif.is_none() {
@@ -111,10 +112,15 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
             "nothing to write: give -o PATTERN (numbered PNG frames), --gif FILE, or both",
         ));
     }
-    if let Some(gif) = &args.gif {
-        image_io::check_output_path(gif, &["gif"])?;
-    }
+    let mut outputs = OutputSet::new();
+    outputs.input("the scene file", &args.scene)?;
+    let gif_output = args
+        .gif
+        .as_deref()
+        .map(|gif| outputs.output("the GIF output", gif, &["gif"]))
+        .transpose()?;
     let (scene, animation) = scene::file::load_animated(&args.scene)?;
+    super::declare_scene_inputs(&mut outputs, &scene.inputs)?;
     let animation = animation.ok_or_else(|| {
         Error::in_file(&args.scene, "the scene has no [animation] table to animate")
     })?;
@@ -124,6 +130,18 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         .as_deref()
         .map(|p| FramePattern::new(p, frames))
         .transpose()?;
+    let frame_outputs = match &pattern {
+        Some(pattern) => (0..frames)
+            .map(|n| {
+                outputs.output(
+                    &format!("frame {n} of the output"),
+                    &pattern.path(n),
+                    &["png"],
+                )
+            })
+            .collect::<Result<Vec<_>>>()?,
+        None => Vec::new(),
+    };
     let width = args.width.unwrap_or(scene.image.width);
     let height = args.height.unwrap_or(scene.image.height);
     scene::file::validate_resolution(width, height)?;
@@ -133,12 +151,10 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         Shading::Lit => ColorEncoding::Srgb,
     };
     let progress = RenderProgress::new();
-    let mut staged: Vec<StagedFile> = Vec::new();
     let mut gif = args.gif.as_ref().map(|_| GifFrames::default());
     for frame_number in 0..frames {
         let spec = ProjectionSpec::Flexible(Box::new(animation.projection(frame_number)));
-        let projection = spec
-            .build(width, height)
+        let (projection, _) = flexcam::calibrate::build(&spec, width, height)
             .map_err(|e| e.or_in_file(&args.scene))?;
         let done_before = u64::from(frame_number);
         let report = |done: u64, total: u64| {
@@ -151,23 +167,16 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
             ..RenderOptions::default()
         };
         let (frame, _) = method.render(&scene, projection.as_ref(), &options)?;
-        if let Some(pattern) = &pattern {
-            staged.push(image_io::write_color_png(
-                &frame,
-                &pattern.path(frame_number),
-                encoding,
-            )?);
+        if let Some(&id) = frame_outputs.get(frame_number as usize) {
+            outputs.stage(id, |tmp| image_io::write_color_png(&frame, tmp, encoding))?;
         }
         if let Some(gif) = &mut gif {
             gif.push(&frame, encoding)?;
         }
     }
     progress.finish();
-    if let (Some(gif), Some(path)) = (gif, &args.gif) {
-        staged.push(gif.write(path, animation.fps())?);
+    if let (Some(gif), Some(id)) = (gif, gif_output) {
+        outputs.stage(id, |tmp| gif.write(tmp, animation.fps()))?;
     }
-    for file in staged {
-        file.commit()?;
-    }
-    Ok(())
+    outputs.commit()
 }

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use flexcam::image_io::{self, ColorEncoding};
+use flexcam::image_io::{self, ColorEncoding, OutputSet};
 use flexcam::render::compare::{compare, Comparison};
 use flexcam::render::{composite, Frame, Method, RenderOptions};
 use flexcam::{Error, Result};
@@ -57,10 +57,17 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let method: Method = args.method.parse()?;
     let reference: Method = args.reference.parse()?;
     validate_thresholds(args)?;
-    if let Some(path) = &args.diff {
-        image_io::check_output_path(path, &["png"])?;
+    let mut outputs = OutputSet::new();
+    if let Some(source) = &args.scene.scene {
+        super::declare_scene_file(&mut outputs, source)?;
     }
+    let diff = args
+        .diff
+        .as_deref()
+        .map(|path| outputs.output("the diff output", path, &["png"]))
+        .transpose()?;
     let loaded = args.scene.load()?;
+    super::declare_scene_inputs(&mut outputs, &loaded.scene.inputs)?;
     let reference_options = RenderOptions {
         shading: args.shading.shading(),
         spp: args.spp,
@@ -88,14 +95,13 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let (reference_frame, reference_ms) = timed_render(reference, &reference_options, false)?;
     let result = compare(&frame, &reference_frame)?;
 
-    if let Some(path) = &args.diff {
-        image_io::write_color_png(
-            &difference_image(&frame, &reference_frame),
-            path,
-            ColorEncoding::Linear,
-        )?
-        .commit()?;
+    if let Some(id) = diff {
+        let image = difference_image(&frame, &reference_frame);
+        outputs.stage(id, |tmp| {
+            image_io::write_color_png(&image, tmp, ColorEncoding::Linear)
+        })?;
     }
+    outputs.commit()?;
     let header = Header {
         source: &loaded.source,
         projection: loaded.projection.kind(),

@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use flexcam::image_io;
+use flexcam::image_io::{self, OutputSet};
 use flexcam::scene::file::fit_scene;
 use flexcam::{Error, Result};
 
@@ -21,23 +21,20 @@ pub struct FitArgs {
 }
 
 /// Runs `flexcam fit`: reads and fits the scene, prints the residual, and writes the fitted
-/// scene atomically (never over the input).
+/// scene atomically (never over the fitting scene, with its correspondences, nor over a
+/// file the scene names).
 pub fn run(args: &FitArgs) -> Result<()> {
-    image_io::check_output_path(&args.output, &["toml"])?;
-    let same_file = match (args.scene.canonicalize(), args.output.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    };
-    if same_file {
-        return Err(Error::in_file(
-            &args.output,
-            "the output would overwrite the fitting scene (and its correspondences)",
-        ));
-    }
+    let mut outputs = OutputSet::new();
+    let output = outputs.output("the output", &args.output, &["toml"])?;
+    outputs.input("the fitting scene", &args.scene)?;
     let text = std::fs::read_to_string(&args.scene)
         .map_err(|e| Error::in_file(&args.scene, format!("cannot read scene file: {e}")))?;
     let fitted = fit_scene(&text, &args.scene, &args.output)?;
-    image_io::write_bytes(&args.output, fitted.text.as_bytes())?.commit()?;
+    super::declare_scene_inputs(&mut outputs, &fitted.inputs)?;
+    outputs.stage(output, |tmp| {
+        image_io::write_bytes(tmp, fitted.text.as_bytes())
+    })?;
+    outputs.commit()?;
     let r = fitted.report;
     if let Some(warning) = r.warning() {
         eprintln!("flexcam: warning: {}: {warning}", args.scene.display());

@@ -9,6 +9,28 @@ pub mod reproject;
 pub mod scene_args;
 pub mod scenes;
 
+/// Declares the scene file a command was given (a path; nothing for `builtin:NAME`) as an
+/// input of `outputs`, so that an output aimed at it is refused before the scene is read.
+pub fn declare_scene_file(
+    outputs: &mut flexcam::image_io::OutputSet,
+    source: &str,
+) -> flexcam::Result<()> {
+    if source.starts_with("builtin:") {
+        return Ok(());
+    }
+    outputs.input("the scene file", std::path::Path::new(source))
+}
+
+/// Declares every file a loaded scene was read from as an input of `outputs`.
+pub fn declare_scene_inputs(
+    outputs: &mut flexcam::image_io::OutputSet,
+    inputs: &[flexcam::scene::InputFile],
+) -> flexcam::Result<()> {
+    inputs
+        .iter()
+        .try_for_each(|file| outputs.input(&format!("the {}", file.what), &file.path))
+}
+
 /// Writes `text` to standard output and flushes it. A closed pipe (say `flexcam render
 /// --stats - | head -c 0`) is then one error line and a non-zero exit, not the panic of
 /// `print!`.

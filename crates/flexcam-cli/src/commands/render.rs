@@ -1,12 +1,12 @@
 //! `flexcam render`: load a scene, render it through its projection, write the outputs.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use flexcam::image_io::{self, ColorEncoding, StagedFile};
+use flexcam::image_io::{self, ColorEncoding, DepthFormat, OutputSet};
 use flexcam::render::{composite, Counter, Method, RenderOptions, Shading};
-use flexcam::{Error, Result};
+use flexcam::Result;
 
 use super::scene_args::{MethodTuning, SceneArgs, ShadingArg};
 use crate::progress::RenderProgress;
@@ -45,13 +45,39 @@ pub struct RenderArgs {
     stats: Option<OutputTarget>,
 }
 
-/// Runs `flexcam render`. Outputs are written only once everything has succeeded.
+/// Runs `flexcam render`. Outputs are written only once everything has succeeded, all
+/// together, and never over an input.
 pub fn run(args: &RenderArgs) -> Result<()> {
     let method: Method = args.method.parse()?;
-    check_outputs(args)?;
+    let mut outputs = OutputSet::new();
+    if let Some(source) = &args.scene.scene {
+        super::declare_scene_file(&mut outputs, source)?;
+    }
+    let color = outputs.output("the output", &args.output, &["png"])?;
+    let depth = match &args.depth {
+        Some(path) => Some((
+            outputs.output("the depth output", path, &DepthFormat::EXTENSIONS)?,
+            DepthFormat::of(path)?,
+        )),
+        None => None,
+    };
+    let ids = args
+        .ids
+        .as_deref()
+        .map(|path| outputs.output("the ids output", path, &["png"]))
+        .transpose()?;
+    let stats = match &args.stats {
+        Some(OutputTarget::File(path)) => {
+            Some(outputs.output("the stats output", path, &["json", "txt", ""])?)
+        }
+        _ => None,
+    };
 
     let loaded = args.scene.load()?;
-    warn_of_fit(&loaded.source, &loaded.projection.notes());
+    super::declare_scene_inputs(&mut outputs, &loaded.scene.inputs)?;
+    for warning in &loaded.build_report.warnings {
+        eprintln!("flexcam: warning: {}: {warning}", loaded.source);
+    }
 
     let progress = RenderProgress::new();
     let report = |done: u64, total: u64| progress.update(done, total);
@@ -71,7 +97,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
     progress.finish();
     let (frame, mut counters) = rendered?;
-    for (name, value) in loaded.projection.notes() {
+    for &(name, value) in &loaded.build_report.counters {
         counters.insert(name, Counter::Value(value));
     }
 
@@ -79,13 +105,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         Shading::Flat => ColorEncoding::Linear,
         Shading::Lit => ColorEncoding::Srgb,
     };
-    let mut staged: Vec<StagedFile> =
-        vec![image_io::write_color_png(&frame, &args.output, encoding)?];
-    if let Some(path) = &args.depth {
-        staged.push(image_io::write_depth(&frame, path)?);
+    outputs.stage(color, |tmp| {
+        image_io::write_color_png(&frame, tmp, encoding)
+    })?;
+    if let Some((id, format)) = depth {
+        outputs.stage(id, |tmp| image_io::write_depth(&frame, tmp, format))?;
     }
-    if let Some(path) = &args.ids {
-        staged.push(image_io::write_ids_png(&frame, path)?);
+    if let Some(id) = ids {
+        outputs.stage(id, |tmp| image_io::write_ids_png(&frame, tmp))?;
     }
     let facts = RunFacts {
         method: method.name(),
@@ -100,58 +127,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         render_ms,
     };
     let json = stats_json::to_json(&facts, &counters).to_string();
-    if let Some(OutputTarget::File(path)) = &args.stats {
-        staged.push(image_io::write_bytes(path, format!("{json}\n").as_bytes())?);
+    if let Some(id) = stats {
+        outputs.stage(id, |tmp| {
+            image_io::write_bytes(tmp, format!("{json}\n").as_bytes())
+        })?;
     }
-    for file in staged {
-        file.commit()?;
-    }
+    outputs.commit()?;
     if let Some(OutputTarget::Stdout) = &args.stats {
         super::print_stdout(&format!("{json}\n"))?;
-    }
-    Ok(())
-}
-
-/// Prints the warning of a fitted projector grid (as `flexcam fit` does) from the
-/// projection's notes, on stderr; the render goes on.
-fn warn_of_fit(source: &str, notes: &[(&'static str, f64)]) {
-    let count = |key: &str| {
-        notes
-            .iter()
-            .find(|(name, _)| *name == key)
-            .map_or(0, |(_, value)| *value as usize)
-    };
-    let warning = flexcam::projection::flexible::fit::node_warning(
-        count("fit_wild_nodes"),
-        count("fit_sparse_nodes"),
-    );
-    if let Some(warning) = warning {
-        eprintln!("flexcam: warning: {source}: {warning}");
-    }
-}
-
-/// Fails before rendering on output paths that could not be written afterwards.
-fn check_outputs(args: &RenderArgs) -> Result<()> {
-    image_io::check_output_path(&args.output, &["png"])?;
-    if let Some(path) = &args.depth {
-        image_io::check_output_path(path, &["exr", "pfm"])?;
-    }
-    if let Some(path) = &args.ids {
-        image_io::check_output_path(path, &["png"])?;
-    }
-    if let Some(OutputTarget::File(path)) = &args.stats {
-        image_io::check_output_path(path, &["json", "txt", ""])?;
-    }
-    let mut paths: Vec<&Path> = vec![&args.output];
-    paths.extend(args.depth.as_deref());
-    paths.extend(args.ids.as_deref());
-    if let Some(OutputTarget::File(path)) = &args.stats {
-        paths.push(path);
-    }
-    for (i, a) in paths.iter().enumerate() {
-        if paths[..i].contains(a) {
-            return Err(Error::in_file(a, "the same file is given for two outputs"));
-        }
     }
     Ok(())
 }

@@ -3,9 +3,9 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use flexcam::image_io::{self, ColorEncoding};
+use flexcam::image_io::{self, ColorEncoding, OutputSet};
 use flexcam::render::reproject::{reproject, EquirectPhoto};
-use flexcam::{Error, Result};
+use flexcam::Result;
 
 use super::scene_args::SceneArgs;
 
@@ -27,25 +27,28 @@ pub struct ReprojectArgs {
     spp: u32,
 }
 
-/// Runs `flexcam reproject`: checks the output path, reads the photo (an unsupported
-/// extension fails before reading), builds the scene's
-/// projection, resamples and writes the PNG atomically.
+/// Runs `flexcam reproject`: checks the output path (never the photo or a file of the
+/// scene), reads the photo (an unsupported extension fails before reading), builds the
+/// scene's projection, resamples and writes the PNG atomically.
 pub fn run(args: &ReprojectArgs) -> Result<()> {
-    image_io::check_output_path(&args.output, &["png"])?;
-    if args.input == args.output {
-        return Err(Error::in_file(
-            &args.output,
-            "the output would overwrite the input photo",
-        ));
+    let mut outputs = OutputSet::new();
+    let output = outputs.output("the output", &args.output, &["png"])?;
+    outputs.input("the photo", &args.input)?;
+    if let Some(source) = &args.scene.scene {
+        super::declare_scene_file(&mut outputs, source)?;
     }
     let photo = EquirectPhoto::new(image_io::read_linear_image(&args.input)?)
         .map_err(|e| e.or_in_file(&args.input))?;
     let loaded = args.scene.load()?;
+    super::declare_scene_inputs(&mut outputs, &loaded.scene.inputs)?;
     let frame = reproject(
         &photo,
         loaded.projection.as_ref(),
         args.spp,
         loaded.scene.image.background,
     );
-    image_io::write_color_png(&frame, &args.output, ColorEncoding::Srgb)?.commit()
+    outputs.stage(output, |tmp| {
+        image_io::write_color_png(&frame, tmp, ColorEncoding::Srgb)
+    })?;
+    outputs.commit()
 }

@@ -6,7 +6,7 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 use flexcam::projection::flexible::panorama::edit_source;
 use flexcam::projection::flexible::FlexibleSpec;
-use flexcam::projection::{Projection, ProjectionSpec};
+use flexcam::projection::{BuildReport, Projection, ProjectionSpec};
 use flexcam::render::raster::Subdivision;
 use flexcam::render::trilinear::CurveOptions;
 use flexcam::render::{Method, Shading};
@@ -44,6 +44,8 @@ pub struct LoadedScene {
     pub source: String,
     pub scene: Scene,
     pub projection: Box<dyn Projection>,
+    /// What building the projection reported (a fitted grid's residual and warnings).
+    pub build_report: BuildReport,
     pub width: u32,
     pub height: u32,
     /// Time spent loading and building, in milliseconds.
@@ -66,14 +68,14 @@ impl SceneArgs {
         let width = self.width.unwrap_or(scene.image.width);
         let height = self.height.unwrap_or(scene.image.height);
         scene::file::validate_resolution(width, height)?;
-        let projection = scene
-            .projection
-            .build(width, height)
-            .map_err(|e: Error| e.or_in_file(&source))?;
+        let (projection, build_report) =
+            flexcam::calibrate::build(&scene.projection, width, height)
+                .map_err(|e: Error| e.or_in_file(&source))?;
         Ok(LoadedScene {
             source,
             scene,
             projection,
+            build_report,
             width,
             height,
             load_ms: start.elapsed().as_secs_f64() * 1e3,

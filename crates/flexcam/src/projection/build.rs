@@ -1,11 +1,11 @@
 //! [`ProjectionSpec::build`]: from a parsed description to a validated projection.
 
 use super::fisheye::Fisheye;
-use super::flexible::Flexible;
+use super::flexible::{Flexible, GridFitter};
 use super::linear::{Orthographic, Perspective};
 use super::panoramic::{Cylindrical, Equirectangular};
 use super::trilinear::Trilinear;
-use super::{Projection, ProjectionSpec};
+use super::{BuildReport, Projection, ProjectionSpec};
 use crate::error::Result;
 
 impl ProjectionSpec {
@@ -17,8 +17,32 @@ impl ProjectionSpec {
     /// (0, 360] and v_fov in (0, 180], cylindrical h_fov in (0, 360] and v_fov in (0, 180));
     /// a trilinear mesh with no triangles, mismatched arrays, an index out of range, a
     /// zero-length normal or a zero-area screen triangle; a flexible volume with a bad preset
-    /// parameter or surface, or whose near and far surfaces coincide everywhere.
+    /// parameter or surface, or whose near and far surfaces coincide everywhere; a projector
+    /// grid with correspondences (those need [`ProjectionSpec::build_fitted`]).
     pub fn build(&self, width: u32, height: u32) -> Result<Box<dyn Projection>> {
+        self.build_with(width, height, None, &mut BuildReport::default())
+    }
+
+    /// [`ProjectionSpec::build`] where projector grids may have correspondences, fitted by
+    /// `fitter` (`crate::calibrate` provides it), with the build's report.
+    pub fn build_fitted(
+        &self,
+        width: u32,
+        height: u32,
+        fitter: &dyn GridFitter,
+    ) -> Result<(Box<dyn Projection>, BuildReport)> {
+        let mut report = BuildReport::default();
+        let projection = self.build_with(width, height, Some(fitter), &mut report)?;
+        Ok((projection, report))
+    }
+
+    fn build_with(
+        &self,
+        width: u32,
+        height: u32,
+        fitter: Option<&dyn GridFitter>,
+        report: &mut BuildReport,
+    ) -> Result<Box<dyn Projection>> {
         Ok(match self {
             ProjectionSpec::Perspective { frame, fov } => {
                 Box::new(Perspective::new(frame, *fov, width, height)?)
@@ -41,7 +65,9 @@ impl ProjectionSpec {
                 v_fov,
             } => Box::new(Cylindrical::new(frame, *h_fov, *v_fov, width, height)?),
             ProjectionSpec::Trilinear(mesh) => Box::new(Trilinear::new(mesh, width, height)?),
-            ProjectionSpec::Flexible(spec) => Box::new(Flexible::new(spec, width, height)?),
+            ProjectionSpec::Flexible(spec) => {
+                Box::new(Flexible::build(spec, width, height, fitter, report)?)
+            }
         })
     }
 }

@@ -9,6 +9,7 @@
 //! turns it into a [`Projection`] for a given image size, validating it on the way.
 
 mod build;
+mod build_report;
 mod camera_basis;
 pub mod chart;
 mod fisheye;
@@ -22,6 +23,7 @@ mod params;
 pub mod projector;
 mod trilinear;
 
+pub use build_report::BuildReport;
 pub use camera_basis::CameraBasis;
 pub use chart::{HalfSpace, InverseChart, Pole};
 pub use fisheye::Fisheye;
@@ -30,10 +32,10 @@ pub use image_coords::Resolution;
 pub use linear::{Orthographic, Perspective};
 pub use panoramic::{Cylindrical, Equirectangular};
 pub use projector::{Projector, ProjectorHull};
+pub use trilinear::mesh_builders as trilinear_builders;
 pub use trilinear::{
-    project_solved_triangle, project_triangle, surfaces, ProjectionTriangleCache, ProjectiveMap,
-    SceneEdge, Shape, ShapeVertex, Solutions, TriangleShapes, TriangleSolution, Trilinear,
-    Unprojectable,
+    project_solved_triangle, project_triangle, ProjectionTriangleCache, ProjectiveMap, SceneEdge,
+    Shape, ShapeVertex, Solutions, TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
 };
 
 use glam::{DVec2, DVec3};
@@ -124,12 +126,6 @@ pub trait Projection: Send + Sync {
     /// (`--method trilinear`); `None` for every other kind.
     fn as_trilinear(&self) -> Option<&Trilinear> {
         None
-    }
-
-    /// Figures about how the projection was built that belong with a render's statistics
-    /// (the residual of a fitted projector grid), as (name, value) pairs.
-    fn notes(&self) -> Vec<(&'static str, f64)> {
-        Vec::new()
     }
 }
 

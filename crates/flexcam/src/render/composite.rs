@@ -27,7 +27,9 @@ use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::projection::surfaces::{reflector_surface, Optic, ReflectorSurface, SurfaceScreenMap};
+use crate::projection::trilinear_builders::{
+    reflector_surface, Optic, ReflectorSurface, SurfaceScreenMap,
+};
 use crate::projection::{Perspective, Projection, ProjectionSpec, Trilinear, TrilinearMesh};
 use crate::render::raycast::{specular, RayCaster};
 use crate::render::surface::normals;

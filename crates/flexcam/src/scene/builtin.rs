@@ -23,22 +23,22 @@ struct Builtin {
 const BUILTINS: [Builtin; 4] = [
     Builtin {
         name: "default",
-        description: "a furnished room seen through a 360 x 180 degree equirectangular panorama",
+        description: "a teapot, mirror and glass spheres, a torus, boxes, a pillar, a cylinder and a lamp around the eye, as a 360 x 180 degree equirectangular panorama",
         text: include_str!("../../../../scenes/default.toml"),
     },
     Builtin {
         name: "cube-floor",
-        description: "seed 000's test scene: a six-coloured cube on a checkerboard, 686 triangles",
+        description: "the cube on a checkerboard of Vallance's thesis: six differently coloured faces, 686 triangles, perspective from above",
         text: include_str!("../../../../scenes/cube-floor.toml"),
     },
     Builtin {
         name: "teapot-room",
-        description: "a teapot among a box, sphere and cylinder, with a mirror and a glass object",
+        description: "a teapot, a box, a sphere and a cylinder on a checkerboard, with a mirror sphere and a glass sphere; perspective",
         text: include_str!("../../../../scenes/teapot-room.toml"),
     },
     Builtin {
         name: "teapot-dense",
-        description: "a finely tessellated teapot of over 100,000 triangles, for benchmarks",
+        description: "a finely tessellated teapot on a floor, 123,554 triangles, perspective: the ray-casting benchmark scene",
         text: include_str!("../../../../scenes/teapot-dense.toml"),
     },
 ];

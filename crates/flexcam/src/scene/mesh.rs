@@ -3,6 +3,7 @@
 use glam::{Affine3A, Vec2, Vec3};
 
 use crate::error::{Error, Result};
+use crate::geometry::MeshView;
 
 /// An indexed triangle mesh.
 ///
@@ -15,6 +16,16 @@ pub struct Mesh {
     pub uvs: Vec<Vec2>,
     pub colors: Vec<Vec3>,
     pub triangles: Vec<[u32; 3]>,
+}
+
+impl<'a> From<&'a Mesh> for MeshView<'a> {
+    fn from(mesh: &'a Mesh) -> Self {
+        MeshView {
+            positions: &mesh.positions,
+            normals: &mesh.normals,
+            triangles: &mesh.triangles,
+        }
+    }
 }
 
 impl Mesh {

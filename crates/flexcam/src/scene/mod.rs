@@ -15,7 +15,7 @@ use std::path::PathBuf;
 
 use glam::{Affine3A, Vec3};
 
-use crate::projection::surfaces::SurfaceScreenMap;
+use crate::projection::trilinear_builders::SurfaceScreenMap;
 use crate::projection::ProjectionSpec;
 
 /// One object of a scene. Its id (1-based, in file order; 0 is the background) is what the
@@ -64,6 +64,19 @@ pub struct Scene {
     /// trilinear surface and composited into the main image (scene-file key
     /// `trilinear_reflector`; see [`crate::render::composite`]). Empty: plain rendering.
     pub trilinear_reflectors: Vec<TrilinearReflector>,
+    /// Every file the scene was read from (the scene file, models and the files they name,
+    /// textures, surfaces), so that a command can refuse to write over any of them. Empty
+    /// for built-in scenes (they name no files) and scenes built in code.
+    pub inputs: Vec<InputFile>,
+}
+
+/// A file a scene was read from, and what it was to the scene.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct InputFile {
+    /// What the file is, for messages: "scene file", "model file", "material library",
+    /// "texture", "model buffer", "trilinear surface".
+    pub what: &'static str,
+    pub path: PathBuf,
 }
 
 /// A mirror or glass object rendered through a trilinear surface (seed 000, chapter 7).
@@ -103,6 +116,8 @@ impl Scene {
 pub mod builtin;
 pub mod file;
 pub mod loaders;
+#[cfg(test)]
+pub(crate) mod reflector_fixtures;
 pub mod shapes;
 
 pub use file::validate_resolution;

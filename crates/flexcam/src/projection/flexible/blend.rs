@@ -10,7 +10,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::surface::Surface;
+use super::control_surface::Surface;
 use crate::error::{Error, Result};
 use crate::projection::{Projector, ProjectorHull};
 

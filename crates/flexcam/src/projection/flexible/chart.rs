@@ -23,9 +23,9 @@ use std::f64::consts::{FRAC_PI_2, PI};
 
 use glam::DVec3;
 
+use super::control_surface::{lerp_range, CylinderPatch, SpherePatch};
 use super::inverse::{Affine, Inverse};
 use super::reparam::Reparam;
-use super::surface::{lerp_range, CylinderPatch, SpherePatch};
 use crate::geometry::solve_quadratic;
 use crate::projection::chart::{axis_poles, HalfSpace, InverseChart};
 use crate::projection::image_coords::Resolution;

@@ -20,8 +20,8 @@ use std::f64::consts::PI;
 
 use glam::{DMat2, DVec2, DVec3};
 
+use super::control_surface::{CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface};
 use super::panorama::lookup::{self, PanoramaInverse};
-use super::surface::{CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface};
 use crate::error::Result;
 
 /// Relative tolerance for "the same" centre, frame or range, and for the domain edges.

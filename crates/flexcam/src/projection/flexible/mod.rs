@@ -1,16 +1,17 @@
 //! The flexible projection (seed 003, Flexible Projection): a parametric viewing volume
 //! Q(u, v, t) between control surfaces, mapped to the image by a re-parameterisation.
 //!
-//! - [`surface`]: control surfaces Q_i(u, v) on the shared domain (u, v) in [0, 1]^2, u to the
+//! - [`control_surface`]: control surfaces Q_i(u, v) on the shared domain (u, v) in [0, 1]^2, u to the
 //!   right of the image, v up;
-//! - [`volume`]: Q(u, v, t) = (1 - t) Q_near + t Q_far and dQ/dt (straight projectors);
+//! - [`volume`]: the volume Q(u, v, t) and dQ/dt over every kind of projector, and
+//!   `linear_volume`: Q(u, v, t) = (1 - t) Q_near + t Q_far (straight projectors);
 //! - [`blend`]: volumes of two or more surfaces blended in t, piecewise-linear (polyline
 //!   projectors) or Bernstein (Bezier projectors);
 //! - `patch`: bicubic Bezier and uniform cubic B-spline control surfaces;
 //! - [`reparam`]: pixel <-> (u, v) (linear, polar fisheye, lens-like, equisolid, Mercator);
 //! - [`presets`]: named volumes from a camera frame (perspective, pushbroom, crossed slits, ...);
-//! - [`projector_grid`]: a volume interpolated from a grid of placed projectors (5.2), and
-//!   [`fit`]: aiming all of them by least squares from point correspondences;
+//! - [`projector_grid`]: a volume interpolated from a grid of placed projectors (5.2), aimed
+//!   at point correspondences by a [`GridFitter`] (the fit itself is `crate::calibrate`'s);
 //! - [`panorama`]: shape-defined panoramas (ch. 9), outlines and profiles by arc length;
 //! - `inverse`: (u, v, t) from a scene point for the analytic class (parallel planes, nested
 //!   spheres, coaxial cylinders);
@@ -23,15 +24,15 @@
 pub mod animation;
 pub mod blend;
 mod chart;
-pub mod fit;
+pub mod control_surface;
 pub mod interpolate;
 mod inverse;
+mod linear_volume;
 pub mod panorama;
 mod patch;
 pub mod presets;
 pub mod projector_grid;
 pub mod reparam;
-pub mod surface;
 #[cfg(test)]
 mod tests;
 pub mod volume;
@@ -40,22 +41,23 @@ use glam::{DVec2, DVec3};
 
 pub use animation::{Animation, Easing, Keyframe};
 pub use blend::{BezierVolume, PiecewiseVolume};
-pub use interpolate::InterpolatedVolume;
+pub use control_surface::{
+    BSplinePatch, BezierPatch, CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface,
+};
+pub use linear_volume::LinearVolume;
 pub use panorama::{PanoramaShape, PanoramaSpec};
 pub use presets::{DepthStyle, Magnifier, McopPath, Preset, PresetSpec};
 pub use projector_grid::{
-    Aim, GridInterpolation, GridVolume, NodeProjector, ProjectorGrid, ProjectorGridSpec,
+    Aim, Correspondence, GridFitter, GridInterpolation, GridVolume, NodeProjector, ProjectorGrid,
+    ProjectorGridSpec, Starts,
 };
 pub use reparam::Reparam;
-pub use surface::{
-    BSplinePatch, BezierPatch, CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface,
-};
-pub use volume::{LinearVolume, Volume};
+pub use volume::{InterpolatedVolume, Volume};
 
 use self::inverse::Inverse;
 use super::chart::InverseChart;
 use super::image_coords::Resolution;
-use super::{ImagePoint, Projection, Projector, ProjectorHull};
+use super::{BuildReport, ImagePoint, Projection, Projector, ProjectorHull};
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
 
@@ -122,11 +124,23 @@ impl Flexible {
     /// invalid surface; control surfaces that coincide everywhere; bad knots or segments of
     /// a blended volume (see [`PiecewiseVolume::new`], [`BezierVolume::new`]); a map latitude
     /// out of range; an interpolation of volumes with different re-parameterisations or a
-    /// non-finite weight.
+    /// non-finite weight; a projector grid with correspondences (see [`Flexible::build`]).
     pub fn new(spec: &FlexibleSpec, width: u32, height: u32) -> Result<Self> {
+        Self::build(spec, width, height, None, &mut BuildReport::default())
+    }
+
+    /// [`Flexible::new`] where projector grids may have correspondences: `fitter` fits them
+    /// and what it reports is added to `report`.
+    pub fn build(
+        spec: &FlexibleSpec,
+        width: u32,
+        height: u32,
+        fitter: Option<&dyn GridFitter>,
+        report: &mut BuildReport,
+    ) -> Result<Self> {
         let resolution = Resolution::new(width, height)?;
         let aspect = f64::from(height) / f64::from(width);
-        let (volume, reparam) = build_volume(spec, aspect)?;
+        let (volume, reparam) = build_volume(spec, aspect, fitter, report)?;
         let classified = match &volume {
             Volume::Linear(v) => Inverse::classify(&v.near, &v.far),
             Volume::Piecewise(_)
@@ -170,7 +184,13 @@ impl Flexible {
 
 /// The volume and re-parameterisation of `spec` for an image of aspect ratio
 /// `aspect` = height / width.
-fn build_volume(spec: &FlexibleSpec, aspect: f64) -> Result<(Volume, Reparam)> {
+/// Projector grids with correspondences are fitted by `fitter` (see [`GridVolume::build`]).
+fn build_volume(
+    spec: &FlexibleSpec,
+    aspect: f64,
+    fitter: Option<&dyn GridFitter>,
+    report: &mut BuildReport,
+) -> Result<(Volume, Reparam)> {
     let linear = |near, far| LinearVolume::new(near, far).map(|v| Volume::Linear(Box::new(v)));
     let (volume, default_reparam) = match &spec.source {
         VolumeSource::Preset(p) => (p.volume(aspect)?, p.preset.default_reparam()),
@@ -197,8 +217,8 @@ fn build_volume(spec: &FlexibleSpec, aspect: f64) -> Result<(Volume, Reparam)> {
             first,
             second,
         } => {
-            let (a, map_a) = build_volume(first, aspect)?;
-            let (b, map_b) = build_volume(second, aspect)?;
+            let (a, map_a) = build_volume(first, aspect, fitter, report)?;
+            let (b, map_b) = build_volume(second, aspect, fitter, report)?;
             if map_a != map_b {
                 return Err(Error::new(format!(
                     "flexible interpolation needs both volumes on one (u, v) domain: they \
@@ -211,8 +231,14 @@ fn build_volume(spec: &FlexibleSpec, aspect: f64) -> Result<(Volume, Reparam)> {
             (interpolate::interpolate(*weight, a, b)?, map_a)
         }
         VolumeSource::ProjectorGrid { base, grid } => {
-            let (base_volume, base_reparam) = build_volume(base, aspect)?;
-            let volume = GridVolume::build(grid, &base_volume)?;
+            let (base_volume, base_reparam) = build_volume(base, aspect, fitter, report)?;
+            let Volume::Linear(linear) = &base_volume else {
+                return Err(Error::new(
+                    "a projector grid starts from a volume with straight projectors (a preset \
+                     or near and far surfaces), not from blended surfaces",
+                ));
+            };
+            let volume = GridVolume::build(grid, linear, fitter, report)?;
             (Volume::Grid(Box::new(volume)), base_reparam)
         }
     };
@@ -236,42 +262,6 @@ fn describe(reparam: &Reparam) -> String {
 impl Projection for Flexible {
     fn kind(&self) -> &'static str {
         "flexible"
-    }
-
-    fn notes(&self) -> Vec<(&'static str, f64)> {
-        match &self.volume {
-            Volume::Grid(grid) => grid.fit.map_or_else(Vec::new, |r| {
-                let mut notes = vec![
-                    ("fit_correspondences", r.correspondences as f64),
-                    ("fit_unconstrained_nodes", r.unconstrained_nodes as f64),
-                    ("fit_max_angle_deg", r.max_angle_deg),
-                    ("fit_rms_angle_deg", r.rms_angle_deg),
-                    ("fit_wild_nodes", r.wild_nodes as f64),
-                    ("fit_sparse_nodes", r.sparse_nodes as f64),
-                ];
-                // 1 when the starts lie on projectors through a fitted eye (given next), or
-                // were fitted per node.
-                let eye = match r.starts {
-                    fit::FittedStarts::Eye(eye) => Some(eye),
-                    fit::FittedStarts::Kept | fit::FittedStarts::Free => None,
-                };
-                notes.push(("fit_starts_eye", f64::from(u8::from(eye.is_some()))));
-                let free = r.starts == fit::FittedStarts::Free;
-                notes.push(("fit_starts_free", f64::from(u8::from(free))));
-                if let Some(smoothness) = r.smoothness {
-                    notes.push(("fit_smoothness", smoothness));
-                }
-                if let Some(eye) = eye {
-                    notes.extend([
-                        ("fit_eye_x", eye.x),
-                        ("fit_eye_y", eye.y),
-                        ("fit_eye_z", eye.z),
-                    ]);
-                }
-                notes
-            }),
-            _ => Vec::new(),
-        }
     }
 
     fn resolution(&self) -> (u32, u32) {

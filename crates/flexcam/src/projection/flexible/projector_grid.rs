@@ -38,18 +38,20 @@
 //! A grid starts as a sample of any volume with straight projectors (the thesis fills it as a
 //! perspective frustum from the perspective preset); [`ProjectorGrid::set_projector`] places
 //! one node's projector explicitly, [`ProjectorGrid::aim`] re-aims one through a scene point,
-//! and `fit` (module `fit`) aims all of them at once from point correspondences.
+//! and the grid fit of `crate::calibrate` aims all of them at once from point correspondences
+//! (module `correspondence`).
 
 use glam::{DVec2, DVec3};
 
-use super::fit::{fit_with, Correspondence, FitReport, Starts};
-use super::volume::{LinearVolume, Volume};
+use super::linear_volume::LinearVolume;
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
 use crate::projection::projector::{quadratic_point, quadratic_tangent};
-use crate::projection::Projector;
+use crate::projection::{BuildReport, Projector};
 
+mod correspondence;
 mod through;
+pub use correspondence::{Correspondence, GridFitter, Starts};
 pub use through::Through;
 
 /// Fewest nodes per side: a grid needs two to span the domain.
@@ -476,27 +478,25 @@ pub struct ProjectorGridSpec {
     pub starts: Starts,
 }
 
-/// A projector grid in use as a viewing volume, with the residual of its fit if it had one.
+/// A projector grid in use as a viewing volume.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GridVolume {
     pub grid: ProjectorGrid,
-    pub fit: Option<FitReport>,
 }
 
 impl GridVolume {
-    /// Samples `base` (which must have straight projectors), places the explicit node
-    /// projectors, applies the aims in order, then fits the grid to the correspondences when
-    /// there are any. Errors: a base with curved projectors, and the errors of
+    /// Samples `base`, places the explicit node
+    /// projectors, applies the aims in order, then, when there are correspondences, has
+    /// `fitter` fit the grid to them and adds what it reports to `report`. Errors: correspondences without a fitter; the errors of
     /// [`ProjectorGrid::sample`], [`ProjectorGrid::set_projector`], [`ProjectorGrid::aim`] and
-    /// [`fit_with`] (which fits curved projectors when the grid has tangents).
-    pub fn build(spec: &ProjectorGridSpec, base: &Volume) -> Result<Self> {
-        let Volume::Linear(linear) = base else {
-            return Err(Error::new(
-                "a projector grid starts from a volume with straight projectors (a preset or \
-                 near and far surfaces), not from blended surfaces",
-            ));
-        };
-        let mut grid = ProjectorGrid::sample(linear, spec.size, spec.interpolation)?;
+    /// of the fitter.
+    pub fn build(
+        spec: &ProjectorGridSpec,
+        base: &LinearVolume,
+        fitter: Option<&dyn GridFitter>,
+        report: &mut BuildReport,
+    ) -> Result<Self> {
+        let mut grid = ProjectorGrid::sample(base, spec.size, spec.interpolation)?;
         for node in &spec.projectors {
             let (col, row) = node.node;
             let j = grid.index(col, row)?;
@@ -512,13 +512,17 @@ impl GridVolume {
             grid.aim(aim.node.0, aim.node.1, aim.at)?;
         }
         if spec.correspondences.is_empty() {
-            return Ok(GridVolume { grid, fit: None });
+            return Ok(GridVolume { grid });
         }
-        let (grid, report) = fit_with(&grid, &spec.correspondences, spec.starts)?;
-        Ok(GridVolume {
-            grid,
-            fit: Some(report),
-        })
+        let fitter = fitter.ok_or_else(|| {
+            Error::new(
+                "a projector grid with `fit` correspondences is built with the grid fit \
+                 (flexcam::calibrate::build)",
+            )
+        })?;
+        let (grid, fitted) = fitter.fit(&grid, &spec.correspondences, spec.starts)?;
+        report.extend(fitted);
+        Ok(GridVolume { grid })
     }
 }
 
@@ -553,26 +557,20 @@ fn bernstein(degree: usize, x: f64) -> Vec<f64> {
 }
 
 #[cfg(test)]
-pub(super) mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::projection::flexible::presets::{Preset, PresetSpec};
     use crate::projection::CameraFrame;
 
     /// A perspective volume with horizontal field of view `fov` (degrees), aspect 3:4, its
     /// control surfaces at the distances `clip`: the test fixture of grids and fits.
-    pub(in crate::projection::flexible) fn perspective_volume(
-        fov: f64,
-        clip: [f64; 2],
-    ) -> LinearVolume {
+    pub(crate) fn perspective_volume(fov: f64, clip: [f64; 2]) -> LinearVolume {
         preset_volume(Preset::Perspective { fov }, clip)
     }
 
     /// `preset` seen from the fixture's camera, aspect 3:4, its control surfaces at the
     /// distances `clip`.
-    pub(in crate::projection::flexible) fn preset_volume(
-        preset: Preset,
-        clip: [f64; 2],
-    ) -> LinearVolume {
+    pub(crate) fn preset_volume(preset: Preset, clip: [f64; 2]) -> LinearVolume {
         let spec = PresetSpec {
             preset,
             frame: CameraFrame {

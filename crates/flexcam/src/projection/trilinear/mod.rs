@@ -14,12 +14,12 @@
 //! [`projective_map`], which makes a surface whose screen positions are an eye's image of its
 //! base points send each screen point's ray from the base point that the eye sees there.
 
+pub mod mesh_builders;
 mod obj;
 mod point_projection;
 mod projective_map;
 mod screen_locator;
 mod shapes;
-pub mod surfaces;
 
 use glam::{DVec2, DVec3};
 
@@ -366,7 +366,7 @@ impl Trilinear {
 mod tests {
     use super::*;
     use crate::projection::linear::Perspective;
-    use crate::projection::surfaces::{screen_grid, GridVertex};
+    use crate::projection::trilinear_builders::{screen_grid, GridVertex};
     use crate::projection::CameraFrame;
 
     /// A 2 x 2 quad grid (8 triangles) on the image plane at distance 1 in front of `eye`

@@ -68,7 +68,7 @@
 //!   triangle); edges still over the tolerance at the cap (or below [`MIN_EDGE_PX`]) are
 //!   left as they are and counted ([`Refinement::unsplit`]);
 //! - **a mesh without vertex normals, or a zero normal**: the area-weighted face normal, as
-//!   [`reflector_surface`](crate::projection::surfaces::reflector_surface) uses at the
+//!   [`reflector_surface`](crate::projection::trilinear_builders::reflector_surface) uses at the
 //!   original vertices; the refined surface then converges to that smooth mirror, not to the
 //!   ray caster's faceted one (which uses each face's own normal);
 //! - **a tolerance of 0**: no refinement, the mesh as it is (the thesis's surface).
@@ -77,7 +77,7 @@ use std::collections::HashMap;
 
 use glam::{DVec2, DVec3, Vec3};
 
-use crate::projection::surfaces::{vertex_normals, vertex_ray, Optic, SurfaceScreenMap};
+use crate::projection::trilinear_builders::{vertex_normals, vertex_ray, Optic, SurfaceScreenMap};
 use crate::projection::{Perspective, Projection};
 use crate::scene::Mesh;
 
@@ -236,7 +236,7 @@ impl<'a> Refiner<'a> {
     }
 
     /// The sample of a vertex at `position` with raw shading normal `normal` and face normal
-    /// `face`, as [`crate::projection::surfaces::reflector_surface`] computes its ray; `None`
+    /// `face`, as [`crate::projection::trilinear_builders::reflector_surface`] computes its ray; `None`
     /// where it has no ray.
     fn sample_at(&self, position: Vec3, normal: Vec3, face: DVec3) -> Option<Sample> {
         let point = position.as_dvec3();
@@ -257,7 +257,7 @@ impl<'a> Refiner<'a> {
         })
     }
 
-    /// Whether the surface ([`reflector_surface`](crate::projection::surfaces::reflector_surface))
+    /// Whether the surface ([`reflector_surface`](crate::projection::trilinear_builders::reflector_surface))
     /// drops `[a, b, c]` and every triangle its refinement could make, so that splitting
     /// it is wasted: its vertex normals all lie clearly on the side of its plane away from
     /// the eye ([`BACK_FACING_COSINE`]). Its descendants lie in its plane with its winding,

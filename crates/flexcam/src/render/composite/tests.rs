@@ -1,11 +1,11 @@
 use glam::{DVec3, Vec3};
 
 use super::*;
-use crate::projection::surfaces::test_scenes::{
-    lens_plane, sphere_and_cube, ReflectorFixture, BALL, BALL_CENTER,
-};
 use crate::render::compare::{compare, Comparison};
 use crate::render::Method;
+use crate::scene::reflector_fixtures::{
+    lens_plane, sphere_and_cube, ReflectorFixture, BALL, BALL_CENTER,
+};
 use crate::scene::TrilinearReflector;
 
 const SIZE: (u32, u32) = (160, 120);

@@ -11,7 +11,6 @@ mod bvh;
 mod curve;
 mod curve_triangle;
 mod hull_cull;
-pub(crate) mod optics;
 pub(crate) mod sampling;
 mod shade;
 mod tiles;

@@ -22,8 +22,8 @@
 use glam::{DVec3, Vec3};
 
 use super::hull_cull::LiveParts;
-use super::optics::{reflect, refract};
 use super::{polyline_segment, Hit, Hit32, RayCaster};
+use crate::geometry::optics::{reflect, refract};
 use crate::geometry::Ray;
 use crate::projection::projector::{quadratic_arc_length, quadratic_point, quadratic_tangent};
 use crate::projection::Projector;

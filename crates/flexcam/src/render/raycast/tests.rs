@@ -94,6 +94,7 @@ fn scene(objects: Vec<Object>, lights: Vec<Light>) -> Scene {
         },
         base_dir: None,
         trilinear_reflectors: Vec::new(),
+        inputs: Vec::new(),
     }
 }
 

@@ -38,6 +38,7 @@ pub fn teapot_scene(faces: u32) -> (Scene, usize) {
         objects: vec![object],
         lights: Vec::new(),
         trilinear_reflectors: Vec::new(),
+        inputs: Vec::new(),
         image: ImageSettings {
             width: TABLE_SIZE,
             height: TABLE_SIZE,

@@ -14,7 +14,7 @@
 use glam::{Affine3A, DVec2, DVec3, Vec3};
 
 use crate::error::Result;
-use crate::projection::surfaces::{screen_grid, GridVertex};
+use crate::projection::trilinear_builders::{screen_grid, GridVertex};
 use crate::projection::{CameraFrame, ProjectionSpec, TrilinearMesh};
 use crate::scene::{ImageSettings, Material, Mesh, Object, Scene};
 
@@ -108,6 +108,7 @@ pub fn random_triangles(count: u32, seed: u64) -> Scene {
         },
         base_dir: None,
         trilinear_reflectors: Vec::new(),
+        inputs: Vec::new(),
     }
 }
 

@@ -10,10 +10,9 @@ use toml::Spanned;
 
 use super::raw::{RawAnimation, RawKey};
 use super::source::Source;
+use crate::calibrate;
 use crate::error::Result;
-use crate::projection::flexible::{
-    Animation, Easing, Flexible, FlexibleSpec, Keyframe, VolumeSource,
-};
+use crate::projection::flexible::{Animation, Easing, FlexibleSpec, Keyframe, VolumeSource};
 use crate::projection::ProjectionSpec;
 use crate::scene::ImageSettings;
 
@@ -71,7 +70,7 @@ pub(super) fn convert(
             ));
         }
         let at_projection = |message: String| src.error(&key.get_ref().projection.span(), message);
-        Flexible::new(&keyframe.projection, image.width, image.height)
+        calibrate::build_flexible(&keyframe.projection, image.width, image.height)
             .map_err(|e| at_projection(e.message))?;
         if let Some(before) = keys.last() {
             if keyframe.time <= before.time {
@@ -91,7 +90,7 @@ pub(super) fn convert(
                 },
                 reparam: None,
             };
-            Flexible::new(&halfway, image.width, image.height).map_err(|e| {
+            calibrate::build_flexible(&halfway, image.width, image.height).map_err(|e| {
                 at_projection(format!(
                     "keys {} and {index} cannot be interpolated: {}",
                     index - 1,

@@ -15,16 +15,19 @@ use std::path::Path;
 
 use toml_edit::{Array, DocumentMut, InlineTable, Item, TableLike, Value};
 
+use crate::calibrate::{self, FitReport};
 use crate::error::{Error, Result};
-use crate::projection::flexible::fit::FitReport;
 use crate::projection::flexible::{Flexible, FlexibleSpec, ProjectorGrid, Volume, VolumeSource};
 use crate::projection::ProjectionSpec;
+use crate::scene::InputFile;
 
-/// A fitted scene: the text to write and the fit's residual.
+/// A fitted scene: the text to write, the fit's residual, and the files the fitting scene's
+/// values named (models, textures, surfaces; see [`crate::scene::Scene::inputs`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FittedScene {
     pub text: String,
     pub report: FitReport,
+    pub inputs: Vec<InputFile>,
 }
 
 /// Fits the projector grid of the scene file `text` (read from `path`) to its `fit`
@@ -70,6 +73,7 @@ pub fn fit_scene(text: &str, path: &Path, output: &Path) -> Result<FittedScene> 
     Ok(FittedScene {
         text: written,
         report,
+        inputs: scene.inputs,
     })
 }
 
@@ -86,9 +90,10 @@ fn fitted_grid(
     if !has_fit(spec) {
         return Ok(None);
     }
-    let flexible = Flexible::new(spec, width, height)?;
-    Ok(match flexible.volume() {
-        Volume::Grid(grid) => grid.fit.map(|report| (grid.grid.clone(), report)),
+    // The top-level grid is fitted last (after any grids of its base).
+    let (flexible, mut reports) = calibrate::build_flexible(spec, width, height)?;
+    Ok(match (flexible.volume(), reports.pop()) {
+        (Volume::Grid(grid), Some(report)) => Some((grid.grid.clone(), report)),
         _ => None,
     })
 }

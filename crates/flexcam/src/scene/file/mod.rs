@@ -26,7 +26,7 @@ use toml::Spanned;
 
 use self::raw::{RawImage, RawScene};
 use self::source::Source;
-use super::{ImageSettings, Scene};
+use super::{ImageSettings, InputFile, Scene};
 use crate::error::{Error, Result};
 use crate::projection::flexible::Animation;
 
@@ -52,9 +52,7 @@ pub fn validate_resolution(width: u32, height: u32) -> Result<()> {
 
 /// Reads and parses the scene file at `path`. Errors name `path` as given.
 pub fn load(path: &Path) -> Result<Scene> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| Error::in_file(path, format!("cannot read scene file: {e}")))?;
-    parse(&text, path)
+    load_animated(path).map(|(scene, _)| scene)
 }
 
 /// Parses scene-file text. `path` names the file in errors, and its folder is the base for
@@ -64,16 +62,26 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene> {
     parse_animated(text, path).map(|(scene, _)| scene)
 }
 
-/// Reads and parses the scene file at `path` with its `[animation]` table, if any.
+/// Reads and parses the scene file at `path` with its `[animation]` table, if any. The
+/// scene file is the first of the scene's [`Scene::inputs`].
 pub fn load_animated(path: &Path) -> Result<(Scene, Option<Animation>)> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| Error::in_file(path, format!("cannot read scene file: {e}")))?;
-    parse_animated(&text, path)
+    let (mut scene, animation) = parse_animated(&text, path)?;
+    scene.inputs.insert(
+        0,
+        InputFile {
+            what: "scene file",
+            path: path.to_path_buf(),
+        },
+    );
+    Ok((scene, animation))
 }
 
-/// As [`parse`], also giving the keyframed camera of the `[animation]` table, if any.
+/// As [`parse`], also giving the keyframed camera of the `[animation]` table, if any. The
+/// scene's [`Scene::inputs`] are the files its values name (and the files those name).
 pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animation>)> {
-    let src = Source { text, path };
+    let src = Source::new(text, path);
     projection::reject_unsupported(&src)?;
     let raw: RawScene = toml::from_str(text).map_err(|e| src.toml_error(&e))?;
     let base_dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
@@ -103,12 +111,12 @@ pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animatio
         .map(|table| light::convert(&src, table))
         .collect::<Result<Vec<_>>>()?;
     // Building the projection is what detects degenerate parameters.
-    projection
-        .build(image.width, image.height)
-        .map_err(|e| match e.location {
+    crate::calibrate::build(&projection, image.width, image.height).map_err(|e| {
+        match e.location {
             Some(_) => e,
             None => src.error(&projection_table.span(), e.message),
-        })?;
+        }
+    })?;
     let animation = raw
         .animation
         .as_ref()
@@ -121,6 +129,7 @@ pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animatio
         projection,
         base_dir: Some(base_dir),
         trilinear_reflectors,
+        inputs: src.into_inputs(),
     };
     Ok((scene, animation))
 }

@@ -11,7 +11,7 @@ use super::raw::{Numbers, RawObject};
 use super::shape::{analytic_mesh, Shape, MAX_TESSELLATION};
 use super::source::Source;
 use crate::error::Result;
-use crate::projection::surfaces::SurfaceScreenMap;
+use crate::projection::trilinear_builders::SurfaceScreenMap;
 use crate::projection::ProjectionSpec;
 use crate::scene::loaders::{load_model, load_texture};
 use crate::scene::{Material, Mesh, Object, Pattern, Surface, TrilinearReflector};
@@ -42,8 +42,10 @@ pub(super) fn convert(
         (_, Some((mesh, base))) => vec![(mesh, overrides.apply(base))],
         (Some(file), None) => {
             let path = src.existing_file(file, base_dir, "model file")?;
-            load_model(&path)
-                .map_err(|e| e.or_in_file(&path))?
+            let model = load_model(&path).map_err(|e| e.or_in_file(&path))?;
+            src.read_files(model.files);
+            model
+                .parts
                 .into_iter()
                 .map(|part| {
                     (

@@ -9,9 +9,9 @@ use toml::Spanned;
 use super::raw::{RawNodeProjector, RawProjectors};
 use super::source::Source;
 use crate::error::Result;
-use crate::projection::flexible::fit::{Correspondence, Starts};
 use crate::projection::flexible::projector_grid::{Through, MAX_NODES, MIN_NODES};
 use crate::projection::flexible::{Aim, GridInterpolation, NodeProjector, ProjectorGridSpec};
+use crate::projection::flexible::{Correspondence, Starts};
 
 /// Nodes per side when `size` is not given: the thesis's 5 x 5.
 const DEFAULT_SIZE: usize = 5;

@@ -1,20 +1,42 @@
 //! The text of a scene file and its name, for turning byte spans into `FILE:LINE:COLUMN`
 //! errors.
 
+use std::cell::RefCell;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use toml::Spanned;
 
 use crate::error::{Error, Result};
+use crate::scene::InputFile;
 
-/// A scene file being parsed: its text and the path the user gave for it.
+/// A scene file being parsed: its text, the path the user gave for it, and the files its
+/// values named so far.
 pub(super) struct Source<'a> {
     pub text: &'a str,
     pub path: &'a Path,
+    inputs: RefCell<Vec<InputFile>>,
 }
 
 impl<'a> Source<'a> {
+    pub fn new(text: &'a str, path: &'a Path) -> Source<'a> {
+        Source {
+            text,
+            path,
+            inputs: RefCell::new(Vec::new()),
+        }
+    }
+
+    /// Records files read on behalf of the scene (a model's material libraries, say).
+    pub fn read_files(&self, files: impl IntoIterator<Item = InputFile>) {
+        self.inputs.borrow_mut().extend(files);
+    }
+
+    /// The files recorded so far, in the order they were read.
+    pub fn into_inputs(self) -> Vec<InputFile> {
+        self.inputs.into_inner()
+    }
+
     /// An error at the start of the byte span `span` of the text.
     pub fn error(&self, span: &Range<usize>, message: impl Into<String>) -> Error {
         let (line, column) = self.line_column(span.start);
@@ -25,15 +47,19 @@ impl<'a> Source<'a> {
     /// `base_dir`. Fails at the value when no regular file is there (an empty name, a
     /// folder, a missing file), so that the error points into the scene rather than at a
     /// path the user never wrote; the loader's own errors (a file it cannot parse) name the
-    /// file itself.
+    /// file itself. The file is recorded as an input of the scene.
     pub fn existing_file(
         &self,
         name: &Spanned<String>,
         base_dir: &Path,
-        what: &str,
+        what: &'static str,
     ) -> Result<PathBuf> {
         let path = base_dir.join(name.get_ref());
         if path.is_file() {
+            self.read_files([InputFile {
+                what,
+                path: path.clone(),
+            }]);
             return Ok(path);
         }
         Err(self.error(
@@ -119,10 +145,7 @@ mod tests {
 
     #[test]
     fn line_column_counts_characters_from_one() {
-        let src = Source {
-            text: "ab\nc\u{e9}d\n",
-            path: Path::new("s.toml"),
-        };
+        let src = Source::new("ab\nc\u{e9}d\n", Path::new("s.toml"));
         assert_eq!(src.line_column(0), (1, 1));
         assert_eq!(src.line_column(1), (1, 2));
         assert_eq!(src.line_column(3), (2, 1));

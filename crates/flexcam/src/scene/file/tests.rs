@@ -1229,9 +1229,12 @@ fn flexible_projector_grids_parse_and_fit() {
     assert_eq!(grid.aims[0].node, (2, 3));
     assert_eq!(grid.correspondences.len(), 1);
     // The fit's residual is reported with the projection.
-    let projection = ProjectionSpec::Flexible(spec).build(32, 24).unwrap();
-    let notes = projection.notes();
-    assert!(notes.contains(&("fit_correspondences", 1.0)), "{notes:?}");
+    let (_, report) = crate::calibrate::build(&ProjectionSpec::Flexible(spec), 32, 24).unwrap();
+    let counters = report.counters;
+    assert!(
+        counters.contains(&("fit_correspondences", 1.0)),
+        "{counters:?}"
+    );
 
     let with = |projectors: &str| format!("{head}projectors = {projectors}\n");
     assert_error_at(
@@ -1324,13 +1327,13 @@ fn flexible_projector_grid_nodes_with_tangents() {
     else {
         panic!("not flexible");
     };
-    let flexible = crate::projection::flexible::Flexible::new(&spec, 32, 24).unwrap();
+    let (flexible, reports) = crate::calibrate::build_flexible(&spec, 32, 24).unwrap();
     let Volume::Grid(volume) = flexible.volume() else {
         panic!("not a grid volume");
     };
     assert_eq!(volume.grid.tangents()[0], Some(DVec3::X));
     assert_eq!(volume.grid.tangents()[12], None);
-    assert!(volume.fit.is_some_and(|r| r.max_angle_deg < 1e-9));
+    assert!(reports[0].max_angle_deg < 1e-9);
     // One correspondence cannot fix a node's end direction and tangent (four angles).
     assert_error(
         &with(
@@ -1348,7 +1351,7 @@ fn flexible_projector_grid_nodes_with_tangents() {
 
 #[test]
 fn trilinear_screen_map_key() {
-    use crate::projection::surfaces::SurfaceScreenMap;
+    use crate::projection::trilinear_builders::SurfaceScreenMap;
     use crate::scene::TrilinearReflector;
     let mirror = |extra: &str| {
         format!("{CAMERA}[[object]]\nshape = \"sphere\"\nmaterial = \"mirror\"\n{extra}\n")
@@ -1423,4 +1426,45 @@ fn trilinear_refine_px_key() {
         23,
         "needs `trilinear_reflector = true`",
     );
+}
+
+/// A scene lists every file it was read from: itself, its models with the files they name,
+/// its textures and its trilinear surface.
+#[test]
+fn scenes_list_the_files_they_were_read_from() {
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let inputs = |name: &str| -> Vec<(&'static str, String)> {
+        let scene = load(&scenes.join(name)).unwrap();
+        let mut files: Vec<_> = scene
+            .inputs
+            .iter()
+            .map(|f| {
+                let path = f.path.strip_prefix(&scenes).unwrap();
+                (f.what, path.to_string_lossy().into_owned())
+            })
+            .collect();
+        files.dedup();
+        files
+    };
+    assert_eq!(
+        inputs("models.toml"),
+        [
+            ("scene file", "models.toml"),
+            ("model file", "models/octahedron.obj"),
+            ("material library", "models/octahedron.mtl"),
+            ("texture", "models/checker.png"),
+            ("model file", "models/pyramid.ply"),
+            ("model file", "models/tetra-quad.glb"),
+            ("texture", "models/checker.png"),
+        ]
+        .map(|(what, path)| (what, path.to_string()))
+    );
+    assert_eq!(
+        inputs("trilinear-fan.toml"),
+        [
+            ("scene file", "trilinear-fan.toml".to_string()),
+            ("trilinear surface", "surfaces/fan18.obj".to_string())
+        ]
+    );
+    assert!(scene(CAMERA).inputs.is_empty());
 }

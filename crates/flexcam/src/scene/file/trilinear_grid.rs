@@ -10,7 +10,7 @@ use super::projection::Required;
 use super::raw::RawCamera;
 use super::source::Source;
 use crate::error::{Error, Result};
-use crate::projection::surfaces::{
+use crate::projection::trilinear_builders::{
     between_surfaces, screen_grid, DetailInContext, GridCamera, TwoViews,
 };
 use crate::projection::{CameraFrame, TrilinearMesh};

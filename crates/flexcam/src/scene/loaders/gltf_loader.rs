@@ -5,7 +5,7 @@
 //! checked against its buffer here first, so that a malformed file is an error, not a panic.
 
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use ::gltf::buffer::Data as BufferData;
@@ -15,26 +15,38 @@ use ::gltf::{Accessor, Document, Node, Primitive};
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 
 use super::texture::{srgb_to_linear, texture_from_texels};
-use super::ModelPart;
+use super::{Model, ModelPart};
 use crate::error::{Error, Result};
-use crate::scene::{Material, Mesh, Pattern, Texture};
+use crate::scene::{InputFile, Material, Mesh, Pattern, Texture};
 
 /// Loads the triangle primitives of the default scene (the first scene if none is marked
 /// default; every mesh untransformed if the file has no scene), with node transforms
 /// applied. Each primitive becomes one part; a primitive with a material gets
 /// `baseColorFactor` as its colour and `baseColorTexture` (sRGB decoded) as its pattern.
 /// Point and line primitives are skipped; a file without triangles is an error.
-pub(super) fn load_gltf(path: &Path) -> Result<Vec<ModelPart>> {
+pub(super) fn load_gltf(path: &Path) -> Result<Model> {
     let fail = |e: ::gltf::Error| Error::in_file(path, format!("malformed glTF: {e}"));
     let ::gltf::Gltf { document, blob } = open_validated(path).map_err(fail)?;
     let base = path.parent().unwrap_or(Path::new(""));
     let buffers = ::gltf::import_buffers(&document, Some(base), blob).map_err(fail)?;
+    let buffer_files = document
+        .buffers()
+        .filter_map(|buffer| match buffer.source() {
+            ::gltf::buffer::Source::Uri(uri) => uri_file(base, uri),
+            ::gltf::buffer::Source::Bin => None,
+        });
     let mut loader = Loader {
         path,
         base,
         buffers: &buffers,
         textures: HashMap::new(),
         parts: Vec::new(),
+        files: buffer_files
+            .map(|path| InputFile {
+                what: "model buffer",
+                path,
+            })
+            .collect(),
     };
     match document
         .default_scene()
@@ -50,7 +62,45 @@ pub(super) fn load_gltf(path: &Path) -> Result<Vec<ModelPart>> {
     if loader.parts.is_empty() {
         return Err(Error::in_file(path, "contains no triangle meshes"));
     }
-    Ok(loader.parts)
+    Ok(Model::read_from(path, loader.parts, loader.files))
+}
+
+/// The file a glTF URI names, resolved as the gltf crate resolves it when it reads the
+/// file: a `data:` or other non-file scheme names none, `file:` and `file://` URIs are
+/// paths, anything else is a percent-encoded path relative to the glTF file's folder.
+fn uri_file(base: &Path, uri: &str) -> Option<PathBuf> {
+    if uri.contains(':') {
+        let path = uri
+            .strip_prefix("file://")
+            .or_else(|| uri.strip_prefix("file:"))?;
+        return Some(PathBuf::from(path));
+    }
+    Some(base.join(percent_decode(uri)?))
+}
+
+/// `text` with each `%XX` replaced by the byte it encodes; `None` when the result is not
+/// UTF-8 (the gltf crate cannot read such a file either).
+fn percent_decode(text: &str) -> Option<String> {
+    let bytes = text.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = bytes
+            .get(i + 1..i + 3)
+            .and_then(|h| std::str::from_utf8(h).ok())
+            .and_then(|h| u8::from_str_radix(h, 16).ok());
+        match (bytes[i], hex) {
+            (b'%', Some(byte)) => {
+                out.push(byte);
+                i += 3;
+            }
+            (byte, _) => {
+                out.push(byte);
+                i += 1;
+            }
+        }
+    }
+    String::from_utf8(out).ok()
 }
 
 /// Reads and validates a glTF or GLB file as `gltf::Gltf::open` does, but checks first
@@ -94,6 +144,8 @@ struct Loader<'a> {
     /// Textures by glTF image index, so that primitives sharing an image share it.
     textures: HashMap<usize, Arc<Texture>>,
     parts: Vec<ModelPart>,
+    /// The files read besides the glTF itself: buffers, then images as they are decoded.
+    files: Vec<InputFile>,
 }
 
 impl Loader<'_> {
@@ -275,6 +327,13 @@ impl Loader<'_> {
         }
         let data = ::gltf::image::Data::from_source(image.source(), Some(self.base), self.buffers)
             .map_err(|e| Error::new(format!("image {}: {e}", image.index())))?;
+        if let ::gltf::image::Source::Uri { uri, .. } = image.source() {
+            self.files
+                .extend(uri_file(self.base, uri).map(|path| InputFile {
+                    what: "texture",
+                    path,
+                }));
+        }
         let texture = Arc::new(texture_from_gltf_image(&data)?);
         self.textures.insert(image.index(), texture.clone());
         Ok(texture)
@@ -346,7 +405,7 @@ fn texture_from_gltf_image(data: &::gltf::image::Data) -> Result<Texture> {
 mod tests {
     use glam::Vec2;
 
-    use super::super::test_files::{example, write};
+    use super::super::test_files::{example, listed, write};
     use super::*;
 
     fn bounds(part: &ModelPart) -> (Vec3, Vec3) {
@@ -354,9 +413,66 @@ mod tests {
     }
 
     #[test]
+    fn uris_name_files_as_the_gltf_crate_reads_them() {
+        let base = Path::new("m");
+        assert_eq!(uri_file(base, "a%20b.bin"), Some(base.join("a b.bin")));
+        assert_eq!(uri_file(base, "t/x%2.png"), Some(base.join("t/x%2.png")));
+        assert_eq!(
+            uri_file(base, "file:///abs/t.png"),
+            Some(PathBuf::from("/abs/t.png"))
+        );
+        assert_eq!(
+            uri_file(base, "data:application/octet-stream;base64,AA"),
+            None
+        );
+        assert_eq!(uri_file(base, "https://example.org/t.png"), None);
+        assert_eq!(uri_file(base, "%ff.bin"), None);
+    }
+
+    /// A glTF with its buffer and image in files of their own names both as inputs.
+    #[test]
+    fn external_buffers_and_images_are_listed() {
+        let dir = tempfile::tempdir().unwrap();
+        let triangle: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .chain(
+                [0.0f32, 0.0, 1.0, 0.0, 0.0, 1.0]
+                    .iter()
+                    .flat_map(|v| v.to_le_bytes()),
+            )
+            .collect();
+        write(&dir, "tri angle.bin", &triangle);
+        std::fs::copy(example("checker.png"), dir.path().join("tex.png")).unwrap();
+        let gltf = r#"{
+            "asset": {"version": "2.0"},
+            "buffers": [{"byteLength": 60, "uri": "tri%20angle.bin"}],
+            "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24}],
+            "accessors": [
+                {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                 "min": [0, 0, 0], "max": [1, 1, 0]},
+                {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}],
+            "images": [{"uri": "tex.png"}],
+            "textures": [{"source": 0}],
+            "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+            "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "material": 0}]}]
+        }"#;
+        let path = write(&dir, "m.gltf", gltf);
+        let model = load_gltf(&path).unwrap();
+        assert_eq!(
+            listed(&model),
+            [
+                ("model file", path.clone()),
+                ("model buffer", dir.path().join("tri angle.bin")),
+                ("texture", dir.path().join("tex.png")),
+            ]
+        );
+    }
+
+    #[test]
     fn loads_gltf_and_glb_alike() {
         for name in ["tetra-quad.gltf", "tetra-quad.glb"] {
-            let parts = load_gltf(&example(name)).unwrap();
+            let parts = load_gltf(&example(name)).unwrap().parts;
             assert_eq!(parts.len(), 2, "{name}");
             let (tetra, quad) = (&parts[0], &parts[1]);
             tetra.mesh.validate().unwrap();

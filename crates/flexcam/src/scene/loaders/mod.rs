@@ -13,7 +13,7 @@ mod texture;
 
 use std::path::Path;
 
-use super::{Material, Mesh};
+use super::{InputFile, Material, Mesh};
 use crate::error::{Error, Result};
 
 pub use texture::load_texture;
@@ -25,12 +25,34 @@ pub struct ModelPart {
     pub material: Option<Material>,
 }
 
+/// A loaded model: its parts, and every file the load read (the model file first, then the
+/// files it names: material libraries, textures, buffers).
+#[derive(Debug, Clone)]
+pub struct Model {
+    pub parts: Vec<ModelPart>,
+    pub files: Vec<InputFile>,
+}
+
+impl Model {
+    /// A model read from `path` and the `named` files.
+    fn read_from(path: &Path, parts: Vec<ModelPart>, named: Vec<InputFile>) -> Model {
+        let model_file = InputFile {
+            what: "model file",
+            path: path.to_path_buf(),
+        };
+        Model {
+            parts,
+            files: std::iter::once(model_file).chain(named).collect(),
+        }
+    }
+}
+
 /// Model file extensions [`load_model`] accepts (compared case-insensitively).
 pub const MODEL_EXTENSIONS: [&str; 4] = ["obj", "gltf", "glb", "ply"];
 
 /// Loads an OBJ (with its MTL), glTF / GLB or PLY file, chosen by extension. Errors name the
 /// file (and line where the format allows).
-pub fn load_model(path: &Path) -> Result<Vec<ModelPart>> {
+pub fn load_model(path: &Path) -> Result<Model> {
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
@@ -66,6 +88,15 @@ pub(super) mod test_files {
             .join(name)
     }
 
+    /// What each file `model` was read from is, and its path.
+    pub fn listed(model: &super::Model) -> Vec<(&'static str, PathBuf)> {
+        model
+            .files
+            .iter()
+            .map(|f| (f.what, f.path.clone()))
+            .collect()
+    }
+
     /// Writes `contents` to `name` in `dir` and returns its path.
     pub fn write(dir: &tempfile::TempDir, name: &str, contents: impl AsRef<[u8]>) -> PathBuf {
         let path = dir.path().join(name);
@@ -84,7 +115,15 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let ply = std::fs::read(example("pyramid.ply")).unwrap();
         let upper = write(&dir, "PYRAMID.PLY", ply);
-        assert_eq!(load_model(&upper).unwrap()[0].mesh.triangle_count(), 6);
+        let model = load_model(&upper).unwrap();
+        assert_eq!(model.parts[0].mesh.triangle_count(), 6);
+        assert_eq!(
+            model.files,
+            [InputFile {
+                what: "model file",
+                path: upper
+            }]
+        );
     }
 
     #[test]

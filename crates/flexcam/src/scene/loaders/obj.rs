@@ -8,9 +8,9 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
-use super::{load_texture, read_file, ModelPart};
+use super::{load_texture, read_file, Model, ModelPart};
 use crate::error::{Error, Result};
-use crate::scene::{Material, Mesh, Pattern, Surface, Texture};
+use crate::scene::{InputFile, Material, Mesh, Pattern, Surface, Texture};
 
 /// One `mtllib` the OBJ asked for: where it is and the material names it defined, or why it
 /// could not be loaded.
@@ -22,7 +22,7 @@ struct MtlLibrary {
 /// Loads an OBJ file and the MTL libraries it names (relative to the OBJ's folder). Each OBJ
 /// object / group becomes one part; `map_Kd` textures are resolved relative to their MTL.
 /// A named MTL that is missing or malformed is an error, as is a file with no faces.
-pub(super) fn load_obj(path: &Path) -> Result<Vec<ModelPart>> {
+pub(super) fn load_obj(path: &Path) -> Result<Model> {
     let data = read_file(path)?;
     let dir = path.parent().unwrap_or(Path::new(""));
     let libraries = RefCell::new(Vec::new());
@@ -43,7 +43,12 @@ pub(super) fn load_obj(path: &Path) -> Result<Vec<ModelPart>> {
     };
     let libraries = libraries.into_inner();
     let mut material_dirs = HashMap::new();
+    let mut named: Vec<InputFile> = Vec::new();
     for library in libraries {
+        named.push(InputFile {
+            what: "material library",
+            path: library.path.clone(),
+        });
         let names = library.outcome?;
         let mtl_dir = library.path.parent().unwrap_or(Path::new("")).to_path_buf();
         material_dirs.extend(names.into_iter().map(|name| (name, mtl_dir.clone())));
@@ -67,7 +72,11 @@ pub(super) fn load_obj(path: &Path) -> Result<Vec<ModelPart>> {
     if parts.is_empty() {
         return Err(Error::in_file(path, "contains no faces"));
     }
-    Ok(parts)
+    named.extend(textures.0.into_keys().map(|path| InputFile {
+        what: "texture",
+        path,
+    }));
+    Ok(Model::read_from(path, parts, named))
 }
 
 /// Reads and parses one MTL file: the record of it, and what tobj needs of it.
@@ -240,12 +249,21 @@ fn convert_material(
 
 #[cfg(test)]
 mod tests {
-    use super::super::test_files::{example, write};
+    use super::super::test_files::{example, listed, write};
     use super::*;
 
     #[test]
     fn loads_the_textured_octahedron() {
-        let parts = load_obj(&example("octahedron.obj")).unwrap();
+        let model = load_obj(&example("octahedron.obj")).unwrap();
+        assert_eq!(
+            listed(&model),
+            [
+                ("model file", example("octahedron.obj")),
+                ("material library", example("octahedron.mtl")),
+                ("texture", example("checker.png")),
+            ]
+        );
+        let parts = model.parts;
         let triangles: usize = parts.iter().map(|p| p.mesh.triangle_count()).sum();
         assert_eq!(triangles, 8);
         assert_eq!(parts.len(), 2, "one part per material");
@@ -357,7 +375,7 @@ mod tests {
         for m in ["glass", "mirror", "lamp", "tex"] {
             obj += &format!("o {m}\nusemtl {m}\nf 1 2 3\n");
         }
-        let parts = load_obj(&write(&dir, "hints.obj", obj)).unwrap();
+        let parts = load_obj(&write(&dir, "hints.obj", obj)).unwrap().parts;
         let materials: Vec<Material> = parts.into_iter().map(|p| p.material.unwrap()).collect();
         assert_eq!(materials[0].surface, Surface::Glass { ior: 1.33 });
         assert_eq!(materials[1].surface, Surface::Mirror);
@@ -375,7 +393,7 @@ mod tests {
             "plain.obj",
             "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 4 3\n",
         );
-        let parts = load_obj(&path).unwrap();
+        let parts = load_obj(&path).unwrap().parts;
         assert_eq!(parts.len(), 1);
         assert!(parts[0].material.is_none());
         assert_eq!(parts[0].mesh.triangle_count(), 2, "quad triangulated");

@@ -8,7 +8,7 @@ use ply_rs::ply::{DefaultElement, Property};
 
 use super::read_file;
 use super::texture::srgb_to_linear;
-use super::ModelPart;
+use super::{Model, ModelPart};
 use crate::error::{Error, Result};
 use crate::scene::Mesh;
 
@@ -18,7 +18,7 @@ use crate::scene::Mesh;
 /// `texture_u texture_v`, and colours `red green blue`: integer colours are taken as
 /// sRGB-encoded and decoded to linear, floating-point colours as linear. Faces:
 /// `vertex_indices` or `vertex_index` lists, fan-triangulated.
-pub(super) fn load_ply(path: &Path) -> Result<Vec<ModelPart>> {
+pub(super) fn load_ply(path: &Path) -> Result<Model> {
     let data = read_file(path)?;
     check_element_counts(path, &data)?;
     let ply = Parser::<DefaultElement>::new()
@@ -34,10 +34,11 @@ pub(super) fn load_ply(path: &Path) -> Result<Vec<ModelPart>> {
     if mesh.triangles.is_empty() {
         return Err(Error::in_file(path, "contains no faces"));
     }
-    Ok(vec![ModelPart {
+    let part = ModelPart {
         mesh,
         material: None,
-    }])
+    };
+    Ok(Model::read_from(path, vec![part], Vec::new()))
 }
 
 /// Checks each header `element NAME COUNT` line before ply-rs sees it: ply-rs panics on a
@@ -206,7 +207,7 @@ mod tests {
 
     #[test]
     fn loads_the_coloured_pyramid() {
-        let parts = load_ply(&example("pyramid.ply")).unwrap();
+        let parts = load_ply(&example("pyramid.ply")).unwrap().parts;
         assert_eq!(parts.len(), 1);
         let mesh = &parts[0].mesh;
         assert_eq!(mesh.positions.len(), 5);
@@ -245,7 +246,7 @@ mod tests {
         bytes.push(3);
         bytes.extend([0u32, 1, 2].iter().flat_map(|v| v.to_le_bytes()));
         let dir = tempfile::tempdir().unwrap();
-        let parts = load_ply(&write(&dir, "bin.ply", bytes)).unwrap();
+        let parts = load_ply(&write(&dir, "bin.ply", bytes)).unwrap().parts;
         let mesh = &parts[0].mesh;
         assert_eq!(mesh.triangles, vec![[0, 1, 2]]);
         assert_eq!(mesh.normals[0], Vec3::Z, "normalised");

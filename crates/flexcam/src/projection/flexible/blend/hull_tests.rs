@@ -5,7 +5,7 @@ use glam::{DVec2, DVec3};
 use proptest::prelude::*;
 
 use super::{BezierVolume, PiecewiseVolume};
-use crate::projection::flexible::surface::{PolarFrame, SpherePatch, Surface};
+use crate::projection::flexible::control_surface::{PolarFrame, SpherePatch, Surface};
 use crate::projection::{Projector, ProjectorHull};
 
 /// The control points of a projector (polyline vertices or Bezier control points).

@@ -41,8 +41,11 @@ pub use self::edit::{edit_source, make_perspective};
 pub use self::shape::{OutlineShape, ProfileShape};
 use super::super::camera_basis::CameraBasis;
 use super::super::CameraFrame;
-use super::surface::Surface;
+use super::control_surface::Surface;
 use crate::error::{Error, Result};
+
+/// The default far clip distance of the presets and shape-defined panoramas, in world units.
+pub const DEFAULT_FAR: f64 = 1000.0;
 
 /// How neighbouring outlines (or profiles) are blended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -327,7 +330,7 @@ impl PanoramaSpec {
     /// not 0 <= near < far.
     pub fn surfaces(&self) -> Result<(Surface, Surface)> {
         let basis = CameraBasis::new(&self.frame)?;
-        let [near, far] = self.clip.unwrap_or([0.0, super::presets::DEFAULT_FAR]);
+        let [near, far] = self.clip.unwrap_or([0.0, DEFAULT_FAR]);
         if !(near.is_finite() && far.is_finite() && 0.0 <= near && near < far) {
             return Err(Error::new(format!(
                 "flexible clip must be [near, far] with 0 <= near < far, got [{near}, {far}]"

@@ -19,7 +19,7 @@
 //!   k a perspective whose eye lies on the axis where its rays meet.
 
 use super::super::blend::{BezierVolume, PiecewiseVolume};
-use super::super::surface::Surface;
+use super::super::control_surface::Surface;
 use super::super::volume::Volume;
 use crate::error::{Error, Result};
 

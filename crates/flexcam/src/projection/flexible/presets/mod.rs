@@ -61,19 +61,18 @@ use super::super::camera_basis::CameraBasis;
 use super::super::params::{angle_radians, positive_length, UpTo};
 use super::super::CameraFrame;
 use super::blend::PiecewiseVolume;
+use super::control_surface::{CylinderPatch, PolarFrame, SpherePatch, Surface};
+use super::linear_volume::LinearVolume;
+pub use super::panorama::DEFAULT_FAR;
 use super::panorama::{OutlineShape, PanoramaShape, PanoramaSpec, ProfileShape};
 use super::reparam::Reparam;
-use super::surface::{CylinderPatch, PolarFrame, SpherePatch, Surface};
-use super::volume::{LinearVolume, Volume};
+use super::volume::Volume;
 use crate::error::{Error, Result};
 use depth_transition::Station;
 pub use depth_transition::{DepthStyle, DEPTH_STYLE_NAMES};
 pub use lens::Magnifier;
 pub use mcop::{McopPath, PathSurface};
 pub use occlusion::PinchedRectangle;
-
-/// The default far clip distance of the presets, in world units.
-pub const DEFAULT_FAR: f64 = 1000.0;
 
 /// A named volume and its own parameters (angles in degrees).
 #[derive(Debug, Clone, PartialEq)]

@@ -1,10 +1,10 @@
 use glam::{DVec2, DVec3, Vec3};
 
 use super::*;
-use crate::projection::surfaces::test_scenes::{
+use crate::projection::trilinear_builders::{reflector_surface, ReflectorSurface};
+use crate::scene::reflector_fixtures::{
     camera, lens_plane, sphere_and_cube, ReflectorFixture, BALL,
 };
-use crate::projection::surfaces::{reflector_surface, ReflectorSurface};
 
 const SIZE: (u32, u32) = (160, 120);
 

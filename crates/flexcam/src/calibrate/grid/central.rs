@@ -1,0 +1,783 @@
+//! The central fit (`starts = "eye"`): one common eye E found together with the node
+//! directions, every projector a line through E, for correspondences taken from a pinhole
+//! camera whose eye is not where the prior's starts are (module section "Starts" of `grid`).
+//!
+//! With the starts kept off the camera's eye no grid meets such data: a projector from a
+//! start off the eye through two points at different depths at nearby (u, v) disagrees, and
+//! where the data are sparse the kept-starts fit bends between the points (docs/flexible.md,
+//! "A small residual is not a faithful image"). Here every node starts on its own projector
+//! at S_j = E + s D_j, with one s for all nodes: then S(u, v) = E + s D(u, v) for any
+//! weights that sum to 1, so every projector of the grid, not only the nodes', passes
+//! through E, and a bilinear grid is any pinhole camera exactly (its direction field is
+//! affine in (u, v)).
+//!
+//! Two direction fields are fitted for a given E: the pinhole's affine field
+//! D(u, v) = A (u - 1/2) + B (v - 1/2) + C (8 unknowns; [`pinhole_grid`]), tried first and
+//! kept when it is exact or explains the data nearly as well as the free field
+//! ([`pinhole_suffices`]), and the free node directions (3 a node). Free directions meet
+//! sparse data exactly in many ways, most of them bent between the points, so six points
+//! determine the pinhole where the free field needs points enough for every node.
+//!
+//! E is found by variable projection: for a given E the directions are the model's (the
+//! pinhole's least-squares field, or the linear fit's of module `grid`, starts at E, solved
+//! twice, the second centred on the first), and
+//! Levenberg-Marquardt moves E to minimise the chords 2 sin(angle / 2) between the blended
+//! directions and the points seen from E, with central-difference derivatives in E (three
+//! unknowns; each residual is two small linear solves). It starts from the point nearest to
+//! the prior's node projectors (the prior's own eye, for a perspective prior) and from the
+//! centre of the 3 x 4 camera matrix that the direct linear transform fits to the data
+//! (exact for pinhole data), and keeps the better. For the free field, the grid at the found
+//! eye is then fitted by `fit` with its starts at E. The starts are moved along their projectors to the
+//! prior's near distance s (the prior's mean start parameter seen from its own eye, 0 when
+//! the prior has none), less where a point lies nearer the eye than that.
+//!
+//! Degenerate cases (each an error naming the cause, which `starts = "auto"` answers by
+//! keeping the prior's starts): a prior with tangents (curved projectors have no common
+//! eye); fewer than `MIN_POINTS` correspondences; points that all coincide; an eye the data
+//! do not determine (the misses change by less than `FLAT` of the data's extent when E
+//! moves in some direction, for the pinhole and for the free directions alike: points all
+//! on one plane, or, for the free directions, so few that they absorb any move of E); image
+//! positions all on one line (points on one line through the eye among them); a descent
+//! that finds no eye at which either field solves.
+
+use glam::{DMat3, DVec3};
+use nalgebra::{DMatrix, Matrix3, SymmetricEigen};
+
+use super::{blended, prior_directions, targets, Correspondence, FitReport, System};
+use crate::error::{Error, Result};
+use crate::projection::flexible::projector_grid::ProjectorGrid;
+
+/// The fewest correspondences an eye is fitted from: the direct linear transform's 11
+/// unknowns need six points.
+pub(super) const MIN_POINTS: usize = 6;
+
+/// Levenberg-Marquardt iterations at most per starting eye.
+const MAX_ITERATIONS: usize = 40;
+
+/// The eye is taken as undetermined when moving it by the data's extent in some direction
+/// changes the misses (rad, root sum of squares) by less than this, or by less than this
+/// fraction of the most that any direction changes them.
+const FLAT: f64 = 1e-6;
+
+/// The central-difference step in E, as a fraction of the data's extent.
+const STEP: f64 = 1e-5;
+
+/// Fits `prior`'s node directions and one common eye to `correspondences` (module docs);
+/// returns the grid, its residual and the eye.
+pub(super) fn fit(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+) -> Result<(ProjectorGrid, FitReport, DVec3)> {
+    if prior.is_curved() {
+        return Err(Error::new(
+            "projector grid fit: `starts = \"eye\"` fits straight projectors through one eye; \
+             this grid has tangents",
+        ));
+    }
+    if correspondences.len() < MIN_POINTS {
+        return Err(Error::new(format!(
+            "projector grid fit: an eye needs at least {MIN_POINTS} correspondences, not {}",
+            correspondences.len()
+        )));
+    }
+    let extent = extent(correspondences);
+    if extent <= 0.0 || !extent.is_finite() {
+        return Err(Error::new(
+            "projector grid fit: the correspondences' points all coincide; they determine no eye",
+        ));
+    }
+    if on_one_image_line(correspondences) {
+        return Err(undetermined());
+    }
+    let problem = |model| Problem {
+        prior,
+        correspondences,
+        step: STEP * extent,
+        model,
+    };
+    let (pinhole, free) = (problem(Model::Pinhole), problem(Model::Free));
+    let starts = [prior_centre(prior), dlt_centre(correspondences)];
+    let best = |problem: &Problem| {
+        starts
+            .into_iter()
+            .flatten()
+            .filter_map(|start| problem.descend(start))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(eye, _)| eye)
+    };
+    // The pinhole first (8 unknowns and the eye): six points in general position determine
+    // it, where the free directions need points enough for every node.
+    let pinhole_fit = best(&pinhole)
+        .filter(|&eye| pinhole.check_determined(eye, extent).is_ok())
+        .and_then(|eye| Some((pinhole_grid(&pinhole, eye)?, eye)));
+    if let Some(((grid, report), eye)) = &pinhole_fit {
+        if report.rms_angle_deg.to_radians() <= PINHOLE_EXACT {
+            return finish(grid, correspondences, *eye, prior, true);
+        }
+    }
+    let free_fit = best(&free)
+        .ok_or_else(|| {
+            Error::new(
+                "projector grid fit: no eye found at which the node directions can be fitted",
+            )
+        })
+        .and_then(|eye| {
+            free.check_determined(eye, extent)?;
+            let at_eye = free.grid_at(eye, &prior_directions(prior))?;
+            Ok((super::fit(&at_eye, correspondences)?, eye))
+        });
+    let (fitted, eye, pinhole) = match (pinhole_fit, free_fit) {
+        (Some(((grid, report), eye)), Ok(((_, free_report), _)))
+            if pinhole_suffices(&report, &free_report, prior.starts().len()) =>
+        {
+            (grid, eye, true)
+        }
+        (_, Ok(((grid, _), eye))) => (grid, eye, false),
+        (Some(((grid, _), eye)), Err(_)) => (grid, eye, true),
+        (None, Err(e)) => return Err(e),
+    };
+    finish(&fitted, correspondences, eye, prior, pinhole)
+}
+
+/// `fitted` (every start at `eye`) with its starts moved to the prior's near distance, its
+/// report and the eye. The report's `sparse_nodes` counts the nodes the data leave
+/// undetermined: none under the `pinhole` field (its eye and 8 unknowns were found
+/// determined), else those of the free directions at the eye.
+fn finish(
+    fitted: &ProjectorGrid,
+    correspondences: &[Correspondence],
+    eye: DVec3,
+    prior: &ProjectorGrid,
+    pinhole: bool,
+) -> Result<(ProjectorGrid, FitReport, DVec3)> {
+    let grid = starts_moved(fitted, correspondences, eye, near_fraction(prior))?;
+    let report = super::report_of(&grid, correspondences)?;
+    let sparse_nodes = if pinhole {
+        0
+    } else {
+        super::straight_undetermined(&grid, correspondences)?
+    };
+    Ok((
+        grid,
+        FitReport {
+            sparse_nodes,
+            ..report
+        },
+        eye,
+    ))
+}
+
+/// The error of an eye the correspondences do not determine.
+fn undetermined() -> Error {
+    Error::new(
+        "projector grid fit: the correspondences do not determine an eye (they are met as \
+         well from other eyes: image positions on one line, points all on one plane, or too \
+         few points for the grid's nodes); use `starts = \"kept\"` or add points off that \
+         plane or line",
+    )
+}
+
+/// Whether the image positions all lie on one line (or at one position): a pinhole's points
+/// then lie in one plane through its eye, and every eye in that plane sees them in one plane
+/// of directions too, which the node directions can follow.
+fn on_one_image_line(correspondences: &[Correspondence]) -> bool {
+    let n = correspondences.len() as f64;
+    let mean = correspondences.iter().map(|c| c.uv).sum::<glam::DVec2>() / n;
+    let (mut xx, mut xy, mut yy) = (0.0, 0.0, 0.0);
+    for c in correspondences {
+        let d = c.uv - mean;
+        (xx, xy, yy) = (xx + d.x * d.x, xy + d.x * d.y, yy + d.y * d.y);
+    }
+    // The covariance's least eigenvalue, against a spread of 1e-6 in the image.
+    let (half_trace, det) = (0.5 * (xx + yy) / n, (xx * yy - xy * xy) / (n * n));
+    let least = half_trace - (half_trace * half_trace - det).max(0.0).sqrt();
+    least < 1e-12
+}
+
+/// The root mean square distance of the correspondences' points from their centroid.
+fn extent(correspondences: &[Correspondence]) -> f64 {
+    let n = correspondences.len() as f64;
+    let centroid = correspondences.iter().map(|c| c.point).sum::<DVec3>() / n;
+    let spread: f64 = correspondences
+        .iter()
+        .map(|c| (c.point - centroid).length_squared())
+        .sum();
+    (spread / n).sqrt()
+}
+
+/// The point nearest (least squares) to the lines of `grid`'s node projectors: the eye of a
+/// perspective grid. `None` when the lines are (nearly) parallel.
+fn prior_centre(grid: &ProjectorGrid) -> Option<DVec3> {
+    let mut matrix = DMat3::ZERO;
+    let mut rhs = DVec3::ZERO;
+    for (s, e) in grid.starts().iter().zip(grid.ends()) {
+        let d = (*e - *s).try_normalize()?;
+        let off = DMat3::IDENTITY - DMat3::from_cols(d * d.x, d * d.y, d * d.z);
+        matrix += off;
+        rhs += off * *s;
+    }
+    let scale = matrix.x_axis.x + matrix.y_axis.y + matrix.z_axis.z;
+    let det = matrix.determinant();
+    (det.abs() > 1e-9 * scale.powi(3))
+        .then(|| matrix.inverse() * rhs)
+        .filter(|c| c.is_finite())
+}
+
+/// The start parameter s of the prior's nodes seen from its own eye ([`prior_centre`]):
+/// the mean of (S_j - E0) . D_j / |D_j|^2, at least 0; 0 when the prior has no eye.
+fn near_fraction(prior: &ProjectorGrid) -> f64 {
+    let Some(eye) = prior_centre(prior) else {
+        return 0.0;
+    };
+    let n = prior.starts().len() as f64;
+    let sum: f64 = prior
+        .starts()
+        .iter()
+        .zip(prior.ends())
+        .map(|(s, e)| (*s - eye).dot(*e - *s) / (*e - *s).length_squared())
+        .sum();
+    (sum / n).max(0.0)
+}
+
+/// The centre of the 3 x 4 camera matrix that the direct linear transform fits to the
+/// correspondences (points centred and scaled first), or `None` where the fit is degenerate
+/// or the centre is at infinity (an affine camera).
+fn dlt_centre(correspondences: &[Correspondence]) -> Option<DVec3> {
+    let n = correspondences.len() as f64;
+    let centroid = correspondences.iter().map(|c| c.point).sum::<DVec3>() / n;
+    let scale = extent(correspondences);
+    let mut a = DMatrix::<f64>::zeros(2 * correspondences.len(), 12);
+    for (k, c) in correspondences.iter().enumerate() {
+        let x = (c.point - centroid) / scale;
+        let h = [x.x, x.y, x.z, 1.0];
+        let (u, v) = (c.uv.x - 0.5, c.uv.y - 0.5);
+        for i in 0..4 {
+            a[(2 * k, i)] = -h[i];
+            a[(2 * k, 8 + i)] = u * h[i];
+            a[(2 * k + 1, 4 + i)] = -h[i];
+            a[(2 * k + 1, 8 + i)] = v * h[i];
+        }
+    }
+    // The camera matrix: the eigenvector of A^T A with the least eigenvalue.
+    let eigen = SymmetricEigen::new(a.transpose() * &a);
+    let least = eigen.eigenvalues.imin();
+    let p = eigen.eigenvectors.column(least);
+    let m = |r: usize, c: usize| p[4 * r + c];
+    // The centre: the null vector of P, by cofactors.
+    let minor = |skip: usize| {
+        let cols: Vec<usize> = (0..4).filter(|c| *c != skip).collect();
+        Matrix3::from_fn(|r, c| m(r, cols[c])).determinant()
+    };
+    let w = -minor(3);
+    let centre = DVec3::new(minor(0), -minor(1), minor(2)) / w;
+    (w.abs() > 1e-12 && centre.is_finite()).then_some(centroid + scale * centre)
+}
+
+/// Rms miss (radians) at or below which the pinhole's direction field is taken as exact.
+const PINHOLE_EXACT: f64 = 1e-6;
+
+/// The grid at `eye` whose node directions sample the affine direction field
+/// D(u, v) = A (u - 1/2) + B (v - 1/2) + C that best meets the correspondences: the pinhole
+/// camera with its centre at `eye` (its 9 unknowns, 8 up to scale, against 3 a node for the
+/// free directions), by homogeneous least squares on P_k D(u_k, v_k) = 0, scaled to the
+/// prior's mean length and lengthened so that every point is in view. A bilinear or Bezier
+/// grid reproduces an affine field exactly (linear precision), so with pinhole data every
+/// projector between the correspondences is the camera's too, where the free directions
+/// fit the points and may bend between them (module docs). `None` where the field is
+/// degenerate or turns some point behind the eye.
+fn pinhole_grid(problem: &Problem, eye: DVec3) -> Option<(ProjectorGrid, FitReport)> {
+    let dirs = pinhole_directions(problem.prior, problem.correspondences, eye)?;
+    let at_eye = problem.grid_at(eye, &dirs).ok()?;
+    let targets = targets(&at_eye, problem.correspondences).ok()?;
+    super::in_view(&at_eye, problem.correspondences, &targets, dirs).ok()
+}
+
+/// The node directions of [`pinhole_grid`] before they are lengthened into view.
+fn pinhole_directions(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+    eye: DVec3,
+) -> Option<Vec<DVec3>> {
+    let mut normal = DMatrix::<f64>::zeros(9, 9);
+    for c in correspondences {
+        let a = (c.point - eye).try_normalize()?;
+        let off = DMat3::IDENTITY - DMat3::from_cols(a * a.x, a * a.y, a * a.z);
+        let (u, v) = (c.uv.x - 0.5, c.uv.y - 0.5);
+        // The 3 x 9 block P [u I, v I, I] of this correspondence.
+        let block = DMatrix::<f64>::from_fn(3, 9, |r, col| {
+            let factor = [u, v, 1.0][col / 3];
+            factor * off.col(col % 3)[r]
+        });
+        normal += block.transpose() * block;
+    }
+    let eigen = SymmetricEigen::new(normal);
+    let field = eigen
+        .eigenvectors
+        .column(eigen.eigenvalues.imin())
+        .into_owned();
+    let column = |i: usize| DVec3::new(field[3 * i], field[3 * i + 1], field[3 * i + 2]);
+    let (a, b, c) = (column(0), column(1), column(2));
+    let at = |uv: glam::DVec2| a * (uv.x - 0.5) + b * (uv.y - 0.5) + c;
+    let facing: Vec<f64> = correspondences
+        .iter()
+        .map(|k| at(k.uv).dot(k.point - eye))
+        .collect();
+    let sign = if facing.iter().sum::<f64>() < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    if facing.iter().any(|f| sign * f <= 0.0) {
+        return None;
+    }
+    let (cols, rows) = prior.size();
+    let mut dirs = Vec::with_capacity(cols * rows);
+    for row in 0..rows {
+        for col in 0..cols {
+            dirs.push(sign * at(prior.node_uv(col, row)));
+        }
+    }
+    let mean = |d: &[DVec3]| d.iter().map(|v| v.length()).sum::<f64>() / d.len() as f64;
+    let scale = mean(&prior_directions(prior)) / mean(&dirs);
+    if !(scale.is_finite() && scale > 0.0) {
+        return None;
+    }
+    dirs.iter_mut().for_each(|d| *d *= scale);
+    Some(dirs)
+}
+
+/// Whether the pinhole's direction field (8 unknowns) explains the data as well as the
+/// free directions of `nodes` nodes (3 a node less 1) do: its misses are at rounding level, or the
+/// free fit lowers the sum of squared misses by no more than 4 noise variances per extra
+/// unknown, the variance estimated from the pinhole's own misses (the simpler model's
+/// estimate, so that sparse data, where the free fit has few or no spare equations, keep
+/// the pinhole). The same rule as `starts = "auto"`'s between kept starts and the eye.
+fn pinhole_suffices(pinhole: &FitReport, free: &FitReport, nodes: usize) -> bool {
+    let rad = |deg: f64| deg.to_radians();
+    if rad(pinhole.rms_angle_deg) <= PINHOLE_EXACT {
+        return true;
+    }
+    let n = pinhole.correspondences as f64;
+    let sse = |r: &FitReport| n * rad(r.rms_angle_deg).powi(2);
+    let free_unknowns = 3.0 * nodes as f64 - 1.0;
+    let extra = free_unknowns - 8.0;
+    let spare = 2.0 * n - 8.0;
+    if spare <= 0.0 || extra <= 0.0 {
+        return true;
+    }
+    let variance = sse(pinhole) / spare;
+    sse(pinhole) - sse(free) <= 4.0 * extra * variance
+}
+
+/// The direction field fitted for a given eye.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Model {
+    /// Every node direction free (the linear fit of module `grid`).
+    Free,
+    /// The affine field of a pinhole camera at the eye ([`pinhole_directions`]).
+    Pinhole,
+}
+
+/// The variable-projection problem in the eye E.
+struct Problem<'a> {
+    prior: &'a ProjectorGrid,
+    correspondences: &'a [Correspondence],
+    /// The central-difference step in E.
+    step: f64,
+    model: Model,
+}
+
+impl Problem<'_> {
+    /// The prior's grid with every start at `eye` and the node directions `dirs`.
+    fn grid_at(&self, eye: DVec3, dirs: &[DVec3]) -> Result<ProjectorGrid> {
+        let starts = vec![eye; dirs.len()];
+        let ends = dirs.iter().map(|d| eye + *d).collect();
+        ProjectorGrid::new(self.prior.size(), starts, ends, self.prior.interpolation())
+    }
+
+    /// The chords n_k - a_k (3 per correspondence) between the blended directions of the
+    /// model's field at `eye` (the linear fit with every start at `eye`, or the pinhole's)
+    /// and the unit directions from `eye` to the points; `None` where that fit fails (a point
+    /// at the eye, a zero-length node, a pinhole field turning a point behind).
+    fn misses(&self, eye: DVec3) -> Option<Vec<f64>> {
+        if self.model == Model::Pinhole {
+            let dirs = pinhole_directions(self.prior, self.correspondences, eye)?;
+            let grid = self.grid_at(eye, &dirs).ok()?;
+            let targets = targets(&grid, self.correspondences).ok()?;
+            return self.chords(&grid, &targets, &dirs);
+        }
+        let first = self.grid_at(eye, &prior_directions(self.prior)).ok()?;
+        let targets = targets(&first, self.correspondences).ok()?;
+        let dirs = System::new(&first, self.correspondences, &targets)
+            .solve(0.0)
+            .ok()?;
+        // Centred on the first solve: the prior's pull acts on its small residual only.
+        let second = self.grid_at(eye, &dirs).ok()?;
+        let dirs = System::new(&second, self.correspondences, &targets)
+            .solve(0.0)
+            .ok()?;
+        self.chords(&second, &targets, &dirs)
+    }
+
+    /// The chords n_k - a_k between the blended unit directions of `grid`'s nodes `dirs`
+    /// and the unit directions `targets` from the starts to the points.
+    fn chords(&self, grid: &ProjectorGrid, targets: &[DVec3], dirs: &[DVec3]) -> Option<Vec<f64>> {
+        let mut out = Vec::with_capacity(3 * self.correspondences.len());
+        for (c, a) in self.correspondences.iter().zip(targets) {
+            let n = blended(grid, c, dirs).try_normalize()?;
+            out.extend((n - *a).to_array());
+        }
+        Some(out)
+    }
+
+    /// The derivative of [`Problem::misses`] in E by central differences: 3 columns.
+    fn jacobian(&self, eye: DVec3) -> Option<Vec<[f64; 3]>> {
+        let mut rows = vec![[0.0; 3]; 3 * self.correspondences.len()];
+        for axis in 0..3 {
+            let mut h = DVec3::ZERO;
+            h[axis] = self.step;
+            let (plus, minus) = (self.misses(eye + h)?, self.misses(eye - h)?);
+            for (row, (p, m)) in rows.iter_mut().zip(plus.iter().zip(&minus)) {
+                row[axis] = (p - m) / (2.0 * self.step);
+            }
+        }
+        Some(rows)
+    }
+
+    /// J^T J and J^T r at `eye`.
+    fn normal(&self, eye: DVec3, r: &[f64]) -> Option<(DMat3, DVec3)> {
+        let jacobian = self.jacobian(eye)?;
+        let mut jtj = DMat3::ZERO;
+        let mut jtr = DVec3::ZERO;
+        for (row, value) in jacobian.iter().zip(r) {
+            let j = DVec3::from_array(*row);
+            jtj += DMat3::from_cols(j * j.x, j * j.y, j * j.z);
+            jtr += j * *value;
+        }
+        Some((jtj, jtr))
+    }
+
+    /// Levenberg-Marquardt on the sum of squared misses from the eye `start`: the eye found
+    /// and its cost, or `None` where the misses cannot be evaluated at `start`.
+    fn descend(&self, start: DVec3) -> Option<(DVec3, f64)> {
+        let cost_of = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>();
+        let mut eye = start;
+        let mut r = self.misses(eye)?;
+        let mut cost = cost_of(&r);
+        let mut damping = 1e-3;
+        for _ in 0..MAX_ITERATIONS {
+            if cost < 1e-30 {
+                break;
+            }
+            let Some((jtj, jtr)) = self.normal(eye, &r) else {
+                break;
+            };
+            let mut improved = false;
+            for _ in 0..12 {
+                let diagonal = DVec3::new(jtj.x_axis.x, jtj.y_axis.y, jtj.z_axis.z);
+                let damped =
+                    jtj + DMat3::from_diagonal(damping * diagonal.max(DVec3::splat(1e-30)));
+                let step = -(damped.inverse() * jtr);
+                let next = eye + step;
+                if let Some(r_next) = step.is_finite().then(|| self.misses(next)).flatten() {
+                    let next_cost = cost_of(&r_next);
+                    if next_cost < cost {
+                        let decrease = cost - next_cost;
+                        (eye, r, cost) = (next, r_next, next_cost);
+                        damping = (damping * 0.1).max(1e-12);
+                        improved = decrease > 1e-14 * cost;
+                        break;
+                    }
+                }
+                damping *= 10.0;
+            }
+            if !improved {
+                break;
+            }
+        }
+        Some((eye, cost))
+    }
+
+    /// An error when the misses at `eye` hardly change as E moves in some direction (module
+    /// docs, degenerate cases): the eye is then not determined by the data.
+    fn check_determined(&self, eye: DVec3, extent: f64) -> Result<()> {
+        let r = self.misses(eye).ok_or_else(undetermined)?;
+        let (jtj, _) = self.normal(eye, &r).ok_or_else(undetermined)?;
+        let symmetric = Matrix3::from_fn(|i, j| jtj.col(j)[i]);
+        let eigenvalues = SymmetricEigen::new(symmetric).eigenvalues;
+        let (least, most) = (eigenvalues.min().max(0.0).sqrt(), eigenvalues.max().sqrt());
+        if least * extent < FLAT || least < FLAT * most {
+            return Err(undetermined());
+        }
+        Ok(())
+    }
+}
+
+/// `fitted` (every start at `eye`) with its starts moved along their projectors to
+/// S_j = E + s D_j, the end D_j beyond, for the near fraction `s` less where a point lies
+/// nearer the eye than that (then half the nearest point's parameter).
+fn starts_moved(
+    fitted: &ProjectorGrid,
+    correspondences: &[Correspondence],
+    eye: DVec3,
+    near: f64,
+) -> Result<ProjectorGrid> {
+    let dirs = prior_directions(fitted);
+    let nearest = correspondences
+        .iter()
+        .map(|c| {
+            let d = blended(fitted, c, &dirs);
+            (c.point - eye).dot(d) / d.length_squared()
+        })
+        .fold(f64::INFINITY, f64::min);
+    let s = near.min(0.5 * nearest);
+    if s <= 0.0 {
+        return Ok(fitted.clone());
+    }
+    let starts = dirs.iter().map(|d| eye + s * *d).collect();
+    let ends = dirs.iter().map(|d| eye + (1.0 + s) * *d).collect();
+    ProjectorGrid::new(fitted.size(), starts, ends, fitted.interpolation())
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::DVec2;
+    use proptest::prelude::*;
+
+    use super::super::{fit_with, FittedStarts, Starts};
+    use super::*;
+    use crate::projection::flexible::projector_grid::tests::perspective_volume as perspective;
+    use crate::projection::flexible::projector_grid::GridInterpolation;
+
+    /// The fixture camera's eye (`projector_grid::tests::preset_volume`).
+    const EYE: DVec3 = DVec3::new(0.0, 1.0, 5.0);
+
+    /// A 3 x 3 bilinear grid of a `fov`-degree perspective camera with near clip 1, every
+    /// point moved by `offset`.
+    fn camera_grid(fov: f64, offset: DVec3) -> ProjectorGrid {
+        let grid = ProjectorGrid::sample(
+            &perspective(fov, [1.0, 40.0]),
+            (3, 3),
+            GridInterpolation::Bilinear,
+        )
+        .unwrap();
+        let starts = grid.starts().iter().map(|s| *s + offset).collect();
+        let ends = grid.ends().iter().map(|e| *e + offset).collect();
+        ProjectorGrid::new((3, 3), starts, ends, GridInterpolation::Bilinear).unwrap()
+    }
+
+    /// `count` points seen by `truth` at seeded image positions and depths t in (0.1, 0.6).
+    fn seen_by(truth: &ProjectorGrid, count: usize, seed: u64) -> Vec<Correspondence> {
+        let mut state = seed;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (0..count)
+            .map(|_| {
+                let uv = DVec2::new(next(), next());
+                let t = 0.1 + 0.5 * next();
+                Correspondence {
+                    uv,
+                    point: truth.point(uv, t),
+                }
+            })
+            .collect()
+    }
+
+    /// The largest distance from `eye` to a projector line of `grid` over a 9 x 9 grid of
+    /// (u, v).
+    fn farthest_line(grid: &ProjectorGrid, eye: DVec3) -> f64 {
+        let mut worst = 0.0f64;
+        for i in 0..=8 {
+            for j in 0..=8 {
+                let uv = DVec2::new(f64::from(i), f64::from(j)) / 8.0;
+                let (s, e) = grid.start_end(uv);
+                let d = (e - s).normalize();
+                worst = worst.max((eye - s).cross(d).length());
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn recovers_a_pinhole_eye_from_a_prior_whose_starts_are_off_it() {
+        let truth = camera_grid(50.0, DVec3::ZERO);
+        // The prior: a wider camera 1.2 away, its starts on its own near plane.
+        let prior = camera_grid(70.0, DVec3::new(0.8, -0.5, 0.7));
+        let data = seen_by(&truth, 16, 3);
+        let (fitted, report, eye) = fit(&prior, &data).unwrap();
+        assert!((eye - EYE).length() < 1e-9, "{eye}");
+        assert!(report.max_angle_deg < 1e-6, "{report:?}");
+        assert!(farthest_line(&fitted, EYE) < 1e-8);
+        // The starts moved to the prior's near fraction 1 / 39 along the projectors.
+        let d = fitted.ends()[4] - fitted.starts()[4];
+        assert!((fitted.starts()[4] - (EYE + d / 39.0)).length() < 1e-8 * d.length());
+        // `auto` takes it (the kept starts miss by degrees), and says so.
+        let (kept, kept_report) = fit_with(&prior, &data, Starts::Kept).unwrap();
+        assert!(kept_report.max_angle_deg > 0.1, "{kept_report:?}");
+        assert_eq!(kept_report.starts, FittedStarts::Kept);
+        let (auto, auto_report) = fit_with(&prior, &data, Starts::Auto).unwrap();
+        assert_eq!(auto, fitted);
+        assert!(matches!(auto_report.starts, FittedStarts::Eye(e) if e == eye));
+        assert_ne!(kept, fitted);
+    }
+
+    #[test]
+    fn auto_keeps_exact_kept_starts_bit_for_bit() {
+        let truth = camera_grid(50.0, DVec3::ZERO);
+        // The prior has the truth's starts: the kept fit is exact, and `auto` is that fit.
+        let prior = truth
+            .with_ends(camera_grid(80.0, DVec3::ZERO).ends().to_vec())
+            .unwrap();
+        let data = seen_by(&truth, 30, 5);
+        let kept = super::super::fit(&prior, &data).unwrap();
+        assert!(kept.1.max_angle_deg < 1e-6);
+        let (grid, report) = fit_with(&prior, &data, Starts::Auto).unwrap();
+        assert_eq!(grid, kept.0);
+        assert_eq!(report.starts, FittedStarts::Kept);
+        assert_eq!(
+            (report.max_angle_deg, report.rms_angle_deg),
+            (kept.1.max_angle_deg, kept.1.rms_angle_deg)
+        );
+    }
+
+    #[test]
+    fn too_few_points_curved_priors_and_undetermined_eyes_are_refused() {
+        let truth = camera_grid(50.0, DVec3::ZERO);
+        let prior = camera_grid(70.0, DVec3::new(0.8, -0.5, 0.7));
+        let five = seen_by(&truth, 5, 3);
+        let e = fit(&prior, &five).unwrap_err();
+        assert!(e.message.contains("at least 6 correspondences"), "{e}");
+        // Eight points on one line through the eye, at one (u, v): any eye on that line
+        // meets them.
+        let uv = DVec2::new(0.3, 0.6);
+        let line: Vec<_> = (0..8)
+            .map(|k| Correspondence {
+                uv,
+                point: truth.point(uv, 0.1 + 0.1 * f64::from(k)),
+            })
+            .collect();
+        let e = fit(&prior, &line).unwrap_err();
+        assert!(e.message.contains("do not determine an eye"), "{e}");
+        // Six and twelve points, fewer equations than a 3 x 3 grid's 27 free direction
+        // unknowns (the free directions absorb any move of the eye): the pinhole field's
+        // 8 unknowns still determine it, and every projector, not only the points', is the
+        // camera's.
+        for count in [6, 12] {
+            let (fitted, _, eye) = fit(&prior, &seen_by(&truth, count, 3)).unwrap();
+            assert!((eye - EYE).length() < 1e-8, "{count}: {eye}");
+            assert!(farthest_line(&fitted, EYE) < 1e-7, "{count}");
+            for uv in [
+                DVec2::new(0.9, 0.1),
+                DVec2::new(0.05, 0.95),
+                DVec2::splat(0.5),
+            ] {
+                let along = |g: &ProjectorGrid| {
+                    let (s, e) = g.start_end(uv);
+                    (e - s).normalize()
+                };
+                assert!(
+                    (along(&fitted) - along(&truth)).length() < 1e-8,
+                    "{count} {uv}"
+                );
+            }
+        }
+        // Twenty points on one plane (z = -5, across the view): from any eye the plane's
+        // points are affine in (u, v), which a bilinear grid meets exactly.
+        let plane: Vec<_> = seen_by(&truth, 20, 4)
+            .into_iter()
+            .map(|c| {
+                let (s, e) = truth.start_end(c.uv);
+                let t = (-5.0 - s.z) / (e.z - s.z);
+                Correspondence {
+                    point: s + t * (e - s),
+                    ..c
+                }
+            })
+            .collect();
+        let e = fit(&prior, &plane).unwrap_err();
+        assert!(e.message.contains("do not determine an eye"), "{e}");
+        // `auto` then keeps the prior's starts.
+        let (_, report) = fit_with(&prior, &line, Starts::Auto).unwrap();
+        assert_eq!(report.starts, FittedStarts::Kept);
+        // A curved prior has no common eye.
+        let mut curved = prior.clone();
+        let (s, end) = (curved.starts()[4], curved.ends()[4]);
+        curved
+            .set_projector((1, 1), s, end, Some((end - s).normalize() + DVec3::X * 0.1))
+            .unwrap();
+        let e = fit(&curved, &seen_by(&truth, 16, 3)).unwrap_err();
+        assert!(e.message.contains("has tangents"), "{e}");
+        // All points at one place.
+        let same = vec![five[0]; 8];
+        assert!(fit(&prior, &same).unwrap_err().message.contains("coincide"));
+    }
+
+    #[test]
+    fn wild_nodes_are_counted_and_undetermined_ones_only_where_the_model_leaves_them_open() {
+        let prior = camera_grid(60.0, DVec3::ZERO);
+        let data = seen_by(&prior, 40, 9);
+        let (grid, report) = fit_with(&prior, &data, Starts::Kept).unwrap();
+        assert_eq!(
+            (report.wild_nodes, report.sparse_nodes),
+            (0, 0),
+            "{report:?}"
+        );
+        assert!(report.warning().is_none());
+        // Node 0 ten times as long, node 8 turned by 90 degrees: both wild.
+        let mut ends = grid.ends().to_vec();
+        ends[0] = grid.starts()[0] + 10.0 * (ends[0] - grid.starts()[0]);
+        let d = ends[8] - grid.starts()[8];
+        ends[8] = grid.starts()[8] + d.cross(DVec3::Y).normalize() * d.length();
+        let wild = grid.with_ends(ends).unwrap();
+        assert_eq!(super::super::wild_nodes(&prior, &wild, &data), 2);
+        // Kept starts, three points in the lower left cell: its four nodes' 12 direction
+        // unknowns against 6 equations are undetermined, and the user is told.
+        let cell: Vec<_> = data
+            .iter()
+            .filter(|c| c.uv.max_element() < 0.5)
+            .take(3)
+            .copied()
+            .collect();
+        assert_eq!(cell.len(), 3);
+        let (_, report) = fit_with(&prior, &cell, Starts::Kept).unwrap();
+        assert_eq!(report.sparse_nodes, 4, "{report:?}");
+        assert!(report.warning().unwrap().contains("not determined"));
+        // A pinhole off the prior's eye recovered exactly from 8 points: some nodes carry
+        // little weight (the old summed-weight rule warned of them), but the pinhole's field
+        // determines every node: no warning.
+        let truth = camera_grid(50.0, DVec3::ZERO);
+        let off = camera_grid(70.0, DVec3::new(0.8, -0.5, 0.7));
+        let eight = seen_by(&truth, 8, 3);
+        assert!(super::super::thinly_weighted_nodes(&off, &eight) > 0);
+        let (fitted, report) = fit_with(&off, &eight, Starts::Auto).unwrap();
+        assert!(matches!(report.starts, FittedStarts::Eye(_)), "{report:?}");
+        assert!(farthest_line(&fitted, EYE) < 1e-7);
+        assert_eq!(report.sparse_nodes, 0, "{report:?}");
+        assert!(report.warning().is_none());
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+
+        /// The central fit inverts a pinhole camera: its eye comes back from any 16 of its
+        /// points, whatever the prior's position.
+        #[test]
+        fn the_eye_of_any_pinhole_camera_comes_back(
+            fov in 20.0f64..120.0,
+            offset in prop::array::uniform3(-2.0f64..2.0),
+            moved in prop::array::uniform3(-1.5f64..1.5),
+            seed in 0u64..1000,
+        ) {
+            let truth = camera_grid(fov, DVec3::from(offset));
+            let prior = camera_grid(60.0, DVec3::from(moved));
+            let data = seen_by(&truth, 16, seed);
+            let (_, report, eye) = fit(&prior, &data).unwrap();
+            prop_assert!((eye - (EYE + DVec3::from(offset))).length() < 1e-7, "{eye}");
+            prop_assert!(report.max_angle_deg < 1e-5, "{report:?}");
+        }
+    }
+}

@@ -1,0 +1,83 @@
+//! Reading and writing images: PNG colour, 16-bit PNG object ids, depth as OpenEXR or PFM,
+//! animated GIF, and the photos `flexcam reproject` reads.
+//!
+//! Writers write to the path they are given; [`OutputSet`] gives a command's outputs their
+//! safety: refused when aimed at an input or at each other, staged in temporary files,
+//! committed all together or not at all.
+
+mod depth;
+mod gif;
+mod identity;
+mod outputs;
+mod png;
+mod read;
+
+use std::path::Path;
+
+use glam::Vec3;
+
+use crate::render::Frame;
+
+pub use depth::{write_depth, DepthFormat};
+pub use gif::GifFrames;
+pub use identity::{FileIdentity, Target};
+pub use outputs::{check_extension, write_bytes, OutputId, OutputSet};
+pub use png::{write_color_png, write_ids_png};
+pub use read::{read_linear_image, LinearImage, INPUT_EXTENSIONS};
+
+/// How linear colour is turned into 8-bit PNG values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ColorEncoding {
+    /// The sRGB transfer curve (for `lit` images).
+    Srgb,
+    /// `round(255 * c)` with no transfer curve, so that flat colours round-trip exactly.
+    Linear,
+}
+
+/// Lower-case extension of `path`, or "" when it has none.
+fn extension(path: &Path) -> String {
+    path.extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default()
+}
+
+/// The sRGB transfer curve of one linear channel value, clamped to [0,1].
+fn srgb_encode(c: f32) -> f32 {
+    let c = c.clamp(0.0, 1.0);
+    if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// 8-bit value of a linear colour channel under `encoding`; NaN maps to 0.
+pub fn encode_channel(c: f32, encoding: ColorEncoding) -> u8 {
+    let c = if c.is_nan() { 0.0 } else { c };
+    let v = match encoding {
+        ColorEncoding::Srgb => srgb_encode(c),
+        ColorEncoding::Linear => c.clamp(0.0, 1.0),
+    };
+    (255.0 * v).round() as u8
+}
+
+/// The 8-bit RGB bytes of the colour of `frame`, row by row from the top.
+fn rgb_bytes(frame: &Frame, encoding: ColorEncoding) -> Vec<u8> {
+    frame
+        .color
+        .iter()
+        .flat_map(|c: &Vec3| c.to_array().map(|v| encode_channel(v, encoding)))
+        .collect()
+}
+
+/// The inverse of the sRGB transfer curve: an encoded value in [0, 1] to linear.
+pub fn srgb_decode(c: f32) -> f32 {
+    if c <= 0.040_45 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[cfg(test)]
+mod tests;
