@@ -7,6 +7,7 @@
 //! a scene and a projection into a [`render::Frame`]; the ray caster is the exact reference.
 
 pub mod calibrate;
+pub mod displace;
 pub mod error;
 pub mod geometry;
 pub mod image_io;

@@ -5,6 +5,7 @@
 //! use f32 ([`glam::Vec3`]) where precision has been shown to suffice.
 
 mod aabb;
+mod bilinear_patch;
 mod mesh_view;
 pub(crate) mod optics;
 mod ray;
@@ -12,6 +13,7 @@ mod roots;
 mod triangle;
 
 pub use aabb::Aabb;
+pub use bilinear_patch::{BilinearPatch, PatchHit};
 pub use mesh_view::MeshView;
 pub use ray::Ray;
 pub use roots::{solve_cubic, solve_quadratic, Roots};

@@ -4,6 +4,8 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
+use super::texel::TexelGrid;
+
 /// How the base colour varies over a surface.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Pattern {
@@ -64,34 +66,20 @@ pub struct Texture {
 impl Texture {
     /// Nearest-texel lookup (no filtering, as `--shading flat` requires).
     pub fn nearest(&self, uv: Vec2) -> Vec3 {
-        let (x, y) = self.texel_coords(uv);
-        self.texel(x.floor() as i64, y.floor() as i64)
+        self.grid().nearest(uv)
     }
 
     /// Bilinear lookup between the four nearest texel centres.
     pub fn bilinear(&self, uv: Vec2) -> Vec3 {
-        let (x, y) = self.texel_coords(uv);
-        let (x, y) = (x - 0.5, y - 0.5);
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let (x0, y0) = (x0 as i64, y0 as i64);
-        let top = self.texel(x0, y0).lerp(self.texel(x0 + 1, y0), fx);
-        let bottom = self.texel(x0, y0 + 1).lerp(self.texel(x0 + 1, y0 + 1), fx);
-        top.lerp(bottom, fy)
+        self.grid().bilinear(uv)
     }
 
-    /// Continuous texel coordinates of `uv` (x right, y down from the top row).
-    fn texel_coords(&self, uv: Vec2) -> (f32, f32) {
-        let u = uv.x - uv.x.floor();
-        let v = uv.y - uv.y.floor();
-        (u * self.width as f32, (1.0 - v) * self.height as f32)
-    }
-
-    /// The texel at integer coordinates, wrapped into range.
-    fn texel(&self, x: i64, y: i64) -> Vec3 {
-        let x = x.rem_euclid(self.width as i64) as usize;
-        let y = y.rem_euclid(self.height as i64) as usize;
-        self.texels[y * self.width as usize + x]
+    fn grid(&self) -> TexelGrid<'_, Vec3> {
+        TexelGrid {
+            width: self.width,
+            height: self.height,
+            texels: &self.texels,
+        }
     }
 }
 

@@ -5,6 +5,7 @@
 mod light;
 mod material;
 mod mesh;
+pub mod texel;
 
 pub use light::Light;
 pub use material::{Material, Pattern, Surface, Texture};

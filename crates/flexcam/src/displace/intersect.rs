@@ -1,0 +1,327 @@
+//! Exact ray tracing of a displaced base triangle through a min/max hierarchy over its
+//! subdivision, after Smits, Shirley and Stark 2000 ("Direct ray tracing of displacement
+//! mapped triangles"), with nothing stored per triangle.
+//!
+//! The hierarchy is the recursion of the 4-to-1 subdivision itself: a node is a sub-triangle
+//! at some level, its children the four triangles its edge midpoints cut it into, its leaves
+//! (level `L`) the micro-triangles of [`super::micro`]. A node is bounded by a box, in a frame
+//! of the base triangle (x along the first edge, z its normal, so thin displacements give thin
+//! boxes), that provably contains every displaced micro-vertex below it, hence (by convexity)
+//! every micro-triangle below it:
+//! * a micro-vertex is `P + N * e`: `P` in the node's flat triangle (midpoints of midpoints);
+//!   `N = q / |q|` for some `q` in the convex hull of the node's corner normals (each midpoint
+//!   normal is the normalised mean of two such), so each component of `N` lies between the
+//!   corners' extreme components times `1 / max |n_i|` and `1 / min_i (n_i . m)` (`m` the
+//!   normalised mean corner normal, a lower bound of `|q|`); where the corner normals spread
+//!   over a half space or more, `|N_k| <= max(1, max |n_i|)` instead;
+//! * `e = S * (h - h_max) * F` with `h` between the height field's bounds over the node's uv
+//!   bounding rectangle ([`HeightField::range`]: a min/max pyramid for maps, interval
+//!   arithmetic for procedural heights), computed on the fly.
+//!
+//! Interval arithmetic over these gives the box, widened by a relative allowance (1e-9 of the
+//! node's extent plus 1e-14 of its distance from the origin) for the rounding of the frame and
+//! the midpoints, and, per ray, by 1e-8 of the ray origin's distance from the base triangle:
+//! a reported micro-triangle hit lies within `2e-10` of that distance of its triangle (rays
+//! grazing a micro-triangle's plane closer than [`GRAZING`](super::micro::GRAZING) do not hit
+//! it), so the ray enters every box on the way to it. Traversal is front to back: children are visited in
+//! order of their boxes' entry distance, and a child whose entry lies beyond the best hit so
+//! far is skipped. A leaf tests its micro-triangle exactly as the brute-force reference
+//! ([`MicroGrid::intersect`](super::micro::MicroGrid::intersect)) does, on bit-identical
+//! micro-vertices, with the same tie rule ([`MicroHit::before`]), so the two find the same
+//! hit: same `t`, micro-triangle and barycentrics.
+
+use glam::{DVec2, DVec3};
+
+use super::height::HeightField;
+use super::micro::{hit_micro_triangle, BaseVertex, Displacement, MicroHit, MicroTriangle};
+use crate::geometry::Ray;
+
+/// A base triangle (vertices with positions, normals and uv) and its displacement.
+#[derive(Debug, Clone, Copy)]
+pub struct DisplacedTriangle<'a> {
+    corners: [BaseVertex; 3],
+    displacement: &'a Displacement,
+    frame: Frame,
+}
+
+/// An orthonormal frame: `origin` and the rows `x, y, z`.
+#[derive(Debug, Clone, Copy)]
+struct Frame {
+    origin: DVec3,
+    axes: [DVec3; 3],
+}
+
+impl Frame {
+    fn local(&self, p: DVec3) -> DVec3 {
+        self.direction(p - self.origin)
+    }
+
+    fn direction(&self, d: DVec3) -> DVec3 {
+        DVec3::new(
+            self.axes[0].dot(d),
+            self.axes[1].dot(d),
+            self.axes[2].dot(d),
+        )
+    }
+
+    fn world(&self, p: DVec3) -> DVec3 {
+        self.origin + self.axes[0] * p.x + self.axes[1] * p.y + self.axes[2] * p.z
+    }
+}
+
+/// A node of the hierarchy: three undisplaced micro-vertices and their grid points.
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    v: [BaseVertex; 3],
+    g: [[u32; 2]; 3],
+}
+
+impl Node {
+    /// The four children (corner triangles first, then the middle one).
+    fn children(&self) -> [Node; 4] {
+        let [a, b, c] = self.v;
+        let [ga, gb, gc] = self.g;
+        let (ab, bc, ca) = (a.midpoint(b), b.midpoint(c), c.midpoint(a));
+        let mid = |p: [u32; 2], q: [u32; 2]| [(p[0] + q[0]) / 2, (p[1] + q[1]) / 2];
+        let (gab, gbc, gca) = (mid(ga, gb), mid(gb, gc), mid(gc, ga));
+        [
+            Node {
+                v: [a, ab, ca],
+                g: [ga, gab, gca],
+            },
+            Node {
+                v: [ab, b, bc],
+                g: [gab, gb, gbc],
+            },
+            Node {
+                v: [ca, bc, c],
+                g: [gca, gbc, gc],
+            },
+            Node {
+                v: [bc, ca, ab],
+                g: [gbc, gca, gab],
+            },
+        ]
+    }
+
+    /// The micro-triangle this leaf is, and its displaced vertices in that triangle's order.
+    fn micro_triangle(&self, displacement: &Displacement) -> (MicroTriangle, [DVec3; 3]) {
+        let i = self.g.iter().map(|g| g[0]).min().unwrap_or(0);
+        let j = self.g.iter().map(|g| g[1]).min().unwrap_or(0);
+        let up = self.g.contains(&[i, j]);
+        let triangle = MicroTriangle { i, j, up };
+        let positions = triangle.vertices().map(|g| {
+            let k = self.g.iter().position(|&x| x == g).unwrap_or(0);
+            displacement.displace(&self.v[k])
+        });
+        (triangle, positions)
+    }
+}
+
+/// A ray in the base triangle's frame, for slab tests.
+struct LocalRay {
+    origin: DVec3,
+    direction: DVec3,
+    t_min: f64,
+    t_max: f64,
+    /// How much every box is widened for this ray (module docs).
+    slack: f64,
+}
+
+impl<'a> DisplacedTriangle<'a> {
+    /// The base triangle `corners` (in order `a, b, c`) displaced by `displacement`. Vertex
+    /// normals are used as given (the mesh's; unit length expected). A degenerate base
+    /// triangle (zero area) is traced in the world axes.
+    pub fn new(corners: [BaseVertex; 3], displacement: &'a Displacement) -> Self {
+        let [a, b, c] = corners.map(|v| v.position);
+        let x = (b - a).normalize_or_zero();
+        let z = (b - a).cross(c - a).normalize_or_zero();
+        let axes = if x == DVec3::ZERO || z == DVec3::ZERO {
+            [DVec3::X, DVec3::Y, DVec3::Z]
+        } else {
+            [x, z.cross(x), z]
+        };
+        DisplacedTriangle {
+            corners,
+            displacement,
+            frame: Frame { origin: a, axes },
+        }
+    }
+
+    /// A world-space box `[min, max]` containing every micro-triangle.
+    pub fn bounds(&self) -> [DVec3; 2] {
+        let [lo, hi] = self.node_box(&self.root());
+        let mut out = [DVec3::INFINITY, DVec3::NEG_INFINITY];
+        for k in 0..8 {
+            let corner = DVec3::new(
+                if k & 1 == 0 { lo.x } else { hi.x },
+                if k & 2 == 0 { lo.y } else { hi.y },
+                if k & 4 == 0 { lo.z } else { hi.z },
+            );
+            let p = self.frame.world(corner);
+            out = [out[0].min(p), out[1].max(p)];
+        }
+        let slack = DVec3::splat(1e-14) * out[0].abs().max(out[1].abs());
+        [out[0] - slack, out[1] + slack]
+    }
+
+    /// The first micro-triangle hit with `t` in `[ray.t_min, ray.t_max]`, from either side;
+    /// the same hit as [`MicroGrid::intersect`](super::micro::MicroGrid::intersect).
+    pub fn intersect(&self, ray: &Ray) -> Option<MicroHit> {
+        if !(ray.origin.is_finite() && ray.direction.is_finite()) || ray.direction == DVec3::ZERO {
+            return None;
+        }
+        let origin = self.frame.local(ray.origin);
+        let local = LocalRay {
+            origin,
+            direction: self.frame.direction(ray.direction),
+            t_min: ray.t_min,
+            t_max: ray.t_max,
+            slack: 1e-8 * origin.abs().max_element(),
+        };
+        let root = self.root();
+        let mut best = None;
+        if slab_entry(&local, self.node_box(&root), f64::INFINITY).is_some() {
+            self.visit(ray, &local, &root, 0, &mut best);
+        }
+        best
+    }
+
+    fn root(&self) -> Node {
+        let n = 1u32 << self.displacement.level();
+        Node {
+            v: self.corners,
+            g: [[0, 0], [n, 0], [0, n]],
+        }
+    }
+
+    /// Descends into `node` (at subdivision `depth`, its box already entered).
+    fn visit(
+        &self,
+        ray: &Ray,
+        local: &LocalRay,
+        node: &Node,
+        depth: u32,
+        best: &mut Option<MicroHit>,
+    ) {
+        if depth == self.displacement.level() {
+            let (triangle, positions) = node.micro_triangle(self.displacement);
+            if let Some(hit) = hit_micro_triangle(ray, triangle, positions) {
+                if best.is_none_or(|b| hit.before(&b)) {
+                    *best = Some(hit);
+                }
+            }
+            return;
+        }
+        let children = node.children();
+        let mut order: [(f64, usize); 4] = [(f64::INFINITY, 4); 4];
+        let mut count = 0;
+        for (k, child) in children.iter().enumerate() {
+            let limit = best.map_or(f64::INFINITY, |b| b.t);
+            if let Some(entry) = slab_entry(local, self.node_box(child), limit) {
+                let mut at = count;
+                while at > 0 && order[at - 1].0 > entry {
+                    order[at] = order[at - 1];
+                    at -= 1;
+                }
+                order[at] = (entry, k);
+                count += 1;
+            }
+        }
+        for &(entry, k) in &order[..count] {
+            // Ties with the best hit stay: a hit at equal t may win on the triangle order.
+            if best.is_some_and(|b| entry > b.t) {
+                break;
+            }
+            self.visit(ray, local, &children[k], depth + 1, best);
+        }
+    }
+
+    /// The node's box `[lo, hi]` in the base triangle's frame (module docs).
+    fn node_box(&self, node: &Node) -> [DVec3; 2] {
+        let p = node.v.map(|v| self.frame.local(v.position));
+        let n = node.v.map(|v| self.frame.direction(v.normal));
+        let [p_lo, p_hi] = [p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2])];
+        let [n_lo, n_hi] = normal_range(n);
+        let [e_lo, e_hi] = self
+            .displacement
+            .offset_range(uv_height_range(self.displacement.height(), &node.v));
+        // Component-wise product of the intervals [n_lo, n_hi] and [e_lo, e_hi].
+        let products = [n_lo * e_lo, n_lo * e_hi, n_hi * e_lo, n_hi * e_hi];
+        let d_lo = products[0]
+            .min(products[1])
+            .min(products[2])
+            .min(products[3]);
+        let d_hi = products[0]
+            .max(products[1])
+            .max(products[2])
+            .max(products[3]);
+        let reach = p_lo.abs().max(p_hi.abs()).max_element() + e_lo.abs().max(e_hi.abs());
+        let far = self.frame.origin.abs().max_element();
+        let slack = DVec3::splat(1e-9 * reach + 1e-14 * far);
+        [p_lo + d_lo - slack, p_hi + d_hi + slack]
+    }
+}
+
+/// Component bounds of every normal below a node with corner normals `n` (module docs).
+fn normal_range(n: [DVec3; 3]) -> [DVec3; 2] {
+    let q_lo = n[0].min(n[1]).min(n[2]);
+    let q_hi = n[0].max(n[1]).max(n[2]);
+    let longest = n[0].length().max(n[1].length()).max(n[2].length());
+    let m = (n[0] + n[1] + n[2]).normalize_or_zero();
+    let nearest = n[0].dot(m).min(n[1].dot(m)).min(n[2].dot(m));
+    if nearest.is_nan() || nearest <= 0.0 || longest == 0.0 {
+        let r = DVec3::splat(longest.max(1.0) * (1.0 + 1e-12));
+        return [-r, r];
+    }
+    // Allow for the rounding of the normalisations.
+    let (s_lo, s_hi) = ((1.0 - 1e-12) / longest, (1.0 + 1e-12) / nearest);
+    let candidates = [
+        q_lo,
+        q_hi,
+        q_lo * s_lo,
+        q_lo * s_hi,
+        q_hi * s_lo,
+        q_hi * s_hi,
+    ];
+    let lo = candidates.iter().fold(DVec3::INFINITY, |a, &c| a.min(c));
+    let hi = candidates
+        .iter()
+        .fold(DVec3::NEG_INFINITY, |a, &c| a.max(c));
+    [lo, hi]
+}
+
+/// Height bounds over the uv bounding rectangle of a node's corners, widened for the rounding
+/// of the uv midpoints below it.
+fn uv_height_range(height: &HeightField, v: &[BaseVertex; 3]) -> [f64; 2] {
+    let lo = v[0].uv.min(v[1].uv).min(v[2].uv);
+    let hi = v[0].uv.max(v[1].uv).max(v[2].uv);
+    let slack = DVec2::splat(1e-12) * (DVec2::ONE + lo.abs().max(hi.abs()));
+    height.range(lo - slack, hi + slack)
+}
+
+/// Where the ray enters `[lo, hi]` within its interval and before `limit`, if it does.
+/// A zero direction component tests the origin against that slab instead of dividing.
+#[inline]
+fn slab_entry(ray: &LocalRay, [lo, hi]: [DVec3; 2], limit: f64) -> Option<f64> {
+    let mut near = ray.t_min;
+    let mut far = ray.t_max.min(limit);
+    let (lo, hi) = (lo - ray.slack, hi + ray.slack);
+    for k in 0..3 {
+        let (o, d) = (ray.origin[k], ray.direction[k]);
+        if d == 0.0 {
+            if o < lo[k] || o > hi[k] {
+                return None;
+            }
+            continue;
+        }
+        let (t0, t1) = ((lo[k] - o) / d, (hi[k] - o) / d);
+        near = near.max(t0.min(t1));
+        far = far.min(t0.max(t1));
+    }
+    // Rounding of the slab distances is covered by the boxes' slack.
+    (near <= far).then_some(near)
+}
+
+#[cfg(test)]
+mod tests;

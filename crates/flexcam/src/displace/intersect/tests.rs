@@ -1,0 +1,207 @@
+use glam::{DVec2, DVec3};
+use proptest::prelude::*;
+
+use super::DisplacedTriangle;
+use crate::displace::{
+    BaseVertex, Displacement, HeightField, HeightMap, MicroGrid, Procedural, Wave,
+};
+use crate::geometry::Ray;
+
+/// A test case: base triangle, displacement, and the parameters of the rays aimed at it.
+#[derive(Debug, Clone)]
+struct Case {
+    corners: [BaseVertex; 3],
+    displacement: Displacement,
+}
+
+fn unit() -> impl Strategy<Value = f64> {
+    -1.0..1.0f64
+}
+
+fn vec3() -> impl Strategy<Value = DVec3> {
+    (unit(), unit(), unit()).prop_map(|(x, y, z)| DVec3::new(x, y, z))
+}
+
+fn height_field() -> impl Strategy<Value = HeightField> {
+    let map = (
+        1u32..12,
+        1u32..12,
+        proptest::collection::vec(0.0..=1.0f32, 144),
+    )
+        .prop_map(|(w, h, values)| {
+            let values = values[..(w * h) as usize].to_vec();
+            HeightField::Map(HeightMap::from_values(w, h, values).unwrap())
+        });
+    let waves = (1i32..5, -4i32..4, 0.0..6.0f64).prop_map(|(m, n, phase)| {
+        let waves = vec![
+            Wave {
+                amplitude: 1.0,
+                frequency: [m, n],
+                phase,
+            },
+            Wave {
+                amplitude: 0.3,
+                frequency: [n, -m],
+                phase: 0.0,
+            },
+        ];
+        HeightField::Procedural(Procedural::waves(waves).unwrap())
+    });
+    let bumps = (1u32..6, 1u32..6, 0.1..0.5f64)
+        .prop_map(|(nu, nv, r)| HeightField::Procedural(Procedural::bumps([nu, nv], r).unwrap()));
+    prop_oneof![2 => map, 1 => waves, 1 => bumps]
+}
+
+fn case() -> impl Strategy<Value = Case> {
+    (
+        [vec3(), vec3(), vec3()],
+        [vec3(), vec3(), vec3()],
+        [(unit(), unit()), (unit(), unit()), (unit(), unit())],
+        height_field(),
+        -0.6..0.6f64,
+        0u32..=5,
+    )
+        .prop_filter_map(
+            "degenerate base triangle",
+            |(p, bend, uv, height, scale, level)| {
+                let face = (p[1] - p[0]).cross(p[2] - p[0]);
+                (face.length() > 0.05).then(|| {
+                    let n = face.normalize();
+                    let corners = [0, 1, 2].map(|k| BaseVertex {
+                        position: p[k],
+                        normal: (n + 0.6 * bend[k]).normalize_or(n),
+                        uv: DVec2::new(uv[k].0, uv[k].1) * 1.5,
+                    });
+                    Case {
+                        corners,
+                        displacement: Displacement::new(height, scale, 1.0, level).unwrap(),
+                    }
+                })
+            },
+        )
+}
+
+/// The same hit, bit for bit, from the hierarchy and from testing every micro-triangle.
+fn check(case: &Case, grid: &MicroGrid, ray: &Ray) -> Result<(), TestCaseError> {
+    let fast = DisplacedTriangle::new(case.corners, &case.displacement).intersect(ray);
+    let brute = grid.intersect(ray);
+    prop_assert_eq!(fast, brute, "ray {:?}", ray);
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(1000))]
+
+    /// Rays aimed at random points of the displaced surface's shell, rays through
+    /// micro-vertices, grazing rays and rays along micro-edges, from random origins.
+    #[test]
+    fn same_hits_as_brute_force(
+        case in case(),
+        origins in proptest::collection::vec(vec3(), 8),
+        weights in proptest::collection::vec((0.0..1.0f64, 0.0..1.0f64, -1.2..0.2f64), 8),
+        picks in proptest::collection::vec((0u32..1024, 0u32..1024), 4),
+    ) {
+        let grid = MicroGrid::new(&case.corners, &case.displacement);
+        let triangles: Vec<_> = grid.triangles().collect();
+        let [a, b, c] = case.corners.map(|v| v.position);
+        let normal = (b - a).cross(c - a).normalize();
+        let scale = case.displacement_scale();
+        for (origin, &(s, t, depth)) in origins.iter().zip(&weights) {
+            // A point of the base triangle, pushed into the displacement shell.
+            let (s, t) = if s + t > 1.0 { (1.0 - s, 1.0 - t) } else { (s, t) };
+            let target = a + s * (b - a) + t * (c - a) + normal * depth * scale;
+            let from = target + *origin * 3.0;
+            check(&case, &grid, &Ray::new(from, target - from))?;
+            // Grazing: nearly in the base plane.
+            let along = (b - a).normalize();
+            let grazing = along + normal * 1e-3 * origin.x;
+            check(&case, &grid, &Ray::new(target - grazing * 2.0, grazing))?;
+            // With a clipped interval.
+            let clipped = Ray { t_min: 0.9, t_max: 1.05, ..Ray::new(from, target - from) };
+            check(&case, &grid, &clipped)?;
+        }
+        for &(k, e) in &picks {
+            let tri = triangles[k as usize % triangles.len()];
+            let p = grid.positions(tri);
+            let (p0, p1) = (p[e as usize % 3], p[(e as usize + 1) % 3]);
+            // Through a micro-vertex, and exactly along a micro-edge (shared by two
+            // micro-triangles, or a base edge), from outside and from on it.
+            let from = p0 + origins[0] * 2.0;
+            check(&case, &grid, &Ray::new(from, p0 - from))?;
+            check(&case, &grid, &Ray::new(p0 - (p1 - p0), p1 - p0))?;
+            check(&case, &grid, &Ray::new((p0 + p1) * 0.5, p1 - p0))?;
+            // Through an edge's midpoint, crossing it.
+            let mid = (p0 + p1) * 0.5;
+            check(&case, &grid, &Ray::new(mid + normal + origins[1] * 0.5, -(normal + origins[1] * 0.5)))?;
+        }
+    }
+
+    /// Every displaced micro-vertex lies inside the triangle's world bounds.
+    #[test]
+    fn bounds_contain_every_micro_vertex(case in case()) {
+        let grid = MicroGrid::new(&case.corners, &case.displacement);
+        let [lo, hi] = DisplacedTriangle::new(case.corners, &case.displacement).bounds();
+        for tri in grid.triangles() {
+            for p in grid.positions(tri) {
+                prop_assert!(p.cmpge(lo).all() && p.cmple(hi).all(), "{} outside [{}, {}]", p, lo, hi);
+            }
+        }
+    }
+}
+
+impl Case {
+    /// The largest displacement magnitude (|S| with h - h_max in [-1, 0]).
+    fn displacement_scale(&self) -> f64 {
+        let [lo, _] = self.displacement.offset_range([0.0, 0.0]);
+        lo.abs().max(1e-3)
+    }
+}
+
+#[test]
+fn misses_and_bad_rays() {
+    let height = HeightField::Procedural(Procedural::bumps([3, 3], 0.4).unwrap());
+    let d = Displacement::new(height, 0.1, 1.0, 4).unwrap();
+    let v = |p: [f64; 3], uv: [f64; 2]| BaseVertex {
+        position: DVec3::from(p),
+        normal: DVec3::Z,
+        uv: DVec2::from(uv),
+    };
+    let tri = DisplacedTriangle::new(
+        [
+            v([0.0; 3], [0.0, 0.0]),
+            v([1.0, 0.0, 0.0], [1.0, 0.0]),
+            v([0.0, 1.0, 0.0], [0.0, 1.0]),
+        ],
+        &d,
+    );
+    let down = DVec3::NEG_Z;
+    assert!(tri
+        .intersect(&Ray::new(DVec3::new(2.0, 2.0, 1.0), down))
+        .is_none());
+    assert!(tri
+        .intersect(&Ray::new(DVec3::new(0.2, 0.2, 1.0), DVec3::ZERO))
+        .is_none());
+    assert!(tri
+        .intersect(&Ray::new(DVec3::new(f64::NAN, 0.2, 1.0), down))
+        .is_none());
+    // Over a bump's centre (h = h_max: not displaced) and between bumps (h = 0: 0.1 down).
+    let centre = tri
+        .intersect(&Ray::new(DVec3::new(1.0 / 6.0, 1.0 / 6.0, 1.0), down))
+        .unwrap();
+    assert!((centre.t - 1.0).abs() < 0.05, "{centre:?}");
+    let low = tri
+        .intersect(&Ray::new(DVec3::new(1.0 / 3.0, 1.0 / 3.0, 1.0), down))
+        .unwrap();
+    assert!((low.t - 1.1).abs() < 1e-3, "{low:?}");
+    // A degenerate base triangle still traces (world axes), like the brute force.
+    let flat = [
+        v([0.0; 3], [0.0, 0.0]),
+        v([1.0, 0.0, 0.0], [1.0, 0.0]),
+        v([2.0, 0.0, 0.0], [0.0, 1.0]),
+    ];
+    let ray = Ray::new(DVec3::new(0.5, 1.0, 1.0), DVec3::new(0.0, -1.0, -1.0));
+    assert_eq!(
+        DisplacedTriangle::new(flat, &d).intersect(&ray),
+        MicroGrid::new(&flat, &d).intersect(&ray)
+    );
+}

@@ -1,0 +1,21 @@
+//! Displacement mapping: height fields, the micro-geometry of displaced triangles, and exact
+//! ray tracing of it.
+//!
+//! A base triangle with vertex positions, normals and texture coordinates is subdivided `L`
+//! times by 4-to-1 midpoint subdivision, and every micro-vertex moves along its normal by
+//! `S * (h(uv) - h_max) * F` (scale `S`, fraction `F`), so the undisplaced mesh is the outer
+//! hull ([`micro`]). Rays meet exactly these `4^L` micro-triangles; [`intersect`] finds the
+//! nearest through a min/max hierarchy over the subdivision, computed on the fly from height
+//! bounds, with no tessellation stored.
+//!
+//! This layer sits beside [`crate::scene`] and uses geometry and scene types only.
+
+pub mod height;
+pub mod intersect;
+pub mod micro;
+pub mod procedural;
+
+pub use height::{HeightField, HeightMap};
+pub use intersect::DisplacedTriangle;
+pub use micro::{BaseVertex, Displacement, MicroGrid, MicroHit, MicroTriangle, MAX_LEVEL};
+pub use procedural::{Procedural, Wave};
