@@ -841,6 +841,26 @@ fn bench_trilinear_quick_prints_both_tables() {
     assert!(e.contains("--repeat"), "{e}");
 }
 
+/// `bench flexible --part table --rows 1` prints Table 7.1's four tables with the one row
+/// asked for, times named as medians, and with `--hash` one frame hash per column.
+#[test]
+fn bench_flexible_table_prints_median_times_and_hashes() {
+    let dir = TempDir::new().unwrap();
+    let args = [
+        "bench", "flexible", "--part", "table", "--rows", "1", "--repeat", "1", "--hash",
+    ];
+    let text = String::from_utf8(run_ok(&dir, &args).stdout).unwrap();
+    assert!(text.contains("median of 1 after one warm-up"), "{text}");
+    assert!(text.contains("flexcam (median seconds)"), "{text}");
+    let kia_rows: Vec<&str> = text.lines().filter(|l| l.starts_with("Kia ")).collect();
+    // Thesis, flexcam, speed-up, CPU, hashes: each a model, then six columns.
+    assert_eq!(kia_rows.len(), 5, "{text}");
+    let hashes: Vec<&str> = kia_rows[4].split_whitespace().skip(1).collect();
+    assert_eq!(hashes.len(), 6, "{text}");
+    assert!(hashes.iter().all(|h| u64::from_str_radix(h, 16).is_ok()));
+    assert!(!text.contains("panorama"), "{text}");
+}
+
 /// `--perspective-rect` applies the local perspective edit to a shape-defined panorama (here
 /// the rounded cubic preset of an example scene) before rendering: the image changes inside
 /// the rectangle's column band, both methods render it and agree; other projections and bad

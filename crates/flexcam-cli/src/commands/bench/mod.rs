@@ -1,6 +1,7 @@
 //! `flexcam bench`: the source documents' timing tables, rerun with flexcam's renderers.
 
 pub mod flexible;
+mod timing;
 pub mod trilinear;
 
 use clap::Subcommand;
