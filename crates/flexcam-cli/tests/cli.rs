@@ -812,7 +812,7 @@ fn reproject_errors_are_one_line() {
     assert!(output.contains("unsupported output extension"), "{output}");
 }
 
-/// `bench trilinear --quick` with one timed render per cell prints both of seed 000's tables
+/// `bench trilinear --quick` with one timed render per cell prints both of Vallance 2005's tables
 /// and the cube's kept-frame table with a row per cell of the quick subset; an out-of-range
 /// `--repeat` is one error line.
 #[test]

@@ -1,4 +1,4 @@
-//! `flexcam bench flexible`: Table 7.1 of seed 003 (Brosz, The Flexible Projection Framework)
+//! `flexcam bench flexible`: Table 7.1 of Brosz 2011 (The Flexible Projection Framework)
 //! with flexcam's BVH-accelerated ray caster.
 //!
 //! The thesis timed one frame at 800 x 800 through a perspective-to-perspective volume with
@@ -9,7 +9,7 @@
 //! The volume is three rectangles (near, bent middle, far) placed around the model's bounding
 //! box; the polylines are the quadratic sampled at equal steps in t.
 //!
-//! The second table is item 9's panorama throughput: `builtin:teapot-dense` (123,554
+//! The second table is the panorama throughput of `--method raster`: `builtin:teapot-dense` (123,554
 //! triangles) as a 1280 x 720 equirectangular panorama from the scene's camera, by
 //! `--method raster` (the first frame of a new renderer; later frames of the same one,
 //! whose pixel projectors and buffers are then ready, with flat and with lit shading) and
@@ -108,7 +108,7 @@ fn table(args: &FlexibleArgs) -> Result<()> {
     let rows = args.rows.map_or(THESIS.len(), |r| r as usize);
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
-        "Table 7.1 (seed 003): {TABLE_SIZE}x{TABLE_SIZE}, lit shading (headlight), one frame per cell, median \
+        "Table 7.1 (Brosz 2011): {TABLE_SIZE}x{TABLE_SIZE}, lit shading (headlight), one frame per cell, median \
          of {} after one warm-up, {threads} threads; models: the Utah teapot at the tessellation nearest each \
          face count",
         args.repeat

@@ -1,4 +1,4 @@
-//! `flexcam bench trilinear`: the timing study of seed 000 (Vallance, Trilinear Projection,
+//! `flexcam bench trilinear`: the timing study of Vallance 2005 (Trilinear Projection,
 //! chapter 8 and appendix D) with flexcam's two renderers of the same trilinear projection:
 //! the BVH ray caster (`--method raycast`) and the rasteriser (`--method trilinear`, adaptive
 //! curves), with and without scene-space clipping.
@@ -8,7 +8,7 @@
 //!   1 to 640^2 pixels (`render::trilinear::workloads`).
 //! - Table 8.1, figure 7.4: the cube-floor scene (686 triangles) through 2, 8, 18, 32 and 50
 //!   projection triangles (the fan grid of the accuracy tests) at 800 x 800, with the
-//!   accuracy against the ray caster (item 9 of issue 3) and the trilinear stage times.
+//!   accuracy against the ray caster (id agreement and relative RGB error) and the trilinear stage times.
 //!
 //! Flat shading, as in the thesis ("no lighting or texture mapping"). Each cell is one
 //! warm-up render, then the median of `--repeat` timed renders; renderers (BVH, scene
@@ -106,7 +106,7 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
         (&SIDES, &SCENE_TRIANGLES, &CELLS)
     };
     println!(
-        "seed 000 chapter 8 / appendix D: flat shading, {threads} threads, median of {} after \
+        "Vallance 2005 chapter 8 / appendix D: flat shading, {threads} threads, median of {} after \
          one warm-up; raycast = BVH ray caster, trilinear = adaptive curves without / with \
          scene-space clipping (clip); times in ms",
         args.repeat
