@@ -9,17 +9,17 @@ use std::ops::Range;
 use glam::{DVec2, DVec3};
 use toml::Spanned;
 
-use super::projection::{camera_frame, Required};
+use super::control_surface::surface;
+use super::projection_table::{camera_frame, clip, Required};
 use super::raw::{RawProjection, RawSurface};
 use super::source::Source;
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::projection::flexible::presets::{
     DepthStyle, Magnifier, DEPTH_STYLE_NAMES, PRESET_NAMES,
 };
 use crate::projection::flexible::reparam::{DEFAULT_MERCATOR_LATITUDE, REPARAM_NAMES};
 use crate::projection::flexible::{
-    BSplinePatch, BezierPatch, BezierVolume, Blend, CylinderPatch, FlexibleSpec, LineParam,
-    PiecewiseVolume, PolarFrame, Preset, PresetSpec, Reparam, SpherePatch, Surface, VolumeSource,
+    BezierVolume, Blend, FlexibleSpec, PiecewiseVolume, Preset, PresetSpec, Reparam, VolumeSource,
 };
 
 /// Every key of a flexible table (besides `type`).
@@ -82,19 +82,6 @@ const BLEND_KEYS: [&str; 6] = [
     "segments",
     "reparam",
     "max_latitude",
-];
-
-/// The surface type names of scene files.
-const SURFACE_NAMES: [&str; 9] = [
-    "rectangle",
-    "bilinear",
-    "sphere",
-    "hemisphere",
-    "cylinder",
-    "point",
-    "line",
-    "bezier",
-    "bspline",
 ];
 
 /// The `blend` names of scene files.
@@ -414,21 +401,6 @@ fn preset_angle_map(src: &Source, raw: &RawProjection, name: &Spanned<String>) -
     Ok(reparam)
 }
 
-/// `clip = [near, far]` with 0 <= near < far, when given.
-pub(super) fn clip(src: &Source, raw: &RawProjection) -> Result<Option<[f64; 2]>> {
-    let Some(c) = &raw.clip else {
-        return Ok(None);
-    };
-    let [near, far] = src.vector(c, "clip")?;
-    if !(0.0 <= near && near < far) {
-        return Err(src.error(
-            &c.span(),
-            format!("`clip` must be [near, far] with 0 <= near < far, got [{near}, {far}]"),
-        ));
-    }
-    Ok(Some([near, far]))
-}
-
 /// A preset with its camera frame and parameters (already checked to belong to it).
 fn preset(required: &Required, name: &str) -> Result<PresetSpec> {
     let src = required.src;
@@ -615,29 +587,6 @@ fn check_preset(src: &Source, raw: &RawProjection, spec: &PresetSpec) -> Result<
     Err(src.error(&at.unwrap_or(fallback), e.message))
 }
 
-/// A bicubic Bezier surface from `control[row][column]`. Errors: not 4 rows of 4 points.
-fn bezier_patch(rows: Vec<Vec<DVec3>>) -> Result<Surface> {
-    let size = |rows: &[Vec<DVec3>]| {
-        format!(
-            "{} x {}",
-            rows.len(),
-            rows.iter().map(Vec::len).max().unwrap_or(0)
-        )
-    };
-    let grid: Option<[[DVec3; 4]; 4]> = rows
-        .iter()
-        .map(|row| <[DVec3; 4]>::try_from(row.as_slice()).ok())
-        .collect::<Option<Vec<_>>>()
-        .and_then(|r| r.try_into().ok());
-    match grid {
-        Some(control) => Ok(Surface::Bezier(Box::new(BezierPatch { control }))),
-        None => Err(Error::new(format!(
-            "bezier surface needs 4 rows of 4 control points, got {}",
-            size(&rows)
-        ))),
-    }
-}
-
 /// `generators`: exactly three finite rays [x0, y0, x1, y1].
 fn generators(src: &Source, value: &Spanned<Vec<[f64; 4]>>) -> Result<[[f64; 4]; 3]> {
     let rays: [[f64; 4]; 3] = value.get_ref().as_slice().try_into().map_err(|_| {
@@ -651,191 +600,4 @@ fn generators(src: &Source, value: &Spanned<Vec<[f64; 4]>>) -> Result<[[f64; 4];
     })?;
     src.all_finite(rays.as_flattened(), value, "generators")?;
     Ok(rays)
-}
-
-/// The keys each surface type takes (besides `surface`).
-fn surface_keys(name: &str) -> &'static [&'static str] {
-    match name {
-        "rectangle" => &["center", "u_axis", "v_axis", "corner", "u_edge", "v_edge"],
-        "bilinear" => &["corners"],
-        "sphere" | "hemisphere" => &["center", "radius", "longitude", "latitude", "axis", "front"],
-        "cylinder" => &["center", "radius", "angle", "height", "axis", "front"],
-        "point" => &["point"],
-        "bezier" | "bspline" => &["control"],
-        _ => &["start", "end", "along"],
-    }
-}
-
-/// One control surface table (`which` is `near`, `far` or `surface N`, for messages).
-pub(super) fn surface(src: &Source, table: &Spanned<RawSurface>, which: &str) -> Result<Surface> {
-    let raw = table.get_ref();
-    let name = raw.surface.get_ref().as_str();
-    if !SURFACE_NAMES.contains(&name) {
-        return Err(src.unknown(&raw.surface.span(), "surface", name, &SURFACE_NAMES));
-    }
-    src.reject_foreign_key(
-        raw.present_keys(),
-        surface_keys(name),
-        &format!("{name} surfaces"),
-    )?;
-    let need = |v: &Option<Spanned<[f64; 3]>>, key: &str| -> Result<DVec3> {
-        let v = v.as_ref().ok_or_else(|| {
-            src.error(
-                &table.span(),
-                format!("{which} {name} surface needs `{key}`"),
-            )
-        })?;
-        src.dvec3(v, key)
-    };
-    let or = |v: &Option<Spanned<[f64; 3]>>, key: &str, default: DVec3| -> Result<DVec3> {
-        v.as_ref().map_or(Ok(default), |v| src.dvec3(v, key))
-    };
-    let range =
-        |v: &Option<Spanned<[f64; 2]>>, key: &str, default: Option<[f64; 2]>| match (v, default) {
-            (Some(v), _) => src.vector(v, key).map(|r| r.map(f64::to_radians)),
-            (None, Some(d)) => Ok(d.map(f64::to_radians)),
-            (None, None) => Err(src.error(
-                &table.span(),
-                format!("{which} {name} surface needs `{key}`"),
-            )),
-        };
-    let radius = || -> Result<f64> {
-        let r = raw.radius.as_ref().ok_or_else(|| {
-            src.error(
-                &table.span(),
-                format!("{which} {name} surface needs `radius`"),
-            )
-        })?;
-        let x = src.number(r, "radius")?;
-        if x < 0.0 {
-            return Err(src.error(&r.span(), format!("`radius` must not be negative, got {x}")));
-        }
-        Ok(x)
-    };
-    let frame = || -> Result<PolarFrame> {
-        let axis = or(&raw.axis, "axis", DVec3::Y)?;
-        let front = or(&raw.front, "front", DVec3::NEG_Z)?;
-        PolarFrame::new(axis, front).map_err(|e| {
-            let at = raw
-                .front
-                .as_ref()
-                .or(raw.axis.as_ref())
-                .map_or(table.span(), Spanned::span);
-            src.error(&at, e.message)
-        })
-    };
-    let surface = match name {
-        "rectangle" => {
-            if raw.corner.is_some() {
-                if let Some(c) = raw.center.as_ref() {
-                    return Err(src.error(
-                        &c.span(),
-                        "give a rectangle by `center`, `u_axis`, `v_axis` or by `corner`, \
-                         `u_edge`, `v_edge`, not both",
-                    ));
-                }
-                Surface::Rectangle {
-                    corner: need(&raw.corner, "corner")?,
-                    u_edge: need(&raw.u_edge, "u_edge")?,
-                    v_edge: need(&raw.v_edge, "v_edge")?,
-                }
-            } else {
-                Surface::rectangle_centred(
-                    need(&raw.center, "center")?,
-                    need(&raw.u_axis, "u_axis")?,
-                    need(&raw.v_axis, "v_axis")?,
-                )
-            }
-        }
-        "bilinear" => {
-            let c = raw.corners.as_ref().ok_or_else(|| {
-                src.error(
-                    &table.span(),
-                    format!("{which} bilinear surface needs `corners`"),
-                )
-            })?;
-            src.all_finite(c.get_ref().as_flattened(), c, "corners")?;
-            Surface::Bilinear {
-                corners: c.get_ref().map(DVec3::from_array),
-            }
-        }
-        "sphere" | "hemisphere" => {
-            let latitude = if name == "sphere" {
-                [-90.0, 90.0]
-            } else {
-                [90.0, 0.0]
-            };
-            Surface::Sphere(SpherePatch {
-                center: need(&raw.center, "center")?,
-                radius: radius()?,
-                frame: frame()?,
-                longitude: range(&raw.longitude, "longitude", Some([-180.0, 180.0]))?,
-                latitude: range(&raw.latitude, "latitude", Some(latitude))?,
-            })
-        }
-        "cylinder" => Surface::Cylinder(CylinderPatch {
-            center: need(&raw.center, "center")?,
-            radius: radius()?,
-            frame: frame()?,
-            angle: range(&raw.angle, "angle", Some([-180.0, 180.0]))?,
-            height: match &raw.height {
-                Some(h) => src.vector(h, "height")?,
-                None => range(&None, "height", None)?,
-            },
-        }),
-        "point" => Surface::Point(need(&raw.point, "point")?),
-        "bezier" | "bspline" => {
-            let c = raw.control.as_ref().ok_or_else(|| {
-                src.error(
-                    &table.span(),
-                    format!("{which} {name} surface needs `control`"),
-                )
-            })?;
-            let rows: Vec<Vec<DVec3>> = c
-                .get_ref()
-                .iter()
-                .map(|row| row.iter().map(|p| DVec3::from_array(*p)).collect())
-                .collect();
-            src.all_finite(c.get_ref().concat().as_flattened(), c, "control")?;
-            let patch = if name == "bezier" {
-                bezier_patch(rows)
-            } else {
-                BSplinePatch::new(rows).map(Surface::BSpline)
-            };
-            patch.map_err(|e| src.error(&c.span(), format!("{which} {}", e.message)))?
-        }
-        _ => {
-            let along = match raw.along.as_ref() {
-                None => LineParam::U,
-                Some(a) => match a.get_ref().as_str() {
-                    "u" => LineParam::U,
-                    "v" => LineParam::V,
-                    other => {
-                        return Err(src.error(
-                            &a.span(),
-                            format!("`along` must be \"u\" or \"v\", not \"{other}\""),
-                        ))
-                    }
-                },
-            };
-            Surface::Line {
-                start: need(&raw.start, "start")?,
-                end: need(&raw.end, "end")?,
-                along,
-            }
-        }
-    };
-    surface.validate().map_err(|e| {
-        let at = [
-            ("latitude", &raw.latitude),
-            ("longitude", &raw.longitude),
-            ("angle", &raw.angle),
-        ]
-        .into_iter()
-        .find(|(key, value)| value.is_some() && e.message.contains(key))
-        .and_then(|(_, value)| value.as_ref())
-        .map_or(table.span(), Spanned::span);
-        src.error(&at, format!("{which} {}", e.message))
-    })?;
-    Ok(surface)
 }

@@ -5,12 +5,14 @@
 //! TOML syntax error to a degenerate projection, is one line `FILE:LINE:COLUMN: message`.
 
 mod animation;
+mod control_surface;
 mod fitted_grid;
 mod flexible;
 mod light;
 mod object;
 mod panorama;
 mod projection;
+mod projection_table;
 mod projector_grid;
 mod raw;
 mod shape;

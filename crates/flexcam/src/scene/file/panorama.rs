@@ -23,8 +23,7 @@ use std::sync::Arc;
 use glam::DVec2;
 use toml::Spanned;
 
-use super::flexible::clip;
-use super::projection::{camera_frame, Required};
+use super::projection_table::{camera_frame, clip, Required};
 use super::raw::{RawCurve, RawProjection};
 use super::source::Source;
 use crate::error::Result;

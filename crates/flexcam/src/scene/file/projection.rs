@@ -6,10 +6,11 @@ use std::path::Path;
 use glam::{DVec2, DVec3};
 use toml::Spanned;
 
+use super::projection_table::{camera_frame, Required};
 use super::raw::{ProjectionTypeProbe, RawProjection};
 use super::source::Source;
 use crate::error::Result;
-use crate::projection::{CameraFrame, ProjectionSpec, TrilinearMesh};
+use crate::projection::{ProjectionSpec, TrilinearMesh};
 
 /// The projection types this parser converts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -134,7 +135,11 @@ pub(super) fn convert(
         &kind.keys(),
         &format!("{name} projections"),
     )?;
-    let required = Required { src, table, kind };
+    let required = Required {
+        src,
+        table,
+        type_name: kind.name(),
+    };
     let angle = |value: &Option<Spanned<f64>>, key: &str, default: f64| {
         value.as_ref().map_or(Ok(default), |v| src.number(v, key))
     };
@@ -163,42 +168,6 @@ pub(super) fn convert(
             h_fov: angle(&raw.h_fov, "h_fov", 360.0)?,
             v_fov: angle(&raw.v_fov, "v_fov", 90.0)?,
         },
-    })
-}
-
-/// Looks up parameters a projection type cannot do without; a missing one is reported at the
-/// table's header.
-pub(super) struct Required<'a> {
-    pub src: &'a Source<'a>,
-    pub table: &'a Spanned<RawProjection>,
-    kind: Kind,
-}
-
-impl Required<'_> {
-    pub fn raw(&self) -> &RawProjection {
-        self.table.get_ref()
-    }
-
-    pub fn get<'v, T>(&self, value: &'v Option<Spanned<T>>, key: &str) -> Result<&'v Spanned<T>> {
-        value.as_ref().ok_or_else(|| {
-            self.src.error(
-                &self.table.span(),
-                format!("{} projection needs `{key}`", self.kind.name()),
-            )
-        })
-    }
-}
-
-/// `position`, `look_at` (required) and `up` (default +y).
-pub(super) fn camera_frame(src: &Source, required: &Required) -> Result<CameraFrame> {
-    let raw = required.raw();
-    Ok(CameraFrame {
-        position: src.dvec3(required.get(&raw.position, "position")?, "position")?,
-        look_at: src.dvec3(required.get(&raw.look_at, "look_at")?, "look_at")?,
-        up: raw
-            .up
-            .as_ref()
-            .map_or(Ok(DVec3::Y), |up| src.dvec3(up, "up"))?,
     })
 }
 

@@ -5,8 +5,8 @@
 use glam::{DVec2, DVec3};
 use toml::Spanned;
 
-use super::flexible::surface;
-use super::projection::Required;
+use super::control_surface::surface;
+use super::projection_table::Required;
 use super::raw::RawCamera;
 use super::source::Source;
 use crate::error::{Error, Result};
