@@ -37,6 +37,14 @@ pub struct Charted<'a> {
     pub map: &'a dyn ContinuousInverse,
 }
 
+impl std::fmt::Debug for Charted<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Charted")
+            .field("chart", &self.chart)
+            .finish_non_exhaustive()
+    }
+}
+
 /// The continuous branch of an inverse described by an [`InverseChart`].
 pub trait ContinuousInverse: Send + Sync {
     /// The image of `point` on the continuous branch: unclipped to the image and to the

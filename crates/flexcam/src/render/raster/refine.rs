@@ -424,7 +424,7 @@ impl<'a> Refiner<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::projection::{CameraFrame, ProjectionSpec};
+    use crate::projection::{CameraFrame, Projection, ProjectionSpec};
 
     fn panorama() -> Box<dyn Projection> {
         let frame = CameraFrame {
