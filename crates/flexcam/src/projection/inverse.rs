@@ -91,3 +91,125 @@ impl<T: SingleImage> AnalyticInverse for T {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use std::f64::consts::FRAC_PI_4;
+    use std::sync::Arc;
+
+    use glam::{DVec2, DVec3};
+
+    use crate::projection::flexible::panorama::{OutlineShape, ProfileShape};
+    use crate::projection::flexible::{
+        FlexibleSpec, PanoramaShape, PanoramaSpec, Reparam, Surface, VolumeSource,
+    };
+    use crate::projection::{CameraFrame, ProjectionSpec, TrilinearMesh};
+
+    fn frame() -> CameraFrame {
+        CameraFrame {
+            position: DVec3::new(0.5, 1.0, 4.0),
+            look_at: DVec3::new(0.0, 0.5, 0.0),
+            up: DVec3::Y,
+        }
+    }
+
+    fn panorama(profile: ProfileShape, reparam: Option<Reparam>) -> ProjectionSpec {
+        let shape = PanoramaShape::single(
+            OutlineShape::Circle.curve().unwrap(),
+            profile.curve().unwrap(),
+        )
+        .unwrap();
+        ProjectionSpec::Flexible(Box::new(FlexibleSpec {
+            source: VolumeSource::Panorama(PanoramaSpec {
+                shape: Arc::new(shape),
+                frame: frame(),
+                clip: None,
+            }),
+            reparam,
+        }))
+    }
+
+    /// What each kind answers: an inverse, the reason for none, a chart, the trilinear
+    /// structure.
+    #[test]
+    fn every_kind_reports_its_capabilities() {
+        let frame = frame();
+        let segment = || ProfileShape::Segment {
+            elevation: [-FRAC_PI_4, FRAC_PI_4],
+        };
+        let folded = ProfileShape::Points(
+            [[1.0, 0.0], [1.0, 2.0], [3.0, 1.0]]
+                .map(DVec2::from_array)
+                .to_vec(),
+        );
+        let twisted = Surface::Bilinear {
+            corners: [
+                DVec3::new(-1.0, -1.0, 0.0),
+                DVec3::new(1.0, -1.0, 0.5),
+                DVec3::new(1.0, 1.0, 0.0),
+                DVec3::new(-1.0, 1.0, 0.0),
+            ],
+        };
+        let surfaces = ProjectionSpec::Flexible(Box::new(FlexibleSpec {
+            source: VolumeSource::Surfaces {
+                near: twisted,
+                far: Surface::rectangle_centred(DVec3::Z * 2.0, DVec3::X, DVec3::Y),
+            },
+            reparam: None,
+        }));
+        let trilinear = ProjectionSpec::Trilinear(TrilinearMesh {
+            points: vec![DVec3::ZERO; 3],
+            normals: vec![DVec3::Z; 3],
+            screen: vec![DVec2::ZERO, DVec2::X, DVec2::Y],
+            triangles: vec![[0, 1, 2]],
+        });
+        let single = |spec: ProjectionSpec| (spec, Ok(true), false);
+        let cases: Vec<(ProjectionSpec, Result<bool, Option<&str>>, bool)> = vec![
+            single(ProjectionSpec::Perspective { frame, fov: 60.0 }),
+            single(ProjectionSpec::Orthographic { frame, width: 3.0 }),
+            single(ProjectionSpec::Fisheye { frame, fov: 180.0 }),
+            single(ProjectionSpec::Equirectangular {
+                frame,
+                h_fov: 360.0,
+                v_fov: 180.0,
+            }),
+            single(ProjectionSpec::Cylindrical {
+                frame,
+                h_fov: 360.0,
+                v_fov: 90.0,
+            }),
+            // The mesh folds: an inverse without a chart.
+            (trilinear, Ok(false), true),
+            // A panorama in the lookup's class, with a chart under the linear map only.
+            (panorama(segment(), None), Ok(true), false),
+            (panorama(segment(), Some(Reparam::Polar)), Ok(false), false),
+            // Outside the lookup's class: the reason; outside the analytic class: none.
+            (
+                panorama(folded, None),
+                Err(Some("profile does not rise strictly")),
+                false,
+            ),
+            (surfaces, Err(None), false),
+        ];
+        for (spec, inverse, trilinear) in cases {
+            let projection = spec.build(32, 16).unwrap();
+            let kind = projection.kind();
+            assert_eq!(kind, spec.kind());
+            match (projection.inverse(), inverse) {
+                (Ok(found), Ok(charted)) => {
+                    assert_eq!(found.charted().is_some(), charted, "{kind}");
+                }
+                (Err(none), Err(Some(reason))) => {
+                    let why = none.reason.unwrap();
+                    assert!(why.contains(reason), "{kind}: {why}");
+                }
+                (Err(none), Err(None)) => assert_eq!(none.reason, None, "{kind}"),
+                (found, expected) => panic!(
+                    "{kind}: inverse {:?}, expected {expected:?}",
+                    found.map(|_| ())
+                ),
+            }
+            assert_eq!(projection.trilinear().is_some(), trilinear, "{kind}");
+        }
+    }
+}
