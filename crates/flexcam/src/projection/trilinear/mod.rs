@@ -6,7 +6,7 @@
 //! tripoint(u, v) + t * trinorm(u, v), t >= 0, where tripoint and trinorm interpolate the
 //! p_k and n_k linearly (trinorm is never renormalised: its length is the depth scale).
 //! The inverse solves a cubic per projection triangle ([`point_projection`], with the cached
-//! N/K form of each triangle): [`Projection::project`] returns every visible image.
+//! N/K form of each triangle): [`AnalyticInverse::project`] returns every visible image.
 //!
 //! The map from screen position to `(u, v)` is affine (the thesis's screen-space
 //! interpolation) unless the projection has screen weights

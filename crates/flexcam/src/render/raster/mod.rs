@@ -2,8 +2,9 @@
 //! (seed 003, 7.3 and 9.4).
 //!
 //! Per frame:
-//! 1. every scene vertex is projected once through [`Projection::project_continuous`] (the
-//!    per-vertex cache shared by the triangles around it);
+//! 1. every scene vertex is projected once through the projection's continuous inverse
+//!    ([`crate::projection::ContinuousInverse`], looked up once per renderer; the per-vertex
+//!    cache shared by the triangles around it);
 //! 2. each triangle is clipped in 3D to the chart's half-spaces ([`clip`]), cut by the
 //!    uniform grid and refined adaptively ([`refine`]) until the straight polygon of each
 //!    piece's projected corners follows its curved image within the tolerance;
