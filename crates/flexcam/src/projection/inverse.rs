@@ -129,6 +129,10 @@ mod tests {
         }))
     }
 
+    /// A projection and what it answers: an inverse with a chart or without (`Ok`), or none
+    /// with the reason's text or without a reason (`Err`); whether it is a trilinear mesh.
+    type Case = (ProjectionSpec, Result<bool, Option<&'static str>>, bool);
+
     /// What each kind answers: an inverse, the reason for none, a chart, the trilinear
     /// structure.
     #[test]
@@ -164,7 +168,7 @@ mod tests {
             triangles: vec![[0, 1, 2]],
         });
         let single = |spec: ProjectionSpec| (spec, Ok(true), false);
-        let cases: Vec<(ProjectionSpec, Result<bool, Option<&str>>, bool)> = vec![
+        let cases: Vec<Case> = vec![
             single(ProjectionSpec::Perspective { frame, fov: 60.0 }),
             single(ProjectionSpec::Orthographic { frame, width: 3.0 }),
             single(ProjectionSpec::Fisheye { frame, fov: 180.0 }),
