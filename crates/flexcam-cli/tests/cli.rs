@@ -812,7 +812,7 @@ fn reproject_errors_are_one_line() {
     assert!(output.contains("unsupported output extension"), "{output}");
 }
 
-/// `bench trilinear --quick` with one timed render per cell prints both of seed 000's tables
+/// `bench trilinear --quick` with one timed render per cell prints both of Vallance 2005's tables
 /// and the cube's kept-frame table with a row per cell of the quick subset; an out-of-range
 /// `--repeat` is one error line.
 #[test]
@@ -839,6 +839,26 @@ fn bench_trilinear_quick_prints_both_tables() {
     assert_eq!(rows(kept), ["2", "18", "50"], "{text}");
     let e = expect_failure(&dir, &["bench", "trilinear", "--quick", "--repeat", "0"]);
     assert!(e.contains("--repeat"), "{e}");
+}
+
+/// `bench flexible --part table --rows 1` prints Table 7.1's four tables with the one row
+/// asked for, times named as medians, and with `--hash` one frame hash per column.
+#[test]
+fn bench_flexible_table_prints_median_times_and_hashes() {
+    let dir = TempDir::new().unwrap();
+    let args = [
+        "bench", "flexible", "--part", "table", "--rows", "1", "--repeat", "1", "--hash",
+    ];
+    let text = String::from_utf8(run_ok(&dir, &args).stdout).unwrap();
+    assert!(text.contains("median of 1 after one warm-up"), "{text}");
+    assert!(text.contains("flexcam (median seconds)"), "{text}");
+    let kia_rows: Vec<&str> = text.lines().filter(|l| l.starts_with("Kia ")).collect();
+    // Thesis, flexcam, speed-up, CPU, hashes: each a model, then six columns.
+    assert_eq!(kia_rows.len(), 5, "{text}");
+    let hashes: Vec<&str> = kia_rows[4].split_whitespace().skip(1).collect();
+    assert_eq!(hashes.len(), 6, "{text}");
+    assert!(hashes.iter().all(|h| u64::from_str_radix(h, 16).is_ok()));
+    assert!(!text.contains("panorama"), "{text}");
 }
 
 /// `--perspective-rect` applies the local perspective edit to a shape-defined panorama (here

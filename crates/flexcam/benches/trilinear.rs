@@ -1,7 +1,7 @@
 //! Trilinear rasterisation (`--method trilinear`) against the ray caster of the same
 //! projection: the cube-floor scene (686 triangles) through the 18-projection fan grid
-//! (`render::trilinear::workloads::fan_grid(3)`) at 800 x 800, flat shading: the speed target
-//! of issue 3 (at least 10x the ray caster, under 33 ms). Both renderers are prepared once
+//! (`render::trilinear::workloads::fan_grid(3)`) at 800 x 800, flat shading: the trilinear
+//! renderer's speed target (at least 10x the ray caster, under 33 ms). Both renderers are prepared once
 //! (BVH, scene geometry); each iteration is one frame. `trilinear_frame` uses the default
 //! adaptive curves with scene-space clipping, `trilinear_unclipped` the thesis's cheaper
 //! screen-space clipping only, `trilinear_kept_unclipped` the same into a frame kept from

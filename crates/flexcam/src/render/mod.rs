@@ -28,7 +28,7 @@ pub struct RenderOptions<'a> {
     /// The renderer (`--method`).
     pub method: Method,
     /// Composite the scene's trilinear reflectors (scene key `trilinear_reflector`) into the
-    /// main view, each reflection rendered by `method` ([`composite`]); `false` renders them
+    /// main view, each reflection rendered by `method` (module `composite`); `false` renders them
     /// as the method's own mirrors and glass (the reference of a comparison).
     pub composite_reflectors: bool,
     pub shading: Shading,
@@ -129,7 +129,7 @@ impl Frame {
 pub struct Rendered {
     pub frame: Frame,
     /// The method's counters (rays cast, build times, ...), for `--stats`; with reflectors
-    /// composited, also the compositing's (see [`composite::render`]).
+    /// composited, also the compositing's (`reflector_pixels` and the like).
     pub counters: Stats,
 }
 
@@ -169,7 +169,8 @@ pub enum Counter {
 pub type Stats = BTreeMap<&'static str, Counter>;
 pub(crate) mod bvh;
 pub mod compare;
-pub mod composite;
+/// Reflector compositing, reached only through [`render`] (`RenderOptions::composite_reflectors`).
+mod composite;
 mod huge_pages;
 mod method;
 pub mod prepared;

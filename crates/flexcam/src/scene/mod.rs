@@ -62,7 +62,7 @@ pub struct Scene {
     pub base_dir: Option<PathBuf>,
     /// The mirror and glass objects whose reflection or refraction is rendered through a
     /// trilinear surface and composited into the main image (scene-file key
-    /// `trilinear_reflector`; see [`crate::render::composite`]). Empty: plain rendering.
+    /// `trilinear_reflector`; composited by [`crate::render::render`]). Empty: plain rendering.
     pub trilinear_reflectors: Vec<TrilinearReflector>,
     /// Every file the scene was read from (the scene file, models and the files they name,
     /// textures, surfaces), so that a command can refuse to write over any of them. Empty
@@ -88,7 +88,7 @@ pub struct TrilinearReflector {
     /// `trilinear_screen_map`).
     pub screen_map: SurfaceScreenMap,
     /// The surface's refinement tolerance in main-image pixels, 0 for none (scene-file key
-    /// `trilinear_refine_px`; see [`crate::render::composite::refine`]).
+    /// `trilinear_refine_px`; used by the reflector compositing of [`crate::render::render`]).
     pub refine_px: f64,
 }
 

@@ -1,4 +1,4 @@
-//! `flexcam bench flexible`: Table 7.1 of seed 003 (Brosz, The Flexible Projection Framework)
+//! `flexcam bench flexible`: Table 7.1 of Brosz 2011 (The Flexible Projection Framework)
 //! with flexcam's BVH-accelerated ray caster.
 //!
 //! The thesis timed one frame at 800 x 800 through a perspective-to-perspective volume with
@@ -9,7 +9,7 @@
 //! The volume is three rectangles (near, bent middle, far) placed around the model's bounding
 //! box; the polylines are the quadratic sampled at equal steps in t.
 //!
-//! The second table is item 9's panorama throughput: `builtin:teapot-dense` (123,554
+//! The second table is the panorama throughput of `--method raster`: `builtin:teapot-dense` (123,554
 //! triangles) as a 1280 x 720 equirectangular panorama from the scene's camera, by
 //! `--method raster` (the first frame of a new renderer; later frames of the same one,
 //! whose pixel projectors and buffers are then ready, with flat and with lit shading) and
@@ -26,6 +26,8 @@ use flexcam::render::{raycast, PreparedScene};
 use flexcam::render::{Counter, Frame, RenderOptions, Shading};
 use flexcam::scene::Scene;
 use flexcam::{Error, Result};
+
+use super::timing::{measure, Timing};
 
 /// Table 7.1's rows: model, faces, then seconds for quadratic and 2, 3, 4, 5, 6 segments.
 const THESIS: [(&str, u32, [f64; 6]); 6] = [
@@ -60,7 +62,7 @@ const THESIS: [(&str, u32, [f64; 6]); 6] = [
 /// Arguments of `flexcam bench flexible`.
 #[derive(Args, Debug)]
 pub struct FlexibleArgs {
-    /// Renders per cell; the fastest is reported.
+    /// Timed renders per cell, after one warm-up render; the median is reported.
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100))]
     repeat: u32,
     /// Only the first N rows of the table (smallest models first).
@@ -106,8 +108,8 @@ fn table(args: &FlexibleArgs) -> Result<()> {
     let rows = args.rows.map_or(THESIS.len(), |r| r as usize);
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
-        "Table 7.1 (seed 003): {TABLE_SIZE}x{TABLE_SIZE}, lit shading (headlight), one frame per cell, best \
-         of {}, {threads} threads; models: the Utah teapot at the tessellation nearest each \
+        "Table 7.1 (Brosz 2011): {TABLE_SIZE}x{TABLE_SIZE}, lit shading (headlight), one frame per cell, median \
+         of {} after one warm-up, {threads} threads; models: the Utah teapot at the tessellation nearest each \
          face count",
         args.repeat
     );
@@ -121,11 +123,11 @@ fn table(args: &FlexibleArgs) -> Result<()> {
     print_table("thesis (seconds, no acceleration structure)", rows, |r| {
         THESIS[r].2.map(|t| format!("{t:.2}"))
     });
-    print_table("flexcam (seconds)", rows, |r| {
-        ours[r].3.map(|t| format!("{:.4}", t.wall))
+    print_table("flexcam (median seconds)", rows, |r| {
+        ours[r].3.map(|t| format!("{:.4}", t.median))
     });
     print_table("speed-up (thesis / flexcam)", rows, |r| {
-        std::array::from_fn(|c| format!("{:.0}x", THESIS[r].2[c] / ours[r].3[c].wall))
+        std::array::from_fn(|c| format!("{:.0}x", THESIS[r].2[c] / ours[r].3[c].median))
     });
     print_table(
         "flexcam CPU seconds per frame, all threads (independent of other load)",
@@ -146,9 +148,9 @@ fn table(args: &FlexibleArgs) -> Result<()> {
     Ok(())
 }
 
-/// One row of Table 7.1: the best time of one lit frame of `scene` through each column's
-/// projectors, the BVH built once for the row, and the [`frame_hash`] of each column's last
-/// frame.
+/// One row of Table 7.1: the [`Timing`] of one lit frame of `scene` through each column's
+/// projectors, the BVH built once for the row, and the [`frame_hash`] of each column's
+/// median frame.
 fn row_times(scene: &Scene, repeat: u32) -> Result<([Timing; 6], [u64; 6])> {
     let caster = PreparedScene::new(scene);
     let options = RenderOptions {
@@ -159,12 +161,10 @@ fn row_times(scene: &Scene, repeat: u32) -> Result<([Timing; 6], [u64; 6])> {
     let mut hashes = [0; 6];
     for ((time, hash), column) in times.iter_mut().zip(&mut hashes).zip(COLUMNS) {
         let projection = table_volume(scene, column, TABLE_SIZE)?;
-        let mut last = None;
-        *time = measure(repeat, || {
-            last = Some(raycast::render(&caster, &projection, &options).0);
-            Ok(())
+        let (timing, frame) = measure(repeat, || {
+            Ok(raycast::render(&caster, &projection, &options).0)
         })?;
-        *hash = last.as_ref().map_or(0, frame_hash);
+        (*time, *hash) = (timing, frame_hash(&frame));
     }
     Ok((times, hashes))
 }
@@ -189,8 +189,8 @@ fn frame_hash(frame: &Frame) -> u64 {
 
 /// The panorama throughput table (the workload of
 /// `flexcam::render::raster::workloads`): raster (first frame of a new renderer,
-/// later frames of one renderer into one kept frame, flat and lit) and ray caster, best of
-/// `repeat` frames each.
+/// later frames of one renderer into one kept frame, flat and lit) and ray caster, the
+/// median of `repeat` frames each after one warm-up.
 fn panorama(repeat: u32) -> Result<()> {
     let PanoramaWorkload { scene, projection } = teapot_dense_panorama()?;
     let projection: &dyn Projection = projection.as_ref();
@@ -204,44 +204,36 @@ fn panorama(repeat: u32) -> Result<()> {
     let prepared = PreparedScene::new(&scene);
     let build = start.elapsed().as_secs_f64();
     // A new renderer per frame: the pixel projectors are computed during the frame.
-    let first = measure(repeat, || {
+    let (first, _) = measure(repeat, || {
         InverseRaster::new(&prepared, projection, &flat)?.render();
         Ok(())
     })?;
-    // Later frames, and the mean wall-clock milliseconds of their two stages (building the
-    // pieces; filling and shading them) from the renderer's own counters.
+    // Later frames, and the wall-clock milliseconds of the two stages (building the pieces;
+    // filling and shading them) of the median frame, from the renderer's own counters.
     let later = |options: &RenderOptions| {
         let raster = InverseRaster::new(&prepared, projection, options)?;
         let mut frame = raster.render().0;
-        let mut stages = [0.0; 2];
-        let timing = measure(repeat, || {
-            let stats = raster.render_into(&mut frame);
-            for (sum, name) in stages
-                .iter_mut()
-                .zip(["raster_pieces_ms", "raster_fill_ms"])
-            {
-                if let Some(Counter::Value(ms)) = stats.get(name) {
-                    *sum += ms / f64::from(repeat.max(1));
-                }
-            }
-            Ok(())
-        })?;
+        let (timing, stats) = measure(repeat, || Ok(raster.render_into(&mut frame)))?;
+        let stages = ["raster_pieces_ms", "raster_fill_ms"].map(|name| match stats.get(name) {
+            Some(Counter::Value(ms)) => *ms,
+            _ => f64::NAN,
+        });
         Ok::<_, Error>((timing, stages))
     };
     let ((later_flat, stages), (later_lit, _)) = (later(&flat)?, later(&options(Shading::Lit))?);
-    let cast = measure(repeat, || {
+    let (cast, _) = measure(repeat, || {
         raycast::render(&prepared, projection, &flat);
         Ok(())
     })?;
     let (width, height) = PANORAMA_SIZE;
     println!(
         "\npanorama: teapot-dense, {} triangles, {width}x{height} equirectangular (360 x 180), \
-         best of {repeat}",
+         median of {repeat} after one warm-up",
         scene.triangle_count()
     );
     println!(
         "{:<40}{:>10}{:>8}{:>14}",
-        "method", "ms/frame", "fps", "CPU ms/frame"
+        "method", "median ms", "fps", "CPU ms/frame"
     );
     for (name, t) in [
         ("raster, first frame, flat", first),
@@ -251,14 +243,14 @@ fn panorama(repeat: u32) -> Result<()> {
     ] {
         println!(
             "{name:<40}{:>10.1}{:>8.1}{:>14}",
-            1e3 * t.wall,
-            1.0 / t.wall,
+            t.median_ms(),
+            1.0 / t.median,
             t.cpu_text(1e3, 1)
         );
     }
     println!("{:<40}{:>10.1}", "raycast, BVH build (once)", 1e3 * build);
     println!(
-        "later flat frame, mean wall ms by stage: pieces {:.1}, fill and shade {:.1}",
+        "median later flat frame, wall ms by stage: pieces {:.1}, fill and shade {:.1}",
         stages[0], stages[1]
     );
     Ok(())
@@ -278,53 +270,6 @@ fn print_table(title: &str, rows: usize, cell: impl Fn(usize) -> [String; 6]) {
             c[0], c[1], c[2], c[3], c[4], c[5]
         );
     }
-}
-
-/// What [`measure`] found: the fastest wall-clock time of one run, and the mean CPU time of
-/// one run over all threads (`None` where the system does not report it), in seconds.
-#[derive(Debug, Clone, Copy, Default)]
-struct Timing {
-    wall: f64,
-    cpu: Option<f64>,
-}
-
-impl Timing {
-    /// The CPU time times `scale` with `decimals` decimals, or "-" when unknown.
-    fn cpu_text(&self, scale: f64, decimals: usize) -> String {
-        self.cpu.map_or_else(
-            || "-".to_string(),
-            |c| format!("{:.*}", decimals, c * scale),
-        )
-    }
-}
-
-/// Runs `f` `repeat` times: the fastest wall-clock time and the mean CPU time per run. On a
-/// machine shared with other work the wall-clock time grows with the load; the CPU time
-/// does not, and over the two cores of an idle machine a frame would take about half of it.
-fn measure(repeat: u32, mut f: impl FnMut() -> Result<()>) -> Result<Timing> {
-    let cpu_start = process_cpu_seconds();
-    let mut wall = f64::INFINITY;
-    for _ in 0..repeat {
-        let start = Instant::now();
-        f()?;
-        wall = wall.min(start.elapsed().as_secs_f64());
-    }
-    let cpu = match (cpu_start, process_cpu_seconds()) {
-        (Some(a), Some(b)) => Some((b - a) / f64::from(repeat)),
-        _ => None,
-    };
-    Ok(Timing { wall, cpu })
-}
-
-/// The user and system CPU time of this process so far, all threads, from `/proc/self/stat`
-/// (fields 14 and 15, in clock ticks of 1/100 s: Linux's USER_HZ); `None` elsewhere.
-fn process_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // The command name (field 2) is parenthesised and may hold spaces: count from after it.
-    let rest = &stat[stat.rfind(')')? + 1..];
-    let fields: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| fields.get(i)?.parse::<u64>().ok();
-    Some((ticks(11)? + ticks(12)?) as f64 / 100.0)
 }
 
 #[cfg(test)]

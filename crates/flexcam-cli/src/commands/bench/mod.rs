@@ -1,6 +1,7 @@
 //! `flexcam bench`: the source documents' timing tables, rerun with flexcam's renderers.
 
 pub mod flexible;
+mod timing;
 pub mod trilinear;
 
 use clap::Subcommand;
@@ -9,10 +10,10 @@ use flexcam::Result;
 /// Which table to measure.
 #[derive(Subcommand, Debug)]
 pub enum BenchCommand {
-    /// Table 7.1 of seed 003: quadratic vs 2 to 6 segment projectors at 800 x 800, and the
+    /// Table 7.1 of Brosz 2011: quadratic vs 2 to 6 segment projectors at 800 x 800, and the
     /// throughput of --method raster on a 1280 x 720 panorama of a 123,554-triangle scene.
     Flexible(flexible::FlexibleArgs),
-    /// Chapter 8 and appendix D of seed 000: ray casting vs trilinear rasterisation of random
+    /// Chapter 8 and appendix D of Vallance 2005: ray casting vs trilinear rasterisation of random
     /// scenes and of the cube-floor scene through 2 to 50 projection triangles.
     Trilinear(trilinear::TrilinearArgs),
 }

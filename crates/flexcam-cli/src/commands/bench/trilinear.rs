@@ -1,4 +1,4 @@
-//! `flexcam bench trilinear`: the timing study of seed 000 (Vallance, Trilinear Projection,
+//! `flexcam bench trilinear`: the timing study of Vallance 2005 (Trilinear Projection,
 //! chapter 8 and appendix D) with flexcam's two renderers of the same trilinear projection:
 //! the BVH ray caster (`--method raycast`) and the rasteriser (`--method trilinear`, adaptive
 //! curves), with and without scene-space clipping.
@@ -8,7 +8,7 @@
 //!   1 to 640^2 pixels (`render::trilinear::workloads`).
 //! - Table 8.1, figure 7.4: the cube-floor scene (686 triangles) through 2, 8, 18, 32 and 50
 //!   projection triangles (the fan grid of the accuracy tests) at 800 x 800, with the
-//!   accuracy against the ray caster (item 9 of issue 3) and the trilinear stage times.
+//!   accuracy against the ray caster (id agreement and relative RGB error) and the trilinear stage times.
 //!
 //! Flat shading, as in the thesis ("no lighting or texture mapping"). Each cell is one
 //! warm-up render, then the median of `--repeat` timed renders; renderers (BVH, scene
@@ -24,8 +24,6 @@
 //! alike (`raycast::render_into`, `TrilinearRenderer::render_into` without and with
 //! clipping), and compares them like for like.
 
-use std::time::Instant;
-
 use clap::Args;
 use flexcam::projection::{Trilinear, TrilinearMesh};
 use flexcam::render::compare::compare;
@@ -35,6 +33,8 @@ use flexcam::render::{raycast, PreparedScene};
 use flexcam::render::{Counter, Frame, RenderOptions, Shading};
 use flexcam::scene;
 use flexcam::Result;
+
+use super::timing::measure;
 
 /// Arguments of `flexcam bench trilinear`.
 #[derive(Args, Debug)]
@@ -106,7 +106,7 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
         (&SIDES, &SCENE_TRIANGLES, &CELLS)
     };
     println!(
-        "seed 000 chapter 8 / appendix D: flat shading, {threads} threads, median of {} after \
+        "Vallance 2005 chapter 8 / appendix D: flat shading, {threads} threads, median of {} after \
          one warm-up; raycast = BVH ray caster, trilinear = adaptive curves without / with \
          scene-space clipping (clip); times in ms",
         args.repeat
@@ -288,11 +288,11 @@ impl<'a> Renderers<'a> {
             shading: Shading::Flat,
             ..RenderOptions::default()
         };
-        let (raycast, raycast_cpu, reference) = median(repeat, || {
+        let (raycast, reference) = measure(repeat, || {
             Ok(raycast::render(self.caster, &projection, &options).0)
         })?;
         let trilinear = |curves: CurveOptions| {
-            median(repeat, || {
+            measure(repeat, || {
                 self.trilinear.render(&projection, &options, curves)
             })
         };
@@ -300,20 +300,20 @@ impl<'a> Renderers<'a> {
             scene_clipping: false,
             ..CurveOptions::ADAPTIVE
         };
-        let (plain, plain_cpu, (plain_frame, _)) = trilinear(unclipped)?;
-        let (clipped, clipped_cpu, (frame, stats)) = trilinear(CurveOptions::ADAPTIVE)?;
+        let (plain, (plain_frame, _)) = trilinear(unclipped)?;
+        let (clipped, (frame, stats)) = trilinear(CurveOptions::ADAPTIVE)?;
         // Each kept frame starts at the wrong size, so its first (warm-up) render allocates
         // it, as a program's first frame would.
         let into_kept = |curves: CurveOptions| {
             let mut kept = Frame::new(1, 1, glam::Vec3::ZERO);
-            median(repeat, || {
+            measure(repeat, || {
                 self.trilinear
                     .render_into(&mut kept, &projection, &options, curves)
             })
         };
         let kept = if kept {
             let mut frame = Frame::new(1, 1, glam::Vec3::ZERO);
-            let (raycast, raycast_cpu, _) = median(repeat, || {
+            let (raycast, _) = measure(repeat, || {
                 Ok(raycast::render_into(
                     self.caster,
                     &mut frame,
@@ -321,13 +321,13 @@ impl<'a> Renderers<'a> {
                     &options,
                 ))
             })?;
-            let (trilinear, kept_cpu, _) = into_kept(unclipped)?;
-            let (clipped, clipped_cpu, _) = into_kept(CurveOptions::ADAPTIVE)?;
+            let (trilinear, _) = into_kept(unclipped)?;
+            let (clipped, _) = into_kept(CurveOptions::ADAPTIVE)?;
             Some(Kept {
-                raycast,
-                trilinear,
-                clipped,
-                cpu: [raycast_cpu, kept_cpu, clipped_cpu],
+                raycast: raycast.median_ms(),
+                trilinear: trilinear.median_ms(),
+                clipped: clipped.median_ms(),
+                cpu: [raycast, trilinear, clipped].map(|t| t.cpu_ms()),
             })
         } else {
             None
@@ -341,46 +341,14 @@ impl<'a> Renderers<'a> {
             _ => f64::NAN,
         };
         let timing = Timing {
-            raycast,
-            trilinear: plain,
-            clipped,
+            raycast: raycast.median_ms(),
+            trilinear: plain.median_ms(),
+            clipped: clipped.median_ms(),
             stages: ["project_ms", "raster_ms", "shade_ms"].map(stage),
-            cpu: [raycast_cpu, plain_cpu, clipped_cpu],
+            cpu: [raycast, plain, clipped].map(|t| t.cpu_ms()),
             kept,
             accuracy: [plain_accuracy?, clipped_accuracy?],
         };
         Ok(timing)
     }
-}
-
-/// One warm-up call of `render`, then the median time (ms) of `repeat` timed calls, their
-/// mean CPU time (ms, NaN where unknown) and the output of the median call.
-fn median<T>(repeat: u32, mut render: impl FnMut() -> Result<T>) -> Result<(f64, f64, T)> {
-    render()?;
-    let mut runs = Vec::with_capacity(repeat as usize);
-    let cpu_start = cpu_ms();
-    for _ in 0..repeat {
-        let start = Instant::now();
-        let out = render()?;
-        runs.push((start.elapsed().as_secs_f64() * 1e3, out));
-    }
-    let cpu = match (cpu_start, cpu_ms()) {
-        (Some(start), Some(end)) => (end - start) / f64::from(repeat),
-        _ => f64::NAN,
-    };
-    runs.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let middle = runs.len() / 2;
-    let (wall, out) = runs.swap_remove(middle);
-    Ok((wall, cpu, out))
-}
-
-/// The CPU time (ms) this process has used so far, all threads, user and system, from
-/// `/proc/self/stat` (its 14th and 15th fields, in ticks of 10 ms: Linux's fixed `USER_HZ`
-/// of 100); `None` where that file is missing or unreadable.
-fn cpu_ms() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // After the command name, which is in parentheses and may hold spaces: field 3 on.
-    let fields: Vec<&str> = stat.rsplit_once(')')?.1.split_whitespace().collect();
-    let ticks = |field: usize| fields.get(field - 3)?.parse::<f64>().ok();
-    Some((ticks(14)? + ticks(15)?) * 10.0)
 }

@@ -46,6 +46,8 @@ mod seam;
 mod subdivision;
 #[cfg(test)]
 mod tests;
+/// Bench scenes, for `flexcam bench` and the criterion benches only.
+#[cfg(any(test, feature = "workloads"))]
 pub mod workloads;
 
 use std::ops::Range;

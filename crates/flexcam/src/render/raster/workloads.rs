@@ -1,4 +1,4 @@
-//! The panorama throughput workload of issue 4 item 9, shared by `flexcam bench flexible
+//! The panorama throughput workload (frames per second of `--method raster` on a large scene), shared by `flexcam bench flexible
 //! --part panorama` and the criterion bench `raster`, so that both time the same work:
 //! `builtin:teapot-dense` (123,554 triangles) as a 1280 x 720 equirectangular (360 x 180)
 //! panorama from the position of the scene's own camera, looking where it looks.

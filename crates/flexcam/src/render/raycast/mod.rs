@@ -9,6 +9,8 @@ pub(in crate::render) mod pieces;
 pub(crate) mod sampling;
 mod shade;
 mod tiles;
+/// Bench scenes, for `flexcam bench` and the criterion benches only.
+#[cfg(any(test, feature = "workloads"))]
 pub mod workloads;
 
 use glam::DVec3;

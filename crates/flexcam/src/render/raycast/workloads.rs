@@ -1,4 +1,4 @@
-//! The Table 7.1 workload of seed 003 (issue 4 item 9), shared by `flexcam bench flexible
+//! The workload of Brosz 2011's Table 7.1 (frame time against the projectors' segment count), shared by `flexcam bench flexible
 //! --part table` and the ray caster's tests of its culls, so that both use the same layout:
 //! the Utah teapot tessellated to a given face count, seen through a perspective-to-
 //! perspective volume of three rectangles (a small near square in front, a middle square

@@ -37,6 +37,8 @@ mod shade;
 mod tests;
 mod view_plane;
 mod volume_bounds;
+/// Bench scenes, for `flexcam bench` and the criterion benches only.
+#[cfg(any(test, feature = "workloads"))]
 pub mod workloads;
 
 use std::time::Instant;

@@ -1,4 +1,4 @@
-//! The scenes and projection meshes of the timing study of seed 000 (chapter 8, appendix D),
+//! The scenes and projection meshes of the timing study of Vallance 2005 (chapter 8, appendix D),
 //! shared by `flexcam bench trilinear` and the criterion benches, so that both time the same
 //! work.
 //!
