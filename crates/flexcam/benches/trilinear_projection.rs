@@ -60,7 +60,7 @@ fn projection_stage(c: &mut Criterion) {
         .build(width, height)
         .unwrap_or_else(|e| panic!("{path}: {e}"));
     let surface = built
-        .as_trilinear()
+        .trilinear()
         .unwrap_or_else(|| panic!("{path}: not a trilinear projection"));
     bench_stage(
         c,

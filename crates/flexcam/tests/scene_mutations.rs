@@ -38,10 +38,10 @@ fn exercise(text: &str, path: &Path) -> bool {
         ..RenderOptions::default()
     };
     let mut methods = vec![Method::Raycast];
-    if projection.has_inverse() {
+    if projection.inverse().is_ok() {
         methods.push(Method::Raster);
     }
-    if projection.as_trilinear().is_some() {
+    if projection.trilinear().is_some() {
         methods.push(Method::Trilinear);
     }
     let prepared = PreparedScene::new(&scene);

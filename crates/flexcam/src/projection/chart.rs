@@ -1,10 +1,10 @@
 //! What rasterisation by the analytic inverse needs from a projection beyond
-//! [`super::Projection::project`]: where the image of a scene point is a continuous function
-//! of the point, so that a triangle can be drawn from the images of its corners (and of its
-//! edge midpoints, when it is subdivided).
+//! [`super::AnalyticInverse::project`]: where the image of a scene point is a continuous
+//! function of the point, so that a triangle can be drawn from the images of its corners (and
+//! of its edge midpoints, when it is subdivided).
 //!
-//! [`super::Projection::project_continuous`] gives the image on the continuous branch, also
-//! outside the image rectangle and outside the projection's visible domain (a fisheye point
+//! [`super::ContinuousInverse::project_continuous`] gives the image on the continuous branch,
+//! also outside the image rectangle and outside the projection's visible domain (a fisheye point
 //! beyond its field of view, a flexible point with t or (u, v) outside [0, 1]), so that a
 //! triangle reaching out of the view is cut by the screen clip instead of being lost. The
 //! [`InverseChart`] says where that branch stops being continuous:

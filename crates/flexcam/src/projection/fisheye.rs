@@ -7,7 +7,10 @@ use super::camera_basis::CameraBasis;
 use super::chart::{InverseChart, Pole};
 use super::image_coords::Resolution;
 use super::params::{angle_radians, UpTo};
-use super::{CameraFrame, ImagePoint, Projection};
+use super::{
+    AnalyticInverse, BranchImage, CameraFrame, ImagePoint, NoInverse, Projection, SingleImage,
+    Trilinear,
+};
 use crate::error::Result;
 use crate::geometry::Ray;
 
@@ -67,39 +70,39 @@ impl Projection for Fisheye {
         Some(Ray::new(self.basis.origin, self.basis.to_world(local)))
     }
 
-    fn has_inverse(&self) -> bool {
-        true
+    fn inverse(&self) -> std::result::Result<&dyn AnalyticInverse, NoInverse> {
+        Ok(self)
     }
 
-    /// Appends the one image of `point`, `t` its distance from the eye. Degenerate cases
-    /// append nothing: the eye itself; a point more than fov/2 off the axis (outside the
-    /// image circle, where no ray exists); the point straight behind the eye when fov = 360
-    /// (the whole image circle sees it: no single position).
-    fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
-        if let Some((image, off_axis)) = self.image(point) {
-            if off_axis <= self.half_fov {
-                out.push(image);
-            }
-        }
+    fn trilinear(&self) -> Option<&Trilinear> {
+        None
+    }
+}
+
+/// The one image of a point, `t` its distance from the eye; the branch has the radius
+/// unlimited (points more than fov/2 off the axis land outside the image circle, on the same
+/// radial line, where the projection does not see). Degenerate: the eye and the axis behind
+/// it have no image (at fov = 360 the whole image circle sees the point straight behind).
+impl SingleImage for Fisheye {
+    fn branch_image(&self, point: DVec3) -> Option<BranchImage> {
+        let (image, off_axis) = self.image(point)?;
+        Some(BranchImage {
+            image,
+            seen: off_axis <= self.half_fov,
+        })
     }
 
     /// The axis behind the eye is a pole (it maps to the whole circle of radius
     /// pi / (fov/2) image-circle radii); no clip, no wrap.
-    fn inverse_chart(&self) -> Option<InverseChart> {
-        Some(InverseChart {
+    fn chart(&self) -> InverseChart {
+        InverseChart {
             poles: vec![Pole {
                 origin: self.basis.origin,
                 direction: -self.basis.forward,
                 clearance: std::f64::consts::PI - self.widest_pixel_angle(),
             }],
             ..InverseChart::default()
-        })
-    }
-
-    /// The image of [`Projection::project`] without the field-of-view limit: points more
-    /// than fov/2 off the axis land outside the image circle, on the same radial line.
-    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
-        self.image(point).map(|(image, _)| image)
+        }
     }
 }
 

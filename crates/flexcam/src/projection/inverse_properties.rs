@@ -108,7 +108,7 @@ proptest! {
     ) {
         let projection = spec.build(size.0, size.1).unwrap();
         let mut images = Vec::new();
-        projection.project(point, &mut images);
+        projection.inverse().unwrap().project(point, &mut images);
         if must_be_imaged(&spec, point) {
             prop_assert!(!images.is_empty(), "{} lost {point}", spec.kind());
         }
@@ -145,7 +145,7 @@ proptest! {
         prop_assume!(t > 0.0 || matches!(spec, ProjectionSpec::Orthographic { .. }));
         let point = ray.at(t);
         let mut images = Vec::new();
-        projection.project(point, &mut images);
+        projection.inverse().unwrap().project(point, &mut images);
         let back = images.iter().find(|image| {
             (image.pixel - pixel).length() <= 1e-9 * (1.0 + image_size.max_element())
         });

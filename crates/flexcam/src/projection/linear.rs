@@ -10,7 +10,10 @@ use super::camera_basis::CameraBasis;
 use super::chart::{HalfSpace, InverseChart, EYE_CLEARANCE};
 use super::image_coords::Resolution;
 use super::params::{angle_radians, positive_length, UpTo};
-use super::{CameraFrame, ImagePoint, Projection};
+use super::{
+    AnalyticInverse, BranchImage, CameraFrame, ImagePoint, NoInverse, Projection, SingleImage,
+    Trilinear,
+};
 use crate::error::Result;
 use crate::geometry::Ray;
 
@@ -57,37 +60,39 @@ impl Projection for Perspective {
         Some(Ray::new(self.basis.origin, direction))
     }
 
-    fn has_inverse(&self) -> bool {
-        true
+    fn inverse(&self) -> std::result::Result<&dyn AnalyticInverse, NoInverse> {
+        Ok(self)
     }
 
-    /// Appends the one image of `point`, `t` its distance from the eye. Degenerate: a point
-    /// on or behind the plane through the eye perpendicular to the view direction (the eye
-    /// itself included) has no image and appends nothing.
-    fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
-        out.extend(self.project_continuous(point));
+    fn trilinear(&self) -> Option<&Trilinear> {
+        None
     }
+}
 
-    /// Triangles are clipped [`EYE_CLEARANCE`] in front of the eye plane.
-    fn inverse_chart(&self) -> Option<InverseChart> {
-        Some(InverseChart {
-            clip: vec![in_front(&self.basis, EYE_CLEARANCE)],
-            ..InverseChart::default()
-        })
-    }
-
-    /// The image [`Projection::project`] appends, `None` where it appends nothing.
-    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
+/// The one image of a point, `t` its distance from the eye. Degenerate: a point on or behind
+/// the plane through the eye perpendicular to the view direction (the eye itself included)
+/// has no image.
+impl SingleImage for Perspective {
+    fn branch_image(&self, point: DVec3) -> Option<BranchImage> {
         let offset = point - self.basis.origin;
         let local = self.basis.to_local(offset);
         if local.z <= 0.0 {
             return None;
         }
         let centred = DVec2::new(local.x, local.y) / (local.z * self.pixel_size);
-        Some(ImagePoint {
+        let image = ImagePoint {
             pixel: self.resolution.pixel(centred),
             t: offset.length(),
-        })
+        };
+        Some(BranchImage { image, seen: true })
+    }
+
+    /// Triangles are clipped [`EYE_CLEARANCE`] in front of the eye plane.
+    fn chart(&self) -> InverseChart {
+        InverseChart {
+            clip: vec![in_front(&self.basis, EYE_CLEARANCE)],
+            ..InverseChart::default()
+        }
     }
 }
 
@@ -149,33 +154,35 @@ impl Projection for Orthographic {
         Some(Ray::new(origin, self.basis.forward))
     }
 
-    fn has_inverse(&self) -> bool {
-        true
+    fn inverse(&self) -> std::result::Result<&dyn AnalyticInverse, NoInverse> {
+        Ok(self)
     }
 
-    /// Appends the one image of `point`, `t` its distance from the view plane. Degenerate: a
-    /// point behind the view plane (t < 0) is on no ray (rays start at t = 0) and appends
-    /// nothing; a point on the plane has t = 0.
-    fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
-        out.extend(
-            self.project_continuous(point)
-                .filter(|image| image.t >= 0.0),
-        );
+    fn trilinear(&self) -> Option<&Trilinear> {
+        None
+    }
+}
+
+/// The one image of a point, `t` its distance from the view plane; the branch extends behind
+/// the plane (negative `t`), where the projection does not see (rays start at `t = 0`). A
+/// point on the plane has `t = 0`.
+impl SingleImage for Orthographic {
+    fn branch_image(&self, point: DVec3) -> Option<BranchImage> {
+        let local = self.basis.to_local(point - self.basis.origin);
+        let centred = DVec2::new(local.x, local.y) / self.pixel_size;
+        let image = ImagePoint {
+            pixel: self.resolution.pixel(centred),
+            t: local.z,
+        };
+        Some(BranchImage {
+            image,
+            seen: image.t >= 0.0,
+        })
     }
 
     /// The map is linear everywhere: no clip, no wrap, no pole.
-    fn inverse_chart(&self) -> Option<InverseChart> {
-        Some(InverseChart::default())
-    }
-
-    /// The image of `point` extended behind the view plane (negative `t`).
-    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
-        let local = self.basis.to_local(point - self.basis.origin);
-        let centred = DVec2::new(local.x, local.y) / self.pixel_size;
-        Some(ImagePoint {
-            pixel: self.resolution.pixel(centred),
-            t: local.z,
-        })
+    fn chart(&self) -> InverseChart {
+        InverseChart::default()
     }
 }
 

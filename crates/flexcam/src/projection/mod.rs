@@ -1,7 +1,7 @@
 //! The projection: the object at the centre of flexcam.
 //!
 //! A projection maps a continuous image position to a ray (its projector) and, where it has an
-//! inverse, maps a scene point back to every image position that sees it, with depth. A
+//! inverse (an optional capability, see [`AnalyticInverse`]), maps a scene point back to every image position that sees it, with depth. A
 //! projection may image a point zero, one or several times (a trilinear mesh can fold; a
 //! panorama can wrap), so the inverse appends to a list.
 //!
@@ -15,6 +15,7 @@ pub mod chart;
 mod fisheye;
 pub mod flexible;
 mod image_coords;
+mod inverse;
 #[cfg(test)]
 mod inverse_properties;
 mod linear;
@@ -29,6 +30,9 @@ pub use chart::{HalfSpace, InverseChart, Pole};
 pub use fisheye::Fisheye;
 pub use flexible::{Flexible, FlexibleSpec};
 pub use image_coords::Resolution;
+pub use inverse::{
+    AnalyticInverse, BranchImage, Charted, ContinuousInverse, NoInverse, SingleImage,
+};
 pub use linear::{Orthographic, Perspective};
 pub use panoramic::{Cylindrical, Equirectangular};
 pub use projector::{Projector, ProjectorHull};
@@ -85,48 +89,20 @@ pub trait Projection: Send + Sync {
     /// A bound on the projectors of every sample position in the closed pixel-space
     /// rectangle `[lo, hi]`, each of which has a projector (see [`ProjectorHull`]): lets a
     /// renderer cull a whole tile at once. `None` (the default) where the projection cannot
-    /// promise that.
+    /// promise that. This is an honest answer for every projection, not a missing
+    /// capability: a renderer without a hull searches projector by projector, so `None`
+    /// only costs time, and whether a bound exists can depend on the rectangle.
     fn projector_hull(&self, _lo: DVec2, _hi: DVec2) -> Option<ProjectorHull> {
         None
     }
 
-    /// Whether [`Projection::project`] is implemented.
-    fn has_inverse(&self) -> bool {
-        false
-    }
-
-    /// Why this projection has no inverse where its kind may have one (a panorama shape
-    /// outside the lookup's class), for error messages; `None` otherwise.
-    fn inverse_refusal(&self) -> Option<String> {
-        None
-    }
-
-    /// Appends to `out` every image position of scene point `point`, each with the ray
-    /// parameter that reaches it. Projections without an inverse append nothing.
-    fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
-        let _ = (point, out);
-    }
-
-    /// Where the inverse is a continuous map that a rasteriser can fill triangles by (see
-    /// [`chart`]); `None` when it is not (no inverse, or one that folds or jumps in ways a
-    /// chart cannot describe).
-    fn inverse_chart(&self) -> Option<InverseChart> {
-        None
-    }
-
-    /// The image of `point` on the continuous branch described by [`Projection::inverse_chart`]:
-    /// unclipped to the image and to the visible domain. `None` on the singular set (an eye,
-    /// a pole) and for projections without a chart.
-    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
-        let _ = point;
-        None
-    }
+    /// The analytic inverse (every image of a scene point, see [`AnalyticInverse`]), or why
+    /// this projection has none.
+    fn inverse(&self) -> Result<&dyn AnalyticInverse, NoInverse>;
 
     /// This projection as a trilinear mesh, for the renderers that need its triangles
     /// (`--method trilinear`); `None` for every other kind.
-    fn as_trilinear(&self) -> Option<&Trilinear> {
-        None
-    }
+    fn trilinear(&self) -> Option<&Trilinear>;
 }
 
 /// A camera placement shared by the single-viewpoint projections: an eye position, a point

@@ -11,7 +11,10 @@ use super::camera_basis::CameraBasis;
 use super::chart::{axis_poles, InverseChart};
 use super::image_coords::Resolution;
 use super::params::{angle_radians, UpTo};
-use super::{CameraFrame, ImagePoint, Projection};
+use super::{
+    AnalyticInverse, BranchImage, CameraFrame, ImagePoint, NoInverse, Projection, SingleImage,
+    Trilinear,
+};
 use crate::error::Result;
 use crate::geometry::Ray;
 
@@ -89,30 +92,21 @@ impl Projection for Equirectangular {
         Some(Ray::new(self.basis.origin, direction))
     }
 
-    fn has_inverse(&self) -> bool {
-        true
+    fn inverse(&self) -> std::result::Result<&dyn AnalyticInverse, NoInverse> {
+        Ok(self)
     }
 
-    /// Appends the one image of `point` with its longitude taken in [-pi, pi): for
-    /// h_fov = 360 that lies in the image, otherwise it may lie left or right of it.
-    /// Degenerate: the eye appends nothing; a point straight above or below the eye (a pole,
-    /// seen by a whole row) appends the centre column only.
-    fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
-        out.extend(self.project_continuous(point));
+    fn trilinear(&self) -> Option<&Trilinear> {
+        None
     }
+}
 
-    /// Longitude wraps every 360 degrees; the poles straight up and down are singular.
-    fn inverse_chart(&self) -> Option<InverseChart> {
-        let top = (0.5 * f64::from(self.resolution.height) - 0.5) * self.radians_per_pixel.y;
-        Some(InverseChart {
-            clip: Vec::new(),
-            period: Some(2.0 * PI / self.radians_per_pixel.x),
-            poles: axis_poles(self.basis.origin, self.basis.up, -top, top),
-        })
-    }
-
-    /// The image [`Projection::project`] appends, `None` where it appends nothing.
-    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
+/// The one image of a point with its longitude taken in [-pi, pi): for h_fov = 360 that lies
+/// in the image, otherwise it may lie left or right of it. Degenerate: the eye has no image;
+/// a point straight above or below the eye (a pole, seen by a whole row) has the centre
+/// column only.
+impl SingleImage for Equirectangular {
+    fn branch_image(&self, point: DVec3) -> Option<BranchImage> {
         let offset = point - self.basis.origin;
         let local = self.basis.to_local(offset);
         if local == DVec3::ZERO {
@@ -121,10 +115,21 @@ impl Projection for Equirectangular {
         let lon = longitude(local).unwrap_or(0.0);
         let lat = local.y.atan2(DVec2::new(local.x, local.z).length());
         let centred = DVec2::new(lon, lat) / self.radians_per_pixel;
-        Some(ImagePoint {
+        let image = ImagePoint {
             pixel: self.resolution.pixel(centred),
             t: offset.length(),
-        })
+        };
+        Some(BranchImage { image, seen: true })
+    }
+
+    /// Longitude wraps every 360 degrees; the poles straight up and down are singular.
+    fn chart(&self) -> InverseChart {
+        let top = (0.5 * f64::from(self.resolution.height) - 0.5) * self.radians_per_pixel.y;
+        InverseChart {
+            clip: Vec::new(),
+            period: Some(2.0 * PI / self.radians_per_pixel.x),
+            poles: axis_poles(self.basis.origin, self.basis.up, -top, top),
+        }
     }
 }
 
@@ -186,39 +191,41 @@ impl Projection for Cylindrical {
         Some(Ray::new(self.basis.origin, direction))
     }
 
-    fn has_inverse(&self) -> bool {
-        true
+    fn inverse(&self) -> std::result::Result<&dyn AnalyticInverse, NoInverse> {
+        Ok(self)
     }
 
-    /// Appends the one image of `point` with its longitude taken in [-pi, pi) (see
-    /// [`Equirectangular::project`]); the row may lie above or below the image. Degenerate:
-    /// points on the cylinder's axis (the eye and the poles straight above or below it, at
-    /// infinite height) append nothing.
-    fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
-        out.extend(self.project_continuous(point));
+    fn trilinear(&self) -> Option<&Trilinear> {
+        None
     }
+}
 
-    /// Longitude wraps every 360 degrees; the poles (at infinite height) are singular.
-    fn inverse_chart(&self) -> Option<InverseChart> {
-        let top = ((0.5 * f64::from(self.resolution.height) - 0.5) * self.height_per_pixel).atan();
-        Some(InverseChart {
-            clip: Vec::new(),
-            period: Some(2.0 * PI / self.radians_per_pixel),
-            poles: axis_poles(self.basis.origin, self.basis.up, -top, top),
-        })
-    }
-
-    /// The image [`Projection::project`] appends, `None` where it appends nothing.
-    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
+/// The one image of a point with its longitude taken in [-pi, pi) (see [`Equirectangular`]'s
+/// branch); the row may lie above or below the image. Degenerate: points on the cylinder's
+/// axis (the eye and the poles straight above or below it, at infinite height) have no
+/// image.
+impl SingleImage for Cylindrical {
+    fn branch_image(&self, point: DVec3) -> Option<BranchImage> {
         let offset = point - self.basis.origin;
         let local = self.basis.to_local(offset);
         let lon = longitude(local)?;
         let height = local.y / DVec2::new(local.x, local.z).length();
         let centred = DVec2::new(lon / self.radians_per_pixel, height / self.height_per_pixel);
-        Some(ImagePoint {
+        let image = ImagePoint {
             pixel: self.resolution.pixel(centred),
             t: offset.length(),
-        })
+        };
+        Some(BranchImage { image, seen: true })
+    }
+
+    /// Longitude wraps every 360 degrees; the poles (at infinite height) are singular.
+    fn chart(&self) -> InverseChart {
+        let top = ((0.5 * f64::from(self.resolution.height) - 0.5) * self.height_per_pixel).atan();
+        InverseChart {
+            clip: Vec::new(),
+            period: Some(2.0 * PI / self.radians_per_pixel),
+            poles: axis_poles(self.basis.origin, self.basis.up, -top, top),
+        }
     }
 }
 

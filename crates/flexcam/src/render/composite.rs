@@ -152,7 +152,7 @@ pub fn render_with_method(
     let pinhole = perspective_as_trilinear(&main_camera(scene, main)?)?;
     let main_as_trilinear = |s: &PreparedScene, p: &dyn Projection, o: &RenderOptions| {
         // The main pass is the only one through a projection that is not trilinear.
-        if p.as_trilinear().is_none() {
+        if p.trilinear().is_none() {
             method.render(s, &pinhole, o)
         } else {
             method.render(s, p, o)

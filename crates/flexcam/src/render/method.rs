@@ -57,7 +57,7 @@ impl Method {
             Method::Raycast => Ok(raycast::render(prepared, projection, options)),
             Method::Raster => Ok(InverseRaster::new(prepared, projection, options)?.render()),
             Method::Trilinear => {
-                let trilinear = projection.as_trilinear().ok_or_else(|| {
+                let trilinear = projection.trilinear().ok_or_else(|| {
                     Error::new(format!(
                         "the trilinear method renders only trilinear projections, \
                          not a {} projection",

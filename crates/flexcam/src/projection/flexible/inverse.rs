@@ -15,6 +15,9 @@
 //!
 //! Anything else has no inverse ([`Inverse::classify`] gives `None`, or for a panorama the
 //! reason).
+//!
+//! [`BoundInverse`] is the projection's inverse: the solver with the re-parameterisation and
+//! image size that turn (u, v) into pixels.
 
 use std::f64::consts::PI;
 
@@ -22,7 +25,10 @@ use glam::{DMat2, DVec2, DVec3};
 
 use super::control_surface::{CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface};
 use super::panorama::lookup::{self, PanoramaInverse};
+use super::reparam::Reparam;
 use crate::error::Result;
+use crate::projection::image_coords::Resolution;
+use crate::projection::{AnalyticInverse, Charted, ContinuousInverse, ImagePoint};
 
 /// Relative tolerance for "the same" centre, frame or range, and for the domain edges.
 const SAME: f64 = 1e-12;
@@ -281,4 +287,44 @@ fn cylinders(near: &CylinderPatch, far: &CylinderPatch, p: DVec3) -> Option<(DVe
     }
     let v = (h - start) / span;
     Some((DVec2::new(u, v), t))
+}
+
+/// The inverse of a flexible projection: an [`Inverse`] with the re-parameterisation and image
+/// size that turn its (u, v) into pixels.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct BoundInverse {
+    pub solver: Inverse,
+    pub reparam: Reparam,
+    pub resolution: Resolution,
+}
+
+impl AnalyticInverse for BoundInverse {
+    /// Appends the one image of `point` when it lies inside the viewing volume (t and
+    /// (u, v) in [0, 1]); points outside it, and degenerate spots where a whole set of
+    /// projectors meets (the eye of a perspective volume), append nothing.
+    fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
+        let Some((uv, t)) = self.solver.solve(point) else {
+            return;
+        };
+        if let Some(pixel) = self.reparam.to_pixel(&self.resolution, uv) {
+            out.push(ImagePoint { pixel, t });
+        }
+    }
+
+    /// The analytic class under the maps that keep the extended inverse continuous (see
+    /// the `chart` module); `None` otherwise.
+    fn charted(&self) -> Option<Charted<'_>> {
+        let chart = self.solver.chart(self.reparam, &self.resolution)?;
+        Some(Charted { chart, map: self })
+    }
+}
+
+impl ContinuousInverse for BoundInverse {
+    /// (u, v, t) by the inverse's formulas without the domain test, then the pixel by the
+    /// extended re-parameterisation.
+    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
+        let (uv, t) = self.solver.solve_unbounded(point)?;
+        let pixel = self.reparam.to_pixel_unbounded(&self.resolution, uv)?;
+        Some(ImagePoint { pixel, t })
+    }
 }

@@ -54,10 +54,11 @@ pub use projector_grid::{
 pub use reparam::Reparam;
 pub use volume::{InterpolatedVolume, Volume};
 
-use self::inverse::Inverse;
-use super::chart::InverseChart;
+use self::inverse::{BoundInverse, Inverse};
 use super::image_coords::Resolution;
-use super::{BuildReport, ImagePoint, Projection, Projector, ProjectorHull};
+use super::{
+    AnalyticInverse, BuildReport, NoInverse, Projection, Projector, ProjectorHull, Trilinear,
+};
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
 
@@ -114,9 +115,9 @@ pub struct Flexible {
     volume: Volume,
     reparam: Reparam,
     resolution: Resolution,
-    inverse: Option<Inverse>,
-    /// Why a panorama has no inverse (for the refusal of `--method raster`).
-    inverse_refusal: Option<String>,
+    /// The analytic inverse, or why there is none (a panorama shape outside the lookup's
+    /// class names its reason, for the refusal of `--method raster`).
+    inverse: std::result::Result<BoundInverse, NoInverse>,
 }
 
 impl Flexible {
@@ -148,13 +149,19 @@ impl Flexible {
             | Volume::Interpolated(_)
             | Volume::Grid(_) => Ok(None),
         };
-        let (inverse, inverse_refusal) = match classified {
-            Ok(inverse) => (inverse, None),
-            Err(e) => (None, Some(e.message)),
+        let inverse = match classified {
+            Ok(Some(solver)) => Ok(BoundInverse {
+                solver,
+                reparam,
+                resolution,
+            }),
+            Ok(None) => Err(NoInverse { reason: None }),
+            Err(e) => Err(NoInverse {
+                reason: Some(e.message),
+            }),
         };
         Ok(Flexible {
             inverse,
-            inverse_refusal,
             volume,
             reparam,
             resolution,
@@ -303,42 +310,17 @@ impl Projection for Flexible {
         self.volume.projector_hull(a.min(b), a.max(b))
     }
 
-    /// True for the analytic class: parallel planes sharing a normal, nested spheres,
-    /// coaxial cylinders, star-shaped panoramas (see the `inverse` module).
-    fn has_inverse(&self) -> bool {
-        self.inverse.is_some()
-    }
-
-    fn inverse_refusal(&self) -> Option<String> {
-        self.inverse_refusal.clone()
-    }
-
-    /// Appends the one image of `point` when it lies inside the viewing volume (t and
-    /// (u, v) in [0, 1]); points outside it, and degenerate spots where a whole set of
-    /// projectors meets (the eye of a perspective volume), append nothing.
-    fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
-        let Some(inverse) = &self.inverse else {
-            return;
-        };
-        let Some((uv, t)) = inverse.solve(point) else {
-            return;
-        };
-        if let Some(pixel) = self.reparam.to_pixel(&self.resolution, uv) {
-            out.push(ImagePoint { pixel, t });
+    /// The analytic class: parallel planes sharing a normal, nested spheres, coaxial
+    /// cylinders, star-shaped panoramas (see the `inverse` module); for a linear volume
+    /// outside it, the reason.
+    fn inverse(&self) -> std::result::Result<&dyn AnalyticInverse, NoInverse> {
+        match &self.inverse {
+            Ok(inverse) => Ok(inverse),
+            Err(none) => Err(none.clone()),
         }
     }
 
-    /// The analytic class under the maps that keep the extended inverse continuous (see
-    /// the `chart` module); `None` otherwise, also for volumes with an inverse.
-    fn inverse_chart(&self) -> Option<InverseChart> {
-        self.inverse.as_ref()?.chart(self.reparam, &self.resolution)
-    }
-
-    /// (u, v, t) by the inverse's formulas without the domain test, then the pixel by the
-    /// extended re-parameterisation.
-    fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
-        let (uv, t) = self.inverse.as_ref()?.solve_unbounded(point)?;
-        let pixel = self.reparam.to_pixel_unbounded(&self.resolution, uv)?;
-        Some(ImagePoint { pixel, t })
+    fn trilinear(&self) -> Option<&Trilinear> {
+        None
     }
 }

@@ -148,7 +148,9 @@ fn pushbroom_is_x_and_y_over_z() {
         (DVec3::new(4.0, 4.0, 3.0), DVec2::new(4.0, 4.0 / 3.0)),
     ] {
         let mut out = Vec::new();
-        f.project(basis.origin + basis.to_world(local), &mut out);
+        f.inverse()
+            .unwrap()
+            .project(basis.origin + basis.to_world(local), &mut out);
         assert_eq!(out.len(), 1);
         let got = 4.0 * centred_uv(&f, out[0].pixel);
         assert!((got - want).length() < 1e-9, "{local}: {got}");
@@ -292,7 +294,7 @@ fn builds_through_projection_spec_and_checks_parameters() {
     let spec = ProjectionSpec::Flexible(Box::new(preset(Preset::Perspective { fov: 60.0 }, None)));
     let p = spec.build(20, 10).unwrap();
     assert_eq!((p.kind(), spec.kind()), ("flexible", "flexible"));
-    assert!(p.has_inverse());
+    assert!(p.inverse().is_ok());
     for (bad, needle) in [
         (
             Preset::Perspective { fov: 180.0 },
@@ -348,10 +350,10 @@ fn a_point_near_surface_is_a_pinhole() {
     let (ra, rb) = (a.ray(pixel).unwrap(), b.ray(pixel).unwrap());
     assert!((ra.origin - rb.origin).length() < 1e-12);
     assert!((ra.direction - rb.direction).length() < 1e-12);
-    assert!(a.has_inverse());
+    assert!(a.inverse().is_ok());
     // The eye itself: every projector meets there, no single image.
     let mut out = Vec::new();
-    a.project(basis.origin, &mut out);
+    a.inverse().unwrap().project(basis.origin, &mut out);
     assert!(out.is_empty());
 }
 
@@ -401,10 +403,11 @@ fn volumes_outside_the_analytic_class_have_no_inverse() {
         (rect(0.0), sphere),
     ] {
         let f = custom(near.clone(), far.clone());
-        assert!(!f.has_inverse(), "{near:?} {far:?}");
-        let mut out = Vec::new();
-        f.project(DVec3::new(0.1, 0.1, 1.0), &mut out);
-        assert!(out.is_empty());
+        // Outside the analytic class, with no reason (only panoramas name one).
+        assert!(
+            matches!(f.inverse(), Err(NoInverse { reason: None })),
+            "{near:?} {far:?}"
+        );
     }
     // A flat (parallelogram) bilinear quad is affine: invertible.
     let flat = Surface::Bilinear {
@@ -415,7 +418,7 @@ fn volumes_outside_the_analytic_class_have_no_inverse() {
             DVec3::new(-1.0, 1.0, 0.0),
         ],
     };
-    assert!(custom(flat, rect(2.0)).has_inverse());
+    assert!(custom(flat, rect(2.0)).inverse().is_ok());
 }
 
 /// The invertible volumes of the proptest: every preset, and custom planes, spheres and
@@ -539,11 +542,11 @@ proptest! {
         x in 0.0..16.0f64, y in 0.0..12.0f64, t in 0.01..1.0f64
     ) {
         for f in invertible() {
-            prop_assert!(f.has_inverse());
+            prop_assert!(f.inverse().is_ok());
             let Some(ray) = f.ray(DVec2::new(x, y)) else { continue };
             let p = ray.at(t);
             let mut out = Vec::new();
-            f.project(p, &mut out);
+            f.inverse().unwrap().project(p, &mut out);
             prop_assert_eq!(out.len(), 1, "{:?} {}", f.volume(), p);
             let back = f.ray(out[0].pixel);
             prop_assert!(back.is_some());
@@ -568,10 +571,14 @@ fn points_outside_the_volume_have_no_image() {
         DVec3::new(0.0, 0.0, 3.0), // beyond the far clip
         DVec3::new(5.0, 0.0, 1.5), // outside the frustum
     ] {
-        f.project(basis.origin + basis.to_world(local), &mut out);
+        f.inverse()
+            .unwrap()
+            .project(basis.origin + basis.to_world(local), &mut out);
     }
     assert!(out.is_empty());
-    f.project(basis.origin + 1.5 * basis.forward, &mut out);
+    f.inverse()
+        .unwrap()
+        .project(basis.origin + 1.5 * basis.forward, &mut out);
     assert_eq!(out.len(), 1);
     assert!((out[0].pixel - DVec2::new(4.0, 4.0)).length() < 1e-9);
     assert!((out[0].t - 0.5).abs() < 1e-12);
@@ -653,7 +660,7 @@ fn axonometric_axes(azimuth: f64, elevation: f64) -> [DVec2; 3] {
     let f = build(&spec, w, w);
     let image = |p: DVec3| {
         let mut out = Vec::new();
-        f.project(p, &mut out);
+        f.inverse().unwrap().project(p, &mut out);
         assert_eq!(out.len(), 1, "{p}");
         out[0].pixel * (width / f64::from(w))
     };
@@ -968,12 +975,12 @@ fn blends_of_matching_surfaces_stay_invertible() {
         let (a, b) = pairs[i].clone();
         let f = build(&blend_of(weight, a, b), 9, 7);
         assert!(matches!(f.volume, Volume::Linear(_)), "{i} {weight}");
-        assert!(f.has_inverse(), "{i} {weight}");
+        assert!(f.inverse().is_ok(), "{i} {weight}");
     }
     let (a, b) = pairs[1].clone();
     let f = build(&blend_of(0.5, a, b), 9, 7);
     assert!(matches!(f.volume, Volume::Interpolated(_)));
-    assert!(!f.has_inverse());
+    assert!(f.inverse().is_err());
 }
 
 #[test]

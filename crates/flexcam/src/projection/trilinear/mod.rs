@@ -6,7 +6,7 @@
 //! tripoint(u, v) + t * trinorm(u, v), t >= 0, where tripoint and trinorm interpolate the
 //! p_k and n_k linearly (trinorm is never renormalised: its length is the depth scale).
 //! The inverse solves a cubic per projection triangle ([`point_projection`], with the cached
-//! N/K form of each triangle): [`Projection::project`] returns every visible image.
+//! N/K form of each triangle): [`AnalyticInverse::project`] returns every visible image.
 //!
 //! The map from screen position to `(u, v)` is affine (the thesis's screen-space
 //! interpolation) unless the projection has screen weights
@@ -24,7 +24,7 @@ mod shapes;
 use glam::{DVec2, DVec3};
 
 use super::image_coords::Resolution;
-use super::{ImagePoint, Projection, TrilinearMesh};
+use super::{AnalyticInverse, Charted, ImagePoint, NoInverse, Projection, TrilinearMesh};
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
 pub use point_projection::{ProjectionTriangleCache, Solutions, TriangleSolution};
@@ -252,14 +252,16 @@ impl Projection for Trilinear {
         Some(Ray::new(interpolate(&self.mesh.points), direction))
     }
 
-    fn has_inverse(&self) -> bool {
-        true
+    fn inverse(&self) -> std::result::Result<&dyn AnalyticInverse, NoInverse> {
+        Ok(self)
     }
 
-    fn as_trilinear(&self) -> Option<&Trilinear> {
+    fn trilinear(&self) -> Option<&Trilinear> {
         Some(self)
     }
+}
 
+impl AnalyticInverse for Trilinear {
     /// Appends every image of `point`: per projection triangle, each solution of the cubic
     /// that is inside (up to [`ProjectionTriangleCache::INSIDE_TOL`] in barycentrics)
     /// and on a ray (`t >= 0`), at pixel `(s_x W, (1 - s_y) H)` of its screen position `s`
@@ -328,6 +330,12 @@ impl Projection for Trilinear {
                 out.push(ImagePoint { pixel, t });
             }
         }
+    }
+
+    /// `None`: the mesh's inverse folds (a point can have several images, which appear and
+    /// vanish across the mesh's fold lines), which no chart describes.
+    fn charted(&self) -> Option<Charted<'_>> {
+        None
     }
 }
 

@@ -78,7 +78,7 @@ use std::collections::HashMap;
 use glam::{DVec2, DVec3, Vec3};
 
 use crate::projection::trilinear_builders::{vertex_normals, vertex_ray, Optic, SurfaceScreenMap};
-use crate::projection::{Perspective, Projection};
+use crate::projection::{ContinuousInverse, Perspective, Projection};
 use crate::scene::Mesh;
 
 /// The deepest edge level: an input edge is split into at most `2^MAX_LEVEL` pieces.

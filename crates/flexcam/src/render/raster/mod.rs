@@ -2,8 +2,9 @@
 //! (seed 003, 7.3 and 9.4).
 //!
 //! Per frame:
-//! 1. every scene vertex is projected once through [`Projection::project_continuous`] (the
-//!    per-vertex cache shared by the triangles around it);
+//! 1. every scene vertex is projected once through the projection's continuous inverse
+//!    ([`crate::projection::ContinuousInverse`], looked up once per renderer; the per-vertex
+//!    cache shared by the triangles around it);
 //! 2. each triangle is clipped in 3D to the chart's half-spaces ([`clip`]), cut by the
 //!    uniform grid and refined adaptively ([`refine`]) until the straight polygon of each
 //!    piece's projected corners follows its curved image within the tolerance;
@@ -66,7 +67,7 @@ use self::pixel_rays::PixelRays;
 use self::refine::{Node, Refiner};
 use self::seam::{covers_a_centre, place, Placement};
 use crate::error::{Error, Result};
-use crate::projection::{InverseChart, Projection};
+use crate::projection::{Charted, Projection};
 use crate::render::prepared::PreparedScene;
 use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
 use crate::scene::{Scene, Surface};
@@ -80,7 +81,8 @@ const CHUNK: usize = 2048;
 pub struct InverseRaster<'a> {
     scene: &'a Scene,
     projection: &'a dyn Projection,
-    chart: InverseChart,
+    /// The projection's continuous inverse and its chart, looked up once.
+    inverse: Charted<'a>,
     rays: PixelRays<'a>,
     caster: Option<&'a PreparedScene>,
     options: RenderOptions<'a>,
@@ -138,25 +140,26 @@ impl std::ops::AddAssign for PieceCounts {
     }
 }
 
-/// The projection's chart, or the one-line refusal of method raster.
-pub fn supported_chart(projection: &dyn Projection) -> Result<InverseChart> {
+/// The projection's charted inverse, or the one-line refusal of method raster.
+pub fn supported_chart(projection: &dyn Projection) -> Result<Charted<'_>> {
     let kind = projection.kind();
-    if !projection.has_inverse() {
-        let why = projection
-            .inverse_refusal()
+    let inverse = projection.inverse().map_err(|none| {
+        let why = none
+            .reason
             .map_or_else(String::new, |reason| format!(": {reason}"));
-        return Err(Error::new(format!(
+        Error::new(format!(
             "method raster needs a projection with an analytic inverse; {kind} has none{why} \
              (use --method raycast)"
-        )));
-    }
-    let chart = projection.inverse_chart().ok_or_else(|| {
+        ))
+    })?;
+    let charted = inverse.charted().ok_or_else(|| {
         Error::new(format!(
             "method raster needs a projection with an analytic inverse it can fill triangles \
              by; this {kind} projection's inverse is not continuous in a way it handles \
              (see docs/raster.md; use --method raycast)"
         ))
     })?;
+    let chart = &charted.chart;
     if chart.clip.len() > clip::MAX_PLANES {
         return Err(Error::new(format!(
             "method raster: {kind} projection clips by {} planes, at most {} are supported",
@@ -164,7 +167,7 @@ pub fn supported_chart(projection: &dyn Projection) -> Result<InverseChart> {
             clip::MAX_PLANES
         )));
     }
-    Ok(chart)
+    Ok(charted)
 }
 
 impl<'a> InverseRaster<'a> {
@@ -175,7 +178,7 @@ impl<'a> InverseRaster<'a> {
         projection: &'a dyn Projection,
         options: &RenderOptions<'a>,
     ) -> Result<Self> {
-        let chart = supported_chart(projection)?;
+        let inverse = supported_chart(projection)?;
         options.subdivision.validate()?;
         if options.spp != 1 {
             return Err(Error::new(format!(
@@ -195,7 +198,7 @@ impl<'a> InverseRaster<'a> {
             buffers: Mutex::default(),
             scene,
             projection,
-            chart,
+            inverse,
             rays,
             caster,
             options: *options,
@@ -288,11 +291,7 @@ impl<'a> InverseRaster<'a> {
     /// parallel jobs of [`CHUNK`] scene triangles, one element of `bins` per job, with their
     /// counters (both buffers resized and overwritten).
     fn pieces(&self, images: &mut Vec<Vec<Option<DVec2>>>, bins: &mut Vec<Bins>) -> PieceCounts {
-        let refiner = Refiner::new(
-            self.projection,
-            &self.chart,
-            self.options.subdivision.tolerance,
-        );
+        let refiner = Refiner::new(&self.inverse, self.options.subdivision.tolerance);
         images.resize_with(self.scene.objects.len(), Vec::new);
         for (object, images) in self.scene.objects.iter().zip(images.iter_mut()) {
             object
@@ -353,8 +352,9 @@ impl<'a> InverseRaster<'a> {
         let key = key(object, triangle);
         let (width, height) = self.projection.resolution();
         let size = DVec2::new(f64::from(width), f64::from(height));
-        let period = self.chart.period;
+        let period = self.inverse.chart.period;
         let inside = self
+            .inverse
             .chart
             .clip
             .iter()
@@ -415,7 +415,7 @@ impl<'a> InverseRaster<'a> {
             });
             subdivide(nodes, grid);
         } else {
-            let clipped = clip::clip(points, &self.chart.clip);
+            let clipped = clip::clip(points, &self.inverse.chart.clip);
             for fan in clipped.fan() {
                 subdivide(fan.map(|p| refiner.node(p)), grid);
             }

@@ -31,7 +31,7 @@ use glam::{DVec2, DVec3};
 use super::clip::canonical;
 use super::subdivision::MAX_LEVEL;
 use crate::geometry::intersect_triangle;
-use crate::projection::{InverseChart, Pole, Projection};
+use crate::projection::{Charted, ContinuousInverse, InverseChart, Pole};
 
 /// A point of a scene triangle and its image (`None` on the singular set).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -42,7 +42,7 @@ pub struct Node {
 
 /// Decides and performs subdivision for one projection.
 pub struct Refiner<'a> {
-    projection: &'a dyn Projection,
+    inverse: &'a dyn ContinuousInverse,
     chart: &'a InverseChart,
     tolerance: Option<f64>,
 }
@@ -78,14 +78,11 @@ fn angle_between(a: DVec3, b: DVec3) -> f64 {
 }
 
 impl<'a> Refiner<'a> {
-    pub fn new(
-        projection: &'a dyn Projection,
-        chart: &'a InverseChart,
-        tolerance: Option<f64>,
-    ) -> Self {
+    /// Refines by `inverse`'s continuous map and chart.
+    pub fn new(inverse: &'a Charted<'a>, tolerance: Option<f64>) -> Self {
         Refiner {
-            projection,
-            chart,
+            inverse: inverse.map,
+            chart: &inverse.chart,
             tolerance,
         }
     }
@@ -94,7 +91,7 @@ impl<'a> Refiner<'a> {
     pub fn node(&self, point: DVec3) -> Node {
         Node {
             point,
-            image: self.projection.project_continuous(point).map(|i| i.pixel),
+            image: self.inverse.project_continuous(point).map(|i| i.pixel),
         }
     }
 
@@ -427,7 +424,7 @@ impl<'a> Refiner<'a> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::projection::{CameraFrame, ProjectionSpec};
+    use crate::projection::{CameraFrame, Projection, ProjectionSpec};
 
     fn panorama() -> Box<dyn Projection> {
         let frame = CameraFrame {
@@ -446,8 +443,8 @@ mod tests {
     #[test]
     fn curved_edges_split_and_straight_or_degenerate_ones_do_not() {
         let projection = panorama();
-        let chart = projection.inverse_chart().unwrap();
-        let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
+        let charted = projection.inverse().unwrap().charted().unwrap();
+        let refiner = Refiner::new(&charted, Some(0.5));
         let node = |p: DVec3| refiner.node(p);
         // A horizontal edge 90 degrees wide above the horizon bends in the panorama.
         let (a, b) = (
@@ -493,8 +490,8 @@ mod tests {
     #[test]
     fn pieces_around_a_pole_are_found_and_shrunk() {
         let projection = panorama();
-        let chart = projection.inverse_chart().unwrap();
-        let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
+        let charted = projection.inverse().unwrap().charted().unwrap();
+        let refiner = Refiner::new(&charted, Some(0.5));
         let ceiling = [
             DVec3::new(-1.0, 1.0, -1.0),
             DVec3::new(1.0, 1.0, -1.0),
@@ -503,7 +500,7 @@ mod tests {
         assert!(refiner.is_pole_piece(ceiling));
         assert!(!refiner.is_pole_piece(ceiling.map(|p| p + DVec3::X * 5.0)));
         // Refined, only pieces within the pole's clearance still contain the pole.
-        let clearance = chart.poles[0].clearance;
+        let clearance = charted.chart.poles[0].clearance;
         let mut pole_pieces = 0;
         refiner.refine(
             ceiling.map(|p| refiner.node(p)),
@@ -542,9 +539,9 @@ mod tests {
         };
         for fov in [220.0, 300.0, 360.0] {
             let projection = fisheye(fov);
-            let chart = projection.inverse_chart().unwrap();
-            let clearance = chart.poles[0].clearance;
-            let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
+            let charted = projection.inverse().unwrap().charted().unwrap();
+            let clearance = charted.chart.poles[0].clearance;
+            let refiner = Refiner::new(&charted, Some(0.5));
             // A small piece on the axis behind, and one beside it, both well within.
             let r = 0.2 * clearance.tan();
             let behind = [
@@ -565,9 +562,9 @@ mod tests {
         // Fisheye 180: the clearance is just over 90 degrees, the cone is the half-space
         // behind the eye plane (strictly).
         let projection = fisheye(180.0);
-        let chart = projection.inverse_chart().unwrap();
-        assert!(chart.poles[0].clearance > std::f64::consts::FRAC_PI_2);
-        let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
+        let charted = projection.inverse().unwrap().charted().unwrap();
+        assert!(charted.chart.poles[0].clearance > std::f64::consts::FRAC_PI_2);
+        let refiner = Refiner::new(&charted, Some(0.5));
         let side = [
             DVec3::new(-5.0, 0.0, 0.1),
             DVec3::new(5.0, 0.0, 0.1),
@@ -583,8 +580,8 @@ mod tests {
     #[test]
     fn triangles_far_from_the_poles_need_no_pole_tests() {
         let projection = panorama();
-        let chart = projection.inverse_chart().unwrap();
-        let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
+        let charted = projection.inverse().unwrap().charted().unwrap();
+        let refiner = Refiner::new(&charted, Some(0.5));
         let pieces = |points: [DVec3; 3], poles: bool| {
             let mut out = Vec::new();
             refiner.refine(
@@ -665,8 +662,8 @@ mod tests {
             size in proptest::prop_oneof![0.001f64..0.01, 0.01f64..1.0],
         ) {
             let projection = panorama();
-            let chart = projection.inverse_chart().unwrap();
-            let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
+            let charted = projection.inverse().unwrap().charted().unwrap();
+            let refiner = Refiner::new(&charted, Some(0.5));
             let centre = DVec3::from_array(centre);
             let corner =
                 |k: usize| centre + size * DVec3::new(offsets[2 * k], offsets[2 * k + 1], 0.5);
@@ -684,8 +681,8 @@ mod tests {
     #[test]
     fn stays_whole_cases() {
         let projection = panorama();
-        let chart = projection.inverse_chart().unwrap();
-        let refiner = Refiner::new(projection.as_ref(), &chart, Some(0.5));
+        let charted = projection.inverse().unwrap().charted().unwrap();
+        let refiner = Refiner::new(&charted, Some(0.5));
         let nodes = |points: [DVec3; 3]| points.map(|p| refiner.node(p));
         let tiny = nodes([
             DVec3::new(0.0, 0.0, -1.0),
@@ -714,15 +711,15 @@ mod tests {
         let mut with_eye = tiny;
         with_eye[0] = refiner.node(DVec3::ZERO);
         assert!(with_eye[0].image.is_none() && refiner.stays_whole(&with_eye));
-        let uniform_only = Refiner::new(projection.as_ref(), &chart, None);
+        let uniform_only = Refiner::new(&charted, None);
         assert!(uniform_only.stays_whole(&wide));
     }
 
     #[test]
     fn uniform_grid_makes_n_squared_pieces() {
         let projection = panorama();
-        let chart = projection.inverse_chart().unwrap();
-        let refiner = Refiner::new(projection.as_ref(), &chart, None);
+        let charted = projection.inverse().unwrap().charted().unwrap();
+        let refiner = Refiner::new(&charted, None);
         let corners = [
             DVec3::new(-1.0, 0.0, -2.0),
             DVec3::new(1.0, 0.0, -2.0),

@@ -120,7 +120,7 @@ mod tests {
     use super::{LiveParts, PreparedScene};
     use crate::geometry::Ray;
     use crate::projection::flexible::Flexible;
-    use crate::projection::{Projection, Projector};
+    use crate::projection::{AnalyticInverse, NoInverse, Projection, Projector, Trilinear};
     use crate::render::raycast::workloads::{table_volume, teapot_scene};
     use crate::render::{raycast, Counter, Frame, RenderOptions, Shading, Stats};
 
@@ -139,6 +139,12 @@ mod tests {
         }
         fn projector(&self, pixel: DVec2) -> Option<Projector> {
             self.0.projector(pixel)
+        }
+        fn inverse(&self) -> Result<&dyn AnalyticInverse, NoInverse> {
+            self.0.inverse()
+        }
+        fn trilinear(&self) -> Option<&Trilinear> {
+            None
         }
     }
 

@@ -4,7 +4,7 @@ use glam::{Affine3A, DVec2, DVec3, Vec3};
 
 use super::*;
 use crate::geometry::intersect_triangle;
-use crate::projection::{CameraFrame, ProjectionSpec};
+use crate::projection::{AnalyticInverse, CameraFrame, NoInverse, ProjectionSpec, Trilinear};
 use crate::render::{raycast, Counter, Shading};
 use crate::scene::{ImageSettings, Light, Material, Mesh, Object, Pattern, Scene, Surface};
 
@@ -49,6 +49,12 @@ impl Projection for Parallel {
                 self.direction,
             )
         })
+    }
+    fn inverse(&self) -> std::result::Result<&dyn AnalyticInverse, NoInverse> {
+        Err(NoInverse { reason: None })
+    }
+    fn trilinear(&self) -> Option<&Trilinear> {
+        None
     }
 }
 

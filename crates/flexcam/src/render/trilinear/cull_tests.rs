@@ -243,7 +243,7 @@ fn the_tree_changes_no_polygon_of_the_example_scenes() {
         let scene = scene::load(dir.join(&name).to_str().unwrap()).unwrap();
         let (width, height) = (scene.image.width, scene.image.height);
         let projection = scene.projection.build(width, height).unwrap();
-        let projection = projection.as_trilinear().unwrap();
+        let projection = projection.trilinear().unwrap();
         let (c, others) = check(&scene, projection, CurveOptions::ADAPTIVE, &name);
         println!(
             "{name}: {} pairs, {} culled by the tree, {} one by one, {} live, {} shapes; \
@@ -357,7 +357,7 @@ fn the_tree_changes_no_polygon_of_central_projections() {
     );
     let mut scene = scene::load(path).unwrap();
     let built = scene.projection.build(64, 32).unwrap();
-    let projection = built.as_trilinear().unwrap();
+    let projection = built.trilinear().unwrap();
     let c = check_central(&scene, projection, "inward sphere");
     assert!(c.culled_tree > c.pairs / 2 && c.shapes > 0, "{c:?}");
     for (count, seed) in [(40, 1), (200, 7)] {

@@ -605,7 +605,7 @@ fn fan_scene_shows_the_nearest_surface_everywhere() {
     let scene = scene::load(path.to_str().unwrap()).unwrap();
     let (width, height) = (scene.image.width, scene.image.height);
     let projection = scene.projection.build(width, height).unwrap();
-    let mesh = projection.as_trilinear().unwrap().mesh().clone();
+    let mesh = projection.trilinear().unwrap().mesh().clone();
     let (c, _) = against_raycast(
         &scene,
         &mesh,

@@ -477,12 +477,12 @@ mod round_trip {
             let (name, spec) = &invertible_panoramas()[which];
             let (w, h) = (360, 180);
             let f = Flexible::new(spec, w, h).unwrap();
-            prop_assert!(f.has_inverse(), "{}", name);
+            prop_assert!(f.inverse().is_ok(), "{}", name);
             let pixel = DVec2::new(x * f64::from(w), y * f64::from(h));
             let ray = f.ray(pixel).unwrap();
             let p = ray.at(t);
             let mut images = Vec::new();
-            f.project(p, &mut images);
+            f.inverse().unwrap().project(p, &mut images);
             prop_assert_eq!(images.len(), 1, "{}", name);
             let image = images[0];
             // u wraps: compare across the seam.
@@ -569,8 +569,8 @@ fn lookup_inverse_is_refused_outside_its_class() {
         ),
     ] {
         let f = Flexible::new(&panorama(shape, None), 32, 16).unwrap();
-        assert!(!f.has_inverse(), "{name}");
-        let why = f.inverse_refusal().unwrap();
+        assert!(f.inverse().is_err(), "{name}");
+        let why = f.inverse().err().unwrap().reason.unwrap();
         assert!(why.contains(reason), "{name}: {why}");
         // Ray casting still works.
         assert!(f.ray(DVec2::new(16.0, 8.0)).is_some(), "{name}");
@@ -586,15 +586,14 @@ fn blended_panoramas_have_a_lookup_inverse() {
         two_outlines_three_profiles(),
     ] {
         let f = Flexible::new(&panorama(shape, None), 32, 16).unwrap();
-        assert!(f.has_inverse() && f.inverse_refusal().is_none());
-        assert!(f.inverse_chart().is_some());
+        assert!(f.inverse().unwrap().charted().is_some());
     }
 }
 
 #[test]
 fn lookup_chart_wraps_the_width_and_keeps_the_poles_clear() {
     let f = Flexible::new(&preset(Preset::Cubic { v_fov: 90.0 }, None), 64, 16).unwrap();
-    let chart = f.inverse_chart().unwrap();
+    let chart = f.inverse().unwrap().charted().unwrap().chart;
     assert_eq!(chart.period, Some(64.0));
     assert!(chart.clip.is_empty());
     // The top pixel-centre row at v = 1 - 1/32: height tan(45) (1 - 1/16) at the corners
@@ -607,13 +606,17 @@ fn lookup_chart_wraps_the_width_and_keeps_the_poles_clear() {
     assert!((chart.poles[1].clearance - (FRAC_PI_2 - top)).abs() < 1e-12);
     // Points on the axis have no image.
     let mut out = Vec::new();
-    f.project(basis.origin + 3.0 * basis.up, &mut out);
+    f.inverse()
+        .unwrap()
+        .project(basis.origin + 3.0 * basis.up, &mut out);
     assert!(out.is_empty());
     // Other re-parameterisations have no chart.
     let mut polar = preset(Preset::Cubic { v_fov: 90.0 }, None);
     polar.reparam = Some(crate::projection::flexible::Reparam::Polar);
     assert!(Flexible::new(&polar, 16, 16)
         .unwrap()
-        .inverse_chart()
+        .inverse()
+        .unwrap()
+        .charted()
         .is_none());
 }

@@ -401,7 +401,7 @@ fn magnifier_is_perspective_outside_and_magnifies_the_centre() {
     let at = |dx: f64, dy: f64| b.origin + b.forward * 10.0 + b.right * dx + b.up * dy;
     let image = |f: &Flexible, p: DVec3| {
         let mut out = Vec::new();
-        f.project(p, &mut out);
+        f.inverse().unwrap().project(p, &mut out);
         out[0].pixel
     };
     let centre = DVec2::new(40.0, 30.0);
@@ -425,7 +425,7 @@ proptest! {
         let pixel = DVec2::new(x, y);
         let point = lens.ray(pixel).unwrap().at(t);
         let mut out = Vec::new();
-        lens.project(point, &mut out);
+        lens.inverse().unwrap().project(point, &mut out);
         prop_assert_eq!(out.len(), 1);
         prop_assert!((out[0].pixel - pixel).length() < 1e-6, "{} {}", out[0].pixel, pixel);
         prop_assert!((out[0].t - t).abs() < 1e-9);

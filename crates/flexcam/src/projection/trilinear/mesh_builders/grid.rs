@@ -87,7 +87,7 @@ pub fn between_surfaces<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::projection::{Projection, Trilinear};
+    use crate::projection::{AnalyticInverse, Projection, Trilinear};
 
     fn flat(s: DVec2) -> GridVertex {
         GridVertex {

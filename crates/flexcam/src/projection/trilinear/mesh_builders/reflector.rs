@@ -16,7 +16,9 @@ use crate::error::{Error, Result};
 use crate::geometry::optics::{reflect, refract};
 use crate::geometry::MeshView;
 use crate::projection::trilinear::is_degenerate_screen_triangle;
-use crate::projection::{ImagePoint, Perspective, Projection, Trilinear, TrilinearMesh};
+use crate::projection::{
+    AnalyticInverse, ImagePoint, Perspective, Projection, Trilinear, TrilinearMesh,
+};
 
 /// What the reflector does to the eye's rays.
 #[derive(Debug, Clone, Copy, PartialEq)]

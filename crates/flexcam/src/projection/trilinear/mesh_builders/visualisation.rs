@@ -192,7 +192,7 @@ mod tests {
 
     use super::*;
     use crate::projection::trilinear::mesh_builders::{between_surfaces, screen_grid};
-    use crate::projection::{CameraFrame, Projection, Trilinear};
+    use crate::projection::{AnalyticInverse, CameraFrame, Projection, Trilinear};
 
     fn camera() -> GridCamera {
         let frame = CameraFrame {
