@@ -1481,7 +1481,7 @@ fn trilinear_rays_meeting_in_front_of_the_scene() {
     }
 }
 
-/// The inward-looking sphere (seed 000, Figure 6.9): every ray passes through the centre,
+/// The inward-looking sphere (Vallance 2005, Figure 6.9): every ray passes through the centre,
 /// inside the cube, so every projection triangle but the 48 of the pole rows (which sweep no
 /// volume and are ray cast) is a central projection, drawn exactly: every pixel the ray
 /// caster's id and colour.

@@ -88,8 +88,8 @@ fn trilinear_method_renders_reflector_scenes() {
 /// `flexcam compare` composites the method under test (as `render` does) and compares it
 /// with the ray caster's exact mirror. A plane mirror's surface with
 /// `trilinear_screen_map = "projective"` is the exact mirror up to rounding at colour edges,
-/// for both methods; with the default affine map (seed 000's screen-space interpolation) the
-/// interpolated rays move checker edges, still within issue 3's targets, and the trilinear
+/// for both methods; with the default affine map (the screen-space interpolation of Vallance 2005) the
+/// interpolated rays move checker edges, still within the trilinear targets of docs/trilinear-raster.md, and the trilinear
 /// composite is the ray-cast composite but for edge pixels.
 #[test]
 fn compare_measures_the_composite_against_the_exact_mirror() {

@@ -114,7 +114,7 @@ pub struct CameraFrame {
     pub up: DVec3,
 }
 
-/// The vertices of a trilinear projection mesh (seed 000). Vertex `k` has a base point
+/// The vertices of a trilinear projection mesh (Vallance 2005). Vertex `k` has a base point
 /// `points[k]`, a ray direction `normals[k]` (not normalised: its length is the depth scale)
 /// and a screen position `screen[k]` in [0,1]^2 with (0,0) the bottom-left of the image.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -148,7 +148,7 @@ pub enum ProjectionSpec {
     },
     /// A mesh of trilinear projection triangles.
     Trilinear(TrilinearMesh),
-    /// A parametric viewing volume between control surfaces (seed 003); boxed, as it is
+    /// A parametric viewing volume between control surfaces (Brosz 2011); boxed, as it is
     /// much larger than the other variants.
     Flexible(Box<FlexibleSpec>),
 }

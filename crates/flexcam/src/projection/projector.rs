@@ -1,7 +1,7 @@
 //! The projector of an image position: the curve in the scene that the position sees along.
 //!
 //! Straight projectors are rays; the flexible projection's volumes blended in t over several
-//! control surfaces have curved ones (seed 003, 7.2): polylines (piecewise-linear blending)
+//! control surfaces have curved ones (Brosz 2011, 7.2): polylines (piecewise-linear blending)
 //! and quadratic Bezier curves (Bernstein blending of three surfaces). A renderer finds the
 //! first scene surface along the projector, in the order of its parameter, and reports the
 //! distance along the projector (arc length) as depth.

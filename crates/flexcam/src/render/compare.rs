@@ -6,7 +6,7 @@
 //!   both frames; it counts silhouette and visibility errors.
 //! - **depth error**: over the pixels where both frames hit the same object, the largest and
 //!   the mean of `|d - d_ref| / d_ref`; it counts geometric error inside shapes.
-//! - **relative RGB error** (the measure of seed 000, ch. 8): the mean over pixels and channels
+//! - **relative RGB error** (the measure of Vallance 2005, ch. 8): the mean over pixels and channels
 //!   of `|c - c_ref|`, divided by the mean over pixels and channels of `c_ref`.
 //!
 //! Degenerate cases: two empty frames agree perfectly (agreement 1, errors 0); a reference

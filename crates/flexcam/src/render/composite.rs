@@ -1,4 +1,4 @@
-//! Reflections and refractions through trilinear surfaces (seed 000, chapter 7), composited
+//! Reflections and refractions through trilinear surfaces (Vallance 2005, chapter 7), composited
 //! into the main image.
 //!
 //! The main view is rendered with the reflectors treated as diffuse (their pixels are
@@ -133,7 +133,7 @@ pub fn render(
 /// [`render`] does. With [`Method::Trilinear`] and reflectors, the main view (a perspective
 /// camera, which that method does not render) is rendered through
 /// [`perspective_as_trilinear`], the same pinhole as two projection triangles, so that the
-/// whole frame, main view and reflections, is rendered by the trilinear method (seed 000,
+/// whole frame, main view and reflections, is rendered by the trilinear method (Vallance 2005,
 /// chapter 7: the reflection surfaces are meant for the fast renderer). Without reflectors
 /// this is `method.render` unchanged (a perspective scene is still refused by the trilinear
 /// method). Errors: as [`render`].

@@ -19,7 +19,7 @@ pub enum Method {
     /// Rasterisation by the analytic inverse with subdivision (see
     /// [`crate::render::raster`]); projections with a continuous inverse only.
     Raster,
-    /// Trilinear rasterisation (seed 000), curved edges followed as `options.curves` says;
+    /// Trilinear rasterisation (Vallance 2005), curved edges followed as `options.curves` says;
     /// renders trilinear projections only.
     Trilinear,
 }

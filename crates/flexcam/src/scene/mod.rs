@@ -79,7 +79,7 @@ pub struct InputFile {
     pub path: PathBuf,
 }
 
-/// A mirror or glass object rendered through a trilinear surface (seed 000, chapter 7).
+/// A mirror or glass object rendered through a trilinear surface (Vallance 2005, chapter 7).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrilinearReflector {
     /// The object's id.

@@ -1,4 +1,4 @@
-//! Volumes of two or more control surfaces blended in t (seed 003, 4.2 and 7.2): curved
+//! Volumes of two or more control surfaces blended in t (Brosz 2011, 4.2 and 7.2): curved
 //! projectors.
 //!
 //! - [`PiecewiseVolume`]: Q(u, v, t) is linear in t between surfaces at knots t_0 = 0 < t_1 <

@@ -1,4 +1,4 @@
-//! The flexible projection (seed 003, Flexible Projection): a parametric viewing volume
+//! The flexible projection (Brosz 2011, Flexible Projection): a parametric viewing volume
 //! Q(u, v, t) between control surfaces, mapped to the image by a re-parameterisation.
 //!
 //! - [`control_surface`]: control surfaces Q_i(u, v) on the shared domain (u, v) in [0, 1]^2, u to the

@@ -1,4 +1,4 @@
-//! The projector-grid interface (seed 003, section 5.2): a viewing volume interpolated from a
+//! The projector-grid interface (Brosz 2011, section 5.2): a viewing volume interpolated from a
 //! small grid of explicitly placed projectors, the way the thesis reproduces a painting.
 //!
 //! Node (c, r) of a `cols x rows` grid sits at (u, v) = (c / (cols - 1), r / (rows - 1)): column

@@ -1,4 +1,4 @@
-//! The trilinear projection (seed 000) as a ray generator: a mesh of projection triangles
+//! The trilinear projection (Vallance 2005) as a ray generator: a mesh of projection triangles
 //! whose screen triangles tile (part of) the image.
 //!
 //! Vertex k has base point p_k, ray direction n_k and screen position S_k. A screen point at

@@ -1,4 +1,4 @@
-//! Analytic point projection for one trilinear projection triangle (seed 000, chapter 3, with
+//! Analytic point projection for one trilinear projection triangle (Vallance 2005, chapter 3, with
 //! the corrected formulas of notes/trilinear.md).
 //!
 //! A projection triangle has base points `p1, p2, p3` and (unnormalised) directions

@@ -1,6 +1,6 @@
 //! The projective (perspective-correct) map between a screen triangle and its projection
 //! triangle's barycentrics, for surfaces whose screen positions are a pinhole camera's image
-//! of their base points (reflection and refraction surfaces, seed 000 chapter 7).
+//! of their base points (reflection and refraction surfaces, Vallance 2005 chapter 7).
 //!
 //! The thesis interpolates in screen space (7.2.2): a screen point with affine barycentrics
 //! `l` in the screen triangle takes the ray at barycentrics `b = l`. When the screen

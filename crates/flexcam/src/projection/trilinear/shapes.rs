@@ -1,4 +1,4 @@
-//! Projecting a scene triangle through one trilinear projection triangle into shapes (seed 000,
+//! Projecting a scene triangle through one trilinear projection triangle into shapes (Vallance 2005,
 //! chapter 4, with the corrections of notes/trilinear.md, "Connecting projected vertices").
 //!
 //! # Why shapes

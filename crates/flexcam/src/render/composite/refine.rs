@@ -1,4 +1,4 @@
-//! Adaptive refinement of a reflector mesh before its trilinear surface is built (seed 000,
+//! Adaptive refinement of a reflector mesh before its trilinear surface is built (Vallance 2005,
 //! 7.2.2 leaves open "when and how much to tessellate").
 //!
 //! Between its vertices a reflection or refraction surface interpolates the vertex rays,

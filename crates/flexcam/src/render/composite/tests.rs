@@ -50,7 +50,7 @@ fn masked(frame: &Frame, reference: &Frame, id: u32) -> Frame {
     }
 }
 
-/// Agreement on the reflector's pixels: the comparison (relative RGB error of seed 000) and
+/// Agreement on the reflector's pixels: the comparison (relative RGB error of Vallance 2005) and
 /// the fraction of pixels with exactly the reference colour (flat colours are discrete).
 fn agreement(frame: &Frame, reference: &Frame, id: u32) -> (Comparison, f64) {
     let (a, b) = (
@@ -423,7 +423,7 @@ fn bad_reflectors_are_errors() {
     assert!(e.message.contains("need a perspective projection"), "{e}");
 }
 
-/// Finer reflector meshes approximate the mirror better (seed 000, Figure 7.4: the error
+/// Finer reflector meshes approximate the mirror better (Vallance 2005, Figure 7.4: the error
 /// falls as the projection surface is refined): the relative RGB error on the sphere's
 /// pixels decreases from 8 to 16 to 64 segments.
 #[test]
@@ -645,7 +645,7 @@ fn flat_mirror_scene(map: SurfaceScreenMap) -> Scene {
 /// Straight vertex rays (ior 1) and a flat mirror: with the projective screen map every
 /// main-image pixel's surface ray is the exact ray (the eye ray from the point it meets the
 /// plate on, or its mirror image), so the composite is the exact image up to rounding at
-/// colour edges, for the ray-cast and the trilinear composite; the affine map of seed 000
+/// colour edges, for the ray-cast and the trilinear composite; the affine map of Vallance 2005
 /// (7.2.2) misses by an order of magnitude more (docs/robustness.md, audit 3).
 #[test]
 fn projective_surfaces_are_exact_for_straight_rays_and_flat_mirrors() {

@@ -1,5 +1,5 @@
 //! `--method raster`: rasterisation of nonlinear projections by their analytic inverse
-//! (seed 003, 7.3 and 9.4).
+//! (Brosz 2011, 7.3 and 9.4).
 //!
 //! Per frame:
 //! 1. every scene vertex is projected once through the projection's continuous inverse

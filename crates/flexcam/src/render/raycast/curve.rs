@@ -1,4 +1,4 @@
-//! The first hit of a quadratic Bezier projector (seed 003, 7.2), found analytically and
+//! The first hit of a quadratic Bezier projector (Brosz 2011, 7.2), found analytically and
 //! accelerated by the BVH.
 //!
 //! Per triangle, the signed distance of B(s) = (1-s)^2 P0 + 2 s (1-s) P1 + s^2 P2 to the

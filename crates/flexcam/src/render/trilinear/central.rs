@@ -1,5 +1,5 @@
 //! Projection triangles whose rays all meet in one point, drawn exactly as central
-//! projections (the inward-looking sphere of seed 000, 6.3, whose rays all pass through its
+//! projections (the inward-looking sphere of Vallance 2005, 6.3, whose rays all pass through its
 //! centre).
 //!
 //! With every vertex ray through the focus `F` at one depth `t0 > 0` (`p_i + t0 n_i = F`),

@@ -1,4 +1,4 @@
-//! Clipping of a shape's outline (seed 000, 4.6 and chapter 5): to the view plane `t >= 0` and
+//! Clipping of a shape's outline (Vallance 2005, 4.6 and chapter 5): to the view plane `t >= 0` and
 //! to the projection triangle's domain `u >= 0`, `v >= 0`, `u + v <= 1`, by Sutherland-Hodgman
 //! against one half-space at a time.
 //!

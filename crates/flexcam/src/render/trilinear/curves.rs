@@ -1,4 +1,4 @@
-//! How the trilinear renderer follows the curved edges of projected scene triangles (seed 000,
+//! How the trilinear renderer follows the curved edges of projected scene triangles (Vallance 2005,
 //! section 4.5): the image of a straight scene edge under a trilinear projection is a curve,
 //! and a shape's polygon of vertex images only approximates it.
 //!
@@ -100,7 +100,7 @@ pub struct CurveOptions {
     /// Segments per scene edge (tessellate), slices per shape (slice) or the most segments
     /// per edge piece (adaptive); 1 to [`MAX_STEPS`].
     pub steps: u32,
-    /// Scene-space clipping (seed 000, chapter 5; the default): outlines get exact anchors
+    /// Scene-space clipping (Vallance 2005, chapter 5; the default): outlines get exact anchors
     /// where their scene edges cross the projection triangle's edge surfaces, so images are
     /// continuous across projection edges. Without it (the thesis's cheaper variant, timed
     /// by `flexcam bench trilinear`) outlines are clipped to the screen triangle by

@@ -1,4 +1,4 @@
-//! The exact image of a scene edge in one projection triangle, followed by depth (seed 000,
+//! The exact image of a scene edge in one projection triangle, followed by depth (Vallance 2005,
 //! sections 4.5 and 5).
 //!
 //! While a shape's polygon edge runs from an image of scene vertex `a` at depth `t_a` to the

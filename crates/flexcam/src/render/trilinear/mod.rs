@@ -1,4 +1,4 @@
-//! `--method trilinear`: the fast renderer of trilinear projections (seed 000, chapters 4
+//! `--method trilinear`: the fast renderer of trilinear projections (Vallance 2005, chapters 4
 //! and 5). Instead of casting a ray per pixel it projects the scene into each projection
 //! triangle and rasterises the result; docs/trilinear.md has the design and measurements.
 //!

@@ -1,4 +1,4 @@
-//! A view plane for projection triangles whose base collapses (seed 000, 4.6).
+//! A view plane for projection triangles whose base collapses (Vallance 2005, 4.6).
 //!
 //! View-plane clipping cuts every shape at `t = 0`, the plane of the base triangle, through
 //! the exact crossing of each scene edge with that plane. When the base points coincide (a

@@ -1,4 +1,4 @@
-//! `projectors = { ... }` in a flexible projection: a projector grid (seed 003, 5.2) sampled
+//! `projectors = { ... }` in a flexible projection: a projector grid (Brosz 2011, 5.2) sampled
 //! from the projection's own volume, with node projectors placed explicitly (optionally
 //! curved by a tangent), re-aimed node by node and fitted to point correspondences (with
 //! tangents: curved projectors fitted). See scenes/README.md.

@@ -109,7 +109,7 @@ pub(super) fn analytic_mesh(
 }
 
 /// A box centred on the origin whose faces are `tessellation` x `tessellation` grids, built
-/// from six planes so that faces can be subdivided (as the 686-triangle cube scene of seed 000
+/// from six planes so that faces can be subdivided (as the 686-triangle cube scene of Vallance 2005
 /// needs) and coloured one by one.
 fn tessellated_box(size: Vec3, tessellation: u32, face_colors: Option<[Vec3; 6]>) -> Mesh {
     let mut mesh = Mesh::default();

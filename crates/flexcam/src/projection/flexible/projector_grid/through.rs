@@ -1,4 +1,4 @@
-//! The thesis's projector construction (seed 003, 5.2.1): a node projector given by its start
+//! The thesis's projector construction (Brosz 2011, 5.2.1): a node projector given by its start
 //! p_n, the scene point p_i it must pass through, an optional tangent v *at p_i* (only its
 //! direction counts) and the distance D of its end from p_n, converted to the grid's own node
 //! form (start, end, unit tangent at the start) so that rendering, ray casting, fitting and the

@@ -66,7 +66,7 @@ pub fn screen_grid(n: u32, vertex: impl Fn(DVec2) -> GridVertex) -> Result<Trili
     Ok(mesh)
 }
 
-/// The base of a flexible volume between two control surfaces (seed 003's linear volume):
+/// The base of a flexible volume between two control surfaces (the linear volume of Brosz 2011):
 /// screen position `s` is the domain point (u, v) = `s`, its base point is `near(s)` and its
 /// ray runs to `far(s)`, so the trilinear grid samples the volume's projectors at the grid
 /// vertices and interpolates between them. The direction is zero where the surfaces meet

@@ -1,4 +1,4 @@
-//! Reflection and refraction surfaces (seed 000, chapter 7): a trilinear projection whose
+//! Reflection and refraction surfaces (Vallance 2005, chapter 7): a trilinear projection whose
 //! base triangles are a reflector's (or lens's) triangles and whose vertex rays are the
 //! reflected (refracted) rays of the eye's rays at the vertices.
 //!
@@ -73,7 +73,7 @@ pub enum SurfaceScreenMap {
     /// mirrors seen from close by and strong lenses worse than the affine map
     /// (docs/trilinear-surfaces.md).
     Projective,
-    /// Screen-space interpolation as in seed 000, 7.2.2, with unit vertex rays as in the
+    /// Screen-space interpolation as in Vallance 2005, 7.2.2, with unit vertex rays as in the
     /// thesis: exact at the vertices only. The default.
     #[default]
     Affine,

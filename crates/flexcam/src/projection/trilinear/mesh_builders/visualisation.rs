@@ -1,4 +1,4 @@
-//! The visualisation surfaces of seed 000, chapter 6: detail in context (6.1), multiple
+//! The visualisation surfaces of Vallance 2005, chapter 6: detail in context (6.1), multiple
 //! perspectives joined by a transition band (6.2) and the inward-looking sphere (6.3).
 
 use glam::{DVec2, DVec3};
