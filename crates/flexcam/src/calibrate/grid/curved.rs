@@ -722,18 +722,7 @@ impl<'a> Problem<'a> {
                 off.atan2((on - p[0]).length()).to_degrees()
             })
             .collect();
-        let count = angles.len();
-        FitReport {
-            correspondences: count,
-            unconstrained_nodes: grid.starts().len() - self.free.len(),
-            max_angle_deg: angles.iter().copied().fold(0.0, f64::max),
-            rms_angle_deg: if count == 0 {
-                0.0
-            } else {
-                (angles.iter().map(|a| a * a).sum::<f64>() / count as f64).sqrt()
-            },
-            ..FitReport::default()
-        }
+        FitReport::from_angles(&angles, grid.starts().len() - self.free.len())
     }
 }
 

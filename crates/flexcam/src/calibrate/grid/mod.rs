@@ -154,6 +154,24 @@ pub struct FitReport {
 }
 
 impl FitReport {
+    /// The report of a fit whose projectors miss their points by `angles` (degrees, one per
+    /// correspondence), with `unconstrained_nodes` nodes no correspondence reaches; the other
+    /// fields at their defaults. No angles give a largest and RMS angle of 0.
+    pub(crate) fn from_angles(angles: &[f64], unconstrained_nodes: usize) -> FitReport {
+        let count = angles.len();
+        FitReport {
+            correspondences: count,
+            unconstrained_nodes,
+            max_angle_deg: angles.iter().copied().fold(0.0, f64::max),
+            rms_angle_deg: if count == 0 {
+                0.0
+            } else {
+                (angles.iter().map(|a| a * a).sum::<f64>() / count as f64).sqrt()
+            },
+            ..FitReport::default()
+        }
+    }
+
     /// The model in words, for `flexcam fit`'s line and the written header: the starts, and
     /// for the free fit the smoothness weight the data chose.
     pub fn model(&self) -> String {

@@ -401,16 +401,5 @@ pub(super) fn residual(
             d.cross(*a).length().atan2(d.dot(*a)).to_degrees()
         })
         .collect();
-    let count = angles.len();
-    FitReport {
-        correspondences: count,
-        unconstrained_nodes: constrained.iter().filter(|c| !**c).count(),
-        max_angle_deg: angles.iter().copied().fold(0.0, f64::max),
-        rms_angle_deg: if count == 0 {
-            0.0
-        } else {
-            (angles.iter().map(|a| a * a).sum::<f64>() / count as f64).sqrt()
-        },
-        ..FitReport::default()
-    }
+    FitReport::from_angles(&angles, constrained.iter().filter(|c| !**c).count())
 }
