@@ -23,12 +23,14 @@
 mod collapse;
 mod fan;
 mod halfedge;
+mod obj;
 mod polymesh;
 mod split;
 mod sweep;
 
 pub use collapse::CollapseKind;
 pub use halfedge::{Defect, HalfEdge, HalfEdgeMesh, NONE};
+pub use obj::{write_obj, ObjPolygons};
 pub use polymesh::{polygon_normal, PolyMesh};
 pub use split::{Simplified, SplitVertex, VertexSplit};
 pub use sweep::{simplify, SimplifyOptions};

@@ -64,16 +64,13 @@ pub fn simplify(mesh: &PolyMesh, options: &SimplifyOptions) -> Result<Simplified
         let mut altered = vec![false; work.mesh.faces.len()];
         let before = splits.len();
         while !pool.is_empty() && work.live_faces > options.target_faces {
-            let mut picks: Vec<usize> = if pool.len() <= draws {
-                (0..pool.len()).collect()
-            } else {
-                (0..draws).map(|_| rng.below(pool.len())).collect()
-            };
-            picks.sort_unstable();
-            picks.dedup();
+            // Draws with replacement: an edge drawn twice is evaluated once (cached).
+            let all = pool.len() <= draws;
+            let count = if all { pool.len() } else { draws };
             let mut dropped = Vec::new();
             let mut best: Option<(f32, usize, bool)> = None;
-            for &i in &picks {
+            for k in 0..count {
+                let i = if all { k } else { rng.below(pool.len()) };
                 let c = &mut pool[i];
                 let stale = c.faces.iter().any(|&f| {
                     f != NONE && (altered[f as usize] || work.mesh.faces[f as usize].is_empty())
@@ -102,6 +99,7 @@ pub fn simplify(mesh: &PolyMesh, options: &SimplifyOptions) -> Result<Simplified
                 dropped.push(i);
             }
             dropped.sort_unstable_by(|x, y| y.cmp(x));
+            dropped.dedup();
             for i in dropped {
                 pool.swap_remove(i);
             }
