@@ -95,8 +95,8 @@ pub fn run(args: &SimplifyArgs) -> Result<()> {
         "splits": simplified.splits.len(),
         "sweeps": simplified.sweeps,
         "collapse": match args.collapse { CollapseArg::Full => "full", CollapseArg::Half => "half" },
-        "threshold_degrees": args.threshold,
-        "candidate_fraction": args.candidates,
+        "threshold_degrees": decimal(args.threshold),
+        "candidate_fraction": decimal(args.candidates),
         "seed": args.seed,
         "dropped_attributes": obj.dropped,
         "read_ms": read_ms,
@@ -145,4 +145,9 @@ fn options(args: &SimplifyArgs) -> Result<SimplifyOptions> {
         seed: args.seed,
         ..SimplifyOptions::to_faces(0)
     })
+}
+
+/// An `f32` flag value as the decimal it was typed as (0.01, not 0.009999999776482582).
+fn decimal(x: f32) -> f64 {
+    x.to_string().parse().unwrap_or(f64::NAN)
 }
