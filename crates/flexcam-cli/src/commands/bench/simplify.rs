@@ -12,10 +12,9 @@
 use std::path::Path;
 
 use clap::Args;
-use flexcam::displace::simplify::{simplify, ObjPolygons, PolyMesh, SimplifyOptions};
+use flexcam::displace::simplify::{closed_torus, simplify, ObjPolygons, PolyMesh, SimplifyOptions};
 use flexcam::scene::shapes::teapot;
 use flexcam::{Error, Result};
-use glam::Vec3;
 
 use super::timing::measure;
 
@@ -97,41 +96,11 @@ fn meshes() -> Result<Vec<(String, PolyMesh)>> {
     }
     out.push((
         "torus, 100 x 50 quads".to_string(),
-        closed_torus(100, 50, false),
+        closed_torus(1.0, 0.4, 100, 50, false),
     ));
     out.push((
         "torus, 2 x 320 x 160 triangles".to_string(),
-        closed_torus(320, 160, true),
+        closed_torus(1.0, 0.4, 320, 160, true),
     ));
     Ok(out)
-}
-
-/// A closed torus (radii 1 and 0.4) of `m` x `n` quads, or of twice as many triangles.
-fn closed_torus(m: u32, n: u32, triangles: bool) -> PolyMesh {
-    let mut mesh = PolyMesh::default();
-    for i in 0..m {
-        for j in 0..n {
-            let (u, v) = (
-                i as f32 / m as f32 * std::f32::consts::TAU,
-                j as f32 / n as f32 * std::f32::consts::TAU,
-            );
-            let normal = Vec3::new(u.cos() * v.cos(), u.sin() * v.cos(), v.sin());
-            mesh.positions
-                .push(Vec3::new(u.cos(), u.sin(), 0.0) + normal * 0.4);
-            mesh.normals.push(normal);
-        }
-    }
-    let at = |i: u32, j: u32| (i % m) * n + j % n;
-    for i in 0..m {
-        for j in 0..n {
-            let q = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
-            if triangles {
-                mesh.faces.push(vec![q[0], q[1], q[2]]);
-                mesh.faces.push(vec![q[0], q[2], q[3]]);
-            } else {
-                mesh.faces.push(q.to_vec());
-            }
-        }
-    }
-    mesh
 }

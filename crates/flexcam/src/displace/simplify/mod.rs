@@ -31,7 +31,7 @@ mod sweep;
 pub use collapse::CollapseKind;
 pub use halfedge::{Defect, HalfEdge, HalfEdgeMesh, NONE};
 pub use obj::{write_obj, ObjPolygons};
-pub use polymesh::{polygon_normal, PolyMesh};
+pub use polymesh::{closed_torus, polygon_normal, PolyMesh};
 pub use split::{Simplified, SplitVertex, VertexSplit};
 pub use sweep::{simplify, SimplifyOptions};
 

@@ -66,6 +66,39 @@ impl PolyMesh {
     }
 }
 
+/// A closed torus about the z axis (tube radius `minor` around a circle of radius `major`)
+/// of `m` x `n` quads, or twice as many triangles, with outward unit normals. Unlike
+/// [`crate::scene::shapes::torus`], whose texture seams are open, it is welded: a surface of
+/// genus one without boundary, as simplification tests and benches need.
+pub fn closed_torus(major: f32, minor: f32, m: u32, n: u32, triangles: bool) -> PolyMesh {
+    let mut mesh = PolyMesh::default();
+    for i in 0..m {
+        for j in 0..n {
+            let (u, v) = (
+                i as f32 / m as f32 * std::f32::consts::TAU,
+                j as f32 / n as f32 * std::f32::consts::TAU,
+            );
+            let normal = Vec3::new(u.cos() * v.cos(), u.sin() * v.cos(), v.sin());
+            mesh.positions
+                .push(Vec3::new(u.cos(), u.sin(), 0.0) * major + normal * minor);
+            mesh.normals.push(normal);
+        }
+    }
+    let at = |i: u32, j: u32| (i % m) * n + j % n;
+    for i in 0..m {
+        for j in 0..n {
+            let q = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+            if triangles {
+                mesh.faces.push(vec![q[0], q[1], q[2]]);
+                mesh.faces.push(vec![q[0], q[2], q[3]]);
+            } else {
+                mesh.faces.push(q.to_vec());
+            }
+        }
+    }
+    mesh
+}
+
 /// Newell's normal of the polygon with vertices `face` at positions `position(v)`: twice its
 /// area times its unit normal for a planar polygon, convex or not; the least-squares plane
 /// normal otherwise. For a triangle it is the cross product of two edges, as in the

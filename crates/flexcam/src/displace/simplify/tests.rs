@@ -45,29 +45,9 @@ fn grid(w: u32, h: u32, triangles: bool, jitter: f32, bump: f32, seed: u64) -> P
     mesh
 }
 
-/// A closed torus of `m` x `n` quads (radii 2 and 0.7), with outward normals.
+/// A closed torus of `m` x `n` quads (radii 2 and 0.7).
 fn torus(m: u32, n: u32) -> PolyMesh {
-    let mut mesh = PolyMesh::default();
-    for i in 0..m {
-        for j in 0..n {
-            let (u, v) = (
-                i as f32 / m as f32 * std::f32::consts::TAU,
-                j as f32 / n as f32 * std::f32::consts::TAU,
-            );
-            let normal = Vec3::new(u.cos() * v.cos(), u.sin() * v.cos(), v.sin());
-            let centre = Vec3::new(u.cos(), u.sin(), 0.0) * 2.0;
-            mesh.positions.push(centre + normal * 0.7);
-            mesh.normals.push(normal);
-        }
-    }
-    let at = |i: u32, j: u32| (i % m) * n + j % n;
-    for i in 0..m {
-        for j in 0..n {
-            mesh.faces
-                .push(vec![at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
-        }
-    }
-    mesh
+    closed_torus(2.0, 0.7, m, n, false)
 }
 
 /// A closed prism over a regular `k`-gon: two k-gon caps and k quads.
