@@ -42,3 +42,25 @@ pub fn print_stdout(text: &str) -> flexcam::Result<()> {
         .and_then(|()| out.flush())
         .map_err(|e| flexcam::Error::new(format!("cannot write to standard output: {e}")))
 }
+
+/// Finishes a command with a `--stats FILE|-` flag: the JSON line `json` is staged as the
+/// output `file` (declared for a file target) and every output committed together, or, for
+/// `-`, printed once the outputs are committed.
+pub fn commit_with_stats(
+    mut outputs: flexcam::image_io::OutputSet,
+    file: Option<flexcam::image_io::OutputId>,
+    target: Option<&crate::OutputTarget>,
+    json: &str,
+) -> flexcam::Result<()> {
+    let line = format!("{json}\n");
+    if let Some(id) = file {
+        outputs.stage(id, |tmp| {
+            flexcam::image_io::write_bytes(tmp, line.as_bytes())
+        })?;
+    }
+    outputs.commit()?;
+    if let Some(crate::OutputTarget::Stdout) = target {
+        print_stdout(&line)?;
+    }
+    Ok(())
+}

@@ -130,14 +130,5 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         render_ms,
     };
     let json = stats_json::to_json(&facts, &counters).to_string();
-    if let Some(id) = stats {
-        outputs.stage(id, |tmp| {
-            image_io::write_bytes(tmp, format!("{json}\n").as_bytes())
-        })?;
-    }
-    outputs.commit()?;
-    if let Some(OutputTarget::Stdout) = &args.stats {
-        super::print_stdout(&format!("{json}\n"))?;
-    }
-    Ok(())
+    super::commit_with_stats(outputs, stats, args.stats.as_ref(), &json)
 }

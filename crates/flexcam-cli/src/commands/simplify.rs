@@ -102,16 +102,7 @@ pub fn run(args: &SimplifyArgs) -> Result<()> {
         "read_ms": read_ms,
         "simplify_ms": simplify_ms,
     });
-    if let Some(id) = stats {
-        outputs.stage(id, |tmp| {
-            image_io::write_bytes(tmp, format!("{json}\n").as_bytes())
-        })?;
-    }
-    outputs.commit()?;
-    if let Some(OutputTarget::Stdout) = &args.stats {
-        super::print_stdout(&format!("{json}\n"))?;
-    }
-    Ok(())
+    super::commit_with_stats(outputs, stats, args.stats.as_ref(), &json.to_string())
 }
 
 /// The options the flags give, target aside; refuses values out of range.

@@ -173,34 +173,6 @@ impl HalfEdgeMesh {
         Ok(he)
     }
 
-    /// The vertex a half-edge ends at.
-    pub fn target(&self, h: u32) -> u32 {
-        self.half_edges[self.half_edges[h as usize].next as usize].origin
-    }
-
-    /// The half-edge before `h` around its face.
-    pub fn prev(&self, h: u32) -> u32 {
-        let mut p = h;
-        loop {
-            let n = self.half_edges[p as usize].next;
-            if n == h {
-                return p;
-            }
-            p = n;
-        }
-    }
-
-    /// The half-edges of a face, in order.
-    pub fn face_half_edges(&self, f: u32) -> impl Iterator<Item = u32> + '_ {
-        let start = self.face_start[f as usize];
-        let end = self
-            .face_start
-            .get(f as usize + 1)
-            .copied()
-            .unwrap_or(self.half_edges.len() as u32);
-        start..end
-    }
-
     /// Whether a vertex lies on the boundary (or is used by no face).
     pub fn is_boundary_vertex(&self, v: u32) -> bool {
         self.boundary[v as usize]

@@ -88,15 +88,21 @@ pub fn closed_torus(major: f32, minor: f32, m: u32, n: u32, triangles: bool) -> 
     for i in 0..m {
         for j in 0..n {
             let q = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
-            if triangles {
-                mesh.faces.push(vec![q[0], q[1], q[2]]);
-                mesh.faces.push(vec![q[0], q[2], q[3]]);
-            } else {
-                mesh.faces.push(q.to_vec());
-            }
+            push_cell(&mut mesh.faces, q, triangles);
         }
     }
     mesh
+}
+
+/// Adds the grid cell `q` (corners counter-clockwise) as one quad, or as two triangles split
+/// along its diagonal from `q[0]`.
+pub(super) fn push_cell(faces: &mut Vec<Vec<u32>>, q: [u32; 4], triangles: bool) {
+    if triangles {
+        faces.push(vec![q[0], q[1], q[2]]);
+        faces.push(vec![q[0], q[2], q[3]]);
+    } else {
+        faces.push(q.to_vec());
+    }
 }
 
 /// Newell's normal of the polygon with vertices `face` at positions `position(v)`: twice its

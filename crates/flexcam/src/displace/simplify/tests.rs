@@ -34,12 +34,7 @@ fn grid(w: u32, h: u32, triangles: bool, jitter: f32, bump: f32, seed: u64) -> P
     for j in 0..h {
         for i in 0..w {
             let q = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
-            if triangles {
-                mesh.faces.push(vec![q[0], q[1], q[2]]);
-                mesh.faces.push(vec![q[0], q[2], q[3]]);
-            } else {
-                mesh.faces.push(q.to_vec());
-            }
+            polymesh::push_cell(&mut mesh.faces, q, triangles);
         }
     }
     mesh
