@@ -53,6 +53,7 @@ impl Method {
         if options.spp == 0 {
             return Err(Error::new("samples per pixel must be at least 1"));
         }
+        prepared.check_displaced_renders(self, projection)?;
         match self {
             Method::Raycast => Ok(raycast::render(prepared, projection, options)),
             Method::Raster => Ok(InverseRaster::new(prepared, projection, options)?.render()),
