@@ -23,14 +23,14 @@ use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
 
-use crate::displace::{BaseVertex, DisplacedTriangle, Displacement, MicroHit, MicroTriangle};
+use crate::displace::{base_corners, DisplacedTriangle, Displacement, MicroHit, MicroTriangle};
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
 use crate::projection::{Projection, Projector};
 use crate::render::prepared::{Hit, Hit32, PreparedScene};
 use crate::render::shading::Normals;
 use crate::render::Method;
-use crate::scene::{Object, Scene};
+use crate::scene::Scene;
 
 /// Most base triangles per leaf.
 const LEAF: usize = 2;
@@ -82,7 +82,8 @@ impl DisplacedSet {
             };
             for triangle in 0..object.mesh.triangles.len() {
                 let [lo, hi] =
-                    DisplacedTriangle::new(corners(object, triangle), displacement).bounds();
+                    DisplacedTriangle::new(base_corners(&object.mesh, triangle), displacement)
+                        .bounds();
                 boxed.push(([index as u32, triangle as u32], lo, hi));
             }
         }
@@ -118,7 +119,10 @@ impl DisplacedSet {
         triangle: usize,
         displacement: &'a Displacement,
     ) -> DisplacedTriangle<'a> {
-        DisplacedTriangle::new(corners(&scene.objects[object], triangle), displacement)
+        DisplacedTriangle::new(
+            base_corners(&scene.objects[object].mesh, triangle),
+            displacement,
+        )
     }
 
     /// The nearest micro-triangle hit of `ray` with `t` in `[ray.t_min, min(ray.t_max,
@@ -311,23 +315,6 @@ impl Slabs {
     }
 }
 
-/// The base vertices of triangle `triangle` of `object` (world space, f64); a zero vertex
-/// normal (the mesh's "use the face normal") is the face normal.
-fn corners(object: &Object, triangle: usize) -> [BaseVertex; 3] {
-    let mesh = &object.mesh;
-    let indices = mesh.triangles[triangle].map(|i| i as usize);
-    let [p0, p1, p2] = indices.map(|i| mesh.positions[i].as_dvec3());
-    let face = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-    indices.map(|i| {
-        let normal = mesh.normals[i].as_dvec3();
-        BaseVertex {
-            position: mesh.positions[i].as_dvec3(),
-            normal: if normal == DVec3::ZERO { face } else { normal },
-            uv: mesh.uvs[i].as_dvec2(),
-        }
-    })
-}
-
 impl PreparedScene {
     /// The displaced hit `found` as a hit of the prepared scene: base triangle and base
     /// barycentrics (module docs).
@@ -477,3 +464,6 @@ impl PreparedScene {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests;
