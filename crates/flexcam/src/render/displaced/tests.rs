@@ -192,3 +192,70 @@ fn methods_that_draw_base_triangles_refuse_displaced_objects() {
         .frame;
     assert!(frame.ids.contains(&1) && frame.ids.contains(&2) && frame.ids.contains(&3));
 }
+
+/// Polyline projectors (with the tile culling that tests whole tiles against the scene)
+/// see the displaced micro-geometry: every pixel's id is that of a brute-force search of the
+/// pixel's segments in order, every micro-triangle tested.
+#[test]
+fn polyline_projectors_see_the_micro_geometry() {
+    use crate::projection::Projector;
+    use crate::render::raycast::pieces::polyline_segment;
+
+    let text = r#"
+[image]
+width = 48
+height = 36
+
+[projection]
+type = "flexible"
+preset = "ortho_near_persp_far"
+position = [0.0, 5.5, 7.0]
+look_at = [0.0, 0.4, 0.0]
+fov = 50.0
+transition = 8.0
+clip = [0.0, 30.0]
+style = "piecewise"
+
+[[object]]
+shape = "torus"
+size = [1.5, 0.5]
+tessellation = 7
+translate = [0.0, 0.5, 0.0]
+displacement = { procedural = "waves", waves = [[1.0, 8, 0, 0.0], [1.0, 0, 4, 0.0]], scale = 0.3, level = 2 }
+"#;
+    let scene = parse(text, Path::new("poly.toml")).unwrap();
+    let prepared = PreparedScene::new(&scene);
+    let projection = scene.projection.build(48, 36).unwrap();
+    let options = RenderOptions {
+        shading: Shading::Flat,
+        ..RenderOptions::default()
+    };
+    let frame = render(&prepared, projection.as_ref(), &options)
+        .unwrap()
+        .frame;
+    let object = &scene.objects[0];
+    let d = Displacement::from_spec(object.displacement.as_deref().unwrap());
+    let grids: Vec<MicroGrid> = (0..object.mesh.triangles.len())
+        .map(|k| MicroGrid::new(&base_corners(&object.mesh, k), &d))
+        .collect();
+    let mut hits = 0;
+    for y in 0..36u32 {
+        for x in 0..48u32 {
+            let pixel = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+            let Some(Projector::Polyline(points)) = projection.projector(pixel) else {
+                panic!("not a polyline at {pixel}");
+            };
+            let hit = (0..points.len() - 1).any(|k| {
+                let segment = polyline_segment(&points, k);
+                grids.iter().any(|g| g.intersect(&segment).is_some())
+            });
+            hits += hit as u32;
+            assert_eq!(
+                frame.ids[(y * 48 + x) as usize],
+                hit as u32,
+                "pixel ({x}, {y})"
+            );
+        }
+    }
+    assert!(hits > 100, "{hits}");
+}
