@@ -1508,7 +1508,6 @@ fn trilinear_inward_sphere_is_drawn_as_central_projections() {
 #[test]
 fn displaced_renders_hit_the_micro_triangles_brute_force_finds() {
     use flexcam::displace::{base_corners, Displacement, MicroGrid};
-    use flexcam::projection::Projection;
 
     let dir = TempDir::new().unwrap();
     let (width, height) = (40u32, 32u32);

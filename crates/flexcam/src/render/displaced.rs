@@ -11,6 +11,7 @@
 //! Memory per base triangle: its object and index, a share of the tree's boxes (about 120
 //! bytes in all); the micro-geometry is recomputed per ray from the mesh.
 //!
+//! The prepared scene's queries over this set are in `render::prepared::displaced_hits`.
 //! A hit is reported on the base triangle, as any hit is: `triangle` is the base triangle,
 //! `barycentric` the base-triangle weights of the hit point's place in the subdivision (the
 //! micro-triangle's grid position blended by the micro-hit's barycentrics), so texture
@@ -21,15 +22,10 @@
 
 use std::sync::Arc;
 
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 
-use crate::displace::{base_corners, DisplacedTriangle, Displacement, MicroHit, MicroTriangle};
-use crate::error::{Error, Result};
+use crate::displace::{base_corners, DisplacedTriangle, Displacement, MicroHit};
 use crate::geometry::Ray;
-use crate::projection::{Projection, Projector};
-use crate::render::prepared::{Hit, Hit32, PreparedScene};
-use crate::render::shading::Normals;
-use crate::render::Method;
 use crate::scene::Scene;
 
 /// Most base triangles per leaf.
@@ -112,7 +108,7 @@ impl DisplacedSet {
     }
 
     /// Base triangle `triangle` of object `object` (displaced) with its displacement.
-    fn triangle<'a>(
+    pub fn triangle<'a>(
         &'a self,
         scene: &Scene,
         object: usize,
@@ -129,18 +125,14 @@ impl DisplacedSet {
     /// limit)]`; on equal `t`, the lower object, then the lower base triangle. With `any`,
     /// the first hit found.
     pub fn closest(&self, scene: &Scene, ray: &Ray, limit: f64, any: bool) -> Option<DisplacedHit> {
-        let Some(slabs) = Slabs::new(ray) else {
-            return None;
-        };
+        let slabs = Slabs::new(ray)?;
         let mut t_max = ray.t_max.min(limit);
         let mut best: Option<DisplacedHit> = None;
         // At most one pending node per level; median splits keep the tree under 40 deep.
         let mut stack = [(0u32, 0.0f64); STACK];
         let mut depth = 0;
         let root = self.nodes.first()?;
-        if slabs.entry(root, ray.t_min, t_max).is_none() {
-            return None;
-        }
+        slabs.entry(root, ray.t_min, t_max)?;
         let mut current = 0u32;
         loop {
             let node = self.nodes[current as usize];
@@ -312,156 +304,6 @@ impl Slabs {
         }
         let slack = 1e-12 * far.abs().max(near.abs());
         (near <= far + slack).then_some(near)
-    }
-}
-
-impl PreparedScene {
-    /// The displaced hit `found` as a hit of the prepared scene: base triangle and base
-    /// barycentrics (module docs).
-    pub(in crate::render) fn displaced_hit32(&self, found: DisplacedHit) -> Hit32 {
-        Hit32 {
-            t: found.micro.t as f32,
-            object: found.object,
-            triangle: found.triangle,
-            barycentric: self.base_barycentric(&found).as_vec2(),
-        }
-    }
-
-    fn base_barycentric(&self, found: &DisplacedHit) -> DVec2 {
-        let level = self
-            .displaced
-            .as_ref()
-            .and_then(|d| d.displacement(found.object))
-            .map_or(0, Displacement::level);
-        found
-            .micro
-            .triangle
-            .base_barycentric(level, found.micro.barycentric)
-    }
-
-    /// [`PreparedScene::intersect_f32`]'s hit `found` (from the triangle BVH) or a nearer
-    /// one on a displaced object.
-    #[inline]
-    pub(in crate::render) fn nearer_displaced(
-        &self,
-        ray: &Ray,
-        found: Option<Hit32>,
-    ) -> Option<Hit32> {
-        let Some(set) = &self.displaced else {
-            return found;
-        };
-        let limit = found.map_or(f64::INFINITY, |f| f.t as f64);
-        // On equal distance the triangle BVH's hit stays.
-        match set.closest(&self.scene, ray, limit, false) {
-            Some(d) if d.micro.t < limit => Some(self.displaced_hit32(d)),
-            _ => found,
-        }
-    }
-
-    /// Whether a displaced object blocks `ray` (the shadow-ray query's second half).
-    pub(in crate::render) fn displaced_occludes(&self, ray: &Ray) -> bool {
-        self.displaced
-            .as_ref()
-            .is_some_and(|set| set.closest(&self.scene, ray, f64::INFINITY, true).is_some())
-    }
-
-    /// The f64 hit of `ray` on displaced base triangle `found` (searched again in f64); `None`
-    /// when `found` is not on a displaced object.
-    pub(in crate::render) fn refine_displaced(&self, ray: &Ray, found: Hit32) -> Option<Hit> {
-        let set = self.displaced.as_ref()?;
-        let displacement = set.displacement(found.object)?;
-        let hit = set
-            .triangle(&self.scene, found.object, found.triangle, displacement)
-            .intersect(ray);
-        Some(match hit {
-            Some(micro) => {
-                let d = DisplacedHit {
-                    object: found.object,
-                    triangle: found.triangle,
-                    micro,
-                };
-                Hit {
-                    t: micro.t,
-                    object: found.object,
-                    triangle: found.triangle,
-                    barycentric: self.base_barycentric(&d).as_vec2(),
-                }
-            }
-            // Not found again (cannot happen: the same f64 search); keep the f32 values.
-            None => Hit {
-                t: found.t as f64,
-                object: found.object,
-                triangle: found.triangle,
-                barycentric: found.barycentric,
-            },
-        })
-    }
-
-    /// The normals at `hit` on a displaced object, seen along `incoming`: the face normal of
-    /// the micro-triangle holding the hit (module docs); `None` when the object is not
-    /// displaced.
-    pub(in crate::render) fn displaced_normals(
-        &self,
-        hit: &Hit,
-        incoming: DVec3,
-    ) -> Option<Normals> {
-        let set = self.displaced.as_ref()?;
-        let displacement = set.displacement(hit.object)?;
-        let micro = MicroTriangle::containing(displacement.level(), hit.barycentric.as_dvec2());
-        let [a, b, c] = set
-            .triangle(&self.scene, hit.object, hit.triangle, displacement)
-            .positions(micro);
-        let face = (b - a).cross(c - a).normalize_or_zero().as_vec3();
-        let front_face = face.dot(incoming.as_vec3()) <= 0.0;
-        let geometric = if front_face { face } else { -face };
-        Some(Normals {
-            geometric,
-            shading: geometric,
-            front_face,
-        })
-    }
-
-    /// Whether object `object` is displaced.
-    pub fn is_displaced(&self, object: usize) -> bool {
-        self.displaced
-            .as_ref()
-            .is_some_and(|set| set.displacement(object).is_some())
-    }
-
-    /// Fails, naming the first displaced object, where `method` cannot render this scene's
-    /// displaced objects through `projection`: `raster` and `trilinear` draw base triangles
-    /// (they are refused rather than showing the undisplaced surface), and the ray caster
-    /// does not trace quadratic Bezier projectors through micro-geometry (the projector of
-    /// the image centre decides: a projection's projectors are all of one kind).
-    pub(in crate::render) fn check_displaced_renders(
-        &self,
-        method: Method,
-        projection: &dyn Projection,
-    ) -> Result<()> {
-        let Some(set) = &self.displaced else {
-            return Ok(());
-        };
-        let Some(name) = (0..self.scene.objects.len())
-            .find(|&i| set.displacement(i).is_some())
-            .map(|i| self.scene.objects[i].name.as_str())
-        else {
-            return Ok(());
-        };
-        if method != Method::Raycast {
-            return Err(Error::new(format!(
-                "object \"{name}\" is displaced, and displaced objects render with --method \
-                 raycast only (method {method} would draw the undisplaced triangles)"
-            )));
-        }
-        let (width, height) = projection.resolution();
-        let centre = DVec2::new(width as f64 / 2.0, height as f64 / 2.0);
-        if let Some(Projector::QuadraticBezier(_)) = projection.projector(centre) {
-            return Err(Error::new(format!(
-                "object \"{name}\" is displaced, and displaced objects are not traced along \
-                 quadratic projectors (use straight or polyline projectors)"
-            )));
-        }
-        Ok(())
     }
 }
 

@@ -24,6 +24,8 @@ use crate::render::bvh::{Bvh, BvhHit};
 use crate::render::displaced::DisplacedSet;
 use crate::scene::Scene;
 
+mod displaced_hits;
+
 /// The first surface a ray meets.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hit {

@@ -3,8 +3,8 @@ use std::path::Path;
 use glam::{DVec2, DVec3};
 
 use super::*;
-use crate::displace::MicroGrid;
-use crate::render::{render, RenderOptions, Shading};
+use crate::displace::{MicroGrid, MicroTriangle};
+use crate::render::{render, Method, PreparedScene, RenderOptions, Shading};
 use crate::scene::file::parse;
 
 /// Two displaced tori (waves and bumps) crossing each other, and an undisplaced box that
