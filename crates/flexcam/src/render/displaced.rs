@@ -8,7 +8,7 @@
 //! others) search both, the triangle BVH first, then this set up to the hit found there. The
 //! set is a binary tree over the shells' boxes (median splits of the box centres along the
 //! widest axis, leaves of at most [`LEAF`] base triangles), searched in f64 front to back.
-//! Memory per base triangle: its object and index, a share of the tree's boxes (about 120
+//! Memory per base triangle: its object and index, a share of the tree's boxes (about 80
 //! bytes in all); the micro-geometry is recomputed per ray from the mesh.
 //!
 //! The prepared scene's queries over this set are in `render::prepared::displaced_hits`.
