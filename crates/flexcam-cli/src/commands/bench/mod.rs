@@ -1,5 +1,6 @@
 //! `flexcam bench`: the source documents' timing tables, rerun with flexcam's renderers.
 
+pub mod displaced;
 pub mod flexible;
 pub mod simplify;
 mod timing;
@@ -11,13 +12,17 @@ use flexcam::Result;
 /// Which table to measure.
 #[derive(Subcommand, Debug)]
 pub enum BenchCommand {
+    /// Figure 8.1 of Ramsey 2005: the displaced three-holed torus at subdivision levels 0 to
+    /// 6, ray traced without tessellation, beside the same micro-triangles as a
+    /// pre-tessellated mesh (time and peak memory).
+    Displaced(displaced::DisplacedArgs),
     /// Table 7.1 of Brosz 2011: quadratic vs 2 to 6 segment projectors at 800 x 800, and the
     /// throughput of --method raster on a 1280 x 720 panorama of a 123,554-triangle scene.
     Flexible(flexible::FlexibleArgs),
     /// Chapter 8 and appendix D of Vallance 2005: ray casting vs trilinear rasterisation of random
     /// scenes and of the cube-floor scene through 2 to 50 projection triangles.
     Trilinear(trilinear::TrilinearArgs),
-    /// Table 6.2 of the displaced-LOD dissertation: simplification of polygon meshes (teapot
+    /// Table 6.2 of Ramsey 2005: simplification of polygon meshes (teapot
     /// tessellations, closed tori, the repository's OBJ models) with tau = 0.99 and 1 % of
     /// the edges searched per collapse.
     Simplify(simplify::SimplifyBenchArgs),
@@ -26,6 +31,7 @@ pub enum BenchCommand {
 /// Runs `flexcam bench`.
 pub fn run(command: &BenchCommand) -> Result<()> {
     match command {
+        BenchCommand::Displaced(args) => displaced::run(args),
         BenchCommand::Flexible(args) => flexible::run(args),
         BenchCommand::Trilinear(args) => trilinear::run(args),
         BenchCommand::Simplify(args) => simplify::run(args),

@@ -1,4 +1,4 @@
-//! `flexcam bench simplify`: Table 6.2 of the displaced-LOD dissertation (simplification of
+//! `flexcam bench simplify`: Table 6.2 of Ramsey 2005 (simplification of
 //! arbitrary polygon meshes, Ramsey et al.'s method) with flexcam's simplifier.
 //!
 //! The dissertation simplified four scanned models with 1 % of the edges searched per
