@@ -1,6 +1,6 @@
 //! Simplification of polygon meshes of arbitrary n-gons by edge collapses, with the vertex
-//! splits that rebuild the input exactly (Ramsey et al.'s method, chapter 6 of the
-//! displaced-LOD dissertation).
+//! splits that rebuild the input exactly (Ramsey et al.'s method, as chapter 6 of Ramsey 2005
+//! describes it).
 //!
 //! - [`PolyMesh`]: vertices with optional normals, texture coordinates and colours, faces as
 //!   vertex lists of any length.

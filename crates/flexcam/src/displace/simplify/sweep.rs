@@ -1,6 +1,6 @@
 //! The simplification driver: random candidate edges, the best by normal deviation, in sweeps.
 //!
-//! As in Ramsey et al.'s method (the dissertation's chapter 6): every step draws a number of
+//! As in Ramsey et al.'s method (chapter 6 of Ramsey 2005): every step draws a number of
 //! candidate edges at random (a fraction of the input's edges), computes for each the cost
 //! of collapsing it (the smallest cosine between a face's normal before and after), and
 //! collapses the one that turns its faces least, if that cosine is above the threshold. The
