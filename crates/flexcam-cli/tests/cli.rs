@@ -627,13 +627,23 @@ fn animate_stats_report_one_bvh_build_for_all_frames() {
 }
 
 /// `compare` renders both methods from one prepared scene (one BVH build), and `render
-/// --stats` reports the build too.
+/// --stats` reports the build too; compositing a lit glass reflector (the scene without it,
+/// the reflector alone for the Fresnel split) builds no other.
 #[test]
 fn compare_and_render_build_the_bvh_once() {
     let dir = good_scene_in("s.toml");
     let report = run_json(&dir, &["compare", "s.toml", "--method", "raster", "--json"]);
     assert_eq!(report["bvh_builds"], 1);
     let stats = run_json(&dir, &["render", "s.toml", "-o", "a.png", "--stats", "-"]);
+    assert_eq!(stats["bvh_builds"], 1);
+    let lens = example_scene("refract-lens.toml");
+    let small = ["--width", "48", "--height", "36", "--stats", "-"];
+    let stats = run_json(
+        &dir,
+        &[&["render", &lens, "-o", "b.png"][..], &small].concat(),
+    );
+    assert_eq!(stats["reflectors"], 1);
+    assert!(stats["reflector_fresnel_rays"].as_u64().unwrap() > 0);
     assert_eq!(stats["bvh_builds"], 1);
 }
 

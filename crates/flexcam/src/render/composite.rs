@@ -14,10 +14,9 @@
 //!
 //! The renderer is a parameter ([`Renderer`]): any method that renders a prepared scene
 //! through a projection, e.g. `|s, p, o| Method::Raycast.render(s, p, o)`, or a faster
-//! trilinear one. The main view shares the prepared scene's BVH (only materials differ);
-//! the scene without a reflector, rendered through that reflector's surfaces, and the
-//! reflector alone (the Fresnel split) are variants with BVHs of their own, counted in
-//! [`PreparedScene::bvh_builds`].
+//! trilinear one. The main view (the reflectors made diffuse), the scene without a reflector
+//! (rendered through that reflector's surfaces) and the reflector alone (the Fresnel split)
+//! are views of the prepared scene ([`PreparedScene::view`]): they share its one BVH.
 //! In `lit` shading a mirror's reflected colour is tinted by its base colour, and glass mixes
 //! the images through its refraction surface and through a second, reflection surface by the
 //! exact Fresnel reflectance at each pixel, as the ray caster's glass does ([`FresnelSplit`],
@@ -76,7 +75,7 @@ pub fn render(
             object.material.surface = Surface::Diffuse;
         }
     }
-    let (mut frame, mut stats) = renderer(&prepared.with_materials(&main_scene), main, options)?;
+    let (mut frame, mut stats) = renderer(&prepared.view(main_scene), main, options)?;
     let start = Instant::now();
     let (mut triangles, mut dropped, mut pixels, mut fresnel_rays) = (0, 0, 0, 0);
     let exact = ExactPixels::new(prepared, &camera, options);
@@ -90,7 +89,7 @@ pub fn render(
         dropped += surface.dropped;
         let projection = surface_projection(&surface, map, &camera)?;
         if let Some(projection) = &projection {
-            let others = prepared.variant(&without(scene, id));
+            let others = prepared.view(without(scene, id));
             let image = renderer(&others, projection, options)?.0;
             pixels += match (options.shading, reflector.optic) {
                 (Shading::Flat, _) => paste(&mut frame, id, &image, Vec3::ONE)?,
@@ -304,12 +303,24 @@ pub fn render_through(
         .transpose()
 }
 
-/// `scene` without object `id` and without reflectors: what a reflector's surface sees.
+/// `scene` without object `id` (its parts keep their places, with empty meshes: a view of
+/// the prepared scene, [`PreparedScene::view`]) and without reflectors: what a reflector's
+/// surface sees.
 pub fn without(scene: &Scene, id: u32) -> Scene {
-    let mut others = scene.clone();
-    others.objects.retain(|o| o.id != id);
-    others.trilinear_reflectors.clear();
-    others
+    only(scene, |o| o.id != id)
+}
+
+/// `scene` with only the objects `shown` accepts (the others keep their places, with empty
+/// meshes) and without reflectors to composite.
+fn only(scene: &Scene, shown: impl Fn(&Object) -> bool) -> Scene {
+    let mut part = scene.clone();
+    for object in &mut part.objects {
+        if !shown(object) {
+            object.mesh = Mesh::default();
+        }
+    }
+    part.trilinear_reflectors.clear();
+    part
 }
 
 /// The trilinear projection of `surface` with screen map `map` at the main camera's
@@ -425,10 +436,8 @@ pub struct FresnelSplit {
 impl FresnelSplit {
     /// The split of reflector `id` of `prepared` seen by `camera`.
     pub fn new(prepared: &PreparedScene, id: u32, camera: Perspective) -> FresnelSplit {
-        let mut only = prepared.scene().clone();
-        only.objects.retain(|o| o.id == id);
         FresnelSplit {
-            caster: prepared.variant(&only),
+            caster: prepared.view(only(prepared.scene(), |o| o.id == id)),
             camera,
         }
     }

@@ -636,7 +636,7 @@ fn packet_rendering_equals_single_ray_rendering() {
 fn segment_by_segment(caster: &PreparedScene, points: &[DVec3]) -> Option<(usize, Hit32)> {
     (0..points.len().saturating_sub(1)).find_map(|k| {
         crate::render::bvh::triangle::FastRay::new(&polyline_segment(points, k))
-            .and_then(|fast| caster.bvh.closest(&fast))
+            .and_then(|fast| caster.bvh.closest(&fast, &crate::render::bvh::AllTriangles))
             .map(|found| (k, caster.hit32(found)))
     })
 }
