@@ -8,7 +8,9 @@ use std::time::Instant;
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, GifFrames, OutputSet};
 use flexcam::projection::ProjectionSpec;
-use flexcam::render::{self, Counter, Method, PreparedScene, RenderOptions, Shading, Stats};
+use flexcam::render::{
+    self, Counter, Method, Outputs, PreparedScene, RenderOptions, Shading, Stats,
+};
 use flexcam::scene;
 use flexcam::{Error, Result};
 
@@ -183,6 +185,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
             shading: args.shading.shading(),
             spp: args.spp,
             progress: Some(&report),
+            outputs: Outputs::COLOR,
             ..RenderOptions::default()
         };
         let frame = render::render(&prepared, projection.as_ref(), &options)?.frame;

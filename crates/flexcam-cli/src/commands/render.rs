@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, DepthFormat, OutputSet};
-use flexcam::render::{self, Counter, Method, PreparedScene, RenderOptions, Shading};
+use flexcam::render::{self, Counter, Method, Outputs, PreparedScene, RenderOptions, Shading};
 use flexcam::Result;
 
 use super::scene_args::{print_warnings, MethodTuning, SceneArgs, ShadingArg};
@@ -86,6 +86,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         subdivision: args.tuning.subdivision(method)?,
         curves: args.tuning.curves(method)?,
         progress: Some(&report),
+        outputs: Outputs {
+            depth: depth.is_some(),
+            ids: ids.is_some(),
+        },
         ..RenderOptions::default()
     };
     let render_start = Instant::now();

@@ -37,7 +37,7 @@ use crate::projection::{Perspective, Projection, ProjectionSpec, Trilinear, Tril
 use crate::render::prepared::PreparedScene;
 use crate::render::shading::normals;
 use crate::render::shading::trace::specular;
-use crate::render::{Counter, Frame, Method, RenderOptions, Shading, Stats};
+use crate::render::{Counter, Frame, Method, Outputs, RenderOptions, Shading, Stats};
 use crate::scene::{Mesh, Object, Scene, Surface, TrilinearReflector};
 
 /// A way of rendering a scene through a projection (a [`crate::render::Method`] or any
@@ -75,7 +75,20 @@ pub fn render(
             object.material.surface = Surface::Diffuse;
         }
     }
-    let (mut frame, mut stats) = renderer(&prepared.view(main_scene), main, options)?;
+    // The main view's ids find the reflectors' pixels; the images through the surfaces are
+    // read for their colour alone.
+    let main_options = RenderOptions {
+        outputs: Outputs {
+            ids: true,
+            ..options.outputs
+        },
+        ..*options
+    };
+    let (mut frame, mut stats) = renderer(&prepared.view(main_scene), main, &main_options)?;
+    let options = &RenderOptions {
+        outputs: Outputs::COLOR,
+        ..*options
+    };
     let start = Instant::now();
     let (mut triangles, mut dropped, mut pixels, mut fresnel_rays) = (0, 0, 0, 0);
     let exact = ExactPixels::new(prepared, &camera, options);
