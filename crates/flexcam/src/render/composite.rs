@@ -37,7 +37,9 @@ use crate::projection::{Perspective, Projection, ProjectionSpec, Trilinear, Tril
 use crate::render::prepared::PreparedScene;
 use crate::render::shading::normals;
 use crate::render::shading::trace::specular;
-use crate::render::{Counter, Frame, Method, Outputs, RenderOptions, Shading, Stats};
+use crate::render::{
+    Counter, Frame, Method, Outputs, RenderOptions, RenderWarning, Rendered, Shading, Stats,
+};
 use crate::scene::{Mesh, Object, Scene, Surface, TrilinearReflector};
 
 /// A way of rendering a scene through a projection (a [`crate::render::Method`] or any
@@ -53,8 +55,9 @@ pub type Renderer<'a> =
 /// reflector alone for the Fresnel split), `reflector_exact_pixels` (reflector pixels that no
 /// triangle of the surface covers, ray cast exactly instead: [`ExactPixels`]),
 /// `reflector_unsplit_edges` (edges the refinement left over its tolerance at its depth cap
-/// or below a pixel: [`refine`]) and `reflector_render_ms` (surface refinement, building and
-/// rendering).
+/// or below a pixel: [`refine`]; a [`RenderWarning::ReflectorOverTolerance`] for each
+/// reflector that has such edges) and `reflector_render_ms` (surface refinement, building
+/// and rendering).
 ///
 /// Errors: the renderer's; a scene projection that is not perspective (the main camera);
 /// a reflector id that no object has, or whose material is not mirror or glass.
@@ -63,10 +66,15 @@ pub fn render(
     main: &dyn Projection,
     options: &RenderOptions,
     renderer: &Renderer,
-) -> Result<(Frame, Stats)> {
+) -> Result<Rendered> {
     let scene = prepared.scene();
     if scene.trilinear_reflectors.is_empty() {
-        return renderer(prepared, main, options);
+        let (frame, counters) = renderer(prepared, main, options)?;
+        return Ok(Rendered {
+            frame,
+            counters,
+            warnings: Vec::new(),
+        });
     }
     let camera = main_camera(scene, main)?;
     let mut main_scene = scene.clone();
@@ -92,12 +100,12 @@ pub fn render(
     let start = Instant::now();
     let (mut triangles, mut dropped, mut pixels, mut fresnel_rays) = (0, 0, 0, 0);
     let exact = ExactPixels::new(prepared, &camera, options);
-    let (mut exact_pixels, mut unsplit) = (0, 0);
+    let mut exact_pixels = 0;
+    let (mut unsplit, mut warnings) = (0, Vec::new());
     for entry in &scene.trilinear_reflectors {
         let (id, map) = (entry.id, entry.screen_map);
         let reflector = Reflector::of(scene, id)?;
-        let (surface, left) = refined_surface(&reflector, reflector.optic, entry, &camera)?;
-        unsplit += left;
+        let (surface, mut left) = refined_surface(&reflector, reflector.optic, entry, &camera)?;
         triangles += surface.mesh.triangles.len();
         dropped += surface.dropped;
         let projection = surface_projection(&surface, map, &camera)?;
@@ -108,9 +116,9 @@ pub fn render(
                 (Shading::Flat, _) => paste(&mut frame, id, &image, Vec3::ONE)?,
                 (Shading::Lit, Optic::Reflect) => paste(&mut frame, id, &image, reflector.tint)?,
                 (Shading::Lit, Optic::Refract { .. }) => {
-                    let (mirror, left) =
+                    let (mirror, mirror_left) =
                         refined_surface(&reflector, Optic::Reflect, entry, &camera)?;
-                    unsplit += left;
+                    left += mirror_left;
                     let reflection =
                         render_through(&others, &mirror, map, &camera, options, renderer)?
                             .unwrap_or_else(|| {
@@ -125,6 +133,14 @@ pub fn render(
             };
         }
         exact_pixels += exact.cast_uncovered(&mut frame, id, projection.as_ref());
+        unsplit += left;
+        if left > 0 {
+            warnings.push(RenderWarning::ReflectorOverTolerance {
+                id,
+                edges: left as u64,
+                tolerance_px: entry.refine_px,
+            });
+        }
     }
     let count = |n: usize| Counter::Count(n as u64);
     stats.insert("reflectors", count(scene.trilinear_reflectors.len()));
@@ -138,7 +154,11 @@ pub fn render(
         "reflector_render_ms",
         Counter::Value(start.elapsed().as_secs_f64() * 1e3),
     );
-    Ok((frame, stats))
+    Ok(Rendered {
+        frame,
+        counters: stats,
+        warnings,
+    })
 }
 
 /// Renders `scene` through `main` with `method`, compositing its trilinear reflectors as
@@ -154,7 +174,7 @@ pub fn render_with_method(
     main: &dyn Projection,
     options: &RenderOptions,
     method: Method,
-) -> Result<(Frame, Stats)> {
+) -> Result<Rendered> {
     let renderer =
         |s: &PreparedScene, p: &dyn Projection, o: &RenderOptions| method.render(s, p, o);
     let scene = prepared.scene();

@@ -187,6 +187,8 @@ pub struct Rendered {
     /// The method's counters (rays cast, build times, ...), for `--stats`; with reflectors
     /// composited, also the compositing's (`reflector_pixels` and the like).
     pub counters: Stats,
+    /// What the user should be told about this frame (none when everything asked held).
+    pub warnings: Vec<RenderWarning>,
 }
 
 /// Renders `prepared` through `projection` as `options` say: the one entry point of every
@@ -197,13 +199,18 @@ pub fn render(
     projection: &dyn Projection,
     options: &RenderOptions,
 ) -> Result<Rendered> {
-    let (mut frame, counters) = if options.composite_reflectors {
+    let mut rendered = if options.composite_reflectors {
         composite::render_with_method(prepared, projection, options, options.method)?
     } else {
-        options.method.render(prepared, projection, options)?
+        let (frame, counters) = options.method.render(prepared, projection, options)?;
+        Rendered {
+            frame,
+            counters,
+            warnings: Vec::new(),
+        }
     };
-    frame.keep_only(options.outputs);
-    Ok(Rendered { frame, counters })
+    rendered.frame.keep_only(options.outputs);
+    Ok(rendered)
 }
 
 /// A colour image in linear RGB, rows from the top: a photo to reproject
@@ -237,8 +244,10 @@ pub mod reproject;
 pub mod scan;
 pub mod shading;
 pub mod trilinear;
+mod warning;
 pub use method::Method;
 pub use prepared::PreparedScene;
+pub use warning::RenderWarning;
 
 #[cfg(test)]
 mod tests {
@@ -325,7 +334,11 @@ mod tests {
                 let got = render(&prepared, main.as_ref(), &options(wanted)).unwrap();
                 let what = format!("{method} {composite_reflectors} {wanted:?}");
                 assert_eq!(got.frame.color, all.frame.color, "{what}");
-                let depth_want = if depth { all.frame.depth.clone() } else { vec![] };
+                let depth_want = if depth {
+                    all.frame.depth.clone()
+                } else {
+                    vec![]
+                };
                 assert_eq!(got.frame.depth, depth_want, "{what}");
                 let ids_want = if ids { all.frame.ids.clone() } else { vec![] };
                 assert_eq!(got.frame.ids, ids_want, "{what}");
@@ -352,8 +365,9 @@ mod tests {
         let renderer = |s: &PreparedScene, p: &dyn Projection, o: &RenderOptions| {
             Method::Raycast.render(s, p, o)
         };
-        let (frame, counters) =
-            composite::render(&prepared, main.as_ref(), &options, &renderer).unwrap();
+        let Rendered {
+            frame, counters, ..
+        } = composite::render(&prepared, main.as_ref(), &options, &renderer).unwrap();
         assert_eq!(composited.frame, frame);
         assert_eq!(composited.counters.len(), counters.len());
         assert_eq!(
