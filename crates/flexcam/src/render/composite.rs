@@ -40,7 +40,7 @@ use crate::render::shading::trace::specular;
 use crate::render::{
     Counter, Frame, Method, Outputs, RenderOptions, RenderWarning, Rendered, Shading, Stats,
 };
-use crate::scene::{Mesh, Object, Scene, Surface, TrilinearReflector};
+use crate::scene::{Finish, Mesh, Object, Scene, TrilinearReflector};
 
 /// A way of rendering a scene through a projection (a [`crate::render::Method`] or any
 /// other renderer).
@@ -80,7 +80,7 @@ pub fn render(
     let mut main_scene = scene.clone();
     for object in &mut main_scene.objects {
         if scene.trilinear_reflectors.iter().any(|r| r.id == object.id) {
-            object.material.surface = Surface::Diffuse;
+            object.material.finish = Finish::Diffuse;
         }
     }
     // The main view's ids find the reflectors' pixels; the images through the surfaces are
@@ -267,9 +267,9 @@ impl Reflector {
         let first = parts.first().ok_or_else(|| {
             Error::new(format!("trilinear reflector {id}: no object has this id"))
         })?;
-        let optic = match first.material.surface {
-            Surface::Mirror => Optic::Reflect,
-            Surface::Glass { ior } => Optic::Refract {
+        let optic = match first.material.finish {
+            Finish::Mirror => Optic::Reflect,
+            Finish::Glass { ior } => Optic::Refract {
                 ior: f64::from(ior),
             },
             _ => {
@@ -281,7 +281,7 @@ impl Reflector {
         };
         let mut mesh = Mesh::default();
         for part in &parts {
-            if part.material.surface != first.material.surface {
+            if part.material.finish != first.material.finish {
                 return Err(Error::new(format!(
                     "trilinear reflector \"{}\" has parts of different materials",
                     first.name
@@ -486,7 +486,7 @@ impl FresnelSplit {
         };
         let part = &self.caster.scene.objects[hit.object];
         let seen = normals(part, hit.triangle, hit.barycentric, ray.direction.as_vec3());
-        match specular(&ray, &seen, part.material.surface).fresnel {
+        match specular(&ray, &seen, part.material.finish).fresnel {
             Some((_, reflectance)) => GlassSplit::Fresnel(reflectance),
             None => GlassSplit::TotalReflection,
         }

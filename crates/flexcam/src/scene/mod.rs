@@ -8,7 +8,7 @@ mod mesh;
 pub mod texel;
 
 pub use light::Light;
-pub use material::{Material, Pattern, Surface, Texture};
+pub use material::{Finish, Material, Pattern, Texture};
 pub use mesh::Mesh;
 
 use std::path::PathBuf;

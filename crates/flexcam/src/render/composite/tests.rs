@@ -85,7 +85,7 @@ fn composite_from(scene: &Scene, main: &dyn Projection, surface: &ReflectorSurfa
     let camera = main_camera(scene, main).unwrap();
     let mut plain = scene.clone();
     plain.trilinear_reflectors.clear();
-    plain.objects[0].material.surface = Surface::Diffuse;
+    plain.objects[0].material.finish = Finish::Diffuse;
     let mut frame = raycast(&PreparedScene::new(&plain), main, &flat())
         .unwrap()
         .0;
@@ -288,7 +288,7 @@ fn lit_glass_mixes_reflection_and_refraction_by_fresnel() {
     let refraction = reflector_surface(&lens.mesh, &camera, lens.optic).unwrap();
     let mut plain = scene.clone();
     plain.trilinear_reflectors.clear();
-    plain.objects[0].material.surface = Surface::Diffuse;
+    plain.objects[0].material.finish = Finish::Diffuse;
     let mut alone = raycast(&PreparedScene::new(&plain), main.as_ref(), &lit)
         .unwrap()
         .0;
@@ -625,7 +625,7 @@ fn trilinear_method_composites_reflectors() {
 /// flat mirror).
 fn plate_scene(ior: f32, map: SurfaceScreenMap, flat_normals: bool) -> Scene {
     let mut scene = lens_scene();
-    scene.objects[0].material.surface = Surface::Glass { ior };
+    scene.objects[0].material.finish = Finish::Glass { ior };
     if flat_normals {
         scene.objects[0].mesh.normals.fill(Vec3::Y);
     }
