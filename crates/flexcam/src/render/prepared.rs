@@ -76,6 +76,28 @@ pub struct PreparedScene {
 /// 256 f32 ulps, well above the rounding of an f32 hit point and small against any feature.
 const OFFSET_SCALE: f64 = 1.0 / 65536.0;
 
+// A view's masked queries, out of line: the unmasked queries (every render of a whole scene)
+// inline only the traversal they had.
+
+#[inline(never)]
+fn closest_shown(bvh: &Bvh, ray: &FastRay, mask: &TriangleMask) -> Option<BvhHit> {
+    bvh.closest(ray, mask)
+}
+
+#[inline(never)]
+fn closest4_shown(
+    bvh: &Bvh,
+    rays: [Option<&FastRay>; 4],
+    mask: &TriangleMask,
+) -> [Option<BvhHit>; 4] {
+    bvh.closest4(rays, mask)
+}
+
+#[inline(never)]
+fn occluded_shown(bvh: &Bvh, ray: &FastRay, mask: &TriangleMask) -> bool {
+    bvh.occluded(ray, mask)
+}
+
 /// The secondary-ray offset of `scene`: [`OFFSET_SCALE`] of its largest coordinate magnitude.
 fn offset_of(scene: &Scene) -> f64 {
     let extent = scene
@@ -210,7 +232,7 @@ impl PreparedScene {
         let ray = FastRay::new(ray)?;
         let found = match &self.shown {
             None => self.bvh.closest(&ray, &AllTriangles),
-            Some(mask) => self.bvh.closest(&ray, mask),
+            Some(mask) => closest_shown(&self.bvh, &ray, mask),
         }?;
         Some(self.hit32(found))
     }
@@ -233,7 +255,7 @@ impl PreparedScene {
         let rays = fast.each_ref().map(Option::as_ref);
         let found = match &self.shown {
             None => self.bvh.closest4(rays, &AllTriangles),
-            Some(mask) => self.bvh.closest4(rays, mask),
+            Some(mask) => closest4_shown(&self.bvh, rays, mask),
         };
         found.map(|f| f.map(|f| self.hit32(f)))
     }
@@ -284,7 +306,7 @@ impl PreparedScene {
     pub fn occluded(&self, ray: &Ray) -> bool {
         FastRay::new(ray).is_some_and(|r| match &self.shown {
             None => self.bvh.occluded(&r, &AllTriangles),
-            Some(mask) => self.bvh.occluded(&r, mask),
+            Some(mask) => occluded_shown(&self.bvh, &r, mask),
         })
     }
 
