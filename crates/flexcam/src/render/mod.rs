@@ -235,6 +235,7 @@ pub(crate) mod bvh;
 pub mod compare;
 /// Reflector compositing, reached only through [`render`] (`RenderOptions::composite_reflectors`).
 mod composite;
+mod displaced;
 mod huge_pages;
 mod method;
 pub mod prepared;

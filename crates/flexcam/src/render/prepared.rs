@@ -25,7 +25,10 @@ use crate::geometry::{intersect_triangle, Ray};
 use crate::render::bvh::curve_triangle::CurveTriangle;
 use crate::render::bvh::triangle::FastRay;
 use crate::render::bvh::{AllTriangles, Bvh, BvhHit, Keep, TriangleMask};
+use crate::render::displaced::DisplacedSet;
 use crate::scene::Scene;
+
+mod displaced_hits;
 
 /// The first surface a ray meets.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -70,6 +73,9 @@ pub struct PreparedScene {
     /// built on the first quadratic search ([`PreparedScene::curve_triangles`]): renders
     /// without curved projectors neither pay for it nor hold it. Shared by the views.
     curve_triangles: Arc<OnceLock<Vec<CurveTriangle>>>,
+    /// The displaced objects, whose triangles the BVH leaves out ([`crate::render::displaced`]);
+    /// `None` when there are none.
+    pub(in crate::render) displaced: Option<Arc<DisplacedSet>>,
 }
 
 /// Secondary-ray offset relative to the scene's largest coordinate magnitude: 2^-16, about
@@ -118,6 +124,9 @@ impl PreparedScene {
         let mut triangles = Vec::with_capacity(scene.triangle_count());
         for object in &scene.objects {
             first_triangle.push(triangles.len() as u32);
+            if object.displacement.is_some() {
+                continue;
+            }
             let p = &object.mesh.positions;
             triangles.extend(
                 object
@@ -138,6 +147,7 @@ impl PreparedScene {
             build_ms: start.elapsed().as_secs_f64() * 1e3,
             bvh_builds: AtomicU64::new(1),
             curve_triangles: Arc::default(),
+            displaced: DisplacedSet::new(scene),
         }
     }
 
@@ -163,6 +173,15 @@ impl PreparedScene {
                 object_shown[self.first_triangle.partition_point(|&f| f <= id) - 1]
             })
         });
+        // The displaced objects are not in the BVH: a view hiding one has a displaced set of
+        // its own.
+        let hides_displaced = (self.scene.objects.iter().zip(&object_shown))
+            .any(|(o, &shown)| !shown && o.displacement.is_some());
+        let displaced = if hides_displaced {
+            DisplacedSet::new(&scene)
+        } else {
+            self.displaced.clone()
+        };
         PreparedScene {
             bvh: Arc::clone(&self.bvh),
             shown,
@@ -173,6 +192,7 @@ impl PreparedScene {
             build_ms: self.build_ms,
             bvh_builds: AtomicU64::new(0),
             curve_triangles: Arc::clone(&self.curve_triangles),
+            displaced,
         }
     }
 
@@ -226,15 +246,17 @@ impl PreparedScene {
     /// origin's magnitude to the hit distance). Enough for a flat colour and a depth stored
     /// as f32; everything that spawns rays from the hit refines it first.
     pub(in crate::render) fn intersect_f32(&self, ray: &Ray) -> Option<Hit32> {
-        if self.misses_scene_box(ray) {
-            return None;
-        }
-        let ray = FastRay::new(ray)?;
-        let found = match &self.shown {
-            None => self.bvh.closest(&ray, &AllTriangles),
-            Some(mask) => closest_shown(&self.bvh, &ray, mask),
-        }?;
-        Some(self.hit32(found))
+        let found = if self.misses_scene_box(ray) {
+            None
+        } else {
+            let ray = FastRay::new(ray)?;
+            match &self.shown {
+                None => self.bvh.closest(&ray, &AllTriangles),
+                Some(mask) => closest_shown(&self.bvh, &ray, mask),
+            }
+            .map(|f| self.hit32(f))
+        };
+        self.nearer_displaced(ray, found)
     }
 
     /// Whether `ray`'s segment (its points over `[t_min, t_max]`, both ends finite) lies
@@ -252,12 +274,19 @@ impl PreparedScene {
     /// coherent rays (a 2x2 quad of primary rays) share one BVH traversal.
     pub(in crate::render) fn intersect4_f32(&self, rays: [Option<&Ray>; 4]) -> [Option<Hit32>; 4] {
         let fast = rays.map(|r| self.fast_unless_outside(r));
-        let rays = fast.each_ref().map(Option::as_ref);
+        let fast_rays = fast.each_ref().map(Option::as_ref);
         let found = match &self.shown {
-            None => self.bvh.closest4(rays, &AllTriangles),
-            Some(mask) => closest4_shown(&self.bvh, rays, mask),
+            None => self.bvh.closest4(fast_rays, &AllTriangles),
+            Some(mask) => closest4_shown(&self.bvh, fast_rays, mask),
         };
-        found.map(|f| f.map(|f| self.hit32(f)))
+        let found = found.map(|f| f.map(|f| self.hit32(f)));
+        if self.displaced.is_none() {
+            return found;
+        }
+        std::array::from_fn(|i| match rays[i] {
+            Some(ray) => self.nearer_displaced(ray, found[i]),
+            None => None,
+        })
     }
 
     /// The f32 form of `ray` for a BVH search, or `None` where it cannot hit anything: no
@@ -285,6 +314,9 @@ impl PreparedScene {
 
     /// `found` (a hit of `ray`) with `t` and the barycentrics recomputed in f64.
     pub(in crate::render) fn refine(&self, ray: &Ray, found: Hit32) -> Hit {
+        if let Some(hit) = self.refine_displaced(ray, found) {
+            return hit;
+        }
         let mesh = &self.scene.objects[found.object].mesh;
         let [a, b, c] = mesh.triangles[found.triangle];
         let vertex = |i: u32| mesh.positions[i as usize].as_dvec3();
@@ -307,7 +339,7 @@ impl PreparedScene {
         FastRay::new(ray).is_some_and(|r| match &self.shown {
             None => self.bvh.occluded(&r, &AllTriangles),
             Some(mask) => occluded_shown(&self.bvh, &r, mask),
-        })
+        }) || self.displaced_occludes(ray)
     }
 
     /// A ray leaving surface point `point` (geometric normal `normal`) along `direction`,

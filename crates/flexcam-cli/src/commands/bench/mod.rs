@@ -1,5 +1,6 @@
 //! `flexcam bench`: the source documents' timing tables, rerun with flexcam's renderers.
 
+pub mod displaced;
 pub mod flexible;
 mod timing;
 pub mod trilinear;
@@ -10,6 +11,10 @@ use flexcam::Result;
 /// Which table to measure.
 #[derive(Subcommand, Debug)]
 pub enum BenchCommand {
+    /// Figure 8.1 of Ramsey 2005: the displaced three-holed torus at subdivision levels 0 to
+    /// 6, ray traced without tessellation, beside the same micro-triangles as a
+    /// pre-tessellated mesh (time and peak memory).
+    Displaced(displaced::DisplacedArgs),
     /// Table 7.1 of Brosz 2011: quadratic vs 2 to 6 segment projectors at 800 x 800, and the
     /// throughput of --method raster on a 1280 x 720 panorama of a 123,554-triangle scene.
     Flexible(flexible::FlexibleArgs),
@@ -21,6 +26,7 @@ pub enum BenchCommand {
 /// Runs `flexcam bench`.
 pub fn run(command: &BenchCommand) -> Result<()> {
     match command {
+        BenchCommand::Displaced(args) => displaced::run(args),
         BenchCommand::Flexible(args) => flexible::run(args),
         BenchCommand::Trilinear(args) => trilinear::run(args),
     }
