@@ -40,6 +40,8 @@ pub struct RenderOptions<'a> {
     pub subdivision: raster::Subdivision,
     /// How method trilinear follows curved edges.
     pub curves: trilinear::CurveOptions,
+    /// The bound and culling of method camera-triangles.
+    pub camera_triangles: camera_triangles::Options,
     /// Called from worker threads with (work units done, total) as rendering progresses.
     pub progress: Option<&'a (dyn Fn(u64, u64) + Sync)>,
 }
@@ -54,6 +56,7 @@ impl Default for RenderOptions<'_> {
             max_bounces: 8,
             subdivision: raster::Subdivision::default(),
             curves: trilinear::CurveOptions::ADAPTIVE,
+            camera_triangles: camera_triangles::Options::default(),
             progress: None,
         }
     }
@@ -168,6 +171,7 @@ pub enum Counter {
 /// Named counters a renderer reports (rays cast, build times, ...), for `--stats`.
 pub type Stats = BTreeMap<&'static str, Counter>;
 pub(crate) mod bvh;
+pub mod camera_triangles;
 pub mod compare;
 /// Reflector compositing, reached only through [`render`] (`RenderOptions::composite_reflectors`).
 mod composite;

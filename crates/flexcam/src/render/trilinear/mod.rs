@@ -47,13 +47,14 @@ use glam::{DVec2, DVec3, Vec3};
 
 pub use curves::{CurveMode, CurveOptions};
 pub use polygons::{project_all, projection_triangles};
+pub(crate) use resolve::plane_hit;
 pub use scene_geometry::SceneGeometry;
+pub use screen_map::ScreenMap;
 
 use self::central::CentralProjection;
 use self::gbuffer::GBuffer;
 use self::polygons::ProjectedScene;
 use self::resolve::Resolver;
-use self::screen_map::ScreenMap;
 use self::shade::{ShadeCounts, Shader};
 use crate::error::{Error, Result};
 use crate::projection::{Projection, Trilinear};
