@@ -1,5 +1,6 @@
 //! `flexcam bench`: the source documents' timing tables, rerun with flexcam's renderers.
 
+pub mod camera_triangles;
 pub mod flexible;
 mod timing;
 pub mod trilinear;
@@ -10,6 +11,9 @@ use flexcam::Result;
 /// Which table to measure.
 #[derive(Subcommand, Debug)]
 pub enum BenchCommand {
+    /// Table 1 of Hou et al. 2006 (reflection rows) and the 5,000-triangle mirror-sphere
+    /// target: camera triangles against the paper and against the ray caster.
+    CameraTriangles(camera_triangles::CameraTrianglesArgs),
     /// Table 7.1 of Brosz 2011: quadratic vs 2 to 6 segment projectors at 800 x 800, and the
     /// throughput of --method raster on a 1280 x 720 panorama of a 123,554-triangle scene.
     Flexible(flexible::FlexibleArgs),
@@ -21,6 +25,7 @@ pub enum BenchCommand {
 /// Runs `flexcam bench`.
 pub fn run(command: &BenchCommand) -> Result<()> {
     match command {
+        BenchCommand::CameraTriangles(args) => camera_triangles::run(args),
         BenchCommand::Flexible(args) => flexible::run(args),
         BenchCommand::Trilinear(args) => trilinear::run(args),
     }

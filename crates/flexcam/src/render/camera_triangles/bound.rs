@@ -30,19 +30,16 @@ use glam::{DVec2, DVec3};
 
 use super::camera::{Camera, CORNERS};
 use super::convex::{cross, Convex};
+use crate::render::trilinear::plane_hit;
 
 /// How far bound regions are pushed out, in pixels, against rounding.
 pub const MARGIN_PX: f64 = 1e-4;
 
 /// Deepest quartering of the camera triangle by the tight bound.
-const MAX_DEPTH: u32 = 4;
+const MAX_DEPTH: u32 = 6;
 
 /// A region of fewer pixels than this is not quartered further.
-const MIN_SPLIT_PIXELS: f64 = 48.0;
-
-/// A region that covers at least this fraction of its (sub-)triangle is not quartered
-/// further (the scene triangle covers it, or nearly: quarters would all be kept).
-const FULL_FRACTION: f64 = 0.9;
+const MIN_SPLIT_PIXELS: f64 = 16.0;
 
 /// Which bounding region is rasterised per scene triangle and camera triangle (`--bound`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -255,8 +252,14 @@ fn tight(
         return;
     }
     let pixels = region.area() * camera.pixels_per_area;
-    let full = region.area() >= FULL_FRACTION * whole.area();
-    if depth >= MAX_DEPTH || pixels < MIN_SPLIT_PIXELS || full {
+    // Where the rays at the corners and centre all hit the scene triangle, it (nearly)
+    // covers the sub-triangle: quarters would all be kept.
+    let centre = (sub[0] + sub[1] + sub[2]) / 3.0;
+    let covered = [sub[0], sub[1], sub[2], centre].iter().all(|&b| {
+        plane_hit(&camera.ray_at(b), *q)
+            .is_some_and(|(t, u, v)| t >= 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0)
+    });
+    if depth >= MAX_DEPTH || pixels < MIN_SPLIT_PIXELS || covered {
         return emit_in_camera(camera, &region, emit);
     }
     let [a, b, c] = sub;

@@ -14,6 +14,7 @@
 
 use glam::{DVec2, DVec3};
 
+use crate::geometry::Ray;
 use crate::projection::{Projection, ProjectionTriangleCache, Trilinear};
 use crate::render::trilinear::ScreenMap;
 
@@ -108,6 +109,11 @@ impl Camera {
             pixel_box: (lo, hi),
             pixels_per_area,
         }
+    }
+
+    /// The ray at barycentrics `b`.
+    pub fn ray_at(&self, b: DVec2) -> Ray {
+        Ray::new(self.cache.tripoint(b.x, b.y), self.cache.trinorm(b.x, b.y))
     }
 
     /// The ray direction at barycentrics `b`.
