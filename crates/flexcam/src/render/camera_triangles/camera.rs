@@ -15,7 +15,7 @@
 use glam::{DVec2, DVec3};
 
 use crate::geometry::Ray;
-use crate::projection::{Projection, ProjectionTriangleCache, Trilinear};
+use crate::projection::{ProjectionTriangleCache, Trilinear};
 use crate::render::trilinear::ScreenMap;
 
 /// A base triangle counts as collapsed when twice its area is below this fraction of the
@@ -77,17 +77,13 @@ impl Plane {
 impl Camera {
     /// The camera triangles of `projection`, in mesh order.
     pub fn all(projection: &Trilinear) -> Vec<Camera> {
-        let mesh = projection.mesh();
-        let (width, height) = projection.resolution();
-        let size = DVec2::new(f64::from(width), f64::from(height));
-        mesh.triangles
+        projection
+            .mesh()
+            .triangles
             .iter()
             .zip(projection.triangle_caches())
             .map(|(t, cache)| {
-                let [i, j, k] = t.map(|x| x as usize);
-                let screen = [mesh.screen[i], mesh.screen[j], mesh.screen[k]];
-                let map = ScreenMap::new(screen, size, *cache)
-                    .with_projective(projection.projective_map([i, j, k]));
+                let map = ScreenMap::of_triangle(projection, t.map(|x| x as usize), *cache);
                 Camera::new(map, *cache)
             })
             .collect()

@@ -41,8 +41,7 @@ use crate::projection::{Projection, Trilinear};
 use crate::render::prepared::PreparedScene;
 use crate::render::scan::{band_rows_for, for_each_band, PolygonBatch, Vertex};
 use crate::render::shading::triangle_color::TriangleColor;
-use crate::render::shading::TextureFilter;
-use crate::render::trilinear::SceneGeometry;
+use crate::render::trilinear::{self, SceneGeometry};
 use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
 
 /// How the method runs (`--bound`; culling is switched off only to measure it).
@@ -117,19 +116,8 @@ impl std::ops::Add for BandWork {
 
 impl<'a> CameraTriangleRenderer<'a> {
     pub fn new(prepared: &'a PreparedScene) -> CameraTriangleRenderer<'a> {
-        let scene = prepared.scene();
-        let geometry = SceneGeometry::new(scene);
-        let flat_colors = geometry
-            .owners
-            .iter()
-            .map(|owner| {
-                let object = owner.object as usize;
-                prepared.flat_shows_base_color(object).then(|| {
-                    let triangle = owner.triangle as usize;
-                    TriangleColor::new(&scene.objects[object], triangle, TextureFilter::Nearest)
-                })
-            })
-            .collect();
+        let geometry = SceneGeometry::new(prepared.scene());
+        let flat_colors = trilinear::flat_colors(prepared, &geometry);
         CameraTriangleRenderer {
             prepared,
             scene: geometry,

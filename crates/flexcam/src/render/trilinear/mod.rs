@@ -83,17 +83,7 @@ impl<'a> TrilinearRenderer<'a> {
     pub fn new(prepared: &'a PreparedScene) -> TrilinearRenderer<'a> {
         let scene = prepared.scene();
         let geometry = SceneGeometry::new(scene);
-        let flat_colors = geometry
-            .owners
-            .iter()
-            .map(|owner| {
-                let object = owner.object as usize;
-                prepared.flat_shows_base_color(object).then(|| {
-                    let triangle = owner.triangle as usize;
-                    TriangleColor::new(&scene.objects[object], triangle, TextureFilter::Nearest)
-                })
-            })
-            .collect();
+        let flat_colors = flat_colors(prepared, &geometry);
         let bounding_sphere = bounding_sphere(&geometry.vertices);
         TrilinearRenderer {
             prepared,
@@ -271,6 +261,27 @@ impl<'a> TrilinearRenderer<'a> {
         stats.insert("shade_ms", Counter::Value(shade_ms));
         Ok(stats)
     }
+}
+
+/// Per scene triangle of `geometry` (a [`SceneGeometry`] of `prepared`'s scene), its base
+/// colour where flat shading shows it (nearest texel), `None` for mirrors and glass: what
+/// the rasterising renderers read instead of the ray caster's per-hit `base_color`.
+pub(crate) fn flat_colors(
+    prepared: &PreparedScene,
+    geometry: &SceneGeometry,
+) -> Vec<Option<TriangleColor>> {
+    let scene = prepared.scene();
+    geometry
+        .owners
+        .iter()
+        .map(|owner| {
+            let object = owner.object as usize;
+            prepared.flat_shows_base_color(object).then(|| {
+                let triangle = owner.triangle as usize;
+                TriangleColor::new(&scene.objects[object], triangle, TextureFilter::Nearest)
+            })
+        })
+        .collect()
 }
 
 /// What drawing and shading some bands did, and their CPU time (summed over threads).
