@@ -14,7 +14,8 @@ use std::path::Path;
 use glam::DVec2;
 
 use super::procedural::Procedural;
-use crate::error::{Error, Result};
+use crate::error::Result;
+use crate::scene::displacement::{HeightImage, HeightSource};
 use crate::scene::texel::TexelGrid;
 
 /// How far an f32 bilinear blend of texels in [0, 1] may stray outside their range (a few
@@ -29,6 +30,14 @@ pub enum HeightField {
 }
 
 impl HeightField {
+    /// The height field a scene describes.
+    pub fn new(source: &HeightSource) -> HeightField {
+        match source {
+            HeightSource::Map(image) => HeightField::Map(HeightMap::new(image)),
+            HeightSource::Procedural(spec) => HeightField::Procedural(Procedural::new(spec)),
+        }
+    }
+
     /// h at texture coordinates `uv`, in [0, 1].
     #[inline]
     pub fn sample(&self, uv: DVec2) -> f64 {
@@ -80,66 +89,27 @@ struct Level {
 }
 
 impl HeightMap {
-    /// Loads an 8- or 16-bit grey PNG. Errors (one line, naming the file): unreadable, not a
-    /// PNG, not grey (RGB, with alpha, ...), empty.
+    /// Loads an 8- or 16-bit grey PNG ([`HeightImage::load`]). Errors (one line, naming the
+    /// file): unreadable, not a PNG, not grey (RGB, with alpha, ...), empty.
     pub fn load(path: &Path) -> Result<HeightMap> {
-        let bytes =
-            std::fs::read(path).map_err(|e| Error::in_file(path, format!("cannot read: {e}")))?;
-        let not_grey = |what: &str| {
-            Error::in_file(
-                path,
-                format!("a height map must be an 8- or 16-bit grey PNG, this is {what}"),
-            )
-        };
-        match image::guess_format(&bytes) {
-            Ok(image::ImageFormat::Png) => {}
-            Ok(format) => return Err(not_grey(&format!("{format:?}"))),
-            Err(_) => return Err(not_grey("not an image")),
-        }
-        let image = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
-            .map_err(|e| Error::in_file(path, format!("cannot decode PNG: {e}")))?;
-        let (width, height) = (image.width(), image.height());
-        let values = match &image {
-            image::DynamicImage::ImageLuma8(grey) => {
-                grey.as_raw().iter().map(|&g| g as f32 / 255.0).collect()
-            }
-            image::DynamicImage::ImageLuma16(grey) => {
-                grey.as_raw().iter().map(|&g| g as f32 / 65535.0).collect()
-            }
-            other => return Err(not_grey(&format!("{:?}", other.color()))),
-        };
-        HeightMap::from_values(width, height, values).map_err(|e| e.or_in_file(path))
+        HeightImage::load(path).map(|image| HeightMap::new(&image))
     }
 
     /// A map from `width * height` heights, top row first. Errors: an empty image, a wrong
     /// count, a value outside [0, 1] (NaN included).
     pub fn from_values(width: u32, height: u32, values: Vec<f32>) -> Result<HeightMap> {
-        if width == 0 || height == 0 {
-            return Err(Error::new(format!(
-                "height map is empty ({width} x {height} pixels)"
-            )));
-        }
-        if values.len() != width as usize * height as usize {
-            return Err(Error::new(format!(
-                "height map has {} values, expected {width} x {height}",
-                values.len()
-            )));
-        }
-        if let Some(i) = values.iter().position(|h| !(0.0..=1.0).contains(h)) {
-            return Err(Error::new(format!(
-                "height {} at pixel ({}, {}) is outside [0, 1]",
-                values[i],
-                i % width as usize,
-                i / width as usize
-            )));
-        }
-        let levels = pyramid(width as usize, height as usize, &values);
-        Ok(HeightMap {
+        HeightImage::new(width, height, values).map(|image| HeightMap::new(&image))
+    }
+
+    /// The map of a (validated) height image, with its pyramid.
+    pub fn new(image: &HeightImage) -> HeightMap {
+        let (width, height) = (image.width, image.height);
+        HeightMap {
             width,
             height,
-            values,
-            levels,
-        })
+            values: image.values.clone(),
+            levels: pyramid(width as usize, height as usize, &image.values),
+        }
     }
 
     /// h at `uv`: the bilinear texture lookup of the grey values, widened to f64.

@@ -77,7 +77,8 @@ struct Node {
 }
 
 impl Node {
-    /// The four children (corner triangles first, then the middle one).
+    /// The four children in the order of the scene contract: `(a, ab, ac)`, `(ab, b, bc)`,
+    /// `(ac, bc, c)`, `(ac, ab, bc)`.
     fn children(&self) -> [Node; 4] {
         let [a, b, c] = self.v;
         let [ga, gb, gc] = self.g;
@@ -98,10 +99,20 @@ impl Node {
                 g: [gca, gbc, gc],
             },
             Node {
-                v: [bc, ca, ab],
-                g: [gbc, gca, gab],
+                v: [ca, ab, bc],
+                g: [gca, gab, gbc],
             },
         ]
+    }
+
+    /// Whether the node's grid triangle holds the point `p / 3` (grid units), edges included.
+    fn holds(&self, p: [i64; 2]) -> bool {
+        let g = self.g.map(|g| [3 * g[0] as i64, 3 * g[1] as i64]);
+        let side = |a: [i64; 2], b: [i64; 2]| {
+            (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+        };
+        let s = [side(g[0], g[1]), side(g[1], g[2]), side(g[2], g[0])];
+        s.iter().all(|&x| x >= 0) || s.iter().all(|&x| x <= 0)
     }
 
     /// The micro-triangle this leaf is, and its displaced vertices in that triangle's order.
@@ -185,6 +196,27 @@ impl<'a> DisplacedTriangle<'a> {
             self.visit(ray, &local, &root, 0, &mut best);
         }
         best
+    }
+
+    /// The displaced vertices of micro-triangle `triangle` (in [`MicroTriangle::vertices`]
+    /// order), bit for bit those the intersection tests: found by descending the subdivision
+    /// into the child that holds it, `L` steps.
+    pub fn positions(&self, triangle: MicroTriangle) -> [DVec3; 3] {
+        let target = triangle.vertices();
+        // Three times the target's centroid, in grid units: integer and strictly inside.
+        let centroid = [0, 1].map(|k| target.iter().map(|g| g[k] as i64).sum::<i64>());
+        let mut node = self.root();
+        for _ in 0..self.displacement.level() {
+            node = node
+                .children()
+                .into_iter()
+                .find(|child| child.holds(centroid))
+                .unwrap_or(node);
+        }
+        target.map(|g| {
+            let k = node.g.iter().position(|&x| x == g).unwrap_or(0);
+            self.displacement.displace(&node.v[k])
+        })
     }
 
     fn root(&self) -> Node {

@@ -32,9 +32,9 @@ use glam::{DVec2, DVec3};
 use super::height::HeightField;
 use crate::error::{Error, Result};
 use crate::geometry::{intersect_triangle, Ray};
+use crate::scene::displacement::DisplacementSpec;
 
-/// Deepest subdivision level accepted (`4^16` micro-triangles per base triangle).
-pub const MAX_LEVEL: u32 = 16;
+pub use crate::scene::displacement::MAX_LEVEL;
 
 /// A base-triangle vertex or an undisplaced micro-vertex.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -86,13 +86,23 @@ impl Displacement {
                 "displacement level {level} is above the largest, {MAX_LEVEL}"
             )));
         }
-        Ok(Displacement {
+        Ok(Displacement::build(height, scale, fraction, level))
+    }
+
+    /// The displacement a scene describes (validated when the scene loaded).
+    pub fn from_spec(spec: &DisplacementSpec) -> Self {
+        let height = HeightField::new(&spec.height);
+        Displacement::build(height, spec.scale, spec.fraction, spec.level)
+    }
+
+    fn build(height: HeightField, scale: f64, fraction: f64, level: u32) -> Self {
+        Displacement {
             h_max: height.max(),
             height,
             scale,
             fraction,
             level,
-        })
+        }
     }
 
     pub fn height(&self) -> &HeightField {
@@ -137,6 +147,35 @@ impl MicroTriangle {
         } else {
             [[i + 1, j + 1], [i, j + 1], [i + 1, j]]
         }
+    }
+}
+
+impl MicroTriangle {
+    /// The micro-triangle of a base triangle subdivided `level` times that holds the point
+    /// with barycentric weights `barycentric` (of the base triangle's second and third
+    /// vertex); a point on an edge between two goes to one of them, a point outside the
+    /// base triangle to the nearest along the grid.
+    pub fn containing(level: u32, barycentric: DVec2) -> MicroTriangle {
+        let n = (1u32 << level) as f64;
+        let (x, y) = (barycentric.x * n, barycentric.y * n);
+        let last = n - 1.0;
+        let i = x.floor().clamp(0.0, last);
+        let j = y.floor().clamp(0.0, last - i);
+        let up = i + j >= last || (x - i) + (y - j) <= 1.0;
+        MicroTriangle {
+            i: i as u32,
+            j: j as u32,
+            up,
+        }
+    }
+
+    /// The base-triangle barycentrics (of its second and third vertex) of the point with
+    /// barycentrics `barycentric` on this micro-triangle, at subdivision `level`.
+    pub fn base_barycentric(&self, level: u32, barycentric: DVec2) -> DVec2 {
+        let [g0, g1, g2] = self.vertices().map(|[i, j]| DVec2::new(i as f64, j as f64));
+        let grid =
+            g0 * (1.0 - barycentric.x - barycentric.y) + g1 * barycentric.x + g2 * barycentric.y;
+        grid / (1u32 << level) as f64
     }
 }
 

@@ -14,8 +14,10 @@ pub mod height;
 pub mod intersect;
 pub mod micro;
 pub mod procedural;
+pub mod tessellate;
 
 pub use height::{HeightField, HeightMap};
 pub use intersect::DisplacedTriangle;
 pub use micro::{BaseVertex, Displacement, MicroGrid, MicroHit, MicroTriangle, MAX_LEVEL};
 pub use procedural::{Procedural, Wave};
+pub use tessellate::{base_corners, tessellate};

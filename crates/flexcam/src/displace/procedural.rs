@@ -14,15 +14,9 @@ use std::f64::consts::{PI, TAU};
 
 use glam::DVec2;
 
-use crate::error::{Error, Result};
-
-/// One term of [`Procedural::waves`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Wave {
-    pub amplitude: f64,
-    pub frequency: [i32; 2],
-    pub phase: f64,
-}
+use crate::error::Result;
+use crate::scene::displacement::ProceduralSpec;
+pub use crate::scene::displacement::Wave;
 
 /// A procedural height function; build it with [`Procedural::waves`] or
 /// [`Procedural::bumps`].
@@ -48,42 +42,25 @@ const BUMP_SLOPE: f64 = 1.539_600_717_839_002;
 const ROUNDING: f64 = 1e-12;
 
 impl Procedural {
-    /// A sum of waves. Errors: no wave, an amplitude that is not positive and finite, a phase
-    /// that is not finite.
-    pub fn waves(waves: Vec<Wave>) -> Result<Procedural> {
-        if waves.is_empty() {
-            return Err(Error::new("waves: at least one wave is needed"));
-        }
-        for w in &waves {
-            if !(w.amplitude > 0.0 && w.amplitude.is_finite()) {
-                return Err(Error::new(format!(
-                    "waves: amplitude {} must be positive",
-                    w.amplitude
-                )));
+    /// The function `spec` describes (already validated by its constructors).
+    pub fn new(spec: &ProceduralSpec) -> Procedural {
+        let kind = match spec {
+            ProceduralSpec::Waves(waves) => {
+                Kind::Waves(waves.clone(), waves.iter().map(|w| w.amplitude).sum())
             }
-            if !w.phase.is_finite() {
-                return Err(Error::new("waves: phase must be finite"));
-            }
-        }
-        let sum = waves.iter().map(|w| w.amplitude).sum();
-        Ok(Procedural {
-            kind: Kind::Waves(waves, sum),
-        })
+            &ProceduralSpec::Bumps { cells, radius } => Kind::Bumps { cells, radius },
+        };
+        Procedural { kind }
     }
 
-    /// A grid of round bumps. Errors: a zero cell count, a radius outside (0, 1/2].
+    /// A sum of waves. Errors: those of [`ProceduralSpec::waves`].
+    pub fn waves(waves: Vec<Wave>) -> Result<Procedural> {
+        ProceduralSpec::waves(waves).map(|spec| Procedural::new(&spec))
+    }
+
+    /// A grid of round bumps. Errors: those of [`ProceduralSpec::bumps`].
     pub fn bumps(cells: [u32; 2], radius: f64) -> Result<Procedural> {
-        if cells.contains(&0) {
-            return Err(Error::new("bumps: cell counts must be at least 1"));
-        }
-        if !(radius > 0.0 && radius <= 0.5) {
-            return Err(Error::new(format!(
-                "bumps: radius {radius} must be in (0, 0.5] (cell units)"
-            )));
-        }
-        Ok(Procedural {
-            kind: Kind::Bumps { cells, radius },
-        })
+        ProceduralSpec::bumps(cells, radius).map(|spec| Procedural::new(&spec))
     }
 
     /// h at `uv`, in [0, 1].

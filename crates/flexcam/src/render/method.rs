@@ -4,8 +4,10 @@
 use std::fmt;
 use std::str::FromStr;
 
+use glam::DVec2;
+
 use crate::error::{Error, Result};
-use crate::projection::Projection;
+use crate::projection::{Projection, Projector};
 use crate::render::raster::InverseRaster;
 use crate::render::trilinear::TrilinearRenderer;
 use crate::render::{camera_triangles, raycast, Frame, PreparedScene, RenderOptions, Stats};
@@ -59,6 +61,7 @@ impl Method {
         if options.spp == 0 {
             return Err(Error::new("samples per pixel must be at least 1"));
         }
+        check_displaced(prepared, self, projection)?;
         match self {
             Method::Raycast => Ok(raycast::render(prepared, projection, options)),
             Method::Raster => Ok(InverseRaster::new(prepared, projection, options)?.render()),
@@ -75,6 +78,36 @@ impl Method {
             Method::CameraTriangles => camera_triangles::render(prepared, projection, options),
         }
     }
+}
+
+/// Fails, naming the first displaced object, where `method` cannot render the displaced
+/// objects of `prepared` through `projection`: `raster` and `trilinear` draw base triangles
+/// (they are refused rather than showing the undisplaced surface), and the ray caster does
+/// not trace quadratic Bezier projectors through micro-geometry (the projector of the image
+/// centre decides: a projection's projectors are all of one kind).
+fn check_displaced(
+    prepared: &PreparedScene,
+    method: Method,
+    projection: &dyn Projection,
+) -> Result<()> {
+    let Some(name) = prepared.first_displaced() else {
+        return Ok(());
+    };
+    if method != Method::Raycast {
+        return Err(Error::new(format!(
+            "object \"{name}\" is displaced, and displaced objects render with --method \
+             raycast only (method {method} would draw the undisplaced triangles)"
+        )));
+    }
+    let (width, height) = projection.resolution();
+    let centre = DVec2::new(width as f64 / 2.0, height as f64 / 2.0);
+    if let Some(Projector::QuadraticBezier(_)) = projection.projector(centre) {
+        return Err(Error::new(format!(
+            "object \"{name}\" is displaced, and displaced objects are not traced along \
+             quadratic projectors (use straight or polyline projectors)"
+        )));
+    }
+    Ok(())
 }
 
 impl FromStr for Method {

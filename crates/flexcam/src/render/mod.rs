@@ -175,6 +175,7 @@ pub mod camera_triangles;
 pub mod compare;
 /// Reflector compositing, reached only through [`render`] (`RenderOptions::composite_reflectors`).
 mod composite;
+mod displaced;
 mod huge_pages;
 mod method;
 pub mod prepared;

@@ -12,7 +12,7 @@
 //! those of the scene variants reflector compositing renders ([`PreparedScene::variant`]).
 
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 use glam::{DVec3, Vec2};
@@ -21,7 +21,10 @@ use crate::geometry::{intersect_triangle, Ray};
 use crate::render::bvh::curve_triangle::CurveTriangle;
 use crate::render::bvh::triangle::FastRay;
 use crate::render::bvh::{Bvh, BvhHit};
+use crate::render::displaced::DisplacedSet;
 use crate::scene::Scene;
+
+mod displaced_hits;
 
 /// The first surface a ray meets.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -63,6 +66,9 @@ pub struct PreparedScene {
     /// built on the first quadratic search ([`PreparedScene::curve_triangles`]): renders
     /// without curved projectors neither pay for it nor hold it.
     curve_triangles: OnceLock<Vec<CurveTriangle>>,
+    /// The displaced objects, whose triangles the BVH leaves out ([`crate::render::displaced`]);
+    /// `None` when there are none.
+    pub(in crate::render) displaced: Option<Arc<DisplacedSet>>,
 }
 
 /// Secondary-ray offset relative to the scene's largest coordinate magnitude: 2^-16, about
@@ -77,6 +83,9 @@ impl PreparedScene {
         let mut triangles = Vec::with_capacity(scene.triangle_count());
         for object in &scene.objects {
             first_triangle.push(triangles.len() as u32);
+            if object.displacement.is_some() {
+                continue;
+            }
             let p = &object.mesh.positions;
             triangles.extend(
                 object
@@ -103,6 +112,7 @@ impl PreparedScene {
             build_ms: start.elapsed().as_secs_f64() * 1e3,
             bvh_builds: AtomicU64::new(1),
             curve_triangles: OnceLock::new(),
+            displaced: DisplacedSet::new(scene),
         }
     }
 
@@ -131,6 +141,7 @@ impl PreparedScene {
             build_ms: self.build_ms,
             bvh_builds: AtomicU64::new(0),
             curve_triangles: OnceLock::new(),
+            displaced: self.displaced.clone(),
         }
     }
 
@@ -178,11 +189,12 @@ impl PreparedScene {
     /// origin's magnitude to the hit distance). Enough for a flat colour and a depth stored
     /// as f32; everything that spawns rays from the hit refines it first.
     pub(in crate::render) fn intersect_f32(&self, ray: &Ray) -> Option<Hit32> {
-        if self.misses_scene_box(ray) {
-            return None;
-        }
-        let found = self.bvh.closest(&FastRay::new(ray)?)?;
-        Some(self.hit32(found))
+        let found = if self.misses_scene_box(ray) {
+            None
+        } else {
+            self.bvh.closest(&FastRay::new(ray)?).map(|f| self.hit32(f))
+        };
+        self.nearer_displaced(ray, found)
     }
 
     /// Whether `ray`'s segment (its points over `[t_min, t_max]`, both ends finite) lies
@@ -201,7 +213,14 @@ impl PreparedScene {
     pub(in crate::render) fn intersect4_f32(&self, rays: [Option<&Ray>; 4]) -> [Option<Hit32>; 4] {
         let fast = rays.map(|r| self.fast_unless_outside(r));
         let found = self.bvh.closest4(fast.each_ref().map(Option::as_ref));
-        found.map(|f| f.map(|f| self.hit32(f)))
+        let found = found.map(|f| f.map(|f| self.hit32(f)));
+        if self.displaced.is_none() {
+            return found;
+        }
+        std::array::from_fn(|i| match rays[i] {
+            Some(ray) => self.nearer_displaced(ray, found[i]),
+            None => None,
+        })
     }
 
     /// The f32 form of `ray` for a BVH search, or `None` where it cannot hit anything: no
@@ -229,6 +248,9 @@ impl PreparedScene {
 
     /// `found` (a hit of `ray`) with `t` and the barycentrics recomputed in f64.
     pub(in crate::render) fn refine(&self, ray: &Ray, found: Hit32) -> Hit {
+        if let Some(hit) = self.refine_displaced(ray, found) {
+            return hit;
+        }
         let mesh = &self.scene.objects[found.object].mesh;
         let [a, b, c] = mesh.triangles[found.triangle];
         let vertex = |i: u32| mesh.positions[i as usize].as_dvec3();
@@ -248,7 +270,7 @@ impl PreparedScene {
 
     /// Whether anything is hit within the ray's interval (the shadow-ray query).
     pub fn occluded(&self, ray: &Ray) -> bool {
-        FastRay::new(ray).is_some_and(|r| self.bvh.occluded(&r))
+        FastRay::new(ray).is_some_and(|r| self.bvh.occluded(&r)) || self.displaced_occludes(ray)
     }
 
     /// A ray leaving surface point `point` (geometric normal `normal`) along `direction`,

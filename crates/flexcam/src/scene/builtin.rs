@@ -20,7 +20,7 @@ struct Builtin {
     text: &'static str,
 }
 
-const BUILTINS: [Builtin; 4] = [
+const BUILTINS: [Builtin; 6] = [
     Builtin {
         name: "default",
         description: "a teapot, mirror and glass spheres, a torus, boxes, a pillar, a cylinder and a lamp around the eye, as a 360 x 180 degree equirectangular panorama",
@@ -40,6 +40,16 @@ const BUILTINS: [Builtin; 4] = [
         name: "teapot-dense",
         description: "a finely tessellated teapot on a floor, 123,554 triangles, perspective: the ray-casting benchmark scene",
         text: include_str!("../../../../scenes/teapot-dense.toml"),
+    },
+    Builtin {
+        name: "displaced-torus",
+        description: "a three-holed torus of 5,046 triangles displaced at level 5 by procedural waves (5.2 million micro-triangles, traced without tessellating), perspective; --method raycast",
+        text: include_str!("../../../../scenes/displaced-torus.toml"),
+    },
+    Builtin {
+        name: "displaced-scan",
+        description: "a scanned-style model of 101,760 triangles roughened by procedural displacement at level 2, on a floor, perspective; --method raycast",
+        text: include_str!("../../../../scenes/displaced-scan.toml"),
     },
 ];
 
@@ -97,7 +107,14 @@ mod tests {
         let names: Vec<&str> = list().iter().map(|(name, _)| *name).collect();
         assert_eq!(
             names,
-            ["default", "cube-floor", "teapot-room", "teapot-dense"]
+            [
+                "default",
+                "cube-floor",
+                "teapot-room",
+                "teapot-dense",
+                "displaced-torus",
+                "displaced-scan"
+            ]
         );
         assert!(names.contains(&DEFAULT));
         assert!(list()
@@ -116,7 +133,9 @@ mod tests {
             "{message}"
         );
         assert!(
-            message.contains("default, cube-floor, teapot-room, teapot-dense"),
+            message.contains(
+                "default, cube-floor, teapot-room, teapot-dense, displaced-torus, displaced-scan"
+            ),
             "{message}"
         );
         let via_scene = crate::scene::load("builtin:nope")

@@ -2,16 +2,19 @@
 //! the projection named by the scene, with loaders for model files, built-in shapes and
 //! scenes, and the TOML scene-file format.
 
+pub mod displacement;
 mod light;
 mod material;
 mod mesh;
 pub mod texel;
 
+pub use displacement::DisplacementSpec;
 pub use light::Light;
 pub use material::{Material, Pattern, Surface, Texture};
 pub use mesh::Mesh;
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use glam::{Affine3A, Vec3};
 
@@ -29,6 +32,9 @@ pub struct Object {
     pub material: Material,
     /// World to object space, for patterns defined in object space (the checker).
     pub world_to_object: Affine3A,
+    /// Displacement of the mesh's triangles (scene key `displacement`): the mesh then has
+    /// texture coordinates and vertex normals, and renderers see its micro-geometry.
+    pub displacement: Option<Arc<DisplacementSpec>>,
 }
 
 /// Image settings of a scene; CLI flags override them.

@@ -1,6 +1,7 @@
 //! `flexcam bench`: the source documents' timing tables, rerun with flexcam's renderers.
 
 pub mod camera_triangles;
+pub mod displaced;
 pub mod flexible;
 mod timing;
 pub mod trilinear;
@@ -14,6 +15,10 @@ pub enum BenchCommand {
     /// Table 1 of Hou et al. 2006 (reflection rows) and the 5,000-triangle mirror-sphere
     /// target: camera triangles against the paper and against the ray caster.
     CameraTriangles(camera_triangles::CameraTrianglesArgs),
+    /// Figure 8.1 of Ramsey 2005: the displaced three-holed torus at subdivision levels 0 to
+    /// 6, ray traced without tessellation, beside the same micro-triangles as a
+    /// pre-tessellated mesh (time and peak memory).
+    Displaced(displaced::DisplacedArgs),
     /// Table 7.1 of Brosz 2011: quadratic vs 2 to 6 segment projectors at 800 x 800, and the
     /// throughput of --method raster on a 1280 x 720 panorama of a 123,554-triangle scene.
     Flexible(flexible::FlexibleArgs),
@@ -26,6 +31,7 @@ pub enum BenchCommand {
 pub fn run(command: &BenchCommand) -> Result<()> {
     match command {
         BenchCommand::CameraTriangles(args) => camera_triangles::run(args),
+        BenchCommand::Displaced(args) => displaced::run(args),
         BenchCommand::Flexible(args) => flexible::run(args),
         BenchCommand::Trilinear(args) => trilinear::run(args),
     }

@@ -108,8 +108,10 @@ impl PreparedScene {
             finite &= p.is_finite();
             (lo, hi) = (lo.min(p), hi.max(p));
         }
-        let pad = DVec3::splat(pad);
-        finite && !self.bvh.leaves_overlap(lo - pad, hi + pad)
+        let (lo, hi) = (lo - DVec3::splat(pad), hi + DVec3::splat(pad));
+        finite
+            && !self.bvh.leaves_overlap(lo, hi)
+            && !self.displaced.as_ref().is_some_and(|d| d.overlaps(lo, hi))
     }
 }
 

@@ -103,6 +103,12 @@ pub fn render_into(
         "triangles",
         crate::render::Counter::Count(scene.triangle_count as u64),
     );
+    if let Some(displaced) = &scene.displaced {
+        stats.insert(
+            "displaced_triangles",
+            crate::render::Counter::Count(displaced.len() as u64),
+        );
+    }
     stats
 }
 

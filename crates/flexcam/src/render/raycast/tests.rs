@@ -78,6 +78,7 @@ fn object(id: u32, mesh: Mesh, color: Vec3, surface: Surface) -> Object {
             surface,
         },
         world_to_object: Affine3A::IDENTITY,
+        displacement: None,
     }
 }
 

@@ -33,6 +33,7 @@ pub fn teapot_scene(faces: u32) -> (Scene, usize) {
             ..Material::default()
         },
         world_to_object: Affine3A::IDENTITY,
+        displacement: None,
     };
     let scene = Scene {
         objects: vec![object],

@@ -371,6 +371,7 @@ mod tests {
                 surface: Surface::Diffuse,
             },
             world_to_object: Affine3A::IDENTITY,
+            displacement: None,
         }
     }
 

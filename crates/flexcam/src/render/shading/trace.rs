@@ -254,6 +254,9 @@ impl<'a> HitShader<'a> {
 
     /// The normals at `hit` as seen along `ray`.
     fn normals(&self, ray: &Ray, hit: &Hit) -> Normals {
+        if let Some(normals) = self.caster.displaced_normals(hit, ray.direction) {
+            return normals;
+        }
         let object = &self.caster.scene.objects[hit.object];
         normals(
             object,

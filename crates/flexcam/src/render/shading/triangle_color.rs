@@ -316,6 +316,7 @@ mod tests {
             },
             world_to_object: Affine3A::from_rotation_y(0.5)
                 * Affine3A::from_translation(Vec3::new(0.3, -1.0, 0.2)),
+            displacement: None,
         }
     }
 

@@ -236,6 +236,7 @@ mod tests {
                     mesh,
                     material: Material::default(),
                     world_to_object: Affine3A::IDENTITY,
+                    displacement: None,
                 }
             })
             .collect();

@@ -210,6 +210,7 @@ pub(super) fn object(id: u32, triangles: &[[DVec3; 3]], color: Vec3) -> Object {
             ..Material::default()
         },
         world_to_object: glam::Affine3A::IDENTITY,
+        displacement: None,
     }
 }
 

@@ -91,6 +91,7 @@ pub fn random_triangles(count: u32, seed: u64) -> Scene {
             mesh,
             material: Material::default(),
             world_to_object: Affine3A::IDENTITY,
+            displacement: None,
         }],
         lights: Vec::new(),
         image: ImageSettings {

@@ -6,6 +6,7 @@
 
 mod animation;
 mod control_surface;
+mod displacement;
 mod fitted_grid;
 mod flexible;
 mod light;

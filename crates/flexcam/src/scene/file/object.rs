@@ -7,6 +7,7 @@ use std::sync::Arc;
 use glam::{Affine3A, Mat3, Vec3};
 use toml::Spanned;
 
+use super::displacement;
 use super::raw::{Numbers, RawObject};
 use super::shape::{analytic_mesh, Shape, MAX_TESSELLATION};
 use super::source::Source;
@@ -62,6 +63,13 @@ pub(super) fn convert(
         .as_ref()
         .map_or_else(|| shape.name().to_string(), |n| n.get_ref().clone());
     let world_to_object = object_to_world.inverse();
+    let displacement = match &raw.displacement {
+        Some(table) => {
+            let meshes: Vec<&Mesh> = parts.iter().map(|(mesh, _)| mesh).collect();
+            Some(displacement::convert(src, table, base_dir, &name, &meshes)?)
+        }
+        None => None,
+    };
     Ok(parts
         .into_iter()
         .map(|(mut mesh, material)| {
@@ -72,6 +80,7 @@ pub(super) fn convert(
                 mesh,
                 material,
                 world_to_object,
+                displacement: displacement.clone(),
             }
         })
         .collect())

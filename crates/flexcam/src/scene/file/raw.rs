@@ -377,6 +377,7 @@ pub struct RawObject {
     pub trilinear_reflector: Option<Spanned<bool>>,
     pub trilinear_screen_map: Option<Spanned<String>>,
     pub trilinear_refine_px: Option<Spanned<f64>>,
+    pub displacement: Option<Spanned<super::displacement::RawDisplacement>>,
 }
 
 /// `checker = { color = [...], size = ... }`.

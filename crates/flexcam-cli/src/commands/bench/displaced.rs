@@ -1,0 +1,261 @@
+//! `flexcam bench displaced`: Figure 8.1 of Ramsey 2005 (Ray Tracing Displaced Models in a
+//! Level-of-Detail Hierarchy), time per frame of the displaced three-holed torus at
+//! subdivision levels 0 and up, beside the same micro-triangles given to the ray caster as an
+//! ordinary pre-tessellated mesh, in time and in peak memory.
+//!
+//! The scene is `builtin:displaced-torus` (5,046 base triangles, procedural waves) with its
+//! level replaced per row; every frame is `--method raycast` at the same size and shading.
+//! The dissertation traced 180 x 180 pixels on ten R14000 processors testing every
+//! micro-triangle of a base triangle per ray; flexcam descends a min/max hierarchy per base
+//! triangle instead (`flexcam::displace`).
+//!
+//! Each cell runs in a process of its own (this binary again, with the hidden `--cell`
+//! argument), so that its peak memory is its own: the peak resident set size (`VmHWM` of
+//! `/proc/self/status`, Linux; "-" elsewhere) of a process that loads the scene, builds the
+//! variant (a copy of the scene, or its tessellation), prepares it and renders it. Both
+//! variants share the process's fixed cost (the binary, the base scene, the frame).
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use clap::{Args, ValueEnum};
+use flexcam::displace::{tessellate, Displacement};
+use flexcam::render::{render, PreparedScene, RenderOptions, Shading};
+use flexcam::scene::{self, DisplacementSpec, Scene};
+use flexcam::{Error, Result};
+
+use super::timing::measure;
+
+/// Figure 8.1: (level, micro-triangles per base triangle, seconds per frame).
+const DISSERTATION: [(u32, u32, f64); 5] = [
+    (1, 4, 0.41),
+    (2, 16, 1.02),
+    (3, 64, 3.43),
+    (4, 256, 13.04),
+    (5, 1024, 51.48),
+];
+
+/// Arguments of `flexcam bench displaced`.
+#[derive(Args, Debug)]
+pub struct DisplacedArgs {
+    /// Timed renders per cell, after one warm-up render; the median is reported.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=100))]
+    repeat: u32,
+    /// Image width and height in pixels.
+    #[arg(long, default_value_t = 512, value_parser = clap::value_parser!(u32).range(16..=4096))]
+    size: u32,
+    /// Deepest subdivision level of the sweep.
+    #[arg(long, default_value_t = 6, value_parser = clap::value_parser!(u32).range(0..=8))]
+    max_level: u32,
+    /// Deepest level also rendered pre-tessellated (its mesh grows 4x per level: level 5 is
+    /// 5.2 million triangles, about 1 GB with its BVH).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(0..=6))]
+    max_tessellated: u32,
+    /// Shading of every frame.
+    #[arg(long, value_enum, default_value_t = BenchShading::Flat)]
+    shading: BenchShading,
+    /// Internal: measure one cell (`displaced:LEVEL` or `tessellated:LEVEL`) in this process
+    /// and print it as one line.
+    #[arg(long, hide = true)]
+    cell: Option<String>,
+}
+
+/// `--shading` of the bench.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BenchShading {
+    /// Primary rays only: the geometry's cost.
+    Flat,
+    /// Lights and shadow rays (micro-triangle normals).
+    Lit,
+}
+
+/// One variant's measurements, in milliseconds and megabytes.
+struct Cell {
+    median_ms: f64,
+    cpu_ms: f64,
+    prepare_ms: f64,
+    peak_mb: Option<f64>,
+}
+
+/// Runs the sweep and prints it beside Figure 8.1, or measures one cell (`--cell`).
+pub fn run(args: &DisplacedArgs) -> Result<()> {
+    if let Some(cell) = &args.cell {
+        return measure_cell(args, cell);
+    }
+    let base = scene::load("builtin:displaced-torus")?;
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    println!(
+        "Figure 8.1 (Ramsey 2005): the displaced three-holed torus, {} base triangles, {s}x{s}, \
+         {:?} shading, --method raycast, median of {} after one warm-up, {threads} threads",
+        base.triangle_count(),
+        args.shading,
+        args.repeat,
+        s = args.size,
+    );
+    println!(
+        "dissertation: 180x180, ten 600 MHz R14000, every micro-triangle of a base triangle tested"
+    );
+    println!(
+        "{:>5} {:>10} {:>8} | {:>12} {:>8} {:>8} | {:>12} {:>9} {:>8} | {:>6} {:>6}",
+        "level",
+        "micro/base",
+        "diss. s",
+        "displaced ms",
+        "cpu ms",
+        "peak MB",
+        "tessel. ms",
+        "build ms",
+        "peak MB",
+        "time x",
+        "mem x"
+    );
+    for level in 0..=args.max_level {
+        let displaced = spawn_cell(args, "displaced", level)?;
+        let tessellated = if level <= args.max_tessellated {
+            Some(spawn_cell(args, "tessellated", level)?)
+        } else {
+            None
+        };
+        let diss = DISSERTATION
+            .iter()
+            .find(|(l, _, _)| *l == level)
+            .map_or("-".to_string(), |(_, _, s)| format!("{s:.2}"));
+        let mb = |m: Option<f64>| m.map_or("-".to_string(), |m| format!("{m:.1}"));
+        let (t_ms, t_build, t_mb, ratio, mem_ratio) = match &tessellated {
+            Some(t) => (
+                format!("{:.1}", t.median_ms),
+                format!("{:.0}", t.prepare_ms),
+                mb(t.peak_mb),
+                format!("{:.2}", displaced.median_ms / t.median_ms),
+                match (displaced.peak_mb, t.peak_mb) {
+                    (Some(d), Some(t)) => format!("{:.3}", d / t),
+                    _ => "-".to_string(),
+                },
+            ),
+            None => Default::default(),
+        };
+        println!(
+            "{level:>5} {:>10} {diss:>8} | {:>12.1} {:>8} {:>8} | {t_ms:>12} {t_build:>9} {t_mb:>8} | {ratio:>6} {mem_ratio:>6}",
+            1u64 << (2 * level),
+            displaced.median_ms,
+            format!("{:.1}", displaced.cpu_ms),
+            mb(displaced.peak_mb),
+        );
+    }
+    println!(
+        "time x: displaced / tessellated frame time; mem x: displaced / tessellated peak memory; \
+         build ms: tessellation and BVH build of the tessellated mesh (the displaced set's own \
+         build is under 100 ms)"
+    );
+    Ok(())
+}
+
+/// `scene` with every displacement at subdivision `level`.
+fn with_level(scene: &Scene, level: u32) -> Scene {
+    let mut scene = scene.clone();
+    for object in &mut scene.objects {
+        if let Some(spec) = &object.displacement {
+            object.displacement = Some(Arc::new(DisplacementSpec {
+                level,
+                ..DisplacementSpec::clone(spec)
+            }));
+        }
+    }
+    scene
+}
+
+/// `scene` with every displaced object replaced by its micro-triangles as a mesh.
+fn tessellated(scene: &Scene) -> Scene {
+    let mut scene = scene.clone();
+    for object in &mut scene.objects {
+        if let Some(spec) = object.displacement.take() {
+            object.mesh = tessellate(&object.mesh, &Displacement::from_spec(&spec));
+        }
+    }
+    scene
+}
+
+/// Measures cell `variant:level` in a child process (module docs).
+fn spawn_cell(args: &DisplacedArgs, variant: &str, level: u32) -> Result<Cell> {
+    let exe = std::env::current_exe()
+        .map_err(|e| Error::new(format!("cannot find this program to run a cell: {e}")))?;
+    let shading = match args.shading {
+        BenchShading::Flat => "flat",
+        BenchShading::Lit => "lit",
+    };
+    let out = std::process::Command::new(exe)
+        .args([
+            "bench",
+            "displaced",
+            "--cell",
+            &format!("{variant}:{level}"),
+        ])
+        .args(["--size", &args.size.to_string(), "--shading", shading])
+        .args(["--repeat", &args.repeat.to_string()])
+        .output()
+        .map_err(|e| Error::new(format!("cannot run a bench cell: {e}")))?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let fields: Vec<f64> = text
+        .split_whitespace()
+        .filter_map(|f| f.parse().ok())
+        .collect();
+    match (out.status.success(), fields.as_slice()) {
+        (true, &[median_ms, cpu_ms, prepare_ms, peak_kb]) => Ok(Cell {
+            median_ms,
+            cpu_ms,
+            prepare_ms,
+            peak_mb: (peak_kb >= 0.0).then_some(peak_kb / 1024.0),
+        }),
+        _ => Err(Error::new(format!(
+            "bench cell {variant}:{level} failed: {}",
+            String::from_utf8_lossy(&out.stderr).trim()
+        ))),
+    }
+}
+
+/// Measures one cell in this process and prints `median_ms cpu_ms prepare_ms peak_kb`
+/// (peak -1 where unknown).
+fn measure_cell(args: &DisplacedArgs, cell: &str) -> Result<()> {
+    let parsed = cell
+        .split_once(':')
+        .and_then(|(variant, level)| Some((variant, level.parse::<u32>().ok()?)));
+    let (variant, level) = match parsed {
+        Some((v @ ("displaced" | "tessellated"), l)) if l <= 8 => (v, l),
+        _ => return Err(Error::new(format!("bad bench cell \"{cell}\""))),
+    };
+    let base = scene::load("builtin:displaced-torus")?;
+    let projection = base.projection.build(args.size, args.size)?;
+    let options = RenderOptions {
+        shading: match args.shading {
+            BenchShading::Flat => Shading::Flat,
+            BenchShading::Lit => Shading::Lit,
+        },
+        ..RenderOptions::default()
+    };
+    let start = Instant::now();
+    let scene = with_level(&base, level);
+    let scene = match variant {
+        "tessellated" => tessellated(&scene),
+        _ => scene,
+    };
+    let prepared = PreparedScene::new(&scene);
+    drop(scene);
+    let prepare_ms = start.elapsed().as_secs_f64() * 1e3;
+    let (timing, _) = measure(args.repeat, || {
+        render(&prepared, projection.as_ref(), &options)
+    })?;
+    let peak_kb = memory_kb("VmHWM:").map_or(-1.0, |k| k as f64);
+    println!(
+        "{} {} {prepare_ms} {peak_kb}",
+        timing.median_ms(),
+        timing.cpu_ms()
+    );
+    Ok(())
+}
+
+/// A `kB` field of `/proc/self/status` (`VmRSS:`, `VmHWM:`), if readable.
+fn memory_kb(field: &str) -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with(field))?;
+    line[field.len()..].split_whitespace().next()?.parse().ok()
+}

@@ -1,0 +1,311 @@
+//! Displaced objects in the prepared scene: every base triangle of a displaced object is a
+//! leaf of its own bounding volume hierarchy, bounded by its displacement shell, and traced
+//! exactly through the min/max hierarchy of [`crate::displace::DisplacedTriangle`]; nothing is
+//! tessellated.
+//!
+//! The triangles of displaced objects are left out of the prepared scene's triangle BVH, so
+//! that its f32 inner loop stays as it is; queries ([`PreparedScene::intersect`] and the
+//! others) search both, the triangle BVH first, then this set up to the hit found there. The
+//! set is a binary tree over the shells' boxes (median splits of the box centres along the
+//! widest axis, leaves of at most [`LEAF`] base triangles), searched in f64 front to back.
+//! Memory per base triangle: its object and index, a share of the tree's boxes (about 80
+//! bytes in all); the micro-geometry is recomputed per ray from the mesh.
+//!
+//! The prepared scene's queries over this set are in `render::prepared::displaced_hits`.
+//! A hit is reported on the base triangle, as any hit is: `triangle` is the base triangle,
+//! `barycentric` the base-triangle weights of the hit point's place in the subdivision (the
+//! micro-triangle's grid position blended by the micro-hit's barycentrics), so texture
+//! coordinates and vertex colours are interpolated there exactly as micro-vertices carry
+//! them (midpoint uvs are linear). Normals are the micro-triangle's face normal, used as both
+//! geometric and shading normal: micro-vertex normals are those of the undisplaced surface
+//! and would hide the displacement from lit shading.
+
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use crate::displace::{base_corners, DisplacedTriangle, Displacement, MicroHit};
+use crate::geometry::Ray;
+use crate::scene::Scene;
+
+/// Most base triangles per leaf.
+const LEAF: usize = 2;
+/// Traversal stack size: more than the depth of a median-split tree over `u32` items.
+const STACK: usize = 40;
+
+/// The displaced objects' base triangles and the tree over their shells.
+#[derive(Debug)]
+pub(in crate::render) struct DisplacedSet {
+    /// Per object of the scene (by index): its displacement, if it has one.
+    displacements: Vec<Option<Displacement>>,
+    /// Base triangles in tree order: object index and triangle index.
+    items: Vec<[u32; 2]>,
+    /// Depth-first: an interior node's first child follows it, `second` is the other.
+    nodes: Vec<Node>,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    lo: DVec3,
+    hi: DVec3,
+    /// Leaf: the first item; interior: the second child's node index.
+    index: u32,
+    /// Leaf: the number of items (at least 1); interior: 0.
+    count: u32,
+}
+
+/// A hit on a displaced base triangle.
+#[derive(Debug, Clone, Copy)]
+pub(in crate::render) struct DisplacedHit {
+    pub object: usize,
+    pub triangle: usize,
+    pub micro: MicroHit,
+}
+
+impl DisplacedSet {
+    /// The set of `scene`'s displaced objects; `None` when it has none.
+    pub fn new(scene: &Scene) -> Option<Arc<DisplacedSet>> {
+        let displacements: Vec<Option<Displacement>> = scene
+            .objects
+            .iter()
+            .map(|o| o.displacement.as_deref().map(Displacement::from_spec))
+            .collect();
+        let mut boxed = Vec::new();
+        for (index, (object, displacement)) in scene.objects.iter().zip(&displacements).enumerate()
+        {
+            let Some(displacement) = displacement else {
+                continue;
+            };
+            for triangle in 0..object.mesh.triangles.len() {
+                let [lo, hi] =
+                    DisplacedTriangle::new(base_corners(&object.mesh, triangle), displacement)
+                        .bounds();
+                boxed.push(([index as u32, triangle as u32], lo, hi));
+            }
+        }
+        if displacements.iter().all(Option::is_none) {
+            return None;
+        }
+        let mut nodes = Vec::with_capacity(2 * boxed.len() / LEAF + 1);
+        if !boxed.is_empty() {
+            build(&mut boxed, 0, &mut nodes);
+        }
+        Some(Arc::new(DisplacedSet {
+            displacements,
+            items: boxed.into_iter().map(|(item, _, _)| item).collect(),
+            nodes,
+        }))
+    }
+
+    /// Number of displaced base triangles.
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    /// The displacement of object `object`, if it is displaced.
+    pub fn displacement(&self, object: usize) -> Option<&Displacement> {
+        self.displacements[object].as_ref()
+    }
+
+    /// Base triangle `triangle` of object `object` (displaced) with its displacement.
+    pub fn triangle<'a>(
+        &'a self,
+        scene: &Scene,
+        object: usize,
+        triangle: usize,
+        displacement: &'a Displacement,
+    ) -> DisplacedTriangle<'a> {
+        DisplacedTriangle::new(
+            base_corners(&scene.objects[object].mesh, triangle),
+            displacement,
+        )
+    }
+
+    /// The nearest micro-triangle hit of `ray` with `t` in `[ray.t_min, min(ray.t_max,
+    /// limit)]`; on equal `t`, the lower object, then the lower base triangle. With `any`,
+    /// the first hit found.
+    pub fn closest(&self, scene: &Scene, ray: &Ray, limit: f64, any: bool) -> Option<DisplacedHit> {
+        let slabs = Slabs::new(ray)?;
+        let mut t_max = ray.t_max.min(limit);
+        let mut best: Option<DisplacedHit> = None;
+        // At most one pending node per level; median splits keep the tree under 40 deep.
+        let mut stack = [(0u32, 0.0f64); STACK];
+        let mut depth = 0;
+        let root = self.nodes.first()?;
+        slabs.entry(root, ray.t_min, t_max)?;
+        let mut current = 0u32;
+        loop {
+            let node = self.nodes[current as usize];
+            if node.count > 0 {
+                for &[object, triangle] in
+                    &self.items[node.index as usize..(node.index + node.count) as usize]
+                {
+                    let (object, triangle) = (object as usize, triangle as usize);
+                    let Some(displacement) = self.displacement(object) else {
+                        continue;
+                    };
+                    let bounded = Ray { t_max, ..*ray };
+                    let found = self
+                        .triangle(scene, object, triangle, displacement)
+                        .intersect(&bounded);
+                    if let Some(micro) = found {
+                        let better = best.is_none_or(|b| {
+                            micro.t < b.micro.t
+                                || (micro.t == b.micro.t
+                                    && (object, triangle) < (b.object, b.triangle))
+                        });
+                        if better {
+                            t_max = micro.t;
+                            best = Some(DisplacedHit {
+                                object,
+                                triangle,
+                                micro,
+                            });
+                            if any {
+                                return best;
+                            }
+                        }
+                    }
+                }
+            } else {
+                let (a, b) = (current + 1, node.index);
+                let ea = slabs.entry(&self.nodes[a as usize], ray.t_min, t_max);
+                let eb = slabs.entry(&self.nodes[b as usize], ray.t_min, t_max);
+                // The nearer child next, the other pending with its entry distance.
+                let next = match (ea, eb) {
+                    (Some(x), Some(y)) => {
+                        let (near, far, far_entry) = if y < x { (b, a, x) } else { (a, b, y) };
+                        stack[depth] = (far, far_entry);
+                        depth += 1;
+                        Some(near)
+                    }
+                    (Some(_), None) => Some(a),
+                    (None, Some(_)) => Some(b),
+                    (None, None) => None,
+                };
+                if let Some(next) = next {
+                    current = next;
+                    continue;
+                }
+            }
+            // Ties with the best hit stay: an equal t may win on the triangle order.
+            loop {
+                if depth == 0 {
+                    return best;
+                }
+                depth -= 1;
+                let (node, entry) = stack[depth];
+                if entry <= t_max {
+                    current = node;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// Whether any shell box overlaps the box `[lo, hi]`.
+    pub fn overlaps(&self, lo: DVec3, hi: DVec3) -> bool {
+        let mut stack = vec![0u32];
+        while let Some(i) = stack.pop() {
+            let Some(node) = self.nodes.get(i as usize) else {
+                return false;
+            };
+            if node.lo.cmpgt(hi).any() || node.hi.cmplt(lo).any() {
+                continue;
+            }
+            if node.count > 0 {
+                return true;
+            }
+            stack.extend([i + 1, node.index]);
+        }
+        false
+    }
+}
+
+/// Builds the subtree over `items` (stored from item `offset` on), appending its nodes.
+fn build(items: &mut [([u32; 2], DVec3, DVec3)], offset: usize, nodes: &mut Vec<Node>) {
+    let (lo, hi) = items.iter().fold(
+        (DVec3::INFINITY, DVec3::NEG_INFINITY),
+        |(lo, hi), &(_, a, b)| (lo.min(a), hi.max(b)),
+    );
+    let slot = nodes.len();
+    nodes.push(Node {
+        lo,
+        hi,
+        index: offset as u32,
+        count: items.len() as u32,
+    });
+    if items.len() <= LEAF {
+        return;
+    }
+    let (c_lo, c_hi) = items.iter().fold(
+        (DVec3::INFINITY, DVec3::NEG_INFINITY),
+        |(lo, hi), &(_, a, b)| {
+            let c = (a + b) * 0.5;
+            (lo.min(c), hi.max(c))
+        },
+    );
+    let extent = c_hi - c_lo;
+    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
+    let mid = items.len() / 2;
+    items.select_nth_unstable_by(mid, |p, q| {
+        let (cp, cq) = (p.1[axis] + p.2[axis], q.1[axis] + q.2[axis]);
+        cp.total_cmp(&cq).then(p.0.cmp(&q.0))
+    });
+    let (left, right) = items.split_at_mut(mid);
+    build(left, offset, nodes);
+    let second = nodes.len() as u32;
+    build(right, offset + mid, nodes);
+    nodes[slot].index = second;
+    nodes[slot].count = 0;
+}
+
+/// A ray's slab-test constants in f64.
+struct Slabs {
+    origin: DVec3,
+    inv: DVec3,
+}
+
+impl Slabs {
+    fn new(ray: &Ray) -> Option<Slabs> {
+        let valid = ray.origin.is_finite()
+            && ray.direction.is_finite()
+            && ray.direction != DVec3::ZERO
+            && ray.t_min <= ray.t_max;
+        valid.then(|| Slabs {
+            origin: ray.origin,
+            inv: ray.direction.recip(),
+        })
+    }
+
+    /// Where the ray enters the node's box within `[t_min, t_max]`, if it does. The boxes
+    /// already hold their shells' rounding allowance; a zero direction component gives an
+    /// infinite reciprocal, and the origin test by the sign of the NaN-free products.
+    fn entry(&self, node: &Node, t_min: f64, t_max: f64) -> Option<f64> {
+        let mut near = t_min;
+        let mut far = t_max;
+        for k in 0..3 {
+            let (o, inv) = (self.origin[k], self.inv[k]);
+            if inv.is_infinite() {
+                if o < node.lo[k] || o > node.hi[k] {
+                    return None;
+                }
+                continue;
+            }
+            let (t0, t1) = ((node.lo[k] - o) * inv, (node.hi[k] - o) * inv);
+            near = near.max(t0.min(t1));
+            far = far.min(t0.max(t1));
+        }
+        let slack = 1e-12 * far.abs().max(near.abs());
+        (near <= far + slack).then_some(near)
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,261 @@
+use std::path::Path;
+
+use glam::{DVec2, DVec3};
+
+use super::*;
+use crate::displace::{MicroGrid, MicroTriangle};
+use crate::render::{render, Method, PreparedScene, RenderOptions, Shading};
+use crate::scene::file::parse;
+
+/// Two displaced tori (waves and bumps) crossing each other, and an undisplaced box that
+/// cuts into one of them.
+const SCENE: &str = r#"
+[image]
+width = 48
+height = 40
+
+[projection]
+type = "perspective"
+position = [0.0, 2.5, 3.0]
+look_at = [0.0, 0.0, 0.0]
+fov = 60.0
+
+[[object]]
+name = "waves"
+shape = "torus"
+size = [1.0, 0.35]
+tessellation = 6
+displacement = { procedural = "waves", waves = [[1.0, 5, 0, 0.0], [0.5, 2, 3, 1.0]], scale = 0.2, level = 3 }
+
+[[object]]
+name = "bumps"
+shape = "torus"
+size = [0.8, 0.3]
+tessellation = 5
+rotate = [90.0, 0.0, 0.0]
+translate = [0.7, 0.0, 0.0]
+displacement = { procedural = "bumps", cells = [6, 3], radius = 0.45, scale = 0.15, level = 2, fraction = 0.7 }
+
+[[object]]
+name = "box"
+shape = "box"
+size = [0.5, 0.5, 0.5]
+translate = [-0.9, 0.2, 0.3]
+"#;
+
+fn prepared() -> PreparedScene {
+    PreparedScene::new(&parse(SCENE, Path::new("displaced-test.toml")).unwrap())
+}
+
+/// Deterministic rays from around the scene through points near it.
+fn rays() -> impl Iterator<Item = Ray> {
+    let mut x = 0x2545_F491_4F6C_DD1Du64;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..3000).map(move |_| {
+        let mut point = || DVec3::new(next(), next(), next()) * 2.0 - 1.0;
+        let origin = point() * 4.0;
+        let target = point() * 1.3;
+        Ray::new(origin, target - origin)
+    })
+}
+
+/// The nearest hit by testing every micro-triangle of every displaced base triangle, and
+/// every triangle of the other objects: (t, object, base triangle, base barycentrics).
+fn brute_force(prepared: &PreparedScene, ray: &Ray) -> Option<(f64, usize, usize, DVec2)> {
+    let scene = prepared.scene();
+    let mut best: Option<(f64, usize, usize, DVec2)> = None;
+    let mut offer = |hit: (f64, usize, usize, DVec2)| {
+        if best.is_none_or(|b| hit.0 < b.0) {
+            best = Some(hit);
+        }
+    };
+    for (o, object) in scene.objects.iter().enumerate() {
+        let Some(spec) = &object.displacement else {
+            let mesh = &object.mesh;
+            for (k, t) in mesh.triangles.iter().enumerate() {
+                let v = t.map(|i| mesh.positions[i as usize].as_dvec3());
+                if let Some(hit) = crate::geometry::intersect_triangle(ray.origin, ray.direction, v)
+                {
+                    offer((hit.t, o, k, hit.barycentric));
+                }
+            }
+            continue;
+        };
+        let d = Displacement::from_spec(spec);
+        for k in 0..object.mesh.triangles.len() {
+            let grid = MicroGrid::new(&base_corners(&object.mesh, k), &d);
+            if let Some(hit) = grid.intersect(ray) {
+                let bary = hit.triangle.base_barycentric(d.level(), hit.barycentric);
+                offer((hit.t, o, k, bary));
+            }
+        }
+    }
+    best
+}
+
+#[test]
+fn prepared_scene_hits_exactly_the_micro_triangles_brute_force_finds() {
+    let prepared = prepared();
+    let set = prepared.displaced.as_ref().unwrap();
+    assert_eq!(set.len(), 2 * 36 + 2 * 25);
+    let (mut displaced, mut plain) = (0, 0);
+    for ray in rays() {
+        let want = brute_force(&prepared, &ray);
+        let got = prepared.intersect(&ray);
+        match (want, got) {
+            (None, None) => {}
+            (Some((t, object, triangle, bary)), Some(hit)) => {
+                assert_eq!((hit.object, hit.triangle), (object, triangle), "{ray:?}");
+                if prepared.is_displaced(object) {
+                    displaced += 1;
+                    // The same f64 micro-triangle test: bit for bit.
+                    assert_eq!(hit.t, t, "{ray:?}");
+                    assert_eq!(hit.barycentric, bary.as_vec2(), "{ray:?}");
+                } else {
+                    plain += 1;
+                    assert!((hit.t - t).abs() < 1e-5 * t.max(1.0), "{ray:?}");
+                }
+                // The shadow-ray query agrees with the closest-hit query.
+                let segment = Ray {
+                    t_max: t * 1.0001,
+                    ..ray
+                };
+                assert!(prepared.occluded(&segment));
+            }
+            (want, got) => panic!("{ray:?}: brute force {want:?}, prepared {got:?}"),
+        }
+        if want.is_none() {
+            assert!(!prepared.occluded(&ray), "{ray:?}");
+        }
+    }
+    assert!(displaced > 300 && plain > 20, "{displaced} {plain}");
+}
+
+#[test]
+fn lit_normals_are_the_micro_triangle_faces() {
+    let prepared = prepared();
+    let mut checked = 0;
+    for ray in rays().take(500) {
+        let Some(hit) = prepared.intersect(&ray) else {
+            continue;
+        };
+        let Some(normals) = prepared.displaced_normals(&hit, ray.direction) else {
+            continue;
+        };
+        let object = &prepared.scene().objects[hit.object];
+        let d = Displacement::from_spec(object.displacement.as_deref().unwrap());
+        let grid = MicroGrid::new(&base_corners(&object.mesh, hit.triangle), &d);
+        let micro = grid.intersect(&ray).unwrap();
+        let [a, b, c] = grid.positions(micro.triangle);
+        let face = (b - a).cross(c - a).normalize().as_vec3();
+        // Away from micro-edges the micro-triangle found from the base barycentrics is the
+        // one hit; on an edge it may be the neighbour, so compare where it is the same one.
+        if MicroTriangle::containing(d.level(), hit.barycentric.as_dvec2()) == micro.triangle {
+            assert!(normals.geometric.dot(face).abs() > 1.0 - 1e-5, "{ray:?}");
+            assert!(normals.geometric.dot(ray.direction.as_vec3()) <= 0.0);
+            checked += 1;
+        }
+    }
+    assert!(checked > 50, "{checked}");
+}
+
+#[test]
+fn methods_that_draw_base_triangles_refuse_displaced_objects() {
+    let prepared = prepared();
+    let projection = prepared.scene().projection.build(16, 16).unwrap();
+    for method in [Method::Raster, Method::Trilinear] {
+        let options = RenderOptions {
+            method,
+            shading: Shading::Flat,
+            ..RenderOptions::default()
+        };
+        let e = render(&prepared, projection.as_ref(), &options).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "object \"waves\" is displaced, and displaced objects render with --method \
+                 raycast only (method {method} would draw the undisplaced triangles)"
+            )
+        );
+    }
+    let options = RenderOptions {
+        shading: Shading::Flat,
+        ..RenderOptions::default()
+    };
+    let frame = render(&prepared, projection.as_ref(), &options)
+        .unwrap()
+        .frame;
+    assert!(frame.ids.contains(&1) && frame.ids.contains(&2) && frame.ids.contains(&3));
+}
+
+/// Polyline projectors (with the tile culling that tests whole tiles against the scene)
+/// see the displaced micro-geometry: every pixel's id is that of a brute-force search of the
+/// pixel's segments in order, every micro-triangle tested.
+#[test]
+fn polyline_projectors_see_the_micro_geometry() {
+    use crate::projection::Projector;
+    use crate::render::raycast::pieces::polyline_segment;
+
+    let text = r#"
+[image]
+width = 48
+height = 36
+
+[projection]
+type = "flexible"
+preset = "ortho_near_persp_far"
+position = [0.0, 5.5, 7.0]
+look_at = [0.0, 0.4, 0.0]
+fov = 50.0
+transition = 8.0
+clip = [0.0, 30.0]
+style = "piecewise"
+
+[[object]]
+shape = "torus"
+size = [1.5, 0.5]
+tessellation = 7
+translate = [0.0, 0.5, 0.0]
+displacement = { procedural = "waves", waves = [[1.0, 8, 0, 0.0], [1.0, 0, 4, 0.0]], scale = 0.3, level = 2 }
+"#;
+    let scene = parse(text, Path::new("poly.toml")).unwrap();
+    let prepared = PreparedScene::new(&scene);
+    let projection = scene.projection.build(48, 36).unwrap();
+    let options = RenderOptions {
+        shading: Shading::Flat,
+        ..RenderOptions::default()
+    };
+    let frame = render(&prepared, projection.as_ref(), &options)
+        .unwrap()
+        .frame;
+    let object = &scene.objects[0];
+    let d = Displacement::from_spec(object.displacement.as_deref().unwrap());
+    let grids: Vec<MicroGrid> = (0..object.mesh.triangles.len())
+        .map(|k| MicroGrid::new(&base_corners(&object.mesh, k), &d))
+        .collect();
+    let mut hits = 0;
+    for y in 0..36u32 {
+        for x in 0..48u32 {
+            let pixel = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+            let Some(Projector::Polyline(points)) = projection.projector(pixel) else {
+                panic!("not a polyline at {pixel}");
+            };
+            let hit = (0..points.len() - 1).any(|k| {
+                let segment = polyline_segment(&points, k);
+                grids.iter().any(|g| g.intersect(&segment).is_some())
+            });
+            hits += hit as u32;
+            assert_eq!(
+                frame.ids[(y * 48 + x) as usize],
+                hit as u32,
+                "pixel ({x}, {y})"
+            );
+        }
+    }
+    assert!(hits > 100, "{hits}");
+}
