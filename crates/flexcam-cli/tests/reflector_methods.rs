@@ -116,3 +116,72 @@ fn compare_measures_the_composite_against_the_exact_mirror() {
         }
     }
 }
+
+/// `--method camera-triangles` renders the reflector's surface by camera triangles (Hou et
+/// al. 2006): both bounds give the same image, the fragment counters are reported and
+/// `overdraw` is bounding over rendered fragments; `--bound` is refused with another method.
+#[test]
+fn camera_triangles_render_reflector_scenes_with_either_bound() {
+    let dir = mirror_scene();
+    let mut images = Vec::new();
+    for bound in ["paper", "tight"] {
+        let out = format!("{bound}.png");
+        let args = [
+            "render",
+            "mirror.toml",
+            "--method",
+            "camera-triangles",
+            "--bound",
+            bound,
+            "--shading",
+            "flat",
+            "--stats",
+            "-",
+            "-o",
+            &out,
+        ];
+        let stats = run_json(&dir, &args);
+        assert_eq!(stats["method"], "camera-triangles");
+        let bounding = stats["bounding_fragments"].as_u64().unwrap();
+        let rendered = stats["rendered_fragments"].as_u64().unwrap();
+        assert!(rendered > 1000 && bounding >= rendered, "{stats}");
+        let overdraw = stats["overdraw"].as_f64().unwrap();
+        assert!((overdraw - bounding as f64 / rendered as f64).abs() < 1e-9);
+        assert!(stats["camera_triangles"].as_u64().unwrap() > 0);
+        images.push(std::fs::read(dir.path().join(&out)).unwrap());
+    }
+    assert_eq!(images[0], images[1]);
+    let refused = common::run(
+        &dir,
+        &[
+            "render",
+            "mirror.toml",
+            "--method",
+            "raycast",
+            "--bound",
+            "paper",
+            "-o",
+            "r.png",
+        ],
+    );
+    assert!(!refused.status.success());
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains("--bound applies to --method camera-triangles, not raycast"),
+        "{stderr}"
+    );
+    let report = run_json(
+        &dir,
+        &[
+            "compare",
+            "mirror.toml",
+            "--method",
+            "camera-triangles",
+            "--json",
+        ],
+    );
+    assert!(
+        report["id_agreement"].as_f64().unwrap() >= 0.995,
+        "{report}"
+    );
+}

@@ -84,6 +84,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         composite_reflectors: true,
         subdivision: args.tuning.subdivision(method)?,
         curves: args.tuning.curves(method)?,
+        camera_triangles: args.tuning.camera_triangles(method)?,
         ..reference_options
     };
     let timed_render = |options: &RenderOptions| {

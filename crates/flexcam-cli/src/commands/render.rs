@@ -87,6 +87,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         spp: args.spp,
         subdivision: args.tuning.subdivision(method)?,
         curves: args.tuning.curves(method)?,
+        camera_triangles: args.tuning.camera_triangles(method)?,
         progress: Some(&report),
         outputs: Outputs {
             depth: depth.is_some(),

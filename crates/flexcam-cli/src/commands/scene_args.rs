@@ -3,6 +3,7 @@
 //! options, and the warnings printed on stderr.
 
 use clap::{Args, ValueEnum};
+use flexcam::render::camera_triangles;
 use flexcam::render::raster::Subdivision;
 use flexcam::render::trilinear::CurveOptions;
 use flexcam::render::{Method, RenderWarning, Shading};
@@ -126,6 +127,10 @@ pub struct MethodTuning {
     /// and 256.
     #[arg(long, value_name = "N")]
     curve_steps: Option<u32>,
+    /// Method camera-triangles: the bounding region of each scene triangle in each camera
+    /// triangle, `paper` (the bounding triangle of Hou et al. 2006) or `tight` (the default).
+    #[arg(long, value_name = "BOUND")]
+    bound: Option<String>,
 }
 
 impl MethodTuning {
@@ -163,5 +168,22 @@ impl MethodTuning {
             None => CurveOptions::ADAPTIVE.mode,
         };
         CurveOptions::new(mode, self.curve_steps)
+    }
+
+    /// The options of method camera-triangles from `--bound`; an error when it is given to
+    /// another method.
+    pub fn camera_triangles(&self, method: Method) -> Result<camera_triangles::Options> {
+        if method != Method::CameraTriangles && self.bound.is_some() {
+            return Err(Error::new(format!(
+                "--bound applies to --method camera-triangles, not {method}"
+            )));
+        }
+        Ok(camera_triangles::Options {
+            bound: match &self.bound {
+                Some(name) => name.parse()?,
+                None => camera_triangles::Bound::default(),
+            },
+            ..camera_triangles::Options::default()
+        })
     }
 }

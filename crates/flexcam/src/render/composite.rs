@@ -111,7 +111,8 @@ pub fn render(
         let projection = surface_projection(&surface, map, &camera)?;
         if let Some(projection) = &projection {
             let others = prepared.view(without(scene, id));
-            let image = renderer(&others, projection, options)?.0;
+            let (image, counters) = renderer(&others, projection, options)?;
+            add_camera_triangle_counts(&mut stats, &counters);
             pixels += match (options.shading, reflector.optic) {
                 (Shading::Flat, _) => paste(&mut frame, id, &image, Vec3::ONE)?,
                 (Shading::Lit, Optic::Reflect) => paste(&mut frame, id, &image, reflector.tint)?,
@@ -161,8 +162,36 @@ pub fn render(
     })
 }
 
+/// Adds the fragment counts of a reflector surface rendered by camera triangles
+/// (`camera_triangles`, `bounding_fragments`, `rendered_fragments`) to `stats`, and sets
+/// `overdraw` to bounding over rendered fragments of all surfaces so far.
+fn add_camera_triangle_counts(stats: &mut Stats, surface: &Stats) {
+    const SUMMED: [&str; 3] = [
+        "camera_triangles",
+        "bounding_fragments",
+        "rendered_fragments",
+    ];
+    for name in SUMMED {
+        if let Some(Counter::Count(n)) = surface.get(name) {
+            let sum = match stats.get(name) {
+                Some(Counter::Count(m)) => m + n,
+                _ => *n,
+            };
+            stats.insert(name, Counter::Count(sum));
+        }
+    }
+    if let (Some(Counter::Count(b)), Some(Counter::Count(r))) = (
+        stats.get("bounding_fragments"),
+        stats.get("rendered_fragments"),
+    ) {
+        let overdraw = if *r > 0 { *b as f64 / *r as f64 } else { 0.0 };
+        stats.insert("overdraw", Counter::Value(overdraw));
+    }
+}
+
 /// Renders `scene` through `main` with `method`, compositing its trilinear reflectors as
-/// [`render`] does. With [`Method::Trilinear`] and reflectors, the main view (a perspective
+/// [`render`] does. With [`Method::Trilinear`] (or [`Method::CameraTriangles`], whose
+/// reflector surfaces are rendered by camera triangles) and reflectors, the main view (a perspective
 /// camera, which that method does not render) is rendered through
 /// [`perspective_as_trilinear`], the same pinhole as two projection triangles, so that the
 /// whole frame, main view and reflections, is rendered by the trilinear method (Vallance 2005,
@@ -178,14 +207,20 @@ pub fn render_with_method(
     let renderer =
         |s: &PreparedScene, p: &dyn Projection, o: &RenderOptions| method.render(s, p, o);
     let scene = prepared.scene();
-    if method != Method::Trilinear || scene.trilinear_reflectors.is_empty() {
+    // Camera triangles render the reflectors' surfaces; their main view (a pinhole, which
+    // camera triangles could only bound loosely) is the trilinear method's exact one.
+    let main_method = match method {
+        Method::Trilinear | Method::CameraTriangles => Method::Trilinear,
+        _ => return render(prepared, main, options, &renderer),
+    };
+    if scene.trilinear_reflectors.is_empty() {
         return render(prepared, main, options, &renderer);
     }
     let pinhole = perspective_as_trilinear(&main_camera(scene, main)?)?;
     let main_as_trilinear = |s: &PreparedScene, p: &dyn Projection, o: &RenderOptions| {
         // The main pass is the only one through a projection that is not trilinear.
         if p.trilinear().is_none() {
-            method.render(s, &pinhole, o)
+            main_method.render(s, &pinhole, o)
         } else {
             method.render(s, p, o)
         }

@@ -10,7 +10,7 @@ use crate::error::{Error, Result};
 use crate::projection::{Projection, Projector};
 use crate::render::raster::InverseRaster;
 use crate::render::trilinear::TrilinearRenderer;
-use crate::render::{raycast, Frame, PreparedScene, RenderOptions, Stats};
+use crate::render::{camera_triangles, raycast, Frame, PreparedScene, RenderOptions, Stats};
 
 /// A way of rendering a projection.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -24,14 +24,19 @@ pub enum Method {
     /// Trilinear rasterisation (Vallance 2005), curved edges followed as `options.curves` says;
     /// renders trilinear projections only.
     Trilinear,
+    /// Camera triangles (Hou, Wei, Shum and Guo 2006): each projection triangle a
+    /// multi-perspective camera, scene triangles drawn through bounding regions and exact
+    /// per-fragment hits; renders trilinear projections only.
+    CameraTriangles,
 }
 
 impl Method {
     /// Every method with its command-line name.
-    pub const ALL: [(&'static str, Method); 3] = [
+    pub const ALL: [(&'static str, Method); 4] = [
         ("raycast", Method::Raycast),
         ("raster", Method::Raster),
         ("trilinear", Method::Trilinear),
+        ("camera-triangles", Method::CameraTriangles),
     ];
 
     /// The command-line name.
@@ -40,6 +45,7 @@ impl Method {
             Method::Raycast => "raycast",
             Method::Raster => "raster",
             Method::Trilinear => "trilinear",
+            Method::CameraTriangles => "camera-triangles",
         }
     }
 
@@ -69,6 +75,7 @@ impl Method {
                 })?;
                 TrilinearRenderer::new(prepared).render(trilinear, options, options.curves)
             }
+            Method::CameraTriangles => camera_triangles::render(prepared, projection, options),
         }
     }
 }
@@ -140,7 +147,7 @@ mod tests {
         let e = "raster-ish".parse::<Method>().unwrap_err();
         assert!(
             e.to_string()
-                .contains("available: raycast, raster, trilinear"),
+                .contains("available: raycast, raster, trilinear, camera-triangles"),
             "{e}"
         );
     }

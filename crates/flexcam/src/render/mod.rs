@@ -42,6 +42,8 @@ pub struct RenderOptions<'a> {
     pub curves: trilinear::CurveOptions,
     /// The buffers the caller wants besides colour; the others come back empty.
     pub outputs: Outputs,
+    /// The bound and culling of method camera-triangles.
+    pub camera_triangles: camera_triangles::Options,
     /// Called from worker threads with (work units done, total) as rendering progresses.
     pub progress: Option<&'a (dyn Fn(u64, u64) + Sync)>,
 }
@@ -57,6 +59,7 @@ impl Default for RenderOptions<'_> {
             subdivision: raster::Subdivision::default(),
             curves: trilinear::CurveOptions::ADAPTIVE,
             outputs: Outputs::ALL,
+            camera_triangles: camera_triangles::Options::default(),
             progress: None,
         }
     }
@@ -232,6 +235,7 @@ pub enum Counter {
 /// Named counters a renderer reports (rays cast, build times, ...), for `--stats`.
 pub type Stats = BTreeMap<&'static str, Counter>;
 pub(crate) mod bvh;
+pub mod camera_triangles;
 pub mod compare;
 /// Reflector compositing, reached only through [`render`] (`RenderOptions::composite_reflectors`).
 mod composite;

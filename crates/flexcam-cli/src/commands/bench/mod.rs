@@ -1,5 +1,6 @@
 //! `flexcam bench`: the source documents' timing tables, rerun with flexcam's renderers.
 
+pub mod camera_triangles;
 pub mod displaced;
 pub mod flexible;
 pub mod simplify;
@@ -12,6 +13,9 @@ use flexcam::Result;
 /// Which table to measure.
 #[derive(Subcommand, Debug)]
 pub enum BenchCommand {
+    /// Table 1 of Hou et al. 2006 (reflection rows) and the 5,000-triangle mirror-sphere
+    /// target: camera triangles against the paper and against the ray caster.
+    CameraTriangles(camera_triangles::CameraTrianglesArgs),
     /// Figure 8.1 of Ramsey 2005: the displaced three-holed torus at subdivision levels 0 to
     /// 6, ray traced without tessellation, beside the same micro-triangles as a
     /// pre-tessellated mesh (time and peak memory).
@@ -31,6 +35,7 @@ pub enum BenchCommand {
 /// Runs `flexcam bench`.
 pub fn run(command: &BenchCommand) -> Result<()> {
     match command {
+        BenchCommand::CameraTriangles(args) => camera_triangles::run(args),
         BenchCommand::Displaced(args) => displaced::run(args),
         BenchCommand::Flexible(args) => flexible::run(args),
         BenchCommand::Trilinear(args) => trilinear::run(args),

@@ -47,13 +47,14 @@ use glam::{DVec2, DVec3, Vec3};
 
 pub use curves::{CurveMode, CurveOptions};
 pub use polygons::{project_all, projection_triangles};
+pub(crate) use resolve::plane_hit;
 pub use scene_geometry::SceneGeometry;
+pub use screen_map::ScreenMap;
 
 use self::central::CentralProjection;
 use self::gbuffer::GBuffer;
 use self::polygons::ProjectedScene;
 use self::resolve::Resolver;
-use self::screen_map::ScreenMap;
 use self::shade::{ShadeCounts, Shader};
 use crate::error::{Error, Result};
 use crate::projection::{Projection, Trilinear};
@@ -82,17 +83,7 @@ impl<'a> TrilinearRenderer<'a> {
     pub fn new(prepared: &'a PreparedScene) -> TrilinearRenderer<'a> {
         let scene = prepared.scene();
         let geometry = SceneGeometry::new(scene);
-        let flat_colors = geometry
-            .owners
-            .iter()
-            .map(|owner| {
-                let object = owner.object as usize;
-                prepared.flat_shows_base_color(object).then(|| {
-                    let triangle = owner.triangle as usize;
-                    TriangleColor::new(&scene.objects[object], triangle, TextureFilter::Nearest)
-                })
-            })
-            .collect();
+        let flat_colors = flat_colors(prepared, &geometry);
         let bounding_sphere = bounding_sphere(&geometry.vertices);
         TrilinearRenderer {
             prepared,
@@ -270,6 +261,27 @@ impl<'a> TrilinearRenderer<'a> {
         stats.insert("shade_ms", Counter::Value(shade_ms));
         Ok(stats)
     }
+}
+
+/// Per scene triangle of `geometry` (a [`SceneGeometry`] of `prepared`'s scene), its base
+/// colour where flat shading shows it (nearest texel), `None` for mirrors and glass: what
+/// the rasterising renderers read instead of the ray caster's per-hit `base_color`.
+pub(crate) fn flat_colors(
+    prepared: &PreparedScene,
+    geometry: &SceneGeometry,
+) -> Vec<Option<TriangleColor>> {
+    let scene = prepared.scene();
+    geometry
+        .owners
+        .iter()
+        .map(|owner| {
+            let object = owner.object as usize;
+            prepared.flat_shows_base_color(object).then(|| {
+                let triangle = owner.triangle as usize;
+                TriangleColor::new(&scene.objects[object], triangle, TextureFilter::Nearest)
+            })
+        })
+        .collect()
 }
 
 /// What drawing and shading some bands did, and their CPU time (summed over threads).

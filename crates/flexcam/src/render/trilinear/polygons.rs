@@ -4,7 +4,7 @@
 //! cubic), cull pairs whose images cannot be visible, form the shapes, trace their curved
 //! outlines, clip them, and append them to one polygon batch.
 
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 use rayon::prelude::*;
 
 use super::central;
@@ -20,7 +20,7 @@ use super::scene_geometry::SceneGeometry;
 use super::screen_map::ScreenMap;
 use super::view_plane::clipping_base;
 use crate::projection::{
-    project_solved_triangle, Projection, ProjectionTriangleCache, Shape, Solutions, Trilinear,
+    project_solved_triangle, ProjectionTriangleCache, Shape, Solutions, Trilinear,
 };
 use crate::render::scan::{PolygonBatch, Vertex};
 
@@ -40,15 +40,12 @@ pub struct ProjectedScene {
 /// ([`clipping_base`]).
 pub fn projection_triangles(projection: &Trilinear) -> Vec<ProjectionTriangle> {
     let mesh = projection.mesh();
-    let (width, height) = projection.resolution();
-    let size = DVec2::new(f64::from(width), f64::from(height));
     mesh.triangles
         .iter()
         .zip(projection.triangle_caches())
         .map(|(t, cache)| {
             let [i, j, k] = t.map(|x| x as usize);
             let pick = |values: &[DVec3]| [values[i], values[j], values[k]];
-            let screen = [mesh.screen[i], mesh.screen[j], mesh.screen[k]];
             let normals = pick(&mesh.normals);
             let base = clipping_base(pick(&mesh.points), normals);
             // The projection's own cache unless the base collapsed (`view_plane`).
@@ -57,8 +54,7 @@ pub fn projection_triangles(projection: &Trilinear) -> Vec<ProjectionTriangle> {
             } else {
                 ProjectionTriangleCache::new(base, normals)
             };
-            let map = ScreenMap::new(screen, size, cache)
-                .with_projective(projection.projective_map([i, j, k]));
+            let map = ScreenMap::of_triangle(projection, [i, j, k], cache);
             ProjectionTriangle::new(base, normals, map)
         })
         .collect()
@@ -481,6 +477,8 @@ impl Pair<'_> {
 
 #[cfg(test)]
 pub(super) mod tests {
+    use glam::DVec2;
+
     use super::*;
     use crate::projection::{project_triangle, ProjectionTriangleCache};
     use crate::render::trilinear::workloads::fan_grid;

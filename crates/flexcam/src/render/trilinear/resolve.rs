@@ -175,7 +175,7 @@ impl Stage {
 /// Where `ray` meets the plane of triangle `[a, b, c]`: `(t, u, v)` with `u`, `v` the
 /// barycentrics of `b` and `c`, unbounded (Moller-Trumbore without the inside tests).
 /// `None` for a projector parallel to the plane, a degenerate triangle or non-finite input.
-fn plane_hit(ray: &Ray, [a, b, c]: [DVec3; 3]) -> Option<(f64, f64, f64)> {
+pub(crate) fn plane_hit(ray: &Ray, [a, b, c]: [DVec3; 3]) -> Option<(f64, f64, f64)> {
     let (e1, e2) = (b - a, c - a);
     let p = ray.direction.cross(e2);
     let det = e1.dot(p);

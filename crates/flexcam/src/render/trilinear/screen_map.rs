@@ -8,7 +8,7 @@
 use glam::{DMat2, DVec2, DVec3};
 
 use crate::geometry::Ray;
-use crate::projection::{ProjectionTriangleCache, ProjectiveMap};
+use crate::projection::{Projection, ProjectionTriangleCache, ProjectiveMap, Trilinear};
 
 /// One projection triangle's screen placement and rays.
 #[derive(Debug, Clone, Copy)]
@@ -51,6 +51,19 @@ impl ScreenMap {
             cache,
             projective: None,
         }
+    }
+
+    /// The map of `projection`'s triangle with vertices `vertices` (mesh indices), its rays
+    /// from `cache`, with the projection's screen map (affine or projective).
+    pub fn of_triangle(
+        projection: &Trilinear,
+        vertices: [usize; 3],
+        cache: ProjectionTriangleCache,
+    ) -> ScreenMap {
+        let (width, height) = projection.resolution();
+        let size = DVec2::new(f64::from(width), f64::from(height));
+        let screen = vertices.map(|k| projection.mesh().screen[k]);
+        ScreenMap::new(screen, size, cache).with_projective(projection.projective_map(vertices))
     }
 
     /// The same map with the projective screen map `projective` (`None`: affine, `self`

@@ -1,0 +1,282 @@
+//! The region of a camera triangle's image where a scene triangle can appear: the pixels the
+//! fragment stage is run on.
+//!
+//! Both bounds rest on the paper's argument (Hou et al. 2006, 2.1): a point `q` of the scene
+//! triangle seen at barycentrics `b` lies on the ray from the camera plane along
+//! `d(b)`, a convex combination of the corner directions `d_j`; projecting `q` along the
+//! directions of that cone onto the camera plane (a central projection from `q`, as long as
+//! no direction of the cone is parallel to the plane: [`Camera::one_sided`]) lands inside the
+//! convex hull of its projections along the `d_j`, and the projection along one direction is
+//! affine in `q`; so `b` lies in the convex hull of the nine points `p_ij`, the corners `q_i`
+//! projected along the `d_j`.
+//!
+//! - [`Bound::Paper`]: the paper's bounding triangle of the nine points, its edges parallel
+//!   to the lines `L_k` (in the plane, orthogonal to `d_k`), each pushed out to the outermost
+//!   point; the camera triangle's own edges where a `d_k` is orthogonal to the plane or the
+//!   three lines do not enclose a triangle. It is rasterised clipped to the camera triangle's
+//!   pixel rectangle (the paper's viewport; with a projective screen map, to the camera
+//!   triangle itself, where the map has no pole).
+//! - [`Bound::Tight`]: the convex hull of the nine points clipped to the camera triangle, and
+//!   where that region is still large, the same on each quarter of the camera triangle
+//!   (recursively): a quarter is itself a camera triangle (its corner rays are interpolated
+//!   rays of the parent), so the argument holds for it, and its narrower cone of directions
+//!   gives a smaller hull. The union of the quarters' regions holds every fragment.
+//!
+//! Where the cone of directions meets the plane from both sides (or there is no plane), no
+//! hull bounds the region: the whole (sub-)triangle is the bound. Every region is dilated by
+//! [`MARGIN_PX`] so that rounding never drops a pixel centre on its exact boundary.
+
+use glam::{DVec2, DVec3};
+
+use super::camera::{Camera, CORNERS};
+use super::convex::{cross, Convex};
+use crate::render::trilinear::plane_hit;
+
+/// How far bound regions are pushed out, in pixels, against rounding.
+pub const MARGIN_PX: f64 = 1e-4;
+
+/// Deepest quartering of the camera triangle by the tight bound.
+const MAX_DEPTH: u32 = 6;
+
+/// A region of fewer pixels than this is not quartered further.
+const MIN_SPLIT_PIXELS: f64 = 16.0;
+
+/// Which bounding region is rasterised per scene triangle and camera triangle (`--bound`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Bound {
+    /// The paper's bounding triangle (module doc).
+    Paper,
+    /// The hull of the nine projections clipped to the camera triangle, quartered where
+    /// large (module doc).
+    #[default]
+    Tight,
+}
+
+impl std::str::FromStr for Bound {
+    type Err = crate::error::Error;
+
+    fn from_str(s: &str) -> crate::error::Result<Bound> {
+        match s {
+            "paper" => Ok(Bound::Paper),
+            "tight" => Ok(Bound::Tight),
+            _ => Err(crate::error::Error::new(format!(
+                "unknown bound \"{s}\" (available: paper, tight)"
+            ))),
+        }
+    }
+}
+
+/// Calls `emit` with each pixel-space region (convex, counter-clockwise in a y-up frame or
+/// clockwise, either) of `camera`'s image where scene triangle `q` may appear by `bound`.
+pub fn regions(camera: &Camera, q: &[DVec3; 3], bound: Bound, emit: &mut impl FnMut(&Convex)) {
+    match bound {
+        Bound::Paper => paper(camera, q, emit),
+        Bound::Tight => tight(camera, q, CORNERS, 0, emit),
+    }
+}
+
+/// Whether the convex hull of `points` projected along the corner directions misses the
+/// camera triangle (so nothing inside that hull is seen by it): the culling of section 2.4
+/// for a box (its eight corners) or a triangle. `false` where no hull bounds the region.
+pub fn misses(camera: &Camera, points: &[DVec3]) -> bool {
+    let directions = CORNERS.map(|c| camera.direction(c));
+    if !camera.one_sided(&directions) {
+        return false;
+    }
+    let mut projected = [DVec2::ZERO; 24];
+    let mut n = 0;
+    for &q in points.iter().take(8) {
+        for &d in &directions {
+            match camera.project_along(q, d).and_then(near) {
+                Some(p) => projected[n] = p,
+                None => return false,
+            }
+            n += 1;
+        }
+    }
+    // Conservative: a miss is reported only where a line separates the points from the
+    // camera triangle (one of its edges, or an axis of its bounding box).
+    let points = &projected[..n];
+    separated(points, CORNERS)
+}
+
+/// Whether some edge of triangle `t` or an axis has all `points` strictly outside.
+fn separated(points: &[DVec2], t: [DVec2; 3]) -> bool {
+    if points.iter().any(|p| !p.is_finite()) {
+        return false;
+    }
+    let orient = cross(t[0], t[1], t[2]).signum();
+    let edge_out = (0..3).any(|i| {
+        let (a, b) = (t[i], t[(i + 1) % 3]);
+        points.iter().all(|&p| cross(a, b, p) * orient < 0.0)
+    });
+    let lo = t[0].min(t[1]).min(t[2]);
+    let hi = t[0].max(t[1]).max(t[2]);
+    let axis_out = points.iter().all(|p| p.x < lo.x)
+        || points.iter().all(|p| p.x > hi.x)
+        || points.iter().all(|p| p.y < lo.y)
+        || points.iter().all(|p| p.y > hi.y);
+    edge_out || axis_out
+}
+
+/// Projections farther than this from the camera triangle (in barycentrics) make no bound:
+/// their rounding error could exceed the triangle itself.
+const FAR: f64 = 1e6;
+
+/// The nine projections `p_ij` of the corners `q` along `directions` (`None` if one is
+/// parallel to the plane or beyond [`FAR`]).
+fn nine(camera: &Camera, q: &[DVec3; 3], directions: &[DVec3; 3]) -> Option<[DVec2; 9]> {
+    let mut out = [DVec2::ZERO; 9];
+    for (i, &qi) in q.iter().enumerate() {
+        for (j, &d) in directions.iter().enumerate() {
+            out[3 * i + j] = near(camera.project_along(qi, d)?)?;
+        }
+    }
+    Some(out)
+}
+
+/// `p` unless it is beyond [`FAR`] or not finite.
+fn near(p: DVec2) -> Option<DVec2> {
+    (p.abs().max_element() <= FAR).then_some(p)
+}
+
+/// The paper's bound (module doc).
+fn paper(camera: &Camera, q: &[DVec3; 3], emit: &mut impl FnMut(&Convex)) {
+    let directions = CORNERS.map(|c| camera.direction(c));
+    let triangle = camera
+        .one_sided(&directions)
+        .then(|| nine(camera, q, &directions))
+        .flatten()
+        .and_then(|points| bounding_triangle(camera, &directions, &points));
+    let Some(triangle) = triangle else {
+        return emit_in_camera(camera, &Convex::from_points(&CORNERS), emit);
+    };
+    let region = Convex::from_points(&triangle);
+    let region = if cross(triangle[0], triangle[1], triangle[2]) < 0.0 {
+        Convex::from_points(&[triangle[0], triangle[2], triangle[1]])
+    } else {
+        region
+    };
+    if camera.map.homogeneous_weight(0.0, 0.0).is_none() {
+        // Affine screen map: the triangle in pixels, clipped to the viewport.
+        let (lo, hi) = camera.pixel_box;
+        let pixels = region
+            .map(|b| camera.map.pixel(b.x, b.y))
+            .clip_to_rect(lo, hi);
+        emit_pixels(&pixels, emit);
+    } else {
+        emit_in_camera(camera, &region.clip_to_triangle(CORNERS), emit);
+    }
+}
+
+/// The bounding triangle of `points` with edges parallel to the lines `L_k` orthogonal to
+/// `directions` (in the camera plane), or to the camera triangle's edges in the singular
+/// cases; `None` for non-finite results.
+fn bounding_triangle(
+    camera: &Camera,
+    directions: &[DVec3; 3],
+    points: &[DVec2; 9],
+) -> Option<[DVec2; 3]> {
+    let centroid = DVec2::splat(1.0 / 3.0);
+    // The outward normal of the edge opposite corner k, as a covector on barycentrics:
+    // m_k turned to point from the centroid towards corner k (the line L_k is then on the
+    // far side of the region from the opposite edge), or the camera edge's own.
+    let lines: Option<[DVec2; 3]> = (0..3)
+        .map(|k| {
+            let g = camera.in_plane_covector(directions[k])?;
+            Some(if g.dot(CORNERS[k] - centroid) < 0.0 {
+                -g
+            } else {
+                g
+            })
+        })
+        .collect::<Option<Vec<_>>>()
+        .map(|v| [v[0], v[1], v[2]]);
+    let edges = [
+        DVec2::new(1.0, 1.0),
+        DVec2::new(-1.0, 0.0),
+        DVec2::new(0.0, -1.0),
+    ];
+    let normals = match lines {
+        Some(g) if encloses(g) => g,
+        _ => edges,
+    };
+    let offsets = normals.map(|g| {
+        points
+            .iter()
+            .map(|&p| g.dot(p))
+            .fold(f64::NEG_INFINITY, f64::max)
+    });
+    // Corner b_k lies on the two lines other than line k.
+    let corner = |i: usize, j: usize| {
+        let m = glam::DMat2::from_cols(normals[i], normals[j]).transpose();
+        let det = m.determinant();
+        (det != 0.0).then(|| m.inverse() * DVec2::new(offsets[i], offsets[j]))
+    };
+    let b = [corner(1, 2)?, corner(0, 2)?, corner(0, 1)?];
+    b.iter().all(|p| p.is_finite()).then_some(b)
+}
+
+/// Whether half-planes with outward normals `g` enclose a bounded triangle: the origin lies
+/// strictly inside the triangle of the normals (they span the plane positively).
+fn encloses(g: [DVec2; 3]) -> bool {
+    let c = [
+        g[0].perp_dot(g[1]),
+        g[1].perp_dot(g[2]),
+        g[2].perp_dot(g[0]),
+    ];
+    let scale = g.iter().map(|v| v.length_squared()).fold(0.0, f64::max);
+    let tiny = 1e-9 * scale;
+    (c.iter().all(|&x| x > tiny)) || (c.iter().all(|&x| x < -tiny))
+}
+
+/// The tight bound on the sub-triangle `sub` of the camera triangle (module doc).
+fn tight(
+    camera: &Camera,
+    q: &[DVec3; 3],
+    sub: [DVec2; 3],
+    depth: u32,
+    emit: &mut impl FnMut(&Convex),
+) {
+    let whole = Convex::from_points(&sub).clip_to_triangle(CORNERS);
+    let directions = sub.map(|c| camera.direction(c));
+    let region = if camera.one_sided(&directions) {
+        match nine(camera, q, &directions) {
+            Some(points) => Convex::hull(&points).clip_to_triangle(sub),
+            None => whole,
+        }
+    } else {
+        whole
+    };
+    if region.points().len() < 3 {
+        return;
+    }
+    let pixels = region.area() * camera.pixels_per_area;
+    // Where the rays at the corners and centre all hit the scene triangle, it (nearly)
+    // covers the sub-triangle: quarters would all be kept.
+    let centre = (sub[0] + sub[1] + sub[2]) / 3.0;
+    let covered = [sub[0], sub[1], sub[2], centre].iter().all(|&b| {
+        plane_hit(&camera.ray_at(b), *q)
+            .is_some_and(|(t, u, v)| t >= 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0)
+    });
+    if depth >= MAX_DEPTH || pixels < MIN_SPLIT_PIXELS || covered {
+        return emit_in_camera(camera, &region, emit);
+    }
+    let [a, b, c] = sub;
+    let (ab, bc, ca) = ((a + b) / 2.0, (b + c) / 2.0, (c + a) / 2.0);
+    for quarter in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]] {
+        tight(camera, q, quarter, depth + 1, emit);
+    }
+}
+
+/// Emits a region given in barycentrics inside the camera triangle, in pixels.
+fn emit_in_camera(camera: &Camera, region: &Convex, emit: &mut impl FnMut(&Convex)) {
+    emit_pixels(&region.map(|b| camera.map.pixel(b.x, b.y)), emit);
+}
+
+/// Emits a pixel-space region with the rounding margin, if it has an area.
+fn emit_pixels(region: &Convex, emit: &mut impl FnMut(&Convex)) {
+    if region.points().len() >= 3 {
+        emit(&region.dilated(MARGIN_PX));
+    }
+}

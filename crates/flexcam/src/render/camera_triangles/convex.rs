@@ -1,0 +1,176 @@
+//! Small convex polygons in the plane: the convex hull of a few points and clipping by
+//! half-planes, for the bounding regions of [`super::bound`]. Fixed capacity, no allocation:
+//! a hull of nine points clipped by a triangle or a rectangle has at most 13 vertices.
+
+use glam::DVec2;
+
+/// Most vertices a [`Convex`] holds.
+const CAPACITY: usize = 16;
+
+/// A convex polygon, counter-clockwise (in a y-up frame), possibly empty.
+#[derive(Debug, Clone, Copy)]
+pub struct Convex {
+    points: [DVec2; CAPACITY],
+    len: usize,
+}
+
+impl Convex {
+    pub const EMPTY: Convex = Convex {
+        points: [DVec2::ZERO; CAPACITY],
+        len: 0,
+    };
+
+    /// The polygon with these vertices (convex, counter-clockwise, at most 16).
+    pub fn from_points(points: &[DVec2]) -> Convex {
+        let mut out = Convex::EMPTY;
+        for &p in points.iter().take(CAPACITY) {
+            out.push(p);
+        }
+        out
+    }
+
+    /// The convex hull of `points` (at most 16; Andrew's monotone chain), counter-clockwise,
+    /// collinear points dropped. Non-finite points make the hull empty: no bound can be made.
+    pub fn hull(points: &[DVec2]) -> Convex {
+        let mut sorted = [DVec2::ZERO; CAPACITY];
+        let n = points.len().min(CAPACITY);
+        if points[..n].iter().any(|p| !p.is_finite()) {
+            return Convex::EMPTY;
+        }
+        sorted[..n].copy_from_slice(&points[..n]);
+        let sorted = &mut sorted[..n];
+        sorted.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+        let mut chain = [DVec2::ZERO; 2 * CAPACITY];
+        let mut k = 0;
+        for &p in sorted.iter() {
+            while k >= 2 && cross(chain[k - 2], chain[k - 1], p) <= 0.0 {
+                k -= 1;
+            }
+            chain[k] = p;
+            k += 1;
+        }
+        let lower = k + 1;
+        for &p in sorted.iter().rev().skip(1) {
+            while k >= lower && cross(chain[k - 2], chain[k - 1], p) <= 0.0 {
+                k -= 1;
+            }
+            chain[k] = p;
+            k += 1;
+        }
+        // The last point repeats the first.
+        let count = k.saturating_sub(1);
+        if n == 1 {
+            return Convex::from_points(&sorted[..1]);
+        }
+        Convex::from_points(&chain[..count.min(CAPACITY)])
+    }
+
+    fn push(&mut self, p: DVec2) {
+        if self.len < CAPACITY {
+            self.points[self.len] = p;
+            self.len += 1;
+        }
+    }
+
+    pub fn points(&self) -> &[DVec2] {
+        &self.points[..self.len]
+    }
+
+    /// The part on the left of the directed line `a -> b` (the line included)
+    /// (Sutherland-Hodgman).
+    pub fn clip(&self, a: DVec2, b: DVec2) -> Convex {
+        let mut out = Convex::EMPTY;
+        let side = |p: DVec2| cross(a, b, p);
+        for i in 0..self.len {
+            let (p, q) = (self.points[i], self.points[(i + 1) % self.len]);
+            let (sp, sq) = (side(p), side(q));
+            if sp >= 0.0 {
+                out.push(p);
+            }
+            if (sp >= 0.0) != (sq >= 0.0) {
+                out.push(p + (q - p) * (sp / (sp - sq)));
+            }
+        }
+        out
+    }
+
+    /// The part inside triangle `t` (either orientation).
+    pub fn clip_to_triangle(&self, t: [DVec2; 3]) -> Convex {
+        let [a, b, c] = if cross(t[0], t[1], t[2]) >= 0.0 {
+            t
+        } else {
+            [t[0], t[2], t[1]]
+        };
+        self.clip(a, b).clip(b, c).clip(c, a)
+    }
+
+    /// The part inside the axis-aligned rectangle `[lo, hi]`.
+    pub fn clip_to_rect(&self, lo: DVec2, hi: DVec2) -> Convex {
+        let corners = [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
+        (0..4).fold(*self, |poly, i| poly.clip(corners[i], corners[(i + 1) % 4]))
+    }
+
+    /// The area (zero for fewer than three vertices).
+    pub fn area(&self) -> f64 {
+        let p = self.points();
+        (0..p.len())
+            .map(|i| p[i].perp_dot(p[(i + 1) % p.len()]))
+            .sum::<f64>()
+            .abs()
+            / 2.0
+    }
+
+    /// The same polygon with every vertex mapped by `f` (which must keep it convex: an
+    /// affine or a projective map without a pole on it).
+    pub fn map(&self, f: impl Fn(DVec2) -> DVec2) -> Convex {
+        let mut out = *self;
+        for p in &mut out.points[..out.len] {
+            *p = f(*p);
+        }
+        out
+    }
+
+    /// The polygon with each vertex moved `by` away from the vertices' mean: a margin for
+    /// rounding, so that a pixel centre on the exact boundary is never lost.
+    pub fn dilated(&self, by: f64) -> Convex {
+        if self.len == 0 {
+            return *self;
+        }
+        let centre = self.points().iter().sum::<DVec2>() / self.len as f64;
+        self.map(|p| p + (p - centre).normalize_or_zero() * by)
+    }
+}
+
+/// Twice the signed area of `a b c` (positive counter-clockwise).
+pub fn cross(a: DVec2, b: DVec2, c: DVec2) -> f64 {
+    (b - a).perp_dot(c - a)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hull_of_a_square_with_inner_points() {
+        let pts = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(0.5, 0.5),
+            DVec2::new(1.0, 1.0),
+            DVec2::new(0.0, 1.0),
+            DVec2::new(0.2, 0.7),
+        ];
+        let hull = Convex::hull(&pts);
+        assert_eq!(hull.points().len(), 4);
+        assert!((hull.area() - 1.0).abs() < 1e-12);
+        let tri = [DVec2::ZERO, DVec2::new(1.0, 0.0), DVec2::new(0.0, 1.0)];
+        assert!((hull.clip_to_triangle(tri).area() - 0.5).abs() < 1e-12);
+        let rect = hull.clip_to_rect(DVec2::new(0.5, -1.0), DVec2::new(2.0, 0.5));
+        assert!((rect.area() - 0.25).abs() < 1e-12);
+        assert!(hull
+            .clip_to_triangle(tri.map(|p| p + DVec2::splat(5.0)))
+            .points()
+            .is_empty());
+        assert!(Convex::hull(&[DVec2::NAN, DVec2::ONE]).points().is_empty());
+    }
+}

@@ -1,0 +1,288 @@
+//! Camera triangles against the ray caster of the same projection, and the exactness of both
+//! bounds.
+
+use glam::DVec2;
+
+use super::*;
+use crate::render::compare::{compare, Comparison};
+use crate::render::{raycast, Method};
+use crate::scene::{self, Scene};
+
+/// The trilinear scenes of `scenes/`.
+const TRILINEAR_SCENES: [&str; 5] = [
+    "trilinear-detail-in-context",
+    "trilinear-fan",
+    "trilinear-grid-cylinder",
+    "trilinear-inward-sphere",
+    "trilinear-two-views",
+];
+
+fn load(name: &str) -> Scene {
+    scene::load(&format!(
+        "{}/../../scenes/{name}.toml",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap()
+}
+
+fn options(shading: Shading, bound: Bound) -> RenderOptions<'static> {
+    RenderOptions {
+        method: Method::CameraTriangles,
+        shading,
+        camera_triangles: Options {
+            bound,
+            ..Options::default()
+        },
+        ..RenderOptions::default()
+    }
+}
+
+fn count(stats: &Stats, name: &str) -> u64 {
+    match stats.get(name) {
+        Some(Counter::Count(n)) => *n,
+        other => panic!("{name}: {other:?}"),
+    }
+}
+
+/// The fraction of pixels away from id edges (the reference's id is the same over the
+/// pixel's 3 x 3 neighbourhood) whose ids agree.
+fn id_agreement_inside(frame: &Frame, reference: &Frame) -> f64 {
+    let (w, h) = (reference.width as i64, reference.height as i64);
+    let (mut inside, mut same) = (0u64, 0u64);
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            let k = (y * w + x) as usize;
+            let id = reference.ids[k];
+            let interior = (-1..=1)
+                .all(|dy| (-1..=1).all(|dx| reference.ids[((y + dy) * w + x + dx) as usize] == id));
+            if interior {
+                inside += 1;
+                same += u64::from(frame.ids[k] == id);
+            }
+        }
+    }
+    same as f64 / inside.max(1) as f64
+}
+
+/// Renders `scene` at `size` by camera triangles and by the ray caster.
+fn against_raycast(
+    scene: &Scene,
+    size: (u32, u32),
+    options: &RenderOptions,
+) -> (Comparison, f64, Stats) {
+    let projection = scene.projection.build(size.0, size.1).unwrap();
+    let prepared = PreparedScene::new(scene);
+    let (reference, _) = raycast::render(&prepared, projection.as_ref(), options);
+    let (frame, stats) = render(&prepared, projection.as_ref(), options).unwrap();
+    let inside = id_agreement_inside(&frame, &reference);
+    (compare(&frame, &reference).unwrap(), inside, stats)
+}
+
+#[test]
+fn trilinear_scenes_match_the_ray_caster() {
+    for name in TRILINEAR_SCENES {
+        let scene = load(name);
+        for shading in [Shading::Flat, Shading::Lit] {
+            let (c, inside, stats) =
+                against_raycast(&scene, (160, 120), &options(shading, Bound::Tight));
+            println!(
+                "{name} {shading:?}: ids {:.5} (inside {inside:.5}), rgb {:.5}, depth max {:.2e}, \
+                 overdraw {:?}",
+                c.id_agreement, c.relative_rgb_error, c.depth_max, stats["overdraw"]
+            );
+            assert!(inside >= 0.99, "{name}: {inside} {c:?}");
+            assert!(c.id_agreement >= 0.98, "{name}: {c:?}");
+            // The mean, not the largest: at two pixels of the inward sphere, rays through the
+            // cube's centre, the ray caster misses the cube's top face that we hit.
+            assert!(c.depth_mean < 1e-4, "{name}: {c:?}");
+            assert!(c.relative_rgb_error < 0.02, "{name}: {c:?}");
+            assert!(count(&stats, "rendered_fragments") > 0);
+        }
+    }
+}
+
+/// The paper's bound and the tight bound give the same rendered fragments (both are exact),
+/// hence the same image; the tight one rasterises fewer bounding fragments.
+#[test]
+fn both_bounds_render_the_same_fragments() {
+    for name in TRILINEAR_SCENES {
+        let scene = load(name);
+        let projection = scene.projection.build(160, 120).unwrap();
+        let prepared = PreparedScene::new(&scene);
+        let run = |bound| {
+            render(
+                &prepared,
+                projection.as_ref(),
+                &options(Shading::Flat, bound),
+            )
+        };
+        let (paper, paper_stats) = run(Bound::Paper).unwrap();
+        let (tight, tight_stats) = run(Bound::Tight).unwrap();
+        assert_eq!(paper, tight, "{name}");
+        assert_eq!(
+            count(&paper_stats, "rendered_fragments"),
+            count(&tight_stats, "rendered_fragments"),
+            "{name}"
+        );
+        assert!(
+            count(&tight_stats, "bounding_fragments") <= count(&paper_stats, "bounding_fragments"),
+            "{name}"
+        );
+    }
+}
+
+/// Every pixel of a camera triangle whose ray hits a scene triangle lies in a region of each
+/// bound, for every pair of every trilinear scene (brute force over the camera triangle's
+/// pixels).
+#[test]
+fn bounds_hold_every_fragment() {
+    for name in TRILINEAR_SCENES {
+        let scene = load(name);
+        let projection = scene.projection.build(64, 48).unwrap();
+        let trilinear = projection.trilinear().unwrap();
+        let cameras = Camera::all(trilinear);
+        let owners = owners::owners(&cameras, 64, 48);
+        let geometry = SceneGeometry::new(&scene);
+        let mut checked = 0;
+        for (c, camera) in cameras.iter().enumerate() {
+            for k in 0..geometry.triangles.len() {
+                let q = geometry.corners(k);
+                for bound in [Bound::Paper, Bound::Tight] {
+                    let mut regions = Vec::new();
+                    bound::regions(camera, &q, bound, &mut |r| regions.push(*r));
+                    for (i, &owner) in owners.iter().enumerate() {
+                        if owner != c as u32 {
+                            continue;
+                        }
+                        let centre = DVec2::new((i % 64) as f64 + 0.5, (i / 64) as f64 + 0.5);
+                        let Some(ray) = camera.map.ray(centre) else {
+                            continue;
+                        };
+                        let hit = crate::render::trilinear::plane_hit(&ray, q);
+                        let Some((t, u, v)) = hit else { continue };
+                        if !(t >= 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0) {
+                            continue;
+                        }
+                        checked += 1;
+                        let held = regions.iter().any(|r| contains(r.points(), centre));
+                        assert!(
+                            held,
+                            "{name}: camera {c}, triangle {k}, {bound:?}, {centre}"
+                        );
+                    }
+                }
+            }
+        }
+        assert!(checked > 100, "{name}: {checked}");
+    }
+}
+
+/// Whether the convex polygon `p` (either orientation) holds `x`.
+fn contains(p: &[DVec2], x: DVec2) -> bool {
+    // Edges between (nearly) coincident vertices have no direction to test.
+    let sides: Vec<f64> = (0..p.len())
+        .filter(|&i| p[i].distance(p[(i + 1) % p.len()]) > 1e-9)
+        .map(|i| convex::cross(p[i], p[(i + 1) % p.len()], x))
+        .collect();
+    sides.iter().all(|&s| s >= 0.0) || sides.iter().all(|&s| s <= 0.0)
+}
+
+/// Culling clusters changes nothing but the work.
+#[test]
+fn culling_keeps_the_image() {
+    let scene = load("trilinear-detail-in-context");
+    let projection = scene.projection.build(160, 120).unwrap();
+    let prepared = PreparedScene::new(&scene);
+    let renderer = CameraTriangleRenderer::new(&prepared);
+    let trilinear = projection.trilinear().unwrap();
+    let flat = options(Shading::Flat, Bound::Tight);
+    let with = |cull| {
+        renderer
+            .render(
+                trilinear,
+                &flat,
+                Options {
+                    cull,
+                    ..Options::default()
+                },
+            )
+            .unwrap()
+    };
+    let ((culled, culled_stats), (all, all_stats)) = (with(true), with(false));
+    assert_eq!(culled, all);
+    assert!(count(&culled_stats, "culled_pairs") > 0);
+    assert_eq!(count(&all_stats, "culled_pairs"), 0);
+    assert!(count(&culled_stats, "pairs") < count(&all_stats, "pairs"));
+}
+
+#[test]
+fn refuses_what_it_cannot_render() {
+    let scene = scene::load("builtin:cube-floor").unwrap();
+    let projection = scene.projection.build(8, 8).unwrap();
+    let prepared = PreparedScene::new(&scene);
+    let e = render(
+        &prepared,
+        projection.as_ref(),
+        &options(Shading::Flat, Bound::Tight),
+    );
+    assert_eq!(
+        e.unwrap_err().to_string(),
+        format!(
+            "the camera-triangles method renders only trilinear projections (and trilinear \
+             reflectors in a perspective view), not a {} projection",
+            projection.kind()
+        )
+    );
+    let trilinear = load("trilinear-fan");
+    let projection = trilinear.projection.build(8, 8).unwrap();
+    let four = RenderOptions {
+        spp: 4,
+        ..options(Shading::Flat, Bound::Tight)
+    };
+    let e = render(&PreparedScene::new(&trilinear), projection.as_ref(), &four);
+    assert_eq!(
+        e.unwrap_err().to_string(),
+        "method camera-triangles renders one sample per pixel; got --spp 4"
+    );
+    assert_eq!(
+        "loose".parse::<Bound>().unwrap_err().to_string(),
+        "unknown bound \"loose\" (available: paper, tight)"
+    );
+}
+
+/// Reflections and refractions composited into the perspective view: the surfaces rendered
+/// by camera triangles give the trilinear method's image (both render the same surfaces
+/// exactly), and the stats carry the fragment counts.
+#[test]
+fn reflectors_composite_as_the_trilinear_method_does() {
+    for name in [
+        "reflect-sphere-cube",
+        "reflect-funny-mirror",
+        "refract-lens",
+    ] {
+        let scene = load(name);
+        let main = scene.projection.build(160, 120).unwrap();
+        let prepared = PreparedScene::new(&scene);
+        for shading in [Shading::Flat, Shading::Lit] {
+            let ours =
+                crate::render::render(&prepared, main.as_ref(), &options(shading, Bound::Tight))
+                    .unwrap();
+            let trilinear = crate::render::render(
+                &prepared,
+                main.as_ref(),
+                &RenderOptions {
+                    method: Method::Trilinear,
+                    shading,
+                    ..RenderOptions::default()
+                },
+            )
+            .unwrap();
+            let c = compare(&ours.frame, &trilinear.frame).unwrap();
+            println!("{name} {shading:?}: {c:?}");
+            assert!(c.id_agreement == 1.0, "{name}: {c:?}");
+            assert!(c.relative_rgb_error < 0.01, "{name}: {c:?}");
+            assert!(count(&ours.counters, "rendered_fragments") > 0, "{name}");
+            assert!(count(&ours.counters, "camera_triangles") > 0, "{name}");
+        }
+    }
+}
