@@ -116,7 +116,7 @@ pub struct CameraFrame {
 
 /// The vertices of a trilinear projection mesh (Vallance 2005). Vertex `k` has a base point
 /// `points[k]`, a ray direction `normals[k]` (not normalised: its length is the depth scale)
-/// and a screen position `screen[k]` in [0,1]^2 with (0,0) the bottom-left of the image.
+/// and a screen position `screen[k]` in \[0,1\]^2 with (0,0) the bottom-left of the image.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct TrilinearMesh {
     pub points: Vec<DVec3>,

@@ -72,8 +72,8 @@ const ARC_PIECES: usize = 4;
 const CANCELLATION_LIMIT: f64 = 1e3;
 
 /// The arc length of quadratic Bezier curve `p` from 0 to `s` (s in [0, 1]): in closed form
-/// where that is accurate to about 1e-12 relative ([`arc_length_closed_form`]), else by
-/// quadrature ([`arc_length_by_quadrature`]). The closed form is several times cheaper: the
+/// where that is accurate to about 1e-12 relative (`arc_length_closed_form`), else by
+/// quadrature (`arc_length_by_quadrature`). The closed form is several times cheaper: the
 /// ray caster computes this once per pixel that a quadratic projector hits, for its depth.
 /// Degenerate cases: all control points equal gives 0; a straight curve at uniform speed
 /// (P1 the midpoint of P0 and P2) gives 2 |P1 - P0| s.

@@ -2,7 +2,7 @@
 //! read-only (`&PreparedScene`) by all of them.
 //!
 //! [`PreparedScene::new`] gathers every object's world-space triangles into one BVH (binned
-//! SAH, f32 traversal; [`crate::render::bvh`]) beside the scene itself (objects with their
+//! SAH, f32 traversal; `crate::render::bvh`) beside the scene itself (objects with their
 //! meshes, materials and textures, lights, background) and the secondary-ray offset. The BVH
 //! queries here are what shading and every renderer's fallbacks trace with:
 //! [`PreparedScene::intersect`] is the exact closest-hit query other renderers are checked
@@ -12,8 +12,8 @@
 //!
 //! Reflector compositing renders parts of the scene (the scene without a reflector, the
 //! reflector alone) and the scene with other materials: those are views
-//! ([`PreparedScene::view`]) that share this scene's BVH, and leave out the triangles of the
-//! objects they hide by a [`TriangleMask`] the queries honour.
+//! (`PreparedScene::view`) that share this scene's BVH, and leave out the triangles of the
+//! objects they hide by a `TriangleMask` the queries honour.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};

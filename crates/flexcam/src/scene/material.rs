@@ -54,7 +54,7 @@ impl Default for Material {
 }
 
 /// An RGB image in linear colour, addressed with OBJ-style texture coordinates
-/// ((0,0) bottom-left, (1,1) top-right), wrapping (repeat) outside [0,1].
+/// ((0,0) bottom-left, (1,1) top-right), wrapping (repeat) outside \[0,1\].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Texture {
     pub width: u32,

@@ -1,6 +1,6 @@
 //! Texel addressing shared by every image looked up by texture coordinates (colour textures,
 //! height maps): OBJ-style coordinates ((0,0) bottom-left, (1,1) top-right, so v = 1 is the top
-//! row), wrapping (repeat) outside [0,1], bilinear filtering between texel centres.
+//! row), wrapping (repeat) outside \[0,1\], bilinear filtering between texel centres.
 //!
 //! The arithmetic is written once, generic over the texel type, so that a height map sampled
 //! here agrees bit for bit with a texture of the same grey image.

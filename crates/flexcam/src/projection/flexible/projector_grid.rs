@@ -31,7 +31,7 @@
 //! three-surface Bezier volumes).
 //!
 //! Degenerate tangents: a zero tangent means "no tangent" (straight), and so does one along
-//! the chord (within rounding, [`ALONG_CHORD`]); a tangent opposite to
+//! the chord (within rounding, `ALONG_CHORD`); a tangent opposite to
 //! the chord is an error (the projector would run backwards from its start and fold back over
 //! itself along one line, seeing what lies behind the image plane).
 //!

@@ -58,7 +58,7 @@ impl Trilinear {
     /// triangles; `points`, `normals` and `screen` of different lengths; a vertex index out
     /// of range; a non-finite value; a zero-length normal; a zero-area (degenerate) screen
     /// triangle. Screen triangles may overlap (the lowest index wins) and have either
-    /// orientation; screen positions outside [0,1]^2 simply fall outside the image.
+    /// orientation; screen positions outside \[0,1\]^2 simply fall outside the image.
     pub fn new(mesh: &TrilinearMesh, width: u32, height: u32) -> Result<Self> {
         let resolution = Resolution::new(width, height)?;
         validate(mesh)?;

@@ -1,15 +1,15 @@
 //! `--method camera-triangles`: multi-perspective rendering by camera triangles (Hou, Wei,
 //! Shum and Guo 2006), the feed-forward counterpart of ray casting a trilinear projection.
 //!
-//! Every projection triangle of a trilinear projection is a camera triangle ([`camera`]):
+//! Every projection triangle of a trilinear projection is a camera triangle (`camera`):
 //! its pixels' rays interpolate the corner rays barycentrically. Per camera triangle (in
 //! parallel) and scene triangle, a bounding region of the scene triangle's curved image is
-//! computed ([`bound`]: the paper's bounding triangle or our tighter hull, `--bound`), after
+//! computed (`bound`: the paper's bounding triangle or our tighter hull, `--bound`), after
 //! culling clusters of scene triangles whose boxes the camera triangle cannot see (section
 //! 2.4). The regions are scan-converted band by band (`render::scan`), and every fragment
 //! intersects its pixel's ray with its scene triangle's plane, is killed outside the triangle
-//! and z-tested on its exact depth ([`fragment`]); each pixel's winner is then shaded by the
-//! shared shading ([`shade`]). Nothing is ray cast to find first hits: the scene is only
+//! and z-tested on its exact depth (`fragment`); each pixel's winner is then shaded by the
+//! shared shading (`shade`). Nothing is ray cast to find first hits: the scene is only
 //! pushed through the cameras, so the result is exact up to rounding (the same first hits as
 //! the ray caster) whatever the bound, and the bound only decides how many fragments are
 //! wasted (`overdraw`, bounding over rendered fragments, as in the paper's Table 1).

@@ -5,20 +5,20 @@
 //! 1. every scene vertex is projected once through the projection's continuous inverse
 //!    ([`crate::projection::ContinuousInverse`], looked up once per renderer; the per-vertex
 //!    cache shared by the triangles around it);
-//! 2. each triangle is clipped in 3D to the chart's half-spaces ([`clip`]), cut by the
-//!    uniform grid and refined adaptively ([`refine`]) until the straight polygon of each
+//! 2. each triangle is clipped in 3D to the chart's half-spaces (`clip`), cut by the
+//!    uniform grid and refined adaptively (`refine`) until the straight polygon of each
 //!    piece's projected corners follows its curved image within the tolerance;
-//! 3. each piece is placed on the screen ([`seam`]): unwrapped across a panorama's seam and
+//! 3. each piece is placed on the screen (`seam`): unwrapped across a panorama's seam and
 //!    drawn once more on the other side when it straddles it; pieces around a pole are
 //!    dropped (they cover no pixel centre), and so are pieces whose screen box holds no
 //!    pixel centre (most pieces of a finely tessellated model); the others are sorted into
-//!    bands of rows by the parallel job that built them ([`coverage::Bins`]);
+//!    bands of rows by the parallel job that built them (`coverage::Bins`);
 //! 4. the bands are filled in parallel by the polygon rasteriser's fill and tie rule
-//!    specialised to triangles ([`coverage::cover`]); each fragment reconstructs its exact
-//!    depth and barycentrics once from its pixel's projector ([`fragment`]; the projectors
-//!    are computed on first use and kept for later frames, [`pixel_rays`]);
+//!    specialised to triangles (`coverage::cover`); each fragment reconstructs its exact
+//!    depth and barycentrics once from its pixel's projector (`fragment`; the projectors
+//!    are computed on first use and kept for later frames, `pixel_rays`);
 //! 5. each band's visible fragments are shaded once, from that reconstruction, straight
-//!    into the frame ([`band_fill`]), so depth and shading are the ray caster's and only
+//!    into the frame (`band_fill`), so depth and shading are the ray caster's and only
 //!    coverage near silhouettes depends on the subdivision.
 //!
 //! Shading: flat base colours are computed here; lit shading (lights and shadows) and the
@@ -32,7 +32,7 @@
 //! z-buffer are kept between frames, and [`InverseRaster::render_into`] reuses the caller's
 //! frame.
 //!
-//! Supported: every projection with an [`InverseChart`] (perspective, orthographic,
+//! Supported: every projection with an `InverseChart` (perspective, orthographic,
 //! fisheye, equirectangular, cylindrical, and the flexible volumes described in
 //! `projection::flexible::chart`); others are refused with one line naming the projection.
 

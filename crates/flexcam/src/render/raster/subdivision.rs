@@ -62,7 +62,7 @@ impl Subdivision {
     }
 
     /// Errors: `uniform` outside [1, [`MAX_UNIFORM`]], a tolerance that is not a finite
-    /// number of pixels of at least [`MIN_TOLERANCE`].
+    /// number of pixels of at least `MIN_TOLERANCE`.
     pub fn validate(&self) -> Result<()> {
         if !(1..=MAX_UNIFORM).contains(&self.uniform) {
             return Err(Error::new(format!(

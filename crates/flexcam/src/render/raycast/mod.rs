@@ -63,7 +63,7 @@ impl PreparedScene {
 
 /// Renders `projection` (colour, depth and object ids) with `options` into a new frame
 /// (see [`render_into`]). The frame starts as zeroed memory
-/// ([`Frame::zeroed`]), not cleared to the background: every pixel is written.
+/// (`Frame::zeroed`), not cleared to the background: every pixel is written.
 pub fn render(
     scene: &PreparedScene,
     projection: &dyn Projection,
@@ -81,7 +81,7 @@ pub fn render(
 /// one frame and pays neither its allocation nor the first touch of its pages again; a
 /// frame of another size than the projection's resolution (or whose buffers do not match
 /// its size) is replaced by one of the right size. `options.spp = 0` counts as one
-/// sample. See [`shade`] for what the depth and id of a pixel are.
+/// sample. See `shade` for what the depth and id of a pixel are.
 pub fn render_into(
     scene: &PreparedScene,
     frame: &mut Frame,

@@ -21,7 +21,7 @@ use crate::render::Frame;
 /// is then about 200 to 256 KiB, well inside a core's L2 cache on the machines we measure.
 const BAND_PIXELS: u32 = 8192;
 
-/// The rows per band for an image `width` pixels wide: about [`BAND_PIXELS`] pixels, at
+/// The rows per band for an image `width` pixels wide: about `BAND_PIXELS` pixels, at
 /// least one row and at most 64.
 pub fn band_rows_for(width: u32) -> u32 {
     (BAND_PIXELS / width.max(1)).clamp(1, 64)

@@ -12,7 +12,7 @@
 //!   frame-sized buffers);
 //! - [`stats`]: counters for `--stats`.
 //!
-//! A *stage* (see [`rasterize_parallel_staged`]) may rewrite each fragment before its z-test
+//! A *stage* (see `rasterize_parallel_staged`) may rewrite each fragment before its z-test
 //! (an exact per-pixel depth instead of the interpolated one) or discard it.
 //!
 //! Determinism: a pixel keeps the fragment with the smallest `(depth, primitive)` pair, and
@@ -175,7 +175,7 @@ fn draw<const N: usize>(
 
 /// Calls `emit` with the runs of pixel centres that `polygon` covers in rows
 /// `rows.0..rows.1` and columns `0..width`, row by row, left to right, each pixel in at most
-/// one span: a polygon's by `rule` ([`scan`]), a line's pixels one by one ([`line`](mod@line)),
+/// one span: a polygon's by `rule` (`scan`), a line's pixels one by one ([`line`](mod@line)),
 /// none for a shape that is not drawn. For renderers that run their own stage and z-test
 /// along a span (see [`Span::start_and_step`]) instead of one fragment at a time.
 pub fn spans<const N: usize>(

@@ -14,7 +14,7 @@
 //!   included, casts a hard shadow); a scene without lights gets an unshadowed headlight along
 //!   the ray. Mirrors reflect tinted by their base colour; glass mixes reflection and
 //!   refraction by the exact Fresnel reflectance, its transmission tinted by the base colour.
-//!   Branches whose weight in the pixel drops below [`MIN_WEIGHT`] yield the background, as
+//!   Branches whose weight in the pixel drops below `MIN_WEIGHT` yield the background, as
 //!   at the depth limit, so that nested glass costs at most a few hundred rays.
 
 use glam::{DVec3, Vec3};

@@ -6,7 +6,7 @@
 //! Everything `base_color` interpolates is affine in the barycentrics `(u, v)`: the world
 //! point, so the object-space point and the checker's cell coordinates `(p + nudge) / size`
 //! too, the texture coordinates and the vertex colour. Each is kept as its value at the first
-//! corner plus its change per unit `u` and `v` ([`Affine`]). Where a triangle lies inside one
+//! corner plus its change per unit `u` and `v` (`Affine`). Where a triangle lies inside one
 //! checker cell and its vertex colours agree, the colour is one constant.
 //!
 //! The colours are [`super::base_color`]'s up to `f32` rounding: the same affine values

@@ -98,7 +98,7 @@ pub const MAX_STEPS: u32 = 1024;
 pub struct CurveOptions {
     pub mode: CurveMode,
     /// Segments per scene edge (tessellate), slices per shape (slice) or the most segments
-    /// per edge piece (adaptive); 1 to [`MAX_STEPS`].
+    /// per edge piece (adaptive); 1 to `MAX_STEPS`.
     pub steps: u32,
     /// Scene-space clipping (Vallance 2005, chapter 5; the default): outlines get exact anchors
     /// where their scene edges cross the projection triangle's edge surfaces, so images are
@@ -117,7 +117,7 @@ impl CurveOptions {
     };
 
     /// `mode` with `steps`, or the mode's default steps when `None`. Errors: `steps` outside
-    /// 1 to [`MAX_STEPS`].
+    /// 1 to `MAX_STEPS`.
     pub fn new(mode: CurveMode, steps: Option<u32>) -> Result<CurveOptions> {
         let steps = steps.unwrap_or(mode.default_steps());
         if !(1..=MAX_STEPS).contains(&steps) {

@@ -2,17 +2,17 @@
 //! and 5). Instead of casting a ray per pixel it projects the scene into each projection
 //! triangle and rasterises the result; docs/trilinear.md has the design and measurements.
 //!
-//! Per projection triangle (in parallel), [`polygons`]: scene triangles beyond a bounding
-//! plane of the triangle's ray volume are culled ([`volume_bounds`]), each remaining scene
+//! Per projection triangle (in parallel), `polygons`: scene triangles beyond a bounding
+//! plane of the triangle's ray volume are culled (`volume_bounds`), each remaining scene
 //! vertex is projected once (its cubic), pairs whose images cannot be visible are culled, each scene triangle is cut into
 //! shapes (`projection::project_solved_triangle`), each shape's curved edges are sampled along
-//! the exact images of their scene edges ([`edge_path`], [`outline`], by the [`curves`]
+//! the exact images of their scene edges (`edge_path`, `outline`, by the `curves`
 //! mode), with exact anchors at the view plane and at the projection triangle's edge surfaces,
-//! and the outline is clipped ([`clip`]) and mapped to pixels ([`screen_map`]), each vertex
+//! and the outline is clipped (`clip`) and mapped to pixels (`screen_map`), each vertex
 //! carrying the terms of its projector's hit with the scene triangle's plane that are affine
-//! in pixel position ([`hit_terms`]). All polygons are then rasterised (`render::scan`,
+//! in pixel position (`hit_terms`). All polygons are then rasterised (`render::scan`,
 //! non-zero fill, z-buffer), every fragment finished to its exact hit from its interpolated
-//! terms before its z-test, and each pixel's winner shaded once ([`shade`]).
+//! terms before its z-test, and each pixel's winner shaded once (`shade`).
 //!
 //! Unprojectable pairs (see `projection::Unprojectable`) are counted and their projection
 //! triangle is ray cast instead, so they never silently vanish.
@@ -95,7 +95,7 @@ impl<'a> TrilinearRenderer<'a> {
 
     /// Renders the scene through `projection` with `curves` into a new frame (see
     /// [`TrilinearRenderer::render_into`]). The frame starts as zeroed memory
-    /// ([`Frame::zeroed`]), not cleared to the background: `render_into` writes every pixel,
+    /// (`Frame::zeroed`), not cleared to the background: `render_into` writes every pixel,
     /// so no clearing pass runs and each page is first touched by the shading that fills it.
     pub fn render(
         &self,

@@ -37,7 +37,7 @@ pub struct ProjectedScene {
 
 /// The projection triangles of `projection`, each with its screen placement and the
 /// bounding planes of its ray volume; a collapsed base is moved along its rays first
-/// ([`clipping_base`]).
+/// (`clipping_base`).
 pub fn projection_triangles(projection: &Trilinear) -> Vec<ProjectionTriangle> {
     let mesh = projection.mesh();
     mesh.triangles

@@ -35,7 +35,7 @@ pub struct SceneGeometry {
     /// Per triangle, the edges `<V1V2, V1V3, V2V3>` (bits 0, 1, 2) that another triangle
     /// shares (same end positions, any object): the surface continues across them.
     pub shared_edges: Vec<u8>,
-    /// Runs of at most [`CLUSTER_SIZE`] consecutive triangles of one object, each with the
+    /// Runs of at most `CLUSTER_SIZE` consecutive triangles of one object, each with the
     /// corners of its bounding box: a projection triangle can cull a whole run at once.
     pub clusters: Vec<Cluster>,
     /// The box tree over `clusters`: a projection triangle skips whole subtrees.

@@ -117,7 +117,7 @@ impl ScreenMap {
     }
 
     /// The projector through `pixel` as [`ScreenMap::ray`] gives it, with only its direction
-    /// computed: the origin is built by [`Projector::ray`] when needed. `None` where
+    /// computed: the origin is built by `Projector::ray` when needed. `None` where
     /// `trinorm` is zero.
     pub fn projector(&self, pixel: DVec2) -> Option<Projector<'_>> {
         let uv = self.barycentrics(pixel);
@@ -129,8 +129,8 @@ impl ScreenMap {
         })
     }
 
-    /// The projector directions (`trinorm`, [`Projector::direction`]) along a row from
-    /// pixel position `pixel`: [`RowDirections::at`]`(k)` is the direction at
+    /// The projector directions (`trinorm`, `Projector::direction`) along a row from
+    /// pixel position `pixel`: `RowDirections::at``(k)` is the direction at
     /// `pixel + (k, 0)` up to rounding, for callers walking a run of pixels of this
     /// projection triangle (shading) instead of mapping each pixel on its own. Unlike
     /// [`ScreenMap::projector`] it does not single out a zero `trinorm`: the caller checks

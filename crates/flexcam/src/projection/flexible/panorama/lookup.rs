@@ -50,7 +50,7 @@
 //!
 //! Degenerate cases: points on the up axis through the eye (no azimuth) have no image (the
 //! chart's poles); elevations beyond the profile's ends continue the end intervals of the
-//! samples linearly (v outside [0, 1], clipped by [`super::super::inverse::Inverse::solve`]);
+//! samples linearly (v outside [0, 1], clipped by the inverse's `Inverse::solve`);
 //! a coupled iteration that does not converge (above).
 
 use std::f64::consts::{PI, TAU};

@@ -27,8 +27,8 @@
 //! - twist: the perspective volume with the far rectangle turned by `twist` about the view
 //!   axis (thesis 4.2, 6.3: "rotating the far surface of a perspective projection");
 //! - axonometric: the orthographic volume seen from the direction given by `azimuth` and
-//!   `elevation` ([`axonometric`]);
-//! - general linear camera: the affine combinations of three generator rays ([`glc`]).
+//!   `elevation` (`axonometric`);
+//! - general linear camera: the affine combinations of three generator rays (`glc`).
 //!
 //! Volumes that change with depth or are made of other surfaces (built by
 //! [`PresetSpec::volume`]):
