@@ -46,6 +46,10 @@ enum Command {
     /// they agree (object ids, depth, relative RGB error).
     #[command(after_help = OUTPUTS_HELP)]
     Compare(commands::compare::CompareArgs),
+    /// Simplify a polygon mesh (OBJ, faces of any number of corners) by edge collapses that
+    /// turn no face by more than a threshold angle, and write the coarse mesh (OBJ).
+    #[command(after_help = OUTPUTS_HELP)]
+    Simplify(commands::simplify::SimplifyArgs),
     /// Rerun a source document's timing table with flexcam's renderers.
     #[command(subcommand)]
     Bench(commands::bench::BenchCommand),
@@ -63,6 +67,7 @@ fn main() -> ExitCode {
         Command::Fit(args) => commands::fit::run(&args),
         Command::Scenes => commands::scenes::run(),
         Command::Compare(args) => commands::compare::run(&args),
+        Command::Simplify(args) => commands::simplify::run(&args),
         Command::Bench(command) => commands::bench::run(&command),
     };
     match result {

@@ -15,6 +15,8 @@ pub struct RunFacts<'a> {
     pub triangles: usize,
     pub load_ms: f64,
     pub render_ms: f64,
+    /// The warnings printed on stderr (the scene's load, the render), one line each.
+    pub warnings: &'a [String],
 }
 
 /// One JSON object: the run's facts, then the renderer's counters (which never override a
@@ -31,6 +33,7 @@ pub fn to_json(facts: &RunFacts, counters: &Stats) -> Value {
     map.insert("triangles".into(), facts.triangles.into());
     map.insert("load_ms".into(), number(facts.load_ms));
     map.insert("render_ms".into(), number(facts.render_ms));
+    map.insert("warnings".into(), facts.warnings.into());
     for (name, counter) in counters {
         let value = match *counter {
             Counter::Count(n) => Value::from(n),
@@ -63,6 +66,7 @@ mod tests {
             triangles: 686,
             load_ms: 1.0,
             render_ms: 2.5,
+            warnings: &["a warning".to_string()],
         };
         let mut counters = Stats::new();
         counters.insert("rays_cast", Counter::Count(12));
@@ -73,5 +77,6 @@ mod tests {
         assert_eq!(v["rays_cast"], 12);
         assert_eq!(v["render_ms"], 2.5);
         assert!(v["bvh_build_ms"].is_null());
+        assert_eq!(v["warnings"], serde_json::json!(["a warning"]));
     }
 }

@@ -626,14 +626,60 @@ fn animate_stats_report_one_bvh_build_for_all_frames() {
     );
 }
 
+/// A render warning (a reflector's refinement left edges over its tolerance) is one stderr
+/// line naming the scene, and listed in `--stats`; without it the list is empty.
+#[test]
+fn render_warnings_go_to_stderr_and_stats() {
+    let dir = TempDir::new().unwrap();
+    let text = fs::read_to_string(scenes_dir().join("reflect-sphere-cube.toml")).unwrap();
+    let tight = text.replace(
+        "trilinear_reflector = true",
+        "trilinear_reflector = true\ntrilinear_refine_px = 0.0001",
+    );
+    assert_ne!(tight, text);
+    write(&dir, "tight.toml", &tight);
+    write(&dir, "plain.toml", &text);
+    let args = |scene| {
+        [
+            "render", scene, "--width", "40", "--height", "30", "--stats", "-",
+        ]
+    };
+    let out = run_ok(&dir, &args("tight.toml"));
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    let lines: Vec<&str> = stderr.lines().filter(|l| l.contains("warning")).collect();
+    assert_eq!(lines.len(), 1, "{stderr}");
+    assert!(
+        lines[0].starts_with("flexcam: warning: tight.toml: trilinear reflector 1: "),
+        "{stderr}"
+    );
+    let stats: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let listed = stats["warnings"].as_array().unwrap();
+    assert_eq!(listed.len(), 1);
+    assert!(lines[0].ends_with(listed[0].as_str().unwrap()));
+    let out = run_ok(&dir, &args("plain.toml"));
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
+    let stats: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(stats["warnings"], serde_json::json!([]));
+}
+
 /// `compare` renders both methods from one prepared scene (one BVH build), and `render
-/// --stats` reports the build too.
+/// --stats` reports the build too; compositing a lit glass reflector (the scene without it,
+/// the reflector alone for the Fresnel split) builds no other.
 #[test]
 fn compare_and_render_build_the_bvh_once() {
     let dir = good_scene_in("s.toml");
     let report = run_json(&dir, &["compare", "s.toml", "--method", "raster", "--json"]);
     assert_eq!(report["bvh_builds"], 1);
     let stats = run_json(&dir, &["render", "s.toml", "-o", "a.png", "--stats", "-"]);
+    assert_eq!(stats["bvh_builds"], 1);
+    let lens = example_scene("refract-lens.toml");
+    let small = ["--width", "48", "--height", "36", "--stats", "-"];
+    let stats = run_json(
+        &dir,
+        &[&["render", &lens, "-o", "b.png"][..], &small].concat(),
+    );
+    assert_eq!(stats["reflectors"], 1);
+    assert!(stats["reflector_fresnel_rays"].as_u64().unwrap() > 0);
     assert_eq!(stats["bvh_builds"], 1);
 }
 

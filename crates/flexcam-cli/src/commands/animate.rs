@@ -8,11 +8,13 @@ use std::time::Instant;
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, GifFrames, OutputSet};
 use flexcam::projection::ProjectionSpec;
-use flexcam::render::{self, Counter, Method, PreparedScene, RenderOptions, Shading, Stats};
+use flexcam::render::{
+    self, Counter, Method, Outputs, PreparedScene, RenderOptions, Shading, Stats,
+};
 use flexcam::scene;
 use flexcam::{Error, Result};
 
-use super::scene_args::ShadingArg;
+use super::scene_args::{print_lines, warning_lines, ShadingArg};
 use crate::progress::RenderProgress;
 use crate::stats_json::{self, RunFacts};
 use crate::OutputTarget;
@@ -170,6 +172,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     let render_start = Instant::now();
     let progress = RenderProgress::new();
     let mut gif = args.gif.as_ref().map(|_| GifFrames::default());
+    let mut warnings = Vec::new();
     for frame_number in 0..frames {
         let spec = ProjectionSpec::Flexible(Box::new(animation.projection(frame_number)));
         let (projection, _) = flexcam::calibrate::build(&spec, width, height)
@@ -183,9 +186,12 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
             shading: args.shading.shading(),
             spp: args.spp,
             progress: Some(&report),
+            outputs: Outputs::COLOR,
             ..RenderOptions::default()
         };
-        let frame = render::render(&prepared, projection.as_ref(), &options)?.frame;
+        let rendered = render::render(&prepared, projection.as_ref(), &options)?;
+        warnings.extend(rendered.warnings);
+        let frame = rendered.frame;
         if let Some(&id) = frame_outputs.get(frame_number as usize) {
             outputs.stage(id, |tmp| image_io::write_color_png(&frame, tmp, encoding))?;
         }
@@ -195,6 +201,8 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     }
     progress.finish();
     let render_ms = render_start.elapsed().as_secs_f64() * 1e3;
+    let warnings = warning_lines(&warnings);
+    print_lines(&args.scene.to_string_lossy(), &warnings);
     if let (Some(gif), Some(id)) = (gif, gif_output) {
         outputs.stage(id, |tmp| gif.write(tmp, animation.fps()))?;
     }
@@ -213,6 +221,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         triangles: scene.triangle_count(),
         load_ms,
         render_ms,
+        warnings: &warnings,
     };
     let json = format!("{}\n", stats_json::to_json(&facts, &counters));
     if let Some(id) = stats_output {

@@ -89,6 +89,8 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let timed_render = |options: &RenderOptions| {
         let start = Instant::now();
         let rendered = render::render(&prepared, loaded.projection.as_ref(), options)?;
+        let lines = super::scene_args::warning_lines(&rendered.warnings);
+        super::scene_args::print_lines(&loaded.source, &lines);
         Ok::<_, Error>((rendered.frame, start.elapsed().as_secs_f64() * 1e3))
     };
     let (frame, method_ms) = timed_render(&options)?;

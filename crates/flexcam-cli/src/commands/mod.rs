@@ -8,6 +8,7 @@ pub mod render;
 pub mod reproject;
 pub mod scene_args;
 pub mod scenes;
+pub mod simplify;
 
 /// Declares the scene file a command was given (a path; nothing for `builtin:NAME`) as an
 /// input of `outputs`, so that an output aimed at it is refused before the scene is read.
@@ -40,4 +41,26 @@ pub fn print_stdout(text: &str) -> flexcam::Result<()> {
     out.write_all(text.as_bytes())
         .and_then(|()| out.flush())
         .map_err(|e| flexcam::Error::new(format!("cannot write to standard output: {e}")))
+}
+
+/// Finishes a command with a `--stats FILE|-` flag: the JSON line `json` is staged as the
+/// output `file` (declared for a file target) and every output committed together, or, for
+/// `-`, printed once the outputs are committed.
+pub fn commit_with_stats(
+    mut outputs: flexcam::image_io::OutputSet,
+    file: Option<flexcam::image_io::OutputId>,
+    target: Option<&crate::OutputTarget>,
+    json: &str,
+) -> flexcam::Result<()> {
+    let line = format!("{json}\n");
+    if let Some(id) = file {
+        outputs.stage(id, |tmp| {
+            flexcam::image_io::write_bytes(tmp, line.as_bytes())
+        })?;
+    }
+    outputs.commit()?;
+    if let Some(crate::OutputTarget::Stdout) = target {
+        print_stdout(&line)?;
+    }
+    Ok(())
 }

@@ -5,10 +5,12 @@ use std::time::Instant;
 
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, DepthFormat, OutputSet};
-use flexcam::render::{self, Counter, Method, PreparedScene, RenderOptions, Shading};
+use flexcam::render::{self, Counter, Method, Outputs, PreparedScene, RenderOptions, Shading};
 use flexcam::Result;
 
-use super::scene_args::{print_warnings, MethodTuning, SceneArgs, ShadingArg};
+use super::scene_args::{
+    print_lines, print_warnings, warning_lines, MethodTuning, SceneArgs, ShadingArg,
+};
 use crate::progress::RenderProgress;
 use crate::stats_json::{self, RunFacts};
 use crate::OutputTarget;
@@ -86,6 +88,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         subdivision: args.tuning.subdivision(method)?,
         curves: args.tuning.curves(method)?,
         progress: Some(&report),
+        outputs: Outputs {
+            depth: depth.is_some(),
+            ids: ids.is_some(),
+        },
         ..RenderOptions::default()
     };
     let render_start = Instant::now();
@@ -98,7 +104,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let render::Rendered {
         frame,
         mut counters,
+        warnings,
     } = rendered?;
+    let warnings = warning_lines(&warnings);
+    print_lines(&loaded.source, &warnings);
     for &(name, value) in &loaded.build_report.counters {
         counters.insert(name, Counter::Value(value));
     }
@@ -128,16 +137,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         triangles: loaded.scene.triangle_count(),
         load_ms: loaded.load_ms,
         render_ms,
+        warnings: &[&loaded.build_report.warnings[..], &warnings].concat(),
     };
     let json = stats_json::to_json(&facts, &counters).to_string();
-    if let Some(id) = stats {
-        outputs.stage(id, |tmp| {
-            image_io::write_bytes(tmp, format!("{json}\n").as_bytes())
-        })?;
-    }
-    outputs.commit()?;
-    if let Some(OutputTarget::Stdout) = &args.stats {
-        super::print_stdout(&format!("{json}\n"))?;
-    }
-    Ok(())
+    super::commit_with_stats(outputs, stats, args.stats.as_ref(), &json)
 }

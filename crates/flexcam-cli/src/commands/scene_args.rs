@@ -1,11 +1,11 @@
 //! What `render`, `compare` and `reproject` share: the scene argument and its overrides,
 //! shading and the methods' tuning options, turned into the library's load and render
-//! options.
+//! options, and the warnings printed on stderr.
 
 use clap::{Args, ValueEnum};
 use flexcam::render::raster::Subdivision;
 use flexcam::render::trilinear::CurveOptions;
-use flexcam::render::{Method, Shading};
+use flexcam::render::{Method, RenderWarning, Shading};
 use flexcam::scene::{self, LoadedScene, Overrides};
 use flexcam::{Error, Result};
 
@@ -62,9 +62,25 @@ impl SceneArgs {
 
 /// Prints the warnings of a scene's load on stderr (the command goes on).
 pub fn print_warnings(loaded: &LoadedScene) {
-    for warning in &loaded.build_report.warnings {
-        eprintln!("flexcam: warning: {}: {warning}", loaded.source);
+    print_lines(&loaded.source, &loaded.build_report.warnings);
+}
+
+/// Prints warnings about scene `source` on stderr, one line each (the command goes on).
+pub fn print_lines(source: &str, warnings: &[String]) {
+    for warning in warnings {
+        eprintln!("flexcam: warning: {source}: {warning}");
     }
+}
+
+/// The lines of render warnings `warnings`, each once, in the order first reported.
+pub fn warning_lines<'a>(warnings: impl IntoIterator<Item = &'a RenderWarning>) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    for line in warnings.into_iter().map(RenderWarning::to_string) {
+        if !lines.contains(&line) {
+            lines.push(line);
+        }
+    }
+    lines
 }
 
 /// `--shading` on the command line.

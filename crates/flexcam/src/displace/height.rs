@@ -138,7 +138,7 @@ impl HeightMap {
     /// rectangle is split at the wrap into at most four, and each is bounded by the at most
     /// 2 x 2 pyramid blocks of the finest level at which it spans no more than two blocks per
     /// axis: conservative, O(1), and tight to within a block of that size. The bounds are
-    /// widened by [`BLEND_ROUNDING`] for the f32 rounding of the blend itself.
+    /// widened by `BLEND_ROUNDING` for the f32 rounding of the blend itself.
     pub fn range(&self, min: DVec2, max: DVec2) -> [f64; 2] {
         let (w, h) = (self.width as f64, self.height as f64);
         let slack = |a: f64, b: f64, n: f64| 1.0 + a.abs().max(b.abs()) * n * 1e-6;

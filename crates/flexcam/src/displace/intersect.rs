@@ -22,7 +22,7 @@
 //! node's extent plus 1e-14 of its distance from the origin) for the rounding of the frame and
 //! the midpoints, and, per ray, by 1e-8 of the ray origin's distance from the base triangle:
 //! a reported micro-triangle hit lies within `2e-10` of that distance of its triangle (rays
-//! grazing a micro-triangle's plane closer than [`GRAZING`](super::micro::GRAZING) do not hit
+//! grazing a micro-triangle's plane closer than `micro::GRAZING` do not hit
 //! it), so the ray enters every box on the way to it. Traversal is front to back: children are visited in
 //! order of their boxes' entry distance, and a child whose entry lies beyond the best hit so
 //! far is skipped. A leaf tests its micro-triangle exactly as the brute-force reference

@@ -25,7 +25,7 @@
 //! 2`). Both keep the base triangle's orientation. Hits report barycentric weights of the second
 //! and third vertex in that order, from [`intersect_triangle`] on the displaced positions; a
 //! ray within 1e-6 (sine of the angle) of a micro-triangle's plane does not hit it (see
-//! [`GRAZING`]).
+//! `GRAZING`).
 
 use glam::{DVec2, DVec3};
 

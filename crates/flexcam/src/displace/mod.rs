@@ -8,12 +8,16 @@
 //! nearest through a min/max hierarchy over the subdivision, computed on the fly from height
 //! bounds, with no tessellation stored.
 //!
+//! [`simplify`] reduces polygon meshes by edge collapses and records the vertex splits that
+//! rebuild them exactly.
+//!
 //! This layer sits beside [`crate::scene`] and uses geometry and scene types only.
 
 pub mod height;
 pub mod intersect;
 pub mod micro;
 pub mod procedural;
+pub mod simplify;
 pub mod tessellate;
 
 pub use height::{HeightField, HeightMap};

@@ -14,10 +14,9 @@
 //!
 //! The renderer is a parameter ([`Renderer`]): any method that renders a prepared scene
 //! through a projection, e.g. `|s, p, o| Method::Raycast.render(s, p, o)`, or a faster
-//! trilinear one. The main view shares the prepared scene's BVH (only materials differ);
-//! the scene without a reflector, rendered through that reflector's surfaces, and the
-//! reflector alone (the Fresnel split) are variants with BVHs of their own, counted in
-//! [`PreparedScene::bvh_builds`].
+//! trilinear one. The main view (the reflectors made diffuse), the scene without a reflector
+//! (rendered through that reflector's surfaces) and the reflector alone (the Fresnel split)
+//! are views of the prepared scene ([`PreparedScene::view`]): they share its one BVH.
 //! In `lit` shading a mirror's reflected colour is tinted by its base colour, and glass mixes
 //! the images through its refraction surface and through a second, reflection surface by the
 //! exact Fresnel reflectance at each pixel, as the ray caster's glass does ([`FresnelSplit`],
@@ -38,8 +37,10 @@ use crate::projection::{Perspective, Projection, ProjectionSpec, Trilinear, Tril
 use crate::render::prepared::PreparedScene;
 use crate::render::shading::normals;
 use crate::render::shading::trace::specular;
-use crate::render::{Counter, Frame, Method, RenderOptions, Shading, Stats};
-use crate::scene::{Mesh, Object, Scene, Surface, TrilinearReflector};
+use crate::render::{
+    Counter, Frame, Method, Outputs, RenderOptions, RenderWarning, Rendered, Shading, Stats,
+};
+use crate::scene::{Finish, Mesh, Object, Scene, TrilinearReflector};
 
 /// A way of rendering a scene through a projection (a [`crate::render::Method`] or any
 /// other renderer).
@@ -54,8 +55,9 @@ pub type Renderer<'a> =
 /// reflector alone for the Fresnel split), `reflector_exact_pixels` (reflector pixels that no
 /// triangle of the surface covers, ray cast exactly instead: [`ExactPixels`]),
 /// `reflector_unsplit_edges` (edges the refinement left over its tolerance at its depth cap
-/// or below a pixel: [`refine`]) and `reflector_render_ms` (surface refinement, building and
-/// rendering).
+/// or below a pixel: [`refine`]; a [`RenderWarning::ReflectorOverTolerance`] for each
+/// reflector that has such edges) and `reflector_render_ms` (surface refinement, building
+/// and rendering).
 ///
 /// Errors: the renderer's; a scene projection that is not perspective (the main camera);
 /// a reflector id that no object has, or whose material is not mirror or glass.
@@ -64,41 +66,59 @@ pub fn render(
     main: &dyn Projection,
     options: &RenderOptions,
     renderer: &Renderer,
-) -> Result<(Frame, Stats)> {
+) -> Result<Rendered> {
     let scene = prepared.scene();
     if scene.trilinear_reflectors.is_empty() {
-        return renderer(prepared, main, options);
+        let (frame, counters) = renderer(prepared, main, options)?;
+        return Ok(Rendered {
+            frame,
+            counters,
+            warnings: Vec::new(),
+        });
     }
     let camera = main_camera(scene, main)?;
     let mut main_scene = scene.clone();
     for object in &mut main_scene.objects {
         if scene.trilinear_reflectors.iter().any(|r| r.id == object.id) {
-            object.material.surface = Surface::Diffuse;
+            object.material.finish = Finish::Diffuse;
         }
     }
-    let (mut frame, mut stats) = renderer(&prepared.with_materials(&main_scene), main, options)?;
+    // The main view's ids find the reflectors' pixels; the images through the surfaces are
+    // read for their colour alone.
+    let main_options = RenderOptions {
+        outputs: Outputs {
+            ids: true,
+            ..options.outputs
+        },
+        ..*options
+    };
+    let (mut frame, mut stats) = renderer(&prepared.view(main_scene), main, &main_options)?;
+    let options = &RenderOptions {
+        outputs: Outputs::COLOR,
+        ..*options
+    };
     let start = Instant::now();
     let (mut triangles, mut dropped, mut pixels, mut fresnel_rays) = (0, 0, 0, 0);
     let exact = ExactPixels::new(prepared, &camera, options);
-    let (mut exact_pixels, mut unsplit) = (0, 0);
+    let mut exact_pixels = 0;
+    let (mut unsplit, mut warnings) = (0, Vec::new());
     for entry in &scene.trilinear_reflectors {
         let (id, map) = (entry.id, entry.screen_map);
         let reflector = Reflector::of(scene, id)?;
-        let (surface, left) = refined_surface(&reflector, reflector.optic, entry, &camera)?;
-        unsplit += left;
+        let (surface, mut left) = refined_surface(&reflector, reflector.optic, entry, &camera)?;
         triangles += surface.mesh.triangles.len();
         dropped += surface.dropped;
         let projection = surface_projection(&surface, map, &camera)?;
         if let Some(projection) = &projection {
-            let others = prepared.variant(&without(scene, id));
+            let others = prepared.view(without(scene, id));
             let image = renderer(&others, projection, options)?.0;
             pixels += match (options.shading, reflector.optic) {
                 (Shading::Flat, _) => paste(&mut frame, id, &image, Vec3::ONE)?,
                 (Shading::Lit, Optic::Reflect) => paste(&mut frame, id, &image, reflector.tint)?,
                 (Shading::Lit, Optic::Refract { .. }) => {
-                    let (mirror, left) =
+                    let (mirror, mirror_left) =
                         refined_surface(&reflector, Optic::Reflect, entry, &camera)?;
-                    unsplit += left;
+                    left += mirror_left;
                     let reflection =
                         render_through(&others, &mirror, map, &camera, options, renderer)?
                             .unwrap_or_else(|| {
@@ -113,6 +133,14 @@ pub fn render(
             };
         }
         exact_pixels += exact.cast_uncovered(&mut frame, id, projection.as_ref());
+        unsplit += left;
+        if left > 0 {
+            warnings.push(RenderWarning::ReflectorOverTolerance {
+                id,
+                edges: left as u64,
+                tolerance_px: entry.refine_px,
+            });
+        }
     }
     let count = |n: usize| Counter::Count(n as u64);
     stats.insert("reflectors", count(scene.trilinear_reflectors.len()));
@@ -126,7 +154,11 @@ pub fn render(
         "reflector_render_ms",
         Counter::Value(start.elapsed().as_secs_f64() * 1e3),
     );
-    Ok((frame, stats))
+    Ok(Rendered {
+        frame,
+        counters: stats,
+        warnings,
+    })
 }
 
 /// Renders `scene` through `main` with `method`, compositing its trilinear reflectors as
@@ -142,7 +174,7 @@ pub fn render_with_method(
     main: &dyn Projection,
     options: &RenderOptions,
     method: Method,
-) -> Result<(Frame, Stats)> {
+) -> Result<Rendered> {
     let renderer =
         |s: &PreparedScene, p: &dyn Projection, o: &RenderOptions| method.render(s, p, o);
     let scene = prepared.scene();
@@ -235,9 +267,9 @@ impl Reflector {
         let first = parts.first().ok_or_else(|| {
             Error::new(format!("trilinear reflector {id}: no object has this id"))
         })?;
-        let optic = match first.material.surface {
-            Surface::Mirror => Optic::Reflect,
-            Surface::Glass { ior } => Optic::Refract {
+        let optic = match first.material.finish {
+            Finish::Mirror => Optic::Reflect,
+            Finish::Glass { ior } => Optic::Refract {
                 ior: f64::from(ior),
             },
             _ => {
@@ -249,7 +281,7 @@ impl Reflector {
         };
         let mut mesh = Mesh::default();
         for part in &parts {
-            if part.material.surface != first.material.surface {
+            if part.material.finish != first.material.finish {
                 return Err(Error::new(format!(
                     "trilinear reflector \"{}\" has parts of different materials",
                     first.name
@@ -304,12 +336,24 @@ pub fn render_through(
         .transpose()
 }
 
-/// `scene` without object `id` and without reflectors: what a reflector's surface sees.
+/// `scene` without object `id` (its parts keep their places, with empty meshes: a view of
+/// the prepared scene, [`PreparedScene::view`]) and without reflectors: what a reflector's
+/// surface sees.
 pub fn without(scene: &Scene, id: u32) -> Scene {
-    let mut others = scene.clone();
-    others.objects.retain(|o| o.id != id);
-    others.trilinear_reflectors.clear();
-    others
+    only(scene, |o| o.id != id)
+}
+
+/// `scene` with only the objects `shown` accepts (the others keep their places, with empty
+/// meshes) and without reflectors to composite.
+fn only(scene: &Scene, shown: impl Fn(&Object) -> bool) -> Scene {
+    let mut part = scene.clone();
+    for object in &mut part.objects {
+        if !shown(object) {
+            object.mesh = Mesh::default();
+        }
+    }
+    part.trilinear_reflectors.clear();
+    part
 }
 
 /// The trilinear projection of `surface` with screen map `map` at the main camera's
@@ -425,10 +469,8 @@ pub struct FresnelSplit {
 impl FresnelSplit {
     /// The split of reflector `id` of `prepared` seen by `camera`.
     pub fn new(prepared: &PreparedScene, id: u32, camera: Perspective) -> FresnelSplit {
-        let mut only = prepared.scene().clone();
-        only.objects.retain(|o| o.id == id);
         FresnelSplit {
-            caster: prepared.variant(&only),
+            caster: prepared.view(only(prepared.scene(), |o| o.id == id)),
             camera,
         }
     }
@@ -444,7 +486,7 @@ impl FresnelSplit {
         };
         let part = &self.caster.scene.objects[hit.object];
         let seen = normals(part, hit.triangle, hit.barycentric, ray.direction.as_vec3());
-        match specular(&ray, &seen, part.material.surface).fresnel {
+        match specular(&ray, &seen, part.material.finish).fresnel {
             Some((_, reflectance)) => GlassSplit::Fresnel(reflectance),
             None => GlassSplit::TotalReflection,
         }

@@ -40,6 +40,8 @@ pub struct RenderOptions<'a> {
     pub subdivision: raster::Subdivision,
     /// How method trilinear follows curved edges.
     pub curves: trilinear::CurveOptions,
+    /// The buffers the caller wants besides colour; the others come back empty.
+    pub outputs: Outputs,
     /// Called from worker threads with (work units done, total) as rendering progresses.
     pub progress: Option<&'a (dyn Fn(u64, u64) + Sync)>,
 }
@@ -54,7 +56,45 @@ impl Default for RenderOptions<'_> {
             max_bounces: 8,
             subdivision: raster::Subdivision::default(),
             curves: trilinear::CurveOptions::ADAPTIVE,
+            outputs: Outputs::ALL,
             progress: None,
+        }
+    }
+}
+
+/// Which of a frame's buffers besides colour a caller wants ([`RenderOptions::outputs`]);
+/// the unwanted ones come back empty. The ray caster neither allocates nor fills them
+/// (a colour-only frame is 12 bytes a pixel instead of 20); raster and trilinear resolve
+/// depth and ids in the same pass as colour (their depth test needs them), and drop the
+/// unwanted buffers at the end. Reflector compositing renders the reflected images in
+/// colour only, and the main view's ids whatever the caller wants (it finds the
+/// reflector's pixels by them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Outputs {
+    /// [`Frame::depth`].
+    pub depth: bool,
+    /// [`Frame::ids`].
+    pub ids: bool,
+}
+
+impl Outputs {
+    /// Colour, depth and object ids.
+    pub const ALL: Outputs = Outputs {
+        depth: true,
+        ids: true,
+    };
+    /// Colour alone.
+    pub const COLOR: Outputs = Outputs {
+        depth: false,
+        ids: false,
+    };
+
+    /// The length of a buffer of `pixels` pixels: `pixels` if `wanted`, else 0.
+    fn len(wanted: bool, pixels: usize) -> usize {
+        if wanted {
+            pixels
+        } else {
+            0
         }
     }
 }
@@ -67,9 +107,9 @@ pub struct Frame {
     /// Linear RGB.
     pub color: Vec<Vec3>,
     /// Distance from the projector's origin to the first hit, along the projector;
-    /// `f32::INFINITY` where nothing is hit.
+    /// `f32::INFINITY` where nothing is hit. Empty when not wanted ([`Outputs`]).
     pub depth: Vec<f32>,
-    /// Object id of the first hit, 0 for background.
+    /// Object id of the first hit, 0 for background. Empty when not wanted ([`Outputs`]).
     pub ids: Vec<u32>,
 }
 
@@ -94,14 +134,15 @@ impl Frame {
     /// (memory the allocator reuses is cleared by it, in the calling thread).
     /// Large buffers are mapped with transparent huge pages where the system allows
     /// ([`huge_pages::advise_huge_pages`]): far fewer page faults on that first touch.
-    pub(crate) fn zeroed(width: u32, height: u32) -> Self {
+    /// Only the buffers `outputs` asks for are allocated (the others are empty).
+    pub(crate) fn zeroed(width: u32, height: u32, outputs: Outputs) -> Self {
         let n = width as usize * height as usize;
         let mut frame = Frame {
             width,
             height,
             color: bytemuck::zeroed_vec(n),
-            depth: bytemuck::zeroed_vec(n),
-            ids: bytemuck::zeroed_vec(n),
+            depth: bytemuck::zeroed_vec(Outputs::len(outputs.depth, n)),
+            ids: bytemuck::zeroed_vec(Outputs::len(outputs.ids, n)),
         };
         huge_pages::advise_huge_pages(&mut frame.color);
         huge_pages::advise_huge_pages(&mut frame.depth);
@@ -109,17 +150,32 @@ impl Frame {
         frame
     }
 
-    /// Makes this frame `width` x `height` for a renderer that overwrites every pixel: a
-    /// frame of that size (whose three buffers hold `width * height` pixels) is kept as it
-    /// is, contents and all, so a caller drawing frame after frame pays neither its
-    /// allocation nor the first touch of its pages again; any other is replaced by
-    /// [`Frame::zeroed`].
-    pub(crate) fn fit(&mut self, width: u32, height: u32) {
+    /// Makes this frame `width` x `height` with the buffers of `outputs` for a renderer that
+    /// overwrites every pixel: a frame of that size and those buffers (each holding `width
+    /// * height` pixels, the unwanted ones empty) is kept as it is, contents and all, so a
+    /// caller drawing frame after frame pays neither its allocation nor the first touch of
+    /// its pages again; any other is replaced by [`Frame::zeroed`].
+    pub(crate) fn fit(&mut self, width: u32, height: u32, outputs: Outputs) {
         let n = width as usize * height as usize;
         let fits = (self.width, self.height) == (width, height)
-            && [self.color.len(), self.depth.len(), self.ids.len()] == [n; 3];
+            && [self.color.len(), self.depth.len(), self.ids.len()]
+                == [
+                    n,
+                    Outputs::len(outputs.depth, n),
+                    Outputs::len(outputs.ids, n),
+                ];
         if !fits {
-            *self = Frame::zeroed(width, height);
+            *self = Frame::zeroed(width, height, outputs);
+        }
+    }
+
+    /// Drops the buffers `outputs` does not ask for.
+    fn keep_only(&mut self, outputs: Outputs) {
+        if !outputs.depth {
+            self.depth = Vec::new();
+        }
+        if !outputs.ids {
+            self.ids = Vec::new();
         }
     }
 }
@@ -131,6 +187,8 @@ pub struct Rendered {
     /// The method's counters (rays cast, build times, ...), for `--stats`; with reflectors
     /// composited, also the compositing's (`reflector_pixels` and the like).
     pub counters: Stats,
+    /// What the user should be told about this frame (none when everything asked held).
+    pub warnings: Vec<RenderWarning>,
 }
 
 /// Renders `prepared` through `projection` as `options` say: the one entry point of every
@@ -141,12 +199,18 @@ pub fn render(
     projection: &dyn Projection,
     options: &RenderOptions,
 ) -> Result<Rendered> {
-    let (frame, counters) = if options.composite_reflectors {
+    let mut rendered = if options.composite_reflectors {
         composite::render_with_method(prepared, projection, options, options.method)?
     } else {
-        options.method.render(prepared, projection, options)?
+        let (frame, counters) = options.method.render(prepared, projection, options)?;
+        Rendered {
+            frame,
+            counters,
+            warnings: Vec::new(),
+        }
     };
-    Ok(Rendered { frame, counters })
+    rendered.frame.keep_only(options.outputs);
+    Ok(rendered)
 }
 
 /// A colour image in linear RGB, rows from the top: a photo to reproject
@@ -181,8 +245,10 @@ pub mod reproject;
 pub mod scan;
 pub mod shading;
 pub mod trilinear;
+mod warning;
 pub use method::Method;
 pub use prepared::PreparedScene;
+pub use warning::RenderWarning;
 
 #[cfg(test)]
 mod tests {
@@ -239,10 +305,52 @@ mod tests {
         }
     }
 
+    /// A caller asking for fewer outputs gets the same colour and the buffers it asked for,
+    /// the others empty, by every method, with reflectors composited or not.
+    #[test]
+    fn unwanted_outputs_come_back_empty() {
+        let scene = scene::load(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../scenes/reflect-sphere-cube.toml"
+        ))
+        .unwrap();
+        let main = scene.projection.build(32, 24).unwrap();
+        let prepared = PreparedScene::new(&scene);
+        for (method, composite_reflectors) in [
+            (Method::Raycast, true),
+            (Method::Raycast, false),
+            (Method::Raster, false),
+            (Method::Trilinear, true),
+        ] {
+            let options = |outputs| RenderOptions {
+                method,
+                composite_reflectors,
+                outputs,
+                ..RenderOptions::default()
+            };
+            let all = render(&prepared, main.as_ref(), &options(Outputs::ALL)).unwrap();
+            assert_eq!(all.frame.depth.len(), 32 * 24);
+            for (depth, ids) in [(false, false), (true, false), (false, true)] {
+                let wanted = Outputs { depth, ids };
+                let got = render(&prepared, main.as_ref(), &options(wanted)).unwrap();
+                let what = format!("{method} {composite_reflectors} {wanted:?}");
+                assert_eq!(got.frame.color, all.frame.color, "{what}");
+                let depth_want = if depth {
+                    all.frame.depth.clone()
+                } else {
+                    vec![]
+                };
+                assert_eq!(got.frame.depth, depth_want, "{what}");
+                let ids_want = if ids { all.frame.ids.clone() } else { vec![] };
+                assert_eq!(got.frame.ids, ids_want, "{what}");
+            }
+        }
+    }
+
     /// Reflector compositing as an option of the entry point is [`composite::render`] with
     /// the method as renderer, frame and counters; without it the reflector is the method's
-    /// own mirror. Both renders share one prepared scene, whose count holds the builds of
-    /// the compositing's variant (the scene without the reflector).
+    /// own mirror. Both renders share one prepared scene and its one BVH: the compositing's
+    /// parts of the scene are views of it.
     #[test]
     fn compositing_is_an_option_giving_the_composite_frame() {
         let scene = scene::load(concat!(
@@ -258,16 +366,16 @@ mod tests {
         let renderer = |s: &PreparedScene, p: &dyn Projection, o: &RenderOptions| {
             Method::Raycast.render(s, p, o)
         };
-        let (frame, counters) =
-            composite::render(&prepared, main.as_ref(), &options, &renderer).unwrap();
+        let Rendered {
+            frame, counters, ..
+        } = composite::render(&prepared, main.as_ref(), &options, &renderer).unwrap();
         assert_eq!(composited.frame, frame);
         assert_eq!(composited.counters.len(), counters.len());
         assert_eq!(
             composited.counters["reflector_pixels"],
             counters["reflector_pixels"]
         );
-        let builds = prepared.bvh_builds();
-        assert!(builds > 1, "{builds}");
+        assert_eq!(prepared.bvh_builds(), 1);
         let plain = RenderOptions {
             composite_reflectors: false,
             ..options
@@ -282,10 +390,6 @@ mod tests {
         );
         assert_ne!(mirror.frame.color, frame.color);
         assert!(!mirror.counters.contains_key("reflectors"));
-        assert_eq!(
-            prepared.bvh_builds(),
-            builds,
-            "no build without compositing"
-        );
+        assert_eq!(prepared.bvh_builds(), 1);
     }
 }

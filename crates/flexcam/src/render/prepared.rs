@@ -8,8 +8,12 @@
 //! [`PreparedScene::intersect`] is the exact closest-hit query other renderers are checked
 //! against, [`PreparedScene::occluded`] the shadow-ray query. A command builds one prepared
 //! scene and renders it as often as it likes (every frame of an animation, both methods of a
-//! comparison); [`PreparedScene::bvh_builds`] counts the BVH builds made for it, including
-//! those of the scene variants reflector compositing renders ([`PreparedScene::variant`]).
+//! comparison); [`PreparedScene::bvh_builds`] counts the BVH builds made for it: 1.
+//!
+//! Reflector compositing renders parts of the scene (the scene without a reflector, the
+//! reflector alone) and the scene with other materials: those are views
+//! ([`PreparedScene::view`]) that share this scene's BVH, and leave out the triangles of the
+//! objects they hide by a [`TriangleMask`] the queries honour.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
@@ -20,7 +24,7 @@ use glam::{DVec3, Vec2};
 use crate::geometry::{intersect_triangle, Ray};
 use crate::render::bvh::curve_triangle::CurveTriangle;
 use crate::render::bvh::triangle::FastRay;
-use crate::render::bvh::{Bvh, BvhHit};
+use crate::render::bvh::{AllTriangles, Bvh, BvhHit, Keep, TriangleMask};
 use crate::render::displaced::DisplacedSet;
 use crate::scene::Scene;
 
@@ -52,20 +56,23 @@ pub(in crate::render) struct Hit32 {
 #[derive(Debug)]
 pub struct PreparedScene {
     pub(in crate::render) scene: Scene,
-    pub(in crate::render) bvh: Bvh,
+    /// The BVH over every object's triangles, shared by the views of this scene.
+    pub(in crate::render) bvh: Arc<Bvh>,
+    /// The stored triangles a view shows (`None`: all of them, the scene itself).
+    shown: Option<TriangleMask>,
     /// Global index of each object's first triangle, as the BVH numbers triangles.
-    pub(in crate::render) first_triangle: Vec<u32>,
+    pub(in crate::render) first_triangle: Arc<[u32]>,
     /// How far secondary rays start off a surface: a fixed fraction of the scene's largest
     /// coordinate magnitude, so it covers f32 rounding at any scene scale.
     pub(in crate::render) offset: f64,
     pub(in crate::render) triangle_count: usize,
     pub(in crate::render) build_ms: f64,
-    /// BVH builds made for this scene: its own, and those of the variants built from it.
+    /// BVH builds made for this scene (views build none).
     bvh_builds: AtomicU64,
     /// The BVH's triangles in stored order with the quadratic search's tests precomputed,
     /// built on the first quadratic search ([`PreparedScene::curve_triangles`]): renders
-    /// without curved projectors neither pay for it nor hold it.
-    curve_triangles: OnceLock<Vec<CurveTriangle>>,
+    /// without curved projectors neither pay for it nor hold it. Shared by the views.
+    curve_triangles: Arc<OnceLock<Vec<CurveTriangle>>>,
     /// The displaced objects, whose triangles the BVH leaves out ([`crate::render::displaced`]);
     /// `None` when there are none.
     pub(in crate::render) displaced: Option<Arc<DisplacedSet>>,
@@ -74,6 +81,40 @@ pub struct PreparedScene {
 /// Secondary-ray offset relative to the scene's largest coordinate magnitude: 2^-16, about
 /// 256 f32 ulps, well above the rounding of an f32 hit point and small against any feature.
 const OFFSET_SCALE: f64 = 1.0 / 65536.0;
+
+// A view's masked queries, out of line: the unmasked queries (every render of a whole scene)
+// inline only the traversal they had.
+
+#[inline(never)]
+fn closest_shown(bvh: &Bvh, ray: &FastRay, mask: &TriangleMask) -> Option<BvhHit> {
+    bvh.closest(ray, mask)
+}
+
+#[inline(never)]
+fn closest4_shown(
+    bvh: &Bvh,
+    rays: [Option<&FastRay>; 4],
+    mask: &TriangleMask,
+) -> [Option<BvhHit>; 4] {
+    bvh.closest4(rays, mask)
+}
+
+#[inline(never)]
+fn occluded_shown(bvh: &Bvh, ray: &FastRay, mask: &TriangleMask) -> bool {
+    bvh.occluded(ray, mask)
+}
+
+/// The secondary-ray offset of `scene`: [`OFFSET_SCALE`] of its largest coordinate magnitude.
+fn offset_of(scene: &Scene) -> f64 {
+    let extent = scene
+        .objects
+        .iter()
+        .filter_map(|o| o.mesh.bounds())
+        .fold(0.0f32, |m, (lo, hi)| {
+            m.max(lo.abs().max_element()).max(hi.abs().max_element())
+        });
+    (extent as f64 * OFFSET_SCALE).max(f64::MIN_POSITIVE)
+}
 
 impl PreparedScene {
     /// Builds the BVH over all triangles of `scene` (a copy of which it keeps).
@@ -96,53 +137,69 @@ impl PreparedScene {
             );
         }
         let bvh = Bvh::build(&triangles);
-        let extent = scene
-            .objects
-            .iter()
-            .filter_map(|o| o.mesh.bounds())
-            .fold(0.0f32, |m, (lo, hi)| {
-                m.max(lo.abs().max_element()).max(hi.abs().max_element())
-            });
         PreparedScene {
-            bvh,
+            bvh: Arc::new(bvh),
+            shown: None,
             scene: scene.clone(),
-            first_triangle,
-            offset: (extent as f64 * OFFSET_SCALE).max(f64::MIN_POSITIVE),
+            first_triangle: first_triangle.into(),
+            offset: offset_of(scene),
             triangle_count: triangles.len(),
             build_ms: start.elapsed().as_secs_f64() * 1e3,
             bvh_builds: AtomicU64::new(1),
-            curve_triangles: OnceLock::new(),
+            curve_triangles: Arc::default(),
             displaced: DisplacedSet::new(scene),
         }
     }
 
-    /// A prepared scene for `scene`, a variant of this one (another set of objects, e.g. the
-    /// scene without a reflector), with its own BVH; the build is counted here too.
-    pub(in crate::render) fn variant(&self, scene: &Scene) -> PreparedScene {
-        self.bvh_builds.fetch_add(1, Ordering::Relaxed);
-        PreparedScene::new(scene)
-    }
-
-    /// This scene with the materials of `scene`, whose objects' meshes must be this scene's
-    /// (only materials differ): the BVH is copied, not built again.
-    pub(in crate::render) fn with_materials(&self, scene: &Scene) -> PreparedScene {
+    /// A view of this scene as `scene` shows it, sharing this scene's BVH (no build).
+    /// `scene` is this scene's objects in the same order, each with this scene's mesh or
+    /// with an empty one (hidden: the view leaves its triangles out of every query), and any
+    /// materials. The view renders exactly as `scene` prepared on its own would (the
+    /// secondary-ray offset is that of the shown objects), up to the order of hits at equal
+    /// `t`.
+    pub(in crate::render) fn view(&self, scene: Scene) -> PreparedScene {
+        debug_assert_eq!(self.scene.objects.len(), scene.objects.len());
         debug_assert!(self
             .scene
             .objects
             .iter()
             .zip(&scene.objects)
-            .all(|(a, b)| a.mesh == b.mesh));
+            .all(|(a, b)| a.mesh == b.mesh || b.mesh.triangles.is_empty()));
+        let object_shown: Vec<bool> = (self.scene.objects.iter().zip(&scene.objects))
+            .map(|(a, b)| a.mesh.triangles.is_empty() || !b.mesh.triangles.is_empty())
+            .collect();
+        let shown = (!object_shown.iter().all(|&s| s)).then(|| {
+            TriangleMask::by_id(&self.bvh, |id| {
+                object_shown[self.first_triangle.partition_point(|&f| f <= id) - 1]
+            })
+        });
+        // The displaced objects are not in the BVH: a view hiding one has a displaced set of
+        // its own.
+        let hides_displaced = (self.scene.objects.iter().zip(&object_shown))
+            .any(|(o, &shown)| !shown && o.displacement.is_some());
+        let displaced = if hides_displaced {
+            DisplacedSet::new(&scene)
+        } else {
+            self.displaced.clone()
+        };
         PreparedScene {
-            scene: scene.clone(),
-            bvh: self.bvh.clone(),
-            first_triangle: self.first_triangle.clone(),
-            offset: self.offset,
-            triangle_count: self.triangle_count,
+            bvh: Arc::clone(&self.bvh),
+            shown,
+            first_triangle: Arc::clone(&self.first_triangle),
+            offset: offset_of(&scene),
+            triangle_count: scene.triangle_count(),
+            scene,
             build_ms: self.build_ms,
             bvh_builds: AtomicU64::new(0),
-            curve_triangles: OnceLock::new(),
-            displaced: self.displaced.clone(),
+            curve_triangles: Arc::clone(&self.curve_triangles),
+            displaced,
         }
+    }
+
+    /// Whether stored triangle `stored` is shown (see [`PreparedScene::view`]).
+    #[inline]
+    pub(in crate::render) fn shows(&self, stored: usize) -> bool {
+        self.shown.as_ref().is_none_or(|mask| mask.keeps(stored))
     }
 
     /// The scene this was prepared from.
@@ -150,8 +207,8 @@ impl PreparedScene {
         &self.scene
     }
 
-    /// How many BVHs were built for this scene so far: 1 for itself, plus one per variant
-    /// that reflector compositing built from it.
+    /// How many BVHs were built for this scene: 1 (the views reflector compositing renders
+    /// share it).
     pub fn bvh_builds(&self) -> u64 {
         self.bvh_builds.load(Ordering::Relaxed)
     }
@@ -192,7 +249,12 @@ impl PreparedScene {
         let found = if self.misses_scene_box(ray) {
             None
         } else {
-            self.bvh.closest(&FastRay::new(ray)?).map(|f| self.hit32(f))
+            let ray = FastRay::new(ray)?;
+            match &self.shown {
+                None => self.bvh.closest(&ray, &AllTriangles),
+                Some(mask) => closest_shown(&self.bvh, &ray, mask),
+            }
+            .map(|f| self.hit32(f))
         };
         self.nearer_displaced(ray, found)
     }
@@ -212,7 +274,11 @@ impl PreparedScene {
     /// coherent rays (a 2x2 quad of primary rays) share one BVH traversal.
     pub(in crate::render) fn intersect4_f32(&self, rays: [Option<&Ray>; 4]) -> [Option<Hit32>; 4] {
         let fast = rays.map(|r| self.fast_unless_outside(r));
-        let found = self.bvh.closest4(fast.each_ref().map(Option::as_ref));
+        let fast_rays = fast.each_ref().map(Option::as_ref);
+        let found = match &self.shown {
+            None => self.bvh.closest4(fast_rays, &AllTriangles),
+            Some(mask) => closest4_shown(&self.bvh, fast_rays, mask),
+        };
         let found = found.map(|f| f.map(|f| self.hit32(f)));
         if self.displaced.is_none() {
             return found;
@@ -270,7 +336,10 @@ impl PreparedScene {
 
     /// Whether anything is hit within the ray's interval (the shadow-ray query).
     pub fn occluded(&self, ray: &Ray) -> bool {
-        FastRay::new(ray).is_some_and(|r| self.bvh.occluded(&r)) || self.displaced_occludes(ray)
+        FastRay::new(ray).is_some_and(|r| match &self.shown {
+            None => self.bvh.occluded(&r, &AllTriangles),
+            Some(mask) => occluded_shown(&self.bvh, &r, mask),
+        }) || self.displaced_occludes(ray)
     }
 
     /// A ray leaving surface point `point` (geometric normal `normal`) along `direction`,

@@ -150,11 +150,11 @@ mod tests {
         assert_eq!(scene.projection.kind(), "equirectangular");
         assert_eq!((scene.image.width, scene.image.height), (1024, 512));
         assert!(scene.objects.len() >= 8 && scene.lights.len() == 2);
-        let surfaces: Vec<_> = scene.objects.iter().map(|o| o.material.surface).collect();
-        assert!(surfaces.contains(&crate::scene::Surface::Mirror));
+        let surfaces: Vec<_> = scene.objects.iter().map(|o| o.material.finish).collect();
+        assert!(surfaces.contains(&crate::scene::Finish::Mirror));
         assert!(surfaces
             .iter()
-            .any(|s| matches!(s, crate::scene::Surface::Glass { .. })));
+            .any(|s| matches!(s, crate::scene::Finish::Glass { .. })));
         assert!(
             (5_000..200_000).contains(&scene.triangle_count()),
             "{}",
@@ -187,12 +187,12 @@ mod tests {
                 .objects
                 .iter()
                 .find(|o| o.name == name)
-                .map(|o| o.material.surface)
+                .map(|o| o.material.finish)
         };
-        assert_eq!(named("mirror"), Some(crate::scene::Surface::Mirror));
+        assert_eq!(named("mirror"), Some(crate::scene::Finish::Mirror));
         assert!(matches!(
             named("glass"),
-            Some(crate::scene::Surface::Glass { .. })
+            Some(crate::scene::Finish::Glass { .. })
         ));
         assert!(named("teapot").is_some());
         assert!(

@@ -20,9 +20,9 @@ pub enum Pattern {
     Texture(Arc<Texture>),
 }
 
-/// How light leaves the surface.
+/// How light leaves the surface: an object's finish (scene-file key `surface`).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Surface {
+pub enum Finish {
     /// Lambert diffuse plus a Phong highlight in `lit` shading.
     Diffuse,
     /// A perfect mirror.
@@ -33,14 +33,14 @@ pub enum Surface {
     Emissive,
 }
 
-/// A material: base colour, pattern and surface kind. The base colour at a point is
+/// A material: base colour, pattern and finish. The base colour at a point is
 /// `color * pattern * vertex colour` (the glTF convention: factor times texture times vertex
 /// colour; meshes without vertex colours count as white).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Material {
     pub color: Vec3,
     pub pattern: Pattern,
-    pub surface: Surface,
+    pub finish: Finish,
 }
 
 impl Default for Material {
@@ -48,7 +48,7 @@ impl Default for Material {
         Material {
             color: Vec3::splat(0.8),
             pattern: Pattern::Solid,
-            surface: Surface::Diffuse,
+            finish: Finish::Diffuse,
         }
     }
 }

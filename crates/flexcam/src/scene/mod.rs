@@ -10,7 +10,7 @@ pub mod texel;
 
 pub use displacement::DisplacementSpec;
 pub use light::Light;
-pub use material::{Material, Pattern, Surface, Texture};
+pub use material::{Finish, Material, Pattern, Texture};
 pub use mesh::Mesh;
 
 use std::path::PathBuf;

@@ -2,6 +2,7 @@
 
 pub mod displaced;
 pub mod flexible;
+pub mod simplify;
 mod timing;
 pub mod trilinear;
 
@@ -21,6 +22,10 @@ pub enum BenchCommand {
     /// Chapter 8 and appendix D of Vallance 2005: ray casting vs trilinear rasterisation of random
     /// scenes and of the cube-floor scene through 2 to 50 projection triangles.
     Trilinear(trilinear::TrilinearArgs),
+    /// Table 6.2 of Ramsey 2005: simplification of polygon meshes (teapot
+    /// tessellations, closed tori, the repository's OBJ models) with tau = 0.99 and 1 % of
+    /// the edges searched per collapse.
+    Simplify(simplify::SimplifyBenchArgs),
 }
 
 /// Runs `flexcam bench`.
@@ -29,5 +34,6 @@ pub fn run(command: &BenchCommand) -> Result<()> {
         BenchCommand::Displaced(args) => displaced::run(args),
         BenchCommand::Flexible(args) => flexible::run(args),
         BenchCommand::Trilinear(args) => trilinear::run(args),
+        BenchCommand::Simplify(args) => simplify::run(args),
     }
 }

@@ -271,7 +271,7 @@ pub fn fit(
 /// Fits `prior` to `correspondences` with the starts model `starts` (module section
 /// "Starts"): `Kept` is [`fit`]; `Eye` the central fit (module `central`, its errors
 /// included); `Free` the free fit (module `free`); `Auto` the simplest model that explains the
-/// data ([`auto_fit`]). Then counts the wild nodes and, for kept starts, the undetermined ones
+/// data (`auto_fit`). Then counts the wild nodes and, for kept starts, the undetermined ones
 /// (the other models count their own; module section "Warnings").
 pub fn fit_with(
     prior: &ProjectorGrid,

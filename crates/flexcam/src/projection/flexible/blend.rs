@@ -191,7 +191,7 @@ pub struct PiecewiseVolume {
 impl PiecewiseVolume {
     /// Surfaces at `knots` (default: equally spaced). Errors: fewer than 2 surfaces; knots
     /// whose count differs from the surfaces', that do not start at 0 and end at 1, or do not
-    /// increase strictly; invalid or everywhere coincident surfaces (see [`check_surfaces`]).
+    /// increase strictly; invalid or everywhere coincident surfaces (see `check_surfaces`).
     /// Two successive surfaces may coincide at some or all (u, v): that piece of the
     /// projector has zero length and sees nothing.
     pub fn new(surfaces: Vec<Surface>, knots: Option<Vec<f64>>) -> Result<Self> {
@@ -249,7 +249,7 @@ impl PiecewiseVolume {
         control_points(&self.surfaces, uv).map(Projector::Polyline)
     }
 
-    /// [`PiecewiseVolume::projector`] written into `out` (see [`set_polyline`]).
+    /// [`PiecewiseVolume::projector`] written into `out` (see `set_polyline`).
     pub fn projector_into(&self, uv: DVec2, out: &mut Option<Projector>) {
         with_control_points(&self.surfaces, uv, |points| {
             set_polyline(out, points.iter().copied())
@@ -258,7 +258,7 @@ impl PiecewiseVolume {
     }
 
     /// The hull of the projectors of the (u, v) rectangle `[lo, hi]`; see
-    /// [`projector_hull`] for when there is none.
+    /// `projector_hull` for when there is none.
     pub fn projector_hull(&self, lo: DVec2, hi: DVec2) -> Option<ProjectorHull> {
         projector_hull(&self.surfaces, lo, hi, |uv| self.projector(uv))
     }
@@ -340,7 +340,7 @@ impl BezierVolume {
     }
 
     /// [`BezierVolume::projector`] written into `out`: a polyline refills the vertex buffer
-    /// of a polyline already in `out` (see [`set_polyline`]).
+    /// of a polyline already in `out` (see `set_polyline`).
     pub fn projector_into(&self, uv: DVec2, out: &mut Option<Projector>) {
         let Some(weights) = &self.polyline_weights else {
             *out = self.projector(uv);
@@ -354,7 +354,7 @@ impl BezierVolume {
 
     /// The hull of the projectors of the (u, v) rectangle `[lo, hi]` (polyline samples are
     /// sums of the surfaces' points with Bernstein weights, non-negative and summing to 1);
-    /// see [`projector_hull`] for when there is none.
+    /// see `projector_hull` for when there is none.
     pub fn projector_hull(&self, lo: DVec2, hi: DVec2) -> Option<ProjectorHull> {
         projector_hull(&self.surfaces, lo, hi, |uv| self.projector(uv))
     }

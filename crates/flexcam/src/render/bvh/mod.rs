@@ -101,6 +101,52 @@ pub(in crate::render) struct BvhHit {
     pub hit: FastHit,
 }
 
+/// Which stored triangles a query considers. Queries are monomorphised over it: with
+/// [`AllTriangles`] the test folds away and the traversal is the unmasked one.
+pub(in crate::render) trait Keep {
+    /// Whether stored triangle `stored` (see [`Bvh::all_triangles`]) takes part.
+    fn keeps(&self, stored: usize) -> bool;
+}
+
+/// Every triangle of the tree.
+pub(in crate::render) struct AllTriangles;
+
+impl Keep for AllTriangles {
+    #[inline(always)]
+    fn keeps(&self, _: usize) -> bool {
+        true
+    }
+}
+
+/// The stored triangles of a chosen subset (one bit each, by stored index): a query over part
+/// of the scene (the scene without one object, or that object alone) answered by the whole
+/// scene's tree, exactly as a tree of that part alone would answer it up to the order of
+/// hits at equal `t`.
+#[derive(Debug, Clone)]
+pub(in crate::render) struct TriangleMask {
+    bits: Vec<u64>,
+}
+
+impl TriangleMask {
+    /// The mask keeping the stored triangles whose build-input index `keeps` accepts.
+    pub fn by_id(bvh: &Bvh, keeps: impl Fn(u32) -> bool) -> TriangleMask {
+        let mut bits = vec![0u64; bvh.ids.len().div_ceil(64)];
+        for (stored, &id) in bvh.ids.iter().enumerate() {
+            if keeps(id) {
+                bits[stored / 64] |= 1 << (stored % 64);
+            }
+        }
+        TriangleMask { bits }
+    }
+}
+
+impl Keep for TriangleMask {
+    #[inline(always)]
+    fn keeps(&self, stored: usize) -> bool {
+        self.bits[stored / 64] & (1 << (stored % 64)) != 0
+    }
+}
+
 impl Bvh {
     /// Number of nodes of the binary tree (interior nodes and leaves).
     pub fn node_count(&self) -> usize {

@@ -33,8 +33,20 @@ fn soup(rng: &mut Rng, n: usize) -> Vec<[Vec3; 3]> {
 
 /// The closest hit by testing every triangle with the same f32 routine.
 fn brute_force(triangles: &[[Vec3; 3]], ray: &FastRay) -> Option<(u32, f32)> {
+    brute_force_of(triangles, ray, |_| true)
+}
+
+/// The closest hit among the triangles whose index `keeps` accepts, by testing each.
+fn brute_force_of(
+    triangles: &[[Vec3; 3]],
+    ray: &FastRay,
+    keeps: impl Fn(u32) -> bool,
+) -> Option<(u32, f32)> {
     let mut best: Option<(u32, f32)> = None;
     for (i, &[a, b, c]) in triangles.iter().enumerate() {
+        if !keeps(i as u32) {
+            continue;
+        }
         let Some(tri) = PackedTriangle::new(a.into(), b.into(), c.into()) else {
             continue;
         };
@@ -44,6 +56,36 @@ fn brute_force(triangles: &[[Vec3; 3]], ray: &FastRay) -> Option<(u32, f32)> {
         }
     }
     best
+}
+
+/// A masked query finds what testing only the kept triangles finds, one ray or four at once,
+/// and an any-hit query sees only them.
+#[test]
+fn masked_queries_see_only_the_kept_triangles() {
+    let mut rng = Rng(11);
+    let triangles = soup(&mut rng, 3000);
+    let bvh = Bvh::build(&triangles);
+    let keeps = |id: u32| id % 3 != 0 && !(1000..1600).contains(&id);
+    let mask = TriangleMask::by_id(&bvh, keeps);
+    let mut hidden_hits = 0;
+    for k in 0..300 {
+        let origin = rng.vec(15.0).as_dvec3();
+        let rays: [FastRay; 4] = std::array::from_fn(|lane| {
+            let target = (rng.vec(8.0) + lane as f32 * 0.01).as_dvec3();
+            FastRay::new(&Ray::new(origin, target - origin)).unwrap()
+        });
+        let packet = bvh.closest4(rays.each_ref().map(Some), &mask);
+        for (ray, got) in rays.iter().zip(packet) {
+            let expected = brute_force_of(&triangles, ray, keeps);
+            let single = bvh.closest(ray, &mask).map(|h| (h.id, h.hit.t));
+            assert_eq!(single, expected, "ray {k}");
+            assert_eq!(got.map(|h| (h.id, h.hit.t)), expected, "packet {k}");
+            assert_eq!(bvh.occluded(ray, &mask), expected.is_some());
+            let all = bvh.closest(ray, &AllTriangles).map(|h| h.id);
+            hidden_hits += usize::from(all.is_some_and(|id| !keeps(id)));
+        }
+    }
+    assert!(hidden_hits > 50, "{hidden_hits}");
 }
 
 #[test]
@@ -65,9 +107,9 @@ fn closest_hit_equals_brute_force_on_random_soups() {
             }
             let fast = FastRay::new(&ray).unwrap();
             let expected = brute_force(&triangles, &fast);
-            let got = bvh.closest(&fast).map(|h| (h.id, h.hit.t));
+            let got = bvh.closest(&fast, &AllTriangles).map(|h| (h.id, h.hit.t));
             assert_eq!(got, expected, "soup of {n}, ray {k}");
-            assert_eq!(bvh.occluded(&fast), expected.is_some());
+            assert_eq!(bvh.occluded(&fast, &AllTriangles), expected.is_some());
             if let Some((_, t)) = got {
                 assert!(t as f64 >= ray.t_min as f32 as f64 && t as f64 <= ray.t_max);
                 hits += 1;
@@ -85,7 +127,9 @@ fn degenerate_triangles_are_never_hit() {
     assert_eq!(bvh.node_count(), 0);
     for d in [DVec3::X, DVec3::ONE, DVec3::new(-1.0, 1.0, 0.0)] {
         let ray = Ray::new(DVec3::ONE - d, d);
-        assert!(bvh.closest(&FastRay::new(&ray).unwrap()).is_none());
+        assert!(bvh
+            .closest(&FastRay::new(&ray).unwrap(), &AllTriangles)
+            .is_none());
     }
     // Mixed with a proper triangle, only that one is found.
     let good = [
@@ -95,7 +139,12 @@ fn degenerate_triangles_are_never_hit() {
     ];
     let bvh = Bvh::build(&[line, good, point]);
     let ray = Ray::new(DVec3::new(1.0, 1.0, 5.0), DVec3::NEG_Z);
-    assert_eq!(bvh.closest(&FastRay::new(&ray).unwrap()).unwrap().id, 1);
+    assert_eq!(
+        bvh.closest(&FastRay::new(&ray).unwrap(), &AllTriangles)
+            .unwrap()
+            .id,
+        1
+    );
 }
 
 #[test]
@@ -104,7 +153,9 @@ fn rays_parallel_to_a_triangle_miss_it() {
     let bvh = Bvh::build(&[tri]);
     for origin in [DVec3::new(-1.0, 0.25, 0.0), DVec3::new(-1.0, 0.25, 1e-3)] {
         let ray = Ray::new(origin, DVec3::X);
-        assert!(bvh.closest(&FastRay::new(&ray).unwrap()).is_none());
+        assert!(bvh
+            .closest(&FastRay::new(&ray).unwrap(), &AllTriangles)
+            .is_none());
     }
 }
 
@@ -117,13 +168,21 @@ fn interval_limits_are_honoured() {
     ];
     let bvh = Bvh::build(&[tri]);
     let mut ray = Ray::new(DVec3::new(0.0, 0.0, 4.0), DVec3::new(0.0, 0.0, -2.0));
-    let t = bvh.closest(&FastRay::new(&ray).unwrap()).unwrap().hit.t;
+    let t = bvh
+        .closest(&FastRay::new(&ray).unwrap(), &AllTriangles)
+        .unwrap()
+        .hit
+        .t;
     assert_eq!(t, 2.0);
     ray.t_max = 1.99;
-    assert!(bvh.closest(&FastRay::new(&ray).unwrap()).is_none());
+    assert!(bvh
+        .closest(&FastRay::new(&ray).unwrap(), &AllTriangles)
+        .is_none());
     ray.t_max = 3.0;
     ray.t_min = 2.01;
-    assert!(bvh.closest(&FastRay::new(&ray).unwrap()).is_none());
+    assert!(bvh
+        .closest(&FastRay::new(&ray).unwrap(), &AllTriangles)
+        .is_none());
     ray.t_min = 3.5;
     assert!(FastRay::new(&ray).is_none(), "empty interval");
     ray.t_min = f64::NAN;
@@ -136,7 +195,9 @@ fn coincident_triangles_build_a_bounded_tree() {
     let tri = [Vec3::ZERO, Vec3::X, Vec3::Y];
     let bvh = Bvh::build(&vec![tri; 1000]);
     let ray = Ray::new(DVec3::new(0.2, 0.2, 1.0), DVec3::NEG_Z);
-    let hit = bvh.closest(&FastRay::new(&ray).unwrap()).unwrap();
+    let hit = bvh
+        .closest(&FastRay::new(&ray).unwrap(), &AllTriangles)
+        .unwrap();
     assert_eq!(hit.hit.t, 1.0);
     assert!(bvh
         .nodes
@@ -157,10 +218,10 @@ fn assert_packet_matches(bvh: &Bvh, rays: [Option<FastRay>; 4], what: &str) -> u
             )
         })
     };
-    let got = bvh.closest4([0, 1, 2, 3].map(|i| rays[i].as_ref()));
+    let got = bvh.closest4([0, 1, 2, 3].map(|i| rays[i].as_ref()), &AllTriangles);
     let mut hits = 0;
     for (r, got) in rays.iter().zip(got) {
-        let expected = r.as_ref().and_then(|r| bvh.closest(r));
+        let expected = r.as_ref().and_then(|r| bvh.closest(r, &AllTriangles));
         assert_eq!(key(got), key(expected), "{what}");
         hits += usize::from(expected.is_some());
     }
@@ -239,7 +300,7 @@ fn packets_and_single_rays_break_ties_alike() {
     ]
     .map(|d| {
         let ray = FastRay::new(&Ray::new(DVec3::new(0.2, 0.2, 0.0) - d, d)).unwrap();
-        bvh.closest(&ray).unwrap().id
+        bvh.closest(&ray, &AllTriangles).unwrap().id
     })
     .to_vec();
     assert!(

@@ -8,7 +8,7 @@ use std::mem::MaybeUninit;
 use glam::{BVec4A, Vec3, Vec3A, Vec4, Vec4Swizzles};
 
 use super::triangle::{FastHit, FastRay};
-use super::{Bvh, BvhHit, Child, Node, STACK_SIZE};
+use super::{Bvh, BvhHit, Child, Keep, Node, STACK_SIZE};
 use crate::geometry::Aabb;
 
 impl Node {
@@ -327,21 +327,25 @@ impl<E: Copy> Pending<E> {
 }
 
 impl Bvh {
-    /// The hit with the smallest `t` in the ray's interval, if any.
-    pub fn closest(&self, ray: &FastRay) -> Option<BvhHit> {
-        self.traverse::<false>(ray)
+    /// The hit with the smallest `t` in the ray's interval among the triangles `keep` keeps,
+    /// if any.
+    pub fn closest<K: Keep>(&self, ray: &FastRay, keep: &K) -> Option<BvhHit> {
+        self.traverse::<false, K>(ray, keep)
     }
 
-    /// Whether anything is hit in the ray's interval (stops at the first hit found).
-    pub fn occluded(&self, ray: &FastRay) -> bool {
-        self.traverse::<true>(ray).is_some()
+    /// Whether a triangle `keep` keeps is hit in the ray's interval (stops at the first hit
+    /// found).
+    pub fn occluded<K: Keep>(&self, ray: &FastRay, keep: &K) -> bool {
+        self.traverse::<true, K>(ray, keep).is_some()
     }
 
     /// Near-first traversal: at an interior node both children's boxes are tested at once,
     /// the nearer is visited and the farther pushed with its entry distance, and popped nodes
     /// entered beyond the closest hit so far are skipped. With `ANY`, returns at the first hit.
+    /// A hit on a triangle `keep` leaves out is ignored (tested after the intersection, which
+    /// rarely succeeds, so the unmasked [`AllTriangles`](super::AllTriangles) costs nothing).
     #[inline(always)]
-    fn traverse<const ANY: bool>(&self, ray: &FastRay) -> Option<BvhHit> {
+    fn traverse<const ANY: bool, K: Keep>(&self, ray: &FastRay, keep: &K) -> Option<BvhHit> {
         if self.triangles.is_empty() || box_entry(&self.root_bounds, ray, ray.t_max).is_infinite() {
             return None;
         }
@@ -360,6 +364,9 @@ impl Bvh {
                 let count = current.count as usize;
                 for (i, tri) in self.triangles[first..first + count].iter().enumerate() {
                     if let Some(hit) = tri.intersect(ray, t_max) {
+                        if !keep.keeps(first + i) {
+                            continue;
+                        }
                         if hit.t < t_max || first + i < best_index {
                             t_max = hit.t;
                             best = Some((first + i, hit));
@@ -400,13 +407,13 @@ impl Bvh {
     /// and every ray keeps its own closest hit. Pays for coherent rays (neighbouring pixels'
     /// primary rays); the rays' direction signs must agree on every axis, else (or when a
     /// ray is `None`) each ray is traced alone.
-    pub fn closest4(&self, rays: [Option<&FastRay>; 4]) -> [Option<BvhHit>; 4] {
+    pub fn closest4<K: Keep>(&self, rays: [Option<&FastRay>; 4], keep: &K) -> [Option<BvhHit>; 4] {
         match rays {
             [Some(a), Some(b), Some(c), Some(d)] if same_signs([a, b, c, d]) => {
-                self.traverse4([a, b, c, d])
+                self.traverse4([a, b, c, d], keep)
             }
             [a, b, c, d] => {
-                let single = |r: Option<&FastRay>| r.and_then(|r| self.closest(r));
+                let single = |r: Option<&FastRay>| r.and_then(|r| self.closest(r, keep));
                 [single(a), single(b), single(c), single(d)]
             }
         }
@@ -418,7 +425,7 @@ impl Bvh {
     /// smaller than the winning `t`), and which other leaves are visited, or in what order,
     /// does not change that minimum.
     #[inline(always)]
-    fn traverse4(&self, rays: [&FastRay; 4]) -> [Option<BvhHit>; 4] {
+    fn traverse4<K: Keep>(&self, rays: [&FastRay; 4], keep: &K) -> [Option<BvhHit>; 4] {
         if self.triangles.is_empty() {
             return [None; 4];
         }
@@ -445,6 +452,9 @@ impl Bvh {
                     let ray = rays[r];
                     for (i, tri) in self.triangles[first..first + count].iter().enumerate() {
                         if let Some(hit) = tri.intersect(ray, t_max_lanes[r]) {
+                            if !keep.keeps(first + i) {
+                                continue;
+                            }
                             if hit.t < t_max_lanes[r] || first + i < best_index[r] {
                                 t_max_lanes[r] = hit.t;
                                 best[r] = Some((first + i, hit));

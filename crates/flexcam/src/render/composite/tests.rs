@@ -85,7 +85,7 @@ fn composite_from(scene: &Scene, main: &dyn Projection, surface: &ReflectorSurfa
     let camera = main_camera(scene, main).unwrap();
     let mut plain = scene.clone();
     plain.trilinear_reflectors.clear();
-    plain.objects[0].material.surface = Surface::Diffuse;
+    plain.objects[0].material.finish = Finish::Diffuse;
     let mut frame = raycast(&PreparedScene::new(&plain), main, &flat())
         .unwrap()
         .0;
@@ -113,7 +113,11 @@ fn sphere_composite_matches_the_true_mirror() {
     let scene = scene();
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let reference = reference(&scene, main.as_ref());
-    let (frame, stats) = render(
+    let Rendered {
+        frame,
+        counters: stats,
+        ..
+    } = render(
         &PreparedScene::new(&scene),
         main.as_ref(),
         &flat(),
@@ -240,7 +244,7 @@ fn lens_composite_matches_ray_cast_glass() {
     let scene = lens_scene();
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let reference = reference(&scene, main.as_ref());
-    let (frame, _) = render(
+    let Rendered { frame, .. } = render(
         &PreparedScene::new(&scene),
         main.as_ref(),
         &flat(),
@@ -271,8 +275,11 @@ fn lit_glass_mixes_reflection_and_refraction_by_fresnel() {
     let lit = RenderOptions::default();
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let reference = reference_with(&scene, main.as_ref(), &lit);
-    let (frame, stats) =
-        render(&PreparedScene::new(&scene), main.as_ref(), &lit, &raycast).unwrap();
+    let Rendered {
+        frame,
+        counters: stats,
+        ..
+    } = render(&PreparedScene::new(&scene), main.as_ref(), &lit, &raycast).unwrap();
     let (fresnel, _) = agreement(&frame, &reference, 1);
 
     // Refraction alone, tinted: the main view with the lens diffuse, the refraction pasted.
@@ -281,7 +288,7 @@ fn lit_glass_mixes_reflection_and_refraction_by_fresnel() {
     let refraction = reflector_surface(&lens.mesh, &camera, lens.optic).unwrap();
     let mut plain = scene.clone();
     plain.trilinear_reflectors.clear();
-    plain.objects[0].material.surface = Surface::Diffuse;
+    plain.objects[0].material.finish = Finish::Diffuse;
     let mut alone = raycast(&PreparedScene::new(&plain), main.as_ref(), &lit)
         .unwrap()
         .0;
@@ -352,7 +359,11 @@ fn without_reflectors_the_renderer_runs_once_and_unchanged() {
     let mut scene = scene();
     scene.trilinear_reflectors.clear();
     let main = scene.projection.build(40, 30).unwrap();
-    let (frame, stats) = render(
+    let Rendered {
+        frame,
+        counters: stats,
+        ..
+    } = render(
         &PreparedScene::new(&scene),
         main.as_ref(),
         &flat(),
@@ -435,7 +446,7 @@ fn finer_reflectors_agree_better() {
         scene.trilinear_reflectors[0].refine_px = 0.0;
         let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
         let reference = reference(&scene, main.as_ref());
-        let (frame, _) = render(
+        let Rendered { frame, .. } = render(
             &PreparedScene::new(&scene),
             main.as_ref(),
             &flat(),
@@ -474,7 +485,11 @@ fn uncovered_reflector_pixels_are_ray_cast_exactly() {
     let surface = reflector_surface(&mirror.mesh, &camera, mirror.optic).unwrap();
     assert!(surface.mesh.triangles.is_empty(), "seen from behind");
     let reference = reference(&scene, main.as_ref());
-    let (frame, stats) = render(
+    let Rendered {
+        frame,
+        counters: stats,
+        ..
+    } = render(
         &PreparedScene::new(&scene),
         main.as_ref(),
         &flat(),
@@ -501,7 +516,9 @@ fn uncovered_reflector_pixels_are_ray_cast_exactly() {
     let mut scene = front.scene("front.toml");
     scene.trilinear_reflectors = vec![TrilinearReflector::new(BALL)];
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
-    let (_, stats) = render(
+    let Rendered {
+        counters: stats, ..
+    } = render(
         &PreparedScene::new(&scene),
         main.as_ref(),
         &flat(),
@@ -563,14 +580,18 @@ fn perspective_as_trilinear_is_the_same_pinhole() {
 fn trilinear_method_composites_reflectors() {
     let scene = scene();
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
-    let (trilinear, stats) = render_with_method(
+    let Rendered {
+        frame: trilinear,
+        counters: stats,
+        ..
+    } = render_with_method(
         &PreparedScene::new(&scene),
         main.as_ref(),
         &flat(),
         Method::Trilinear,
     )
     .unwrap();
-    let (raycast, _) = render(
+    let Rendered { frame: raycast, .. } = render(
         &PreparedScene::new(&scene),
         main.as_ref(),
         &flat(),
@@ -604,7 +625,7 @@ fn trilinear_method_composites_reflectors() {
 /// flat mirror).
 fn plate_scene(ior: f32, map: SurfaceScreenMap, flat_normals: bool) -> Scene {
     let mut scene = lens_scene();
-    scene.objects[0].material.surface = Surface::Glass { ior };
+    scene.objects[0].material.finish = Finish::Glass { ior };
     if flat_normals {
         scene.objects[0].mesh.normals.fill(Vec3::Y);
     }
@@ -617,7 +638,7 @@ fn plate_scene(ior: f32, map: SurfaceScreenMap, flat_normals: bool) -> Scene {
 fn composite_error(scene: &Scene, method: Method) -> (Comparison, Comparison) {
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let reference = reference(scene, main.as_ref());
-    let (frame, _) =
+    let Rendered { frame, .. } =
         render_with_method(&PreparedScene::new(scene), main.as_ref(), &flat(), method).unwrap();
     let whole = compare(&frame, &reference).unwrap();
     (whole, agreement(&frame, &reference, 1).0)
@@ -692,7 +713,11 @@ fn refined_error(scene: &Scene, id: u32, refine_px: f64) -> (Comparison, f64, St
     scene.trilinear_reflectors[0].refine_px = refine_px;
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let reference = reference(&scene, main.as_ref());
-    let (frame, stats) = render(
+    let Rendered {
+        frame,
+        counters: stats,
+        ..
+    } = render(
         &PreparedScene::new(&scene),
         main.as_ref(),
         &flat(),

@@ -22,7 +22,7 @@ use crate::render::prepared::{Hit, PreparedScene};
 use crate::render::scan::NO_PRIMITIVE;
 use crate::render::shading::{base_color, TextureFilter};
 use crate::render::{RenderOptions, Shading};
-use crate::scene::{Object, Surface};
+use crate::scene::{Finish, Object};
 
 /// The primitive key of triangle `triangle` of object index `object`: objects in the high
 /// half, so keys order like (object, triangle).
@@ -104,10 +104,7 @@ impl Shader<'_> {
     pub fn shade(&self, x: u32, y: u32, visible: &Visible) -> (Vec3, u64) {
         let (object_index, triangle) = unkey(visible.key);
         let object = &self.objects[object_index];
-        let flat = matches!(
-            object.material.surface,
-            Surface::Diffuse | Surface::Emissive
-        );
+        let flat = matches!(object.material.finish, Finish::Diffuse | Finish::Emissive);
         let base = || {
             let color = base_color(
                 object,

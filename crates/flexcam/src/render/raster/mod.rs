@@ -70,7 +70,7 @@ use crate::error::{Error, Result};
 use crate::projection::{Charted, Projection};
 use crate::render::prepared::PreparedScene;
 use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
-use crate::scene::{Scene, Surface};
+use crate::scene::{Finish, Scene};
 
 /// Scene triangles per parallel task when building pieces.
 const CHUNK: usize = 2048;
@@ -192,7 +192,7 @@ impl<'a> InverseRaster<'a> {
         let specular = scene
             .objects
             .iter()
-            .any(|o| !matches!(o.material.surface, Surface::Diffuse | Surface::Emissive));
+            .any(|o| !matches!(o.material.finish, Finish::Diffuse | Finish::Emissive));
         let caster = (options.shading == Shading::Lit || specular).then_some(prepared);
         Ok(InverseRaster {
             buffers: Mutex::default(),

@@ -195,7 +195,7 @@ impl PreparedScene {
     /// leaf, a triangle whose box is apart from the piece's, whose plane the piece's control
     /// points lie strictly on one side of, or one of whose edge planes the piece's chord
     /// (near the plane) or its control points lie outside is skipped without root finding
-    /// (see `CurveTriangle`).
+    /// (see `CurveTriangle`), as is one that a view hides ([`PreparedScene::shows`]).
     fn search_pieces(
         &self,
         pieces: &[Option<PieceSearch>; 4],
@@ -211,6 +211,9 @@ impl PreparedScene {
             let bound = |best: &Option<(usize, CurveHit)>| {
                 best.map_or(f32::MAX, |(_, h)| piece.bound(h.s, (a, b)))
             };
+            if !self.shows(stored) {
+                return bound(best);
+            }
             let tri = &triangles[stored];
             let margin = tri.margin(piece.scale);
             if tri.boxes_apart(piece.lo, piece.hi, margin)

@@ -70,7 +70,7 @@ pub fn render(
     options: &RenderOptions,
 ) -> (Frame, Stats) {
     let (width, height) = projection.resolution();
-    let mut frame = Frame::zeroed(width, height);
+    let mut frame = Frame::zeroed(width, height, options.outputs);
     let stats = render_into(scene, &mut frame, projection, options);
     (frame, stats)
 }
@@ -89,7 +89,7 @@ pub fn render_into(
     options: &RenderOptions,
 ) -> Stats {
     let (width, height) = projection.resolution();
-    frame.fit(width, height);
+    frame.fit(width, height, options.outputs);
     let mut stats = tiles::render(scene, projection, options, frame);
     stats.insert(
         "bvh_build_ms",

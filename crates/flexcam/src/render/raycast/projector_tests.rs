@@ -217,7 +217,7 @@ fn segments_outside_the_scene_box_are_culled_without_changing_any_hit() {
                     t_max: 1.0,
                 };
                 let uncull = crate::render::bvh::triangle::FastRay::new(&ray)
-                    .and_then(|fast| caster.bvh.closest(&fast))
+                    .and_then(|fast| caster.bvh.closest(&fast, &crate::render::bvh::AllTriangles))
                     .map(|found| caster.hit32(found));
                 assert_eq!(caster.intersect_f32(&ray), uncull, "pixel ({x}, {y})");
                 segments += 1;

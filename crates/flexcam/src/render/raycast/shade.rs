@@ -229,7 +229,7 @@ impl<'a> Tracer<'a> {
         let (color, t) = match self.shader.shading {
             // The common flat case, a diffuse or emissive first hit, needs neither an exact
             // hit point nor normals: the f32 hit gives the colour and the depth.
-            Shading::Flat if shows_base_color(object.material.surface) => (
+            Shading::Flat if shows_base_color(object.material.finish) => (
                 base_color(
                     object,
                     found.triangle,

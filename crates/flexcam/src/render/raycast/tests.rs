@@ -6,7 +6,7 @@ use super::*;
 use crate::geometry::intersect_triangle;
 use crate::projection::{AnalyticInverse, CameraFrame, NoInverse, ProjectionSpec, Trilinear};
 use crate::render::{raycast, Counter, Shading};
-use crate::scene::{ImageSettings, Light, Material, Mesh, Object, Pattern, Scene, Surface};
+use crate::scene::{Finish, ImageSettings, Light, Material, Mesh, Object, Pattern, Scene};
 
 /// Parallel rays along `direction` from a grid of origins: pixel (x, y) starts at
 /// `corner + x * right - y * up` (continuous pixel coordinates). Columns left of `blind`
@@ -67,7 +67,7 @@ fn quad(c: Vec3, u: Vec3, v: Vec3) -> Mesh {
     }
 }
 
-fn object(id: u32, mesh: Mesh, color: Vec3, surface: Surface) -> Object {
+fn object(id: u32, mesh: Mesh, color: Vec3, finish: Finish) -> Object {
     Object {
         id,
         name: format!("o{id}"),
@@ -75,7 +75,7 @@ fn object(id: u32, mesh: Mesh, color: Vec3, surface: Surface) -> Object {
         material: Material {
             color,
             pattern: Pattern::Solid,
-            surface,
+            finish,
         },
         world_to_object: Affine3A::IDENTITY,
         displacement: None,
@@ -141,7 +141,7 @@ fn intersect_maps_hits_to_objects_and_agrees_with_f64_brute_force() {
             k + 1,
             quad(c, u, Vec3::new(0.0, 1.0, 0.3)),
             RED,
-            Surface::Diffuse,
+            Finish::Diffuse,
         ));
     }
     let scene = scene(objects, vec![]);
@@ -181,7 +181,7 @@ fn intersect_maps_hits_to_objects_and_agrees_with_f64_brute_force() {
 /// id `id`, and no lights.
 fn red_wall(id: u32) -> Scene {
     let wall = quad(Vec3::ZERO, Vec3::X * 9.0, Vec3::Y * 9.0);
-    scene(vec![object(id, wall, RED, Surface::Diffuse)], vec![])
+    scene(vec![object(id, wall, RED, Finish::Diffuse)], vec![])
 }
 
 #[test]
@@ -218,13 +218,13 @@ fn mirror_scene(scale: f32) -> Scene {
                 1,
                 quad(Vec3::ZERO, s(Vec3::X * 2.0), s(Vec3::Y * 2.0)),
                 GREEN,
-                Surface::Mirror,
+                Finish::Mirror,
             ),
             object(
                 2,
                 quad(s(Vec3::new(2.0, 0.0, 2.0)), s(Vec3::Y), s(Vec3::Z * 0.5)),
                 RED,
-                Surface::Diffuse,
+                Finish::Diffuse,
             ),
         ],
         vec![],
@@ -260,7 +260,7 @@ fn facing_mirrors_run_out_of_bounces() {
             1,
             quad(Vec3::Z * z, Vec3::X * 100.0, Vec3::Y * 100.0),
             GREEN,
-            Surface::Mirror,
+            Finish::Mirror,
         )
     };
     let scene = scene(vec![m(0.0), m(1.0)], vec![]);
@@ -285,7 +285,7 @@ fn glass_scene(targets: Vec<Object>) -> Scene {
         1,
         quad(Vec3::ZERO, Vec3::X * 50.0, Vec3::Y * 50.0),
         Vec3::ONE,
-        Surface::Glass { ior: 1.5 },
+        Finish::Glass { ior: 1.5 },
     )];
     objects.extend(targets);
     scene(objects, vec![])
@@ -299,7 +299,7 @@ fn flat_glass_refracts_entering_and_leaving() {
             id,
             quad(Vec3::new(x, 0.0, -1.0), Vec3::X * 0.2, Vec3::Y),
             color,
-            Surface::Diffuse,
+            Finish::Diffuse,
         )
     };
     let scene = glass_scene(vec![target(2, 1.53, RED), target(3, 2.0, BLUE)]);
@@ -316,7 +316,7 @@ fn flat_glass_refracts_entering_and_leaving() {
             id,
             quad(Vec3::new(x, 0.0, 1.0), Vec3::Y, Vec3::X * 0.2),
             color,
-            Surface::Diffuse,
+            Finish::Diffuse,
         )
     };
     let scene = glass_scene(vec![up(2, 0.577 + 1.134, RED), up(3, 1.155, BLUE)]);
@@ -332,13 +332,13 @@ fn flat_glass_total_internal_reflection_reflects() {
         2,
         quad(Vec3::new(3.0, 0.0, -2.0), Vec3::X * 0.3, Vec3::Y),
         GREEN,
-        Surface::Diffuse,
+        Finish::Diffuse,
     );
     let above = object(
         3,
         quad(Vec3::new(2.0, 0.0, 1.0), Vec3::X * 3.0, Vec3::Y),
         RED,
-        Surface::Diffuse,
+        Finish::Diffuse,
     );
     let scene = glass_scene(vec![below, above]);
     let (color, _, _) = trace(
@@ -358,19 +358,19 @@ fn busy_scene(lights: Vec<Light>) -> Scene {
                 1,
                 quad(Vec3::new(0.0, 0.0, -2.0), Vec3::X * 8.0, Vec3::Y * 8.0),
                 Vec3::splat(0.8),
-                Surface::Diffuse,
+                Finish::Diffuse,
             ),
             object(
                 2,
                 quad(Vec3::new(-1.0, 0.0, 0.0), Vec3::X, Vec3::Y),
                 RED,
-                Surface::Diffuse,
+                Finish::Diffuse,
             ),
             object(
                 3,
                 quad(Vec3::new(1.5, 1.5, -1.0), Vec3::new(1.0, 0.0, 0.5), Vec3::Y),
                 Vec3::splat(0.9),
-                Surface::Mirror,
+                Finish::Mirror,
             ),
             object(
                 4,
@@ -380,13 +380,13 @@ fn busy_scene(lights: Vec<Light>) -> Scene {
                     Vec3::Y,
                 ),
                 Vec3::new(0.9, 1.0, 0.9),
-                Surface::Glass { ior: 1.5 },
+                Finish::Glass { ior: 1.5 },
             ),
             object(
                 5,
                 quad(Vec3::new(-3.0, -3.0, 0.5), Vec3::X * 0.5, Vec3::Y * 0.5),
                 GREEN,
-                Surface::Emissive,
+                Finish::Emissive,
             ),
         ],
         lights,
@@ -522,13 +522,13 @@ fn supersampling_averages_colour_and_keeps_the_centre_sample_aov() {
         1,
         quad(Vec3::new(-4.51, 0.0, 0.0), Vec3::X * 5.0, Vec3::Y * 5.0),
         RED,
-        Surface::Diffuse,
+        Finish::Diffuse,
     );
     let right = object(
         2,
         quad(Vec3::new(5.5, 0.0, -1.0), Vec3::X * 5.0, Vec3::Y * 5.0),
         BLUE,
-        Surface::Diffuse,
+        Finish::Diffuse,
     );
     let scene = scene(vec![left, right], vec![]);
     let caster = PreparedScene::new(&scene);
@@ -637,7 +637,7 @@ fn packet_rendering_equals_single_ray_rendering() {
 fn segment_by_segment(caster: &PreparedScene, points: &[DVec3]) -> Option<(usize, Hit32)> {
     (0..points.len().saturating_sub(1)).find_map(|k| {
         crate::render::bvh::triangle::FastRay::new(&polyline_segment(points, k))
-            .and_then(|fast| caster.bvh.closest(&fast))
+            .and_then(|fast| caster.bvh.closest(&fast, &crate::render::bvh::AllTriangles))
             .map(|found| (k, caster.hit32(found)))
     })
 }

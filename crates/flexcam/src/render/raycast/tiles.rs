@@ -56,13 +56,14 @@ pub(super) fn render(
     let tiles_x = width.div_ceil(TILE);
     let total = tiles_x as u64 * height.div_ceil(TILE) as u64;
     let done = AtomicU64::new(0);
-    // One band of the frame per row of tiles.
+    // One band of the frame per row of tiles; no band of a buffer not wanted.
     let band = TILE as usize * width as usize;
+    let rows = height.div_ceil(TILE) as usize;
     let tallies: Vec<(RayCounts, u64)> = frame
         .color
         .par_chunks_mut(band)
-        .zip(frame.depth.par_chunks_mut(band))
-        .zip(frame.ids.par_chunks_mut(band))
+        .zip(bands(&mut frame.depth, band, rows))
+        .zip(bands(&mut frame.ids, band, rows))
         .enumerate()
         .map(|(row, ((color, depth), ids))| {
             let y0 = row as u32 * TILE;
@@ -85,8 +86,12 @@ pub(super) fn render(
                     let start = r * width as usize + tile.x0 as usize;
                     let dst = start..start + w;
                     color[dst.clone()].copy_from_slice(&tile.color[src.clone()]);
-                    depth[dst.clone()].copy_from_slice(&tile.depth[src.clone()]);
-                    ids[dst].copy_from_slice(&tile.ids[src]);
+                    if !depth.is_empty() {
+                        depth[dst.clone()].copy_from_slice(&tile.depth[src.clone()]);
+                    }
+                    if !ids.is_empty() {
+                        ids[dst].copy_from_slice(&tile.ids[src]);
+                    }
                 }
                 tally.0.primary += tile.counts.primary;
                 tally.0.secondary += tile.counts.secondary;
@@ -114,6 +119,16 @@ pub(super) fn render(
         ),
         ("blocks_culled", Counter::Count(culled)),
     ])
+}
+
+/// `buffer` cut into `rows` bands of `band` pixels (the last one shorter), or `rows` empty
+/// bands when `buffer` is empty (an output not wanted).
+fn bands<T: Send>(buffer: &mut [T], band: usize, rows: usize) -> Vec<&mut [T]> {
+    if buffer.is_empty() {
+        (0..rows).map(|_| &mut [][..]).collect()
+    } else {
+        buffer.chunks_mut(band).collect()
+    }
 }
 
 /// Which parts of the projectors of each block (`[row][column]`) of tile

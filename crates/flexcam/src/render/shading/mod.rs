@@ -358,7 +358,7 @@ mod tests {
     use glam::Affine3A;
 
     use super::*;
-    use crate::scene::{Mesh, Surface, Texture};
+    use crate::scene::{Finish, Mesh, Texture};
 
     fn object(mesh: Mesh, pattern: Pattern) -> Object {
         Object {
@@ -368,7 +368,7 @@ mod tests {
             material: Material {
                 color: Vec3::new(1.0, 0.5, 0.25),
                 pattern,
-                surface: Surface::Diffuse,
+                finish: Finish::Diffuse,
             },
             world_to_object: Affine3A::IDENTITY,
             displacement: None,

@@ -24,7 +24,7 @@ use crate::geometry::Ray;
 use crate::render::prepared::{Hit, PreparedScene};
 use crate::render::shading::{base_color, normals, Normals, TextureFilter};
 use crate::render::{RenderOptions, Shading};
-use crate::scene::{Light, Surface};
+use crate::scene::{Finish, Light};
 
 /// Ambient fraction of the base colour in `lit` shading.
 const AMBIENT: f32 = 0.1;
@@ -34,10 +34,10 @@ const SHININESS: i32 = 32;
 /// Lit branches weighing less than this in the final pixel are not traced.
 const MIN_WEIGHT: f32 = 1.0 / 1024.0;
 
-/// Whether flat shading shows the base colour of `surface` (else it is specular and passes
+/// Whether flat shading shows the base colour of `finish` (else it is specular and passes
 /// the ray on).
-pub(in crate::render) fn shows_base_color(surface: Surface) -> bool {
-    matches!(surface, Surface::Diffuse | Surface::Emissive)
+pub(in crate::render) fn shows_base_color(finish: Finish) -> bool {
+    matches!(finish, Finish::Diffuse | Finish::Emissive)
 }
 
 impl PreparedScene {
@@ -46,7 +46,7 @@ impl PreparedScene {
     /// colour at the hit ([`crate::render::shading::base_color`], nearest texels) and casts
     /// no ray; `false` for a mirror or glass, which pass the ray on.
     pub fn flat_shows_base_color(&self, object: usize) -> bool {
-        shows_base_color(self.scene.objects[object].material.surface)
+        shows_base_color(self.scene.objects[object].material.finish)
     }
 
     /// [`PreparedScene::shade_hit`] for a caller that builds the primary ray only where shading
@@ -60,7 +60,7 @@ impl PreparedScene {
         options: &RenderOptions,
     ) -> (Vec3, u64) {
         let object = &self.scene.objects[hit.object];
-        if options.shading == Shading::Flat && shows_base_color(object.material.surface) {
+        if options.shading == Shading::Flat && shows_base_color(object.material.finish) {
             let color = base_color(
                 object,
                 hit.triangle,
@@ -137,7 +137,7 @@ impl<'a> HitShader<'a> {
         let (mut ray, mut hit) = (*ray, hit);
         for bounce in 0.. {
             let object = &self.caster.scene.objects[hit.object];
-            if shows_base_color(object.material.surface) {
+            if shows_base_color(object.material.finish) {
                 return base_color(
                     object,
                     hit.triangle,
@@ -149,7 +149,7 @@ impl<'a> HitShader<'a> {
                 break;
             }
             let normals = self.normals(&ray, &hit);
-            let direction = specular(&ray, &normals, object.material.surface).main;
+            let direction = specular(&ray, &normals, object.material.finish).main;
             ray = self
                 .caster
                 .spawn(ray.at(hit.t), normals.geometric.as_dvec3(), direction);
@@ -173,13 +173,13 @@ impl<'a> HitShader<'a> {
             TextureFilter::Bilinear,
         );
         let position = ray.at(hit.t);
-        match object.material.surface {
-            Surface::Emissive => base,
-            Surface::Diffuse => self.direct(ray, position, &normals, base),
+        match object.material.finish {
+            Finish::Emissive => base,
+            Finish::Diffuse => self.direct(ray, position, &normals, base),
             surface => {
                 let specular = specular(ray, &normals, surface);
                 let main_weight = match (surface, specular.fresnel) {
-                    (Surface::Mirror, _) => base,
+                    (Finish::Mirror, _) => base,
                     (_, Some((_, reflectance))) => base * (1.0 - reflectance),
                     (_, None) => Vec3::ONE,
                 };
@@ -267,15 +267,15 @@ impl<'a> HitShader<'a> {
     }
 }
 
-/// Where `surface` sends `ray` (seen with `normals`): a mirror reflects; glass refracts and
+/// Where `finish` sends `ray` (seen with `normals`): a mirror reflects; glass refracts and
 /// also reflects by its Fresnel reflectance, or only reflects on total internal reflection.
 /// Shared with the trilinear composites (`render::composite`), which mix the same way.
-pub(crate) fn specular(ray: &Ray, normals: &Normals, surface: Surface) -> Specular {
+pub(crate) fn specular(ray: &Ray, normals: &Normals, finish: Finish) -> Specular {
     let direction = ray.direction.normalize();
     let normal = normals.shading.as_dvec3();
     let reflected = reflect(direction, normal);
-    let refracted = match surface {
-        Surface::Glass { ior } => {
+    let refracted = match finish {
+        Finish::Glass { ior } => {
             let ior = ior as f64;
             let eta = if normals.front_face { 1.0 / ior } else { ior };
             refract(direction, normal, eta)

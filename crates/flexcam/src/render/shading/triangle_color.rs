@@ -297,7 +297,7 @@ mod tests {
 
     use super::*;
     use crate::render::shading::base_color;
-    use crate::scene::{Mesh, Surface};
+    use crate::scene::{Finish, Mesh};
 
     fn object(positions: [Vec3; 3], colors: Option<[Vec3; 3]>, pattern: Pattern) -> Object {
         Object {
@@ -312,7 +312,7 @@ mod tests {
             material: Material {
                 color: Vec3::new(0.9, 0.5, 0.25),
                 pattern,
-                surface: Surface::Diffuse,
+                finish: Finish::Diffuse,
             },
             world_to_object: Affine3A::from_rotation_y(0.5)
                 * Affine3A::from_translation(Vec3::new(0.3, -1.0, 0.2)),

@@ -62,7 +62,7 @@ use crate::render::raycast::SamplePattern;
 use crate::render::scan::{band_rows_for, for_each_band, RasterStats, Scratch};
 use crate::render::shading::triangle_color::TriangleColor;
 use crate::render::shading::TextureFilter;
-use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
+use crate::render::{Counter, Frame, Outputs, RenderOptions, Shading, Stats};
 
 /// A prepared scene made ready for trilinear rendering: its triangles in f64 and the flat base
 /// colour of each, built once for any number of renders; shading (shadows, mirrors, glass)
@@ -113,7 +113,7 @@ impl<'a> TrilinearRenderer<'a> {
         curves: CurveOptions,
     ) -> Result<(Frame, Stats)> {
         let (width, height) = projection.resolution();
-        let mut frame = Frame::zeroed(width, height);
+        let mut frame = Frame::zeroed(width, height, Outputs::ALL);
         let stats = self.render_into(&mut frame, projection, options, curves)?;
         Ok((frame, stats))
     }
@@ -179,7 +179,7 @@ impl<'a> TrilinearRenderer<'a> {
 
         let maps: Vec<ScreenMap> = triangles.iter().map(|t| t.map).collect();
         let pattern = SamplePattern::new(options.spp);
-        frame.fit(width, height);
+        frame.fit(width, height, Outputs::ALL);
         let mut samples = Samples::new(frame, &pattern);
         let flat_colors = (options.shading == Shading::Flat).then_some(&self.flat_colors[..]);
         let mut raster = RasterStats::default();
@@ -313,7 +313,7 @@ struct Samples<'a> {
 impl<'a> Samples<'a> {
     fn new(out: &'a mut Frame, pattern: &SamplePattern) -> Samples<'a> {
         let scratch = (pattern.offsets.len() > 1).then(|| {
-            let frame = Frame::zeroed(out.width, out.height);
+            let frame = Frame::zeroed(out.width, out.height, Outputs::ALL);
             (frame, bytemuck::zeroed_vec(out.color.len()))
         });
         Samples {

@@ -15,7 +15,7 @@ use crate::error::Result;
 use crate::projection::trilinear_builders::SurfaceScreenMap;
 use crate::projection::ProjectionSpec;
 use crate::scene::loaders::{load_model, load_texture};
-use crate::scene::{Material, Mesh, Object, Pattern, Surface, TrilinearReflector};
+use crate::scene::{Finish, Material, Mesh, Object, Pattern, TrilinearReflector};
 
 /// Surface names as written in scene files.
 const MATERIALS: [&str; 4] = ["diffuse", "mirror", "glass", "emissive"];
@@ -151,14 +151,14 @@ pub(super) fn trilinear_reflector(
     };
     if let Some(part) = parts
         .iter()
-        .find(|p| !matches!(p.material.surface, Surface::Mirror | Surface::Glass { .. }))
+        .find(|p| !matches!(p.material.finish, Finish::Mirror | Finish::Glass { .. }))
     {
         return Err(src.error(
             &flag.span(),
             format!(
                 "`trilinear_reflector` needs material \"mirror\" or \"glass\", but \"{}\" is {}",
                 part.name,
-                surface_name(part.material.surface)
+                surface_name(part.material.finish)
             ),
         ));
     }
@@ -178,13 +178,13 @@ pub(super) fn trilinear_reflector(
     }))
 }
 
-/// The scene-file name of a surface kind.
-fn surface_name(surface: Surface) -> &'static str {
-    match surface {
-        Surface::Diffuse => "diffuse",
-        Surface::Mirror => "mirror",
-        Surface::Glass { .. } => "glass",
-        Surface::Emissive => "emissive",
+/// The scene-file name (key `surface`) of a finish.
+fn surface_name(finish: Finish) -> &'static str {
+    match finish {
+        Finish::Diffuse => "diffuse",
+        Finish::Mirror => "mirror",
+        Finish::Glass { .. } => "glass",
+        Finish::Emissive => "emissive",
     }
 }
 
@@ -289,7 +289,7 @@ fn analytic(src: &Source, raw: &RawObject, shape: Shape) -> Result<Option<(Mesh,
 struct MaterialOverrides {
     color: Option<Vec3>,
     pattern: Option<Pattern>,
-    surface: Option<Surface>,
+    finish: Option<Finish>,
 }
 
 impl MaterialOverrides {
@@ -325,7 +325,7 @@ impl MaterialOverrides {
         Ok(MaterialOverrides {
             color,
             pattern,
-            surface: surface(src, raw)?,
+            finish: finish(src, raw)?,
         })
     }
 
@@ -333,13 +333,13 @@ impl MaterialOverrides {
         Material {
             color: self.color.unwrap_or(base.color),
             pattern: self.pattern.clone().unwrap_or(base.pattern),
-            surface: self.surface.unwrap_or(base.surface),
+            finish: self.finish.unwrap_or(base.finish),
         }
     }
 }
 
 /// `material` and `ior`; `ior` belongs to glass only.
-fn surface(src: &Source, raw: &RawObject) -> Result<Option<Surface>> {
+fn finish(src: &Source, raw: &RawObject) -> Result<Option<Finish>> {
     let is_glass = raw
         .material
         .as_ref()
@@ -351,10 +351,10 @@ fn surface(src: &Source, raw: &RawObject) -> Result<Option<Surface>> {
         return Ok(None);
     };
     Ok(Some(match material.get_ref().as_str() {
-        "diffuse" => Surface::Diffuse,
-        "mirror" => Surface::Mirror,
-        "emissive" => Surface::Emissive,
-        "glass" => Surface::Glass {
+        "diffuse" => Finish::Diffuse,
+        "mirror" => Finish::Mirror,
+        "emissive" => Finish::Emissive,
+        "glass" => Finish::Glass {
             ior: raw
                 .ior
                 .as_ref()

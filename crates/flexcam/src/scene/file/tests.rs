@@ -6,7 +6,7 @@ use glam::{Affine3A, DVec3, Vec3};
 
 use super::*;
 use crate::projection::ProjectionSpec;
-use crate::scene::{Light, Pattern, Surface};
+use crate::scene::{Finish, Light, Pattern};
 
 /// A valid projection table of five lines, so objects written after it start on line 6.
 const CAMERA: &str = "[projection]
@@ -804,13 +804,13 @@ fn material_defaults_and_keys() {
     ));
     let m: Vec<_> = s.objects.iter().map(|o| &o.material).collect();
     assert_eq!(
-        (m[0].color, m[0].surface, &m[0].pattern),
-        (Vec3::splat(0.8), Surface::Diffuse, &Pattern::Solid)
+        (m[0].color, m[0].finish, &m[0].pattern),
+        (Vec3::splat(0.8), Finish::Diffuse, &Pattern::Solid)
     );
-    assert_eq!(m[1].surface, Surface::Glass { ior: 1.5 });
+    assert_eq!(m[1].finish, Finish::Glass { ior: 1.5 });
     assert_eq!(
-        (m[2].surface, m[2].color),
-        (Surface::Glass { ior: 1.33 }, Vec3::new(1.0, 0.5, 0.0))
+        (m[2].finish, m[2].color),
+        (Finish::Glass { ior: 1.33 }, Vec3::new(1.0, 0.5, 0.0))
     );
     assert_eq!(
         m[3].pattern,
@@ -819,8 +819,8 @@ fn material_defaults_and_keys() {
             size: 1.0
         }
     );
-    assert_eq!(m[3].surface, Surface::Mirror);
-    assert_eq!(m[4].surface, Surface::Emissive);
+    assert_eq!(m[3].finish, Finish::Mirror);
+    assert_eq!(m[4].finish, Finish::Emissive);
 }
 
 #[test]
@@ -980,8 +980,8 @@ fn object_keys_override_file_materials() {
     let s = load_with_files(&text, &files).unwrap_or_else(|e| panic!("{e}"));
     for o in &s.objects {
         assert_eq!(
-            (o.material.color, o.material.surface),
-            (Vec3::Y, Surface::Mirror)
+            (o.material.color, o.material.finish),
+            (Vec3::Y, Finish::Mirror)
         );
     }
 }

@@ -10,7 +10,7 @@ use glam::{Vec2, Vec3};
 
 use super::{load_texture, read_file, Model, ModelPart};
 use crate::error::{Error, Result};
-use crate::scene::{InputFile, Material, Mesh, Pattern, Surface, Texture};
+use crate::scene::{Finish, InputFile, Material, Mesh, Pattern, Texture};
 
 /// One `mtllib` the OBJ asked for: where it is and the material names it defined, or why it
 /// could not be loaded.
@@ -229,21 +229,21 @@ fn convert_material(
     let color = emission
         .or(m.diffuse.map(Vec3::from))
         .unwrap_or(default_color);
-    let surface = match (emission, m.illumination_model) {
-        (Some(_), _) => Surface::Emissive,
-        (None, Some(3 | 5)) => Surface::Mirror,
-        (None, Some(6 | 7)) => Surface::Glass {
+    let finish = match (emission, m.illumination_model) {
+        (Some(_), _) => Finish::Emissive,
+        (None, Some(3 | 5)) => Finish::Mirror,
+        (None, Some(6 | 7)) => Finish::Glass {
             ior: m
                 .optical_density
                 .filter(|n| n.is_finite() && *n > 0.0)
                 .unwrap_or(1.5),
         },
-        _ => Surface::Diffuse,
+        _ => Finish::Diffuse,
     };
     Ok(Material {
         color,
         pattern,
-        surface,
+        finish,
     })
 }
 
@@ -292,8 +292,8 @@ mod tests {
         let red = parts[1].material.as_ref().unwrap();
         assert_eq!(red.color, Vec3::new(0.8, 0.1, 0.1));
         assert_eq!(
-            (&red.pattern, red.surface),
-            (&Pattern::Solid, Surface::Diffuse)
+            (&red.pattern, red.finish),
+            (&Pattern::Solid, Finish::Diffuse)
         );
     }
 
@@ -377,9 +377,9 @@ mod tests {
         }
         let parts = load_obj(&write(&dir, "hints.obj", obj)).unwrap().parts;
         let materials: Vec<Material> = parts.into_iter().map(|p| p.material.unwrap()).collect();
-        assert_eq!(materials[0].surface, Surface::Glass { ior: 1.33 });
-        assert_eq!(materials[1].surface, Surface::Mirror);
-        assert_eq!(materials[2].surface, Surface::Emissive);
+        assert_eq!(materials[0].finish, Finish::Glass { ior: 1.33 });
+        assert_eq!(materials[1].finish, Finish::Mirror);
+        assert_eq!(materials[2].finish, Finish::Emissive);
         assert_eq!(materials[2].color, Vec3::new(2.0, 2.0, 1.0));
         assert!(matches!(materials[3].pattern, Pattern::Texture(_)));
         assert_eq!(materials[3].color, Vec3::ONE);

@@ -15,7 +15,7 @@
 //! Each curve is sampled at [`TABLE_SAMPLES`] + 1 fractions; a blend of two curves is
 //! sampled by blending their samples (the blend is pointwise, so its samples are exact). A
 //! lookup is a binary search of the (blended) samples' angles, polished on the exact blended
-//! curve inside the bracketing interval ([`POLISH_STEPS`]).
+//! curve inside the bracketing interval (`POLISH_STEPS`).
 //!
 //! With one outline, u depends on the azimuth alone and the lookup is separable: u, then v.
 //! With several outlines the outline depends on v, so u and v are coupled: v is the fixed
@@ -71,7 +71,7 @@ pub const TABLE_SAMPLES: usize = 4096;
 
 /// The lookup's stated accuracy in (u, v) and t. The samples alone are off by O(h) beside a
 /// kink of a polyline outline or profile (measured 6e-5 in u, h = 1 / TABLE_SAMPLES), so
-/// each lookup is polished on the exact curve ([`POLISH_STEPS`]); what remains is rounding.
+/// each lookup is polished on the exact curve (`POLISH_STEPS`); what remains is rounding.
 /// The inverse's domain test allows this much outside [0, 1], so that points on the
 /// volume's boundary (the near surface, t = 0) are kept.
 pub const ACCURACY: f64 = 1e-6;
