@@ -30,11 +30,18 @@
 //! micro-vertices, with the same tie rule ([`MicroHit::before`]), so the two find the same
 //! hit: same `t`, micro-triangle and barycentrics.
 
-use glam::{DVec2, DVec3};
+use glam::{DVec2, DVec3, Vec3};
 
 use super::height::HeightField;
 use super::micro::{hit_micro_triangle, BaseVertex, Displacement, MicroHit, MicroTriangle};
 use crate::geometry::Ray;
+
+/// Deepest level of the hierarchy whose node boxes [`DisplacedTriangle::top_boxes`] keeps
+/// (`1 + 4 + 16 + 64` boxes, 2,040 bytes per base triangle in f32).
+const CACHED_DEPTH: u32 = 3;
+
+/// A node box in f32, rounded outward from the f64 box (see [`DisplacedTriangle::top_boxes`]).
+pub type CachedBox = [Vec3; 2];
 
 /// A base triangle (vertices with positions, normals and uv) and its displacement.
 #[derive(Debug, Clone, Copy)]
@@ -42,16 +49,34 @@ pub struct DisplacedTriangle<'a> {
     corners: [BaseVertex; 3],
     displacement: &'a Displacement,
     frame: Frame,
+    /// The boxes of the nodes at depths `0..=k` in level order (the root at 0, the children
+    /// of node `i` at `4 i + 1 ..= 4 i + 4`); the boxes of deeper nodes, or all of them when
+    /// this is empty, are computed per ray.
+    boxes: &'a [CachedBox],
 }
 
-/// An orthonormal frame: `origin` and the rows `x, y, z`.
+/// The orthonormal frame a base triangle's node boxes are expressed in: `origin` and the
+/// rows `x, y, z` (x along the first edge, z the face normal).
 #[derive(Debug, Clone, Copy)]
-struct Frame {
+pub struct Frame {
     origin: DVec3,
     axes: [DVec3; 3],
 }
 
 impl Frame {
+    /// The frame of the base triangle with corner positions `[a, b, c]`: the world axes for
+    /// a degenerate one (zero area).
+    pub fn new([a, b, c]: [DVec3; 3]) -> Frame {
+        let x = (b - a).normalize_or_zero();
+        let z = (b - a).cross(c - a).normalize_or_zero();
+        let axes = if x == DVec3::ZERO || z == DVec3::ZERO {
+            [DVec3::X, DVec3::Y, DVec3::Z]
+        } else {
+            [x, z.cross(x), z]
+        };
+        Frame { origin: a, axes }
+    }
+
     fn local(&self, p: DVec3) -> DVec3 {
         self.direction(p - self.origin)
     }
@@ -115,15 +140,16 @@ impl Node {
         s.iter().all(|&x| x >= 0) || s.iter().all(|&x| x <= 0)
     }
 
-    /// The micro-triangle this leaf is, and its displaced vertices in that triangle's order.
-    fn micro_triangle(&self, displacement: &Displacement) -> (MicroTriangle, [DVec3; 3]) {
+    /// The micro-triangle this leaf is, and its vertices' displaced positions `displaced`
+    /// (in the order of `v`) put in that triangle's order.
+    fn micro_triangle(&self, displaced: [DVec3; 3]) -> (MicroTriangle, [DVec3; 3]) {
         let i = self.g.iter().map(|g| g[0]).min().unwrap_or(0);
         let j = self.g.iter().map(|g| g[1]).min().unwrap_or(0);
         let up = self.g.contains(&[i, j]);
         let triangle = MicroTriangle { i, j, up };
         let positions = triangle.vertices().map(|g| {
             let k = self.g.iter().position(|&x| x == g).unwrap_or(0);
-            displacement.displace(&self.v[k])
+            displaced[k]
         });
         (triangle, positions)
     }
@@ -139,24 +165,85 @@ struct LocalRay {
     slack: f64,
 }
 
+impl LocalRay {
+    fn new(frame: &Frame, ray: &Ray) -> LocalRay {
+        let origin = frame.local(ray.origin);
+        LocalRay {
+            origin,
+            direction: frame.direction(ray.direction),
+            t_min: ray.t_min,
+            t_max: ray.t_max,
+            slack: 1e-8 * origin.abs().max_element(),
+        }
+    }
+}
+
+/// Whether `ray` enters a triangle's kept root box `root` (the first of its
+/// [`DisplacedTriangle::top_boxes`], in its `frame`): the test
+/// [`DisplacedTriangle::intersect`] starts with, without the triangle's corners, so that a
+/// caller can skip fetching them for the many triangles a ray reaches only in their world
+/// box. `false` means no hit.
+pub fn enters_root(frame: &Frame, root: &CachedBox, ray: &Ray) -> bool {
+    let [lo, hi] = *root;
+    let local = LocalRay::new(frame, ray);
+    slab_entry(&local, [lo.as_dvec3(), hi.as_dvec3()], f64::INFINITY).is_some()
+}
+
 impl<'a> DisplacedTriangle<'a> {
     /// The base triangle `corners` (in order `a, b, c`) displaced by `displacement`. Vertex
     /// normals are used as given (the mesh's; unit length expected). A degenerate base
     /// triangle (zero area) is traced in the world axes.
     pub fn new(corners: [BaseVertex; 3], displacement: &'a Displacement) -> Self {
-        let [a, b, c] = corners.map(|v| v.position);
-        let x = (b - a).normalize_or_zero();
-        let z = (b - a).cross(c - a).normalize_or_zero();
-        let axes = if x == DVec3::ZERO || z == DVec3::ZERO {
-            [DVec3::X, DVec3::Y, DVec3::Z]
-        } else {
-            [x, z.cross(x), z]
-        };
         DisplacedTriangle {
             corners,
             displacement,
-            frame: Frame { origin: a, axes },
+            frame: Frame::new(corners.map(|v| v.position)),
+            boxes: &[],
         }
+    }
+
+    /// The same triangle with its frame and top node boxes kept from
+    /// [`DisplacedTriangle::frame`] and [`DisplacedTriangle::top_boxes`] of it, so that a
+    /// ray pays one slab test per kept box instead of computing it: same hits.
+    pub fn with_boxes(
+        corners: [BaseVertex; 3],
+        displacement: &'a Displacement,
+        frame: Frame,
+        boxes: &'a [CachedBox],
+    ) -> Self {
+        DisplacedTriangle {
+            corners,
+            displacement,
+            frame,
+            boxes,
+        }
+    }
+
+    /// The frame its node boxes are expressed in.
+    pub fn frame(&self) -> Frame {
+        self.frame
+    }
+
+    /// The boxes of its internal nodes down to depth `min(L - 1, 3)` (a leaf-parent's
+    /// children are tested directly, without boxes), in level order, each rounded outward to
+    /// f32 (so it still contains its node's micro-geometry): `1`, `5`, `21` or `85` boxes, at
+    /// most 2,040 bytes. These are the boxes nearly every ray reaching the triangle opens; they are
+    /// the costliest to compute per ray (wide uv rectangles, a wide spread of normals).
+    pub fn top_boxes(&self) -> Vec<CachedBox> {
+        let depth = self
+            .displacement
+            .level()
+            .saturating_sub(1)
+            .min(CACHED_DEPTH);
+        let mut level = vec![self.root()];
+        let mut out = Vec::new();
+        for d in 0..=depth {
+            out.extend(level.iter().map(|node| outward(self.node_box(node))));
+            if d < depth {
+                level = level.iter().flat_map(Node::children).collect();
+            }
+        }
+        out
     }
 
     /// A world-space box `[min, max]` containing every micro-triangle.
@@ -182,18 +269,11 @@ impl<'a> DisplacedTriangle<'a> {
         if !(ray.origin.is_finite() && ray.direction.is_finite()) || ray.direction == DVec3::ZERO {
             return None;
         }
-        let origin = self.frame.local(ray.origin);
-        let local = LocalRay {
-            origin,
-            direction: self.frame.direction(ray.direction),
-            t_min: ray.t_min,
-            t_max: ray.t_max,
-            slack: 1e-8 * origin.abs().max_element(),
-        };
+        let local = LocalRay::new(&self.frame, ray);
         let root = self.root();
         let mut best = None;
-        if slab_entry(&local, self.node_box(&root), f64::INFINITY).is_some() {
-            self.visit(ray, &local, &root, 0, &mut best);
+        if slab_entry(&local, self.box_of(&root, 0), f64::INFINITY).is_some() {
+            self.visit(ray, &local, &root, 0, 0, &mut best);
         }
         best
     }
@@ -227,30 +307,62 @@ impl<'a> DisplacedTriangle<'a> {
         }
     }
 
-    /// Descends into `node` (at subdivision `depth`, its box already entered).
+    /// The box of `node`, the node with index `index` in its level order: kept or computed.
+    #[inline]
+    fn box_of(&self, node: &Node, index: usize) -> [DVec3; 2] {
+        match self.boxes.get(index) {
+            Some(&[lo, hi]) => [lo.as_dvec3(), hi.as_dvec3()],
+            None => self.node_box(node),
+        }
+    }
+
+    /// Descends into `node` (at subdivision `depth`, with index `index` in the level order
+    /// of [`DisplacedTriangle::boxes`], its box already entered).
     fn visit(
         &self,
         ray: &Ray,
         local: &LocalRay,
         node: &Node,
         depth: u32,
+        index: usize,
         best: &mut Option<MicroHit>,
     ) {
-        if depth == self.displacement.level() {
-            let (triangle, positions) = node.micro_triangle(self.displacement);
-            if let Some(hit) = hit_micro_triangle(ray, triangle, positions) {
+        let level = self.displacement.level();
+        let keep = |best: &mut Option<MicroHit>, found: Option<MicroHit>| {
+            if let Some(hit) = found {
                 if best.is_none_or(|b| hit.before(&b)) {
                     *best = Some(hit);
                 }
             }
+        };
+        if depth == level {
+            let (triangle, positions) =
+                node.micro_triangle(node.v.map(|v| self.displacement.displace(&v)));
+            keep(best, hit_micro_triangle(ray, triangle, positions));
             return;
         }
         let children = node.children();
+        if depth + 1 == level {
+            // The four leaves share six micro-vertices: displace each once and test the
+            // leaves without boxes (a box costs about what its triangle test does). The best
+            // hit does not depend on the order of the tests (`MicroHit::before`).
+            let [a, b, c] = node.v.map(|v| self.displacement.displace(&v));
+            let [ab, bc, ca] = [children[0].v[1], children[1].v[2], children[0].v[2]]
+                .map(|v| self.displacement.displace(&v));
+            let corners = [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ca, ab, bc]];
+            for (child, displaced) in children.iter().zip(corners) {
+                let (triangle, positions) = child.micro_triangle(displaced);
+                keep(best, hit_micro_triangle(ray, triangle, positions));
+            }
+            return;
+        }
+        // Index of the first child in the level order of the next depth.
+        let first = 4 * index + 1;
         let mut order: [(f64, usize); 4] = [(f64::INFINITY, 4); 4];
         let mut count = 0;
         for (k, child) in children.iter().enumerate() {
             let limit = best.map_or(f64::INFINITY, |b| b.t);
-            if let Some(entry) = slab_entry(local, self.node_box(child), limit) {
+            if let Some(entry) = slab_entry(local, self.box_of(child, first + k), limit) {
                 let mut at = count;
                 while at > 0 && order[at - 1].0 > entry {
                     order[at] = order[at - 1];
@@ -265,7 +377,7 @@ impl<'a> DisplacedTriangle<'a> {
             if best.is_some_and(|b| entry > b.t) {
                 break;
             }
-            self.visit(ray, local, &children[k], depth + 1, best);
+            self.visit(ray, local, &children[k], depth + 1, first + k, best);
         }
     }
 
@@ -293,6 +405,32 @@ impl<'a> DisplacedTriangle<'a> {
         let slack = DVec3::splat(1e-9 * reach + 1e-14 * far);
         [p_lo + d_lo - slack, p_hi + d_hi + slack]
     }
+}
+
+/// The f32 box containing the f64 box `[lo, hi]`.
+fn outward([lo, hi]: [DVec3; 2]) -> CachedBox {
+    // Rounding to nearest may land inside: step out by at least one unit in the last place.
+    let step = |x: f32| x.abs() * f32::EPSILON + f32::MIN_POSITIVE;
+    let down = |x: f64| {
+        let f = x as f32;
+        if f as f64 > x {
+            f - step(f)
+        } else {
+            f
+        }
+    };
+    let up = |x: f64| {
+        let f = x as f32;
+        if (f as f64) < x {
+            f + step(f)
+        } else {
+            f
+        }
+    };
+    [
+        Vec3::new(down(lo.x), down(lo.y), down(lo.z)),
+        Vec3::new(up(hi.x), up(hi.y), up(hi.z)),
+    ]
 }
 
 /// Component bounds of every normal below a node with corner normals `n` (module docs).

@@ -21,7 +21,7 @@ pub mod simplify;
 pub mod tessellate;
 
 pub use height::{HeightField, HeightMap};
-pub use intersect::DisplacedTriangle;
+pub use intersect::{CachedBox, DisplacedTriangle, Frame};
 pub use micro::{BaseVertex, Displacement, MicroGrid, MicroHit, MicroTriangle, MAX_LEVEL};
 pub use procedural::{Procedural, Wave};
 pub use tessellate::{base_corners, tessellate};

@@ -24,7 +24,8 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use crate::displace::{base_corners, DisplacedTriangle, Displacement, MicroHit};
+use crate::displace::intersect::enters_root;
+use crate::displace::{base_corners, CachedBox, DisplacedTriangle, Displacement, Frame, MicroHit};
 use crate::geometry::Ray;
 use crate::scene::Scene;
 
@@ -38,8 +39,10 @@ const STACK: usize = 40;
 pub(in crate::render) struct DisplacedSet {
     /// Per object of the scene (by index): its displacement, if it has one.
     displacements: Vec<Option<Displacement>>,
-    /// Base triangles in tree order: object index and triangle index.
-    items: Vec<[u32; 2]>,
+    /// Base triangles in tree order.
+    items: Vec<Item>,
+    /// The kept node boxes of every item ([`DisplacedTriangle::top_boxes`]).
+    boxes: Vec<CachedBox>,
     /// Depth-first: an interior node's first child follows it, `second` is the other.
     nodes: Vec<Node>,
 }
@@ -52,6 +55,17 @@ struct Node {
     index: u32,
     /// Leaf: the number of items (at least 1); interior: 0.
     count: u32,
+}
+
+/// A displaced base triangle: object index, triangle index, the frame of its node boxes and
+/// where its kept boxes are in [`DisplacedSet::boxes`].
+#[derive(Debug, Clone, Copy)]
+struct Item {
+    object: u32,
+    triangle: u32,
+    first_box: u32,
+    box_count: u32,
+    frame: Frame,
 }
 
 /// A hit on a displaced base triangle.
@@ -90,9 +104,28 @@ impl DisplacedSet {
         if !boxed.is_empty() {
             build(&mut boxed, 0, &mut nodes);
         }
+        let mut items = Vec::with_capacity(boxed.len());
+        let mut boxes = Vec::new();
+        for ([object, triangle], _, _) in boxed {
+            let Some(displacement) = &displacements[object as usize] else {
+                continue;
+            };
+            let mesh = &scene.objects[object as usize].mesh;
+            let shell = DisplacedTriangle::new(base_corners(mesh, triangle as usize), displacement);
+            let top = shell.top_boxes();
+            items.push(Item {
+                object,
+                triangle,
+                first_box: boxes.len() as u32,
+                box_count: top.len() as u32,
+                frame: shell.frame(),
+            });
+            boxes.extend(top);
+        }
         Some(Arc::new(DisplacedSet {
             displacements,
-            items: boxed.into_iter().map(|(item, _, _)| item).collect(),
+            items,
+            boxes,
             nodes,
         }))
     }
@@ -137,17 +170,24 @@ impl DisplacedSet {
         loop {
             let node = self.nodes[current as usize];
             if node.count > 0 {
-                for &[object, triangle] in
-                    &self.items[node.index as usize..(node.index + node.count) as usize]
-                {
-                    let (object, triangle) = (object as usize, triangle as usize);
+                for item in &self.items[node.index as usize..(node.index + node.count) as usize] {
+                    let (object, triangle) = (item.object as usize, item.triangle as usize);
                     let Some(displacement) = self.displacement(object) else {
                         continue;
                     };
                     let bounded = Ray { t_max, ..*ray };
-                    let found = self
-                        .triangle(scene, object, triangle, displacement)
-                        .intersect(&bounded);
+                    let boxes = &self.boxes
+                        [item.first_box as usize..(item.first_box + item.box_count) as usize];
+                    if !enters_root(&item.frame, &boxes[0], &bounded) {
+                        continue;
+                    }
+                    let found = DisplacedTriangle::with_boxes(
+                        base_corners(&scene.objects[object].mesh, triangle),
+                        displacement,
+                        item.frame,
+                        boxes,
+                    )
+                    .intersect(&bounded);
                     if let Some(micro) = found {
                         let better = best.is_none_or(|b| {
                             micro.t < b.micro.t
