@@ -84,6 +84,12 @@ impl DisplacedSet {
             .iter()
             .map(|o| o.displacement.as_deref().map(Displacement::from_spec))
             .collect();
+        if displacements.iter().all(Option::is_none) {
+            return None;
+        }
+        // Every displaced base triangle's shell, with its stored boxes, in scene order; the
+        // tree is built over (shell index, box) and the shells are then laid out in its order.
+        let mut shells = Vec::new();
         let mut boxed = Vec::new();
         for (index, (object, displacement)) in scene.objects.iter().zip(&displacements).enumerate()
         {
@@ -91,14 +97,16 @@ impl DisplacedSet {
                 continue;
             };
             for triangle in 0..object.mesh.triangles.len() {
-                let [lo, hi] =
-                    DisplacedTriangle::new(base_corners(&object.mesh, triangle), displacement)
-                        .bounds();
-                boxed.push(([index as u32, triangle as u32], lo, hi));
+                let shell =
+                    DisplacedTriangle::new(base_corners(&object.mesh, triangle), displacement);
+                let [lo, hi] = shell.bounds();
+                boxed.push(([shells.len() as u32, 0], lo, hi));
+                shells.push((
+                    [index as u32, triangle as u32],
+                    shell.frame(),
+                    shell.top_boxes(),
+                ));
             }
-        }
-        if displacements.iter().all(Option::is_none) {
-            return None;
         }
         let mut nodes = Vec::with_capacity(2 * boxed.len() / LEAF + 1);
         if !boxed.is_empty() {
@@ -106,21 +114,16 @@ impl DisplacedSet {
         }
         let mut items = Vec::with_capacity(boxed.len());
         let mut boxes = Vec::new();
-        for ([object, triangle], _, _) in boxed {
-            let Some(displacement) = &displacements[object as usize] else {
-                continue;
-            };
-            let mesh = &scene.objects[object as usize].mesh;
-            let shell = DisplacedTriangle::new(base_corners(mesh, triangle as usize), displacement);
-            let top = shell.top_boxes();
+        for ([shell, _], _, _) in boxed {
+            let &([object, triangle], frame, ref top) = &shells[shell as usize];
             items.push(Item {
                 object,
                 triangle,
                 first_box: boxes.len() as u32,
                 box_count: top.len() as u32,
-                frame: shell.frame(),
+                frame,
             });
-            boxes.extend(top);
+            boxes.extend_from_slice(top);
         }
         Some(Arc::new(DisplacedSet {
             displacements,
