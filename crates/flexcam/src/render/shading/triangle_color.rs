@@ -199,7 +199,8 @@ impl TriangleColor {
         }
     }
 
-    /// Whether the colour is the same at every point of the triangle.
+    /// Whether the colour is the same at every point of the triangle (checked by the tests).
+    #[cfg(test)]
     pub fn is_uniform(&self) -> bool {
         matches!(self.pattern, PatternMap::Uniform(_)) && self.vertex.is_none()
     }

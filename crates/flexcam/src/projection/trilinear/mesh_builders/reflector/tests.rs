@@ -3,7 +3,7 @@ use glam::{DVec2, DVec3, Vec2};
 use super::*;
 use crate::geometry::Ray;
 use crate::projection::Projection;
-use crate::render::shading::normals;
+use crate::render::normals;
 use crate::render::PreparedScene;
 use crate::scene::reflector_fixtures::{self as test_scenes, lens_plane, BALL_CENTER};
 use crate::scene::{Mesh, Scene};
