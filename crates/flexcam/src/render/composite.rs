@@ -25,6 +25,7 @@
 //! flat contract asks of mirrors and glass (the refraction, or the reflection on total
 //! internal reflection, without Fresnel mixing).
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use glam::{DVec2, DVec3, Vec3};
@@ -386,7 +387,7 @@ fn only(scene: &Scene, shown: impl Fn(&Object) -> bool) -> Scene {
     let mut part = scene.clone();
     for object in &mut part.objects {
         if !shown(object) {
-            object.mesh = Mesh::default();
+            object.mesh = Arc::default();
         }
     }
     part.trilinear_reflectors.clear();

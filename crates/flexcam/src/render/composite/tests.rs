@@ -248,7 +248,7 @@ fn lens_scene() -> Scene {
     }
     .scene("lens.toml");
     // Replace the placeholder sphere by the lens plane at y = 1.2.
-    scene.objects[0].mesh = lens_plane(1.2, 2.2);
+    scene.objects[0].mesh = lens_plane(1.2, 2.2).into();
     scene.trilinear_reflectors = vec![TrilinearReflector::new(1)];
     scene
 }
@@ -575,7 +575,9 @@ fn plate_scene(ior: f32, map: SurfaceScreenMap, flat_normals: bool) -> Scene {
     let mut scene = lens_scene();
     scene.objects[0].material.finish = Finish::Glass { ior };
     if flat_normals {
-        scene.objects[0].mesh.normals.fill(Vec3::Y);
+        Arc::make_mut(&mut scene.objects[0].mesh)
+            .normals
+            .fill(Vec3::Y);
     }
     scene.trilinear_reflectors[0].screen_map = map;
     scene

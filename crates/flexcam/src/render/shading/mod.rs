@@ -366,7 +366,7 @@ mod tests {
         Object {
             id: 1,
             name: "t".into(),
-            mesh,
+            mesh: mesh.into(),
             material: Material {
                 color: Vec3::new(1.0, 0.5, 0.25),
                 pattern,

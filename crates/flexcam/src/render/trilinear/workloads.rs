@@ -88,7 +88,7 @@ pub fn random_triangles(count: u32, seed: u64) -> Scene {
         objects: vec![Object {
             id: 1,
             name: "random triangles".to_string(),
-            mesh,
+            mesh: mesh.into(),
             material: Material::default(),
             world_to_object: Affine3A::IDENTITY,
             displacement: None,
