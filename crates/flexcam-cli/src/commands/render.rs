@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use clap::Args;
-use flexcam::image_io::{self, ColorEncoding, DepthFormat, OutputSet};
+use flexcam::image_io::{self, ColorEncoding, ColorFormat, DepthFormat, OutputSet, PngBits};
 use flexcam::render::{self, Counter, Method, Outputs, PreparedScene, RenderOptions, Shading};
 use flexcam::Result;
 
@@ -20,9 +20,14 @@ use crate::OutputTarget;
 pub struct RenderArgs {
     #[command(flatten)]
     scene: SceneArgs,
-    /// The colour image to write (PNG).
+    /// The colour image to write, in the format its extension names: `.png` (8-bit, or
+    /// 16-bit with `--png-bits 16`; sRGB-encoded, or linear with `--shading flat`), `.exr`
+    /// (OpenEXR) or `.pfm`, both linear 32-bit float RGB as rendered (no curve, no clamping).
     #[arg(short, long, default_value = "flexcam.png")]
     output: PathBuf,
+    /// Bits per channel of a PNG colour output: 8 or 16.
+    #[arg(long, value_enum, default_value_t = PngBitsArg::Eight)]
+    png_bits: PngBitsArg,
     /// Rendering method: `raycast` (the reference, every projection), `raster`
     /// (rasterisation by the analytic inverse, projections that have one) or `trilinear`
     /// (rasterisation of trilinear projections).
@@ -42,9 +47,25 @@ pub struct RenderArgs {
     /// Write object ids as a 16-bit grayscale PNG (0 = background).
     #[arg(long, value_name = "FILE")]
     ids: Option<PathBuf>,
+    /// Write object ids as an 8-bit false-colour PNG: a fixed colour per id, black background.
+    #[arg(long, value_name = "FILE")]
+    ids_preview: Option<PathBuf>,
+    /// Write every AOV as one multi-channel OpenEXR (.exr): linear colour `R`, `G`, `B`,
+    /// depth `Z` (+inf where nothing is hit) and object id `id` (uint, 0 = background).
+    #[arg(long, value_name = "FILE")]
+    aovs: Option<PathBuf>,
     /// Write statistics as one JSON object to FILE, or to standard output with `-`.
     #[arg(long, value_name = "FILE|-")]
     stats: Option<OutputTarget>,
+}
+
+/// The values of `--png-bits`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum PngBitsArg {
+    #[value(name = "8")]
+    Eight,
+    #[value(name = "16")]
+    Sixteen,
 }
 
 /// Runs `flexcam render`. Outputs are written only once everything has succeeded, all
@@ -55,7 +76,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if let Some(source) = &args.scene.scene {
         super::declare_scene_file(&mut outputs, source)?;
     }
-    let color = outputs.output("the output", &args.output, &["png"])?;
+    let color = outputs.output("the output", &args.output, &ColorFormat::EXTENSIONS)?;
+    let png_bits = match args.png_bits {
+        PngBitsArg::Eight => PngBits::Eight,
+        PngBitsArg::Sixteen => PngBits::Sixteen,
+    };
+    let color_format = ColorFormat::of(&args.output, png_bits)?;
+    if png_bits == PngBits::Sixteen && !matches!(color_format, ColorFormat::Png(_)) {
+        return Err(flexcam::Error::in_file(
+            &args.output,
+            "--png-bits 16 applies to a .png output only (.exr and .pfm are float)",
+        ));
+    }
     let depth = match &args.depth {
         Some(path) => Some((
             outputs.output("the depth output", path, &DepthFormat::EXTENSIONS)?,
@@ -67,6 +99,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .ids
         .as_deref()
         .map(|path| outputs.output("the ids output", path, &["png"]))
+        .transpose()?;
+    let ids_preview = args
+        .ids_preview
+        .as_deref()
+        .map(|path| outputs.output("the ids preview", path, &["png"]))
+        .transpose()?;
+    let aovs = args
+        .aovs
+        .as_deref()
+        .map(|path| outputs.output("the AOV output", path, &["exr"]))
         .transpose()?;
     let stats = match &args.stats {
         Some(OutputTarget::File(path)) => {
@@ -90,8 +132,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         camera_triangles: args.tuning.camera_triangles(method)?,
         progress: Some(&report),
         outputs: Outputs {
-            depth: depth.is_some(),
-            ids: ids.is_some(),
+            depth: depth.is_some() || aovs.is_some(),
+            ids: ids.is_some() || ids_preview.is_some() || aovs.is_some(),
         },
         ..RenderOptions::default()
     };
@@ -119,13 +161,19 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         Shading::Lit => ColorEncoding::Srgb,
     };
     outputs.stage(color, |tmp| {
-        image_io::write_color_png(&frame, tmp, encoding)
+        image_io::write_color(&frame, tmp, color_format, encoding)
     })?;
     if let Some((id, format)) = depth {
         outputs.stage(id, |tmp| image_io::write_depth(&frame, tmp, format))?;
     }
     if let Some(id) = ids {
         outputs.stage(id, |tmp| image_io::write_ids_png(&frame, tmp))?;
+    }
+    if let Some(id) = ids_preview {
+        outputs.stage(id, |tmp| image_io::write_ids_preview_png(&frame, tmp))?;
+    }
+    if let Some(id) = aovs {
+        outputs.stage(id, |tmp| image_io::write_aovs_exr(&frame, tmp))?;
     }
     let facts = RunFacts {
         method: method.name(),

@@ -1,11 +1,15 @@
-//! Reading and writing images: PNG colour, 16-bit PNG object ids, depth as OpenEXR or PFM,
-//! animated GIF, and the photos `flexcam reproject` reads.
+//! Reading and writing images: colour as PNG (8- or 16-bit), OpenEXR or PFM, 16-bit PNG
+//! object ids and their false-colour previews, depth as OpenEXR or PFM, the multi-channel
+//! OpenEXR of every AOV, animated GIF, and the photos `flexcam reproject` reads.
 //!
 //! Writers write to the path they are given; [`OutputSet`] gives a command's outputs their
 //! safety: refused when aimed at an input or at each other, staged in temporary files,
 //! committed all together or not at all.
 
+mod aovs;
+mod color;
 mod depth;
+mod float;
 mod gif;
 mod identity;
 mod outputs;
@@ -18,14 +22,16 @@ use glam::Vec3;
 
 use crate::render::Frame;
 
+pub use aovs::write_aovs_exr;
+pub use color::{encode_channel16, write_color, ColorFormat, PngBits};
 pub use depth::{write_depth, DepthFormat};
 pub use gif::GifFrames;
 pub use identity::{FileIdentity, Target};
 pub use outputs::{check_extension, write_bytes, OutputId, OutputSet};
-pub use png::{write_color_png, write_ids_png};
+pub use png::{id_preview_color, write_color_png, write_ids_png, write_ids_preview_png};
 pub use read::{read_linear_image, LinearImage, INPUT_EXTENSIONS};
 
-/// How linear colour is turned into 8-bit PNG values.
+/// How linear colour is turned into 8- or 16-bit PNG values.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ColorEncoding {
     /// The sRGB transfer curve (for `lit` images).
@@ -51,14 +57,18 @@ fn srgb_encode(c: f32) -> f32 {
     }
 }
 
-/// 8-bit value of a linear colour channel under `encoding`; NaN maps to 0.
-pub fn encode_channel(c: f32, encoding: ColorEncoding) -> u8 {
+/// A linear colour channel value encoded under `encoding`, in [0, 1]; NaN maps to 0.
+fn encoded(c: f32, encoding: ColorEncoding) -> f32 {
     let c = if c.is_nan() { 0.0 } else { c };
-    let v = match encoding {
+    match encoding {
         ColorEncoding::Srgb => srgb_encode(c),
         ColorEncoding::Linear => c.clamp(0.0, 1.0),
-    };
-    (255.0 * v).round() as u8
+    }
+}
+
+/// 8-bit value of a linear colour channel under `encoding`; NaN maps to 0.
+pub fn encode_channel(c: f32, encoding: ColorEncoding) -> u8 {
+    (255.0 * encoded(c, encoding)).round() as u8
 }
 
 /// The 8-bit RGB bytes of the colour of `frame`, row by row from the top.

@@ -1,4 +1,5 @@
-//! 8-bit RGB colour PNGs and 16-bit grayscale object-id PNGs.
+//! 8-bit RGB colour PNGs, 16-bit grayscale object-id PNGs and their 8-bit false-colour
+//! previews.
 
 use std::path::Path;
 
@@ -37,4 +38,39 @@ pub fn write_ids_png(frame: &Frame, path: &Path) -> Result<()> {
     buffer
         .save_with_format(path, image::ImageFormat::Png)
         .map_err(|e| Error::new(format!("cannot write PNG: {e}")))
+}
+
+/// The false colour of object `id` in an ids preview: black for the background (0), else a
+/// fixed hash of the id (the "lowbias32" integer mix of Wellons) with each channel lifted to
+/// [64, 255], so that every object is visible and neighbouring ids differ.
+pub fn id_preview_color(id: u32) -> [u8; 3] {
+    if id == 0 {
+        return [0, 0, 0];
+    }
+    let mut x = id;
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^= x >> 16;
+    let [r, g, b, _] = x.to_le_bytes();
+    [r, g, b].map(|v| 64 + (u16::from(v) * 191 / 255) as u8)
+}
+
+/// Writes object ids as an 8-bit RGB PNG at `path`, each id in its [`id_preview_color`].
+pub fn write_ids_preview_png(frame: &Frame, path: &Path) -> Result<()> {
+    let bytes: Vec<u8> = frame
+        .ids
+        .iter()
+        .flat_map(|&id| id_preview_color(id))
+        .collect();
+    image::save_buffer_with_format(
+        path,
+        &bytes,
+        frame.width,
+        frame.height,
+        image::ExtendedColorType::Rgb8,
+        image::ImageFormat::Png,
+    )
+    .map_err(|e| Error::new(format!("cannot write PNG: {e}")))
 }

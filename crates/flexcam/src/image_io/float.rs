@@ -1,0 +1,68 @@
+//! Linear float images: OpenEXR (one layer of named channels, 32-bit float or unsigned int,
+//! lossless compression) and PFM (`Pf` grayscale or `PF` RGB, little-endian, rows bottom to
+//! top as PFM requires). Samples are given row by row from the top, as frames hold them.
+
+use std::fs;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::render::Frame;
+
+/// The samples of one EXR channel, one per pixel, row by row from the top.
+pub enum ExrSamples {
+    F32(Vec<f32>),
+    U32(Vec<u32>),
+}
+
+/// Writes one EXR layer named `layer` of the size of `frame` holding `channels` (name,
+/// samples). Readers list the channels sorted by name, as the format stores them.
+pub fn write_exr(
+    frame: &Frame,
+    path: &Path,
+    layer: &str,
+    channels: Vec<(&str, ExrSamples)>,
+) -> Result<()> {
+    use exr::prelude::*;
+    let channels: Vec<AnyChannel<FlatSamples>> = channels
+        .into_iter()
+        .map(|(name, samples)| {
+            let samples = match samples {
+                ExrSamples::F32(v) => FlatSamples::F32(v),
+                ExrSamples::U32(v) => FlatSamples::U32(v),
+            };
+            AnyChannel::new(name, samples)
+        })
+        .collect();
+    let layer = Layer::new(
+        (frame.width as usize, frame.height as usize),
+        LayerAttributes::named(layer),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(SmallVec::from_vec(channels)),
+    );
+    Image::from_layer(layer)
+        .write()
+        .to_file(path)
+        .map_err(|e| crate::error::Error::new(format!("cannot write OpenEXR: {e}")))
+}
+
+/// The red, green and blue channels of the linear colour of `frame`, for [`write_exr`].
+pub fn rgb_channels(frame: &Frame) -> Vec<(&'static str, ExrSamples)> {
+    let channel = |k: usize| ExrSamples::F32(frame.color.iter().map(|c| c[k]).collect());
+    vec![("R", channel(0)), ("G", channel(1)), ("B", channel(2))]
+}
+
+/// Writes a PFM of the size of `frame` at `path`: `samples` holds `channels` (1 or 3)
+/// interleaved values a pixel, row by row from the top.
+pub fn write_pfm(frame: &Frame, path: &Path, channels: usize, samples: &[f32]) -> Result<()> {
+    let io = |e: std::io::Error| Error::new(format!("cannot write PFM: {e}"));
+    let tag = if channels == 3 { "PF" } else { "Pf" };
+    let mut out = BufWriter::new(fs::File::create(path).map_err(io)?);
+    write!(out, "{tag}\n{} {}\n-1.0\n", frame.width, frame.height).map_err(io)?;
+    for row in samples.chunks(frame.width as usize * channels).rev() {
+        for v in row {
+            out.write_all(&v.to_le_bytes()).map_err(io)?;
+        }
+    }
+    out.flush().map_err(io)
+}
