@@ -228,3 +228,164 @@ fn outputs_aimed_at_inputs_or_each_other_are_refused_naming_both() {
         .to_string();
     assert!(e.contains("the output would overwrite the texture"), "{e}");
 }
+
+/// A frame whose colours leave [0, 1] (HDR) and differ per pixel, with depth and ids.
+fn hdr_frame() -> Frame {
+    let mut f = Frame::new(3, 2, Vec3::ZERO);
+    for (i, c) in f.color.iter_mut().enumerate() {
+        let k = i as f32;
+        *c = Vec3::new(0.25 * k, 7.5 - k, -0.125 * k);
+    }
+    f.depth[1] = 2.5;
+    f.ids[1] = 70_000;
+    f.ids[4] = 3;
+    f
+}
+
+/// The channels of the first layer of the EXR at `path`, by name, as read by the exr crate.
+fn exr_channels(path: &std::path::Path) -> Vec<(String, exr::prelude::FlatSamples)> {
+    let image = exr::prelude::read_all_flat_layers_from_file(path).unwrap();
+    let layer = &image.layer_data[0];
+    assert_eq!((layer.size.0, layer.size.1), (3, 2));
+    layer
+        .channel_data
+        .list
+        .iter()
+        .map(|c| (c.name.to_string(), c.sample_data.clone()))
+        .collect()
+}
+
+fn f32_samples(samples: &exr::prelude::FlatSamples) -> Vec<f32> {
+    match samples {
+        exr::prelude::FlatSamples::F32(v) => v.clone(),
+        other => panic!("not f32: {other:?}"),
+    }
+}
+
+#[test]
+fn colour_exr_reads_back_as_the_linear_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("c.exr");
+    let f = hdr_frame();
+    let format = ColorFormat::of(&path, PngBits::Eight).unwrap();
+    write_color(&f, &path, format, ColorEncoding::Srgb).unwrap();
+    let channels = exr_channels(&path);
+    let names: Vec<&str> = channels.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["B", "G", "R"]);
+    for (name, k) in [("R", 0), ("G", 1), ("B", 2)] {
+        let (_, samples) = channels.iter().find(|(n, _)| n == name).unwrap();
+        let expected: Vec<f32> = f.color.iter().map(|c| c[k]).collect();
+        assert_eq!(f32_samples(samples), expected, "{name}");
+    }
+}
+
+#[test]
+fn colour_pfm_reads_back_as_the_linear_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("c.PFM");
+    let f = hdr_frame();
+    let format = ColorFormat::of(&path, PngBits::Eight).unwrap();
+    assert_eq!(format, ColorFormat::Pfm);
+    write_color(&f, &path, format, ColorEncoding::Linear).unwrap();
+    // A PFM reader: three header lines, then little-endian (negative scale) floats, the
+    // bottom row first.
+    let bytes = fs::read(&path).unwrap();
+    let mut header = bytes.splitn(4, |&b| b == b'\n');
+    assert_eq!(header.next().unwrap(), b"PF");
+    assert_eq!(header.next().unwrap(), b"3 2");
+    let scale: f32 = std::str::from_utf8(header.next().unwrap())
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(scale < 0.0);
+    let data = header.next().unwrap();
+    assert_eq!(data.len(), 3 * 2 * 3 * 4);
+    let values: Vec<f32> = data
+        .chunks(4)
+        .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    for (row_in_file, row) in values.chunks(9).enumerate() {
+        let y = 1 - row_in_file;
+        for x in 0..3 {
+            let c = f.color[y * 3 + x];
+            assert_eq!(&row[3 * x..3 * x + 3], &c.to_array(), "pixel ({x}, {y})");
+        }
+    }
+}
+
+#[test]
+fn png16_holds_the_encoded_channels() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("c.png");
+    let mut f = frame();
+    f.color[1] = Vec3::new(0.5, 2.0, -1.0);
+    let format = ColorFormat::of(&path, PngBits::Sixteen).unwrap();
+    write_color(&f, &path, format, ColorEncoding::Srgb).unwrap();
+    let img = image::open(&path).unwrap();
+    assert_eq!(img.color(), image::ColorType::Rgb16);
+    let img = img.to_rgb16();
+    assert_eq!(img.get_pixel(1, 0).0, [48_192, 65_535, 0]);
+    assert_eq!(
+        img.get_pixel(2, 1).0[0],
+        encode_channel16(0.2, ColorEncoding::Srgb)
+    );
+    write_color(&f, &path, format, ColorEncoding::Linear).unwrap();
+    let img = image::open(&path).unwrap().to_rgb16();
+    assert_eq!(img.get_pixel(2, 1).0, [13_107, 26_214, 39_321]);
+    // The 8-bit PNG is unchanged by the choice of format.
+    let eight = dir.path().join("c8.png");
+    let format = ColorFormat::of(&eight, PngBits::Eight).unwrap();
+    write_color(&f, &eight, format, ColorEncoding::Linear).unwrap();
+    let direct = dir.path().join("d8.png");
+    write_color_png(&f, &direct, ColorEncoding::Linear).unwrap();
+    assert_eq!(fs::read(eight).unwrap(), fs::read(direct).unwrap());
+    let e = ColorFormat::of(std::path::Path::new("x.tif"), PngBits::Eight).unwrap_err();
+    assert!(
+        e.to_string().contains("x.tif") && e.to_string().contains(".exr"),
+        "{e}"
+    );
+}
+
+#[test]
+fn aov_exr_holds_colour_depth_and_ids() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("a.exr");
+    let f = hdr_frame();
+    write_aovs_exr(&f, &path).unwrap();
+    let channels = exr_channels(&path);
+    let names: Vec<&str> = channels.iter().map(|(n, _)| n.as_str()).collect();
+    assert_eq!(names, ["B", "G", "R", "Z", "id"]);
+    let get = |name: &str| &channels.iter().find(|(n, _)| n == name).unwrap().1;
+    let red: Vec<f32> = f.color.iter().map(|c| c.x).collect();
+    assert_eq!(f32_samples(get("R")), red);
+    let z = f32_samples(get("Z"));
+    assert_eq!(z[1], 2.5);
+    assert!(z[0].is_infinite() && z[5].is_infinite());
+    match get("id") {
+        exr::prelude::FlatSamples::U32(ids) => assert_eq!(ids, &f.ids),
+        other => panic!("id is not u32: {other:?}"),
+    }
+    let mut colour_only = f.clone();
+    colour_only.ids.clear();
+    let e = write_aovs_exr(&colour_only, &path).unwrap_err();
+    assert!(e.to_string().contains("depth and ids"), "{e}");
+}
+
+#[test]
+fn ids_preview_colours_are_fixed_visible_and_distinct() {
+    assert_eq!(id_preview_color(0), [0, 0, 0]);
+    let colours: Vec<[u8; 3]> = (1..=255).map(id_preview_color).collect();
+    assert!(colours.iter().all(|c| c.iter().all(|&v| v >= 64)));
+    let distinct: std::collections::HashSet<_> = colours.iter().collect();
+    assert_eq!(distinct.len(), colours.len());
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("p.png");
+    let f = hdr_frame();
+    write_ids_preview_png(&f, &path).unwrap();
+    let img = image::open(&path).unwrap();
+    assert_eq!(img.color(), image::ColorType::Rgb8);
+    let img = img.to_rgb8();
+    assert_eq!(img.get_pixel(0, 0).0, [0, 0, 0]);
+    assert_eq!(img.get_pixel(1, 0).0, id_preview_color(70_000));
+    assert_eq!(img.get_pixel(1, 1).0, id_preview_color(3));
+}
