@@ -217,3 +217,41 @@ fn bad_outputs_are_refused_and_nothing_is_written() {
         .collect();
     assert_eq!(left, ["a.exr"]);
 }
+
+#[test]
+fn animate_writes_float_frames_by_extension() {
+    let dir = TempDir::new().unwrap();
+    let d = dir.path();
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/flexible-animation.toml"
+    );
+    for pattern in ["f_##.exr", "f_##.png"] {
+        let args = [
+            "animate",
+            scene,
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--shading",
+            "flat",
+            "-o",
+            pattern,
+        ];
+        let out = flexcam(d, &args);
+        assert!(out.status.success(), "{out:?}");
+    }
+    let colour = exr_channels(&d.join("f_01.exr"));
+    let png = image::open(d.join("f_01.png")).unwrap().to_rgb8();
+    let rgb = [
+        floats(&colour, "R"),
+        floats(&colour, "G"),
+        floats(&colour, "B"),
+    ];
+    for (i, pixel) in png.pixels().enumerate() {
+        for k in 0..3 {
+            assert_eq!((255.0 * rgb[k][i]).round() as u8, pixel.0[k], "pixel {i}");
+        }
+    }
+}

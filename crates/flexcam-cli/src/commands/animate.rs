@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::Args;
-use flexcam::image_io::{self, ColorEncoding, GifFrames, OutputSet};
+use flexcam::image_io::{self, ColorEncoding, ColorFormat, GifFrames, OutputSet, PngBits};
 use flexcam::projection::ProjectionSpec;
 use flexcam::render::{
     self, Counter, Method, Outputs, PreparedScene, RenderOptions, Shading, Stats,
@@ -24,8 +24,9 @@ use crate::OutputTarget;
 pub struct AnimateArgs {
     /// A scene file (.toml) with an `[animation]` table.
     scene: PathBuf,
-    /// Numbered PNG frames: the run of `#` in the file name becomes the zero-padded frame
-    /// number, from 0 (e.g. `frames/out_####.png`).
+    /// Numbered frames: the run of `#` in the file name becomes the zero-padded frame
+    /// number, from 0 (e.g. `frames/out_####.png`); 8-bit PNG, or linear float `.exr` or
+    /// `.pfm` as `render -o` writes them.
     #[arg(short, long, value_name = "PATTERN")]
     output: Option<PathBuf>,
     /// An animated GIF of all frames.
@@ -62,9 +63,9 @@ struct FramePattern {
 
 impl FramePattern {
     /// Errors: no `#` in the file name, two separate runs of them, an extension other than
-    /// .png, or fewer `#` than the last frame number has digits.
+    /// .png, .exr or .pfm, or fewer `#` than the last frame number has digits.
     fn new(path: &Path, frames: u32) -> Result<Self> {
-        image_io::check_extension(path, &["png"])?;
+        image_io::check_extension(path, &ColorFormat::EXTENSIONS)?;
         let name = path
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
@@ -146,13 +147,17 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         .as_deref()
         .map(|p| FramePattern::new(p, frames))
         .transpose()?;
+    let frame_format = match &pattern {
+        Some(pattern) => ColorFormat::of(&pattern.path(0), PngBits::Eight)?,
+        None => ColorFormat::Png(PngBits::Eight),
+    };
     let frame_outputs = match &pattern {
         Some(pattern) => (0..frames)
             .map(|n| {
                 outputs.output(
                     &format!("frame {n} of the output"),
                     &pattern.path(n),
-                    &["png"],
+                    &ColorFormat::EXTENSIONS,
                 )
             })
             .collect::<Result<Vec<_>>>()?,
@@ -193,7 +198,9 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         warnings.extend(rendered.warnings);
         let frame = rendered.frame;
         if let Some(&id) = frame_outputs.get(frame_number as usize) {
-            outputs.stage(id, |tmp| image_io::write_color_png(&frame, tmp, encoding))?;
+            outputs.stage(id, |tmp| {
+                image_io::write_color(&frame, tmp, frame_format, encoding)
+            })?;
         }
         if let Some(gif) = &mut gif {
             gif.push(&frame, encoding)?;
