@@ -57,6 +57,19 @@ fn floats(channels: &[(String, FlatSamples)], name: &str) -> Vec<f32> {
     }
 }
 
+/// The float channels `R`, `G` and `B` of `channels`.
+fn rgb_of(channels: &[(String, FlatSamples)]) -> [Vec<f32>; 3] {
+    ["R", "G", "B"].map(|name| floats(channels, name))
+}
+
+/// Asserts that the flat (linear 8-bit) PNG `png` holds round(255 * value) of `rgb`.
+fn assert_flat_png_holds(rgb: &[Vec<f32>; 3], png: &image::RgbImage) {
+    for (i, pixel) in png.pixels().enumerate() {
+        let expected = rgb.each_ref().map(|c| (255.0 * c[i]).round() as u8);
+        assert_eq!(pixel.0, expected, "pixel {i}");
+    }
+}
+
 /// The samples of a PFM, row by row from the top, and its channel count.
 fn read_pfm(path: &Path) -> (usize, Vec<f32>) {
     let bytes = fs::read(path).unwrap();
@@ -104,16 +117,8 @@ fn float_colour_and_aovs_agree_with_the_png_outputs() {
     let colour = exr_channels(&d.join("c.exr"));
     let names: Vec<&str> = colour.iter().map(|(n, _)| n.as_str()).collect();
     assert_eq!(names, ["B", "G", "R"]);
-    let rgb = [
-        floats(&colour, "R"),
-        floats(&colour, "G"),
-        floats(&colour, "B"),
-    ];
-    for (i, pixel) in png.pixels().enumerate() {
-        for k in 0..3 {
-            assert_eq!((255.0 * rgb[k][i]).round() as u8, pixel.0[k], "pixel {i}");
-        }
-    }
+    let rgb = rgb_of(&colour);
+    assert_flat_png_holds(&rgb, &png);
     let (channels, pfm) = read_pfm(&d.join("c.PFM"));
     assert_eq!(channels, 3);
     for (i, v) in pfm.iter().enumerate() {
@@ -121,10 +126,10 @@ fn float_colour_and_aovs_agree_with_the_png_outputs() {
     }
     let png16 = image::open(d.join("c16.png")).unwrap().to_rgb16();
     for (i, pixel) in png16.pixels().enumerate() {
-        for k in 0..3 {
-            let expected = (65535.0 * rgb[k][i].clamp(0.0, 1.0)).round() as u16;
-            assert_eq!(pixel.0[k], expected, "pixel {i}");
-        }
+        let expected = rgb
+            .each_ref()
+            .map(|c| (65535.0 * c[i].clamp(0.0, 1.0)).round() as u16);
+        assert_eq!(pixel.0, expected, "pixel {i}");
     }
 
     let aovs = exr_channels(&d.join("aovs.exr"));
@@ -244,14 +249,6 @@ fn animate_writes_float_frames_by_extension() {
     }
     let colour = exr_channels(&d.join("f_01.exr"));
     let png = image::open(d.join("f_01.png")).unwrap().to_rgb8();
-    let rgb = [
-        floats(&colour, "R"),
-        floats(&colour, "G"),
-        floats(&colour, "B"),
-    ];
-    for (i, pixel) in png.pixels().enumerate() {
-        for k in 0..3 {
-            assert_eq!((255.0 * rgb[k][i]).round() as u8, pixel.0[k], "pixel {i}");
-        }
-    }
+    let rgb = rgb_of(&colour);
+    assert_flat_png_holds(&rgb, &png);
 }
