@@ -9,31 +9,21 @@ use std::path::Path;
 use exr::prelude::FlatSamples;
 use tempfile::TempDir;
 
-fn flexcam(folder: &Path, args: &[&str]) -> std::process::Output {
-    assert_cmd::Command::cargo_bin("flexcam")
-        .unwrap()
-        .current_dir(folder)
-        .args(args)
-        .output()
-        .unwrap()
-}
+mod common;
+use common::{run, run_ok};
 
-fn render_ok(folder: &Path, outputs: &[&str]) {
-    let args = [
-        &[
-            "render",
-            "--width",
-            "32",
-            "--height",
-            "24",
-            "--shading",
-            "flat",
-        ][..],
-        outputs,
-    ]
-    .concat();
-    let out = flexcam(folder, &args);
-    assert!(out.status.success(), "{args:?}: {out:?}");
+/// Renders the default scene, 32 x 24, flat, to `outputs` in `dir`.
+fn render_ok(dir: &TempDir, outputs: &[&str]) {
+    let small = [
+        "render",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--shading",
+        "flat",
+    ];
+    run_ok(dir, &[&small[..], outputs].concat());
 }
 
 /// The channels of the EXR at `path` (one layer of 32 x 24 pixels), sorted by name.
@@ -97,7 +87,7 @@ fn float_colour_and_aovs_agree_with_the_png_outputs() {
     let dir = TempDir::new().unwrap();
     let d = dir.path();
     render_ok(
-        d,
+        &dir,
         &[
             "-o",
             "c.png",
@@ -109,9 +99,9 @@ fn float_colour_and_aovs_agree_with_the_png_outputs() {
             "p.png",
         ],
     );
-    render_ok(d, &["-o", "c.exr", "--aovs", "aovs.exr"]);
-    render_ok(d, &["-o", "c.PFM"]);
-    render_ok(d, &["-o", "c16.png", "--png-bits", "16"]);
+    render_ok(&dir, &["-o", "c.exr", "--aovs", "aovs.exr"]);
+    render_ok(&dir, &["-o", "c.PFM"]);
+    render_ok(&dir, &["-o", "c16.png", "--png-bits", "16"]);
 
     let png = image::open(d.join("c.png")).unwrap().to_rgb8();
     let colour = exr_channels(&d.join("c.exr"));
@@ -166,8 +156,8 @@ fn bad_outputs_are_refused_and_nothing_is_written() {
     let dir = TempDir::new().unwrap();
     let d = dir.path();
     let refused = |args: &[&str], expected: &str| {
-        let out = flexcam(
-            d,
+        let out = run(
+            &dir,
             &[&["render", "--width", "8", "--height", "8"][..], args].concat(),
         );
         let stderr = String::from_utf8_lossy(&out.stderr);
@@ -197,8 +187,8 @@ fn bad_outputs_are_refused_and_nothing_is_written() {
 
     // The AOV path is a folder: the colour and preview outputs are not written either.
     fs::create_dir_all(d.join("a.exr/inside")).unwrap();
-    let out = flexcam(
-        d,
+    let out = run(
+        &dir,
         &[
             "render",
             "--width",
@@ -244,8 +234,7 @@ fn animate_writes_float_frames_by_extension() {
             "-o",
             pattern,
         ];
-        let out = flexcam(d, &args);
-        assert!(out.status.success(), "{out:?}");
+        run_ok(&dir, &args);
     }
     let colour = exr_channels(&d.join("f_01.exr"));
     let png = image::open(d.join("f_01.png")).unwrap().to_rgb8();

@@ -9,10 +9,14 @@ use crate::render::Frame;
 
 /// Writes the colour of `frame` as an 8-bit RGB PNG at `path`.
 pub fn write_color_png(frame: &Frame, path: &Path, encoding: ColorEncoding) -> Result<()> {
-    let bytes = rgb_bytes(frame, encoding);
+    write_rgb8_png(frame, path, &rgb_bytes(frame, encoding))
+}
+
+/// Writes `bytes`, 8-bit RGB of the size of `frame`, as a PNG at `path`.
+fn write_rgb8_png(frame: &Frame, path: &Path, bytes: &[u8]) -> Result<()> {
     image::save_buffer_with_format(
         path,
-        &bytes,
+        bytes,
         frame.width,
         frame.height,
         image::ExtendedColorType::Rgb8,
@@ -64,13 +68,5 @@ pub fn write_ids_preview_png(frame: &Frame, path: &Path) -> Result<()> {
         .iter()
         .flat_map(|&id| id_preview_color(id))
         .collect();
-    image::save_buffer_with_format(
-        path,
-        &bytes,
-        frame.width,
-        frame.height,
-        image::ExtendedColorType::Rgb8,
-        image::ImageFormat::Png,
-    )
-    .map_err(|e| Error::new(format!("cannot write PNG: {e}")))
+    write_rgb8_png(frame, path, &bytes)
 }
