@@ -58,7 +58,7 @@ pub(super) fn convert(
     }
     let mut keys: Vec<Keyframe> = Vec::with_capacity(raw.key.len());
     for (index, key) in raw.key.iter().enumerate() {
-        let keyframe = keyframe(src, key.get_ref(), base_dir)?;
+        let keyframe = keyframe(src, key.get_ref(), base_dir, image)?;
         let time = &key.get_ref().time;
         if keyframe.time < 0.0 {
             return Err(src.error(
@@ -104,9 +104,15 @@ pub(super) fn convert(
 }
 
 /// One key: its time and its projection, which must be flexible.
-fn keyframe(src: &Source, key: &RawKey, base_dir: &Path) -> Result<Keyframe> {
+fn keyframe(
+    src: &Source,
+    key: &RawKey,
+    base_dir: &Path,
+    image: &ImageSettings,
+) -> Result<Keyframe> {
     let time = src.number(&key.time, "time")?;
-    match super::projection::convert(src, &key.projection, base_dir)? {
+    let image_size = [image.width, image.height];
+    match super::projection::convert(src, &key.projection, base_dir, image_size)? {
         ProjectionSpec::Flexible(projection) => Ok(Keyframe {
             time,
             projection: *projection,

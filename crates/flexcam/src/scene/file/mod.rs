@@ -5,6 +5,7 @@
 //! TOML syntax error to a degenerate projection, is one line `FILE:LINE:COLUMN: message`.
 
 mod animation;
+mod calibrated_projection;
 mod control_surface;
 mod displacement;
 mod fitted_grid;
@@ -94,7 +95,12 @@ pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animatio
         .projection
         .as_ref()
         .ok_or_else(|| src.file_error("missing [projection] table: a scene needs exactly one"))?;
-    let projection = projection::convert(&src, projection_table, &base_dir)?;
+    let projection = projection::convert(
+        &src,
+        projection_table,
+        &base_dir,
+        [image.width, image.height],
+    )?;
     check_unique_names(&src, &raw.object)?;
     let mut objects = Vec::new();
     let mut trilinear_reflectors = Vec::new();

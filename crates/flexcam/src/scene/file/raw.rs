@@ -116,6 +116,13 @@ pub struct RawProjection {
     pub profile: Option<Spanned<RawCurve>>,
     pub profiles: Option<Spanned<Vec<Spanned<RawCurve>>>>,
     pub perspective_rect: Option<Spanned<[f64; 4]>>,
+    pub fx: Option<Spanned<f64>>,
+    pub fy: Option<Spanned<f64>>,
+    pub cx: Option<Spanned<f64>>,
+    pub cy: Option<Spanned<f64>>,
+    pub distortion: Option<Spanned<Vec<f64>>>,
+    pub k: Option<Spanned<Vec<f64>>>,
+    pub calibration_size: Option<Spanned<[u32; 2]>>,
 }
 
 /// `outline = { ... }`, `profile`, and the entries of `outlines` / `profiles` (with `at`): a
@@ -335,6 +342,16 @@ impl RawProjection {
             ("directions", self.directions.as_ref().map(Spanned::span)),
             ("center", self.center.as_ref().map(Spanned::span)),
             ("radius", self.radius.as_ref().map(Spanned::span)),
+            ("fx", self.fx.as_ref().map(Spanned::span)),
+            ("fy", self.fy.as_ref().map(Spanned::span)),
+            ("cx", self.cx.as_ref().map(Spanned::span)),
+            ("cy", self.cy.as_ref().map(Spanned::span)),
+            ("distortion", self.distortion.as_ref().map(Spanned::span)),
+            ("k", self.k.as_ref().map(Spanned::span)),
+            (
+                "calibration_size",
+                self.calibration_size.as_ref().map(Spanned::span),
+            ),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))
