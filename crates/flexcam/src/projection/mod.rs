@@ -11,6 +11,8 @@
 mod build;
 mod build_report;
 mod calibrated;
+#[cfg(test)]
+mod calibrated_properties;
 mod camera_basis;
 pub mod chart;
 mod fisheye;
