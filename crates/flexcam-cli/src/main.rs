@@ -50,6 +50,10 @@ enum Command {
     /// turn no face by more than a threshold angle, and write the coarse mesh (OBJ).
     #[command(after_help = OUTPUTS_HELP)]
     Simplify(commands::simplify::SimplifyArgs),
+    /// Convert a COLMAP cameras.txt into scene projection tables (`opencv`, `opencv_fisheye`),
+    /// one per camera, as TOML.
+    #[command(after_help = OUTPUTS_HELP)]
+    ImportCameras(commands::import_cameras::ImportCamerasArgs),
     /// Rerun a source document's timing table with flexcam's renderers.
     #[command(subcommand)]
     Bench(commands::bench::BenchCommand),
@@ -68,6 +72,7 @@ fn main() -> ExitCode {
         Command::Scenes => commands::scenes::run(),
         Command::Compare(args) => commands::compare::run(&args),
         Command::Simplify(args) => commands::simplify::run(&args),
+        Command::ImportCameras(args) => commands::import_cameras::run(&args),
         Command::Bench(command) => commands::bench::run(&command),
     };
     match result {

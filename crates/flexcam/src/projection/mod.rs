@@ -15,6 +15,7 @@ mod calibrated;
 mod calibrated_properties;
 mod camera_basis;
 pub mod chart;
+pub mod colmap;
 mod fisheye;
 pub mod flexible;
 mod image_coords;

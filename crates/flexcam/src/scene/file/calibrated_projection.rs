@@ -87,3 +87,68 @@ fn camera(required: &Required, image_size: [u32; 2]) -> Result<CalibratedCamera>
         size,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use std::path::Path;
+
+    use super::super::parse;
+    use super::super::tests::assert_error_at;
+    use crate::projection::{CalibrationSize, ProjectionSpec};
+
+    fn scene(projection_keys: &str) -> String {
+        format!(
+            "[image]\nwidth = 64\nheight = 48\n[projection]\nposition = [0, 1, 5]\n\
+             look_at = [0, 1, 0]\nfx = 60\nfy = 61\ncx = 31.5\ncy = 23.5\n{projection_keys}"
+        )
+    }
+
+    #[test]
+    fn opencv_keys_and_defaults() {
+        let text = scene("type = \"opencv\"\ndistortion = [-0.1, 0.01, 0.001, 0.002, 0.003]\n");
+        let parsed = parse(&text, Path::new("s.toml")).unwrap();
+        let ProjectionSpec::Opencv { camera, distortion } = parsed.projection else {
+            panic!("{:?}", parsed.projection)
+        };
+        assert_eq!(distortion, [-0.1, 0.01, 0.001, 0.002, 0.003, 0.0, 0.0, 0.0]);
+        assert_eq!(camera.intrinsics.fy, 61.0);
+        assert_eq!(camera.size, CalibrationSize::SceneImage([64, 48]));
+        let text = scene("type = \"opencv_fisheye\"\ncalibration_size = [640, 480]\n");
+        let parsed = parse(&text, Path::new("s.toml")).unwrap();
+        let ProjectionSpec::OpencvFisheye { camera, k } = parsed.projection else {
+            panic!("{:?}", parsed.projection)
+        };
+        assert_eq!(k, [0.0; 4]);
+        assert_eq!(camera.size, CalibrationSize::Given([640, 480]));
+    }
+
+    #[test]
+    fn bad_calibrated_keys_are_refused_at_their_place() {
+        assert_error_at(
+            &scene("type = \"opencv\"\ndistortion = [0.1, 0.2, 0.3]\n"),
+            12,
+            14,
+            "`distortion` needs 4, 5 or 8 coefficients",
+        );
+        assert_error_at(
+            &scene("type = \"opencv_fisheye\"\nk = [0.1, 0.2]\n"),
+            12,
+            5,
+            "`k` needs 4 coefficients",
+        );
+        assert_error_at(
+            &scene("type = \"opencv\"\nk = [0.1, 0.2, 0.0, 0.0]\n"),
+            12,
+            1,
+            "k",
+        );
+        assert_error_at(
+            &scene("type = \"opencv\"\nfx = -3\n").replace("fx = 60\n", ""),
+            4,
+            1,
+            "opencv fx must be a positive focal length in pixels, got -3",
+        );
+        let missing = scene("type = \"opencv\"\n").replace("cy = 23.5\n", "");
+        assert_error_at(&missing, 4, 1, "opencv projection needs `cy`");
+    }
+}
