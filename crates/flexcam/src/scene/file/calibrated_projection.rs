@@ -139,8 +139,8 @@ mod tests {
         assert_error_at(
             &scene("type = \"opencv\"\nk = [0.1, 0.2, 0.0, 0.0]\n"),
             12,
-            1,
-            "k",
+            5,
+            "`k` is not a parameter of opencv projections",
         );
         assert_error_at(
             &scene("type = \"opencv\"\nfx = -3\n").replace("fx = 60\n", ""),
