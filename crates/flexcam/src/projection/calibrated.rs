@@ -47,7 +47,7 @@ pub struct CalibratedCamera {
 
 /// A calibrated camera bound to an image: the basis, and the intrinsics scaled to the image
 /// in flexcam's pixel convention (pixel centres at +0.5).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct BoundCamera {
     pub basis: CameraBasis,
     pub resolution: Resolution,
