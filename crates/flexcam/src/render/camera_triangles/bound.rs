@@ -28,7 +28,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::camera::{Camera, CORNERS};
+use super::camera::{Camera, CameraPlane, CORNERS};
 use super::convex::{cross, Convex};
 use crate::render::trilinear::plane_hit;
 
@@ -71,7 +71,10 @@ impl std::str::FromStr for Bound {
 pub fn regions(camera: &Camera, q: &[DVec3; 3], bound: Bound, emit: &mut impl FnMut(&Convex)) {
     match bound {
         Bound::Paper => paper(camera, q, emit),
-        Bound::Tight => tight(camera, q, CORNERS, 0, emit),
+        Bound::Tight => {
+            let plane = camera.plane_near((q[0] + q[1] + q[2]) / 3.0);
+            tight(camera, plane.as_ref(), q, CORNERS, 0, emit)
+        }
     }
 }
 
@@ -80,14 +83,18 @@ pub fn regions(camera: &Camera, q: &[DVec3; 3], bound: Bound, emit: &mut impl Fn
 /// for a box (its eight corners) or a triangle. `false` where no hull bounds the region.
 pub fn misses(camera: &Camera, points: &[DVec3]) -> bool {
     let directions = CORNERS.map(|c| camera.direction(c));
-    if !camera.one_sided(&directions) {
+    let centre = points.iter().sum::<DVec3>() / points.len().max(1) as f64;
+    let Some(plane) = camera
+        .plane_near(centre)
+        .filter(|p| p.one_sided(&directions))
+    else {
         return false;
-    }
+    };
     let mut projected = [DVec2::ZERO; 24];
     let mut n = 0;
     for &q in points.iter().take(8) {
         for &d in &directions {
-            match camera.project_along(q, d).and_then(near) {
+            match plane.project_along(q, d).and_then(near) {
                 Some(p) => projected[n] = p,
                 None => return false,
             }
@@ -125,11 +132,11 @@ const FAR: f64 = 1e6;
 
 /// The nine projections `p_ij` of the corners `q` along `directions` (`None` if one is
 /// parallel to the plane or beyond [`FAR`]).
-fn nine(camera: &Camera, q: &[DVec3; 3], directions: &[DVec3; 3]) -> Option<[DVec2; 9]> {
+fn nine(plane: &CameraPlane, q: &[DVec3; 3], directions: &[DVec3; 3]) -> Option<[DVec2; 9]> {
     let mut out = [DVec2::ZERO; 9];
     for (i, &qi) in q.iter().enumerate() {
         for (j, &d) in directions.iter().enumerate() {
-            out[3 * i + j] = near(camera.project_along(qi, d)?)?;
+            out[3 * i + j] = near(plane.project_along(qi, d)?)?;
         }
     }
     Some(out)
@@ -144,10 +151,12 @@ fn near(p: DVec2) -> Option<DVec2> {
 fn paper(camera: &Camera, q: &[DVec3; 3], emit: &mut impl FnMut(&Convex)) {
     let directions = CORNERS.map(|c| camera.direction(c));
     let triangle = camera
-        .one_sided(&directions)
-        .then(|| nine(camera, q, &directions))
-        .flatten()
-        .and_then(|points| bounding_triangle(camera, &directions, &points));
+        .plane()
+        .filter(|plane| plane.one_sided(&directions))
+        .and_then(|plane| {
+            let points = nine(plane, q, &directions)?;
+            bounding_triangle(plane, &directions, &points)
+        });
     let Some(triangle) = triangle else {
         return emit_in_camera(camera, &Convex::from_points(&CORNERS), emit);
     };
@@ -173,7 +182,7 @@ fn paper(camera: &Camera, q: &[DVec3; 3], emit: &mut impl FnMut(&Convex)) {
 /// `directions` (in the camera plane), or to the camera triangle's edges in the singular
 /// cases; `None` for non-finite results.
 fn bounding_triangle(
-    camera: &Camera,
+    plane: &CameraPlane,
     directions: &[DVec3; 3],
     points: &[DVec2; 9],
 ) -> Option<[DVec2; 3]> {
@@ -183,7 +192,7 @@ fn bounding_triangle(
     // far side of the region from the opposite edge), or the camera edge's own.
     let lines: Option<[DVec2; 3]> = (0..3)
         .map(|k| {
-            let g = camera.in_plane_covector(directions[k])?;
+            let g = plane.in_plane_covector(directions[k])?;
             Some(if g.dot(CORNERS[k] - centroid) < 0.0 {
                 -g
             } else {
@@ -233,6 +242,7 @@ fn encloses(g: [DVec2; 3]) -> bool {
 /// The tight bound on the sub-triangle `sub` of the camera triangle (module doc).
 fn tight(
     camera: &Camera,
+    plane: Option<&CameraPlane>,
     q: &[DVec3; 3],
     sub: [DVec2; 3],
     depth: u32,
@@ -240,13 +250,12 @@ fn tight(
 ) {
     let whole = Convex::from_points(&sub).clip_to_triangle(CORNERS);
     let directions = sub.map(|c| camera.direction(c));
-    let region = if camera.one_sided(&directions) {
-        match nine(camera, q, &directions) {
+    let region = match plane.filter(|p| p.one_sided(&directions)) {
+        Some(plane) => match nine(plane, q, &directions) {
             Some(points) => Convex::hull(&points).clip_to_triangle(sub),
             None => whole,
-        }
-    } else {
-        whole
+        },
+        None => whole,
     };
     if region.points().len() < 3 {
         return;
@@ -265,7 +274,7 @@ fn tight(
     let [a, b, c] = sub;
     let (ab, bc, ca) = ((a + b) / 2.0, (b + c) / 2.0, (c + a) / 2.0);
     for quarter in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]] {
-        tight(camera, q, quarter, depth + 1, emit);
+        tight(camera, plane, q, quarter, depth + 1, emit);
     }
 }
 
