@@ -28,7 +28,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::camera::{Camera, CameraPlane, CORNERS};
+use super::camera::{AlongDirection, Camera, CameraPlane, CORNERS};
 use super::convex::{cross, Convex};
 use crate::render::trilinear::plane_hit;
 
@@ -90,11 +90,14 @@ pub fn misses(camera: &Camera, points: &[DVec3]) -> bool {
     else {
         return false;
     };
+    let Some(along) = alongs(&plane, &directions) else {
+        return false;
+    };
     let mut projected = [DVec2::ZERO; 24];
     let mut n = 0;
     for &q in points.iter().take(8) {
-        for &d in &directions {
-            match plane.project_along(q, d).and_then(near) {
+        for a in &along {
+            match near(a.project(q)) {
                 Some(p) => projected[n] = p,
                 None => return false,
             }
@@ -133,13 +136,23 @@ const FAR: f64 = 1e6;
 /// The nine projections `p_ij` of the corners `q` along `directions` (`None` if one is
 /// parallel to the plane or beyond [`FAR`]).
 fn nine(plane: &CameraPlane, q: &[DVec3; 3], directions: &[DVec3; 3]) -> Option<[DVec2; 9]> {
+    let along = alongs(plane, directions)?;
     let mut out = [DVec2::ZERO; 9];
     for (i, &qi) in q.iter().enumerate() {
-        for (j, &d) in directions.iter().enumerate() {
-            out[3 * i + j] = near(plane.project_along(qi, d)?)?;
+        for (j, a) in along.iter().enumerate() {
+            out[3 * i + j] = near(a.project(qi))?;
         }
     }
     Some(out)
+}
+
+/// The projections along each of `directions` (`None` if one is parallel to the plane).
+fn alongs(plane: &CameraPlane, directions: &[DVec3; 3]) -> Option<[AlongDirection; 3]> {
+    Some([
+        plane.along(directions[0])?,
+        plane.along(directions[1])?,
+        plane.along(directions[2])?,
+    ])
 }
 
 /// `p` unless it is beyond [`FAR`] or not finite.
@@ -248,27 +261,17 @@ fn tight(
     depth: u32,
     emit: &mut impl FnMut(&Convex),
 ) {
-    let whole = Convex::from_points(&sub).clip_to_triangle(CORNERS);
     let directions = sub.map(|c| camera.direction(c));
-    let region = match plane.filter(|p| p.one_sided(&directions)) {
-        Some(plane) => match nine(plane, q, &directions) {
-            Some(points) => Convex::hull(&points).clip_to_triangle(sub),
-            None => whole,
-        },
-        None => whole,
-    };
+    let region = plane
+        .filter(|p| p.one_sided(&directions))
+        .and_then(|plane| nine(plane, q, &directions))
+        .map(|points| Convex::hull(&points).clip_to_triangle(sub))
+        .unwrap_or_else(|| Convex::from_points(&sub).clip_to_triangle(CORNERS));
     if region.points().len() < 3 {
         return;
     }
     let pixels = region.area() * camera.pixels_per_area;
-    // Where the rays at the corners and centre all hit the scene triangle, it (nearly)
-    // covers the sub-triangle: quarters would all be kept.
-    let centre = (sub[0] + sub[1] + sub[2]) / 3.0;
-    let covered = [sub[0], sub[1], sub[2], centre].iter().all(|&b| {
-        plane_hit(&camera.ray_at(b), *q)
-            .is_some_and(|(t, u, v)| t >= 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0)
-    });
-    if depth >= MAX_DEPTH || pixels < MIN_SPLIT_PIXELS || covered {
+    if depth >= MAX_DEPTH || pixels < MIN_SPLIT_PIXELS || covers(camera, q, sub) {
         return emit_in_camera(camera, &region, emit);
     }
     let [a, b, c] = sub;
@@ -276,6 +279,16 @@ fn tight(
     for quarter in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]] {
         tight(camera, plane, q, quarter, depth + 1, emit);
     }
+}
+
+/// Whether the rays at the corners and centre of `sub` all hit the scene triangle `q`: then
+/// it (nearly) covers the sub-triangle, and quarters would all be kept.
+fn covers(camera: &Camera, q: &[DVec3; 3], sub: [DVec2; 3]) -> bool {
+    let centre = (sub[0] + sub[1] + sub[2]) / 3.0;
+    [sub[0], sub[1], sub[2], centre].iter().all(|&b| {
+        plane_hit(&camera.ray_at(b), *q)
+            .is_some_and(|(t, u, v)| t >= 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0)
+    })
 }
 
 /// Emits a region given in barycentrics inside the camera triangle, in pixels.

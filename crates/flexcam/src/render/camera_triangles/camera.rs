@@ -56,6 +56,25 @@ pub struct CameraPlane {
     normal: DVec3,
 }
 
+/// The projection of points along one direction onto a [`CameraPlane`], in its
+/// barycentrics: affine in the point, so set up once per direction.
+#[derive(Debug, Clone, Copy)]
+pub struct AlongDirection {
+    origin: DVec3,
+    u: DVec3,
+    v: DVec3,
+}
+
+impl AlongDirection {
+    /// The barycentrics of the point where the line through `q` along the direction meets
+    /// the plane.
+    #[inline]
+    pub fn project(&self, q: DVec3) -> DVec2 {
+        let r = q - self.origin;
+        DVec2::new(r.dot(self.u), r.dot(self.v))
+    }
+}
+
 impl CameraPlane {
     /// The plane through `p`, `None` when the three points (nearly) lie on a line or
     /// (nearly) coincide: its longest side below [`FLAT_SINE`] of the points' magnitude, or
@@ -103,18 +122,15 @@ impl CameraPlane {
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// The barycentrics of the point where the line through `q` along `d` meets the plane
-    /// (`None` for `d` parallel to it).
+    /// The projection along `d` onto the plane (`None` for `d` parallel to it).
     #[inline]
-    pub fn project_along(&self, q: DVec3, d: DVec3) -> Option<DVec2> {
+    pub fn along(&self, d: DVec3) -> Option<AlongDirection> {
         let det = self.normal.dot(d);
-        if det == 0.0 {
-            return None;
-        }
-        let r = q - self.origin;
-        let u = r.dot(self.e2.cross(d)) / det;
-        let v = self.e1.dot(r.cross(d)) / det;
-        Some(DVec2::new(u, v))
+        (det != 0.0).then(|| AlongDirection {
+            origin: self.origin,
+            u: self.e2.cross(d) / det,
+            v: d.cross(self.e1) / det,
+        })
     }
 
     /// The in-plane component of `d` as a linear function on barycentrics: the covector
@@ -194,11 +210,11 @@ impl PlaneChoices {
     /// The choice nearest `s` in ratio (the smallest for `s <= 0`), `None` if there is none.
     fn nearest(&self, s: f64) -> Option<f64> {
         let choices = &self.s[..self.len];
-        let target = if s > 0.0 { s.ln() } else { f64::NEG_INFINITY };
-        choices
-            .iter()
-            .copied()
-            .min_by(|a, b| (a.ln() - target).abs().total_cmp(&(b.ln() - target).abs()))
+        let above = choices.partition_point(|&c| c < s);
+        match (above.checked_sub(1).map(|i| choices[i]), choices.get(above)) {
+            (Some(below), Some(&above)) => Some(if s * s <= below * above { below } else { above }),
+            (below, above) => below.or(above.copied()),
+        }
     }
 }
 
