@@ -80,17 +80,23 @@ pub fn regions(camera: &Camera, q: &[DVec3; 3], bound: Bound, emit: &mut impl Fn
 
 /// Whether the convex hull of `points` projected along the corner directions misses the
 /// camera triangle (so nothing inside that hull is seen by it): the culling of section 2.4
-/// for a box (its eight corners) or a triangle. `false` where no hull bounds the region.
+/// for a box (its eight corners) or a triangle, on the plane near the points and on the
+/// camera plane (either hull that misses proves it). `false` where no hull bounds the region.
 pub fn misses(camera: &Camera, points: &[DVec3]) -> bool {
     let directions = CORNERS.map(|c| camera.direction(c));
     let centre = points.iter().sum::<DVec3>() / points.len().max(1) as f64;
-    let Some(plane) = camera
-        .plane_near(centre)
-        .filter(|p| p.one_sided(&directions))
-    else {
+    [camera.plane_near(centre).as_ref(), camera.plane()]
+        .into_iter()
+        .flatten()
+        .any(|plane| misses_on(plane, &directions, points))
+}
+
+/// [`misses`] on one plane.
+fn misses_on(plane: &CameraPlane, directions: &[DVec3; 3], points: &[DVec3]) -> bool {
+    if !plane.one_sided(directions) {
         return false;
-    };
-    let Some(along) = alongs(&plane, &directions) else {
+    }
+    let Some(along) = alongs(plane, directions) else {
         return false;
     };
     let mut projected = [DVec2::ZERO; 24];
@@ -106,8 +112,7 @@ pub fn misses(camera: &Camera, points: &[DVec3]) -> bool {
     }
     // Conservative: a miss is reported only where a line separates the points from the
     // camera triangle (one of its edges, or an axis of its bounding box).
-    let points = &projected[..n];
-    separated(points, CORNERS)
+    separated(&projected[..n], CORNERS)
 }
 
 /// Whether some edge of triangle `t` or an axis has all `points` strictly outside.

@@ -321,3 +321,44 @@ fn reflectors_composite_as_the_trilinear_method_does() {
         }
     }
 }
+
+/// The applications' scenes (convex, concave and mixed reflectors, a single curved
+/// refraction) by camera triangles against the ray caster's exact mirror or glass (the same
+/// scene without trilinear reflectors): object ids away from id edges, and the relative RGB
+/// error, which is that of the reflector surfaces' interpolated rays.
+#[test]
+fn application_scenes_match_the_exact_ray_caster() {
+    for (name, max_rgb) in [
+        ("camtri-convex", 0.05),
+        ("camtri-concave", 0.05),
+        ("camtri-mixed", 0.05),
+        ("camtri-refract", 0.05),
+    ] {
+        let scene = load(name);
+        let main = scene.projection.build(160, 120).unwrap();
+        let ours = crate::render::render(
+            &PreparedScene::new(&scene),
+            main.as_ref(),
+            &options(Shading::Flat, Bound::Tight),
+        )
+        .unwrap();
+        let mut exact = scene.clone();
+        exact.trilinear_reflectors.clear();
+        let reference = crate::render::render(
+            &PreparedScene::new(&exact),
+            main.as_ref(),
+            &RenderOptions {
+                method: Method::Raycast,
+                shading: Shading::Flat,
+                ..RenderOptions::default()
+            },
+        )
+        .unwrap();
+        let inside = id_agreement_inside(&ours.frame, &reference.frame);
+        let c = compare(&ours.frame, &reference.frame).unwrap();
+        println!("{name}: ids inside {inside:.5}, {c:?}");
+        assert!(inside >= 0.99, "{name}: {inside}");
+        assert!(c.relative_rgb_error < max_rgb, "{name}: {c:?}");
+        assert!(count(&ours.counters, "rendered_fragments") > 0, "{name}");
+    }
+}
