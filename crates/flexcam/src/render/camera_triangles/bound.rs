@@ -16,8 +16,11 @@
 //!   three lines do not enclose a triangle. It is rasterised clipped to the camera triangle's
 //!   pixel rectangle (the paper's viewport; with a projective screen map, to the camera
 //!   triangle itself, where the map has no pole).
-//! - [`Bound::Tight`]: the convex hull of the nine points clipped to the camera triangle, and
-//!   where that region is still large, the same on each quarter of the camera triangle
+//! - [`Bound::Tight`]: the convex hull of the nine points clipped to the camera triangle, the
+//!   points projected onto the camera triangle's plane along its rays nearest the scene
+//!   triangle ([`Camera::plane_near`]: the argument holds on every plane of the points a
+//!   fixed distance along the rays, and projecting onto a plane near the points moves them
+//!   little, however much the rays diverge), and where that region is still large, the same on each quarter of the camera triangle
 //!   (recursively): a quarter is itself a camera triangle (its corner rays are interpolated
 //!   rays of the parent), so the argument holds for it, and its narrower cone of directions
 //!   gives a smaller hull. The union of the quarters' regions holds every fragment.

@@ -10,7 +10,11 @@
 //! triangle has collapsed (a pinhole's base points all at the eye), the triangle of the
 //! points one ray length along the rays: the ray at `(u, v)` is the same line either way
 //! (`tripoint + s trinorm` is affine in `(u, v)` for any fixed `s`), so a bound computed on
-//! either plane holds for the camera's rays.
+//! either plane holds for the camera's rays. For the same reason any plane of the points `s`
+//! along the rays serves ([`CameraPlane`], [`Camera::plane_at`]); where the rays diverge the
+//! base plane may be crossed by them from both sides (rays grazing a mirror), while farther
+//! along them their cone crosses the plane from one side, so each camera keeps the distances
+//! whose planes it crosses steeply and a bound picks the one nearest its scene points.
 
 use glam::{DVec2, DVec3};
 
