@@ -329,10 +329,10 @@ fn reflectors_composite_as_the_trilinear_method_does() {
 #[test]
 fn application_scenes_match_the_exact_ray_caster() {
     for (name, max_rgb) in [
-        ("camtri-convex", 0.05),
-        ("camtri-concave", 0.05),
-        ("camtri-mixed", 0.05),
-        ("camtri-refract", 0.05),
+        ("camtri-convex", 0.02),
+        ("camtri-concave", 0.02),
+        ("camtri-mixed", 0.02),
+        ("camtri-refract", 0.02),
     ] {
         let scene = load(name);
         let main = scene.projection.build(160, 120).unwrap();
