@@ -7,6 +7,7 @@ use glam::Vec3;
 
 use super::{extension, srgb_decode};
 use crate::error::{Error, Result};
+use crate::file_read::{check_regular, MAX_DATA_FILE_BYTES};
 
 pub use crate::render::LinearImage;
 
@@ -15,8 +16,10 @@ pub const INPUT_EXTENSIONS: [&str; 4] = ["png", "jpg", "jpeg", "exr"];
 
 /// Reads a PNG or JPEG (sRGB-encoded: decoded to linear) or an OpenEXR file (linear; its
 /// first layer's R, G and B, alpha ignored). Errors (each one line naming the file): an
-/// unsupported extension, a missing or unreadable file, an image of zero width or height.
+/// unsupported extension, a missing or unreadable file, one that is not a regular file (a
+/// FIFO would block), an image of zero width or height.
 pub fn read_linear_image(path: &Path) -> Result<LinearImage> {
+    check_regular(path, "image", MAX_DATA_FILE_BYTES)?;
     let ext = extension(path);
     let image = match ext.as_str() {
         "png" | "jpg" | "jpeg" => read_srgb_image(path),
