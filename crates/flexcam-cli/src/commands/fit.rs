@@ -36,9 +36,6 @@ pub fn run(args: &FitArgs) -> Result<()> {
     })?;
     outputs.commit()?;
     let r = fitted.report;
-    if let Some(warning) = r.warning() {
-        eprintln!("flexcam: warning: {}: {warning}", args.scene.display());
-    }
     super::print_stdout(&format!(
         "fitted {} correspondences ({} nodes unconstrained): residual max {:e} degrees, rms \
          {:e} degrees, {}; wrote {}\n",
@@ -49,5 +46,9 @@ pub fn run(args: &FitArgs) -> Result<()> {
         r.model(),
         args.output.display()
     ))?;
+    // The warning only once the command has succeeded: a failing command prints one line.
+    if let Some(warning) = r.warning() {
+        eprintln!("flexcam: warning: {}: {warning}", args.scene.display());
+    }
     Ok(())
 }
