@@ -405,6 +405,23 @@ fn messages_name_the_argument_and_the_file() {
         &dir,
         |j| j.replacen("\"uri\": \"m.bin\"", "\"uri\": \"gone.bin\"", 1),
         "buffer 0: \"gone.bin\" is not a file (looked for gone.bin)",
+    );    // A NaN ray in a trilinear surface: at the OBJ's line, not the scene's table.
+    write(
+        &dir,
+        "s.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nvn 0 nan 1\n\
+         f 1/1/1 2/2/1 3/3/2\n",
+    );
+    write(
+        &dir,
+        "trilinear.toml",
+        "[projection]\ntype = \"trilinear\"\nsurface = \"s.obj\"\n",
+    );
+    refused(
+        &dir,
+        &["render", "trilinear.toml", "-o", "out.png"],
+        1,
+        "flexcam: s.obj:8:1: `vn` value nan is not a finite number",
     );
 }
 

@@ -19,6 +19,7 @@ use super::{InputFile, Material, Mesh};
 use crate::error::{Error, Result};
 use crate::file_read::{read_regular, MAX_DATA_FILE_BYTES};
 
+pub use obj_lines::check_obj_file;
 pub use texture::load_texture;
 
 /// One part of a loaded model: a mesh and the material the file gives it, if any.

@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
-use super::obj_lines::{check_face_references, check_mtl_values};
+use super::obj_lines::{check_face_references, check_finite_numbers, check_mtl_values};
 use super::{load_texture, read_file, Model, ModelPart};
 use crate::error::{Error, Result};
 use crate::scene::{Finish, InputFile, Material, Mesh, Pattern, Texture};
@@ -25,6 +25,7 @@ struct MtlLibrary {
 /// A named MTL that is missing or malformed is an error, as is a file with no faces.
 pub(super) fn load_obj(path: &Path) -> Result<Model> {
     let data = read_file(path)?;
+    check_finite_numbers(path, &data)?;
     check_face_references(path, &data)?;
     let dir = path.parent().unwrap_or(Path::new(""));
     let libraries = RefCell::new(Vec::new());

@@ -1,11 +1,42 @@
 //! Line checks of OBJ and MTL text that tobj does not make: it drops a face's texture
 //! coordinate or normal reference when the file has none of that kind (so `f 1/1 2/2 3/3`
 //! in a file without `vt` loads without texture coordinates), and it reads `nan` and
-//! negative colours as they are. Both are errors here, at their line.
+//! negative colours as they are. All are errors here, at their line.
 
 use std::path::Path;
 
+use super::read_file;
 use crate::error::{Error, Result};
+
+/// Checks the OBJ file at `path` ([`check_finite_numbers`], [`check_face_references`])
+/// for a reader other than the model loader (trilinear surfaces), so that its errors carry
+/// the OBJ's line too.
+pub fn check_obj_file(path: &Path) -> Result<()> {
+    let text = read_file(path)?;
+    check_finite_numbers(path, &text)?;
+    check_face_references(path, &text)
+}
+
+/// Fails at the first `v`, `vn`, `vt` or `vp` line with a number that is not finite in
+/// single precision (`nan`, `inf`, `1e39`), which tobj reads as it is.
+pub(super) fn check_finite_numbers(path: &Path, text: &[u8]) -> Result<()> {
+    for (number, line) in text.split(|&b| b == b'\n').enumerate() {
+        let line = String::from_utf8_lossy(line);
+        let mut words = line.split_whitespace();
+        let Some(keyword @ ("v" | "vn" | "vt" | "vp")) = words.next() else {
+            continue;
+        };
+        if let Some(word) = words.find(|w| w.parse::<f32>().is_ok_and(|x| !x.is_finite())) {
+            return Err(Error::at(
+                path,
+                number + 1,
+                1,
+                format!("`{keyword}` value {word} is not a finite number"),
+            ));
+        }
+    }
+    Ok(())
+}
 
 /// Fails at the first face vertex whose texture coordinate or normal index names none of
 /// the file's `vt` / `vn` lines (positive indices count from the file's start, negative
@@ -130,6 +161,21 @@ mod tests {
         assert!(e.starts_with("m.obj:6:1:") && e.contains("normal 2"), "{e}");
         let e = face_error(&format!("{v}f 1/-1 2/-1 3/-1\nvt 0 0\n")).unwrap();
         assert!(e.starts_with("m.obj:4:1:"), "{e}");
+    }
+
+    #[test]
+    fn vertex_numbers_must_be_finite() {
+        let check = |text: &str| {
+            check_finite_numbers(Path::new("m.obj"), text.as_bytes())
+                .err()
+                .map(|e| e.to_string())
+        };
+        assert_eq!(check("v 0 0 0\nvn 0 0 1\nvt 0.5 0.5\nf 1/1/1 1/1/1 1/1/1\n"), None);
+        assert_eq!(
+            check("v 0 0 0\nvn 0 nan 1\n").as_deref(),
+            Some("m.obj:2:1: `vn` value nan is not a finite number")
+        );
+        assert!(check("v 0 0 1e39\n").unwrap().starts_with("m.obj:1:1: `v` value 1e39"));
     }
 
     #[test]
