@@ -211,6 +211,41 @@ fn unbounded_counts_and_memory_are_refused_before_allocating() {
         "flexcam: teapots.toml:15:16: needs about 1.8 GB of memory (8388608 triangles), more \
          than the memory budget of 1.0 GB (--max-memory changes it)",
     );
+    // Textures and photos count from their headers, before they are decoded.
+    image::RgbImage::new(64, 64)
+        .save(dir.path().join("photo.png"))
+        .unwrap();
+    refused(
+        &dir,
+        &[
+            "reproject",
+            "--input",
+            "photo.png",
+            "--max-memory",
+            "100k",
+            "-o",
+            "out.png",
+        ],
+        1,
+        "flexcam: photo.png: needs about 131.1 kB of memory (a 64 x 64 image), more than the \
+         memory budget of 100.0 kB (--max-memory changes it)",
+    );
+    let textured = "[[object]]\nshape = \"sphere\"\ntexture = \"photo.png\"\n";
+    write(&dir, "textured.toml", format!("{CAMERA}{textured}"));
+    refused(
+        &dir,
+        &[
+            "render",
+            "textured.toml",
+            "--max-memory",
+            "100k",
+            "-o",
+            "out.png",
+        ],
+        1,
+        "flexcam: photo.png: needs about 131.1 kB of memory (a 64 x 64 image), more than the \
+         memory budget of 100.0 kB (--max-memory changes it)",
+    );
     // The image counts too.
     refused(
         &dir,
@@ -341,48 +376,42 @@ fn nonsense_is_refused_at_its_place_not_accepted() {
 
     // glTF: attribute shapes, node transforms and the version.
     let positions = "\"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\",\n";
-    gltf_refused(
-        &dir,
-        |j| {
-            j.replacen(
-                positions,
-                "\"componentType\": 5123, \"count\": 3, \"type\": \"VEC3\",\n",
-                1,
-            )
-        },
-        "mesh 0 primitive 0: accessor 0 (POSITION) is U16 Vec3; glTF 2.0 allows f32 VEC3",
-    );
-    gltf_refused(
-        &dir,
-        |j| {
-            j.replacen(
-                positions,
-                "\"componentType\": 5126, \"count\": 3, \"type\": \"VEC2\",\n",
-                1,
-            )
-        },
-        "mesh 0 primitive 0: accessor 0 (POSITION) is F32 Vec2; glTF 2.0 allows f32 VEC3",
-    );
-    gltf_refused(
-        &dir,
-        |j| j.replacen("\"NORMAL\": 1", "\"NORMAL\": 2", 1),
-        "mesh 0 primitive 0: accessor 2 (NORMAL) is F32 Vec2; glTF 2.0 allows f32 VEC3",
-    );
-    gltf_refused(
-        &dir,
-        |j| j.replacen("{\"mesh\": 0}", "{\"mesh\": 0, \"scale\": [1e39, 1, 1]}", 1),
-        "node 0: transform has a value that is not finite in single precision",
-    );
-    gltf_refused(
-        &dir,
-        |j| j.replacen("{\"mesh\": 0}", "{\"mesh\": 0, \"scale\": [1, 0, 1]}", 1),
-        "node 0: transform is singular (it flattens its meshes)",
-    );
-    gltf_refused(
-        &dir,
-        |j| j.replacen("\"2.0\"", "\"1.0\"", 1),
-        "asset.version \"1.0\" is not supported (glTF 2.x only)",
-    );
+    let u16_positions = positions.replace("5126", "5123");
+    let vec2_positions = positions.replace("VEC3", "VEC2");
+    for (from, to, expected) in [
+        (
+            positions,
+            u16_positions.as_str(),
+            "mesh 0 primitive 0: accessor 0 (POSITION) is U16 Vec3; glTF 2.0 allows f32 VEC3",
+        ),
+        (
+            positions,
+            &vec2_positions,
+            "mesh 0 primitive 0: accessor 0 (POSITION) is F32 Vec2; glTF 2.0 allows f32 VEC3",
+        ),
+        (
+            "\"NORMAL\": 1",
+            "\"NORMAL\": 2",
+            "mesh 0 primitive 0: accessor 2 (NORMAL) is F32 Vec2; glTF 2.0 allows f32 VEC3",
+        ),
+        (
+            "{\"mesh\": 0}",
+            "{\"mesh\": 0, \"scale\": [1e39, 1, 1]}",
+            "node 0: transform has a value that is not finite in single precision",
+        ),
+        (
+            "{\"mesh\": 0}",
+            "{\"mesh\": 0, \"scale\": [1, 0, 1]}",
+            "node 0: transform is singular (it flattens its meshes)",
+        ),
+        (
+            "\"2.0\"",
+            "\"1.0\"",
+            "asset.version \"1.0\" is not supported (glTF 2.x only)",
+        ),
+    ] {
+        gltf_refused(&dir, |j| j.replacen(from, to, 1), expected);
+    }
 }
 
 /// Class 5: messages that did not say which argument or file.
@@ -405,7 +434,8 @@ fn messages_name_the_argument_and_the_file() {
         &dir,
         |j| j.replacen("\"uri\": \"m.bin\"", "\"uri\": \"gone.bin\"", 1),
         "buffer 0: \"gone.bin\" is not a file (looked for gone.bin)",
-    );    // A NaN ray in a trilinear surface: at the OBJ's line, not the scene's table.
+    );
+    // A NaN ray in a trilinear surface: at the OBJ's line, not the scene's table.
     write(
         &dir,
         "s.obj",

@@ -26,6 +26,10 @@ pub const BYTES_PER_MODEL_FILE_BYTE: u64 = 8;
 /// output, and a second frame for `compare`.
 pub const BYTES_PER_PIXEL: u64 = 64;
 
+/// Estimated bytes per texel of a decoded texture or photo while it is converted: the
+/// decoded image, its f32 copy and the linear texels.
+pub const BYTES_PER_TEXEL: u64 = 32;
+
 /// The budget set by [`set_max_memory`]; 0 while unset.
 static MAX_MEMORY: AtomicU64 = AtomicU64::new(0);
 
@@ -88,6 +92,16 @@ pub fn check(estimate: u64, what: &str) -> Result<()> {
         format_bytes(estimate),
         format_bytes(budget)
     )))
+}
+
+/// Fails when decoding a `width` x `height` image (a texture, a photo) would exceed the
+/// budget on its own: checked from the image's header, before it is decoded.
+pub fn check_image(width: u32, height: u32) -> Result<()> {
+    let texels = u64::from(width) * u64::from(height);
+    check(
+        texels.saturating_mul(BYTES_PER_TEXEL),
+        &format!("a {width} x {height} image"),
+    )
 }
 
 /// `bytes` for people: "9.1 GB", "512.0 MB", "900 bytes" (decimal units).

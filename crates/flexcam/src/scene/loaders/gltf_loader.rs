@@ -372,6 +372,7 @@ fn triangulation(mode: Mode) -> Option<Triangulate> {
 /// A linear texture from a decoded glTF image (PNG or JPEG, so sRGB-encoded integers);
 /// grey images are spread to RGB, alpha is dropped.
 fn texture_from_gltf_image(data: &::gltf::image::Data) -> Result<Texture> {
+    crate::scene::budget::check_image(data.width, data.height)?;
     let (channels, bytes) = match data.format {
         Format::R8 => (1, 1),
         Format::R8G8 => (2, 1),

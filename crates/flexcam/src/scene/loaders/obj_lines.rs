@@ -170,12 +170,17 @@ mod tests {
                 .err()
                 .map(|e| e.to_string())
         };
-        assert_eq!(check("v 0 0 0\nvn 0 0 1\nvt 0.5 0.5\nf 1/1/1 1/1/1 1/1/1\n"), None);
+        assert_eq!(
+            check("v 0 0 0\nvn 0 0 1\nvt 0.5 0.5\nf 1/1/1 1/1/1 1/1/1\n"),
+            None
+        );
         assert_eq!(
             check("v 0 0 0\nvn 0 nan 1\n").as_deref(),
             Some("m.obj:2:1: `vn` value nan is not a finite number")
         );
-        assert!(check("v 0 0 1e39\n").unwrap().starts_with("m.obj:1:1: `v` value 1e39"));
+        assert!(check("v 0 0 1e39\n")
+            .unwrap()
+            .starts_with("m.obj:1:1: `v` value 1e39"));
     }
 
     #[test]
