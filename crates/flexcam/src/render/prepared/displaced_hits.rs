@@ -117,8 +117,9 @@ impl PreparedScene {
         })
     }
 
-    /// Whether object `object` is displaced.
-    pub fn is_displaced(&self, object: usize) -> bool {
+    /// Whether object `object` is displaced (the tests tell displaced hits apart by it).
+    #[cfg(test)]
+    pub(in crate::render) fn is_displaced(&self, object: usize) -> bool {
         self.displaced
             .as_ref()
             .is_some_and(|set| set.displacement(object).is_some())

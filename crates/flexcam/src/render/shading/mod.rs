@@ -56,7 +56,9 @@ where
     values[a] * w.x + values[b] * w.y + values[c] * w.z
 }
 
-/// The world-space point at barycentrics `barycentric` of triangle `triangle` of `object`.
+/// The world-space point at barycentrics `barycentric` of triangle `triangle` of `object`
+/// (the tests' check of interpolated colours and textures).
+#[cfg(test)]
 pub fn position(object: &Object, triangle: usize, barycentric: Vec2) -> Vec3 {
     interpolate(
         &object.mesh.positions,
@@ -364,7 +366,7 @@ mod tests {
         Object {
             id: 1,
             name: "t".into(),
-            mesh,
+            mesh: mesh.into(),
             material: Material {
                 color: Vec3::new(1.0, 0.5, 0.25),
                 pattern,

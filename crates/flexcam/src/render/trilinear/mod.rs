@@ -37,7 +37,7 @@ mod shade;
 mod tests;
 mod view_plane;
 mod volume_bounds;
-/// Bench scenes, for `flexcam bench` and the criterion benches only.
+// Bench scenes, for `flexcam bench` and the criterion benches only (`bench_support`).
 #[cfg(any(test, feature = "workloads"))]
 pub mod workloads;
 
