@@ -48,12 +48,13 @@ pub(super) fn check_nodes(document: &Document) -> Result<()> {
     Ok(())
 }
 
-/// Whether the linear part of `matrix` has no inverse, relative to its column lengths.
+/// Whether the linear part of the finite `matrix` has no inverse, relative to its column
+/// lengths.
 fn is_singular(matrix: &Mat4) -> bool {
     let [x, y, z] = [matrix.x_axis, matrix.y_axis, matrix.z_axis].map(|c| c.truncate());
     let scale = f64::from(x.length()) * f64::from(y.length()) * f64::from(z.length());
     let determinant = f64::from(x.dot(y.cross(z)));
-    !(determinant.abs() > 1e-12 * scale)
+    determinant.abs() <= 1e-12 * scale
 }
 
 /// Checks every accessor `primitive` uses (attributes and indices): its type and shape for
