@@ -20,11 +20,11 @@ pub const INPUT_EXTENSIONS: [&str; 4] = ["png", "jpg", "jpeg", "exr"];
 /// unsupported extension, a missing or unreadable file, one that is not a regular file (a
 /// FIFO would block), an image of zero width or height.
 pub fn read_linear_image(path: &Path) -> Result<LinearImage> {
-    check_regular(path, "image", MAX_DATA_FILE_BYTES)?;
     let ext = extension(path);
+    let regular = || check_regular(path, "image", MAX_DATA_FILE_BYTES);
     let image = match ext.as_str() {
-        "png" | "jpg" | "jpeg" => read_srgb_image(path),
-        "exr" => read_exr_image(path),
+        "png" | "jpg" | "jpeg" => regular().and_then(|()| read_srgb_image(path)),
+        "exr" => regular().and_then(|()| read_exr_image(path)),
         other => Err(Error::new(format!(
             "unsupported input format \"{other}\" (expected {})",
             INPUT_EXTENSIONS
