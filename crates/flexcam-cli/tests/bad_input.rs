@@ -133,6 +133,35 @@ fn gltf_accessors_of_the_wrong_type_are_errors_not_panics() {
     }
 }
 
+/// Class 1, found by fuzzing: a short MTL colour (tobj unwraps three values) and a glTF
+/// image in a buffer view without a MIME type (the gltf crate unwraps it).
+#[test]
+fn fuzzed_panics_are_errors() {
+    let dir = TempDir::new().unwrap();
+    write(
+        &dir,
+        "m.obj",
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n",
+    );
+    write(&dir, "m.mtl", "newmtl a\nKd 0.8 0.1\n");
+    scene_refused(
+        &dir,
+        "[[object]]\nshape = \"mesh\"\nfile = \"m.obj\"\n",
+        "flexcam: m.mtl:2:1: `Kd` needs three values (r g b), not 2",
+    );
+    gltf_refused(
+        &dir,
+        |j| {
+            j.replacen(
+                "\"nodes\":",
+                "\"images\": [{\"bufferView\": 0}],\n\"nodes\":",
+                1,
+            )
+        },
+        "image 0 has a bufferView but no mimeType",
+    );
+}
+
 /// Class 2: counts from a file are bounded, and so is the memory a scene may take.
 #[test]
 fn unbounded_counts_and_memory_are_refused_before_allocating() {

@@ -28,6 +28,20 @@ pub(super) fn check_version(document: &Document) -> Result<()> {
     Ok(())
 }
 
+/// Fails on an image with neither a URI nor a buffer view, or a buffer view without a MIME
+/// type (required there by glTF 2.0; the gltf crate unwraps it).
+pub(super) fn check_images(document: &Document) -> Result<()> {
+    for (index, image) in document.as_json().images.iter().enumerate() {
+        let problem = match (&image.uri, &image.buffer_view, &image.mime_type) {
+            (None, None, _) => "has neither a uri nor a bufferView",
+            (_, Some(_), None) => "has a bufferView but no mimeType",
+            _ => continue,
+        };
+        return Err(Error::new(format!("image {index} {problem}")));
+    }
+    Ok(())
+}
+
 /// Fails unless the transform of every node is finite in f32 and invertible (a singular
 /// matrix flattens its meshes and has no normal transform).
 pub(super) fn check_nodes(document: &Document) -> Result<()> {

@@ -14,7 +14,7 @@ use ::gltf::mesh::Mode;
 use ::gltf::{Document, Node, Primitive};
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 
-use super::gltf_checks::{check_nodes, check_primitive, check_version, check_view};
+use super::gltf_checks::{check_images, check_nodes, check_primitive, check_version, check_view};
 use super::texture::{srgb_to_linear, texture_from_texels};
 use super::{read_file, Model, ModelPart};
 use crate::error::{Error, Result};
@@ -33,6 +33,7 @@ pub(super) fn load_gltf(path: &Path) -> Result<Model> {
     let in_file = |e: Error| Error::in_file(path, e.message);
     check_version(&document).map_err(in_file)?;
     check_nodes(&document).map_err(in_file)?;
+    check_images(&document).map_err(in_file)?;
     let base = path.parent().unwrap_or(Path::new(""));
     for buffer in document.buffers() {
         if let ::gltf::buffer::Source::Uri(uri) = buffer.source() {

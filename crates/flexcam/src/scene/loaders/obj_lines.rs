@@ -94,8 +94,9 @@ pub(super) fn check_face_references(path: &Path, text: &[u8]) -> Result<()> {
 const COLOR_KEYWORDS: [&str; 5] = ["Ka", "Kd", "Ks", "Ke", "Tf"];
 const FINITE_KEYWORDS: [&str; 4] = ["Ns", "Ni", "d", "Tr"];
 
-/// Fails at the first MTL colour with a component that is not a finite number of at least
-/// zero, or the first `Ns`, `Ni`, `d` or `Tr` that is not finite.
+/// Fails at the first MTL colour with fewer than three values (tobj unwraps three) or a
+/// component that is not a finite number of at least zero, or the first `Ns`, `Ni`, `d` or
+/// `Tr` that is not finite.
 pub(super) fn check_mtl_values(path: &Path, text: &[u8]) -> Result<()> {
     for (number, line) in text.split(|&b| b == b'\n').enumerate() {
         let line = String::from_utf8_lossy(line);
@@ -106,6 +107,15 @@ pub(super) fn check_mtl_values(path: &Path, text: &[u8]) -> Result<()> {
         let color = COLOR_KEYWORDS.contains(&keyword);
         if !color && !FINITE_KEYWORDS.contains(&keyword) {
             continue;
+        }
+        let values = line.split_whitespace().count() - 1;
+        if matches!(keyword, "Ka" | "Kd" | "Ks" | "Ke") && values < 3 {
+            return Err(Error::at(
+                path,
+                number + 1,
+                1,
+                format!("`{keyword}` needs three values (r g b), not {values}"),
+            ));
         }
         for word in words {
             let Ok(x) = word.parse::<f32>() else {
@@ -192,6 +202,10 @@ mod tests {
         );
         let e = mtl_error("newmtl a\nKa 0 0 0\nKs -1 0 0\n").unwrap();
         assert!(e.starts_with("m.mtl:3:1: `Ks` value -1 is negative"), "{e}");
+        assert_eq!(
+            mtl_error("newmtl a\nKd 0.8 0.1\n").as_deref(),
+            Some("m.mtl:2:1: `Kd` needs three values (r g b), not 2")
+        );
         let e = mtl_error("newmtl a\nNi inf\n").unwrap();
         assert!(e.starts_with("m.mtl:2:1:"), "{e}");
     }
