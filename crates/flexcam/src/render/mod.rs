@@ -3,6 +3,14 @@
 //! The one entry point is [`render`]: a [`PreparedScene`] (built once per scene and command)
 //! through a projection with [`RenderOptions`] (method, shading, samples, the methods'
 //! tunings, reflector compositing, progress) gives a [`Rendered`] frame and its report.
+//!
+//! The renderers (the ray caster, `raster`, `trilinear`, camera triangles, reflector
+//! compositing) and what they share (the scan converter, shading, the BVH) are private
+//! modules; this module re-exports what a program needs: the entry point and its types, each
+//! method's options ([`Subdivision`], [`CurveOptions`], [`CameraTriangleOptions`]), the
+//! prepared scene's queries ([`PreparedScene::intersect`], [`Hit`]), frame comparison
+//! ([`compare`]) and photo reprojection ([`reproject`]). The bench scenes and the stages the
+//! benches time apart are in `bench_support`, with the `workloads` feature only.
 
 use std::collections::BTreeMap;
 

@@ -259,8 +259,8 @@ impl<'a> HitShader<'a> {
 
     /// The normals at `hit` as seen along `ray`.
     fn normals(&self, ray: &Ray, hit: &Hit) -> Normals {
-        if let Some(normals) = self.caster.displaced_normals(hit, ray.direction) {
-            return normals;
+        if let Some(face) = self.caster.displaced_face_normal(hit) {
+            return Normals::of_face(face, ray.direction.as_vec3());
         }
         let object = &self.caster.scene.objects[hit.object];
         normals(
