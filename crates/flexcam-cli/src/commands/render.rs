@@ -77,7 +77,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
     let loaded = args.scene.load()?;
     super::declare_scene_inputs(&mut outputs, &loaded.scene.inputs)?;
-    print_warnings(&loaded);
 
     let progress = RenderProgress::new();
     let report = |done: u64, total: u64| progress.update(done, total);
@@ -106,9 +105,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         frame,
         mut counters,
         warnings,
-    } = rendered?;
+    } = rendered.map_err(|e| e.or_in_file(&loaded.source))?;
     let warnings = warning_lines(&warnings);
-    print_lines(&loaded.source, &warnings);
     for &(name, value) in &loaded.build_report.counters {
         counters.insert(name, Counter::Value(value));
     }
@@ -141,5 +139,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         warnings: &[&loaded.build_report.warnings[..], &warnings].concat(),
     };
     let json = stats_json::to_json(&facts, &counters).to_string();
-    super::commit_with_stats(outputs, stats, args.stats.as_ref(), &json)
+    super::commit_with_stats(outputs, stats, args.stats.as_ref(), &json)?;
+    // Warnings only once the command has succeeded: a failing command prints one line.
+    print_warnings(&loaded);
+    print_lines(&loaded.source, &warnings);
+    Ok(())
 }

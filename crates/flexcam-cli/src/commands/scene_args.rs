@@ -33,6 +33,27 @@ pub struct SceneArgs {
         allow_negative_numbers = true
     )]
     pub perspective_rect: Option<Vec<f64>>,
+    #[command(flatten)]
+    pub memory: MemoryArgs,
+}
+
+/// The memory budget of a rendering command.
+#[derive(Args, Debug)]
+pub struct MemoryArgs {
+    /// The memory budget (e.g. 8G, 512MiB, 1.5GB): a scene whose estimated memory
+    /// (triangles, image) exceeds it is refused before it is built, with the estimate. The
+    /// default is three quarters of the memory this process may use.
+    #[arg(long, value_name = "SIZE", value_parser = scene::budget::parse_size)]
+    pub max_memory: Option<u64>,
+}
+
+impl MemoryArgs {
+    /// Sets the process's memory budget if `--max-memory` was given.
+    pub fn apply(&self) {
+        if let Some(bytes) = self.max_memory {
+            scene::budget::set_max_memory(bytes);
+        }
+    }
 }
 
 impl SceneArgs {
@@ -52,6 +73,7 @@ impl SceneArgs {
             })?),
             None => None,
         };
+        self.memory.apply();
         let overrides = Overrides {
             width: self.width,
             height: self.height,

@@ -19,6 +19,10 @@ use crate::scene::ImageSettings;
 /// Frames per second when `fps` is absent.
 pub const DEFAULT_FPS: f64 = 24.0;
 
+/// The most frames an animation may have: over an hour at 24 frames per second. Every
+/// frame's output is named before the first is rendered, and a GIF holds them all.
+pub const MAX_FRAMES: u32 = 100_000;
+
 /// Converts and checks the `[animation]` table.
 pub(super) fn convert(
     src: &Source,
@@ -28,8 +32,11 @@ pub(super) fn convert(
 ) -> Result<Animation> {
     let raw = table.get_ref();
     let frames = *raw.frames.get_ref();
-    if frames == 0 {
-        return Err(src.error(&raw.frames.span(), "`frames` must be at least 1"));
+    if !(1..=MAX_FRAMES).contains(&frames) {
+        return Err(src.error(
+            &raw.frames.span(),
+            format!("`frames` must be in 1..={MAX_FRAMES}, not {frames}"),
+        ));
     }
     let fps = raw
         .fps

@@ -19,6 +19,7 @@ mod projector_grid;
 mod raw;
 mod shape;
 mod source;
+mod strict;
 mod trilinear_grid;
 mod values;
 
@@ -32,6 +33,7 @@ use self::raw::{RawImage, RawScene};
 use self::source::Source;
 use super::{ImageSettings, InputFile, Scene};
 use crate::error::{Error, Result};
+use crate::file_read::{read_regular_text, MAX_SCENE_FILE_BYTES};
 use crate::projection::flexible::Animation;
 
 pub use self::animation::DEFAULT_FPS;
@@ -69,8 +71,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene> {
 /// Reads and parses the scene file at `path` with its `[animation]` table, if any. The
 /// scene file is the first of the scene's [`Scene::inputs`].
 pub fn load_animated(path: &Path) -> Result<(Scene, Option<Animation>)> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| Error::in_file(path, format!("cannot read scene file: {e}")))?;
+    let text = read_regular_text(path, "scene file", MAX_SCENE_FILE_BYTES)?;
     let (mut scene, animation) = parse_animated(&text, path)?;
     scene.inputs.insert(
         0,

@@ -212,6 +212,7 @@ fn trilinear(src: &Source, required: &Required, base_dir: &Path) -> Result<Trili
             ));
         }
         let path = src.existing_file(surface, base_dir, "trilinear surface")?;
+        crate::scene::loaders::check_obj_file(&path)?;
         return TrilinearMesh::load_obj(&path).map_err(|e| e.or_in_file(&path));
     }
     if raw.points.is_none() {
