@@ -6,7 +6,7 @@ use clap::{Args, ValueEnum};
 use flexcam::render::camera_triangles;
 use flexcam::render::raster::Subdivision;
 use flexcam::render::trilinear::CurveOptions;
-use flexcam::render::{Method, RenderWarning, Shading};
+use flexcam::render::{Method, RenderWarning, Shading, TransitionShading};
 use flexcam::scene::{self, LoadedScene, Overrides};
 use flexcam::{Error, Result};
 
@@ -89,6 +89,10 @@ pub fn warning_lines<'a>(warnings: impl IntoIterator<Item = &'a RenderWarning>) 
 pub enum ShadingArg {
     Flat,
     Lit,
+    /// Displaced objects coloured by the transition system's method per pixel.
+    Transitions,
+    /// Displaced objects shaded by the transition system (BRDF, bump, displacement).
+    TransitionLit,
 }
 
 impl ShadingArg {
@@ -96,6 +100,12 @@ impl ShadingArg {
         match self {
             ShadingArg::Flat => Shading::Flat,
             ShadingArg::Lit => Shading::Lit,
+            ShadingArg::Transitions => {
+                Shading::Transitions(TransitionShading::with_default_d(true))
+            }
+            ShadingArg::TransitionLit => {
+                Shading::Transitions(TransitionShading::with_default_d(false))
+            }
         }
     }
 
@@ -103,6 +113,8 @@ impl ShadingArg {
         match self {
             ShadingArg::Flat => "flat",
             ShadingArg::Lit => "lit",
+            ShadingArg::Transitions => "transitions",
+            ShadingArg::TransitionLit => "transition-lit",
         }
     }
 }

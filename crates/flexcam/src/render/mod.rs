@@ -20,6 +20,10 @@ pub enum Shading {
     /// Lambert + Phong with hard shadows, recursive reflection and refraction with Fresnel.
     #[default]
     Lit,
+    /// Displaced objects shaded by the per-ray transition system (BRDF, redistributed bump,
+    /// displacement), or coloured by the method chosen; `--method raycast` only (module
+    /// `transitions`).
+    Transitions(TransitionShading),
 }
 
 /// What [`render`] does: the method and everything that tunes it.
@@ -248,10 +252,12 @@ pub mod raycast;
 pub mod reproject;
 pub mod scan;
 pub mod shading;
+pub mod transitions;
 pub mod trilinear;
 mod warning;
 pub use method::Method;
 pub use prepared::PreparedScene;
+pub use transitions::TransitionShading;
 pub use warning::RenderWarning;
 
 #[cfg(test)]

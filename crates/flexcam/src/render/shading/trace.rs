@@ -128,7 +128,8 @@ impl<'a> HitShader<'a> {
     pub fn shade_hit(&mut self, ray: &Ray, hit: Hit) -> Vec3 {
         match self.shading {
             Shading::Flat => self.flat(ray, hit),
-            Shading::Lit => self.lit(ray, hit, 0, 1.0),
+            // The transition system shades displaced objects itself and the others lit.
+            Shading::Lit | Shading::Transitions(_) => self.lit(ray, hit, 0, 1.0),
         }
     }
 
