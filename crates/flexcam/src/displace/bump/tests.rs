@@ -3,7 +3,7 @@ use std::f64::consts::PI;
 use glam::{DVec2, DVec3};
 
 use super::*;
-use crate::displace::normal_distribution::tests::bumpy_chart;
+use crate::displace::normal_distribution::tests::{bumpy_chart, noise};
 use crate::displace::normal_distribution::{
     bin, distance, histogram, rotate, unit, view_angle, visible_normal_samples, visible_normals,
     Chart,
@@ -41,7 +41,8 @@ fn redistributed_normals_reproduce_the_displaced_distribution() {
             .map(|n| redistribution.map(*n, 0.0, theta))
             .collect();
         let gap = distance(&histogram(&moved), distribution.view(k));
-        assert!(gap < 0.08, "view {k}: {gap}");
+        let noise = noise(&chart, theta, 32);
+        assert!(gap < 1.3 * noise, "view {k}: {gap} against noise {noise}");
         if k >= 20 {
             let unmoved = distance(&plain, distribution.view(k));
             assert!(unmoved > 3.0 * gap, "view {k}: {unmoved} against {gap}");
@@ -103,7 +104,8 @@ fn partial_displacement_sees_the_full_surface_from_the_corrected_angle() {
     let corrected = distance(&seen, &flattened(partial_view_angle(theta_v, s)));
     let printed = distance(&seen, &flattened(partial_view_angle(theta_v, 1.0 - s)));
     let inverse = distance(&seen, &flattened((theta_v.tan() / s).atan()));
-    assert!(corrected < 0.12, "{corrected}");
-    assert!(printed > 1.5 * corrected, "{printed} against {corrected}");
-    assert!(inverse > 1.5 * corrected, "{inverse} against {corrected}");
+    let noise = noise(&partial, theta_v, 32);
+    assert!(corrected < 1.3 * noise, "{corrected} against noise {noise}");
+    assert!(printed > 2.0 * corrected, "{printed} against {corrected}");
+    assert!(inverse > 2.0 * corrected, "{inverse} against {corrected}");
 }

@@ -250,3 +250,6 @@ pub(in crate::render) fn render(
     ]);
     Ok((frame, stats))
 }
+
+#[cfg(test)]
+mod tests;
