@@ -8,7 +8,7 @@ use crate::displace::{base_corners, DisplacedTriangle, Displacement};
 use crate::geometry::{intersect_triangle, Ray};
 use crate::render::bvh::triangle::FastRay;
 use crate::render::bvh::AllTriangles;
-use crate::render::prepared::{closest_shown, Hit, PreparedScene};
+use crate::render::prepared::{closest_shown, occluded_shown, Hit, PreparedScene};
 
 impl PreparedScene {
     /// The first hit of `ray` on the triangle BVH alone (displaced objects left out), in f64.
@@ -49,6 +49,27 @@ impl PreparedScene {
             }),
             _ => found,
         }
+    }
+
+    /// Whether anything blocks `ray` with every displaced object undisplaced (the shadow
+    /// rays of the bump and BRDF methods, whose relief is below a few footprints).
+    pub(in crate::render) fn occluded_hull(&self, ray: &Ray) -> bool {
+        let blocked = FastRay::new(ray).is_some_and(|r| match &self.shown {
+            None => self.bvh.occluded(&r, &AllTriangles),
+            Some(mask) => occluded_shown(&self.bvh, &r, mask),
+        });
+        blocked
+            || self.displaced.as_ref().is_some_and(|set| {
+                set.closest_by(ray, f64::INFINITY, true, |item, _, bounded| {
+                    let mesh = &self.scene.objects[item.object as usize].mesh;
+                    let corners = mesh.triangles[item.triangle as usize]
+                        .map(|i| mesh.positions[i as usize].as_dvec3());
+                    intersect_triangle(bounded.origin, bounded.direction, corners)
+                        .filter(|h| h.t >= bounded.t_min && h.t <= bounded.t_max)
+                        .map(|h| (h.t, ()))
+                })
+                .is_some()
+            })
     }
 
     /// The first hit of `ray` with each displaced object displaced as `partial(object)`

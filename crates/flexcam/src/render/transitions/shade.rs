@@ -10,7 +10,10 @@
 //! traces the displaced surface and keeps the normal (from the angle to itself); the BRDF
 //! shades the undisplaced surface with the table, the mean of what the bump normals give.
 //! Light is diffuse: ambient plus, per light a shadow ray reaches, the Lambert term of the
-//! normal (or the BRDF); no highlight (the tables are diffuse).
+//! normal (or the BRDF); no highlight (the tables are diffuse). Shadow rays of displaced
+//! geometry meet the displaced objects displaced; those of the bump and BRDF methods, where
+//! the relief is under a few footprints, meet them undisplaced (their hulls: cheap, and the
+//! shadows differ by less than the relief).
 
 use glam::{DVec2, DVec3, Vec3};
 
@@ -20,8 +23,9 @@ use crate::displace::normal_distribution::rotate;
 use crate::displace::transition::{self, partial_view_angle, Blend};
 use crate::geometry::Ray;
 use crate::render::prepared::Hit;
+use crate::render::shading::trace::light_from;
 use crate::render::shading::{base_color, TextureFilter};
-use crate::scene::{Light, Object};
+use crate::scene::Object;
 
 /// Ambient fraction of the base colour (as in lit shading).
 const AMBIENT: f32 = 0.1;
@@ -125,6 +129,9 @@ impl Renderer<'_> {
         let step = (blend.fraction * PARTIAL_STEPS as f64).round() as usize;
         let hit = if step == 0 {
             Some(hull)
+        } else if step == PARTIAL_STEPS {
+            // Full displacement: the prepared scene's own search, with its kept boxes.
+            self.prepared.intersect(ray)
         } else {
             self.partial_rays += 1;
             self.prepared.intersect_partial(ray, |o| {
@@ -192,18 +199,7 @@ impl Renderer<'_> {
         }
         let mut color = base * AMBIENT;
         for light in lights {
-            let (to_light, t_max, radiance) = match *light {
-                Light::Point {
-                    position: p,
-                    color,
-                    intensity,
-                } => (p.as_dvec3() - position, 1.0, color * intensity),
-                Light::Directional {
-                    direction,
-                    color,
-                    intensity,
-                } => (-direction.as_dvec3(), f64::INFINITY, color * intensity),
-            };
+            let (to_light, t_max, radiance) = light_from(light, position);
             let term = reflect(to_light.normalize_or_zero());
             if term <= 0.0 {
                 continue;
@@ -211,7 +207,12 @@ impl Renderer<'_> {
             let mut shadow = self.prepared.spawn(position, frame.normal, to_light);
             shadow.t_max = t_max;
             self.shadow_rays += 1;
-            if !self.prepared.occluded(&shadow) {
+            let blocked = if s > 0.0 {
+                self.prepared.occluded(&shadow)
+            } else {
+                self.prepared.occluded_hull(&shadow)
+            };
+            if !blocked {
                 color += base * radiance * term;
             }
         }
