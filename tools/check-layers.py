@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Checks the module graph of a Rust crate: no import cycles, layers that only point down.
 
-Usage: tools/check-layers.py [SRC_DIR] [--cycles-under PREFIX ...]
+Usage: tools/check-layers.py [SRC_DIR] [--cycles-under PREFIX ...] [--coarse]
        SRC_DIR defaults to crates/flexcam/src.
 
 Nodes are file modules (src/a/b.rs and src/a/b/mod.rs are `a::b`). An edge A -> B means code of
@@ -21,6 +21,10 @@ Reports
 Exits 1 when it finds either, 0 otherwise. With --cycles-under PREFIX (repeatable), only
 cycles whose modules all lie under one of the prefixes count towards the exit status (the
 others are still printed).
+With --coarse, the graph is that of the library's parts instead of its files: every module
+stands for its top-level module (`scene`, `projection`, ...), and under `render` for its
+renderer or service (`render::raycast`, `render::shading`, ...; `render` itself is mod.rs).
+A cycle there is two parts that use each other through any of their files.
 """
 
 import os
@@ -306,9 +310,27 @@ def layer(mod):
     return None
 
 
+def part(mod):
+    """The part of the library `mod` belongs to (see --coarse)."""
+    return mod[:2] if mod[:1] == ("render",) else mod[:1]
+
+
+def coarse(graph):
+    """`graph` with every module replaced by its part, edges within a part dropped."""
+    parts = {}
+    for mod, targets in graph.items():
+        edges = parts.setdefault(part(mod), set())
+        for target in targets:
+            parts.setdefault(part(target), set())
+            if part(target) != part(mod):
+                edges.add(part(target))
+    return parts
+
+
 def main(argv):
     src = "crates/flexcam/src"
     prefixes = []
+    grain = None
     args = list(argv)
     while args:
         a = args.pop(0)
@@ -316,10 +338,14 @@ def main(argv):
             return self_test()
         if a == "--cycles-under":
             prefixes.append(tuple(args.pop(0).split("::")))
+        elif a == "--coarse":
+            grain = coarse
         else:
             src = a
     crate = Crate(src)
     graph = crate.edges()
+    if grain:
+        graph = grain(graph)
     failed = False
     comps = strongly_connected(graph)
     for comp in comps:
@@ -358,7 +384,7 @@ def self_test():
         "scene/mod.rs": "use crate::projection::A;\npub struct S;\n",
     }
 
-    def run(tree):
+    def run(tree, *options):
         with tempfile.TemporaryDirectory() as tmp:
             for rel, text in tree.items():
                 path = os.path.join(tmp, rel)
@@ -367,7 +393,7 @@ def self_test():
                     f.write(text)
             out = io.StringIO()
             with contextlib.redirect_stdout(out):
-                status = main([tmp])
+                status = main([tmp, *options])
             return status, out.getvalue()
 
     status, out = run(files)
@@ -382,6 +408,15 @@ def self_test():
     files["projection/b.rs"] = "pub struct B;\n"
     status, out = run(files)
     assert status == 0 and "0 cycles" in out, out
+    # Two parts using each other through different files are a coarse cycle only.
+    files["scene/mod.rs"] = "mod x;\nuse crate::projection::A;\npub struct S;\n"
+    files["scene/x.rs"] = "pub struct X;\n"
+    files["projection/b.rs"] = "pub struct B;\nfn f() { let _ = crate::scene::x::X; }\n"
+    status, out = run(files)
+    assert status == 1 and "upward: projection::b -> scene::x" in out, out
+    assert "0 cycles" in out, out
+    status, out = run(files, "--coarse")
+    assert status == 1 and "cycle (2 modules: projection, scene)" in out, out
     print("self-test passed")
     return 0
 

@@ -1,5 +1,5 @@
 //! Panorama rasterisation throughput (`--method raster`) against the ray caster in the same
-//! run, on the workload of `render::raster::workloads` (`teapot-dense`, 123,554
+//! run, on the workload of `render::bench_support::workloads::raster` (`teapot-dense`, 123,554
 //! triangles, as a 1280 x 720 equirectangular panorama), flat shading. Throughput is frames
 //! per second. `raster_first_frame` is a new renderer and its first frame (the pixel
 //! projectors it needs are computed during the frame); `raster_frame` is a later frame of
@@ -10,10 +10,9 @@
 //! Run with `cargo bench -p flexcam --bench raster`. Figures are recorded in docs/raster.md.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use flexcam::render::raster::workloads::{teapot_dense_panorama, PanoramaWorkload};
-use flexcam::render::raster::InverseRaster;
-use flexcam::render::{raycast, PreparedScene};
-use flexcam::render::{RenderOptions, Shading};
+use flexcam::render::bench_support::workloads::raster::{teapot_dense_panorama, PanoramaWorkload};
+use flexcam::render::bench_support::InverseRaster;
+use flexcam::render::{self, PreparedScene, RenderOptions, Shading};
 
 fn panorama(c: &mut Criterion) {
     let PanoramaWorkload { scene, projection } =
@@ -39,7 +38,7 @@ fn panorama(c: &mut Criterion) {
         })
     });
     group.bench_function("raycast_frame", |b| {
-        b.iter(|| raycast::render(&prepared, projection.as_ref(), &options))
+        b.iter(|| render::render(&prepared, projection.as_ref(), &options))
     });
     group.finish();
 }

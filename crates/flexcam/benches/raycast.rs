@@ -6,8 +6,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use flexcam::projection::{CameraFrame, ProjectionSpec};
-use flexcam::render::{raycast, PreparedScene};
-use flexcam::render::{RenderOptions, Shading};
+use flexcam::render::{self, PreparedScene, RenderOptions, Shading};
 use flexcam::scene::{builtin, Scene};
 
 const SIZE: u32 = 800;
@@ -50,7 +49,7 @@ fn primary_rays(c: &mut Criterion) {
                 .build(SIZE, SIZE)
                 .unwrap_or_else(|e| panic!("{name} {label}: {e}"));
             group.bench_function(format!("{name}/{label}"), |b| {
-                b.iter(|| raycast::render(&caster, projection.as_ref(), &options))
+                b.iter(|| render::render(&caster, projection.as_ref(), &options))
             });
         }
     }

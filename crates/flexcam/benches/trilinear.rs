@@ -1,22 +1,22 @@
 //! Trilinear rasterisation (`--method trilinear`) against the ray caster of the same
 //! projection: the cube-floor scene (686 triangles) through the 18-projection fan grid
-//! (`render::trilinear::workloads::fan_grid(3)`) at 800 x 800, flat shading: the trilinear
+//! (`render::bench_support::workloads::trilinear::fan_grid(3)`) at 800 x 800, flat shading: the trilinear
 //! renderer's speed target (at least 10x the ray caster, under 33 ms). Both renderers are prepared once
 //! (BVH, scene geometry); each iteration is one frame. `trilinear_frame` uses the default
 //! adaptive curves with scene-space clipping, `trilinear_unclipped` the thesis's cheaper
 //! screen-space clipping only, `trilinear_kept_unclipped` the same into a frame kept from
 //! iteration to iteration (`TrilinearRenderer::render_into`, a program's later frames);
-//! `raycast_frame` and `raycast_kept` the ray caster into a new frame and into a kept one.
+//! `raycast_frame` (the entry point, `render::render`) and `raycast_kept` the ray caster into
+//! a new frame and into a kept one (`bench_support::raycast_into`).
 //!
 //! Run with `cargo bench -p flexcam --bench trilinear`. Figures are recorded in
 //! docs/trilinear.md (with `flexcam bench trilinear`, which prints the thesis's tables).
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use flexcam::projection::Trilinear;
-use flexcam::render::trilinear::workloads::fan_grid;
-use flexcam::render::trilinear::{CurveOptions, TrilinearRenderer};
-use flexcam::render::{raycast, PreparedScene};
-use flexcam::render::{RenderOptions, Shading};
+use flexcam::render::bench_support::workloads::trilinear::fan_grid;
+use flexcam::render::bench_support::{raycast_into, TrilinearRenderer};
+use flexcam::render::{self, CurveOptions, PreparedScene, RenderOptions, Shading};
 use flexcam::scene::builtin;
 
 const SIDE: u32 = 800;
@@ -56,13 +56,15 @@ fn cube_floor_18(c: &mut Criterion) {
         b.iter(|| renderer.render_into(&mut kept, &projection, &options, unclipped))
     });
     group.bench_function("raycast_frame", |b| {
-        b.iter(|| raycast::render(&caster, &projection, &options))
+        b.iter(|| render::render(&caster, &projection, &options))
     });
     // The ray caster's later frames into a frame it keeps: like for like with
     // `trilinear_kept_unclipped`.
-    let mut kept = raycast::render(&caster, &projection, &options).0;
+    let mut kept = render::render(&caster, &projection, &options)
+        .unwrap_or_else(|e| panic!("render: {e}"))
+        .frame;
     group.bench_function("raycast_kept", |b| {
-        b.iter(|| raycast::render_into(&caster, &mut kept, &projection, &options))
+        b.iter(|| raycast_into(&caster, &mut kept, &projection, &options))
     });
     group.finish();
 }

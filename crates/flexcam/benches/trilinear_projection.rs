@@ -1,5 +1,5 @@
-//! The projection stage of `--method trilinear` alone (`render::trilinear::polygons::
-//! project_all`: volume cull, cubics, shapes, outlines, clipping), without rasterisation
+//! The projection stage of `--method trilinear` alone (`render::bench_support::project_all`:
+//! volume cull, cubics, shapes, outlines, clipping), without rasterisation
 //! or shading: the cube-floor scene through the 18-projection fan grid at 800 x 800 with and
 //! without scene-space clipping (the bench's cube rows), and the detail-in-context
 //! visualisation surface of `scenes/trilinear-detail-in-context.toml` (686 scene triangles
@@ -11,10 +11,9 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use flexcam::projection::Trilinear;
-use flexcam::render::trilinear::workloads::fan_grid;
-use flexcam::render::trilinear::CurveOptions;
-use flexcam::render::trilinear::SceneGeometry;
-use flexcam::render::trilinear::{project_all, projection_triangles};
+use flexcam::render::bench_support::workloads::trilinear::fan_grid;
+use flexcam::render::bench_support::{project_all, projection_triangles, SceneGeometry};
+use flexcam::render::CurveOptions;
 use flexcam::scene::{self, builtin, Scene};
 
 /// Times `project_all` of `scene` through `projection` with `curves` as `name`.

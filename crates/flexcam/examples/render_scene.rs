@@ -5,7 +5,7 @@
 //!
 //! SCENE is a scene file or `builtin:NAME` (default `builtin:teapot-room`).
 
-use flexcam::render::{self, compare::compare, Method, PreparedScene, RenderOptions, Shading};
+use flexcam::render::{self, compare, Method, PreparedScene, RenderOptions, Shading};
 use flexcam::scene::{self, Overrides};
 
 fn main() -> flexcam::Result<()> {

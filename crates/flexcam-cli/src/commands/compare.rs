@@ -8,8 +8,7 @@ use std::time::Instant;
 
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, OutputSet};
-use flexcam::render::compare::{compare, Comparison};
-use flexcam::render::{self, Frame, Method, PreparedScene, RenderOptions};
+use flexcam::render::{self, compare, Comparison, Frame, Method, PreparedScene, RenderOptions};
 use flexcam::{Error, Result};
 use glam::Vec3;
 use serde_json::json;

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, OutputSet};
-use flexcam::render::reproject::{reproject, EquirectPhoto};
+use flexcam::render::{reproject, EquirectPhoto};
 use flexcam::Result;
 
 use super::scene_args::SceneArgs;

@@ -3,10 +3,10 @@
 //! options, and the warnings printed on stderr.
 
 use clap::{Args, ValueEnum};
-use flexcam::render::camera_triangles;
-use flexcam::render::raster::Subdivision;
-use flexcam::render::trilinear::CurveOptions;
-use flexcam::render::{Method, RenderWarning, Shading, TransitionShading};
+use flexcam::render::{
+    CameraTriangleBound, CameraTriangleOptions, CurveOptions, Method, RenderWarning, Shading,
+    Subdivision, TransitionShading,
+};
 use flexcam::scene::{self, LoadedScene, Overrides};
 use flexcam::{Error, Result};
 
@@ -184,18 +184,18 @@ impl MethodTuning {
 
     /// The options of method camera-triangles from `--bound`; an error when it is given to
     /// another method.
-    pub fn camera_triangles(&self, method: Method) -> Result<camera_triangles::Options> {
+    pub fn camera_triangles(&self, method: Method) -> Result<CameraTriangleOptions> {
         if method != Method::CameraTriangles && self.bound.is_some() {
             return Err(Error::new(format!(
                 "--bound applies to --method camera-triangles, not {method}"
             )));
         }
-        Ok(camera_triangles::Options {
+        Ok(CameraTriangleOptions {
             bound: match &self.bound {
                 Some(name) => name.parse()?,
-                None => camera_triangles::Bound::default(),
+                None => CameraTriangleBound::default(),
             },
-            ..camera_triangles::Options::default()
+            ..CameraTriangleOptions::default()
         })
     }
 }

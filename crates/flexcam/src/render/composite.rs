@@ -12,9 +12,10 @@
 //! Depth and object id stay those of the main view (the reflector's own, as for a mirror in
 //! the ray caster).
 //!
-//! The renderer is a parameter ([`Renderer`]): any method that renders a prepared scene
-//! through a projection, e.g. `|s, p, o| Method::Raycast.render(s, p, o)`, or a faster
-//! trilinear one. The main view (the reflectors made diffuse), the scene without a reflector
+//! Compositing is reached only through [`crate::render::render`]
+//! (`RenderOptions::composite_reflectors`); every view is rendered by the options' method
+//! ([`render`]), and the trilinear methods render the perspective main view as two projection
+//! triangles. The main view (the reflectors made diffuse), the scene without a reflector
 //! (rendered through that reflector's surfaces) and the reflector alone (the Fresnel split)
 //! are views of the prepared scene ([`PreparedScene::view`]): they share its one BVH.
 //! In `lit` shading a mirror's reflected colour is tinted by its base colour, and glass mixes
@@ -24,6 +25,7 @@
 //! flat contract asks of mirrors and glass (the refraction, or the reflection on total
 //! internal reflection, without Fresnel mixing).
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use glam::{DVec2, DVec3, Vec3};
@@ -42,9 +44,9 @@ use crate::render::{
 };
 use crate::scene::{Finish, Mesh, Object, Scene, TrilinearReflector};
 
-/// A way of rendering a scene through a projection (a [`crate::render::Method`] or any
-/// other renderer).
-pub type Renderer<'a> =
+/// A way of rendering a scene through a projection: a [`Method`] alone, or the trilinear
+/// method with its main view through [`perspective_as_trilinear`].
+type Renderer<'a> =
     dyn Fn(&PreparedScene, &dyn Projection, &RenderOptions) -> Result<(Frame, Stats)> + 'a;
 
 /// Renders `prepared` through `main` with `renderer`, compositing the reflections and
@@ -61,7 +63,7 @@ pub type Renderer<'a> =
 ///
 /// Errors: the renderer's; a scene projection that is not perspective (the main camera);
 /// a reflector id that no object has, or whose material is not mirror or glass.
-pub fn render(
+fn with_renderer(
     prepared: &PreparedScene,
     main: &dyn Projection,
     options: &RenderOptions,
@@ -191,21 +193,22 @@ fn add_camera_triangle_counts(stats: &mut Stats, surface: &Stats) {
     }
 }
 
-/// Renders `scene` through `main` with `method`, compositing its trilinear reflectors as
-/// [`render`] does. With [`Method::Trilinear`] (or [`Method::CameraTriangles`], whose
+/// Renders `prepared` through `main` by `options.method`, compositing the scene's trilinear
+/// reflectors ([`with_renderer`]): what [`crate::render::render`] does with
+/// `RenderOptions::composite_reflectors`. With [`Method::Trilinear`] (or [`Method::CameraTriangles`], whose
 /// reflector surfaces are rendered by camera triangles) and reflectors, the main view (a perspective
 /// camera, which that method does not render) is rendered through
 /// [`perspective_as_trilinear`], the same pinhole as two projection triangles, so that the
 /// whole frame, main view and reflections, is rendered by the trilinear method (Vallance 2005,
 /// chapter 7: the reflection surfaces are meant for the fast renderer). Without reflectors
 /// this is `method.render` unchanged (a perspective scene is still refused by the trilinear
-/// method). Errors: as [`render`].
-pub fn render_with_method(
+/// method). Errors: as [`with_renderer`].
+pub(super) fn render(
     prepared: &PreparedScene,
     main: &dyn Projection,
     options: &RenderOptions,
-    method: Method,
 ) -> Result<Rendered> {
+    let method = options.method;
     let renderer =
         |s: &PreparedScene, p: &dyn Projection, o: &RenderOptions| method.render(s, p, o);
     let scene = prepared.scene();
@@ -213,10 +216,10 @@ pub fn render_with_method(
     // camera triangles could only bound loosely) is the trilinear method's exact one.
     let main_method = match method {
         Method::Trilinear | Method::CameraTriangles => Method::Trilinear,
-        _ => return render(prepared, main, options, &renderer),
+        _ => return with_renderer(prepared, main, options, &renderer),
     };
     if scene.trilinear_reflectors.is_empty() {
-        return render(prepared, main, options, &renderer);
+        return with_renderer(prepared, main, options, &renderer);
     }
     let pinhole = perspective_as_trilinear(&main_camera(scene, main)?)?;
     let main_as_trilinear = |s: &PreparedScene, p: &dyn Projection, o: &RenderOptions| {
@@ -227,7 +230,7 @@ pub fn render_with_method(
             method.render(s, p, o)
         }
     };
-    render(prepared, main, options, &main_as_trilinear)
+    with_renderer(prepared, main, options, &main_as_trilinear)
 }
 
 /// The perspective camera `camera` as an exact trilinear projection: two projection
@@ -386,7 +389,7 @@ fn only(scene: &Scene, shown: impl Fn(&Object) -> bool) -> Scene {
     let mut part = scene.clone();
     for object in &mut part.objects {
         if !shown(object) {
-            object.mesh = Mesh::default();
+            object.mesh = Arc::default();
         }
     }
     part.trilinear_reflectors.clear();

@@ -20,8 +20,8 @@ pub enum Method {
     /// The reference ray caster; renders every projection.
     #[default]
     Raycast,
-    /// Rasterisation by the analytic inverse with subdivision (see
-    /// [`crate::render::raster`]); projections with a continuous inverse only.
+    /// Rasterisation by the analytic inverse with subdivision
+    /// ([`RenderOptions::subdivision`]); projections with a continuous inverse only.
     Raster,
     /// Trilinear rasterisation (Vallance 2005), curved edges followed as `options.curves` says;
     /// renders trilinear projections only.

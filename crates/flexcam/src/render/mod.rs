@@ -3,6 +3,14 @@
 //! The one entry point is [`render`]: a [`PreparedScene`] (built once per scene and command)
 //! through a projection with [`RenderOptions`] (method, shading, samples, the methods'
 //! tunings, reflector compositing, progress) gives a [`Rendered`] frame and its report.
+//!
+//! The renderers (the ray caster, `raster`, `trilinear`, camera triangles, reflector
+//! compositing) and what they share (the scan converter, shading, the BVH) are private
+//! modules; this module re-exports what a program needs: the entry point and its types, each
+//! method's options ([`Subdivision`], [`CurveOptions`], [`CameraTriangleOptions`]), the
+//! prepared scene's queries ([`PreparedScene::intersect`], [`Hit`]), frame comparison
+//! ([`compare`]) and photo reprojection ([`reproject`]). The bench scenes and the stages the
+//! benches time apart are in `bench_support`, with the `workloads` feature only.
 
 use std::collections::BTreeMap;
 
@@ -41,13 +49,13 @@ pub struct RenderOptions<'a> {
     /// Maximum number of specular bounces.
     pub max_bounces: u32,
     /// How method `raster` subdivides triangles (other methods ignore it).
-    pub subdivision: raster::Subdivision,
+    pub subdivision: Subdivision,
     /// How method trilinear follows curved edges.
-    pub curves: trilinear::CurveOptions,
+    pub curves: CurveOptions,
     /// The buffers the caller wants besides colour; the others come back empty.
     pub outputs: Outputs,
     /// The bound and culling of method camera-triangles.
-    pub camera_triangles: camera_triangles::Options,
+    pub camera_triangles: CameraTriangleOptions,
     /// Called from worker threads with (work units done, total) as rendering progresses.
     pub progress: Option<&'a (dyn Fn(u64, u64) + Sync)>,
 }
@@ -60,10 +68,10 @@ impl Default for RenderOptions<'_> {
             shading: Shading::Lit,
             spp: 1,
             max_bounces: 8,
-            subdivision: raster::Subdivision::default(),
-            curves: trilinear::CurveOptions::ADAPTIVE,
+            subdivision: Subdivision::default(),
+            curves: CurveOptions::ADAPTIVE,
             outputs: Outputs::ALL,
-            camera_triangles: camera_triangles::Options::default(),
+            camera_triangles: CameraTriangleOptions::default(),
             progress: None,
         }
     }
@@ -207,7 +215,7 @@ pub fn render(
     options: &RenderOptions,
 ) -> Result<Rendered> {
     let mut rendered = if options.composite_reflectors {
-        composite::render_with_method(prepared, projection, options, options.method)?
+        composite::render(prepared, projection, options)?
     } else {
         let (frame, counters) = options.method.render(prepared, projection, options)?;
         Rendered {
@@ -221,7 +229,7 @@ pub fn render(
 }
 
 /// A colour image in linear RGB, rows from the top: a photo to reproject
-/// ([`reproject::EquirectPhoto`]), as `image_io` reads it.
+/// ([`EquirectPhoto`]), as `image_io` reads it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearImage {
     pub width: u32,
@@ -238,27 +246,41 @@ pub enum Counter {
 
 /// Named counters a renderer reports (rays cast, build times, ...), for `--stats`.
 pub type Stats = BTreeMap<&'static str, Counter>;
+#[cfg(feature = "workloads")]
+pub mod bench_support;
 pub(crate) mod bvh;
-pub mod camera_triangles;
-pub mod compare;
+mod camera_triangles;
+mod compare;
 /// Reflector compositing, reached only through [`render`] (`RenderOptions::composite_reflectors`).
 mod composite;
 mod displaced;
 mod huge_pages;
 mod method;
-pub mod prepared;
-pub mod raster;
-pub mod raycast;
-pub mod reproject;
-pub mod scan;
-pub mod shading;
-pub mod transitions;
-pub mod trilinear;
+mod prepared;
+mod raster;
+mod raycast;
+mod reproject;
+mod scan;
+mod shading;
+mod transitions;
+mod trilinear;
 mod warning;
+
+pub use camera_triangles::{Bound as CameraTriangleBound, Options as CameraTriangleOptions};
+pub use compare::{compare, Comparison};
 pub use method::Method;
-pub use prepared::PreparedScene;
+pub use prepared::{Hit, PreparedScene};
+pub use raster::Subdivision;
+pub use reproject::{reproject, EquirectPhoto};
 pub use transitions::TransitionShading;
+pub use trilinear::{CurveMode, CurveOptions};
 pub use warning::RenderWarning;
+
+// What the tests of the projection layer check against a renderer.
+#[cfg(test)]
+pub(crate) use raster::supported_chart;
+#[cfg(test)]
+pub(crate) use shading::normals;
 
 #[cfg(test)]
 mod tests {
@@ -357,10 +379,10 @@ mod tests {
         }
     }
 
-    /// Reflector compositing as an option of the entry point is [`composite::render`] with
-    /// the method as renderer, frame and counters; without it the reflector is the method's
-    /// own mirror. Both renders share one prepared scene and its one BVH: the compositing's
-    /// parts of the scene are views of it.
+    /// Reflector compositing is an option of the entry point: with it the reflector's pixels
+    /// are replaced (counted in `reflector_pixels`), without it the reflector is the method's
+    /// own mirror, exactly [`Method::render`]'s frame. Both renders share one prepared scene
+    /// and its one BVH: the compositing's parts of the scene are views of it.
     #[test]
     fn compositing_is_an_option_giving_the_composite_frame() {
         let scene = scene::load(concat!(
@@ -372,19 +394,10 @@ mod tests {
         let main = scene.projection.build(48, 36).unwrap();
         let prepared = PreparedScene::new(&scene);
         let options = flat(Method::Raycast);
-        let composited = render(&prepared, main.as_ref(), &options).unwrap();
-        let renderer = |s: &PreparedScene, p: &dyn Projection, o: &RenderOptions| {
-            Method::Raycast.render(s, p, o)
-        };
         let Rendered {
             frame, counters, ..
-        } = composite::render(&prepared, main.as_ref(), &options, &renderer).unwrap();
-        assert_eq!(composited.frame, frame);
-        assert_eq!(composited.counters.len(), counters.len());
-        assert_eq!(
-            composited.counters["reflector_pixels"],
-            counters["reflector_pixels"]
-        );
+        } = render(&prepared, main.as_ref(), &options).unwrap();
+        assert!(matches!(counters["reflector_pixels"], Counter::Count(n) if n > 0));
         assert_eq!(prepared.bvh_builds(), 1);
         let plain = RenderOptions {
             composite_reflectors: false,

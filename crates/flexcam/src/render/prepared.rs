@@ -12,8 +12,9 @@
 //!
 //! Reflector compositing renders parts of the scene (the scene without a reflector, the
 //! reflector alone) and the scene with other materials: those are views
-//! (`PreparedScene::view`) that share this scene's BVH, and leave out the triangles of the
-//! objects they hide by a `TriangleMask` the queries honour.
+//! (`PreparedScene::view`) that share this scene's BVH and meshes (a scene's objects hold
+//! their meshes by `Arc`, so neither preparing nor a view copies a mesh), and leave out the
+//! triangles of the objects they hide by a `TriangleMask` the queries honour.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
@@ -118,7 +119,8 @@ fn offset_of(scene: &Scene) -> f64 {
 }
 
 impl PreparedScene {
-    /// Builds the BVH over all triangles of `scene` (a copy of which it keeps).
+    /// Builds the BVH over all triangles of `scene`, a copy of which it keeps (sharing its
+    /// meshes and textures).
     pub fn new(scene: &Scene) -> PreparedScene {
         let start = Instant::now();
         let mut first_triangle = Vec::with_capacity(scene.objects.len());
@@ -153,9 +155,9 @@ impl PreparedScene {
     }
 
     /// A view of this scene as `scene` shows it, sharing this scene's BVH (no build).
-    /// `scene` is this scene's objects in the same order, each with this scene's mesh or
-    /// with an empty one (hidden: the view leaves its triangles out of every query), and any
-    /// materials. The view renders exactly as `scene` prepared on its own would (the
+    /// `scene` is this scene's objects in the same order, each with this scene's mesh (the
+    /// same `Arc`, not a copy) or with an empty one (hidden: the view leaves its triangles out
+    /// of every query), and any materials. The view renders exactly as `scene` prepared on its own would (the
     /// secondary-ray offset is that of the shown objects), up to the order of hits at equal
     /// `t`.
     pub(in crate::render) fn view(&self, scene: Scene) -> PreparedScene {
@@ -165,7 +167,7 @@ impl PreparedScene {
             .objects
             .iter()
             .zip(&scene.objects)
-            .all(|(a, b)| a.mesh == b.mesh || b.mesh.triangles.is_empty()));
+            .all(|(a, b)| Arc::ptr_eq(&a.mesh, &b.mesh) || b.mesh.triangles.is_empty()));
         let object_shown: Vec<bool> = (self.scene.objects.iter().zip(&scene.objects))
             .map(|(a, b)| a.mesh.triangles.is_empty() || !b.mesh.triangles.is_empty())
             .collect();

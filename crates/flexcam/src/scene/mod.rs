@@ -27,8 +27,10 @@ use crate::projection::ProjectionSpec;
 pub struct Object {
     pub id: u32,
     pub name: String,
-    /// The mesh, already transformed into world space.
-    pub mesh: Mesh,
+    /// The mesh, already transformed into world space. Shared: copies of a scene (a prepared
+    /// scene's own, the views reflector compositing renders) share every mesh instead of
+    /// copying it; `Arc::make_mut` edits one copy's mesh alone.
+    pub mesh: Arc<Mesh>,
     pub material: Material,
     /// World to object space, for patterns defined in object space (the checker).
     pub world_to_object: Affine3A,

@@ -18,9 +18,10 @@
 use std::path::Path;
 
 use clap::Args;
-use flexcam::render::camera_triangles::{Bound, Options};
-use flexcam::render::compare::compare;
-use flexcam::render::{self, Counter, Frame, Method, PreparedScene, RenderOptions, Shading};
+use flexcam::render::{
+    self, compare, CameraTriangleBound as Bound, CameraTriangleOptions, Counter, Frame, Method,
+    PreparedScene, RenderOptions, Shading,
+};
 use flexcam::scene::{self, Scene};
 use flexcam::Result;
 
@@ -124,7 +125,7 @@ pub fn run(args: &CameraTrianglesArgs) -> Result<()> {
                 let options = RenderOptions {
                     method: Method::CameraTriangles,
                     shading: Shading::Flat,
-                    camera_triangles: Options { bound, cull },
+                    camera_triangles: CameraTriangleOptions { bound, cull },
                     ..RenderOptions::default()
                 };
                 let (timing, rendered) = measure(args.repeat, || {

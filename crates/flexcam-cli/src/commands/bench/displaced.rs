@@ -253,7 +253,7 @@ fn tessellated(scene: &Scene) -> Scene {
     let mut scene = scene.clone();
     for object in &mut scene.objects {
         if let Some(spec) = object.displacement.take() {
-            object.mesh = tessellate(&object.mesh, &Displacement::from_spec(&spec));
+            object.mesh = tessellate(&object.mesh, &Displacement::from_spec(&spec)).into();
         }
     }
     scene

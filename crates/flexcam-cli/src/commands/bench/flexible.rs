@@ -19,11 +19,12 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use flexcam::projection::Projection;
-use flexcam::render::raster::workloads::{teapot_dense_panorama, PanoramaWorkload, PANORAMA_SIZE};
-use flexcam::render::raster::InverseRaster;
-use flexcam::render::raycast::workloads::{table_volume, teapot_scene, TABLE_SIZE};
-use flexcam::render::{raycast, PreparedScene};
-use flexcam::render::{Counter, Frame, RenderOptions, Shading};
+use flexcam::render::bench_support::workloads::raster::{
+    teapot_dense_panorama, PanoramaWorkload, PANORAMA_SIZE,
+};
+use flexcam::render::bench_support::workloads::raycast::{table_volume, teapot_scene, TABLE_SIZE};
+use flexcam::render::bench_support::InverseRaster;
+use flexcam::render::{self, Counter, Frame, PreparedScene, RenderOptions, Shading};
 use flexcam::scene::Scene;
 use flexcam::{Error, Result};
 
@@ -162,7 +163,7 @@ fn row_times(scene: &Scene, repeat: u32) -> Result<([Timing; 6], [u64; 6])> {
     for ((time, hash), column) in times.iter_mut().zip(&mut hashes).zip(COLUMNS) {
         let projection = table_volume(scene, column, TABLE_SIZE)?;
         let (timing, frame) = measure(repeat, || {
-            Ok(raycast::render(&caster, &projection, &options).0)
+            Ok(render::render(&caster, &projection, &options)?.frame)
         })?;
         (*time, *hash) = (timing, frame_hash(&frame));
     }
@@ -188,7 +189,7 @@ fn frame_hash(frame: &Frame) -> u64 {
 }
 
 /// The panorama throughput table (the workload of
-/// `flexcam::render::raster::workloads`): raster (first frame of a new renderer,
+/// `flexcam::render::bench_support::workloads::raster`): raster (first frame of a new renderer,
 /// later frames of one renderer into one kept frame, flat and lit) and ray caster, the
 /// median of `repeat` frames each after one warm-up.
 fn panorama(repeat: u32) -> Result<()> {
@@ -222,7 +223,7 @@ fn panorama(repeat: u32) -> Result<()> {
     };
     let ((later_flat, stages), (later_lit, _)) = (later(&flat)?, later(&options(Shading::Lit))?);
     let (cast, _) = measure(repeat, || {
-        raycast::render(&prepared, projection, &flat);
+        render::render(&prepared, projection, &flat)?;
         Ok(())
     })?;
     let (width, height) = PANORAMA_SIZE;

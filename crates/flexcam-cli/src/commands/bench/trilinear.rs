@@ -5,7 +5,7 @@
 //!
 //! - Tables D.1 to D.3: random scenes of 1 to 640 disconnected vertex-coloured triangles
 //!   through random regular screen meshes of 2 to 50 projection triangles, square images of
-//!   1 to 640^2 pixels (`render::trilinear::workloads`).
+//!   1 to 640^2 pixels (`render::bench_support::workloads::trilinear`).
 //! - Table 8.1, figure 7.4: the cube-floor scene (686 triangles) through 2, 8, 18, 32 and 50
 //!   projection triangles (the fan grid of the accuracy tests) at 800 x 800, with the
 //!   accuracy against the ray caster (id agreement and relative RGB error) and the trilinear stage times.
@@ -18,19 +18,21 @@
 //! time (Linux only, in 10 ms ticks: use a `--repeat` of 10 or more).
 //!
 //! Every render above returns a new frame, the ray caster's and trilinear's alike
-//! (`raycast::render`, `TrilinearRenderer::render`): its 12.8 MB at 800 x 800 are allocated
+//! (`render::render`, `TrilinearRenderer::render`): its 12.8 MB at 800 x 800 are allocated
 //! and their pages first touched in each timed render. A second cube table times the later
 //! frames of a program that draws frame after frame into one frame it keeps, both renderers
-//! alike (`raycast::render_into`, `TrilinearRenderer::render_into` without and with
+//! alike (`bench_support::raycast_into`, `TrilinearRenderer::render_into` without and with
 //! clipping), and compares them like for like.
 
 use clap::Args;
 use flexcam::projection::{Trilinear, TrilinearMesh};
-use flexcam::render::compare::compare;
-use flexcam::render::trilinear::workloads::{fan_grid, random_grid, random_triangles};
-use flexcam::render::trilinear::{CurveOptions, TrilinearRenderer};
-use flexcam::render::{raycast, PreparedScene};
-use flexcam::render::{Counter, Frame, RenderOptions, Shading};
+use flexcam::render::bench_support::workloads::trilinear::{
+    fan_grid, random_grid, random_triangles,
+};
+use flexcam::render::bench_support::{raycast_into, TrilinearRenderer};
+use flexcam::render::{
+    self, compare, Counter, CurveOptions, Frame, PreparedScene, RenderOptions, Shading,
+};
 use flexcam::scene;
 use flexcam::Result;
 
@@ -226,7 +228,7 @@ pub fn run(args: &TrilinearArgs) -> Result<()> {
 /// without clipping against the ray caster (the clipped render's is in Table 8.1).
 fn print_kept(cells: &[(usize, Timing)]) {
     println!(
-        "\ncube-floor, later frames, KEPT FRAMES: the ray caster (raycast::render_into) and \
+        "\ncube-floor, later frames, KEPT FRAMES: the ray caster (raycast_into) and \
          trilinear without / with clipping (TrilinearRenderer::render_into) each draw into a \
          frame kept from render to render; accuracy of trilinear without clipping against \
          raycast; cpu = mean CPU ms per render, all threads"
@@ -289,7 +291,7 @@ impl<'a> Renderers<'a> {
             ..RenderOptions::default()
         };
         let (raycast, reference) = measure(repeat, || {
-            Ok(raycast::render(self.caster, &projection, &options).0)
+            Ok(render::render(self.caster, &projection, &options)?.frame)
         })?;
         let trilinear = |curves: CurveOptions| {
             measure(repeat, || {
@@ -314,12 +316,7 @@ impl<'a> Renderers<'a> {
         let kept = if kept {
             let mut frame = Frame::new(1, 1, glam::Vec3::ZERO);
             let (raycast, _) = measure(repeat, || {
-                Ok(raycast::render_into(
-                    self.caster,
-                    &mut frame,
-                    &projection,
-                    &options,
-                ))
+                Ok(raycast_into(self.caster, &mut frame, &projection, &options))
             })?;
             let (trilinear, _) = into_kept(unclipped)?;
             let (clipped, _) = into_kept(CurveOptions::ADAPTIVE)?;

@@ -13,7 +13,7 @@ use glam::DVec2;
 
 use super::camera::Camera;
 use crate::render::scan::{spans, FillRule, Polygon, Scratch, NO_PRIMITIVE};
-use crate::render::trilinear::{plane_hit, SceneGeometry};
+use crate::render::trilinear::{plane_hit, GBuffer, SceneGeometry};
 
 /// The fragments of some shapes: how many the bounds produced and how many were rendered.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -33,18 +33,11 @@ impl std::ops::Add for FragmentCounts {
     }
 }
 
-/// The winners of one band of rows.
+/// The winners of one band of rows (the trilinear method's [`GBuffer`]: depth as the exact
+/// ray parameter, key, scene barycentrics) and what the stage needs besides.
 #[derive(Debug, Clone)]
 pub struct BandBuffer {
-    width: u32,
-    /// The rows `[rows.0, rows.1)` the buffer holds now.
-    pub rows: (u32, u32),
-    /// The winner's ray parameter; `f64::INFINITY` where nothing won.
-    pub depth: Vec<f64>,
-    /// The winner's key; [`NO_PRIMITIVE`] where nothing won.
-    pub keys: Vec<u64>,
-    /// The winner's scene barycentrics (weights of the second and third corners).
-    pub barycentrics: Vec<[f32; 2]>,
+    pub hits: GBuffer,
     /// The key of the last fragment at each pixel: a pair's regions (the tight bound's
     /// pieces) are drawn one after the other and may share boundary pixels, which are one
     /// fragment of the pair, counted once.
@@ -55,24 +48,17 @@ pub struct BandBuffer {
 impl BandBuffer {
     /// A buffer for bands of up to `rows` rows of an image `width` pixels wide.
     pub fn new(width: u32, rows: u32) -> BandBuffer {
-        let n = width as usize * rows as usize;
         BandBuffer {
-            width,
-            rows: (0, 0),
-            depth: vec![f64::INFINITY; n],
-            keys: vec![NO_PRIMITIVE; n],
-            barycentrics: vec![[0.0; 2]; n],
-            last: vec![NO_PRIMITIVE; n],
+            hits: GBuffer::new(width, rows),
+            last: vec![NO_PRIMITIVE; width as usize * rows as usize],
             scratch: Scratch::default(),
         }
     }
 
     /// Empties the buffer for rows `rows`.
     pub fn start_band(&mut self, rows: (u32, u32)) {
-        let n = (rows.1 - rows.0) as usize * self.width as usize;
-        self.rows = rows;
-        self.depth[..n].fill(f64::INFINITY);
-        self.keys[..n].fill(NO_PRIMITIVE);
+        let n = (rows.1 - rows.0) as usize * self.hits.width() as usize;
+        self.hits.start_band(rows);
         self.last[..n].fill(NO_PRIMITIVE);
     }
 }
@@ -93,7 +79,7 @@ impl Stage<'_> {
         let camera_index = (key >> 32) as u32;
         let camera = &self.cameras[camera_index as usize];
         let corners = self.scene.corners((key & u64::from(u32::MAX)) as usize);
-        let (rows, width) = (buffer.rows, buffer.width);
+        let (rows, width) = (buffer.hits.rows(), buffer.hits.width());
         let mut counts = FragmentCounts::default();
         let mut scratch = std::mem::take(&mut buffer.scratch);
         spans(
@@ -126,10 +112,11 @@ impl Stage<'_> {
                         continue;
                     }
                     counts.rendered += 1;
-                    if t < buffer.depth[i] || (t == buffer.depth[i] && key < buffer.keys[i]) {
-                        buffer.depth[i] = t;
-                        buffer.keys[i] = key;
-                        buffer.barycentrics[i] = [u as f32, v as f32];
+                    let hits = &mut buffer.hits;
+                    if t < hits.depth[i] || (t == hits.depth[i] && key < hits.keys[i]) {
+                        hits.depth[i] = t;
+                        hits.keys[i] = key;
+                        hits.barycentrics[i] = [u as f32, v as f32];
                     }
                 }
             },

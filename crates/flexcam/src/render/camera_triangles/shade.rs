@@ -31,14 +31,14 @@ impl Shader<'_> {
     /// Shades the drawn band into the same rows of the frame, every pixel written; returns
     /// the secondary and shadow rays cast.
     pub fn rows(&self, drawn: &BandBuffer, out: FrameRows<'_>) -> u64 {
-        let width = out.width as usize;
+        let (drawn, width) = (&drawn.hits, out.width as usize);
         let mut rays = 0;
         for (i, &key) in drawn.keys[..out.color.len()].iter().enumerate() {
             if key == NO_PRIMITIVE {
                 (out.color[i], out.depth[i], out.ids[i]) = (self.background, f32::INFINITY, 0);
                 continue;
             }
-            let (x, y) = ((i % width) as u32, drawn.rows.0 + (i / width) as u32);
+            let (x, y) = ((i % width) as u32, drawn.rows().0 + (i / width) as u32);
             let centre = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
             let camera = &self.cameras[(key >> 32) as usize];
             let k = (key & u64::from(u32::MAX)) as usize;

@@ -30,10 +30,30 @@ fn raycast(
 }
 
 fn flat() -> RenderOptions<'static> {
+    flat_by(Method::Raycast)
+}
+
+/// Flat shading by `method` (which renders every view of the composite).
+fn flat_by(method: Method) -> RenderOptions<'static> {
     RenderOptions {
+        method,
         shading: Shading::Flat,
         ..RenderOptions::default()
     }
+}
+
+/// `scene` through `main` by the entry point, the reflectors composited as `options` say.
+fn try_composite(
+    scene: &Scene,
+    main: &dyn Projection,
+    options: &RenderOptions,
+) -> Result<Rendered> {
+    crate::render::render(&PreparedScene::new(scene), main, options)
+}
+
+/// [`try_composite`], which must succeed.
+fn composited(scene: &Scene, main: &dyn Projection, options: &RenderOptions) -> Rendered {
+    try_composite(scene, main, options).unwrap()
 }
 
 /// The pixels of `frame` where `reference` sees object `id`, as a one-row frame.
@@ -117,13 +137,7 @@ fn sphere_composite_matches_the_true_mirror() {
         frame,
         counters: stats,
         ..
-    } = render(
-        &PreparedScene::new(&scene),
-        main.as_ref(),
-        &flat(),
-        &raycast,
-    )
-    .unwrap();
+    } = composited(&scene, main.as_ref(), &flat());
     assert_eq!(frame.ids, reference.ids, "ids are the main view's");
     // Depth is the reflector's own (to f32 rounding: the diffuse path reports the f32 hit).
     let depth_ok = frame
@@ -234,7 +248,7 @@ fn lens_scene() -> Scene {
     }
     .scene("lens.toml");
     // Replace the placeholder sphere by the lens plane at y = 1.2.
-    scene.objects[0].mesh = lens_plane(1.2, 2.2);
+    scene.objects[0].mesh = lens_plane(1.2, 2.2).into();
     scene.trilinear_reflectors = vec![TrilinearReflector::new(1)];
     scene
 }
@@ -244,13 +258,7 @@ fn lens_composite_matches_ray_cast_glass() {
     let scene = lens_scene();
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let reference = reference(&scene, main.as_ref());
-    let Rendered { frame, .. } = render(
-        &PreparedScene::new(&scene),
-        main.as_ref(),
-        &flat(),
-        &raycast,
-    )
-    .unwrap();
+    let Rendered { frame, .. } = composited(&scene, main.as_ref(), &flat());
     let (c, same) = agreement(&frame, &reference, 1);
     println!(
         "lens composite: {} pixels, same colour {same:.4}, relative RGB error {:.4}",
@@ -279,7 +287,7 @@ fn lit_glass_mixes_reflection_and_refraction_by_fresnel() {
         frame,
         counters: stats,
         ..
-    } = render(&PreparedScene::new(&scene), main.as_ref(), &lit, &raycast).unwrap();
+    } = composited(&scene, main.as_ref(), &lit);
     let (fresnel, _) = agreement(&frame, &reference, 1);
 
     // Refraction alone, tinted: the main view with the lens diffuse, the refraction pasted.
@@ -363,13 +371,7 @@ fn without_reflectors_the_renderer_runs_once_and_unchanged() {
         frame,
         counters: stats,
         ..
-    } = render(
-        &PreparedScene::new(&scene),
-        main.as_ref(),
-        &flat(),
-        &raycast,
-    )
-    .unwrap();
+    } = composited(&scene, main.as_ref(), &flat());
     assert_eq!(
         frame,
         raycast(&PreparedScene::new(&scene), main.as_ref(), &flat())
@@ -397,22 +399,10 @@ fn bad_reflectors_are_errors() {
     let mut scene = scene();
     scene.trilinear_reflectors = vec![TrilinearReflector::new(9)];
     let main = scene.projection.build(40, 30).unwrap();
-    let e = render(
-        &PreparedScene::new(&scene),
-        main.as_ref(),
-        &flat(),
-        &raycast,
-    )
-    .unwrap_err();
+    let e = try_composite(&scene, main.as_ref(), &flat()).unwrap_err();
     assert!(e.message.contains("no object has this id"), "{e}");
     scene.trilinear_reflectors = vec![TrilinearReflector::new(2)];
-    let e = render(
-        &PreparedScene::new(&scene),
-        main.as_ref(),
-        &flat(),
-        &raycast,
-    )
-    .unwrap_err();
+    let e = try_composite(&scene, main.as_ref(), &flat()).unwrap_err();
     assert!(e.message.contains("must be a mirror or glass"), "{e}");
     let mut scene = self::scene();
     scene.projection = ProjectionSpec::Orthographic {
@@ -424,13 +414,7 @@ fn bad_reflectors_are_errors() {
         width: 4.0,
     };
     let main = scene.projection.build(40, 30).unwrap();
-    let e = render(
-        &PreparedScene::new(&scene),
-        main.as_ref(),
-        &flat(),
-        &raycast,
-    )
-    .unwrap_err();
+    let e = try_composite(&scene, main.as_ref(), &flat()).unwrap_err();
     assert!(e.message.contains("need a perspective projection"), "{e}");
 }
 
@@ -446,13 +430,7 @@ fn finer_reflectors_agree_better() {
         scene.trilinear_reflectors[0].refine_px = 0.0;
         let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
         let reference = reference(&scene, main.as_ref());
-        let Rendered { frame, .. } = render(
-            &PreparedScene::new(&scene),
-            main.as_ref(),
-            &flat(),
-            &raycast,
-        )
-        .unwrap();
+        let Rendered { frame, .. } = composited(&scene, main.as_ref(), &flat());
         let (c, same) = agreement(&frame, &reference, BALL);
         println!(
             "{segments} segments: same colour {same:.4}, relative RGB error {:.4}",
@@ -489,13 +467,7 @@ fn uncovered_reflector_pixels_are_ray_cast_exactly() {
         frame,
         counters: stats,
         ..
-    } = render(
-        &PreparedScene::new(&scene),
-        main.as_ref(),
-        &flat(),
-        &raycast,
-    )
-    .unwrap();
+    } = composited(&scene, main.as_ref(), &flat());
     let (c, same) = agreement(&frame, &reference, BALL);
     assert!(
         c.pixels > 1000,
@@ -518,13 +490,7 @@ fn uncovered_reflector_pixels_are_ray_cast_exactly() {
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let Rendered {
         counters: stats, ..
-    } = render(
-        &PreparedScene::new(&scene),
-        main.as_ref(),
-        &flat(),
-        &raycast,
-    )
-    .unwrap();
+    } = composited(&scene, main.as_ref(), &flat());
     let Some(Counter::Count(cast)) = stats.get("reflector_exact_pixels") else {
         panic!("no counter: {stats:?}");
     };
@@ -584,20 +550,8 @@ fn trilinear_method_composites_reflectors() {
         frame: trilinear,
         counters: stats,
         ..
-    } = render_with_method(
-        &PreparedScene::new(&scene),
-        main.as_ref(),
-        &flat(),
-        Method::Trilinear,
-    )
-    .unwrap();
-    let Rendered { frame: raycast, .. } = render(
-        &PreparedScene::new(&scene),
-        main.as_ref(),
-        &flat(),
-        &raycast,
-    )
-    .unwrap();
+    } = composited(&scene, main.as_ref(), &flat_by(Method::Trilinear));
+    let Rendered { frame: raycast, .. } = composited(&scene, main.as_ref(), &flat());
     let c = compare(&trilinear, &raycast).unwrap();
     assert!(c.id_agreement >= 0.9999, "{c:?}");
     assert!(c.relative_rgb_error < 0.002, "{c:?}");
@@ -611,13 +565,7 @@ fn trilinear_method_composites_reflectors() {
     // Without reflectors the method is unchanged: a perspective scene is still refused.
     let mut plain = scene.clone();
     plain.trilinear_reflectors.clear();
-    assert!(render_with_method(
-        &PreparedScene::new(&plain),
-        main.as_ref(),
-        &flat(),
-        Method::Trilinear
-    )
-    .is_err());
+    assert!(try_composite(&plain, main.as_ref(), &flat_by(Method::Trilinear)).is_err());
 }
 
 /// [`lens_scene`] with index of refraction `ior` and the lens's screen map `map`; with
@@ -627,7 +575,9 @@ fn plate_scene(ior: f32, map: SurfaceScreenMap, flat_normals: bool) -> Scene {
     let mut scene = lens_scene();
     scene.objects[0].material.finish = Finish::Glass { ior };
     if flat_normals {
-        scene.objects[0].mesh.normals.fill(Vec3::Y);
+        Arc::make_mut(&mut scene.objects[0].mesh)
+            .normals
+            .fill(Vec3::Y);
     }
     scene.trilinear_reflectors[0].screen_map = map;
     scene
@@ -638,8 +588,7 @@ fn plate_scene(ior: f32, map: SurfaceScreenMap, flat_normals: bool) -> Scene {
 fn composite_error(scene: &Scene, method: Method) -> (Comparison, Comparison) {
     let main = scene.projection.build(SIZE.0, SIZE.1).unwrap();
     let reference = reference(scene, main.as_ref());
-    let Rendered { frame, .. } =
-        render_with_method(&PreparedScene::new(scene), main.as_ref(), &flat(), method).unwrap();
+    let Rendered { frame, .. } = composited(scene, main.as_ref(), &flat_by(method));
     let whole = compare(&frame, &reference).unwrap();
     (whole, agreement(&frame, &reference, 1).0)
 }
@@ -717,13 +666,7 @@ fn refined_error(scene: &Scene, id: u32, refine_px: f64) -> (Comparison, f64, St
         frame,
         counters: stats,
         ..
-    } = render(
-        &PreparedScene::new(&scene),
-        main.as_ref(),
-        &flat(),
-        &raycast,
-    )
-    .unwrap();
+    } = composited(&scene, main.as_ref(), &flat());
     let (c, same) = agreement(&frame, &reference, id);
     (c, same, stats)
 }

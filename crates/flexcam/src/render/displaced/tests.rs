@@ -4,6 +4,7 @@ use glam::{DVec2, DVec3};
 
 use super::*;
 use crate::displace::{MicroGrid, MicroTriangle};
+use crate::render::shading::Normals;
 use crate::render::{render, Method, PreparedScene, RenderOptions, Shading};
 use crate::scene::file::parse;
 
@@ -144,9 +145,10 @@ fn lit_normals_are_the_micro_triangle_faces() {
         let Some(hit) = prepared.intersect(&ray) else {
             continue;
         };
-        let Some(normals) = prepared.displaced_normals(&hit, ray.direction) else {
+        let Some(face_normal) = prepared.displaced_face_normal(&hit) else {
             continue;
         };
+        let normals = Normals::of_face(face_normal, ray.direction.as_vec3());
         let object = &prepared.scene().objects[hit.object];
         let d = Displacement::from_spec(object.displacement.as_deref().unwrap());
         let grid = MicroGrid::new(&base_corners(&object.mesh, hit.triangle), &d);

@@ -1,15 +1,14 @@
 //! The prepared scene's queries over its displaced objects ([`crate::render::displaced`]):
 //! hits on displaced base triangles as prepared-scene hits, their f64 refinement and normals.
 //! A displaced hit is reported on its base triangle, with the base-triangle barycentrics of
-//! the hit's place in the subdivision; its normals are the micro-triangle's face normal.
+//! the hit's place in the subdivision; its normal is the micro-triangle's face normal.
 
-use glam::{DVec2, DVec3};
+use glam::{DVec2, Vec3};
 
 use crate::displace::{Displacement, MicroTriangle};
 use crate::geometry::Ray;
 use crate::render::displaced::DisplacedHit;
 use crate::render::prepared::{Hit, Hit32, PreparedScene};
-use crate::render::shading::Normals;
 
 impl PreparedScene {
     /// The displaced hit `found` as a hit of the prepared scene: base triangle and base
@@ -93,32 +92,22 @@ impl PreparedScene {
         })
     }
 
-    /// The normals at `hit` on a displaced object, seen along `incoming`: the face normal of
-    /// the micro-triangle holding the hit (module docs); `None` when the object is not
-    /// displaced.
-    pub(in crate::render) fn displaced_normals(
-        &self,
-        hit: &Hit,
-        incoming: DVec3,
-    ) -> Option<Normals> {
+    /// The unit face normal (by its winding) of the micro-triangle holding `hit` on a
+    /// displaced object, the normal shading uses there (module docs); `None` when the object
+    /// is not displaced.
+    pub(in crate::render) fn displaced_face_normal(&self, hit: &Hit) -> Option<Vec3> {
         let set = self.displaced.as_ref()?;
         let displacement = set.displacement(hit.object)?;
         let micro = MicroTriangle::containing(displacement.level(), hit.barycentric.as_dvec2());
         let [a, b, c] = set
             .triangle(&self.scene, hit.object, hit.triangle, displacement)
             .positions(micro);
-        let face = (b - a).cross(c - a).normalize_or_zero().as_vec3();
-        let front_face = face.dot(incoming.as_vec3()) <= 0.0;
-        let geometric = if front_face { face } else { -face };
-        Some(Normals {
-            geometric,
-            shading: geometric,
-            front_face,
-        })
+        Some((b - a).cross(c - a).normalize_or_zero().as_vec3())
     }
 
-    /// Whether object `object` is displaced.
-    pub fn is_displaced(&self, object: usize) -> bool {
+    /// Whether object `object` is displaced (the tests tell displaced hits apart by it).
+    #[cfg(test)]
+    pub(in crate::render) fn is_displaced(&self, object: usize) -> bool {
         self.displaced
             .as_ref()
             .is_some_and(|set| set.displacement(object).is_some())

@@ -46,7 +46,7 @@ mod seam;
 mod subdivision;
 #[cfg(test)]
 mod tests;
-/// Bench scenes, for `flexcam bench` and the criterion benches only.
+// Bench scenes, for `flexcam bench` and the criterion benches only (`bench_support`).
 #[cfg(any(test, feature = "workloads"))]
 pub mod workloads;
 
@@ -58,7 +58,7 @@ use std::time::Instant;
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
-pub use subdivision::{Subdivision, DEFAULT_TOLERANCE, MAX_LEVEL, MAX_UNIFORM};
+pub use subdivision::Subdivision;
 
 use self::band_fill::{fill_and_shade, BAND_ROWS};
 use self::coverage::{Bins, ScreenTriangle};

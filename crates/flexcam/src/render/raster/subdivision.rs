@@ -35,7 +35,7 @@ pub struct Subdivision {
 }
 
 impl Default for Subdivision {
-    /// Adaptive with [`DEFAULT_TOLERANCE`].
+    /// Adaptive with the default tolerance of 0.5 pixels.
     fn default() -> Self {
         Subdivision {
             uniform: 1,
@@ -61,8 +61,8 @@ impl Subdivision {
         }
     }
 
-    /// Errors: `uniform` outside [1, [`MAX_UNIFORM`]], a tolerance that is not a finite
-    /// number of pixels of at least `MIN_TOLERANCE`.
+    /// Errors: `uniform` outside [1, 64], a tolerance that is not a finite
+    /// number of pixels of at least 0.001.
     pub fn validate(&self) -> Result<()> {
         if !(1..=MAX_UNIFORM).contains(&self.uniform) {
             return Err(Error::new(format!(

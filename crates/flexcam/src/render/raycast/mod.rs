@@ -9,7 +9,7 @@ pub(in crate::render) mod pieces;
 pub(crate) mod sampling;
 mod shade;
 mod tiles;
-/// Bench scenes, for `flexcam bench` and the criterion benches only.
+// Bench scenes, for `flexcam bench` and the criterion benches only (`bench_support`).
 #[cfg(any(test, feature = "workloads"))]
 pub mod workloads;
 

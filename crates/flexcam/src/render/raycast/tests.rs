@@ -71,7 +71,7 @@ fn object(id: u32, mesh: Mesh, color: Vec3, finish: Finish) -> Object {
     Object {
         id,
         name: format!("o{id}"),
-        mesh,
+        mesh: mesh.into(),
         material: Material {
             color,
             pattern: Pattern::Solid,

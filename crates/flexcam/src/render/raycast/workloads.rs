@@ -27,7 +27,7 @@ pub fn teapot_scene(faces: u32) -> (Scene, usize) {
     let object = Object {
         id: 1,
         name: "teapot".to_string(),
-        mesh,
+        mesh: mesh.into(),
         material: Material {
             color: Vec3::new(0.85, 0.3, 0.2),
             ..Material::default()

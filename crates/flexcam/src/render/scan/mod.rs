@@ -1,19 +1,20 @@
 //! The software polygon rasteriser shared by the fast renderers: shapes in continuous pixel
 //! coordinates (polygons of any shape, or two-vertex lines) with a depth and `N` attributes
 //! per vertex, scan-converted at pixel centres by an explicit [`FillRule`] with a top-left tie
-//! rule, z-tested and shaded into a [`Target`].
+//! rule into spans ([`spans`]) that each renderer z-tests and shades its own way.
 //!
 //! - [`polygon`]: the input ([`Vertex`], [`Polygon`], [`PolygonBatch`]);
 //! - [`fill`]: polygon coverage, the fill and tie rules, and attribute interpolation;
 //! - [`line`](mod@line): one-pixel-wide lines for two-vertex shapes;
-//! - [`target`]: the z-buffered target and [`Fragment`]s;
+//! - `reference` and `target` (tests only): the reference rasteriser, one fragment at a time
+//!   into a z-buffered target, that the renderers' scan conversion is checked against;
 //! - [`fused`]: the image cut into bands drawn in parallel into small band-local buffers,
 //!   each shaded into the output [`crate::render::Frame`] at once (deferred shading without
 //!   frame-sized buffers);
 //! - [`stats`]: counters for `--stats`.
 //!
-//! A *stage* (see `rasterize_parallel_staged`) may rewrite each fragment before its z-test
-//! (an exact per-pixel depth instead of the interpolated one) or discard it.
+//! A renderer may rewrite each fragment before its z-test (an exact per-pixel depth instead
+//! of the interpolated one) or discard it.
 //!
 //! Determinism: a pixel keeps the fragment with the smallest `(depth, primitive)` pair, and
 //! every fragment's position and values depend only on its own shape, so the image does not
@@ -25,100 +26,26 @@ pub mod fused;
 pub mod interpolate;
 pub mod line;
 pub mod polygon;
+#[cfg(test)]
+mod reference;
 pub mod stats;
+#[cfg(test)]
 pub mod target;
 #[cfg(test)]
 mod tests;
 
-use glam::Vec3;
-use rayon::prelude::*;
-
 pub use fill::{FillRule, Scratch, Span};
 pub use fused::{band_rows_for, for_each_band, FrameRows};
-pub use interpolate::Varying;
-pub use polygon::{Polygon, PolygonBatch, Vertex, LIMIT};
+pub use polygon::{Polygon, PolygonBatch, Vertex, LIMIT, NO_PRIMITIVE};
+#[cfg(test)]
+pub use reference::{rasterize, rasterize_parallel, rasterize_parallel_resolved, BAND_ROWS};
 pub use stats::RasterStats;
+#[cfg(test)]
+pub use target::{Fragment, Target};
 
-use stats::FragmentCounts;
-pub use target::{Fragment, Layers, Target, NO_PRIMITIVE};
+use rayon::prelude::*;
 
 use polygon::Kind;
-use target::Band;
-
-/// Rows per band in [`rasterize_parallel`]: enough for little per-band overhead on small
-/// shapes, few enough for many tasks on typical images.
-pub const BAND_ROWS: u32 = 16;
-
-/// Draws `polygons` into `target` in order on the calling thread, shading each fragment that
-/// passes the z-test with `shader`. Returns what was done (`covered` counts the whole
-/// target after the pass).
-pub fn rasterize<const N: usize>(
-    target: &mut Target,
-    polygons: &PolygonBatch<N>,
-    rule: FillRule,
-    shader: &impl Fn(&Fragment<N>) -> Vec3,
-) -> RasterStats {
-    let mut stats = RasterStats::of_shapes(polygons);
-    let mut scratch = Scratch::default();
-    let mut band = target.band();
-    for polygon in polygons.iter() {
-        let counts = draw(&mut band, &polygon, rule, &mut scratch, &keep, shader);
-        stats.add_fragments(counts);
-    }
-    stats.covered = target.covered();
-    stats
-}
-
-/// Like [`rasterize`], with the target cut into bands of `band_rows` rows drawn in parallel
-/// (rayon), each band by one task drawing the shapes that reach it in input order. The result
-/// is bit for bit that of [`rasterize`], whatever the thread count or band size.
-pub fn rasterize_parallel<const N: usize>(
-    target: &mut Target,
-    polygons: &PolygonBatch<N>,
-    rule: FillRule,
-    band_rows: u32,
-    shader: &(impl Fn(&Fragment<N>) -> Vec3 + Sync),
-) -> RasterStats {
-    rasterize_parallel_resolved(target, polygons, rule, band_rows, &keep, shader)
-}
-
-/// Keeps every fragment as interpolated (the resolve step of plain rasterisation).
-fn keep<const N: usize>(_: &mut Fragment<N>) -> bool {
-    true
-}
-
-/// [`rasterize_parallel`] with a resolve step run on every covered fragment before its
-/// z-test: `resolve` may replace the interpolated depth and attributes (a renderer that
-/// computes exact per-pixel values from the fragment's primitive) or discard the fragment by
-/// returning `false` (counted in [`RasterStats::discarded`]). It must be a pure function of
-/// the fragment, like the shader, for the result to stay deterministic.
-pub fn rasterize_parallel_resolved<const N: usize>(
-    target: &mut Target,
-    polygons: &PolygonBatch<N>,
-    rule: FillRule,
-    band_rows: u32,
-    resolve: &(impl Fn(&mut Fragment<N>) -> bool + Sync),
-    shader: &(impl Fn(&Fragment<N>) -> Vec3 + Sync),
-) -> RasterStats {
-    let band_rows = band_rows.max(1);
-    let bins = bins(polygons, target.height(), band_rows);
-    let counts = target
-        .bands(band_rows)
-        .into_par_iter()
-        .zip(bins)
-        .map(|(mut band, bin)| {
-            let mut scratch = Scratch::default();
-            bin.iter().fold(FragmentCounts::default(), |sum, &i| {
-                let polygon = polygons.get(i);
-                sum + draw(&mut band, &polygon, rule, &mut scratch, resolve, shader)
-            })
-        })
-        .reduce(FragmentCounts::default, |a, b| a + b);
-    let mut stats = RasterStats::of_shapes(polygons);
-    stats.add_fragments(counts);
-    stats.covered = target.covered();
-    stats
-}
 
 /// The shapes reaching each band of `band_rows` rows (at least 1) of an image `height` rows
 /// tall, in input order: their row ranges in parallel, then a serial pass over the ranges.
@@ -140,37 +67,6 @@ fn bins<const N: usize>(
         }
     }
     bins
-}
-
-/// Draws one shape into the rows of `band`, resolving each fragment before its z-test.
-fn draw<const N: usize>(
-    band: &mut Band<'_>,
-    polygon: &Polygon<'_, N>,
-    rule: FillRule,
-    scratch: &mut Scratch<N>,
-    resolve: &impl Fn(&mut Fragment<N>) -> bool,
-    shader: &impl Fn(&Fragment<N>) -> Vec3,
-) -> FragmentCounts {
-    let mut counts = FragmentCounts::default();
-    let (rows, width) = (band.rows, band.width);
-    spans(polygon, rule, rows, width, scratch, |span| {
-        for x in span.x0..span.x1 {
-            let mut fragment = Fragment {
-                x,
-                y: span.y,
-                varying: span.at(x),
-                object: polygon.object,
-                primitive: polygon.primitive,
-            };
-            counts.fragments += 1;
-            if resolve(&mut fragment) {
-                counts.writes += u64::from(band.test_and_write(&fragment, shader));
-            } else {
-                counts.discarded += 1;
-            }
-        }
-    });
-    counts
 }
 
 /// Calls `emit` with the runs of pixel centres that `polygon` covers in rows

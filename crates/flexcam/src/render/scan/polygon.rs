@@ -13,6 +13,9 @@ use super::interpolate::Varying;
 /// (or with a NaN or infinite component) are skipped and counted, never drawn.
 pub const LIMIT: f64 = 1e300;
 
+/// No primitive: the key of an empty pixel, beaten by any fragment.
+pub const NO_PRIMITIVE: u64 = u64::MAX;
+
 /// One vertex of a shape.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Vertex<const N: usize> {

@@ -49,13 +49,6 @@ impl RasterStats {
         self.covered += other.covered;
     }
 
-    /// Adds the fragment counts of some drawing.
-    pub(super) fn add_fragments(&mut self, counts: FragmentCounts) {
-        self.fragments += counts.fragments;
-        self.writes += counts.writes;
-        self.discarded += counts.discarded;
-    }
-
     /// Fragments per covered pixel (1 = no overdraw); 0 when nothing is covered.
     pub fn overdraw(&self) -> f64 {
         if self.covered == 0 {
@@ -79,25 +72,5 @@ impl RasterStats {
             stats.insert(name, Counter::Count(value));
         }
         stats.insert("raster_overdraw", Counter::Value(self.overdraw()));
-    }
-}
-
-/// What drawing some shapes did with their fragments.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub(super) struct FragmentCounts {
-    pub fragments: u64,
-    pub writes: u64,
-    pub discarded: u64,
-}
-
-impl std::ops::Add for FragmentCounts {
-    type Output = FragmentCounts;
-
-    fn add(self, other: FragmentCounts) -> FragmentCounts {
-        FragmentCounts {
-            fragments: self.fragments + other.fragments,
-            writes: self.writes + other.writes,
-            discarded: self.discarded + other.discarded,
-        }
     }
 }

@@ -1,10 +1,12 @@
-//! The depth-tested render target: colour, depth, object id and the winning primitive per
-//! pixel, cut into horizontal bands that can be written in parallel.
+//! The depth-tested render target of the reference rasteriser (`super::reference`): colour,
+//! depth, object id and the winning primitive per pixel, cut into horizontal bands that can
+//! be written in parallel.
 
 use glam::Vec3;
 use rayon::prelude::*;
 
 use super::interpolate::Varying;
+use super::NO_PRIMITIVE;
 use crate::render::Frame;
 
 /// One covered pixel centre of one shape, as handed to the shader.
@@ -17,21 +19,6 @@ pub struct Fragment<const N: usize> {
     /// The shape's object id and primitive key (see [`super::Polygon`]).
     pub object: u32,
     pub primitive: u64,
-}
-
-/// No primitive: the key of an empty pixel, beaten by any fragment.
-pub const NO_PRIMITIVE: u64 = u64::MAX;
-
-/// A drawn target taken apart for a deferred shading pass, which overwrites the frame in
-/// place (no second image allocated) while it reads each pixel's depth and key.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Layers {
-    /// Colour, depth rounded to `f32`, object ids.
-    pub frame: Frame,
-    /// Row-major depths in full precision; `f64::INFINITY` where nothing was drawn.
-    pub depth: Vec<f64>,
-    /// Row-major winning primitive keys; [`NO_PRIMITIVE`] where nothing was drawn.
-    pub primitives: Vec<u64>,
 }
 
 /// A framebuffer with an `f64` z-buffer and, per pixel, the primitive key that won it.
@@ -59,26 +46,8 @@ impl Target {
         }
     }
 
-    /// Empties the target for another frame, as [`Target::new`] leaves it, keeping its
-    /// buffers (no allocation, no fresh pages to fault in); in parallel.
-    pub fn clear(&mut self, background: Vec3) {
-        fill(&mut self.color, background);
-        fill(&mut self.depth, f64::INFINITY);
-        fill(&mut self.ids, 0);
-        fill(&mut self.primitives, NO_PRIMITIVE);
-    }
-
-    pub fn width(&self) -> u32 {
-        self.width
-    }
-
     pub fn height(&self) -> u32 {
         self.height
-    }
-
-    /// Row-major colours, top row first.
-    pub fn color(&self) -> &[Vec3] {
-        &self.color
     }
 
     /// Row-major depths; `f64::INFINITY` where nothing was drawn.
@@ -108,22 +77,12 @@ impl Target {
 
     /// The image as a [`Frame`] (depth rounded to `f32`).
     pub fn into_frame(self) -> Frame {
-        self.into_layers().frame
-    }
-
-    /// The image as a [`Frame`], with the full-precision depths and the primitive keys.
-    pub fn into_layers(self) -> Layers {
-        let frame = Frame {
+        Frame {
             width: self.width,
             height: self.height,
             color: self.color,
             depth: self.depth.par_iter().map(|&d| d as f32).collect(),
             ids: self.ids,
-        };
-        Layers {
-            frame,
-            depth: self.depth,
-            primitives: self.primitives,
         }
     }
 
@@ -164,22 +123,12 @@ impl Target {
     }
 }
 
-/// Elements per parallel task of [`fill`].
-const FILL_CHUNK: usize = 1 << 15;
-
 /// `n` copies of `value`, written in parallel: a new frame-sized buffer's first touch (its
 /// page faults) is shared by the cores instead of serialised in `vec![value; n]`.
 fn filled<T: Copy + Send + Sync>(n: usize, value: T) -> Vec<T> {
     let mut values = Vec::with_capacity(n);
     values.par_extend(rayon::iter::repeat_n(value, n));
     values
-}
-
-/// Sets every element of `values` to `value`, in parallel chunks.
-fn fill<T: Copy + Send + Sync>(values: &mut [T], value: T) {
-    values
-        .par_chunks_mut(FILL_CHUNK)
-        .for_each(|chunk| chunk.fill(value));
 }
 
 /// Rows `[rows.0, rows.1)` of a [`Target`], borrowed mutably.

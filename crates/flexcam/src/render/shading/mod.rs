@@ -33,6 +33,21 @@ pub struct Normals {
     pub front_face: bool,
 }
 
+impl Normals {
+    /// The normals of a flat face with unit normal `face` (by its winding; zero for a
+    /// degenerate face) seen along `incoming`: the face normal, flipped to face the ray, as
+    /// both the geometric and the shading normal (a displaced micro-triangle's).
+    pub fn of_face(face: Vec3, incoming: Vec3) -> Normals {
+        let front_face = face.dot(incoming) <= 0.0;
+        let geometric = if front_face { face } else { -face };
+        Normals {
+            geometric,
+            shading: geometric,
+            front_face,
+        }
+    }
+}
+
 /// The barycentric weights of the three vertices.
 fn weights(barycentric: Vec2) -> Vec3 {
     Vec3::new(
@@ -56,7 +71,9 @@ where
     values[a] * w.x + values[b] * w.y + values[c] * w.z
 }
 
-/// The world-space point at barycentrics `barycentric` of triangle `triangle` of `object`.
+/// The world-space point at barycentrics `barycentric` of triangle `triangle` of `object`
+/// (the tests' check of interpolated colours and textures).
+#[cfg(test)]
 pub fn position(object: &Object, triangle: usize, barycentric: Vec2) -> Vec3 {
     interpolate(
         &object.mesh.positions,
@@ -78,8 +95,11 @@ pub fn normals(object: &Object, triangle: usize, barycentric: Vec2, incoming: Ve
     let corners = corners(object, triangle);
     let [p0, p1, p2] = corners.map(|i| mesh.positions[i]);
     let face = (p1 - p0).cross(p2 - p0).normalize_or_zero();
-    let front_face = face.dot(incoming) <= 0.0;
-    let geometric = if front_face { face } else { -face };
+    let Normals {
+        geometric,
+        front_face,
+        ..
+    } = Normals::of_face(face, incoming);
     let interpolated = if mesh.normals.is_empty() {
         Vec3::ZERO
     } else {
@@ -364,7 +384,7 @@ mod tests {
         Object {
             id: 1,
             name: "t".into(),
-            mesh,
+            mesh: mesh.into(),
             material: Material {
                 color: Vec3::new(1.0, 0.5, 0.25),
                 pattern,

@@ -45,7 +45,7 @@ impl PreparedScene {
     /// scene's objects) wherever it is hit, so that a hit's colour is the surface's base
     /// colour at the hit ([`crate::render::shading::base_color`], nearest texels) and casts
     /// no ray; `false` for a mirror or glass, which pass the ray on.
-    pub fn flat_shows_base_color(&self, object: usize) -> bool {
+    pub(in crate::render) fn flat_shows_base_color(&self, object: usize) -> bool {
         shows_base_color(self.scene.objects[object].material.finish)
     }
 
@@ -53,7 +53,7 @@ impl PreparedScene {
     /// reads it: flat shading of a surface that shows its base colour reads only the hit (as
     /// `Tracer::flat` does at its first hit), so `ray` is not called there. Same colour and
     /// ray count as `shade_hit(&ray(), hit, options)`.
-    pub fn shade_hit_lazy(
+    pub(in crate::render) fn shade_hit_lazy(
         &self,
         ray: impl FnOnce() -> Ray,
         hit: Hit,
@@ -76,7 +76,12 @@ impl PreparedScene {
     /// any means: a ray cast, a rasterised fragment), exactly as the ray caster shades its own
     /// hits: mirrors, glass and shadows are traced from there through this scene. Also returns
     /// the number of secondary and shadow rays that took.
-    pub fn shade_hit(&self, ray: &Ray, hit: Hit, options: &RenderOptions) -> (Vec3, u64) {
+    pub(in crate::render) fn shade_hit(
+        &self,
+        ray: &Ray,
+        hit: Hit,
+        options: &RenderOptions,
+    ) -> (Vec3, u64) {
         let mut shader = HitShader::new(self, options);
         let color = shader.shade_hit(ray, hit);
         (color, shader.counts.secondary + shader.counts.shadow)
@@ -125,7 +130,7 @@ impl<'a> HitShader<'a> {
     }
 
     /// The colour of primary ray `ray` whose first hit is `hit` (exact, f64).
-    pub fn shade_hit(&mut self, ray: &Ray, hit: Hit) -> Vec3 {
+    pub(in crate::render) fn shade_hit(&mut self, ray: &Ray, hit: Hit) -> Vec3 {
         match self.shading {
             Shading::Flat => self.flat(ray, hit),
             // The transition system shades displaced objects itself and the others lit.
@@ -244,8 +249,8 @@ impl<'a> HitShader<'a> {
 
     /// The normals at `hit` as seen along `ray`.
     fn normals(&self, ray: &Ray, hit: &Hit) -> Normals {
-        if let Some(normals) = self.caster.displaced_normals(hit, ray.direction) {
-            return normals;
+        if let Some(face) = self.caster.displaced_face_normal(hit) {
+            return Normals::of_face(face, ray.direction.as_vec3());
         }
         let object = &self.caster.scene.objects[hit.object];
         normals(

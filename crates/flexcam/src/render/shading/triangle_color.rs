@@ -199,7 +199,8 @@ impl TriangleColor {
         }
     }
 
-    /// Whether the colour is the same at every point of the triangle.
+    /// Whether the colour is the same at every point of the triangle (checked by the tests).
+    #[cfg(test)]
     pub fn is_uniform(&self) -> bool {
         matches!(self.pattern, PatternMap::Uniform(_)) && self.vertex.is_none()
     }
@@ -303,12 +304,12 @@ mod tests {
         Object {
             id: 1,
             name: "t".into(),
-            mesh: Mesh {
+            mesh: Arc::new(Mesh {
                 positions: positions.to_vec(),
                 triangles: vec![[0, 1, 2]],
                 colors: colors.map_or(Vec::new(), |c| c.to_vec()),
                 ..Default::default()
-            },
+            }),
             material: Material {
                 color: Vec3::new(0.9, 0.5, 0.25),
                 pattern,
@@ -442,7 +443,7 @@ mod tests {
             !TriangleColor::new(&object(large, None, CHECKER), 0, TextureFilter::Nearest)
                 .is_uniform()
         );
-        o.mesh.colors[1] = Vec3::ONE;
+        Arc::make_mut(&mut o.mesh).colors[1] = Vec3::ONE;
         assert!(!TriangleColor::new(&o, 0, TextureFilter::Nearest).is_uniform());
     }
 
@@ -496,7 +497,7 @@ mod tests {
             texels: vec![Vec3::splat(0.2), Vec3::ONE],
         };
         let mut o = object(corners, None, Pattern::Texture(Arc::new(texture)));
-        o.mesh.uvs = vec![
+        Arc::make_mut(&mut o.mesh).uvs = vec![
             Vec2::new(0.1, 0.5),
             Vec2::new(0.9, 0.5),
             Vec2::new(0.1, 0.5),

@@ -4,6 +4,8 @@
 //! the example scenes but the inward sphere, the cube through the fan, randomised scenes and
 //! degenerate configurations.
 
+use std::sync::Arc;
+
 use glam::{DVec3, Vec3};
 use proptest::prelude::*;
 
@@ -364,7 +366,7 @@ fn the_tree_changes_no_polygon_of_central_projections() {
         let random = random_scene(count, seed);
         scene.objects = random.objects;
         for object in &mut scene.objects {
-            for p in &mut object.mesh.positions {
+            for p in &mut Arc::make_mut(&mut object.mesh).positions {
                 *p += Vec3::new(0.0, 1.5, 4.0);
             }
         }
@@ -381,15 +383,16 @@ fn random_scene(count: u32, seed: u64) -> Scene {
     let mut scene = workloads::random_triangles(count, seed);
     let mut behind = scene.objects[0].clone();
     behind.id = 2;
-    for p in &mut behind.mesh.positions {
+    for p in &mut Arc::make_mut(&mut behind.mesh).positions {
         p.z = -p.z;
     }
     let mut collapsed = scene.objects[0].clone();
     collapsed.id = 3;
-    for triangle in &collapsed.mesh.triangles {
-        let first = collapsed.mesh.positions[triangle[0] as usize];
+    let mesh = Arc::make_mut(&mut collapsed.mesh);
+    for triangle in &mesh.triangles {
+        let first = mesh.positions[triangle[0] as usize];
         for &i in &triangle[1..] {
-            collapsed.mesh.positions[i as usize] = first;
+            mesh.positions[i as usize] = first;
         }
     }
     scene.objects.extend([behind, collapsed]);

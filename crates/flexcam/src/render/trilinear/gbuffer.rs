@@ -19,19 +19,21 @@ use super::hit_terms::{self, Terms, TERMS};
 use super::resolve::Resolver;
 use crate::render::scan::{spans, FillRule, Polygon, RasterStats, Scratch, Span, NO_PRIMITIVE};
 
-/// The drawn state of one band of rows.
+/// The drawn state of one band of rows: per pixel the winner's depth, key and scene
+/// barycentrics. Camera-triangle rendering keeps its winners in the same buffer (its
+/// `BandBuffer` wraps one), drawn by its own per-fragment stage.
 #[derive(Debug, Clone)]
 pub struct GBuffer {
     width: u32,
     /// The rows `[rows.0, rows.1)` of the image the buffer holds now.
     rows: (u32, u32),
     /// The winner's depth; `f64::INFINITY` where nothing was drawn.
-    pub(super) depth: Vec<f64>,
+    pub(in crate::render) depth: Vec<f64>,
     /// The winner's key; [`NO_PRIMITIVE`] where nothing was drawn.
-    pub(super) keys: Vec<u64>,
+    pub(in crate::render) keys: Vec<u64>,
     /// The winner's scene barycentrics (weights of the second and third corners); only
     /// meaningful where a key was written.
-    pub(super) barycentrics: Vec<[f32; 2]>,
+    pub(in crate::render) barycentrics: Vec<[f32; 2]>,
 }
 
 impl GBuffer {

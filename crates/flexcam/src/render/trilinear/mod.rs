@@ -37,7 +37,7 @@ mod shade;
 mod tests;
 mod view_plane;
 mod volume_bounds;
-/// Bench scenes, for `flexcam bench` and the criterion benches only.
+// Bench scenes, for `flexcam bench` and the criterion benches only (`bench_support`).
 #[cfg(any(test, feature = "workloads"))]
 pub mod workloads;
 
@@ -46,13 +46,13 @@ use std::time::Instant;
 use glam::{DVec2, DVec3, Vec3};
 
 pub use curves::{CurveMode, CurveOptions};
+pub(in crate::render) use gbuffer::GBuffer;
 pub use polygons::{project_all, projection_triangles};
 pub(crate) use resolve::plane_hit;
 pub use scene_geometry::SceneGeometry;
 pub use screen_map::ScreenMap;
 
 use self::central::CentralProjection;
-use self::gbuffer::GBuffer;
 use self::polygons::ProjectedScene;
 use self::resolve::Resolver;
 use self::shade::{ShadeCounts, Shader};

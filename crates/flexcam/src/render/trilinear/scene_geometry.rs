@@ -233,7 +233,7 @@ mod tests {
                 Object {
                     id: index as u32 + 1,
                     name: format!("o{index}"),
-                    mesh,
+                    mesh: mesh.into(),
                     material: Material::default(),
                     world_to_object: Affine3A::IDENTITY,
                     displacement: None,

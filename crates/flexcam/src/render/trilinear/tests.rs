@@ -1,6 +1,8 @@
 //! The trilinear renderer against the reference ray caster on the same scene, projection and
 //! resolution, and its degenerate cases.
 
+use std::sync::Arc;
+
 use glam::{DVec2, DVec3, Vec3};
 
 use super::*;
@@ -204,7 +206,7 @@ pub(super) fn object(id: u32, triangles: &[[DVec3; 3]], color: Vec3) -> Object {
     Object {
         id,
         name: format!("o{id}"),
-        mesh,
+        mesh: mesh.into(),
         material: Material {
             color,
             ..Material::default()
@@ -344,7 +346,7 @@ fn projection_triangles_folding_inside_the_scene_are_ray_cast() {
     ] {
         let mut scene = scene::load("builtin:cube-floor").unwrap();
         scene.objects.retain(|o| o.name == "cube");
-        for p in &mut scene.objects[0].mesh.positions {
+        for p in &mut Arc::make_mut(&mut scene.objects[0].mesh).positions {
             *p = (p.as_dvec3() * scale + shift).as_vec3();
         }
         let points = [v(-3.0, 4.0, 7.0), v(3.0, 6.0, 7.0), v(-3.0, 6.0, 7.0)];

@@ -9,7 +9,7 @@
 //! - [`random_grid`] and [`random_triangles`]: the thesis's random data (8.1.1): "random
 //!   points and normals corresponding to a regular mesh on screen space", and disconnected
 //!   vertex-coloured triangles "constrained such that some of the scene triangle should be
-//!   rendered on the screen". Both are seeded and deterministic ([`SplitMix64`]).
+//!   rendered on the screen". Both are seeded and deterministic (`SplitMix64`).
 
 use glam::{Affine3A, DVec2, DVec3, Vec3};
 
@@ -88,7 +88,7 @@ pub fn random_triangles(count: u32, seed: u64) -> Scene {
         objects: vec![Object {
             id: 1,
             name: "random triangles".to_string(),
-            mesh,
+            mesh: mesh.into(),
             material: Material::default(),
             world_to_object: Affine3A::IDENTITY,
             displacement: None,

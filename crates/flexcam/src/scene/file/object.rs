@@ -77,7 +77,7 @@ pub(super) fn convert(
             Object {
                 id,
                 name: name.clone(),
-                mesh,
+                mesh: mesh.into(),
                 material,
                 world_to_object,
                 displacement: displacement.clone(),

@@ -6,7 +6,7 @@ use proptest::prelude::*;
 use super::super::{Flexible, FlexibleSpec, VolumeSource};
 use super::*;
 use crate::projection::{Projection, Projector};
-use crate::render::raster::supported_chart;
+use crate::render::supported_chart;
 
 const ASPECT: f64 = 0.75;
 

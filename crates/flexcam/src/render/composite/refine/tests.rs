@@ -12,7 +12,7 @@ const SIZE: (u32, u32) = (160, 120);
 fn sphere(segments: u32) -> (Mesh, Perspective) {
     let scene = sphere_and_cube(segments);
     let ball = scene.objects.iter().find(|o| o.id == BALL).unwrap();
-    (ball.mesh.clone(), camera(&scene, SIZE))
+    (Mesh::clone(&ball.mesh), camera(&scene, SIZE))
 }
 
 /// The T-junctions of `mesh`: (vertex, triangle edge) pairs where the vertex lies strictly

@@ -633,8 +633,8 @@ mod round_trip {
 /// fewer than 1.
 #[test]
 fn edited_round_presets_raster_like_the_ray_caster() {
-    use crate::render::compare::compare;
-    use crate::render::raster::Subdivision;
+    use crate::render::compare;
+    use crate::render::Subdivision;
     use crate::render::{Frame, Method, RenderOptions, Shading};
     use crate::scene::file::parse;
 

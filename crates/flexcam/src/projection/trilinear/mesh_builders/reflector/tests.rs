@@ -3,7 +3,7 @@ use glam::{DVec2, DVec3, Vec2};
 use super::*;
 use crate::geometry::Ray;
 use crate::projection::Projection;
-use crate::render::shading::normals;
+use crate::render::normals;
 use crate::render::PreparedScene;
 use crate::scene::reflector_fixtures::{self as test_scenes, lens_plane, BALL_CENTER};
 use crate::scene::{Mesh, Scene};
@@ -35,7 +35,7 @@ fn vertex_rays_are_the_ray_casters_mirror_reflections() {
     let caster = PreparedScene::new(&scene);
     let ball = &scene.objects[0];
     let camera = camera();
-    let surface = reflector_surface(&ball.mesh, &camera, Optic::Reflect).unwrap();
+    let surface = reflector_surface(ball.mesh.as_ref(), &camera, Optic::Reflect).unwrap();
     let mut checked = 0;
     for k in 0..surface.mesh.points.len() {
         let p = surface.mesh.points[k];
@@ -83,7 +83,7 @@ fn vertex_rays_are_the_ray_casters_mirror_reflections() {
 #[test]
 fn back_and_hidden_triangles_are_left_out() {
     let scene = scene();
-    let ball = &scene.objects[0].mesh;
+    let ball = scene.objects[0].mesh.as_ref();
     let surface = reflector_surface(ball, &camera(), Optic::Reflect).unwrap();
     let total = ball.triangles.len();
     assert_eq!(surface.dropped + surface.mesh.triangles.len(), total);
@@ -111,7 +111,7 @@ fn back_and_hidden_triangles_are_left_out() {
 #[test]
 fn reflectors_behind_the_camera_give_an_empty_surface() {
     let scene = scene();
-    let mut ball = scene.objects[0].mesh.clone();
+    let mut ball = (*scene.objects[0].mesh).clone();
     ball.transform(&glam::Affine3A::from_translation(glam::Vec3::new(
         0.0, 0.0, 10.0,
     )));
@@ -120,7 +120,7 @@ fn reflectors_behind_the_camera_give_an_empty_surface() {
     // Partly behind: the eye plane cuts the sphere (centred on it, 1.5 to the right of the
     // eye), the triangles across it are left out.
     let basis = *camera().basis();
-    let mut ball = scene.objects[0].mesh.clone();
+    let mut ball = (*scene.objects[0].mesh).clone();
     let shift = basis.origin + 1.5 * basis.right - BALL_CENTER;
     ball.transform(&glam::Affine3A::from_translation(shift.as_vec3()));
     let surface = reflector_surface(&ball, &camera(), Optic::Reflect).unwrap();
