@@ -133,7 +133,7 @@ impl Chart {
     /// over the cells under the ray, each cell's bilinear patch tested where the ray's
     /// height range meets the cell's. `None` for a direction that does not descend.
     pub fn trace(&self, entry: DVec2, direction: DVec3) -> Option<DVec3> {
-        if !(direction.z < 0.0) {
+        if direction.z.is_nan() || direction.z >= 0.0 {
             return None;
         }
         let cell = self.cell();
