@@ -175,7 +175,8 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
 
     let encoding = match args.shading.shading() {
         Shading::Flat => ColorEncoding::Linear,
-        Shading::Lit => ColorEncoding::Srgb,
+        Shading::Transitions(t) if t.methods => ColorEncoding::Linear,
+        Shading::Lit | Shading::Transitions(_) => ColorEncoding::Srgb,
     };
     // The scene is static: one prepared scene (one BVH) for every frame.
     let prepared = PreparedScene::new(&scene);

@@ -5,7 +5,7 @@
 use clap::{Args, ValueEnum};
 use flexcam::render::{
     CameraTriangleBound, CameraTriangleOptions, CurveOptions, Method, RenderWarning, Shading,
-    Subdivision,
+    Subdivision, TransitionShading,
 };
 use flexcam::scene::{self, LoadedScene, Overrides};
 use flexcam::{Error, Result};
@@ -111,6 +111,10 @@ pub fn warning_lines<'a>(warnings: impl IntoIterator<Item = &'a RenderWarning>) 
 pub enum ShadingArg {
     Flat,
     Lit,
+    /// Displaced objects coloured by the transition system's method per pixel.
+    Transitions,
+    /// Displaced objects shaded by the transition system (BRDF, bump, displacement).
+    TransitionLit,
 }
 
 impl ShadingArg {
@@ -118,6 +122,12 @@ impl ShadingArg {
         match self {
             ShadingArg::Flat => Shading::Flat,
             ShadingArg::Lit => Shading::Lit,
+            ShadingArg::Transitions => {
+                Shading::Transitions(TransitionShading::with_default_d(true))
+            }
+            ShadingArg::TransitionLit => {
+                Shading::Transitions(TransitionShading::with_default_d(false))
+            }
         }
     }
 
@@ -125,6 +135,8 @@ impl ShadingArg {
         match self {
             ShadingArg::Flat => "flat",
             ShadingArg::Lit => "lit",
+            ShadingArg::Transitions => "transitions",
+            ShadingArg::TransitionLit => "transition-lit",
         }
     }
 }

@@ -117,8 +117,10 @@ fn with_renderer(
             add_camera_triangle_counts(&mut stats, &counters);
             pixels += match (options.shading, reflector.optic) {
                 (Shading::Flat, _) => paste(&mut frame, id, &image, Vec3::ONE)?,
-                (Shading::Lit, Optic::Reflect) => paste(&mut frame, id, &image, reflector.tint)?,
-                (Shading::Lit, Optic::Refract { .. }) => {
+                (Shading::Lit | Shading::Transitions(_), Optic::Reflect) => {
+                    paste(&mut frame, id, &image, reflector.tint)?
+                }
+                (Shading::Lit | Shading::Transitions(_), Optic::Refract { .. }) => {
                     let (mirror, mirror_left) =
                         refined_surface(&reflector, Optic::Reflect, entry, &camera)?;
                     left += mirror_left;
