@@ -144,6 +144,7 @@ pub struct RawProjection {
     pub cy: Option<Spanned<f64>>,
     pub distortion: Option<Spanned<Vec<f64>>>,
     pub k: Option<Spanned<Vec<f64>>>,
+    #[serde(default, deserialize_with = "strict")]
     pub calibration_size: Option<Spanned<[u32; 2]>>,
 }
 

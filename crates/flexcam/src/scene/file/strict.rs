@@ -143,4 +143,37 @@ mod tests {
         assert!(error("list = [[0, 1, 2, 3]]").contains("invalid length 4"));
         assert!(error("v = [1, 2, \"x\"]").contains("invalid type"));
     }
+
+    /// The class guard: every field of the raw scene-file structs whose type holds a
+    /// fixed-length array (`[T; N]`, or `Vec3Value`) is read through [`strict`], so a new key
+    /// cannot silently drop extra elements again.
+    #[test]
+    fn every_fixed_length_field_is_read_strictly() {
+        for (file, text) in [
+            ("raw.rs", include_str!("raw.rs")),
+            ("displacement.rs", include_str!("displacement.rs")),
+        ] {
+            let lines: Vec<&str> = text.lines().collect();
+            for (i, line) in lines.iter().enumerate().skip(1) {
+                let Some((name, ty)) = line.trim().trim_start_matches("pub ").split_once(": ")
+                else {
+                    continue;
+                };
+                let is_field = name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_');
+                let fixed = ty.contains("Vec3Value")
+                    || ty
+                        .split("; ")
+                        .skip(1)
+                        .any(|rest| rest.trim_start().starts_with(|c: char| c.is_ascii_digit()));
+                if is_field && fixed && !ty.starts_with("type ") {
+                    assert!(
+                        lines[i - 1].contains("deserialize_with = \"strict\""),
+                        "{file}:{}: `{}` holds a fixed-length array but is not read strictly",
+                        i + 1,
+                        line.trim()
+                    );
+                }
+            }
+        }
+    }
 }
