@@ -105,6 +105,15 @@ room_eye='position = [0.0, 2.6, 6.5]
 look_at = [0.0, 0.6, 0.0]'
 render builtin:teapot-room "${small[@]}" -o "$out/teapot-perspective.png"
 render scenes/cameras/teapot-fisheye.toml --width 240 --height 240 -o "$out/teapot-fisheye.png"
+# Calibrated lenses: barrel distortion beside the undistorted pinhole of the same fx, and the
+# Kannala-Brandt fisheye.
+render scenes/cameras/opencv-checker.toml -o "$out/opencv-checker.png"
+render "$(variant scenes/cameras/opencv-checker.toml checker-persp 'type = "perspective"
+position = [0.0, 3.0, 0.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, -1.0]
+fov = 77.3196')" -o "$out/opencv-checker-perspective.png"
+render scenes/cameras/opencv-fisheye-teapot.toml --width 240 --height 240 -o "$out/opencv-fisheye-teapot.png"
 render "$(variant scenes/teapot-room.toml room-ortho "type = \"orthographic\"
 $room_eye
 width = 7.0")" "${small[@]}" -o "$out/teapot-orthographic.png"

@@ -10,7 +10,7 @@ mod stats_json;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{Command as ClapCommand, CommandFactory, FromArgMatches, Parser, Subcommand};
 
 /// Renders 3D scenes through nonlinear and multi-perspective projections.
 #[derive(Parser, Debug)]
@@ -50,13 +50,20 @@ enum Command {
     /// turn no face by more than a threshold angle, and write the coarse mesh (OBJ).
     #[command(after_help = OUTPUTS_HELP)]
     Simplify(commands::simplify::SimplifyArgs),
+    /// Convert a COLMAP cameras.txt into scene projection tables (`opencv`, `opencv_fisheye`),
+    /// one per camera, as TOML.
+    #[command(after_help = OUTPUTS_HELP)]
+    ImportCameras(commands::import_cameras::ImportCamerasArgs),
     /// Rerun a source document's timing table with flexcam's renderers.
     #[command(subcommand)]
     Bench(commands::bench::BenchCommand),
 }
 
 fn main() -> ExitCode {
-    let cli = match Cli::try_parse() {
+    let parsed = accept_negative_values(Cli::command())
+        .try_get_matches()
+        .and_then(|matches| Cli::from_arg_matches(&matches));
+    let cli = match parsed {
         Ok(cli) => cli,
         Err(e) => return report_usage_error(e),
     };
@@ -68,6 +75,7 @@ fn main() -> ExitCode {
         Command::Scenes => commands::scenes::run(),
         Command::Compare(args) => commands::compare::run(&args),
         Command::Simplify(args) => commands::simplify::run(&args),
+        Command::ImportCameras(args) => commands::import_cameras::run(&args),
         Command::Bench(command) => commands::bench::run(&command),
     };
     match result {
@@ -79,8 +87,24 @@ fn main() -> ExitCode {
     }
 }
 
-/// Help and version go to stdout as usual; a usage error is cut to its first line (clap adds
-/// usage text and hints on further lines) so that every error is one line.
+/// `command` with every option that takes a value accepting a negative number as that value
+/// (in every subcommand), so that `--width -1` is reported as a bad `--width` value, not as
+/// an unknown argument `-1` that names no option.
+fn accept_negative_values(command: ClapCommand) -> ClapCommand {
+    command
+        .mut_args(|arg| {
+            if arg.get_action().takes_values() {
+                arg.allow_negative_numbers(true)
+            } else {
+                arg
+            }
+        })
+        .mut_subcommands(accept_negative_values)
+}
+
+/// Help and version go to stdout as usual; a usage error is folded into one line: clap's
+/// message lines up to the usage text, without its tips (a message such as "the following
+/// required arguments were not provided:" goes on to name them on the next line).
 fn report_usage_error(e: clap::Error) -> ExitCode {
     use clap::error::ErrorKind;
     if matches!(
@@ -92,14 +116,22 @@ fn report_usage_error(e: clap::Error) -> ExitCode {
         let _ = e.print();
         return ExitCode::SUCCESS;
     }
-    let text = e.render().to_string();
-    let first = text
-        .lines()
-        .find(|l| !l.trim().is_empty())
-        .unwrap_or("invalid arguments");
-    let first = first.trim_start_matches("error: ");
-    eprintln!("flexcam: {first}");
+    eprintln!("flexcam: {}", usage_error_line(&e.render().to_string()));
     ExitCode::from(2)
+}
+
+/// The one line of a rendered clap error (see [`report_usage_error`]).
+fn usage_error_line(text: &str) -> String {
+    let message: Vec<&str> = text
+        .lines()
+        .map(str::trim)
+        .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .filter(|l| !l.is_empty() && !l.starts_with("tip:"))
+        .collect();
+    match message.join(" ").trim_start_matches("error: ") {
+        "" => "invalid arguments".to_string(),
+        line => line.to_string(),
+    }
 }
 
 /// A path argument that may be `-` for standard output.

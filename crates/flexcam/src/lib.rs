@@ -9,6 +9,7 @@
 pub mod calibrate;
 pub mod displace;
 pub mod error;
+pub mod file_read;
 pub mod geometry;
 pub mod image_io;
 pub mod projection;

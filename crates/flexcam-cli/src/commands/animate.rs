@@ -14,7 +14,7 @@ use flexcam::render::{
 use flexcam::scene;
 use flexcam::{Error, Result};
 
-use super::scene_args::{print_lines, warning_lines, ShadingArg};
+use super::scene_args::{print_lines, warning_lines, MemoryArgs, ShadingArg};
 use crate::progress::RenderProgress;
 use crate::stats_json::{self, RunFacts};
 use crate::OutputTarget;
@@ -51,7 +51,12 @@ pub struct AnimateArgs {
     /// output with `-` (as `flexcam render --stats`; `frames`, `bvh_builds`).
     #[arg(long, value_name = "FILE|-")]
     stats: Option<OutputTarget>,
+    #[command(flatten)]
+    memory: MemoryArgs,
 }
+
+/// Estimated bytes a GIF holds per frame pixel until it is written.
+const GIF_BYTES_PER_PIXEL: u64 = 4;
 
 /// A file name with one run of `#` to be replaced by the frame number.
 struct FramePattern {
@@ -135,6 +140,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         }
         _ => None,
     };
+    args.memory.apply();
     let load_start = Instant::now();
     let (scene, animation) = scene::file::load_animated(&args.scene)?;
     super::declare_scene_inputs(&mut outputs, &scene.inputs)?;
@@ -166,10 +172,16 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     let width = args.width.unwrap_or(scene.image.width);
     let height = args.height.unwrap_or(scene.image.height);
     scene::file::validate_resolution(width, height)?;
+    let gif_bytes = match &args.gif {
+        Some(_) => u64::from(frames) * u64::from(width) * u64::from(height) * GIF_BYTES_PER_PIXEL,
+        None => 0,
+    };
+    scene::check_budget(&scene, width, height, gif_bytes).map_err(|e| e.or_in_file(&args.scene))?;
 
     let encoding = match args.shading.shading() {
         Shading::Flat => ColorEncoding::Linear,
-        Shading::Lit => ColorEncoding::Srgb,
+        Shading::Transitions(t) if t.methods => ColorEncoding::Linear,
+        Shading::Lit | Shading::Transitions(_) => ColorEncoding::Srgb,
     };
     // The scene is static: one prepared scene (one BVH) for every frame.
     let prepared = PreparedScene::new(&scene);

@@ -86,11 +86,12 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         camera_triangles: args.tuning.camera_triangles(method)?,
         ..reference_options
     };
-    let timed_render = |options: &RenderOptions| {
+    let mut warnings = Vec::new();
+    let mut timed_render = |options: &RenderOptions| {
         let start = Instant::now();
-        let rendered = render::render(&prepared, loaded.projection.as_ref(), options)?;
-        let lines = super::scene_args::warning_lines(&rendered.warnings);
-        super::scene_args::print_lines(&loaded.source, &lines);
+        let rendered = render::render(&prepared, loaded.projection.as_ref(), options)
+            .map_err(|e| e.or_in_file(&loaded.source))?;
+        warnings.extend(super::scene_args::warning_lines(&rendered.warnings));
         Ok::<_, Error>((rendered.frame, start.elapsed().as_secs_f64() * 1e3))
     };
     let (frame, method_ms) = timed_render(&options)?;
@@ -120,7 +121,10 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     } else {
         super::print_stdout(&report_text(&header, &result))?;
     }
-    check_thresholds(args, &result)
+    check_thresholds(args, &result)?;
+    // Warnings only once the command has succeeded: a failing command prints one line.
+    super::scene_args::print_lines(&loaded.source, &warnings);
+    Ok(())
 }
 
 /// What was compared, for the report.

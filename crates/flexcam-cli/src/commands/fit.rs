@@ -4,9 +4,10 @@
 use std::path::PathBuf;
 
 use clap::Args;
+use flexcam::file_read::{read_regular_text, MAX_SCENE_FILE_BYTES};
 use flexcam::image_io::{self, OutputSet};
 use flexcam::scene::file::fit_scene;
-use flexcam::{Error, Result};
+use flexcam::Result;
 
 /// Arguments of `flexcam fit`.
 #[derive(Args, Debug)]
@@ -27,8 +28,7 @@ pub fn run(args: &FitArgs) -> Result<()> {
     let mut outputs = OutputSet::new();
     let output = outputs.output("the output", &args.output, &["toml"])?;
     outputs.input("the fitting scene", &args.scene)?;
-    let text = std::fs::read_to_string(&args.scene)
-        .map_err(|e| Error::in_file(&args.scene, format!("cannot read scene file: {e}")))?;
+    let text = read_regular_text(&args.scene, "scene file", MAX_SCENE_FILE_BYTES)?;
     let fitted = fit_scene(&text, &args.scene, &args.output)?;
     super::declare_scene_inputs(&mut outputs, &fitted.inputs)?;
     outputs.stage(output, |tmp| {
@@ -36,9 +36,6 @@ pub fn run(args: &FitArgs) -> Result<()> {
     })?;
     outputs.commit()?;
     let r = fitted.report;
-    if let Some(warning) = r.warning() {
-        eprintln!("flexcam: warning: {}: {warning}", args.scene.display());
-    }
     super::print_stdout(&format!(
         "fitted {} correspondences ({} nodes unconstrained): residual max {:e} degrees, rms \
          {:e} degrees, {}; wrote {}\n",
@@ -49,5 +46,9 @@ pub fn run(args: &FitArgs) -> Result<()> {
         r.model(),
         args.output.display()
     ))?;
+    // The warning only once the command has succeeded: a failing command prints one line.
+    if let Some(warning) = r.warning() {
+        eprintln!("flexcam: warning: {}: {warning}", args.scene.display());
+    }
     Ok(())
 }

@@ -4,6 +4,7 @@ pub mod animate;
 pub mod bench;
 pub mod compare;
 pub mod fit;
+pub mod import_cameras;
 pub mod render;
 pub mod reproject;
 pub mod scene_args;

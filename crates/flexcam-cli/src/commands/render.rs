@@ -5,7 +5,9 @@ use std::time::Instant;
 
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, ColorFormat, DepthFormat, OutputSet, PngBits};
-use flexcam::render::{self, Counter, Method, Outputs, PreparedScene, RenderOptions, Shading};
+use flexcam::render::{
+    self, Counter, Method, Outputs, PreparedScene, RenderOptions, Shading, TransitionShading,
+};
 use flexcam::Result;
 
 use super::scene_args::{
@@ -35,9 +37,18 @@ pub struct RenderArgs {
     method: String,
     #[command(flatten)]
     tuning: MethodTuning,
-    /// Shading: `flat` (base colours, exact) or `lit` (lights, shadows, reflections).
+    /// Shading: `flat` (base colours, exact), `lit` (lights, shadows, reflections),
+    /// `transition-lit` (lit, with displaced objects shaded per ray by full displacement,
+    /// redistributed bump mapping or their BRDF, as the transition function chooses from the
+    /// ray's footprint) or `transitions` (each pixel coloured by the method chosen: green
+    /// displacement, blue bump, red BRDF, mixed in the blends).
     #[arg(long, value_enum, default_value_t = ShadingArg::Lit)]
     shading: ShadingArg,
+    /// The transition function's constant D for `--shading transitions` and
+    /// `transition-lit` (default 2): relief of D + 1 pixel footprints or more seen head on is
+    /// displaced, below D - 1 the BRDF is used; larger D favours the cheaper methods.
+    #[arg(long, value_name = "D")]
+    transition_d: Option<f64>,
     /// Samples per pixel.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
     spp: u32,
@@ -119,13 +130,23 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
     let loaded = args.scene.load()?;
     super::declare_scene_inputs(&mut outputs, &loaded.scene.inputs)?;
-    print_warnings(&loaded);
 
     let progress = RenderProgress::new();
     let report = |done: u64, total: u64| progress.update(done, total);
+    let shading = match (args.shading.shading(), args.transition_d) {
+        (shading, None) => shading,
+        (Shading::Transitions(t), Some(d)) => {
+            Shading::Transitions(TransitionShading::new(t.methods, d)?)
+        }
+        (_, Some(_)) => {
+            return Err(flexcam::Error::new(
+                "--transition-d applies to --shading transitions and transition-lit only",
+            ))
+        }
+    };
     let options = RenderOptions {
         method,
-        shading: args.shading.shading(),
+        shading,
         spp: args.spp,
         subdivision: args.tuning.subdivision(method)?,
         curves: args.tuning.curves(method)?,
@@ -148,9 +169,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         frame,
         mut counters,
         warnings,
-    } = rendered?;
+    } = rendered.map_err(|e| e.or_in_file(&loaded.source))?;
     let warnings = warning_lines(&warnings);
-    print_lines(&loaded.source, &warnings);
     for &(name, value) in &loaded.build_report.counters {
         counters.insert(name, Counter::Value(value));
     }
@@ -158,7 +178,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
     let encoding = match options.shading {
         Shading::Flat => ColorEncoding::Linear,
-        Shading::Lit => ColorEncoding::Srgb,
+        Shading::Transitions(t) if t.methods => ColorEncoding::Linear,
+        Shading::Lit | Shading::Transitions(_) => ColorEncoding::Srgb,
     };
     outputs.stage(color, |tmp| {
         image_io::write_color(&frame, tmp, color_format, encoding)
@@ -189,5 +210,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         warnings: &[&loaded.build_report.warnings[..], &warnings].concat(),
     };
     let json = stats_json::to_json(&facts, &counters).to_string();
-    super::commit_with_stats(outputs, stats, args.stats.as_ref(), &json)
+    super::commit_with_stats(outputs, stats, args.stats.as_ref(), &json)?;
+    // Warnings only once the command has succeeded: a failing command prints one line.
+    print_warnings(&loaded);
+    print_lines(&loaded.source, &warnings);
+    Ok(())
 }

@@ -31,6 +31,8 @@ pub struct ReprojectArgs {
 /// scene), reads the photo (an unsupported extension fails before reading), builds the
 /// scene's projection, resamples and writes the PNG atomically.
 pub fn run(args: &ReprojectArgs) -> Result<()> {
+    // The budget applies to the photo too, which is read before the scene.
+    args.scene.memory.apply();
     let mut outputs = OutputSet::new();
     let output = outputs.output("the output", &args.output, &["png"])?;
     outputs.input("the photo", &args.input)?;

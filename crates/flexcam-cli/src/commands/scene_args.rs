@@ -5,7 +5,7 @@
 use clap::{Args, ValueEnum};
 use flexcam::render::{
     CameraTriangleBound, CameraTriangleOptions, CurveOptions, Method, RenderWarning, Shading,
-    Subdivision,
+    Subdivision, TransitionShading,
 };
 use flexcam::scene::{self, LoadedScene, Overrides};
 use flexcam::{Error, Result};
@@ -33,6 +33,27 @@ pub struct SceneArgs {
         allow_negative_numbers = true
     )]
     pub perspective_rect: Option<Vec<f64>>,
+    #[command(flatten)]
+    pub memory: MemoryArgs,
+}
+
+/// The memory budget of a rendering command.
+#[derive(Args, Debug)]
+pub struct MemoryArgs {
+    /// The memory budget (e.g. 8G, 512MiB, 1.5GB): a scene whose estimated memory
+    /// (triangles, image) exceeds it is refused before it is built, with the estimate. The
+    /// default is three quarters of the memory this process may use.
+    #[arg(long, value_name = "SIZE", value_parser = scene::budget::parse_size)]
+    pub max_memory: Option<u64>,
+}
+
+impl MemoryArgs {
+    /// Sets the process's memory budget if `--max-memory` was given.
+    pub fn apply(&self) {
+        if let Some(bytes) = self.max_memory {
+            scene::budget::set_max_memory(bytes);
+        }
+    }
 }
 
 impl SceneArgs {
@@ -52,6 +73,7 @@ impl SceneArgs {
             })?),
             None => None,
         };
+        self.memory.apply();
         let overrides = Overrides {
             width: self.width,
             height: self.height,
@@ -89,6 +111,10 @@ pub fn warning_lines<'a>(warnings: impl IntoIterator<Item = &'a RenderWarning>) 
 pub enum ShadingArg {
     Flat,
     Lit,
+    /// Displaced objects coloured by the transition system's method per pixel.
+    Transitions,
+    /// Displaced objects shaded by the transition system (BRDF, bump, displacement).
+    TransitionLit,
 }
 
 impl ShadingArg {
@@ -96,6 +122,12 @@ impl ShadingArg {
         match self {
             ShadingArg::Flat => Shading::Flat,
             ShadingArg::Lit => Shading::Lit,
+            ShadingArg::Transitions => {
+                Shading::Transitions(TransitionShading::with_default_d(true))
+            }
+            ShadingArg::TransitionLit => {
+                Shading::Transitions(TransitionShading::with_default_d(false))
+            }
         }
     }
 
@@ -103,6 +135,8 @@ impl ShadingArg {
         match self {
             ShadingArg::Flat => "flat",
             ShadingArg::Lit => "lit",
+            ShadingArg::Transitions => "transitions",
+            ShadingArg::TransitionLit => "transition-lit",
         }
     }
 }

@@ -113,6 +113,25 @@ impl Displacement {
         self.level
     }
 
+    /// The scale `S`.
+    pub fn scale(&self) -> f64 {
+        self.scale
+    }
+
+    /// The fraction `F`.
+    pub fn fraction(&self) -> f64 {
+        self.fraction
+    }
+
+    /// The same displacement with fraction `fraction` in place of `F` (partial displacement
+    /// of the transition system).
+    pub fn with_fraction(&self, fraction: f64) -> Displacement {
+        Displacement {
+            fraction,
+            ..self.clone()
+        }
+    }
+
     /// The displaced micro-vertex `P + N * S * (h(uv) - h_max) * F`, evaluated left to right
     /// in exactly that order.
     #[inline]

@@ -11,14 +11,24 @@
 //! [`simplify`] reduces polygon meshes by edge collapses and records the vertex splits that
 //! rebuild them exactly.
 //!
+//! For the transition system (Becker and Max 1993, Ramsey 2005 chapter 7), a height field
+//! laid flat ([`normal_distribution::Chart`]) gives the distributions of the normals visible
+//! from each view angle, and from them the diffuse BRDF ([`brdf_table`]) and redistributed
+//! bump mapping ([`bump`]); [`transition`] chooses among them and displacement per ray.
+//!
 //! This layer sits beside [`crate::scene`] and uses geometry and scene types only.
 
+pub mod brdf_table;
+pub mod bump;
 pub mod height;
 pub mod intersect;
 pub mod micro;
+pub mod normal_distribution;
 pub mod procedural;
 pub mod simplify;
+pub mod square_map;
 pub mod tessellate;
+pub mod transition;
 
 pub use height::{HeightField, HeightMap};
 pub use intersect::{CachedBox, DisplacedTriangle, Frame};

@@ -2,7 +2,9 @@
 
 use super::fisheye::Fisheye;
 use super::flexible::{Flexible, GridFitter};
+use super::kannala_brandt::KannalaBrandt;
 use super::linear::{Orthographic, Perspective};
+use super::opencv::Opencv;
 use super::panoramic::{Cylindrical, Equirectangular};
 use super::trilinear::Trilinear;
 use super::{BuildReport, Projection, ProjectionSpec};
@@ -15,6 +17,8 @@ impl ProjectionSpec {
     /// or parallel to the view direction; an angle or extent out of range (perspective fov in
     /// (0, 180), fisheye fov in (0, 360], orthographic width > 0, equirectangular h_fov in
     /// (0, 360] and v_fov in (0, 180], cylindrical h_fov in (0, 360] and v_fov in (0, 180));
+    /// calibrated intrinsics that are not finite or have a focal length <= 0, or are rendered
+    /// at a size other than the scene's without a calibration size;
     /// a trilinear mesh with no triangles, mismatched arrays, an index out of range, a
     /// zero-length normal or a zero-area screen triangle; a flexible volume with a bad preset
     /// parameter or surface, or whose near and far surfaces coincide everywhere; a projector
@@ -64,6 +68,12 @@ impl ProjectionSpec {
                 h_fov,
                 v_fov,
             } => Box::new(Cylindrical::new(frame, *h_fov, *v_fov, width, height)?),
+            ProjectionSpec::Opencv { camera, distortion } => {
+                Box::new(Opencv::new(camera, *distortion, width, height)?)
+            }
+            ProjectionSpec::OpencvFisheye { camera, k } => {
+                Box::new(KannalaBrandt::new(camera, *k, width, height)?)
+            }
             ProjectionSpec::Trilinear(mesh) => Box::new(Trilinear::new(mesh, width, height)?),
             ProjectionSpec::Flexible(spec) => {
                 Box::new(Flexible::build(spec, width, height, fitter, report)?)

@@ -60,7 +60,10 @@ fn frame_of(spec: &ProjectionSpec) -> CameraFrame {
         | ProjectionSpec::Fisheye { frame, .. }
         | ProjectionSpec::Equirectangular { frame, .. }
         | ProjectionSpec::Cylindrical { frame, .. } => *frame,
-        ProjectionSpec::Trilinear(_) | ProjectionSpec::Flexible(_) => unreachable!("not generated"),
+        ProjectionSpec::Opencv { .. }
+        | ProjectionSpec::OpencvFisheye { .. }
+        | ProjectionSpec::Trilinear(_)
+        | ProjectionSpec::Flexible(_) => unreachable!("not generated (calibrated_properties)"),
     }
 }
 
@@ -84,7 +87,10 @@ fn must_be_imaged(spec: &ProjectionSpec, point: DVec3) -> bool {
             let vertical = offset.dot(true_up);
             (distance * distance - vertical * vertical).sqrt() > 1e-6 * distance
         }
-        ProjectionSpec::Trilinear(_) | ProjectionSpec::Flexible(_) => false,
+        ProjectionSpec::Opencv { .. }
+        | ProjectionSpec::OpencvFisheye { .. }
+        | ProjectionSpec::Trilinear(_)
+        | ProjectionSpec::Flexible(_) => false,
     }
 }
 

@@ -98,7 +98,7 @@ impl SingleImage for Perspective {
 
 /// The points at least `distance` in front of the plane through the eye perpendicular to
 /// the view direction.
-fn in_front(basis: &CameraBasis, distance: f64) -> HalfSpace {
+pub(super) fn in_front(basis: &CameraBasis, distance: f64) -> HalfSpace {
     HalfSpace {
         normal: basis.forward,
         offset: basis.forward.dot(basis.origin) + distance,

@@ -10,21 +10,29 @@
 
 mod build;
 mod build_report;
+mod calibrated;
+#[cfg(test)]
+mod calibrated_properties;
 mod camera_basis;
 pub mod chart;
+pub mod colmap;
 mod fisheye;
 pub mod flexible;
 mod image_coords;
 mod inverse;
 #[cfg(test)]
 mod inverse_properties;
+mod kannala_brandt;
 mod linear;
+mod opencv;
 mod panoramic;
 mod params;
 pub mod projector;
+mod radial_tangential;
 mod trilinear;
 
 pub use build_report::BuildReport;
+pub use calibrated::{CalibratedCamera, CalibrationSize, Intrinsics};
 pub use camera_basis::CameraBasis;
 pub use chart::{HalfSpace, InverseChart, Pole};
 pub use fisheye::Fisheye;
@@ -33,7 +41,9 @@ pub use image_coords::Resolution;
 pub use inverse::{
     AnalyticInverse, BranchImage, Charted, ContinuousInverse, NoInverse, SingleImage,
 };
+pub use kannala_brandt::KannalaBrandt;
 pub use linear::{Orthographic, Perspective};
+pub use opencv::Opencv;
 pub use panoramic::{Cylindrical, Equirectangular};
 pub use projector::{Projector, ProjectorHull};
 pub use trilinear::mesh_builders as trilinear_builders;
@@ -146,6 +156,17 @@ pub enum ProjectionSpec {
         h_fov: f64,
         v_fov: f64,
     },
+    /// A calibrated pinhole with OpenCV's radial-tangential distortion, coefficients in
+    /// OpenCV's order [k1, k2, p1, p2, k3, k4, k5, k6] (zeros for the shorter forms).
+    Opencv {
+        camera: CalibratedCamera,
+        distortion: [f64; 8],
+    },
+    /// A calibrated Kannala-Brandt fisheye (OpenCV's `cv::fisheye`), `k` = [k1, k2, k3, k4].
+    OpencvFisheye {
+        camera: CalibratedCamera,
+        k: [f64; 4],
+    },
     /// A mesh of trilinear projection triangles.
     Trilinear(TrilinearMesh),
     /// A parametric viewing volume between control surfaces (Brosz 2011); boxed, as it is
@@ -162,6 +183,8 @@ impl ProjectionSpec {
             ProjectionSpec::Fisheye { .. } => "fisheye",
             ProjectionSpec::Equirectangular { .. } => "equirectangular",
             ProjectionSpec::Cylindrical { .. } => "cylindrical",
+            ProjectionSpec::Opencv { .. } => "opencv",
+            ProjectionSpec::OpencvFisheye { .. } => "opencv_fisheye",
             ProjectionSpec::Trilinear(_) => "trilinear",
             ProjectionSpec::Flexible(_) => "flexible",
         }

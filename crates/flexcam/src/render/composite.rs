@@ -117,8 +117,10 @@ fn with_renderer(
             add_camera_triangle_counts(&mut stats, &counters);
             pixels += match (options.shading, reflector.optic) {
                 (Shading::Flat, _) => paste(&mut frame, id, &image, Vec3::ONE)?,
-                (Shading::Lit, Optic::Reflect) => paste(&mut frame, id, &image, reflector.tint)?,
-                (Shading::Lit, Optic::Refract { .. }) => {
+                (Shading::Lit | Shading::Transitions(_), Optic::Reflect) => {
+                    paste(&mut frame, id, &image, reflector.tint)?
+                }
+                (Shading::Lit | Shading::Transitions(_), Optic::Refract { .. }) => {
                     let (mirror, mirror_left) =
                         refined_surface(&reflector, Optic::Reflect, entry, &camera)?;
                     left += mirror_left;
@@ -164,23 +166,37 @@ fn with_renderer(
     })
 }
 
-/// Adds the fragment counts of a reflector surface rendered by camera triangles
-/// (`camera_triangles`, `bounding_fragments`, `rendered_fragments`) to `stats`, and sets
-/// `overdraw` to bounding over rendered fragments of all surfaces so far.
+/// Adds the counts and stage times of a reflector surface rendered by camera triangles
+/// (`camera_triangles`, `bounding_fragments`, `rendered_fragments`, `culled_pairs`,
+/// `bounding_regions`, `owner_ms`, `bound_ms`) to `stats`, with its `pairs`, `raster_ms` and
+/// `shade_ms` as `surface_pairs`, `surface_raster_ms` and `surface_shade_ms` (the main view
+/// has its own), and
+/// sets `overdraw` to bounding over rendered fragments of all surfaces so far.
 fn add_camera_triangle_counts(stats: &mut Stats, surface: &Stats) {
-    const SUMMED: [&str; 3] = [
-        "camera_triangles",
-        "bounding_fragments",
-        "rendered_fragments",
+    const SUMMED: [(&str, &str); 10] = [
+        ("camera_triangles", "camera_triangles"),
+        ("bounding_fragments", "bounding_fragments"),
+        ("rendered_fragments", "rendered_fragments"),
+        ("pairs", "surface_pairs"),
+        ("culled_pairs", "culled_pairs"),
+        ("bounding_regions", "bounding_regions"),
+        ("owner_ms", "owner_ms"),
+        ("bound_ms", "bound_ms"),
+        ("raster_ms", "surface_raster_ms"),
+        ("shade_ms", "surface_shade_ms"),
     ];
-    for name in SUMMED {
-        if let Some(Counter::Count(n)) = surface.get(name) {
-            let sum = match stats.get(name) {
-                Some(Counter::Count(m)) => m + n,
-                _ => *n,
-            };
-            stats.insert(name, Counter::Count(sum));
-        }
+    if surface.get("camera_triangles").is_none() {
+        return;
+    }
+    for (name, as_name) in SUMMED {
+        let sum = match (surface.get(name), stats.get(as_name)) {
+            (Some(Counter::Count(n)), Some(Counter::Count(m))) => Counter::Count(n + m),
+            (Some(Counter::Count(n)), _) => Counter::Count(*n),
+            (Some(Counter::Value(n)), Some(Counter::Value(m))) => Counter::Value(n + m),
+            (Some(Counter::Value(n)), _) => Counter::Value(*n),
+            _ => continue,
+        };
+        stats.insert(as_name, sum);
     }
     if let (Some(Counter::Count(b)), Some(Counter::Count(r))) = (
         stats.get("bounding_fragments"),

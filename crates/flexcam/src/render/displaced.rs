@@ -60,9 +60,9 @@ struct Node {
 /// A displaced base triangle: object index, triangle index, the frame of its node boxes and
 /// where its kept boxes are in [`DisplacedSet::boxes`].
 #[derive(Debug, Clone, Copy)]
-struct Item {
-    object: u32,
-    triangle: u32,
+pub(in crate::render) struct Item {
+    pub object: u32,
+    pub triangle: u32,
     first_box: u32,
     box_count: u32,
     frame: Frame,
@@ -161,9 +161,48 @@ impl DisplacedSet {
     /// limit)]`; on equal `t`, the lower object, then the lower base triangle. With `any`,
     /// the first hit found.
     pub fn closest(&self, scene: &Scene, ray: &Ray, limit: f64, any: bool) -> Option<DisplacedHit> {
+        self.closest_by(ray, limit, any, |item, displacement, bounded| {
+            let boxes =
+                &self.boxes[item.first_box as usize..(item.first_box + item.box_count) as usize];
+            if !enters_root(&item.frame, &boxes[0], bounded) {
+                return None;
+            }
+            DisplacedTriangle::with_boxes(
+                base_corners(
+                    &scene.objects[item.object as usize].mesh,
+                    item.triangle as usize,
+                ),
+                displacement,
+                item.frame,
+                boxes,
+            )
+            .intersect(bounded)
+            .map(|micro| (micro.t, micro))
+        })
+        .map(|(object, triangle, micro)| DisplacedHit {
+            object,
+            triangle,
+            micro,
+        })
+    }
+
+    /// The nearest hit of `ray` with `t` in `[ray.t_min, min(ray.t_max, limit)]` that `test`
+    /// finds on the base triangles whose shell boxes the ray enters: `test(item, its
+    /// object's displacement, the ray bounded by the best hit so far)` gives `(t, what)`.
+    /// On equal `t`, the lower object, then the lower base triangle; with `any`, the first
+    /// hit found. Every shell box bounds its base triangle displaced by any fraction from 0
+    /// to the object's (the offsets `S * (h - h_max) * F * s` lie between 0 and the full
+    /// ones), so `test` may trace the undisplaced or a partly displaced surface.
+    pub fn closest_by<H: Copy>(
+        &self,
+        ray: &Ray,
+        limit: f64,
+        any: bool,
+        test: impl Fn(&Item, &Displacement, &Ray) -> Option<(f64, H)>,
+    ) -> Option<(usize, usize, H)> {
         let slabs = Slabs::new(ray)?;
         let mut t_max = ray.t_max.min(limit);
-        let mut best: Option<DisplacedHit> = None;
+        let mut best: Option<(f64, usize, usize, H)> = None;
         // At most one pending node per level; median splits keep the tree under 40 deep.
         let mut stack = [(0u32, 0.0f64); STACK];
         let mut depth = 0;
@@ -179,33 +218,15 @@ impl DisplacedSet {
                         continue;
                     };
                     let bounded = Ray { t_max, ..*ray };
-                    let boxes = &self.boxes
-                        [item.first_box as usize..(item.first_box + item.box_count) as usize];
-                    if !enters_root(&item.frame, &boxes[0], &bounded) {
-                        continue;
-                    }
-                    let found = DisplacedTriangle::with_boxes(
-                        base_corners(&scene.objects[object].mesh, triangle),
-                        displacement,
-                        item.frame,
-                        boxes,
-                    )
-                    .intersect(&bounded);
-                    if let Some(micro) = found {
-                        let better = best.is_none_or(|b| {
-                            micro.t < b.micro.t
-                                || (micro.t == b.micro.t
-                                    && (object, triangle) < (b.object, b.triangle))
+                    if let Some((t, found)) = test(item, displacement, &bounded) {
+                        let better = best.is_none_or(|(b, bo, bt, _)| {
+                            t < b || (t == b && (object, triangle) < (bo, bt))
                         });
                         if better {
-                            t_max = micro.t;
-                            best = Some(DisplacedHit {
-                                object,
-                                triangle,
-                                micro,
-                            });
+                            t_max = t;
+                            best = Some((t, object, triangle, found));
                             if any {
-                                return best;
+                                return best.map(|(_, o, tr, f)| (o, tr, f));
                             }
                         }
                     }
@@ -234,7 +255,7 @@ impl DisplacedSet {
             // Ties with the best hit stay: an equal t may win on the triangle order.
             loop {
                 if depth == 0 {
-                    return best;
+                    return best.map(|(_, o, tr, f)| (o, tr, f));
                 }
                 depth -= 1;
                 let (node, entry) = stack[depth];

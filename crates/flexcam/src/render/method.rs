@@ -10,7 +10,9 @@ use crate::error::{Error, Result};
 use crate::projection::{Projection, Projector};
 use crate::render::raster::InverseRaster;
 use crate::render::trilinear::TrilinearRenderer;
-use crate::render::{camera_triangles, raycast, Frame, PreparedScene, RenderOptions, Stats};
+use crate::render::{
+    camera_triangles, raycast, transitions, Frame, PreparedScene, RenderOptions, Shading, Stats,
+};
 
 /// A way of rendering a projection.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -62,6 +64,15 @@ impl Method {
             return Err(Error::new("samples per pixel must be at least 1"));
         }
         check_displaced(prepared, self, projection)?;
+        if let Shading::Transitions(shading) = options.shading {
+            if self != Method::Raycast {
+                return Err(Error::new(format!(
+                    "--shading transitions and transition-lit render with --method raycast \
+                     only, not {self}"
+                )));
+            }
+            return transitions::render(prepared, projection, options, shading);
+        }
         match self {
             Method::Raycast => Ok(raycast::render(prepared, projection, options)),
             Method::Raster => Ok(InverseRaster::new(prepared, projection, options)?.render()),

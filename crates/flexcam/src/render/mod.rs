@@ -28,6 +28,10 @@ pub enum Shading {
     /// Lambert + Phong with hard shadows, recursive reflection and refraction with Fresnel.
     #[default]
     Lit,
+    /// Displaced objects shaded by the per-ray transition system (BRDF, redistributed bump,
+    /// displacement), or coloured by the method chosen; `--method raycast` only (module
+    /// `transitions`).
+    Transitions(TransitionShading),
 }
 
 /// What [`render`] does: the method and everything that tunes it.
@@ -258,6 +262,7 @@ mod raycast;
 mod reproject;
 mod scan;
 mod shading;
+mod transitions;
 mod trilinear;
 mod warning;
 
@@ -267,6 +272,7 @@ pub use method::Method;
 pub use prepared::{Hit, PreparedScene};
 pub use raster::Subdivision;
 pub use reproject::{reproject, EquirectPhoto};
+pub use transitions::TransitionShading;
 pub use trilinear::{CurveMode, CurveOptions};
 pub use warning::RenderWarning;
 

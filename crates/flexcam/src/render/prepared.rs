@@ -30,6 +30,7 @@ use crate::render::displaced::DisplacedSet;
 use crate::scene::Scene;
 
 mod displaced_hits;
+mod transition_hits;
 
 /// The first surface a ray meets.
 #[derive(Debug, Clone, Copy, PartialEq)]

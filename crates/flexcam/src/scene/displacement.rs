@@ -9,6 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
+use crate::file_read::{read_regular, MAX_DATA_FILE_BYTES};
 
 /// Deepest subdivision level accepted (`4^16` micro-triangles per base triangle).
 pub const MAX_LEVEL: u32 = 16;
@@ -79,8 +80,7 @@ impl HeightImage {
     /// decoding). Errors (one line, naming the file): unreadable, not a PNG, not grey (RGB,
     /// with alpha, ...), empty.
     pub fn load(path: &Path) -> Result<HeightImage> {
-        let bytes =
-            std::fs::read(path).map_err(|e| Error::in_file(path, format!("cannot read: {e}")))?;
+        let bytes = read_regular(path, "file", MAX_DATA_FILE_BYTES)?;
         let not_grey = |what: &str| {
             Error::in_file(
                 path,

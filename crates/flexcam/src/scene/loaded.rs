@@ -8,7 +8,7 @@ use crate::error::{Error, Result};
 use crate::projection::flexible::panorama::edit_source;
 use crate::projection::flexible::FlexibleSpec;
 use crate::projection::{BuildReport, Projection, ProjectionSpec};
-use crate::scene::{self, Scene};
+use crate::scene::{self, budget, Scene};
 
 /// What a caller changes in a scene file's settings. `None` keeps the file's value.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -50,6 +50,7 @@ pub fn load_with(source: &str, overrides: &Overrides) -> Result<LoadedScene> {
     let width = overrides.width.unwrap_or(scene.image.width);
     let height = overrides.height.unwrap_or(scene.image.height);
     scene::validate_resolution(width, height)?;
+    check_budget(&scene, width, height, 0).map_err(|e| e.or_in_file(source))?;
     let (projection, build_report) = crate::calibrate::build(&scene.projection, width, height)
         .map_err(|e: Error| e.or_in_file(source))?;
     Ok(LoadedScene {
@@ -61,6 +62,21 @@ pub fn load_with(source: &str, overrides: &Overrides) -> Result<LoadedScene> {
         build_report,
         load_ms: start.elapsed().as_secs_f64() * 1e3,
     })
+}
+
+/// Fails when the scene's triangles and a `width` x `height` image need more memory than
+/// the budget ([`budget::check`]), before any frame is allocated. `extra_bytes` counts what
+/// the command holds besides (the frames of a GIF).
+pub fn check_budget(scene: &Scene, width: u32, height: u32, extra_bytes: u64) -> Result<()> {
+    let triangles = scene.triangle_count() as u64;
+    let pixels = u64::from(width) * u64::from(height);
+    let estimate = (triangles.saturating_mul(budget::BYTES_PER_TRIANGLE))
+        .saturating_add(pixels.saturating_mul(budget::BYTES_PER_PIXEL))
+        .saturating_add(extra_bytes);
+    budget::check(
+        estimate,
+        &format!("{triangles} triangles, a {width} x {height} image"),
+    )
 }
 
 /// `projection` with the perspective edit `rect`.

@@ -121,6 +121,7 @@ impl Scene {
     }
 }
 
+pub mod budget;
 pub mod builtin;
 pub mod file;
 mod loaded;
@@ -130,7 +131,7 @@ pub(crate) mod reflector_fixtures;
 pub mod shapes;
 
 pub use file::validate_resolution;
-pub use loaded::{load_with, LoadedScene, Overrides};
+pub use loaded::{check_budget, load_with, LoadedScene, Overrides};
 
 /// Loads a scene from `source`: `builtin:NAME` names a built-in scene, anything else is the
 /// path of a scene file. This is the SCENE argument of `flexcam render`.

@@ -20,7 +20,8 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use flexcam::displace::{tessellate, Displacement};
-use flexcam::render::{render, PreparedScene, RenderOptions, Shading};
+use flexcam::projection::{CameraFrame, ProjectionSpec};
+use flexcam::render::{render, Counter, PreparedScene, RenderOptions, Shading, TransitionShading};
 use flexcam::scene::{self, DisplacementSpec, Scene};
 use flexcam::{Error, Result};
 
@@ -147,7 +148,90 @@ pub fn run(args: &DisplacedArgs) -> Result<()> {
          build ms: tessellation and BVH build of the tessellated mesh (the displaced set's own \
          build is under 100 ms)"
     );
+    transition_rows(args, &base)
+}
+
+/// Camera distances of the transition rows, as fractions of the scene's own: the near view
+/// (Table 8.1's e = (0, 0, 1) in spirit: the torus filling the frame) and the scene's view.
+const TRANSITION_VIEWS: [(&str, f64); 2] = [("near", 0.45), ("scene", 1.0)];
+
+/// Values of the transition function's `D` in the transition rows: the default and two
+/// that favour the cheaper methods more.
+const TRANSITION_DS: [f64; 3] = [TransitionShading::DEFAULT_D, 8.0, 32.0];
+
+/// The transition system (`--shading transition-lit`) against full displacement (`--shading
+/// lit`) at the near and the scene's view, level 5, in this process: Table 8.1's "transition
+/// system" row beside "displaced detailed", for each `D` of [`TRANSITION_DS`].
+fn transition_rows(args: &DisplacedArgs, base: &Scene) -> Result<()> {
+    println!(
+        "Table 8.1 (Ramsey 2005): transition system (transition-lit) against full displacement \
+         (lit), level 5; the dissertation's was over 4x faster at the near view"
+    );
+    println!(
+        "{:>6} {:>5} {:>14} {:>14} {:>8} | {:>6} {:>6} {:>6}",
+        "view", "D", "displaced ms", "transition ms", "speed-up", "BRDF", "bump", "disp."
+    );
+    let scene = with_level(base, 5);
+    let prepared = PreparedScene::new(&scene);
+    for (name, fraction) in TRANSITION_VIEWS {
+        let projection = closer(&scene.projection, fraction)?.build(args.size, args.size)?;
+        let time = |shading| {
+            let options = RenderOptions {
+                shading,
+                ..RenderOptions::default()
+            };
+            measure(args.repeat, || {
+                render(&prepared, projection.as_ref(), &options)
+            })
+        };
+        let (full, _) = time(Shading::Lit)?;
+        for d in TRANSITION_DS {
+            let (transition, rendered) =
+                time(Shading::Transitions(TransitionShading::new(false, d)?))?;
+            let weight = |key| match rendered.counters.get(key) {
+                Some(Counter::Value(v)) => *v,
+                _ => 0.0,
+            };
+            let weights = [
+                "transition_brdf_weight",
+                "transition_bump_weight",
+                "transition_displacement_weight",
+            ]
+            .map(weight);
+            let total: f64 = weights.iter().sum::<f64>().max(1.0);
+            println!(
+                "{name:>6} {d:>5} {:>14.1} {:>14.1} {:>8.2} | {:>5.0}% {:>5.0}% {:>5.0}%",
+                full.median_ms(),
+                transition.median_ms(),
+                full.median_ms() / transition.median_ms(),
+                100.0 * weights[0] / total,
+                100.0 * weights[1] / total,
+                100.0 * weights[2] / total,
+            );
+        }
+    }
+    println!(
+        "BRDF, bump, disp.: share of the samples on the displaced object by method weight; \
+         transition ms includes building its tables"
+    );
     Ok(())
+}
+
+/// `projection` (a perspective camera) moved towards its target to `fraction` of its
+/// distance.
+fn closer(projection: &ProjectionSpec, fraction: f64) -> Result<ProjectionSpec> {
+    match projection {
+        ProjectionSpec::Perspective { frame, fov } => Ok(ProjectionSpec::Perspective {
+            frame: CameraFrame {
+                position: frame.look_at + (frame.position - frame.look_at) * fraction,
+                ..*frame
+            },
+            fov: *fov,
+        }),
+        _ => Err(Error::new(
+            "the displaced torus bench needs a perspective camera",
+        )),
+    }
 }
 
 /// `scene` with every displacement at subdivision `level`.

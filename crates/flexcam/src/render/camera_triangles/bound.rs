@@ -16,8 +16,11 @@
 //!   three lines do not enclose a triangle. It is rasterised clipped to the camera triangle's
 //!   pixel rectangle (the paper's viewport; with a projective screen map, to the camera
 //!   triangle itself, where the map has no pole).
-//! - [`Bound::Tight`]: the convex hull of the nine points clipped to the camera triangle, and
-//!   where that region is still large, the same on each quarter of the camera triangle
+//! - [`Bound::Tight`]: the convex hull of the nine points clipped to the camera triangle, the
+//!   points projected onto the camera triangle's plane along its rays nearest the scene
+//!   triangle ([`Camera::plane_near`]: the argument holds on every plane of the points a
+//!   fixed distance along the rays, and projecting onto a plane near the points moves them
+//!   little, however much the rays diverge), and where that region is still large, the same on each quarter of the camera triangle
 //!   (recursively): a quarter is itself a camera triangle (its corner rays are interpolated
 //!   rays of the parent), so the argument holds for it, and its narrower cone of directions
 //!   gives a smaller hull. The union of the quarters' regions holds every fragment.
@@ -28,7 +31,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::camera::{Camera, CORNERS};
+use super::camera::{AlongDirection, Camera, CameraPlane, CORNERS};
 use super::convex::{cross, Convex};
 use crate::render::trilinear::plane_hit;
 
@@ -71,23 +74,39 @@ impl std::str::FromStr for Bound {
 pub fn regions(camera: &Camera, q: &[DVec3; 3], bound: Bound, emit: &mut impl FnMut(&Convex)) {
     match bound {
         Bound::Paper => paper(camera, q, emit),
-        Bound::Tight => tight(camera, q, CORNERS, 0, emit),
+        Bound::Tight => {
+            let plane = camera.plane_near((q[0] + q[1] + q[2]) / 3.0);
+            tight(camera, plane.as_ref(), q, CORNERS, 0, emit)
+        }
     }
 }
 
 /// Whether the convex hull of `points` projected along the corner directions misses the
 /// camera triangle (so nothing inside that hull is seen by it): the culling of section 2.4
-/// for a box (its eight corners) or a triangle. `false` where no hull bounds the region.
+/// for a box (its eight corners) or a triangle, on the plane near the points and on the
+/// camera plane (either hull that misses proves it). `false` where no hull bounds the region.
 pub fn misses(camera: &Camera, points: &[DVec3]) -> bool {
     let directions = CORNERS.map(|c| camera.direction(c));
-    if !camera.one_sided(&directions) {
+    let centre = points.iter().sum::<DVec3>() / points.len().max(1) as f64;
+    [camera.plane_near(centre).as_ref(), camera.plane()]
+        .into_iter()
+        .flatten()
+        .any(|plane| misses_on(plane, &directions, points))
+}
+
+/// [`misses`] on one plane.
+fn misses_on(plane: &CameraPlane, directions: &[DVec3; 3], points: &[DVec3]) -> bool {
+    if !plane.one_sided(directions) {
         return false;
     }
+    let Some(along) = alongs(plane, directions) else {
+        return false;
+    };
     let mut projected = [DVec2::ZERO; 24];
     let mut n = 0;
     for &q in points.iter().take(8) {
-        for &d in &directions {
-            match camera.project_along(q, d).and_then(near) {
+        for a in &along {
+            match near(a.project(q)) {
                 Some(p) => projected[n] = p,
                 None => return false,
             }
@@ -96,8 +115,7 @@ pub fn misses(camera: &Camera, points: &[DVec3]) -> bool {
     }
     // Conservative: a miss is reported only where a line separates the points from the
     // camera triangle (one of its edges, or an axis of its bounding box).
-    let points = &projected[..n];
-    separated(points, CORNERS)
+    separated(&projected[..n], CORNERS)
 }
 
 /// Whether some edge of triangle `t` or an axis has all `points` strictly outside.
@@ -125,14 +143,24 @@ const FAR: f64 = 1e6;
 
 /// The nine projections `p_ij` of the corners `q` along `directions` (`None` if one is
 /// parallel to the plane or beyond [`FAR`]).
-fn nine(camera: &Camera, q: &[DVec3; 3], directions: &[DVec3; 3]) -> Option<[DVec2; 9]> {
+fn nine(plane: &CameraPlane, q: &[DVec3; 3], directions: &[DVec3; 3]) -> Option<[DVec2; 9]> {
+    let along = alongs(plane, directions)?;
     let mut out = [DVec2::ZERO; 9];
     for (i, &qi) in q.iter().enumerate() {
-        for (j, &d) in directions.iter().enumerate() {
-            out[3 * i + j] = near(camera.project_along(qi, d)?)?;
+        for (j, a) in along.iter().enumerate() {
+            out[3 * i + j] = near(a.project(qi))?;
         }
     }
     Some(out)
+}
+
+/// The projections along each of `directions` (`None` if one is parallel to the plane).
+fn alongs(plane: &CameraPlane, directions: &[DVec3; 3]) -> Option<[AlongDirection; 3]> {
+    Some([
+        plane.along(directions[0])?,
+        plane.along(directions[1])?,
+        plane.along(directions[2])?,
+    ])
 }
 
 /// `p` unless it is beyond [`FAR`] or not finite.
@@ -144,10 +172,12 @@ fn near(p: DVec2) -> Option<DVec2> {
 fn paper(camera: &Camera, q: &[DVec3; 3], emit: &mut impl FnMut(&Convex)) {
     let directions = CORNERS.map(|c| camera.direction(c));
     let triangle = camera
-        .one_sided(&directions)
-        .then(|| nine(camera, q, &directions))
-        .flatten()
-        .and_then(|points| bounding_triangle(camera, &directions, &points));
+        .plane()
+        .filter(|plane| plane.one_sided(&directions))
+        .and_then(|plane| {
+            let points = nine(plane, q, &directions)?;
+            bounding_triangle(plane, &directions, &points)
+        });
     let Some(triangle) = triangle else {
         return emit_in_camera(camera, &Convex::from_points(&CORNERS), emit);
     };
@@ -173,7 +203,7 @@ fn paper(camera: &Camera, q: &[DVec3; 3], emit: &mut impl FnMut(&Convex)) {
 /// `directions` (in the camera plane), or to the camera triangle's edges in the singular
 /// cases; `None` for non-finite results.
 fn bounding_triangle(
-    camera: &Camera,
+    plane: &CameraPlane,
     directions: &[DVec3; 3],
     points: &[DVec2; 9],
 ) -> Option<[DVec2; 3]> {
@@ -183,7 +213,7 @@ fn bounding_triangle(
     // far side of the region from the opposite edge), or the camera edge's own.
     let lines: Option<[DVec2; 3]> = (0..3)
         .map(|k| {
-            let g = camera.in_plane_covector(directions[k])?;
+            let g = plane.in_plane_covector(directions[k])?;
             Some(if g.dot(CORNERS[k] - centroid) < 0.0 {
                 -g
             } else {
@@ -233,40 +263,40 @@ fn encloses(g: [DVec2; 3]) -> bool {
 /// The tight bound on the sub-triangle `sub` of the camera triangle (module doc).
 fn tight(
     camera: &Camera,
+    plane: Option<&CameraPlane>,
     q: &[DVec3; 3],
     sub: [DVec2; 3],
     depth: u32,
     emit: &mut impl FnMut(&Convex),
 ) {
-    let whole = Convex::from_points(&sub).clip_to_triangle(CORNERS);
     let directions = sub.map(|c| camera.direction(c));
-    let region = if camera.one_sided(&directions) {
-        match nine(camera, q, &directions) {
-            Some(points) => Convex::hull(&points).clip_to_triangle(sub),
-            None => whole,
-        }
-    } else {
-        whole
-    };
+    let region = plane
+        .filter(|p| p.one_sided(&directions))
+        .and_then(|plane| nine(plane, q, &directions))
+        .map(|points| Convex::hull(&points).clip_to_triangle(sub))
+        .unwrap_or_else(|| Convex::from_points(&sub).clip_to_triangle(CORNERS));
     if region.points().len() < 3 {
         return;
     }
     let pixels = region.area() * camera.pixels_per_area;
-    // Where the rays at the corners and centre all hit the scene triangle, it (nearly)
-    // covers the sub-triangle: quarters would all be kept.
-    let centre = (sub[0] + sub[1] + sub[2]) / 3.0;
-    let covered = [sub[0], sub[1], sub[2], centre].iter().all(|&b| {
-        plane_hit(&camera.ray_at(b), *q)
-            .is_some_and(|(t, u, v)| t >= 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0)
-    });
-    if depth >= MAX_DEPTH || pixels < MIN_SPLIT_PIXELS || covered {
+    if depth >= MAX_DEPTH || pixels < MIN_SPLIT_PIXELS || covers(camera, q, sub) {
         return emit_in_camera(camera, &region, emit);
     }
     let [a, b, c] = sub;
     let (ab, bc, ca) = ((a + b) / 2.0, (b + c) / 2.0, (c + a) / 2.0);
     for quarter in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]] {
-        tight(camera, q, quarter, depth + 1, emit);
+        tight(camera, plane, q, quarter, depth + 1, emit);
     }
+}
+
+/// Whether the rays at the corners and centre of `sub` all hit the scene triangle `q`: then
+/// it (nearly) covers the sub-triangle, and quarters would all be kept.
+fn covers(camera: &Camera, q: &[DVec3; 3], sub: [DVec2; 3]) -> bool {
+    let centre = (sub[0] + sub[1] + sub[2]) / 3.0;
+    [sub[0], sub[1], sub[2], centre].iter().all(|&b| {
+        plane_hit(&camera.ray_at(b), *q)
+            .is_some_and(|(t, u, v)| t >= 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0)
+    })
 }
 
 /// Emits a region given in barycentrics inside the camera triangle, in pixels.

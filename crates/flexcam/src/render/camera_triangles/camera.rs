@@ -10,7 +10,11 @@
 //! triangle has collapsed (a pinhole's base points all at the eye), the triangle of the
 //! points one ray length along the rays: the ray at `(u, v)` is the same line either way
 //! (`tripoint + s trinorm` is affine in `(u, v)` for any fixed `s`), so a bound computed on
-//! either plane holds for the camera's rays.
+//! either plane holds for the camera's rays. For the same reason any plane of the points `s`
+//! along the rays serves ([`CameraPlane`], [`Camera::plane_at`]); where the rays diverge the
+//! base plane may be crossed by them from both sides (rays grazing a mirror), while farther
+//! along them their cone crosses the plane from one side, so each camera keeps the distances
+//! whose planes it crosses steeply and a bound picks the one nearest its scene points.
 
 use glam::{DVec2, DVec3};
 
@@ -35,7 +39,9 @@ pub struct Camera {
     pub map: ScreenMap,
     cache: ProjectionTriangleCache,
     /// The camera plane (module doc); `None` where even the shifted base is degenerate.
-    plane: Option<Plane>,
+    plane: Option<CameraPlane>,
+    /// The ray parameters of the planes the tight bound may project onto.
+    choices: PlaneChoices,
     /// The pixel bounding box `(lo, hi)` of its screen triangle.
     pub pixel_box: (DVec2, DVec2),
     /// Pixels per unit of barycentric area, for sizing bound regions (exact for the affine
@@ -43,21 +49,42 @@ pub struct Camera {
     pub pixels_per_area: f64,
 }
 
-/// The plane `origin + u e1 + v e2` and its normal `e1 x e2`.
+/// A plane of the camera triangle: the triangle of the points `s` along its corner rays,
+/// `origin + u e1 + v e2` at barycentrics `(u, v)`, where the ray at `(u, v)` crosses it
+/// (`tripoint + s trinorm` is affine in `(u, v)`), and its normal `e1 x e2`.
 #[derive(Debug, Clone, Copy)]
-struct Plane {
+pub struct CameraPlane {
     origin: DVec3,
     e1: DVec3,
     e2: DVec3,
     normal: DVec3,
 }
 
-impl Plane {
+/// The projection of points along one direction onto a [`CameraPlane`], in its
+/// barycentrics: affine in the point, so set up once per direction.
+#[derive(Debug, Clone, Copy)]
+pub struct AlongDirection {
+    origin: DVec3,
+    u: DVec3,
+    v: DVec3,
+}
+
+impl AlongDirection {
+    /// The barycentrics of the point where the line through `q` along the direction meets
+    /// the plane.
+    #[inline]
+    pub fn project(&self, q: DVec3) -> DVec2 {
+        let r = q - self.origin;
+        DVec2::new(r.dot(self.u), r.dot(self.v))
+    }
+}
+
+impl CameraPlane {
     /// The plane through `p`, `None` when the three points (nearly) lie on a line or
     /// (nearly) coincide: its longest side below [`FLAT_SINE`] of the points' magnitude, or
     /// twice its area below [`FLAT_SINE`] of that side squared. Projections onto a plane so
     /// badly conditioned would be rounding noise.
-    fn through(p: [DVec3; 3]) -> Option<Plane> {
+    fn through(p: [DVec3; 3]) -> Option<CameraPlane> {
         let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
         let normal = e1.cross(e2);
         let side = e1.length().max(e2.length()).max((e2 - e1).length());
@@ -65,12 +92,133 @@ impl Plane {
         let ok = side > FLAT_SINE * magnitude
             && normal.length() > FLAT_SINE * side * side
             && normal.is_finite();
-        ok.then_some(Plane {
+        ok.then_some(CameraPlane {
             origin: p[0],
             e1,
             e2,
             normal,
         })
+    }
+
+    /// Whether every direction of the cone spanned by `directions` crosses the plane from
+    /// the same side (none parallel to it): then projecting a point along them is a central
+    /// projection of the cone from the point, and the projections of a point along the cone
+    /// lie in the convex hull of its projections along `directions`.
+    pub fn one_sided(&self, directions: &[DVec3; 3]) -> bool {
+        let n = self.normal.length();
+        let signs = directions.map(|d| {
+            let s = self.normal.dot(d);
+            if s.abs() <= GRAZING_SINE * n * d.length() || !s.is_finite() {
+                0
+            } else {
+                s.signum() as i32
+            }
+        });
+        signs[0] != 0 && signs.iter().all(|&s| s == signs[0])
+    }
+
+    /// The smallest sine of the angle between the plane and `directions`.
+    fn min_sine(&self, directions: &[DVec3; 3]) -> f64 {
+        let n = self.normal.normalize();
+        directions
+            .iter()
+            .map(|d| (n.dot(*d) / d.length()).abs())
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The projection along `d` onto the plane (`None` for `d` parallel to it).
+    #[inline]
+    pub fn along(&self, d: DVec3) -> Option<AlongDirection> {
+        let det = self.normal.dot(d);
+        (det != 0.0).then(|| AlongDirection {
+            origin: self.origin,
+            u: self.e2.cross(d) / det,
+            v: d.cross(self.e1) / det,
+        })
+    }
+
+    /// The in-plane component of `d` as a linear function on barycentrics: the covector
+    /// `g` with `g . (u, v) = m . (point at (u, v)) + const`, `m` being `d` without its
+    /// component along the plane's normal (the normal of the paper's line `L`, which lies in
+    /// the plane orthogonal to `d`). `None` where `m` vanishes (`d` orthogonal to the
+    /// plane: the paper's singular case).
+    pub fn in_plane_covector(&self, d: DVec3) -> Option<DVec2> {
+        let n = self.normal / self.normal.length();
+        let m = d - n * n.dot(d);
+        (m.length() > GRAZING_SINE * d.length()).then(|| DVec2::new(m.dot(self.e1), m.dot(self.e2)))
+    }
+}
+
+/// The ray parameters `s` (on a geometric grid) whose planes [`Camera::plane_at`] the cone
+/// of the corner rays crosses from one side at an angle of at least [`STEEP_SINE`] (or, where
+/// none does, from one side at all), in increasing order: the planes a bound may project
+/// onto. Where the rays diverge, the camera plane itself may be crossed from both sides
+/// (rays grazing the reflector), yet far enough along the rays the cone always crosses the
+/// plane of its corner rays' points from one side (unless the directions are coplanar).
+#[derive(Debug, Clone, Copy)]
+struct PlaneChoices {
+    s: [f64; GRID_STEPS],
+    len: usize,
+}
+
+impl Default for PlaneChoices {
+    fn default() -> Self {
+        PlaneChoices {
+            s: [0.0; GRID_STEPS],
+            len: 0,
+        }
+    }
+}
+
+/// Points of the grid of ray parameters: `s = scale * GRID_RATIO^i`, `i` from
+/// `-GRID_STEPS / 2`.
+const GRID_STEPS: usize = 48;
+const GRID_RATIO: f64 = 1.5;
+
+/// The sine of the angle below which a plane counts as grazed by the cone.
+const STEEP_SINE: f64 = 0.02;
+
+impl PlaneChoices {
+    fn of(camera: &Camera) -> PlaneChoices {
+        let directions = CORNERS.map(|c| camera.direction(c));
+        let points = CORNERS.map(|c| camera.ray_at(c).origin);
+        let size = (points[1] - points[0])
+            .length()
+            .max((points[2] - points[0]).length());
+        let length = directions.iter().map(|d| d.length()).fold(0.0, f64::max);
+        let scale = if size > 0.0 && length > 0.0 {
+            size / length
+        } else {
+            1.0
+        };
+        let grid =
+            (0..GRID_STEPS).map(|i| scale * GRID_RATIO.powi(i as i32 - GRID_STEPS as i32 / 2));
+        let steepness = |s: f64| {
+            let plane = camera.plane_at(s)?;
+            plane
+                .one_sided(&directions)
+                .then(|| plane.min_sine(&directions))
+        };
+        let mut out = PlaneChoices::default();
+        let sines: Vec<(f64, f64)> = grid.filter_map(|s| Some((s, steepness(s)?))).collect();
+        let steep = sines.iter().any(|&(_, sine)| sine >= STEEP_SINE);
+        for &(s, sine) in &sines {
+            if sine >= STEEP_SINE || !steep {
+                out.s[out.len] = s;
+                out.len += 1;
+            }
+        }
+        out
+    }
+
+    /// The choice nearest `s` in ratio (the smallest for `s <= 0`), `None` if there is none.
+    fn nearest(&self, s: f64) -> Option<f64> {
+        let choices = &self.s[..self.len];
+        let above = choices.partition_point(|&c| c < s);
+        match (above.checked_sub(1).map(|i| choices[i]), choices.get(above)) {
+            (Some(below), Some(&above)) => Some(if s * s <= below * above { below } else { above }),
+            (below, above) => below.or(above.copied()),
+        }
     }
 }
 
@@ -90,21 +238,49 @@ impl Camera {
     }
 
     fn new(map: ScreenMap, cache: ProjectionTriangleCache) -> Camera {
-        let at = |s: f64| CORNERS.map(|c| cache.tripoint(c.x, c.y) + s * cache.trinorm(c.x, c.y));
-        let plane = Plane::through(at(0.0)).or_else(|| Plane::through(at(1.0)));
+        let mut camera = Camera {
+            map,
+            cache,
+            plane: None,
+            choices: PlaneChoices::default(),
+            pixel_box: (DVec2::ZERO, DVec2::ZERO),
+            pixels_per_area: 0.0,
+        };
+        camera.plane = camera.plane_at(0.0).or_else(|| camera.plane_at(1.0));
+        camera.choices = PlaneChoices::of(&camera);
         let pixels = CORNERS.map(|c| map.pixel(c.x, c.y));
         let lo = pixels[0].min(pixels[1]).min(pixels[2]);
         let hi = pixels[0].max(pixels[1]).max(pixels[2]);
-        let pixels_per_area = (pixels[1] - pixels[0])
+        camera.pixel_box = (lo, hi);
+        camera.pixels_per_area = (pixels[1] - pixels[0])
             .perp_dot(pixels[2] - pixels[0])
             .abs();
-        Camera {
-            map,
-            cache,
-            plane,
-            pixel_box: (lo, hi),
-            pixels_per_area,
-        }
+        camera
+    }
+
+    /// The camera plane: the base triangle's, or one ray length along the rays where the
+    /// base has collapsed (module doc); `None` where both are degenerate.
+    pub fn plane(&self) -> Option<&CameraPlane> {
+        self.plane.as_ref()
+    }
+
+    /// The plane of the points `s` along the corner rays (`None` where degenerate).
+    pub fn plane_at(&self, s: f64) -> Option<CameraPlane> {
+        CameraPlane::through(CORNERS.map(|c| self.cache.ray_point(c.x, c.y, s)))
+    }
+
+    /// A plane for bounding the image of points around `centre`: of the camera's
+    /// [`PlaneChoices`], the one nearest the centre's distance along the central ray (in
+    /// ratio), else the camera plane. Projecting along diverging rays onto a plane near the
+    /// points moves them little, so their hull is small; the cone of the corner rays crosses
+    /// every choice from one side.
+    pub fn plane_near(&self, centre: DVec3) -> Option<CameraPlane> {
+        let ray = self.ray_at(DVec2::splat(1.0 / 3.0));
+        let s = (centre - ray.origin).dot(ray.direction) / ray.direction.length_squared();
+        self.choices
+            .nearest(s)
+            .and_then(|s| self.plane_at(s))
+            .or(self.plane)
     }
 
     /// The ray at barycentrics `b`.
@@ -115,53 +291,5 @@ impl Camera {
     /// The ray direction at barycentrics `b`.
     pub fn direction(&self, b: DVec2) -> DVec3 {
         self.cache.trinorm(b.x, b.y)
-    }
-
-    /// Whether every direction of the cone spanned by `directions` crosses the camera plane
-    /// from the same side (none parallel to it): then projecting a point along them is a
-    /// central projection of the cone from the point, and the projections of a point along
-    /// the cone lie in the convex hull of its projections along `directions`.
-    pub fn one_sided(&self, directions: &[DVec3; 3]) -> bool {
-        let Some(plane) = &self.plane else {
-            return false;
-        };
-        let n = plane.normal.length();
-        let signs = directions.map(|d| {
-            let s = plane.normal.dot(d);
-            if s.abs() <= GRAZING_SINE * n * d.length() || !s.is_finite() {
-                0
-            } else {
-                s.signum() as i32
-            }
-        });
-        signs[0] != 0 && signs.iter().all(|&s| s == signs[0])
-    }
-
-    /// The barycentrics of the point where the line through `q` along `d` meets the camera
-    /// plane (`None` without a plane or for `d` parallel to it).
-    #[inline]
-    pub fn project_along(&self, q: DVec3, d: DVec3) -> Option<DVec2> {
-        let plane = self.plane.as_ref()?;
-        let det = plane.normal.dot(d);
-        if det == 0.0 {
-            return None;
-        }
-        let r = q - plane.origin;
-        let u = r.dot(plane.e2.cross(d)) / det;
-        let v = plane.e1.dot(r.cross(d)) / det;
-        Some(DVec2::new(u, v))
-    }
-
-    /// The in-plane component of `d` as a linear function on barycentrics: the covector
-    /// `g` with `g . (u, v) = m . (point at (u, v)) + const`, `m` being `d` without its
-    /// component along the plane's normal (the normal of the paper's line `L`, which lies in
-    /// the plane orthogonal to `d`). `None` without a plane or where `m` vanishes (`d`
-    /// orthogonal to the plane: the paper's singular case).
-    pub fn in_plane_covector(&self, d: DVec3) -> Option<DVec2> {
-        let plane = self.plane.as_ref()?;
-        let n = plane.normal / plane.normal.length();
-        let m = d - n * n.dot(d);
-        (m.length() > GRAZING_SINE * d.length())
-            .then(|| DVec2::new(m.dot(plane.e1), m.dot(plane.e2)))
     }
 }

@@ -139,42 +139,77 @@ fn bounds_hold_every_fragment() {
     for name in TRILINEAR_SCENES {
         let scene = load(name);
         let projection = scene.projection.build(64, 48).unwrap();
-        let trilinear = projection.trilinear().unwrap();
-        let cameras = Camera::all(trilinear);
-        let owners = owners::owners(&cameras, 64, 48);
-        let geometry = SceneGeometry::new(&scene);
-        let mut checked = 0;
-        for (c, camera) in cameras.iter().enumerate() {
-            for k in 0..geometry.triangles.len() {
-                let q = geometry.corners(k);
-                for bound in [Bound::Paper, Bound::Tight] {
-                    let mut regions = Vec::new();
-                    bound::regions(camera, &q, bound, &mut |r| regions.push(*r));
-                    for (i, &owner) in owners.iter().enumerate() {
-                        if owner != c as u32 {
-                            continue;
-                        }
-                        let centre = DVec2::new((i % 64) as f64 + 0.5, (i / 64) as f64 + 0.5);
-                        let Some(ray) = camera.map.ray(centre) else {
-                            continue;
-                        };
-                        let hit = crate::render::trilinear::plane_hit(&ray, q);
-                        let Some((t, u, v)) = hit else { continue };
-                        if !(t >= 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0) {
-                            continue;
-                        }
-                        checked += 1;
-                        let held = regions.iter().any(|r| contains(r.points(), centre));
-                        assert!(
-                            held,
-                            "{name}: camera {c}, triangle {k}, {bound:?}, {centre}"
-                        );
+        let checked = fragments_in_bounds(name, projection.trilinear().unwrap(), &scene);
+        assert!(checked > 100, "{name}: {checked}");
+    }
+}
+
+/// The same on the reflection surfaces of mirror spheres, whose rays diverge (rays near the
+/// silhouette graze the sphere and cross the camera plane from both sides, so the tight
+/// bound projects onto planes farther along the rays).
+#[test]
+fn bounds_hold_every_fragment_of_diverging_rays() {
+    use crate::projection::trilinear_builders::{reflector_surface, Optic};
+    for name in ["reflect-sphere-cube", "reflect-funny-mirror"] {
+        let mut scene = load(name);
+        let entry = scene.trilinear_reflectors[0];
+        let object = scene.objects.iter().find(|o| o.id == entry.id).unwrap();
+        let mesh: &crate::scene::Mesh = &object.mesh;
+        let crate::projection::ProjectionSpec::Perspective { frame, fov } = &scene.projection
+        else {
+            panic!("{name}: not perspective")
+        };
+        let camera = crate::projection::Perspective::new(frame, *fov, 96, 72).unwrap();
+        let surface = reflector_surface(mesh, &camera, Optic::Reflect).unwrap();
+        let projection = surface
+            .projection(entry.screen_map, 96, 72)
+            .unwrap()
+            .unwrap();
+        scene.objects.retain(|o| o.id != entry.id);
+        let checked = fragments_in_bounds(name, &projection, &scene);
+        assert!(checked > 100, "{name}: {checked}");
+    }
+}
+
+/// Checks that every fragment of every (camera, scene triangle) pair of `scene` through
+/// `projection` lies in a region of each bound; returns the fragments checked.
+fn fragments_in_bounds(name: &str, projection: &Trilinear, scene: &Scene) -> usize {
+    let (width, height) = projection.resolution();
+    let cameras = Camera::all(projection);
+    let owners = owners::owners(&cameras, width, height);
+    let geometry = SceneGeometry::new(scene);
+    let mut checked = 0;
+    for (c, camera) in cameras.iter().enumerate() {
+        for k in 0..geometry.triangles.len() {
+            let q = geometry.corners(k);
+            for bound in [Bound::Paper, Bound::Tight] {
+                let mut regions = Vec::new();
+                bound::regions(camera, &q, bound, &mut |r| regions.push(*r));
+                for (i, &owner) in owners.iter().enumerate() {
+                    if owner != c as u32 {
+                        continue;
                     }
+                    let (x, y) = (i % width as usize, i / width as usize);
+                    let centre = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+                    let Some(ray) = camera.map.ray(centre) else {
+                        continue;
+                    };
+                    let hit = crate::render::trilinear::plane_hit(&ray, q);
+                    let Some((t, u, v)) = hit else { continue };
+                    if !(t >= 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0) {
+                        continue;
+                    }
+                    checked += 1;
+                    let held = regions.iter().any(|r| contains(r.points(), centre));
+                    assert!(
+                        held,
+                        "{name}: camera {c}, triangle {k}, {bound:?}, {centre}"
+                    );
                 }
             }
         }
-        assert!(checked > 100, "{name}: {checked}");
     }
+    checked
 }
 
 /// Whether the convex polygon `p` (either orientation) holds `x`.
@@ -284,5 +319,46 @@ fn reflectors_composite_as_the_trilinear_method_does() {
             assert!(count(&ours.counters, "rendered_fragments") > 0, "{name}");
             assert!(count(&ours.counters, "camera_triangles") > 0, "{name}");
         }
+    }
+}
+
+/// The applications' scenes (convex, concave and mixed reflectors, a single curved
+/// refraction) by camera triangles against the ray caster's exact mirror or glass (the same
+/// scene without trilinear reflectors): object ids away from id edges, and the relative RGB
+/// error, which is that of the reflector surfaces' interpolated rays.
+#[test]
+fn application_scenes_match_the_exact_ray_caster() {
+    for (name, max_rgb) in [
+        ("camtri-convex", 0.02),
+        ("camtri-concave", 0.02),
+        ("camtri-mixed", 0.02),
+        ("camtri-refract", 0.02),
+    ] {
+        let scene = load(name);
+        let main = scene.projection.build(160, 120).unwrap();
+        let ours = crate::render::render(
+            &PreparedScene::new(&scene),
+            main.as_ref(),
+            &options(Shading::Flat, Bound::Tight),
+        )
+        .unwrap();
+        let mut exact = scene.clone();
+        exact.trilinear_reflectors.clear();
+        let reference = crate::render::render(
+            &PreparedScene::new(&exact),
+            main.as_ref(),
+            &RenderOptions {
+                method: Method::Raycast,
+                shading: Shading::Flat,
+                ..RenderOptions::default()
+            },
+        )
+        .unwrap();
+        let inside = id_agreement_inside(&ours.frame, &reference.frame);
+        let c = compare(&ours.frame, &reference.frame).unwrap();
+        println!("{name}: ids inside {inside:.5}, {c:?}");
+        assert!(inside >= 0.99, "{name}: {inside}");
+        assert!(c.relative_rgb_error < max_rgb, "{name}: {c:?}");
+        assert!(count(&ours.counters, "rendered_fragments") > 0, "{name}");
     }
 }

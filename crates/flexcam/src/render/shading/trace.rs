@@ -133,7 +133,8 @@ impl<'a> HitShader<'a> {
     pub(in crate::render) fn shade_hit(&mut self, ray: &Ray, hit: Hit) -> Vec3 {
         match self.shading {
             Shading::Flat => self.flat(ray, hit),
-            Shading::Lit => self.lit(ray, hit, 0, 1.0),
+            // The transition system shades displaced objects itself and the others lit.
+            Shading::Lit | Shading::Transitions(_) => self.lit(ray, hit, 0, 1.0),
         }
     }
 
@@ -231,18 +232,7 @@ impl<'a> HitShader<'a> {
         }
         let mut color = base * AMBIENT;
         for light in &self.caster.scene.lights {
-            let (to_light, t_max, radiance) = match *light {
-                Light::Point {
-                    position: p,
-                    color,
-                    intensity,
-                } => (p.as_dvec3() - position, 1.0, color * intensity),
-                Light::Directional {
-                    direction,
-                    color,
-                    intensity,
-                } => (-direction.as_dvec3(), f64::INFINITY, color * intensity),
-            };
+            let (to_light, t_max, radiance) = light_from(light, position);
             let unit = to_light.normalize_or_zero();
             if normal.dot(unit) <= 0.0 {
                 continue;
@@ -269,6 +259,24 @@ impl<'a> HitShader<'a> {
             hit.barycentric,
             ray.direction.as_vec3(),
         )
+    }
+}
+
+/// How `light` reaches surface point `position`: the vector to it (not normalised), the
+/// parameter of a shadow ray along that vector that reaches the light (1 for a point light,
+/// infinity for a directional one), and its radiance.
+pub(in crate::render) fn light_from(light: &Light, position: DVec3) -> (DVec3, f64, Vec3) {
+    match *light {
+        Light::Point {
+            position: p,
+            color,
+            intensity,
+        } => (p.as_dvec3() - position, 1.0, color * intensity),
+        Light::Directional {
+            direction,
+            color,
+            intensity,
+        } => (-direction.as_dvec3(), f64::INFINITY, color * intensity),
     }
 }
 

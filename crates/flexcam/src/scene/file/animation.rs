@@ -19,6 +19,10 @@ use crate::scene::ImageSettings;
 /// Frames per second when `fps` is absent.
 pub const DEFAULT_FPS: f64 = 24.0;
 
+/// The most frames an animation may have: over an hour at 24 frames per second. Every
+/// frame's output is named before the first is rendered, and a GIF holds them all.
+pub const MAX_FRAMES: u32 = 100_000;
+
 /// Converts and checks the `[animation]` table.
 pub(super) fn convert(
     src: &Source,
@@ -28,8 +32,11 @@ pub(super) fn convert(
 ) -> Result<Animation> {
     let raw = table.get_ref();
     let frames = *raw.frames.get_ref();
-    if frames == 0 {
-        return Err(src.error(&raw.frames.span(), "`frames` must be at least 1"));
+    if !(1..=MAX_FRAMES).contains(&frames) {
+        return Err(src.error(
+            &raw.frames.span(),
+            format!("`frames` must be in 1..={MAX_FRAMES}, not {frames}"),
+        ));
     }
     let fps = raw
         .fps
@@ -58,7 +65,7 @@ pub(super) fn convert(
     }
     let mut keys: Vec<Keyframe> = Vec::with_capacity(raw.key.len());
     for (index, key) in raw.key.iter().enumerate() {
-        let keyframe = keyframe(src, key.get_ref(), base_dir)?;
+        let keyframe = keyframe(src, key.get_ref(), base_dir, image)?;
         let time = &key.get_ref().time;
         if keyframe.time < 0.0 {
             return Err(src.error(
@@ -104,9 +111,15 @@ pub(super) fn convert(
 }
 
 /// One key: its time and its projection, which must be flexible.
-fn keyframe(src: &Source, key: &RawKey, base_dir: &Path) -> Result<Keyframe> {
+fn keyframe(
+    src: &Source,
+    key: &RawKey,
+    base_dir: &Path,
+    image: &ImageSettings,
+) -> Result<Keyframe> {
     let time = src.number(&key.time, "time")?;
-    match super::projection::convert(src, &key.projection, base_dir)? {
+    let image_size = [image.width, image.height];
+    match super::projection::convert(src, &key.projection, base_dir, image_size)? {
         ProjectionSpec::Flexible(projection) => Ok(Keyframe {
             time,
             projection: *projection,

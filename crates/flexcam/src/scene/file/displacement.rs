@@ -15,6 +15,7 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::source::Source;
+use super::strict::strict;
 use crate::error::Result;
 use crate::scene::displacement::{
     check_parameters, DisplacementSpec, HeightImage, HeightSource, ProceduralSpec, Wave, MAX_LEVEL,
@@ -30,7 +31,9 @@ pub struct RawDisplacement {
     scale: Spanned<f64>,
     level: Spanned<i64>,
     fraction: Option<Spanned<f64>>,
+    #[serde(default, deserialize_with = "strict")]
     waves: Option<Spanned<Vec<[f64; 4]>>>,
+    #[serde(default, deserialize_with = "strict")]
     cells: Option<Spanned<[i64; 2]>>,
     radius: Option<Spanned<f64>>,
 }

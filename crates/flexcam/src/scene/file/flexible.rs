@@ -242,6 +242,11 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
     Ok(FlexibleSpec { source, reparam })
 }
 
+/// The largest `segments` of a bezier blend: each projector is a polyline of that many
+/// steps, evaluated per ray; far more steps than pixels along a projector change nothing
+/// but the time and memory taken.
+pub(super) const MAX_SEGMENTS: u32 = 4096;
+
 /// `surfaces = [...]` with `blend` (default piecewise), `knots` (piecewise only) and
 /// `segments` (bezier only). Counts and knot values are checked when the volume is built;
 /// the errors point at the key they concern.
@@ -278,6 +283,19 @@ fn blended(
         "bezier" => {
             if let Some(k) = &raw.knots {
                 return Err(src.error(&k.span(), "`knots` belongs to blend = \"piecewise\""));
+            }
+            if let Some(s) = raw
+                .segments
+                .as_ref()
+                .filter(|s| *s.get_ref() > MAX_SEGMENTS)
+            {
+                return Err(src.error(
+                    &s.span(),
+                    format!(
+                        "`segments` must be at most {MAX_SEGMENTS}, not {}",
+                        s.get_ref()
+                    ),
+                ));
             }
             Blend::Bezier {
                 segments: raw.segments.as_ref().map(|s| *s.get_ref()),

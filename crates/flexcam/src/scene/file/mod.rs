@@ -5,6 +5,7 @@
 //! TOML syntax error to a degenerate projection, is one line `FILE:LINE:COLUMN: message`.
 
 mod animation;
+mod calibrated_projection;
 mod control_surface;
 mod displacement;
 mod fitted_grid;
@@ -18,6 +19,7 @@ mod projector_grid;
 mod raw;
 mod shape;
 mod source;
+mod strict;
 mod trilinear_grid;
 mod values;
 
@@ -31,6 +33,7 @@ use self::raw::{RawImage, RawScene};
 use self::source::Source;
 use super::{ImageSettings, InputFile, Scene};
 use crate::error::{Error, Result};
+use crate::file_read::{read_regular_text, MAX_SCENE_FILE_BYTES};
 use crate::projection::flexible::Animation;
 
 pub use self::animation::DEFAULT_FPS;
@@ -68,8 +71,7 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene> {
 /// Reads and parses the scene file at `path` with its `[animation]` table, if any. The
 /// scene file is the first of the scene's [`Scene::inputs`].
 pub fn load_animated(path: &Path) -> Result<(Scene, Option<Animation>)> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| Error::in_file(path, format!("cannot read scene file: {e}")))?;
+    let text = read_regular_text(path, "scene file", MAX_SCENE_FILE_BYTES)?;
     let (mut scene, animation) = parse_animated(&text, path)?;
     scene.inputs.insert(
         0,
@@ -94,7 +96,12 @@ pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animatio
         .projection
         .as_ref()
         .ok_or_else(|| src.file_error("missing [projection] table: a scene needs exactly one"))?;
-    let projection = projection::convert(&src, projection_table, &base_dir)?;
+    let projection = projection::convert(
+        &src,
+        projection_table,
+        &base_dir,
+        [image.width, image.height],
+    )?;
     check_unique_names(&src, &raw.object)?;
     let mut objects = Vec::new();
     let mut trilinear_reflectors = Vec::new();

@@ -43,7 +43,10 @@ pub(super) fn convert(
         (_, Some((mesh, base))) => vec![(mesh, overrides.apply(base))],
         (Some(file), None) => {
             let path = src.existing_file(file, base_dir, "model file")?;
+            src.check_model_size(&path, &file.span())?;
             let model = load_model(&path).map_err(|e| e.or_in_file(&path))?;
+            let triangles = model.parts.iter().map(|p| p.mesh.triangle_count() as u64);
+            src.reserve_triangles(triangles.sum(), &file.span())?;
             src.read_files(model.files);
             model
                 .parts
@@ -281,6 +284,11 @@ fn analytic(src: &Source, raw: &RawObject, shape: Shape) -> Result<Option<(Mesh,
         },
         ..Material::default()
     };
+    let at = raw
+        .tessellation
+        .as_ref()
+        .map_or(raw.shape.span(), Spanned::span);
+    src.reserve_triangles(shape.triangle_bound(tessellation), &at)?;
     Ok(analytic_mesh(shape, size, tessellation, face_colors).map(|mesh| (mesh, base)))
 }
 

@@ -6,6 +6,7 @@ use std::path::Path;
 use glam::{DVec2, DVec3};
 use toml::Spanned;
 
+use super::calibrated_projection;
 use super::projection_table::{camera_frame, Required};
 use super::raw::{ProjectionTypeProbe, RawProjection};
 use super::source::Source;
@@ -20,17 +21,21 @@ enum Kind {
     Fisheye,
     Equirectangular,
     Cylindrical,
+    Opencv,
+    OpencvFisheye,
     Trilinear,
     Flexible,
 }
 
 /// Type names as written in scene files.
-const KINDS: [(&str, Kind); 7] = [
+const KINDS: [(&str, Kind); 9] = [
     ("perspective", Kind::Perspective),
     ("orthographic", Kind::Orthographic),
     ("fisheye", Kind::Fisheye),
     ("equirectangular", Kind::Equirectangular),
     ("cylindrical", Kind::Cylindrical),
+    ("opencv", Kind::Opencv),
+    ("opencv_fisheye", Kind::OpencvFisheye),
     ("trilinear", Kind::Trilinear),
     ("flexible", Kind::Flexible),
 ];
@@ -81,6 +86,8 @@ impl Kind {
             Kind::Perspective | Kind::Fisheye => &["fov"],
             Kind::Orthographic => &["width"],
             Kind::Equirectangular | Kind::Cylindrical => &["h_fov", "v_fov"],
+            Kind::Opencv => &calibrated_projection::OPENCV_KEYS,
+            Kind::OpencvFisheye => &calibrated_projection::FISHEYE_KEYS,
             Kind::Trilinear => {
                 return MESH_KEYS.iter().chain(&GRID_KEYS).copied().collect();
             }
@@ -119,12 +126,14 @@ pub(super) fn reject_unsupported(src: &Source) -> Result<()> {
 }
 
 /// Converts the `[projection]` table. Relative paths (`surface`) are resolved against
-/// `base_dir`. Only the file's form is checked here; [`ProjectionSpec::build`] checks that
-/// the projection is not degenerate.
+/// `base_dir`; `image_size` is the scene's `[image]` size, the one a calibrated camera
+/// without `calibration_size` is for. Only the file's form is checked here;
+/// [`ProjectionSpec::build`] checks that the projection is not degenerate.
 pub(super) fn convert(
     src: &Source,
     table: &Spanned<RawProjection>,
     base_dir: &Path,
+    image_size: [u32; 2],
 ) -> Result<ProjectionSpec> {
     let raw = table.get_ref();
     let name = raw.kind.get_ref();
@@ -168,6 +177,8 @@ pub(super) fn convert(
             h_fov: angle(&raw.h_fov, "h_fov", 360.0)?,
             v_fov: angle(&raw.v_fov, "v_fov", 90.0)?,
         },
+        Kind::Opencv => calibrated_projection::opencv(&required, image_size)?,
+        Kind::OpencvFisheye => calibrated_projection::opencv_fisheye(&required, image_size)?,
     })
 }
 
@@ -201,6 +212,7 @@ fn trilinear(src: &Source, required: &Required, base_dir: &Path) -> Result<Trili
             ));
         }
         let path = src.existing_file(surface, base_dir, "trilinear surface")?;
+        crate::scene::loaders::check_obj_file(&path)?;
         return TrilinearMesh::load_obj(&path).map_err(|e| e.or_in_file(&path));
     }
     if raw.points.is_none() {

@@ -11,6 +11,8 @@ use serde::de::{self, Deserializer, SeqAccess, Visitor};
 use serde::Deserialize;
 use toml::Spanned;
 
+use super::strict::strict;
+
 /// A 3-vector as written in the file: `[x, y, z]`.
 pub type Vec3Value = Spanned<[f64; 3]>;
 
@@ -52,6 +54,7 @@ pub struct RawKey {
 pub struct RawImage {
     pub width: Option<Spanned<u32>>,
     pub height: Option<Spanned<u32>>,
+    #[serde(default, deserialize_with = "strict")]
     pub background: Option<Vec3Value>,
 }
 
@@ -61,17 +64,24 @@ pub struct RawImage {
 pub struct RawProjection {
     #[serde(rename = "type")]
     pub kind: Spanned<String>,
+    #[serde(default, deserialize_with = "strict")]
     pub position: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub look_at: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub up: Option<Vec3Value>,
     pub fov: Option<Spanned<f64>>,
     pub width: Option<Spanned<f64>>,
     pub h_fov: Option<Spanned<f64>>,
     pub v_fov: Option<Spanned<f64>>,
     pub surface: Option<Spanned<String>>,
+    #[serde(default, deserialize_with = "strict")]
     pub points: Option<Spanned<Vec<[f64; 3]>>>,
+    #[serde(default, deserialize_with = "strict")]
     pub normals: Option<Spanned<Vec<[f64; 3]>>>,
+    #[serde(default, deserialize_with = "strict")]
     pub screen: Option<Spanned<Vec<[f64; 2]>>>,
+    #[serde(default, deserialize_with = "strict")]
     pub triangles: Option<Spanned<Vec<[u32; 3]>>>,
     pub preset: Option<Spanned<String>>,
     pub near: Option<Spanned<RawSurface>>,
@@ -82,32 +92,43 @@ pub struct RawProjection {
     pub segments: Option<Spanned<u32>>,
     pub reparam: Option<Spanned<String>>,
     pub max_latitude: Option<Spanned<f64>>,
+    #[serde(default, deserialize_with = "strict")]
     pub clip: Option<Spanned<[f64; 2]>>,
+    #[serde(default, deserialize_with = "strict")]
     pub shear: Option<Spanned<[f64; 2]>>,
     pub slit_distance: Option<Spanned<f64>>,
     pub grid: Option<Spanned<u32>>,
     pub view: Option<Spanned<String>>,
     pub camera: Option<Spanned<RawCamera>>,
+    #[serde(default, deserialize_with = "strict")]
     pub focus: Option<Spanned<[f64; 2]>>,
+    #[serde(default, deserialize_with = "strict")]
     pub inset: Option<Spanned<[f64; 2]>>,
     pub magnification: Option<Spanned<f64>>,
     pub first: Option<Spanned<RawCamera>>,
     pub second: Option<Spanned<RawCamera>>,
+    #[serde(default, deserialize_with = "strict")]
     pub band: Option<Spanned<[f64; 2]>>,
+    #[serde(default, deserialize_with = "strict")]
     pub shift: Option<Spanned<[f64; 2]>>,
     pub twist: Option<Spanned<f64>>,
     pub azimuth: Option<Spanned<f64>>,
     pub elevation: Option<Spanned<f64>>,
+    #[serde(default, deserialize_with = "strict")]
     pub generators: Option<Spanned<Vec<[f64; 4]>>>,
     pub projectors: Option<Spanned<RawProjectors>>,
     pub transition: Option<Spanned<f64>>,
     pub transitions: Option<Spanned<Vec<f64>>>,
     pub fovs: Option<Spanned<Vec<f64>>>,
     pub style: Option<Spanned<String>>,
+    #[serde(default, deserialize_with = "strict")]
     pub pole: Option<Spanned<[f64; 2]>>,
     pub strength: Option<Spanned<f64>>,
+    #[serde(default, deserialize_with = "strict")]
     pub path: Option<Spanned<Vec<[f64; 3]>>>,
+    #[serde(default, deserialize_with = "strict")]
     pub directions: Option<Spanned<Vec<[f64; 3]>>>,
+    #[serde(default, deserialize_with = "strict")]
     pub center: Option<Spanned<[f64; 2]>>,
     pub radius: Option<Spanned<f64>>,
     pub corner_radius: Option<Spanned<f64>>,
@@ -115,7 +136,16 @@ pub struct RawProjection {
     pub outlines: Option<Spanned<Vec<Spanned<RawCurve>>>>,
     pub profile: Option<Spanned<RawCurve>>,
     pub profiles: Option<Spanned<Vec<Spanned<RawCurve>>>>,
+    #[serde(default, deserialize_with = "strict")]
     pub perspective_rect: Option<Spanned<[f64; 4]>>,
+    pub fx: Option<Spanned<f64>>,
+    pub fy: Option<Spanned<f64>>,
+    pub cx: Option<Spanned<f64>>,
+    pub cy: Option<Spanned<f64>>,
+    pub distortion: Option<Spanned<Vec<f64>>>,
+    pub k: Option<Spanned<Vec<f64>>>,
+    #[serde(default, deserialize_with = "strict")]
+    pub calibration_size: Option<Spanned<[u32; 2]>>,
 }
 
 /// `outline = { ... }`, `profile`, and the entries of `outlines` / `profiles` (with `at`): a
@@ -125,8 +155,10 @@ pub struct RawProjection {
 pub struct RawCurve {
     pub at: Option<Spanned<f64>>,
     pub shape: Option<Spanned<String>>,
+    #[serde(default, deserialize_with = "strict")]
     pub points: Option<Spanned<Vec<[f64; 2]>>>,
     pub radius: Option<Spanned<f64>>,
+    #[serde(default, deserialize_with = "strict")]
     pub elevation: Option<Spanned<[f64; 2]>>,
 }
 
@@ -151,6 +183,7 @@ impl RawCurve {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawProjectors {
+    #[serde(default, deserialize_with = "strict")]
     pub size: Option<Spanned<[i64; 2]>>,
     pub interpolation: Option<Spanned<String>>,
     pub projector: Option<Vec<Spanned<RawNodeProjector>>>,
@@ -166,10 +199,15 @@ pub struct RawProjectors {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawNodeProjector {
+    #[serde(deserialize_with = "strict")]
     pub node: Spanned<[i64; 2]>,
+    #[serde(default, deserialize_with = "strict")]
     pub start: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub end: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub tangent: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub point: Option<Vec3Value>,
     pub length: Option<Spanned<f64>>,
 }
@@ -178,7 +216,9 @@ pub struct RawNodeProjector {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawAim {
+    #[serde(deserialize_with = "strict")]
     pub node: Spanned<[i64; 2]>,
+    #[serde(deserialize_with = "strict")]
     pub at: Vec3Value,
 }
 
@@ -186,7 +226,9 @@ pub struct RawAim {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawCorrespondence {
+    #[serde(deserialize_with = "strict")]
     pub uv: Spanned<[f64; 2]>,
+    #[serde(deserialize_with = "strict")]
     pub point: Vec3Value,
 }
 
@@ -195,8 +237,11 @@ pub struct RawCorrespondence {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawCamera {
+    #[serde(deserialize_with = "strict")]
     pub position: Vec3Value,
+    #[serde(deserialize_with = "strict")]
     pub look_at: Vec3Value,
+    #[serde(default, deserialize_with = "strict")]
     pub up: Option<Vec3Value>,
     pub h_fov: Option<Spanned<f64>>,
     pub v_fov: Option<Spanned<f64>>,
@@ -210,24 +255,41 @@ pub struct RawCamera {
 #[serde(deny_unknown_fields)]
 pub struct RawSurface {
     pub surface: Spanned<String>,
+    #[serde(default, deserialize_with = "strict")]
     pub center: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub u_axis: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub v_axis: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub corner: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub u_edge: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub v_edge: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub corners: Option<Spanned<[[f64; 3]; 4]>>,
     pub radius: Option<Spanned<f64>>,
+    #[serde(default, deserialize_with = "strict")]
     pub longitude: Option<Spanned<[f64; 2]>>,
+    #[serde(default, deserialize_with = "strict")]
     pub latitude: Option<Spanned<[f64; 2]>>,
+    #[serde(default, deserialize_with = "strict")]
     pub angle: Option<Spanned<[f64; 2]>>,
+    #[serde(default, deserialize_with = "strict")]
     pub height: Option<Spanned<[f64; 2]>>,
+    #[serde(default, deserialize_with = "strict")]
     pub axis: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub front: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub point: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub start: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub end: Option<Vec3Value>,
     pub along: Option<Spanned<String>>,
+    #[serde(default, deserialize_with = "strict")]
     pub control: Option<Spanned<Vec<Vec<[f64; 3]>>>>,
 }
 
@@ -335,6 +397,16 @@ impl RawProjection {
             ("directions", self.directions.as_ref().map(Spanned::span)),
             ("center", self.center.as_ref().map(Spanned::span)),
             ("radius", self.radius.as_ref().map(Spanned::span)),
+            ("fx", self.fx.as_ref().map(Spanned::span)),
+            ("fy", self.fy.as_ref().map(Spanned::span)),
+            ("cx", self.cx.as_ref().map(Spanned::span)),
+            ("cy", self.cy.as_ref().map(Spanned::span)),
+            ("distortion", self.distortion.as_ref().map(Spanned::span)),
+            ("k", self.k.as_ref().map(Spanned::span)),
+            (
+                "calibration_size",
+                self.calibration_size.as_ref().map(Spanned::span),
+            ),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))
@@ -364,15 +436,19 @@ pub struct RawObject {
     pub shape: Spanned<String>,
     pub size: Option<Spanned<Numbers>>,
     pub file: Option<Spanned<String>>,
+    #[serde(default, deserialize_with = "strict")]
     pub color: Option<Vec3Value>,
     pub checker: Option<Spanned<RawChecker>>,
     pub texture: Option<Spanned<String>>,
     pub material: Option<Spanned<String>>,
     pub ior: Option<Spanned<f64>>,
+    #[serde(default, deserialize_with = "strict")]
     pub translate: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub rotate: Option<Vec3Value>,
     pub scale: Option<Spanned<Numbers>>,
     pub tessellation: Option<Spanned<u32>>,
+    #[serde(default, deserialize_with = "strict")]
     pub face_colors: Option<Spanned<[[f64; 3]; 6]>>,
     pub trilinear_reflector: Option<Spanned<bool>>,
     pub trilinear_screen_map: Option<Spanned<String>>,
@@ -384,6 +460,7 @@ pub struct RawObject {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawChecker {
+    #[serde(deserialize_with = "strict")]
     pub color: Vec3Value,
     pub size: Option<Spanned<f64>>,
 }
@@ -394,9 +471,12 @@ pub struct RawChecker {
 pub struct RawLight {
     #[serde(rename = "type")]
     pub kind: Spanned<String>,
+    #[serde(default, deserialize_with = "strict")]
     pub position: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
     pub direction: Option<Vec3Value>,
     pub intensity: Option<Spanned<f64>>,
+    #[serde(default, deserialize_with = "strict")]
     pub color: Option<Vec3Value>,
 }
 

@@ -87,6 +87,24 @@ impl Shape {
     }
 }
 
+impl Shape {
+    /// An upper bound of the triangles [`analytic_mesh`] builds at `tessellation`, known
+    /// before building it (for the memory budget); 0 for model files.
+    pub fn triangle_bound(self, tessellation: u32) -> u64 {
+        let t = u64::from(tessellation.max(1));
+        match self {
+            Shape::Plane => 2 * t * t,
+            Shape::Box => 12 * t * t,
+            // Rows of quads from pole to pole, two triangles each.
+            Shape::Sphere | Shape::Torus => 2 * t * t,
+            Shape::Cylinder => 4 * t.max(3),
+            // 32 patches of n x n quads, n = max(t / 4, 1).
+            Shape::Teapot => 64 * (t / 4).max(1).pow(2),
+            Shape::Mesh => 0,
+        }
+    }
+}
+
 /// The object-space mesh of an analytic shape, `None` for [`Shape::Mesh`]. `size` holds the
 /// shape's [`SizeForm`] values in order (unused entries are ignored); `face_colors` (boxes
 /// only) colours the faces +x, -x, +y, -y, +z, -z.

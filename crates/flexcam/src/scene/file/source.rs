@@ -1,14 +1,14 @@
 //! The text of a scene file and its name, for turning byte spans into `FILE:LINE:COLUMN`
 //! errors.
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
 use toml::Spanned;
 
 use crate::error::{Error, Result};
-use crate::scene::InputFile;
+use crate::scene::{budget, InputFile};
 
 /// A scene file being parsed: its text, the path the user gave for it, and the files its
 /// values named so far.
@@ -16,6 +16,8 @@ pub(super) struct Source<'a> {
     pub text: &'a str,
     pub path: &'a Path,
     inputs: RefCell<Vec<InputFile>>,
+    /// Triangles of the objects converted so far, for the memory budget.
+    triangles: Cell<u64>,
 }
 
 impl<'a> Source<'a> {
@@ -24,12 +26,37 @@ impl<'a> Source<'a> {
             text,
             path,
             inputs: RefCell::new(Vec::new()),
+            triangles: Cell::new(0),
         }
     }
 
     /// Records files read on behalf of the scene (a model's material libraries, say).
     pub fn read_files(&self, files: impl IntoIterator<Item = InputFile>) {
         self.inputs.borrow_mut().extend(files);
+    }
+
+    /// Adds `count` triangles to the scene's, failing at `span` before they are built when
+    /// the scene's triangles would exceed the memory budget ([`budget::check`]).
+    pub fn reserve_triangles(&self, count: u64, span: &Range<usize>) -> Result<()> {
+        let total = self.triangles.get().saturating_add(count);
+        let bytes = total.saturating_mul(budget::BYTES_PER_TRIANGLE);
+        budget::check(bytes, &format!("{total} triangles"))
+            .map_err(|e| self.error(span, e.message))?;
+        self.triangles.set(total);
+        Ok(())
+    }
+
+    /// Fails at `span` before the model file `path` is parsed when its size suggests more
+    /// memory than the budget leaves (its triangles are reserved once it is loaded).
+    pub fn check_model_size(&self, path: &Path, span: &Range<usize>) -> Result<()> {
+        let size = std::fs::metadata(path).map_or(0, |m| m.len());
+        let reserved = self.triangles.get() * budget::BYTES_PER_TRIANGLE;
+        let estimate = size.saturating_mul(budget::BYTES_PER_MODEL_FILE_BYTE);
+        budget::check(
+            reserved.saturating_add(estimate),
+            &format!("model file {} of {size} bytes", path.display()),
+        )
+        .map_err(|e| self.error(span, e.message))
     }
 
     /// The files recorded so far, in the order they were read.

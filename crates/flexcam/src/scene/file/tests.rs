@@ -1178,7 +1178,7 @@ fn animation_errors_have_positions() {
         ),
         7,
         10,
-        "`frames` must be at least 1",
+        "`frames` must be in 1..=100000, not 0",
     );
     assert_error_at(
         &format!(

@@ -1,8 +1,8 @@
 //! glTF 2.0 (`.gltf` with embedded or external buffers, and binary `.glb`), through gltf.
 //!
-//! The gltf crate validates the document's indices, but reads accessors and image views by
-//! slicing buffers with unchecked arithmetic; every accessor and image view is therefore
-//! checked against its buffer here first, so that a malformed file is an error, not a panic.
+//! The gltf crate validates the document's indices, but not what it reads: every accessor,
+//! image view, node transform and named file is checked first (module `gltf_checks` and
+//! here), so that a malformed file is an error naming what is wrong, never a panic.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -11,11 +11,12 @@ use std::sync::Arc;
 use ::gltf::buffer::Data as BufferData;
 use ::gltf::image::Format;
 use ::gltf::mesh::Mode;
-use ::gltf::{Accessor, Document, Node, Primitive};
+use ::gltf::{Document, Node, Primitive};
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 
+use super::gltf_checks::{check_images, check_nodes, check_primitive, check_version, check_view};
 use super::texture::{srgb_to_linear, texture_from_texels};
-use super::{Model, ModelPart};
+use super::{read_file, Model, ModelPart};
 use crate::error::{Error, Result};
 use crate::scene::{InputFile, Material, Mesh, Pattern, Texture};
 
@@ -26,8 +27,19 @@ use crate::scene::{InputFile, Material, Mesh, Pattern, Texture};
 /// Point and line primitives are skipped; a file without triangles is an error.
 pub(super) fn load_gltf(path: &Path) -> Result<Model> {
     let fail = |e: ::gltf::Error| Error::in_file(path, format!("malformed glTF: {e}"));
-    let ::gltf::Gltf { document, blob } = open_validated(path).map_err(fail)?;
+    let bytes = read_file(path)?;
+    check_glb_length(&bytes).map_err(|e| e.or_in_file(path))?;
+    let ::gltf::Gltf { document, blob } = open_validated(&bytes).map_err(fail)?;
+    let in_file = |e: Error| Error::in_file(path, e.message);
+    check_version(&document).map_err(in_file)?;
+    check_nodes(&document).map_err(in_file)?;
+    check_images(&document).map_err(in_file)?;
     let base = path.parent().unwrap_or(Path::new(""));
+    for buffer in document.buffers() {
+        if let ::gltf::buffer::Source::Uri(uri) = buffer.source() {
+            check_named_file(base, uri, &format!("buffer {}", buffer.index())).map_err(in_file)?;
+        }
+    }
     let buffers = ::gltf::import_buffers(&document, Some(base), blob).map_err(fail)?;
     let buffer_files = document
         .buffers()
@@ -103,14 +115,44 @@ fn percent_decode(text: &str) -> Option<String> {
     String::from_utf8(out).ok()
 }
 
-/// Reads and validates a glTF or GLB file as `gltf::Gltf::open` does, but checks first
+/// Fails when a file named by a glTF URI (a buffer or image, `what`) is not a regular file,
+/// naming the URI and where it was looked for (the gltf crate's own error names neither).
+fn check_named_file(base: &Path, uri: &str, what: &str) -> Result<()> {
+    match uri_file(base, uri) {
+        Some(file) if !file.is_file() => Err(Error::new(format!(
+            "{what}: \"{uri}\" is not a file (looked for {})",
+            file.display()
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// Fails when a GLB header claims more bytes than the file holds (the gltf crate's reader
+/// would allocate the claimed length first).
+fn check_glb_length(bytes: &[u8]) -> Result<()> {
+    let Some(claimed) = bytes
+        .strip_prefix(b"glTF")
+        .and_then(|rest| rest.get(4..8))
+        .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    else {
+        return Ok(());
+    };
+    if claimed as usize > bytes.len() {
+        return Err(Error::new(format!(
+            "malformed GLB: its header claims {claimed} bytes, the file holds {}",
+            bytes.len()
+        )));
+    }
+    Ok(())
+}
+
+/// Parses and validates glTF or GLB bytes as `gltf::Gltf::open` does, but checks first
 /// that every primitive's `POSITION` accessor exists: gltf-json's validation indexes the
 /// accessor list with it unchecked and panics on an index past its end.
-fn open_validated(path: &Path) -> std::result::Result<::gltf::Gltf, ::gltf::Error> {
+fn open_validated(bytes: &[u8]) -> std::result::Result<::gltf::Gltf, ::gltf::Error> {
     use ::gltf::json::validation::{Checked, Error as Invalid};
     use ::gltf::json::Path as JsonPath;
-    let reader = std::io::BufReader::new(std::fs::File::open(path)?);
-    let ::gltf::Gltf { document, blob } = ::gltf::Gltf::from_reader_without_validation(reader)?;
+    let ::gltf::Gltf { document, blob } = ::gltf::Gltf::from_slice_without_validation(bytes)?;
     let json = document.into_json();
     let positions = Checked::Valid(::gltf::json::mesh::Semantic::Positions);
     for (m, mesh) in json.meshes.iter().enumerate() {
@@ -166,6 +208,14 @@ impl Loader<'_> {
             }
             let local = Mat4::from_cols_array_2d(&node.transform().matrix());
             let world = parent * Affine3A::from_mat4(local);
+            if !world.is_finite() {
+                let message = format!(
+                    "node {}: transform, composed with its parents', is not finite in single \
+                     precision",
+                    node.index()
+                );
+                return Err(Error::in_file(self.path, message));
+            }
             if let Some(mesh) = node.mesh() {
                 self.add_mesh(&mesh, &world)?;
             }
@@ -204,12 +254,7 @@ impl Loader<'_> {
         let Some(triangulate) = triangulation(primitive.mode()) else {
             return Ok(None);
         };
-        for (_, accessor) in primitive.attributes() {
-            self.check_accessor(&accessor)?;
-        }
-        if let Some(indices) = primitive.indices() {
-            self.check_accessor(&indices)?;
-        }
+        check_primitive(primitive, self.buffers)?;
         let material = primitive.material();
         let texture = material.pbr_metallic_roughness().base_color_texture();
         let uv_set = texture.as_ref().map_or(0, |t| t.tex_coord());
@@ -275,55 +320,16 @@ impl Loader<'_> {
         Ok(Some(ModelPart { mesh, material }))
     }
 
-    /// Checks that every element of `accessor` lies inside its buffer view and the view
-    /// inside its buffer. Sparse accessors (used for morph targets) are not supported.
-    fn check_accessor(&self, accessor: &Accessor) -> Result<()> {
-        let index = accessor.index();
-        if accessor.sparse().is_some() {
-            return Err(Error::new(format!(
-                "accessor {index} is sparse, which is not supported"
-            )));
-        }
-        let Some(view) = accessor.view() else {
-            return Err(Error::new(format!("accessor {index} has no buffer view")));
-        };
-        let element = accessor.size();
-        let stride = view.stride().unwrap_or(element);
-        let end = accessor.count().checked_sub(1).and_then(|last| {
-            stride
-                .checked_mul(last)?
-                .checked_add(element)?
-                .checked_add(accessor.offset())
-        });
-        match end {
-            Some(end) if end <= view.length() => self.check_view(&view),
-            _ => Err(Error::new(format!(
-                "accessor {index} is empty or reaches past its buffer view"
-            ))),
-        }
-    }
-
-    fn check_view(&self, view: &::gltf::buffer::View) -> Result<()> {
-        let buffer_len = self
-            .buffers
-            .get(view.buffer().index())
-            .map_or(0, |b| b.len());
-        match view.offset().checked_add(view.length()) {
-            Some(end) if end <= buffer_len => Ok(()),
-            _ => Err(Error::new(format!(
-                "buffer view {} reaches past its buffer",
-                view.index()
-            ))),
-        }
-    }
-
     /// The texture of a glTF image, decoded once per image.
     fn texture(&mut self, image: ::gltf::Image) -> Result<Arc<Texture>> {
         if let Some(texture) = self.textures.get(&image.index()) {
             return Ok(texture.clone());
         }
         if let ::gltf::image::Source::View { view, .. } = image.source() {
-            self.check_view(&view)?;
+            check_view(&view, self.buffers)?;
+        }
+        if let ::gltf::image::Source::Uri { uri, .. } = image.source() {
+            check_named_file(self.base, uri, &format!("image {}", image.index()))?;
         }
         let data = ::gltf::image::Data::from_source(image.source(), Some(self.base), self.buffers)
             .map_err(|e| Error::new(format!("image {}: {e}", image.index())))?;
@@ -367,6 +373,7 @@ fn triangulation(mode: Mode) -> Option<Triangulate> {
 /// A linear texture from a decoded glTF image (PNG or JPEG, so sRGB-encoded integers);
 /// grey images are spread to RGB, alpha is dropped.
 fn texture_from_gltf_image(data: &::gltf::image::Data) -> Result<Texture> {
+    crate::scene::budget::check_image(data.width, data.height)?;
     let (channels, bytes) = match data.format {
         Format::R8 => (1, 1),
         Format::R8G8 => (2, 1),

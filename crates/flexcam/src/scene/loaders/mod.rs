@@ -6,8 +6,10 @@
 //! file, with a line number where the format and library give one. None panics on
 //! malformed input.
 
+mod gltf_checks;
 mod gltf_loader;
 mod obj;
+mod obj_lines;
 mod ply;
 mod texture;
 
@@ -15,7 +17,9 @@ use std::path::Path;
 
 use super::{InputFile, Material, Mesh};
 use crate::error::{Error, Result};
+use crate::file_read::{read_regular, MAX_DATA_FILE_BYTES};
 
+pub use obj_lines::check_obj_file;
 pub use texture::load_texture;
 
 /// One part of a loaded model: a mesh and the material the file gives it, if any.
@@ -71,9 +75,9 @@ pub fn load_model(path: &Path) -> Result<Model> {
     }
 }
 
-/// The bytes of a file, or an error naming it.
+/// The bytes of a regular file, or an error naming it.
 fn read_file(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|e| Error::in_file(path, format!("cannot read: {e}")))
+    read_regular(path, "file", MAX_DATA_FILE_BYTES)
 }
 
 /// Helpers for the loader tests.

@@ -8,6 +8,7 @@ use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
+use super::obj_lines::{check_face_references, check_finite_numbers, check_mtl_values};
 use super::{load_texture, read_file, Model, ModelPart};
 use crate::error::{Error, Result};
 use crate::scene::{Finish, InputFile, Material, Mesh, Pattern, Texture};
@@ -24,6 +25,8 @@ struct MtlLibrary {
 /// A named MTL that is missing or malformed is an error, as is a file with no faces.
 pub(super) fn load_obj(path: &Path) -> Result<Model> {
     let data = read_file(path)?;
+    check_finite_numbers(path, &data)?;
+    check_face_references(path, &data)?;
     let dir = path.parent().unwrap_or(Path::new(""));
     let libraries = RefCell::new(Vec::new());
     let options = tobj::LoadOptions {
@@ -82,6 +85,7 @@ pub(super) fn load_obj(path: &Path) -> Result<Model> {
 /// Reads and parses one MTL file: the record of it, and what tobj needs of it.
 fn load_mtl(path: &Path) -> (MtlLibrary, tobj::MTLLoadResult) {
     let parsed = read_file(path).and_then(|data| {
+        check_mtl_values(path, &data)?;
         let mut reader = Cursor::new(data.as_slice());
         tobj::load_mtl_buf(&mut reader)
             .map_err(|e| obj_error(path, &data, reader.position() as usize, e))

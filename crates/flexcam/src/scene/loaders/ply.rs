@@ -20,7 +20,7 @@ use crate::scene::Mesh;
 /// `vertex_indices` or `vertex_index` lists, fan-triangulated.
 pub(super) fn load_ply(path: &Path) -> Result<Model> {
     let data = read_file(path)?;
-    check_element_counts(path, &data)?;
+    check_header(path, &data)?;
     let ply = Parser::<DefaultElement>::new()
         .read_ply(&mut data.as_slice())
         .map_err(|e| ply_error(path, &e.to_string()))?;
@@ -41,10 +41,11 @@ pub(super) fn load_ply(path: &Path) -> Result<Model> {
     Ok(Model::read_from(path, vec![part], Vec::new()))
 }
 
-/// Checks each header `element NAME COUNT` line before ply-rs sees it: ply-rs panics on a
-/// count that does not fit 64 bits, and would loop over a huge count of empty elements.
-/// Every element takes at least one byte, so a count above the file size is malformed.
-fn check_element_counts(path: &Path, data: &[u8]) -> Result<()> {
+/// Checks the header before ply-rs sees it. Each `element NAME COUNT` line: ply-rs panics
+/// on a count that does not fit 64 bits, and would loop over a huge count of empty
+/// elements; every element takes at least one byte, so a count above the file size is
+/// malformed. The `format` line: ply-rs accepts any version, but only PLY 1.0 is defined.
+fn check_header(path: &Path, data: &[u8]) -> Result<()> {
     let header = data
         .split(|&b| b == b'\n')
         .take_while(|line| !line.starts_with(b"end_header"));
@@ -56,6 +57,13 @@ fn check_element_counts(path: &Path, data: &[u8]) -> Result<()> {
             if !fits {
                 let column = line.rfind(count).map_or(1, |c| c + 1);
                 let message = format!("element \"{name}\" has an impossible count \"{count}\"");
+                return Err(Error::at(path, k + 1, column, message));
+            }
+        }
+        if let ["format", _, version, ..] = words[..] {
+            if version != "1.0" {
+                let column = line.rfind(version).map_or(1, |c| c + 1);
+                let message = format!("PLY version \"{version}\" is not supported (only 1.0)");
                 return Err(Error::at(path, k + 1, column, message));
             }
         }
@@ -296,6 +304,19 @@ mod tests {
             let e = load_ply(&path).unwrap_err();
             assert_eq!(e.location.unwrap().line_column, Some((3, 16)), "{count}");
         }
+    }
+
+    #[test]
+    fn versions_other_than_1_0_are_errors() {
+        let dir = tempfile::tempdir().unwrap();
+        let text = HEADER.replace("format ascii 1.0", "format ascii 2.0");
+        assert_ne!(text, HEADER);
+        let path = write(&dir, "v2.ply", text);
+        let e = load_ply(&path).unwrap_err().to_string();
+        assert!(
+            e.ends_with("v2.ply:2:14: PLY version \"2.0\" is not supported (only 1.0)"),
+            "{e}"
+        );
     }
 
     #[test]

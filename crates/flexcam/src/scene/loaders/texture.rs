@@ -7,12 +7,20 @@ use image::DynamicImage;
 
 use super::read_file;
 use crate::error::{Error, Result};
-use crate::scene::Texture;
+use crate::scene::{budget, Texture};
 
 /// Loads a PNG or JPEG image as a linear-colour texture: the file's sRGB values are decoded
-/// with the sRGB transfer curve; alpha is dropped; rows are stored top row first.
+/// with the sRGB transfer curve; alpha is dropped; rows are stored top row first. An image
+/// whose header gives a size beyond the memory budget is refused before it is decoded.
 pub fn load_texture(path: &Path) -> Result<Texture> {
     let bytes = read_file(path)?;
+    let cannot = |e: image::ImageError| Error::in_file(path, format!("cannot decode image: {e}"));
+    let (width, height) = image::ImageReader::new(std::io::Cursor::new(&bytes))
+        .with_guessed_format()
+        .map_err(|e| Error::in_file(path, format!("cannot decode image: {e}")))?
+        .into_dimensions()
+        .map_err(cannot)?;
+    budget::check_image(width, height).map_err(|e| e.or_in_file(path))?;
     let image = image::load_from_memory(&bytes)
         .map_err(|e| Error::in_file(path, format!("cannot decode image: {e}")))?;
     texture_from_image(&image).map_err(|e| e.or_in_file(path))
