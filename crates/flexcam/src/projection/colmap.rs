@@ -51,7 +51,7 @@ const MODELS: [(&str, usize); 7] = [
 
 /// Reads the cameras of `text` (the contents of `path`, named in errors). Errors, one line
 /// with the file and line: a line with too few fields, a number that does not parse or is
-/// not finite, a size of zero, a model other than [`MODELS`], the wrong number of parameters
+/// not finite, a size of zero, a model other than `MODELS`, the wrong number of parameters
 /// for the model, a focal length <= 0, a camera id given twice, no camera at all.
 pub fn read_cameras(text: &str, path: &Path) -> Result<Vec<ColmapCamera>> {
     let mut cameras: Vec<ColmapCamera> = Vec::new();

@@ -43,7 +43,7 @@ pub struct KannalaBrandt {
 }
 
 impl KannalaBrandt {
-    /// `k` = [k1, k2, k3, k4]. Errors: those of [`BoundCamera::new`], a non-finite
+    /// `k` = [k1, k2, k3, k4]. Errors: those of `BoundCamera::new`, a non-finite
     /// coefficient.
     pub fn new(camera: &CalibratedCamera, k: [f64; 4], width: u32, height: u32) -> Result<Self> {
         if let Some(bad) = k.iter().find(|c| !c.is_finite()) {

@@ -30,7 +30,7 @@ pub struct Opencv {
 
 impl Opencv {
     /// `distortion` in OpenCV's order [k1, k2, p1, p2, k3, k4, k5, k6]. Errors: those of
-    /// [`BoundCamera::new`], a non-finite coefficient.
+    /// `BoundCamera::new`, a non-finite coefficient.
     pub fn new(
         camera: &CalibratedCamera,
         distortion: [f64; 8],
@@ -54,7 +54,7 @@ impl Opencv {
     }
 
     /// The undistorted normalised radius beyond which the camera sees nothing (see
-    /// [`RadialTangential`]).
+    /// `RadialTangential`).
     pub fn valid_radius(&self) -> f64 {
         self.valid_radius
     }
@@ -90,7 +90,7 @@ impl Projection for Opencv {
 }
 
 /// The one image of a point, `t` its distance from the eye; beyond the valid radius the
-/// branch continues by [`RadialTangential::distort_continued`], where the camera does not
+/// branch continues by `RadialTangential::distort_continued`, where the camera does not
 /// see. Degenerate: a point on or behind the plane through the eye has no image.
 impl SingleImage for Opencv {
     fn branch_image(&self, point: DVec3) -> Option<BranchImage> {

@@ -8,7 +8,7 @@ use std::path::Path;
 use super::read_file;
 use crate::error::{Error, Result};
 
-/// Checks the OBJ file at `path` ([`check_finite_numbers`], [`check_face_references`])
+/// Checks the OBJ file at `path` (`check_finite_numbers`, `check_face_references`)
 /// for a reader other than the model loader (trilinear surfaces), so that its errors carry
 /// the OBJ's line too.
 pub fn check_obj_file(path: &Path) -> Result<()> {
