@@ -178,6 +178,34 @@ fn check_round_trip(
     Ok(())
 }
 
+/// Every pixel centre of a grid of at most 24 x 24 over the `(w, h)` image whose ray exists
+/// images back onto that centre (to 1e-9 px) under `forward`, OpenCV's formulas from camera
+/// coordinates to OpenCV pixels.
+fn pixel_centres_image_back(
+    projection: &dyn Projection,
+    frame: &CameraFrame,
+    (w, h): (u32, u32),
+    forward: impl Fn(DVec3) -> DVec2,
+) -> Result<(), TestCaseError> {
+    for y in 0..h.min(24) {
+        for x in 0..w.min(24) {
+            let (u, v) = (x * w / w.min(24), y * h / h.min(24));
+            let centre = DVec2::new(f64::from(u), f64::from(v));
+            let Some(ray) = projection.ray(centre + 0.5) else {
+                continue;
+            };
+            let imaged = forward(to_camera(frame, ray.at(3.0)));
+            prop_assert!(
+                (imaged - centre).length() < 1e-9,
+                "{} -> {}",
+                centre,
+                imaged
+            );
+        }
+    }
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(400))]
 
@@ -230,18 +258,9 @@ proptest! {
     ) {
         let projection = Opencv::new(&camera(frame, (w, h), k), d, w, h).unwrap();
         prop_assert!(projection.ray(DVec2::new(k.cx, k.cy) + 0.5).is_some());
-        for y in 0..h.min(24) {
-            for x in 0..w.min(24) {
-                let (u, v) = (x * w / w.min(24), y * h / h.min(24));
-                let centre = DVec2::new(f64::from(u), f64::from(v));
-                let Some(ray) = projection.ray(centre + 0.5) else {
-                    continue;
-                };
-                let camera = to_camera(&frame, ray.at(3.0));
-                let imaged = project_points(camera, &k, &d);
-                prop_assert!((imaged - centre).length() < 1e-9, "{} -> {}", centre, imaged);
-            }
-        }
+        pixel_centres_image_back(&projection, &frame, (w, h), |camera| {
+            project_points(camera, &k, &d)
+        })?;
     }
 
     /// The same for the fisheye: every pixel centre inside the valid image.
@@ -252,18 +271,9 @@ proptest! {
         c in fisheye_coefficients(),
     ) {
         let projection = KannalaBrandt::new(&camera(frame, (w, h), k), c, w, h).unwrap();
-        for y in 0..h.min(24) {
-            for x in 0..w.min(24) {
-                let (u, v) = (x * w / w.min(24), y * h / h.min(24));
-                let centre = DVec2::new(f64::from(u), f64::from(v));
-                let Some(ray) = projection.ray(centre + 0.5) else {
-                    continue;
-                };
-                let camera = to_camera(&frame, ray.at(3.0));
-                let imaged = fisheye_project_points(camera, &k, &c);
-                prop_assert!((imaged - centre).length() < 1e-9, "{} -> {}", centre, imaged);
-            }
-        }
+        pixel_centres_image_back(&projection, &frame, (w, h), |camera| {
+            fisheye_project_points(camera, &k, &c)
+        })?;
     }
 }
 

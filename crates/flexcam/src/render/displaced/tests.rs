@@ -4,8 +4,9 @@ use glam::{DVec2, DVec3};
 
 use super::*;
 use crate::displace::{MicroGrid, MicroTriangle};
+use crate::projection::Projection;
 use crate::render::shading::Normals;
-use crate::render::{render, Method, PreparedScene, RenderOptions, Shading};
+use crate::render::{render, Frame, Method, PreparedScene, RenderOptions, Shading};
 use crate::scene::file::parse;
 
 /// Two displaced tori (waves and bumps) crossing each other, and an undisplaced box that
@@ -99,6 +100,15 @@ fn brute_force(prepared: &PreparedScene, ray: &Ray) -> Option<(f64, usize, usize
     best
 }
 
+/// The flat ray-cast frame of `prepared` through `projection`.
+fn flat_frame(prepared: &PreparedScene, projection: &dyn Projection) -> Frame {
+    let options = RenderOptions {
+        shading: Shading::Flat,
+        ..RenderOptions::default()
+    };
+    render(prepared, projection, &options).unwrap().frame
+}
+
 #[test]
 fn prepared_scene_hits_exactly_the_micro_triangles_brute_force_finds() {
     let prepared = prepared();
@@ -185,13 +195,7 @@ fn methods_that_draw_base_triangles_refuse_displaced_objects() {
             )
         );
     }
-    let options = RenderOptions {
-        shading: Shading::Flat,
-        ..RenderOptions::default()
-    };
-    let frame = render(&prepared, projection.as_ref(), &options)
-        .unwrap()
-        .frame;
+    let frame = flat_frame(&prepared, projection.as_ref());
     assert!(frame.ids.contains(&1) && frame.ids.contains(&2) && frame.ids.contains(&3));
 }
 
@@ -228,13 +232,7 @@ displacement = { procedural = "waves", waves = [[1.0, 8, 0, 0.0], [1.0, 0, 4, 0.
     let scene = parse(text, Path::new("poly.toml")).unwrap();
     let prepared = PreparedScene::new(&scene);
     let projection = scene.projection.build(48, 36).unwrap();
-    let options = RenderOptions {
-        shading: Shading::Flat,
-        ..RenderOptions::default()
-    };
-    let frame = render(&prepared, projection.as_ref(), &options)
-        .unwrap()
-        .frame;
+    let frame = flat_frame(&prepared, projection.as_ref());
     let object = &scene.objects[0];
     let d = Displacement::from_spec(object.displacement.as_deref().unwrap());
     let grids: Vec<MicroGrid> = (0..object.mesh.triangles.len())
