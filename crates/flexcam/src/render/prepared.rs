@@ -276,8 +276,19 @@ impl PreparedScene {
     /// [`PreparedScene::intersect_f32`] of four rays at once, with identical results:
     /// coherent rays (a 2x2 quad of primary rays) share one BVH traversal.
     pub(in crate::render) fn intersect4_f32(&self, rays: [Option<&Ray>; 4]) -> [Option<Hit32>; 4] {
-        let fast = rays.map(|r| self.fast_unless_outside(r));
-        let fast_rays = fast.each_ref().map(Option::as_ref);
+        // Spelled out: `array::map` here is not inlined and costs a closure call per ray.
+        let fast = [
+            self.fast_unless_outside(rays[0]),
+            self.fast_unless_outside(rays[1]),
+            self.fast_unless_outside(rays[2]),
+            self.fast_unless_outside(rays[3]),
+        ];
+        let fast_rays = [
+            fast[0].as_ref(),
+            fast[1].as_ref(),
+            fast[2].as_ref(),
+            fast[3].as_ref(),
+        ];
         let found = match &self.shown {
             None => self.bvh.closest4(fast_rays, &AllTriangles),
             Some(mask) => closest4_shown(&self.bvh, fast_rays, mask),
