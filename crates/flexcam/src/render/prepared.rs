@@ -125,11 +125,17 @@ impl PreparedScene {
         let start = Instant::now();
         let mut first_triangle = Vec::with_capacity(scene.objects.len());
         let mut triangles = Vec::with_capacity(scene.triangle_count());
+        // Each composited reflector in a group of its own: the views that hide it, or show
+        // it alone, prune the tree at its group's root.
+        let mut groups = Vec::with_capacity(scene.triangle_count());
         for object in &scene.objects {
             first_triangle.push(triangles.len() as u32);
             if object.displacement.is_some() {
                 continue;
             }
+            let group = (scene.trilinear_reflectors.iter())
+                .position(|r| r.id == object.id)
+                .map_or(0, |k| k as u32 + 1);
             let p = &object.mesh.positions;
             triangles.extend(
                 object
@@ -138,8 +144,9 @@ impl PreparedScene {
                     .iter()
                     .map(|t| t.map(|i| p[i as usize])),
             );
+            groups.resize(triangles.len(), group);
         }
-        let bvh = Bvh::build(&triangles);
+        let bvh = Bvh::build_grouped(&triangles, |id| groups[id as usize]);
         PreparedScene {
             bvh: Arc::new(bvh),
             shown: None,

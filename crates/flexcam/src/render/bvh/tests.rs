@@ -89,10 +89,17 @@ fn masked_queries_see_only_the_kept_triangles() {
 }
 
 /// A mask hiding a compact object (a cluster of small triangles, as a mirror sphere is) clears
-/// the child bits of the subtrees holding only it, so that queries skip them; the answers
-/// stay those of testing only the kept triangles, including rays aimed at the cluster.
+/// the child bits of the subtrees holding only it, so that queries skip them; built with the
+/// object in a group of its own, the hidden part is one child of the root. The answers stay
+/// those of testing only the kept triangles, including rays aimed at the cluster.
 #[test]
 fn masked_queries_skip_the_subtrees_of_a_hidden_object() {
+    for grouped in [false, true] {
+        masked_queries_skip_a_hidden_cluster(grouped);
+    }
+}
+
+fn masked_queries_skip_a_hidden_cluster(grouped: bool) {
     let mut rng = Rng(23);
     let mut triangles = soup(&mut rng, 1500);
     let cluster = triangles.len() as u32;
@@ -100,15 +107,19 @@ fn masked_queries_skip_the_subtrees_of_a_hidden_object() {
         let c = Vec3::new(2.0, 1.0, -1.0) + rng.vec(1.0);
         [c + rng.vec(0.3), c + rng.vec(0.3), c + rng.vec(0.3)]
     }));
-    let bvh = Bvh::build(&triangles);
+    let bvh = match grouped {
+        true => Bvh::build_grouped(&triangles, |id| u32::from(id >= cluster)),
+        false => Bvh::build(&triangles),
+    };
     let keeps = |id: u32| id < cluster;
     let mask = TriangleMask::by_id(&bvh, keeps);
-    let skipped = mask
-        .children
-        .iter()
+    let skipped = (mask.children.iter())
         .map(|b| (b ^ 0b11).count_ones())
         .sum::<u32>();
-    assert!(skipped > 100, "only {skipped} subtrees skipped");
+    assert!(skipped > 100 || grouped, "only {skipped} subtrees skipped");
+    if grouped {
+        assert_eq!(mask.children[bvh.root.index as usize], 0b01);
+    }
     let mut through_cluster = 0;
     for k in 0..300 {
         let origin = rng.vec(15.0).as_dvec3();
