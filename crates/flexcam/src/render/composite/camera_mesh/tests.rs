@@ -59,8 +59,8 @@ fn the_automatic_size_is_the_smallest_within_the_tolerance() {
     let half = coarse_triangles(&smooth.mesh, (n / 2).max(1), SEED).unwrap();
     let error = seen.normal_error_px(&half, Optic::Reflect);
     assert!(error > tolerance, "half the size: {error} px");
-    // The own mesh against itself: no error.
-    assert_eq!(seen.normal_error_px(&smooth.mesh, Optic::Reflect), 0.0);
+    // The own mesh against itself: no error (up to rounding).
+    assert!(seen.normal_error_px(&smooth.mesh, Optic::Reflect) < 1e-6);
 
     let (coarse, camera) = ball(6);
     let chosen = camera_mesh(&coarse.mesh, &entry, &camera, Optic::Reflect).unwrap();
