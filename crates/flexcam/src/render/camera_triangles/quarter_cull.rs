@@ -94,7 +94,14 @@ fn descend(
         }
     } else {
         for quarter in quarters(sub) {
-            descend(camera, scene, quarter, depth + 1, survivors.clone(), buffers);
+            descend(
+                camera,
+                scene,
+                quarter,
+                depth + 1,
+                survivors.clone(),
+                buffers,
+            );
         }
     }
     buffers.kept.truncate(start);

@@ -163,10 +163,7 @@ impl SeenVertices {
             Some((point, normal, ray, pixel, here.angle_between(beside), face))
         };
         let samples: Vec<_> = (0..reflector.positions.len()).map(sample).collect();
-        let mut sigma: Vec<f64> = samples
-            .iter()
-            .map(|s| s.map_or(0.0, |s| s.4))
-            .collect();
+        let mut sigma: Vec<f64> = samples.iter().map(|s| s.map_or(0.0, |s| s.4)).collect();
         for t in &reflector.triangles {
             for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
                 let (a, b) = (a as usize, b as usize);

@@ -1418,7 +1418,10 @@ fn camera_triangles_key() {
     );
     at(
         &format!("camera_triangles = {}", own + 1),
-        &format!("must be between 1 and the object's {own} triangles, not {}", own + 1),
+        &format!(
+            "must be between 1 and the object's {own} triangles, not {}",
+            own + 1
+        ),
     );
     at("camera_triangles = -3", "invalid value");
     at("camera_triangles = 2.5", "invalid type");

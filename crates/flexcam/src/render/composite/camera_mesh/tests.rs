@@ -9,7 +9,10 @@ use crate::scene::reflector_fixtures::{camera, sphere_and_cube};
 /// The mirror ball of the sphere-and-cube fixture at `segments`, its camera at 320 x 240.
 fn ball(segments: u32) -> (Reflector, Perspective) {
     let scene = sphere_and_cube(segments);
-    (Reflector::of(&scene, 1).unwrap(), camera(&scene, (320, 240)))
+    (
+        Reflector::of(&scene, 1).unwrap(),
+        camera(&scene, (320, 240)),
+    )
 }
 
 #[test]
@@ -83,7 +86,11 @@ fn the_automatic_size_is_the_smallest_within_the_tolerance() {
 #[test]
 fn closest_point_is_the_nearest_of_the_triangle() {
     let t = CoarseTriangle {
-        corners: [DVec3::ZERO, DVec3::new(2.0, 0.0, 0.0), DVec3::new(0.5, 1.5, 0.3)],
+        corners: [
+            DVec3::ZERO,
+            DVec3::new(2.0, 0.0, 0.0),
+            DVec3::new(0.5, 1.5, 0.3),
+        ],
         normals: [DVec3::Z; 3],
         face: DVec3::Z,
     };
@@ -107,7 +114,9 @@ fn closest_point_is_the_nearest_of_the_triangle() {
                 best = best.min(q.distance(p));
             }
         }
-        assert!(d <= best + 1e-12 && d >= best - 1e-2, "{p}: {d} against {best}");
+        assert!(
+            d <= best + 1e-12 && d >= best - 1e-2,
+            "{p}: {d} against {best}"
+        );
     }
 }
-
