@@ -224,7 +224,9 @@ impl SeenVertices {
                 continue;
             };
             let ray = vertex_ray(incident, normal, v.face, optic);
-            let error = ray.angle_between(v.ray) / v.sigma + distance / v.footprint;
+            // atan2 rather than acos: exact for the small angles compared here.
+            let angle = ray.cross(v.ray).length().atan2(ray.dot(v.ray));
+            let error = angle / v.sigma + distance / v.footprint;
             worst = worst.max(if error.is_nan() { f64::INFINITY } else { error });
         }
         worst
