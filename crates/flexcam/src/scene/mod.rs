@@ -98,6 +98,11 @@ pub struct TrilinearReflector {
     /// The surface's refinement tolerance in main-image pixels, 0 for none (scene-file key
     /// `trilinear_refine_px`; used by the reflector compositing of [`crate::render::render`]).
     pub refine_px: f64,
+    /// The size of the reflector's camera mesh (scene-file key `camera_triangles`): a
+    /// simplification of its mesh to this many triangles, used as it is; `None` chooses
+    /// the size automatically and refines the result by [`Self::refine_px`]
+    /// (docs/camera-triangles.md).
+    pub camera_triangles: Option<usize>,
 }
 
 impl TrilinearReflector {
@@ -110,6 +115,7 @@ impl TrilinearReflector {
             id,
             screen_map: SurfaceScreenMap::default(),
             refine_px: Self::DEFAULT_REFINE_PX,
+            camera_triangles: None,
         }
     }
 }

@@ -453,6 +453,7 @@ pub struct RawObject {
     pub trilinear_reflector: Option<Spanned<bool>>,
     pub trilinear_screen_map: Option<Spanned<String>>,
     pub trilinear_refine_px: Option<Spanned<f64>>,
+    pub camera_triangles: Option<Spanned<u32>>,
     pub displacement: Option<Spanned<super::displacement::RawDisplacement>>,
 }
 

@@ -1390,6 +1390,57 @@ fn trilinear_screen_map_key() {
 }
 
 #[test]
+fn camera_triangles_key() {
+    let mirror = |extra: &str| {
+        format!(
+            "{CAMERA}[[object]]\nshape = \"sphere\"\ntessellation = 8\nmaterial = \"mirror\"\n{extra}\n"
+        )
+    };
+    let size = |extra: &str| {
+        scene(&mirror(&format!("trilinear_reflector = true\n{extra}"))).trilinear_reflectors[0]
+            .camera_triangles
+    };
+    assert_eq!(size(""), None);
+    assert_eq!(size("camera_triangles = 20"), Some(20));
+    let own = scene(&mirror("")).objects[0].mesh.triangles.len();
+    assert_eq!(size(&format!("camera_triangles = {own}")), Some(own));
+    let at = |extra: &str, message: &str| {
+        assert_error_at(
+            &mirror(&format!("trilinear_reflector = true\n{extra}")),
+            11,
+            20,
+            message,
+        )
+    };
+    at(
+        "camera_triangles = 0",
+        &format!("`camera_triangles` must be between 1 and the object's {own} triangles, not 0"),
+    );
+    at(
+        &format!("camera_triangles = {}", own + 1),
+        &format!(
+            "must be between 1 and the object's {own} triangles, not {}",
+            own + 1
+        ),
+    );
+    at("camera_triangles = -3", "invalid value");
+    at("camera_triangles = 2.5", "invalid type");
+    at("camera_triangles = \"auto\"", "invalid type");
+    assert_error_at(
+        &mirror("trilinear_reflector = true\ntrilinear_refine_px = 0.25\ncamera_triangles = 20"),
+        12,
+        20,
+        "leave out `trilinear_refine_px`",
+    );
+    assert_error_at(
+        &mirror("camera_triangles = 20"),
+        10,
+        20,
+        "`camera_triangles` needs `trilinear_reflector = true`",
+    );
+}
+
+#[test]
 fn trilinear_refine_px_key() {
     use crate::scene::TrilinearReflector;
     let mirror = |extra: &str| {
