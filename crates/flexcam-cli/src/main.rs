@@ -73,17 +73,14 @@ fn main() -> ExitCode {
         Command::Reproject(args) => commands::reproject::run(&args),
         Command::Fit(args) => commands::fit::run(&args),
         Command::Scenes => commands::scenes::run(),
-        Command::Compare(args) => commands::compare::run(&args),
+        Command::Compare(args) => return commands::compare::run(&args),
         Command::Simplify(args) => commands::simplify::run(&args),
         Command::ImportCameras(args) => commands::import_cameras::run(&args),
         Command::Bench(command) => commands::bench::run(&command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("flexcam: {e}");
-            ExitCode::FAILURE
-        }
+        Err(e) => commands::fail(&e),
     }
 }
 

@@ -49,9 +49,9 @@ pub struct RenderArgs {
     /// displaced, below D - 1 the BRDF is used; larger D favours the cheaper methods.
     #[arg(long, value_name = "D")]
     transition_d: Option<f64>,
-    /// Samples per pixel.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    spp: u32,
+    /// Samples per pixel (overrides the scene's `[image] spp`, whose default is 1).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    spp: Option<u32>,
     /// Write the depth along each pixel's ray (.exr or .pfm; +inf where nothing is hit).
     #[arg(long, value_name = "FILE")]
     depth: Option<PathBuf>,
@@ -82,6 +82,7 @@ enum PngBitsArg {
 /// Runs `flexcam render`. Outputs are written only once everything has succeeded, all
 /// together, and never over an input.
 pub fn run(args: &RenderArgs) -> Result<()> {
+    let start = Instant::now();
     let method: Method = args.method.parse()?;
     let mut outputs = OutputSet::new();
     if let Some(source) = &args.scene.scene {
@@ -144,10 +145,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             ))
         }
     };
+    let spp = args.spp.unwrap_or(loaded.scene.image.spp);
     let options = RenderOptions {
         method,
         shading,
-        spp: args.spp,
+        spp,
         subdivision: args.tuning.subdivision(method)?,
         curves: args.tuning.curves(method)?,
         camera_triangles: args.tuning.camera_triangles(method)?,
@@ -203,11 +205,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         shading: args.shading.name(),
         width: loaded.width,
         height: loaded.height,
-        spp: args.spp,
+        spp,
         triangles: loaded.scene.triangle_count(),
         load_ms: loaded.load_ms,
         render_ms,
         warnings: &[&loaded.build_report.warnings[..], &warnings].concat(),
+        wall_ms: start.elapsed().as_secs_f64() * 1e3,
+        outputs: stats_json::shown(&outputs),
     };
     let json = stats_json::to_json(&facts, &counters).to_string();
     super::commit_with_stats(outputs, stats, args.stats.as_ref(), &json)?;

@@ -35,6 +35,31 @@ pub struct SceneArgs {
     pub perspective_rect: Option<Vec<f64>>,
     #[command(flatten)]
     pub memory: MemoryArgs,
+    #[command(flatten)]
+    pub threads: ThreadsArg,
+}
+
+/// The number of threads a rendering command renders with.
+#[derive(Args, Debug)]
+pub struct ThreadsArg {
+    /// Render with N threads (a pool of N workers; the default is one per core). Images do
+    /// not depend on it.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub threads: Option<u16>,
+}
+
+impl ThreadsArg {
+    /// Makes the process's rayon pool N threads if `--threads` was given. Call it before
+    /// anything runs on the pool (it is built once).
+    pub fn apply(&self) -> Result<()> {
+        match self.threads {
+            Some(n) => rayon::ThreadPoolBuilder::new()
+                .num_threads(usize::from(n))
+                .build_global()
+                .map_err(|e| Error::new(format!("--threads {n}: {e}"))),
+            None => Ok(()),
+        }
+    }
 }
 
 /// The memory budget of a rendering command.
@@ -74,6 +99,7 @@ impl SceneArgs {
             None => None,
         };
         self.memory.apply();
+        self.threads.apply()?;
         let overrides = Overrides {
             width: self.width,
             height: self.height,

@@ -46,6 +46,8 @@ pub struct ImageSettings {
     pub height: u32,
     /// Linear RGB of pixels whose ray hits nothing (or that no projector covers).
     pub background: Vec3,
+    /// Samples per pixel a command renders with unless told otherwise (`--spp`).
+    pub spp: u32,
 }
 
 impl Default for ImageSettings {
@@ -54,6 +56,7 @@ impl Default for ImageSettings {
             width: 800,
             height: 600,
             background: Vec3::ZERO,
+            spp: 1,
         }
     }
 }

@@ -43,6 +43,9 @@ pub use self::fitted_grid::{fit_scene, FittedScene};
 /// that frame buffers (several values per pixel) fit in memory.
 pub const MAX_IMAGE_SIDE: u32 = 16384;
 
+/// The most samples per pixel a scene (`[image] spp`) or `--spp` may ask for.
+pub const MAX_SPP: u32 = 4096;
+
 /// Checks an image resolution: both sides in 1..=[`MAX_IMAGE_SIDE`]. The CLI reuses it for
 /// its `--width` / `--height` overrides.
 pub fn validate_resolution(width: u32, height: u32) -> Result<()> {
@@ -170,10 +173,21 @@ fn image_settings(src: &Source, table: Option<&Spanned<RawImage>>) -> Result<Ima
         .background
         .as_ref()
         .map_or(Ok(Vec3::ZERO), |b| src.color(b, "background"))?;
+    let spp = match &raw.spp {
+        Some(spp) if !(1..=MAX_SPP).contains(spp.get_ref()) => {
+            return Err(src.error(
+                &spp.span(),
+                format!("spp must be 1 to {MAX_SPP}, got {}", spp.get_ref()),
+            ))
+        }
+        Some(spp) => *spp.get_ref(),
+        None => defaults.spp,
+    };
     Ok(ImageSettings {
         width,
         height,
         background,
+        spp,
     })
 }
 
