@@ -6,7 +6,8 @@ use std::time::Instant;
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, ColorFormat, DepthFormat, OutputSet, PngBits};
 use flexcam::render::{
-    self, Counter, Method, Outputs, PreparedScene, RenderOptions, Shading, TransitionShading,
+    self, Counter, Method, Outputs, PixelWindow, PreparedScene, RenderOptions, Shading,
+    TransitionShading,
 };
 use flexcam::Result;
 
@@ -49,6 +50,11 @@ pub struct RenderArgs {
     /// displaced, below D - 1 the BRDF is used; larger D favours the cheaper methods.
     #[arg(long, value_name = "D")]
     transition_d: Option<f64>,
+    /// Render only the pixels of columns X0..X1 and rows Y0..Y1 (pixel (0, 0) the top-left;
+    /// X1 and Y1 excluded): every output is that rectangle of the whole frame, byte for byte,
+    /// so a large frame split into tiles on several machines can be stitched back exactly.
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_delimiter = ',', num_args = 1)]
+    crop: Option<Vec<u32>>,
     /// Samples per pixel (overrides the scene's `[image] spp`, whose default is 1).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     spp: Option<u32>,
@@ -68,6 +74,20 @@ pub struct RenderArgs {
     /// Write statistics as one JSON object to FILE, or to standard output with `-`.
     #[arg(long, value_name = "FILE|-")]
     stats: Option<OutputTarget>,
+}
+
+/// The window of `--crop X0,Y0,X1,Y1` in a `size` image; errors name the flag.
+fn crop_window(bounds: &[u32], size: (u32, u32)) -> Result<PixelWindow> {
+    let refuse = |why: String| flexcam::Error::new(format!("--crop: {why}"));
+    let &[x0, y0, x1, y1] = bounds else {
+        return Err(refuse(format!(
+            "needs 4 pixel bounds X0,Y0,X1,Y1, got {}",
+            bounds.len()
+        )));
+    };
+    let window = PixelWindow { x0, y0, x1, y1 };
+    window.check(size).map_err(|e| refuse(e.message))?;
+    Ok(window)
 }
 
 /// The values of `--png-bits`.
@@ -146,6 +166,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
     };
     let spp = args.spp.unwrap_or(loaded.scene.image.spp);
+    let crop = args
+        .crop
+        .as_deref()
+        .map(|bounds| crop_window(bounds, (loaded.width, loaded.height)))
+        .transpose()?;
     let options = RenderOptions {
         method,
         shading,
@@ -154,6 +179,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         curves: args.tuning.curves(method)?,
         camera_triangles: args.tuning.camera_triangles(method)?,
         progress: Some(&report),
+        crop,
         outputs: Outputs {
             depth: depth.is_some() || aovs.is_some(),
             ids: ids.is_some() || ids_preview.is_some() || aovs.is_some(),
