@@ -391,7 +391,11 @@ fn compare_reports_agreement_and_enforces_thresholds() {
             "x",
         ],
     );
-    assert!(e.contains("unknown method \"x\""), "{e}");
+    assert!(
+        e.contains("invalid value 'x' for '--reference <REFERENCE>'")
+            && e.contains("[possible values: raycast, raster, trilinear, camera-triangles]"),
+        "{e}"
+    );
 }
 
 /// `compare --spp 4` supersamples both renders with the same pattern: trilinear against the

@@ -433,3 +433,126 @@ fn exit_statuses_tell_the_kinds_of_failure_apart() {
         Some(1)
     );
 }
+
+/// `-D KEY=VALUE` renders what the edited file renders; by table name and index in arrays
+/// of tables, on built-in scenes too.
+#[test]
+fn definitions_render_as_the_edited_file() {
+    let dir = TempDir::new().unwrap();
+    let text = fs::read_to_string(scenes().join("cube-floor.toml")).unwrap();
+    let edited = text.replacen("fov = 50.0", "fov = 70.0", 1).replacen(
+        "color = [0.9, 0.9, 0.9]",
+        "color = [1.0, 0.0, 0.0]",
+        1,
+    );
+    assert_ne!(edited, text);
+    fs::write(dir.path().join("s.toml"), &text).unwrap();
+    fs::write(dir.path().join("edited.toml"), &edited).unwrap();
+    let small = ["--width", "40", "--height", "30"];
+    run_ok(
+        &dir,
+        &[&["render", "edited.toml", "-o", "edited.png"][..], &small].concat(),
+    );
+    for (name, floor) in [
+        ("by_name.png", "object.floor.color"),
+        ("by_index.png", "object.0.color"),
+    ] {
+        let floor = format!("{floor}=[1.0, 0.0, 0.0]");
+        let args = [
+            "render",
+            "s.toml",
+            "-o",
+            name,
+            "-D",
+            "projection.fov=70",
+            "-D",
+            &floor,
+        ];
+        run_ok(&dir, &[&args[..], &small].concat());
+        assert_eq!(
+            fs::read(dir.path().join(name)).unwrap(),
+            fs::read(dir.path().join("edited.png")).unwrap(),
+            "{name}"
+        );
+    }
+    let v = run_json(
+        &dir,
+        &[
+            "render",
+            "builtin:cube-floor",
+            "-D",
+            "image.width=24",
+            "-D",
+            "image.height=20",
+            "--stats",
+            "-",
+        ],
+    );
+    assert_eq!(
+        (v["width"].as_u64(), v["height"].as_u64()),
+        (Some(24), Some(20))
+    );
+}
+
+#[test]
+fn bad_definitions_name_the_argument() {
+    let dir = TempDir::new().unwrap();
+    fs::copy(scenes().join("cube-floor.toml"), dir.path().join("s.toml")).unwrap();
+    for (definition, status, message) in [
+        (
+            "projection.fov=wide",
+            1,
+            "flexcam: s.toml: -D projection.fov=wide: invalid type: string \"wide\", expected f64",
+        ),
+        (
+            "projection.fvo=90",
+            1,
+            "flexcam: s.toml: -D projection.fvo=90: unknown key `fvo`; did you mean `fov`?",
+        ),
+        (
+            "object.table.color=[1,0,0]",
+            1,
+            "flexcam: s.toml: -D object.table.color=[1,0,0]: object has no table table (give a 0-based index below 2 or a name)",
+        ),
+        (
+            "projection.fov.x=1",
+            1,
+            "flexcam: s.toml: -D projection.fov.x=1: projection.fov is not a table",
+        ),
+        (
+            "projection.fov",
+            2,
+            "flexcam: invalid value 'projection.fov' for '--define <KEY=VALUE>': -D projection.fov: needs KEY=VALUE, e.g. projection.fov=90",
+        ),
+    ] {
+        let out = run(&dir, &["render", "s.toml", "-D", definition, "--width", "8", "--height", "8"]);
+        assert_eq!(out.status.code(), Some(status), "{definition}");
+        assert_eq!(String::from_utf8_lossy(&out.stderr).trim(), message);
+        assert!(!dir.path().join("flexcam.png").exists());
+    }
+}
+
+/// `--width` or `--height` alone keeps the scene's aspect ratio (cube-floor is 800 x 800,
+/// the default scene 800 x 600 unless its file says otherwise).
+#[test]
+fn one_side_keeps_the_aspect_ratio() {
+    let dir = TempDir::new().unwrap();
+    let size = |args: &[&str]| {
+        let v = run_json(&dir, &[&["render", "--stats", "-"][..], args].concat());
+        (v["width"].as_u64().unwrap(), v["height"].as_u64().unwrap())
+    };
+    assert_eq!(size(&["builtin:cube-floor", "--width", "33"]), (33, 33));
+    let scene = scenes().join("cube-floor.toml");
+    let wide = fs::read_to_string(&scene)
+        .unwrap()
+        .replacen("height = 800", "height = 450", 1);
+    fs::write(dir.path().join("wide.toml"), wide).unwrap();
+    assert_eq!(size(&["wide.toml", "--width", "64"]), (64, 36));
+    assert_eq!(size(&["wide.toml", "--height", "45"]), (80, 45));
+    assert_eq!(size(&["wide.toml", "--width", "3"]), (3, 2));
+    assert_eq!(size(&["wide.toml", "--width", "1"]), (1, 1));
+    assert_eq!(
+        size(&["wide.toml", "--width", "50", "--height", "50"]),
+        (50, 50)
+    );
+}

@@ -15,7 +15,9 @@ use flexcam::scene;
 use flexcam::{Error, Result};
 
 use super::frame_list;
-use super::scene_args::{print_lines, warning_lines, MemoryArgs, ShadingArg, ThreadsArg};
+use super::scene_args::{
+    method_names, print_lines, warning_lines, DefineArgs, MemoryArgs, ShadingArg, ThreadsArg,
+};
 use crate::progress::RenderProgress;
 use crate::stats_json::{self, RunFacts};
 use crate::OutputTarget;
@@ -33,14 +35,17 @@ pub struct AnimateArgs {
     /// An animated GIF of all frames.
     #[arg(long, value_name = "FILE")]
     gif: Option<PathBuf>,
-    /// Image width in pixels (overrides the scene file).
+    /// Image width in pixels (overrides the scene file; alone, it keeps the scene's aspect
+    /// ratio).
     #[arg(long)]
     width: Option<u32>,
-    /// Image height in pixels (overrides the scene file).
+    /// Image height in pixels (overrides the scene file; alone, it keeps the scene's aspect
+    /// ratio).
     #[arg(long)]
     height: Option<u32>,
-    /// Rendering method: `raycast` (the reference, every projection).
-    #[arg(long, default_value = "raycast")]
+    /// Rendering method: `raycast` (the reference, every projection) or `raster`
+    /// (projections with an analytic inverse).
+    #[arg(long, default_value = "raycast", value_parser = method_names())]
     method: String,
     /// Shading: `flat` (base colours, exact) or `lit` (lights, shadows, reflections).
     #[arg(long, value_enum, default_value_t = ShadingArg::Lit)]
@@ -61,6 +66,8 @@ pub struct AnimateArgs {
     /// output with `-` (as `flexcam render --stats`; `frames`, `bvh_builds`).
     #[arg(long, value_name = "FILE|-")]
     stats: Option<OutputTarget>,
+    #[command(flatten)]
+    define: DefineArgs,
     #[command(flatten)]
     memory: MemoryArgs,
     #[command(flatten)]
@@ -156,7 +163,8 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     args.memory.apply();
     args.threads.apply()?;
     let load_start = Instant::now();
-    let (scene, animation) = scene::file::load_animated(&args.scene)?;
+    let (scene, animation) =
+        scene::file::load_animated_defined(&args.scene, &args.define.definitions)?;
     super::declare_scene_inputs(&mut outputs, &scene.inputs)?;
     let animation = animation.ok_or_else(|| {
         Error::in_file(&args.scene, "the scene has no [animation] table to animate")
@@ -193,8 +201,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         None => Vec::new(),
     };
     let rendered_frames = chosen.len() as u32;
-    let width = args.width.unwrap_or(scene.image.width);
-    let height = args.height.unwrap_or(scene.image.height);
+    let (width, height) = scene.image.size_with(args.width, args.height);
     scene::file::validate_resolution(width, height)?;
     let gif_bytes = match &args.gif {
         Some(_) => {

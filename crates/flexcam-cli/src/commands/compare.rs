@@ -14,7 +14,7 @@ use flexcam::{Error, Result};
 use glam::Vec3;
 use serde_json::json;
 
-use super::scene_args::{MethodTuning, SceneArgs, ShadingArg};
+use super::scene_args::{method_names, MethodTuning, SceneArgs, ShadingArg};
 
 /// Arguments of `flexcam compare`.
 #[derive(Args, Debug)]
@@ -22,10 +22,10 @@ pub struct CompareArgs {
     #[command(flatten)]
     scene: SceneArgs,
     /// The method under test.
-    #[arg(long)]
+    #[arg(long, value_parser = method_names())]
     method: String,
     /// The reference method.
-    #[arg(long, default_value = "raycast")]
+    #[arg(long, default_value = "raycast", value_parser = method_names())]
     reference: String,
     /// Tuning of the method under test (the reference runs with its defaults).
     #[command(flatten)]
