@@ -215,27 +215,15 @@ fn threads_change_no_pixel() {
         "--height",
         "32",
     ];
-    let one = run_json(
-        &dir,
-        &[
-            &small[..],
-            &["--threads", "1", "-o", "one.png", "--stats", "-"],
-        ]
-        .concat(),
-    );
-    assert_eq!(one["threads"], 1);
-    let three = run_json(
-        &dir,
-        &[
-            &small[..],
-            &["--threads", "3", "-o", "three.png", "--stats", "-"],
-        ]
-        .concat(),
-    );
-    assert_eq!(three["threads"], 3);
+    for threads in ["1", "3"] {
+        let out = format!("{threads}.png");
+        let args = ["--threads", threads, "-o", &out, "--stats", "-"];
+        let v = run_json(&dir, &[&small[..], &args].concat());
+        assert_eq!(v["threads"].to_string(), threads);
+    }
     assert_eq!(
-        fs::read(dir.path().join("one.png")).unwrap(),
-        fs::read(dir.path().join("three.png")).unwrap()
+        fs::read(dir.path().join("1.png")).unwrap(),
+        fs::read(dir.path().join("3.png")).unwrap()
     );
 }
 
