@@ -420,6 +420,11 @@ fn exit_statuses_tell_the_kinds_of_failure_apart() {
         code(&[&compare[..], &["--min-id-agreement", "nan"]].concat()),
         Some(1)
     );
+    let help = String::from_utf8(run(&dir, &["--help"]).stdout).unwrap();
+    assert!(
+        help.contains("Exit status: 0 done; 1 a render or input error"),
+        "{help}"
+    );
 }
 
 /// `-D KEY=VALUE` renders what the edited file renders; by table name and index in arrays
