@@ -56,6 +56,7 @@ pub struct RawImage {
     pub height: Option<Spanned<u32>>,
     #[serde(default, deserialize_with = "strict")]
     pub background: Option<Vec3Value>,
+    pub spp: Option<Spanned<u32>>,
 }
 
 /// `[projection]`: the union of every projection type's parameters.

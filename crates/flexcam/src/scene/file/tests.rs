@@ -98,18 +98,23 @@ fn unknown_keys_are_errors_everywhere() {
         &format!("{CAMERA}[camera]\n"),
         6,
         2,
-        "unknown field `camera`",
+        "unknown key `camera`; did you mean `image`?",
     );
-    assert_error_at("[image]\nwidht = 3\n", 2, 1, "unknown field `widht`");
+    assert_error_at(
+        "[image]\nwidht = 3\n",
+        2,
+        1,
+        "unknown key `widht`; did you mean `width`?",
+    );
     assert_error_at(
         &object("shape = \"sphere\"\nradius = 2\n"),
         8,
         1,
-        "unknown field `radius`",
+        "unknown key `radius`; did you mean",
     );
     assert_error(
         &object("shape = \"plane\"\nchecker = { colour = [0, 0, 0] }\n"),
-        "unknown field `colour`",
+        "unknown key `colour`; did you mean `color`?",
     );
     assert_error(
         &format!("{CAMERA}[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\npower = 2\n"),
@@ -119,7 +124,7 @@ fn unknown_keys_are_errors_everywhere() {
         &format!("{CAMERA}lookat = [0, 0, 0]\n"),
         6,
         1,
-        "unknown field `lookat`",
+        "unknown key `lookat`; did you mean `look_at`?",
     );
 }
 
