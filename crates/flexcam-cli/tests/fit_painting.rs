@@ -1,0 +1,257 @@
+//! The painting workflow judged by the image: correspondences clicked on a pinhole camera's
+//! view of a checker floor, a cube and a ball (each picked with `flexcam pick` at a random
+//! pixel, the pixel then moved by 1 to 2 px of noise), fitted on a 5 x 5 grid from a guessed
+//! perspective prior with each `starts` model, and the fitted scene's object ids compared
+//! with the camera's own, pixel by pixel, away from object edges (docs/fitting.md,
+//! "Accuracy"). `fits_of_noisy_pinhole_clicks` (ignored: a few minutes) prints the table of
+//! seeds x models; run it with
+//! `cargo test --release -p flexcam-cli --test fit_painting -- --ignored --nocapture`
+//! (`FIT_PAINTING_SEEDS=1..20` picks the seeds, `FIT_PAINTING_MODELS=kept,eye,free,pinhole,auto`
+//! the columns).
+
+mod common;
+
+use common::{run, run_ok};
+use tempfile::TempDir;
+
+/// The image of every case, in pixels.
+const SIZE: [u32; 2] = [320, 240];
+
+/// The scene's objects and lights: a checker floor, a cube and a ball.
+const OBJECTS: &str = r#"
+[[object]]
+name = "floor"
+shape = "plane"
+size = [10.0, 10.0]
+tessellation = 21
+color = [0.9, 0.9, 0.9]
+checker = { color = [0.1, 0.1, 0.1], size = 1.0 }
+
+[[object]]
+name = "cube"
+shape = "box"
+size = [2.0, 2.0, 2.0]
+tessellation = 3
+color = [0.8, 0.3, 0.2]
+translate = [-1.3, 1.0, 0.0]
+rotate = [0.0, 30.0, 0.0]
+
+[[object]]
+name = "ball"
+shape = "sphere"
+size = 1.0
+tessellation = 32
+color = [0.2, 0.4, 0.9]
+translate = [1.6, 1.0, 1.0]
+
+[[light]]
+type = "directional"
+direction = [-0.3, -1.0, -0.5]
+intensity = 1.0
+"#;
+
+/// Deterministic uniform numbers in [0, 1) from `seed` (SplitMix64).
+fn uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed.wrapping_mul(0x2545_F491_4F6C_DD1D);
+    move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        (z ^ (z >> 31)) as f64 / u64::MAX as f64
+    }
+}
+
+/// The `[image]` table of every case.
+fn image_table() -> String {
+    format!(
+        "[image]\nwidth = {}\nheight = {}\nbackground = [0.05, 0.05, 0.08]\n",
+        SIZE[0], SIZE[1]
+    )
+}
+
+/// One seed's case: the true camera, the clicked correspondences and the noise.
+struct Case {
+    /// The true camera's `[projection]` table.
+    truth: String,
+    /// The correspondences as `fit` entries, in pixel coordinates.
+    fit: String,
+    count: usize,
+    noise: f64,
+}
+
+/// Seed `seed`'s true camera (eye 7 to 10 from the scene's centre, 3 to 7 up, within 50
+/// degrees of +z, a field of view of 45 to 70 degrees) and 15 to 60 of its clicks, each at a
+/// random pixel where the camera sees an object, the pixel then moved by normal noise of 1
+/// to 2 px (one standard deviation per seed) and kept in the image.
+fn case(dir: &TempDir, seed: u64) -> Case {
+    let mut next = uniform(seed);
+    let azimuth = (100.0 * next() - 50.0_f64).to_radians();
+    let (distance, height) = (7.0 + 3.0 * next(), 3.0 + 4.0 * next());
+    let look_at = [next() - 0.5, 0.3 + 0.5 * next(), next() - 0.5];
+    let fov = 45.0 + 25.0 * next();
+    let count = 15 + (next() * 46.0) as usize;
+    let noise = 1.0 + next();
+    let truth = format!(
+        "[projection]\ntype = \"perspective\"\nposition = [{}, {height}, {}]\nlook_at = [{}, \
+         {}, {}]\nfov = {fov}\n",
+        distance * azimuth.sin(),
+        distance * azimuth.cos(),
+        look_at[0],
+        look_at[1],
+        look_at[2],
+    );
+    std::fs::write(
+        dir.path().join("truth.toml"),
+        format!("{}{truth}{OBJECTS}", image_table()),
+    )
+    .unwrap();
+    let pixels: Vec<String> = (0..6 * count)
+        .map(|_| {
+            format!(
+                "{},{}",
+                f64::from(SIZE[0]) * next(),
+                f64::from(SIZE[1]) * next()
+            )
+        })
+        .collect();
+    let mut args = vec!["pick", "truth.toml", "--json"];
+    args.extend(pixels.iter().map(String::as_str));
+    let out = run_ok(dir, &args);
+    let mut gauss = {
+        let mut jitter = uniform(seed + 1000);
+        move || {
+            let (a, b) = (jitter().max(1e-300), jitter());
+            (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+        }
+    };
+    let mut fit = String::from("fit = [\n");
+    let picked = String::from_utf8(out.stdout).unwrap();
+    let hits = picked
+        .lines()
+        .map(|line| serde_json::from_str::<serde_json::Value>(line).unwrap())
+        .filter(|hit| !hit["object"].is_null())
+        .take(count);
+    for hit in hits {
+        let at = |v: &serde_json::Value, i: usize| v[i].as_f64().unwrap();
+        let (pixel, point) = (&hit["pixel"], &hit["point"]);
+        let moved = |x: f64, size: u32, z: f64| (x + noise * z).clamp(0.0, f64::from(size));
+        let (x, y) = (
+            moved(at(pixel, 0), SIZE[0], gauss()),
+            moved(at(pixel, 1), SIZE[1], gauss()),
+        );
+        // The grid's (u, v): u right, v up, over the whole image.
+        let (u, v) = (x / f64::from(SIZE[0]), 1.0 - y / f64::from(SIZE[1]));
+        fit += &format!(
+            "    {{ uv = [{u}, {v}], point = [{}, {}, {}] }},\n",
+            at(point, 0),
+            at(point, 1),
+            at(point, 2)
+        );
+    }
+    Case {
+        truth,
+        fit: fit + "]\n",
+        count,
+        noise,
+    }
+}
+
+/// The fitting scene of `case` with the starts model `starts` (`None`: the key left out):
+/// the guessed prior, a 60-degree perspective camera over the scene, on a 5 x 5 grid.
+fn fitting_scene(case: &Case, starts: Option<&str>) -> String {
+    let starts = starts.map_or_else(String::new, |s| format!("starts = \"{s}\"\n"));
+    format!(
+        "{}[projection]\ntype = \"flexible\"\npreset = \"perspective\"\nposition = [0.0, 5.5, \
+         7.0]\nlook_at = [0.0, 0.4, 0.0]\nfov = 60.0\nclip = [0.5, 40.0]\n\n\
+         [projection.projectors]\nsize = [5, 5]\ninterpolation = \"bilinear\"\n{starts}{}\n\
+         {OBJECTS}",
+        image_table(),
+        case.fit
+    )
+}
+
+/// The percentage of pixels away from object edges (no other id within 2 px in the truth's
+/// id image) where `fitted` and `truth` show the same object.
+fn agreement_away_from_edges(truth: &image::ImageBuffer<image::Luma<u16>, Vec<u16>>, fitted: &image::ImageBuffer<image::Luma<u16>, Vec<u16>>) -> f64 {
+    let (w, h) = truth.dimensions();
+    let (mut same, mut counted) = (0usize, 0usize);
+    for y in 0..h {
+        for x in 0..w {
+            let id = truth.get_pixel(x, y);
+            let near_edge = (y.saturating_sub(2)..(y + 3).min(h)).any(|yy| {
+                (x.saturating_sub(2)..(x + 3).min(w)).any(|xx| truth.get_pixel(xx, yy) != id)
+            });
+            if !near_edge {
+                counted += 1;
+                same += usize::from(fitted.get_pixel(x, y) == id);
+            }
+        }
+    }
+    100.0 * same as f64 / counted as f64
+}
+
+/// What fitting `case` with `starts` gave: the agreement in percent and the model chosen (K
+/// kept, E eye, F free, P pinhole), or the error line.
+fn fitted(dir: &TempDir, case: &Case, starts: Option<&str>) -> Result<(f64, String), String> {
+    std::fs::write(dir.path().join("fitting.toml"), fitting_scene(case, starts)).unwrap();
+    let fit = run(dir, &["fit", "fitting.toml", "-o", "fitted.toml"]);
+    if !fit.status.success() {
+        return Err(String::from_utf8_lossy(&fit.stderr).trim().to_string());
+    }
+    let stdout = String::from_utf8_lossy(&fit.stdout);
+    let model = [
+        ("pinhole", "P"),
+        ("fitted eye", "E"),
+        ("fitted per node", "F"),
+        ("starts kept", "K"),
+    ]
+    .iter()
+    .find(|(needle, _)| stdout.contains(needle))
+    .map_or("?", |(_, code)| code);
+    for (scene, ids) in [
+        ("fitted.toml", "fitted-ids.png"),
+        ("truth.toml", "truth-ids.png"),
+    ] {
+        run_ok(dir, &["render", scene, "-o", "out.png", "--ids", ids]);
+    }
+    let load = |name: &str| image::open(dir.path().join(name)).unwrap().to_luma16();
+    Ok((
+        agreement_away_from_edges(&load("truth-ids.png"), &load("fitted-ids.png")),
+        model.to_string(),
+    ))
+}
+
+#[test]
+#[ignore = "a few minutes: prints the table of seeds x models (docs/fitting.md, \"Accuracy\")"]
+fn fits_of_noisy_pinhole_clicks() {
+    let seeds = std::env::var("FIT_PAINTING_SEEDS").unwrap_or_else(|_| "1..20".into());
+    let (first, last) = seeds.split_once("..").unwrap();
+    let models = std::env::var("FIT_PAINTING_MODELS")
+        .unwrap_or_else(|_| "kept,eye,free,pinhole,auto".into());
+    let models: Vec<&str> = models.split(',').collect();
+    println!("| seed | points | noise px | {} |", models.join(" | "));
+    println!("| --- | --- | --- |{}", " --- |".repeat(models.len()));
+    let dir = TempDir::new().unwrap();
+    let mut worst = vec![f64::INFINITY; models.len()];
+    for seed in first.parse::<u64>().unwrap()..=last.parse().unwrap() {
+        let case = case(&dir, seed);
+        let mut row = format!("| {seed} | {} | {:.2} |", case.count, case.noise);
+        for (i, model) in models.iter().enumerate() {
+            match fitted(&dir, &case, Some(model)) {
+                Ok((percent, chosen)) => {
+                    worst[i] = worst[i].min(percent);
+                    row += &format!(" {percent:.2} {chosen} |");
+                }
+                Err(e) => {
+                    worst[i] = f64::NAN;
+                    row += &format!(" error: {e} |");
+                }
+            }
+        }
+        println!("{row}");
+        let _ = &case.truth;
+    }
+    let worst: Vec<String> = worst.iter().map(|w| format!("{w:.2}")).collect();
+    println!("| worst | | | {} |", worst.join(" | "));
+}
