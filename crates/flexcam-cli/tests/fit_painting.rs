@@ -78,6 +78,7 @@ struct Case {
     fit: String,
     count: usize,
     noise: f64,
+    seed: u64,
 }
 
 /// Seed `seed`'s true camera (eye 7 to 10 from the scene's centre, 3 to 7 up, within 50
@@ -154,6 +155,7 @@ fn case(dir: &TempDir, seed: u64) -> Case {
         fit: fit + "]\n",
         count,
         noise,
+        seed,
     }
 }
 
@@ -173,7 +175,10 @@ fn fitting_scene(case: &Case, starts: Option<&str>) -> String {
 
 /// The percentage of pixels away from object edges (no other id within 2 px in the truth's
 /// id image) where `fitted` and `truth` show the same object.
-fn agreement_away_from_edges(truth: &image::ImageBuffer<image::Luma<u16>, Vec<u16>>, fitted: &image::ImageBuffer<image::Luma<u16>, Vec<u16>>) -> f64 {
+fn agreement_away_from_edges(
+    truth: &image::ImageBuffer<image::Luma<u16>, Vec<u16>>,
+    fitted: &image::ImageBuffer<image::Luma<u16>, Vec<u16>>,
+) -> f64 {
     let (w, h) = truth.dimensions();
     let (mut same, mut counted) = (0usize, 0usize);
     for y in 0..h {
@@ -191,11 +196,33 @@ fn agreement_away_from_edges(truth: &image::ImageBuffer<image::Luma<u16>, Vec<u1
     100.0 * same as f64 / counted as f64
 }
 
+/// Runs `ARGS` in `dir` with the binary that fits and renders: `FIT_PAINTING_BIN` where set
+/// (another build's, for a before and after table; the clicks are always picked by this
+/// build's `flexcam pick`), else this build's.
+fn fitting_binary(dir: &TempDir, args: &[&str]) -> std::process::Output {
+    match std::env::var("FIT_PAINTING_BIN") {
+        Ok(binary) => std::process::Command::new(binary)
+            .current_dir(dir.path())
+            .args(args)
+            .output()
+            .unwrap(),
+        Err(_) => run(dir, args),
+    }
+}
+
 /// What fitting `case` with `starts` gave: the agreement in percent and the model chosen (K
 /// kept, E eye, F free, P pinhole), or the error line.
 fn fitted(dir: &TempDir, case: &Case, starts: Option<&str>) -> Result<(f64, String), String> {
     std::fs::write(dir.path().join("fitting.toml"), fitting_scene(case, starts)).unwrap();
-    let fit = run(dir, &["fit", "fitting.toml", "-o", "fitted.toml"]);
+    if let Ok(keep) = std::env::var("FIT_PAINTING_KEEP") {
+        let name = format!("s{}-{}.toml", case.seed, starts.unwrap_or("default"));
+        std::fs::copy(
+            dir.path().join("fitting.toml"),
+            std::path::Path::new(&keep).join(name),
+        )
+        .unwrap();
+    }
+    let fit = fitting_binary(dir, &["fit", "fitting.toml", "-o", "fitted.toml"]);
     if !fit.status.success() {
         return Err(String::from_utf8_lossy(&fit.stderr).trim().to_string());
     }
@@ -213,7 +240,12 @@ fn fitted(dir: &TempDir, case: &Case, starts: Option<&str>) -> Result<(f64, Stri
         ("fitted.toml", "fitted-ids.png"),
         ("truth.toml", "truth-ids.png"),
     ] {
-        run_ok(dir, &["render", scene, "-o", "out.png", "--ids", ids]);
+        let out = fitting_binary(dir, &["render", scene, "-o", "out.png", "--ids", ids]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
     let load = |name: &str| image::open(dir.path().join(name)).unwrap().to_luma16();
     Ok((
