@@ -60,25 +60,36 @@ pub(super) fn clearly_better(
     simpler_ss > ss * (1.0 + 4.0 * extra as f64 / (freedom - unknowns) as f64)
 }
 
-/// `Starts::Auto`: [`nested_fit`]'s choice where it is exact or the grid is curved (exact
-/// data keep their model, bit for bit). Inexact data: the four models (kept starts, one
+/// `Starts::Auto`: [`nested_fit`]'s choice where the grid is curved, or where it is exact
+/// and the data determine it or no pinhole fits them (too few points, all on one plane):
+/// exact data keep their model, bit for bit. Inexact data: the four models (kept starts, one
 /// eye, free starts, one pinhole camera) are judged by their held-out misses
 /// ([`held_out_misses`]: each fitted without a fifth of the points, measured at that fifth),
 /// which the extra unknowns of a model that only fits the noise raise instead of lowering;
-/// a grid that folds ([`folded`]) is taken only where every model's does. The least
+/// a grid that folds ([`folded`]) is taken only where every model's does, and one that
+/// leaves nodes undetermined only where every unfolded one does. Among the rest the least
 /// held-out misses win; a model within `TIE` of a simpler one's loses to it.
 pub(super) fn auto_fit(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport)> {
     let nested = nested_fit(prior, correspondences);
-    if prior.is_curved() || nested.as_ref().is_ok_and(|(_, r)| exact(r)) {
+    // An exact fit that leaves nodes undetermined meets any data (fewer equations than
+    // unknowns), so it is evidence only where no pinhole can be fitted instead.
+    let open = |(grid, report): &(ProjectorGrid, FitReport)| match report.starts {
+        FittedStarts::Kept => straight_undetermined(grid, correspondences).map_or(true, |n| n > 0),
+        _ => report.sparse_nodes > 0,
+    };
+    let stands = |fitted: &(ProjectorGrid, FitReport)| {
+        exact(&fitted.1) && (!open(fitted) || pinhole_fit(prior, correspondences).is_err())
+    };
+    if prior.is_curved() || nested.as_ref().is_ok_and(stands) {
         return nested;
     }
     // Simplest first: the pinhole's 11 unknowns, the eye's, the kept starts', the free ones'.
     let models: [fn(&ProjectorGrid, &[Correspondence]) -> Fitted; 4] =
         [pinhole_fit, central_fit, fit, free_fit];
-    let mut best: Option<(f64, bool, (ProjectorGrid, FitReport))> = None;
+    let mut best: Option<(f64, (bool, bool), (ProjectorGrid, FitReport))> = None;
     for model in models {
         let Ok(fitted) = model(prior, correspondences) else {
             continue;
@@ -86,17 +97,16 @@ pub(super) fn auto_fit(
         let Some(misses) = held_out_misses(prior, correspondences, model) else {
             continue;
         };
-        let folds = folded(&fitted.0, correspondences);
+        // Flaws, worst first: a folded grid, nodes the data leave undetermined.
+        let flaws = (folded(&fitted.0, correspondences), open(&fitted));
         let better = match &best {
             None => true,
-            Some((least, best_folds, _)) => match (folds, *best_folds) {
-                (false, true) => true,
-                (true, false) => false,
-                _ => misses < least * (1.0 - TIE),
-            },
+            Some((least, best_flaws, _)) => {
+                flaws < *best_flaws || (flaws == *best_flaws && misses < least * (1.0 - TIE))
+            }
         };
         if better {
-            best = Some((misses, folds, fitted));
+            best = Some((misses, flaws, fitted));
         }
     }
     match best {
