@@ -246,7 +246,7 @@ fn fitted(dir: &TempDir, case: &Case, starts: Option<&str>) -> Result<(f64, Stri
 }
 
 #[test]
-#[ignore = "a few minutes: prints the table of seeds x models (docs/fitting.md, \"Accuracy\")"]
+#[ignore = "a few minutes: prints the table of seeds x models (docs/fitting.md, \"Choosing the model on clicked data\")"]
 fn fits_of_noisy_pinhole_clicks() {
     let seeds = std::env::var("FIT_PAINTING_SEEDS").unwrap_or_else(|_| "1..20".into());
     let (first, last) = seeds.split_once("..").unwrap();
