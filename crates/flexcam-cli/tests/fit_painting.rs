@@ -3,8 +3,8 @@
 //! pixel, the pixel then moved by 1 to 2 px of noise), fitted on a 5 x 5 grid from a guessed
 //! perspective prior with each `starts` model, and the fitted scene's object ids compared
 //! with the camera's own, pixel by pixel, away from object edges (docs/fitting.md, "Choosing
-//! the model on clicked data"). `fits_of_noisy_pinhole_clicks` (ignored: a few minutes) prints the table of
-//! seeds x models; run it with
+//! the model on clicked data"). `fits_of_noisy_pinhole_clicks` (ignored: a few minutes)
+//! prints the table of seeds x models; run it with
 //! `cargo test --release -p flexcam-cli --test fit_painting -- --ignored --nocapture`
 //! (`FIT_PAINTING_SEEDS=1..20` picks the seeds, `FIT_PAINTING_MODELS=kept,eye,free,pinhole,auto`
 //! the columns).
