@@ -45,6 +45,9 @@ enum Command {
     /// fitted node projectors explicit.
     #[command(after_help = OUTPUTS_HELP)]
     Fit(commands::fit::FitArgs),
+    /// Print the object and world point the ray caster sees at image positions of a scene
+    /// (for collecting a fit's correspondences from a render).
+    Pick(commands::pick::PickArgs),
     /// List the built-in scenes: name, then a description.
     Scenes,
     /// Render a scene with a method and with the reference ray caster, and report how closely
@@ -77,6 +80,7 @@ fn main() -> ExitCode {
         Command::Animate(args) => commands::animate::run(&args),
         Command::Reproject(args) => commands::reproject::run(&args),
         Command::Fit(args) => commands::fit::run(&args),
+        Command::Pick(args) => commands::pick::run(&args),
         Command::Scenes => commands::scenes::run(),
         Command::Compare(args) => return commands::compare::run(&args),
         Command::Simplify(args) => commands::simplify::run(&args),

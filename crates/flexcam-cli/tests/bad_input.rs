@@ -208,7 +208,8 @@ fn unbounded_counts_and_memory_are_refused_before_allocating() {
         ],
         1,
         "flexcam: bezier.toml: method raster needs a projection with an analytic inverse; \
-         flexible has none (use --method raycast)",
+         flexible has none: its projectors are Bezier curves, with no closed-form inverse (use \
+         --method raycast)",
     );
 
     // A 20-byte GLB whose header claims 4 GiB.

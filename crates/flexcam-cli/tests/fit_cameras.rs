@@ -10,7 +10,7 @@ mod common;
 
 use std::path::Path;
 
-use common::{run, run_json, run_ok};
+use common::{run, run_json, run_ok, uniform};
 use tempfile::TempDir;
 
 type V3 = [f64; 3];
@@ -232,18 +232,6 @@ fn bilinear(n: usize, values: &[V3], u: f64, v: f64) -> V3 {
 
 fn array(v: V3) -> String {
     format!("[{}, {}, {}]", v[0], v[1], v[2])
-}
-
-/// Deterministic uniform numbers in [0, 1) from `seed` (SplitMix64).
-fn uniform(seed: u64) -> impl FnMut() -> f64 {
-    let mut state = seed;
-    move || {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        (z ^ (z >> 31)) as f64 / u64::MAX as f64
-    }
 }
 
 /// The example scene's image size in pixels (`[image]` of `flexible-projector-fit.toml`).

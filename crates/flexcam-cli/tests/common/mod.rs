@@ -36,3 +36,15 @@ pub fn run_ok(dir: &TempDir, args: &[&str]) -> Output {
 pub fn run_json(dir: &TempDir, args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&run_ok(dir, args).stdout).expect("stdout is one JSON object")
 }
+
+/// Deterministic uniform numbers in [0, 1) from `seed` (SplitMix64).
+pub fn uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        (z ^ (z >> 31)) as f64 / u64::MAX as f64
+    }
+}

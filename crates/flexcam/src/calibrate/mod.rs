@@ -78,15 +78,17 @@ fn build_report(fit: &FitReport) -> BuildReport {
         ("fit_wild_nodes", fit.wild_nodes as f64),
         ("fit_sparse_nodes", fit.sparse_nodes as f64),
     ];
-    // 1 when the starts lie on projectors through a fitted eye (given next), or were fitted
-    // per node.
+    // 1 when the starts lie on projectors through a fitted eye (given next), were fitted per
+    // node, or are those of one fitted pinhole camera (its eye given as well).
     let eye = match fit.starts {
-        FittedStarts::Eye(eye) => Some(eye),
+        FittedStarts::Eye(eye) | FittedStarts::Pinhole(eye) => Some(eye),
         FittedStarts::Kept | FittedStarts::Free => None,
     };
     counters.push(("fit_starts_eye", f64::from(u8::from(eye.is_some()))));
     let free = fit.starts == FittedStarts::Free;
     counters.push(("fit_starts_free", f64::from(u8::from(free))));
+    let pinhole = matches!(fit.starts, FittedStarts::Pinhole(_));
+    counters.push(("fit_starts_pinhole", f64::from(u8::from(pinhole))));
     if let Some(smoothness) = fit.smoothness {
         counters.push(("fit_smoothness", smoothness));
     }

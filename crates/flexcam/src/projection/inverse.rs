@@ -14,8 +14,8 @@ use super::{ImagePoint, InverseChart};
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct NoInverse {
     /// The reason, where the projection's kind may have an inverse but this one has not (a
-    /// panorama shape outside the lookup's class), for error messages; `None` where the
-    /// kind has none at all (a volume between curved control surfaces).
+    /// panorama shape outside the lookup's class, a flexible volume with curved projectors),
+    /// for error messages; `None` where the kind has none at all.
     pub reason: Option<String>,
 }
 

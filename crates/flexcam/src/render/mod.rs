@@ -293,6 +293,7 @@ pub use compare::{compare, Comparison};
 pub use method::Method;
 pub use prepared::{Hit, PreparedScene};
 pub use raster::Subdivision;
+pub use raycast::{pick, Picked};
 pub use reproject::{reproject, EquirectPhoto};
 pub use transitions::TransitionShading;
 pub use trilinear::{CurveMode, CurveOptions};

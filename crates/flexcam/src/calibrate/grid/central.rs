@@ -11,38 +11,40 @@
 //! through E, and a bilinear grid is any pinhole camera exactly (its direction field is
 //! affine in (u, v)).
 //!
-//! Two direction fields are fitted for a given E: the pinhole's affine field
-//! D(u, v) = A (u - 1/2) + B (v - 1/2) + C (8 unknowns; [`pinhole_grid`]), tried first and
-//! kept when it is exact or explains the data nearly as well as the free field
-//! ([`pinhole_suffices`]), and the free node directions (3 a node). Free directions meet
+//! Two direction fields are fitted: the pinhole's affine field
+//! D(u, v) = A (u - 1/2) + B (v - 1/2) + C, with its eye, from the 3 x 4 camera matrix of
+//! least reprojection error in the image (module `camera_matrix`), tried first and kept when
+//! it is exact or explains the data nearly as well as the free field ([`pinhole_suffices`]),
+//! and the free node directions (3 a node) at an eye found as below. Free directions meet
 //! sparse data exactly in many ways, most of them bent between the points, so six points
 //! determine the pinhole where the free field needs points enough for every node.
+//! `starts = "pinhole"` is the pinhole field alone ([`fit_pinhole`]).
 //!
-//! E is found by variable projection: for a given E the directions are the model's (the
-//! pinhole's least-squares field, or the linear fit's of module `grid`, starts at E, solved
-//! twice, the second centred on the first), and
-//! Levenberg-Marquardt moves E to minimise the chords 2 sin(angle / 2) between the blended
-//! directions and the points seen from E, with central-difference derivatives in E (three
-//! unknowns; each residual is two small linear solves). It starts from the point nearest to
-//! the prior's node projectors (the prior's own eye, for a perspective prior) and from the
-//! centre of the 3 x 4 camera matrix that the direct linear transform fits to the data
-//! (exact for pinhole data), and keeps the better. For the free field, the grid at the found
-//! eye is then fitted by `fit` with its starts at E. The starts are moved along their projectors to the
-//! prior's near distance s (the prior's mean start parameter seen from its own eye, 0 when
-//! the prior has none), less where a point lies nearer the eye than that.
+//! The free field's E is found by variable projection: for a given E the directions are the
+//! linear fit's of module `grid` (starts at E, solved twice, the second centred on the
+//! first), and Levenberg-Marquardt moves E to minimise the chords 2 sin(angle / 2) between
+//! the blended directions and the points seen from E, with central-difference derivatives
+//! in E (three unknowns; each residual is two small linear solves). It starts from the
+//! point nearest to the prior's node projectors (the prior's own eye, for a perspective
+//! prior) and from the pinhole's eye, and keeps the better. The grid at the found eye is
+//! then fitted by `fit` with its starts at E. The starts are moved along their projectors to
+//! the prior's near distance s (the prior's mean start parameter seen from its own eye, 0
+//! when the prior has none), less where a point lies nearer the eye than that.
 //!
 //! Degenerate cases (each an error naming the cause, which `starts = "auto"` answers by
 //! keeping the prior's starts): a prior with tangents (curved projectors have no common
 //! eye); fewer than `MIN_POINTS` correspondences; points that all coincide; an eye the data
-//! do not determine (the misses change by less than `FLAT` of the data's extent when E
-//! moves in some direction, for the pinhole and for the free directions alike: points all
-//! on one plane, or, for the free directions, so few that they absorb any move of E); image
-//! positions all on one line (points on one line through the eye among them); a descent
-//! that finds no eye at which either field solves.
+//! do not determine (for the pinhole, a second camera matrix meets the data: points all on
+//! one plane; for the free directions, the misses change by less than `FLAT` of the data's
+//! extent when E moves in some direction: so few points that they absorb any move of E);
+//! image positions all on one line (points on one line through the eye among them); no
+//! pinhole and no eye at which the free directions solve. Data that are merely
+//! inconsistent (two eyes' points mixed) get the pinhole's least-squares fit.
 
 use glam::{DMat3, DVec3};
-use nalgebra::{DMatrix, Matrix3, SymmetricEigen};
+use nalgebra::{Matrix3, SymmetricEigen};
 
+use super::camera_matrix::CameraMatrix;
 use super::{blended, prior_directions, targets, Correspondence, FitReport, System};
 use crate::error::{Error, Result};
 use crate::projection::flexible::projector_grid::ProjectorGrid;
@@ -68,54 +70,16 @@ pub(super) fn fit(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport, DVec3)> {
-    if prior.is_curved() {
-        return Err(Error::new(
-            "projector grid fit: `starts = \"eye\"` fits straight projectors through one eye; \
-             this grid has tangents",
-        ));
-    }
-    if correspondences.len() < MIN_POINTS {
-        return Err(Error::new(format!(
-            "projector grid fit: an eye needs at least {MIN_POINTS} correspondences, not {}",
-            correspondences.len()
-        )));
-    }
-    let extent = extent(correspondences);
-    if extent <= 0.0 || !extent.is_finite() {
-        return Err(Error::new(
-            "projector grid fit: the correspondences' points all coincide; they determine no eye",
-        ));
-    }
-    if on_one_image_line(correspondences) {
-        return Err(undetermined());
-    }
-    let problem = |model| Problem {
-        prior,
-        correspondences,
-        step: STEP * extent,
-        model,
-    };
-    let (pinhole, free) = (problem(Model::Pinhole), problem(Model::Free));
-    let starts = [prior_centre(prior), dlt_centre(correspondences)];
-    let best = |problem: &Problem| {
-        starts
-            .into_iter()
-            .flatten()
-            .filter_map(|start| problem.descend(start))
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(eye, _)| eye)
-    };
-    // The pinhole first (8 unknowns and the eye): six points in general position determine
-    // it, where the free directions need points enough for every node.
-    let pinhole_fit = best(&pinhole)
-        .filter(|&eye| pinhole.check_determined(eye, extent).is_ok())
-        .and_then(|eye| Some((pinhole_grid(&pinhole, eye)?, eye)));
+    let setup = Setup::new(prior, correspondences)?;
+    let pinhole_fit = setup.pinhole_fit();
     if let Some(((grid, report), eye)) = &pinhole_fit {
         if report.rms_angle_deg.to_radians() <= PINHOLE_EXACT {
             return finish(grid, correspondences, *eye, prior, true);
         }
     }
-    let free_fit = best(&free)
+    let (free, extent) = (setup.problem(), setup.extent);
+    let free_fit = setup
+        .best(&free)
         .ok_or_else(|| {
             Error::new(
                 "projector grid fit: no eye found at which the node directions can be fitted",
@@ -137,6 +101,109 @@ pub(super) fn fit(
         (None, Err(e)) => return Err(e),
     };
     finish(&fitted, correspondences, eye, prior, pinhole)
+}
+
+/// The pinhole model alone (`starts = "pinhole"`): the eye and the affine direction field
+/// of one pinhole camera that best meet `correspondences`, with its residual however large
+/// (module docs). Errors: those of [`fit`]'s degenerate cases, and no eye at which the field
+/// keeps every point in front.
+pub(super) fn fit_pinhole(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+) -> Result<(ProjectorGrid, FitReport, DVec3)> {
+    let ((grid, _), eye) = Setup::new(prior, correspondences)?
+        .pinhole_fit()
+        .ok_or_else(undetermined)?;
+    finish(&grid, correspondences, eye, prior, true)
+}
+
+/// What both direction fields of a central fit share: the checked data, their extent and
+/// the starting eyes of the descent.
+struct Setup<'a> {
+    prior: &'a ProjectorGrid,
+    correspondences: &'a [Correspondence],
+    extent: f64,
+    starts: [Option<DVec3>; 2],
+}
+
+impl<'a> Setup<'a> {
+    /// The setup of fitting `prior` to `correspondences` through one eye; errors for the
+    /// degenerate cases of the module docs that the data show before any fit.
+    fn new(prior: &'a ProjectorGrid, correspondences: &'a [Correspondence]) -> Result<Self> {
+        if prior.is_curved() {
+            return Err(Error::new(
+                "projector grid fit: `starts = \"eye\"` fits straight projectors through one \
+                 eye; this grid has tangents",
+            ));
+        }
+        if correspondences.len() < MIN_POINTS {
+            return Err(Error::new(format!(
+                "projector grid fit: an eye needs at least {MIN_POINTS} correspondences, not {}",
+                correspondences.len()
+            )));
+        }
+        let extent = extent(correspondences);
+        if extent <= 0.0 || !extent.is_finite() {
+            return Err(Error::new(
+                "projector grid fit: the correspondences' points all coincide; they determine \
+                 no eye",
+            ));
+        }
+        if on_one_image_line(correspondences) {
+            return Err(undetermined());
+        }
+        Ok(Setup {
+            prior,
+            correspondences,
+            extent,
+            starts: [
+                prior_centre(prior),
+                CameraMatrix::fit(correspondences).and_then(|c| c.eye()),
+            ],
+        })
+    }
+
+    /// The variable-projection problem of the free directions.
+    fn problem(&self) -> Problem<'a> {
+        Problem {
+            prior: self.prior,
+            correspondences: self.correspondences,
+            step: STEP * self.extent,
+        }
+    }
+
+    /// The eye of least cost descended to from either starting eye.
+    fn best(&self, problem: &Problem) -> Option<DVec3> {
+        self.starts
+            .into_iter()
+            .flatten()
+            .filter_map(|start| problem.descend(start))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(eye, _)| eye)
+    }
+
+    /// The pinhole's grid (module `camera_matrix`: 11 unknowns, which six points in general
+    /// position determine, where the free directions need points enough for every node),
+    /// lengthened into view, with its eye; `None` where the data determine no camera.
+    fn pinhole_fit(&self) -> Option<((ProjectorGrid, FitReport), DVec3)> {
+        let camera = CameraMatrix::fit(self.correspondences)?;
+        let eye = camera.eye()?;
+        let (cols, rows) = self.prior.size();
+        let mut dirs: Vec<DVec3> = (0..rows)
+            .flat_map(|row| (0..cols).map(move |col| (col, row)))
+            .map(|(col, row)| camera.direction(self.prior.node_uv(col, row)))
+            .collect();
+        let mean = |d: &[DVec3]| d.iter().map(|v| v.length()).sum::<f64>() / d.len() as f64;
+        let scale = mean(&prior_directions(self.prior)) / mean(&dirs);
+        if !(scale.is_finite() && scale > 0.0) {
+            return None;
+        }
+        dirs.iter_mut().for_each(|d| *d *= scale);
+        let at_eye = self.problem().grid_at(eye, &dirs).ok()?;
+        let targets = targets(&at_eye, self.correspondences).ok()?;
+        let fitted = super::in_view(&at_eye, self.correspondences, &targets, dirs).ok()?;
+        Some((fitted, eye))
+    }
 }
 
 /// `fitted` (every start at `eye`) with its starts moved to the prior's near distance, its
@@ -239,112 +306,8 @@ fn near_fraction(prior: &ProjectorGrid) -> f64 {
     (sum / n).max(0.0)
 }
 
-/// The centre of the 3 x 4 camera matrix that the direct linear transform fits to the
-/// correspondences (points centred and scaled first), or `None` where the fit is degenerate
-/// or the centre is at infinity (an affine camera).
-fn dlt_centre(correspondences: &[Correspondence]) -> Option<DVec3> {
-    let n = correspondences.len() as f64;
-    let centroid = correspondences.iter().map(|c| c.point).sum::<DVec3>() / n;
-    let scale = extent(correspondences);
-    let mut a = DMatrix::<f64>::zeros(2 * correspondences.len(), 12);
-    for (k, c) in correspondences.iter().enumerate() {
-        let x = (c.point - centroid) / scale;
-        let h = [x.x, x.y, x.z, 1.0];
-        let (u, v) = (c.uv.x - 0.5, c.uv.y - 0.5);
-        for i in 0..4 {
-            a[(2 * k, i)] = -h[i];
-            a[(2 * k, 8 + i)] = u * h[i];
-            a[(2 * k + 1, 4 + i)] = -h[i];
-            a[(2 * k + 1, 8 + i)] = v * h[i];
-        }
-    }
-    // The camera matrix: the eigenvector of A^T A with the least eigenvalue.
-    let eigen = SymmetricEigen::new(a.transpose() * &a);
-    let least = eigen.eigenvalues.imin();
-    let p = eigen.eigenvectors.column(least);
-    let m = |r: usize, c: usize| p[4 * r + c];
-    // The centre: the null vector of P, by cofactors.
-    let minor = |skip: usize| {
-        let cols: Vec<usize> = (0..4).filter(|c| *c != skip).collect();
-        Matrix3::from_fn(|r, c| m(r, cols[c])).determinant()
-    };
-    let w = -minor(3);
-    let centre = DVec3::new(minor(0), -minor(1), minor(2)) / w;
-    (w.abs() > 1e-12 && centre.is_finite()).then_some(centroid + scale * centre)
-}
-
 /// Rms miss (radians) at or below which the pinhole's direction field is taken as exact.
 const PINHOLE_EXACT: f64 = 1e-6;
-
-/// The grid at `eye` whose node directions sample the affine direction field
-/// D(u, v) = A (u - 1/2) + B (v - 1/2) + C that best meets the correspondences: the pinhole
-/// camera with its centre at `eye` (its 9 unknowns, 8 up to scale, against 3 a node for the
-/// free directions), by homogeneous least squares on P_k D(u_k, v_k) = 0, scaled to the
-/// prior's mean length and lengthened so that every point is in view. A bilinear or Bezier
-/// grid reproduces an affine field exactly (linear precision), so with pinhole data every
-/// projector between the correspondences is the camera's too, where the free directions
-/// fit the points and may bend between them (module docs). `None` where the field is
-/// degenerate or turns some point behind the eye.
-fn pinhole_grid(problem: &Problem, eye: DVec3) -> Option<(ProjectorGrid, FitReport)> {
-    let dirs = pinhole_directions(problem.prior, problem.correspondences, eye)?;
-    let at_eye = problem.grid_at(eye, &dirs).ok()?;
-    let targets = targets(&at_eye, problem.correspondences).ok()?;
-    super::in_view(&at_eye, problem.correspondences, &targets, dirs).ok()
-}
-
-/// The node directions of [`pinhole_grid`] before they are lengthened into view.
-fn pinhole_directions(
-    prior: &ProjectorGrid,
-    correspondences: &[Correspondence],
-    eye: DVec3,
-) -> Option<Vec<DVec3>> {
-    let mut normal = DMatrix::<f64>::zeros(9, 9);
-    for c in correspondences {
-        let a = (c.point - eye).try_normalize()?;
-        let off = DMat3::IDENTITY - DMat3::from_cols(a * a.x, a * a.y, a * a.z);
-        let (u, v) = (c.uv.x - 0.5, c.uv.y - 0.5);
-        // The 3 x 9 block P [u I, v I, I] of this correspondence.
-        let block = DMatrix::<f64>::from_fn(3, 9, |r, col| {
-            let factor = [u, v, 1.0][col / 3];
-            factor * off.col(col % 3)[r]
-        });
-        normal += block.transpose() * block;
-    }
-    let eigen = SymmetricEigen::new(normal);
-    let field = eigen
-        .eigenvectors
-        .column(eigen.eigenvalues.imin())
-        .into_owned();
-    let column = |i: usize| DVec3::new(field[3 * i], field[3 * i + 1], field[3 * i + 2]);
-    let (a, b, c) = (column(0), column(1), column(2));
-    let at = |uv: glam::DVec2| a * (uv.x - 0.5) + b * (uv.y - 0.5) + c;
-    let facing: Vec<f64> = correspondences
-        .iter()
-        .map(|k| at(k.uv).dot(k.point - eye))
-        .collect();
-    let sign = if facing.iter().sum::<f64>() < 0.0 {
-        -1.0
-    } else {
-        1.0
-    };
-    if facing.iter().any(|f| sign * f <= 0.0) {
-        return None;
-    }
-    let (cols, rows) = prior.size();
-    let mut dirs = Vec::with_capacity(cols * rows);
-    for row in 0..rows {
-        for col in 0..cols {
-            dirs.push(sign * at(prior.node_uv(col, row)));
-        }
-    }
-    let mean = |d: &[DVec3]| d.iter().map(|v| v.length()).sum::<f64>() / d.len() as f64;
-    let scale = mean(&prior_directions(prior)) / mean(&dirs);
-    if !(scale.is_finite() && scale > 0.0) {
-        return None;
-    }
-    dirs.iter_mut().for_each(|d| *d *= scale);
-    Some(dirs)
-}
 
 /// Whether the pinhole's direction field (8 unknowns) explains the data as well as the
 /// free directions of `nodes` nodes (3 a node less 1) do: its misses are at rounding level, or the
@@ -369,22 +332,12 @@ fn pinhole_suffices(pinhole: &FitReport, free: &FitReport, nodes: usize) -> bool
     sse(pinhole) - sse(free) <= 4.0 * extra * variance
 }
 
-/// The direction field fitted for a given eye.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Model {
-    /// Every node direction free (the linear fit of module `grid`).
-    Free,
-    /// The affine field of a pinhole camera at the eye ([`pinhole_directions`]).
-    Pinhole,
-}
-
 /// The variable-projection problem in the eye E.
 struct Problem<'a> {
     prior: &'a ProjectorGrid,
     correspondences: &'a [Correspondence],
     /// The central-difference step in E.
     step: f64,
-    model: Model,
 }
 
 impl Problem<'_> {
@@ -400,12 +353,6 @@ impl Problem<'_> {
     /// and the unit directions from `eye` to the points; `None` where that fit fails (a point
     /// at the eye, a zero-length node, a pinhole field turning a point behind).
     fn misses(&self, eye: DVec3) -> Option<Vec<f64>> {
-        if self.model == Model::Pinhole {
-            let dirs = pinhole_directions(self.prior, self.correspondences, eye)?;
-            let grid = self.grid_at(eye, &dirs).ok()?;
-            let targets = targets(&grid, self.correspondences).ok()?;
-            return self.chords(&grid, &targets, &dirs);
-        }
         let first = self.grid_at(eye, &prior_directions(self.prior)).ok()?;
         let targets = targets(&first, self.correspondences).ok()?;
         let dirs = System::new(&first, self.correspondences, &targets)

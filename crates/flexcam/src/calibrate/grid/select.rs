@@ -1,3 +1,4 @@
+use super::folds::folded;
 use super::{
     central, constrained_nodes, fit, free, miss_seen_from, straight_undetermined, Correspondence,
     FitReport, FittedStarts, EXACT_RMS_RAD,
@@ -15,6 +16,21 @@ pub(super) fn central_fit(
         grid,
         FitReport {
             starts: FittedStarts::Eye(eye),
+            ..report
+        },
+    ))
+}
+
+/// The pinhole fit (module `central`), its report saying which eye it found.
+pub(super) fn pinhole_fit(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+) -> Result<(ProjectorGrid, FitReport)> {
+    let (grid, report, eye) = central::fit_pinhole(prior, correspondences)?;
+    Ok((
+        grid,
+        FitReport {
+            starts: FittedStarts::Pinhole(eye),
             ..report
         },
     ))
@@ -44,7 +60,107 @@ pub(super) fn clearly_better(
     simpler_ss > ss * (1.0 + 4.0 * extra as f64 / (freedom - unknowns) as f64)
 }
 
-/// `Starts::Auto`: [`fit`]'s result, bit for bit, when that meets the data exactly with the
+/// `Starts::Auto`: [`nested_fit`]'s choice where the grid is curved, or where it is exact
+/// and the data determine it or no pinhole fits them (too few points, all on one plane):
+/// exact data keep their model, bit for bit. Inexact data: the four models (kept starts, one
+/// eye, free starts, one pinhole camera) are judged by their held-out misses
+/// ([`held_out_misses`]: each fitted without a fifth of the points, measured at that fifth),
+/// which the extra unknowns of a model that only fits the noise raise instead of lowering;
+/// a grid that folds ([`folded`]) is taken only where every model's does, and one that
+/// leaves nodes undetermined only where every unfolded one does. Among the rest the least
+/// held-out misses win; a model within `TIE` of a simpler one's loses to it.
+pub(super) fn auto_fit(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+) -> Result<(ProjectorGrid, FitReport)> {
+    let nested = nested_fit(prior, correspondences);
+    // An exact fit that leaves nodes undetermined meets any data (fewer equations than
+    // unknowns), so it is evidence only where no pinhole can be fitted instead.
+    let open = |(grid, report): &(ProjectorGrid, FitReport)| match report.starts {
+        FittedStarts::Kept => straight_undetermined(grid, correspondences).map_or(true, |n| n > 0),
+        _ => report.sparse_nodes > 0,
+    };
+    let stands = |fitted: &(ProjectorGrid, FitReport)| {
+        exact(&fitted.1) && (!open(fitted) || pinhole_fit(prior, correspondences).is_err())
+    };
+    if prior.is_curved() || nested.as_ref().is_ok_and(stands) {
+        return nested;
+    }
+    // Simplest first: the pinhole's 11 unknowns, the eye's, the kept starts', the free ones'.
+    let models: [fn(&ProjectorGrid, &[Correspondence]) -> Fitted; 4] =
+        [pinhole_fit, central_fit, fit, free_fit];
+    let mut best: Option<(f64, (bool, bool), (ProjectorGrid, FitReport))> = None;
+    for model in models {
+        let Ok(fitted) = model(prior, correspondences) else {
+            continue;
+        };
+        let Some(misses) = held_out_misses(prior, correspondences, model) else {
+            continue;
+        };
+        // Flaws, worst first: a folded grid, nodes the data leave undetermined.
+        let flaws = (folded(&fitted.0, correspondences), open(&fitted));
+        let better = match &best {
+            None => true,
+            Some((least, best_flaws, _)) => {
+                flaws < *best_flaws || (flaws == *best_flaws && misses < least * (1.0 - TIE))
+            }
+        };
+        if better {
+            best = Some((misses, flaws, fitted));
+        }
+    }
+    match best {
+        Some((_, _, fitted)) => Ok(fitted),
+        None => nested,
+    }
+}
+
+/// How much lower (as a fraction) a model's held-out misses must be to beat a simpler one's.
+const TIE: f64 = 0.02;
+
+/// Parts the correspondences are split into for [`held_out_misses`].
+const FOLDS: usize = 5;
+
+/// The free fit (module `free`) from the kept and eye fits' grids.
+pub(super) fn free_fit(prior: &ProjectorGrid, correspondences: &[Correspondence]) -> Fitted {
+    let (kept, central) = (
+        fit(prior, correspondences),
+        central_fit(prior, correspondences),
+    );
+    let guesses: Vec<_> = [&kept, &central]
+        .into_iter()
+        .filter_map(|r| r.as_ref().ok().map(|(g, _)| g))
+        .collect();
+    let (grid, report, _) = free::fit(prior, correspondences, &guesses)?;
+    Ok((grid, report))
+}
+
+/// The sum of squared misses ([`miss_seen_from`] the prior's starts) of every
+/// correspondence by `model` fitted without it: the correspondences are split into
+/// `FOLDS` parts (every `FOLDS`-th), and each part measured against the fit of the others.
+/// `None` where a part's fit fails (the model needs more points than the others give).
+fn held_out_misses(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+    model: fn(&ProjectorGrid, &[Correspondence]) -> Fitted,
+) -> Option<f64> {
+    let mut sum = 0.0;
+    for part in 0..FOLDS.min(correspondences.len()) {
+        let (held, kept): (Vec<_>, Vec<_>) = correspondences
+            .iter()
+            .enumerate()
+            .partition(|(k, _)| k % FOLDS == part);
+        let kept: Vec<Correspondence> = kept.into_iter().map(|(_, c)| *c).collect();
+        let (grid, _) = model(prior, &kept).ok()?;
+        sum += held
+            .iter()
+            .map(|(_, c)| miss_seen_from(prior, &grid, c).powi(2))
+            .sum::<f64>();
+    }
+    Some(sum)
+}
+
+/// The choice of the nested models, simplest first: [`fit`]'s result, bit for bit, when that meets the data exactly with the
 /// data determining the free directions (rms below `EXACT_RMS_RAD`), or when the grid is
 /// curved; else the central fit when it is exact, or when it beats the kept one
 /// ([`clearly_better`], its 3 eye coordinates extra), or when [`fit`] fails where it does
@@ -61,7 +177,7 @@ pub(super) fn clearly_better(
 /// each model's own residual. So pinhole data keep
 /// their eye, bit for bit, and bilinear non-central data from as few as 10 points may take
 /// the free starts.
-pub(super) fn auto_fit(
+pub(super) fn nested_fit(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport)> {

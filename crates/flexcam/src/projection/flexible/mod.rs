@@ -144,10 +144,7 @@ impl Flexible {
         let (volume, reparam) = build_volume(spec, aspect, fitter, report)?;
         let classified = match &volume {
             Volume::Linear(v) => Inverse::classify(&v.near, &v.far),
-            Volume::Piecewise(_)
-            | Volume::Bezier(_)
-            | Volume::Interpolated(_)
-            | Volume::Grid(_) => Ok(None),
+            _ => Ok(None),
         };
         let inverse = match classified {
             Ok(Some(solver)) => Ok(BoundInverse {
@@ -155,7 +152,9 @@ impl Flexible {
                 reparam,
                 resolution,
             }),
-            Ok(None) => Err(NoInverse { reason: None }),
+            Ok(None) => Err(NoInverse {
+                reason: Some(no_inverse_reason(&volume).to_string()),
+            }),
             Err(e) => Err(NoInverse {
                 reason: Some(e.message),
             }),
@@ -186,6 +185,31 @@ impl Flexible {
     /// Q(u, v, t) for a pixel: the point at depth t on its projector.
     pub fn point(&self, pixel: DVec2, t: f64) -> Option<DVec3> {
         self.uv(pixel).map(|uv| self.volume.point(uv, t))
+    }
+}
+
+/// Why `volume` has no analytic inverse when `Inverse::classify` finds none: the scanline
+/// class of Brosz 2011 (7.3) is two control surfaces of one type with a closed-form inverse
+/// whose depth follows from the point (parallel planes, nested spheres, coaxial cylinders),
+/// straight projectors between them.
+fn no_inverse_reason(volume: &Volume) -> &'static str {
+    match volume {
+        Volume::Linear(_) => {
+            "its near and far control surfaces are outside the scanline class (planes \
+             sharing a normal, nested spheres or coaxial cylinders, both of one type)"
+        }
+        Volume::Piecewise(_) => {
+            "its projectors are polylines through more than two control surfaces, with no \
+             closed-form inverse"
+        }
+        Volume::Bezier(_) => "its projectors are Bezier curves, with no closed-form inverse",
+        Volume::Interpolated(_) => {
+            "it interpolates two volumes of different structure, with no closed-form inverse"
+        }
+        Volume::Grid(_) => {
+            "its projectors are interpolated from a projector grid's nodes, with no \
+             closed-form inverse"
+        }
     }
 }
 

@@ -206,8 +206,9 @@ fn projections_without_a_chart_are_refused_in_one_line() {
     .unwrap();
     assert_eq!(
         e.message,
-        "method raster needs a projection with an analytic inverse; flexible has none \
-         (use --method raycast)"
+        "method raster needs a projection with an analytic inverse; flexible has none: its \
+         near and far control surfaces are outside the scanline class (planes sharing a \
+         normal, nested spheres or coaxial cylinders, both of one type) (use --method raycast)"
     );
 }
 

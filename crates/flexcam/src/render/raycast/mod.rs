@@ -5,6 +5,7 @@
 
 mod curve;
 mod hull_cull;
+mod pick;
 pub(in crate::render) mod pieces;
 pub(crate) mod sampling;
 mod shade;
@@ -15,6 +16,7 @@ pub mod workloads;
 
 use glam::DVec3;
 
+pub use self::pick::{pick, Picked};
 pub(crate) use self::sampling::SamplePattern;
 
 use self::pieces::polyline_segment;

@@ -135,6 +135,7 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
                     &PRESET_NAMES,
                 ));
             }
+            reparam_matches_preset(src, raw, name)?;
             // The axonometric preset's up is always +y; the magnifier's map is its lens.
             let common = |key: &str| {
                 PRESET_COMMON.contains(&key)
@@ -346,6 +347,45 @@ fn reject_keys(
         )),
         None => Ok(()),
     }
+}
+
+/// An error at the `reparam` key where its map assumes a (u, v) that preset `preset` does
+/// not have: the polar maps (`polar`, `lens`) read v as the angle off a fisheye's axis and u
+/// as its azimuth; the latitude maps (`mercator`, `equal_area`) read v as a latitude linear
+/// over the image's height. With another preset either gives an image of no projection. The
+/// angle maps (`equisolid`, `equiangular`) name their preset themselves
+/// (`preset_angle_map`); `linear` and the `magnifier` preset's own refusal stand apart.
+fn reparam_matches_preset(
+    src: &Source,
+    raw: &RawProjection,
+    preset: &Spanned<String>,
+) -> Result<()> {
+    let Some(map) = &raw.reparam else {
+        return Ok(());
+    };
+    let (owner, why) = match map.get_ref().as_str() {
+        "polar" | "lens" => (
+            "fisheye",
+            "it reads v as the angle off a fisheye's axis and u as the azimuth",
+        ),
+        "mercator" | "equal_area" => (
+            "equirectangular",
+            "it reads v as a latitude spread evenly over the image's height",
+        ),
+        _ => return Ok(()),
+    };
+    let preset = preset.get_ref();
+    if preset == owner || preset == "magnifier" {
+        return Ok(());
+    }
+    Err(src.error(
+        &map.span(),
+        format!(
+            "reparam \"{}\" does not go with preset \"{preset}\": {why}, which only the \
+             \"{owner}\" preset's volume has",
+            map.get_ref()
+        ),
+    ))
 }
 
 /// `reparam` (and `max_latitude`); `None` when absent.

@@ -384,6 +384,46 @@ fn equisolid_fisheye_takes_its_angle_from_the_preset() {
     );
 }
 
+/// A re-parameterisation whose (u, v) the preset's volume does not have is one error at the
+/// `reparam` key naming both; the matching pairs parse.
+#[test]
+fn meaningless_reparam_and_preset_pairs_are_refused() {
+    let head = "[projection]\ntype = \"flexible\"\nposition = [0, 1, 5]\nlook_at = [0, 1, 0]\n";
+    for (preset, map) in [
+        ("fisheye", "mercator"),
+        ("fisheye", "equal_area"),
+        ("perspective", "polar"),
+        ("perspective", "lens"),
+        ("equirectangular", "polar"),
+        ("cylindrical", "mercator"),
+        ("orthographic", "lens"),
+    ] {
+        assert_error_at(
+            &format!("{head}preset = \"{preset}\"\nfov = 60\nreparam = \"{map}\"\n"),
+            7,
+            11,
+            &format!("reparam \"{map}\" does not go with preset \"{preset}\""),
+        );
+    }
+    for (preset, map) in [
+        ("fisheye", "polar"),
+        ("fisheye", "lens"),
+        ("equirectangular", "mercator"),
+        ("equirectangular", "equal_area"),
+        ("perspective", "linear"),
+    ] {
+        let fov = if preset == "equirectangular" {
+            ""
+        } else {
+            "fov = 60\n"
+        };
+        let s = scene(&format!(
+            "{head}preset = \"{preset}\"\n{fov}reparam = \"{map}\"\n"
+        ));
+        assert_eq!(s.projection.kind(), "flexible", "{preset} {map}");
+    }
+}
+
 #[test]
 fn new_flexible_preset_errors_have_positions() {
     let head = "[projection]\ntype = \"flexible\"\nposition = [0, 1, 5]\nlook_at = [0, 1, 0]\n";

@@ -369,7 +369,10 @@ fn every_mcop_column_starts_at_its_path_point() {
     }
     // Not in the analytic class: method raster refuses it with the one-line message.
     let e = supported_chart(&f).unwrap_err();
-    assert!(e.message.contains("has none (use --method raycast)"), "{e}");
+    assert!(
+        e.message.contains("has none: its ") && e.message.ends_with("(use --method raycast)"),
+        "{e}"
+    );
 }
 
 fn magnifier(m: f64) -> Preset {
@@ -455,6 +458,9 @@ fn curved_presets_are_refused_by_method_raster() {
     for preset in curved {
         let f = flexible(preset, [1.0, 20.0], 16, 12);
         let e = supported_chart(&f).unwrap_err();
-        assert!(e.message.contains("has none (use --method raycast)"), "{e}");
+        assert!(
+            e.message.contains("has none: its ") && e.message.ends_with("(use --method raycast)"),
+            "{e}"
+        );
     }
 }
