@@ -10,6 +10,7 @@ pub mod reproject;
 pub mod scene_args;
 pub mod scenes;
 pub mod simplify;
+pub mod view;
 
 /// Declares the scene file a command was given (a path; nothing for `builtin:NAME`) as an
 /// input of `outputs`, so that an output aimed at it is refused before the scene is read.

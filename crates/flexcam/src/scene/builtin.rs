@@ -73,8 +73,9 @@ pub fn list() -> &'static [(&'static str, &'static str)] {
     &LIST
 }
 
-/// Loads the built-in scene `name`. An unknown name is an error listing the valid ones.
-pub fn load(name: &str) -> Result<Scene> {
+/// The scene-file text of the built-in scene `name`. An unknown name is an error listing
+/// the valid ones.
+pub fn text(name: &str) -> Result<&'static str> {
     let builtin = BUILTINS.iter().find(|b| b.name == name).ok_or_else(|| {
         let names: Vec<&str> = BUILTINS.iter().map(|b| b.name).collect();
         Error::new(format!(
@@ -82,7 +83,12 @@ pub fn load(name: &str) -> Result<Scene> {
             names.join(", ")
         ))
     })?;
-    let mut scene = file::parse(builtin.text, Path::new(&format!("builtin:{name}")))?;
+    Ok(builtin.text)
+}
+
+/// Loads the built-in scene `name`. An unknown name is an error listing the valid ones.
+pub fn load(name: &str) -> Result<Scene> {
+    let mut scene = file::parse(text(name)?, Path::new(&format!("builtin:{name}")))?;
     scene.base_dir = None;
     Ok(scene)
 }
