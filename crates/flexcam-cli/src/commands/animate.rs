@@ -8,9 +8,7 @@ use std::time::Instant;
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, ColorFormat, GifFrames, OutputSet, PngBits};
 use flexcam::projection::ProjectionSpec;
-use flexcam::render::{
-    self, Counter, Method, Outputs, PreparedScene, RenderOptions, Shading, Stats,
-};
+use flexcam::render::{self, Counter, Method, Outputs, PreparedScene, RenderOptions, Stats};
 use flexcam::scene;
 use flexcam::{Error, Result};
 
