@@ -51,8 +51,11 @@ fn frame_follows_method_and_shading() {
             "flat",
         ],
     );
-    let args = ["render", "s.toml", "-o", "r.png", "--method", "raster"];
-    run_ok(&dir, &[&args[..], &["--shading", "flat"]].concat());
+    let args = ["render", "s.toml", "--method", "raster"];
+    run_ok(
+        &dir,
+        &[&args[..], &["--shading", "flat", "-o", "r.png"]].concat(),
+    );
     assert_eq!(read(&dir, "f.png"), read(&dir, "r.png"));
     run_ok(
         &dir,
