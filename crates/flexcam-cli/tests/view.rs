@@ -12,6 +12,9 @@ use tempfile::TempDir;
 
 const CUBE_FLOOR: &str = include_str!("../../../scenes/cube-floor.toml");
 
+/// `flexcam view` on the scene and script of [`setup`].
+const VIEW: [&str; 4] = ["view", "scene.toml", "--script", "view.txt"];
+
 /// A folder holding `scene.toml` (cube-floor at a small size) and `view.txt` (`script`).
 fn setup(script: &str) -> TempDir {
     let dir = TempDir::new().unwrap();
@@ -29,7 +32,7 @@ fn read(dir: &TempDir, name: &str) -> Vec<u8> {
 #[test]
 fn frame_is_what_render_writes_for_the_saved_scene() {
     let dir = setup("set fov 70\norbit 20 10\nidle\nframe f.png\nsave s.toml\n");
-    run_ok(&dir, &["view", "scene.toml", "--script", "view.txt"]);
+    run_ok(&dir, &VIEW);
     run_ok(&dir, &["render", "s.toml", "-o", "r.png"]);
     assert_eq!(read(&dir, "f.png"), read(&dir, "r.png"));
     // The edit changed the image.
@@ -40,17 +43,7 @@ fn frame_is_what_render_writes_for_the_saved_scene() {
 #[test]
 fn frame_follows_method_and_shading() {
     let dir = setup("method raster\nset fov 65.5\nframe f.png\nsave s.toml\n");
-    run_ok(
-        &dir,
-        &[
-            "view",
-            "scene.toml",
-            "--script",
-            "view.txt",
-            "--shading",
-            "flat",
-        ],
-    );
+    run_ok(&dir, &[&VIEW[..], &["--shading", "flat"]].concat());
     let args = ["render", "s.toml", "--method", "raster"];
     run_ok(
         &dir,
@@ -67,7 +60,7 @@ fn frame_follows_method_and_shading() {
 #[test]
 fn save_keeps_comments_and_layout() {
     let dir = setup("set fov 42.25\nsave s.toml\n");
-    run_ok(&dir, &["view", "scene.toml", "--script", "view.txt"]);
+    run_ok(&dir, &VIEW);
     let original = String::from_utf8(read(&dir, "scene.toml")).unwrap();
     let saved = String::from_utf8(read(&dir, "s.toml")).unwrap();
     assert_eq!(saved, original.replace("fov = 50.0", "fov = 42.25"));
@@ -94,7 +87,7 @@ fn bad_lines_are_one_error_naming_script_line_and_column() {
     ];
     for (script, expected) in cases {
         let dir = setup(script);
-        let out = run(&dir, &["view", "scene.toml", "--script", "view.txt"]);
+        let out = run(&dir, &VIEW);
         let stderr = String::from_utf8(out.stderr).unwrap();
         assert!(!out.status.success(), "{script:?}");
         assert_eq!(stderr.lines().count(), 1, "{script:?}: {stderr}");
@@ -109,7 +102,7 @@ fn bad_lines_are_one_error_naming_script_line_and_column() {
 #[test]
 fn invalid_edit_keeps_the_last_valid_projection_message() {
     let dir = setup("set fov 500\n");
-    let out = run(&dir, &["view", "scene.toml", "--script", "view.txt"]);
+    let out = run(&dir, &VIEW);
     let stderr = String::from_utf8(out.stderr).unwrap();
     assert!(
         stderr.contains("perspective fov must be in (0, 180) degrees, got 500"),
@@ -123,16 +116,7 @@ fn invalid_edit_keeps_the_last_valid_projection_message() {
 fn window_screenshot_under_a_display() {
     let dir = setup("set fov 60\nidle\nwindow w.png\nframe f.png\n");
     let flexcam = assert_cmd::cargo::cargo_bin("flexcam");
-    let args = [
-        "view",
-        "scene.toml",
-        "--script",
-        "view.txt",
-        "--shading",
-        "flat",
-        "--refine-spp",
-        "1",
-    ];
+    let args = [&VIEW[..], &["--shading", "flat", "--refine-spp", "1"]].concat();
     let has_display = std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty());
     let mut command = if has_display {
         Process::new(&flexcam)

@@ -5,24 +5,28 @@
 //! view's right axis (pitch); the pitch stops [`MIN_POLE_ANGLE_DEG`] short of the up axis
 //! either way, where the frame would lose its right axis.
 
+use flexcam::projection::CameraFrame;
 use glam::DVec3;
 
 /// How close (degrees) an orbit may bring the view direction to the up axis.
 pub const MIN_POLE_ANGLE_DEG: f64 = 1.0;
 
-/// An eye position, the point it looks at and an up hint (as in a scene file).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct CameraFrame {
-    pub position: DVec3,
-    pub look_at: DVec3,
-    pub up: DVec3,
-}
-
-impl CameraFrame {
+/// Orbit, pan and dolly of a camera frame.
+pub trait Navigate: Sized {
     /// The frame with the eye turned `yaw_deg` degrees about the up axis through `look_at`
     /// (positive: the eye moves to its right, the view turns left) and `pitch_deg` degrees
     /// about the view's right axis (positive: the eye rises), at the same distance.
-    pub fn orbit(self, yaw_deg: f64, pitch_deg: f64) -> CameraFrame {
+    fn orbit(self, yaw_deg: f64, pitch_deg: f64) -> Self;
+    /// The frame moved sideways: `dx` along the view's right axis and `dy` along its true
+    /// up axis, both in units of the eye's distance to `look_at`.
+    fn pan(self, dx: f64, dy: f64) -> Self;
+    /// The frame with the eye's distance to `look_at` multiplied by `factor` (> 0; below 1
+    /// moves closer).
+    fn dolly(self, factor: f64) -> Self;
+}
+
+impl Navigate for CameraFrame {
+    fn orbit(self, yaw_deg: f64, pitch_deg: f64) -> CameraFrame {
         let up = self.up.normalize_or_zero();
         let offset = self.position - self.look_at;
         if up == DVec3::ZERO || offset.length_squared() == 0.0 {
@@ -45,9 +49,7 @@ impl CameraFrame {
         }
     }
 
-    /// The frame moved sideways: `dx` along the view's right axis and `dy` along its true
-    /// up axis, both in units of the eye's distance to `look_at`.
-    pub fn pan(self, dx: f64, dy: f64) -> CameraFrame {
+    fn pan(self, dx: f64, dy: f64) -> CameraFrame {
         let view = self.look_at - self.position;
         let distance = view.length();
         let right = view.cross(self.up).normalize_or_zero();
@@ -60,9 +62,7 @@ impl CameraFrame {
         }
     }
 
-    /// The frame with the eye's distance to `look_at` multiplied by `factor` (> 0; below 1
-    /// moves closer).
-    pub fn dolly(self, factor: f64) -> CameraFrame {
+    fn dolly(self, factor: f64) -> CameraFrame {
         if !(factor.is_finite() && factor > 0.0) {
             return self;
         }
@@ -85,8 +85,8 @@ mod tests {
 
     fn frame() -> CameraFrame {
         CameraFrame {
-            position: DVec3::new(0.0, 1.0, 5.0),
-            look_at: DVec3::new(0.0, 1.0, 0.0),
+            position: DVec3::new(1.0, 2.0, 6.0),
+            look_at: DVec3::new(1.0, 2.0, 1.0),
             up: DVec3::Y,
         }
     }
@@ -124,10 +124,10 @@ mod tests {
     #[test]
     fn pan_moves_both_points_and_dolly_scales_the_distance() {
         let f = frame().pan(0.1, -0.2);
-        assert!(close(f.position, DVec3::new(0.5, 0.0, 5.0)));
-        assert!(close(f.look_at, DVec3::new(0.5, 0.0, 0.0)));
+        assert!(close(f.position, DVec3::new(1.5, 1.0, 6.0)));
+        assert!(close(f.look_at, DVec3::new(1.5, 1.0, 1.0)));
         let f = frame().dolly(0.5);
-        assert!(close(f.position, DVec3::new(0.0, 1.0, 2.5)));
+        assert!(close(f.position, DVec3::new(1.0, 2.0, 3.5)));
         assert_eq!(frame().dolly(0.0), frame());
         assert_eq!(frame().dolly(f64::NAN), frame());
     }

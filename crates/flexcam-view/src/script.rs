@@ -12,6 +12,7 @@ use flexcam::render::Method;
 use flexcam::{Error, Result};
 use toml_edit::Value;
 
+use crate::camera::Navigate;
 use crate::viewer::Viewer;
 
 /// One command of a script.

@@ -26,7 +26,7 @@ use flexcam::{Error, Result};
 use glam::{DVec2, DVec3};
 use toml_edit::{DocumentMut, Value};
 
-use crate::camera::CameraFrame;
+use flexcam::projection::CameraFrame;
 
 /// A scene file open for viewing and editing its projection.
 pub struct Session {
@@ -185,7 +185,7 @@ impl Session {
         }
     }
 
-    /// Moves the camera frame by `change` (see [`CameraFrame`]); `up` is left as written.
+    /// Moves the camera frame by `change` (see [`crate::camera::Navigate`]); `up` is left as written.
     pub fn move_camera(&mut self, change: impl FnOnce(CameraFrame) -> CameraFrame) -> Result<()> {
         let moved = change(self.camera()?);
         self.set_all(&[

@@ -8,9 +8,9 @@ use flexcam::render::Method;
 use flexcam::Result;
 use toml_edit::Value;
 
-use crate::camera::CameraFrame;
 use crate::render_loop::{Job, RenderLoop, Settings};
 use crate::session::Session;
+use flexcam::projection::CameraFrame;
 
 /// A session, its render loop and the view's settings.
 pub struct Viewer {

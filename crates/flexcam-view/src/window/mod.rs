@@ -19,6 +19,7 @@ use flexcam::render::{Frame, Method, Shading};
 use flexcam::{Error, Result};
 use glam::{DVec2, Vec3};
 
+use crate::camera::Navigate;
 use crate::script::{self, Command, Script};
 use crate::viewer::Viewer;
 
