@@ -100,7 +100,7 @@ mod tests {
         let f = frame().orbit(90.0, 0.0);
         // The eye moves to its right (+x seen from +z looking at -z).
         assert!(
-            close(f.position, DVec3::new(5.0, 1.0, 0.0)),
+            close(f.position, DVec3::new(6.0, 2.0, 1.0)),
             "{:?}",
             f.position
         );
