@@ -62,6 +62,9 @@ enum Command {
     /// one per camera, as TOML.
     #[command(after_help = OUTPUTS_HELP)]
     ImportCameras(commands::import_cameras::ImportCamerasArgs),
+    /// Open the interactive viewer on a scene file: design its projection live, or run a
+    /// script of viewer commands.
+    View(commands::view::ViewArgs),
     /// Rerun a source document's timing table with flexcam's renderers.
     #[command(subcommand)]
     Bench(commands::bench::BenchCommand),
@@ -85,6 +88,7 @@ fn main() -> ExitCode {
         Command::Compare(args) => return commands::compare::run(&args),
         Command::Simplify(args) => commands::simplify::run(&args),
         Command::ImportCameras(args) => commands::import_cameras::run(&args),
+        Command::View(args) => commands::view::run(&args),
         Command::Bench(command) => commands::bench::run(&command),
     };
     match result {

@@ -8,9 +8,7 @@ use std::time::Instant;
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, ColorFormat, GifFrames, OutputSet, PngBits};
 use flexcam::projection::ProjectionSpec;
-use flexcam::render::{
-    self, Counter, Method, Outputs, PreparedScene, RenderOptions, Shading, Stats,
-};
+use flexcam::render::{self, Counter, Method, Outputs, PreparedScene, RenderOptions, Stats};
 use flexcam::scene;
 use flexcam::{Error, Result};
 
@@ -211,11 +209,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     };
     scene::check_budget(&scene, width, height, gif_bytes).map_err(|e| e.or_in_file(&args.scene))?;
 
-    let encoding = match args.shading.shading() {
-        Shading::Flat => ColorEncoding::Linear,
-        Shading::Transitions(t) if t.methods => ColorEncoding::Linear,
-        Shading::Lit | Shading::Transitions(_) => ColorEncoding::Srgb,
-    };
+    let encoding = ColorEncoding::of_shading(args.shading.shading());
     // The scene is static: one prepared scene (one BVH) for every frame.
     let prepared = PreparedScene::new(&scene);
     let load_ms = load_start.elapsed().as_secs_f64() * 1e3;

@@ -211,11 +211,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     counters.insert("bvh_builds", Counter::Count(prepared.bvh_builds()));
 
-    let encoding = match options.shading {
-        Shading::Flat => ColorEncoding::Linear,
-        Shading::Transitions(t) if t.methods => ColorEncoding::Linear,
-        Shading::Lit | Shading::Transitions(_) => ColorEncoding::Srgb,
-    };
+    let encoding = ColorEncoding::of_shading(options.shading);
     outputs.stage(color, |tmp| {
         image_io::write_color(&frame, tmp, color_format, encoding)
     })?;

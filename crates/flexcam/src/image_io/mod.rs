@@ -20,7 +20,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use crate::render::Frame;
+use crate::render::{Frame, Shading};
 
 pub use aovs::write_aovs_exr;
 pub use color::{encode_channel16, write_color, ColorFormat, PngBits};
@@ -38,6 +38,18 @@ pub enum ColorEncoding {
     Srgb,
     /// `round(255 * c)` with no transfer curve, so that flat colours round-trip exactly.
     Linear,
+}
+
+impl ColorEncoding {
+    /// How images rendered with `shading` are written: linear where colours are exact codes
+    /// (flat base colours, the transition methods' colours), sRGB for lit images.
+    pub fn of_shading(shading: Shading) -> ColorEncoding {
+        match shading {
+            Shading::Flat => ColorEncoding::Linear,
+            Shading::Transitions(t) if t.methods => ColorEncoding::Linear,
+            Shading::Lit | Shading::Transitions(_) => ColorEncoding::Srgb,
+        }
+    }
 }
 
 /// Lower-case extension of `path`, or "" when it has none.

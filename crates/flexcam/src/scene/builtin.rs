@@ -73,6 +73,19 @@ pub fn list() -> &'static [(&'static str, &'static str)] {
     &LIST
 }
 
+/// The scene-file text of the built-in scene `name`. An unknown name is an error listing
+/// the valid ones.
+pub fn text(name: &str) -> Result<&'static str> {
+    let builtin = BUILTINS.iter().find(|b| b.name == name).ok_or_else(|| {
+        let names: Vec<&str> = BUILTINS.iter().map(|b| b.name).collect();
+        Error::new(format!(
+            "unknown built-in scene \"{name}\"; expected one of: {}",
+            names.join(", ")
+        ))
+    })?;
+    Ok(builtin.text)
+}
+
 /// Loads the built-in scene `name`. An unknown name is an error listing the valid ones.
 pub fn load(name: &str) -> Result<Scene> {
     load_defined(name, &[])
@@ -81,15 +94,8 @@ pub fn load(name: &str) -> Result<Scene> {
 /// [`load`] with `definitions` (`-D KEY=VALUE`) written into the scene's text
 /// ([`file::parse_defined`]).
 pub fn load_defined(name: &str, definitions: &[file::Definition]) -> Result<Scene> {
-    let builtin = BUILTINS.iter().find(|b| b.name == name).ok_or_else(|| {
-        let names: Vec<&str> = BUILTINS.iter().map(|b| b.name).collect();
-        Error::new(format!(
-            "unknown built-in scene \"{name}\"; expected one of: {}",
-            names.join(", ")
-        ))
-    })?;
     let path = format!("builtin:{name}");
-    let (mut scene, _) = file::parse_defined(builtin.text, Path::new(&path), definitions)?;
+    let (mut scene, _) = file::parse_defined(text(name)?, Path::new(&path), definitions)?;
     scene.base_dir = None;
     Ok(scene)
 }

@@ -6,6 +6,7 @@ pub mod flexible;
 pub mod simplify;
 mod timing;
 pub mod trilinear;
+pub mod view;
 
 use clap::Subcommand;
 use flexcam::Result;
@@ -30,6 +31,10 @@ pub enum BenchCommand {
     /// tessellations, closed tori, the repository's OBJ models) with tau = 0.99 and 1 % of
     /// the edges searched per collapse.
     Simplify(simplify::SimplifyBenchArgs),
+    /// The viewer's frame rate at 1280 x 720 while a projection parameter changes every
+    /// frame: cube-floor through a perspective and a fisheye, and the 123,554-triangle
+    /// teapot-dense scene as an equirectangular panorama.
+    View(view::ViewBenchArgs),
 }
 
 /// Runs `flexcam bench`.
@@ -40,5 +45,6 @@ pub fn run(command: &BenchCommand) -> Result<()> {
         BenchCommand::Flexible(args) => flexible::run(args),
         BenchCommand::Trilinear(args) => trilinear::run(args),
         BenchCommand::Simplify(args) => simplify::run(args),
+        BenchCommand::View(args) => view::run(args),
     }
 }

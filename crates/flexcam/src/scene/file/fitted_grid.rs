@@ -13,7 +13,9 @@
 
 use std::path::Path;
 
-use toml_edit::{Array, DocumentMut, InlineTable, Item, TableLike, Value};
+use toml_edit::{Array, InlineTable, Item, TableLike, Value};
+
+use super::edit::{float_array, parse_document};
 
 use crate::calibrate::{self, FitReport};
 use crate::error::{Error, Result};
@@ -47,9 +49,7 @@ pub fn fit_scene(text: &str, path: &Path, output: &Path) -> Result<FittedScene> 
                  `projectors` table holding `fit` correspondences",
             )
         })?;
-    let mut document: DocumentMut = text
-        .parse()
-        .map_err(|e: toml_edit::TomlError| Error::in_file(path, e.message().to_string()))?;
+    let mut document = parse_document(text, path)?;
     let projectors = document
         .get_mut("projection")
         .and_then(|p| p.get_mut("projectors"))
@@ -115,10 +115,10 @@ fn replace_nodes(table: &mut dyn TableLike, grid: &ProjectorGrid) {
     for (j, ((start, end), tangent)) in nodes_of.enumerate() {
         let mut node = InlineTable::new();
         node.insert("node", pair([j % cols, j / cols]));
-        node.insert("start", point(start.to_array()));
-        node.insert("end", point(end.to_array()));
+        node.insert("start", float_array(&start.to_array()));
+        node.insert("end", float_array(&end.to_array()));
         if let Some(tangent) = tangent {
-            node.insert("tangent", point(tangent.to_array()));
+            node.insert("tangent", float_array(&tangent.to_array()));
         }
         let mut value = Value::InlineTable(node);
         value.decor_mut().set_prefix("\n    ");
@@ -132,10 +132,6 @@ fn replace_nodes(table: &mut dyn TableLike, grid: &ProjectorGrid) {
 fn pair(values: [usize; 2]) -> Value {
     // Node indices are below 10 (the grid's largest side is 9).
     Value::Array(values.iter().map(|&i| i as i64).collect())
-}
-
-fn point(values: [f64; 3]) -> Value {
-    Value::Array(values.iter().copied().collect())
 }
 
 /// Parses `written` as if it were at `output` and checks that it holds exactly `grid`.

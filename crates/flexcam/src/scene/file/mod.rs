@@ -9,6 +9,7 @@ mod calibrated_projection;
 mod control_surface;
 mod definitions;
 mod displacement;
+pub mod edit;
 mod fitted_grid;
 mod flexible;
 mod light;
@@ -31,12 +32,13 @@ use std::path::Path;
 use glam::Vec3;
 use toml::Spanned;
 
-use self::raw::{RawImage, RawScene};
+use self::raw::{RawImage, RawProjection, RawScene};
 use self::source::Source;
 use super::{ImageSettings, InputFile, Scene};
 use crate::error::{Error, Result};
 use crate::file_read::{read_regular_text, MAX_SCENE_FILE_BYTES};
 use crate::projection::flexible::Animation;
+use crate::projection::ProjectionSpec;
 
 pub use self::animation::DEFAULT_FPS;
 pub use self::definitions::Definition;
@@ -116,21 +118,9 @@ pub fn parse_defined(
 /// scene's [`Scene::inputs`] are the files its values name (and the files those name).
 pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animation>)> {
     let src = Source::new(text, path);
-    projection::reject_unsupported(&src)?;
-    let raw: RawScene = toml::from_str(text).map_err(|e| src.toml_error(&e))?;
+    let raw = read_raw(&src)?;
     let base_dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
-
-    let image = image_settings(&src, raw.image.as_ref())?;
-    let projection_table = raw
-        .projection
-        .as_ref()
-        .ok_or_else(|| src.file_error("missing [projection] table: a scene needs exactly one"))?;
-    let projection = projection::convert(
-        &src,
-        projection_table,
-        &base_dir,
-        [image.width, image.height],
-    )?;
+    let (image, projection_table, projection) = image_and_projection(&src, &raw, &base_dir)?;
     check_unique_names(&src, &raw.object)?;
     let mut objects = Vec::new();
     let mut trilinear_reflectors = Vec::new();
@@ -171,6 +161,43 @@ pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animatio
         inputs: src.into_inputs(),
     };
     Ok((scene, animation))
+}
+
+/// The image settings and the projection of scene-file text (read from `path`), checked and
+/// converted as [`parse`] does but neither built nor followed by the objects: what a program
+/// that edits the projection alone (the viewer) reads again after each edit, without
+/// loading the scene's models again. The projection is not built (see
+/// [`crate::calibrate::build`]), so a degenerate one is found only then.
+pub fn parse_projection(text: &str, path: &Path) -> Result<(ImageSettings, ProjectionSpec)> {
+    let src = Source::new(text, path);
+    let raw = read_raw(&src)?;
+    let base_dir = path.parent().unwrap_or(Path::new(""));
+    let (image, _, projection) = image_and_projection(&src, &raw, base_dir)?;
+    Ok((image, projection))
+}
+
+/// The raw tables of scene-file text, after refusing a projection type that is recognised
+/// but not supported.
+fn read_raw(src: &Source) -> Result<RawScene> {
+    projection::reject_unsupported(src)?;
+    toml::from_str(src.text).map_err(|e| src.toml_error(&e))
+}
+
+/// `[image]` and `[projection]` converted, with the projection's raw table (for the span
+/// of errors found when it is built).
+fn image_and_projection<'r>(
+    src: &Source,
+    raw: &'r RawScene,
+    base_dir: &Path,
+) -> Result<(ImageSettings, &'r Spanned<RawProjection>, ProjectionSpec)> {
+    let image = image_settings(src, raw.image.as_ref())?;
+    let projection_table = raw
+        .projection
+        .as_ref()
+        .ok_or_else(|| src.file_error("missing [projection] table: a scene needs exactly one"))?;
+    let projection =
+        projection::convert(src, projection_table, base_dir, [image.width, image.height])?;
+    Ok((image, projection_table, projection))
 }
 
 /// `[image]`, with [`ImageSettings::default`] for absent keys.

@@ -1,0 +1,157 @@
+//! `flexcam view --script`: frames byte for byte those of `flexcam render` of the saved
+//! scene, the scene saved with its comments and layout, bad lines and invalid edits as one
+//! error line naming the script, and a scripted window screenshot under a display.
+
+mod common;
+
+use std::path::Path;
+use std::process::Command as Process;
+
+use common::{run, run_ok};
+use tempfile::TempDir;
+
+const CUBE_FLOOR: &str = include_str!("../../../scenes/cube-floor.toml");
+
+/// `flexcam view` on the scene and script of [`setup`].
+const VIEW: [&str; 4] = ["view", "scene.toml", "--script", "view.txt"];
+
+/// A folder holding `scene.toml` (cube-floor at a small size) and `view.txt` (`script`).
+fn setup(script: &str) -> TempDir {
+    let dir = TempDir::new().unwrap();
+    let scene = CUBE_FLOOR.replace("width = 800\nheight = 800", "width = 96\nheight = 64");
+    assert_ne!(scene, CUBE_FLOOR);
+    std::fs::write(dir.path().join("scene.toml"), scene).unwrap();
+    std::fs::write(dir.path().join("view.txt"), script).unwrap();
+    dir
+}
+
+fn read(dir: &TempDir, name: &str) -> Vec<u8> {
+    std::fs::read(dir.path().join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+#[test]
+fn frame_is_what_render_writes_for_the_saved_scene() {
+    let dir = setup("set fov 70\norbit 20 10\nidle\nframe f.png\nsave s.toml\n");
+    run_ok(&dir, &VIEW);
+    run_ok(&dir, &["render", "s.toml", "-o", "r.png"]);
+    assert_eq!(read(&dir, "f.png"), read(&dir, "r.png"));
+    // The edit changed the image.
+    run_ok(&dir, &["render", "scene.toml", "-o", "original.png"]);
+    assert_ne!(read(&dir, "f.png"), read(&dir, "original.png"));
+}
+
+#[test]
+fn frame_follows_method_and_shading() {
+    let dir = setup("method raster\nset fov 65.5\nframe f.png\nsave s.toml\n");
+    run_ok(&dir, &[&VIEW[..], &["--shading", "flat"]].concat());
+    let args = ["render", "s.toml", "--method", "raster"];
+    run_ok(
+        &dir,
+        &[&args[..], &["--shading", "flat", "-o", "r.png"]].concat(),
+    );
+    assert_eq!(read(&dir, "f.png"), read(&dir, "r.png"));
+    run_ok(
+        &dir,
+        &[&args[..], &["--shading", "lit", "-o", "lit.png"]].concat(),
+    );
+    assert_ne!(read(&dir, "f.png"), read(&dir, "lit.png"));
+}
+
+#[test]
+fn save_keeps_comments_and_layout() {
+    let dir = setup("set fov 42.25\nsave s.toml\n");
+    run_ok(&dir, &VIEW);
+    let original = String::from_utf8(read(&dir, "scene.toml")).unwrap();
+    let saved = String::from_utf8(read(&dir, "s.toml")).unwrap();
+    assert_eq!(saved, original.replace("fov = 50.0", "fov = 42.25"));
+}
+
+#[test]
+fn bad_lines_are_one_error_naming_script_line_and_column() {
+    let cases = [
+        (
+            "idle\n  orbit 1 x\nframe f.png\n",
+            "view.txt:2:11: expected a number, got `x`",
+        ),
+        (
+            "frame f.png\nzoom 2\n",
+            "view.txt:2:1: unknown command `zoom`",
+        ),
+        (
+            "idle\nmethod warp\n",
+            "view.txt:2:8: unknown method \"warp\"",
+        ),
+        // Errors found when a line runs name it too; the lines before it have run.
+        ("set fov 500\nframe f.png\n", "view.txt:1:1: scene.toml:"),
+        ("drag p3 1 2\n", "view.txt:1:1: no handle `p3`"),
+    ];
+    for (script, expected) in cases {
+        let dir = setup(script);
+        let out = run(&dir, &VIEW);
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert!(!out.status.success(), "{script:?}");
+        assert_eq!(stderr.lines().count(), 1, "{script:?}: {stderr}");
+        assert!(
+            stderr.starts_with(&format!("flexcam: {expected}")),
+            "{script:?}: {stderr}"
+        );
+        assert!(!dir.path().join("f.png").exists(), "{script:?}");
+    }
+}
+
+#[test]
+fn invalid_edit_keeps_the_last_valid_projection_message() {
+    let dir = setup("set fov 500\n");
+    let out = run(&dir, &VIEW);
+    let stderr = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        stderr.contains("perspective fov must be in (0, 180) degrees, got 500"),
+        "{stderr}"
+    );
+}
+
+/// Runs a scripted window session: under the display of `DISPLAY`, or a virtual one from
+/// `xvfb-run` when there is none. Skipped, saying why, only when no display can be opened.
+#[test]
+fn window_screenshot_under_a_display() {
+    let dir = setup("set fov 60\nidle\nwindow w.png\nframe f.png\n");
+    let flexcam = assert_cmd::cargo::cargo_bin("flexcam");
+    let args = [&VIEW[..], &["--shading", "flat", "--refine-spp", "1"]].concat();
+    let has_display = std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty());
+    let mut command = if has_display {
+        Process::new(&flexcam)
+    } else if which("xvfb-run") {
+        let mut c = Process::new("xvfb-run");
+        c.args(["-a", "-s", "-screen 0 1280x1024x24"]).arg(&flexcam);
+        c
+    } else {
+        println!("skipped: no DISPLAY and no xvfb-run to open a virtual display");
+        return;
+    };
+    let out = command
+        .current_dir(dir.path())
+        .args(args)
+        .env("LIBGL_ALWAYS_SOFTWARE", "1")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() && stderr.contains("cannot open the viewer's window") {
+        println!("skipped: the display cannot be opened: {stderr}");
+        return;
+    }
+    assert!(out.status.success(), "{stderr}");
+    let shot = image::open(dir.path().join("w.png")).unwrap().to_rgb8();
+    let frame = image::open(dir.path().join("f.png")).unwrap().to_rgb8();
+    assert!(shot.width() > frame.width() && shot.height() > frame.height());
+    // The frame is shown in the window: its centre pixel's colour (a flat face) is on
+    // screen, within the texture filter's rounding.
+    let centre = frame.get_pixel(frame.width() / 2, frame.height() / 2);
+    let near = |p: &image::Rgb<u8>| p.0.iter().zip(centre.0).all(|(&a, b)| a.abs_diff(b) <= 2);
+    assert!(shot.pixels().any(near), "{centre:?}");
+}
+
+fn which(program: &str) -> bool {
+    std::env::var_os("PATH").is_some_and(|paths| {
+        std::env::split_paths(&paths).any(|dir| Path::new(&dir).join(program).is_file())
+    })
+}

@@ -1,0 +1,380 @@
+//! The window (eframe / egui on OpenGL): a thin layer over [`Viewer`] that shows its latest
+//! frame, turns mouse and keys into camera moves and parameter edits, and runs a script's
+//! lines one per displayed frame (`window OUT.png` takes a screenshot of the whole window).
+//!
+//! Controls (docs/viewer.md): drag with the left button to orbit, with the right or middle
+//! button to pan, scroll to dolly; arrow keys orbit by 5 degrees, with Shift they pan,
+//! `+` / `-` dolly; a click picks the object and world point under the pointer; Ctrl+S
+//! saves into the scene file.
+
+mod params;
+
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use eframe::egui;
+use flexcam::image_io;
+use flexcam::render::{Frame, Method, Shading};
+use flexcam::{Error, Result};
+use glam::{DVec2, Vec3};
+
+use crate::camera::Navigate;
+use crate::script::{self, Command, Script};
+use crate::viewer::Viewer;
+
+/// Degrees of orbit per pixel dragged, and per arrow-key press.
+const ORBIT_DEG_PER_PX: f64 = 0.3;
+const ORBIT_KEY_DEG: f64 = 5.0;
+/// How often the scene file's modification time is checked.
+const RELOAD_POLL: Duration = Duration::from_millis(500);
+
+/// Opens the window on `viewer` and runs until it is closed, or until `script` (if any) has
+/// run its last line. The error of a failing script line, or of a window that cannot open.
+pub fn run(viewer: Viewer, script: Option<Script>) -> Result<()> {
+    let (width, height) = viewer.session().size();
+    let title = format!("flexcam view {}", viewer.session().path().display());
+    let outcome: Arc<Mutex<Option<Error>>> = Arc::default();
+    let app = App {
+        viewer,
+        texture: None,
+        shown_count: 0,
+        status: String::new(),
+        message: None,
+        save_as: String::new(),
+        last_poll: Instant::now(),
+        script: script.map(|script| ScriptRun {
+            script,
+            next: 0,
+            screenshot: None,
+        }),
+        outcome: Arc::clone(&outcome),
+    };
+    let panel = 300.0;
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default().with_inner_size([
+            (width as f32).min(1280.0) + panel,
+            (height as f32).min(800.0) + 60.0,
+        ]),
+        ..eframe::NativeOptions::default()
+    };
+    eframe::run_native(&title, options, Box::new(|_| Ok(Box::new(app))))
+        .map_err(|e| Error::new(format!("cannot open the viewer's window: {e}")))?;
+    let error = outcome.lock().unwrap_or_else(|e| e.into_inner()).take();
+    error.map_or(Ok(()), Err)
+}
+
+/// A script being run by the window.
+struct ScriptRun {
+    script: Script,
+    next: usize,
+    /// The screenshot asked for by the current `window` line, once it has arrived.
+    screenshot: Option<Arc<Mutex<Option<Arc<egui::ColorImage>>>>>,
+}
+
+struct App {
+    viewer: Viewer,
+    texture: Option<egui::TextureHandle>,
+    shown_count: u64,
+    status: String,
+    /// The last error (an invalid edit, a failed reload or save) or pick, shown until the next.
+    message: Option<String>,
+    save_as: String,
+    last_poll: Instant,
+    script: Option<ScriptRun>,
+    outcome: Arc<Mutex<Option<Error>>>,
+}
+
+impl eframe::App for App {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        self.poll_reload();
+        self.upload_frame(&ctx);
+        self.step_script(&ctx);
+        egui::Panel::bottom("status").show(ui, |ui| {
+            ui.label(&self.status);
+            if let Some(message) = &self.message {
+                ui.colored_label(egui::Color32::LIGHT_RED, message);
+            }
+        });
+        egui::Panel::left("parameters")
+            .resizable(true)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui));
+            });
+        egui::CentralPanel::default().show(ui, |ui| self.image_panel(ui));
+        self.keys(&ctx);
+        if !self.viewer.render_loop().is_refined() || self.script.is_some() {
+            ctx.request_repaint_after(Duration::from_millis(15));
+        } else {
+            ctx.request_repaint_after(RELOAD_POLL);
+        }
+    }
+}
+
+impl App {
+    /// Shows `result`'s error in the window (the last valid state is kept).
+    fn report(&mut self, result: Result<()>) {
+        match result {
+            Ok(()) => self.message = None,
+            Err(e) => self.message = Some(e.to_string()),
+        }
+    }
+
+    fn poll_reload(&mut self) {
+        if self.last_poll.elapsed() < RELOAD_POLL {
+            return;
+        }
+        self.last_poll = Instant::now();
+        match self.viewer.reload_if_changed() {
+            Ok(true) => self.message = Some("reloaded the scene file".into()),
+            Ok(false) => {}
+            Err(e) => self.message = Some(format!("reload failed, kept the last scene: {e}")),
+        }
+    }
+
+    /// Uploads the render loop's latest frame as the image texture, if it changed.
+    fn upload_frame(&mut self, ctx: &egui::Context) {
+        let (count, shown) = self.viewer.render_loop().shown();
+        let Some(shown) = shown else { return };
+        let refined = if self.viewer.render_loop().is_refined() {
+            "refined"
+        } else {
+            "refining"
+        };
+        self.status = format!("{}: {:.1} ms, {refined}", shown.label, shown.ms);
+        if count == self.shown_count {
+            return;
+        }
+        self.shown_count = count;
+        let size = [shown.width as usize, shown.height as usize];
+        let image = egui::ColorImage::from_rgba_unmultiplied(size, &shown.rgba);
+        match &mut self.texture {
+            Some(texture) => texture.set(image, egui::TextureOptions::LINEAR),
+            None => {
+                self.texture = Some(ctx.load_texture("frame", image, egui::TextureOptions::LINEAR))
+            }
+        }
+    }
+
+    fn side_panel(&mut self, ui: &mut egui::Ui) {
+        ui.heading("Projection");
+        let kind = self.viewer.session().spec().kind();
+        let change = self
+            .viewer
+            .session()
+            .document()
+            .get("projection")
+            .and_then(|item| params::show(ui, kind, "", item));
+        if let Some((key, value)) = change {
+            let result = self.viewer.set(&key, value);
+            self.report(result);
+        }
+        ui.separator();
+        ui.heading("Rendering");
+        let mut settings = self.viewer.settings();
+        egui::ComboBox::from_label("method")
+            .selected_text(settings.method.name())
+            .show_ui(ui, |ui| {
+                for (name, method) in Method::ALL {
+                    ui.selectable_value(&mut settings.method, method, name);
+                }
+            });
+        egui::ComboBox::from_label("shading")
+            .selected_text(if settings.shading == Shading::Flat {
+                "flat"
+            } else {
+                "lit"
+            })
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut settings.shading, Shading::Lit, "lit");
+                ui.selectable_value(&mut settings.shading, Shading::Flat, "flat");
+            });
+        ui.horizontal(|ui| {
+            ui.label("refine spp");
+            ui.add(egui::DragValue::new(&mut settings.refine_spp).range(1..=64));
+        });
+        if settings != self.viewer.settings() {
+            self.viewer.set_settings(settings);
+        }
+        ui.separator();
+        if ui.button("Save into the scene file (Ctrl+S)").clicked() {
+            self.save(None);
+        }
+        ui.horizontal(|ui| {
+            ui.text_edit_singleline(&mut self.save_as);
+            if ui.button("Save as").clicked() && !self.save_as.is_empty() {
+                self.save(Some(PathBuf::from(&self.save_as)));
+            }
+        });
+    }
+
+    fn save(&mut self, to: Option<PathBuf>) {
+        let out = to.unwrap_or_else(|| self.viewer.session().path().to_path_buf());
+        let result = self.viewer.save(&out);
+        self.message = Some(match result {
+            Ok(()) => format!("saved {}", out.display()),
+            Err(e) => e.to_string(),
+        });
+    }
+
+    fn image_panel(&mut self, ui: &mut egui::Ui) {
+        let Some(texture) = &self.texture else {
+            ui.label("rendering...");
+            return;
+        };
+        let (width, height) = self.viewer.session().size();
+        let available = ui.available_size();
+        let scale = (available.x / width as f32)
+            .min(available.y / height as f32)
+            .min(1.0);
+        let size = egui::vec2(width as f32 * scale, height as f32 * scale);
+        let (rect, response) = ui.allocate_exact_size(size, egui::Sense::click_and_drag());
+        let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+        ui.painter()
+            .image(texture.id(), rect, uv, egui::Color32::WHITE);
+        let delta = response.drag_delta();
+        if response.dragged_by(egui::PointerButton::Primary) && delta != egui::Vec2::ZERO {
+            let (dx, dy) = (f64::from(delta.x), f64::from(delta.y));
+            let result = self
+                .viewer
+                .move_camera(|c| c.orbit(-dx * ORBIT_DEG_PER_PX, dy * ORBIT_DEG_PER_PX));
+            self.report(result);
+        } else if (response.dragged_by(egui::PointerButton::Secondary)
+            || response.dragged_by(egui::PointerButton::Middle))
+            && delta != egui::Vec2::ZERO
+        {
+            let (dx, dy) = (f64::from(delta.x / size.x), f64::from(delta.y / size.y));
+            let result = self.viewer.move_camera(|c| c.pan(-dx, dy));
+            self.report(result);
+        }
+        if response.hovered() {
+            let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+            if scroll != 0.0 {
+                let result = self
+                    .viewer
+                    .move_camera(|c| c.dolly((-f64::from(scroll) * 0.002).exp()));
+                self.report(result);
+            }
+        }
+        if response.clicked() {
+            if let Some(pos) = response.interact_pointer_pos() {
+                let pixel = (pos - rect.min) / scale;
+                self.pick(DVec2::new(f64::from(pixel.x), f64::from(pixel.y)));
+            }
+        }
+    }
+
+    fn pick(&mut self, pixel: DVec2) {
+        self.message = Some(match self.viewer.session().pick(pixel) {
+            Ok(Some(p)) => format!(
+                "pixel ({:.0}, {:.0}): object {} \"{}\" at ({:.4}, {:.4}, {:.4})",
+                pixel.x, pixel.y, p.id, p.name, p.point.x, p.point.y, p.point.z
+            ),
+            Ok(None) => format!("pixel ({:.0}, {:.0}): background", pixel.x, pixel.y),
+            Err(e) => e.to_string(),
+        });
+    }
+
+    fn keys(&mut self, ctx: &egui::Context) {
+        if ctx.egui_wants_keyboard_input() {
+            return;
+        }
+        let (shift, ctrl) = ctx.input(|i| (i.modifiers.shift, i.modifiers.command));
+        let pressed = |key| ctx.input(|i| i.key_pressed(key));
+        if ctrl && pressed(egui::Key::S) {
+            self.save(None);
+            return;
+        }
+        let arrows = [
+            (egui::Key::ArrowLeft, -1.0, 0.0),
+            (egui::Key::ArrowRight, 1.0, 0.0),
+            (egui::Key::ArrowUp, 0.0, 1.0),
+            (egui::Key::ArrowDown, 0.0, -1.0),
+        ];
+        for (key, x, y) in arrows {
+            if pressed(key) {
+                let result = if shift {
+                    self.viewer.move_camera(|c| c.pan(x * 0.05, y * 0.05))
+                } else {
+                    self.viewer
+                        .move_camera(|c| c.orbit(x * ORBIT_KEY_DEG, y * ORBIT_KEY_DEG))
+                };
+                self.report(result);
+            }
+        }
+        for (key, factor) in [(egui::Key::Plus, 0.9), (egui::Key::Minus, 1.0 / 0.9)] {
+            if pressed(key) {
+                let result = self.viewer.move_camera(|c| c.dolly(factor));
+                self.report(result);
+            }
+        }
+    }
+
+    /// Runs the script's next line (one per displayed frame, so that each `window` shows
+    /// the state the lines before it made), and closes the window after the last.
+    fn step_script(&mut self, ctx: &egui::Context) {
+        let Some(run) = &mut self.script else { return };
+        let Some(line) = run.script.lines.get(run.next).cloned() else {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            return;
+        };
+        let result = match &line.command {
+            Command::Window(out) => match &run.screenshot {
+                None => {
+                    // The refined frame must be on screen first.
+                    if let Err(e) = self.viewer.idle() {
+                        Err(e)
+                    } else if self.shown_count != self.viewer.render_loop().shown().0 {
+                        return;
+                    } else {
+                        let slot: Arc<Mutex<Option<Arc<egui::ColorImage>>>> = Arc::default();
+                        let filled = Arc::clone(&slot);
+                        let repaint = ctx.clone();
+                        ctx.request_screenshot(move |image| {
+                            *filled.lock().unwrap_or_else(|e| e.into_inner()) = Some(image);
+                            repaint.request_repaint();
+                        });
+                        run.screenshot = Some(slot);
+                        return;
+                    }
+                }
+                Some(slot) => {
+                    let Some(image) = slot.lock().unwrap_or_else(|e| e.into_inner()).take() else {
+                        return;
+                    };
+                    run.screenshot = None;
+                    write_screenshot(&image, out)
+                }
+            },
+            command => script::run_line(&mut self.viewer, command),
+        };
+        let Some(run) = &mut self.script else { return };
+        run.next += 1;
+        if let Err(e) = result {
+            *self.outcome.lock().unwrap_or_else(|e| e.into_inner()) =
+                Some(run.script.error_at(&line, &e));
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
+    }
+}
+
+/// Writes a screenshot as an 8-bit RGB PNG (alpha dropped): each byte goes through the
+/// linear encoding unchanged (round(255 * v / 255) = v).
+fn write_screenshot(image: &egui::ColorImage, out: &std::path::Path) -> Result<()> {
+    let [width, height] = image.size;
+    let mut frame = Frame::new(width as u32, height as u32, Vec3::ZERO);
+    for (pixel, color) in frame.color.iter_mut().zip(&image.pixels) {
+        *pixel = Vec3::new(
+            f32::from(color.r()),
+            f32::from(color.g()),
+            f32::from(color.b()),
+        ) / 255.0;
+    }
+    let mut outputs = image_io::OutputSet::new();
+    let id = outputs.output("the screenshot", out, &["png"])?;
+    outputs.stage(id, |tmp| {
+        image_io::write_color_png(&frame, tmp, image_io::ColorEncoding::Linear)
+    })?;
+    outputs.commit()
+}
