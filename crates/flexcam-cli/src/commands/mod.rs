@@ -5,6 +5,7 @@ pub mod bench;
 pub mod compare;
 pub mod fit;
 pub mod import_cameras;
+pub mod project;
 pub mod render;
 pub mod reproject;
 pub mod scene_args;

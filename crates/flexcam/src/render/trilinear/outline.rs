@@ -5,8 +5,8 @@
 use glam::DVec3;
 
 use super::central::CentralProjection;
-use super::ray_fan::RayFan;
 use super::edge_path::{refine_around, CrossingQuadratic, EdgePath, EdgeSurface, OutlinePoint};
+use super::ray_fan::RayFan;
 use super::screen_map::ScreenMap;
 use super::volume_bounds::VolumeBounds;
 use crate::geometry::Roots;

@@ -20,8 +20,7 @@ use super::scene_geometry::SceneGeometry;
 use super::screen_map::ScreenMap;
 use super::view_plane::clipping_base;
 use crate::projection::{
-    project_solved_triangle, ProjectionTriangleCache, Shape, Solutions, TriangleShapes,
-    Trilinear,
+    project_solved_triangle, ProjectionTriangleCache, Shape, Solutions, TriangleShapes, Trilinear,
 };
 use crate::render::scan::{PolygonBatch, Vertex};
 

@@ -330,13 +330,16 @@ fn degenerate_configurations_match_the_ray_caster() {
 }
 
 #[test]
-fn projection_triangles_folding_inside_the_scene_are_ray_cast() {
+fn projection_triangles_degenerating_inside_the_scene_are_ray_cast() {
     // One projection triangle above cube-floor's cube whose rays cross: its left vertices
-    // look right and its right vertex left, and the Jacobian, -12 - 0.2 t + 0.24 t^2 over
-    // the whole triangle, changes sign at t = 7.5, inside the cube. Followed through the
-    // fold, the projected shapes drew the cube's hidden faces over its top (relative RGB
-    // error 0.064 with adaptive curves, 0.062 with slicing). The same with the scene and
-    // the mesh scaled by 1e-3 and 1e3 and moved 1e4 away: the rule is relative.
+    // look right and its right vertex left. Base points and directions have one z each, so
+    // the parametric triangle stays horizontal, and its area, -12 - 0.2 t + 0.24 t^2 (the
+    // Jacobian over the whole triangle), passes zero at t = 7.5, inside the cube: there it
+    // degenerates to a segment. Followed across that depth, the projected shapes' outlines
+    // ran through infinity and drew the cube's hidden faces over its top (relative RGB
+    // error 0.064 with adaptive curves, 0.062 with slicing); the pairs reaching across it
+    // are unprojectable, and the triangle is ray cast. The same with the scene and the mesh
+    // scaled by 1e-3 and 1e3 and moved 1e4 away: the rule is relative.
     let v = DVec3::new;
     for (scale, shift) in [
         (1.0, DVec3::ZERO),
@@ -361,6 +364,7 @@ fn projection_triangles_folding_inside_the_scene_are_ray_cast() {
             let (c, stats) = against_raycast(&scene, &mesh, (96, 72), curves, &flat());
             let case = format!("{scale} {shift} {mode}");
             assert_eq!(count(&stats, "fallback_triangles"), 1, "{case}");
+            assert!(count(&stats, "unprojectable") > 0, "{case}");
             assert!(c.relative_rgb_error <= 1e-6, "{case}: {c:?}");
             assert_eq!(c.id_agreement, 1.0, "{case}: {c:?}");
         }

@@ -81,7 +81,8 @@ impl ProjectionTriangleCache {
     /// Whether the parametric triangle degenerates at some depth in `(0, t_max]` (`t_max`
     /// may be infinite; see [`Self::degenerate_depths`]).
     pub fn degenerates_before(&self, t_max: f64) -> bool {
-        self.degenerate_depths().is_some_and(|(first, _)| first <= t_max)
+        self.degenerate_depths()
+            .is_some_and(|(first, _)| first <= t_max)
     }
 
     /// The largest depth `t >= 0` at which a ray of the triangle can be inside the sphere
@@ -139,7 +140,10 @@ mod tests {
         assert!(cache.degenerates_before(f64::INFINITY));
         assert!(!cache.degenerates_before(1.6), "the scene ends before");
         let (first, last) = cache.degenerate_depths().unwrap();
-        assert!((first - 1.0 / 0.6).abs() < 1e-9 && last == first, "{first} {last}");
+        assert!(
+            (first - 1.0 / 0.6).abs() < 1e-9 && last == first,
+            "{first} {last}"
+        );
         // The same triangle with the rays turned outwards: they diverge, never cross.
         let unfolded = crossing().map(|n| V(-n.x, n.y, n.z));
         let cache = ProjectionTriangleCache::new(unit_base(), unfolded);
@@ -151,8 +155,16 @@ mod tests {
     /// Vallance 2005).
     #[test]
     fn generic_folds_do_not_degenerate() {
-        let p = [V(-0.45, 0.44, -0.43), V(0.58, -0.75, -0.58), V(0.0, 0.81, -0.26)];
-        let n = [V(0.34, 0.54, -0.77), V(-0.74, -0.52, -0.43), V(0.37, 0.52, 0.77)];
+        let p = [
+            V(-0.45, 0.44, -0.43),
+            V(0.58, -0.75, -0.58),
+            V(0.0, 0.81, -0.26),
+        ];
+        let n = [
+            V(0.34, 0.54, -0.77),
+            V(-0.74, -0.52, -0.43),
+            V(0.37, 0.52, 0.77),
+        ];
         let cache = ProjectionTriangleCache::new(p, n);
         assert!(!cache.degenerates_before(f64::INFINITY));
         let signs: Vec<bool> = (0..200)
@@ -176,7 +188,10 @@ mod tests {
             let centre = V(0.3, 0.2, 4.0) * s + shift;
             let cache = ProjectionTriangleCache::new(base, base.map(|x| centre - x));
             assert!(cache.degenerates_before(1.01), "{s}");
-            assert!(!cache.degenerates_before(0.99), "{s}: the scene ends before");
+            assert!(
+                !cache.degenerates_before(0.99),
+                "{s}: the scene ends before"
+            );
         }
         let centre = V(0.3, 0.2, 4.0);
         let lengths = [1.0, 2.0, 0.5];
@@ -196,7 +211,10 @@ mod tests {
         assert!(cylinder.degenerates_before(1.0 + 1e-9));
         assert!(!cylinder.degenerates_before(0.9));
         let (first, last) = cylinder.degenerate_depths().unwrap();
-        assert!(first <= 1.0 && last >= 1.0 && last - first < 0.1, "{first} {last}");
+        assert!(
+            first <= 1.0 && last >= 1.0 && last - first < 0.1,
+            "{first} {last}"
+        );
     }
 
     #[test]
