@@ -14,8 +14,13 @@
 //! non-zero fill, z-buffer), every fragment finished to its exact hit from its interpolated
 //! terms before its z-test, and each pixel's winner shaded once (`shade`).
 //!
-//! Unprojectable pairs (see `projection::Unprojectable`) are counted and their projection
-//! triangle is ray cast instead, so they never silently vanish.
+//! Projection triangles whose rays fold are drawn so too (the sweep by depth covers each pixel
+//! once, see `projection::trilinear::point_projection::fold`); those whose rays meet in one
+//! point are drawn as central projections (`central`), and those with two equal vertices,
+//! which sweep no volume, as strips of one ray each (`ray_fan`). Unprojectable pairs (see
+//! `projection::Unprojectable`, and pairs with a shape reaching across a depth where the
+//! parametric triangle degenerates) are counted and their projection triangle is ray cast
+//! instead, so they never silently vanish; docs/trilinear-raster.md lists these cases.
 
 mod central;
 mod clip;

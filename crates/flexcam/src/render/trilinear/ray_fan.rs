@@ -281,7 +281,7 @@ mod tests {
             let cache = ProjectionTriangleCache::new(p, n);
             let point = cache.ray_point(corner.u, corner.v, corner.t);
             assert!((point.y - 0.5).abs() < 1e-12, "{point}");
-            assert!(point.x > 0.1 - 1e-9 && point.x < 0.3 + 1e-9, "{point}");
+            assert!((0.1 - 1e-9..=0.3 + 1e-9).contains(&point.x), "{point}");
         }
     }
 }
