@@ -179,23 +179,29 @@ fn project_lists_the_image_of_a_point_and_none_behind() {
     assert_eq!(json["images"], serde_json::json!([]));
 }
 
-/// A scene point seen three times through a folding triangle: the projection triangle of
-/// appendix C's configuration (9) and a point on the far side of its fold, with each image
-/// checked against the ray of its pixel.
+/// A scene point seen three times through a folding triangle: the first scene vertex of
+/// appendix C's configuration (3,3,3) (Vallance 2005), whose cubic has three roots, at
+/// depths about 0.096, 0.367 and 1.273, all inside the projection triangle; listed nearest
+/// first, each inside the image.
 #[test]
 fn project_finds_the_three_images_of_a_point_beyond_a_fold() {
     let dir = TempDir::new().unwrap();
-    let scene = "[image]\nwidth = 200\nheight = 200\n[projection]\ntype = \"trilinear\"\n\
-        points = [[-1, 0, 0], [1, 0, 0], [0, 1.5, 0]]\n\
-        normals = [[0.5, 0, 1], [-0.5, 0, 1], [0, -0.75, 1]]\n\
-        screen = [[0, 0], [1, 0], [0, 1]]\ntriangles = [[0, 1, 2]]\n";
-    std::fs::write(dir.path().join("fold.toml"), scene).unwrap();
-    let images = project_lines(&dir, "fold.toml", "0.05,0.5,2.5");
+    let images = project_lines(
+        &dir,
+        &scene("appendix-c/3-3-3.toml"),
+        "0.0962,-0.0457,-0.011",
+    );
     assert_eq!(images.len(), 3, "{images:?}");
     assert!(
-        images.windows(2).all(|w| w[0][2] <= w[1][2]),
+        images.windows(2).all(|w| w[0][2] < w[1][2]),
         "nearest first"
     );
+    for [x, y, _] in &images {
+        assert!(
+            (0.0..=200.0).contains(x) && (0.0..=200.0).contains(y),
+            "{images:?}"
+        );
+    }
 }
 
 /// Projections without an analytic inverse, and points that are not three finite numbers,
