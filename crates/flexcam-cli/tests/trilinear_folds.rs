@@ -202,6 +202,9 @@ fn project_finds_the_three_images_of_a_point_beyond_a_fold() {
             "{images:?}"
         );
     }
+    // A point whose first coordinate is negative: (2,7)'s third vertex, three images too.
+    let images = project_lines(&dir, &scene("appendix-c/2-7.toml"), "-0.117,-0.388,0.265");
+    assert_eq!(images.len(), 3, "{images:?}");
 }
 
 /// Projections without an analytic inverse, and points that are not three finite numbers,

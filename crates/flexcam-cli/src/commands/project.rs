@@ -20,7 +20,7 @@ pub struct ProjectArgs {
     #[arg(
         value_name = "X,Y,Z",
         value_delimiter = ',',
-        allow_negative_numbers = true,
+        allow_hyphen_values = true,
         required = true
     )]
     point: Vec<f64>,
