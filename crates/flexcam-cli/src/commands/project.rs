@@ -21,6 +21,7 @@ pub struct ProjectArgs {
         value_name = "X,Y,Z",
         value_delimiter = ',',
         allow_hyphen_values = true,
+        num_args = 1,
         required = true
     )]
     point: Vec<f64>,
