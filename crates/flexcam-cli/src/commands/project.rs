@@ -16,15 +16,10 @@ pub struct ProjectArgs {
     /// The projection: the scene file's `[projection]` and `[image]` (objects are ignored).
     #[command(flatten)]
     scene: SceneArgs,
-    /// The scene point, as three numbers.
-    #[arg(
-        value_name = "X,Y,Z",
-        value_delimiter = ',',
-        allow_hyphen_values = true,
-        num_args = 1,
-        required = true
-    )]
-    point: Vec<f64>,
+    /// The scene point, as three numbers separated by commas (a leading minus sign is
+    /// part of the point, not an option).
+    #[arg(value_name = "X,Y,Z", allow_hyphen_values = true)]
+    point: String,
     /// Print one JSON object (`point`, `images`: each with `x`, `y`, `depth`, `t`) instead
     /// of one line per image.
     #[arg(long)]
@@ -47,11 +42,17 @@ struct Image {
 /// A projection without an analytic inverse, or a point that is not three finite numbers,
 /// is one error line.
 pub fn run(args: &ProjectArgs) -> Result<()> {
-    let point = match args.point[..] {
+    let coordinates: Vec<f64> = args
+        .point
+        .split(',')
+        .map(|c| c.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .unwrap_or_default();
+    let point = match coordinates[..] {
         [x, y, z] if [x, y, z].iter().all(|c| c.is_finite()) => DVec3::new(x, y, z),
         _ => {
             return Err(Error::new(format!(
-                "the point must be three finite numbers X,Y,Z, got {:?}",
+                "the point must be three finite numbers X,Y,Z, got '{}'",
                 args.point
             )))
         }
