@@ -14,11 +14,16 @@ use clap::{Command as ClapCommand, CommandFactory, FromArgMatches, Parser, Subco
 
 /// Renders 3D scenes through nonlinear and multi-perspective projections.
 #[derive(Parser, Debug)]
-#[command(name = "flexcam", version, about)]
+#[command(name = "flexcam", version, about, after_help = EXIT_STATUS_HELP)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
 }
+
+/// The exit statuses of every command (shown after the commands in `--help`).
+const EXIT_STATUS_HELP: &str = "Exit status: 0 done; 1 a render or input error (one line on \
+stderr, nothing written); 2 a usage error (an unknown flag, a bad flag value); 3 `compare` \
+ran but missed a threshold.";
 
 /// How every command that writes files writes them (shown after its options in `--help`).
 const OUTPUTS_HELP: &str = "Outputs are written all together or not at all, never over an \
@@ -82,17 +87,14 @@ fn main() -> ExitCode {
         Command::Fit(args) => commands::fit::run(&args),
         Command::Scenes => commands::scenes::run(),
         Command::Project(args) => commands::project::run(&args),
-        Command::Compare(args) => commands::compare::run(&args),
+        Command::Compare(args) => return commands::compare::run(&args),
         Command::Simplify(args) => commands::simplify::run(&args),
         Command::ImportCameras(args) => commands::import_cameras::run(&args),
         Command::Bench(command) => commands::bench::run(&command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("flexcam: {e}");
-            ExitCode::FAILURE
-        }
+        Err(e) => commands::fail(&e),
     }
 }
 

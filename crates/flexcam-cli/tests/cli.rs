@@ -364,7 +364,7 @@ fn compare_reports_agreement_and_enforces_thresholds() {
         "identical renders differ"
     );
 
-    // An unreachable threshold fails with one line naming the measure; the diff image of a
+    // An unreachable threshold fails (status 3) with one line naming the measure; the diff image of a
     // failed check is kept on purpose (it is what one looks at next).
     let args = [
         "compare",
@@ -375,7 +375,7 @@ fn compare_reports_agreement_and_enforces_thresholds() {
         "100.5",
     ];
     let out = run(&dir, &args);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(3), "a missed threshold exits 3");
     let e = error_line(out, &args);
     assert!(e.contains("id agreement 100.000 % is below"), "{e}");
 
@@ -391,7 +391,11 @@ fn compare_reports_agreement_and_enforces_thresholds() {
             "x",
         ],
     );
-    assert!(e.contains("unknown method \"x\""), "{e}");
+    assert!(
+        e.contains("invalid value 'x' for '--reference <REFERENCE>'")
+            && e.contains("[possible values: raycast, raster, trilinear, camera-triangles]"),
+        "{e}"
+    );
 }
 
 /// `compare --spp 4` supersamples both renders with the same pattern: trilinear against the

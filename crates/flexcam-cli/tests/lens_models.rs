@@ -118,7 +118,16 @@ fn other_sizes_need_calibration_size() {
     run_ok(&dir, &["render", "fixed.toml", "-o", "same.png"]);
     let out = run(
         &dir,
-        &["render", "fixed.toml", "--width", "200", "-o", "half.png"],
+        &[
+            "render",
+            "fixed.toml",
+            "--width",
+            "200",
+            "--height",
+            "300",
+            "-o",
+            "half.png",
+        ],
     );
     assert_eq!(out.status.code(), Some(1));
     let stderr = String::from_utf8(out.stderr).unwrap();

@@ -14,7 +14,10 @@ use flexcam::render::{
 use flexcam::scene;
 use flexcam::{Error, Result};
 
-use super::scene_args::{print_lines, warning_lines, MemoryArgs, ShadingArg};
+use super::frame_list;
+use super::scene_args::{
+    method_names, print_lines, warning_lines, DefineArgs, MemoryArgs, ShadingArg, ThreadsArg,
+};
 use crate::progress::RenderProgress;
 use crate::stats_json::{self, RunFacts};
 use crate::OutputTarget;
@@ -32,27 +35,43 @@ pub struct AnimateArgs {
     /// An animated GIF of all frames.
     #[arg(long, value_name = "FILE")]
     gif: Option<PathBuf>,
-    /// Image width in pixels (overrides the scene file).
+    /// Image width in pixels (overrides the scene file; alone, it keeps the scene's aspect
+    /// ratio).
     #[arg(long)]
     width: Option<u32>,
-    /// Image height in pixels (overrides the scene file).
+    /// Image height in pixels (overrides the scene file; alone, it keeps the scene's aspect
+    /// ratio).
     #[arg(long)]
     height: Option<u32>,
-    /// Rendering method: `raycast` (the reference, every projection).
-    #[arg(long, default_value = "raycast")]
+    /// Rendering method: `raycast` (the reference, every projection) or `raster`
+    /// (projections with an analytic inverse).
+    #[arg(long, default_value = "raycast", value_parser = method_names())]
     method: String,
     /// Shading: `flat` (base colours, exact) or `lit` (lights, shadows, reflections).
     #[arg(long, value_enum, default_value_t = ShadingArg::Lit)]
     shading: ShadingArg,
-    /// Samples per pixel.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    spp: u32,
+    /// Samples per pixel (overrides the scene's `[image] spp`, whose default is 1).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    spp: Option<u32>,
+    /// Render only these frames (numbered from 0): comma-separated frame numbers `N`,
+    /// ranges `A-B` and ranges with a step `A-B:S`, e.g. `3,5-10,20-40:5`. A GIF then holds
+    /// these frames alone.
+    #[arg(long, value_name = "LIST")]
+    frames: Option<String>,
+    /// Leave out the frames whose file (-o PATTERN) exists already, so that a farm task that
+    /// was cut off can be rerun; not with --gif, which needs every frame.
+    #[arg(long, requires = "output", conflicts_with = "gif")]
+    skip_existing: bool,
     /// Write statistics of the whole animation as one JSON object to FILE, or to standard
     /// output with `-` (as `flexcam render --stats`; `frames`, `bvh_builds`).
     #[arg(long, value_name = "FILE|-")]
     stats: Option<OutputTarget>,
     #[command(flatten)]
+    define: DefineArgs,
+    #[command(flatten)]
     memory: MemoryArgs,
+    #[command(flatten)]
+    threads: ThreadsArg,
 }
 
 /// Estimated bytes a GIF holds per frame pixel until it is written.
@@ -121,6 +140,7 @@ impl FramePattern {
 /// Runs `flexcam animate`. Every frame and the GIF are written only once all frames have
 /// rendered, all together, and never over an input.
 pub fn run(args: &AnimateArgs) -> Result<()> {
+    let start = Instant::now();
     let method: Method = args.method.parse()?;
     if args.output.is_none() && args.gif.is_none() {
         return Err(Error::new(
@@ -141,8 +161,10 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         _ => None,
     };
     args.memory.apply();
+    args.threads.apply()?;
     let load_start = Instant::now();
-    let (scene, animation) = scene::file::load_animated(&args.scene)?;
+    let (scene, animation) =
+        scene::file::load_animated_defined(&args.scene, &args.define.definitions)?;
     super::declare_scene_inputs(&mut outputs, &scene.inputs)?;
     let animation = animation.ok_or_else(|| {
         Error::in_file(&args.scene, "the scene has no [animation] table to animate")
@@ -153,13 +175,22 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         .as_deref()
         .map(|p| FramePattern::new(p, frames))
         .transpose()?;
+    let mut chosen = match &args.frames {
+        Some(list) => frame_list::parse(list, frames)?,
+        None => (0..frames).collect(),
+    };
+    if let (true, Some(pattern)) = (args.skip_existing, &pattern) {
+        chosen.retain(|&n| !pattern.path(n).exists());
+    }
     let frame_format = match &pattern {
         Some(pattern) => ColorFormat::of(&pattern.path(0), PngBits::Eight)?,
         None => ColorFormat::Png(PngBits::Eight),
     };
+    // The output of each chosen frame, in the order of `chosen`.
     let frame_outputs = match &pattern {
-        Some(pattern) => (0..frames)
-            .map(|n| {
+        Some(pattern) => chosen
+            .iter()
+            .map(|&n| {
                 outputs.output(
                     &format!("frame {n} of the output"),
                     &pattern.path(n),
@@ -169,11 +200,13 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
             .collect::<Result<Vec<_>>>()?,
         None => Vec::new(),
     };
-    let width = args.width.unwrap_or(scene.image.width);
-    let height = args.height.unwrap_or(scene.image.height);
+    let rendered_frames = chosen.len() as u32;
+    let (width, height) = scene.image.size_with(args.width, args.height);
     scene::file::validate_resolution(width, height)?;
     let gif_bytes = match &args.gif {
-        Some(_) => u64::from(frames) * u64::from(width) * u64::from(height) * GIF_BYTES_PER_PIXEL,
+        Some(_) => {
+            u64::from(rendered_frames) * u64::from(width) * u64::from(height) * GIF_BYTES_PER_PIXEL
+        }
         None => 0,
     };
     scene::check_budget(&scene, width, height, gif_bytes).map_err(|e| e.or_in_file(&args.scene))?;
@@ -190,18 +223,22 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     let progress = RenderProgress::new();
     let mut gif = args.gif.as_ref().map(|_| GifFrames::default());
     let mut warnings = Vec::new();
-    for frame_number in 0..frames {
+    let spp = args.spp.unwrap_or(scene.image.spp);
+    for (index, &frame_number) in chosen.iter().enumerate() {
         let spec = ProjectionSpec::Flexible(Box::new(animation.projection(frame_number)));
         let (projection, _) = flexcam::calibrate::build(&spec, width, height)
             .map_err(|e| e.or_in_file(&args.scene))?;
-        let done_before = u64::from(frame_number);
+        let done_before = index as u64;
         let report = |done: u64, total: u64| {
-            progress.update(done_before * total + done, u64::from(frames) * total)
+            progress.update(
+                done_before * total + done,
+                u64::from(rendered_frames) * total,
+            )
         };
         let options = RenderOptions {
             method,
             shading: args.shading.shading(),
-            spp: args.spp,
+            spp,
             progress: Some(&report),
             outputs: Outputs::COLOR,
             ..RenderOptions::default()
@@ -209,7 +246,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         let rendered = render::render(&prepared, projection.as_ref(), &options)?;
         warnings.extend(rendered.warnings);
         let frame = rendered.frame;
-        if let Some(&id) = frame_outputs.get(frame_number as usize) {
+        if let Some(&id) = frame_outputs.get(index) {
             outputs.stage(id, |tmp| {
                 image_io::write_color(&frame, tmp, frame_format, encoding)
             })?;
@@ -226,7 +263,7 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         outputs.stage(id, |tmp| gif.write(tmp, animation.fps()))?;
     }
     let mut counters = Stats::new();
-    counters.insert("frames", Counter::Count(u64::from(frames)));
+    counters.insert("frames", Counter::Count(u64::from(rendered_frames)));
     counters.insert("bvh_builds", Counter::Count(prepared.bvh_builds()));
     counters.insert("bvh_build_ms", Counter::Value(prepared.bvh_build_ms()));
     let facts = RunFacts {
@@ -236,11 +273,13 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
         shading: args.shading.name(),
         width,
         height,
-        spp: args.spp,
+        spp,
         triangles: scene.triangle_count(),
         load_ms,
         render_ms,
         warnings: &warnings,
+        wall_ms: start.elapsed().as_secs_f64() * 1e3,
+        outputs: stats_json::shown(&outputs),
     };
     let json = format!("{}\n", stats_json::to_json(&facts, &counters));
     if let Some(id) = stats_output {

@@ -4,6 +4,7 @@
 //! `flexcam::render::compare`). Optional thresholds turn it into a check with an exit status.
 
 use std::path::PathBuf;
+use std::process::ExitCode;
 use std::time::Instant;
 
 use clap::Args;
@@ -13,7 +14,7 @@ use flexcam::{Error, Result};
 use glam::Vec3;
 use serde_json::json;
 
-use super::scene_args::{MethodTuning, SceneArgs, ShadingArg};
+use super::scene_args::{method_names, MethodTuning, SceneArgs, ShadingArg};
 
 /// Arguments of `flexcam compare`.
 #[derive(Args, Debug)]
@@ -21,10 +22,10 @@ pub struct CompareArgs {
     #[command(flatten)]
     scene: SceneArgs,
     /// The method under test.
-    #[arg(long)]
+    #[arg(long, value_parser = method_names())]
     method: String,
     /// The reference method.
-    #[arg(long, default_value = "raycast")]
+    #[arg(long, default_value = "raycast", value_parser = method_names())]
     reference: String,
     /// Tuning of the method under test (the reference runs with its defaults).
     #[command(flatten)]
@@ -35,24 +36,41 @@ pub struct CompareArgs {
     shading: ShadingArg,
     /// Samples per pixel of both renders (the same pattern in every method that supports
     /// supersampling): colours averaged, depth and id of the sample nearest the centre.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    spp: u32,
+    /// Overrides the scene's `[image] spp`, whose default is 1.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    spp: Option<u32>,
     /// Write a difference image (PNG): id mismatches red, colour differences amplified 4x.
     #[arg(long, value_name = "FILE")]
     diff: Option<PathBuf>,
     /// Print the report as one JSON object instead of text.
     #[arg(long)]
     json: bool,
-    /// Fail (exit 1) when the id agreement, in percent, is below this.
+    /// Fail (exit 3) when the id agreement, in percent, is below this.
     #[arg(long, value_name = "PERCENT")]
     min_id_agreement: Option<f64>,
-    /// Fail (exit 1) when the relative RGB error is above this.
+    /// Fail (exit 3) when the relative RGB error is above this.
     #[arg(long, value_name = "ERROR")]
     max_rgb_error: Option<f64>,
 }
 
-/// Runs `flexcam compare`.
-pub fn run(args: &CompareArgs) -> Result<()> {
+/// The exit status of a comparison that ran but missed a threshold (`--min-id-agreement`,
+/// `--max-rgb-error`), told apart from 1, a comparison that could not run.
+pub const THRESHOLD_MISSED: u8 = 3;
+
+/// Runs `flexcam compare`: exit status 0 when the renders compared within the thresholds,
+/// [`THRESHOLD_MISSED`] (with the missed threshold on stderr) when they did not, 1 when they
+/// could not be compared.
+pub fn run(args: &CompareArgs) -> ExitCode {
+    match compare_renders(args) {
+        Ok(true) => ExitCode::SUCCESS,
+        Ok(false) => ExitCode::from(THRESHOLD_MISSED),
+        Err(e) => super::fail(&e),
+    }
+}
+
+/// Renders and compares, writes the report and the outputs; `false` when a threshold was
+/// missed (reported on stderr).
+fn compare_renders(args: &CompareArgs) -> Result<bool> {
     let method: Method = args.method.parse()?;
     let reference: Method = args.reference.parse()?;
     validate_thresholds(args)?;
@@ -68,6 +86,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     let loaded = args.scene.load()?;
     super::declare_scene_inputs(&mut outputs, &loaded.scene.inputs)?;
     let prepared = PreparedScene::new(&loaded.scene);
+    let spp = args.spp.unwrap_or(loaded.scene.image.spp);
     // The method under test renders as `flexcam render` does (trilinear reflectors
     // composited through their surfaces); the reference renders the scene as it is (a
     // reflector is then the ray caster's exact mirror or glass).
@@ -75,7 +94,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         method: reference,
         composite_reflectors: false,
         shading: args.shading.shading(),
-        spp: args.spp,
+        spp,
         ..RenderOptions::default()
     };
     let options = RenderOptions {
@@ -112,7 +131,7 @@ pub fn run(args: &CompareArgs) -> Result<()> {
         reference,
         size: (loaded.width, loaded.height),
         shading: args.shading.name(),
-        spp: args.spp,
+        spp,
         times_ms: (method_ms, reference_ms),
         bvh_builds: prepared.bvh_builds(),
     };
@@ -121,10 +140,13 @@ pub fn run(args: &CompareArgs) -> Result<()> {
     } else {
         super::print_stdout(&report_text(&header, &result))?;
     }
-    check_thresholds(args, &result)?;
+    if let Err(missed) = check_thresholds(args, &result) {
+        eprintln!("flexcam: {missed}");
+        return Ok(false);
+    }
     // Warnings only once the command has succeeded: a failing command prints one line.
     super::scene_args::print_lines(&loaded.source, &warnings);
-    Ok(())
+    Ok(true)
 }
 
 /// What was compared, for the report.

@@ -4,6 +4,7 @@ pub mod animate;
 pub mod bench;
 pub mod compare;
 pub mod fit;
+pub mod frame_list;
 pub mod import_cameras;
 pub mod project;
 pub mod render;
@@ -11,6 +12,13 @@ pub mod reproject;
 pub mod scene_args;
 pub mod scenes;
 pub mod simplify;
+
+/// Reports a command's failure, one line on stderr, and gives exit status 1 (a render or
+/// input error; 2 is a usage error, found before any command runs).
+pub fn fail(e: &flexcam::Error) -> std::process::ExitCode {
+    eprintln!("flexcam: {e}");
+    std::process::ExitCode::FAILURE
+}
 
 /// Declares the scene file a command was given (a path; nothing for `builtin:NAME`) as an
 /// input of `outputs`, so that an output aimed at it is refused before the scene is read.

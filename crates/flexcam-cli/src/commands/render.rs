@@ -6,12 +6,13 @@ use std::time::Instant;
 use clap::Args;
 use flexcam::image_io::{self, ColorEncoding, ColorFormat, DepthFormat, OutputSet, PngBits};
 use flexcam::render::{
-    self, Counter, Method, Outputs, PreparedScene, RenderOptions, Shading, TransitionShading,
+    self, Counter, Method, Outputs, PixelWindow, PreparedScene, RenderOptions, Shading,
+    TransitionShading,
 };
 use flexcam::Result;
 
 use super::scene_args::{
-    print_lines, print_warnings, warning_lines, MethodTuning, SceneArgs, ShadingArg,
+    method_names, print_lines, print_warnings, warning_lines, MethodTuning, SceneArgs, ShadingArg,
 };
 use crate::progress::RenderProgress;
 use crate::stats_json::{self, RunFacts};
@@ -20,54 +21,80 @@ use crate::OutputTarget;
 /// Arguments of `flexcam render`.
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    #[command(flatten)]
+    #[command(flatten, next_help_heading = "Scene")]
     scene: SceneArgs,
     /// The colour image to write, in the format its extension names: `.png` (8-bit, or
     /// 16-bit with `--png-bits 16`; sRGB-encoded, or linear with `--shading flat`), `.exr`
     /// (OpenEXR) or `.pfm`, both linear 32-bit float RGB as rendered (no curve, no clamping).
-    #[arg(short, long, default_value = "flexcam.png")]
+    #[arg(help_heading = "Outputs", short, long, default_value = "flexcam.png")]
     output: PathBuf,
     /// Bits per channel of a PNG colour output: 8 or 16.
-    #[arg(long, value_enum, default_value_t = PngBitsArg::Eight)]
+    #[arg(help_heading = "Outputs", long, value_enum, default_value_t = PngBitsArg::Eight)]
     png_bits: PngBitsArg,
     /// Rendering method: `raycast` (the reference, every projection), `raster`
-    /// (rasterisation by the analytic inverse, projections that have one) or `trilinear`
-    /// (rasterisation of trilinear projections).
-    #[arg(long, default_value = "raycast")]
+    /// (rasterisation by the analytic inverse, projections that have one), `trilinear`
+    /// (rasterisation of trilinear projections) or `camera-triangles` (trilinear projections
+    /// and trilinear reflectors, by camera triangles).
+    #[arg(help_heading = "Rendering", long, default_value = "raycast", value_parser = method_names())]
     method: String,
-    #[command(flatten)]
+    #[command(flatten, next_help_heading = "Method tuning")]
     tuning: MethodTuning,
     /// Shading: `flat` (base colours, exact), `lit` (lights, shadows, reflections),
     /// `transition-lit` (lit, with displaced objects shaded per ray by full displacement,
     /// redistributed bump mapping or their BRDF, as the transition function chooses from the
     /// ray's footprint) or `transitions` (each pixel coloured by the method chosen: green
     /// displacement, blue bump, red BRDF, mixed in the blends).
-    #[arg(long, value_enum, default_value_t = ShadingArg::Lit)]
+    #[arg(help_heading = "Rendering", long, value_enum, default_value_t = ShadingArg::Lit)]
     shading: ShadingArg,
     /// The transition function's constant D for `--shading transitions` and
     /// `transition-lit` (default 2): relief of D + 1 pixel footprints or more seen head on is
     /// displaced, below D - 1 the BRDF is used; larger D favours the cheaper methods.
-    #[arg(long, value_name = "D")]
+    #[arg(help_heading = "Rendering", long, value_name = "D")]
     transition_d: Option<f64>,
-    /// Samples per pixel.
-    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    spp: u32,
+    /// Render only the pixels of columns X0..X1 and rows Y0..Y1 (pixel (0, 0) the top-left;
+    /// X1 and Y1 excluded): every output is that rectangle of the whole frame, byte for byte,
+    /// so a large frame split into tiles on several machines can be stitched back exactly.
+    #[arg(
+        help_heading = "Outputs",
+        long,
+        value_name = "X0,Y0,X1,Y1",
+        value_delimiter = ',',
+        num_args = 1
+    )]
+    crop: Option<Vec<u32>>,
+    /// Samples per pixel (overrides the scene's `[image] spp`, whose default is 1).
+    #[arg(help_heading = "Rendering", long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    spp: Option<u32>,
     /// Write the depth along each pixel's ray (.exr or .pfm; +inf where nothing is hit).
-    #[arg(long, value_name = "FILE")]
+    #[arg(help_heading = "Outputs", long, value_name = "FILE")]
     depth: Option<PathBuf>,
     /// Write object ids as a 16-bit grayscale PNG (0 = background).
-    #[arg(long, value_name = "FILE")]
+    #[arg(help_heading = "Outputs", long, value_name = "FILE")]
     ids: Option<PathBuf>,
     /// Write object ids as an 8-bit false-colour PNG: a fixed colour per id, black background.
-    #[arg(long, value_name = "FILE")]
+    #[arg(help_heading = "Outputs", long, value_name = "FILE")]
     ids_preview: Option<PathBuf>,
     /// Write every AOV as one multi-channel OpenEXR (.exr): linear colour `R`, `G`, `B`,
     /// depth `Z` (+inf where nothing is hit) and object id `id` (uint, 0 = background).
-    #[arg(long, value_name = "FILE")]
+    #[arg(help_heading = "Outputs", long, value_name = "FILE")]
     aovs: Option<PathBuf>,
     /// Write statistics as one JSON object to FILE, or to standard output with `-`.
-    #[arg(long, value_name = "FILE|-")]
+    #[arg(help_heading = "Outputs", long, value_name = "FILE|-")]
     stats: Option<OutputTarget>,
+}
+
+/// The window of `--crop X0,Y0,X1,Y1` in a `size` image; errors name the flag.
+fn crop_window(bounds: &[u32], size: (u32, u32)) -> Result<PixelWindow> {
+    let refuse = |why: String| flexcam::Error::new(format!("--crop: {why}"));
+    let &[x0, y0, x1, y1] = bounds else {
+        return Err(refuse(format!(
+            "needs 4 pixel bounds X0,Y0,X1,Y1, got {}",
+            bounds.len()
+        )));
+    };
+    let window = PixelWindow { x0, y0, x1, y1 };
+    window.check(size).map_err(|e| refuse(e.message))?;
+    Ok(window)
 }
 
 /// The values of `--png-bits`.
@@ -82,6 +109,7 @@ enum PngBitsArg {
 /// Runs `flexcam render`. Outputs are written only once everything has succeeded, all
 /// together, and never over an input.
 pub fn run(args: &RenderArgs) -> Result<()> {
+    let start = Instant::now();
     let method: Method = args.method.parse()?;
     let mut outputs = OutputSet::new();
     if let Some(source) = &args.scene.scene {
@@ -144,14 +172,21 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             ))
         }
     };
+    let spp = args.spp.unwrap_or(loaded.scene.image.spp);
+    let crop = args
+        .crop
+        .as_deref()
+        .map(|bounds| crop_window(bounds, (loaded.width, loaded.height)))
+        .transpose()?;
     let options = RenderOptions {
         method,
         shading,
-        spp: args.spp,
+        spp,
         subdivision: args.tuning.subdivision(method)?,
         curves: args.tuning.curves(method)?,
         camera_triangles: args.tuning.camera_triangles(method)?,
         progress: Some(&report),
+        crop,
         outputs: Outputs {
             depth: depth.is_some() || aovs.is_some(),
             ids: ids.is_some() || ids_preview.is_some() || aovs.is_some(),
@@ -203,11 +238,13 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         shading: args.shading.name(),
         width: loaded.width,
         height: loaded.height,
-        spp: args.spp,
+        spp,
         triangles: loaded.scene.triangle_count(),
         load_ms: loaded.load_ms,
         render_ms,
         warnings: &[&loaded.build_report.warnings[..], &warnings].concat(),
+        wall_ms: start.elapsed().as_secs_f64() * 1e3,
+        outputs: stats_json::shown(&outputs),
     };
     let json = stats_json::to_json(&facts, &counters).to_string();
     super::commit_with_stats(outputs, stats, args.stats.as_ref(), &json)?;

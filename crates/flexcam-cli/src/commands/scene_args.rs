@@ -2,11 +2,13 @@
 //! shading and the methods' tuning options, turned into the library's load and render
 //! options, and the warnings printed on stderr.
 
+use clap::builder::PossibleValuesParser;
 use clap::{Args, ValueEnum};
 use flexcam::render::{
-    CameraTriangleBound, CameraTriangleOptions, CurveOptions, Method, RenderWarning, Shading,
-    Subdivision, TransitionShading,
+    CameraTriangleBound, CameraTriangleOptions, CurveMode, CurveOptions, Method, RenderWarning,
+    Shading, Subdivision, TransitionShading,
 };
+use flexcam::scene::file::Definition;
 use flexcam::scene::{self, LoadedScene, Overrides};
 use flexcam::{Error, Result};
 
@@ -15,10 +17,12 @@ use flexcam::{Error, Result};
 pub struct SceneArgs {
     /// A scene file (.toml) or `builtin:NAME`; the default built-in scene when omitted.
     pub scene: Option<String>,
-    /// Image width in pixels (overrides the scene file).
+    /// Image width in pixels (overrides the scene file; alone, it keeps the scene's aspect
+    /// ratio).
     #[arg(long)]
     pub width: Option<u32>,
-    /// Image height in pixels (overrides the scene file).
+    /// Image height in pixels (overrides the scene file; alone, it keeps the scene's aspect
+    /// ratio).
     #[arg(long)]
     pub height: Option<u32>,
     /// The local perspective edit of a shape-defined panorama (or the cubic, rounded_cubic,
@@ -34,7 +38,51 @@ pub struct SceneArgs {
     )]
     pub perspective_rect: Option<Vec<f64>>,
     #[command(flatten)]
+    pub define: DefineArgs,
+    #[command(flatten, next_help_heading = "Resources")]
     pub memory: MemoryArgs,
+    #[command(flatten, next_help_heading = "Resources")]
+    pub threads: ThreadsArg,
+}
+
+/// The names `--method` accepts, listed in `--help` (clap refuses any other).
+pub fn method_names() -> PossibleValuesParser {
+    PossibleValuesParser::new(Method::ALL.map(|(name, _)| name))
+}
+
+/// Scene keys set on the command line.
+#[derive(Args, Debug)]
+pub struct DefineArgs {
+    /// Set a scene key as if the scene file said so (repeatable, applied in order): KEY is a
+    /// dotted path (`projection.fov`, `image.width`; `object.NAME.KEY` or `object.N.KEY`, N
+    /// from 0, for a table of `[[object]]`), VALUE a TOML value (a bare word is a string),
+    /// checked as the file's own would be. E.g. `-D projection.fov=90 -D
+    /// object.floor.color=[1,0,0]`.
+    #[arg(short = 'D', long = "define", value_name = "KEY=VALUE")]
+    pub definitions: Vec<Definition>,
+}
+
+/// The number of threads a rendering command renders with.
+#[derive(Args, Debug)]
+pub struct ThreadsArg {
+    /// Render with N threads (a pool of N workers; the default is one per core). Images do
+    /// not depend on it.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub threads: Option<u16>,
+}
+
+impl ThreadsArg {
+    /// Makes the process's rayon pool N threads if `--threads` was given. Call it before
+    /// anything runs on the pool (it is built once).
+    pub fn apply(&self) -> Result<()> {
+        match self.threads {
+            Some(n) => rayon::ThreadPoolBuilder::new()
+                .num_threads(usize::from(n))
+                .build_global()
+                .map_err(|e| Error::new(format!("--threads {n}: {e}"))),
+            None => Ok(()),
+        }
+    }
 }
 
 /// The memory budget of a rendering command.
@@ -74,10 +122,12 @@ impl SceneArgs {
             None => None,
         };
         self.memory.apply();
+        self.threads.apply()?;
         let overrides = Overrides {
             width: self.width,
             height: self.height,
             perspective_rect,
+            definitions: self.define.definitions.clone(),
         };
         scene::load_with(&source, &overrides)
     }
@@ -154,7 +204,7 @@ pub struct MethodTuning {
     raster_tolerance: Option<f64>,
     /// Method trilinear: how curved edges are followed, `tessellate`, `slice` or `adaptive`
     /// (the default).
-    #[arg(long, value_name = "MODE")]
+    #[arg(long, value_name = "MODE", value_parser = PossibleValuesParser::new(CurveMode::ALL.map(|(name, _)| name)))]
     curves: Option<String>,
     /// Method trilinear: steps of the curve mode: segments per scene edge (tessellate),
     /// slices per shape (slice) or most segments per edge piece (adaptive); defaults 8, 10

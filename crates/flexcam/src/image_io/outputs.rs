@@ -103,6 +103,11 @@ impl OutputSet {
         Ok(OutputId(self.outputs.len() - 1))
     }
 
+    /// The declared outputs, as the user named them, in the order declared.
+    pub fn output_paths(&self) -> impl Iterator<Item = &Path> {
+        self.outputs.iter().map(|o| o.shown.as_path())
+    }
+
     /// Records a file, refusing one already declared under another role.
     fn declare(
         &mut self,

@@ -31,6 +31,7 @@ use std::time::Instant;
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 
+use self::camera_mesh::camera_mesh;
 use crate::error::{Error, Result};
 use crate::projection::trilinear_builders::{
     reflector_surface, Optic, ReflectorSurface, SurfaceScreenMap,
@@ -351,17 +352,22 @@ impl Reflector {
     }
 }
 
-/// The surface of `reflector` for `optic` seen by `camera`, its mesh first refined with
-/// `entry`'s screen map and tolerance ([`refine`]), and the number of edges left over the
-/// tolerance (see [`refine::Refinement::unsplit`]).
+/// The surface of `reflector` for `optic` seen by `camera`: its camera mesh
+/// ([`camera_mesh`]: the given size as it is, or the automatic size refined with `entry`'s
+/// screen map and tolerance, [`refine`]), and the number of edges left over the tolerance
+/// (see [`refine::Refinement::unsplit`]).
 fn refined_surface(
     reflector: &Reflector,
     optic: Optic,
     entry: &TrilinearReflector,
     camera: &Perspective,
 ) -> Result<(ReflectorSurface, usize)> {
+    let chosen = camera_mesh(&reflector.mesh, entry, camera, optic)?;
+    if !chosen.refine {
+        return Ok((reflector_surface(&*chosen.mesh, camera, optic)?, 0));
+    }
     let refined = refine::refine(
-        &reflector.mesh,
+        &chosen.mesh,
         camera,
         optic,
         entry.screen_map,
@@ -603,6 +609,7 @@ fn check_size(main: &Frame, other: &Frame) -> Result<()> {
     Ok(())
 }
 
+pub mod camera_mesh;
 pub mod refine;
 #[cfg(test)]
 mod tests;

@@ -58,6 +58,9 @@ pub struct RenderOptions<'a> {
     pub camera_triangles: CameraTriangleOptions,
     /// Called from worker threads with (work units done, total) as rendering progresses.
     pub progress: Option<&'a (dyn Fn(u64, u64) + Sync)>,
+    /// Render only this rectangle of the image (`--crop`): the frame is that rectangle of
+    /// the whole frame, byte for byte (module `window`). `None`: the whole image.
+    pub crop: Option<PixelWindow>,
 }
 
 impl Default for RenderOptions<'_> {
@@ -73,6 +76,7 @@ impl Default for RenderOptions<'_> {
             outputs: Outputs::ALL,
             camera_triangles: CameraTriangleOptions::default(),
             progress: None,
+            crop: None,
         }
     }
 }
@@ -208,12 +212,29 @@ pub struct Rendered {
 
 /// Renders `prepared` through `projection` as `options` say: the one entry point of every
 /// method. Fails, rather than producing a wrong image, when the method cannot render that
-/// projection (with one line naming why), or on zero samples per pixel.
+/// projection (with one line naming why), on zero samples per pixel, or on a crop window
+/// that is empty or does not fit in the image.
 pub fn render(
     prepared: &PreparedScene,
     projection: &dyn Projection,
     options: &RenderOptions,
 ) -> Result<Rendered> {
+    if let Some(window) = options.crop {
+        window.check(projection.resolution())?;
+        // Only the plain ray caster renders a window's pixels alone (module `window`).
+        let raycast_alone = options.method == Method::Raycast
+            && !matches!(options.shading, Shading::Transitions(_))
+            && (!options.composite_reflectors || prepared.scene().trilinear_reflectors.is_empty());
+        if !raycast_alone {
+            let whole = RenderOptions {
+                crop: None,
+                ..*options
+            };
+            let mut rendered = render(prepared, projection, &whole)?;
+            rendered.frame = window.cut(&rendered.frame);
+            return Ok(rendered);
+        }
+    }
     let mut rendered = if options.composite_reflectors {
         composite::render(prepared, projection, options)?
     } else {
@@ -265,6 +286,7 @@ mod shading;
 mod transitions;
 mod trilinear;
 mod warning;
+mod window;
 
 pub use camera_triangles::{Bound as CameraTriangleBound, Options as CameraTriangleOptions};
 pub use compare::{compare, Comparison};
@@ -275,6 +297,7 @@ pub use reproject::{reproject, EquirectPhoto};
 pub use transitions::TransitionShading;
 pub use trilinear::{CurveMode, CurveOptions};
 pub use warning::RenderWarning;
+pub use window::PixelWindow;
 
 // What the tests of the projection layer check against a renderer.
 #[cfg(test)]

@@ -75,6 +75,12 @@ pub fn list() -> &'static [(&'static str, &'static str)] {
 
 /// Loads the built-in scene `name`. An unknown name is an error listing the valid ones.
 pub fn load(name: &str) -> Result<Scene> {
+    load_defined(name, &[])
+}
+
+/// [`load`] with `definitions` (`-D KEY=VALUE`) written into the scene's text
+/// ([`file::parse_defined`]).
+pub fn load_defined(name: &str, definitions: &[file::Definition]) -> Result<Scene> {
     let builtin = BUILTINS.iter().find(|b| b.name == name).ok_or_else(|| {
         let names: Vec<&str> = BUILTINS.iter().map(|b| b.name).collect();
         Error::new(format!(
@@ -82,7 +88,8 @@ pub fn load(name: &str) -> Result<Scene> {
             names.join(", ")
         ))
     })?;
-    let mut scene = file::parse(builtin.text, Path::new(&format!("builtin:{name}")))?;
+    let path = format!("builtin:{name}");
+    let (mut scene, _) = file::parse_defined(builtin.text, Path::new(&path), definitions)?;
     scene.base_dir = None;
     Ok(scene)
 }

@@ -8,19 +8,24 @@ use crate::error::{Error, Result};
 use crate::projection::flexible::panorama::edit_source;
 use crate::projection::flexible::FlexibleSpec;
 use crate::projection::{BuildReport, Projection, ProjectionSpec};
+use crate::scene::file::Definition;
 use crate::scene::{self, budget, Scene};
 
 /// What a caller changes in a scene file's settings. `None` keeps the file's value.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Overrides {
-    /// Image width in pixels.
+    /// Image width in pixels (alone, the height follows the scene's aspect ratio:
+    /// [`scene::ImageSettings::size_with`]).
     pub width: Option<u32>,
-    /// Image height in pixels.
+    /// Image height in pixels (alone, the width follows the scene's aspect ratio).
     pub height: Option<u32>,
     /// The local perspective edit of a shape-defined panorama (the scene key
     /// `perspective_rect`: `[u0, v0, u1, v1]` of the image domain), applied after the scene
     /// file's own rectangle, if any.
     pub perspective_rect: Option<[f64; 4]>,
+    /// Scene keys set as if the file said so (`-D KEY=VALUE`), applied in order before the
+    /// file is parsed.
+    pub definitions: Vec<Definition>,
 }
 
 /// A scene loaded with overrides and its projection built at the image size.
@@ -43,12 +48,11 @@ pub struct LoadedScene {
 /// command-line flag that sets it (`--perspective-rect`), the spelling users see.
 pub fn load_with(source: &str, overrides: &Overrides) -> Result<LoadedScene> {
     let start = Instant::now();
-    let mut scene = scene::load(source)?;
+    let mut scene = scene::load_defined(source, &overrides.definitions)?;
     if let Some(rect) = overrides.perspective_rect {
         scene.projection = perspective_rect(&scene.projection, rect)?;
     }
-    let width = overrides.width.unwrap_or(scene.image.width);
-    let height = overrides.height.unwrap_or(scene.image.height);
+    let (width, height) = scene.image.size_with(overrides.width, overrides.height);
     scene::validate_resolution(width, height)?;
     check_budget(&scene, width, height, 0).map_err(|e| e.or_in_file(source))?;
     let (projection, build_report) = crate::calibrate::build(&scene.projection, width, height)

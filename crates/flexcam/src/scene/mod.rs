@@ -46,6 +46,27 @@ pub struct ImageSettings {
     pub height: u32,
     /// Linear RGB of pixels whose ray hits nothing (or that no projector covers).
     pub background: Vec3,
+    /// Samples per pixel a command renders with unless told otherwise (`--spp`).
+    pub spp: u32,
+}
+
+impl ImageSettings {
+    /// The image size with the caller's `width` and `height` (`None` keeps the scene's):
+    /// one side alone keeps the scene's aspect ratio, the other side rounded to the nearest
+    /// pixel (at least 1).
+    pub fn size_with(&self, width: Option<u32>, height: Option<u32>) -> (u32, u32) {
+        // round(a * b / c) in integers, at least 1.
+        let scaled = |a: u32, b: u32, c: u32| {
+            let exact = (u64::from(a) * u64::from(b) + u64::from(c) / 2) / u64::from(c);
+            u32::try_from(exact).unwrap_or(u32::MAX).max(1)
+        };
+        match (width, height) {
+            (Some(w), Some(h)) => (w, h),
+            (Some(w), None) => (w, scaled(w, self.height, self.width)),
+            (None, Some(h)) => (scaled(h, self.width, self.height), h),
+            (None, None) => (self.width, self.height),
+        }
+    }
 }
 
 impl Default for ImageSettings {
@@ -54,6 +75,7 @@ impl Default for ImageSettings {
             width: 800,
             height: 600,
             background: Vec3::ZERO,
+            spp: 1,
         }
     }
 }
@@ -98,6 +120,11 @@ pub struct TrilinearReflector {
     /// The surface's refinement tolerance in main-image pixels, 0 for none (scene-file key
     /// `trilinear_refine_px`; used by the reflector compositing of [`crate::render::render`]).
     pub refine_px: f64,
+    /// The size of the reflector's camera mesh (scene-file key `camera_triangles`): a
+    /// simplification of its mesh to this many triangles, used as it is; `None` chooses
+    /// the size automatically and refines the result by [`Self::refine_px`]
+    /// (docs/camera-triangles.md).
+    pub camera_triangles: Option<usize>,
 }
 
 impl TrilinearReflector {
@@ -110,6 +137,7 @@ impl TrilinearReflector {
             id,
             screen_map: SurfaceScreenMap::default(),
             refine_px: Self::DEFAULT_REFINE_PX,
+            camera_triangles: None,
         }
     }
 }
@@ -136,8 +164,15 @@ pub use loaded::{check_budget, load_with, LoadedScene, Overrides};
 /// Loads a scene from `source`: `builtin:NAME` names a built-in scene, anything else is the
 /// path of a scene file. This is the SCENE argument of `flexcam render`.
 pub fn load(source: &str) -> crate::Result<Scene> {
+    load_defined(source, &[])
+}
+
+/// [`load`] with `definitions` (`-D KEY=VALUE`) written into the scene's text, as if the
+/// file said so ([`file::parse_defined`]).
+pub fn load_defined(source: &str, definitions: &[file::Definition]) -> crate::Result<Scene> {
     match source.strip_prefix("builtin:") {
-        Some(name) => builtin::load(name),
-        None => file::load(std::path::Path::new(source)),
+        Some(name) => builtin::load_defined(name, definitions),
+        None => file::load_animated_defined(std::path::Path::new(source), definitions)
+            .map(|(scene, _)| scene),
     }
 }

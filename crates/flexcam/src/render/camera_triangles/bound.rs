@@ -39,7 +39,7 @@ use crate::render::trilinear::plane_hit;
 pub const MARGIN_PX: f64 = 1e-4;
 
 /// Deepest quartering of the camera triangle by the tight bound.
-const MAX_DEPTH: u32 = 6;
+pub const MAX_DEPTH: u32 = 6;
 
 /// A region of fewer pixels than this is not quartered further.
 const MIN_SPLIT_PIXELS: f64 = 16.0;
@@ -74,28 +74,55 @@ impl std::str::FromStr for Bound {
 pub fn regions(camera: &Camera, q: &[DVec3; 3], bound: Bound, emit: &mut impl FnMut(&Convex)) {
     match bound {
         Bound::Paper => paper(camera, q, emit),
-        Bound::Tight => {
-            let plane = camera.plane_near((q[0] + q[1] + q[2]) / 3.0);
-            tight(camera, plane.as_ref(), q, CORNERS, 0, emit)
-        }
+        Bound::Tight => tight_in(camera, q, CORNERS, 0, emit),
     }
 }
 
-/// Whether the convex hull of `points` projected along the corner directions misses the
-/// camera triangle (so nothing inside that hull is seen by it): the culling of section 2.4
-/// for a box (its eight corners) or a triangle, on the plane near the points and on the
-/// camera plane (either hull that misses proves it). `false` where no hull bounds the region.
-pub fn misses(camera: &Camera, points: &[DVec3]) -> bool {
-    let directions = CORNERS.map(|c| camera.direction(c));
+/// The regions of [`Bound::Tight`] for scene triangle `q` inside the sub-triangle `sub` of
+/// the camera triangle, a piece of its quartering at `depth` (the whole camera triangle:
+/// [`CORNERS`] at depth 0): the union over the pieces of a quartering holds every fragment
+/// the whole would.
+pub fn tight_in(
+    camera: &Camera,
+    q: &[DVec3; 3],
+    sub: [DVec2; 3],
+    depth: u32,
+    emit: &mut impl FnMut(&Convex),
+) {
+    let plane = camera.plane_near((q[0] + q[1] + q[2]) / 3.0);
+    tight(camera, plane.as_ref(), q, sub, depth, emit)
+}
+
+/// The four quarters of `sub` (corners, then the middle one), in the order the tight bound
+/// visits them.
+pub fn quarters([a, b, c]: [DVec2; 3]) -> [[DVec2; 3]; 4] {
+    let (ab, bc, ca) = ((a + b) / 2.0, (b + c) / 2.0, (c + a) / 2.0);
+    [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]]
+}
+
+/// Whether the convex hull of `points` projected along the corner directions of the
+/// sub-triangle `sub` of the camera triangle misses `sub` (so nothing inside that hull is
+/// seen by it): the culling of section 2.4 for a box (its eight corners) or a triangle, on
+/// the plane near the points and on the camera plane (either hull that misses proves it),
+/// for the whole camera triangle ([`CORNERS`]) or a piece of it (a piece is itself a
+/// camera triangle: its corner rays are the camera's rays there). `false` where no hull
+/// bounds the region.
+pub fn misses(camera: &Camera, sub: [DVec2; 3], points: &[DVec3]) -> bool {
+    let directions = sub.map(|c| camera.direction(c));
     let centre = points.iter().sum::<DVec3>() / points.len().max(1) as f64;
     [camera.plane_near(centre).as_ref(), camera.plane()]
         .into_iter()
         .flatten()
-        .any(|plane| misses_on(plane, &directions, points))
+        .any(|plane| misses_on(plane, &directions, sub, points))
 }
 
 /// [`misses`] on one plane.
-fn misses_on(plane: &CameraPlane, directions: &[DVec3; 3], points: &[DVec3]) -> bool {
+fn misses_on(
+    plane: &CameraPlane,
+    directions: &[DVec3; 3],
+    sub: [DVec2; 3],
+    points: &[DVec3],
+) -> bool {
     if !plane.one_sided(directions) {
         return false;
     }
@@ -115,7 +142,7 @@ fn misses_on(plane: &CameraPlane, directions: &[DVec3; 3], points: &[DVec3]) -> 
     }
     // Conservative: a miss is reported only where a line separates the points from the
     // camera triangle (one of its edges, or an axis of its bounding box).
-    separated(&projected[..n], CORNERS)
+    separated(&projected[..n], sub)
 }
 
 /// Whether some edge of triangle `t` or an axis has all `points` strictly outside.
@@ -282,9 +309,7 @@ fn tight(
     if depth >= MAX_DEPTH || pixels < MIN_SPLIT_PIXELS || covers(camera, q, sub) {
         return emit_in_camera(camera, &region, emit);
     }
-    let [a, b, c] = sub;
-    let (ab, bc, ca) = ((a + b) / 2.0, (b + c) / 2.0, (c + a) / 2.0);
-    for quarter in [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]] {
+    for quarter in quarters(sub) {
         tight(camera, plane, q, quarter, depth + 1, emit);
     }
 }

@@ -6,7 +6,7 @@
 //! parallel) and scene triangle, a bounding region of the scene triangle's curved image is
 //! computed (`bound`: the paper's bounding triangle or our tighter hull, `--bound`), after
 //! culling clusters of scene triangles whose boxes the camera triangle cannot see (section
-//! 2.4). The regions are scan-converted band by band (`render::scan`), and every fragment
+//! 2.4; with the tight bound per quarter of the camera triangle, `quarter_cull`). The regions are scan-converted band by band (`render::scan`), and every fragment
 //! intersects its pixel's ray with its scene triangle's plane, is killed outside the triangle
 //! and z-tested on its exact depth (`fragment`); each pixel's winner is then shaded by the
 //! shared shading (`shade`). Nothing is ray cast to find first hits: the scene is only
@@ -23,6 +23,7 @@ mod camera;
 mod convex;
 mod fragment;
 mod owners;
+mod quarter_cull;
 mod shade;
 #[cfg(test)]
 mod tests;
@@ -34,6 +35,7 @@ use rayon::prelude::*;
 pub use bound::Bound;
 
 use self::camera::Camera;
+use self::convex::Convex;
 use self::fragment::{BandBuffer, FragmentCounts, Stage};
 use self::shade::Shader;
 use crate::error::{Error, Result};
@@ -227,41 +229,64 @@ impl<'a> CameraTriangleRenderer<'a> {
     }
 
     /// The bounding regions of every (camera, scene triangle) pair in pixels, keyed
-    /// `camera << 32 | triangle`, in camera order (computed per camera in parallel).
+    /// `camera << 32 | triangle`, in camera order (computed per camera in parallel), each
+    /// pair's regions consecutive. The tight bound with culling culls per quarter of the
+    /// camera triangle ([`quarter_cull`]); otherwise clusters are culled against the whole
+    /// camera triangle.
     fn bound_all(&self, cameras: &[Camera], method: Options) -> (PolygonBatch<0>, PairCounts) {
         let scene = &self.scene;
         let per_camera: Vec<(PolygonBatch<0>, PairCounts)> = cameras
             .par_iter()
             .enumerate()
-            .map(|(c, camera)| {
-                let mut batch = PolygonBatch::new();
-                let mut counts = PairCounts::default();
-                let mut vertices: Vec<Vertex<0>> = Vec::new();
-                for cluster in &scene.clusters {
-                    let size = cluster.triangles.len() as u64;
-                    if method.cull && bound::misses(camera, &cluster.box_corners) {
-                        counts.culled += size;
-                        continue;
-                    }
-                    counts.pairs += size;
-                    for k in cluster.triangles.clone() {
-                        let key = ((c as u64) << 32) | k as u64;
-                        let id = scene.owners[k].id;
-                        bound::regions(camera, &scene.corners(k), method.bound, &mut |region| {
-                            vertices.clear();
-                            vertices.extend(
-                                region
-                                    .points()
-                                    .iter()
-                                    .map(|p| Vertex::new(p.x, p.y, 0.0, [])),
+            .map_init(
+                || (Vec::new(), quarter_cull::Buffers::default()),
+                |(vertices, buffers), (c, camera)| {
+                    let mut batch = PolygonBatch::new();
+                    let mut counts = PairCounts::default();
+                    let mut push = |k: usize, region: &Convex| {
+                        vertices.clear();
+                        vertices.extend(
+                            region
+                                .points()
+                                .iter()
+                                .map(|p| Vertex::new(p.x, p.y, 0.0, [])),
+                        );
+                        batch.push(vertices, scene.owners[k].id, ((c as u64) << 32) | k as u64);
+                        counts.regions += 1;
+                    };
+                    if method.cull && method.bound == Bound::Tight {
+                        counts.pairs = quarter_cull::pieces(camera, scene, buffers);
+                        counts.culled = scene.triangles.len() as u64 - counts.pairs;
+                        for piece in &buffers.pieces {
+                            let k = piece.triangle as usize;
+                            bound::tight_in(
+                                camera,
+                                &scene.corners(k),
+                                piece.sub,
+                                piece.depth,
+                                &mut |region| push(k, region),
                             );
-                            batch.push(&vertices, id, key);
-                            counts.regions += 1;
-                        });
+                        }
+                    } else {
+                        for cluster in &scene.clusters {
+                            let size = cluster.triangles.len() as u64;
+                            if method.cull
+                                && bound::misses(camera, camera::CORNERS, &cluster.box_corners)
+                            {
+                                counts.culled += size;
+                                continue;
+                            }
+                            counts.pairs += size;
+                            for k in cluster.triangles.clone() {
+                                bound::regions(camera, &scene.corners(k), method.bound, &mut |r| {
+                                    push(k, r)
+                                });
+                            }
+                        }
                     }
-                }
-                (batch, counts)
-            })
+                    (batch, counts)
+                },
+            )
             .collect();
         let mut all = PolygonBatch::new();
         let mut counts = PairCounts::default();

@@ -21,7 +21,7 @@ use self::pieces::polyline_segment;
 use crate::geometry::Ray;
 use crate::projection::Projection;
 use crate::render::prepared::{Hit32, PreparedScene};
-use crate::render::{Frame, RenderOptions, Stats};
+use crate::render::{Frame, PixelWindow, RenderOptions, Stats};
 
 impl PreparedScene {
     /// The first hits of four polyline projectors (`None`: no projector) and the segments
@@ -69,8 +69,8 @@ pub fn render(
     projection: &dyn Projection,
     options: &RenderOptions,
 ) -> (Frame, Stats) {
-    let (width, height) = projection.resolution();
-    let mut frame = Frame::zeroed(width, height, options.outputs);
+    let window = window_of(projection, options);
+    let mut frame = Frame::zeroed(window.width(), window.height(), options.outputs);
     let stats = render_into(scene, &mut frame, projection, options);
     (frame, stats)
 }
@@ -81,16 +81,17 @@ pub fn render(
 /// one frame and pays neither its allocation nor the first touch of its pages again; a
 /// frame of another size than the projection's resolution (or whose buffers do not match
 /// its size) is replaced by one of the right size. `options.spp = 0` counts as one
-/// sample. See `shade` for what the depth and id of a pixel are.
+/// sample. See `shade` for what the depth and id of a pixel are. With `options.crop` the
+/// frame is the window's (a window that fits in the image: `render::render` checks it).
 pub fn render_into(
     scene: &PreparedScene,
     frame: &mut Frame,
     projection: &dyn Projection,
     options: &RenderOptions,
 ) -> Stats {
-    let (width, height) = projection.resolution();
-    frame.fit(width, height, options.outputs);
-    let mut stats = tiles::render(scene, projection, options, frame);
+    let window = window_of(projection, options);
+    frame.fit(window.width(), window.height(), options.outputs);
+    let mut stats = tiles::render(scene, projection, options, window, frame);
     stats.insert(
         "bvh_build_ms",
         crate::render::Counter::Value(scene.build_ms),
@@ -110,6 +111,14 @@ pub fn render_into(
         );
     }
     stats
+}
+
+/// The pixels `options` asks for: its crop window, or the whole image.
+fn window_of(projection: &dyn Projection, options: &RenderOptions) -> PixelWindow {
+    let (width, height) = projection.resolution();
+    options
+        .crop
+        .unwrap_or_else(|| PixelWindow::whole(width, height))
 }
 
 #[cfg(test)]

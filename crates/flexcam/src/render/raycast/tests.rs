@@ -90,6 +90,7 @@ fn scene(objects: Vec<Object>, lights: Vec<Light>) -> Scene {
             width: 1,
             height: 1,
             background: Vec3::new(0.0, 0.0, 0.25),
+            spp: 1,
         },
         projection: ProjectionSpec::Perspective {
             frame: CameraFrame {

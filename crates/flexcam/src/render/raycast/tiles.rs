@@ -15,7 +15,7 @@ use super::shade::{Sample, Tracer};
 use crate::projection::{Projection, Projector};
 use crate::render::prepared::PreparedScene;
 use crate::render::shading::trace::RayCounts;
-use crate::render::{Counter, Frame, RenderOptions, Stats};
+use crate::render::{Counter, Frame, PixelWindow, RenderOptions, Stats};
 
 /// Tile edge in pixels: small enough to balance two to many cores, large enough that the
 /// per-tile bookkeeping is negligible.
@@ -41,16 +41,18 @@ struct Tile {
     culled_blocks: u64,
 }
 
-/// Renders every pixel of `projection`'s image into `frame`, which must already be of its
-/// resolution; see [`raycast::render_into`]. The bands and their tiles cover the frame, so
-/// every pixel is overwritten whatever the frame held.
+/// Renders the pixels of `window` of `projection`'s image into `frame`, which must already
+/// be of the window's size; see [`raycast::render_into`]. The tiles start at the window's
+/// corner; the bands and their tiles cover the frame, so every pixel is overwritten
+/// whatever the frame held.
 pub(super) fn render(
     caster: &PreparedScene,
     projection: &dyn Projection,
     options: &RenderOptions,
+    window: PixelWindow,
     frame: &mut Frame,
 ) -> Stats {
-    let (width, height) = projection.resolution();
+    let (width, height) = (window.width(), window.height());
     debug_assert_eq!((frame.width, frame.height), (width, height));
     let pattern = SamplePattern::new(options.spp);
     let tiles_x = width.div_ceil(TILE);
@@ -71,7 +73,12 @@ pub(super) fn render(
                 .into_par_iter()
                 .map(|column| {
                     let x0 = column * TILE;
-                    let rect = (x0, y0, TILE.min(width - x0), TILE.min(height - y0));
+                    let rect = (
+                        window.x0 + x0,
+                        window.y0 + y0,
+                        TILE.min(width - x0),
+                        TILE.min(height - y0),
+                    );
                     let tile = render_tile(caster, projection, options, &pattern, rect);
                     if let Some(progress) = options.progress {
                         progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
@@ -83,7 +90,7 @@ pub(super) fn render(
             for tile in &tiles {
                 let w = tile.width as usize;
                 for (r, src) in (0..tile.color.len() / w).map(|r| (r, r * w..(r + 1) * w)) {
-                    let start = r * width as usize + tile.x0 as usize;
+                    let start = r * width as usize + (tile.x0 - window.x0) as usize;
                     let dst = start..start + w;
                     color[dst.clone()].copy_from_slice(&tile.color[src.clone()]);
                     if !depth.is_empty() {

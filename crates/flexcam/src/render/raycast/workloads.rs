@@ -44,6 +44,7 @@ pub fn teapot_scene(faces: u32) -> (Scene, usize) {
             width: TABLE_SIZE,
             height: TABLE_SIZE,
             background: Vec3::new(0.55, 0.7, 0.9),
+            spp: 1,
         },
         projection: ProjectionSpec::Perspective {
             frame: CameraFrame {

@@ -98,6 +98,7 @@ pub fn random_triangles(count: u32, seed: u64) -> Scene {
             width: 640,
             height: 640,
             background: Vec3::ZERO,
+            spp: 1,
         },
         projection: ProjectionSpec::Perspective {
             frame: CameraFrame {

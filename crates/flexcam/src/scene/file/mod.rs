@@ -7,6 +7,7 @@
 mod animation;
 mod calibrated_projection;
 mod control_surface;
+mod definitions;
 mod displacement;
 mod fitted_grid;
 mod flexible;
@@ -20,6 +21,7 @@ mod raw;
 mod shape;
 mod source;
 mod strict;
+mod suggest;
 mod trilinear_grid;
 mod values;
 
@@ -37,11 +39,15 @@ use crate::file_read::{read_regular_text, MAX_SCENE_FILE_BYTES};
 use crate::projection::flexible::Animation;
 
 pub use self::animation::DEFAULT_FPS;
+pub use self::definitions::Definition;
 pub use self::fitted_grid::{fit_scene, FittedScene};
 
 /// The largest accepted image side, in pixels. It keeps an image at or below 2^28 pixels, so
 /// that frame buffers (several values per pixel) fit in memory.
 pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+/// The most samples per pixel a scene (`[image] spp`) or `--spp` may ask for.
+pub const MAX_SPP: u32 = 4096;
 
 /// Checks an image resolution: both sides in 1..=[`MAX_IMAGE_SIDE`]. The CLI reuses it for
 /// its `--width` / `--height` overrides.
@@ -71,8 +77,17 @@ pub fn parse(text: &str, path: &Path) -> Result<Scene> {
 /// Reads and parses the scene file at `path` with its `[animation]` table, if any. The
 /// scene file is the first of the scene's [`Scene::inputs`].
 pub fn load_animated(path: &Path) -> Result<(Scene, Option<Animation>)> {
+    load_animated_defined(path, &[])
+}
+
+/// [`load_animated`] with `definitions` (`-D KEY=VALUE`) written into the file's text
+/// ([`parse_defined`]).
+pub fn load_animated_defined(
+    path: &Path,
+    definitions: &[Definition],
+) -> Result<(Scene, Option<Animation>)> {
     let text = read_regular_text(path, "scene file", MAX_SCENE_FILE_BYTES)?;
-    let (mut scene, animation) = parse_animated(&text, path)?;
+    let (mut scene, animation) = parse_defined(&text, path, definitions)?;
     scene.inputs.insert(
         0,
         InputFile {
@@ -81,6 +96,20 @@ pub fn load_animated(path: &Path) -> Result<(Scene, Option<Animation>)> {
         },
     );
     Ok((scene, animation))
+}
+
+/// [`parse_animated`] of `text` with `definitions` (`-D KEY=VALUE`) written into it; an
+/// error in a definition's key or value names the definition (module `definitions`).
+pub fn parse_defined(
+    text: &str,
+    path: &Path,
+    definitions: &[Definition],
+) -> Result<(Scene, Option<Animation>)> {
+    if definitions.is_empty() {
+        return parse_animated(text, path);
+    }
+    let (edited, spans) = definitions::apply(text, path, definitions)?;
+    parse_animated(&edited, path).map_err(|e| definitions::blame(e, &edited, definitions, &spans))
 }
 
 /// As [`parse`], also giving the keyframed camera of the `[animation]` table, if any. The
@@ -170,10 +199,21 @@ fn image_settings(src: &Source, table: Option<&Spanned<RawImage>>) -> Result<Ima
         .background
         .as_ref()
         .map_or(Ok(Vec3::ZERO), |b| src.color(b, "background"))?;
+    let spp = match &raw.spp {
+        Some(spp) if !(1..=MAX_SPP).contains(spp.get_ref()) => {
+            return Err(src.error(
+                &spp.span(),
+                format!("spp must be 1 to {MAX_SPP}, got {}", spp.get_ref()),
+            ))
+        }
+        Some(spp) => *spp.get_ref(),
+        None => defaults.spp,
+    };
     Ok(ImageSettings {
         width,
         height,
         background,
+        spp,
     })
 }
 

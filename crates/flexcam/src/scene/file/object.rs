@@ -94,11 +94,13 @@ pub(super) fn convert(
 /// rendered through a trilinear surface built from its mesh and composited into the main
 /// image, with screen map `trilinear_screen_map` (default affine) and refinement tolerance
 /// `trilinear_refine_px` (main-image pixels, default
-/// [`TrilinearReflector::DEFAULT_REFINE_PX`], 0 for none). Errors, at the key: an object
+/// [`TrilinearReflector::DEFAULT_REFINE_PX`], 0 for none) and camera-mesh size
+/// `camera_triangles` (default automatic). Errors, at the key: an object
 /// whose material is neither mirror nor glass, a scene whose projection is not perspective
 /// (the surface's screen positions are the main camera's image of the reflector), a
 /// `trilinear_screen_map` other than "projective" or "affine", a `trilinear_refine_px` that
-/// is negative or not finite, or either key without `trilinear_reflector = true`.
+/// is negative or not finite, a bad `camera_triangles` ([`camera_triangles`]), or any of
+/// these keys without `trilinear_reflector = true`.
 pub(super) fn trilinear_reflector(
     src: &Source,
     table: &Spanned<RawObject>,
@@ -133,6 +135,7 @@ pub(super) fn trilinear_reflector(
             px
         }
     };
+    let camera_triangles = camera_triangles(src, table, parts)?;
     let enabled = raw
         .trilinear_reflector
         .as_ref()
@@ -148,6 +151,12 @@ pub(super) fn trilinear_reflector(
             return Err(src.error(
                 &value.span(),
                 "`trilinear_refine_px` needs `trilinear_reflector = true`",
+            ));
+        }
+        if let Some(value) = &raw.camera_triangles {
+            return Err(src.error(
+                &value.span(),
+                "`camera_triangles` needs `trilinear_reflector = true`",
             ));
         }
         return Ok(None);
@@ -178,7 +187,40 @@ pub(super) fn trilinear_reflector(
         id,
         screen_map,
         refine_px,
+        camera_triangles,
     }))
+}
+
+/// The object's `camera_triangles` (the size of its camera mesh), if given. Errors, at the
+/// key: not a whole number, below 1, more than the object's own triangles, or given
+/// together with `trilinear_refine_px` (which refines the automatically chosen mesh only).
+fn camera_triangles(
+    src: &Source,
+    table: &Spanned<RawObject>,
+    parts: &[Object],
+) -> Result<Option<usize>> {
+    let raw = table.get_ref();
+    let Some(value) = &raw.camera_triangles else {
+        return Ok(None);
+    };
+    let n = *value.get_ref() as usize;
+    let own: usize = parts.iter().map(|p| p.mesh.triangles.len()).sum();
+    if n == 0 || n > own {
+        return Err(src.error(
+            &value.span(),
+            format!(
+                "`camera_triangles` must be between 1 and the object's {own} triangles, not {n}"
+            ),
+        ));
+    }
+    if raw.trilinear_refine_px.is_some() {
+        return Err(src.error(
+            &value.span(),
+            "`camera_triangles` fixes the camera mesh, which is not refined: leave out \
+             `trilinear_refine_px` (it refines the automatically sized mesh)",
+        ));
+    }
+    Ok(Some(n))
 }
 
 /// The scene-file name (key `surface`) of a finish.

@@ -56,6 +56,7 @@ pub struct RawImage {
     pub height: Option<Spanned<u32>>,
     #[serde(default, deserialize_with = "strict")]
     pub background: Option<Vec3Value>,
+    pub spp: Option<Spanned<u32>>,
 }
 
 /// `[projection]`: the union of every projection type's parameters.
@@ -453,6 +454,7 @@ pub struct RawObject {
     pub trilinear_reflector: Option<Spanned<bool>>,
     pub trilinear_screen_map: Option<Spanned<String>>,
     pub trilinear_refine_px: Option<Spanned<f64>>,
+    pub camera_triangles: Option<Spanned<u32>>,
     pub displacement: Option<Spanned<super::displacement::RawDisplacement>>,
 }
 

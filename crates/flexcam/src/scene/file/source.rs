@@ -145,9 +145,11 @@ impl<'a> Source<'a> {
 
     /// Converts a TOML syntax or type error into a positioned one-line error.
     pub fn toml_error(&self, error: &toml::de::Error) -> Error {
+        let message =
+            super::suggest::unknown_key(error.message()).unwrap_or_else(|| error.message().into());
         match error.span() {
-            Some(span) => self.error(&span, error.message()),
-            None => self.file_error(error.message()),
+            Some(span) => self.error(&span, message),
+            None => self.file_error(message),
         }
     }
 

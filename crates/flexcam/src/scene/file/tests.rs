@@ -98,18 +98,23 @@ fn unknown_keys_are_errors_everywhere() {
         &format!("{CAMERA}[camera]\n"),
         6,
         2,
-        "unknown field `camera`",
+        "unknown key `camera`; did you mean `image`?",
     );
-    assert_error_at("[image]\nwidht = 3\n", 2, 1, "unknown field `widht`");
+    assert_error_at(
+        "[image]\nwidht = 3\n",
+        2,
+        1,
+        "unknown key `widht`; did you mean `width`?",
+    );
     assert_error_at(
         &object("shape = \"sphere\"\nradius = 2\n"),
         8,
         1,
-        "unknown field `radius`",
+        "unknown key `radius`; did you mean",
     );
     assert_error(
         &object("shape = \"plane\"\nchecker = { colour = [0, 0, 0] }\n"),
-        "unknown field `colour`",
+        "unknown key `colour`; did you mean `color`?",
     );
     assert_error(
         &format!("{CAMERA}[[light]]\ntype = \"point\"\nposition = [0, 1, 0]\npower = 2\n"),
@@ -119,7 +124,7 @@ fn unknown_keys_are_errors_everywhere() {
         &format!("{CAMERA}lookat = [0, 0, 0]\n"),
         6,
         1,
-        "unknown field `lookat`",
+        "unknown key `lookat`; did you mean `look_at`?",
     );
 }
 
@@ -1386,6 +1391,57 @@ fn trilinear_screen_map_key() {
         9,
         24,
         "needs `trilinear_reflector = true`",
+    );
+}
+
+#[test]
+fn camera_triangles_key() {
+    let mirror = |extra: &str| {
+        format!(
+            "{CAMERA}[[object]]\nshape = \"sphere\"\ntessellation = 8\nmaterial = \"mirror\"\n{extra}\n"
+        )
+    };
+    let size = |extra: &str| {
+        scene(&mirror(&format!("trilinear_reflector = true\n{extra}"))).trilinear_reflectors[0]
+            .camera_triangles
+    };
+    assert_eq!(size(""), None);
+    assert_eq!(size("camera_triangles = 20"), Some(20));
+    let own = scene(&mirror("")).objects[0].mesh.triangles.len();
+    assert_eq!(size(&format!("camera_triangles = {own}")), Some(own));
+    let at = |extra: &str, message: &str| {
+        assert_error_at(
+            &mirror(&format!("trilinear_reflector = true\n{extra}")),
+            11,
+            20,
+            message,
+        )
+    };
+    at(
+        "camera_triangles = 0",
+        &format!("`camera_triangles` must be between 1 and the object's {own} triangles, not 0"),
+    );
+    at(
+        &format!("camera_triangles = {}", own + 1),
+        &format!(
+            "must be between 1 and the object's {own} triangles, not {}",
+            own + 1
+        ),
+    );
+    at("camera_triangles = -3", "invalid value");
+    at("camera_triangles = 2.5", "invalid type");
+    at("camera_triangles = \"auto\"", "invalid type");
+    assert_error_at(
+        &mirror("trilinear_reflector = true\ntrilinear_refine_px = 0.25\ncamera_triangles = 20"),
+        12,
+        20,
+        "leave out `trilinear_refine_px`",
+    );
+    assert_error_at(
+        &mirror("camera_triangles = 20"),
+        10,
+        20,
+        "`camera_triangles` needs `trilinear_reflector = true`",
     );
 }
 
