@@ -50,6 +50,14 @@ enum Command {
     Pick(commands::pick::PickArgs),
     /// List the built-in scenes: name, then a description.
     Scenes,
+    /// Print every image position of a scene point through the scene's projection, one line
+    /// per image, nearest first: pixel x and y (continuous: pixel (x, y) covers
+    /// [x, x + 1) x [y, y + 1), y down) and the depth (the distance along that pixel's ray,
+    /// as `render --depth` writes it). A trilinear mesh can image a point several times (all
+    /// roots of each projection triangle's cubic) or not at all (no line). Only images inside
+    /// the image and in front of the view plane are listed; projections without an analytic
+    /// inverse are refused.
+    Project(commands::project::ProjectArgs),
     /// Render a scene with a method and with the reference ray caster, and report how closely
     /// they agree (object ids, depth, relative RGB error).
     #[command(after_help = OUTPUTS_HELP)]
@@ -85,6 +93,7 @@ fn main() -> ExitCode {
         Command::Fit(args) => commands::fit::run(&args),
         Command::Pick(args) => commands::pick::run(&args),
         Command::Scenes => commands::scenes::run(),
+        Command::Project(args) => commands::project::run(&args),
         Command::Compare(args) => return commands::compare::run(&args),
         Command::Simplify(args) => commands::simplify::run(&args),
         Command::ImportCameras(args) => commands::import_cameras::run(&args),

@@ -1440,9 +1440,11 @@ fn compare_thresholds_that_cannot_be_checked_are_refused() {
     run_ok(&dir, &[&compare[..], &ok[..]].concat());
 }
 
-/// A projection triangle from an OBJ surface whose rays cross (fold) inside the cube: the
-/// outlines of its projected shapes drew the cube's hidden faces over its top (relative RGB
-/// error 0.064 with adaptive curves, 0.062 with slicing). Its pixels are now ray cast, and
+/// A projection triangle from an OBJ surface whose rays cross inside the cube, where its
+/// parametric triangle (horizontal at every depth) degenerates to a segment: the outlines
+/// of its projected shapes ran through infinity there and drew the cube's hidden faces over
+/// its top (relative RGB error 0.064 with adaptive curves, 0.062 with slicing). The pairs
+/// whose shapes reach across that depth are unprojectable, its pixels are ray cast, and
 /// `--stats` counts it.
 #[test]
 fn trilinear_projection_triangle_folding_inside_the_scene() {
@@ -1532,9 +1534,13 @@ fn trilinear_rays_meeting_in_front_of_the_scene() {
 }
 
 /// The inward-looking sphere (Vallance 2005, Figure 6.9): every ray passes through the centre,
-/// inside the cube, so every projection triangle but the 48 of the pole rows (which sweep no
-/// volume and are ray cast) is a central projection, drawn exactly: every pixel the ray
-/// caster's id and colour.
+/// inside the cube, so every projection triangle but the 48 of the pole rows is a central
+/// projection, drawn exactly; the pole rows' triangles have two equal vertices, sweep no
+/// volume and are drawn as fans of rays (`render::trilinear::ray_fan`): every pixel the ray
+/// caster's id; the colour differs at 7 pixels of one image row whose shared ray passes
+/// exactly through a vertex of the cube's tessellated top or bottom, which the ray caster
+/// misses there and sees the far face (relative RGB error 0.00017; with those pixels ray
+/// cast it was 1.5e-8).
 #[test]
 fn trilinear_inward_sphere_is_drawn_as_central_projections() {
     let dir = TempDir::new().unwrap();
@@ -1543,11 +1549,11 @@ fn trilinear_inward_sphere_is_drawn_as_central_projections() {
     let (report, stats) = trilinear_compare_and_stats(&dir, "inward.toml", "adaptive");
     assert_eq!(report["id_agreement"].as_f64().unwrap(), 1.0, "{report}");
     assert!(
-        report["relative_rgb_error"].as_f64().unwrap() < 1e-6,
+        report["relative_rgb_error"].as_f64().unwrap() < 2e-4,
         "{report}"
     );
     assert_eq!(stats["central_triangles"], 1104, "{stats}");
-    assert_eq!(stats["fallback_triangles"], 48, "{stats}");
+    assert_eq!(stats["fallback_triangles"], 0, "{stats}");
     assert!(stats["shapes"].as_u64().unwrap() > 1104, "{stats}");
 }
 

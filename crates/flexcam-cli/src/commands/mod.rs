@@ -7,6 +7,7 @@ pub mod fit;
 pub mod frame_list;
 pub mod import_cameras;
 pub mod pick;
+pub mod project;
 pub mod render;
 pub mod reproject;
 pub mod scene_args;

@@ -12,7 +12,7 @@
 //! beyond `F` on the way out, turned by 180 degrees. The cubic of a scene point then has a
 //! double root at `t0`, and the outlines of scene-edge images cannot enclose the image of a
 //! scene triangle reaching across that plane (two unbounded pieces; the reason such
-//! triangles were ray cast, `ProjectionTriangleCache::collapses_before`).
+//! triangles cannot be drawn by their shapes, `ProjectionTriangleCache::degenerates_before`).
 //!
 //! Drawn here instead, in homogeneous coordinates: with `Y = X - F`, the base-point
 //! barycentrics times `w` and `w` itself are linear in `Y` (`u w = U . Y`, `v w = V . Y`,

@@ -14,8 +14,13 @@
 //! non-zero fill, z-buffer), every fragment finished to its exact hit from its interpolated
 //! terms before its z-test, and each pixel's winner shaded once (`shade`).
 //!
-//! Unprojectable pairs (see `projection::Unprojectable`) are counted and their projection
-//! triangle is ray cast instead, so they never silently vanish.
+//! Projection triangles whose rays fold are drawn so too (the sweep by depth covers each pixel
+//! once, see `projection::trilinear::point_projection::fold`); those whose rays meet in one
+//! point are drawn as central projections (`central`), and those with two equal vertices,
+//! which sweep no volume, as strips of one ray each (`ray_fan`). Unprojectable pairs (see
+//! `projection::Unprojectable`, and pairs with a shape reaching across a depth where the
+//! parametric triangle degenerates) are counted and their projection triangle is ray cast
+//! instead, so they never silently vanish; docs/trilinear-raster.md lists these cases.
 
 mod central;
 mod clip;
@@ -29,6 +34,7 @@ mod hit_terms;
 mod outline;
 mod pair_cull;
 mod polygons;
+mod ray_fan;
 mod resolve;
 mod scene_geometry;
 mod screen_map;
@@ -54,6 +60,7 @@ pub use screen_map::ScreenMap;
 
 use self::central::CentralProjection;
 use self::polygons::ProjectedScene;
+use self::ray_fan::RayFan;
 use self::resolve::Resolver;
 use self::shade::{ShadeCounts, Shader};
 use crate::error::{Error, Result};
@@ -138,25 +145,29 @@ impl<'a> TrilinearRenderer<'a> {
         let start = Instant::now();
         let (width, height) = projection.resolution();
         let mut triangles = projection_triangles(projection);
-        // Projection triangles that sweep a surface, not a volume, project no scene point
-        // but still see the scene, and those whose rays cross (fold) or all meet in one
-        // point (collapse) at a depth the scene reaches see regions that no outline of
-        // scene-edge images bounds (`ProjectionTriangleCache::folds_before`,
-        // `collapses_before`). Where the rays meet exactly in one point the triangle is a
-        // central projection and is drawn as one (`central`); the pixels of the others are
-        // ray cast, and their pairs are not projected.
+        // Projection triangles whose rays fold are drawn by their shapes like any other
+        // (the module doc of `projection::trilinear::point_projection::fold` says why that
+        // is exact). Two kinds are not. One whose rays meet in one point at a depth the
+        // scene reaches (its parametric triangle degenerates there, `degenerates_before`,
+        // and the plane through the point is imaged at infinity) is drawn as a central
+        // projection (`central`); where it degenerates otherwise (to a segment), only the
+        // pairs with a shape reaching across that depth are ray cast (`polygons`). One that
+        // sweeps a surface, not a volume, projects no scene point and is drawn as a fan of
+        // rays where two of its vertices are equal (`ray_fan`); the pixels of the others
+        // are ray cast, and their pairs are not projected.
         for triangle in &mut triangles {
             let cache = *triangle.map.cache();
-            let reach = self
-                .bounding_sphere
-                .map(|(center, radius)| cache.depth_reaching(center, radius));
-            let sweeps = cache.sweeps_no_volume();
-            let folds = reach.is_some_and(|reach| cache.folds_before(reach));
-            let collapses = reach.is_some_and(|reach| cache.collapses_before(reach));
-            triangle.central = (collapses && !folds && !sweeps)
-                .then(|| CentralProjection::of(&cache))
-                .flatten();
-            triangle.ray_cast = sweeps || folds || (collapses && triangle.central.is_none());
+            if cache.sweeps_no_volume() {
+                triangle.fan = RayFan::of(&cache);
+                triangle.ray_cast = triangle.fan.is_none();
+                continue;
+            }
+            let degenerates = self.bounding_sphere.is_some_and(|(center, radius)| {
+                cache.degenerates_before(cache.depth_reaching(center, radius))
+            });
+            if degenerates {
+                triangle.central = CentralProjection::of(&cache);
+            }
         }
         let ProjectedScene {
             polygons,

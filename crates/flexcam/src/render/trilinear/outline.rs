@@ -6,6 +6,7 @@ use glam::DVec3;
 
 use super::central::CentralProjection;
 use super::edge_path::{refine_around, CrossingQuadratic, EdgePath, EdgeSurface, OutlinePoint};
+use super::ray_fan::RayFan;
 use super::screen_map::ScreenMap;
 use super::volume_bounds::VolumeBounds;
 use crate::geometry::Roots;
@@ -39,6 +40,14 @@ pub struct ProjectionTriangle {
     /// projection its pairs are drawn with instead of their cubics and outlines (set by
     /// the renderer; `None` from [`Self::new`]).
     pub central: Option<CentralProjection>,
+    /// Where two of its vertices share base point and ray (its rays a one-parameter
+    /// family, sweeping no volume): the fan its pairs are drawn with as strips instead of
+    /// their cubics and outlines (set by the renderer; `None` from [`Self::new`]).
+    pub fan: Option<RayFan>,
+    /// The depths at which its parametric triangle degenerates, first and last
+    /// (`ProjectionTriangleCache::degenerate_depths`): a shape reaching across them has an
+    /// outline through infinity, and its pair is ray cast instead.
+    pub degenerate: Option<(f64, f64)>,
 }
 
 impl ProjectionTriangle {
@@ -55,6 +64,8 @@ impl ProjectionTriangle {
             bounds: VolumeBounds::new(p, n),
             ray_cast: false,
             central: None,
+            fan: None,
+            degenerate: map.cache().degenerate_depths(),
         }
     }
 }

@@ -100,7 +100,8 @@ pub struct LivePair {
     pub triangle: u32,
     /// Where its three vertices' solutions are in [`LivePairs::solutions`]; not solved
     /// (`u32::MAX`) for a projection triangle drawn as a central projection
-    /// ([`ProjectionTriangle::central`]), which needs none.
+    /// ([`ProjectionTriangle::central`]) or a fan of rays ([`ProjectionTriangle::fan`]),
+    /// which need none.
     pub solved: [u32; 3],
 }
 
@@ -231,8 +232,12 @@ pub fn live_pairs(
                 counts.culled_zero_area += 1;
                 continue;
             }
+            // A fan of rays projects no scene point: its pairs need no cubic.
             let solved = corners.map(|i| {
                 let state = &mut cache.states[i as usize];
+                if triangle.fan.is_some() {
+                    return NOT_SOLVED;
+                }
                 if state.solved == NOT_SOLVED {
                     counts.vertices_projected += 1;
                     state.solved = live.solutions.len() as u32;

@@ -20,7 +20,7 @@ use super::scene_geometry::SceneGeometry;
 use super::screen_map::ScreenMap;
 use super::view_plane::clipping_base;
 use crate::projection::{
-    project_solved_triangle, ProjectionTriangleCache, Shape, Solutions, Trilinear,
+    project_solved_triangle, ProjectionTriangleCache, Shape, Solutions, TriangleShapes, Trilinear,
 };
 use crate::render::scan::{PolygonBatch, Vertex};
 
@@ -232,6 +232,7 @@ struct Scratch {
     grid: Vec<DVec3>,
     grid_solutions: Vec<Solutions>,
     central: central::Scratch,
+    fan_breaks: Vec<f64>,
 }
 
 /// Culls (behind the view plane, outside a domain line) or draws each of `pairs` (live
@@ -269,6 +270,12 @@ fn draw_pairs(
             if drawn.is_err() {
                 out.counts.unprojectable += 1;
             }
+        } else if let Some(fan) = &triangle.fan {
+            let strips = fan.outlines(positions, &mut scratch.fan_breaks, |outline| {
+                out.push(outline, group.projection, live.triangle);
+                out.counts.outline_points += outline.len() as u64;
+            });
+            out.counts.shapes += strips;
         } else {
             let solved = group.solved(live);
             match cull(triangle, positions, &solved) {
@@ -363,7 +370,8 @@ impl Pair<'_> {
         scratch: &mut Scratch,
     ) {
         let cache = self.triangle.map.cache();
-        let Ok(shapes) = project_solved_triangle(cache, scene, solved) else {
+        let shapes = project_solved_triangle(cache, scene, solved);
+        let Some(shapes) = shapes.ok().filter(|s| !self.reaches_a_degenerate_depth(s)) else {
             out.counts.unprojectable += 1;
             return;
         };
@@ -416,7 +424,7 @@ impl Pair<'_> {
                     let corners = sub.map(|k| scratch.grid[k]);
                     let solved = sub.map(|k| scratch.grid_solutions[k]);
                     match project_solved_triangle(cache, corners, solved) {
-                        Ok(shapes) => {
+                        Ok(shapes) if !self.reaches_a_degenerate_depth(&shapes) => {
                             let mut crossings = self
                                 .crossings(corners, || depth_range(shapes.iter().filter(is_drawn)));
                             for shape in shapes.iter() {
@@ -425,11 +433,29 @@ impl Pair<'_> {
                                 self.draw_shape(&shape, corners, sampling, crossings, out, scratch);
                             }
                         }
-                        Err(_) => out.counts.unprojectable += 1,
+                        _ => out.counts.unprojectable += 1,
                     }
                 }
             }
         }
+    }
+
+    /// Whether a shape of `shapes` reaches from before to beyond a depth at which the
+    /// projection triangle's parametric triangle degenerates
+    /// ([`ProjectionTriangle::degenerate`]): its outline then runs through infinity, which
+    /// no polygon of sampled points follows (the module doc of
+    /// `projection::trilinear::point_projection::fold`). Shapes ending before or starting
+    /// beyond it are bounded and exact.
+    fn reaches_a_degenerate_depth(&self, shapes: &TriangleShapes) -> bool {
+        let Some((first, last)) = self.triangle.degenerate else {
+            return false;
+        };
+        shapes.iter().any(|shape| {
+            let depths = shape.vertices.iter().map(|x| x.t);
+            let lo = depths.clone().fold(f64::INFINITY, f64::min);
+            let hi = depths.fold(f64::NEG_INFINITY, f64::max);
+            lo <= last && hi >= first
+        })
     }
 
     /// The edge-surface crossings of the scene triangle (or piece) `scene` for its shapes,

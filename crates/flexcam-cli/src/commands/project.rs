@@ -1,0 +1,111 @@
+//! `flexcam project`: every image position of one scene point through a scene's projection,
+//! by the projection's analytic inverse (for a trilinear mesh, every root of every projection
+//! triangle's cubic, Vallance 2005, chapter 3).
+
+use clap::Args;
+use flexcam::projection::ImagePoint;
+use flexcam::{Error, Result};
+use glam::{DVec2, DVec3};
+use serde_json::json;
+
+use super::scene_args::SceneArgs;
+
+/// Arguments of `flexcam project`.
+#[derive(Args, Debug)]
+pub struct ProjectArgs {
+    /// The projection: the scene file's `[projection]` and `[image]` (objects are ignored).
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// The scene point, as three numbers separated by commas (a leading minus sign is
+    /// part of the point, not an option).
+    #[arg(value_name = "X,Y,Z", allow_hyphen_values = true)]
+    point: String,
+    /// Print one JSON object (`point`, `images`: each with `x`, `y`, `depth`, `t`) instead
+    /// of one line per image.
+    #[arg(long)]
+    json: bool,
+}
+
+/// One image of the point: its continuous pixel position (x right, y down, pixel (x, y)
+/// covering [x, x + 1) x [y, y + 1)), the distance along its pixel's ray from the ray's
+/// origin (what `render --depth` writes there when nothing is in front) and the ray
+/// parameter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Image {
+    pixel: DVec2,
+    depth: f64,
+    t: f64,
+}
+
+/// Runs `flexcam project`: loads the scene's projection, finds every image of the point
+/// inside the image in front of the view plane (`t >= 0`), nearest first, and prints them.
+/// A projection without an analytic inverse, or a point that is not three finite numbers,
+/// is one error line.
+pub fn run(args: &ProjectArgs) -> Result<()> {
+    let coordinates: Vec<f64> = args
+        .point
+        .split(',')
+        .map(|c| c.trim().parse::<f64>())
+        .collect::<std::result::Result<_, _>>()
+        .unwrap_or_default();
+    let point = match coordinates[..] {
+        [x, y, z] if [x, y, z].iter().all(|c| c.is_finite()) => DVec3::new(x, y, z),
+        _ => {
+            return Err(Error::new(format!(
+                "the point must be three finite numbers X,Y,Z, got '{}'",
+                args.point
+            )))
+        }
+    };
+    let loaded = args.scene.load()?;
+    let projection = loaded.projection.as_ref();
+    let inverse = projection.inverse().map_err(|e| {
+        let reason = e.reason.map(|r| format!(": {r}")).unwrap_or_default();
+        Error::new(format!(
+            "{}: the {} projection has no analytic inverse{reason}",
+            loaded.source,
+            projection.kind()
+        ))
+    })?;
+    let mut found = Vec::new();
+    inverse.project(point, &mut found);
+    let size = DVec2::new(f64::from(loaded.width), f64::from(loaded.height));
+    let mut images: Vec<Image> = found
+        .iter()
+        .filter(|image| image.t >= 0.0)
+        .filter(|image| {
+            let p = image.pixel;
+            p.x >= 0.0 && p.y >= 0.0 && p.x <= size.x && p.y <= size.y
+        })
+        .map(|&ImagePoint { pixel, t }| {
+            let speed = projection
+                .ray(pixel)
+                .map_or(1.0, |ray| ray.direction.length());
+            Image {
+                pixel,
+                depth: t * speed,
+                t,
+            }
+        })
+        .collect();
+    images.sort_by(|a, b| a.depth.total_cmp(&b.depth));
+    let text = if args.json {
+        let images: Vec<_> = images
+            .iter()
+            .map(|i| json!({"x": i.pixel.x, "y": i.pixel.y, "depth": i.depth, "t": i.t}))
+            .collect();
+        let object = json!({
+            "scene": loaded.source,
+            "projection": projection.kind(),
+            "point": [point.x, point.y, point.z],
+            "images": images,
+        });
+        format!("{object}\n")
+    } else {
+        images
+            .iter()
+            .map(|i| format!("{} {} {}\n", i.pixel.x, i.pixel.y, i.depth))
+            .collect()
+    };
+    super::print_stdout(&text)
+}

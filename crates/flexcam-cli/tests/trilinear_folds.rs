@@ -1,0 +1,227 @@
+//! `--method trilinear` on projection triangles whose rays fold or collapse, against the ray
+//! caster through the binary; and `flexcam project`, which lists every image of a point.
+
+use std::path::{Path, PathBuf};
+
+use tempfile::TempDir;
+
+mod common;
+use common::{run, run_json, run_ok};
+
+fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
+fn scene(name: &str) -> String {
+    scenes_dir().join(name).to_str().expect("UTF-8").to_string()
+}
+
+/// The ids PNG `name` in `dir`.
+fn ids(dir: &TempDir, name: &str) -> image::ImageBuffer<image::Luma<u16>, Vec<u16>> {
+    image::open(dir.path().join(name)).unwrap().into_luma16()
+}
+
+/// Renders `scene` flat with `--method trilinear` (its stats) and with the ray caster, and
+/// returns the stats and the object-id agreement over the pixels away from id edges: those
+/// whose 3 x 3 neighbourhood in the reference holds one id (the pixels at an edge depend
+/// on which side of a curved silhouette a pixel centre falls, a sub-pixel matter).
+fn trilinear_against_raycast(scene: &str) -> (serde_json::Value, f64) {
+    let dir = TempDir::new().unwrap();
+    let flat = ["--shading", "flat", "-o", "x.png"];
+    let stats = run_json(
+        &dir,
+        &[
+            &["render", scene, "--method", "trilinear", "--ids", "t.png"][..],
+            &flat,
+            &["--stats", "-"],
+        ]
+        .concat(),
+    );
+    run_ok(
+        &dir,
+        &[&["render", scene, "--ids", "r.png"][..], &flat].concat(),
+    );
+    let (method, reference) = (ids(&dir, "t.png"), ids(&dir, "r.png"));
+    let (width, height) = reference.dimensions();
+    let (mut interior, mut agree) = (0u64, 0u64);
+    for y in 1..height.saturating_sub(1) {
+        for x in 1..width.saturating_sub(1) {
+            let id = reference.get_pixel(x, y)[0];
+            let uniform = (y - 1..=y + 1)
+                .all(|j| (x - 1..=x + 1).all(|i| reference.get_pixel(i, j)[0] == id));
+            if uniform {
+                interior += 1;
+                agree += u64::from(method.get_pixel(x, y)[0] == id);
+            }
+        }
+    }
+    assert!(interior > 0, "{scene}: no interior pixel");
+    (stats, agree as f64 / interior as f64)
+}
+
+/// One configuration of Vallance 2005, appendix C (`scenes/appendix-c/NAME.toml`: the view
+/// triangle of Table C.2 and the scene triangle of Table C.1): its rays fold, and the
+/// triangle is drawn by its shapes (`shapes` of them before clipping), no pixel ray cast,
+/// agreeing with the ray caster on at least 99.5 % of the pixels away from id edges.
+fn appendix_c_configuration(name: &str, shapes: u64) {
+    let (stats, agreement) = trilinear_against_raycast(&scene(&format!("appendix-c/{name}.toml")));
+    assert_eq!(stats["fallback_triangles"], 0, "{name}: {stats}");
+    assert_eq!(stats["fallback_rays"], 0, "{name}: {stats}");
+    assert_eq!(stats["shapes"], shapes, "{name}: {stats}");
+    assert!(
+        stats["raster_covered"].as_u64().unwrap() > 0,
+        "{name}: {stats}"
+    );
+    assert!(agreement >= 0.995, "{name}: {agreement}");
+}
+
+#[test]
+fn appendix_c_2_2_2_3() {
+    appendix_c_configuration("2-2-2-3", 4);
+}
+
+#[test]
+fn appendix_c_3_3_3() {
+    appendix_c_configuration("3-3-3", 3);
+}
+
+#[test]
+fn appendix_c_4_2_3() {
+    appendix_c_configuration("4-2-3", 3);
+}
+
+#[test]
+fn appendix_c_4_5() {
+    appendix_c_configuration("4-5", 2);
+}
+
+#[test]
+fn appendix_c_6_3() {
+    appendix_c_configuration("6-3", 3);
+}
+
+#[test]
+fn appendix_c_2_7() {
+    appendix_c_configuration("2-7", 2);
+}
+
+#[test]
+fn appendix_c_9() {
+    appendix_c_configuration("9", 2);
+}
+
+/// The two-views band (Vallance 2005, 6.2): its rays blend a perspective view into an
+/// orthographic one and fold; its triangles are drawn by their shapes, except the pairs
+/// whose shapes reach across a depth where four of its parametric triangles degenerate
+/// (`ProjectionTriangleCache::degenerate_depths`), which are ray cast.
+#[test]
+fn two_views_band_is_drawn_by_its_shapes() {
+    let (stats, agreement) = trilinear_against_raycast(&scene("trilinear-two-views.toml"));
+    assert!(stats["shapes"].as_u64().unwrap() > 10_000, "{stats}");
+    assert!(
+        stats["fallback_triangles"].as_u64().unwrap() <= 4,
+        "{stats}"
+    );
+    assert!(agreement >= 0.995, "{agreement}");
+}
+
+/// The inward-looking sphere (Vallance 2005, 6.3): the pole rows, whose triangles have two
+/// equal vertices and sweep no volume, are drawn as fans of rays; the rest as central
+/// projections. Nothing is ray cast.
+#[test]
+fn inward_sphere_pole_rows_are_drawn_as_fans() {
+    let (stats, agreement) = trilinear_against_raycast(&scene("trilinear-inward-sphere.toml"));
+    assert_eq!(stats["fallback_triangles"], 0, "{stats}");
+    assert_eq!(stats["central_triangles"], 1104, "{stats}");
+    assert!(agreement >= 0.995, "{agreement}");
+}
+
+/// The lines of `flexcam project SCENE X,Y,Z` in `dir`: `x y depth` each.
+fn project_lines(dir: &TempDir, scene: &str, point: &str) -> Vec<[f64; 3]> {
+    let out = run_ok(dir, &["project", scene, point]);
+    String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|line| {
+            let v: Vec<f64> = line.split(' ').map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect()
+}
+
+/// One projection triangle whose rays all pass through (0.3, 0.3, 1) at t = 1: a point on
+/// its vertical ray beyond that focus is imaged once, at depth 2 (the cubic's double root
+/// at the focus is no image); the JSON lists the same; a point behind the base has none
+/// (no line, exit 0).
+#[test]
+fn project_lists_the_image_of_a_point_and_none_behind() {
+    let dir = TempDir::new().unwrap();
+    let scene = "[image]\nwidth = 100\nheight = 100\n[projection]\ntype = \"trilinear\"\n\
+        points = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\n\
+        normals = [[0.3, 0.3, 1], [-0.7, 0.3, 1], [0.3, -0.7, 1]]\n\
+        screen = [[0, 0], [1, 0], [0, 1]]\ntriangles = [[0, 1, 2]]\n";
+    std::fs::write(dir.path().join("focus.toml"), scene).unwrap();
+    let images = project_lines(&dir, "focus.toml", "0.3,0.3,2");
+    assert_eq!(images.len(), 1, "{images:?}");
+    let [x, y, depth] = images[0];
+    assert!((depth - 2.0).abs() < 1e-9, "{depth}");
+    // Screen (0.3, 0.3) from the bottom left of a 100 x 100 image.
+    assert!(
+        (x - 30.0).abs() < 1e-6 && (y - 70.0).abs() < 1e-6,
+        "{x} {y}"
+    );
+    let json = run_json(&dir, &["project", "focus.toml", "0.3,0.3,2", "--json"]);
+    assert_eq!(json["images"].as_array().unwrap().len(), 1, "{json}");
+    assert_eq!(json["point"], serde_json::json!([0.3, 0.3, 2.0]));
+    assert!((json["images"][0]["depth"].as_f64().unwrap() - 2.0).abs() < 1e-9);
+    assert!(project_lines(&dir, "focus.toml", "0.3,0.3,-1").is_empty());
+    let json = run_json(&dir, &["project", "focus.toml", "0.3,0.3,-1", "--json"]);
+    assert_eq!(json["images"], serde_json::json!([]));
+}
+
+/// A scene point seen three times through a folding triangle: the first scene vertex of
+/// appendix C's configuration (3,3,3) (Vallance 2005), whose cubic has three roots, at
+/// depths about 0.096, 0.367 and 1.273, all inside the projection triangle; listed nearest
+/// first, each inside the image.
+#[test]
+fn project_finds_the_three_images_of_a_point_beyond_a_fold() {
+    let dir = TempDir::new().unwrap();
+    let images = project_lines(
+        &dir,
+        &scene("appendix-c/3-3-3.toml"),
+        "0.0962,-0.0457,-0.011",
+    );
+    assert_eq!(images.len(), 3, "{images:?}");
+    assert!(
+        images.windows(2).all(|w| w[0][2] < w[1][2]),
+        "nearest first"
+    );
+    for [x, y, _] in &images {
+        assert!(
+            (0.0..=200.0).contains(x) && (0.0..=200.0).contains(y),
+            "{images:?}"
+        );
+    }
+    // A point whose first coordinate is negative: (2,7)'s third vertex, three images too.
+    let images = project_lines(&dir, &scene("appendix-c/2-7.toml"), "-0.117,-0.388,0.265");
+    assert_eq!(images.len(), 3, "{images:?}");
+}
+
+/// Projections without an analytic inverse, and points that are not three finite numbers,
+/// are one error line.
+#[test]
+fn project_refuses_what_it_cannot_project() {
+    let dir = TempDir::new().unwrap();
+    for point in ["1,2", "1,2,nan", "1,2,3,4"] {
+        let out = run(&dir, &["project", "builtin:cube-floor", point]);
+        assert!(!out.status.success(), "{point}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains("X,Y,Z"), "{err}");
+    }
+    let out = run(&dir, &["project", &scene("flexible-bent.toml"), "0,0,0"]);
+    let err = String::from_utf8(out.stderr).unwrap();
+    if !out.status.success() {
+        assert!(err.contains("no analytic inverse"), "{err}");
+    }
+}
