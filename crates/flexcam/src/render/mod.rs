@@ -272,6 +272,7 @@ pub use method::Method;
 pub use prepared::{Hit, PreparedScene};
 pub use raster::Subdivision;
 pub use reproject::{reproject, EquirectPhoto};
+pub use displaced::LodSelection;
 pub use transitions::TransitionShading;
 pub use trilinear::{CurveMode, CurveOptions};
 pub use warning::RenderWarning;
