@@ -268,11 +268,11 @@ mod warning;
 
 pub use camera_triangles::{Bound as CameraTriangleBound, Options as CameraTriangleOptions};
 pub use compare::{compare, Comparison};
+pub use displaced::LodSelection;
 pub use method::Method;
 pub use prepared::{Hit, PreparedScene};
 pub use raster::Subdivision;
 pub use reproject::{reproject, EquirectPhoto};
-pub use displaced::LodSelection;
 pub use transitions::TransitionShading;
 pub use trilinear::{CurveMode, CurveOptions};
 pub use warning::RenderWarning;

@@ -201,9 +201,7 @@ fn transition_rows(args: &DisplacedArgs, base: &Scene) -> Result<()> {
         let (full, _) = time(Shading::Lit)?;
         for d in TRANSITION_DS {
             let shading = TransitionShading::new(false, d)?;
-            let (finest, _) = time(Shading::Transitions(
-                shading.with_lod(LodSelection::Finest),
-            ))?;
+            let (finest, _) = time(Shading::Transitions(shading.with_lod(LodSelection::Finest)))?;
             let (footprint, rendered) = time(Shading::Transitions(
                 shading.with_lod(LodSelection::Footprint),
             ))?;

@@ -152,7 +152,8 @@ fn merge_cost(
         .iter()
         .map(|&f| topology.areas[f as usize] * (1.0 - normal.dot(topology.normals[f as usize])))
         .sum();
-    let perimeter = ca.perimeter + cb.perimeter - 2.0 * shared_length(topology, chart_of, &cb.faces, a);
+    let perimeter =
+        ca.perimeter + cb.perimeter - 2.0 * shared_length(topology, chart_of, &cb.faces, a);
     Some(planarity.max(0.0) + perimeter * perimeter / (4.0 * std::f64::consts::PI))
 }
 
@@ -220,7 +221,13 @@ fn labels_at(topology: &Topology, v: u32, label: impl Fn(u32) -> u32) -> usize {
 /// Whether `v` is a chart corner: its faces belong to three or more charts (the mesh's
 /// outside counting as one).
 pub fn is_corner(topology: &Topology, chart_of: &[u32], v: u32) -> bool {
-    labels_at(topology, v, |f| if f == NONE { NONE } else { chart_of[f as usize] }) >= 3
+    labels_at(topology, v, |f| {
+        if f == NONE {
+            NONE
+        } else {
+            chart_of[f as usize]
+        }
+    }) >= 3
 }
 
 /// Straightens every boundary run between two charts (module documentation).
@@ -297,7 +304,9 @@ fn straighten_run(topology: &Topology, chart_of: &mut [u32], a: u32, b: u32, sta
     // Vertices on the outer boundary of the pair stay put: the path may only end there.
     let on_outer = |v: u32| {
         topology.on_boundary(v)
-            || topology.vertex_faces[v as usize].iter().any(|&f| !in_pair(f))
+            || topology.vertex_faces[v as usize]
+                .iter()
+                .any(|&f| !in_pair(f))
     };
     let Some(path) = shortest_path(topology, start, end, |v, w| {
         let [f, g] = topology.faces_of(v, w);
@@ -334,10 +343,15 @@ fn straighten_run(topology: &Topology, chart_of: &mut [u32], a: u32, b: u32, sta
         .iter()
         .filter(|&&f| chart_of[f as usize] == a && component[&f] == 0)
         .count();
-    let a_side = u32::from(2 * from_a < faces.iter().filter(|&&f| chart_of[f as usize] == a).count());
+    let a_side =
+        u32::from(2 * from_a < faces.iter().filter(|&&f| chart_of[f as usize] == a).count());
     let new_label = |f: u32| if component[&f] == a_side { a } else { b };
     for label in [a, b] {
-        let side: Vec<u32> = faces.iter().copied().filter(|&f| new_label(f) == label).collect();
+        let side: Vec<u32> = faces
+            .iter()
+            .copied()
+            .filter(|&f| new_label(f) == label)
+            .collect();
         let inside = |g: u32| g != NONE && component.get(&g).is_some_and(|_| new_label(g) == label);
         if !is_disc(topology, &side, inside) {
             return;

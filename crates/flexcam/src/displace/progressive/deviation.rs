@@ -178,7 +178,14 @@ pub fn samples(
             centre.0 += uv / 3.0;
             centre.1 += position / 3.0;
             if seen.insert((chart, v), ()).is_none() {
-                out.push((Sample { chart, uv, position }, f as u32));
+                out.push((
+                    Sample {
+                        chart,
+                        uv,
+                        position,
+                    },
+                    f as u32,
+                ));
             }
         }
         out.push((

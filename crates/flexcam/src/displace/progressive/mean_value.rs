@@ -41,7 +41,10 @@ pub fn parameterize(
     }
     vertices.sort_unstable();
     vertices.dedup();
-    let start = *next.keys().min().ok_or_else(|| Error::new("a chart has no boundary"))?;
+    let start = *next
+        .keys()
+        .min()
+        .ok_or_else(|| Error::new("a chart has no boundary"))?;
     let mut lengths = Vec::new();
     let mut loop_ = vec![start];
     let mut at = start;

@@ -20,8 +20,7 @@ pub trait HalfEdgeCost {
     /// when that collapse is not allowed. `changed` lists every face through `a` with its
     /// vertex list after the collapse (empty: the face goes); `faces` are the current faces
     /// by stable id (the input's face indices).
-    fn cost(&self, a: u32, b: u32, changed: &[(u32, Vec<u32>)], faces: &[Vec<u32>])
-        -> Option<f64>;
+    fn cost(&self, a: u32, b: u32, changed: &[(u32, Vec<u32>)], faces: &[Vec<u32>]) -> Option<f64>;
 
     /// The collapse of `a` onto `b` was performed: `faces` are the faces after it.
     fn collapsed(&mut self, a: u32, b: u32, changed: &[(u32, Vec<u32>)], faces: &[Vec<u32>]);

@@ -173,16 +173,22 @@ impl Lods {
 }
 
 /// The centre, size and shared bound of displaced object `index` over `levels`.
-fn object_lods(object: &Object, levels: &[Level], index: usize, deviations: Vec<f64>) -> ObjectLods {
+fn object_lods(
+    object: &Object,
+    levels: &[Level],
+    index: usize,
+    deviations: Vec<f64>,
+) -> ObjectLods {
     let mesh = &object.mesh;
     let n = mesh.positions.len().max(1) as f64;
     let centre = mesh.positions.iter().map(|p| p.as_dvec3()).sum::<DVec3>() / n;
     let bound = levels
         .iter()
         .filter_map(|l| l.set.object_bound(index))
-        .fold([DVec3::INFINITY, DVec3::NEG_INFINITY], |[lo, hi], [a, b]| {
-            [lo.min(a), hi.max(b)]
-        });
+        .fold(
+            [DVec3::INFINITY, DVec3::NEG_INFINITY],
+            |[lo, hi], [a, b]| [lo.min(a), hi.max(b)],
+        );
     ObjectLods {
         centre,
         bound,

@@ -14,11 +14,11 @@ use std::sync::OnceLock;
 
 use glam::DVec2;
 
+use super::DisplacedSet;
 use crate::displace::brdf_table::BrdfTable;
 use crate::displace::bump::Redistribution;
 use crate::displace::normal_distribution::{Chart, NormalDistribution};
 use crate::displace::Displacement;
-use super::DisplacedSet;
 use crate::scene::{Object, Scene};
 
 /// Chart nodes per side.
