@@ -91,18 +91,9 @@ pub fn collapse_in_order(
             push_out_of(&work, v, cost, &mut heap);
         }
     }
-    let (coarse, vertex_ids, face_ids) = work.mesh.compact_with_ids();
     let done = splits.len();
     Ok(Ordered {
-        simplified: Simplified {
-            coarse,
-            splits,
-            vertex_ids,
-            face_ids,
-            vertex_id_count: work.mesh.alive.len(),
-            face_id_count: work.mesh.faces.len(),
-            sweeps: 1,
-        },
+        simplified: work.finish(splits, 1),
         costs,
         reached: reached.into_iter().map(|r| r.unwrap_or(done)).collect(),
     })
