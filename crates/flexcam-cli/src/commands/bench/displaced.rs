@@ -218,9 +218,14 @@ fn transition_rows(args: &DisplacedArgs, base: &Scene) -> Result<()> {
             .map(counter);
             let total: f64 = weights.iter().sum::<f64>().max(1.0);
             let levels = LEVEL_KEYS.map(counter);
-            let displacing: f64 = levels.iter().sum::<f64>().max(1.0);
+            let displacing: f64 = levels.iter().sum();
+            let coarser = if displacing > 0.0 {
+                format!("{:.0}%", 100.0 * (displacing - levels[0]) / displacing)
+            } else {
+                "-".to_string()
+            };
             println!(
-                "{name:>6} {d:>5} {:>13.1} {:>13.1} {:>8.2} {:>13.1} {:>8.2} | {:>5.0}% {:>5.0}% {:>5.0}% | {:>6.0}%",
+                "{name:>6} {d:>5} {:>13.1} {:>13.1} {:>8.2} {:>13.1} {:>8.2} | {:>5.0}% {:>5.0}% {:>5.0}% | {coarser:>7}",
                 full.median_ms(),
                 finest.median_ms(),
                 full.median_ms() / finest.median_ms(),
@@ -229,7 +234,6 @@ fn transition_rows(args: &DisplacedArgs, base: &Scene) -> Result<()> {
                 100.0 * weights[0] / total,
                 100.0 * weights[1] / total,
                 100.0 * weights[2] / total,
-                100.0 * (displacing - levels[0]) / displacing,
             );
         }
     }

@@ -122,7 +122,9 @@ impl ProgressiveMesh {
     /// same chart coordinates (found among all of `lod`'s triangles of that chart; a point
     /// outside them all is measured at the nearest border).
     pub fn deviation(&self, lod: &Lod) -> f64 {
-        let mut by_chart: HashMap<u32, Vec<([DVec2; 3], [glam::DVec3; 3])>> = HashMap::new();
+        // Per chart: each triangle's corners in the chart and in space.
+        type Corners = ([DVec2; 3], [glam::DVec3; 3]);
+        let mut by_chart: HashMap<u32, Vec<Corners>> = HashMap::new();
         for (t, &f) in lod.mesh.triangles.iter().zip(&lod.faces) {
             let chart = self.charts[f as usize];
             let ids = t.map(|v| lod.vertices[v as usize]);

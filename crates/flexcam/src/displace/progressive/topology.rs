@@ -22,6 +22,8 @@ pub struct Topology {
     pub vertex_faces: Vec<Vec<u32>>,
     pub normals: Vec<DVec3>,
     pub areas: Vec<f64>,
+    /// Whether each vertex lies on the mesh's boundary.
+    boundary: Vec<bool>,
 }
 
 impl Topology {
@@ -45,6 +47,13 @@ impl Topology {
             normals.push(cross.normalize_or_zero());
             areas.push(cross.length() * 0.5);
         }
+        let mut boundary = vec![false; positions.len()];
+        for (&(v, w), faces) in &edge_faces {
+            if faces.contains(&NONE) {
+                boundary[v as usize] = true;
+                boundary[w as usize] = true;
+            }
+        }
         Topology {
             positions,
             triangles: mesh.triangles.clone(),
@@ -52,6 +61,7 @@ impl Topology {
             vertex_faces,
             normals,
             areas,
+            boundary,
         }
     }
 
@@ -81,11 +91,7 @@ impl Topology {
 
     /// Whether `v` lies on the mesh's boundary.
     pub fn on_boundary(&self, v: u32) -> bool {
-        self.vertex_faces[v as usize].iter().any(|&f| {
-            self.edges(f)
-                .iter()
-                .any(|&(a, b)| (a == v || b == v) && self.faces_of(a, b).contains(&NONE))
-        })
+        self.boundary[v as usize]
     }
 
     /// Length of edge `v`-`w`.
