@@ -125,11 +125,17 @@ impl PreparedScene {
         let start = Instant::now();
         let mut first_triangle = Vec::with_capacity(scene.objects.len());
         let mut triangles = Vec::with_capacity(scene.triangle_count());
+        // Each composited reflector in a group of its own: the views that hide it, or show
+        // it alone, prune the tree at its group's root.
+        let mut groups = Vec::with_capacity(scene.triangle_count());
         for object in &scene.objects {
             first_triangle.push(triangles.len() as u32);
             if object.displacement.is_some() {
                 continue;
             }
+            let group = (scene.trilinear_reflectors.iter())
+                .position(|r| r.id == object.id)
+                .map_or(0, |k| k as u32 + 1);
             let p = &object.mesh.positions;
             triangles.extend(
                 object
@@ -138,8 +144,9 @@ impl PreparedScene {
                     .iter()
                     .map(|t| t.map(|i| p[i as usize])),
             );
+            groups.resize(triangles.len(), group);
         }
-        let bvh = Bvh::build(&triangles);
+        let bvh = Bvh::build_grouped(&triangles, |id| groups[id as usize]);
         PreparedScene {
             bvh: Arc::new(bvh),
             shown: None,
@@ -276,8 +283,19 @@ impl PreparedScene {
     /// [`PreparedScene::intersect_f32`] of four rays at once, with identical results:
     /// coherent rays (a 2x2 quad of primary rays) share one BVH traversal.
     pub(in crate::render) fn intersect4_f32(&self, rays: [Option<&Ray>; 4]) -> [Option<Hit32>; 4] {
-        let fast = rays.map(|r| self.fast_unless_outside(r));
-        let fast_rays = fast.each_ref().map(Option::as_ref);
+        // Spelled out: `array::map` here is not inlined and costs a closure call per ray.
+        let fast = [
+            self.fast_unless_outside(rays[0]),
+            self.fast_unless_outside(rays[1]),
+            self.fast_unless_outside(rays[2]),
+            self.fast_unless_outside(rays[3]),
+        ];
+        let fast_rays = [
+            fast[0].as_ref(),
+            fast[1].as_ref(),
+            fast[2].as_ref(),
+            fast[3].as_ref(),
+        ];
         let found = match &self.shown {
             None => self.bvh.closest4(fast_rays, &AllTriangles),
             Some(mask) => closest4_shown(&self.bvh, fast_rays, mask),

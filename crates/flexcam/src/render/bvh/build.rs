@@ -3,6 +3,8 @@
 //! subtrees built in parallel into their own node lists and appended in depth-first order, so
 //! that the tree is the same whatever the number of threads.
 
+use std::ops::Range;
+
 use glam::Vec3;
 
 use super::triangle::PackedTriangle;
@@ -28,7 +30,19 @@ const PARALLEL_BUILD: usize = 4096;
 impl Bvh {
     /// Builds the hierarchy over `triangles`; zero-area triangles are left out (no ray can
     /// hit them face-on). An empty or all-degenerate input gives a BVH that nothing hits.
+    #[cfg(test)]
     pub fn build(triangles: &[[Vec3; 3]]) -> Bvh {
+        Bvh::build_grouped(triangles, |_| 0)
+    }
+
+    /// [`Bvh::build`] with the triangles of each group (`group` of a triangle's index in
+    /// `triangles`) in a subtree of their own, the groups' subtrees joined by a balanced tree
+    /// above them. A [`TriangleMask`](super::TriangleMask) hiding whole groups then prunes at
+    /// their roots, so that a query over part of the scene (the scene without a mirror, or
+    /// the mirror alone) visits the nodes a tree of that part alone would. With one group the
+    /// tree is exactly [`Bvh::build`]'s. The joining levels count towards the depth that
+    /// bounds the traversal stack: the groups' subtrees are built as starting that deep.
+    pub fn build_grouped(triangles: &[[Vec3; 3]], group: impl Fn(u32) -> u32) -> Bvh {
         let mut prims: Vec<Prim> = triangles
             .iter()
             .enumerate()
@@ -45,8 +59,18 @@ impl Bvh {
         if prims.is_empty() {
             return Bvh::default();
         }
+        // Stable: with one group the order, hence the tree, is that of an ungrouped build.
+        prims.sort_by_key(|p| group(p.id));
+        let mut groups: Vec<Range<usize>> = Vec::new();
+        for (i, p) in prims.iter().enumerate() {
+            match groups.last_mut() {
+                Some(last) if group(prims[last.start].id) == group(p.id) => last.end = i + 1,
+                _ => groups.push(i..i + 1),
+            }
+        }
+        let join_depth = groups.len().next_power_of_two().trailing_zeros() as usize;
         let mut nodes = Vec::with_capacity(prims.len());
-        let (root, root_bounds) = build_subtree(&mut prims, 0, 0, &mut nodes);
+        let (root, root_bounds) = build_groups(&mut prims, &groups, join_depth, &mut nodes);
         let triangles = prims
             .iter()
             .map(|p| {
@@ -73,6 +97,31 @@ impl Bvh {
 /// nodes to `nodes` in depth-first order; returns what the subtree is and its padded box.
 /// Large subtrees build their halves in parallel into separate lists, appended in order, so
 /// the layout is that of a serial build.
+/// The subtree over the groups `groups` (ranges of `prims`, which holds all triangles): a
+/// group alone is [`build_subtree`] of its range, started at depth `depth`; more are split in
+/// two halves under a new node, laid out depth-first like the rest of the tree.
+fn build_groups(
+    prims: &mut [Prim],
+    groups: &[Range<usize>],
+    depth: usize,
+    nodes: &mut Vec<Node>,
+) -> (Child, Aabb) {
+    if let [range] = groups {
+        return build_subtree(&mut prims[range.clone()], range.start, depth, nodes);
+    }
+    let slot = nodes.len();
+    nodes.push(Node::new(
+        [Aabb::EMPTY; 2],
+        [Child { index: 0, count: 0 }; 2],
+    ));
+    let (left, right) = groups.split_at(groups.len() / 2);
+    let (c0, b0) = build_groups(prims, left, depth, nodes);
+    let (c1, b1) = build_groups(prims, right, depth, nodes);
+    nodes[slot] = Node::new([b0, b1], [c0, c1]);
+    let index = slot as u32;
+    (Child { index, count: 0 }, b0.union(b1))
+}
+
 fn build_subtree(
     prims: &mut [Prim],
     offset: usize,

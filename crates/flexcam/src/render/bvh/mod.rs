@@ -106,6 +106,11 @@ pub(in crate::render) struct BvhHit {
 pub(in crate::render) trait Keep {
     /// Whether stored triangle `stored` (see [`Bvh::all_triangles`]) takes part.
     fn keeps(&self, stored: usize) -> bool;
+
+    /// Which children of interior node `node` hold a triangle that takes part: bit 0 for
+    /// child 0, bit 1 for child 1. A traversal skips a child whose bit is clear, so a
+    /// query over part of the scene does not descend into the subtrees of what it hides.
+    fn kept_children(&self, node: usize) -> u8;
 }
 
 /// Every triangle of the tree.
@@ -116,15 +121,24 @@ impl Keep for AllTriangles {
     fn keeps(&self, _: usize) -> bool {
         true
     }
+
+    #[inline(always)]
+    fn kept_children(&self, _: usize) -> u8 {
+        0b11
+    }
 }
 
 /// The stored triangles of a chosen subset (one bit each, by stored index): a query over part
 /// of the scene (the scene without one object, or that object alone) answered by the whole
 /// scene's tree, exactly as a tree of that part alone would answer it up to the order of
-/// hits at equal `t`.
+/// hits at equal `t`. It also records, per interior node, which children hold a kept
+/// triangle ([`Keep::kept_children`]), so that the hidden part's subtrees are not entered:
+/// where the hidden object is compact (a mirror sphere), the masked query visits about the
+/// nodes a tree of the shown part would.
 #[derive(Debug, Clone)]
 pub(in crate::render) struct TriangleMask {
     bits: Vec<u64>,
+    children: Vec<u8>,
 }
 
 impl TriangleMask {
@@ -136,7 +150,29 @@ impl TriangleMask {
                 bits[stored / 64] |= 1 << (stored % 64);
             }
         }
-        TriangleMask { bits }
+        let mut mask = TriangleMask {
+            bits,
+            children: vec![0; bvh.nodes.len()],
+        };
+        if !bvh.triangles.is_empty() {
+            mask.mark_children(bvh, bvh.root);
+        }
+        mask
+    }
+
+    /// Whether subtree `child` holds a kept triangle, recording the answer for every interior
+    /// node below it. Recursion depth is the tree's depth, bounded by the traversal stack's
+    /// size.
+    fn mark_children(&mut self, bvh: &Bvh, child: Child) -> bool {
+        if child.count > 0 {
+            let first = child.index as usize;
+            return (first..first + child.count as usize).any(|stored| self.keeps(stored));
+        }
+        let node = child.index as usize;
+        let [c0, c1] = bvh.nodes[node].children;
+        let kept = [self.mark_children(bvh, c0), self.mark_children(bvh, c1)];
+        self.children[node] = u8::from(kept[0]) | u8::from(kept[1]) << 1;
+        kept[0] || kept[1]
     }
 }
 
@@ -144,6 +180,11 @@ impl Keep for TriangleMask {
     #[inline(always)]
     fn keeps(&self, stored: usize) -> bool {
         self.bits[stored / 64] & (1 << (stored % 64)) != 0
+    }
+
+    #[inline(always)]
+    fn kept_children(&self, node: usize) -> u8 {
+        self.children[node]
     }
 }
 

@@ -88,6 +88,67 @@ fn masked_queries_see_only_the_kept_triangles() {
     assert!(hidden_hits > 50, "{hidden_hits}");
 }
 
+/// A mask hiding a compact object (a cluster of small triangles, as a mirror sphere is) clears
+/// the child bits of the subtrees holding only it, so that queries skip them; built with the
+/// object in a group of its own, the hidden part is one child of the root. The answers stay
+/// those of testing only the kept triangles, including rays aimed at the cluster.
+#[test]
+fn masked_queries_skip_the_subtrees_of_a_hidden_object() {
+    for grouped in [false, true] {
+        masked_queries_skip_a_hidden_cluster(grouped);
+    }
+}
+
+fn masked_queries_skip_a_hidden_cluster(grouped: bool) {
+    let mut rng = Rng(23);
+    let mut triangles = soup(&mut rng, 1500);
+    let cluster = triangles.len() as u32;
+    triangles.extend((0..1500).map(|_| {
+        let c = Vec3::new(2.0, 1.0, -1.0) + rng.vec(1.0);
+        [c + rng.vec(0.3), c + rng.vec(0.3), c + rng.vec(0.3)]
+    }));
+    let bvh = match grouped {
+        true => Bvh::build_grouped(&triangles, |id| u32::from(id >= cluster)),
+        false => Bvh::build(&triangles),
+    };
+    let keeps = |id: u32| id < cluster;
+    let mask = TriangleMask::by_id(&bvh, keeps);
+    let skipped = (mask.children.iter())
+        .map(|b| (b ^ 0b11).count_ones())
+        .sum::<u32>();
+    assert!(skipped > 100 || grouped, "only {skipped} subtrees skipped");
+    if grouped {
+        assert_eq!(mask.children[bvh.root.index as usize], 0b01);
+    }
+    let mut through_cluster = 0;
+    for k in 0..300 {
+        let origin = rng.vec(15.0).as_dvec3();
+        let rays: [FastRay; 4] = std::array::from_fn(|lane| {
+            let aim = if k % 2 == 0 {
+                Vec3::new(2.0, 1.0, -1.0)
+            } else {
+                Vec3::ZERO
+            };
+            let target = (aim + rng.vec(1.0) + lane as f32 * 0.01).as_dvec3();
+            FastRay::new(&Ray::new(origin, target - origin)).unwrap()
+        });
+        let packet = bvh.closest4(rays.each_ref().map(Some), &mask);
+        for (ray, got) in rays.iter().zip(packet) {
+            let expected = brute_force_of(&triangles, ray, keeps);
+            assert_eq!(
+                bvh.closest(ray, &mask).map(|h| (h.id, h.hit.t)),
+                expected,
+                "ray {k}"
+            );
+            assert_eq!(got.map(|h| (h.id, h.hit.t)), expected, "packet {k}");
+            assert_eq!(bvh.occluded(ray, &mask), expected.is_some(), "any hit {k}");
+            let all = bvh.closest(ray, &AllTriangles).map(|h| h.id);
+            through_cluster += usize::from(all.is_some_and(|id| !keeps(id)));
+        }
+    }
+    assert!(through_cluster > 100, "{through_cluster}");
+}
+
 #[test]
 fn closest_hit_equals_brute_force_on_random_soups() {
     let mut rng = Rng(7);

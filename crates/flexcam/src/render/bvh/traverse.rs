@@ -261,6 +261,17 @@ impl NearSegments4 {
     }
 }
 
+/// The children's entry distances `t0`, `t1` (one ray's or a packet's) with a child that
+/// holds no kept triangle ([`Keep::kept_children`] bits `kept`) given the distance `missed`
+/// (infinity), as if its box were missed.
+#[inline(always)]
+fn skip_hidden<E: Copy>(kept: u8, (t0, t1): (E, E), missed: E) -> (E, E) {
+    (
+        if kept & 1 != 0 { t0 } else { missed },
+        if kept & 2 != 0 { t1 } else { missed },
+    )
+}
+
 /// Entry parameter of `ray` into the box `[min, max]` if it meets it within
 /// `[ray.t_min, t_max]`, else infinity. The exit parameter is enlarged by a few ulps (Ize,
 /// "Robust BVH ray traversal", 2013) so that rounding never culls a box the ray touches.
@@ -379,7 +390,8 @@ impl Bvh {
                 }
             } else {
                 let node = &self.nodes[current.index as usize];
-                let (t0, t1) = node.entries(&slabs, t_max);
+                let kept = keep.kept_children(current.index as usize);
+                let (t0, t1) = skip_hidden(kept, node.entries(&slabs, t_max), f32::INFINITY);
                 let [c0, c1] = node.children;
                 let (near, far, t_near, t_far) = if t1 < t0 {
                     (c1, c0, t1, t0)
@@ -466,7 +478,8 @@ impl Bvh {
                 t_max = Vec4::from_array(t_max_lanes);
             } else {
                 let node = &self.nodes[current.index as usize];
-                let (t0, t1) = packet.entries(node, t_max);
+                let kept = keep.kept_children(current.index as usize);
+                let (t0, t1) = skip_hidden(kept, packet.entries(node, t_max), Vec4::INFINITY);
                 let (hit0, hit1) = (
                     t0.cmpne(Vec4::INFINITY).bitmask() != 0,
                     t1.cmpne(Vec4::INFINITY).bitmask() != 0,
