@@ -3,11 +3,11 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use clap::Args;
+use clap::{Args, ValueEnum};
 use flexcam::image_io::{self, ColorEncoding, ColorFormat, DepthFormat, OutputSet, PngBits};
 use flexcam::render::{
-    self, Counter, Method, Outputs, PixelWindow, PreparedScene, RenderOptions, Shading,
-    TransitionShading,
+    self, Counter, LodSelection, Method, Outputs, PixelWindow, PreparedScene, RenderOptions,
+    Shading, TransitionShading,
 };
 use flexcam::Result;
 
@@ -65,6 +65,13 @@ pub struct RenderArgs {
     /// Samples per pixel (overrides the scene's `[image] spp`, whose default is 1).
     #[arg(help_heading = "Rendering", long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     spp: Option<u32>,
+    /// How rays of `--shading transitions` and `transition-lit` that displace pick the level
+    /// of detail of a displaced object (its progressive mesh at 100, 80, 60, 40 or 20 % of
+    /// its faces): `footprint` (default: the coarsest whose texture deviation is at most half
+    /// the ray's footprint), `distance` (the dissertation's rule by the distance from the
+    /// ray's origin) or `finest` (always the detailed mesh).
+    #[arg(help_heading = "Rendering", long, value_enum, value_name = "RULE")]
+    lod: Option<LodArg>,
     /// Write the depth along each pixel's ray (.exr or .pfm; +inf where nothing is hit).
     #[arg(help_heading = "Outputs", long, value_name = "FILE")]
     depth: Option<PathBuf>,
@@ -161,14 +168,20 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
     let progress = RenderProgress::new();
     let report = |done: u64, total: u64| progress.update(done, total);
-    let shading = match (args.shading.shading(), args.transition_d) {
-        (shading, None) => shading,
-        (Shading::Transitions(t), Some(d)) => {
-            Shading::Transitions(TransitionShading::new(t.methods, d)?)
-        }
-        (_, Some(_)) => {
+    let shading = match (args.shading.shading(), args.transition_d, args.lod) {
+        (shading, None, None) => shading,
+        (Shading::Transitions(t), d, lod) => Shading::Transitions(
+            TransitionShading::new(t.methods, d.unwrap_or(t.d()))?
+                .with_lod(lod.map_or(t.lod, LodArg::selection)),
+        ),
+        (_, Some(_), _) => {
             return Err(flexcam::Error::new(
                 "--transition-d applies to --shading transitions and transition-lit only",
+            ))
+        }
+        (_, None, Some(_)) => {
+            return Err(flexcam::Error::new(
+                "--lod applies to --shading transitions and transition-lit only",
             ))
         }
     };
@@ -248,4 +261,22 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     print_warnings(&loaded);
     print_lines(&loaded.source, &warnings);
     Ok(())
+}
+
+/// `--lod` on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum LodArg {
+    Footprint,
+    Distance,
+    Finest,
+}
+
+impl LodArg {
+    fn selection(self) -> LodSelection {
+        match self {
+            LodArg::Footprint => LodSelection::Footprint,
+            LodArg::Distance => LodSelection::Distance,
+            LodArg::Finest => LodSelection::Finest,
+        }
+    }
 }

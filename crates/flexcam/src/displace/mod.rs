@@ -9,7 +9,8 @@
 //! bounds, with no tessellation stored.
 //!
 //! [`simplify`] reduces polygon meshes by edge collapses and records the vertex splits that
-//! rebuild them exactly.
+//! rebuild them exactly; [`progressive`] builds on it the chart-based progressive mesh of a
+//! displaced object and its discrete levels of detail.
 //!
 //! For the transition system (Becker and Max 1993, Ramsey 2005 chapter 7), a height field
 //! laid flat ([`normal_distribution::Chart`]) gives the distributions of the normals visible
@@ -25,6 +26,7 @@ pub mod intersect;
 pub mod micro;
 pub mod normal_distribution;
 pub mod procedural;
+pub mod progressive;
 pub mod simplify;
 pub mod square_map;
 pub mod tessellate;

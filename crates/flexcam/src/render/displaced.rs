@@ -20,7 +20,8 @@
 //! geometric and shading normal: micro-vertex normals are those of the undisplaced surface
 //! and would hide the displacement from lit shading.
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
+use std::time::Instant;
 
 use glam::DVec3;
 
@@ -34,6 +35,32 @@ const LEAF: usize = 2;
 /// Traversal stack size: more than the depth of a median-split tree over `u32` items.
 const STACK: usize = 40;
 
+mod lods;
+mod tables;
+
+pub use lods::LodSelection;
+pub(in crate::render) use lods::Lods;
+pub(in crate::render) use tables::{ObjectTables, Tables, PARTIAL_STEPS};
+
+/// What the transition system reads of the displaced objects, built once per prepared
+/// scene on its first transition render ([`DisplacedSet::transition_data`]): the tables of
+/// normal distributions, BRDF and bump redistribution, and the levels of detail.
+pub(in crate::render) struct TransitionData {
+    pub tables: Tables,
+    pub lods: Lods,
+    /// Milliseconds it took to build.
+    pub build_ms: f64,
+}
+
+impl std::fmt::Debug for TransitionData {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TransitionData")
+            .field("levels", &self.lods.levels.len())
+            .field("build_ms", &self.build_ms)
+            .finish_non_exhaustive()
+    }
+}
+
 /// The displaced objects' base triangles and the tree over their shells.
 #[derive(Debug)]
 pub(in crate::render) struct DisplacedSet {
@@ -45,6 +72,10 @@ pub(in crate::render) struct DisplacedSet {
     boxes: Vec<CachedBox>,
     /// Depth-first: an interior node's first child follows it, `second` is the other.
     nodes: Vec<Node>,
+    /// Per object: the union of its shells' boxes, if it is displaced.
+    bounds: Vec<Option<[DVec3; 2]>>,
+    /// Built on the first transition render; the views of a scene share it with the set.
+    transition: OnceLock<TransitionData>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -91,6 +122,7 @@ impl DisplacedSet {
         // tree is built over (shell index, box) and the shells are then laid out in its order.
         let mut shells = Vec::new();
         let mut boxed = Vec::new();
+        let mut bounds = vec![None; scene.objects.len()];
         for (index, (object, displacement)) in scene.objects.iter().zip(&displacements).enumerate()
         {
             let Some(displacement) = displacement else {
@@ -100,6 +132,8 @@ impl DisplacedSet {
                 let shell =
                     DisplacedTriangle::new(base_corners(&object.mesh, triangle), displacement);
                 let [lo, hi] = shell.bounds();
+                let bound = bounds[index].get_or_insert([DVec3::INFINITY, DVec3::NEG_INFINITY]);
+                *bound = [bound[0].min(lo), bound[1].max(hi)];
                 boxed.push(([shells.len() as u32, 0], lo, hi));
                 shells.push((
                     [index as u32, triangle as u32],
@@ -130,7 +164,30 @@ impl DisplacedSet {
             items,
             boxes,
             nodes,
+            bounds,
+            transition: OnceLock::new(),
         }))
+    }
+
+    /// The transition system's tables and levels of detail for `scene` (the scene this set
+    /// was built from), built on first use (module [`tables`], [`lods`]).
+    pub fn transition_data(&self, scene: &Scene) -> &TransitionData {
+        self.transition.get_or_init(|| {
+            let start = Instant::now();
+            let tables = Tables::new(scene, self);
+            let lods = Lods::new(scene, self);
+            TransitionData {
+                tables,
+                lods,
+                build_ms: start.elapsed().as_secs_f64() * 1e3,
+            }
+        })
+    }
+
+    /// The union of the shell boxes of object `object`'s base triangles; `None` when it is
+    /// not displaced.
+    pub fn object_bound(&self, object: usize) -> Option<[DVec3; 2]> {
+        self.bounds[object]
     }
 
     /// Number of displaced base triangles.

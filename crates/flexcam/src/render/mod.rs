@@ -290,6 +290,7 @@ mod window;
 
 pub use camera_triangles::{Bound as CameraTriangleBound, Options as CameraTriangleOptions};
 pub use compare::{compare, Comparison};
+pub use displaced::LodSelection;
 pub use method::Method;
 pub use prepared::{Hit, PreparedScene};
 pub use raster::Subdivision;

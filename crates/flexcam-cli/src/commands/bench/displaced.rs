@@ -21,7 +21,9 @@ use std::time::Instant;
 use clap::{Args, ValueEnum};
 use flexcam::displace::{tessellate, Displacement};
 use flexcam::projection::{CameraFrame, ProjectionSpec};
-use flexcam::render::{render, Counter, PreparedScene, RenderOptions, Shading, TransitionShading};
+use flexcam::render::{
+    render, Counter, LodSelection, PreparedScene, RenderOptions, Shading, TransitionShading,
+};
 use flexcam::scene::{self, DisplacementSpec, Scene};
 use flexcam::{Error, Result};
 
@@ -161,15 +163,27 @@ const TRANSITION_DS: [f64; 3] = [TransitionShading::DEFAULT_D, 8.0, 32.0];
 
 /// The transition system (`--shading transition-lit`) against full displacement (`--shading
 /// lit`) at the near and the scene's view, level 5, in this process: Table 8.1's "transition
-/// system" row beside "displaced detailed", for each `D` of [`TRANSITION_DS`].
+/// system" row beside "displaced detailed", for each `D` of [`TRANSITION_DS`], with the
+/// displacing rays on the detailed mesh (`--lod finest`) and on the level of detail their
+/// footprint allows (`--lod footprint`).
 fn transition_rows(args: &DisplacedArgs, base: &Scene) -> Result<()> {
     println!(
         "Table 8.1 (Ramsey 2005): transition system (transition-lit) against full displacement \
          (lit), level 5; the dissertation's was over 4x faster at the near view"
     );
     println!(
-        "{:>6} {:>5} {:>14} {:>14} {:>8} | {:>6} {:>6} {:>6}",
-        "view", "D", "displaced ms", "transition ms", "speed-up", "BRDF", "bump", "disp."
+        "{:>6} {:>5} {:>13} {:>13} {:>8} {:>13} {:>8} | {:>6} {:>6} {:>6} | {:>7}",
+        "view",
+        "D",
+        "displaced ms",
+        "finest ms",
+        "speed-up",
+        "footprint ms",
+        "speed-up",
+        "BRDF",
+        "bump",
+        "disp.",
+        "coarser"
     );
     let scene = with_level(base, 5);
     let prepared = PreparedScene::new(&scene);
@@ -186,10 +200,14 @@ fn transition_rows(args: &DisplacedArgs, base: &Scene) -> Result<()> {
         };
         let (full, _) = time(Shading::Lit)?;
         for d in TRANSITION_DS {
-            let (transition, rendered) =
-                time(Shading::Transitions(TransitionShading::new(false, d)?))?;
-            let weight = |key| match rendered.counters.get(key) {
+            let shading = TransitionShading::new(false, d)?;
+            let (finest, _) = time(Shading::Transitions(shading.with_lod(LodSelection::Finest)))?;
+            let (footprint, rendered) = time(Shading::Transitions(
+                shading.with_lod(LodSelection::Footprint),
+            ))?;
+            let counter = |key: &str| match rendered.counters.get(key) {
                 Some(Counter::Value(v)) => *v,
+                Some(Counter::Count(n)) => *n as f64,
                 _ => 0.0,
             };
             let weights = [
@@ -197,13 +215,22 @@ fn transition_rows(args: &DisplacedArgs, base: &Scene) -> Result<()> {
                 "transition_bump_weight",
                 "transition_displacement_weight",
             ]
-            .map(weight);
+            .map(counter);
             let total: f64 = weights.iter().sum::<f64>().max(1.0);
+            let levels = LEVEL_KEYS.map(counter);
+            let displacing: f64 = levels.iter().sum();
+            let coarser = if displacing > 0.0 {
+                format!("{:.0}%", 100.0 * (displacing - levels[0]) / displacing)
+            } else {
+                "-".to_string()
+            };
             println!(
-                "{name:>6} {d:>5} {:>14.1} {:>14.1} {:>8.2} | {:>5.0}% {:>5.0}% {:>5.0}%",
+                "{name:>6} {d:>5} {:>13.1} {:>13.1} {:>8.2} {:>13.1} {:>8.2} | {:>5.0}% {:>5.0}% {:>5.0}% | {coarser:>7}",
                 full.median_ms(),
-                transition.median_ms(),
-                full.median_ms() / transition.median_ms(),
+                finest.median_ms(),
+                full.median_ms() / finest.median_ms(),
+                footprint.median_ms(),
+                full.median_ms() / footprint.median_ms(),
                 100.0 * weights[0] / total,
                 100.0 * weights[1] / total,
                 100.0 * weights[2] / total,
@@ -211,11 +238,22 @@ fn transition_rows(args: &DisplacedArgs, base: &Scene) -> Result<()> {
         }
     }
     println!(
-        "BRDF, bump, disp.: share of the samples on the displaced object by method weight; \
-         transition ms includes building its tables"
+        "finest: --lod finest (the detailed mesh); footprint: --lod footprint (the default); \
+         BRDF, bump, disp.: share of the samples on the displaced object by method weight; \
+         coarser: share of the displacing samples that traced a coarser level; the tables and \
+         levels of detail are built once per prepared scene, in the first (warm-up) render"
     );
     Ok(())
 }
+
+/// The statistics keys of the samples per level of detail (`--stats` of `transition-lit`).
+const LEVEL_KEYS: [&str; 5] = [
+    "lod_100_samples",
+    "lod_80_samples",
+    "lod_60_samples",
+    "lod_40_samples",
+    "lod_20_samples",
+];
 
 /// `projection` (a perspective camera) moved towards its target to `fraction` of its
 /// distance.

@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 
 use super::fan::{fan, Fan};
 use super::polymesh::polygon_normal;
-use super::split::{SplitVertex, Stable, VertexSplit};
+use super::split::{Simplified, SplitVertex, Stable, VertexSplit};
 use super::PolyMesh;
 
 /// Which vertex an edge collapses into.
@@ -308,6 +308,21 @@ impl Work {
         }
         self.around[into as usize] = around_into;
         split
+    }
+
+    /// The simplification that `splits` (the collapses performed, in order) made of the
+    /// input, in `sweeps` sweeps.
+    pub fn finish(self, splits: Vec<VertexSplit>, sweeps: usize) -> Simplified {
+        let (coarse, vertex_ids, face_ids) = self.mesh.compact_with_ids();
+        Simplified {
+            coarse,
+            splits,
+            vertex_ids,
+            face_ids,
+            vertex_id_count: self.mesh.alive.len(),
+            face_id_count: self.mesh.faces.len(),
+            sweeps,
+        }
     }
 
     /// A vertex with its attributes, for a split record.

@@ -11,6 +11,9 @@
 //!   of independent collapses, half- or full-edge collapses ([`CollapseKind`]); the result
 //!   ([`Simplified`]) holds the coarse mesh and the [`VertexSplit`]s, and
 //!   [`Simplified::refine`] replays them.
+//! - [`collapse_in_order`]: half-edge collapses cheapest first by a cost the caller gives
+//!   ([`HalfEdgeCost`]), from a priority queue: the progressive mesh's order
+//!   ([`crate::displace::progressive`]).
 //! - [`coarse_triangles`]: a coarse triangle mesh of a scene mesh, for renderers that want
 //!   few triangles standing for a detailed surface (a camera mesh over a reflector, say).
 //!
@@ -18,13 +21,15 @@
 //! the dissertation finds they look better, each end moving half as far. Half-edge collapses
 //! serve where vertices must stay on the original surface: [`coarse_triangles`].
 //!
-//! Module layers, bottom up: `polymesh`, `fan`, `halfedge`, `split`, `collapse`, `sweep`.
+//! Module layers, bottom up: `polymesh`, `fan`, `halfedge`, `split`, `collapse`, `sweep` and
+//! `queue`.
 
 mod collapse;
 mod fan;
 mod halfedge;
 mod obj;
 mod polymesh;
+mod queue;
 mod split;
 mod sweep;
 
@@ -32,6 +37,7 @@ pub use collapse::CollapseKind;
 pub use halfedge::{Defect, HalfEdge, HalfEdgeMesh, NONE};
 pub use obj::{write_obj, ObjPolygons};
 pub use polymesh::{closed_torus, polygon_normal, PolyMesh};
+pub use queue::{collapse_in_order, HalfEdgeCost, Ordered};
 pub use split::{Simplified, SplitVertex, VertexSplit};
 pub use sweep::{simplify, SimplifyOptions};
 

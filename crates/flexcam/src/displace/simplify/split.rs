@@ -62,6 +62,12 @@ impl Simplified {
     /// The mesh after undoing the last `count` collapses (all of them at most): `refine(0)`
     /// is `coarse`, `refine(splits.len())` the input, exactly.
     pub fn refine(&self, count: usize) -> PolyMesh {
+        self.refine_with_ids(count).0
+    }
+
+    /// [`Simplified::refine`] with the stable ids of its vertices and faces (as
+    /// [`Simplified::vertex_ids`] and [`Simplified::face_ids`] give those of `coarse`).
+    pub fn refine_with_ids(&self, count: usize) -> (PolyMesh, Vec<u32>, Vec<u32>) {
         let count = count.min(self.splits.len());
         let n = self.vertex_id_count;
         let c = &self.coarse;
@@ -94,7 +100,7 @@ impl Simplified {
                 mesh.faces[*f as usize] = face.clone();
             }
         }
-        mesh.compact()
+        mesh.compact_with_ids()
     }
 }
 
@@ -165,9 +171,5 @@ impl Stable {
                 .collect(),
         };
         (mesh, vertex_ids, face_ids)
-    }
-
-    fn compact(&self) -> PolyMesh {
-        self.compact_with_ids().0
     }
 }

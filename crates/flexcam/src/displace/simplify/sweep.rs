@@ -108,16 +108,7 @@ pub fn simplify(mesh: &PolyMesh, options: &SimplifyOptions) -> Result<Simplified
             break;
         }
     }
-    let (coarse, vertex_ids, face_ids) = work.mesh.compact_with_ids();
-    Ok(Simplified {
-        coarse,
-        splits,
-        vertex_ids,
-        face_ids,
-        vertex_id_count: work.mesh.alive.len(),
-        face_id_count: work.mesh.faces.len(),
-        sweeps,
-    })
+    Ok(work.finish(splits, sweeps))
 }
 
 /// An edge that may collapse, with its faces (one is [`NONE`] on the boundary) and its

@@ -259,3 +259,57 @@ displacement = { procedural = "waves", waves = [[1.0, 8, 0, 0.0], [1.0, 0, 4, 0.
     }
     assert!(hits > 100, "{hits}");
 }
+
+#[test]
+fn levels_of_detail_coarsen_within_one_shared_bound() {
+    // The test scene with its first torus fine enough to simplify.
+    let text = SCENE.replacen("tessellation = 6", "tessellation = 32", 1);
+    let prepared = PreparedScene::new(&parse(&text, Path::new("lod-test.toml")).unwrap());
+    let set = prepared.displaced.as_ref().unwrap();
+    let data = set.transition_data(&prepared.scene);
+    // Built once: a second call finds the same data.
+    assert!(std::ptr::eq(data, set.transition_data(&prepared.scene)));
+    let lods = &data.lods;
+    assert!(lods.failures.is_empty(), "{:?}", lods.failures);
+    let sizes: Vec<usize> = lods
+        .levels
+        .iter()
+        .map(|l| l.scene.objects[0].mesh.triangles.len())
+        .collect();
+    assert_eq!(sizes[0], prepared.scene.objects[0].mesh.triangles.len());
+    assert!(sizes.windows(2).all(|w| w[1] < w[0]), "{sizes:?}");
+    assert!(sizes[4] * 100 <= sizes[0] * 21, "{sizes:?}");
+    let deviations = lods.deviations(0);
+    assert!(deviations[0] < 1e-12);
+    assert!(
+        deviations.windows(2).all(|w| w[1] >= w[0]),
+        "{deviations:?}"
+    );
+    assert!(deviations[4] > 0.0);
+    // Every level's shells, and the detailed mesh undisplaced and displaced, are inside the
+    // shared bound.
+    let [lo, hi] = lods.bound(0).unwrap();
+    let inside = |p: DVec3| p.cmpge(lo).all() && p.cmple(hi).all();
+    for level in &lods.levels {
+        let [a, b] = level.set.object_bound(0).unwrap();
+        assert!(inside(a) && inside(b));
+    }
+    let mesh = &prepared.scene.objects[0].mesh;
+    let displacement = set.displacement(0).unwrap();
+    for triangle in 0..mesh.triangles.len() {
+        for v in crate::displace::base_corners(mesh, triangle) {
+            assert!(inside(v.position) && inside(displacement.displace(&v)));
+        }
+    }
+    // Selection.
+    let near = DVec3::new(0.0, 2.5, 3.0);
+    assert_eq!(lods.select(LodSelection::Finest, 0, near, 1e9), 0);
+    assert_eq!(lods.select(LodSelection::Footprint, 0, near, 0.0), 0);
+    assert_eq!(lods.select(LodSelection::Footprint, 0, near, 1e9), 4);
+    let between = lods.select(LodSelection::Footprint, 0, near, 2.0 * deviations[2]);
+    assert!(between >= 2 && deviations[between] <= deviations[2]);
+    assert!(between == 4 || deviations[between + 1] > deviations[2]);
+    assert_eq!(lods.select(LodSelection::Distance, 0, near * 1e3, 0.0), 4);
+    assert_eq!(lods.select(LodSelection::Distance, 0, near, 0.0), 0);
+    assert_eq!(lods.select(LodSelection::Distance, 0, DVec3::ZERO, 0.0), 4);
+}

@@ -17,17 +17,18 @@
 
 mod footprint;
 mod shade;
-mod tables;
 
 use std::time::Instant;
 
 use glam::{DVec2, DVec3, Vec3};
+
+use crate::displace::progressive::LOD_PERCENTS;
 use rayon::prelude::*;
 
-use self::tables::Tables;
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
 use crate::projection::{Projection, Projector};
+use crate::render::displaced::{LodSelection, ObjectTables, TransitionData};
 use crate::render::prepared::PreparedScene;
 use crate::render::raycast::pieces::polyline_segment;
 use crate::render::raycast::SamplePattern;
@@ -41,6 +42,8 @@ pub struct TransitionShading {
     /// Colour by method (`transitions`) rather than the lit image (`transition-lit`).
     pub methods: bool,
     d_bits: u64,
+    /// How rays that displace pick the level of detail they trace.
+    pub lod: LodSelection,
 }
 
 impl TransitionShading {
@@ -58,6 +61,7 @@ impl TransitionShading {
         Ok(TransitionShading {
             methods,
             d_bits: d.to_bits(),
+            lod: LodSelection::default(),
         })
     }
 
@@ -66,6 +70,7 @@ impl TransitionShading {
         TransitionShading {
             methods,
             d_bits: Self::DEFAULT_D.to_bits(),
+            lod: LodSelection::default(),
         }
     }
 
@@ -73,17 +78,26 @@ impl TransitionShading {
     pub fn d(self) -> f64 {
         f64::from_bits(self.d_bits)
     }
+
+    /// With level-of-detail selection `lod`.
+    pub fn with_lod(self, lod: LodSelection) -> TransitionShading {
+        TransitionShading { lod, ..self }
+    }
 }
 
-/// One render's state in a worker: the scene, the tables, the shader of other objects and
-/// the counts.
+/// One render's state in a worker: the scene, the tables and levels of detail, the shader
+/// of other objects and the counts.
 struct Renderer<'a> {
     prepared: &'a PreparedScene,
     projection: &'a dyn Projection,
-    tables: &'a Tables,
+    /// `None` when the scene has no displaced objects.
+    data: Option<&'a TransitionData>,
     lit: HitShader<'a>,
     d: f64,
     methods: bool,
+    lod: LodSelection,
+    /// Samples that traced each level of detail (displacing ones only).
+    levels: [u64; LOD_PERCENTS.len()],
     primary_rays: u64,
     partial_rays: u64,
     shadow_rays: u64,
@@ -91,10 +105,24 @@ struct Renderer<'a> {
     weights: DVec3,
 }
 
+/// The statistics keys of the samples that traced each level of detail.
+const LEVEL_KEYS: [&str; LOD_PERCENTS.len()] = [
+    "lod_100_samples",
+    "lod_80_samples",
+    "lod_60_samples",
+    "lod_40_samples",
+    "lod_20_samples",
+];
+
 /// One sample: colour, depth, object id.
 type Sample = (Vec3, f32, u32);
 
 impl<'a> Renderer<'a> {
+    /// The tables of object `object`, if it is displaced.
+    fn tables(&self, object: usize) -> Option<&'a ObjectTables> {
+        self.data?.tables.get(object)
+    }
+
     fn sample(&mut self, pixel: DVec2) -> Sample {
         let background = (self.prepared.scene.image.background, f32::INFINITY, 0);
         self.primary_rays += 1;
@@ -128,7 +156,7 @@ impl<'a> Renderer<'a> {
     ) -> Sample {
         let id = |index: usize| self.prepared.scene.objects[index].id;
         let depth = |t: f64| (before + t * ray.direction.length()) as f32;
-        if self.tables.get(hit.object).is_none() {
+        if self.tables(hit.object).is_none() {
             let color = self.lit.shade_hit(ray, hit);
             let color = if self.methods {
                 Vec3::splat(0.5 * color.dot(Vec3::new(0.2126, 0.7152, 0.0722)))
@@ -168,24 +196,31 @@ pub(in crate::render) fn render(
              only, not quadratic ones",
         ));
     }
+    // Built once per prepared scene, on its first transition render.
     let start = Instant::now();
-    let tables = Tables::new(prepared);
+    let data = prepared
+        .displaced
+        .as_ref()
+        .map(|set| set.transition_data(&prepared.scene));
     let table_ms = start.elapsed().as_secs_f64() * 1e3;
     let pattern = SamplePattern::new(options.spp);
     let lit_options = RenderOptions {
         shading: Shading::Lit,
         ..*options
     };
-    let rows: Vec<(Vec<Sample>, [u64; 4], DVec3)> = (0..height)
+    type Row = (Vec<Sample>, [u64; 4], DVec3, [u64; LOD_PERCENTS.len()]);
+    let rows: Vec<Row> = (0..height)
         .into_par_iter()
         .map(|y| {
             let mut renderer = Renderer {
                 prepared,
                 projection,
-                tables: &tables,
+                data,
                 lit: HitShader::new(prepared, &lit_options),
                 d: shading.d(),
                 methods: shading.methods,
+                lod: shading.lod,
+                levels: [0; LOD_PERCENTS.len()],
                 primary_rays: 0,
                 partial_rays: 0,
                 shadow_rays: 0,
@@ -216,13 +251,15 @@ pub(in crate::render) fn render(
                     counts.secondary,
                 ],
                 renderer.weights,
+                renderer.levels,
             )
         })
         .collect();
     let mut frame = Frame::zeroed(width, height, options.outputs);
     let mut totals = [0u64; 4];
     let mut weights = DVec3::ZERO;
-    for (y, (samples, counts, w)) in rows.into_iter().enumerate() {
+    let mut levels = [0u64; LOD_PERCENTS.len()];
+    for (y, (samples, counts, w, l)) in rows.into_iter().enumerate() {
         for (x, (color, depth, id)) in samples.into_iter().enumerate() {
             let i = y * width as usize + x;
             frame.color[i] = color;
@@ -237,8 +274,11 @@ pub(in crate::render) fn render(
             *t += c;
         }
         weights += w;
+        for (t, c) in levels.iter_mut().zip(l) {
+            *t += c;
+        }
     }
-    let stats = Stats::from([
+    let mut stats = Stats::from([
         ("primary_rays", Counter::Count(totals[0])),
         ("partial_displacement_rays", Counter::Count(totals[1])),
         ("shadow_rays", Counter::Count(totals[2])),
@@ -248,6 +288,15 @@ pub(in crate::render) fn render(
         ("transition_bump_weight", Counter::Value(weights.y)),
         ("transition_displacement_weight", Counter::Value(weights.z)),
     ]);
+    for (key, count) in LEVEL_KEYS.into_iter().zip(levels) {
+        stats.insert(key, Counter::Count(count));
+    }
+    if let Some(data) = data {
+        stats.insert(
+            "lod_failures",
+            Counter::Count(data.lods.failures.len() as u64),
+        );
+    }
     Ok((frame, stats))
 }
 

@@ -17,15 +17,15 @@
 
 use glam::{DVec2, DVec3, Vec3};
 
-use super::tables::{ObjectTables, PARTIAL_STEPS};
 use super::Renderer;
 use crate::displace::normal_distribution::rotate;
 use crate::displace::transition::{self, partial_view_angle, Blend};
 use crate::geometry::Ray;
+use crate::render::displaced::{ObjectTables, PARTIAL_STEPS};
 use crate::render::prepared::Hit;
 use crate::render::shading::trace::light_from;
 use crate::render::shading::{base_color, TextureFilter};
-use crate::scene::Object;
+use crate::scene::{Object, Scene};
 
 /// Ambient fraction of the base colour (as in lit shading).
 const AMBIENT: f32 = 0.1;
@@ -113,13 +113,22 @@ pub(super) struct Shaded {
     pub blend: Blend,
 }
 
-impl Renderer<'_> {
+impl<'a> Renderer<'a> {
+    /// The scene whose displaced objects have the meshes of level of detail `level`: the
+    /// prepared scene itself for the detailed level.
+    fn level_scene(&self, level: usize) -> &'a Scene {
+        match (level, self.data) {
+            (0, _) | (_, None) => &self.prepared.scene,
+            (k, Some(data)) => &data.lods.levels[k].scene,
+        }
+    }
+
     /// Shades `ray`, whose first hit `hull` is on the hull of a displaced object, seen by
     /// the pixel at `pixel`.
     pub(super) fn shade_displaced(&mut self, ray: &Ray, hull: Hit, pixel: DVec2) -> Shaded {
-        let all = self.tables;
+        let data = self.data.expect("a displaced object has transition data");
         let object = &self.prepared.scene.objects[hull.object];
-        let tables = all.get(hull.object).expect("a displaced object");
+        let tables = data.tables.get(hull.object).expect("a displaced object");
         let view = -ray.direction.normalize();
         let frame = SurfaceFrame::at(object, hull.triangle, hull.barycentric.as_dvec2(), -view);
         let cos_view = frame.normal.dot(view).clamp(0.0, 1.0);
@@ -127,24 +136,40 @@ impl Renderer<'_> {
         let t = transition::value(tables.relief(), footprint, self.d, cos_view);
         let blend = transition::blend(t);
         let step = (blend.fraction * PARTIAL_STEPS as f64).round() as usize;
+        let level = if step == 0 {
+            0
+        } else {
+            data.lods
+                .select(self.lod, hull.object, ray.origin, footprint)
+        };
+        let lod = &data.lods.levels[level];
+        let scene = self.level_scene(level);
         let hit = if step == 0 {
             Some(hull)
-        } else if step == PARTIAL_STEPS {
-            // Full displacement: the prepared scene's own search, with its kept boxes.
-            self.prepared.intersect(ray)
         } else {
-            self.partial_rays += 1;
-            self.prepared.intersect_partial(ray, |o| {
-                all.get(o).expect("a displaced object").partial(step)
-            })
+            self.levels[level] += 1;
+            if step == PARTIAL_STEPS && level == 0 {
+                // Full displacement: the prepared scene's own search, with its kept boxes.
+                self.prepared.intersect(ray)
+            } else if step == PARTIAL_STEPS {
+                self.prepared.intersect_level(ray, &lod.scene, &lod.set)
+            } else {
+                self.partial_rays += 1;
+                self.prepared.intersect_partial(ray, scene, &lod.set, |o| {
+                    data.tables
+                        .get(o)
+                        .expect("a displaced object")
+                        .partial(step)
+                })
+            }
         };
         let color = match hit {
             None => self.prepared.scene.image.background,
-            Some(hit) => match all.get(hit.object) {
+            Some(hit) => match data.tables.get(hit.object) {
                 None => self.lit.shade_hit(ray, hit),
                 Some(tables) => {
                     let s = step as f64 / PARTIAL_STEPS as f64;
-                    self.shade_surface(ray, hit, tables, &blend, s)
+                    self.shade_surface(ray, hit, level, tables, &blend, s)
                 }
             },
         };
@@ -152,16 +177,17 @@ impl Renderer<'_> {
     }
 
     /// The colour of displaced-object hit `hit` on `ray` shaded by `blend`, its geometry
-    /// displaced by fraction `s` (module docs).
+    /// displaced by fraction `s` at level of detail `level` (module docs).
     fn shade_surface(
         &mut self,
         ray: &Ray,
         hit: Hit,
+        level: usize,
         tables: &ObjectTables,
         blend: &Blend,
         s: f64,
     ) -> Vec3 {
-        let object = &self.prepared.scene.objects[hit.object];
+        let object = &self.level_scene(level).objects[hit.object];
         let barycentric = hit.barycentric.as_dvec2();
         let view = -ray.direction.normalize();
         let frame = SurfaceFrame::at(object, hit.triangle, barycentric, -view);
@@ -207,10 +233,13 @@ impl Renderer<'_> {
             let mut shadow = self.prepared.spawn(position, frame.normal, to_light);
             shadow.t_max = t_max;
             self.shadow_rays += 1;
-            let blocked = if s > 0.0 {
+            let blocked = if s == 0.0 {
+                self.prepared.occluded_hull(&shadow)
+            } else if level == 0 {
                 self.prepared.occluded(&shadow)
             } else {
-                self.prepared.occluded_hull(&shadow)
+                let lod = &self.data.expect("transition data").lods.levels[level];
+                self.prepared.occluded_level(&shadow, &lod.scene, &lod.set)
             };
             if !blocked {
                 color += base * radiance * term;

@@ -104,3 +104,35 @@ fn refuses_other_methods_and_bad_constants() {
     };
     assert!(render(&prepared, projection.as_ref(), &options).is_err());
 }
+
+/// Rays that displace trace coarser levels of detail where their footprint allows, and the
+/// image stays close to the one traced on the detailed mesh everywhere.
+#[test]
+fn coarser_levels_where_the_footprint_allows() {
+    let (scene, spec) = scene_at(2, 1.0);
+    let prepared = PreparedScene::new(&scene);
+    let displaced = TransitionShading::new(false, -1e9).unwrap();
+    let projection = spec.build(48, 48).unwrap();
+    let run = |lod| {
+        let options = RenderOptions {
+            method: Method::Raycast,
+            shading: Shading::Transitions(displaced.with_lod(lod)),
+            outputs: Outputs::COLOR,
+            ..RenderOptions::default()
+        };
+        render(&prepared, projection.as_ref(), &options).unwrap()
+    };
+    let finest = run(LodSelection::Finest);
+    let footprint = run(LodSelection::Footprint);
+    let count = |r: &crate::render::Rendered, key: &str| match r.counters.get(key) {
+        Some(crate::render::Counter::Count(n)) => *n,
+        _ => panic!("no {key}"),
+    };
+    let coarse: u64 = LEVEL_KEYS[1..].iter().map(|k| count(&footprint, k)).sum();
+    assert!(coarse > 0, "no ray traced a coarser level");
+    let finest_coarse: u64 = LEVEL_KEYS[1..].iter().map(|k| count(&finest, k)).sum();
+    assert_eq!(finest_coarse, 0);
+    assert!(count(&finest, LEVEL_KEYS[0]) > 0);
+    let difference = mean_difference(&finest.frame.color, &footprint.frame.color);
+    assert!(difference < 0.05, "{difference}");
+}

@@ -1,6 +1,6 @@
-//! What the transition system precomputes per displaced object: the chart of its height
-//! field, its normal distribution, BRDF and redistribution tables (module
-//! [`crate::displace`]), and its partial displacements.
+//! What the transition system (`render::transitions`) precomputes per displaced object: the
+//! chart of its height field, its normal distribution, BRDF and redistribution tables
+//! (module [`crate::displace`]), and its partial displacements.
 //!
 //! The chart is one for the whole object: the height field over one uv period laid flat at
 //! the object's mean world size of that period (the area-weighted means of `|dP/du|` and
@@ -14,25 +14,25 @@ use std::sync::OnceLock;
 
 use glam::DVec2;
 
+use super::DisplacedSet;
 use crate::displace::brdf_table::BrdfTable;
 use crate::displace::bump::Redistribution;
 use crate::displace::normal_distribution::{Chart, NormalDistribution};
 use crate::displace::Displacement;
-use crate::render::PreparedScene;
-use crate::scene::Object;
+use crate::scene::{Object, Scene};
 
 /// Chart nodes per side.
-pub(super) const CHART_CELLS: usize = 128;
+const CHART_CELLS: usize = 128;
 /// Rays per side per view azimuth and view angle for the normal distributions.
 const RAYS: usize = 24;
 /// Partial displacement is traced at fractions `k / PARTIAL_STEPS` of the object's (`k` the
 /// nearest to the ray's `s`): a step moves the surface by 1/64 of its relief, under a tenth
 /// of a pixel footprint wherever partial displacement is chosen (relief below 3 footprints
 /// at `T < 1` with the default `D`).
-pub(super) const PARTIAL_STEPS: usize = 64;
+pub(in crate::render) const PARTIAL_STEPS: usize = 64;
 
 /// The tables of one displaced object.
-pub(super) struct ObjectTables {
+pub(in crate::render) struct ObjectTables {
     pub chart: Chart,
     pub redistribution: Redistribution,
     pub brdf: BrdfTable,
@@ -74,19 +74,17 @@ impl ObjectTables {
 }
 
 /// The tables of every displaced object of a prepared scene (by object index).
-pub(super) struct Tables {
+pub(in crate::render) struct Tables {
     objects: Vec<Option<ObjectTables>>,
 }
 
 impl Tables {
-    pub fn new(prepared: &PreparedScene) -> Tables {
-        let objects = prepared
-            .scene
+    pub fn new(scene: &Scene, set: &DisplacedSet) -> Tables {
+        let objects = scene
             .objects
             .iter()
             .enumerate()
             .map(|(index, object)| {
-                let set = prepared.displaced.as_ref()?;
                 let displacement = set.displacement(index)?;
                 Some(ObjectTables::new(object, displacement))
             })
