@@ -94,10 +94,10 @@ impl CameraMatrix {
             }
             row[3] = p[4 * r + 3] - (0..3).map(|c| p[4 * r + c] * ws * wc[c]).sum::<f64>();
         }
-        for c in 0..4 {
-            let w = rows[2][c];
-            rows[0][c] = rows[0][c] / is + ic[0] * w;
-            rows[1][c] = rows[1][c] / is + ic[1] * w;
+        let [r0, r1, r2] = &mut rows;
+        for ((a, b), &w) in r0.iter_mut().zip(r1.iter_mut()).zip(r2.iter()) {
+            *a = *a / is + ic[0] * w;
+            *b = *b / is + ic[1] * w;
         }
         let depth_sum: f64 = world
             .iter()
@@ -155,7 +155,9 @@ fn direct_linear_transform(uv: &[[f64; 2]], x: &[[f64; 4]]) -> Option<DVector<f6
     let mut order: Vec<usize> = (0..12).collect();
     order.sort_by(|&i, &j| eigen.eigenvalues[i].total_cmp(&eigen.eigenvalues[j]));
     let largest = eigen.eigenvalues[order[11]];
-    if !(eigen.eigenvalues[order[1]] > DEGENERATE * largest) {
+    // Also degenerate where an eigenvalue is NaN (no ordering).
+    let second = eigen.eigenvalues[order[1]];
+    if second.partial_cmp(&(DEGENERATE * largest)) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     Some(eigen.eigenvectors.column(order[0]).into_owned())

@@ -89,7 +89,8 @@ pub(super) fn auto_fit(
     // Simplest first: the pinhole's 11 unknowns, the eye's, the kept starts', the free ones'.
     let models: [fn(&ProjectorGrid, &[Correspondence]) -> Fitted; 4] =
         [pinhole_fit, central_fit, fit, free_fit];
-    let mut best: Option<(f64, (bool, bool), (ProjectorGrid, FitReport))> = None;
+    // (held-out misses, flaws, the fit) of the best model so far.
+    let mut best: Option<(f64, Flaws, (ProjectorGrid, FitReport))> = None;
     for model in models {
         let Ok(fitted) = model(prior, correspondences) else {
             continue;
@@ -114,6 +115,10 @@ pub(super) fn auto_fit(
         None => nested,
     }
 }
+
+/// A fit's flaws, compared worst first: (its grid is folded, nodes the data leave
+/// undetermined).
+type Flaws = (bool, bool);
 
 /// How much lower (as a fraction) a model's held-out misses must be to beat a simpler one's.
 const TIE: f64 = 0.02;
