@@ -68,7 +68,9 @@ pub(super) fn clearly_better(
 /// which the extra unknowns of a model that only fits the noise raise instead of lowering;
 /// a grid that folds ([`folded`]) is taken only where every model's does, and one that
 /// leaves nodes undetermined only where every unfolded one does. Among the rest the least
-/// held-out misses win; a model within `TIE` of a simpler one's loses to it.
+/// held-out misses win; a model within `TIE` of a simpler one's loses to it, and so does one
+/// whose gain is within what exact fits miss (`EXACT_RMS_RAD` a correspondence). Where every
+/// model folds or leaves nodes undetermined, [`nested_fit`]'s choice stands.
 pub(super) fn auto_fit(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
@@ -91,6 +93,8 @@ pub(super) fn auto_fit(
         [pinhole_fit, central_fit, fit, free_fit];
     // (held-out misses, flaws, the fit) of the best model so far.
     let mut best: Option<(f64, Flaws, (ProjectorGrid, FitReport))> = None;
+    // Held-out misses this small are exact fits alike: no evidence for more unknowns.
+    let exact_misses = correspondences.len() as f64 * EXACT_RMS_RAD.powi(2);
     for model in models {
         let Ok(fitted) = model(prior, correspondences) else {
             continue;
@@ -103,7 +107,8 @@ pub(super) fn auto_fit(
         let better = match &best {
             None => true,
             Some((least, best_flaws, _)) => {
-                flaws < *best_flaws || (flaws == *best_flaws && misses < least * (1.0 - TIE))
+                flaws < *best_flaws
+                    || (flaws == *best_flaws && misses < least * (1.0 - TIE) - exact_misses)
             }
         };
         if better {
@@ -111,8 +116,12 @@ pub(super) fn auto_fit(
         }
     }
     match best {
-        Some((_, _, fitted)) => Ok(fitted),
-        None => nested,
+        Some((_, (false, false), fitted)) => Ok(fitted),
+        // Every model folds or leaves nodes undetermined: the held-out points lie where the
+        // others do and cannot judge the nodes no point reaches; the nested choice, which
+        // counts unknowns, decides.
+        Some((_, _, fitted)) if nested.is_err() => Ok(fitted),
+        _ => nested,
     }
 }
 

@@ -25,7 +25,7 @@ pub const FOOTPRINT_SHARE: f64 = 0.5;
 /// How a ray on a displaced object picks its level of detail.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LodSelection {
-    /// The coarsest level whose texture deviation is at most [`FOOTPRINT_SHARE`] of the
+    /// The coarsest level whose texture deviation is at most half (`FOOTPRINT_SHARE`) of the
     /// ray's footprint at the surface.
     #[default]
     Footprint,

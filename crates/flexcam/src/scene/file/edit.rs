@@ -52,17 +52,20 @@ pub fn set_projection_value(
     if last.is_empty() || tables.is_some_and(|t| t.split('.').any(str::is_empty)) {
         return Err(Error::new(format!("`{key}` is not a key")));
     }
-    let mut item = document
+    // Looked up through the tables themselves: `Item::get_mut` would insert a missing key.
+    let mut table = document
+        .as_table_mut()
         .get_mut("projection")
+        .and_then(Item::as_table_like_mut)
         .ok_or_else(|| missing("[projection] table"))?;
     for part in tables.into_iter().flat_map(|t| t.split('.')) {
-        item = item
+        table = table
             .get_mut(part)
+            .and_then(Item::as_table_like_mut)
             .ok_or_else(|| missing(&format!("table `{part}`")))?;
     }
-    let table = item.as_table_like_mut().ok_or_else(|| missing("table"))?;
     match table.get_mut(last) {
-        Some(Item::Value(old)) => {
+        Some(Item::Value(old)) if !old.is_inline_table() => {
             if let (Value::Float(_), Some(i)) = (&*old, value.as_integer()) {
                 value = Value::from(i as f64);
             }
@@ -107,8 +110,8 @@ mod tests {
             Some(70.0)
         );
         assert_eq!(
-            projection_value(&doc, "fov").unwrap().as_float(),
-            Some(100.5)
+            doc.to_string(),
+            TEXT.replace("fov = 60.0 # degrees", "fov = 70.0 # degrees")
         );
     }
 

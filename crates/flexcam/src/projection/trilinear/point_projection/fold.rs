@@ -41,7 +41,7 @@ const DEGENERATE_TOL: f64 = 1e-3;
 
 impl ProjectionTriangleCache {
     /// The depths `t > 0` at which the parametric triangle degenerates (`N(t) = 0`, module
-    /// doc), up to [`DEGENERATE_TOL`] of its size: the least and the greatest, `None`
+    /// doc), up to `DEGENERATE_TOL` (1e-3) of its size: the least and the greatest, `None`
     /// where it never does. (`N` is a quadratic in `t`: it can vanish at two depths.)
     ///
     /// Where `N` vanishes each of its three components does, so the candidates are the real
