@@ -10,9 +10,13 @@
 //!
 //! - **Given size** (`camera_triangles = N`): the simplification to `N` triangles, used as it
 //!   is ([`CameraMesh::refine`] false).
-//! - **Automatic size**: the smallest of `F/2, F/4, ...` (at least [`MIN_AUTO_TRIANGLES`];
-//!   `F` the reflector's triangles) whose *normal error* stays within the reflector's
-//!   tolerance `trilinear_refine_px` in main-image pixels, else the reflector's own mesh;
+//! - **Automatic size**: `F/2, F/4, ...` (at least [`MIN_AUTO_TRIANGLES`]; `F` the
+//!   reflector's triangles) are tried from the finest and the last whose *normal error*
+//!   stays within the reflector's tolerance `trilinear_refine_px` in main-image pixels
+//!   before the first that does not is taken, else the reflector's own mesh (the error
+//!   grows as the mesh coarsens, so this is the smallest within the tolerance; where even
+//!   `F/2` is not, as for every example reflector at the default tolerance, one
+//!   simplification is all it costs);
 //!   the result is then refined by the same tolerance as the reflector's own mesh is
 //!   ([`super::refine`]), which bounds the error of the surface's interpolated rays against
 //!   the coarse mesh's normals. The two errors add: at most about twice the tolerance
@@ -107,19 +111,19 @@ fn automatic<'a>(
     if seen.vertices.is_empty() {
         return Cow::Borrowed(reflector);
     }
-    let mut sizes: Vec<usize> = std::iter::successors(Some(own / 2), |n| Some(n / 2))
-        .take_while(|&n| n >= MIN_AUTO_TRIANGLES)
-        .collect();
-    sizes.reverse();
+    let sizes = std::iter::successors(Some(own / 2), |n| Some(n / 2))
+        .take_while(|&n| n >= MIN_AUTO_TRIANGLES);
+    let mut chosen = Cow::Borrowed(reflector);
     for n in sizes {
         let Ok(coarse) = coarse_triangles(reflector, n, SEED) else {
             return Cow::Borrowed(reflector);
         };
-        if seen.normal_error_px(&coarse, optic) <= tolerance_px {
-            return Cow::Owned(coarse);
+        if seen.normal_error_px(&coarse, optic) > tolerance_px {
+            break;
         }
+        chosen = Cow::Owned(coarse);
     }
-    Cow::Borrowed(reflector)
+    chosen
 }
 
 /// A reflector vertex the main camera sees, with what the normal error compares against.
