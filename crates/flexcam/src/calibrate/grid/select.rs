@@ -1,3 +1,5 @@
+use glam::DVec3;
+
 use super::folds::folded;
 use super::{
     central, constrained_nodes, fit, free, miss_seen_from, straight_undetermined, Correspondence,
@@ -11,14 +13,7 @@ pub(super) fn central_fit(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport)> {
-    let (grid, report, eye) = central::fit(prior, correspondences)?;
-    Ok((
-        grid,
-        FitReport {
-            starts: FittedStarts::Eye(eye),
-            ..report
-        },
-    ))
+    central::fit(prior, correspondences).map(|found| reporting_eye(found, FittedStarts::Eye))
 }
 
 /// The pinhole fit (module `central`), its report saying which eye it found.
@@ -26,14 +21,21 @@ pub(super) fn pinhole_fit(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport)> {
-    let (grid, report, eye) = central::fit_pinhole(prior, correspondences)?;
-    Ok((
-        grid,
-        FitReport {
-            starts: FittedStarts::Pinhole(eye),
-            ..report
-        },
-    ))
+    central::fit_pinhole(prior, correspondences)
+        .map(|found| reporting_eye(found, FittedStarts::Pinhole))
+}
+
+/// A fit through one eye (grid, report, eye), its report's starts naming the eye as
+/// `starts` does.
+fn reporting_eye(
+    (grid, report, eye): (ProjectorGrid, FitReport, DVec3),
+    starts: fn(DVec3) -> FittedStarts,
+) -> (ProjectorGrid, FitReport) {
+    let report = FitReport {
+        starts: starts(eye),
+        ..report
+    };
+    (grid, report)
 }
 
 /// Whether a fit's rms miss is at most `EXACT_RMS_RAD`.
