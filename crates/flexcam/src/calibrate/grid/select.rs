@@ -121,8 +121,8 @@ pub(super) fn auto_fit(
         Some((_, (false, false), fitted)) => Ok(fitted),
         // Every model folds or leaves nodes undetermined: the held-out points lie where the
         // others do and cannot judge the nodes no point reaches; the nested choice, which
-        // counts unknowns, decides.
-        Some((_, _, fitted)) if nested.is_err() => Ok(fitted),
+        // counts unknowns, decides, its error included (a lone correspondence at the
+        // prior's eye is not taken as evidence for free starts).
         _ => nested,
     }
 }
