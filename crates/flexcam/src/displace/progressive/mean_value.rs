@@ -2,7 +2,9 @@
 //! 6.2): the chart's boundary loop on the unit circle by arc length, each inner vertex the
 //! mean-value-weighted mean of its neighbours,
 //!
-//!     w_j = (tan(a_{j-1} / 2) + tan(a_j / 2)) / |v_j - v|,
+//! ```text
+//! w_j = (tan(a_{j-1} / 2) + tan(a_j / 2)) / |v_j - v|,
+//! ```
 //!
 //! `a_j` the angle at `v` between its neighbours `v_j` and `v_{j+1}`, normalised to sum 1.
 //! The weights are positive, so on a convex boundary the map is one to one (Floater's
