@@ -108,7 +108,8 @@ fn with_renderer(
     for entry in &scene.trilinear_reflectors {
         let (id, map) = (entry.id, entry.screen_map);
         let reflector = Reflector::of(scene, id)?;
-        let (surface, mut left) = refined_surface(&reflector, reflector.optic, entry, &camera)?;
+        let (surface, mut left) =
+            refined_surface(&reflector, reflector.optic, entry, &camera, options.method)?;
         triangles += surface.mesh.triangles.len();
         dropped += surface.dropped;
         let projection = surface_projection(&surface, map, &camera)?;
@@ -122,8 +123,13 @@ fn with_renderer(
                     paste(&mut frame, id, &image, reflector.tint)?
                 }
                 (Shading::Lit | Shading::Transitions(_), Optic::Refract { .. }) => {
-                    let (mirror, mirror_left) =
-                        refined_surface(&reflector, Optic::Reflect, entry, &camera)?;
+                    let (mirror, mirror_left) = refined_surface(
+                        &reflector,
+                        Optic::Reflect,
+                        entry,
+                        &camera,
+                        options.method,
+                    )?;
                     left += mirror_left;
                     let reflection =
                         render_through(&others, &mirror, map, &camera, options, renderer)?
@@ -352,17 +358,20 @@ impl Reflector {
     }
 }
 
-/// The surface of `reflector` for `optic` seen by `camera`: its camera mesh
-/// ([`camera_mesh`]: the given size as it is, or the automatic size refined with `entry`'s
-/// screen map and tolerance, [`refine`]), and the number of edges left over the tolerance
-/// (see [`refine::Refinement::unsplit`]).
+/// The surface of `reflector` for `optic` seen by `camera`, rendered by `method`: its camera
+/// mesh ([`camera_mesh`]: the given size as it is, or, refined with `entry`'s screen map and
+/// tolerance ([`refine`]), the automatic size for camera triangles and the reflector's own
+/// mesh for the other methods), and the number of edges left over the tolerance (see
+/// [`refine::Refinement::unsplit`]).
 fn refined_surface(
     reflector: &Reflector,
     optic: Optic,
     entry: &TrilinearReflector,
     camera: &Perspective,
+    method: Method,
 ) -> Result<(ReflectorSurface, usize)> {
-    let chosen = camera_mesh(&reflector.mesh, entry, camera, optic)?;
+    let automatic = method == Method::CameraTriangles;
+    let chosen = camera_mesh(&reflector.mesh, entry, camera, optic, automatic)?;
     if !chosen.refine {
         return Ok((reflector_surface(&*chosen.mesh, camera, optic)?, 0));
     }

@@ -10,7 +10,11 @@
 //!
 //! - **Given size** (`camera_triangles = N`): the simplification to `N` triangles, used as it
 //!   is ([`CameraMesh::refine`] false).
-//! - **Automatic size**: `F/2, F/4, ...` (at least [`MIN_AUTO_TRIANGLES`]; `F` the
+//! - **No size given, another method than camera triangles**: the reflector's own mesh, refined
+//!   ([`CameraMesh::refine`] true): the trilinear method's reflection surface is the
+//!   reflector's triangles (Vallance 2005, chapter 7), and the automatic search below would
+//!   cost every such render a simplification that the example reflectors then discard.
+//! - **Automatic size** (`--method camera-triangles`): `F/2, F/4, ...` (at least [`MIN_AUTO_TRIANGLES`]; `F` the
 //!   reflector's triangles) are tried from the finest and the last whose *normal error*
 //!   stays within the reflector's tolerance `trilinear_refine_px` in main-image pixels
 //!   before the first that does not is taken, else the reflector's own mesh (the error
@@ -64,13 +68,15 @@ pub struct CameraMesh<'a> {
 }
 
 /// The camera mesh of `reflector` (its world-space mesh) for `entry`, seen by `camera`
-/// (module doc). Errors: a given size for a mesh that [`coarse_triangles`] refuses (the
-/// message names the reflector and the defect).
+/// (module doc); `automatic`: search the automatic size when `entry` gives none (the
+/// camera-triangle method), else keep the reflector's own mesh. Errors: a given size for a
+/// mesh that [`coarse_triangles`] refuses (the message names the reflector and the defect).
 pub fn camera_mesh<'a>(
     reflector: &'a Mesh,
     entry: &TrilinearReflector,
     camera: &Perspective,
     optic: Optic,
+    automatic: bool,
 ) -> Result<CameraMesh<'a>> {
     match entry.camera_triangles {
         Some(n) if n < reflector.triangles.len() => {
@@ -89,15 +95,19 @@ pub fn camera_mesh<'a>(
             mesh: Cow::Borrowed(reflector),
             refine: false,
         }),
+        None if automatic => Ok(CameraMesh {
+            mesh: automatic_size(reflector, camera, optic, entry.refine_px),
+            refine: true,
+        }),
         None => Ok(CameraMesh {
-            mesh: automatic(reflector, camera, optic, entry.refine_px),
+            mesh: Cow::Borrowed(reflector),
             refine: true,
         }),
     }
 }
 
 /// The automatic camera mesh (module doc).
-fn automatic<'a>(
+fn automatic_size<'a>(
     reflector: &'a Mesh,
     camera: &Perspective,
     optic: Optic,

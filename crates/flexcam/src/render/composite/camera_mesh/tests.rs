@@ -22,7 +22,7 @@ fn a_given_size_is_the_simplification_used_as_it_is() {
         camera_triangles: Some(100),
         ..TrilinearReflector::new(1)
     };
-    let chosen = camera_mesh(&ball.mesh, &entry, &camera, Optic::Reflect).unwrap();
+    let chosen = camera_mesh(&ball.mesh, &entry, &camera, Optic::Reflect, true).unwrap();
     assert!(!chosen.refine);
     let n = chosen.mesh.triangles.len();
     assert!((90..=100).contains(&n), "{n} triangles");
@@ -36,7 +36,7 @@ fn a_given_size_is_the_simplification_used_as_it_is() {
         camera_triangles: Some(ball.mesh.triangles.len()),
         ..entry
     };
-    let own = camera_mesh(&ball.mesh, &all, &camera, Optic::Reflect).unwrap();
+    let own = camera_mesh(&ball.mesh, &all, &camera, Optic::Reflect, true).unwrap();
     assert!(matches!(own.mesh, Cow::Borrowed(_)));
 }
 
@@ -52,10 +52,13 @@ fn the_automatic_size_is_the_smallest_within_the_tolerance() {
     let tolerance = entry.refine_px;
     let (smooth, camera) = ball(64);
     let own = smooth.mesh.triangles.len();
-    let chosen = camera_mesh(&smooth.mesh, &entry, &camera, Optic::Reflect).unwrap();
+    let chosen = camera_mesh(&smooth.mesh, &entry, &camera, Optic::Reflect, true).unwrap();
     assert!(chosen.refine);
     let n = chosen.mesh.triangles.len();
     assert!(n <= own / 4, "{n} of {own} triangles");
+    // The other methods keep the reflector's own mesh, to be refined.
+    let kept = camera_mesh(&smooth.mesh, &entry, &camera, Optic::Reflect, false).unwrap();
+    assert!(kept.refine && matches!(kept.mesh, Cow::Borrowed(_)));
     let seen = SeenVertices::new(&smooth.mesh, &camera, Optic::Reflect);
     assert!(!seen.vertices.is_empty());
     assert!(seen.normal_error_px(&chosen.mesh, Optic::Reflect) <= tolerance);
@@ -66,11 +69,11 @@ fn the_automatic_size_is_the_smallest_within_the_tolerance() {
     assert!(seen.normal_error_px(&smooth.mesh, Optic::Reflect) < 1e-6);
 
     let (coarse, camera) = ball(6);
-    let chosen = camera_mesh(&coarse.mesh, &entry, &camera, Optic::Reflect).unwrap();
+    let chosen = camera_mesh(&coarse.mesh, &entry, &camera, Optic::Reflect, true).unwrap();
     assert!(matches!(chosen.mesh, Cow::Borrowed(_)));
     let (smooth_ball, camera) = ball(64);
     let default = TrilinearReflector::new(1);
-    let chosen = camera_mesh(&smooth_ball.mesh, &default, &camera, Optic::Reflect).unwrap();
+    let chosen = camera_mesh(&smooth_ball.mesh, &default, &camera, Optic::Reflect, true).unwrap();
     assert!(matches!(chosen.mesh, Cow::Borrowed(_)));
     // No tolerance: no simplification.
     let exact = TrilinearReflector {
@@ -78,7 +81,7 @@ fn the_automatic_size_is_the_smallest_within_the_tolerance() {
         ..entry
     };
     let (smooth, camera) = ball(64);
-    let chosen = camera_mesh(&smooth.mesh, &exact, &camera, Optic::Reflect).unwrap();
+    let chosen = camera_mesh(&smooth.mesh, &exact, &camera, Optic::Reflect, true).unwrap();
     assert!(matches!(chosen.mesh, Cow::Borrowed(_)));
 }
 
