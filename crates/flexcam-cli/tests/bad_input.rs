@@ -498,3 +498,62 @@ fn refusals_leave_no_output() {
     assert_eq!(left.len(), 1, "only scene.toml: {left:?}");
     assert!(Path::new(&dir.path().join("scene.toml")).exists());
 }
+
+/// A correspondence behind the eye (`scenes/flexible-projector-fit.toml` with the point of
+/// its (0.5, 0.6) correspondence mirrored through the camera's position added at the same
+/// image position): kept starts cannot reach it and refuse it by number; the central models
+/// (eye, pinhole, and auto, which takes one of them) move the eye until the point is in
+/// front, so the data are not fitted exactly: the fit says so by a residual of degrees
+/// (`--stats`) and a warning; free starts, which may lie anywhere, fit it exactly by a node
+/// starting behind the camera, and warn that the node left the prior by far. Never silently.
+#[test]
+fn a_correspondence_behind_the_eye_is_refused_or_shown_in_the_residual() {
+    let dir = TempDir::new().unwrap();
+    let example = fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/flexible-projector-fit.toml"),
+    )
+    .unwrap();
+    let cube_top = "    { uv = [0.5, 0.6], point = [0.0, 1.0, 0.0] },";
+    assert!(example.contains(cube_top));
+    // The camera is at [0, 5.5, 7]: the cube top mirrored through it.
+    let behind = format!("{cube_top}\n    {{ uv = [0.5, 0.6], point = [0.0, 10.0, 14.0] }},");
+    for starts in ["kept", "eye", "pinhole", "free", "auto"] {
+        let scene = example.replace(cube_top, &behind).replace(
+            "interpolation = \"bilinear\"",
+            &format!("interpolation = \"bilinear\"\nstarts = \"{starts}\""),
+        );
+        write(&dir, "scene.toml", &scene);
+        let args = ["render", "scene.toml", "-o", "out.png", "--stats", "s.json"];
+        if starts == "kept" {
+            refused(
+                &dir,
+                &args,
+                1,
+                "flexcam: scene.toml:16:1: correspondence 6: no projector of the grid can reach \
+                 [0, 10, 14] at [0.5, 0.6] (the fitted projector points away from it; the \
+                 correspondences contradict each other)",
+            );
+            continue;
+        }
+        let out = run(&dir, &args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{starts}: {stderr}");
+        assert!(
+            stderr.contains("left the prior by far"),
+            "{starts}: {stderr}"
+        );
+        if starts == "free" {
+            fs::remove_file(dir.path().join("out.png")).unwrap();
+            continue;
+        }
+        let stats = fs::read_to_string(dir.path().join("s.json")).unwrap();
+        let max_angle: f64 = stats
+            .split("\"fit_max_angle_deg\":")
+            .nth(1)
+            .and_then(|rest| rest.split([',', '}']).next())
+            .and_then(|v| v.trim().parse().ok())
+            .unwrap_or_else(|| panic!("{starts}: no fit_max_angle_deg in {stats}"));
+        assert!(max_angle > 5.0, "{starts}: fitted to {max_angle} degrees");
+        fs::remove_file(dir.path().join("out.png")).unwrap();
+    }
+}
