@@ -118,7 +118,7 @@ fn with_renderer(
             let others = prepared.view(without(scene, id));
             let through = |surface: &Trilinear| {
                 if entry.env_map {
-                    env_map::image(&others, surface, &reflector.mesh, options, renderer)
+                    env_map::image(&others, surface, &reflector.mesh, options)
                 } else {
                     renderer(&others, surface, options)
                 }

@@ -11,7 +11,7 @@
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 
-use super::{perspective_as_trilinear, Renderer};
+use super::perspective_as_trilinear;
 use crate::error::Result;
 use crate::projection::{CameraFrame, Perspective, Projection, SingleImage, Trilinear};
 use crate::render::prepared::PreparedScene;
@@ -35,15 +35,15 @@ const FACES: [(DVec3, DVec3); 6] = [
 ];
 
 impl CubeMap {
-    /// `others` rendered from `centre` into six `size` x `size` faces by `renderer`: a
-    /// trilinear method gets each face as the same pinhole in two projection triangles
-    /// ([`perspective_as_trilinear`]).
+    /// `others` rendered from `centre` into six `size` x `size` faces by `options.method`; the
+    /// trilinear methods render each face as the same pinhole in two projection triangles
+    /// ([`perspective_as_trilinear`]) by the trilinear method, as they render the main view
+    /// (camera triangles would bound a pinhole only loosely).
     fn render(
         others: &PreparedScene,
         centre: DVec3,
         size: u32,
         options: &RenderOptions,
-        renderer: &Renderer,
     ) -> Result<CubeMap> {
         let mut faces = Vec::with_capacity(6);
         for (axis, up) in FACES {
@@ -55,9 +55,10 @@ impl CubeMap {
             let face = Perspective::new(&frame, 90.0, size, size)?;
             let image = match options.method {
                 Method::Trilinear | Method::CameraTriangles => {
-                    renderer(others, &perspective_as_trilinear(&face)?, options)?.0
+                    let pinhole = perspective_as_trilinear(&face)?;
+                    Method::Trilinear.render(others, &pinhole, options)?.0
                 }
-                _ => renderer(others, &face, options)?.0,
+                method => method.render(others, &face, options)?.0,
             };
             faces.push((face, image));
         }
@@ -90,7 +91,7 @@ impl CubeMap {
 
 /// The image of `others` through `surface` (main-image pixels) by environment mapping: a
 /// cube map of faces as large as the main image's larger side, rendered from the centre of
-/// `reflector`'s bounding box, looked up along the surface's ray direction at each pixel
+/// `reflector`'s bounding box ([`CubeMap::render`]), looked up along the surface's ray direction at each pixel
 /// centre; pixels without a ray get the background. No counters: the faces' renders are not
 /// the reflector's (`reflector_render_ms` times them).
 pub fn image(
@@ -98,12 +99,11 @@ pub fn image(
     surface: &Trilinear,
     reflector: &Mesh,
     options: &RenderOptions,
-    renderer: &Renderer,
 ) -> Result<(Frame, Stats)> {
     let (width, height) = surface.resolution();
     let (lo, hi) = reflector.bounds().unwrap_or_default();
     let centre = ((lo + hi) / 2.0).as_dvec3();
-    let cube = CubeMap::render(others, centre, width.max(height), options, renderer)?;
+    let cube = CubeMap::render(others, centre, width.max(height), options)?;
     let background = others.scene().image.background;
     let color: Vec<Vec3> = (0..width as usize * height as usize)
         .into_par_iter()
