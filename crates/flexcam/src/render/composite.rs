@@ -8,7 +8,9 @@
 //! its colour from that image, which is already in main-image coordinates ([`paste`]). The
 //! reflector's mesh is first refined where the surface's interpolated rays would displace
 //! the reflected image by more than the reflector's tolerance in main-image pixels
-//! ([`refine`]; scene-file key `trilinear_refine_px`).
+//! ([`refine`]; scene-file key `trilinear_refine_px`). With `reflection = "env-map"` the
+//! image through the surface is instead looked up in a cube map rendered from the
+//! reflector's centre ([`env_map`]: the baseline without parallax).
 //! Depth and object id stay those of the main view (the reflector's own, as for a mirror in
 //! the ray caster).
 //!
@@ -115,7 +117,14 @@ fn with_renderer(
         let projection = surface_projection(&surface, map, &camera)?;
         if let Some(projection) = &projection {
             let others = prepared.view(without(scene, id));
-            let (image, counters) = renderer(&others, projection, options)?;
+            let through = |surface: &Trilinear| {
+                if entry.env_map {
+                    env_map::image(&others, surface, &reflector.mesh, options)
+                } else {
+                    renderer(&others, surface, options)
+                }
+            };
+            let (image, counters) = through(projection)?;
             add_camera_triangle_counts(&mut stats, &counters);
             pixels += match (options.shading, reflector.optic) {
                 (Shading::Flat, _) => paste(&mut frame, id, &image, Vec3::ONE)?,
@@ -131,11 +140,10 @@ fn with_renderer(
                         options.method,
                     )?;
                     left += mirror_left;
-                    let reflection =
-                        render_through(&others, &mirror, map, &camera, options, renderer)?
-                            .unwrap_or_else(|| {
-                                Frame::new(image.width, image.height, scene.image.background)
-                            });
+                    let reflection = match surface_projection(&mirror, map, &camera)? {
+                        Some(surface) => through(&surface)?.0,
+                        None => Frame::new(image.width, image.height, scene.image.background),
+                    };
                     let split = FresnelSplit::new(prepared, id, camera.clone());
                     let mixed =
                         fresnel_mix(&frame, id, &image, &reflection, &split, reflector.tint)?;
@@ -391,7 +399,9 @@ fn refined_surface(
 /// Renders `others` (the scene without a reflector: [`without`]) through `surface` with
 /// screen map `map` at the main camera's resolution: the reflected or refracted view in
 /// main-image coordinates; `None` when the surface has no triangles (the main camera does
-/// not see the reflector).
+/// not see the reflector). The tests' way through a surface (compositing goes through
+/// [`surface_projection`] and the reflector's own way of imaging it).
+#[cfg(test)]
 pub fn render_through(
     others: &PreparedScene,
     surface: &ReflectorSurface,
@@ -619,6 +629,7 @@ fn check_size(main: &Frame, other: &Frame) -> Result<()> {
 }
 
 pub mod camera_mesh;
+pub mod env_map;
 pub mod refine;
 #[cfg(test)]
 mod tests;

@@ -224,7 +224,8 @@ pub fn render(
         // Only the plain ray caster renders a window's pixels alone (module `window`).
         let raycast_alone = options.method == Method::Raycast
             && !matches!(options.shading, Shading::Transitions(_))
-            && (!options.composite_reflectors || prepared.scene().trilinear_reflectors.is_empty());
+            && (!options.composite_reflectors || prepared.scene().trilinear_reflectors.is_empty())
+            && !caustics::wanted(prepared.scene(), options);
         if !raycast_alone {
             let whole = RenderOptions {
                 crop: None,
@@ -235,6 +236,18 @@ pub fn render(
             return Ok(rendered);
         }
     }
+    // Caustics are splatted where the main view's ids and depth show their receivers.
+    let caustics = caustics::wanted(prepared.scene(), options);
+    let wanted_outputs = options.outputs;
+    let main_options = RenderOptions {
+        outputs: if caustics {
+            Outputs::ALL
+        } else {
+            options.outputs
+        },
+        ..*options
+    };
+    let options = &main_options;
     let mut rendered = if options.composite_reflectors {
         composite::render(prepared, projection, options)?
     } else {
@@ -245,7 +258,10 @@ pub fn render(
             warnings: Vec::new(),
         }
     };
-    rendered.frame.keep_only(options.outputs);
+    if caustics {
+        caustics::add(prepared, projection, options, &mut rendered)?;
+    }
+    rendered.frame.keep_only(wanted_outputs);
     Ok(rendered)
 }
 
@@ -271,6 +287,8 @@ pub type Stats = BTreeMap<&'static str, Counter>;
 pub mod bench_support;
 pub(crate) mod bvh;
 mod camera_triangles;
+/// Caustics of curved mirrors (scene key `caustics`), added in `lit` shading by [`render`].
+mod caustics;
 mod compare;
 /// Reflector compositing, reached only through [`render`] (`RenderOptions::composite_reflectors`).
 mod composite;

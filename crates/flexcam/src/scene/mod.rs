@@ -94,6 +94,10 @@ pub struct Scene {
     /// trilinear surface and composited into the main image (scene-file key
     /// `trilinear_reflector`; composited by [`crate::render::render`]). Empty: plain rendering.
     pub trilinear_reflectors: Vec<TrilinearReflector>,
+    /// The mirrors that focus the scene's point lights into caustics on the surfaces they
+    /// light (scene-file key `caustics`; added in `lit` shading by [`crate::render::render`]).
+    /// Empty: no caustics.
+    pub caustics: Vec<CausticReflector>,
     /// Every file the scene was read from (the scene file, models and the files they name,
     /// textures, surfaces), so that a command can refuse to write over any of them. Empty
     /// for built-in scenes (they name no files) and scenes built in code.
@@ -125,6 +129,28 @@ pub struct TrilinearReflector {
     /// the size automatically and refines the result by [`Self::refine_px`]
     /// (docs/camera-triangles.md).
     pub camera_triangles: Option<usize>,
+    /// Reflect (refract) an environment cube map rendered from the reflector's centre
+    /// instead of rendering through the surface (scene-file key `reflection = "env-map"`):
+    /// the baseline camera triangles are measured against (docs/camera-triangles.md).
+    pub env_map: bool,
+}
+
+/// A mirror whose reflection of each point light is rendered as a caustic (Hou, Wei, Shum and
+/// Guo 2006, section 3.3; docs/camera-triangles.md, "Caustics").
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CausticReflector {
+    /// The mirror's object id.
+    pub id: u32,
+    /// The side of the square photon-location map rendered from each light (scene-file key
+    /// `caustic_map`).
+    pub map_size: u32,
+}
+
+impl CausticReflector {
+    /// The default of [`CausticReflector::map_size`].
+    pub const DEFAULT_MAP_SIZE: u32 = 256;
+    /// The bounds of [`CausticReflector::map_size`].
+    pub const MAP_SIZES: std::ops::RangeInclusive<u32> = 8..=2048;
 }
 
 impl TrilinearReflector {
@@ -138,6 +164,7 @@ impl TrilinearReflector {
             screen_map: SurfaceScreenMap::default(),
             refine_px: Self::DEFAULT_REFINE_PX,
             camera_triangles: None,
+            env_map: false,
         }
     }
 }

@@ -39,6 +39,7 @@ pub fn teapot_scene(faces: u32) -> (Scene, usize) {
         objects: vec![object],
         lights: Vec::new(),
         trilinear_reflectors: Vec::new(),
+        caustics: Vec::new(),
         inputs: Vec::new(),
         image: ImageSettings {
             width: TABLE_SIZE,

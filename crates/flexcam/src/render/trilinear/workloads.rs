@@ -110,6 +110,7 @@ pub fn random_triangles(count: u32, seed: u64) -> Scene {
         },
         base_dir: None,
         trilinear_reflectors: Vec::new(),
+        caustics: Vec::new(),
         inputs: Vec::new(),
     }
 }

@@ -34,7 +34,7 @@ use toml::Spanned;
 
 use self::raw::{RawImage, RawProjection, RawScene};
 use self::source::Source;
-use super::{ImageSettings, InputFile, Scene};
+use super::{ImageSettings, InputFile, Light, Scene};
 use crate::error::{Error, Result};
 use crate::file_read::{read_regular_text, MAX_SCENE_FILE_BYTES};
 use crate::projection::flexible::Animation;
@@ -124,6 +124,7 @@ pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animatio
     check_unique_names(&src, &raw.object)?;
     let mut objects = Vec::new();
     let mut trilinear_reflectors = Vec::new();
+    let mut caustics = Vec::new();
     for (index, table) in raw.object.iter().enumerate() {
         let id =
             u32::try_from(index + 1).map_err(|_| src.error(&table.span(), "too many objects"))?;
@@ -132,6 +133,9 @@ pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animatio
         {
             trilinear_reflectors.push(reflector);
         }
+        if let Some(caustic) = object::caustic_reflector(&src, table, id, &parts, &projection)? {
+            caustics.push(caustic);
+        }
         objects.extend(parts);
     }
     let lights = raw
@@ -139,6 +143,14 @@ pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animatio
         .iter()
         .map(|table| light::convert(&src, table))
         .collect::<Result<Vec<_>>>()?;
+    if let Some((_, span)) = caustics.first() {
+        if !lights.iter().any(|l| matches!(l, Light::Point { .. })) {
+            return Err(src.error(
+                span,
+                "`caustics` needs a point light ([[light]] type = \"point\") to focus",
+            ));
+        }
+    }
     // Building the projection is what detects degenerate parameters.
     crate::calibrate::build(&projection, image.width, image.height).map_err(|e| {
         match e.location {
@@ -158,6 +170,7 @@ pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animatio
         projection,
         base_dir: Some(base_dir),
         trilinear_reflectors,
+        caustics: caustics.into_iter().map(|(c, _)| c).collect(),
         inputs: src.into_inputs(),
     };
     Ok((scene, animation))

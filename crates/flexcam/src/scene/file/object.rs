@@ -15,7 +15,7 @@ use crate::error::Result;
 use crate::projection::trilinear_builders::SurfaceScreenMap;
 use crate::projection::ProjectionSpec;
 use crate::scene::loaders::{load_model, load_texture};
-use crate::scene::{Finish, Material, Mesh, Object, Pattern, TrilinearReflector};
+use crate::scene::{CausticReflector, Finish, Material, Mesh, Object, Pattern, TrilinearReflector};
 
 /// Surface names as written in scene files.
 const MATERIALS: [&str; 4] = ["diffuse", "mirror", "glass", "emissive"];
@@ -95,10 +95,12 @@ pub(super) fn convert(
 /// image, with screen map `trilinear_screen_map` (default affine) and refinement tolerance
 /// `trilinear_refine_px` (main-image pixels, default
 /// [`TrilinearReflector::DEFAULT_REFINE_PX`], 0 for none) and camera-mesh size
-/// `camera_triangles` (default automatic). Errors, at the key: an object
+/// `camera_triangles` (default automatic), and `reflection` (`"surface"`, the default, or
+/// `"env-map"`: the environment-map baseline). Errors, at the key: an object
 /// whose material is neither mirror nor glass, a scene whose projection is not perspective
 /// (the surface's screen positions are the main camera's image of the reflector), a
-/// `trilinear_screen_map` other than "projective" or "affine", a `trilinear_refine_px` that
+/// `trilinear_screen_map` other than "projective" or "affine", a `reflection` other than
+/// "surface" or "env-map", a `trilinear_refine_px` that
 /// is negative or not finite, a bad `camera_triangles` ([`camera_triangles`]), or any of
 /// these keys without `trilinear_reflector = true`.
 pub(super) fn trilinear_reflector(
@@ -136,6 +138,17 @@ pub(super) fn trilinear_reflector(
         }
     };
     let camera_triangles = camera_triangles(src, table, parts)?;
+    let env_map = match &raw.reflection {
+        None => false,
+        Some(name) => match name.get_ref().as_str() {
+            "surface" => false,
+            "env-map" => true,
+            other => {
+                let expected = ["env-map", "surface"];
+                return Err(src.unknown(&name.span(), "reflection", other, &expected));
+            }
+        },
+    };
     let enabled = raw
         .trilinear_reflector
         .as_ref()
@@ -151,6 +164,12 @@ pub(super) fn trilinear_reflector(
             return Err(src.error(
                 &value.span(),
                 "`trilinear_refine_px` needs `trilinear_reflector = true`",
+            ));
+        }
+        if let Some(name) = &raw.reflection {
+            return Err(src.error(
+                &name.span(),
+                "`reflection` needs `trilinear_reflector = true`",
             ));
         }
         if let Some(value) = &raw.camera_triangles {
@@ -188,7 +207,73 @@ pub(super) fn trilinear_reflector(
         screen_map,
         refine_px,
         camera_triangles,
+        env_map,
     }))
+}
+
+/// The object's caustic entry (object id `id`) if it asks for `caustics = true`, with the
+/// span of that key (the scene's lights are checked against it once they are read): the
+/// mirror's reflection of each point light is then added as a caustic in `lit` shading,
+/// through a photon-location map of `caustic_map` texels a side (default
+/// [`CausticReflector::DEFAULT_MAP_SIZE`]). Errors, at the key: a part that is not a mirror,
+/// a scene whose projection is not perspective (the caustics are splatted into the main
+/// camera's image), a `caustic_map` outside [`CausticReflector::MAP_SIZES`], or
+/// `caustic_map` without `caustics = true`.
+pub(super) fn caustic_reflector(
+    src: &Source,
+    table: &Spanned<RawObject>,
+    id: u32,
+    parts: &[Object],
+    projection: &ProjectionSpec,
+) -> Result<Option<(CausticReflector, std::ops::Range<usize>)>> {
+    let raw = table.get_ref();
+    let Some(flag) = raw.caustics.as_ref().filter(|flag| *flag.get_ref()) else {
+        if let Some(value) = &raw.caustic_map {
+            return Err(src.error(&value.span(), "`caustic_map` needs `caustics = true`"));
+        }
+        return Ok(None);
+    };
+    let map_size = match &raw.caustic_map {
+        None => CausticReflector::DEFAULT_MAP_SIZE,
+        Some(value) => {
+            let sizes = CausticReflector::MAP_SIZES;
+            match u32::try_from(*value.get_ref()) {
+                Ok(n) if sizes.contains(&n) => n,
+                _ => {
+                    return Err(src.error(
+                        &value.span(),
+                        format!(
+                            "`caustic_map` must be between {} and {} texels, not {}",
+                            sizes.start(),
+                            sizes.end(),
+                            value.get_ref()
+                        ),
+                    ))
+                }
+            }
+        }
+    };
+    if let Some(part) = parts.iter().find(|p| p.material.finish != Finish::Mirror) {
+        return Err(src.error(
+            &flag.span(),
+            format!(
+                "`caustics` needs material \"mirror\", but \"{}\" is {}",
+                part.name,
+                surface_name(part.material.finish)
+            ),
+        ));
+    }
+    if !matches!(projection, ProjectionSpec::Perspective { .. }) {
+        return Err(src.error(
+            &flag.span(),
+            format!(
+                "`caustics` needs a perspective [projection] (the eye the caustics are splatted \
+                 into), not {}",
+                projection.kind()
+            ),
+        ));
+    }
+    Ok(Some((CausticReflector { id, map_size }, flag.span())))
 }
 
 /// The object's `camera_triangles` (the size of its camera mesh), if given. Errors, at the
