@@ -287,7 +287,7 @@ mod tests {
             yfov: 0.8,
             aspect_ratio: Some(1.5),
         });
-        for (w, h) in [(800, 533), (800, 534), (3, 2), (1, 1)] {
+        for (w, h) in [(800, 533), (801, 534), (3, 2), (1, 1)] {
             assert!(camera_view(&c, w, h, DVec3::ZERO).is_ok(), "{w} x {h}");
         }
         let e = camera_view(&c, 400, 400, DVec3::ZERO)
