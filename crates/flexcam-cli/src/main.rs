@@ -32,7 +32,8 @@ missing output folders are created.";
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Render a scene file or built-in scene to a PNG (and optional depth / id images).
+    /// Render a scene file, built-in scene or model file to a PNG (and optional depth / id
+    /// images).
     #[command(after_help = OUTPUTS_HELP)]
     Render(commands::render::RenderArgs),
     /// Resample an equirectangular photo through a scene's projection into a PNG.
@@ -66,8 +67,9 @@ enum Command {
     /// turn no face by more than a threshold angle, and write the coarse mesh (OBJ).
     #[command(after_help = OUTPUTS_HELP)]
     Simplify(commands::simplify::SimplifyArgs),
-    /// Convert a COLMAP cameras.txt into scene projection tables (`opencv`, `opencv_fisheye`),
-    /// one per camera, as TOML.
+    /// Convert a COLMAP cameras.txt (`opencv`, `opencv_fisheye`) or the cameras of a glTF /
+    /// GLB model (`perspective`, `orthographic`) into scene projection tables, one per
+    /// camera, as TOML.
     #[command(after_help = OUTPUTS_HELP)]
     ImportCameras(commands::import_cameras::ImportCamerasArgs),
     /// Open the interactive viewer on a scene file: design its projection live, or run a

@@ -53,7 +53,15 @@ pub struct Pick {
 
 impl Session {
     /// Opens the scene file at `path`: loads and prepares the scene, builds its projection.
+    /// A model file is refused: the session edits a scene file's text.
     pub fn open(path: &Path) -> Result<Session> {
+        if scene::model_scene::is_model_file(path) {
+            return Err(Error::in_file(
+                path,
+                "the viewer opens scene files (.toml): render a model with `flexcam render`, \
+                 or view a scene that names it (shape = \"mesh\", file = ...)",
+            ));
+        }
         let source = path.to_str().ok_or_else(|| {
             Error::in_file(
                 path,

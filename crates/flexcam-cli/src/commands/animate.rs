@@ -161,8 +161,12 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     args.memory.apply();
     args.threads.apply()?;
     let load_start = Instant::now();
-    let (scene, animation) =
-        scene::file::load_animated_defined(&args.scene, &args.define.definitions)?;
+    let request = scene::ModelRequest {
+        width: args.width,
+        height: args.height,
+        camera: None,
+    };
+    let (scene, animation) = scene::load_file(&args.scene, &args.define.definitions, &request)?;
     super::declare_scene_inputs(&mut outputs, &scene.inputs)?;
     let animation = animation.ok_or_else(|| {
         Error::in_file(&args.scene, "the scene has no [animation] table to animate")

@@ -15,8 +15,15 @@ use flexcam::{Error, Result};
 /// The scene to render and its image size.
 #[derive(Args, Debug)]
 pub struct SceneArgs {
-    /// A scene file (.toml) or `builtin:NAME`; the default built-in scene when omitted.
+    /// A scene file (.toml), `builtin:NAME`, or a model file (.obj, .gltf, .glb, .ply) seen
+    /// by its default scene (its first glTF camera, or a camera that frames it, and one
+    /// light); the default built-in scene when omitted.
     pub scene: Option<String>,
+    /// The glTF camera to view a glTF / GLB model given as SCENE through: its index in the
+    /// file's `cameras` (from 0), or the camera's or its node's name. Default: the model's
+    /// camera of lowest index, or a camera that frames the model when it has none.
+    #[arg(long, value_name = "N|NAME")]
+    pub camera: Option<String>,
     /// Image width in pixels (overrides the scene file; alone, it keeps the scene's aspect
     /// ratio).
     #[arg(long)]
@@ -128,6 +135,7 @@ impl SceneArgs {
             height: self.height,
             perspective_rect,
             definitions: self.define.definitions.clone(),
+            camera: self.camera.clone(),
         };
         scene::load_with(&source, &overrides)
     }

@@ -10,6 +10,7 @@
 //! 0.9 GB through loading, the acceleration structure and the prepared scene), not exact
 //! accounting.
 
+use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::error::{Error, Result};
@@ -92,6 +93,18 @@ pub fn check(estimate: u64, what: &str) -> Result<()> {
         format_bytes(estimate),
         format_bytes(budget)
     )))
+}
+
+/// Fails when parsing the model file `path`, whose size suggests its memory before it is
+/// parsed ([`BYTES_PER_MODEL_FILE_BYTE`]), would exceed the budget with the `reserved`
+/// bytes already held.
+pub fn check_model_file(path: &Path, reserved: u64) -> Result<()> {
+    let size = std::fs::metadata(path).map_or(0, |m| m.len());
+    let estimate = size.saturating_mul(BYTES_PER_MODEL_FILE_BYTE);
+    check(
+        reserved.saturating_add(estimate),
+        &format!("model file {} of {size} bytes", path.display()),
+    )
 }
 
 /// Fails when decoding a `width` x `height` image (a texture, a photo) would exceed the

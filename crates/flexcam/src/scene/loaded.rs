@@ -26,6 +26,9 @@ pub struct Overrides {
     /// Scene keys set as if the file said so (`-D KEY=VALUE`), applied in order before the
     /// file is parsed.
     pub definitions: Vec<Definition>,
+    /// The glTF camera of a model given as the scene to view it through (an index in the
+    /// file's `cameras`, a camera's or its node's name; [`scene::ModelRequest`]).
+    pub camera: Option<String>,
 }
 
 /// A scene loaded with overrides and its projection built at the image size.
@@ -48,7 +51,12 @@ pub struct LoadedScene {
 /// command-line flag that sets it (`--perspective-rect`), the spelling users see.
 pub fn load_with(source: &str, overrides: &Overrides) -> Result<LoadedScene> {
     let start = Instant::now();
-    let mut scene = scene::load_defined(source, &overrides.definitions)?;
+    let request = scene::ModelRequest {
+        width: overrides.width,
+        height: overrides.height,
+        camera: overrides.camera.as_deref(),
+    };
+    let mut scene = scene::load_requested(source, &overrides.definitions, &request)?;
     if let Some(rect) = overrides.perspective_rect {
         scene.projection = perspective_rect(&scene.projection, rect)?;
     }

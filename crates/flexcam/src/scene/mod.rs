@@ -181,15 +181,20 @@ pub mod builtin;
 pub mod file;
 mod loaded;
 pub mod loaders;
+pub mod model_scene;
+pub mod model_view;
 #[cfg(test)]
 pub(crate) mod reflector_fixtures;
 pub mod shapes;
 
 pub use file::validate_resolution;
 pub use loaded::{check_budget, load_with, LoadedScene, Overrides};
+pub use model_scene::ModelRequest;
 
-/// Loads a scene from `source`: `builtin:NAME` names a built-in scene, anything else is the
-/// path of a scene file. This is the SCENE argument of `flexcam render`.
+/// Loads a scene from `source`: `builtin:NAME` names a built-in scene, a path with a model
+/// file's extension (.obj, .gltf, .glb, .ply) a model seen by its default scene
+/// ([`model_scene`]), anything else is the path of a scene file. This is the SCENE argument
+/// of `flexcam render`.
 pub fn load(source: &str) -> crate::Result<Scene> {
     load_defined(source, &[])
 }
@@ -197,9 +202,37 @@ pub fn load(source: &str) -> crate::Result<Scene> {
 /// [`load`] with `definitions` (`-D KEY=VALUE`) written into the scene's text, as if the
 /// file said so ([`file::parse_defined`]).
 pub fn load_defined(source: &str, definitions: &[file::Definition]) -> crate::Result<Scene> {
+    load_requested(source, definitions, &ModelRequest::default())
+}
+
+/// [`load_defined`], with the image size and camera a model file's default scene is made
+/// for (`request`; naming a camera is an error for the other sources).
+pub fn load_requested(
+    source: &str,
+    definitions: &[file::Definition],
+    request: &ModelRequest,
+) -> crate::Result<Scene> {
     match source.strip_prefix("builtin:") {
-        Some(name) => builtin::load_defined(name, definitions),
-        None => file::load_animated_defined(std::path::Path::new(source), definitions)
-            .map(|(scene, _)| scene),
+        Some(name) => {
+            request.refuse_camera(source)?;
+            builtin::load_defined(name, definitions)
+        }
+        None => {
+            load_file(std::path::Path::new(source), definitions, request).map(|(scene, _)| scene)
+        }
     }
+}
+
+/// The scene of the file at `path`, a model ([`model_scene::load`]) or a scene file
+/// ([`file::load_animated_defined`]), with the keyframed camera of its `[animation]` table.
+pub fn load_file(
+    path: &std::path::Path,
+    definitions: &[file::Definition],
+    request: &ModelRequest,
+) -> crate::Result<(Scene, Option<crate::projection::flexible::Animation>)> {
+    if model_scene::is_model_file(path) {
+        return model_scene::load(path, definitions, request);
+    }
+    request.refuse_camera(&path.display().to_string())?;
+    file::load_animated_defined(path, definitions)
 }

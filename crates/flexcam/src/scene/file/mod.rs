@@ -34,6 +34,7 @@ use toml::Spanned;
 
 use self::raw::{RawImage, RawProjection, RawScene};
 use self::source::Source;
+use super::loaders::Model;
 use super::{ImageSettings, InputFile, Light, Scene};
 use crate::error::{Error, Result};
 use crate::file_read::{read_regular_text, MAX_SCENE_FILE_BYTES};
@@ -107,17 +108,46 @@ pub fn parse_defined(
     path: &Path,
     definitions: &[Definition],
 ) -> Result<(Scene, Option<Animation>)> {
+    parse_defined_with_model(text, path, definitions, None)
+}
+
+/// [`parse_defined`] with `model` already read: the object whose `file` is the model's
+/// file takes it instead of reading the file again (a model given as the scene is read
+/// once to frame it, [`crate::scene::model_scene`]).
+pub fn parse_defined_with_model(
+    text: &str,
+    path: &Path,
+    definitions: &[Definition],
+    model: Option<Model>,
+) -> Result<(Scene, Option<Animation>)> {
     if definitions.is_empty() {
-        return parse_animated(text, path);
+        return parse_source(Source::new(text, path).with_model(model));
     }
     let (edited, spans) = definitions::apply(text, path, definitions)?;
-    parse_animated(&edited, path).map_err(|e| definitions::blame(e, &edited, definitions, &spans))
+    parse_source(Source::new(&edited, path).with_model(model))
+        .map_err(|e| definitions::blame(e, &edited, definitions, &spans))
+}
+
+/// The `[image]` settings of scene-file text with `definitions` (`-D KEY=VALUE`) written
+/// into it, the file's other tables read but not converted: the image size a scene's
+/// camera is made for before the scene is parsed ([`crate::scene::model_scene`]).
+pub fn image_defined(text: &str, path: &Path, definitions: &[Definition]) -> Result<ImageSettings> {
+    let (edited, spans) = definitions::apply(text, path, definitions)?;
+    let src = Source::new(&edited, path);
+    read_raw(&src)
+        .and_then(|raw| image_settings(&src, raw.image.as_ref()))
+        .map_err(|e| definitions::blame(e, &edited, definitions, &spans))
 }
 
 /// As [`parse`], also giving the keyframed camera of the `[animation]` table, if any. The
 /// scene's [`Scene::inputs`] are the files its values name (and the files those name).
 pub fn parse_animated(text: &str, path: &Path) -> Result<(Scene, Option<Animation>)> {
-    let src = Source::new(text, path);
+    parse_source(Source::new(text, path))
+}
+
+/// [`parse_animated`] of the text of `src`.
+fn parse_source(src: Source) -> Result<(Scene, Option<Animation>)> {
+    let path = src.path;
     let raw = read_raw(&src)?;
     let base_dir = path.parent().unwrap_or(Path::new("")).to_path_buf();
     let (image, projection_table, projection) = image_and_projection(&src, &raw, &base_dir)?;

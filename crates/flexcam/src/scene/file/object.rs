@@ -43,8 +43,13 @@ pub(super) fn convert(
         (_, Some((mesh, base))) => vec![(mesh, overrides.apply(base))],
         (Some(file), None) => {
             let path = src.existing_file(file, base_dir, "model file")?;
-            src.check_model_size(&path, &file.span())?;
-            let model = load_model(&path).map_err(|e| e.or_in_file(&path))?;
+            let model = match src.take_model(&path) {
+                Some(model) => model,
+                None => {
+                    src.check_model_size(&path, &file.span())?;
+                    load_model(&path).map_err(|e| e.or_in_file(&path))?
+                }
+            };
             let triangles = model.parts.iter().map(|p| p.mesh.triangle_count() as u64);
             src.reserve_triangles(triangles.sum(), &file.span())?;
             src.read_files(model.files);

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use toml::Spanned;
 
 use crate::error::{Error, Result};
+use crate::scene::loaders::Model;
 use crate::scene::{budget, InputFile};
 
 /// A scene file being parsed: its text, the path the user gave for it, and the files its
@@ -18,6 +19,8 @@ pub(super) struct Source<'a> {
     inputs: RefCell<Vec<InputFile>>,
     /// Triangles of the objects converted so far, for the memory budget.
     triangles: Cell<u64>,
+    /// A model already read, for the object that names its file ([`Source::take_model`]).
+    model: RefCell<Option<Model>>,
 }
 
 impl<'a> Source<'a> {
@@ -27,6 +30,16 @@ impl<'a> Source<'a> {
             path,
             inputs: RefCell::new(Vec::new()),
             triangles: Cell::new(0),
+            model: RefCell::new(None),
+        }
+    }
+
+    /// The source with `model` read already: the object whose file is the model's takes it
+    /// instead of reading the file again.
+    pub fn with_model(self, model: Option<Model>) -> Source<'a> {
+        Source {
+            model: RefCell::new(model),
+            ..self
         }
     }
 
@@ -49,14 +62,18 @@ impl<'a> Source<'a> {
     /// Fails at `span` before the model file `path` is parsed when its size suggests more
     /// memory than the budget leaves (its triangles are reserved once it is loaded).
     pub fn check_model_size(&self, path: &Path, span: &Range<usize>) -> Result<()> {
-        let size = std::fs::metadata(path).map_or(0, |m| m.len());
         let reserved = self.triangles.get() * budget::BYTES_PER_TRIANGLE;
-        let estimate = size.saturating_mul(budget::BYTES_PER_MODEL_FILE_BYTE);
-        budget::check(
-            reserved.saturating_add(estimate),
-            &format!("model file {} of {size} bytes", path.display()),
-        )
-        .map_err(|e| self.error(span, e.message))
+        budget::check_model_file(path, reserved).map_err(|e| self.error(span, e.message))
+    }
+
+    /// The model read from `path` before the text was parsed, if it is the one handed to
+    /// [`Source::with_model`] (once: the model is moved out).
+    pub fn take_model(&self, path: &Path) -> Option<Model> {
+        let mut slot = self.model.borrow_mut();
+        let matches = slot
+            .as_ref()
+            .is_some_and(|m| m.files.first().is_some_and(|f| f.path == path));
+        matches.then(|| slot.take()).flatten()
     }
 
     /// The files recorded so far, in the order they were read.

@@ -14,6 +14,7 @@ use ::gltf::mesh::Mode;
 use ::gltf::{Document, Node, Primitive};
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 
+use super::gltf_cameras::ModelCamera;
 use super::gltf_checks::{check_images, check_nodes, check_primitive, check_version, check_view};
 use super::texture::{srgb_to_linear, texture_from_texels};
 use super::{read_file, Model, ModelPart};
@@ -24,7 +25,8 @@ use crate::scene::{InputFile, Material, Mesh, Pattern, Texture};
 /// default; every mesh untransformed if the file has no scene), with node transforms
 /// applied. Each primitive becomes one part; a primitive with a material gets
 /// `baseColorFactor` as its colour and `baseColorTexture` (sRGB decoded) as its pattern.
-/// Point and line primitives are skipped; a file without triangles is an error.
+/// Point and line primitives are skipped; a file without triangles is an error. The cameras
+/// the scene's nodes place come with the model (module `gltf_cameras`).
 pub(super) fn load_gltf(path: &Path) -> Result<Model> {
     let fail = |e: ::gltf::Error| Error::in_file(path, format!("malformed glTF: {e}"));
     let bytes = read_file(path)?;
@@ -53,6 +55,7 @@ pub(super) fn load_gltf(path: &Path) -> Result<Model> {
         buffers: &buffers,
         textures: HashMap::new(),
         parts: Vec::new(),
+        cameras: Vec::new(),
         files: buffer_files
             .map(|path| InputFile {
                 what: "model buffer",
@@ -74,7 +77,9 @@ pub(super) fn load_gltf(path: &Path) -> Result<Model> {
     if loader.parts.is_empty() {
         return Err(Error::in_file(path, "contains no triangle meshes"));
     }
-    Ok(Model::read_from(path, loader.parts, loader.files))
+    let mut model = Model::read_from(path, loader.parts, loader.files);
+    model.cameras = loader.cameras;
+    Ok(model)
 }
 
 /// The file a glTF URI names, resolved as the gltf crate resolves it when it reads the
@@ -186,12 +191,14 @@ struct Loader<'a> {
     /// Textures by glTF image index, so that primitives sharing an image share it.
     textures: HashMap<usize, Arc<Texture>>,
     parts: Vec<ModelPart>,
+    /// The cameras placed by the nodes met so far.
+    cameras: Vec<ModelCamera>,
     /// The files read besides the glTF itself: buffers, then images as they are decoded.
     files: Vec<InputFile>,
 }
 
 impl Loader<'_> {
-    /// Adds the meshes under `roots`, depth first in file order. A node hierarchy deeper
+    /// Adds the meshes and cameras under `roots`, depth first in file order. A node hierarchy deeper
     /// than the number of nodes must contain a cycle (invalid glTF): an error.
     fn add_nodes<'d>(
         &mut self,
@@ -219,6 +226,8 @@ impl Loader<'_> {
             if let Some(mesh) = node.mesh() {
                 self.add_mesh(&mesh, &world)?;
             }
+            self.cameras
+                .extend(ModelCamera::of_node(document, &node, &world));
             let first_child = stack.len();
             stack.extend(node.children().map(|child| (child, world, depth + 1)));
             stack[first_child..].reverse();

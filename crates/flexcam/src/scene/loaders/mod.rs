@@ -6,6 +6,7 @@
 //! file, with a line number where the format and library give one. None panics on
 //! malformed input.
 
+mod gltf_cameras;
 mod gltf_checks;
 mod gltf_loader;
 mod obj;
@@ -19,6 +20,7 @@ use super::{InputFile, Material, Mesh};
 use crate::error::{Error, Result};
 use crate::file_read::{read_regular, MAX_DATA_FILE_BYTES};
 
+pub use gltf_cameras::{CameraLens, ModelCamera};
 pub use obj_lines::check_obj_file;
 pub use texture::load_texture;
 
@@ -29,12 +31,14 @@ pub struct ModelPart {
     pub material: Option<Material>,
 }
 
-/// A loaded model: its parts, and every file the load read (the model file first, then the
-/// files it names: material libraries, textures, buffers).
+/// A loaded model: its parts, every file the load read (the model file first, then the
+/// files it names: material libraries, textures, buffers) and the cameras it places (glTF
+/// only; in the order the loader meets their nodes, depth first in file order).
 #[derive(Debug, Clone)]
 pub struct Model {
     pub parts: Vec<ModelPart>,
     pub files: Vec<InputFile>,
+    pub cameras: Vec<ModelCamera>,
 }
 
 impl Model {
@@ -47,6 +51,7 @@ impl Model {
         Model {
             parts,
             files: std::iter::once(model_file).chain(named).collect(),
+            cameras: Vec::new(),
         }
     }
 }
