@@ -62,8 +62,12 @@ fn frame_of(spec: &ProjectionSpec) -> CameraFrame {
         | ProjectionSpec::Cylindrical { frame, .. } => *frame,
         ProjectionSpec::Opencv { .. }
         | ProjectionSpec::OpencvFisheye { .. }
+        | ProjectionSpec::Ods { .. }
+        | ProjectionSpec::Vr180 { .. }
         | ProjectionSpec::Trilinear(_)
-        | ProjectionSpec::Flexible(_) => unreachable!("not generated (calibrated_properties)"),
+        | ProjectionSpec::Flexible(_) => {
+            unreachable!("not generated (calibrated_properties, stereo_properties)")
+        }
     }
 }
 
@@ -89,6 +93,8 @@ fn must_be_imaged(spec: &ProjectionSpec, point: DVec3) -> bool {
         }
         ProjectionSpec::Opencv { .. }
         | ProjectionSpec::OpencvFisheye { .. }
+        | ProjectionSpec::Ods { .. }
+        | ProjectionSpec::Vr180 { .. }
         | ProjectionSpec::Trilinear(_)
         | ProjectionSpec::Flexible(_) => false,
     }
