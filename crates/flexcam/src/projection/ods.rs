@@ -279,21 +279,7 @@ impl SingleImage for OdsEye {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Eye at (1, 2, 3) looking down -z with y up: camera right is +x.
-    fn frame() -> CameraFrame {
-        CameraFrame {
-            position: DVec3::new(1.0, 2.0, 3.0),
-            look_at: DVec3::new(1.0, 2.0, 2.0),
-            up: DVec3::Y,
-        }
-    }
-
-    const EYE: DVec3 = DVec3::new(1.0, 2.0, 3.0);
-
-    fn near(a: DVec3, b: DVec3) -> bool {
-        (a - b).length() < 1e-13
-    }
+    use crate::projection::stereo::tests::{frame, near, EYE};
 
     /// The ray through `pixel`, by hand: the left eye is the top 360 x 180 half, the right
     /// the bottom; (lon, lat) from the tile position; origin ipd/2 to the eye's side of the

@@ -284,8 +284,25 @@ impl<E: Projection + SingleImage> AnalyticInverse for StereoPair<E> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
+    use crate::projection::CameraFrame;
+
+    /// The eye of the ods and vr180 tests.
+    pub(in crate::projection) const EYE: DVec3 = DVec3::new(1.0, 2.0, 3.0);
+
+    /// [`EYE`] looking down -z with y up: camera right is +x.
+    pub(in crate::projection) fn frame() -> CameraFrame {
+        CameraFrame {
+            position: EYE,
+            look_at: EYE + DVec3::NEG_Z,
+            up: DVec3::Y,
+        }
+    }
+
+    pub(in crate::projection) fn near(a: DVec3, b: DVec3) -> bool {
+        (a - b).length() < 1e-13
+    }
 
     fn disc() -> KeepClear {
         KeepClear::Disc {

@@ -6,28 +6,8 @@
 use glam::{DVec2, DVec3};
 use proptest::prelude::*;
 
+use super::inverse_properties::{frame, vec3};
 use super::{CameraBasis, CameraFrame, ProjectionSpec};
-
-fn vec3(range: f64) -> impl Strategy<Value = DVec3> {
-    (-range..range, -range..range, -range..range).prop_map(|(x, y, z)| DVec3::new(x, y, z))
-}
-
-/// Frames with a view direction of length >= 0.1 and an up hint at least ~6 degrees away
-/// from it.
-fn frame() -> impl Strategy<Value = CameraFrame> {
-    (vec3(5.0), vec3(1.0), vec3(1.0)).prop_filter_map("degenerate frame", |(position, view, up)| {
-        let forward = view.try_normalize()?;
-        let up_hint = up.try_normalize()?;
-        if view.length() < 0.1 || forward.cross(up_hint).length() < 0.1 {
-            return None;
-        }
-        Some(CameraFrame {
-            position,
-            look_at: position + 3.0 * view,
-            up,
-        })
-    })
-}
 
 fn stereo_spec() -> impl Strategy<Value = ProjectionSpec> {
     (frame(), 0.001..2.0f64).prop_flat_map(|(frame, ipd)| {

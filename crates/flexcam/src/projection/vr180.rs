@@ -48,22 +48,8 @@ mod tests {
     use glam::DVec2;
 
     use super::*;
+    use crate::projection::stereo::tests::{frame, near, EYE};
     use crate::projection::Projection;
-
-    /// Eye at (1, 2, 3) looking down -z with y up: camera right is +x.
-    fn frame() -> CameraFrame {
-        CameraFrame {
-            position: DVec3::new(1.0, 2.0, 3.0),
-            look_at: DVec3::new(1.0, 2.0, 2.0),
-            up: DVec3::Y,
-        }
-    }
-
-    const EYE: DVec3 = DVec3::new(1.0, 2.0, 3.0);
-
-    fn near(a: DVec3, b: DVec3) -> bool {
-        (a - b).length() < 1e-13
-    }
 
     /// The ray through `pixel`, by hand: halves of 180 x 180 degrees, the left eye 0.032 to
     /// the left.
