@@ -40,6 +40,7 @@ use glam::{DVec2, DVec3};
 use super::camera_basis::CameraBasis;
 use super::chart::{axis_poles, InverseChart};
 use super::image_coords::Resolution;
+use super::panoramic::horizontal;
 use super::params::positive_length;
 use super::stereo::{KeepClear, Layout, StereoPair};
 use super::{
@@ -132,11 +133,6 @@ fn merge_radians([from, to]: [f64; 2]) -> Result<PoleMerge> {
         from: from.to_radians(),
         to: to.to_radians(),
     })
-}
-
-/// The horizontal unit vector (camera-local x, z) at longitude `lon`.
-fn horizontal(lon: f64) -> DVec2 {
-    DVec2::new(lon.sin(), lon.cos())
 }
 
 /// The horizontal unit vector to the right of longitude `lon`.
