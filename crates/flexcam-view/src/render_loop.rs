@@ -25,6 +25,7 @@ use std::time::Instant;
 use flexcam::image_io::{encode_channel, ColorEncoding};
 use flexcam::projection::{
     AnalyticInverse, NoInverse, Projection, ProjectionSpec, Projector, ProjectorHull, Trilinear,
+    View,
 };
 use flexcam::render::{self, Frame, Method, Outputs, PreparedScene, RenderOptions, Shading};
 use flexcam::{Error, Result};
@@ -477,6 +478,11 @@ impl Projection for Cancellable<'_> {
 
     fn inverse(&self) -> std::result::Result<&dyn AnalyticInverse, NoInverse> {
         self.inner.inverse()
+    }
+
+    /// The inner projection's views, not cancellable themselves.
+    fn views(&self) -> Vec<View<'_>> {
+        self.inner.views()
     }
 
     fn trilinear(&self) -> Option<&Trilinear> {

@@ -4,9 +4,11 @@ use super::fisheye::Fisheye;
 use super::flexible::{Flexible, GridFitter};
 use super::kannala_brandt::KannalaBrandt;
 use super::linear::{Orthographic, Perspective};
+use super::ods::ods;
 use super::opencv::Opencv;
 use super::panoramic::{Cylindrical, Equirectangular};
 use super::trilinear::Trilinear;
+use super::vr180::vr180;
 use super::{BuildReport, Projection, ProjectionSpec};
 use crate::error::Result;
 
@@ -17,6 +19,8 @@ impl ProjectionSpec {
     /// or parallel to the view direction; an angle or extent out of range (perspective fov in
     /// (0, 180), fisheye fov in (0, 360], orthographic width > 0, equirectangular h_fov in
     /// (0, 360] and v_fov in (0, 180], cylindrical h_fov in (0, 360] and v_fov in (0, 180));
+    /// ods and vr180 with an `ipd` that is not a positive length or an odd image height
+    /// (ods) or width (vr180), ods pole merging outside 0 <= from < to <= 90;
     /// calibrated intrinsics that are not finite or have a focal length <= 0, or are rendered
     /// at a size other than the scene's without a calibration size;
     /// a trilinear mesh with no triangles, mismatched arrays, an index out of range, a
@@ -74,6 +78,12 @@ impl ProjectionSpec {
             ProjectionSpec::OpencvFisheye { camera, k } => {
                 Box::new(KannalaBrandt::new(camera, *k, width, height)?)
             }
+            ProjectionSpec::Ods {
+                frame,
+                ipd,
+                pole_merge,
+            } => Box::new(ods(frame, *ipd, *pole_merge, width, height)?),
+            ProjectionSpec::Vr180 { frame, ipd } => Box::new(vr180(frame, *ipd, width, height)?),
             ProjectionSpec::Trilinear(mesh) => Box::new(Trilinear::new(mesh, width, height)?),
             ProjectionSpec::Flexible(spec) => {
                 Box::new(Flexible::build(spec, width, height, fitter, report)?)

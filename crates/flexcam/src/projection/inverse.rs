@@ -182,6 +182,21 @@ mod tests {
                 h_fov: 360.0,
                 v_fov: 90.0,
             }),
+            // The stereo pairs: an image per eye, two branches without a chart.
+            (
+                ProjectionSpec::Ods {
+                    frame,
+                    ipd: 0.064,
+                    pole_merge: Some([60.0, 75.0]),
+                },
+                Ok(false),
+                false,
+            ),
+            (
+                ProjectionSpec::Vr180 { frame, ipd: 0.064 },
+                Ok(false),
+                false,
+            ),
             // The mesh folds: an inverse without a chart.
             (trilinear, Ok(false), true),
             // A panorama in the lookup's class, with a chart under the linear map only.

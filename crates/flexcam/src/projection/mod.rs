@@ -24,12 +24,17 @@ mod inverse;
 mod inverse_properties;
 mod kannala_brandt;
 mod linear;
+mod ods;
 mod opencv;
 mod panoramic;
 mod params;
 pub mod projector;
 mod radial_tangential;
+mod stereo;
+#[cfg(test)]
+mod stereo_properties;
 mod trilinear;
+mod vr180;
 
 pub use build_report::BuildReport;
 pub use calibrated::{CalibratedCamera, CalibrationSize, Intrinsics};
@@ -43,14 +48,17 @@ pub use inverse::{
 };
 pub use kannala_brandt::KannalaBrandt;
 pub use linear::{Orthographic, Perspective};
+pub use ods::{ods, Ods, OdsEye};
 pub use opencv::Opencv;
 pub use panoramic::{Cylindrical, Equirectangular};
 pub use projector::{Projector, ProjectorHull};
+pub use stereo::{KeepClear, Layout, StereoPair, View};
 pub use trilinear::mesh_builders as trilinear_builders;
 pub use trilinear::{
     project_solved_triangle, project_triangle, ProjectionTriangleCache, ProjectiveMap, SceneEdge,
     Shape, ShapeVertex, Solutions, TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
 };
+pub use vr180::{vr180, Vr180};
 
 use glam::{DVec2, DVec3};
 
@@ -110,6 +118,13 @@ pub trait Projection: Send + Sync {
     /// this projection has none.
     fn inverse(&self) -> Result<&dyn AnalyticInverse, NoInverse>;
 
+    /// The projection as separate views tiled in its image (the two eyes of a stereo pair,
+    /// see [`StereoPair`]), for renderers that draw one continuous view at a time
+    /// (`--method raster`); empty (the default) for a projection that is a single view.
+    fn views(&self) -> Vec<View<'_>> {
+        Vec::new()
+    }
+
     /// This projection as a trilinear mesh, for the renderers that need its triangles
     /// (`--method trilinear`); `None` for every other kind.
     fn trilinear(&self) -> Option<&Trilinear>;
@@ -167,6 +182,17 @@ pub enum ProjectionSpec {
         camera: CalibratedCamera,
         k: [f64; 4],
     },
+    /// Omni-directional stereo: 360 x 180 equirectangular per eye, left eye on top, rays
+    /// tangent to the circle of radius `ipd`/2; `pole_merge` = [from, to] latitudes in
+    /// degrees between which the eye offset fades to zero (Cycles' pole merging).
+    Ods {
+        frame: CameraFrame,
+        ipd: f64,
+        pole_merge: Option<[f64; 2]>,
+    },
+    /// VR180: two 180 x 180 equirectangular halves side by side, left eye on the left, eyes
+    /// `ipd` apart along the camera's right axis.
+    Vr180 { frame: CameraFrame, ipd: f64 },
     /// A mesh of trilinear projection triangles.
     Trilinear(TrilinearMesh),
     /// A parametric viewing volume between control surfaces (Brosz 2011); boxed, as it is
@@ -185,6 +211,8 @@ impl ProjectionSpec {
             ProjectionSpec::Cylindrical { .. } => "cylindrical",
             ProjectionSpec::Opencv { .. } => "opencv",
             ProjectionSpec::OpencvFisheye { .. } => "opencv_fisheye",
+            ProjectionSpec::Ods { .. } => "ods",
+            ProjectionSpec::Vr180 { .. } => "vr180",
             ProjectionSpec::Trilinear(_) => "trilinear",
             ProjectionSpec::Flexible(_) => "flexible",
         }

@@ -31,7 +31,7 @@ fn longitude(local: DVec3) -> Option<f64> {
 }
 
 /// The camera-local horizontal unit direction at longitude `lon`.
-fn horizontal(lon: f64) -> DVec2 {
+pub(super) fn horizontal(lon: f64) -> DVec2 {
     DVec2::new(lon.sin(), lon.cos())
 }
 

@@ -8,7 +8,7 @@ use glam::DVec2;
 
 use crate::error::{Error, Result};
 use crate::projection::{Projection, Projector};
-use crate::render::raster::InverseRaster;
+use crate::render::raster;
 use crate::render::trilinear::TrilinearRenderer;
 use crate::render::{
     camera_triangles, raycast, transitions, Frame, PreparedScene, RenderOptions, Shading, Stats,
@@ -75,7 +75,7 @@ impl Method {
         }
         match self {
             Method::Raycast => Ok(raycast::render(prepared, projection, options)),
-            Method::Raster => Ok(InverseRaster::new(prepared, projection, options)?.render()),
+            Method::Raster => raster::render(prepared, projection, options),
             Method::Trilinear => {
                 let trilinear = projection.trilinear().ok_or_else(|| {
                     Error::new(format!(

@@ -34,7 +34,8 @@
 //!
 //! Supported: every projection with an `InverseChart` (perspective, orthographic,
 //! fisheye, equirectangular, cylindrical, and the flexible volumes described in
-//! `projection::flexible::chart`); others are refused with one line naming the projection.
+//! `projection::flexible::chart`), and projections made of such views (the stereo pairs,
+//! drawn view by view: `views`); others are refused with one line naming the projection.
 
 mod band_fill;
 mod clip;
@@ -46,6 +47,7 @@ mod seam;
 mod subdivision;
 #[cfg(test)]
 mod tests;
+mod views;
 // Bench scenes, for `flexcam bench` and the criterion benches only (`bench_support`).
 #[cfg(any(test, feature = "workloads"))]
 pub mod workloads;
@@ -59,6 +61,7 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 pub use subdivision::Subdivision;
+pub use views::render;
 
 use self::band_fill::{fill_and_shade, BAND_ROWS};
 use self::coverage::{Bins, ScreenTriangle};

@@ -23,12 +23,14 @@ enum Kind {
     Cylindrical,
     Opencv,
     OpencvFisheye,
+    Ods,
+    Vr180,
     Trilinear,
     Flexible,
 }
 
 /// Type names as written in scene files.
-const KINDS: [(&str, Kind); 9] = [
+const KINDS: [(&str, Kind); 11] = [
     ("perspective", Kind::Perspective),
     ("orthographic", Kind::Orthographic),
     ("fisheye", Kind::Fisheye),
@@ -36,6 +38,8 @@ const KINDS: [(&str, Kind); 9] = [
     ("cylindrical", Kind::Cylindrical),
     ("opencv", Kind::Opencv),
     ("opencv_fisheye", Kind::OpencvFisheye),
+    ("ods", Kind::Ods),
+    ("vr180", Kind::Vr180),
     ("trilinear", Kind::Trilinear),
     ("flexible", Kind::Flexible),
 ];
@@ -88,6 +92,8 @@ impl Kind {
             Kind::Equirectangular | Kind::Cylindrical => &["h_fov", "v_fov"],
             Kind::Opencv => &calibrated_projection::OPENCV_KEYS,
             Kind::OpencvFisheye => &calibrated_projection::FISHEYE_KEYS,
+            Kind::Ods => &["ipd", "pole_merge_from", "pole_merge_to"],
+            Kind::Vr180 => &["ipd"],
             Kind::Trilinear => {
                 return MESH_KEYS.iter().chain(&GRID_KEYS).copied().collect();
             }
@@ -179,7 +185,37 @@ pub(super) fn convert(
         },
         Kind::Opencv => calibrated_projection::opencv(&required, image_size)?,
         Kind::OpencvFisheye => calibrated_projection::opencv_fisheye(&required, image_size)?,
+        Kind::Ods => ProjectionSpec::Ods {
+            frame: camera_frame(src, &required)?,
+            ipd: angle(&raw.ipd, "ipd", DEFAULT_IPD)?,
+            pole_merge: pole_merge(&required)?,
+        },
+        Kind::Vr180 => ProjectionSpec::Vr180 {
+            frame: camera_frame(src, &required)?,
+            ipd: angle(&raw.ipd, "ipd", DEFAULT_IPD)?,
+        },
     })
+}
+
+/// The interpupillary distance of the stereo projections when `ipd` is not given (metres):
+/// a typical adult's.
+const DEFAULT_IPD: f64 = 0.064;
+
+/// `pole_merge_from` and `pole_merge_to` (degrees) of an ods projection: both or neither
+/// (no merging); their range is checked when the projection is built.
+fn pole_merge(required: &Required) -> Result<Option<[f64; 2]>> {
+    let raw = required.raw();
+    match (&raw.pole_merge_from, &raw.pole_merge_to) {
+        (None, None) => Ok(None),
+        (Some(from), Some(to)) => Ok(Some([
+            required.src.number(from, "pole_merge_from")?,
+            required.src.number(to, "pole_merge_to")?,
+        ])),
+        (Some(given), None) | (None, Some(given)) => Err(required.src.error(
+            &given.span(),
+            "ods pole merging needs both `pole_merge_from` and `pole_merge_to`",
+        )),
+    }
 }
 
 /// A trilinear mesh from `surface = "file.obj"`, from the inline arrays, or from `grid`.

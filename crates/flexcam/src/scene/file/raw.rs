@@ -147,6 +147,9 @@ pub struct RawProjection {
     pub k: Option<Spanned<Vec<f64>>>,
     #[serde(default, deserialize_with = "strict")]
     pub calibration_size: Option<Spanned<[u32; 2]>>,
+    pub ipd: Option<Spanned<f64>>,
+    pub pole_merge_from: Option<Spanned<f64>>,
+    pub pole_merge_to: Option<Spanned<f64>>,
 }
 
 /// `outline = { ... }`, `profile`, and the entries of `outlines` / `profiles` (with `at`): a
@@ -407,6 +410,15 @@ impl RawProjection {
             (
                 "calibration_size",
                 self.calibration_size.as_ref().map(Spanned::span),
+            ),
+            ("ipd", self.ipd.as_ref().map(Spanned::span)),
+            (
+                "pole_merge_from",
+                self.pole_merge_from.as_ref().map(Spanned::span),
+            ),
+            (
+                "pole_merge_to",
+                self.pole_merge_to.as_ref().map(Spanned::span),
             ),
         ]
         .into_iter()
