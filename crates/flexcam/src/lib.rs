@@ -17,3 +17,9 @@ pub mod render;
 pub mod scene;
 
 pub use error::{Error, Result};
+
+/// The vector library of flexcam's API (positions and directions are `glam::DVec3`, pixel
+/// positions `glam::DVec2`, colours `glam::Vec3`), re-exported so that a program uses the
+/// very version flexcam was built with: write `flexcam::glam::DVec3` instead of adding a
+/// `glam` dependency whose version must match.
+pub use glam;
