@@ -67,6 +67,34 @@ pub struct ImagePoint {
 }
 
 /// A projection bound to an image size.
+///
+/// Ray generation and the inverse of a projection built from its description:
+///
+/// ```
+/// use flexcam::glam::{DVec2, DVec3};
+/// use flexcam::projection::{CameraFrame, ProjectionSpec};
+///
+/// let frame = CameraFrame { position: DVec3::ZERO, look_at: -DVec3::Z, up: DVec3::Y };
+/// let projection = ProjectionSpec::Fisheye { frame, fov: 180.0 }.build(200, 100)?;
+/// // The image centre looks along the view direction.
+/// let ray = projection.ray(DVec2::new(100.0, 50.0)).unwrap();
+/// assert!((ray.direction.normalize() - (-DVec3::Z)).length() < 1e-12);
+/// // Outside the fisheye's image circle there is no ray.
+/// assert!(projection.ray(DVec2::new(1.0, 1.0)).is_none());
+/// // The inverse gives every image of a scene point with its ray parameter.
+/// let point = DVec3::new(1.0, 0.5, -2.0);
+/// let mut images = Vec::new();
+/// projection.inverse().expect("a fisheye has one").project(point, &mut images);
+/// assert_eq!(images.len(), 1);
+/// let back = projection.ray(images[0].pixel).unwrap().at(images[0].t);
+/// assert!((back - point).length() < 1e-9);
+/// # Ok::<(), flexcam::Error>(())
+/// ```
+///
+/// A projection of one's own implements [`Projection::kind`], [`Projection::resolution`] and
+/// [`Projection::ray`]; it renders by ray casting, and also by `--method raster` when it gives
+/// an [`AnalyticInverse`] (implementing [`SingleImage`] gives one). See the example
+/// `crates/flexcam/examples/custom_projection`.
 pub trait Projection: Send + Sync {
     /// The projection's type name as in scene files (`perspective`, `fisheye`, ...).
     fn kind(&self) -> &'static str;
@@ -107,12 +135,17 @@ pub trait Projection: Send + Sync {
     }
 
     /// The analytic inverse (every image of a scene point, see [`AnalyticInverse`]), or why
-    /// this projection has none.
-    fn inverse(&self) -> Result<&dyn AnalyticInverse, NoInverse>;
+    /// this projection has none. The default has none (`reason: None`): such a projection
+    /// renders by ray casting alone, and `--method raster` refuses it with one line.
+    fn inverse(&self) -> Result<&dyn AnalyticInverse, NoInverse> {
+        Err(NoInverse { reason: None })
+    }
 
     /// This projection as a trilinear mesh, for the renderers that need its triangles
-    /// (`--method trilinear`); `None` for every other kind.
-    fn trilinear(&self) -> Option<&Trilinear>;
+    /// (`--method trilinear`); `None` for every other kind, the default.
+    fn trilinear(&self) -> Option<&Trilinear> {
+        None
+    }
 }
 
 /// A camera placement shared by the single-viewpoint projections: an eye position, a point
