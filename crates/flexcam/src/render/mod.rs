@@ -214,6 +214,23 @@ pub struct Rendered {
 /// method. Fails, rather than producing a wrong image, when the method cannot render that
 /// projection (with one line naming why), on zero samples per pixel, or on a crop window
 /// that is empty or does not fit in the image.
+///
+/// ```
+/// use flexcam::render::{self, Method, PreparedScene, RenderOptions, Shading};
+///
+/// let scene = flexcam::scene::load("builtin:cube-floor")?;
+/// let projection = scene.projection.build(40, 30)?;
+/// let prepared = PreparedScene::new(&scene);
+/// let options = RenderOptions { shading: Shading::Flat, ..RenderOptions::default() };
+/// let rendered = render::render(&prepared, projection.as_ref(), &options)?;
+/// assert_eq!((rendered.frame.width, rendered.frame.height), (40, 30));
+/// assert!(rendered.frame.ids.iter().any(|&id| id != 0), "the view sees the scene");
+///
+/// // A method that cannot render the projection fails with a reason, never a wrong image.
+/// let trilinear = RenderOptions { method: Method::Trilinear, ..options };
+/// assert!(render::render(&prepared, projection.as_ref(), &trilinear).is_err());
+/// # Ok::<(), flexcam::Error>(())
+/// ```
 pub fn render(
     prepared: &PreparedScene,
     projection: &dyn Projection,

@@ -46,6 +46,20 @@ pub struct LoadedScene {
 /// Loads `source` (a scene file or `builtin:NAME`), applies `overrides` and builds the
 /// projection. Errors name the scene file; an override that does not apply names the
 /// command-line flag that sets it (`--perspective-rect`), the spelling users see.
+///
+/// ```
+/// use flexcam::scene::{self, Overrides};
+///
+/// // A built-in scene at a size of our own; a scene file's path works the same way.
+/// let overrides = Overrides { width: Some(64), ..Overrides::default() };
+/// let loaded = scene::load_with("builtin:cube-floor", &overrides)?;
+/// // The height follows the scene's aspect ratio (square), and the projection is built at
+/// // that size.
+/// assert_eq!((loaded.width, loaded.height), (64, 64));
+/// assert_eq!(loaded.projection.resolution(), (64, 64));
+/// assert_eq!(loaded.projection.kind(), "perspective");
+/// # Ok::<(), flexcam::Error>(())
+/// ```
 pub fn load_with(source: &str, overrides: &Overrides) -> Result<LoadedScene> {
     let start = Instant::now();
     let mut scene = scene::load_defined(source, &overrides.definitions)?;
