@@ -152,8 +152,12 @@ pub trait Projection: Send + Sync {
 /// it looks at, and an up hint (need not be perpendicular to the view direction).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CameraFrame {
+    /// The eye: where every ray of the projection starts (world units).
     pub position: DVec3,
+    /// A point the view direction passes through (the image centre's ray).
     pub look_at: DVec3,
+    /// Which way is up in the image; only its component perpendicular to the view direction
+    /// counts.
     pub up: DVec3,
 }
 
@@ -162,9 +166,13 @@ pub struct CameraFrame {
 /// and a screen position `screen[k]` in \[0,1\]^2 with (0,0) the bottom-left of the image.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct TrilinearMesh {
+    /// Base point of each vertex's ray (world units).
     pub points: Vec<DVec3>,
+    /// Ray direction of each vertex; its length scales depth.
     pub normals: Vec<DVec3>,
+    /// Image position of each vertex, (0, 0) bottom-left and (1, 1) top-right.
     pub screen: Vec<DVec2>,
+    /// Vertex indices of each projection triangle.
     pub triangles: Vec<[u32; 3]>,
 }
 
@@ -172,32 +180,57 @@ pub struct TrilinearMesh {
 #[derive(Debug, Clone, PartialEq)]
 pub enum ProjectionSpec {
     /// Pinhole; `fov` is the horizontal angle.
-    Perspective { frame: CameraFrame, fov: f64 },
+    Perspective {
+        /// Eye, view direction and up.
+        frame: CameraFrame,
+        /// Horizontal angle of view, degrees.
+        fov: f64,
+    },
     /// Parallel rays; `width` is the horizontal extent in world units.
-    Orthographic { frame: CameraFrame, width: f64 },
+    Orthographic {
+        /// The image centre's ray start, view direction and up.
+        frame: CameraFrame,
+        /// Horizontal extent of the view, world units.
+        width: f64,
+    },
     /// Angular (equidistant) fisheye; `fov` is the angle across the inscribed image circle.
-    Fisheye { frame: CameraFrame, fov: f64 },
+    Fisheye {
+        /// Eye, view axis and up.
+        frame: CameraFrame,
+        /// Angle across the image circle, degrees, up to 360.
+        fov: f64,
+    },
     /// Longitude linear in x, latitude linear in y.
     Equirectangular {
+        /// Eye, the image centre's direction and up (the poles' axis).
         frame: CameraFrame,
+        /// Longitude range across the image, degrees.
         h_fov: f64,
+        /// Latitude range down the image, degrees.
         v_fov: f64,
     },
     /// Longitude linear in x, tan(latitude) linear in y.
     Cylindrical {
+        /// Eye, the image centre's direction and up (the cylinder's axis).
         frame: CameraFrame,
+        /// Longitude range across the image, degrees.
         h_fov: f64,
+        /// Vertical angle at the image centre, degrees.
         v_fov: f64,
     },
     /// A calibrated pinhole with OpenCV's radial-tangential distortion, coefficients in
     /// OpenCV's order [k1, k2, p1, p2, k3, k4, k5, k6] (zeros for the shorter forms).
     Opencv {
+        /// Placement and intrinsics (focal lengths, principal point, calibration size).
         camera: CalibratedCamera,
+        /// [k1, k2, p1, p2, k3, k4, k5, k6].
         distortion: [f64; 8],
     },
     /// A calibrated Kannala-Brandt fisheye (OpenCV's `cv::fisheye`), `k` = [k1, k2, k3, k4].
     OpencvFisheye {
+        /// Placement and intrinsics (focal lengths, principal point, calibration size).
         camera: CalibratedCamera,
+        /// [k1, k2, k3, k4] of theta_d = theta (1 + k1 theta^2 + ... + k4 theta^8).
         k: [f64; 4],
     },
     /// A mesh of trilinear projection triangles.
