@@ -43,6 +43,7 @@ pub struct RenderOptions<'a> {
     /// main view, each reflection rendered by `method` (module `composite`); `false` renders them
     /// as the method's own mirrors and glass (the reference of a comparison).
     pub composite_reflectors: bool,
+    /// How surfaces are shaded (`--shading`).
     pub shading: Shading,
     /// Samples per pixel (1 = one ray through each pixel centre).
     pub spp: u32,
@@ -121,7 +122,9 @@ impl Outputs {
 /// A rendered image with its arbitrary output variables, row-major, top row first.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// Linear RGB.
     pub color: Vec<Vec3>,
@@ -202,6 +205,7 @@ impl Frame {
 /// A rendered frame and what rendering it counted.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Rendered {
+    /// The image and its buffers.
     pub frame: Frame,
     /// The method's counters (rays cast, build times, ...), for `--stats`; with reflectors
     /// composited, also the compositing's (`reflector_pixels` and the like).
@@ -270,15 +274,20 @@ pub fn render(
 /// ([`EquirectPhoto`]), as `image_io` reads it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearImage {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
+    /// Linear RGB, row-major, top row first.
     pub pixels: Vec<Vec3>,
 }
 
 /// One counter of a renderer's statistics.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Counter {
+    /// A number of things (rays, triangles, pixels).
     Count(u64),
+    /// A measure (milliseconds, a ratio).
     Value(f64),
 }
 
