@@ -18,9 +18,13 @@ pub const MAX_LEVEL: u32 = 16;
 /// and fraction `F`; every micro-vertex moves to `P + N * S * (h(uv) - h_max) * F`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DisplacementSpec {
+    /// The height field h(u, v), values in [0, 1].
     pub height: HeightSource,
+    /// S: the displacement of height 1, world units.
     pub scale: f64,
+    /// L: each base triangle is split into 4^L micro-triangles.
     pub level: u32,
+    /// F: how much of the displacement is applied, in [0, 1].
     pub fraction: f64,
 }
 
@@ -61,15 +65,20 @@ pub fn check_parameters(scale: f64, level: u32, fraction: f64) -> Result<()> {
 /// Where heights come from.
 #[derive(Debug, Clone, PartialEq)]
 pub enum HeightSource {
+    /// A grey image sampled at the mesh's texture coordinates.
     Map(HeightImage),
+    /// A height function evaluated in closed form.
     Procedural(ProceduralSpec),
 }
 
 /// A grey height image: `width * height` values in [0, 1], row-major, top row first.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HeightImage {
+    /// Width in height samples.
     pub width: u32,
+    /// Height in height samples (rows).
     pub height: u32,
+    /// The heights, in [0, 1].
     pub values: Vec<f32>,
     /// The file it was read from (none for images made in code).
     pub path: Option<PathBuf>,

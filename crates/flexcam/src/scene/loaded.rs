@@ -32,9 +32,13 @@ pub struct Overrides {
 pub struct LoadedScene {
     /// The scene as named by the caller (`builtin:NAME` for built-ins).
     pub source: String,
+    /// The scene with the overrides applied.
     pub scene: Scene,
+    /// The scene's projection, built at `width` x `height`.
     pub projection: Box<dyn Projection>,
+    /// Image width in pixels: the override, or the scene's.
     pub width: u32,
+    /// Image height in pixels: the override, or the scene's.
     pub height: u32,
     /// What building the projection reported: counters for `--stats` (a fitted grid's
     /// residual, ...) and warnings (a fitted grid's doubtful nodes).
