@@ -6,6 +6,8 @@
 mod little_planet;
 #[path = "../examples/projection_in_tracer/tracer.rs"]
 mod tracer;
+#[path = "../examples/render_scene/two_methods.rs"]
+mod two_methods;
 
 use flexcam::glam::{DVec2, DVec3};
 use flexcam::projection::{CameraFrame, ImagePoint, Projection, ProjectionSpec};
@@ -209,4 +211,26 @@ fn tracer_renders_scene_projections() {
         assert!(hits.iter().flatten().count() > 0, "{scene}");
         assert!(std::fs::metadata(&out).unwrap().len() > 0);
     }
+}
+
+/// The scene-rendering example: both methods from one BVH, raster held to the ray-cast
+/// reference; a projection without an analytic inverse leaves the raster arm with the reason
+/// and the ray-cast frame standing.
+#[test]
+fn render_scene_example_renders_and_compares() {
+    let made = two_methods::render_two_ways("builtin:cube-floor", 64, 48).unwrap();
+    assert!(made.warnings.is_empty(), "{:?}", made.warnings);
+    assert_eq!((made.raycast.width, made.raycast.height), (64, 48));
+    let (raster, agreement) = made.raster.unwrap();
+    assert_eq!((raster.width, raster.height), (64, 48));
+    assert!(agreement.id_agreement > 0.99, "{agreement:?}");
+    assert_eq!(made.bvh_builds, 1);
+    let curved = format!(
+        "{}/../../scenes/flexible-quadratic.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let made = two_methods::render_two_ways(&curved, 32, 24).unwrap();
+    assert_eq!(made.raycast.width, 32);
+    let error = made.raster.unwrap_err().to_string();
+    assert!(error.contains("raster"), "{error}");
 }
