@@ -444,6 +444,7 @@ fn stable_unit(v: DVec3) -> Option<DVec3> {
 pub struct Aim {
     /// (column, row) of the node, (0, 0) at the bottom left.
     pub node: (usize, usize),
+    /// The scene point the node's projector is re-aimed through.
     pub at: DVec3,
 }
 
