@@ -25,7 +25,9 @@ pub use texture::load_texture;
 /// One part of a loaded model: a mesh and the material the file gives it, if any.
 #[derive(Debug, Clone)]
 pub struct ModelPart {
+    /// The part's triangles, in the model file's coordinates.
     pub mesh: Mesh,
+    /// The material the file assigns the part (`None`: the scene object's).
     pub material: Option<Material>,
 }
 
@@ -33,7 +35,9 @@ pub struct ModelPart {
 /// files it names: material libraries, textures, buffers).
 #[derive(Debug, Clone)]
 pub struct Model {
+    /// The model's meshes, each with its material.
     pub parts: Vec<ModelPart>,
+    /// Every file read, the model file first.
     pub files: Vec<InputFile>,
 }
 
