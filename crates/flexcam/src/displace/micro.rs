@@ -108,10 +108,12 @@ impl Displacement {
         }
     }
 
+    /// The height field h(u, v).
     pub fn height(&self) -> &HeightField {
         &self.height
     }
 
+    /// The subdivision level L.
     pub fn level(&self) -> u32 {
         self.level
     }
