@@ -202,14 +202,17 @@ impl PanoramaShape {
         )
     }
 
+    /// The outlines, by increasing v.
     pub fn outlines(&self) -> &[Attached] {
         &self.outlines
     }
 
+    /// The profiles, by increasing u.
     pub fn profiles(&self) -> &[Attached] {
         &self.profiles
     }
 
+    /// How neighbouring outlines and profiles are blended.
     pub fn blend(&self) -> CurveBlend {
         self.blend
     }

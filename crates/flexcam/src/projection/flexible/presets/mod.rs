@@ -264,7 +264,9 @@ pub const PRESET_NAMES: [&str; 20] = [
 /// A preset placed in the scene.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PresetSpec {
+    /// The named volume and its parameters.
     pub preset: Preset,
+    /// The eye, view direction and up it is placed by.
     pub frame: CameraFrame,
     /// Near and far control-surface distances; `None` for [0, 1000], or [0, e] for the
     /// inverse perspective.
