@@ -152,8 +152,11 @@ impl HeightImage {
 /// One term of [`ProceduralSpec::Waves`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Wave {
+    /// The wave's height amplitude.
     pub amplitude: f64,
+    /// Whole periods (m, n) over the unit square in u and v.
     pub frequency: [i32; 2],
+    /// Phase offset, radians.
     pub phase: f64,
 }
 
@@ -165,8 +168,15 @@ pub const MAX_FREQUENCY: i32 = 1 << 16;
 /// functions), validated by the constructors.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ProceduralSpec {
+    /// A sum of sine waves over (u, v).
     Waves(Vec<Wave>),
-    Bumps { cells: [u32; 2], radius: f64 },
+    /// Round bumps on a grid of cells.
+    Bumps {
+        /// Cells (nu, nv) over the unit square, one round bump in each.
+        cells: [u32; 2],
+        /// The bump's radius in cell units, in (0, 1/2].
+        radius: f64,
+    },
 }
 
 impl ProceduralSpec {
