@@ -5,6 +5,11 @@
 //! positions. Scenes ([`scene::Scene`]) are triangle meshes with materials and lights, loaded
 //! from the TOML scene format, model files or the built-in scenes. Renderers ([`render`]) turn
 //! a scene and a projection into a [`render::Frame`]; the ray caster is the exact reference.
+//!
+//! Every public item is documented (`missing_docs` warns, and CI denies warnings): the crate
+//! is meant to be embedded (see `docs/library.md` and the examples).
+
+#![warn(missing_docs)]
 
 pub mod calibrate;
 pub mod displace;
