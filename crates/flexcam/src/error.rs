@@ -9,14 +9,18 @@ use std::path::{Path, PathBuf};
 /// Where an error arose: a file and, when known, a 1-based line and column in it.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Location {
+    /// The input file, as the user named it.
     pub file: PathBuf,
+    /// 1-based line and column in `file`, where the input format has them (scene files, OBJ).
     pub line_column: Option<(usize, usize)>,
 }
 
 /// An error with a human-readable message and an optional input location.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Error {
+    /// The input the error is in, printed before the message; `None` when it concerns no file.
     pub location: Option<Location>,
+    /// What went wrong, one line for the user.
     pub message: String,
 }
 

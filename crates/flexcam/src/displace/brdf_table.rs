@@ -35,6 +35,7 @@ pub struct BrdfTable {
 }
 
 impl BrdfTable {
+    /// Tabulates the BRDF of micro-surfaces whose normals follow `distribution`.
     pub fn new(distribution: &NormalDistribution) -> BrdfTable {
         let centres: Vec<DVec3> = (0..BINS * BINS)
             .map(|k| {

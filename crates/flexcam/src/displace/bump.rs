@@ -130,6 +130,7 @@ pub struct Redistribution {
 }
 
 impl Redistribution {
+    /// The redistribution tables of `distribution`, one per view node.
     pub fn new(distribution: &NormalDistribution) -> Redistribution {
         Redistribution {
             views: (0..VIEWS).map(|k| Cdf::new(distribution.view(k))).collect(),

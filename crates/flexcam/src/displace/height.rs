@@ -25,7 +25,9 @@ const BLEND_ROUNDING: f64 = 1e-6;
 /// A height field: an image map or a procedural function.
 #[derive(Debug, Clone, PartialEq)]
 pub enum HeightField {
+    /// Heights sampled from a grey image by texture coordinates.
     Map(HeightMap),
+    /// Heights from a closed-form function of the texture coordinates.
     Procedural(Procedural),
 }
 

@@ -39,8 +39,11 @@ pub use crate::scene::displacement::MAX_LEVEL;
 /// A base-triangle vertex or an undisplaced micro-vertex.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BaseVertex {
+    /// Position before displacement, world units.
     pub position: DVec3,
+    /// The direction displacement moves the vertex along (unit, or zero: not displaced).
     pub normal: DVec3,
+    /// Texture coordinates the height field is sampled at.
     pub uv: DVec2,
 }
 
@@ -105,10 +108,12 @@ impl Displacement {
         }
     }
 
+    /// The height field h(u, v).
     pub fn height(&self) -> &HeightField {
         &self.height
     }
 
+    /// The subdivision level L.
     pub fn level(&self) -> u32 {
         self.level
     }
@@ -152,8 +157,11 @@ impl Displacement {
 /// One micro-triangle of a base triangle: grid position and orientation (module docs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct MicroTriangle {
+    /// Grid column of its first vertex (module docs).
     pub i: u32,
+    /// Grid row of its first vertex (module docs).
     pub j: u32,
+    /// Whether it points up (vertices (i, j), (i + 1, j), (i, j + 1)) or down.
     pub up: bool,
 }
 
@@ -202,8 +210,11 @@ impl MicroTriangle {
 /// weights of its second and third vertex.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MicroHit {
+    /// The ray parameter of the hit.
     pub t: f64,
+    /// The micro-triangle hit.
     pub triangle: MicroTriangle,
+    /// Barycentric weights of the micro-triangle's second and third vertex.
     pub barycentric: DVec2,
 }
 
@@ -255,6 +266,8 @@ pub struct MicroGrid {
 }
 
 impl MicroGrid {
+    /// Every micro-vertex of the base triangle `corners` at the displacement's level, undisplaced
+    /// and displaced.
     pub fn new(corners: &[BaseVertex; 3], displacement: &Displacement) -> MicroGrid {
         let n = 1u32 << displacement.level;
         let side = n as usize + 1;

@@ -51,8 +51,11 @@ pub fn value(relief: f64, footprint: f64, d: f64, cos_view: f64) -> f64 {
 /// 1) and the fraction of the displacement its geometry takes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Blend {
+    /// Weight of the BRDF shading.
     pub brdf: f64,
+    /// Weight of the redistributed bump shading.
     pub bump: f64,
+    /// Weight of the displaced geometry's shading.
     pub displacement: f64,
     /// `s`: 0 (the undisplaced surface, shaded by bump or BRDF) to 1 (full displacement).
     pub fraction: f64,

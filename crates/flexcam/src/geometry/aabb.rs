@@ -6,7 +6,9 @@ use glam::Vec3;
 /// any point or box gives exactly that point or box.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Aabb {
+    /// The smallest coordinate of every point in the box, per axis.
     pub min: Vec3,
+    /// The largest coordinate of every point in the box, per axis.
     pub max: Vec3,
 }
 

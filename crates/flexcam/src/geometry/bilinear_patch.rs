@@ -31,16 +31,22 @@ use super::Ray;
 /// `p01` at `(0, 1)`, `p11` at `(1, 1)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BilinearPatch {
+    /// The corner at (u, v) = (0, 0).
     pub p00: DVec3,
+    /// The corner at (u, v) = (1, 0).
     pub p10: DVec3,
+    /// The corner at (u, v) = (0, 1).
     pub p01: DVec3,
+    /// The corner at (u, v) = (1, 1).
     pub p11: DVec3,
 }
 
 /// Where a ray meets a bilinear patch: the ray parameter and the patch parameters `(u, v)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PatchHit {
+    /// The ray parameter of the hit (`ray.at(t)` is the point).
     pub t: f64,
+    /// The patch parameters of the hit, each in [0, 1].
     pub uv: DVec2,
 }
 

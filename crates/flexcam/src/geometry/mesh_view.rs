@@ -12,7 +12,10 @@ use glam::Vec3;
 /// normal here".
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MeshView<'a> {
+    /// Vertex positions.
     pub positions: &'a [Vec3],
+    /// Vertex normals, one per position, or empty.
     pub normals: &'a [Vec3],
+    /// Vertex indices of each triangle.
     pub triangles: &'a [[u32; 3]],
 }

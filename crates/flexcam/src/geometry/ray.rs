@@ -8,9 +8,13 @@ use glam::DVec3;
 /// (trilinear, flexible volumes) keep it unnormalised so that `t` means their depth.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ray {
+    /// The point at t = 0.
     pub origin: DVec3,
+    /// The step per unit of t (not necessarily unit length).
     pub direction: DVec3,
+    /// The smallest parameter the ray covers (hits before it are ignored).
     pub t_min: f64,
+    /// The largest parameter the ray covers (may be infinite).
     pub t_max: f64,
 }
 

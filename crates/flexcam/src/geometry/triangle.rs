@@ -6,7 +6,9 @@ use glam::{DVec2, DVec3};
 /// second and third vertices (the first has `1 - u - v`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TriangleHit {
+    /// The line parameter of the hit, any sign.
     pub t: f64,
+    /// The weights (u, v) of the second and third vertices.
     pub barycentric: DVec2,
 }
 

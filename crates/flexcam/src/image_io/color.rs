@@ -12,15 +12,20 @@ use crate::render::Frame;
 /// The bit depth of a PNG colour output.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PngBits {
+    /// 8 bits a channel (the default).
     Eight,
+    /// 16 bits a channel (`--png-bits 16`).
     Sixteen,
 }
 
 /// The file formats of the colour output.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ColorFormat {
+    /// PNG, sRGB-encoded (linear with flat shading), of the given bit depth.
     Png(PngBits),
+    /// OpenEXR, linear 32-bit float RGB.
     Exr,
+    /// Portable float map, linear 32-bit float RGB.
     Pfm,
 }
 

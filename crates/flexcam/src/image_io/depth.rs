@@ -12,7 +12,9 @@ use crate::render::Frame;
 /// The file formats of the depth AOV.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DepthFormat {
+    /// OpenEXR, one 32-bit float channel `Z`.
     Exr,
+    /// Portable float map, one 32-bit float channel.
     Pfm,
 }
 

@@ -12,7 +12,9 @@ use crate::error::{Error, Result};
 /// and inode.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct FileIdentity {
+    /// The path with symlinks, `.` and `..` resolved (of the folder, for a file not yet written).
     pub canonical: PathBuf,
+    /// Device and inode of an existing file on unix, which also catch hard links.
     pub inode: Option<(u64, u64)>,
 }
 
@@ -90,6 +92,7 @@ impl FileIdentity {
 /// Where an output goes.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Target {
+    /// The file the output is written to.
     pub identity: FileIdentity,
     /// The folders writing it creates, outermost first.
     pub folders: Vec<PathBuf>,

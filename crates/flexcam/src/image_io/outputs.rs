@@ -62,6 +62,7 @@ enum Step {
 }
 
 impl OutputSet {
+    /// An empty set: nothing staged yet.
     pub fn new() -> OutputSet {
         OutputSet::default()
     }

@@ -21,9 +21,14 @@ use crate::error::{Error, Result};
 /// view) is at pixel (fx x + cx, fy y + cy).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Intrinsics {
+    /// Focal length in x, calibration pixels.
     pub fx: f64,
+    /// Focal length in y, calibration pixels.
     pub fy: f64,
+    /// Principal point x, calibration pixels, OpenCV's convention (0 = the centre of the left
+    /// column).
     pub cx: f64,
+    /// Principal point y, calibration pixels, OpenCV's convention (0 = the centre of the top row).
     pub cy: f64,
 }
 
@@ -40,8 +45,11 @@ pub enum CalibrationSize {
 /// A calibrated camera: placement, intrinsics and the calibration's image size.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CalibratedCamera {
+    /// Eye, view direction (OpenCV's z) and up (OpenCV's -y).
     pub frame: CameraFrame,
+    /// Focal lengths and principal point, in the calibration's pixels.
     pub intrinsics: Intrinsics,
+    /// The image size the intrinsics are for, and whether they may scale.
     pub size: CalibrationSize,
 }
 

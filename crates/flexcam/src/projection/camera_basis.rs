@@ -16,9 +16,13 @@ const PARALLEL_SINE: f64 = 1e-9;
 /// Camera-local coordinates are (right, up, forward) components: x right, y up, z forward.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CameraBasis {
+    /// The eye (the frame's `position`).
     pub origin: DVec3,
+    /// Unit vector to the image's right.
     pub right: DVec3,
+    /// Unit vector up in the image, perpendicular to `forward`.
     pub up: DVec3,
+    /// Unit view direction.
     pub forward: DVec3,
 }
 

@@ -22,7 +22,9 @@ use glam::DVec3;
 /// The points `p` with `normal . p >= offset`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HalfSpace {
+    /// The boundary plane's normal, pointing inside (any length: it scales `offset`).
     pub normal: DVec3,
+    /// `normal . p` on the boundary plane.
     pub offset: f64,
 }
 
@@ -38,6 +40,7 @@ impl HalfSpace {
 /// whole image circle).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Pole {
+    /// Where the singular ray starts (the panorama's centre).
     pub origin: DVec3,
     /// Unit length.
     pub direction: DVec3,
@@ -54,6 +57,7 @@ pub struct InverseChart {
     pub clip: Vec<HalfSpace>,
     /// The horizontal period of the image in pixels, for panoramas (`None`: no wrap).
     pub period: Option<f64>,
+    /// The singular rays triangles must not cross, each with its clearance.
     pub poles: Vec<Pole>,
 }
 

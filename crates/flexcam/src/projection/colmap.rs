@@ -19,22 +19,35 @@ use crate::error::{Error, Result};
 pub enum Lens {
     /// `type = "opencv"`: `distortion` in OpenCV's order, its first `count` given by the
     /// camera (0, 4 or 8; written out as such).
-    Opencv { distortion: [f64; 8], count: usize },
+    Opencv {
+        /// [k1, k2, p1, p2, k3, k4, k5, k6], zeros past `count`.
+        distortion: [f64; 8],
+        /// How many coefficients the camera's model gives.
+        count: usize,
+    },
     /// `type = "opencv_fisheye"`.
-    Fisheye { k: [f64; 4] },
+    Fisheye {
+        /// Kannala-Brandt [k1, k2, k3, k4].
+        k: [f64; 4],
+    },
 }
 
 /// One camera of a `cameras.txt`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ColmapCamera {
+    /// COLMAP's CAMERA_ID.
     pub id: u64,
     /// 1-based line in the file.
     pub line: usize,
+    /// COLMAP's model name (`OPENCV`, `OPENCV_FISHEYE`, ...).
     pub model: String,
+    /// The calibration's image width, pixels.
     pub width: u32,
+    /// The calibration's image height, pixels.
     pub height: u32,
     /// In OpenCV's pixel convention.
     pub intrinsics: Intrinsics,
+    /// The lens model and its distortion coefficients.
     pub lens: Lens,
 }
 

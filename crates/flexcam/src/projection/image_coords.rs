@@ -8,7 +8,9 @@ use crate::error::{Error, Result};
 /// A validated image size (both sides at least one pixel).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Resolution {
+    /// Width in pixels, at least 1.
     pub width: u32,
+    /// Height in pixels, at least 1.
     pub height: u32,
 }
 

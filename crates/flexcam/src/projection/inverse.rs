@@ -33,7 +33,9 @@ pub trait AnalyticInverse: Send + Sync {
 /// A continuous inverse and the chart that describes where it is continuous.
 #[derive(Clone)]
 pub struct Charted<'a> {
+    /// Where `map` is continuous.
     pub chart: InverseChart,
+    /// The continuous branch of the inverse.
     pub map: &'a dyn ContinuousInverse,
 }
 
@@ -55,6 +57,7 @@ pub trait ContinuousInverse: Send + Sync {
 /// An image on the continuous branch of a [`SingleImage`] projection.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BranchImage {
+    /// The point's position on the branch, and its ray parameter.
     pub image: ImagePoint,
     /// Whether the projection sees the point there: the point is on the ray (orthographic
     /// rays start at `t = 0`) and inside the visible domain (a fisheye's field of view).

@@ -75,6 +75,34 @@ pub struct ImagePoint {
 }
 
 /// A projection bound to an image size.
+///
+/// Ray generation and the inverse of a projection built from its description:
+///
+/// ```
+/// use flexcam::glam::{DVec2, DVec3};
+/// use flexcam::projection::{CameraFrame, ProjectionSpec};
+///
+/// let frame = CameraFrame { position: DVec3::ZERO, look_at: -DVec3::Z, up: DVec3::Y };
+/// let projection = ProjectionSpec::Fisheye { frame, fov: 180.0 }.build(200, 100)?;
+/// // The image centre looks along the view direction.
+/// let ray = projection.ray(DVec2::new(100.0, 50.0)).unwrap();
+/// assert!((ray.direction.normalize() - (-DVec3::Z)).length() < 1e-12);
+/// // Outside the fisheye's image circle there is no ray.
+/// assert!(projection.ray(DVec2::new(1.0, 1.0)).is_none());
+/// // The inverse gives every image of a scene point with its ray parameter.
+/// let point = DVec3::new(1.0, 0.5, -2.0);
+/// let mut images = Vec::new();
+/// projection.inverse().expect("a fisheye has one").project(point, &mut images);
+/// assert_eq!(images.len(), 1);
+/// let back = projection.ray(images[0].pixel).unwrap().at(images[0].t);
+/// assert!((back - point).length() < 1e-9);
+/// # Ok::<(), flexcam::Error>(())
+/// ```
+///
+/// A projection of one's own implements [`Projection::kind`], [`Projection::resolution`] and
+/// [`Projection::ray`]; it renders by ray casting, and also by `--method raster` when it gives
+/// an [`AnalyticInverse`] (implementing [`SingleImage`] gives one). See the example
+/// `crates/flexcam/examples/custom_projection`.
 pub trait Projection: Send + Sync {
     /// The projection's type name as in scene files (`perspective`, `fisheye`, ...).
     fn kind(&self) -> &'static str;
@@ -115,8 +143,11 @@ pub trait Projection: Send + Sync {
     }
 
     /// The analytic inverse (every image of a scene point, see [`AnalyticInverse`]), or why
-    /// this projection has none.
-    fn inverse(&self) -> Result<&dyn AnalyticInverse, NoInverse>;
+    /// this projection has none. The default has none (`reason: None`): such a projection
+    /// renders by ray casting alone, and `--method raster` refuses it with one line.
+    fn inverse(&self) -> Result<&dyn AnalyticInverse, NoInverse> {
+        Err(NoInverse { reason: None })
+    }
 
     /// The projection as separate views tiled in its image (the two eyes of a stereo pair,
     /// see [`StereoPair`]), for renderers that draw one continuous view at a time
@@ -126,16 +157,22 @@ pub trait Projection: Send + Sync {
     }
 
     /// This projection as a trilinear mesh, for the renderers that need its triangles
-    /// (`--method trilinear`); `None` for every other kind.
-    fn trilinear(&self) -> Option<&Trilinear>;
+    /// (`--method trilinear`); `None` for every other kind, the default.
+    fn trilinear(&self) -> Option<&Trilinear> {
+        None
+    }
 }
 
 /// A camera placement shared by the single-viewpoint projections: an eye position, a point
 /// it looks at, and an up hint (need not be perpendicular to the view direction).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CameraFrame {
+    /// The eye: where every ray of the projection starts (world units).
     pub position: DVec3,
+    /// A point the view direction passes through (the image centre's ray).
     pub look_at: DVec3,
+    /// Which way is up in the image; only its component perpendicular to the view direction
+    /// counts.
     pub up: DVec3,
 }
 
@@ -144,9 +181,13 @@ pub struct CameraFrame {
 /// and a screen position `screen[k]` in \[0,1\]^2 with (0,0) the bottom-left of the image.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct TrilinearMesh {
+    /// Base point of each vertex's ray (world units).
     pub points: Vec<DVec3>,
+    /// Ray direction of each vertex; its length scales depth.
     pub normals: Vec<DVec3>,
+    /// Image position of each vertex, (0, 0) bottom-left and (1, 1) top-right.
     pub screen: Vec<DVec2>,
+    /// Vertex indices of each projection triangle.
     pub triangles: Vec<[u32; 3]>,
 }
 
@@ -154,32 +195,57 @@ pub struct TrilinearMesh {
 #[derive(Debug, Clone, PartialEq)]
 pub enum ProjectionSpec {
     /// Pinhole; `fov` is the horizontal angle.
-    Perspective { frame: CameraFrame, fov: f64 },
+    Perspective {
+        /// Eye, view direction and up.
+        frame: CameraFrame,
+        /// Horizontal angle of view, degrees.
+        fov: f64,
+    },
     /// Parallel rays; `width` is the horizontal extent in world units.
-    Orthographic { frame: CameraFrame, width: f64 },
+    Orthographic {
+        /// The image centre's ray start, view direction and up.
+        frame: CameraFrame,
+        /// Horizontal extent of the view, world units.
+        width: f64,
+    },
     /// Angular (equidistant) fisheye; `fov` is the angle across the inscribed image circle.
-    Fisheye { frame: CameraFrame, fov: f64 },
+    Fisheye {
+        /// Eye, view axis and up.
+        frame: CameraFrame,
+        /// Angle across the image circle, degrees, up to 360.
+        fov: f64,
+    },
     /// Longitude linear in x, latitude linear in y.
     Equirectangular {
+        /// Eye, the image centre's direction and up (the poles' axis).
         frame: CameraFrame,
+        /// Longitude range across the image, degrees.
         h_fov: f64,
+        /// Latitude range down the image, degrees.
         v_fov: f64,
     },
     /// Longitude linear in x, tan(latitude) linear in y.
     Cylindrical {
+        /// Eye, the image centre's direction and up (the cylinder's axis).
         frame: CameraFrame,
+        /// Longitude range across the image, degrees.
         h_fov: f64,
+        /// Vertical angle at the image centre, degrees.
         v_fov: f64,
     },
     /// A calibrated pinhole with OpenCV's radial-tangential distortion, coefficients in
     /// OpenCV's order [k1, k2, p1, p2, k3, k4, k5, k6] (zeros for the shorter forms).
     Opencv {
+        /// Placement and intrinsics (focal lengths, principal point, calibration size).
         camera: CalibratedCamera,
+        /// [k1, k2, p1, p2, k3, k4, k5, k6].
         distortion: [f64; 8],
     },
     /// A calibrated Kannala-Brandt fisheye (OpenCV's `cv::fisheye`), `k` = [k1, k2, k3, k4].
     OpencvFisheye {
+        /// Placement and intrinsics (focal lengths, principal point, calibration size).
         camera: CalibratedCamera,
+        /// [k1, k2, k3, k4] of theta_d = theta (1 + k1 theta^2 + ... + k4 theta^8).
         k: [f64; 4],
     },
     /// Omni-directional stereo: 360 x 180 equirectangular per eye, left eye on top, rays

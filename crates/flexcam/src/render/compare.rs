@@ -33,13 +33,43 @@ pub struct Comparison {
     pub relative_rgb_error: f64,
 }
 
-/// Compares `frame` with `reference`. Fails when the sizes differ.
+/// Compares `frame` with `reference`. Fails when the sizes differ, and when either frame
+/// lacks its depth or id buffer (rendered with fewer [`crate::render::Outputs`] than
+/// `Outputs::ALL`): the measures need both.
+///
+/// ```
+/// use flexcam::render::{self, compare, Method, PreparedScene, RenderOptions, Shading};
+///
+/// let scene = flexcam::scene::load("builtin:cube-floor")?;
+/// let projection = scene.projection.build(64, 48)?;
+/// let prepared = PreparedScene::new(&scene);
+/// let frame = |method| {
+///     let options = RenderOptions { method, shading: Shading::Flat, ..RenderOptions::default() };
+///     render::render(&prepared, projection.as_ref(), &options).map(|r| r.frame)
+/// };
+/// let reference = frame(Method::Raycast)?;
+/// let agreement = compare(&frame(Method::Raster)?, &reference)?;
+/// assert_eq!(agreement.pixels, 64 * 48);
+/// assert!(agreement.id_agreement > 0.99, "{agreement:?}");
+/// // A frame agrees with itself exactly.
+/// assert_eq!(compare(&reference, &reference)?.relative_rgb_error, 0.0);
+/// # Ok::<(), flexcam::Error>(())
+/// ```
 pub fn compare(frame: &Frame, reference: &Frame) -> Result<Comparison> {
     if (frame.width, frame.height) != (reference.width, reference.height) {
         return Err(Error::new(format!(
             "cannot compare a {}x{} image with a {}x{} reference",
             frame.width, frame.height, reference.width, reference.height
         )));
+    }
+    let expected = frame.width as usize * frame.height as usize;
+    for (which, f) in [("frame", frame), ("reference", reference)] {
+        if [f.color.len(), f.depth.len(), f.ids.len()] != [expected; 3] {
+            return Err(Error::new(format!(
+                "cannot compare: the {which} lacks its depth or id buffer (render it with \
+                 Outputs::ALL)"
+            )));
+        }
     }
     let pixels = frame.ids.len() as u64;
     let mut same_id = 0u64;
@@ -169,5 +199,16 @@ mod tests {
         let wide = frame(&[0, 0], &[1.0, 1.0], &[0.0, 0.0]);
         let e = compare(&wide, &black).unwrap_err();
         assert!(e.to_string().contains("2x1 image with a 1x1"), "{e}");
+        let colour_only = Frame {
+            ids: Vec::new(),
+            ..grey.clone()
+        };
+        for (f, r, which) in [
+            (&colour_only, &grey, "frame"),
+            (&grey, &colour_only, "reference"),
+        ] {
+            let e = compare(f, r).unwrap_err().to_string();
+            assert!(e.contains(&format!("the {which} lacks")), "{e}");
+        }
     }
 }

@@ -43,6 +43,7 @@ pub struct RenderOptions<'a> {
     /// main view, each reflection rendered by `method` (module `composite`); `false` renders them
     /// as the method's own mirrors and glass (the reference of a comparison).
     pub composite_reflectors: bool,
+    /// How surfaces are shaded (`--shading`).
     pub shading: Shading,
     /// Samples per pixel (1 = one ray through each pixel centre).
     pub spp: u32,
@@ -121,7 +122,9 @@ impl Outputs {
 /// A rendered image with its arbitrary output variables, row-major, top row first.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// Linear RGB.
     pub color: Vec<Vec3>,
@@ -202,6 +205,7 @@ impl Frame {
 /// A rendered frame and what rendering it counted.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Rendered {
+    /// The image and its buffers.
     pub frame: Frame,
     /// The method's counters (rays cast, build times, ...), for `--stats`; with reflectors
     /// composited, also the compositing's (`reflector_pixels` and the like).
@@ -214,6 +218,23 @@ pub struct Rendered {
 /// method. Fails, rather than producing a wrong image, when the method cannot render that
 /// projection (with one line naming why), on zero samples per pixel, or on a crop window
 /// that is empty or does not fit in the image.
+///
+/// ```
+/// use flexcam::render::{self, Method, PreparedScene, RenderOptions, Shading};
+///
+/// let scene = flexcam::scene::load("builtin:cube-floor")?;
+/// let projection = scene.projection.build(40, 30)?;
+/// let prepared = PreparedScene::new(&scene);
+/// let options = RenderOptions { shading: Shading::Flat, ..RenderOptions::default() };
+/// let rendered = render::render(&prepared, projection.as_ref(), &options)?;
+/// assert_eq!((rendered.frame.width, rendered.frame.height), (40, 30));
+/// assert!(rendered.frame.ids.iter().any(|&id| id != 0), "the view sees the scene");
+///
+/// // A method that cannot render the projection fails with a reason, never a wrong image.
+/// let trilinear = RenderOptions { method: Method::Trilinear, ..options };
+/// assert!(render::render(&prepared, projection.as_ref(), &trilinear).is_err());
+/// # Ok::<(), flexcam::Error>(())
+/// ```
 pub fn render(
     prepared: &PreparedScene,
     projection: &dyn Projection,
@@ -269,15 +290,20 @@ pub fn render(
 /// ([`EquirectPhoto`]), as `image_io` reads it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearImage {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
+    /// Linear RGB, row-major, top row first.
     pub pixels: Vec<Vec3>,
 }
 
 /// One counter of a renderer's statistics.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Counter {
+    /// A number of things (rays, triangles, pixels).
     Count(u64),
+    /// A measure (milliseconds, a ratio).
     Value(f64),
 }
 

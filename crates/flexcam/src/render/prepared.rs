@@ -121,6 +121,24 @@ fn offset_of(scene: &Scene) -> f64 {
 impl PreparedScene {
     /// Builds the BVH over all triangles of `scene`, a copy of which it keeps (sharing its
     /// meshes and textures).
+    ///
+    /// ```
+    /// use flexcam::glam::{DVec2, DVec3};
+    /// use flexcam::render::PreparedScene;
+    ///
+    /// let scene = flexcam::scene::load("builtin:cube-floor")?;
+    /// let prepared = PreparedScene::new(&scene);
+    /// // Every render of this scene reads it; it also answers ray queries of its own.
+    /// let projection = scene.projection.build(64, 48)?;
+    /// let centre = projection.ray(DVec2::new(32.0, 24.0)).expect("a pinhole sees everywhere");
+    /// let hit = prepared.intersect(&centre).expect("the cube is in the middle of the view");
+    /// assert_eq!(scene.objects[hit.object].name, "cube");
+    /// assert!(hit.t > 0.0);
+    /// // A ray pointing away from everything hits nothing.
+    /// let up = flexcam::geometry::Ray::new(DVec3::new(0.0, 50.0, 0.0), DVec3::Y);
+    /// assert!(prepared.intersect(&up).is_none());
+    /// # Ok::<(), flexcam::Error>(())
+    /// ```
     pub fn new(scene: &Scene) -> PreparedScene {
         let start = Instant::now();
         let mut first_triangle = Vec::with_capacity(scene.objects.len());

@@ -15,8 +15,11 @@ pub enum RenderWarning {
     /// `tolerance_px` (scene key `trilinear_refine_px`): the reflection may be off by more
     /// than that there.
     ReflectorOverTolerance {
+        /// The reflector object's id.
         id: u32,
+        /// The mesh edges still over the tolerance.
         edges: u64,
+        /// The tolerance asked for, main-image pixels.
         tolerance_px: f64,
     },
 }

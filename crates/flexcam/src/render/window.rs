@@ -14,9 +14,13 @@ use crate::render::Frame;
 /// Columns `x0..x1` and rows `y0..y1` of an image (pixel (0, 0) the top-left).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct PixelWindow {
+    /// First column inside the window.
     pub x0: u32,
+    /// First row inside the window.
     pub y0: u32,
+    /// First column past the window (exclusive).
     pub x1: u32,
+    /// First row past the window (exclusive).
     pub y1: u32,
 }
 

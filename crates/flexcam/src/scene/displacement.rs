@@ -18,9 +18,13 @@ pub const MAX_LEVEL: u32 = 16;
 /// and fraction `F`; every micro-vertex moves to `P + N * S * (h(uv) - h_max) * F`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DisplacementSpec {
+    /// The height field h(u, v), values in [0, 1].
     pub height: HeightSource,
+    /// S: the displacement of height 1, world units.
     pub scale: f64,
+    /// L: each base triangle is split into 4^L micro-triangles.
     pub level: u32,
+    /// F: how much of the displacement is applied, in [0, 1].
     pub fraction: f64,
 }
 
@@ -61,15 +65,20 @@ pub fn check_parameters(scale: f64, level: u32, fraction: f64) -> Result<()> {
 /// Where heights come from.
 #[derive(Debug, Clone, PartialEq)]
 pub enum HeightSource {
+    /// A grey image sampled at the mesh's texture coordinates.
     Map(HeightImage),
+    /// A height function evaluated in closed form.
     Procedural(ProceduralSpec),
 }
 
 /// A grey height image: `width * height` values in [0, 1], row-major, top row first.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HeightImage {
+    /// Width in height samples.
     pub width: u32,
+    /// Height in height samples (rows).
     pub height: u32,
+    /// The heights, in [0, 1].
     pub values: Vec<f32>,
     /// The file it was read from (none for images made in code).
     pub path: Option<PathBuf>,
@@ -143,8 +152,11 @@ impl HeightImage {
 /// One term of [`ProceduralSpec::Waves`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Wave {
+    /// The wave's height amplitude.
     pub amplitude: f64,
+    /// Whole periods (m, n) over the unit square in u and v.
     pub frequency: [i32; 2],
+    /// Phase offset, radians.
     pub phase: f64,
 }
 
@@ -156,8 +168,15 @@ pub const MAX_FREQUENCY: i32 = 1 << 16;
 /// functions), validated by the constructors.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ProceduralSpec {
+    /// A sum of sine waves over (u, v).
     Waves(Vec<Wave>),
-    Bumps { cells: [u32; 2], radius: f64 },
+    /// Round bumps on a grid of cells.
+    Bumps {
+        /// Cells (nu, nv) over the unit square, one round bump in each.
+        cells: [u32; 2],
+        /// The bump's radius in cell units, in (0, 1/2].
+        radius: f64,
+    },
 }
 
 impl ProceduralSpec {

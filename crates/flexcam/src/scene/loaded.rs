@@ -35,9 +35,13 @@ pub struct Overrides {
 pub struct LoadedScene {
     /// The scene as named by the caller (`builtin:NAME` for built-ins).
     pub source: String,
+    /// The scene with the overrides applied.
     pub scene: Scene,
+    /// The scene's projection, built at `width` x `height`.
     pub projection: Box<dyn Projection>,
+    /// Image width in pixels: the override, or the scene's.
     pub width: u32,
+    /// Image height in pixels: the override, or the scene's.
     pub height: u32,
     /// What building the projection reported: counters for `--stats` (a fitted grid's
     /// residual, ...) and warnings (a fitted grid's doubtful nodes).
@@ -49,6 +53,20 @@ pub struct LoadedScene {
 /// Loads `source` (a scene file or `builtin:NAME`), applies `overrides` and builds the
 /// projection. Errors name the scene file; an override that does not apply names the
 /// command-line flag that sets it (`--perspective-rect`), the spelling users see.
+///
+/// ```
+/// use flexcam::scene::{self, Overrides};
+///
+/// // A built-in scene at a size of our own; a scene file's path works the same way.
+/// let overrides = Overrides { width: Some(64), ..Overrides::default() };
+/// let loaded = scene::load_with("builtin:cube-floor", &overrides)?;
+/// // The height follows the scene's aspect ratio (square), and the projection is built at
+/// // that size.
+/// assert_eq!((loaded.width, loaded.height), (64, 64));
+/// assert_eq!(loaded.projection.resolution(), (64, 64));
+/// assert_eq!(loaded.projection.kind(), "perspective");
+/// # Ok::<(), flexcam::Error>(())
+/// ```
 pub fn load_with(source: &str, overrides: &Overrides) -> Result<LoadedScene> {
     let start = Instant::now();
     let request = scene::ModelRequest {

@@ -15,7 +15,12 @@ pub enum Pattern {
     /// cell parity is `floor(x/size) + floor(y/size) + floor(z/size)` (as POV-Ray's `checker`),
     /// evaluated at the object-space hit point nudged by `1e-4 * size` so that an axis-aligned
     /// face lying on a cell boundary (a floor at y = 0) does not flicker between cells.
-    Checker { other: Vec3, size: f32 },
+    Checker {
+        /// The second colour, linear RGB (the first is the material's `color`).
+        other: Vec3,
+        /// Cell width, object-space units.
+        size: f32,
+    },
     /// An image texture looked up by the mesh's texture coordinates, multiplied by `color`.
     Texture(Arc<Texture>),
 }
@@ -28,7 +33,10 @@ pub enum Finish {
     /// A perfect mirror.
     Mirror,
     /// A dielectric with index of refraction `ior` (refraction and Fresnel reflection).
-    Glass { ior: f32 },
+    Glass {
+        /// Index of refraction (1.5 for window glass).
+        ior: f32,
+    },
     /// Emits its base colour; not lit.
     Emissive,
 }
@@ -38,8 +46,11 @@ pub enum Finish {
 /// colour; meshes without vertex colours count as white).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Material {
+    /// The base colour factor, linear RGB.
     pub color: Vec3,
+    /// What varies the base colour over the surface (solid, checker, texture).
     pub pattern: Pattern,
+    /// How light leaves the surface (diffuse, mirror, glass, emissive).
     pub finish: Finish,
 }
 
@@ -57,7 +68,9 @@ impl Default for Material {
 /// ((0,0) bottom-left, (1,1) top-right), wrapping (repeat) outside \[0,1\].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Texture {
+    /// Width in texels.
     pub width: u32,
+    /// Height in texels.
     pub height: u32,
     /// Row-major texels, top row first.
     pub texels: Vec<Vec3>,

@@ -11,10 +11,15 @@ use crate::geometry::MeshView;
 /// entry per position. Colours are linear RGB.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Mesh {
+    /// Vertex positions.
     pub positions: Vec<Vec3>,
+    /// Vertex normals (shading), one per position, or empty for flat shading.
     pub normals: Vec<Vec3>,
+    /// Texture coordinates, one per position, or empty.
     pub uvs: Vec<Vec2>,
+    /// Vertex colours (linear RGB), one per position, or empty (white).
     pub colors: Vec<Vec3>,
+    /// Vertex indices of each triangle, each below `positions.len()`.
     pub triangles: Vec<[u32; 3]>,
 }
 

@@ -25,12 +25,15 @@ use crate::projection::ProjectionSpec;
 /// `--ids` image holds.
 #[derive(Debug, Clone)]
 pub struct Object {
+    /// The object's id: 1-based in file order, 0 being the background.
     pub id: u32,
+    /// The scene file's `name`, or else the shape's (`sphere`, `mesh`, ...); for messages.
     pub name: String,
     /// The mesh, already transformed into world space. Shared: copies of a scene (a prepared
     /// scene's own, the views reflector compositing renders) share every mesh instead of
     /// copying it; `Arc::make_mut` edits one copy's mesh alone.
     pub mesh: Arc<Mesh>,
+    /// Colour, pattern and finish of the whole object.
     pub material: Material,
     /// World to object space, for patterns defined in object space (the checker).
     pub world_to_object: Affine3A,
@@ -42,7 +45,9 @@ pub struct Object {
 /// Image settings of a scene; CLI flags override them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ImageSettings {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Linear RGB of pixels whose ray hits nothing (or that no projector covers).
     pub background: Vec3,
@@ -83,9 +88,13 @@ impl Default for ImageSettings {
 /// A loaded scene: everything a renderer needs, plus the projection the scene asks for.
 #[derive(Debug, Clone)]
 pub struct Scene {
+    /// Every object, in id order.
     pub objects: Vec<Object>,
+    /// The lights of `lit` shading.
     pub lights: Vec<Light>,
+    /// Size, background and samples per pixel.
     pub image: ImageSettings,
+    /// The projection the scene names, to be built at an image size.
     pub projection: ProjectionSpec,
     /// The folder relative paths in the scene (models, textures, projection surfaces) are
     /// resolved against; `None` for built-in scenes.
@@ -110,6 +119,7 @@ pub struct InputFile {
     /// What the file is, for messages: "scene file", "model file", "material library",
     /// "texture", "model buffer", "trilinear surface".
     pub what: &'static str,
+    /// The file's path, as the scene resolved it.
     pub path: PathBuf,
 }
 

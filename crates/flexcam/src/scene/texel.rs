@@ -29,8 +29,11 @@ impl Texel for f32 {
 /// coordinates. The caller guarantees `texels.len() == width * height`, both non-zero.
 #[derive(Debug, Clone, Copy)]
 pub struct TexelGrid<'a, T> {
+    /// Texels per row.
     pub width: u32,
+    /// Rows.
     pub height: u32,
+    /// The texels, row-major, top row first.
     pub texels: &'a [T],
 }
 

@@ -21,8 +21,11 @@ use crate::displace::simplify::HalfEdgeCost;
 /// A point of the original surface where deviation is measured.
 #[derive(Debug, Clone, Copy)]
 pub struct Sample {
+    /// The chart (parameterisation patch) the sample lies in.
     pub chart: u32,
+    /// The sample's parameters in that chart.
     pub uv: DVec2,
+    /// The sample's point on the original surface.
     pub position: DVec3,
 }
 
@@ -37,6 +40,8 @@ pub struct Deviation<'a> {
 }
 
 impl<'a> Deviation<'a> {
+    /// The deviation measure of `topology`, whose faces lie in charts `chart_of` with per-chart
+    /// vertex parameters `uvs`: places the samples in their faces.
     pub fn new(
         topology: &'a Topology,
         chart_of: &'a [u32],

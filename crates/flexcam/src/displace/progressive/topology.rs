@@ -13,14 +13,18 @@ pub const NONE: u32 = u32::MAX;
 /// A triangle mesh's connectivity (see the module documentation).
 #[derive(Debug, Clone)]
 pub struct Topology {
+    /// Vertex positions.
     pub positions: Vec<DVec3>,
+    /// Vertex indices of each face.
     pub triangles: Vec<[u32; 3]>,
     /// The faces of each edge (smaller vertex first): the face where it runs from the
     /// smaller vertex to the larger, and the other ([`NONE`] on the boundary).
     pub edge_faces: HashMap<(u32, u32), [u32; 2]>,
     /// The faces through each vertex.
     pub vertex_faces: Vec<Vec<u32>>,
+    /// Unit normal of each face (zero for a degenerate one).
     pub normals: Vec<DVec3>,
+    /// Area of each face.
     pub areas: Vec<f64>,
     /// Whether each vertex lies on the mesh's boundary.
     boundary: Vec<bool>,

@@ -22,21 +22,59 @@ pub const NONE: u32 = u32::MAX;
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Defect {
     /// A face with fewer than three vertices.
-    TooFewVertices { face: u32 },
+    TooFewVertices {
+        /// The face's index.
+        face: u32,
+    },
     /// A face naming a vertex the mesh does not have.
-    IndexOutOfRange { face: u32, vertex: u32 },
+    IndexOutOfRange {
+        /// The face's index.
+        face: u32,
+        /// The vertex index it names.
+        vertex: u32,
+    },
     /// A face naming one vertex twice.
-    RepeatedVertex { face: u32, vertex: u32 },
+    RepeatedVertex {
+        /// The face's index.
+        face: u32,
+        /// The vertex it names twice.
+        vertex: u32,
+    },
     /// A vertex at infinity or NaN.
-    NonFinite { vertex: u32 },
+    NonFinite {
+        /// The vertex's index.
+        vertex: u32,
+    },
     /// An attribute list neither empty nor one per vertex.
-    AttributeCount { name: &'static str, len: usize },
+    AttributeCount {
+        /// The attribute list (`normals`, `uvs`, `colors`).
+        name: &'static str,
+        /// Its length.
+        len: usize,
+    },
     /// Two faces that both run from `from` to `to`: their orientations disagree.
-    Orientation { from: u32, to: u32, faces: [u32; 2] },
+    Orientation {
+        /// The edge's first vertex.
+        from: u32,
+        /// The edge's second vertex.
+        to: u32,
+        /// The two faces running from `from` to `to`.
+        faces: [u32; 2],
+    },
     /// An edge shared by three or more faces.
-    NonManifoldEdge { a: u32, b: u32, faces: Vec<u32> },
+    NonManifoldEdge {
+        /// One end of the edge.
+        a: u32,
+        /// The other end.
+        b: u32,
+        /// Every face using the edge.
+        faces: Vec<u32>,
+    },
     /// A vertex whose faces do not form one fan (two cones meeting at a point).
-    NonManifoldVertex { vertex: u32 },
+    NonManifoldVertex {
+        /// The vertex's index.
+        vertex: u32,
+    },
 }
 
 impl Defect {
@@ -110,6 +148,7 @@ pub struct HalfEdge {
 /// The half-edges of a checked [`PolyMesh`].
 #[derive(Debug, Clone)]
 pub struct HalfEdgeMesh {
+    /// Every half-edge of the mesh; face f's start at `face_start[f]`.
     pub half_edges: Vec<HalfEdge>,
     /// The first half-edge of each face.
     pub face_start: Vec<u32>,

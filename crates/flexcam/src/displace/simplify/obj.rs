@@ -20,9 +20,11 @@ use crate::error::{Error, Result};
 /// A polygon mesh read from an OBJ file, with where its elements came from.
 #[derive(Debug, Clone)]
 pub struct ObjPolygons {
+    /// The polygons, vertices in file order.
     pub mesh: PolyMesh,
     /// The line of each face's `f` statement and of each vertex's `v` statement.
     pub face_lines: Vec<usize>,
+    /// The line of each vertex's `v` statement.
     pub vertex_lines: Vec<usize>,
     /// Attributes left out because they were given per face corner, not per vertex.
     pub dropped: Vec<&'static str>,

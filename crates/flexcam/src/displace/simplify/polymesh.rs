@@ -12,10 +12,15 @@ use crate::scene::Mesh;
 /// mesh is a manifold the simplifier can work on and names the offending element if not.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PolyMesh {
+    /// Vertex positions.
     pub positions: Vec<Vec3>,
+    /// Vertex normals, one per position, or empty.
     pub normals: Vec<Vec3>,
+    /// Texture coordinates, one per position, or empty.
     pub uvs: Vec<Vec2>,
+    /// Vertex colours, one per position, or empty.
     pub colors: Vec<Vec3>,
+    /// Each face's vertex indices, counter-clockwise seen from outside.
     pub faces: Vec<Vec<u32>>,
 }
 

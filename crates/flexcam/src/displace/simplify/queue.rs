@@ -29,7 +29,9 @@ pub trait HalfEdgeCost {
 /// A simplification in cost order, with the cost of each collapse (in split order).
 #[derive(Debug, Clone)]
 pub struct Ordered {
+    /// The coarse mesh and the splits back to the input.
     pub simplified: Simplified,
+    /// The cost of each collapse, in split order.
     pub costs: Vec<f64>,
     /// After how many collapses the mesh first had at most each of the face counts asked
     /// for (the collapses done in all where it never got there).

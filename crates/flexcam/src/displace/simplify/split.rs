@@ -16,11 +16,15 @@ use super::PolyMesh;
 /// A vertex as a split restores it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SplitVertex {
+    /// The vertex's stable id.
     pub id: u32,
+    /// Its position.
     pub position: Vec3,
     /// Zero where the mesh has no such attribute.
     pub normal: Vec3,
+    /// Its texture coordinates (zero where the mesh has none).
     pub uv: Vec2,
+    /// Its colour (zero where the mesh has none).
     pub color: Vec3,
 }
 
@@ -46,9 +50,13 @@ pub struct VertexSplit {
 /// order of the collapses: refining applies them from the last.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Simplified {
+    /// The simplified mesh, compacted.
     pub coarse: PolyMesh,
+    /// The splits, in the order of the collapses.
     pub splits: Vec<VertexSplit>,
+    /// The stable id of each vertex of `coarse`.
     pub vertex_ids: Vec<u32>,
+    /// The stable id of each face of `coarse`.
     pub face_ids: Vec<u32>,
     /// How many stable vertex ids there are (input vertices and created ones).
     pub vertex_id_count: usize,

@@ -26,6 +26,7 @@ pub struct SimplifyOptions {
     /// The fraction of the input's edges drawn as candidates for each collapse (the
     /// dissertation uses 1 %); at least one.
     pub candidate_fraction: f32,
+    /// Half-edge collapses (a vertex kept) or full-edge ones (a new vertex).
     pub collapse: CollapseKind,
     /// Seed of the candidate draws: the same input and options give the same result.
     pub seed: u64,

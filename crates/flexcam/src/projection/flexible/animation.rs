@@ -19,7 +19,9 @@ pub enum Easing {
 /// One key: the projection shown at `time` seconds.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Keyframe {
+    /// The key's time, seconds.
     pub time: f64,
+    /// The projection shown at `time`.
     pub projection: FlexibleSpec,
 }
 

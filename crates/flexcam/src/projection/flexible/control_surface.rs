@@ -21,7 +21,9 @@ const PARALLEL_SINE: f64 = 1e-9;
 /// Which parameter varies along a [`Surface::Line`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LineParam {
+    /// The line runs with u (columns).
     U,
+    /// The line runs with v (rows).
     V,
 }
 
@@ -31,8 +33,11 @@ pub enum LineParam {
 /// longitude grows to the right of a viewer looking along -z, as in the panoramas.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PolarFrame {
+    /// Unit direction of latitude +90 degrees, or of increasing cylinder height.
     pub axis: DVec3,
+    /// Unit direction of longitude 0, perpendicular to `axis`.
     pub front: DVec3,
+    /// front x axis: longitude +90 degrees.
     pub east: DVec3,
 }
 
@@ -74,10 +79,15 @@ impl PolarFrame {
 /// may run backwards). Radius 0 is allowed: the patch is then the point `center`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpherePatch {
+    /// The sphere's centre.
     pub center: DVec3,
+    /// The sphere's radius, at least 0.
     pub radius: f64,
+    /// The directions longitude and latitude are measured in.
     pub frame: PolarFrame,
+    /// Longitude at u = 0 and at u = 1, radians.
     pub longitude: [f64; 2],
+    /// Latitude at v = 0 and at v = 1, radians.
     pub latitude: [f64; 2],
 }
 
@@ -87,10 +97,15 @@ pub struct SpherePatch {
 /// allowed: the patch is then a segment of the axis.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CylinderPatch {
+    /// A point of the axis, where height 0 is.
     pub center: DVec3,
+    /// The cylinder's radius, at least 0.
     pub radius: f64,
+    /// The axis and the direction of angle 0.
     pub frame: PolarFrame,
+    /// Angle around the axis at u = 0 and at u = 1, radians.
     pub angle: [f64; 2],
+    /// Height along the axis at v = 0 and at v = 1.
     pub height: [f64; 2],
 }
 
@@ -100,13 +115,19 @@ pub enum Surface {
     /// A parallelogram `corner + u * u_edge + v * v_edge` (`corner` at (u, v) = (0, 0), the
     /// bottom-left of the image). Zero edges are allowed (a segment or a point).
     Rectangle {
+        /// The point at (u, v) = (0, 0).
         corner: DVec3,
+        /// The step from u = 0 to u = 1.
         u_edge: DVec3,
+        /// The step from v = 0 to v = 1.
         v_edge: DVec3,
     },
     /// A bilinear patch through four corners, in the order (u, v) = (0, 0), (1, 0), (1, 1),
     /// (0, 1): bottom-left, bottom-right, top-right, top-left.
-    Bilinear { corners: [DVec3; 4] },
+    Bilinear {
+        /// The corners at (0, 0), (1, 0), (1, 1), (0, 1).
+        corners: [DVec3; 4],
+    },
     /// A sphere or hemisphere patch.
     Sphere(SpherePatch),
     /// A cylinder patch.
@@ -116,8 +137,11 @@ pub enum Surface {
     /// The segment from `start` to `end`, parameterised by u or by v (the other parameter is
     /// ignored): the slit of a pushbroom or crossed-slits camera.
     Line {
+        /// The point at parameter 0.
         start: DVec3,
+        /// The point at parameter 1.
         end: DVec3,
+        /// Which of u and v runs along the segment.
         along: LineParam,
     },
     /// A bicubic Bezier patch (boxed: 16 control points).

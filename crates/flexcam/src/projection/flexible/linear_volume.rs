@@ -19,7 +19,9 @@ const CHECK_SAMPLES: u32 = 17;
 /// A volume with straight projectors between a near and a far control surface.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearVolume {
+    /// Where the projectors start (t = 0).
     pub near: Surface,
+    /// Where the projectors end (t = 1).
     pub far: Surface,
 }
 

@@ -70,23 +70,35 @@ pub enum VolumeSource {
     /// A shape-defined panorama (outlines and profiles) placed by a camera frame.
     Panorama(PanoramaSpec),
     /// Two explicit control surfaces, straight projectors between them.
-    Surfaces { near: Surface, far: Surface },
+    Surfaces {
+        /// Where the projectors start (t = 0).
+        near: Surface,
+        /// Where the projectors end (t = 1).
+        far: Surface,
+    },
     /// Two or more explicit control surfaces blended in t: curved projectors.
     Blended {
+        /// The control surfaces, from near (t = 0) to far (t = 1).
         surfaces: Vec<Surface>,
+        /// How they are blended in t.
         blend: Blend,
     },
     /// `weight` Q1 + (1 - `weight`) Q2 of two flexible projections (module [`interpolate`]);
     /// both must end up with the same re-parameterisation (their own or the preset's).
     Interpolated {
+        /// The share of `first`, in [0, 1].
         weight: f64,
+        /// The projection weighted by `weight`.
         first: Box<FlexibleSpec>,
+        /// The projection weighted by `1 - weight`.
         second: Box<FlexibleSpec>,
     },
     /// A projector grid sampled from `base` (straight projectors), re-aimed and fitted
     /// (module [`projector_grid`]); the re-parameterisation is `base`'s unless overridden.
     ProjectorGrid {
+        /// The volume the grid's projectors are sampled from.
         base: Box<FlexibleSpec>,
+        /// The grid's size, aims and fitting.
         grid: ProjectorGridSpec,
     },
 }
@@ -95,17 +107,25 @@ pub enum VolumeSource {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Blend {
     /// Linear between surfaces at `knots` (`None`: equally spaced): polyline projectors.
-    Piecewise { knots: Option<Vec<f64>> },
+    Piecewise {
+        /// The t of each surface, increasing from 0 to 1.
+        knots: Option<Vec<f64>>,
+    },
     /// Bernstein polynomials: Bezier projectors, rendered as polylines of `segments` steps
     /// when given (quadratic ones are analytic otherwise).
-    Bezier { segments: Option<u32> },
+    Bezier {
+        /// Steps of the polyline a projector is rendered as.
+        segments: Option<u32>,
+    },
 }
 
 /// A parsed flexible projection: the volume and the re-parameterisation (`None`: the
 /// preset's own, linear for explicit surfaces).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlexibleSpec {
+    /// The viewing volume: where its control surfaces come from.
     pub source: VolumeSource,
+    /// How image positions map to the volume's (u, v) parameters.
     pub reparam: Option<Reparam>,
 }
 

@@ -42,6 +42,7 @@ fn tensor(at: impl Fn(usize, usize) -> DVec3, wu: [f64; 4], wv: [f64; 4]) -> DVe
 /// A bicubic Bezier patch: `control[row][column]`, 4 x 4 points.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BezierPatch {
+    /// The 16 control points, `control[row][column]`.
     pub control: [[DVec3; 4]; 4],
 }
 

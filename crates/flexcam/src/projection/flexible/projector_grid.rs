@@ -444,6 +444,7 @@ fn stable_unit(v: DVec3) -> Option<DVec3> {
 pub struct Aim {
     /// (column, row) of the node, (0, 0) at the bottom left.
     pub node: (usize, usize),
+    /// The scene point the node's projector is re-aimed through.
     pub at: DVec3,
 }
 
@@ -455,7 +456,9 @@ pub struct Aim {
 pub struct NodeProjector {
     /// (column, row) of the node, (0, 0) at the bottom left.
     pub node: (usize, usize),
+    /// Where the projector starts; `None`: the sampled node's start.
     pub start: Option<DVec3>,
+    /// Where the projector ends; `None`: the sampled node's end.
     pub end: Option<DVec3>,
     /// The direction the projector leaves its start in; `None`: straight.
     pub tangent: Option<DVec3>,
@@ -470,9 +473,13 @@ pub struct NodeProjector {
 pub struct ProjectorGridSpec {
     /// Nodes per side: (columns, rows).
     pub size: (usize, usize),
+    /// How projectors between the nodes are interpolated.
     pub interpolation: GridInterpolation,
+    /// Node projectors placed explicitly.
     pub projectors: Vec<NodeProjector>,
+    /// Node projectors re-aimed through scene points.
     pub aims: Vec<Aim>,
+    /// Scene points the fitted grid must show at given image positions.
     pub correspondences: Vec<Correspondence>,
     /// Where the fitted projectors start (scene key `starts`; unused without correspondences).
     pub starts: Starts,
@@ -481,6 +488,7 @@ pub struct ProjectorGridSpec {
 /// A projector grid in use as a viewing volume.
 #[derive(Debug, Clone, PartialEq)]
 pub struct GridVolume {
+    /// The nodes' projectors and their interpolation.
     pub grid: ProjectorGrid,
 }
 

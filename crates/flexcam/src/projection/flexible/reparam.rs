@@ -32,7 +32,10 @@ pub enum Reparam {
     /// sin(max_angle / 2), for volumes whose v is linear in that angle with v = 1 at
     /// `max_angle` (the fisheye preset, max_angle = fov / 2): v = 2 asin(r sin(max_angle /
     /// 2)) / max_angle. `max_angle` in radians, in (0, pi].
-    Equisolid { max_angle: f64 },
+    Equisolid {
+        /// Half the angle across the image circle, radians, in (0, pi].
+        max_angle: f64,
+    },
     /// Equiangular perspective, the map of an equi-angular cubemap face (EAC, as Blender
     /// Cycles' `EQUIANGULAR_CUBEMAP_FACE` and YouTube's cubemaps): for volumes whose (u, v)
     /// is linear on a pinhole's image plane (the perspective preset, horizontal field of
@@ -41,18 +44,27 @@ pub enum Reparam {
     /// and likewise in y with the vertical half angle h_y, tan h_y = tan(half_fov) H / W, so
     /// that the image frame sees what the perspective camera's frame sees. `half_fov` in
     /// radians, in (0, pi/2).
-    Equiangular { half_fov: f64 },
+    Equiangular {
+        /// Half the perspective camera's horizontal angle, radians, in (0, pi/2).
+        half_fov: f64,
+    },
     /// Mercator map: u = x / W; the image row's Mercator ordinate y_m = py * M(max_latitude),
     /// M(phi) = ln tan(pi/4 + phi/2), gives the latitude phi = atan(sinh(y_m)) and
     /// v = (phi / max_latitude + 1) / 2. So it expects surfaces whose v spans the latitudes
     /// [-max_latitude, max_latitude] linearly (the equirectangular preset with
     /// v_fov = 2 max_latitude). `max_latitude` in radians, in (0, pi/2).
-    Mercator { max_latitude: f64 },
+    Mercator {
+        /// The latitude at the image's top edge, radians, in (0, pi/2).
+        max_latitude: f64,
+    },
     /// Lambert cylindrical equal-area map: u = x / W; the image row's ordinate is
     /// proportional to sin(latitude), py = sin(phi) / sin(max_latitude), so equal image areas
     /// cover equal areas of the sphere. Surfaces as for `Mercator`; `max_latitude` in
     /// (0, pi/2] (the poles can be shown: sin stays finite there).
-    EqualArea { max_latitude: f64 },
+    EqualArea {
+        /// The latitude at the image's top edge, radians, in (0, pi/2].
+        max_latitude: f64,
+    },
     /// The linear map seen through a circular magnifying lens (the `magnifier` preset's
     /// map; [`Magnifier`]): identity outside the circle.
     Magnifier(Magnifier),

@@ -104,8 +104,11 @@ const VERTEX_MASK: [u8; 3] = [0b011, 0b101, 0b110];
 /// 0, 1, 2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum SceneEdge {
+    /// The edge from scene vertex 0 to vertex 1.
     V1V2,
+    /// The edge from scene vertex 0 to vertex 2.
     V1V3,
+    /// The edge from scene vertex 1 to vertex 2.
     V2V3,
 }
 
@@ -257,15 +260,24 @@ pub enum Unprojectable {
     /// The cubic of scene vertex `vertex` (0-based) vanishes identically: every depth images
     /// it (the parametric triangle is degenerate at every `t`, or its planes share a line
     /// through the vertex).
-    EveryDepth { vertex: u8 },
+    EveryDepth {
+        /// The scene vertex, 0-based.
+        vertex: u8,
+    },
     /// The plane of the parametric triangle still crosses the scene triangle at `t -> -inf`
     /// or `+inf`: the vertices' cubics lost different numbers of roots to infinity (listed
     /// per vertex), or their leading non-dropped coefficients differ in sign (coplanar
     /// normals with the scene triangle straddling the limit plane).
-    OpenAtInfinity { lost_to_infinity: [u8; 3] },
+    OpenAtInfinity {
+        /// The roots each vertex's cubic lost to infinity.
+        lost_to_infinity: [u8; 3],
+    },
     /// The sorted images do not close: their counts per vertex (listed, with multiplicity)
     /// differ in parity, from a degenerate-triangle root rejected for some vertices only.
-    OpenShape { images: [u8; 3] },
+    OpenShape {
+        /// The images of each vertex.
+        images: [u8; 3],
+    },
 }
 
 impl fmt::Display for Unprojectable {

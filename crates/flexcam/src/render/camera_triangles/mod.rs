@@ -49,6 +49,7 @@ use crate::render::{Counter, Frame, Outputs, RenderOptions, Shading, Stats};
 /// How the method runs (`--bound`; culling is switched off only to measure it).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Options {
+    /// The bounding region each scene triangle is drawn through (`--bound`).
     pub bound: Bound,
     /// Cull clusters of scene triangles per camera triangle (section 2.4's object culling).
     pub cull: bool,

@@ -12,7 +12,9 @@ pub const PANORAMA_SIZE: (u32, u32) = (1280, 720);
 
 /// The scene and projection of the panorama workload.
 pub struct PanoramaWorkload {
+    /// `builtin:teapot-dense`.
     pub scene: Scene,
+    /// The panorama projection, built at [`PANORAMA_SIZE`].
     pub projection: Box<dyn Projection>,
 }
 

@@ -96,6 +96,7 @@ pub const MAX_STEPS: u32 = 1024;
 /// The curve strategy and its step count.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CurveOptions {
+    /// How curved edges are followed (`--curves`).
     pub mode: CurveMode,
     /// Segments per scene edge (tessellate), slices per shape (slice) or the most segments
     /// per edge piece (adaptive); 1 to `MAX_STEPS`.

@@ -87,6 +87,7 @@ pub struct TrilinearRenderer<'a> {
 }
 
 impl<'a> TrilinearRenderer<'a> {
+    /// The renderer of `prepared`, with the scene's f64 geometry and its bounding sphere.
     pub fn new(prepared: &'a PreparedScene) -> TrilinearRenderer<'a> {
         let scene = prepared.scene();
         let geometry = SceneGeometry::new(scene);

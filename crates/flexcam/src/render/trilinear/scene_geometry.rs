@@ -25,6 +25,7 @@ pub struct Owner {
 /// Every scene vertex (f64, world space) and triangle.
 #[derive(Debug, Clone, Default)]
 pub struct SceneGeometry {
+    /// Every scene vertex, world space, in f64.
     pub vertices: Vec<DVec3>,
     /// Indices into `vertices`.
     pub triangles: Vec<[u32; 3]>,
@@ -122,6 +123,7 @@ fn edge_key(a: DVec3, b: DVec3) -> [u64; 6] {
 }
 
 impl SceneGeometry {
+    /// The vertices and triangles of every object of `scene`, in f64.
     pub fn new(scene: &Scene) -> SceneGeometry {
         let mut out = SceneGeometry::default();
         for (index, object) in scene.objects.iter().enumerate() {

@@ -27,8 +27,11 @@ use crate::scene::InputFile;
 /// values named (models, textures, surfaces; see [`crate::scene::Scene::inputs`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FittedScene {
+    /// The scene file's text with the fitted node projectors written in.
     pub text: String,
+    /// The fit's residual and what it chose.
     pub report: FitReport,
+    /// The files the fitting scene read.
     pub inputs: Vec<InputFile>,
 }
 

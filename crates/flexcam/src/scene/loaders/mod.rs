@@ -27,7 +27,9 @@ pub use texture::load_texture;
 /// One part of a loaded model: a mesh and the material the file gives it, if any.
 #[derive(Debug, Clone)]
 pub struct ModelPart {
+    /// The part's triangles, in the model file's coordinates.
     pub mesh: Mesh,
+    /// The material the file assigns the part (`None`: the scene object's).
     pub material: Option<Material>,
 }
 
@@ -36,7 +38,9 @@ pub struct ModelPart {
 /// only; in the order the loader meets their nodes, depth first in file order).
 #[derive(Debug, Clone)]
 pub struct Model {
+    /// The model's meshes, each with its material.
     pub parts: Vec<ModelPart>,
+    /// Every file read, the model file first.
     pub files: Vec<InputFile>,
     pub cameras: Vec<ModelCamera>,
 }

@@ -20,20 +20,34 @@ use crate::error::{Error, Result};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Piece {
     /// The segment from `from` to `to`.
-    Line { from: DVec2, to: DVec2 },
+    Line {
+        /// The point at fraction 0.
+        from: DVec2,
+        /// The point at fraction 1.
+        to: DVec2,
+    },
     /// The arc of the circle around `centre` of radius `radius` from angle `start` over the
     /// signed angle `sweep` (radians, counter-clockwise positive).
     Circular {
+        /// The circle's centre.
         centre: DVec2,
+        /// The circle's radius.
         radius: f64,
+        /// The angle of the arc's first point, radians.
         start: f64,
+        /// The signed angle the arc turns through, radians.
         sweep: f64,
     },
     /// The segment from `from` to `to` parameterised centrally: the slope y / x of the point
     /// seen from the origin is linear in the fraction (a perspective, not an arc-length,
     /// parameterisation; both ends must have x > 0). Outside [0, 1] the segment continues
     /// linearly. Made by [`ArcCurve::replace`] for the perspective edit (module `edit`).
-    Central { from: DVec2, to: DVec2 },
+    Central {
+        /// The point at fraction 0 (x > 0).
+        from: DVec2,
+        /// The point at fraction 1 (x > 0).
+        to: DVec2,
+    },
 }
 
 impl Piece {

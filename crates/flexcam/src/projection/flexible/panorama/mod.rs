@@ -73,6 +73,7 @@ impl CurveBlend {
 pub struct Attached {
     /// v for an outline, u for a profile, in [0, 1].
     pub at: f64,
+    /// The outline or profile itself.
     pub curve: ArcCurve,
 }
 
@@ -201,14 +202,17 @@ impl PanoramaShape {
         )
     }
 
+    /// The outlines, by increasing v.
     pub fn outlines(&self) -> &[Attached] {
         &self.outlines
     }
 
+    /// The profiles, by increasing u.
     pub fn profiles(&self) -> &[Attached] {
         &self.profiles
     }
 
+    /// How neighbouring outlines and profiles are blended.
     pub fn blend(&self) -> CurveBlend {
         self.blend
     }
@@ -284,8 +288,11 @@ fn blended(list: &[Attached], (i, j, w): (usize, usize, f64), s: f64) -> DVec2 {
 /// A panorama control surface: `scale` Q_1(u, v) around the eye of `basis`, in world space.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PanoramaSurface {
+    /// The eye and the camera axes the shape's local coordinates are in.
     pub basis: CameraBasis,
+    /// The distance factor d of Q_d, at least 0.
     pub scale: f64,
+    /// The outlines and profiles.
     pub shape: Arc<PanoramaShape>,
 }
 
@@ -319,7 +326,9 @@ impl PanoramaSurface {
 /// distance `clip[0]` (0: the eye) to the one at `clip[1]`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PanoramaSpec {
+    /// The outlines and profiles.
     pub shape: Arc<PanoramaShape>,
+    /// The eye, view direction and up the shape is placed by.
     pub frame: CameraFrame,
     /// Near and far scales; `None` for [0, 1000] (as the presets).
     pub clip: Option<[f64; 2]>,

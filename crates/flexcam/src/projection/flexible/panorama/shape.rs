@@ -25,7 +25,10 @@ pub enum OutlineShape {
     Square,
     /// The square of half-width 1 with corners rounded to quarter circles of radius `radius`
     /// in [0, 1] (0: the square, 1: the circle).
-    RoundedSquare { radius: f64 },
+    RoundedSquare {
+        /// Corner radius, in [0, 1].
+        radius: f64,
+    },
     /// The polygon through `points`, listed in either direction; it must go once around the
     /// eye (the origin) without passing through it.
     Points(Vec<DVec2>),
@@ -36,10 +39,16 @@ pub enum OutlineShape {
 pub enum ProfileShape {
     /// The vertical segment at distance 1 from the axis between the elevations `elevation`
     /// (radians, within (-90, 90) degrees, increasing): the cylindrical and cubic profiles.
-    Segment { elevation: [f64; 2] },
+    Segment {
+        /// The lowest and highest elevation, radians.
+        elevation: [f64; 2],
+    },
     /// The unit-radius arc between the elevations `elevation` (radians, within [-90, 90]
     /// degrees, increasing): [-90, 90] degrees is the semicircle of the spherical panorama.
-    Arc { elevation: [f64; 2] },
+    Arc {
+        /// The lowest and highest elevation, radians.
+        elevation: [f64; 2],
+    },
     /// The polyline through `points`, from the bottom of the image to the top.
     Points(Vec<DVec2>),
 }

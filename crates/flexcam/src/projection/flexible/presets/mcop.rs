@@ -147,6 +147,7 @@ impl McopPath {
 /// The control surface Q_d of the module: the path's columns at distance `depth`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PathSurface {
+    /// The camera path and its look directions.
     pub path: McopPath,
     /// tan(v_fov / 2).
     pub tan_half_v: f64,

@@ -77,110 +77,162 @@ pub use occlusion::PinchedRectangle;
 /// A named volume and its own parameters (angles in degrees).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Preset {
+    /// A pinhole as a volume: straight projectors from the eye.
     Perspective {
+        /// Horizontal angle of view, degrees.
         fov: f64,
     },
+    /// Rectangles shrinking with distance, the projectors meeting at `look_at`: far things
+    /// look larger.
     InversePerspective {
+        /// Horizontal angle at which the projectors converge, degrees.
         fov: f64,
     },
+    /// Parallel projectors along the view direction.
     Orthographic {
+        /// Horizontal extent of the view, world units.
         width: f64,
     },
+    /// Parallel projectors sheared off the view direction (cavalier, cabinet views).
     Oblique {
+        /// Horizontal extent of the view, world units.
         width: f64,
+        /// [a, b]: a camera-local point (x, y, z) lands at (x + a z, y + b z).
         shear: DVec2,
     },
+    /// Orthographic across, perspective up and down: a line camera moved sideways.
     Pushbroom {
+        /// Horizontal extent of the view, world units.
         width: f64,
+        /// Vertical angle of view, degrees.
         v_fov: f64,
     },
     /// `v_fov` defaults to the perspective one (from `fov` and the aspect ratio);
     /// `slit_distance` is s, the signed distance from `position` to the horizontal slit.
     CrossedSlits {
+        /// Angle of the fan through the vertical slit at `position`, degrees.
         fov: f64,
+        /// Angle of the fan through the horizontal slit, degrees (`None`: the perspective
+        /// one).
         v_fov: Option<f64>,
+        /// s: signed distance from the eye to the horizontal slit, world units.
         slit_distance: f64,
     },
+    /// Longitude linear in x, tan(latitude) linear in y, as a volume.
     Cylindrical {
+        /// Longitude range across the image, degrees.
         h_fov: f64,
+        /// Vertical angle at the image centre, degrees.
         v_fov: f64,
     },
+    /// Longitude linear in x, latitude linear in y, as a volume.
     Equirectangular {
+        /// Longitude range across the image, degrees.
         h_fov: f64,
+        /// Latitude range down the image, degrees.
         v_fov: f64,
     },
+    /// The angular fisheye as a volume.
     Fisheye {
+        /// Angle across the image circle, degrees.
         fov: f64,
     },
     /// The cubic panorama (360 degrees around, `v_fov` through the middle of each face).
     Cubic {
+        /// Vertical angle through the middle of each face, degrees.
         v_fov: f64,
     },
     /// The cubic panorama with rounded corners: `corner_radius` in [0, 1] of the half-width.
     RoundedCubic {
+        /// Vertical angle through the middle of each face, degrees.
         v_fov: f64,
+        /// Corner radius as a fraction of the half-width, in [0, 1].
         corner_radius: f64,
     },
     /// Perspective with the window shifted by `shift` half-widths and half-heights.
     OffAxis {
+        /// Horizontal angle of view of the unshifted window, degrees.
         fov: f64,
+        /// Window shift in half-widths (x) and half-heights (y).
         shift: DVec2,
     },
     /// Perspective with the far surface turned by `twist` degrees about the view axis
     /// (counter-clockwise as seen from the eye).
     Twist {
+        /// Horizontal angle of view, degrees.
         fov: f64,
+        /// Turn of the far surface about the view axis, degrees.
         twist: f64,
     },
     /// Orthographic, looking at `look_at` from the world direction at `azimuth` degrees
     /// about +y (0 = from +z) and `elevation` degrees above the x-z plane; `position` only
     /// gives the distance of the near clip origin from `look_at`.
     Axonometric {
+        /// Horizontal extent of the view, world units.
         width: f64,
+        /// Direction of view about +y, degrees (0 = from +z).
         azimuth: f64,
+        /// Direction of view above the x-z plane, degrees.
         elevation: f64,
     },
     /// General linear camera (Yu and McMillan): generator k = [x0, y0, x1, y1] is the ray
     /// through the camera-local points (x0, y0, 0) and (x1, y1, 1); the image plane z = 0
     /// spans `width` across.
     Glc {
+        /// Width of the image plane z = 0, camera-local units.
         width: f64,
+        /// The three generator rays, each [x0, y0, x1, y1].
         generators: [[f64; 4]; 3],
     },
     /// Orthographic in front of distance `transition`, the camera's perspective of `fov`
     /// behind it (thesis fig. 4.10); see [`depth_transition`].
     OrthoNearPerspFar {
+        /// Horizontal angle of the far perspective, degrees.
         fov: f64,
+        /// Distance from the eye where orthographic turns perspective, world units.
         transition: f64,
+        /// How the projectors bend at the transition.
         style: DepthStyle,
     },
     /// Perspective views one after another in depth (figs. 7.7, 7.8): view k of `fovs[k]`
     /// from `transitions[k - 1]` to `transitions[k]`; see [`depth_transition`].
     DepthTransition {
+        /// Horizontal angle of each view, degrees, near to far.
         fovs: Vec<f64>,
+        /// Distances where one view hands over to the next, increasing, world units.
         transitions: Vec<f64>,
+        /// How the projectors bend at each transition.
         style: DepthStyle,
     },
     /// The occlusion camera: perspective of `fov` up to distance `transition`, then bent
     /// towards `pole` (image (u, v)) so that the far plane is seen `strength` image widths
     /// further from the pole; see [`occlusion`].
     Occlusion {
+        /// Horizontal angle of the near perspective, degrees.
         fov: f64,
+        /// Distance where the bend starts, world units.
         transition: f64,
+        /// Image position (u, v) the far plane is pushed away from.
         pole: DVec2,
+        /// How far the far plane moves from the pole, image widths.
         strength: f64,
     },
     /// A multiple-centre-of-projection camera along the polyline `path` (world points),
     /// looking along `directions` (one per point; `None`: look_at - position everywhere),
     /// each column a vertical fan of `v_fov`; see [`mcop`].
     Mcop {
+        /// The centres of projection, a polyline of world points.
         path: Vec<DVec3>,
+        /// The view direction at each path point (`None`: look_at - position everywhere).
         directions: Option<Vec<DVec3>>,
+        /// Vertical angle of each column's fan, degrees.
         v_fov: f64,
     },
     /// The perspective of `fov` seen through a circular magnifying lens; see [`lens`].
     Magnifier {
+        /// Horizontal angle of view, degrees.
         fov: f64,
+        /// Where the lens is, its size and its magnification.
         lens: Magnifier,
     },
 }
@@ -212,7 +264,9 @@ pub const PRESET_NAMES: [&str; 20] = [
 /// A preset placed in the scene.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PresetSpec {
+    /// The named volume and its parameters.
     pub preset: Preset,
+    /// The eye, view direction and up it is placed by.
     pub frame: CameraFrame,
     /// Near and far control-surface distances; `None` for [0, 1000], or [0, e] for the
     /// inverse perspective.

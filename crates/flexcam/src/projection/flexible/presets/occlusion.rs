@@ -34,8 +34,11 @@ use crate::error::{Error, Result};
 /// (x, y) = w(u, v) (see the module).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PinchedRectangle {
+    /// The rectangle's point at (x, y) = (0, 0).
     pub corner: DVec3,
+    /// The step from x = 0 to x = 1.
     pub u_edge: DVec3,
+    /// The step from y = 0 to y = 1.
     pub v_edge: DVec3,
     /// q_0 in (u, v).
     pub pole: DVec2,

@@ -15,7 +15,9 @@ use crate::projection::BuildReport;
 /// A scene point and the image position (u, v) in [0, 1]^2 (u right, v up) that must see it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Correspondence {
+    /// The image position, in [0, 1]^2, u right, v up.
     pub uv: DVec2,
+    /// The scene point it must see.
     pub point: DVec3,
 }
 

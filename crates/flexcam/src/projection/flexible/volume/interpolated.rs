@@ -10,8 +10,11 @@ use crate::projection::Projector;
 /// a Q1 + (1 - a) Q2, evaluated point by point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct InterpolatedVolume {
+    /// a: the share of `first`, in [0, 1].
     pub weight: f64,
+    /// Q1.
     pub first: Volume,
+    /// Q2.
     pub second: Volume,
 }
 

@@ -14,10 +14,20 @@ pub enum GridCamera {
     /// Rays from the eye through a plane at distance 1; `half` holds tan(h_fov / 2) and
     /// tan(v_fov / 2). Base points lie on that plane, so depth t counts from it in units of
     /// the distance from the eye.
-    Perspective { basis: CameraBasis, half: DVec2 },
+    Perspective {
+        /// The eye and the view axes.
+        basis: CameraBasis,
+        /// tan(h_fov / 2) and tan(v_fov / 2).
+        half: DVec2,
+    },
     /// Parallel rays along the view direction from a `2 half.x` by `2 half.y` rectangle
     /// centred on the eye; directions are unit length.
-    Orthographic { basis: CameraBasis, half: DVec2 },
+    Orthographic {
+        /// The rectangle's centre and the view axes.
+        basis: CameraBasis,
+        /// Half the rectangle's width and height, world units.
+        half: DVec2,
+    },
 }
 
 impl GridCamera {

@@ -14,7 +14,9 @@ pub const MAX_GRID_CELLS: u32 = 256;
 /// direction (not normalised: its length is the depth scale of the trilinear projection).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GridVertex {
+    /// The base point, on the view plane.
     pub point: DVec3,
+    /// The ray direction; its length is the depth scale.
     pub direction: DVec3,
 }
 

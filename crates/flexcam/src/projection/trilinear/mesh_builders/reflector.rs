@@ -27,7 +27,10 @@ pub enum Optic {
     Reflect,
     /// A refracting surface between air (index 1, the side the vertex normals point to) and a
     /// material of index `ior` (behind the surface).
-    Refract { ior: f64 },
+    Refract {
+        /// Index of refraction of the material behind the surface.
+        ior: f64,
+    },
 }
 
 /// The vertex ray of unit incident direction `incident` (eye to vertex) at a vertex with unit

@@ -50,6 +50,9 @@ pub struct DetailInContext {
 }
 
 impl DetailInContext {
+    /// The detail-in-context view of pinhole `camera`: the focus at screen position `focus`,
+    /// magnified `magnification` times within radius `inner`, the band out to `outer`, the base
+    /// plane at forward distance `distance`. Errors: the degenerate cases above.
     pub fn new(
         camera: GridCamera,
         focus: DVec2,
@@ -128,6 +131,8 @@ pub struct TwoViews {
 }
 
 impl TwoViews {
+    /// `first` below screen height `band[0]`, `second` above `band[1]`. Errors: the degenerate
+    /// cases above.
     pub fn new(first: GridCamera, second: GridCamera, band: [f64; 2]) -> Result<Self> {
         let [low, high] = band;
         if !(0.0 <= low && low < high && high <= 1.0) {
