@@ -252,13 +252,22 @@ pub enum ProjectionSpec {
     /// tangent to the circle of radius `ipd`/2; `pole_merge` = [from, to] latitudes in
     /// degrees between which the eye offset fades to zero (Cycles' pole merging).
     Ods {
+        /// The centre of the eye circle, the image centre's direction and up (the poles' axis).
         frame: CameraFrame,
+        /// Interpupillary distance, world units: the eye circle's diameter.
         ipd: f64,
+        /// Latitudes from and to which the eye offset fades to zero, degrees; `None`: no
+        /// merging.
         pole_merge: Option<[f64; 2]>,
     },
     /// VR180: two 180 x 180 equirectangular halves side by side, left eye on the left, eyes
     /// `ipd` apart along the camera's right axis.
-    Vr180 { frame: CameraFrame, ipd: f64 },
+    Vr180 {
+        /// The point midway between the eyes, the common view direction and up.
+        frame: CameraFrame,
+        /// Interpupillary distance, world units: the eyes' separation.
+        ipd: f64,
+    },
     /// A mesh of trilinear projection triangles.
     Trilinear(TrilinearMesh),
     /// A parametric viewing volume between control surfaces (Brosz 2011); boxed, as it is

@@ -32,15 +32,21 @@ pub struct View<'a> {
 pub enum KeepClear {
     /// The closed disc of `radius` around `centre` perpendicular to the unit `axis`.
     Disc {
+        /// The eye circle's centre.
         centre: DVec3,
+        /// Unit axis (the projection's up).
         axis: DVec3,
+        /// Half the interpupillary distance.
         radius: f64,
     },
     /// The closed solid cylinder of `radius` around the infinite line through `centre` along
     /// the unit `axis`.
     Cylinder {
+        /// The eye circle's centre.
         centre: DVec3,
+        /// Unit axis (the projection's up).
         axis: DVec3,
+        /// Half the interpupillary distance.
         radius: f64,
     },
 }

@@ -53,8 +53,11 @@ pub const OBJECT_NAME: &str = "model";
 /// node's name).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct ModelRequest<'a> {
+    /// `--width`.
     pub width: Option<u32>,
+    /// `--height`.
     pub height: Option<u32>,
+    /// `--camera`.
     pub camera: Option<&'a str>,
 }
 

@@ -35,15 +35,23 @@ pub const FRAME_MARGIN: f64 = 1.1;
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Lens {
     /// `type = "perspective"`: `fov` the horizontal field of view, degrees.
-    Perspective { fov: f64 },
+    Perspective {
+        /// Horizontal field of view, degrees.
+        fov: f64,
+    },
     /// `type = "orthographic"`: `width` the horizontal extent, world units.
-    Orthographic { width: f64 },
+    Orthographic {
+        /// Horizontal extent, world units.
+        width: f64,
+    },
 }
 
 /// A camera for a model: where it stands and what it projects.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct View {
+    /// Where the camera stands and looks.
     pub frame: CameraFrame,
+    /// What it projects.
     pub lens: Lens,
 }
 

@@ -21,11 +21,18 @@ pub enum CameraLens {
     /// `yfov`: the vertical field of view, radians; `aspect_ratio`: the image's width over
     /// its height, when the file fixes it (otherwise the image's own is used).
     Perspective {
+        /// Vertical field of view, radians.
         yfov: f64,
+        /// Image width over height, when the file fixes it.
         aspect_ratio: Option<f64>,
     },
     /// `xmag`, `ymag`: half the width and half the height of the view, world units.
-    Orthographic { xmag: f64, ymag: f64 },
+    Orthographic {
+        /// Half the view's width, world units.
+        xmag: f64,
+        /// Half the view's height, world units.
+        ymag: f64,
+    },
 }
 
 /// A glTF camera placed in the world by a node. The camera looks down the node's -Z axis
@@ -40,6 +47,7 @@ pub struct ModelCamera {
     pub node: usize,
     /// The node's `name`, if any.
     pub node_name: Option<String>,
+    /// What the camera projects.
     pub lens: CameraLens,
     /// The eye: the node's origin in world space.
     pub position: DVec3,

@@ -42,6 +42,8 @@ pub struct Model {
     pub parts: Vec<ModelPart>,
     /// Every file read, the model file first.
     pub files: Vec<InputFile>,
+    /// The glTF file's cameras placed by its nodes, in the file's camera order (none for
+    /// OBJ and PLY).
     pub cameras: Vec<ModelCamera>,
 }
 
