@@ -6,13 +6,13 @@ use proptest::prelude::*;
 
 use super::{CameraFrame, ImagePoint, Projection, ProjectionSpec};
 
-fn vec3(range: f64) -> impl Strategy<Value = DVec3> {
+pub(super) fn vec3(range: f64) -> impl Strategy<Value = DVec3> {
     (-range..range, -range..range, -range..range).prop_map(|(x, y, z)| DVec3::new(x, y, z))
 }
 
 /// Frames with a view direction of length >= 0.1 and an up hint at least ~6 degrees away
 /// from it.
-fn frame() -> impl Strategy<Value = CameraFrame> {
+pub(super) fn frame() -> impl Strategy<Value = CameraFrame> {
     (vec3(5.0), vec3(1.0), vec3(1.0)).prop_filter_map("degenerate frame", |(position, view, up)| {
         let forward = view.try_normalize()?;
         let up_hint = up.try_normalize()?;
@@ -62,8 +62,12 @@ fn frame_of(spec: &ProjectionSpec) -> CameraFrame {
         | ProjectionSpec::Cylindrical { frame, .. } => *frame,
         ProjectionSpec::Opencv { .. }
         | ProjectionSpec::OpencvFisheye { .. }
+        | ProjectionSpec::MappedFisheye { .. }
+        | ProjectionSpec::DomeMaster { .. }
         | ProjectionSpec::Trilinear(_)
-        | ProjectionSpec::Flexible(_) => unreachable!("not generated (calibrated_properties)"),
+        | ProjectionSpec::Flexible(_) => {
+            unreachable!("not generated (calibrated_properties, fisheye_properties)")
+        }
     }
 }
 
@@ -89,6 +93,8 @@ fn must_be_imaged(spec: &ProjectionSpec, point: DVec3) -> bool {
         }
         ProjectionSpec::Opencv { .. }
         | ProjectionSpec::OpencvFisheye { .. }
+        | ProjectionSpec::MappedFisheye { .. }
+        | ProjectionSpec::DomeMaster { .. }
         | ProjectionSpec::Trilinear(_)
         | ProjectionSpec::Flexible(_) => false,
     }

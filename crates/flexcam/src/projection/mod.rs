@@ -16,7 +16,12 @@ mod calibrated_properties;
 mod camera_basis;
 pub mod chart;
 pub mod colmap;
+mod dome_master;
 mod fisheye;
+mod fisheye_circle;
+mod fisheye_mapping;
+#[cfg(test)]
+mod fisheye_properties;
 pub mod flexible;
 mod image_coords;
 mod inverse;
@@ -24,6 +29,7 @@ mod inverse;
 mod inverse_properties;
 mod kannala_brandt;
 mod linear;
+mod monotone_root;
 mod opencv;
 mod panoramic;
 mod params;
@@ -35,7 +41,9 @@ pub use build_report::BuildReport;
 pub use calibrated::{CalibratedCamera, CalibrationSize, Intrinsics};
 pub use camera_basis::CameraBasis;
 pub use chart::{HalfSpace, InverseChart, Pole};
-pub use fisheye::Fisheye;
+pub use fisheye::{Fisheye, FisheyeLens};
+pub use fisheye_circle::{FisheyeFit, Sensor, SensorFit, SENSOR_FIT_NAMES};
+pub use fisheye_mapping::{FisheyeMapping, MAPPING_NAMES};
 pub use flexible::{Flexible, FlexibleSpec};
 pub use image_coords::Resolution;
 pub use inverse::{
@@ -144,6 +152,21 @@ pub enum ProjectionSpec {
     Orthographic { frame: CameraFrame, width: f64 },
     /// Angular (equidistant) fisheye; `fov` is the angle across the inscribed image circle.
     Fisheye { frame: CameraFrame, fov: f64 },
+    /// A fisheye with another mapping or image-circle placement than the angular one
+    /// (`type = "fisheye"` with `mapping`, `fit` or sensor keys); `fov` is the angle across
+    /// the outline, or where a lens polynomial is cut.
+    MappedFisheye {
+        frame: CameraFrame,
+        fov: f64,
+        lens: FisheyeLens,
+    },
+    /// A fulldome master: `frame.up` is the zenith, `frame.look_at` the front, the dome
+    /// tilted forward by `tilt` degrees; `fov` across the circle (180 for a hemisphere).
+    DomeMaster {
+        frame: CameraFrame,
+        fov: f64,
+        tilt: f64,
+    },
     /// Longitude linear in x, latitude linear in y.
     Equirectangular {
         frame: CameraFrame,
@@ -180,7 +203,8 @@ impl ProjectionSpec {
         match self {
             ProjectionSpec::Perspective { .. } => "perspective",
             ProjectionSpec::Orthographic { .. } => "orthographic",
-            ProjectionSpec::Fisheye { .. } => "fisheye",
+            ProjectionSpec::Fisheye { .. } | ProjectionSpec::MappedFisheye { .. } => "fisheye",
+            ProjectionSpec::DomeMaster { .. } => "dome_master",
             ProjectionSpec::Equirectangular { .. } => "equirectangular",
             ProjectionSpec::Cylindrical { .. } => "cylindrical",
             ProjectionSpec::Opencv { .. } => "opencv",
