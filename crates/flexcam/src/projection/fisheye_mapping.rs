@@ -304,8 +304,9 @@ mod tests {
         // theta = 0.1 r - 0.01 r^2 turns at r = 5 (theta = 0.25 rad, 14.3 degrees).
         let e = LensPolynomial::new([0.0, -0.1, 0.01, 0.0, 0.0], PI / 2.0, 20.0).unwrap_err();
         assert!(e.message.starts_with("fisheye polynomial is not increasing over the image circle: d theta / dr = 0 at r = 5.000000 mm"), "{e}");
-        // The same polynomial cut at 10 degrees never reaches the turn.
-        assert!(LensPolynomial::new([0.0, -0.1, 0.01, 0.0, 0.0], 0.1, 20.0).is_ok());
+        // The same polynomial cut at 0.1 rad on an 8 mm image never reaches the turn (on a
+        // 20 mm one it would come back below 0.1 rad beyond r = 8.87).
+        assert!(LensPolynomial::new([0.0, -0.1, 0.01, 0.0, 0.0], 0.1, 8.0).is_ok());
         let e = LensPolynomial::new([0.01, -0.1, 0.0, 0.0, 0.0], 1.0, 20.0).unwrap_err();
         assert!(e.message.starts_with("fisheye polynomial k0 must be <= 0"));
         let e = LensPolynomial::new([0.0, 0.1, 0.0, 0.0, 0.0], 1.0, 20.0).unwrap_err();
