@@ -321,7 +321,9 @@ fn classic_radii_at_fov_180() {
         look_at: DVec3::NEG_Z,
         up: DVec3::Y,
     };
-    let cases: [(FisheyeMapping, fn(f64) -> f64); 4] = [
+    /// A mapping's image radius over the circle's, as a function of theta.
+    type Normalised = fn(f64) -> f64;
+    let cases: [(FisheyeMapping, Normalised); 4] = [
         (FisheyeMapping::Equidistant, |t| t / (PI / 2.0)),
         (FisheyeMapping::Equisolid, |t| {
             2.0 * (t / 2.0).sin() / (2.0 * (PI / 4.0).sin())
