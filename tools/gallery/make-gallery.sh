@@ -114,6 +114,15 @@ look_at = [0.0, 0.0, 0.0]
 up = [0.0, 0.0, -1.0]
 fov = 77.3196')" -o "$out/opencv-checker-perspective.png"
 render scenes/cameras/opencv-fisheye-teapot.toml --width 240 --height 240 -o "$out/opencv-fisheye-teapot.png"
+# The fisheye mappings at fov 180, the sensor ellipse, Cycles' lens polynomial and the dome
+# master.
+for mapping in equisolid stereographic orthographic; do
+  render scenes/cameras/teapot-fisheye.toml -D "projection.mapping=$mapping" --width 240 --height 240 \
+    -o "$out/fisheye-$mapping.png"
+done
+render scenes/cameras/teapot-fisheye.toml -D projection.fit=fill --width 320 --height 192 -o "$out/fisheye-fill.png"
+render scenes/cameras/fisheye-polynomial-teapot.toml --width 320 --height 240 -o "$out/fisheye-polynomial-teapot.png"
+render scenes/cameras/dome-master-teapot.toml --width 240 --height 240 -o "$out/dome-master-teapot.png"
 render "$(variant scenes/teapot-room.toml room-ortho "type = \"orthographic\"
 $room_eye
 width = 7.0")" "${small[@]}" -o "$out/teapot-orthographic.png"

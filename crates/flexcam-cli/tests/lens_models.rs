@@ -7,51 +7,15 @@ mod common;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use common::{run, run_json, run_ok};
+use common::{camera_example, raster_agrees, run, run_json, run_ok};
 use tempfile::TempDir;
-
-fn example(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenes/cameras")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
-}
-
-/// The 16-bit object ids of an `--ids` PNG.
-fn ids(path: &Path) -> (u32, u32, Vec<u16>) {
-    let image = image::open(path).unwrap().to_luma16();
-    let (w, h) = image.dimensions();
-    (w, h, image.into_raw())
-}
-
-/// The fraction of pixels away from object edges (the reference's 3 x 3 neighbourhood has
-/// one id) whose ids agree, and how many such pixels there are.
-fn interior_agreement(reference: &Path, other: &Path) -> (f64, usize) {
-    let (w, h, a) = ids(reference);
-    let (w2, h2, b) = ids(other);
-    assert_eq!((w, h), (w2, h2));
-    let at = |x: u32, y: u32| a[(y * w + x) as usize];
-    let (mut interior, mut agree) = (0usize, 0usize);
-    for y in 1..h - 1 {
-        for x in 1..w - 1 {
-            let id = at(x, y);
-            let uniform = (y - 1..=y + 1).all(|v| (x - 1..=x + 1).all(|u| at(u, v) == id));
-            if uniform {
-                interior += 1;
-                agree += usize::from(b[(y * w + x) as usize] == id);
-            }
-        }
-    }
-    (agree as f64 / interior as f64, interior)
-}
 
 /// Each `scenes/cameras/opencv*.toml` by raycast and raster: every pixel away from object
 /// edges has the same id, and the relative RGB error (flat shading) is small.
 #[test]
 fn opencv_example_scenes_raster_like_the_ray_caster() {
     let dir = TempDir::new().unwrap();
-    let mut scenes: Vec<PathBuf> = fs::read_dir(Path::new(&example("")))
+    let mut scenes: Vec<PathBuf> = fs::read_dir(Path::new(&camera_example("")))
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| {
@@ -62,47 +26,7 @@ fn opencv_example_scenes_raster_like_the_ray_caster() {
     scenes.sort();
     assert!(scenes.len() >= 2, "{scenes:?}");
     for scene in &scenes {
-        let scene = scene.to_string_lossy();
-        for method in ["raycast", "raster"] {
-            run_ok(
-                &dir,
-                &[
-                    "render",
-                    &scene,
-                    "--method",
-                    method,
-                    "--shading",
-                    "flat",
-                    "-o",
-                    &format!("{method}.png"),
-                    "--ids",
-                    &format!("{method}-ids.png"),
-                ],
-            );
-        }
-        let (agreement, interior) = interior_agreement(
-            &dir.path().join("raycast-ids.png"),
-            &dir.path().join("raster-ids.png"),
-        );
-        assert!(interior > 10_000, "{scene}: {interior} interior pixels");
-        assert!(
-            agreement >= 0.9999,
-            "{scene}: interior id agreement {agreement}"
-        );
-        let report = run_json(
-            &dir,
-            &[
-                "compare",
-                &scene,
-                "--method",
-                "raster",
-                "--shading",
-                "flat",
-                "--json",
-            ],
-        );
-        let rgb = report["relative_rgb_error"].as_f64().unwrap();
-        assert!(rgb < 0.002, "{scene}: relative RGB error {rgb}");
+        raster_agrees(&dir, &[&scene.to_string_lossy()]);
     }
 }
 
@@ -111,7 +35,7 @@ fn opencv_example_scenes_raster_like_the_ray_caster() {
 #[test]
 fn other_sizes_need_calibration_size() {
     let dir = TempDir::new().unwrap();
-    let scene = fs::read_to_string(example("opencv-teapot.toml")).unwrap();
+    let scene = fs::read_to_string(camera_example("opencv-teapot.toml")).unwrap();
     let fixed = scene.replace("calibration_size = [400, 300]\n", "");
     assert_ne!(fixed, scene);
     fs::write(dir.path().join("fixed.toml"), &fixed).unwrap();
@@ -143,7 +67,7 @@ fn other_sizes_need_calibration_size() {
         &dir,
         &[
             "render",
-            &example("opencv-teapot.toml"),
+            &camera_example("opencv-teapot.toml"),
             "--width",
             "200",
             "--height",

@@ -5,6 +5,7 @@
 //! the parts one file leaves unused are not dead code.
 #![allow(dead_code)]
 
+use std::path::Path;
 use std::process::Output;
 
 use assert_cmd::Command;
@@ -47,4 +48,74 @@ pub fn uniform(seed: u64) -> impl FnMut() -> f64 {
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         (z ^ (z >> 31)) as f64 / u64::MAX as f64
     }
+}
+
+/// The 16-bit object ids of an `--ids` PNG.
+pub fn ids(path: &Path) -> (u32, u32, Vec<u16>) {
+    let image = image::open(path).unwrap().to_luma16();
+    let (w, h) = image.dimensions();
+    (w, h, image.into_raw())
+}
+
+/// The fraction of pixels away from object edges (the reference's 3 x 3 neighbourhood has
+/// one id) whose ids agree, and how many such pixels there are.
+pub fn interior_agreement(reference: &Path, other: &Path) -> (f64, usize) {
+    let (w, h, a) = ids(reference);
+    let (w2, h2, b) = ids(other);
+    assert_eq!((w, h), (w2, h2));
+    let at = |x: u32, y: u32| a[(y * w + x) as usize];
+    let (mut interior, mut agree) = (0usize, 0usize);
+    for y in 1..h - 1 {
+        for x in 1..w - 1 {
+            let id = at(x, y);
+            let uniform = (y - 1..=y + 1).all(|v| (x - 1..=x + 1).all(|u| at(u, v) == id));
+            if uniform {
+                interior += 1;
+                agree += usize::from(b[(y * w + x) as usize] == id);
+            }
+        }
+    }
+    (agree as f64 / interior as f64, interior)
+}
+
+/// The path of `scenes/cameras/NAME`.
+pub fn camera_example(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes/cameras")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// Renders `scene_args` (a scene and its options) by raycast and raster, flat shaded, into
+/// `raycast.png` / `raster.png` and their `--ids` PNGs in `dir`, and checks that at least
+/// 99.99 % of the (more than 10,000) pixels away from object edges have the same id and
+/// that `compare` reports a relative RGB error below 0.002.
+pub fn raster_agrees(dir: &TempDir, scene_args: &[&str]) {
+    for method in ["raycast", "raster"] {
+        let color = format!("{method}.png");
+        let ids = format!("{method}-ids.png");
+        let mut args = vec!["render"];
+        args.extend_from_slice(scene_args);
+        args.extend_from_slice(&["--method", method, "--shading", "flat", "-o", &color]);
+        args.extend_from_slice(&["--ids", &ids]);
+        run_ok(dir, &args);
+    }
+    let (agreement, interior) = interior_agreement(
+        &dir.path().join("raycast-ids.png"),
+        &dir.path().join("raster-ids.png"),
+    );
+    assert!(
+        interior > 10_000,
+        "{scene_args:?}: {interior} interior pixels"
+    );
+    assert!(
+        agreement >= 0.9999,
+        "{scene_args:?}: interior id agreement {agreement}"
+    );
+    let mut args = vec!["compare"];
+    args.extend_from_slice(scene_args);
+    args.extend_from_slice(&["--method", "raster", "--shading", "flat", "--json"]);
+    let rgb = run_json(dir, &args)["relative_rgb_error"].as_f64().unwrap();
+    assert!(rgb < 0.002, "{scene_args:?}: relative RGB error {rgb}");
 }

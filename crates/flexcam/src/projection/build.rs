@@ -1,5 +1,6 @@
 //! [`ProjectionSpec::build`]: from a parsed description to a validated projection.
 
+use super::dome_master::dome_master;
 use super::fisheye::Fisheye;
 use super::flexible::{Flexible, GridFitter};
 use super::kannala_brandt::KannalaBrandt;
@@ -17,7 +18,8 @@ impl ProjectionSpec {
     /// Degenerate descriptions are errors with a one-line message (the scene-file parser adds
     /// the location): an empty image; a non-finite number; `look_at == position`; `up` zero
     /// or parallel to the view direction; an angle or extent out of range (perspective fov in
-    /// (0, 180), fisheye fov in (0, 360], orthographic width > 0, equirectangular h_fov in
+    /// (0, 180), fisheye fov in (0, 360] or its mapping's range, dome_master tilt in
+    /// [-90, 90], orthographic width > 0, equirectangular h_fov in
     /// (0, 360] and v_fov in (0, 180], cylindrical h_fov in (0, 360] and v_fov in (0, 180));
     /// ods and vr180 with an `ipd` that is not a positive length or an odd image height
     /// (ods) or width (vr180), ods pole merging outside 0 <= from < to <= 90;
@@ -61,6 +63,12 @@ impl ProjectionSpec {
             } => Box::new(Orthographic::new(frame, *extent, width, height)?),
             ProjectionSpec::Fisheye { frame, fov } => {
                 Box::new(Fisheye::new(frame, *fov, width, height)?)
+            }
+            ProjectionSpec::MappedFisheye { frame, fov, lens } => Box::new(Fisheye::with_lens(
+                "fisheye", frame, *fov, lens, width, height,
+            )?),
+            ProjectionSpec::DomeMaster { frame, fov, tilt } => {
+                Box::new(dome_master(frame, *fov, *tilt, width, height)?)
             }
             ProjectionSpec::Equirectangular {
                 frame,

@@ -64,9 +64,13 @@ fn frame_of(spec: &ProjectionSpec) -> CameraFrame {
         | ProjectionSpec::OpencvFisheye { .. }
         | ProjectionSpec::Ods { .. }
         | ProjectionSpec::Vr180 { .. }
+        | ProjectionSpec::MappedFisheye { .. }
+        | ProjectionSpec::DomeMaster { .. }
         | ProjectionSpec::Trilinear(_)
         | ProjectionSpec::Flexible(_) => {
-            unreachable!("not generated (calibrated_properties, stereo_properties)")
+            unreachable!(
+                "not generated (calibrated_properties, stereo_properties, fisheye_properties)"
+            )
         }
     }
 }
@@ -95,6 +99,8 @@ fn must_be_imaged(spec: &ProjectionSpec, point: DVec3) -> bool {
         | ProjectionSpec::OpencvFisheye { .. }
         | ProjectionSpec::Ods { .. }
         | ProjectionSpec::Vr180 { .. }
+        | ProjectionSpec::MappedFisheye { .. }
+        | ProjectionSpec::DomeMaster { .. }
         | ProjectionSpec::Trilinear(_)
         | ProjectionSpec::Flexible(_) => false,
     }

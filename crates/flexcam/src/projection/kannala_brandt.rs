@@ -18,6 +18,7 @@ use glam::{DVec2, DVec3};
 
 use super::calibrated::{BoundCamera, CalibratedCamera};
 use super::chart::{InverseChart, Pole};
+use super::monotone_root::solve_increasing;
 use super::{
     AnalyticInverse, BranchImage, ImagePoint, NoInverse, Projection, SingleImage, Trilinear,
 };
@@ -119,31 +120,13 @@ impl KannalaBrandt {
         if radius > self.radius_max {
             return None;
         }
-        let (mut low, mut high) = (0.0, self.theta_max);
-        let mut theta = radius.min(high);
-        for _ in 0..100 {
-            let f = self.radius(theta) - radius;
-            if f == 0.0 {
-                break;
-            }
-            if f < 0.0 {
-                low = theta;
-            } else {
-                high = theta;
-            }
-            let newton = theta - f / self.slope(theta);
-            let next = if newton > low && newton < high {
-                newton
-            } else {
-                0.5 * (low + high)
-            };
-            if (next - theta).abs() <= 1e-16 * theta.max(1.0) {
-                theta = next;
-                break;
-            }
-            theta = next;
-        }
-        Some(theta)
+        Some(solve_increasing(
+            |theta| self.radius(theta),
+            |theta| self.slope(theta),
+            radius,
+            (0.0, self.theta_max),
+            radius.min(self.theta_max),
+        ))
     }
 }
 

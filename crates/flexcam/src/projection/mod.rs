@@ -16,7 +16,12 @@ mod calibrated_properties;
 mod camera_basis;
 pub mod chart;
 pub mod colmap;
+mod dome_master;
 mod fisheye;
+mod fisheye_circle;
+mod fisheye_mapping;
+#[cfg(test)]
+mod fisheye_properties;
 pub mod flexible;
 mod image_coords;
 mod inverse;
@@ -24,6 +29,7 @@ mod inverse;
 mod inverse_properties;
 mod kannala_brandt;
 mod linear;
+mod monotone_root;
 mod ods;
 mod opencv;
 mod panoramic;
@@ -40,7 +46,9 @@ pub use build_report::BuildReport;
 pub use calibrated::{CalibratedCamera, CalibrationSize, Intrinsics};
 pub use camera_basis::CameraBasis;
 pub use chart::{HalfSpace, InverseChart, Pole};
-pub use fisheye::Fisheye;
+pub use fisheye::{Fisheye, FisheyeLens};
+pub use fisheye_circle::{FisheyeFit, Sensor, SensorFit, SENSOR_FIT_NAMES};
+pub use fisheye_mapping::{FisheyeMapping, MAPPING_NAMES};
 pub use flexible::{Flexible, FlexibleSpec};
 pub use image_coords::Resolution;
 pub use inverse::{
@@ -215,6 +223,27 @@ pub enum ProjectionSpec {
         /// Angle across the image circle, degrees, up to 360.
         fov: f64,
     },
+    /// A fisheye with another mapping or image-circle placement than the angular one
+    /// (`type = "fisheye"` with `mapping`, `fit` or sensor keys); `fov` is the angle across
+    /// the outline, or where a lens polynomial is cut.
+    MappedFisheye {
+        /// Eye, view axis and up.
+        frame: CameraFrame,
+        /// Angle across the outline (or where the lens polynomial is cut), degrees.
+        fov: f64,
+        /// The mapping and the image circle's placement.
+        lens: FisheyeLens,
+    },
+    /// A fulldome master: `frame.up` is the zenith, `frame.look_at` the front, the dome
+    /// tilted forward by `tilt` degrees; `fov` across the circle (180 for a hemisphere).
+    DomeMaster {
+        /// The dome's centre (the eye), its front (`look_at`) and zenith (`up`).
+        frame: CameraFrame,
+        /// Angle across the dome's circle, degrees.
+        fov: f64,
+        /// Forward tilt of the dome, degrees.
+        tilt: f64,
+    },
     /// Longitude linear in x, latitude linear in y.
     Equirectangular {
         /// Eye, the image centre's direction and up (the poles' axis).
@@ -281,7 +310,8 @@ impl ProjectionSpec {
         match self {
             ProjectionSpec::Perspective { .. } => "perspective",
             ProjectionSpec::Orthographic { .. } => "orthographic",
-            ProjectionSpec::Fisheye { .. } => "fisheye",
+            ProjectionSpec::Fisheye { .. } | ProjectionSpec::MappedFisheye { .. } => "fisheye",
+            ProjectionSpec::DomeMaster { .. } => "dome_master",
             ProjectionSpec::Equirectangular { .. } => "equirectangular",
             ProjectionSpec::Cylindrical { .. } => "cylindrical",
             ProjectionSpec::Opencv { .. } => "opencv",

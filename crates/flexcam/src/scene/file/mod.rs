@@ -10,6 +10,7 @@ mod control_surface;
 mod definitions;
 mod displacement;
 pub mod edit;
+mod fisheye_projection;
 mod fitted_grid;
 mod flexible;
 mod light;

@@ -19,6 +19,7 @@ enum Kind {
     Perspective,
     Orthographic,
     Fisheye,
+    DomeMaster,
     Equirectangular,
     Cylindrical,
     Opencv,
@@ -30,10 +31,11 @@ enum Kind {
 }
 
 /// Type names as written in scene files.
-const KINDS: [(&str, Kind); 11] = [
+const KINDS: [(&str, Kind); 12] = [
     ("perspective", Kind::Perspective),
     ("orthographic", Kind::Orthographic),
     ("fisheye", Kind::Fisheye),
+    ("dome_master", Kind::DomeMaster),
     ("equirectangular", Kind::Equirectangular),
     ("cylindrical", Kind::Cylindrical),
     ("opencv", Kind::Opencv),
@@ -87,7 +89,9 @@ impl Kind {
     /// The keys (besides `type`) a table of this type may hold.
     fn keys(self) -> Vec<&'static str> {
         let own: &[&str] = match self {
-            Kind::Perspective | Kind::Fisheye => &["fov"],
+            Kind::Perspective => &["fov"],
+            Kind::Fisheye => &super::fisheye_projection::FISHEYE_KEYS,
+            Kind::DomeMaster => &super::fisheye_projection::DOME_KEYS,
             Kind::Orthographic => &["width"],
             Kind::Equirectangular | Kind::Cylindrical => &["h_fov", "v_fov"],
             Kind::Opencv => &calibrated_projection::OPENCV_KEYS,
@@ -169,10 +173,8 @@ pub(super) fn convert(
             frame: camera_frame(src, &required)?,
             width: src.number(required.get(&raw.width, "width")?, "width")?,
         },
-        Kind::Fisheye => ProjectionSpec::Fisheye {
-            frame: camera_frame(src, &required)?,
-            fov: src.number(required.get(&raw.fov, "fov")?, "fov")?,
-        },
+        Kind::Fisheye => super::fisheye_projection::fisheye(&required)?,
+        Kind::DomeMaster => super::fisheye_projection::dome_master(&required)?,
         Kind::Equirectangular => ProjectionSpec::Equirectangular {
             frame: camera_frame(src, &required)?,
             h_fov: angle(&raw.h_fov, "h_fov", 360.0)?,

@@ -150,6 +150,16 @@ pub struct RawProjection {
     pub ipd: Option<Spanned<f64>>,
     pub pole_merge_from: Option<Spanned<f64>>,
     pub pole_merge_to: Option<Spanned<f64>>,
+    pub mapping: Option<Spanned<String>>,
+    pub fit: Option<Spanned<String>>,
+    pub lens: Option<Spanned<f64>>,
+    pub sensor_width: Option<Spanned<f64>>,
+    pub sensor_height: Option<Spanned<f64>>,
+    pub sensor_fit: Option<Spanned<String>>,
+    #[serde(default, deserialize_with = "strict")]
+    pub pixel_aspect: Option<Spanned<[f64; 2]>>,
+    pub polynomial: Option<Spanned<Vec<f64>>>,
+    pub tilt: Option<Spanned<f64>>,
 }
 
 /// `outline = { ... }`, `profile`, and the entries of `outlines` / `profiles` (with `at`): a
@@ -420,6 +430,24 @@ impl RawProjection {
                 "pole_merge_to",
                 self.pole_merge_to.as_ref().map(Spanned::span),
             ),
+            ("mapping", self.mapping.as_ref().map(Spanned::span)),
+            ("fit", self.fit.as_ref().map(Spanned::span)),
+            ("lens", self.lens.as_ref().map(Spanned::span)),
+            (
+                "sensor_width",
+                self.sensor_width.as_ref().map(Spanned::span),
+            ),
+            (
+                "sensor_height",
+                self.sensor_height.as_ref().map(Spanned::span),
+            ),
+            ("sensor_fit", self.sensor_fit.as_ref().map(Spanned::span)),
+            (
+                "pixel_aspect",
+                self.pixel_aspect.as_ref().map(Spanned::span),
+            ),
+            ("polynomial", self.polynomial.as_ref().map(Spanned::span)),
+            ("tilt", self.tilt.as_ref().map(Spanned::span)),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))
