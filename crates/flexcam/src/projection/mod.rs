@@ -29,6 +29,7 @@ mod panoramic;
 mod params;
 pub mod projector;
 mod radial_tangential;
+pub mod ray_map;
 mod trilinear;
 
 pub use build_report::BuildReport;
