@@ -127,8 +127,8 @@ fn float_colour_and_aovs_agree_with_the_png_outputs() {
     assert_eq!(
         names,
         [
-            "B", "G", "N.X", "N.Y", "N.Z", "Ng.X", "Ng.Y", "Ng.Z", "P.X", "P.Y", "P.Z", "R",
-            "Z", "id", "uv.U", "uv.V"
+            "B", "G", "N.X", "N.Y", "N.Z", "Ng.X", "Ng.Y", "Ng.Z", "P.X", "P.Y", "P.Z", "R", "Z",
+            "id", "uv.U", "uv.V"
         ]
     );
     for (k, name) in ["R", "G", "B"].into_iter().enumerate() {

@@ -45,12 +45,23 @@ fn vec3(layers: &Layers, layer: &str) -> Vec<DVec3> {
 #[test]
 fn a_perspective_ray_map_is_the_eye_and_the_closed_form_directions() {
     let (w, h) = (40, 30);
-    let dir = folder(&[("p.toml", plane_and_sphere(w, h, &camera("perspective", 70.0)))]);
+    let dir = folder(&[(
+        "p.toml",
+        plane_and_sphere(w, h, &camera("perspective", 70.0)),
+    )]);
     run_ok(&dir, &["raymap", "p.toml", "-o", "rays.exr"]);
     let layers = Layers::read(&dir.path().join("rays.exr"), (40, 30));
     assert_eq!(
         layers.names(),
-        ["A", "direction.X", "direction.Y", "direction.Z", "origin.X", "origin.Y", "origin.Z"]
+        [
+            "A",
+            "direction.X",
+            "direction.Y",
+            "direction.Z",
+            "origin.X",
+            "origin.Y",
+            "origin.Z"
+        ]
     );
     let [forward, right, up] = frame();
     let half = 35f64.to_radians().tan();
@@ -68,8 +79,14 @@ fn a_perspective_ray_map_is_the_eye_and_the_closed_form_directions() {
 
 #[test]
 fn a_fisheye_ray_map_marks_the_pixels_outside_its_circle() {
-    let dir = folder(&[("f.toml", plane_and_sphere(32, 24, &camera("fisheye", 180.0)))]);
-    run_ok(&dir, &["raymap", "f.toml", "-o", "rays.exr", "--width", "48"]);
+    let dir = folder(&[(
+        "f.toml",
+        plane_and_sphere(32, 24, &camera("fisheye", 180.0)),
+    )]);
+    run_ok(
+        &dir,
+        &["raymap", "f.toml", "-o", "rays.exr", "--width", "48"],
+    );
     let layers = Layers::read(&dir.path().join("rays.exr"), (48, 24));
     let (alpha, direction) = (layers.floats("A"), vec3(&layers, "direction"));
     for (i, a) in alpha.iter().enumerate() {
@@ -88,15 +105,23 @@ fn a_fisheye_ray_map_marks_the_pixels_outside_its_circle() {
 #[test]
 fn curved_projectors_have_their_exit_ray() {
     let dir = TempDir::new().unwrap();
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/flexible-quadratic.toml");
+    let scene = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/flexible-quadratic.toml"
+    );
     run_ok(
         &dir,
-        &["raymap", scene, "-o", "rays.exr", "--width", "32", "--height", "24"],
+        &[
+            "raymap", scene, "-o", "rays.exr", "--width", "32", "--height", "24",
+        ],
     );
     let layers = Layers::read(&dir.path().join("rays.exr"), (32, 24));
     assert!(layers.names().contains(&"exit_direction.X"));
     let (origin, direction) = (vec3(&layers, "origin"), vec3(&layers, "direction"));
-    let (end, leaving) = (vec3(&layers, "exit_origin"), vec3(&layers, "exit_direction"));
+    let (end, leaving) = (
+        vec3(&layers, "exit_origin"),
+        vec3(&layers, "exit_direction"),
+    );
     assert!(layers.floats("A").iter().all(|&a| a == 1.0));
     for i in 0..32 * 24 {
         assert!((origin[i].z - 6.0).abs() < 1e-6 && (end[i].z + 4.0).abs() < 1e-6);
@@ -115,7 +140,10 @@ fn curved_projectors_have_their_exit_ray() {
 /// holds round(65535 s), round(65535 t) of the EXR's values.
 #[test]
 fn an_stmap_against_the_same_camera_is_the_identity() {
-    let dir = folder(&[("p.toml", plane_and_sphere(40, 30, &camera("perspective", 70.0)))]);
+    let dir = folder(&[(
+        "p.toml",
+        plane_and_sphere(40, 30, &camera("perspective", 70.0)),
+    )]);
     for out in ["st.exr", "st.png"] {
         run_ok(
             &dir,
@@ -141,8 +169,10 @@ fn an_stmap_against_the_same_camera_is_the_identity() {
 /// eye, by the two projections' definitions: `None` outside the perspective image.
 fn fisheye_to_perspective(i: usize, fisheye: u32, (w, h): (u32, u32)) -> Option<DVec2> {
     let n = fisheye as f64;
-    let centred = DVec2::new((i as u32 % fisheye) as f64 + 0.5, (i as u32 / fisheye) as f64 + 0.5)
-        - DVec2::splat(n / 2.0);
+    let centred = DVec2::new(
+        (i as u32 % fisheye) as f64 + 0.5,
+        (i as u32 / fisheye) as f64 + 0.5,
+    ) - DVec2::splat(n / 2.0);
     let theta = centred.length() / (n / 2.0) * 90f64.to_radians();
     let azimuth = centred.normalize();
     let [forward, right, up] = frame();
@@ -160,12 +190,25 @@ fn fisheye_to_perspective(i: usize, fisheye: u32, (w, h): (u32, u32)) -> Option<
 #[test]
 fn a_fisheye_stmap_against_a_perspective_is_the_closed_form() {
     let dir = folder(&[
-        ("f.toml", plane_and_sphere(64, 64, &camera("fisheye", 180.0))),
-        ("p.toml", plane_and_sphere(80, 60, &camera("perspective", 90.0))),
+        (
+            "f.toml",
+            plane_and_sphere(64, 64, &camera("fisheye", 180.0)),
+        ),
+        (
+            "p.toml",
+            plane_and_sphere(80, 60, &camera("perspective", 90.0)),
+        ),
     ]);
     run_ok(
         &dir,
-        &["raymap", "f.toml", "--stmap", "st.exr", "--reference", "p.toml"],
+        &[
+            "raymap",
+            "f.toml",
+            "--stmap",
+            "st.exr",
+            "--reference",
+            "p.toml",
+        ],
     );
     let layers = Layers::read(&dir.path().join("st.exr"), (64, 64));
     let (s, t, a) = (layers.floats("R"), layers.floats("G"), layers.floats("A"));
@@ -180,8 +223,18 @@ fn a_fisheye_stmap_against_a_perspective_is_the_closed_form() {
             Some(_) if a[i] == 0.0 => hidden += 1,
             Some(st) => {
                 inside += 1;
-                assert!((s[i] as f64 - st.x).abs() < 1e-6, "pixel {i}: s {} {}", s[i], st.x);
-                assert!((t[i] as f64 - st.y).abs() < 1e-6, "pixel {i}: t {} {}", t[i], st.y);
+                assert!(
+                    (s[i] as f64 - st.x).abs() < 1e-6,
+                    "pixel {i}: s {} {}",
+                    s[i],
+                    st.x
+                );
+                assert!(
+                    (t[i] as f64 - st.y).abs() < 1e-6,
+                    "pixel {i}: t {} {}",
+                    t[i],
+                    st.y
+                );
             }
         }
     }
@@ -203,16 +256,32 @@ fn sample(rgb: &[Vec3], (w, h): (usize, usize), (s, t): (f32, f32)) -> Vec3 {
 #[test]
 fn an_stmap_warps_a_perspective_render_into_the_fisheye_render() {
     let dir = folder(&[
-        ("f.toml", plane_and_sphere(64, 64, &camera("fisheye", 180.0))),
-        ("p.toml", plane_and_sphere(320, 240, &camera("perspective", 90.0))),
+        (
+            "f.toml",
+            plane_and_sphere(64, 64, &camera("fisheye", 180.0)),
+        ),
+        (
+            "p.toml",
+            plane_and_sphere(320, 240, &camera("perspective", 90.0)),
+        ),
     ]);
     run_ok(
         &dir,
-        &["raymap", "f.toml", "--stmap", "st.exr", "--reference", "p.toml"],
+        &[
+            "raymap",
+            "f.toml",
+            "--stmap",
+            "st.exr",
+            "--reference",
+            "p.toml",
+        ],
     );
     for scene in ["f", "p"] {
         let args = ["render", &format!("{scene}.toml"), "--shading", "flat"];
-        run_ok(&dir, &[&args[..], &["-o", &format!("{scene}.exr")]].concat());
+        run_ok(
+            &dir,
+            &[&args[..], &["-o", &format!("{scene}.exr")]].concat(),
+        );
     }
     let colour = |name: &str, size| {
         let layers = Layers::read(&dir.path().join(name), size);
@@ -234,7 +303,11 @@ fn an_stmap_warps_a_perspective_render_into_the_fisheye_render() {
     let mut compared = 0;
     for i in (0..64 * 64).filter(|&i| a[i] == 1.0 && uniform(i)) {
         let warped = sample(&plate, (320, 240), (s[i], t[i]));
-        assert!(warped.distance(fisheye[i]) < 1e-3, "pixel {i}: {warped} {}", fisheye[i]);
+        assert!(
+            warped.distance(fisheye[i]) < 1e-3,
+            "pixel {i}: {warped} {}",
+            fisheye[i]
+        );
         compared += 1;
     }
     assert!(compared > 600, "{compared}");
@@ -243,7 +316,10 @@ fn an_stmap_warps_a_perspective_render_into_the_fisheye_render() {
 #[test]
 fn bad_raymap_requests_are_one_line_and_write_nothing() {
     let dir = folder(&[
-        ("p.toml", plane_and_sphere(16, 12, &camera("perspective", 70.0))),
+        (
+            "p.toml",
+            plane_and_sphere(16, 12, &camera("perspective", 70.0)),
+        ),
         (
             "q.toml",
             fs::read_to_string(concat!(
@@ -261,30 +337,67 @@ fn bad_raymap_requests_are_one_line_and_write_nothing() {
         assert!(stderr.contains(expected), "{args:?}: {stderr}");
     };
     fails(&["raymap", "p.toml"], 1, "nothing to write");
-    fails(&["raymap", "p.toml", "-o", "rays.png"], 1, "rays.png: unsupported output");
     fails(
-        &["raymap", "p.toml", "--stmap", "st.tif", "--reference", "p.toml"],
+        &["raymap", "p.toml", "-o", "rays.png"],
+        1,
+        "rays.png: unsupported output",
+    );
+    fails(
+        &[
+            "raymap",
+            "p.toml",
+            "--stmap",
+            "st.tif",
+            "--reference",
+            "p.toml",
+        ],
         1,
         "st.tif: unsupported output extension",
     );
     fails(
-        &["raymap", "p.toml", "-o", "a.exr", "--stmap", "a.exr", "--reference", "p.toml"],
+        &[
+            "raymap",
+            "p.toml",
+            "-o",
+            "a.exr",
+            "--stmap",
+            "a.exr",
+            "--reference",
+            "p.toml",
+        ],
         1,
         "a.exr: the STMap is the same file as the ray map",
     );
     fails(&["raymap", "p.toml", "--stmap", "st.exr"], 2, "--reference");
     fails(
-        &["raymap", "p.toml", "--stmap", "st.exr", "--reference", "q.toml"],
+        &[
+            "raymap",
+            "p.toml",
+            "--stmap",
+            "st.exr",
+            "--reference",
+            "q.toml",
+        ],
         1,
         "q.toml: the reference camera needs a projection with an inverse; flexible has none",
     );
     fails(
         &[
-            "raymap", "p.toml", "--stmap", "st.exr", "--reference", "p.toml", "--distance", "-1",
+            "raymap",
+            "p.toml",
+            "--stmap",
+            "st.exr",
+            "--reference",
+            "p.toml",
+            "--distance",
+            "-1",
         ],
         1,
         "--distance must be a positive number",
     );
-    let left: Vec<_> = fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    let left: Vec<_> = fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
     assert_eq!(left.len(), 2, "{left:?}");
 }

@@ -3,8 +3,8 @@
 //! closed forms of a perspective camera's rays, and `--method raster` draws the same
 //! surfaces as the ray caster away from object edges.
 
-use std::fs;
 use glam::{DVec3, Vec3};
+use std::fs;
 use tempfile::TempDir;
 
 mod common;
@@ -43,8 +43,16 @@ fn render_aovs(dir: &TempDir, method: &str, out: &str) -> Layers {
     run_ok(
         dir,
         &[
-            "render", "scene.toml", "--shading", "flat", "--method", method, "-o", "c.png",
-            "--aovs", out,
+            "render",
+            "scene.toml",
+            "--shading",
+            "flat",
+            "--method",
+            method,
+            "-o",
+            "c.png",
+            "--aovs",
+            out,
         ],
     );
     Layers::read(&dir.path().join(out), (W, H))
@@ -58,12 +66,16 @@ fn normals_and_positions_are_the_closed_forms_on_a_plane_and_a_sphere() {
     assert_eq!(
         layers.names(),
         [
-            "B", "G", "N.X", "N.Y", "N.Z", "Ng.X", "Ng.Y", "Ng.Z", "P.X", "P.Y", "P.Z", "R",
-            "Z", "id", "uv.U", "uv.V"
+            "B", "G", "N.X", "N.Y", "N.Z", "Ng.X", "Ng.Y", "Ng.Z", "P.X", "P.Y", "P.Z", "R", "Z",
+            "id", "uv.U", "uv.V"
         ]
     );
     let (ids, depth) = (layers.ids(), layers.floats("Z"));
-    let (n, ng, p) = (layers.vectors("N"), layers.vectors("Ng"), layers.vectors("P"));
+    let (n, ng, p) = (
+        layers.vectors("N"),
+        layers.vectors("Ng"),
+        layers.vectors("P"),
+    );
     let (u, v) = (layers.floats("uv.U"), layers.floats("uv.V"));
     let mut seen = [0; 3];
     for i in 0..W * H {
@@ -91,7 +103,11 @@ fn normals_and_positions_are_the_closed_forms_on_a_plane_and_a_sphere() {
                 let radial = point - CENTRE;
                 assert!((radial.length() - 1.0).abs() < 1e-3, "pixel {i}: {radial}");
                 let analytic = (radial / radial.length()).as_vec3();
-                assert!(n[i].dot(analytic) > 0.9999, "pixel {i}: {} {analytic}", n[i]);
+                assert!(
+                    n[i].dot(analytic) > 0.9999,
+                    "pixel {i}: {} {analytic}",
+                    n[i]
+                );
                 assert!(ng[i].dot(analytic) > 0.999, "pixel {i}");
                 assert!(ng[i].dot(d.as_vec3()) < 0.0, "pixel {i}: faces the camera");
             }
@@ -120,7 +136,9 @@ fn raster_draws_the_surfaces_the_ray_caster_does_away_from_edges() {
             && y > 0
             && x + 1 < W
             && y + 1 < H
-            && [i - 1, i + 1, i - W, i + W].iter().all(|&j| ids[j] == ids[i])
+            && [i - 1, i + 1, i - W, i + W]
+                .iter()
+                .all(|&j| ids[j] == ids[i])
     };
     let depth = raycast.floats("Z");
     let (p, q) = (raycast.vectors("P"), raster.vectors("P"));
@@ -128,7 +146,12 @@ fn raster_draws_the_surfaces_the_ray_caster_does_away_from_edges() {
     let (u, v) = (raycast.floats("uv.U"), raster.floats("uv.U"));
     let mut compared = 0;
     for i in (0..W * H).filter(|&i| ids[i] != 0 && raster_ids[i] == ids[i] && inner(i)) {
-        assert!(p[i].distance(q[i]) < 1e-3 * depth[i], "pixel {i}: {} {}", p[i], q[i]);
+        assert!(
+            p[i].distance(q[i]) < 1e-3 * depth[i],
+            "pixel {i}: {} {}",
+            p[i],
+            q[i]
+        );
         assert!(n[i].dot(m[i]) > 0.9999, "pixel {i}");
         assert!((u[i] - v[i]).abs() < 1e-4, "pixel {i}");
         compared += 1;

@@ -27,7 +27,12 @@ pub struct RaymapArgs {
     /// of the reference image pixel seeing the same scene point (Nuke's convention:
     /// s = (x + 0.5) / w, t = 1 - (y + 0.5) / h), `B` = 0, `A` = 0 where the reference does
     /// not see it.
-    #[arg(help_heading = "Outputs", long, value_name = "FILE", requires = "reference")]
+    #[arg(
+        help_heading = "Outputs",
+        long,
+        value_name = "FILE",
+        requires = "reference"
+    )]
     stmap: Option<PathBuf>,
     /// The reference camera of `--stmap`: a scene file (or `builtin:NAME`) whose projection
     /// and image size are the camera's (its objects are not used); it needs an inverse.
@@ -55,7 +60,11 @@ pub fn run(args: &RaymapArgs) -> Result<()> {
     if let Some(source) = &args.scene.scene {
         super::declare_scene_file(&mut outputs, source)?;
     }
-    if let Some(reference) = args.reference.as_deref().filter(|r| !r.starts_with("builtin:")) {
+    if let Some(reference) = args
+        .reference
+        .as_deref()
+        .filter(|r| !r.starts_with("builtin:"))
+    {
         outputs.input("the reference camera", Path::new(reference))?;
     }
     let rays = args

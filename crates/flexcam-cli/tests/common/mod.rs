@@ -127,4 +127,3 @@ impl Layers {
             .collect()
     }
 }
-

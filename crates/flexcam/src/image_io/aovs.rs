@@ -39,8 +39,14 @@ pub fn write_aovs_exr(frame: &Frame, path: &Path) -> Result<()> {
         channels.extend(vector_channels(["P.X", "P.Y", "P.Z"], surface, |s| {
             s.position.to_array()
         }));
-        channels.push(("uv.U", ExrSamples::F32(surface.iter().map(|s| s.uv.x).collect())));
-        channels.push(("uv.V", ExrSamples::F32(surface.iter().map(|s| s.uv.y).collect())));
+        channels.push((
+            "uv.U",
+            ExrSamples::F32(surface.iter().map(|s| s.uv.x).collect()),
+        ));
+        channels.push((
+            "uv.V",
+            ExrSamples::F32(surface.iter().map(|s| s.uv.y).collect()),
+        ));
     }
     write_exr((frame.width, frame.height), path, "aovs", channels)
 }

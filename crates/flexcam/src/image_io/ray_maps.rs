@@ -18,8 +18,8 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::float::{vector_channels, write_exr, ExrSamples};
 use super::extension;
+use super::float::{vector_channels, write_exr, ExrSamples};
 use crate::error::{Error, Result};
 use crate::projection::ray_map::{PixelRay, RayMap};
 use crate::render::StMap;

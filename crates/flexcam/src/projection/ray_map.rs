@@ -141,7 +141,13 @@ mod tests {
     #[test]
     fn a_polyline_skips_zero_segments_at_both_ends() {
         let p = |x: f64, z: f64| DVec3::new(x, 0.0, z);
-        let points = vec![p(0.0, 0.0), p(0.0, 0.0), p(0.0, -1.0), p(1.0, -1.0), p(1.0, -1.0)];
+        let points = vec![
+            p(0.0, 0.0),
+            p(0.0, 0.0),
+            p(0.0, -1.0),
+            p(1.0, -1.0),
+            p(1.0, -1.0),
+        ];
         let r = pixel_ray(&Projector::Polyline(points)).unwrap();
         assert_eq!((r.origin, r.direction), (DVec3::ZERO, DVec3::NEG_Z));
         assert_eq!((r.exit_origin, r.exit_direction), (p(1.0, -1.0), DVec3::X));
@@ -151,7 +157,11 @@ mod tests {
 
     #[test]
     fn a_curve_leaves_along_its_end_tangents_or_chords() {
-        let c = [DVec3::ZERO, DVec3::new(0.0, 0.0, -1.0), DVec3::new(1.0, 0.0, -1.0)];
+        let c = [
+            DVec3::ZERO,
+            DVec3::new(0.0, 0.0, -1.0),
+            DVec3::new(1.0, 0.0, -1.0),
+        ];
         let r = pixel_ray(&Projector::QuadraticBezier(c)).unwrap();
         assert_eq!((r.direction, r.exit_direction), (DVec3::NEG_Z, DVec3::X));
         assert_eq!(r.exit_origin, c[2]);
@@ -160,6 +170,9 @@ mod tests {
         let c = [DVec3::ZERO, DVec3::ZERO, DVec3::new(3.0, 0.0, 4.0)];
         let r = pixel_ray(&Projector::QuadraticBezier(c)).unwrap();
         assert!(r.direction.distance(DVec3::new(0.6, 0.0, 0.8)) < 1e-15);
-        assert_eq!(pixel_ray(&Projector::QuadraticBezier([DVec3::ONE; 3])), None);
+        assert_eq!(
+            pixel_ray(&Projector::QuadraticBezier([DVec3::ONE; 3])),
+            None
+        );
     }
 }

@@ -110,7 +110,10 @@ pub(super) fn layers(
         })
         .collect();
     let unresolved = points.iter().filter(|(_, missed)| *missed).count() as u64;
-    (points.into_iter().map(|(point, _)| point).collect(), unresolved)
+    (
+        points.into_iter().map(|(point, _)| point).collect(),
+        unresolved,
+    )
 }
 
 /// A view of `prepared` showing object `index` alone.
@@ -165,7 +168,11 @@ mod tests {
     }
 
     fn scene_file(name: &str) -> scene::Scene {
-        scene::load(&format!("{}/../../scenes/{name}", env!("CARGO_MANIFEST_DIR"))).unwrap()
+        scene::load(&format!(
+            "{}/../../scenes/{name}",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .unwrap()
     }
 
     /// The ray caster's layers are its own hits: the position is the point `pick` (the
@@ -221,7 +228,9 @@ mod tests {
             let (x, y) = (i % w, i / w);
             (1..w - 1).contains(&x)
                 && (1..h - 1).contains(&y)
-                && [i - 1, i + 1, i - w, i + w].iter().all(|&j| ids[j] == ids[i])
+                && [i - 1, i + 1, i - w, i + w]
+                    .iter()
+                    .all(|&j| ids[j] == ids[i])
         };
         for &method in methods {
             let (other, unresolved) = frame(method);
@@ -264,8 +273,7 @@ mod tests {
         let scene = scene_file("reflect-sphere-cube.toml");
         let projection = scene.projection.build(32, 24).unwrap();
         let prepared = PreparedScene::new(&scene);
-        for (method, composite_reflectors) in [(Method::Raycast, false), (Method::Raster, false)]
-        {
+        for (method, composite_reflectors) in [(Method::Raycast, false), (Method::Raster, false)] {
             let options = |outputs, crop| RenderOptions {
                 method,
                 composite_reflectors,

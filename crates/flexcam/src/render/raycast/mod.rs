@@ -16,8 +16,8 @@ pub mod workloads;
 
 use glam::DVec3;
 
-pub use self::pick::{pick, Picked};
 pub(in crate::render) use self::pick::{first_hit, ProjectorHit};
+pub use self::pick::{pick, Picked};
 pub(crate) use self::sampling::SamplePattern;
 
 use self::pieces::polyline_segment;

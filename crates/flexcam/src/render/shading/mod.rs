@@ -167,7 +167,11 @@ fn object_point(object: &Object, corners: [usize; 3], w: Vec3) -> Vec3 {
 /// The texture coordinates at barycentrics `barycentric` of triangle `triangle` of `object`,
 /// as textures are sampled there (zero when the mesh has none).
 pub fn texture_coordinates(object: &Object, triangle: usize, barycentric: Vec2) -> Vec2 {
-    uv_at(&object.mesh, corners(object, triangle), weights(barycentric))
+    uv_at(
+        &object.mesh,
+        corners(object, triangle),
+        weights(barycentric),
+    )
 }
 
 /// Texture coordinates at weights `w` (zero when the mesh has none).
