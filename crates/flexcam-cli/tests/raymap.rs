@@ -85,7 +85,9 @@ fn a_fisheye_ray_map_marks_the_pixels_outside_its_circle() {
     )]);
     run_ok(
         &dir,
-        &["raymap", "f.toml", "-o", "rays.exr", "--width", "48"],
+        &[
+            "raymap", "f.toml", "-o", "rays.exr", "--width", "48", "--height", "24",
+        ],
     );
     let layers = Layers::read(&dir.path().join("rays.exr"), (48, 24));
     let (alpha, direction) = (layers.floats("A"), vec3(&layers, "direction"));
@@ -238,7 +240,7 @@ fn a_fisheye_stmap_against_a_perspective_is_the_closed_form() {
             }
         }
     }
-    assert!(inside > 1000 && hidden < 10, "{inside} {hidden}");
+    assert!(inside > 500 && hidden < 10, "{inside} {hidden}");
 }
 
 /// Bilinear sample of the `w` x `h` image `rgb` (rows from the top) at STMap (s, t).
@@ -310,7 +312,7 @@ fn an_stmap_warps_a_perspective_render_into_the_fisheye_render() {
         );
         compared += 1;
     }
-    assert!(compared > 600, "{compared}");
+    assert!(compared > 250, "{compared}");
 }
 
 #[test]

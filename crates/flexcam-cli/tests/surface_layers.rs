@@ -99,9 +99,13 @@ fn normals_and_positions_are_the_closed_forms_on_a_plane_and_a_sphere() {
             }
             2 => {
                 // The sphere: on the ray at the depth, on the unit sphere up to its
-                // tessellation, the shading normal radial up to the same.
+                // tessellation (96 segments, 48 rings: triangles sag up to about 1.1e-3),
+                // the shading normal radial up to the same.
                 let radial = point - CENTRE;
-                assert!((radial.length() - 1.0).abs() < 1e-3, "pixel {i}: {radial}");
+                assert!(
+                    (radial.length() - 1.0).abs() < 1.5e-3,
+                    "pixel {i}: {radial}"
+                );
                 let analytic = (radial / radial.length()).as_vec3();
                 assert!(
                     n[i].dot(analytic) > 0.9999,
