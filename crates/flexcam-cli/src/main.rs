@@ -59,6 +59,10 @@ enum Command {
     /// the image and in front of the view plane are listed; projections without an analytic
     /// inverse are refused.
     Project(commands::project::ProjectArgs),
+    /// Write a scene projection's per-pixel rays (origin, direction, and where curved
+    /// projectors end) and its STMap against a reference camera, as OpenEXR.
+    #[command(after_help = OUTPUTS_HELP)]
+    Raymap(commands::raymap::RaymapArgs),
     /// Render a scene with a method and with the reference ray caster, and report how closely
     /// they agree (object ids, depth, relative RGB error).
     #[command(after_help = OUTPUTS_HELP)]
@@ -96,6 +100,7 @@ fn main() -> ExitCode {
         Command::Pick(args) => commands::pick::run(&args),
         Command::Scenes => commands::scenes::run(),
         Command::Project(args) => commands::project::run(&args),
+        Command::Raymap(args) => commands::raymap::run(&args),
         Command::Compare(args) => return commands::compare::run(&args),
         Command::Simplify(args) => commands::simplify::run(&args),
         Command::ImportCameras(args) => commands::import_cameras::run(&args),

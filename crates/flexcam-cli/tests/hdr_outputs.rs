@@ -124,7 +124,13 @@ fn float_colour_and_aovs_agree_with_the_png_outputs() {
 
     let aovs = exr_channels(&d.join("aovs.exr"));
     let names: Vec<&str> = aovs.iter().map(|(n, _)| n.as_str()).collect();
-    assert_eq!(names, ["B", "G", "R", "Z", "id"]);
+    assert_eq!(
+        names,
+        [
+            "B", "G", "N.X", "N.Y", "N.Z", "Ng.X", "Ng.Y", "Ng.Z", "P.X", "P.Y", "P.Z", "R", "Z",
+            "id", "uv.U", "uv.V"
+        ]
+    );
     for (k, name) in ["R", "G", "B"].into_iter().enumerate() {
         assert_eq!(floats(&aovs, name), rgb[k], "{name}");
     }

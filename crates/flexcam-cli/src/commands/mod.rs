@@ -8,6 +8,7 @@ pub mod frame_list;
 pub mod import_cameras;
 pub mod pick;
 pub mod project;
+pub mod raymap;
 pub mod render;
 pub mod reproject;
 pub mod scene_args;

@@ -82,7 +82,10 @@ pub struct RenderArgs {
     #[arg(help_heading = "Outputs", long, value_name = "FILE")]
     ids_preview: Option<PathBuf>,
     /// Write every AOV as one multi-channel OpenEXR (.exr): linear colour `R`, `G`, `B`,
-    /// depth `Z` (+inf where nothing is hit) and object id `id` (uint, 0 = background).
+    /// depth `Z` (+inf where nothing is hit), object id `id` (uint, 0 = background), and the
+    /// surface drawn, world space: shading normal `N.X/Y/Z`, face normal `Ng.X/Y/Z`,
+    /// position `P.X/Y/Z`, texture coordinates `uv.U/V` (normals 0, position and uv NaN on
+    /// the background).
     #[arg(help_heading = "Outputs", long, value_name = "FILE")]
     aovs: Option<PathBuf>,
     /// Write statistics as one JSON object to FILE, or to standard output with `-`.
@@ -203,6 +206,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         outputs: Outputs {
             depth: depth.is_some() || aovs.is_some(),
             ids: ids.is_some() || ids_preview.is_some() || aovs.is_some(),
+            surface: aovs.is_some(),
         },
         ..RenderOptions::default()
     };

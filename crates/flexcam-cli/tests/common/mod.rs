@@ -119,3 +119,82 @@ pub fn raster_agrees(dir: &TempDir, scene_args: &[&str]) {
     let rgb = run_json(dir, &args)["relative_rgb_error"].as_f64().unwrap();
     assert!(rgb < 0.002, "{scene_args:?}: relative RGB error {rgb}");
 }
+
+/// A scene of a floor plane (id 1: 20 x 20 at y = 0, light grey with a dark checker of
+/// 0.5) and a red sphere of radius 1 standing on it (id 2, centre (0, 1, 0)), black
+/// background, `width` x `height`, seen through `projection` (the `[projection]` table's
+/// keys, one a line).
+pub fn plane_and_sphere(width: u32, height: u32, projection: &str) -> String {
+    format!(
+        r#"[image]
+width = {width}
+height = {height}
+background = [0.0, 0.0, 0.0]
+
+[projection]
+{projection}
+
+[[object]]
+name = "floor"
+shape = "plane"
+size = [20.0, 20.0]
+color = [0.8, 0.8, 0.8]
+checker = {{ color = [0.1, 0.1, 0.1], size = 0.5 }}
+
+[[object]]
+name = "ball"
+shape = "sphere"
+size = 1.0
+tessellation = 96
+color = [0.9, 0.2, 0.1]
+translate = [0.0, 1.0, 0.0]
+"#
+    )
+}
+
+/// The channels of the one-layer OpenEXR file at `path`, by name.
+pub struct Layers(pub Vec<(String, exr::prelude::FlatSamples)>);
+
+impl Layers {
+    /// Reads the file at `path`, asserting it is one layer of `size` pixels.
+    pub fn read(path: &std::path::Path, size: (usize, usize)) -> Layers {
+        let image = exr::prelude::read_all_flat_layers_from_file(path).unwrap();
+        assert_eq!(image.layer_data.len(), 1);
+        let layer = &image.layer_data[0];
+        assert_eq!((layer.size.0, layer.size.1), size);
+        Layers(
+            (layer.channel_data.list.iter())
+                .map(|c| (c.name.to_string(), c.sample_data.clone()))
+                .collect(),
+        )
+    }
+
+    /// The channel names, sorted as the file stores them.
+    pub fn names(&self) -> Vec<&str> {
+        self.0.iter().map(|(n, _)| n.as_str()).collect()
+    }
+
+    /// The samples of float channel `name`.
+    pub fn floats(&self, name: &str) -> Vec<f32> {
+        match &self.0.iter().find(|(n, _)| n == name).unwrap().1 {
+            exr::prelude::FlatSamples::F32(v) => v.clone(),
+            other => panic!("{name} is not f32: {other:?}"),
+        }
+    }
+
+    /// The samples of the unsigned channel `id`.
+    pub fn ids(&self) -> Vec<u32> {
+        match &self.0.iter().find(|(n, _)| n == "id").unwrap().1 {
+            exr::prelude::FlatSamples::U32(v) => v.clone(),
+            other => panic!("id is not u32: {other:?}"),
+        }
+    }
+
+    /// The vector of layer `layer` (`N`, `P`, ...) at every pixel.
+    pub fn vectors(&self, layer: &str) -> Vec<glam::Vec3> {
+        let [x, y, z] = ["X", "Y", "Z"].map(|c| self.floats(&format!("{layer}.{c}")));
+        (0..x.len())
+            .map(|i| glam::Vec3::new(x[i], y[i], z[i]))
+            .collect()
+    }
+}

@@ -58,7 +58,12 @@ pub fn write_color(
     match format {
         ColorFormat::Png(PngBits::Eight) => write_color_png(frame, path, encoding),
         ColorFormat::Png(PngBits::Sixteen) => write_color_png16(frame, path, encoding),
-        ColorFormat::Exr => write_exr(frame, path, "color", rgb_channels(frame)),
+        ColorFormat::Exr => write_exr(
+            (frame.width, frame.height),
+            path,
+            "color",
+            rgb_channels(frame),
+        ),
         ColorFormat::Pfm => write_pfm(frame, path, 3, bytemuck::cast_slice(&frame.color)),
     }
 }

@@ -45,5 +45,10 @@ pub fn write_depth(frame: &Frame, path: &Path, format: DepthFormat) -> Result<()
 
 fn write_depth_exr(frame: &Frame, path: &Path) -> Result<()> {
     let depth = ExrSamples::F32(frame.depth.clone());
-    write_exr(frame, path, "depth", vec![("Z", depth)])
+    write_exr(
+        (frame.width, frame.height),
+        path,
+        "depth",
+        vec![("Z", depth)],
+    )
 }

@@ -15,10 +15,10 @@ pub enum ExrSamples {
     U32(Vec<u32>),
 }
 
-/// Writes one EXR layer named `layer` of the size of `frame` holding `channels` (name,
+/// Writes one EXR layer named `layer` of `(width, height)` pixels holding `channels` (name,
 /// samples). Readers list the channels sorted by name, as the format stores them.
 pub fn write_exr(
-    frame: &Frame,
+    (width, height): (u32, u32),
     path: &Path,
     layer: &str,
     channels: Vec<(&str, ExrSamples)>,
@@ -35,7 +35,7 @@ pub fn write_exr(
         })
         .collect();
     let layer = Layer::new(
-        (frame.width as usize, frame.height as usize),
+        (width as usize, height as usize),
         LayerAttributes::named(layer),
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(SmallVec::from_vec(channels)),
@@ -50,6 +50,21 @@ pub fn write_exr(
 pub fn rgb_channels(frame: &Frame) -> Vec<(&'static str, ExrSamples)> {
     let channel = |k: usize| ExrSamples::F32(frame.color.iter().map(|c| c[k]).collect());
     vec![("R", channel(0)), ("G", channel(1)), ("B", channel(2))]
+}
+
+/// The channels `LAYER.X`, `LAYER.Y`, `LAYER.Z` (names given in `names`) of one vector a
+/// pixel, for [`write_exr`].
+pub fn vector_channels<T>(
+    names: [&'static str; 3],
+    pixels: &[T],
+    vector: impl Fn(&T) -> [f32; 3],
+) -> Vec<(&'static str, ExrSamples)> {
+    (0..3)
+        .map(|k| {
+            let samples = pixels.iter().map(|p| vector(p)[k]).collect();
+            (names[k], ExrSamples::F32(samples))
+        })
+        .collect()
 }
 
 /// Writes a PFM of the size of `frame` at `path`: `samples` holds `channels` (1 or 3)

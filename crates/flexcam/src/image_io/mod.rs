@@ -1,6 +1,6 @@
 //! Reading and writing images: colour as PNG (8- or 16-bit), OpenEXR or PFM, 16-bit PNG
 //! object ids and their false-colour previews, depth as OpenEXR or PFM, the multi-channel
-//! OpenEXR of every AOV, animated GIF, and the photos `flexcam reproject` reads.
+//! OpenEXR of every AOV, ray maps and STMaps (OpenEXR), animated GIF, and the photos `flexcam reproject` reads.
 //!
 //! Writers write to the path they are given; [`OutputSet`] gives a command's outputs their
 //! safety: refused when aimed at an input or at each other, staged in temporary files,
@@ -14,6 +14,7 @@ mod gif;
 mod identity;
 mod outputs;
 mod png;
+mod ray_maps;
 mod read;
 
 use std::path::Path;
@@ -29,6 +30,7 @@ pub use gif::GifFrames;
 pub use identity::{FileIdentity, Target};
 pub use outputs::{check_extension, write_bytes, OutputId, OutputSet};
 pub use png::{id_preview_color, write_color_png, write_ids_png, write_ids_preview_png};
+pub use ray_maps::{write_ray_map_exr, write_stmap, StMapFormat};
 pub use read::{read_linear_image, LinearImage, INPUT_EXTENSIONS};
 
 /// How linear colour is turned into 8- or 16-bit PNG values.

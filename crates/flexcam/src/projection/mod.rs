@@ -36,6 +36,7 @@ mod panoramic;
 mod params;
 pub mod projector;
 mod radial_tangential;
+pub mod ray_map;
 mod stereo;
 #[cfg(test)]
 mod stereo_properties;

@@ -143,6 +143,7 @@ mod tests {
             color: color.iter().map(|&c| Vec3::splat(c)).collect(),
             depth: depth.to_vec(),
             ids: ids.to_vec(),
+            surface: Vec::new(),
         }
     }
 

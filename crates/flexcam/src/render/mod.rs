@@ -95,18 +95,24 @@ pub struct Outputs {
     pub depth: bool,
     /// [`Frame::ids`].
     pub ids: bool,
+    /// [`Frame::surface`]: normals, world position and texture coordinates, derived after
+    /// the method has drawn the frame from its ids and depth (module `surface`), so that no
+    /// renderer does per-pixel work for them.
+    pub surface: bool,
 }
 
 impl Outputs {
-    /// Colour, depth and object ids.
+    /// Colour, depth and object ids (not the surface layers, which cost a pass of their own).
     pub const ALL: Outputs = Outputs {
         depth: true,
         ids: true,
+        surface: false,
     };
     /// Colour alone.
     pub const COLOR: Outputs = Outputs {
         depth: false,
         ids: false,
+        surface: false,
     };
 
     /// The length of a buffer of `pixels` pixels: `pixels` if `wanted`, else 0.
@@ -133,6 +139,9 @@ pub struct Frame {
     pub depth: Vec<f32>,
     /// Object id of the first hit, 0 for background. Empty when not wanted ([`Outputs`]).
     pub ids: Vec<u32>,
+    /// The surface each pixel shows (normals, position, uv; [`SurfacePoint`]). Empty when
+    /// not wanted ([`Outputs::surface`]).
+    pub surface: Vec<SurfacePoint>,
 }
 
 impl Frame {
@@ -145,6 +154,7 @@ impl Frame {
             color: vec![background; n],
             depth: vec![f32::INFINITY; n],
             ids: vec![0; n],
+            surface: Vec::new(),
         }
     }
 
@@ -165,6 +175,7 @@ impl Frame {
             color: bytemuck::zeroed_vec(n),
             depth: bytemuck::zeroed_vec(Outputs::len(outputs.depth, n)),
             ids: bytemuck::zeroed_vec(Outputs::len(outputs.ids, n)),
+            surface: Vec::new(),
         };
         huge_pages::advise_huge_pages(&mut frame.color);
         huge_pages::advise_huge_pages(&mut frame.depth);
@@ -198,6 +209,9 @@ impl Frame {
         }
         if !outputs.ids {
             self.ids = Vec::new();
+        }
+        if !outputs.surface {
+            self.surface = Vec::new();
         }
     }
 }
@@ -240,6 +254,38 @@ pub fn render(
     projection: &dyn Projection,
     options: &RenderOptions,
 ) -> Result<Rendered> {
+    let wanted = options.outputs;
+    if !wanted.surface {
+        return render_buffers(prepared, projection, options);
+    }
+    // The surface layers are found from the method's own ids and depth.
+    let buffers = RenderOptions {
+        outputs: Outputs {
+            depth: true,
+            ids: true,
+            surface: false,
+        },
+        ..*options
+    };
+    let mut rendered = render_buffers(prepared, projection, &buffers)?;
+    let window = (options.crop)
+        .unwrap_or_else(|| PixelWindow::whole(rendered.frame.width, rendered.frame.height));
+    let (surface, unresolved) =
+        surface::layers(prepared, projection, &rendered.frame, window, options.spp);
+    rendered.frame.surface = surface;
+    rendered
+        .counters
+        .insert("surface_unresolved", Counter::Count(unresolved));
+    rendered.frame.keep_only(wanted);
+    Ok(rendered)
+}
+
+/// [`render`] of the colour, depth and id buffers (`options.outputs.surface` is not read).
+fn render_buffers(
+    prepared: &PreparedScene,
+    projection: &dyn Projection,
+    options: &RenderOptions,
+) -> Result<Rendered> {
     if let Some(window) = options.crop {
         window.check(projection.resolution())?;
         // Only the plain ray caster renders a window's pixels alone (module `window`).
@@ -252,7 +298,7 @@ pub fn render(
                 crop: None,
                 ..*options
             };
-            let mut rendered = render(prepared, projection, &whole)?;
+            let mut rendered = render_buffers(prepared, projection, &whole)?;
             rendered.frame = window.cut(&rendered.frame);
             return Ok(rendered);
         }
@@ -327,6 +373,8 @@ mod raycast;
 mod reproject;
 mod scan;
 mod shading;
+mod stmap;
+mod surface;
 mod transitions;
 mod trilinear;
 mod warning;
@@ -340,6 +388,8 @@ pub use prepared::{Hit, PreparedScene};
 pub use raster::Subdivision;
 pub use raycast::{pick, Picked};
 pub use reproject::{reproject, EquirectPhoto};
+pub use stmap::{st_map, StMap, StPoints};
+pub use surface::SurfacePoint;
 pub use transitions::TransitionShading;
 pub use trilinear::{CurveMode, CurveOptions};
 pub use warning::RenderWarning;
@@ -432,7 +482,11 @@ mod tests {
             let all = render(&prepared, main.as_ref(), &options(Outputs::ALL)).unwrap();
             assert_eq!(all.frame.depth.len(), 32 * 24);
             for (depth, ids) in [(false, false), (true, false), (false, true)] {
-                let wanted = Outputs { depth, ids };
+                let wanted = Outputs {
+                    depth,
+                    ids,
+                    surface: false,
+                };
                 let got = render(&prepared, main.as_ref(), &options(wanted)).unwrap();
                 let what = format!("{method} {composite_reflectors} {wanted:?}");
                 assert_eq!(got.frame.color, all.frame.color, "{what}");

@@ -71,6 +71,7 @@ impl PixelWindow {
             color: self.rows(&frame.color, frame.width),
             depth: self.rows(&frame.depth, frame.width),
             ids: self.rows(&frame.ids, frame.width),
+            surface: self.rows(&frame.surface, frame.width),
         }
     }
 

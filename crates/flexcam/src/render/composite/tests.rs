@@ -67,6 +67,7 @@ fn masked(frame: &Frame, reference: &Frame, id: u32) -> Frame {
         color: keep.iter().map(|&k| frame.color[k]).collect(),
         depth: keep.iter().map(|&k| frame.depth[k]).collect(),
         ids: keep.iter().map(|&k| frame.ids[k]).collect(),
+        surface: Vec::new(),
     }
 }
 

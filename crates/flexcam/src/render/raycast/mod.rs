@@ -16,6 +16,7 @@ pub mod workloads;
 
 use glam::DVec3;
 
+pub(in crate::render) use self::pick::{first_hit, ProjectorHit};
 pub use self::pick::{pick, Picked};
 pub(crate) use self::sampling::SamplePattern;
 

@@ -30,7 +30,7 @@ pub(super) struct Sample {
 /// the f64 refinement may move it by rounding). Degenerate case: where B'(s) = 0 (a cusp of a
 /// curve doubling back on itself) the chord P2 - P0 stands in for the tangent, and P1 - P0
 /// where that is zero too (a closed curve).
-fn tangent_ray(p: &[DVec3; 3], s: f64) -> Ray {
+pub(super) fn tangent_ray(p: &[DVec3; 3], s: f64) -> Ray {
     let direction = [quadratic_tangent(p, s), p[2] - p[0], p[1] - p[0]]
         .into_iter()
         .find(|d| *d != DVec3::ZERO)
@@ -46,7 +46,7 @@ fn tangent_ray(p: &[DVec3; 3], s: f64) -> Ray {
 /// The length of polyline `points` before its segment `k`: the sum of the lengths of
 /// segments 0 to k - 1, in order. Computed only for the segment that hits, not as the search
 /// passes each segment (most projectors hit nothing).
-fn length_before(points: &[DVec3], k: usize) -> f64 {
+pub(super) fn length_before(points: &[DVec3], k: usize) -> f64 {
     points[..=k]
         .windows(2)
         .fold(0.0, |sum, pair| sum + (pair[1] - pair[0]).length())

@@ -83,6 +83,7 @@ impl Target {
             color: self.color,
             depth: self.depth.par_iter().map(|&d| d as f32).collect(),
             ids: self.ids,
+            surface: Vec::new(),
         }
     }
 

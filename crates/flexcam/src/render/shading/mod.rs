@@ -164,6 +164,16 @@ fn object_point(object: &Object, corners: [usize; 3], w: Vec3) -> Vec3 {
     interpolate(&local, [0, 1, 2], w)
 }
 
+/// The texture coordinates at barycentrics `barycentric` of triangle `triangle` of `object`,
+/// as textures are sampled there (zero when the mesh has none).
+pub fn texture_coordinates(object: &Object, triangle: usize, barycentric: Vec2) -> Vec2 {
+    uv_at(
+        &object.mesh,
+        corners(object, triangle),
+        weights(barycentric),
+    )
+}
+
 /// Texture coordinates at weights `w` (zero when the mesh has none).
 fn uv_at(mesh: &crate::scene::Mesh, corners: [usize; 3], w: Vec3) -> Vec2 {
     if mesh.uvs.is_empty() {

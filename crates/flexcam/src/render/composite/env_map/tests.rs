@@ -37,6 +37,7 @@ fn errors(scene: &Scene, size: (u32, u32), method: Method, id: u32) -> (f64, f64
             height: 1,
             ids: vec![1; color.len()],
             depth: vec![1.0; color.len()],
+            surface: Vec::new(),
             color,
         }
     };
