@@ -110,7 +110,7 @@ impl Fisheye {
     /// A fisheye with `lens`, reporting `kind` as its type name. Errors: those of
     /// [`Fisheye::new`], a fov outside the mapping's range
     /// ([`FisheyeMapping::half_fov`]), a bad sensor, a bad polynomial
-    /// ([`LensPolynomial::new`]), a polynomial without a sensor or with a focal length, a
+    /// (`LensPolynomial::new`), a polynomial without a sensor or with a focal length, a
     /// classic mapping on a sensor without one.
     pub fn with_lens(
         kind: &'static str,
