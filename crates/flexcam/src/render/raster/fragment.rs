@@ -173,6 +173,12 @@ impl TrianglePlane {
     /// barycentrics (u, v) of the second and third vertices, clamped onto the triangle.
     /// `None` for a ray parallel to the plane (or a zero-area triangle) and for t outside
     /// `[t_min, t_max]`.
+    ///
+    /// Degenerate case: a projector whose origin lies in the triangle's plane meets it at
+    /// its origin (t = t_min = 0) whatever its direction, so the triangle is seen edge-on and
+    /// its screen triangle is a sliver whose fragments would all lie at depth 0 and win
+    /// every depth test. Such a hit counts, as in the ray caster, only where the origin lies
+    /// inside the triangle (unclamped barycentrics).
     pub fn hit(&mut self, ray: &Ray) -> Option<(f64, f64, f64)> {
         let (e1, e2) = (self.e1, self.e2);
         let p = ray.direction.cross(e2);
@@ -200,10 +206,11 @@ impl TrianglePlane {
         if !(ray.t_min..=ray.t_max).contains(&t) {
             return None;
         }
-        let (mut u, mut v) = (
-            (from.s.dot(p) * inv).max(0.0),
-            (ray.direction.dot(from.q) * inv).max(0.0),
-        );
+        let (u_plane, v_plane) = (from.s.dot(p) * inv, ray.direction.dot(from.q) * inv);
+        if t <= 0.0 && !(u_plane >= 0.0 && v_plane >= 0.0 && u_plane + v_plane <= 1.0) {
+            return None;
+        }
+        let (mut u, mut v) = (u_plane.max(0.0), v_plane.max(0.0));
         if u + v > 1.0 {
             let sum = u + v;
             (u, v) = (u / sum, v / sum);
@@ -222,6 +229,22 @@ mod tests {
             DVec3::new(1.0, 0.0, -2.0),
             DVec3::new(0.0, 1.0, -2.0),
         ]
+    }
+
+    /// A projector starting in the triangle's plane meets it at its start only where the
+    /// start lies inside the triangle (the edge-on case of `hit`).
+    #[test]
+    fn an_origin_in_the_plane_hits_only_inside_the_triangle() {
+        let direction = DVec3::new(0.1, 0.2, -1.0);
+        let outside = Ray::new(DVec3::new(2.0, 2.0, -2.0), direction);
+        assert_eq!(TrianglePlane::new(triangle()).hit(&outside), None);
+        let inside = Ray::new(DVec3::new(0.25, 0.25, -2.0), direction);
+        let (t, u, v) = TrianglePlane::new(triangle()).hit(&inside).unwrap();
+        assert_eq!(t, 0.0);
+        assert!(
+            (u - 0.25).abs() < 1e-12 && (v - 0.25).abs() < 1e-12,
+            "{u} {v}"
+        );
     }
 
     #[test]
