@@ -189,8 +189,10 @@ fn fisheye_to_perspective(i: usize, fisheye: u32, (w, h): (u32, u32)) -> Option<
         .then(|| DVec2::new(x / f64::from(w), 1.0 - y / f64::from(h)))
 }
 
-#[test]
-fn a_fisheye_stmap_against_a_perspective_is_the_closed_form() {
+/// A folder with `f.toml` (the plane and sphere through a 64 x 64, 180-degree fisheye),
+/// `p.toml` (the same through a 90-degree perspective of `size`) and `st.exr`, the fisheye's
+/// STMap against that perspective (`flexcam raymap f.toml --stmap st.exr --reference p.toml`).
+fn fisheye_stmap((w, h): (u32, u32)) -> TempDir {
     let dir = folder(&[
         (
             "f.toml",
@@ -198,7 +200,7 @@ fn a_fisheye_stmap_against_a_perspective_is_the_closed_form() {
         ),
         (
             "p.toml",
-            plane_and_sphere(80, 60, &camera("perspective", 90.0)),
+            plane_and_sphere(w, h, &camera("perspective", 90.0)),
         ),
     ]);
     run_ok(
@@ -212,6 +214,12 @@ fn a_fisheye_stmap_against_a_perspective_is_the_closed_form() {
             "p.toml",
         ],
     );
+    dir
+}
+
+#[test]
+fn a_fisheye_stmap_against_a_perspective_is_the_closed_form() {
+    let dir = fisheye_stmap((80, 60));
     let layers = Layers::read(&dir.path().join("st.exr"), (64, 64));
     let (s, t, a) = (layers.floats("R"), layers.floats("G"), layers.floats("A"));
     let (mut inside, mut hidden) = (0, 0);
@@ -257,27 +265,7 @@ fn sample(rgb: &[Vec3], (w, h): (usize, usize), (s, t): (f32, f32)) -> Vec3 {
 
 #[test]
 fn an_stmap_warps_a_perspective_render_into_the_fisheye_render() {
-    let dir = folder(&[
-        (
-            "f.toml",
-            plane_and_sphere(64, 64, &camera("fisheye", 180.0)),
-        ),
-        (
-            "p.toml",
-            plane_and_sphere(320, 240, &camera("perspective", 90.0)),
-        ),
-    ]);
-    run_ok(
-        &dir,
-        &[
-            "raymap",
-            "f.toml",
-            "--stmap",
-            "st.exr",
-            "--reference",
-            "p.toml",
-        ],
-    );
+    let dir = fisheye_stmap((320, 240));
     for scene in ["f", "p"] {
         let args = ["render", &format!("{scene}.toml"), "--shading", "flat"];
         run_ok(
