@@ -9,10 +9,12 @@
 
 pub mod bench;
 pub mod camera;
+pub mod handles;
 pub mod render_loop;
 pub mod script;
 pub mod session;
 pub mod viewer;
+pub mod volume_view;
 mod window;
 
 use std::path::PathBuf;
@@ -31,11 +33,20 @@ pub struct Options {
     /// A script to run instead of waiting for a person (see [`script`]).
     pub script: Option<PathBuf>,
     pub settings: Settings,
+    /// Print the projection's handles (see [`volume_view::listing`]) instead of viewing.
+    pub list_handles: bool,
 }
 
 /// Runs the viewer: the window until it is closed, or the script's lines. A script without
 /// a `window` line runs without opening a window (no display needed).
 pub fn run(options: &Options) -> Result<()> {
+    if options.list_handles {
+        let session = Session::open(&options.scene)?;
+        let (list, sketch) = volume_view::volume_of(&session);
+        let camera = volume_view::VolumeCamera::framing(&sketch);
+        print!("{}", volume_view::listing(&list, &camera));
+        return Ok(());
+    }
     let script = options
         .script
         .as_deref()

@@ -29,7 +29,8 @@ pub enum Command {
     Pan { dx: f64, dy: f64 },
     /// `dolly FACTOR`: multiply the eye's distance to the look-at point.
     Dolly(f64),
-    /// `drag HANDLE DX DY`: move a handle of the viewing volume by (DX, DY) pixels.
+    /// `drag HANDLE DX DY`: move a handle by (DX, DY) pixels (of the volume view at its
+    /// reference height for a world handle, of the image for an image handle).
     Drag { handle: String, dx: f64, dy: f64 },
     /// `idle`: wait until the current state is refined.
     Idle,
@@ -264,9 +265,7 @@ pub fn run_line(viewer: &mut Viewer, command: &Command) -> Result<()> {
         Command::Orbit { dx, dy } => viewer.move_camera(|c| c.orbit(*dx, *dy)),
         Command::Pan { dx, dy } => viewer.move_camera(|c| c.pan(*dx, *dy)),
         Command::Dolly(factor) => viewer.move_camera(|c| c.dolly(*factor)),
-        Command::Drag { handle, .. } => Err(Error::new(format!(
-            "no handle `{handle}`: the viewer has no draggable handles of the viewing volume yet"
-        ))),
+        Command::Drag { handle, dx, dy } => viewer.drag(handle, *dx, *dy),
         Command::Idle => viewer.idle(),
         Command::Frame(out) => viewer.write_frame(out),
         Command::Window(_) => Err(Error::new("`window` needs the window")),

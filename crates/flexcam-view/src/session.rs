@@ -139,10 +139,10 @@ impl Session {
     }
 
     /// Sets several keys at once (all applied, or none).
-    fn set_all(&mut self, values: &[(&str, Value)]) -> Result<()> {
+    pub fn set_all<K: AsRef<str>>(&mut self, values: &[(K, Value)]) -> Result<()> {
         let mut document = self.document.clone();
         for (key, value) in values {
-            set_projection_value(&mut document, key, value.clone(), &self.path)?;
+            set_projection_value(&mut document, key.as_ref(), value.clone(), &self.path)?;
         }
         self.apply(document)
     }
@@ -285,6 +285,21 @@ impl Session {
             })
         }))
     }
+}
+
+/// A session (for tests) on a scene file, in a new folder, whose `[projection]` is
+/// `projection`, at 40 x 30, with one sphere.
+#[cfg(test)]
+pub(crate) fn scratch(projection: &str) -> (tempfile::TempDir, Session) {
+    let dir = tempfile::TempDir::new().unwrap();
+    let path = dir.path().join("scene.toml");
+    let text = format!(
+        "[image]\nwidth = 40\nheight = 30\n\n[projection]\n{projection}\n\n\
+         [[object]]\nshape = \"sphere\"\ntranslate = [0.0, 0.0, -2.0]\n"
+    );
+    std::fs::write(&path, text).unwrap();
+    let session = Session::open(&path).unwrap();
+    (dir, session)
 }
 
 fn modified_time(path: &Path) -> Option<SystemTime> {

@@ -33,6 +33,10 @@ pub struct ViewArgs {
     #[arg(long, default_value_t = Settings::DEFAULT.refine_spp,
           value_parser = clap::value_parser!(u32).range(1..=4096))]
     refine_spp: u32,
+    /// Print the names of the projection's draggable handles (for `drag` lines), where each
+    /// is and the world step of one pixel of a script's drag, then exit.
+    #[arg(long)]
+    list_handles: bool,
 }
 
 /// Runs `flexcam view`.
@@ -46,5 +50,6 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             spp: args.spp,
             refine_spp: args.refine_spp,
         },
+        list_handles: args.list_handles,
     })
 }

@@ -1,13 +1,16 @@
 //! The window (eframe / egui on OpenGL): a thin layer over [`Viewer`] that shows its latest
-//! frame, turns mouse and keys into camera moves and parameter edits, and runs a script's
-//! lines one per displayed frame (`window OUT.png` takes a screenshot of the whole window).
+//! frame and the volume view, turns mouse and keys into camera moves, handle drags and
+//! parameter edits, and runs a script's lines one per displayed frame (`window OUT.png`
+//! takes a screenshot of the whole window).
 //!
 //! Controls (docs/viewer.md): drag with the left button to orbit, with the right or middle
 //! button to pan, scroll to dolly; arrow keys orbit by 5 degrees, with Shift they pan,
 //! `+` / `-` dolly; a click picks the object and world point under the pointer; Ctrl+S
-//! saves into the scene file.
+//! saves into the scene file. Handles (dots in the volume view, and over the image for a
+//! panorama's perspective rectangle) are dragged with the left button.
 
 mod params;
+mod volume;
 
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
@@ -26,6 +29,10 @@ use crate::viewer::Viewer;
 /// Degrees of orbit per pixel dragged, and per arrow-key press.
 const ORBIT_DEG_PER_PX: f64 = 0.3;
 const ORBIT_KEY_DEG: f64 = 5.0;
+/// The window's least height (room for the parameter panel and the volume view).
+const MIN_HEIGHT: f32 = 460.0;
+/// The volume view's default width.
+const VOLUME_PANEL: f32 = 420.0;
 /// How often the scene file's modification time is checked.
 const RELOAD_POLL: Duration = Duration::from_millis(500);
 
@@ -42,6 +49,7 @@ pub fn run(viewer: Viewer, script: Option<Script>) -> Result<()> {
         status: String::new(),
         message: None,
         save_as: String::new(),
+        dragged: None,
         last_poll: Instant::now(),
         script: script.map(|script| ScriptRun {
             script,
@@ -53,8 +61,8 @@ pub fn run(viewer: Viewer, script: Option<Script>) -> Result<()> {
     let panel = 300.0;
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default().with_inner_size([
-            (width as f32).min(1280.0) + panel,
-            (height as f32).min(800.0) + 60.0,
+            (width as f32).min(1280.0) + panel + VOLUME_PANEL,
+            ((height as f32).min(800.0) + 60.0).max(MIN_HEIGHT),
         ]),
         ..eframe::NativeOptions::default()
     };
@@ -80,6 +88,8 @@ struct App {
     /// The last error (an invalid edit, a failed reload or save) or pick, shown until the next.
     message: Option<String>,
     save_as: String,
+    /// The handle being dragged, if any.
+    dragged: Option<String>,
     last_poll: Instant,
     script: Option<ScriptRun>,
     outcome: Arc<Mutex<Option<Error>>>,
@@ -102,6 +112,14 @@ impl eframe::App for App {
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| self.side_panel(ui));
             });
+        egui::Panel::right("volume")
+            .resizable(true)
+            .default_size(VOLUME_PANEL)
+            .show(ui, |ui| {
+                ui.label("Viewing volume: drag a dot to move it, elsewhere to orbit");
+                let result = volume::volume_view(ui, &mut self.viewer, &mut self.dragged);
+                self.report_error(result);
+            });
         egui::CentralPanel::default().show(ui, |ui| self.image_panel(ui));
         self.keys(&ctx);
         if !self.viewer.render_loop().is_refined() || self.script.is_some() {
@@ -118,6 +136,13 @@ impl App {
         match result {
             Ok(()) => self.message = None,
             Err(e) => self.message = Some(e.to_string()),
+        }
+    }
+
+    /// Shows `result`'s error, if any, leaving an earlier message otherwise.
+    fn report_error(&mut self, result: Result<()>) {
+        if let Err(e) = result {
+            self.message = Some(e.to_string());
         }
     }
 
@@ -233,7 +258,21 @@ impl App {
         let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
         ui.painter()
             .image(texture.id(), rect, uv, egui::Color32::WHITE);
-        let delta = response.drag_delta();
+        let (on_handle, result) = volume::image_handles(
+            ui,
+            &response,
+            rect,
+            scale,
+            &mut self.viewer,
+            &mut self.dragged,
+        );
+        self.report_error(result);
+        // A drag that moves a handle does not also orbit or pan.
+        let delta = if on_handle {
+            egui::Vec2::ZERO
+        } else {
+            response.drag_delta()
+        };
         if response.dragged_by(egui::PointerButton::Primary) && delta != egui::Vec2::ZERO {
             let (dx, dy) = (f64::from(delta.x), f64::from(delta.y));
             let result = self
