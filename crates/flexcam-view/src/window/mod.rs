@@ -31,6 +31,8 @@ const ORBIT_DEG_PER_PX: f64 = 0.3;
 const ORBIT_KEY_DEG: f64 = 5.0;
 /// The window's least height (room for the parameter panel and the volume view).
 const MIN_HEIGHT: f32 = 460.0;
+/// The panels' margins and separators, in width.
+const MARGINS: f32 = 40.0;
 /// The volume view's default width.
 const VOLUME_PANEL: f32 = 420.0;
 /// How often the scene file's modification time is checked.
@@ -61,7 +63,7 @@ pub fn run(viewer: Viewer, script: Option<Script>) -> Result<()> {
     let panel = 300.0;
     let options = eframe::NativeOptions {
         viewport: egui::ViewportBuilder::default().with_inner_size([
-            (width as f32).min(1280.0) + panel + VOLUME_PANEL,
+            (width as f32).min(1280.0) + panel + VOLUME_PANEL + MARGINS,
             ((height as f32).min(800.0) + 60.0).max(MIN_HEIGHT),
         ]),
         ..eframe::NativeOptions::default()

@@ -20,7 +20,8 @@ const ORBIT_DEG_PER_PX: f64 = 0.4;
 fn color(kind: Kind) -> Color32 {
     match kind {
         Kind::Scene => Color32::from_gray(120),
-        Kind::Projector => Color32::from_rgb(200, 170, 60),
+        // Translucent: 81 of them would hide the rest.
+        Kind::Projector => Color32::from_rgba_unmultiplied(200, 170, 60, 110),
         Kind::ImageGrid => Color32::from_rgb(90, 170, 255),
         Kind::FarGrid => Color32::from_rgb(120, 120, 210),
         Kind::ControlNet => Color32::from_rgb(255, 140, 40),
