@@ -183,8 +183,12 @@ fn listed(dir: &TempDir, name: &str) -> Vec<f64> {
         .collect()
 }
 
-/// The only line of `saved` that differs from `original` (the rest kept as it was).
-fn changed_line(original: &str, saved: &str) -> String {
+/// Runs the script, which saves `s.toml`: the only line of it that differs from
+/// `scene.toml` (the rest kept as it was).
+fn run_and_changed_line(dir: &TempDir) -> String {
+    run_ok(dir, &VIEW);
+    let original = String::from_utf8(read(dir, "scene.toml")).unwrap();
+    let saved = String::from_utf8(read(dir, "s.toml")).unwrap();
     assert_eq!(original.lines().count(), saved.lines().count());
     let changed: Vec<_> = original
         .lines()
@@ -216,10 +220,7 @@ fn dragging_a_control_point_moves_its_key_in_the_view_plane() {
     // Listed: the point, the world step of a pixel right, of a pixel down.
     let listed = listed(&dir, "surface.1.1.2");
     assert_eq!(&listed[..3], &[0.5, 1.2, 4.5]);
-    run_ok(&dir, &VIEW);
-    let original = String::from_utf8(read(&dir, "scene.toml")).unwrap();
-    let saved = String::from_utf8(read(&dir, "s.toml")).unwrap();
-    let line = changed_line(&original, &saved);
+    let line = run_and_changed_line(&dir);
     // Row 1 of the Bezier patch: its third point moved, the others as written.
     let numbers = numbers_in(&line);
     assert_eq!(numbers.len(), 12, "{line}");
@@ -237,10 +238,18 @@ fn dragging_a_control_point_moves_its_key_in_the_view_plane() {
         ((numbers[6] - 0.5).powi(2) + (numbers[7] - 1.2).powi(2) + (numbers[8] - 4.5).powi(2))
             .sqrt();
     assert!(moved > 0.05 && moved < 2.0, "{moved}");
-    run_ok(&dir, &["render", "s.toml", "-o", "r.png"]);
-    assert_eq!(read(&dir, "f.png"), read(&dir, "r.png"));
+    frame_renders_the_saved_scene(&dir, &[]);
     run_ok(&dir, &["render", "scene.toml", "-o", "original.png"]);
     assert_ne!(read(&dir, "f.png"), read(&dir, "original.png"));
+}
+
+/// The script's `f.png` is what `flexcam render s.toml` writes (with `args`), byte for byte.
+fn frame_renders_the_saved_scene(dir: &TempDir, args: &[&str]) {
+    run_ok(
+        dir,
+        &[&["render", "s.toml"][..], args, &["-o", "r.png"]].concat(),
+    );
+    assert_eq!(read(dir, "f.png"), read(dir, "r.png"));
 }
 
 #[test]
@@ -260,21 +269,14 @@ fn dragging_the_perspective_rectangle_over_the_image() {
         (at[0] - 40.0).abs() < 1e-12 && (at[1] - 6.4).abs() < 1e-12,
         "{at:?}"
     );
-    run_ok(&dir, &VIEW);
-    let original = String::from_utf8(read(&dir, "scene.toml")).unwrap();
-    let saved = String::from_utf8(read(&dir, "s.toml")).unwrap();
-    let line = changed_line(&original, &saved);
+    let line = run_and_changed_line(&dir);
     // 8 pixels right: u1 + 8 / 64; 4 pixels down: v1 - 4 / 32 (v up).
     assert_eq!(
         numbers_in(&line),
         [0.375, 0.15, 0.625 + 0.125, 0.8 - 0.125],
         "{line}"
     );
-    run_ok(
-        &dir,
-        &["render", "s.toml", "--method", "raster", "-o", "r.png"],
-    );
-    assert_eq!(read(&dir, "f.png"), read(&dir, "r.png"));
+    frame_renders_the_saved_scene(&dir, &["--method", "raster"]);
 }
 
 #[test]
@@ -303,8 +305,7 @@ fn dragging_a_projector_grid_node_adds_its_entry() {
             "{entry}: {expected}"
         );
     }
-    run_ok(&dir, &["render", "s.toml", "-o", "r.png"]);
-    assert_eq!(read(&dir, "f.png"), read(&dir, "r.png"));
+    frame_renders_the_saved_scene(&dir, &[]);
 }
 
 #[test]

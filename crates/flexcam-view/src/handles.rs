@@ -492,6 +492,10 @@ mod tests {
     use super::*;
     use crate::session::scratch as session;
 
+    fn names(list: &[Handle]) -> Vec<&str> {
+        list.iter().map(|h| h.name.as_str()).collect()
+    }
+
     fn find<'h>(handles: &'h [Handle], name: &str) -> &'h Handle {
         handles.iter().find(|h| h.name == name).unwrap()
     }
@@ -504,9 +508,8 @@ mod tests {
     fn surface_handles_are_named_after_their_keys_and_edit_them_in_place() {
         let (_dir, mut session) = session(SURFACES);
         let list = handles(&session);
-        let names: Vec<&str> = list.iter().map(|h| h.name.as_str()).collect();
         assert_eq!(
-            names,
+            names(&list),
             [
                 "near.corner",
                 "near.u",
@@ -595,9 +598,8 @@ mod tests {
              perspective_rect = [0.375, 0.2, 0.625, 0.8]",
         );
         let list = handles(&session);
-        let names: Vec<&str> = list.iter().map(|h| h.name.as_str()).collect();
         assert_eq!(
-            names,
+            names(&list),
             [
                 "position",
                 "look_at",
@@ -637,9 +639,8 @@ mod tests {
              profiles = [{ at = 0.0, shape = \"arc\" }, { at = 0.5, points = [[1.0, -1.0], [1.0, 1.0]] }]",
         );
         let list = handles(&session);
-        let names: Vec<&str> = list.iter().map(|h| h.name.as_str()).collect();
         assert_eq!(
-            names,
+            names(&list),
             [
                 "position",
                 "look_at",
