@@ -54,19 +54,43 @@ pub fn scene_variant(
 /// Opens the scene file at `path`, waits for its first refinement, then sets projection key
 /// `key` to each of `values` in turn, waiting after each for the frame's first stage.
 pub fn drag(path: &Path, key: &str, values: &[f64]) -> Result<DragReport> {
+    frames(path, values.len(), |viewer, k| {
+        viewer.set(key, Value::from(values[k]))
+    })
+}
+
+/// Opens the scene file at `path`, waits for its first refinement, then drags handle
+/// `name` by (`dx`, `dy`) pixels (as a script's `drag`) `count` times, waiting after each
+/// for the frame's first stage. The handles and the volume view's sketch are made again
+/// for every frame, as the window does.
+pub fn drag_handle(
+    path: &Path,
+    name: &str,
+    (dx, dy): (f64, f64),
+    count: usize,
+) -> Result<DragReport> {
+    frames(path, count, |viewer, _| viewer.drag(name, dx, dy))
+}
+
+/// Runs `count` edits (`edit(viewer, k)`), each waited for until its first stage is shown.
+fn frames(
+    path: &Path,
+    count: usize,
+    mut edit: impl FnMut(&mut Viewer, usize) -> Result<()>,
+) -> Result<DragReport> {
     let mut viewer = Viewer::open(path, Settings::DEFAULT)?;
     viewer.idle()?;
     let start = Instant::now();
     let mut label = String::new();
-    for &v in values {
-        viewer.set(key, Value::from(v))?;
+    for k in 0..count {
+        edit(&mut viewer, k)?;
         let shown = viewer
             .render_loop()
             .wait_shown(viewer.session().generation())?;
         label = shown.label;
     }
     Ok(DragReport {
-        frames: values.len(),
+        frames: count,
         total_ms: start.elapsed().as_secs_f64() * 1e3,
         label,
     })

@@ -1,12 +1,14 @@
 //! `flexcam bench view`: the viewer's frame rate at 1280 x 720 while a projection parameter
 //! changes every frame (the render loop driven as the window drives it; see
 //! `flexcam_view::bench`), on cube-floor through invertible cameras and on the
-//! 123,554-triangle teapot-dense scene as an equirectangular panorama.
+//! 123,554-triangle teapot-dense scene as an equirectangular panorama; and while a handle
+//! of a flexible volume on cube-floor is dragged (handles and volume sketch made again each
+//! frame, as in the window).
 
 use clap::Args;
 use flexcam::scene::builtin;
 use flexcam::{Error, Result};
-use flexcam_view::bench::{drag, scene_variant};
+use flexcam_view::bench::{drag, drag_handle, scene_variant};
 use toml_edit::Value;
 
 /// Arguments of `flexcam bench view`.
@@ -21,12 +23,20 @@ pub struct ViewBenchArgs {
 const SIZE: (u32, u32) = (1280, 720);
 
 /// A case: a built-in scene, its projection replaced by `keys` (or kept when empty), and
-/// the key dragged from `from` to `to`.
+/// what is dragged.
 struct Case {
     name: &'static str,
     builtin: &'static str,
     keys: Vec<(&'static str, Value)>,
-    drag: (&'static str, f64, f64),
+    drag: Drag,
+}
+
+/// What a case drags every frame.
+enum Drag {
+    /// A key, from a value to another over the frames (a slider).
+    Key(&'static str, f64, f64),
+    /// A handle, by these pixels a frame (as `drag` in a script).
+    Handle(&'static str, f64, f64),
 }
 
 fn vector(v: [f64; 3]) -> Value {
@@ -47,24 +57,43 @@ fn cases() -> Vec<Case> {
         ("h_fov", Value::from(360.0)),
         ("v_fov", Value::from(180.0)),
     ];
+    let rectangle = |center: [f64; 3], half: f64| {
+        let mut table = toml_edit::InlineTable::new();
+        table.insert("surface", Value::from("rectangle"));
+        table.insert("center", vector(center));
+        table.insert("u_axis", vector([half, 0.0, 0.0]));
+        table.insert("v_axis", vector([0.0, half * 9.0 / 16.0, 0.0]));
+        Value::InlineTable(table)
+    };
+    let volume = vec![
+        ("type", Value::from("flexible")),
+        ("near", rectangle([0.0, 2.0, 6.0], 0.4)),
+        ("far", rectangle([0.0, 0.0, -4.0], 5.0)),
+    ];
     vec![
         Case {
             name: "cube-floor, perspective",
             builtin: "cube-floor",
             keys: Vec::new(),
-            drag: ("fov", 40.0, 80.0),
+            drag: Drag::Key("fov", 40.0, 80.0),
         },
         Case {
             name: "cube-floor, fisheye",
             builtin: "cube-floor",
             keys: fisheye,
-            drag: ("fov", 150.0, 200.0),
+            drag: Drag::Key("fov", 150.0, 200.0),
         },
         Case {
             name: "teapot-dense, equirectangular",
             builtin: "teapot-dense",
             keys: panorama,
-            drag: ("h_fov", 300.0, 360.0),
+            drag: Drag::Key("h_fov", 300.0, 360.0),
+        },
+        Case {
+            name: "cube-floor, flexible near/far",
+            builtin: "cube-floor",
+            keys: volume,
+            drag: Drag::Handle("far.center", 1.0, -0.5),
         },
     ]
 }
@@ -90,14 +119,21 @@ fn run_cases(args: &ViewBenchArgs, dir: &std::path::Path) -> Result<()> {
         let path = dir.join(format!("case{i}.toml"));
         std::fs::write(&path, text)
             .map_err(|e| Error::in_file(&path, format!("cannot write: {e}")))?;
-        let (key, from, to) = case.drag;
         let n = args.frames;
-        let values: Vec<f64> = (0..n)
-            .map(|k| from + (to - from) * f64::from(k) / f64::from(n - 1))
-            .collect();
-        let report = drag(&path, key, &values)?;
+        let (report, what) = match case.drag {
+            Drag::Key(key, from, to) => {
+                let values: Vec<f64> = (0..n)
+                    .map(|k| from + (to - from) * f64::from(k) / f64::from(n - 1))
+                    .collect();
+                (drag(&path, key, &values)?, format!("{key} {from}..{to}"))
+            }
+            Drag::Handle(name, dx, dy) => (
+                drag_handle(&path, name, (dx, dy), n as usize)?,
+                format!("{name} by ({dx}, {dy}) px"),
+            ),
+        };
         println!(
-            "{:32} {key:>6} {from}..{to}: {:7.1} frames/s ({:.2} ms/frame), shown by {}",
+            "{:32} {what:>18}: {:7.1} frames/s ({:.2} ms/frame), shown by {}",
             case.name,
             report.fps(),
             report.total_ms / report.frames as f64,
