@@ -117,7 +117,8 @@ fn invalid_edit_keeps_the_last_valid_projection_message() {
 /// `xvfb-run` when there is none. Skipped, saying why, only when no display can be opened.
 #[test]
 fn window_screenshot_under_a_display() {
-    let dir = setup("set fov 60\nidle\nwindow w.png\nframe f.png\n");
+    // The drag runs through the window's script path too (the volume view drawn).
+    let dir = setup("set fov 60\ndrag position 3 2\nidle\nwindow w.png\nframe f.png\n");
     let flexcam = assert_cmd::cargo::cargo_bin("flexcam");
     let args = [&VIEW[..], &["--shading", "flat", "--refine-spp", "1"]].concat();
     let has_display = std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty());

@@ -51,7 +51,7 @@ pub fn run(viewer: Viewer, script: Option<Script>) -> Result<()> {
         status: String::new(),
         message: None,
         save_as: String::new(),
-        dragged: None,
+        dragged: [None, None],
         last_poll: Instant::now(),
         script: script.map(|script| ScriptRun {
             script,
@@ -90,8 +90,9 @@ struct App {
     /// The last error (an invalid edit, a failed reload or save) or pick, shown until the next.
     message: Option<String>,
     save_as: String,
-    /// The handle being dragged, if any.
-    dragged: Option<String>,
+    /// The handle being dragged, if any, in the volume view and over the image (each
+    /// view's own, so that one view's idle pointer does not end the other's drag).
+    dragged: [Option<String>; 2],
     last_poll: Instant,
     script: Option<ScriptRun>,
     outcome: Arc<Mutex<Option<Error>>>,
@@ -119,7 +120,7 @@ impl eframe::App for App {
             .default_size(VOLUME_PANEL)
             .show(ui, |ui| {
                 ui.label("Viewing volume: drag a dot to move it, elsewhere to orbit");
-                let result = volume::volume_view(ui, &mut self.viewer, &mut self.dragged);
+                let result = volume::volume_view(ui, &mut self.viewer, &mut self.dragged[0]);
                 self.report_error(result);
             });
         egui::CentralPanel::default().show(ui, |ui| self.image_panel(ui));
@@ -266,7 +267,7 @@ impl App {
             rect,
             scale,
             &mut self.viewer,
-            &mut self.dragged,
+            &mut self.dragged[1],
         );
         self.report_error(result);
         // A drag that moves a handle does not also orbit or pan.
