@@ -64,11 +64,13 @@ use glam::Vec3;
 
 use self::photon_map::{PhotonMap, PhotonSource};
 use self::splat::splat;
-use super::composite::{main_camera, perspective_as_trilinear, Reflector};
+use super::composite::{
+    add_camera_triangle_counts, main_camera, perspective_as_trilinear, Reflector,
+};
 use crate::error::Result;
 use crate::projection::Projection;
 use crate::render::prepared::PreparedScene;
-use crate::render::{Counter, Method, Outputs, RenderOptions, Rendered, Shading};
+use crate::render::{Counter, Method, Outputs, RenderOptions, Rendered, Shading, Stats};
 use crate::scene::{Finish, Light, Scene};
 
 /// Whether [`add`] has caustics to add: the scene names caustic mirrors and the shading is
@@ -81,7 +83,10 @@ pub(super) fn wanted(scene: &Scene, options: &RenderOptions) -> bool {
 /// the main view through `projection` (which must hold ids and depth), as the module doc
 /// says: the photon maps come from `options.method` ([`PhotonSource::of`]). Reports
 /// `caustic_photons` (map texels holding a photon), `caustic_triangles` (caustic triangles
-/// splatted), `caustic_pixels` (eye pixels lit by a caustic) and `caustic_ms`. Errors: a
+/// splatted), `caustic_pixels` (eye pixels lit by a caustic) and `caustic_ms`, and with
+/// camera triangles the maps' renders through the mirrors' surfaces summed as
+/// `caustic_camera_triangles`, `caustic_bounding_fragments`, `caustic_rendered_fragments`
+/// and `caustic_overdraw` (bounding over rendered: Table 1's caustics row). Errors: a
 /// method without a photon map, a main projection that is not perspective, a light inside
 /// a mirror's bounding sphere.
 pub(super) fn add(
@@ -97,6 +102,7 @@ pub(super) fn add(
     let frame = &mut rendered.frame;
     let mut irradiance = vec![Vec3::ZERO; frame.color.len()];
     let (mut photons, mut triangles) = (0u64, 0u64);
+    let mut maps = Stats::new();
     for caustic in &scene.caustics {
         let tint = Reflector::of(scene, caustic.id)?.tint;
         for light in &scene.lights {
@@ -110,6 +116,7 @@ pub(super) fn add(
             };
             let map = PhotonMap::render(prepared, caustic, position.as_dvec3(), source, options)?;
             photons += map.photon_count();
+            add_camera_triangle_counts(&mut maps, &map.counters);
             let caustic_triangles = map.caustic_triangles(color * intensity * tint);
             triangles += caustic_triangles.len() as u64;
             splat(
@@ -133,6 +140,16 @@ pub(super) fn add(
     stats.insert("caustic_photons", Counter::Count(photons));
     stats.insert("caustic_triangles", Counter::Count(triangles));
     stats.insert("caustic_pixels", Counter::Count(pixels));
+    for (name, as_name) in [
+        ("camera_triangles", "caustic_camera_triangles"),
+        ("bounding_fragments", "caustic_bounding_fragments"),
+        ("rendered_fragments", "caustic_rendered_fragments"),
+        ("overdraw", "caustic_overdraw"),
+    ] {
+        if let Some(counter) = maps.get(name) {
+            stats.insert(as_name, *counter);
+        }
+    }
     stats.insert(
         "caustic_ms",
         Counter::Value(start.elapsed().as_secs_f64() * 1e3),

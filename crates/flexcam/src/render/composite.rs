@@ -57,8 +57,9 @@ type Renderer<'a> =
 /// are the main render's, plus `reflectors`, `reflector_triangles` (in the surfaces),
 /// `reflector_dropped_triangles` (see [`reflector_surface`]), `reflector_pixels` (main-image
 /// pixels replaced), `reflector_fresnel_rays` (lit glass: main-camera rays cast at the
-/// reflector alone for the Fresnel split), `reflector_exact_pixels` (reflector pixels that no
-/// triangle of the surface covers, ray cast exactly instead: [`ExactPixels`]),
+/// reflector alone for the Fresnel split), `reflector_uncovered_pixels` (reflector pixels
+/// that no triangle of the surface covers), `reflector_exact_pixels` (those of them ray cast
+/// exactly instead: [`ExactPixels`]; none without `RenderOptions::cast_reflector_gaps`),
 /// `reflector_unsplit_edges` (edges the refinement left over its tolerance at its depth cap
 /// or below a pixel: [`refine`]; a [`RenderWarning::ReflectorOverTolerance`] for each
 /// reflector that has such edges) and `reflector_render_ms` (surface refinement, building
@@ -105,7 +106,7 @@ fn with_renderer(
     let start = Instant::now();
     let (mut triangles, mut dropped, mut pixels, mut fresnel_rays) = (0, 0, 0, 0);
     let exact = ExactPixels::new(prepared, &camera, options);
-    let mut exact_pixels = 0;
+    let (mut exact_pixels, mut uncovered_pixels) = (0, 0);
     let (mut unsplit, mut warnings) = (0, Vec::new());
     for entry in &scene.trilinear_reflectors {
         let (id, map) = (entry.id, entry.screen_map);
@@ -152,7 +153,12 @@ fn with_renderer(
                 }
             };
         }
-        exact_pixels += exact.cast_uncovered(&mut frame, id, projection.as_ref());
+        let uncovered = exact.uncovered(&frame, id, projection.as_ref());
+        uncovered_pixels += uncovered.len();
+        if options.cast_reflector_gaps {
+            exact.cast(&mut frame, &uncovered);
+            exact_pixels += uncovered.len();
+        }
         unsplit += left;
         if left > 0 {
             warnings.push(RenderWarning::ReflectorOverTolerance {
@@ -168,7 +174,8 @@ fn with_renderer(
     stats.insert("reflector_dropped_triangles", count(dropped));
     stats.insert("reflector_pixels", Counter::Count(pixels));
     stats.insert("reflector_fresnel_rays", Counter::Count(fresnel_rays));
-    stats.insert("reflector_exact_pixels", Counter::Count(exact_pixels));
+    stats.insert("reflector_uncovered_pixels", count(uncovered_pixels));
+    stats.insert("reflector_exact_pixels", count(exact_pixels));
     stats.insert("reflector_unsplit_edges", count(unsplit));
     stats.insert(
         "reflector_render_ms",
@@ -187,7 +194,7 @@ fn with_renderer(
 /// `shade_ms` as `surface_pairs`, `surface_raster_ms` and `surface_shade_ms` (the main view
 /// has its own), and
 /// sets `overdraw` to bounding over rendered fragments of all surfaces so far.
-fn add_camera_triangle_counts(stats: &mut Stats, surface: &Stats) {
+pub(super) fn add_camera_triangle_counts(stats: &mut Stats, surface: &Stats) {
     const SUMMED: [(&str, &str); 10] = [
         ("camera_triangles", "camera_triangles"),
         ("bounding_fragments", "bounding_fragments"),
@@ -468,41 +475,46 @@ impl<'a> ExactPixels<'a> {
         }
     }
 
-    /// Ray casts every pixel of `frame` that sees object `id` and whose centre no screen
-    /// triangle of `surface` covers (all of them when there is no surface): the back of an
-    /// open reflector, whose triangles are all left out (see [`reflector_surface`]), or a
+    /// The pixels of `frame` that see object `id` and whose centre no screen triangle of
+    /// `surface` covers (all of them when there is no surface): the back of an open
+    /// reflector, whose triangles are all left out (see [`reflector_surface`]), or a
     /// silhouette pixel that the surface's screen triangles miss. Such a pixel would
-    /// otherwise keep the reflector's diffuse colour or show the background. Returns the
-    /// number of pixels cast. Degenerate case: a pixel whose ray misses the whole scene (the
-    /// main view saw the reflector at a grazing edge that the exact test rejects) takes the
-    /// background.
-    pub fn cast_uncovered(&self, frame: &mut Frame, id: u32, surface: Option<&Trilinear>) -> u64 {
+    /// otherwise keep the reflector's diffuse colour or show the background.
+    pub fn uncovered(&self, frame: &Frame, id: u32, surface: Option<&Trilinear>) -> Vec<usize> {
         let width = frame.width as usize;
-        let centre = |k: usize| DVec2::new((k % width) as f64 + 0.5, (k / width) as f64 + 0.5);
-        let uncovered: Vec<usize> = (0..frame.ids.len())
+        (0..frame.ids.len())
             .filter(|&k| {
-                frame.ids[k] == id && surface.is_none_or(|s| s.locate(centre(k)).is_none())
+                frame.ids[k] == id
+                    && surface.is_none_or(|s| s.locate(pixel_centre(k, width)).is_none())
             })
-            .collect();
-        if uncovered.is_empty() {
-            return 0;
-        }
+            .collect()
+    }
+
+    /// Ray casts the pixels `pixels` of `frame` ([`ExactPixels::uncovered`]). Degenerate
+    /// case: a pixel whose ray misses the whole scene (the main view saw the reflector at a
+    /// grazing edge that the exact test rejects) takes the background.
+    pub fn cast(&self, frame: &mut Frame, pixels: &[usize]) {
+        let width = frame.width as usize;
         let caster = self.prepared;
-        let colors: Vec<Vec3> = uncovered
+        let colors: Vec<Vec3> = pixels
             .par_iter()
             .map(|&k| {
-                let ray = self.camera.ray(centre(k));
+                let ray = self.camera.ray(pixel_centre(k, width));
                 match ray.as_ref().and_then(|r| Some((r, caster.intersect(r)?))) {
                     Some((ray, hit)) => caster.shade_hit(ray, hit, self.options).0,
                     None => caster.scene.image.background,
                 }
             })
             .collect();
-        for (&k, color) in uncovered.iter().zip(colors) {
+        for (&k, color) in pixels.iter().zip(colors) {
             frame.color[k] = color;
         }
-        uncovered.len() as u64
     }
+}
+
+/// The centre of pixel `k` (row-major) of an image `width` pixels wide.
+fn pixel_centre(k: usize, width: usize) -> DVec2 {
+    DVec2::new((k % width) as f64 + 0.5, (k / width) as f64 + 0.5)
 }
 
 /// Replaces the colour of every pixel of `main` that sees object `id` by `tint` times the

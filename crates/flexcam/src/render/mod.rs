@@ -43,6 +43,12 @@ pub struct RenderOptions<'a> {
     /// main view, each reflection rendered by `method` (module `composite`); `false` renders them
     /// as the method's own mirrors and glass (the reference of a comparison).
     pub composite_reflectors: bool,
+    /// With composited reflectors, ray cast exactly the reflector pixels that no triangle of
+    /// the reflection surface covers (its silhouette's gaps, its back); `false` leaves them
+    /// as they are without it (the background of the image through the surface, or the
+    /// reflector's own colour where it has no surface), so that a measurement sees what the
+    /// surface alone renders (`flexcam bench camera-triangles --figure 6`).
+    pub cast_reflector_gaps: bool,
     /// How surfaces are shaded (`--shading`).
     pub shading: Shading,
     /// Samples per pixel (1 = one ray through each pixel centre).
@@ -69,6 +75,7 @@ impl Default for RenderOptions<'_> {
         RenderOptions {
             method: Method::Raycast,
             composite_reflectors: true,
+            cast_reflector_gaps: true,
             shading: Shading::Lit,
             spp: 1,
             max_bounces: 8,

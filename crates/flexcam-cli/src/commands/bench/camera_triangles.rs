@@ -1,5 +1,5 @@
-//! `flexcam bench camera-triangles`: Table 1 of Hou, Wei, Shum and Guo 2006 (the reflection
-//! rows) and the issue's targets, rerun with `--method camera-triangles`.
+//! `flexcam bench camera-triangles`: Table 1 and Figures 6 and 7 of Hou, Wei, Shum and Guo
+//! 2006 and the issue's targets, rerun with `--method camera-triangles`.
 //!
 //! - Table 1, reflection: a mirror sphere reflecting a cube and a checkered floor (about 108
 //!   scene triangles) at 800 x 600, the sphere's visible triangles being the camera
@@ -7,25 +7,39 @@
 //!   whole-frame time and frames per second, bounding and rendered fragments and overdraw,
 //!   with the paper's bound and ours, beside the paper's figures; each row also with the
 //!   cluster culling of section 2.4 switched off.
+//! - Table 1, caustics: `camtri-caustics.toml` at the paper's 640 x 480 with a photon map of
+//!   512 x 512, lit: the photon map's camera triangles (the mirror's reflection surface seen
+//!   from the light), its bounding and rendered fragments and overdraw (`caustic_*` stats),
+//!   and the whole frame's time.
 //! - A mirror sphere over a floor of about 5,000 scene triangles at 800 x 600: the whole
 //!   frame by camera triangles against `--method raycast` (true mirror), and the agreement
-//!   of the reflector's pixels with the exact reflection (flat colours: the fraction of
-//!   reflector pixels away from colour edges whose colour is the exact one, and the relative
-//!   RGB error).
+//!   of the reflector's pixels with the exact reflection (`measures`).
+//! - `--figure 6` ([`figure6`]): reflection quality per camera mesh size; `--figure 7`
+//!   ([`figure7`]): frames per second of a mirror teapot among moving balls, without and
+//!   with acceleration. Both print a markdown table and write a CSV with `--csv FILE`
+//!   (plotted by `tools/plot/csv_plot.py`).
 //!
-//! Flat shading, one warm-up render, then the median of `--repeat` renders (`timing`).
+//! Flat shading (lit for the caustics), one warm-up render, then the median of `--repeat`
+//! renders (`timing`).
 
-use std::path::Path;
+mod figure6;
+mod figure7;
+mod measures;
 
-use clap::Args;
+use std::path::{Path, PathBuf};
+
+use clap::{Args, ValueEnum};
+use flexcam::image_io::{self, OutputSet};
+use flexcam::projection::Projection;
 use flexcam::render::{
-    self, compare, CameraTriangleBound as Bound, CameraTriangleOptions, Counter, Frame, Method,
-    PreparedScene, RenderOptions, Shading,
+    self, compare, CameraTriangleBound as Bound, CameraTriangleOptions, Method, PreparedScene,
+    RenderOptions, Rendered, Shading,
 };
 use flexcam::scene::{self, Scene};
 use flexcam::Result;
 
-use super::timing::measure;
+use self::measures::{colour_agreement_inside, count, value};
+use super::timing::{measure, Timing};
 
 /// Arguments of `flexcam bench camera-triangles`.
 #[derive(Args, Debug)]
@@ -33,6 +47,50 @@ pub struct CameraTrianglesArgs {
     /// Timed renders per row, after one warm-up render; the median is reported.
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100))]
     repeat: u32,
+    /// Measure a figure instead of Table 1: `6` (reflection quality per camera mesh size
+    /// against the exact mirror) or `7` (frames per second of a mirror teapot among moving
+    /// objects, without and with acceleration).
+    #[arg(long, value_enum)]
+    figure: Option<Figure>,
+    /// Write the figure's measurements as CSV to FILE (with --figure).
+    #[arg(long, value_name = "FILE", requires = "figure")]
+    csv: Option<PathBuf>,
+    /// Image width of every render (default: the paper's, 800, or 640 for caustics).
+    #[arg(long, requires = "height", value_parser = clap::value_parser!(u32).range(1..=16384))]
+    width: Option<u32>,
+    /// Image height of every render (default: the paper's, 600, or 480 for caustics).
+    #[arg(long, requires = "width", value_parser = clap::value_parser!(u32).range(1..=16384))]
+    height: Option<u32>,
+    /// The folder of the example scenes (`camtri-*.toml`) that the caustics row and Figure 6
+    /// load.
+    #[arg(long, value_name = "DIR", default_value = "scenes")]
+    scenes: PathBuf,
+}
+
+/// A figure of the paper.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum Figure {
+    #[value(name = "6")]
+    Six,
+    #[value(name = "7")]
+    Seven,
+}
+
+/// What every part of the bench runs with.
+pub struct Settings {
+    /// Timed renders per row.
+    pub repeat: u32,
+    /// `--width` and `--height`, if given.
+    size: Option<(u32, u32)>,
+    /// The example scenes' folder.
+    pub scenes: PathBuf,
+}
+
+impl Settings {
+    /// The image size: `--width` x `--height`, else `paper`.
+    pub fn size(&self, paper: (u32, u32)) -> (u32, u32) {
+        self.size.unwrap_or(paper)
+    }
 }
 
 /// The paper's reflection rows: camera triangles, bounding and rendered fragments,
@@ -46,10 +104,9 @@ const PAPER: [(&str, u64, u64, f64, f64); 3] = [
 /// Sphere tessellations whose visible triangles are about 26, 104 and 416 camera triangles.
 const TESSELLATIONS: [u32; 3] = [5, 10, 20];
 
-/// The reflection scene: a mirror sphere of `tessellation` whose visible triangles are the
-/// camera triangles (`trilinear_refine_px = 0`), a cube and a floor of `floor` x `floor`
-/// quads.
-fn reflection_scene(tessellation: u32, floor: u32) -> Result<Scene> {
+/// The reflection scene: a mirror sphere of `tessellation` with `reflector_keys` (lines of its
+/// `[[object]]` table), a cube and a floor of `floor` x `floor` quads, at 800 x 600.
+fn reflection_scene(tessellation: u32, floor: u32, reflector_keys: &str) -> Result<Scene> {
     let text = format!(
         r#"
 [image]
@@ -71,7 +128,7 @@ tessellation = {tessellation}
 material = "mirror"
 translate = [0.0, 1.0, 0.0]
 trilinear_reflector = true
-trilinear_refine_px = 0
+{reflector_keys}
 
 [[object]]
 name = "cube"
@@ -94,11 +151,39 @@ checker = {{ color = [0.1, 0.1, 0.1], size = 0.5 }}
 }
 
 pub fn run(args: &CameraTrianglesArgs) -> Result<()> {
+    let settings = Settings {
+        repeat: args.repeat,
+        size: args.width.zip(args.height),
+        scenes: args.scenes.clone(),
+    };
+    if let Some((width, height)) = settings.size {
+        scene::file::validate_resolution(width, height)?;
+    }
+    let mut outputs = OutputSet::new();
+    let csv_output = args
+        .csv
+        .as_deref()
+        .map(|path| outputs.output("the CSV output", path, &["csv"]))
+        .transpose()?;
+    let csv = match args.figure {
+        None => return table1(&settings),
+        Some(Figure::Six) => figure6::csv(&figure6::run(&settings)?),
+        Some(Figure::Seven) => figure7::csv(&figure7::run(&settings)?),
+    };
+    if let Some(id) = csv_output {
+        outputs.stage(id, |tmp| image_io::write_bytes(tmp, csv.as_bytes()))?;
+    }
+    outputs.commit()
+}
+
+/// Table 1's reflection and caustics rows, then the 5,000-triangle target.
+fn table1(settings: &Settings) -> Result<()> {
+    let (width, height) = settings.size((800, 600));
     println!(
-        "Table 1, reflection (Hou et al. 2006): mirror sphere, cube and floor at 800 x 600, flat \
-         shading; whole frame (main view by method trilinear, reflection by camera triangles); \
-         median of {} renders.",
-        args.repeat
+        "Table 1, reflection (Hou et al. 2006): mirror sphere, cube and floor at {width} x \
+         {height}, flat shading; whole frame (main view by method trilinear, reflection by \
+         camera triangles); median of {} renders.",
+        settings.repeat
     );
     println!(
         "{:>7} {:>6} {:>6} | {:>6} {:>10} {:>9} {:>8} {:>7} {:>8} | paper: {:>10} {:>8} {:>8} {:>5}",
@@ -117,9 +202,9 @@ pub fn run(args: &CameraTrianglesArgs) -> Result<()> {
         "fps"
     );
     for (tessellation, paper) in TESSELLATIONS.iter().zip(PAPER) {
-        let scene = reflection_scene(*tessellation, 7)?;
+        let scene = reflection_scene(*tessellation, 7, "trilinear_refine_px = 0")?;
         let prepared = PreparedScene::new(&scene);
-        let main = scene.projection.build(800, 600)?;
+        let main = scene.projection.build(width, height)?;
         for bound in [Bound::Paper, Bound::Tight] {
             for cull in [false, true] {
                 let options = RenderOptions {
@@ -128,9 +213,8 @@ pub fn run(args: &CameraTrianglesArgs) -> Result<()> {
                     camera_triangles: CameraTriangleOptions { bound, cull },
                     ..RenderOptions::default()
                 };
-                let (timing, rendered) = measure(args.repeat, || {
-                    render::render(&prepared, main.as_ref(), &options)
-                })?;
+                let (timing, rendered) =
+                    timed_render(settings.repeat, &prepared, main.as_ref(), &options)?;
                 let c = &rendered.counters;
                 let ms = timing.median_ms();
                 println!(
@@ -152,36 +236,87 @@ pub fn run(args: &CameraTrianglesArgs) -> Result<()> {
             }
         }
     }
-    five_thousand(args.repeat)
+    caustics(settings)?;
+    five_thousand(settings.repeat, width, height)
+}
+
+/// The paper's caustics row: scene triangles, camera triangles, bounding and rendered
+/// fragments, overdraw, frames per second (640 x 480, photon map 512 x 512).
+const PAPER_CAUSTICS: (u64, u64, u64, u64, f64, f64) = (2, 400, 945_962, 475_852, 2.0, 35.0);
+
+/// Table 1's caustics row (module doc).
+fn caustics(settings: &Settings) -> Result<()> {
+    let (width, height) = settings.size((640, 480));
+    let path = settings.scenes.join("camtri-caustics.toml");
+    let map = "object.mirror.caustic_map=512".parse()?;
+    let (scene, _) = scene::load_file(&path, &[map], &scene::ModelRequest::default())?;
+    let prepared = PreparedScene::new(&scene);
+    let main = scene.projection.build(width, height)?;
+    let options = RenderOptions {
+        method: Method::CameraTriangles,
+        shading: Shading::Lit,
+        ..RenderOptions::default()
+    };
+    let (timing, rendered) = timed_render(settings.repeat, &prepared, main.as_ref(), &options)?;
+    let c = &rendered.counters;
+    let ms = timing.median_ms();
+    let paper = PAPER_CAUSTICS;
+    println!();
+    println!(
+        "Table 1, caustics: {} at {width} x {height}, photon map 512 x 512, lit; camera \
+         triangles, fragments and overdraw of the photon map's render through the mirror's \
+         camera triangles (caustic_* stats); time of the whole frame (main view, the mirror's \
+         reflection, the photon map, splatting); median of {} renders.",
+        path.display(),
+        settings.repeat
+    );
+    println!(
+        "{:>7} {:>6} | {:>10} {:>9} {:>8} {:>7} {:>8} | paper: {:>6} {:>6} {:>10} {:>8} {:>8} {:>5}",
+        "camera", "scene", "bounding", "rendered", "overdraw", "ms", "fps", "camera", "scene",
+        "bounding", "rendered", "overdraw", "fps"
+    );
+    println!(
+        "{:>7} {:>6} | {:>10} {:>9} {:>8.2} {:>7.1} {:>8.1} | {:>13} {:>6} {:>10} {:>8} {:>8} {:>5}",
+        count(c, "caustic_camera_triangles"),
+        prepared_triangles(&scene),
+        count(c, "caustic_bounding_fragments"),
+        count(c, "caustic_rendered_fragments"),
+        value(c, "caustic_overdraw"),
+        ms,
+        1e3 / ms,
+        paper.1,
+        paper.0,
+        paper.2,
+        paper.3,
+        paper.4,
+        paper.5,
+    );
+    Ok(())
 }
 
 /// The 5,000-triangle mirror-sphere target (module doc).
-fn five_thousand(repeat: u32) -> Result<()> {
-    let scene = reflection_scene(10, 50)?;
+fn five_thousand(repeat: u32, width: u32, height: u32) -> Result<()> {
+    let scene = reflection_scene(10, 50, "trilinear_refine_px = 0")?;
     let prepared = PreparedScene::new(&scene);
-    let main = scene.projection.build(800, 600)?;
+    let main = scene.projection.build(width, height)?;
     let options = |method| RenderOptions {
         method,
         shading: Shading::Flat,
         ..RenderOptions::default()
     };
     let ours_options = options(Method::CameraTriangles);
-    let (ours_time, ours) = measure(repeat, || {
-        render::render(&prepared, main.as_ref(), &ours_options)
-    })?;
+    let (ours_time, ours) = timed_render(repeat, &prepared, main.as_ref(), &ours_options)?;
     let mut exact_scene = scene.clone();
     exact_scene.trilinear_reflectors.clear();
     let exact = PreparedScene::new(&exact_scene);
     let raycast_options = options(Method::Raycast);
-    let (ray_time, reference) = measure(repeat, || {
-        render::render(&exact, main.as_ref(), &raycast_options)
-    })?;
+    let (ray_time, reference) = timed_render(repeat, &exact, main.as_ref(), &raycast_options)?;
     let id = scene.trilinear_reflectors[0].id;
     let (same, pixels) = colour_agreement_inside(&ours.frame, &reference.frame, id);
     let rgb = compare(&ours.frame, &reference.frame)?.relative_rgb_error;
     println!();
     println!(
-        "Mirror sphere over {} scene triangles at 800 x 600, flat: camera triangles {:.1} ms \
+        "Mirror sphere over {} scene triangles at {width} x {height}, flat: camera triangles {:.1} ms \
          ({} camera triangles, overdraw {:.2}), raycast {:.1} ms: ratio {:.2} (target <= 0.5); \
          reflector pixels away from colour edges with the exact colour {:.4} of {pixels} \
          (target >= 0.99); relative RGB error of the frame {:.5}",
@@ -197,6 +332,17 @@ fn five_thousand(repeat: u32) -> Result<()> {
     Ok(())
 }
 
+/// Renders `prepared` through `main` with `options`, timed by [`measure`]: the timing and
+/// the median render.
+fn timed_render(
+    repeat: u32,
+    prepared: &PreparedScene,
+    main: &dyn Projection,
+    options: &RenderOptions,
+) -> Result<(Timing, Rendered)> {
+    measure(repeat, || render::render(prepared, main, options))
+}
+
 /// Scene triangles other than the reflector's.
 fn prepared_triangles(scene: &Scene) -> usize {
     let reflectors: Vec<u32> = scene.trilinear_reflectors.iter().map(|r| r.id).collect();
@@ -206,45 +352,4 @@ fn prepared_triangles(scene: &Scene) -> usize {
         .filter(|o| !reflectors.contains(&o.id))
         .map(|o| o.mesh.triangles.len())
         .sum()
-}
-
-/// The fraction of the reference's pixels of object `id` whose colour (over the pixel's
-/// 3 x 3 neighbourhood in the reference) is uniform that `frame` gives exactly, and their
-/// number.
-fn colour_agreement_inside(frame: &Frame, reference: &Frame, id: u32) -> (f64, u64) {
-    let (w, h) = (reference.width as usize, reference.height as usize);
-    let (mut pixels, mut same) = (0u64, 0u64);
-    for y in 1..h.saturating_sub(1) {
-        for x in 1..w.saturating_sub(1) {
-            let k = y * w + x;
-            let colour = reference.color[k];
-            let uniform = (y - 1..=y + 1).all(|yy| {
-                (x - 1..=x + 1).all(|xx| {
-                    let n = yy * w + xx;
-                    reference.ids[n] == id
-                        && (reference.color[n] - colour).abs().max_element() < 1e-6
-                })
-            });
-            if uniform {
-                pixels += 1;
-                same += u64::from((frame.color[k] - colour).abs().max_element() < 1e-6);
-            }
-        }
-    }
-    (same as f64 / pixels.max(1) as f64, pixels)
-}
-
-fn count(stats: &render::Stats, name: &str) -> u64 {
-    match stats.get(name) {
-        Some(Counter::Count(n)) => *n,
-        _ => 0,
-    }
-}
-
-fn value(stats: &render::Stats, name: &str) -> f64 {
-    match stats.get(name) {
-        Some(Counter::Value(v)) => *v,
-        Some(Counter::Count(n)) => *n as f64,
-        None => f64::NAN,
-    }
 }

@@ -14,7 +14,7 @@ use crate::projection::{CameraFrame, Perspective, Projection};
 use crate::render::composite::{perspective_as_trilinear, without, Reflector};
 use crate::render::prepared::PreparedScene;
 use crate::render::shading::normals;
-use crate::render::{Frame, Method, Outputs, RenderOptions, Shading};
+use crate::render::{Frame, Method, Outputs, RenderOptions, Shading, Stats};
 use crate::scene::{CausticReflector, Finish, Mesh, Scene};
 
 /// How a photon-location map is made: through the mirror's camera triangles by a method
@@ -65,6 +65,9 @@ pub(in crate::render) struct PhotonMap {
     pub camera: Perspective,
     pub size: u32,
     pub photons: Vec<Option<Photon>>,
+    /// The counters of the render through the mirror's reflection surface (with camera
+    /// triangles: `camera_triangles`, `bounding_fragments`, ...); empty for the exact map.
+    pub counters: Stats,
 }
 
 impl PhotonMap {
@@ -82,8 +85,8 @@ impl PhotonMap {
         let scene = prepared.scene();
         let reflector = Reflector::of(scene, caustic.id)?;
         let camera = light_camera(light, &reflector.mesh, caustic.map_size)?;
-        let photons = match source {
-            PhotonSource::Exact => exact(prepared, caustic.id, &camera),
+        let (photons, counters) = match source {
+            PhotonSource::Exact => (exact(prepared, caustic.id, &camera), Stats::new()),
             PhotonSource::Surface(method) => through_surface(
                 prepared,
                 caustic.id,
@@ -97,6 +100,7 @@ impl PhotonMap {
             camera,
             size: caustic.map_size,
             photons,
+            counters,
         })
     }
 
@@ -222,7 +226,8 @@ fn plain<'a>(method: Method, options: &RenderOptions<'a>) -> RenderOptions<'a> {
 /// at the mirror point its light ray meets), the scene without the mirror rendered through
 /// it by `method`; a texel holds a photon where the scene from the light (the mirror made
 /// diffuse, by the trilinear method through the pinhole as two projection triangles) sees
-/// the mirror first and the surface's ray lands on a receiver.
+/// the mirror first and the surface's ray lands on a receiver. Also the counters of the
+/// render through the surface (none where the light sees no surface).
 fn through_surface(
     prepared: &PreparedScene,
     id: u32,
@@ -230,7 +235,7 @@ fn through_surface(
     camera: &Perspective,
     method: Method,
     options: &RenderOptions,
-) -> Result<Vec<Option<Photon>>> {
+) -> Result<(Vec<Option<Photon>>, Stats)> {
     let scene = prepared.scene();
     let n = camera.resolution().0 as usize;
     let Some(surface) = reflector_surface(mesh, camera, Optic::Reflect)?.projection(
@@ -239,7 +244,7 @@ fn through_surface(
         n as u32,
     )?
     else {
-        return Ok(vec![None; n * n]);
+        return Ok((vec![None; n * n], Stats::new()));
     };
     let mut diffuse = plain_scene(scene);
     for object in &mut diffuse.objects {
@@ -256,7 +261,8 @@ fn through_surface(
         )?
         .0;
     let others = prepared.view(plain_scene(&without(scene, id)));
-    let reflected: Frame = method.render(&others, &surface, &plain(method, options))?.0;
+    let (reflected, counters): (Frame, Stats) =
+        method.render(&others, &surface, &plain(method, options))?;
     let photon = |k: usize| {
         let receiver = reflected.ids[k];
         if seen.ids[k] != id || receiver == 0 || !receives(scene, receiver) {
@@ -270,7 +276,7 @@ fn through_surface(
             id: receiver,
         })
     };
-    Ok((0..n * n).into_par_iter().map(photon).collect())
+    Ok(((0..n * n).into_par_iter().map(photon).collect(), counters))
 }
 
 /// `scene` without trilinear reflectors or caustics: what a map's renders see.

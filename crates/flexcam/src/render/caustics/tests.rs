@@ -9,7 +9,7 @@ use super::photon_map::{
 use super::splat::splat;
 use crate::projection::{Perspective, Projection, ProjectionSpec};
 use crate::render::prepared::PreparedScene;
-use crate::render::{Method, Outputs, RenderOptions, Shading};
+use crate::render::{Counter, Method, Outputs, RenderOptions, Shading, Stats};
 use crate::scene::{self, Light, Mesh, Scene};
 
 /// The two photon maps compared: through camera triangles, and exact.
@@ -235,6 +235,7 @@ fn degenerate_map_triangles_carry_no_light() {
         camera,
         size: 3,
         photons,
+        counters: Stats::new(),
     };
     let triangles = map.caustic_triangles(Vec3::ONE);
     // Square (0, 0): first half (0,0) (1,0) (0,1) on a line; second (1,0) (1,1) (0,1) kept.
@@ -326,4 +327,43 @@ fn splat_counts_a_shared_edge_once_and_tests_depth() {
         let want = if k == 9 { 0.0 } else { 1.0 };
         assert_eq!(v.x, want, "pixel {k}");
     }
+}
+
+/// A map through camera triangles keeps its render's counters, reported as `caustic_*` with
+/// the overdraw their ratio (Table 1's caustics row); the exact map renders nothing through
+/// camera triangles and reports none.
+#[test]
+fn camera_triangle_maps_report_their_fragments() {
+    let mut scene = caustics_scene();
+    scene.caustics[0].map_size = 64;
+    let prepared = PreparedScene::new(&scene);
+    let projection = scene.projection.build(80, 60).unwrap();
+    let counters = |method| {
+        let options = RenderOptions {
+            method,
+            shading: Shading::Lit,
+            ..RenderOptions::default()
+        };
+        crate::render::render(&prepared, projection.as_ref(), &options)
+            .unwrap()
+            .counters
+    };
+    let ours = counters(Method::CameraTriangles);
+    let count = |name| match ours.get(name) {
+        Some(Counter::Count(n)) => *n,
+        other => panic!("{name}: {other:?}"),
+    };
+    assert!(count("caustic_camera_triangles") > 0, "{ours:?}");
+    let (bounding, rendered) = (
+        count("caustic_bounding_fragments"),
+        count("caustic_rendered_fragments"),
+    );
+    assert!(rendered > 0 && bounding >= rendered, "{ours:?}");
+    assert_eq!(
+        ours.get("caustic_overdraw"),
+        Some(&Counter::Value(bounding as f64 / rendered as f64))
+    );
+    let exact = counters(Method::Raycast);
+    assert!(exact.contains_key("caustic_photons"), "{exact:?}");
+    assert!(!exact.contains_key("caustic_camera_triangles"), "{exact:?}");
 }

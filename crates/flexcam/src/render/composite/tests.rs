@@ -480,6 +480,40 @@ fn uncovered_reflector_pixels_are_ray_cast_exactly() {
         stats.get("reflector_exact_pixels"),
         Some(&Counter::Count(c.pixels))
     );
+    assert_eq!(
+        stats.get("reflector_uncovered_pixels"),
+        Some(&Counter::Count(c.pixels))
+    );
+    // Without casting the gaps, the uncovered pixels are counted, none is cast, and (there
+    // being no surface) they keep the main view's flat colour of the reflector, one colour
+    // where the true mirror shows several.
+    let gaps = RenderOptions {
+        cast_reflector_gaps: false,
+        ..flat()
+    };
+    let Rendered {
+        frame: left,
+        counters: stats,
+        ..
+    } = composited(&scene, main.as_ref(), &gaps);
+    assert_eq!(
+        stats.get("reflector_exact_pixels"),
+        Some(&Counter::Count(0))
+    );
+    assert_eq!(
+        stats.get("reflector_uncovered_pixels"),
+        Some(&Counter::Count(c.pixels))
+    );
+    let mirror_pixels: Vec<usize> = (0..left.ids.len())
+        .filter(|&k| reference.ids[k] == BALL)
+        .collect();
+    let first = mirror_pixels[0];
+    assert!(mirror_pixels
+        .iter()
+        .all(|&k| left.color[k] == left.color[first]));
+    assert!(mirror_pixels
+        .iter()
+        .any(|&k| reference.color[k] != reference.color[first]));
     // From the front, the surface covers the mirror: (almost) nothing is cast.
     let front = ReflectorFixture {
         eye: [0.5, 1.2, 3.0],
