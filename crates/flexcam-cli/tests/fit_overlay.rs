@@ -7,32 +7,7 @@ use common::{run, run_ok};
 use tempfile::TempDir;
 
 /// The objects and lights of every case: a checker floor, a cube and a ball.
-const OBJECTS: &str = r#"
-[[object]]
-name = "floor"
-shape = "plane"
-size = [10.0, 10.0]
-tessellation = 21
-checker = { color = [0.1, 0.1, 0.1], size = 1.0 }
-
-[[object]]
-name = "cube"
-shape = "box"
-size = [2.0, 2.0, 2.0]
-translate = [-1.3, 1.0, 0.0]
-rotate = [0.0, 30.0, 0.0]
-
-[[object]]
-name = "ball"
-shape = "sphere"
-size = 1.0
-translate = [1.6, 1.0, 1.0]
-
-[[light]]
-type = "directional"
-direction = [-0.3, -1.0, -0.5]
-intensity = 1.0
-"#;
+const OBJECTS: &str = common::FLOOR_CUBE_BALL;
 
 /// The painting's size.
 const W: u32 = 320;
