@@ -333,6 +333,20 @@ fn bad_painting_input_is_one_line_naming_file_and_entry() {
         );
         assert!(!dir.path().join("out.toml").exists() && !dir.path().join("out.png").exists());
     }
+    // The painting keys go with `fit`.
+    let no_fit =
+        fitting_scene((W, H), "painting_size = [320, 240]\n", "").replace("fit = [\n]\n", "");
+    std::fs::write(dir.path().join("bad.toml"), no_fit).unwrap();
+    let out = run(&dir, &["render", "bad.toml", "-o", "out.png"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.lines().count() == 1,
+        "{stderr}"
+    );
+    assert!(
+        stderr.contains("bad.toml:") && stderr.contains("go with `fit`"),
+        "{stderr}"
+    );
     for size in ["[0, 240]", "[320, 70000]", "[-1, 5]"] {
         let keys = format!("painting_size = {size}\n");
         std::fs::write(

@@ -136,7 +136,18 @@ pub(super) fn convert(
 /// `painting_size`; `None` when neither is given. Both keys go with `fit` only, and not
 /// together.
 fn painting(src: &Source, raw: &RawProjectors) -> Result<Option<Resolution>> {
-    let given = match (&raw.painting, &raw.painting_size) {
+    let with_fit = |span: &std::ops::Range<usize>| {
+        if raw.fit.is_some() {
+            return Ok(());
+        }
+        Err(src.error(
+            span,
+            "`painting` and `painting_size` go with `fit` (they give the size of the image its \
+             `pixel` positions are in)",
+        ))
+    };
+    let (given, (width, height)) = match (&raw.painting, &raw.painting_size) {
+        (None, None) => return Ok(None),
         (Some(_), Some(size)) => {
             return Err(src.error(
                 &size.span(),
@@ -144,53 +155,51 @@ fn painting(src: &Source, raw: &RawProjectors) -> Result<Option<Resolution>> {
                  not both",
             ))
         }
-        (None, None) => return Ok(None),
-        (Some(name), None) => name.span(),
-        (None, Some(size)) => size.span(),
-    };
-    if raw.fit.is_none() {
-        return Err(src.error(
-            &given,
-            "`painting` and `painting_size` go with `fit` (they give the size of the image its \
-             `pixel` positions are in)",
-        ));
-    }
-    let (width, height) = match (&raw.painting, &raw.painting_size) {
-        (Some(name), _) => {
-            let base_dir = src.path.parent().unwrap_or(Path::new(""));
-            let path = src.existing_file(name, base_dir, "painting")?;
-            image::image_dimensions(&path).map_err(|e| {
-                src.error(
-                    &name.span(),
-                    format!("painting \"{}\" cannot be read: {e}", name.get_ref()),
-                )
-            })?
+        (Some(name), None) => {
+            with_fit(&name.span())?;
+            (name.span(), painting_file_size(src, name)?)
         }
         (None, Some(size)) => {
-            let [w, h] = *size.get_ref();
-            let side = |n: i64| {
-                u32::try_from(n)
-                    .ok()
-                    .filter(|n| (1..=MAX_PAINTING_SIDE).contains(n))
-            };
-            match (side(w), side(h)) {
-                (Some(w), Some(h)) => (w, h),
-                _ => {
-                    return Err(src.error(
-                        &size.span(),
-                        format!(
-                            "`painting_size` must be [width, height] in pixels, each from 1 to \
-                             {MAX_PAINTING_SIDE}, not [{w}, {h}]"
-                        ),
-                    ))
-                }
-            }
+            with_fit(&size.span())?;
+            (size.span(), painting_size(src, size)?)
         }
-        (None, None) => unreachable!("returned above"),
     };
     Resolution::new(width, height)
         .map(Some)
         .map_err(|e| src.error(&given, format!("painting: {}", e.message)))
+}
+
+/// The size of the painting file `name` (relative to the scene file's folder), from its
+/// header; the file is recorded as an input of the scene.
+fn painting_file_size(src: &Source, name: &Spanned<String>) -> Result<(u32, u32)> {
+    let base_dir = src.path.parent().unwrap_or(Path::new(""));
+    let path = src.existing_file(name, base_dir, "painting")?;
+    image::image_dimensions(&path).map_err(|e| {
+        src.error(
+            &name.span(),
+            format!("painting \"{}\" cannot be read: {e}", name.get_ref()),
+        )
+    })
+}
+
+/// A `painting_size` value: two sides from 1 to [`MAX_PAINTING_SIDE`].
+fn painting_size(src: &Source, size: &Spanned<[i64; 2]>) -> Result<(u32, u32)> {
+    let [w, h] = *size.get_ref();
+    let side = |n: i64| {
+        u32::try_from(n)
+            .ok()
+            .filter(|n| (1..=MAX_PAINTING_SIDE).contains(n))
+    };
+    match (side(w), side(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(src.error(
+            &size.span(),
+            format!(
+                "`painting_size` must be [width, height] in pixels, each from 1 to \
+                 {MAX_PAINTING_SIDE}, not [{w}, {h}]"
+            ),
+        )),
+    }
 }
 
 /// The largest side of a painting given by `painting_size`, in pixels (that of a large
