@@ -18,37 +18,7 @@ use tempfile::TempDir;
 const SIZE: [u32; 2] = [320, 240];
 
 /// The scene's objects and lights: a checker floor, a cube and a ball.
-const OBJECTS: &str = r#"
-[[object]]
-name = "floor"
-shape = "plane"
-size = [10.0, 10.0]
-tessellation = 21
-color = [0.9, 0.9, 0.9]
-checker = { color = [0.1, 0.1, 0.1], size = 1.0 }
-
-[[object]]
-name = "cube"
-shape = "box"
-size = [2.0, 2.0, 2.0]
-tessellation = 3
-color = [0.8, 0.3, 0.2]
-translate = [-1.3, 1.0, 0.0]
-rotate = [0.0, 30.0, 0.0]
-
-[[object]]
-name = "ball"
-shape = "sphere"
-size = 1.0
-tessellation = 32
-color = [0.2, 0.4, 0.9]
-translate = [1.6, 1.0, 1.0]
-
-[[light]]
-type = "directional"
-direction = [-0.3, -1.0, -0.5]
-intensity = 1.0
-"#;
+const OBJECTS: &str = common::FLOOR_CUBE_BALL;
 
 /// The uniform numbers of seed `seed` (its own stream: the seed scrambled first).
 fn uniform(seed: u64) -> impl FnMut() -> f64 {

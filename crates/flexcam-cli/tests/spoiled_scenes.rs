@@ -18,7 +18,8 @@ use mutations::{example_scenes, mutate, scenes_dir, Rng};
 /// Mutations per example scene (each one a run of the binary).
 const MUTATIONS: usize = 6;
 
-/// Copies the folder `from` into `to` (the models and surfaces the scenes name relatively).
+/// Copies the folder `from` into `to` (the models, surfaces and photos the scenes name
+/// relatively).
 fn copy_dir(from: &Path, to: &Path) {
     fs::create_dir_all(to).unwrap();
     for entry in fs::read_dir(from).unwrap() {
@@ -35,7 +36,7 @@ fn copy_dir(from: &Path, to: &Path) {
 #[test]
 fn spoiled_scenes_render_or_fail_with_one_line_naming_the_file() {
     let dir = TempDir::new().unwrap();
-    for folder in ["models", "surfaces"] {
+    for folder in ["models", "surfaces", "photos"] {
         copy_dir(&scenes_dir().join(folder), &dir.path().join(folder));
     }
     let mut rng = Rng(0x2545_f491_4f6c_dd1d);

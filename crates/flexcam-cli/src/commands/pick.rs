@@ -2,7 +2,8 @@
 //! scene (`flexcam::render::pick`), for collecting a fit's correspondences from a render.
 
 use clap::Args;
-use flexcam::render::{pick, PreparedScene};
+use flexcam::render::{pick, Picked, PreparedScene};
+use flexcam::scene::Object;
 use flexcam::{Error, Result};
 use glam::DVec2;
 use serde_json::json;
@@ -32,6 +33,11 @@ pub struct PickArgs {
     /// Print one JSON object per position instead of text.
     #[arg(long)]
     json: bool,
+    /// Print each position as a `fit` entry of a projector grid,
+    /// `{ pixel = [x, y], point = [x, y, z] },  # object`, ready to paste into a `fit` list
+    /// (positions that see nothing as a comment).
+    #[arg(long, conflicts_with = "json")]
+    fit: bool,
 }
 
 /// Runs `flexcam pick`: one line per position, the object's name and id and the world
@@ -64,6 +70,7 @@ pub fn run(args: &PickArgs) -> Result<()> {
         let picked = pick(&prepared, loaded.projection.as_ref(), pixel);
         let object = picked.map(|p| &loaded.scene.objects[p.object]);
         let line = match (args.json, picked, object) {
+            _ if args.fit => fit_entry(pixel, picked.zip(object)),
             (true, Some(p), Some(o)) => json!({
                 "pixel": [pixel.x, pixel.y],
                 "object": o.name,
@@ -82,6 +89,18 @@ pub fn run(args: &PickArgs) -> Result<()> {
         text.push('\n');
     }
     super::print_stdout(&text)
+}
+
+/// The `fit` entry of a pick at `pixel` (see `PickArgs::fit`): the object's name in a
+/// comment, or a comment alone where nothing is seen.
+fn fit_entry(pixel: DVec2, picked: Option<(Picked, &Object)>) -> String {
+    match picked {
+        Some((p, o)) => format!(
+            "{{ pixel = [{:?}, {:?}], point = [{:?}, {:?}, {:?}] }},  # {}",
+            pixel.x, pixel.y, p.point.x, p.point.y, p.point.z, o.name
+        ),
+        None => format!("# {},{}: nothing", pixel.x, pixel.y),
+    }
 }
 
 /// `X,Y` as a pixel position (two finite numbers).

@@ -198,3 +198,38 @@ impl Layers {
             .collect()
     }
 }
+
+/// The objects and light of the painting tests (`fit_painting`, `fit_overlay`): a checker
+/// floor (id 1, 10 x 10 at y = 0), a cube (id 2, side 2, on the floor at x = -1.3, turned 30
+/// degrees) and a ball (id 3, radius 1, centre (1.6, 1, 1)), lit from above.
+pub const FLOOR_CUBE_BALL: &str = r#"
+[[object]]
+name = "floor"
+shape = "plane"
+size = [10.0, 10.0]
+tessellation = 21
+color = [0.9, 0.9, 0.9]
+checker = { color = [0.1, 0.1, 0.1], size = 1.0 }
+
+[[object]]
+name = "cube"
+shape = "box"
+size = [2.0, 2.0, 2.0]
+tessellation = 3
+color = [0.8, 0.3, 0.2]
+translate = [-1.3, 1.0, 0.0]
+rotate = [0.0, 30.0, 0.0]
+
+[[object]]
+name = "ball"
+shape = "sphere"
+size = 1.0
+tessellation = 32
+color = [0.2, 0.4, 0.9]
+translate = [1.6, 1.0, 1.0]
+
+[[light]]
+type = "directional"
+direction = [-0.3, -1.0, -0.5]
+intensity = 1.0
+"#;

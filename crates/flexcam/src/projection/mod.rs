@@ -30,6 +30,7 @@ mod inverse_properties;
 mod kannala_brandt;
 mod linear;
 mod monotone_root;
+pub mod nearest_image;
 mod ods;
 mod opencv;
 mod panoramic;

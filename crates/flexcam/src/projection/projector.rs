@@ -8,7 +8,7 @@
 
 use glam::DVec3;
 
-use crate::geometry::Ray;
+use crate::geometry::{solve_cubic, Ray};
 
 /// A projector, from its start (the near end) to its end.
 #[derive(Debug, Clone, PartialEq)]
@@ -41,6 +41,32 @@ pub struct ProjectorHull {
 pub fn quadratic_point(p: &[DVec3; 3], s: f64) -> DVec3 {
     let r = 1.0 - s;
     r * r * p[0] + 2.0 * s * r * p[1] + s * s * p[2]
+}
+
+/// The depth t in [0, 1] of the point of the quadratic Bezier curve `p` closest to `x`: an
+/// end, or a root in (0, 1) of the cubic (B(t) - x) . B'(t) / 2 (its global minimum, so that
+/// a point cannot be held at an end while the curve passes nearer further along).
+/// Degenerate cases: a curve that does not move (all control points equal: the cubic is
+/// identically zero) gives 0; equally near candidates give the smallest t.
+pub fn quadratic_closest(p: &[DVec3; 3], x: DVec3) -> f64 {
+    // B(t) - x = d + t b + t^2 a.
+    let (d, b, a) = (p[0] - x, 2.0 * (p[1] - p[0]), p[2] - 2.0 * p[1] + p[0]);
+    let roots = solve_cubic(
+        2.0 * a.length_squared(),
+        3.0 * a.dot(b),
+        b.length_squared() + 2.0 * a.dot(d),
+        b.dot(d),
+    );
+    let inside = roots.iter().filter(|t| *t > 0.0 && *t < 1.0);
+    let distance = |t: f64| (quadratic_point(p, t) - x).length_squared();
+    let mut best = (0.0, distance(0.0));
+    for t in inside.chain([1.0]) {
+        let d = distance(t);
+        if d < best.1 {
+            best = (t, d);
+        }
+    }
+    best.0
 }
 
 /// The derivative B'(s) of quadratic Bezier curve `p`: 2 ((1-s)(P1 - P0) + s (P2 - P1)).

@@ -40,7 +40,7 @@
 //! Levenberg-Marquardt on the node angles (the end's direction and the tangent, two angles
 //! each about their current value), every depth t_k the closest point of its projector to
 //! X_k over [0, 1] after each step (the global minimum of a quadratic's squared distance: a
-//! cubic's roots and the two ends, [`closest_depth`]): a point is never held at an end, such
+//! cubic's roots and the two ends, [`quadratic_closest`]): a point is never held at an end, such
 //! as the start, while the curve passes nearer further along (the trap of the first version,
 //! which stepped the depths with the nodes and clamped them). Each depth enters only its own
 //! residual and sits where the residual is perpendicular to the projector, so it is
@@ -96,9 +96,8 @@ use nalgebra::{DMatrix, DVector};
 
 use super::{Correspondence, FitReport};
 use crate::error::{Error, Result};
-use crate::geometry::solve_cubic;
 use crate::projection::flexible::projector_grid::ProjectorGrid;
-use crate::projection::projector::{quadratic_point, quadratic_tangent};
+use crate::projection::projector::{quadratic_closest, quadratic_point, quadratic_tangent};
 
 /// The prior's weight relative to the data term's mean curvature (see the module docs).
 const PRIOR_WEIGHT: f64 = 1e-12;
@@ -274,7 +273,7 @@ impl<'a> Problem<'a> {
     /// to its scene point.
     fn with_closest_depths(&self, nodes: Vec<Node>) -> State {
         let depths = (0..self.data.len())
-            .map(|k| closest_depth(&self.controls(k, &nodes), self.data[k].point))
+            .map(|k| quadratic_closest(&self.controls(k, &nodes), self.data[k].point))
             .collect();
         State { nodes, depths }
     }
@@ -724,32 +723,6 @@ impl<'a> Problem<'a> {
             .collect();
         FitReport::from_angles(&angles, grid.starts().len() - self.free.len())
     }
-}
-
-/// The depth t in [0, 1] of the point of the quadratic Bezier curve `p` closest to `x`: an
-/// end, or a root in (0, 1) of the cubic (B(t) - x) . B'(t) / 2 (its global minimum, so that
-/// a point cannot be held at an end while the curve passes nearer further along).
-/// Degenerate cases: a curve that does not move (all control points equal: the cubic is
-/// identically zero) gives 0; equally near candidates give the smallest t.
-pub(super) fn closest_depth(p: &[DVec3; 3], x: DVec3) -> f64 {
-    // B(t) - x = d + t b + t^2 a.
-    let (d, b, a) = (p[0] - x, 2.0 * (p[1] - p[0]), p[2] - 2.0 * p[1] + p[0]);
-    let roots = solve_cubic(
-        2.0 * a.length_squared(),
-        3.0 * a.dot(b),
-        b.length_squared() + 2.0 * a.dot(d),
-        b.dot(d),
-    );
-    let inside = roots.iter().filter(|t| *t > 0.0 && *t < 1.0);
-    let distance = |t: f64| (quadratic_point(p, t) - x).length_squared();
-    let mut best = (0.0, distance(0.0));
-    for t in inside.chain([1.0]) {
-        let d = distance(t);
-        if d < best.1 {
-            best = (t, d);
-        }
-    }
-    best.0
 }
 
 /// J^T J, by a blocked matrix product (nalgebra's `tr_mul` forms it entry by entry, column

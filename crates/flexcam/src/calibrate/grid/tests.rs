@@ -781,7 +781,8 @@ fn max_sight_error(fitted: &ProjectorGrid, truth: &ProjectorGrid) -> f64 {
             let p = fitted.control_points(uv);
             for t in [0.25, 0.5, 0.75] {
                 let x = truth.point(uv, t);
-                let on = quadratic_point(&p, curved::closest_depth(&p, x));
+                let on =
+                    quadratic_point(&p, crate::projection::projector::quadratic_closest(&p, x));
                 worst = worst.max((x - on).length().atan2((x - p[0]).length()));
             }
         }

@@ -2,7 +2,8 @@
 //! the fitted node projectors explicit, so that an artist can go on editing them.
 //!
 //! The written file is the original text edited in place (comments and layout kept): in the
-//! projection's `projectors` table the `fit`, `aim`, `projector` and `starts` keys are replaced by one
+//! projection's `projectors` table the `fit`, `aim`, `projector`, `starts`, `painting` and
+//! `painting_size` keys are replaced by one
 //! `projector` entry per node with its fitted `start` and `end`, and its `tangent` when it is
 //! curved (a grid with tangents is fitted with curved projectors). Floats are written in Rust's
 //! shortest round-trip form, so the written grid is the fitted one bit for bit, and rendering
@@ -11,7 +12,7 @@
 //! model paths) and its grid compared with the fitted one: a written scene that would not
 //! load, or load differently, is an error instead of a file.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use toml_edit::{Array, InlineTable, Item, TableLike, Value};
 
@@ -19,12 +20,16 @@ use super::edit::{float_array, parse_document};
 
 use crate::calibrate::{self, FitReport};
 use crate::error::{Error, Result};
-use crate::projection::flexible::{Flexible, FlexibleSpec, ProjectorGrid, Volume, VolumeSource};
+use crate::projection::flexible::{
+    Correspondence, Flexible, FlexibleSpec, ProjectorGrid, Volume, VolumeSource,
+};
 use crate::projection::ProjectionSpec;
 use crate::scene::InputFile;
 
-/// A fitted scene: the text to write, the fit's residual, and the files the fitting scene's
-/// values named (models, textures, surfaces; see [`crate::scene::Scene::inputs`]).
+/// A fitted scene: the text to write, the fit's residual, the files the fitting scene's
+/// values named (models, textures, surfaces, the painting; see
+/// [`crate::scene::Scene::inputs`]), and the correspondences and painting the fit was made
+/// from (for an overlay of the fit on the painting).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FittedScene {
     /// The scene file's text with the fitted node projectors written in.
@@ -33,6 +38,13 @@ pub struct FittedScene {
     pub report: FitReport,
     /// The files the fitting scene read.
     pub inputs: Vec<InputFile>,
+    /// The correspondences fitted, their image positions in (u, v) (`pixel` entries
+    /// converted).
+    pub correspondences: Vec<Correspondence>,
+    /// The painting image (`painting`, resolved from the fitting scene's folder).
+    pub painting: Option<PathBuf>,
+    /// The painting's size given by `painting_size`, in pixels.
+    pub painting_size: Option<[u32; 2]>,
 }
 
 /// Fits the projector grid of the scene file `text` (read from `path`) to its `fit`
@@ -58,6 +70,19 @@ pub fn fit_scene(text: &str, path: &Path, output: &Path) -> Result<FittedScene> 
         .and_then(|p| p.get_mut("projectors"))
         .and_then(Item::as_table_like_mut)
         .ok_or_else(|| Error::in_file(path, "the [projection] table has no `projectors`"))?;
+    // Both were checked by the parse above.
+    let base_dir = path.parent().unwrap_or(Path::new(""));
+    let painting = projectors
+        .get("painting")
+        .and_then(Item::as_str)
+        .map(|name| base_dir.join(name));
+    let painting_size = projectors
+        .get("painting_size")
+        .and_then(Item::as_array)
+        .and_then(|a| {
+            let side = |i| a.get(i)?.as_integer().and_then(|n| u32::try_from(n).ok());
+            Some([side(0)?, side(1)?])
+        });
     replace_nodes(projectors, &grid);
     let warning = report
         .warning()
@@ -77,6 +102,9 @@ pub fn fit_scene(text: &str, path: &Path, output: &Path) -> Result<FittedScene> 
         text: written,
         report,
         inputs: scene.inputs,
+        correspondences: correspondences(&scene.projection),
+        painting,
+        painting_size,
     })
 }
 
@@ -105,11 +133,31 @@ fn has_fit(spec: &FlexibleSpec) -> bool {
     matches!(&spec.source, VolumeSource::ProjectorGrid { grid, .. } if !grid.correspondences.is_empty())
 }
 
-/// Replaces `fit`, `aim`, `projector` and `starts` (which goes with `fit` only) in `table` by one `projector` entry per node of
+/// The correspondences of the top-level projector grid of `projection` (none for any other
+/// projection).
+fn correspondences(projection: &ProjectionSpec) -> Vec<Correspondence> {
+    match projection {
+        ProjectionSpec::Flexible(spec) => match &spec.source {
+            VolumeSource::ProjectorGrid { grid, .. } => grid.correspondences.clone(),
+            _ => Vec::new(),
+        },
+        _ => Vec::new(),
+    }
+}
+
+/// Replaces `fit`, `aim`, `projector` and `starts`, `painting` and `painting_size` (which go
+/// with `fit` only) in `table` by one `projector` entry per node of
 /// `grid` (bottom row first), one per line, with the tangents of curved nodes (unit vectors
 /// that normalising leaves unchanged, so they load back bit for bit).
 fn replace_nodes(table: &mut dyn TableLike, grid: &ProjectorGrid) {
-    for key in ["fit", "aim", "projector", "starts"] {
+    for key in [
+        "fit",
+        "aim",
+        "projector",
+        "starts",
+        "painting",
+        "painting_size",
+    ] {
         table.remove(key);
     }
     let cols = grid.size().0;

@@ -231,12 +231,18 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
                      or near and far surfaces), not from blended `surfaces`",
                 ));
             }
+            // The map the built projection takes (`build_volume`): the given one, else the
+            // preset's own, else linear.
+            let uv_map = reparam.unwrap_or(match &source {
+                VolumeSource::Preset(p) => p.preset.default_reparam(),
+                _ => Reparam::Linear,
+            });
             VolumeSource::ProjectorGrid {
+                grid: super::projector_grid::convert(src, table, &uv_map)?,
                 base: Box::new(FlexibleSpec {
                     source,
                     reparam: None,
                 }),
-                grid: super::projector_grid::convert(src, table)?,
             }
         }
     };

@@ -3,6 +3,8 @@
 //! curved by a tangent), re-aimed node by node and fitted to point correspondences (with
 //! tangents: curved projectors fitted). See scenes/README.md.
 
+use std::path::Path;
+
 use glam::{DVec2, DVec3};
 use toml::Spanned;
 
@@ -11,13 +13,20 @@ use super::source::Source;
 use crate::error::Result;
 use crate::projection::flexible::projector_grid::{Through, MAX_NODES, MIN_NODES};
 use crate::projection::flexible::{Aim, GridInterpolation, NodeProjector, ProjectorGridSpec};
-use crate::projection::flexible::{Correspondence, Starts};
+use crate::projection::flexible::{Correspondence, Reparam, Starts};
+use crate::projection::Resolution;
 
 /// Nodes per side when `size` is not given: the thesis's 5 x 5.
 const DEFAULT_SIZE: usize = 5;
 
 /// Converts a `projectors` table; every value is checked here so that errors point at it.
-pub(super) fn convert(src: &Source, table: &Spanned<RawProjectors>) -> Result<ProjectorGridSpec> {
+/// `reparam` is the projection's map from image positions to the grid's (u, v), which turns
+/// `pixel` correspondences into (u, v).
+pub(super) fn convert(
+    src: &Source,
+    table: &Spanned<RawProjectors>,
+    reparam: &Reparam,
+) -> Result<ProjectorGridSpec> {
     let raw = table.get_ref();
     let size = match &raw.size {
         Some(size) => {
@@ -65,16 +74,48 @@ pub(super) fn convert(src: &Source, table: &Spanned<RawProjectors>) -> Result<Pr
             at: finite_point(src, &a.at, "at")?,
         });
     }
+    let painting = painting(src, raw)?;
     let mut correspondences = Vec::new();
-    for pair in raw.fit.iter().flatten() {
+    for (index, pair) in raw.fit.iter().flatten().enumerate() {
         let c = pair.get_ref();
-        let uv = DVec2::from(*c.uv.get_ref());
-        if !uv.is_finite() || uv.min_element() < 0.0 || uv.max_element() > 1.0 {
-            return Err(src.error(
-                &c.uv.span(),
-                format!("`uv` must lie in [0, 1] x [0, 1], not [{}, {}]", uv.x, uv.y),
-            ));
-        }
+        let entry = index + 1;
+        let uv = match (&c.uv, &c.pixel) {
+            (Some(uv), None) => {
+                let uv_value = DVec2::from(*uv.get_ref());
+                if !uv_value.is_finite()
+                    || uv_value.min_element() < 0.0
+                    || uv_value.max_element() > 1.0
+                {
+                    return Err(src.error(
+                        &uv.span(),
+                        format!(
+                            "`fit` entry {entry}: `uv` must lie in [0, 1] x [0, 1], not [{}, {}]",
+                            uv_value.x, uv_value.y
+                        ),
+                    ));
+                }
+                uv_value
+            }
+            (None, Some(pixel)) => painting_uv(src, painting.as_ref(), pixel, entry, reparam)?,
+            (Some(_), Some(pixel)) => {
+                return Err(src.error(
+                    &pixel.span(),
+                    format!(
+                        "`fit` entry {entry} gives both `uv` and `pixel`: give one image \
+                         position"
+                    ),
+                ))
+            }
+            (None, None) => {
+                return Err(src.error(
+                    &pair.span(),
+                    format!(
+                        "`fit` entry {entry} has no image position: give `pixel = [x, y]` (in \
+                         the painting) or `uv = [u, v]` (in [0, 1])"
+                    ),
+                ))
+            }
+        };
         correspondences.push(Correspondence {
             uv,
             point: finite_point(src, &c.point, "point")?,
@@ -88,6 +129,123 @@ pub(super) fn convert(src: &Source, table: &Spanned<RawProjectors>) -> Result<Pr
         aims,
         correspondences,
         starts,
+    })
+}
+
+/// The painting's size in pixels, from the `painting` image file's header or from
+/// `painting_size`; `None` when neither is given. Both keys go with `fit` only, and not
+/// together.
+fn painting(src: &Source, raw: &RawProjectors) -> Result<Option<Resolution>> {
+    let with_fit = |span: &std::ops::Range<usize>| {
+        if raw.fit.is_some() {
+            return Ok(());
+        }
+        Err(src.error(
+            span,
+            "`painting` and `painting_size` go with `fit` (they give the size of the image its \
+             `pixel` positions are in)",
+        ))
+    };
+    let (given, (width, height)) = match (&raw.painting, &raw.painting_size) {
+        (None, None) => return Ok(None),
+        (Some(_), Some(size)) => {
+            return Err(src.error(
+                &size.span(),
+                "give the painting as `painting = \"FILE\"` or its size as `painting_size`, \
+                 not both",
+            ))
+        }
+        (Some(name), None) => {
+            with_fit(&name.span())?;
+            (name.span(), painting_file_size(src, name)?)
+        }
+        (None, Some(size)) => {
+            with_fit(&size.span())?;
+            (size.span(), painting_size(src, size)?)
+        }
+    };
+    Resolution::new(width, height)
+        .map(Some)
+        .map_err(|e| src.error(&given, format!("painting: {}", e.message)))
+}
+
+/// The size of the painting file `name` (relative to the scene file's folder), from its
+/// header; the file is recorded as an input of the scene.
+fn painting_file_size(src: &Source, name: &Spanned<String>) -> Result<(u32, u32)> {
+    let base_dir = src.path.parent().unwrap_or(Path::new(""));
+    let path = src.existing_file(name, base_dir, "painting")?;
+    image::image_dimensions(&path).map_err(|e| {
+        src.error(
+            &name.span(),
+            format!("painting \"{}\" cannot be read: {e}", name.get_ref()),
+        )
+    })
+}
+
+/// A `painting_size` value: two sides from 1 to [`MAX_PAINTING_SIDE`].
+fn painting_size(src: &Source, size: &Spanned<[i64; 2]>) -> Result<(u32, u32)> {
+    let [w, h] = *size.get_ref();
+    let side = |n: i64| {
+        u32::try_from(n)
+            .ok()
+            .filter(|n| (1..=MAX_PAINTING_SIDE).contains(n))
+    };
+    match (side(w), side(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(src.error(
+            &size.span(),
+            format!(
+                "`painting_size` must be [width, height] in pixels, each from 1 to \
+                 {MAX_PAINTING_SIDE}, not [{w}, {h}]"
+            ),
+        )),
+    }
+}
+
+/// The largest side of a painting given by `painting_size`, in pixels (that of a large
+/// photograph; the painting is only measured, never allocated, by the fit).
+const MAX_PAINTING_SIDE: u32 = 1 << 16;
+
+/// The (u, v) of `fit` entry `entry`'s `pixel` (x right, y down from the painting's
+/// top-left corner, continuous: a pixel's centre at +0.5), through the projection's
+/// re-parameterisation `reparam` at the painting's size. Errors: no painting given, a
+/// position outside the painting or outside the map's domain (a fisheye's image circle).
+fn painting_uv(
+    src: &Source,
+    painting: Option<&Resolution>,
+    pixel: &Spanned<[f64; 2]>,
+    entry: usize,
+    reparam: &Reparam,
+) -> Result<DVec2> {
+    let at = DVec2::from(*pixel.get_ref());
+    let Some(painting) = painting else {
+        return Err(src.error(
+            &pixel.span(),
+            format!(
+                "`fit` entry {entry}: `pixel` positions need the painting: give `painting = \
+                 \"FILE\"` (or `painting_size = [width, height]`) in the `projectors` table"
+            ),
+        ));
+    };
+    let size = painting.size();
+    let inside = at.is_finite() && at.cmpge(DVec2::ZERO).all() && at.cmple(size).all();
+    let uv = inside
+        .then(|| reparam.to_uv(painting, at))
+        .flatten()
+        .filter(|uv| uv.cmpge(DVec2::ZERO).all() && uv.cmple(DVec2::ONE).all());
+    uv.ok_or_else(|| {
+        let domain = if inside {
+            format!(" (outside the {} map's image)", reparam.name())
+        } else {
+            String::new()
+        };
+        src.error(
+            &pixel.span(),
+            format!(
+                "`fit` entry {entry}: pixel [{}, {}] is outside the {} x {} painting{domain}",
+                at.x, at.y, painting.width, painting.height
+            ),
+        )
     })
 }
 

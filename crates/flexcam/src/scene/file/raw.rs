@@ -204,6 +204,9 @@ pub struct RawProjectors {
     pub aim: Option<Vec<Spanned<RawAim>>>,
     pub fit: Option<Vec<Spanned<RawCorrespondence>>>,
     pub starts: Option<Spanned<String>>,
+    pub painting: Option<Spanned<String>>,
+    #[serde(default, deserialize_with = "strict")]
+    pub painting_size: Option<Spanned<[i64; 2]>>,
 }
 
 /// `{ node = [column, row], start = [x, y, z], end = [x, y, z], tangent = [x, y, z] }`: one
@@ -236,12 +239,15 @@ pub struct RawAim {
     pub at: Vec3Value,
 }
 
-/// `{ uv = [u, v], point = [x, y, z] }`: the image position that must see a scene point.
+/// `{ uv = [u, v], point = [x, y, z] }` or `{ pixel = [x, y], point = [x, y, z] }`: the
+/// image position (in [0, 1]^2, or in the painting's pixels) that must see a scene point.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawCorrespondence {
-    #[serde(deserialize_with = "strict")]
-    pub uv: Spanned<[f64; 2]>,
+    #[serde(default, deserialize_with = "strict")]
+    pub uv: Option<Spanned<[f64; 2]>>,
+    #[serde(default, deserialize_with = "strict")]
+    pub pixel: Option<Spanned<[f64; 2]>>,
     #[serde(deserialize_with = "strict")]
     pub point: Vec3Value,
 }
