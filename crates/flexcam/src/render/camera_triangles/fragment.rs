@@ -102,7 +102,7 @@ impl Stage<'_> {
                         continue;
                     }
                     let centre = DVec2::new(f64::from(x) + 0.5, f64::from(span.y) + 0.5);
-                    let Some(ray) = camera.map.ray(centre) else {
+                    let Some(ray) = camera.pixel_ray(centre) else {
                         continue;
                     };
                     let Some((t, u, v)) = plane_hit(&ray, corners) else {

@@ -22,7 +22,10 @@ mod bound;
 mod camera;
 mod convex;
 mod fragment;
+mod mirror_cone;
 mod owners;
+#[cfg(test)]
+mod per_fragment_tests;
 mod quarter_cull;
 mod shade;
 #[cfg(test)]
