@@ -25,8 +25,13 @@
 //!   rays of the parent), so the argument holds for it, and its narrower cone of directions
 //!   gives a smaller hull. The union of the quarters' regions holds every fragment.
 //!
-//! Where the cone of directions meets the plane from both sides (or there is no plane), no
-//! hull bounds the region: the whole (sub-)triangle is the bound. Every region is dilated by
+//! The argument needs only a cone of three directions holding every ray direction of the
+//! (piece of the) camera triangle ([`Camera::cone`]): the corner directions for interpolated
+//! rays, an enclosing cone for the per-fragment rays of a mirror ([`super::mirror_cone`],
+//! projected onto the base plane only, where those rays start at their own barycentrics).
+//!
+//! Where the cone of directions meets the plane from both sides (or there is no plane, or no
+//! cone), no hull bounds the region: the whole (sub-)triangle is the bound. Every region is dilated by
 //! [`MARGIN_PX`] so that rounding never drops a pixel centre on its exact boundary.
 
 use glam::{DVec2, DVec3};

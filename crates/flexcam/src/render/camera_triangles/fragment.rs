@@ -2,7 +2,9 @@
 //!
 //! Each pixel of a bounding region is a fragment of one (camera triangle, scene triangle)
 //! pair, keyed `camera << 32 | scene triangle`. Its ray is the camera triangle's ray at the
-//! pixel centre (origin and direction interpolated barycentrically); it is intersected with
+//! pixel centre ([`Camera::pixel_ray`]: origin and direction interpolated barycentrically,
+//! or for a per-fragment mirror the eye's ray reflected about the interpolated normal); it
+//! is intersected with
 //! the scene triangle's plane, and the fragment is killed when the pixel belongs to another
 //! camera triangle ([`super::owners`]), when the hit lies outside the scene triangle or
 //! behind the ray's origin. A surviving fragment is *rendered*: its depth is the exact ray

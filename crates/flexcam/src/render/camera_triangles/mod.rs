@@ -16,7 +16,10 @@
 //!
 //! Reflections and refractions (`trilinear_reflector = true` objects) are trilinear
 //! surfaces composited into the main view (`render::composite`); with this method their
-//! surfaces are rendered by camera triangles.
+//! surfaces are rendered by camera triangles. A mirror's surface may reflect the eye's ray
+//! per fragment about the interpolated vertex normals instead of interpolating the vertex
+//! rays (the paper's reflection variant, section 3.1; `camera_rays = "per-fragment"`): the
+//! bounds then project along a cone enclosing those rays (`mirror_cone`).
 
 mod bound;
 mod camera;
