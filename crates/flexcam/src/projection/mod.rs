@@ -65,8 +65,9 @@ pub use projector::{Projector, ProjectorHull};
 pub use stereo::{KeepClear, Layout, StereoPair, View};
 pub use trilinear::mesh_builders as trilinear_builders;
 pub use trilinear::{
-    project_solved_triangle, project_triangle, ProjectionTriangleCache, ProjectiveMap, SceneEdge,
-    Shape, ShapeVertex, Solutions, TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
+    project_solved_triangle, project_triangle, FragmentMirror, ProjectionTriangleCache,
+    ProjectiveMap, SceneEdge, Shape, ShapeVertex, Solutions, TriangleMirror, TriangleShapes,
+    TriangleSolution, Trilinear, Unprojectable,
 };
 pub use vr180::{vr180, Vr180};
 

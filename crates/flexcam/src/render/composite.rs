@@ -36,7 +36,7 @@ use rayon::prelude::*;
 use self::camera_mesh::camera_mesh;
 use crate::error::{Error, Result};
 use crate::projection::trilinear_builders::{
-    reflector_surface, Optic, ReflectorSurface, SurfaceScreenMap,
+    reflector_surface, Optic, ReflectorSurface, SurfaceRays, SurfaceScreenMap,
 };
 use crate::projection::{Perspective, Projection, ProjectionSpec, Trilinear, TrilinearMesh};
 use crate::render::prepared::PreparedScene;
@@ -111,11 +111,17 @@ fn with_renderer(
     for entry in &scene.trilinear_reflectors {
         let (id, map) = (entry.id, entry.screen_map);
         let reflector = Reflector::of(scene, id)?;
+        if entry.camera_rays == SurfaceRays::PerFragment && reflector.optic != Optic::Reflect {
+            return Err(Error::new(format!(
+                "trilinear reflector {id}: per-fragment camera rays need a mirror (glass is \
+                 refracted by interpolated rays only)"
+            )));
+        }
         let (surface, mut left) =
             refined_surface(&reflector, reflector.optic, entry, &camera, options.method)?;
         triangles += surface.mesh.triangles.len();
         dropped += surface.dropped;
-        let projection = surface_projection(&surface, map, &camera)?;
+        let projection = surface_projection(&surface, map, entry.camera_rays, &camera)?;
         if let Some(projection) = &projection {
             let others = prepared.view(without(scene, id));
             let through = |surface: &Trilinear| {
@@ -141,7 +147,8 @@ fn with_renderer(
                         options.method,
                     )?;
                     left += mirror_left;
-                    let reflection = match surface_projection(&mirror, map, &camera)? {
+                    let rays = entry.camera_rays;
+                    let reflection = match surface_projection(&mirror, map, rays, &camera)? {
                         Some(surface) => through(&surface)?.0,
                         None => Frame::new(image.width, image.height, scene.image.background),
                     };
@@ -417,7 +424,7 @@ pub fn render_through(
     options: &RenderOptions,
     renderer: &Renderer,
 ) -> Result<Option<Frame>> {
-    surface_projection(surface, map, camera)?
+    surface_projection(surface, map, SurfaceRays::Interpolated, camera)?
         .map(|projection| Ok(renderer(others, &projection, options)?.0))
         .transpose()
 }
@@ -442,15 +449,16 @@ fn only(scene: &Scene, shown: impl Fn(&Object) -> bool) -> Scene {
     part
 }
 
-/// The trilinear projection of `surface` with screen map `map` at the main camera's
-/// resolution; `None` when the surface has no triangles.
+/// The trilinear projection of `surface` with screen map `map` and rays `rays` at the main
+/// camera's resolution; `None` when the surface has no triangles.
 fn surface_projection(
     surface: &ReflectorSurface,
     map: SurfaceScreenMap,
+    rays: SurfaceRays,
     camera: &Perspective,
 ) -> Result<Option<Trilinear>> {
     let (width, height) = camera.resolution();
-    surface.projection(map, width, height)
+    surface.projection(map, rays, width, height)
 }
 
 /// Exact ray casting of the reflector pixels a surface does not cover: the ray caster's own

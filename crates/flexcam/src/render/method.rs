@@ -84,6 +84,12 @@ impl Method {
                         projection.kind()
                     ))
                 })?;
+                if trilinear.fragment_mirror().is_some() {
+                    return Err(Error::new(
+                        "the trilinear method renders interpolated rays only: a reflector with \
+                         camera_rays = \"per-fragment\" needs --method camera-triangles or raycast",
+                    ));
+                }
                 TrilinearRenderer::new(prepared).render(trilinear, options, options.curves)
             }
             Method::CameraTriangles => camera_triangles::render(prepared, projection, options),

@@ -18,7 +18,7 @@ use std::sync::Arc;
 
 use glam::{Affine3A, Vec3};
 
-use crate::projection::trilinear_builders::SurfaceScreenMap;
+use crate::projection::trilinear_builders::{SurfaceRays, SurfaceScreenMap};
 use crate::projection::ProjectionSpec;
 
 /// One object of a scene. Its id (1-based, in file order; 0 is the background) is what the
@@ -143,6 +143,10 @@ pub struct TrilinearReflector {
     /// instead of rendering through the surface (scene-file key `reflection = "env-map"`):
     /// the baseline camera triangles are measured against (docs/camera-triangles.md).
     pub env_map: bool,
+    /// The rays of the reflector's surface (scene-file key `camera_rays`): the vertex rays
+    /// interpolated (the default), or per fragment, the eye's ray reflected about the
+    /// interpolated vertex normals (mirrors; docs/camera-triangles.md).
+    pub camera_rays: SurfaceRays,
 }
 
 /// A mirror whose reflection of each point light is rendered as a caustic (Hou, Wei, Shum and
@@ -175,6 +179,7 @@ impl TrilinearReflector {
             refine_px: Self::DEFAULT_REFINE_PX,
             camera_triangles: None,
             env_map: false,
+            camera_rays: SurfaceRays::Interpolated,
         }
     }
 }

@@ -14,6 +14,7 @@
 //! [`projective_map`], which makes a surface whose screen positions are an eye's image of its
 //! base points send each screen point's ray from the base point that the eye sees there.
 
+mod fragment_mirror;
 pub mod mesh_builders;
 mod obj;
 mod point_projection;
@@ -27,6 +28,7 @@ use super::image_coords::Resolution;
 use super::{AnalyticInverse, Charted, ImagePoint, NoInverse, Projection, TrilinearMesh};
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
+pub use fragment_mirror::{FragmentMirror, TriangleMirror};
 pub use point_projection::{ProjectionTriangleCache, Solutions, TriangleSolution};
 pub use projective_map::ProjectiveMap;
 use screen_locator::ScreenLocator;
@@ -51,6 +53,8 @@ pub struct Trilinear {
     weights: Option<Vec<f64>>,
     /// The projective screen map of each triangle (same order); empty for the affine map.
     maps: Vec<ProjectiveMap>,
+    /// Per-fragment mirror rays instead of interpolated ones ([`FragmentMirror`]).
+    mirror: Option<FragmentMirror>,
 }
 
 impl Trilinear {
@@ -85,6 +89,7 @@ impl Trilinear {
             caches,
             weights: None,
             maps: Vec::new(),
+            mirror: None,
         })
     }
 
@@ -127,6 +132,28 @@ impl Trilinear {
             .collect::<Result<_>>()?;
         trilinear.weights = Some(weights.to_vec());
         Ok(trilinear)
+    }
+
+    /// The same projection with per-fragment mirror rays ([`FragmentMirror`]): each screen
+    /// point reflects the eye's ray about the interpolated vertex normals instead of taking
+    /// the interpolated vertex rays. It has no analytic inverse (its rays are not the
+    /// trilinear family). Errors: those of [`FragmentMirror`]'s validation.
+    pub fn with_fragment_mirror(mut self, mirror: FragmentMirror) -> Result<Self> {
+        mirror.validate(self.mesh.points.len())?;
+        self.mirror = Some(mirror);
+        Ok(self)
+    }
+
+    /// The per-fragment mirror, if the projection has one.
+    pub fn fragment_mirror(&self) -> Option<&FragmentMirror> {
+        self.mirror.as_ref()
+    }
+
+    /// The per-fragment mirror of projection triangle `index`, if the projection has one.
+    pub fn triangle_mirror(&self, index: usize) -> Option<TriangleMirror> {
+        let vertices = self.mesh.triangles[index].map(|k| k as usize);
+        let points = vertices.map(|k| self.mesh.points[k]);
+        Some(self.mirror.as_ref()?.triangle(points, vertices))
     }
 
     /// The projective screen map of the triangle with vertices `vertices`; `None` for the
@@ -240,8 +267,12 @@ impl Projection for Trilinear {
     /// screen position, or projective with screen weights. `None` where no screen triangle covers it,
     /// and where the interpolated direction trinorm is exactly zero (possible inside a
     /// triangle whose normals point in opposing directions: the projector is a single point).
+    /// With a per-fragment mirror, its ray at the pixel's barycentrics ([`TriangleMirror::ray`]).
     fn ray(&self, pixel: DVec2) -> Option<Ray> {
         let (triangle, u, v) = self.locate(pixel)?;
+        if let Some(mirror) = self.triangle_mirror(triangle) {
+            return mirror.ray(DVec2::new(u, v));
+        }
         let [i, j, k] = self.mesh.triangles[triangle].map(|k| k as usize);
         let w = 1.0 - u - v;
         let interpolate = |values: &[DVec3]| w * values[i] + u * values[j] + v * values[k];
@@ -252,8 +283,17 @@ impl Projection for Trilinear {
         Some(Ray::new(interpolate(&self.mesh.points), direction))
     }
 
+    /// None with a per-fragment mirror, whose rays are not the trilinear family.
     fn inverse(&self) -> std::result::Result<&dyn AnalyticInverse, NoInverse> {
-        Ok(self)
+        match self.mirror {
+            None => Ok(self),
+            Some(_) => Err(NoInverse {
+                reason: Some(
+                    "a trilinear surface with per-fragment mirror rays has no analytic inverse"
+                        .into(),
+                ),
+            }),
+        }
     }
 
     fn trilinear(&self) -> Option<&Trilinear> {

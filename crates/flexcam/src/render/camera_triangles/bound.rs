@@ -25,8 +25,13 @@
 //!   rays of the parent), so the argument holds for it, and its narrower cone of directions
 //!   gives a smaller hull. The union of the quarters' regions holds every fragment.
 //!
-//! Where the cone of directions meets the plane from both sides (or there is no plane), no
-//! hull bounds the region: the whole (sub-)triangle is the bound. Every region is dilated by
+//! The argument needs only a cone of three directions holding every ray direction of the
+//! (piece of the) camera triangle ([`Camera::cone`]): the corner directions for interpolated
+//! rays, an enclosing cone for the per-fragment rays of a mirror ([`super::mirror_cone`],
+//! projected onto the base plane only, where those rays start at their own barycentrics).
+//!
+//! Where the cone of directions meets the plane from both sides (or there is no plane, or no
+//! cone), no hull bounds the region: the whole (sub-)triangle is the bound. Every region is dilated by
 //! [`MARGIN_PX`] so that rounding never drops a pixel centre on its exact boundary.
 
 use glam::{DVec2, DVec3};
@@ -108,7 +113,9 @@ pub fn quarters([a, b, c]: [DVec2; 3]) -> [[DVec2; 3]; 4] {
 /// camera triangle: its corner rays are the camera's rays there). `false` where no hull
 /// bounds the region.
 pub fn misses(camera: &Camera, sub: [DVec2; 3], points: &[DVec3]) -> bool {
-    let directions = sub.map(|c| camera.direction(c));
+    let Some(directions) = camera.cone(sub) else {
+        return false;
+    };
     let centre = points.iter().sum::<DVec3>() / points.len().max(1) as f64;
     [camera.plane_near(centre).as_ref(), camera.plane()]
         .into_iter()
@@ -197,14 +204,13 @@ fn near(p: DVec2) -> Option<DVec2> {
 
 /// The paper's bound (module doc).
 fn paper(camera: &Camera, q: &[DVec3; 3], emit: &mut impl FnMut(&Convex)) {
-    let directions = CORNERS.map(|c| camera.direction(c));
-    let triangle = camera
-        .plane()
-        .filter(|plane| plane.one_sided(&directions))
-        .and_then(|plane| {
-            let points = nine(plane, q, &directions)?;
-            bounding_triangle(plane, &directions, &points)
-        });
+    let triangle = camera.cone(CORNERS).and_then(|directions| {
+        let plane = camera
+            .plane()
+            .filter(|plane| plane.one_sided(&directions))?;
+        let points = nine(plane, q, &directions)?;
+        bounding_triangle(plane, &directions, &points)
+    });
     let Some(triangle) = triangle else {
         return emit_in_camera(camera, &Convex::from_points(&CORNERS), emit);
     };
@@ -296,10 +302,12 @@ fn tight(
     depth: u32,
     emit: &mut impl FnMut(&Convex),
 ) {
-    let directions = sub.map(|c| camera.direction(c));
-    let region = plane
-        .filter(|p| p.one_sided(&directions))
-        .and_then(|plane| nine(plane, q, &directions))
+    let region = camera
+        .cone(sub)
+        .and_then(|directions| {
+            let plane = plane.filter(|p| p.one_sided(&directions))?;
+            nine(plane, q, &directions)
+        })
         .map(|points| Convex::hull(&points).clip_to_triangle(sub))
         .unwrap_or_else(|| Convex::from_points(&sub).clip_to_triangle(CORNERS));
     if region.points().len() < 3 {
@@ -319,7 +327,9 @@ fn tight(
 fn covers(camera: &Camera, q: &[DVec3; 3], sub: [DVec2; 3]) -> bool {
     let centre = (sub[0] + sub[1] + sub[2]) / 3.0;
     [sub[0], sub[1], sub[2], centre].iter().all(|&b| {
-        plane_hit(&camera.ray_at(b), *q)
+        camera
+            .ray_at(b)
+            .and_then(|ray| plane_hit(&ray, *q))
             .is_some_and(|(t, u, v)| t >= 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0)
     })
 }

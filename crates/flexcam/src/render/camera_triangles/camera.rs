@@ -15,11 +15,19 @@
 //! base plane may be crossed by them from both sides (rays grazing a mirror), while farther
 //! along them their cone crosses the plane from one side, so each camera keeps the distances
 //! whose planes it crosses steeply and a bound picks the one nearest its scene points.
+//!
+//! A camera triangle of a per-fragment mirror ([`TriangleMirror`]) reflects the eye's ray
+//! about the interpolated normal at each pixel instead: its ray at `(u, v)` still starts at
+//! the base point of barycentrics `(u, v)`, but its direction is not affine in `(u, v)`, so
+//! only the base plane serves (no planes along the rays), and the bounds project along the
+//! three generators of a cone that holds every direction of the (piece of the) triangle
+//! ([`Camera::cone`], [`super::mirror_cone`]) instead of along the corner directions.
 
 use glam::{DVec2, DVec3};
 
+use super::mirror_cone;
 use crate::geometry::Ray;
-use crate::projection::{ProjectionTriangleCache, Trilinear};
+use crate::projection::{ProjectionTriangleCache, TriangleMirror, Trilinear};
 use crate::render::trilinear::ScreenMap;
 
 /// A base triangle counts as collapsed when twice its area is below this fraction of the
@@ -47,6 +55,8 @@ pub struct Camera {
     /// Pixels per unit of barycentric area, for sizing bound regions (exact for the affine
     /// screen map, the value at the corners' triangle for a projective one).
     pub pixels_per_area: f64,
+    /// Per-fragment mirror rays instead of interpolated ones (module doc).
+    mirror: Option<TriangleMirror>,
 }
 
 /// A plane of the camera triangle: the triangle of the points `s` along its corner rays,
@@ -180,8 +190,8 @@ const STEEP_SINE: f64 = 0.02;
 
 impl PlaneChoices {
     fn of(camera: &Camera) -> PlaneChoices {
-        let directions = CORNERS.map(|c| camera.direction(c));
-        let points = CORNERS.map(|c| camera.ray_at(c).origin);
+        let directions = CORNERS.map(|c| camera.cache.trinorm(c.x, c.y));
+        let points = CORNERS.map(|c| camera.cache.tripoint(c.x, c.y));
         let size = (points[1] - points[0])
             .length()
             .max((points[2] - points[0]).length());
@@ -230,14 +240,19 @@ impl Camera {
             .triangles
             .iter()
             .zip(projection.triangle_caches())
-            .map(|(t, cache)| {
+            .enumerate()
+            .map(|(index, (t, cache))| {
                 let map = ScreenMap::of_triangle(projection, t.map(|x| x as usize), *cache);
-                Camera::new(map, *cache)
+                Camera::new(map, *cache, projection.triangle_mirror(index))
             })
             .collect()
     }
 
-    fn new(map: ScreenMap, cache: ProjectionTriangleCache) -> Camera {
+    fn new(
+        map: ScreenMap,
+        cache: ProjectionTriangleCache,
+        mirror: Option<TriangleMirror>,
+    ) -> Camera {
         let mut camera = Camera {
             map,
             cache,
@@ -245,9 +260,15 @@ impl Camera {
             choices: PlaneChoices::default(),
             pixel_box: (DVec2::ZERO, DVec2::ZERO),
             pixels_per_area: 0.0,
+            mirror,
         };
-        camera.plane = camera.plane_at(0.0).or_else(|| camera.plane_at(1.0));
-        camera.choices = PlaneChoices::of(&camera);
+        if mirror.is_some() {
+            // Only the base plane holds the rays' origins at their own barycentrics.
+            camera.plane = camera.plane_at(0.0);
+        } else {
+            camera.plane = camera.plane_at(0.0).or_else(|| camera.plane_at(1.0));
+            camera.choices = PlaneChoices::of(&camera);
+        }
         let pixels = CORNERS.map(|c| map.pixel(c.x, c.y));
         let lo = pixels[0].min(pixels[1]).min(pixels[2]);
         let hi = pixels[0].max(pixels[1]).max(pixels[2]);
@@ -275,7 +296,10 @@ impl Camera {
     /// points moves them little, so their hull is small; the cone of the corner rays crosses
     /// every choice from one side.
     pub fn plane_near(&self, centre: DVec3) -> Option<CameraPlane> {
-        let ray = self.ray_at(DVec2::splat(1.0 / 3.0));
+        if self.choices.len == 0 {
+            return self.plane;
+        }
+        let ray = self.interpolated_ray(DVec2::splat(1.0 / 3.0));
         let s = (centre - ray.origin).dot(ray.direction) / ray.direction.length_squared();
         self.choices
             .nearest(s)
@@ -283,13 +307,38 @@ impl Camera {
             .or(self.plane)
     }
 
-    /// The ray at barycentrics `b`.
-    pub fn ray_at(&self, b: DVec2) -> Ray {
+    /// The ray at barycentrics `b` (`None`: a per-fragment mirror's eye at its origin).
+    pub fn ray_at(&self, b: DVec2) -> Option<Ray> {
+        match &self.mirror {
+            None => Some(self.interpolated_ray(b)),
+            Some(mirror) => mirror.ray(b),
+        }
+    }
+
+    /// The ray through pixel position `pixel` (extrapolated outside the triangle); `None`
+    /// where the interpolated direction is zero or a mirror's eye is at the origin.
+    #[inline]
+    pub fn pixel_ray(&self, pixel: DVec2) -> Option<Ray> {
+        match &self.mirror {
+            None => self.map.ray(pixel),
+            Some(mirror) => mirror.ray(self.map.barycentrics(pixel)),
+        }
+    }
+
+    /// The interpolated ray at barycentrics `b`.
+    fn interpolated_ray(&self, b: DVec2) -> Ray {
         Ray::new(self.cache.tripoint(b.x, b.y), self.cache.trinorm(b.x, b.y))
     }
 
-    /// The ray direction at barycentrics `b`.
-    pub fn direction(&self, b: DVec2) -> DVec3 {
-        self.cache.trinorm(b.x, b.y)
+    /// Three directions whose cone holds the direction of every ray of the piece `sub` of
+    /// the camera triangle: its corner directions for interpolated rays (the directions in
+    /// between are their convex combinations), a cone enclosing the reflected rays of a
+    /// per-fragment mirror ([`mirror_cone::cone`]); `None` where no such cone is known (the
+    /// bounds then take the whole piece).
+    pub fn cone(&self, sub: [DVec2; 3]) -> Option<[DVec3; 3]> {
+        match &self.mirror {
+            None => Some(sub.map(|c| self.cache.trinorm(c.x, c.y))),
+            Some(mirror) => mirror_cone::cone(mirror, sub),
+        }
     }
 }

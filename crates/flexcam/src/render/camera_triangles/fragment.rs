@@ -2,7 +2,9 @@
 //!
 //! Each pixel of a bounding region is a fragment of one (camera triangle, scene triangle)
 //! pair, keyed `camera << 32 | scene triangle`. Its ray is the camera triangle's ray at the
-//! pixel centre (origin and direction interpolated barycentrically); it is intersected with
+//! pixel centre ([`Camera::pixel_ray`]: origin and direction interpolated barycentrically,
+//! or for a per-fragment mirror the eye's ray reflected about the interpolated normal); it
+//! is intersected with
 //! the scene triangle's plane, and the fragment is killed when the pixel belongs to another
 //! camera triangle ([`super::owners`]), when the hit lies outside the scene triangle or
 //! behind the ray's origin. A surviving fragment is *rendered*: its depth is the exact ray
@@ -102,7 +104,7 @@ impl Stage<'_> {
                         continue;
                     }
                     let centre = DVec2::new(f64::from(x) + 0.5, f64::from(span.y) + 0.5);
-                    let Some(ray) = camera.map.ray(centre) else {
+                    let Some(ray) = camera.pixel_ray(centre) else {
                         continue;
                     };
                     let Some((t, u, v)) = plane_hit(&ray, corners) else {

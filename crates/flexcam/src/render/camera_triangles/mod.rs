@@ -16,13 +16,19 @@
 //!
 //! Reflections and refractions (`trilinear_reflector = true` objects) are trilinear
 //! surfaces composited into the main view (`render::composite`); with this method their
-//! surfaces are rendered by camera triangles.
+//! surfaces are rendered by camera triangles. A mirror's surface may reflect the eye's ray
+//! per fragment about the interpolated vertex normals instead of interpolating the vertex
+//! rays (the paper's reflection variant, section 3.1; `camera_rays = "per-fragment"`): the
+//! bounds then project along a cone enclosing those rays (`mirror_cone`).
 
 mod bound;
 mod camera;
 mod convex;
 mod fragment;
+mod mirror_cone;
 mod owners;
+#[cfg(test)]
+mod per_fragment_tests;
 mod quarter_cull;
 mod shade;
 #[cfg(test)]

@@ -45,7 +45,7 @@ impl Shader<'_> {
             let owner = self.scene.owners[k];
             let t = drawn.depth[i];
             let barycentric = Vec2::from(drawn.barycentrics[i]);
-            let Some(ray) = camera.map.ray(centre) else {
+            let Some(ray) = camera.pixel_ray(centre) else {
                 (out.color[i], out.depth[i], out.ids[i]) = (self.background, f32::INFINITY, 0);
                 continue;
             };

@@ -4,6 +4,7 @@
 use glam::DVec2;
 
 use super::*;
+use crate::projection::trilinear_builders::SurfaceRays;
 use crate::render::compare::{compare, Comparison};
 use crate::render::{raycast, Method};
 use crate::scene::{self, Scene};
@@ -17,7 +18,7 @@ const TRILINEAR_SCENES: [&str; 5] = [
     "trilinear-two-views",
 ];
 
-fn load(name: &str) -> Scene {
+pub(super) fn load(name: &str) -> Scene {
     scene::load(&format!(
         "{}/../../scenes/{name}.toml",
         env!("CARGO_MANIFEST_DIR")
@@ -25,7 +26,7 @@ fn load(name: &str) -> Scene {
     .unwrap()
 }
 
-fn options(shading: Shading, bound: Bound) -> RenderOptions<'static> {
+pub(super) fn options(shading: Shading, bound: Bound) -> RenderOptions<'static> {
     RenderOptions {
         method: Method::CameraTriangles,
         shading,
@@ -37,7 +38,7 @@ fn options(shading: Shading, bound: Bound) -> RenderOptions<'static> {
     }
 }
 
-fn count(stats: &Stats, name: &str) -> u64 {
+pub(super) fn count(stats: &Stats, name: &str) -> u64 {
     match stats.get(name) {
         Some(Counter::Count(n)) => *n,
         other => panic!("{name}: {other:?}"),
@@ -149,31 +150,37 @@ fn bounds_hold_every_fragment() {
 /// bound projects onto planes farther along the rays).
 #[test]
 fn bounds_hold_every_fragment_of_diverging_rays() {
-    use crate::projection::trilinear_builders::{reflector_surface, Optic};
     for name in ["reflect-sphere-cube", "reflect-funny-mirror"] {
-        let mut scene = load(name);
-        let entry = scene.trilinear_reflectors[0];
-        let object = scene.objects.iter().find(|o| o.id == entry.id).unwrap();
-        let mesh: &crate::scene::Mesh = &object.mesh;
-        let crate::projection::ProjectionSpec::Perspective { frame, fov } = &scene.projection
-        else {
-            panic!("{name}: not perspective")
-        };
-        let camera = crate::projection::Perspective::new(frame, *fov, 96, 72).unwrap();
-        let surface = reflector_surface(mesh, &camera, Optic::Reflect).unwrap();
-        let projection = surface
-            .projection(entry.screen_map, 96, 72)
-            .unwrap()
-            .unwrap();
-        scene.objects.retain(|o| o.id != entry.id);
+        let (projection, scene) = mirror_surface(name, SurfaceRays::Interpolated);
         let checked = fragments_in_bounds(name, &projection, &scene);
         assert!(checked > 100, "{name}: {checked}");
     }
 }
 
+/// The reflection surface of the first trilinear reflector (a mirror, its own mesh) of
+/// scene `name` seen at 96 x 72 with rays `rays`, and the scene without the reflector.
+pub(super) fn mirror_surface(name: &str, rays: SurfaceRays) -> (Trilinear, Scene) {
+    use crate::projection::trilinear_builders::{reflector_surface, Optic};
+    let mut scene = load(name);
+    let entry = scene.trilinear_reflectors[0];
+    let object = scene.objects.iter().find(|o| o.id == entry.id).unwrap();
+    let mesh: &crate::scene::Mesh = &object.mesh;
+    let crate::projection::ProjectionSpec::Perspective { frame, fov } = &scene.projection else {
+        panic!("{name}: not perspective")
+    };
+    let camera = crate::projection::Perspective::new(frame, *fov, 96, 72).unwrap();
+    let surface = reflector_surface(mesh, &camera, Optic::Reflect).unwrap();
+    let projection = surface
+        .projection(entry.screen_map, rays, 96, 72)
+        .unwrap()
+        .unwrap();
+    scene.objects.retain(|o| o.id != entry.id);
+    (projection, scene)
+}
+
 /// Checks that every fragment of every (camera, scene triangle) pair of `scene` through
 /// `projection` lies in a region of each bound; returns the fragments checked.
-fn fragments_in_bounds(name: &str, projection: &Trilinear, scene: &Scene) -> usize {
+pub(super) fn fragments_in_bounds(name: &str, projection: &Trilinear, scene: &Scene) -> usize {
     let (width, height) = projection.resolution();
     let cameras = Camera::all(projection);
     let owners = owners::owners(&cameras, width, height);
@@ -191,7 +198,7 @@ fn fragments_in_bounds(name: &str, projection: &Trilinear, scene: &Scene) -> usi
                     }
                     let (x, y) = (i % width as usize, i / width as usize);
                     let centre = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
-                    let Some(ray) = camera.map.ray(centre) else {
+                    let Some(ray) = camera.pixel_ray(centre) else {
                         continue;
                     };
                     let hit = crate::render::trilinear::plane_hit(&ray, q);

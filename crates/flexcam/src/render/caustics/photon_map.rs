@@ -9,7 +9,9 @@ use rayon::prelude::*;
 use super::receives;
 use crate::error::{Error, Result};
 use crate::geometry::optics::reflect;
-use crate::projection::trilinear_builders::{reflector_surface, Optic, SurfaceScreenMap};
+use crate::projection::trilinear_builders::{
+    reflector_surface, Optic, SurfaceRays, SurfaceScreenMap,
+};
 use crate::projection::{CameraFrame, Perspective, Projection};
 use crate::render::composite::{perspective_as_trilinear, without, Reflector};
 use crate::render::prepared::PreparedScene;
@@ -240,6 +242,7 @@ fn through_surface(
     let n = camera.resolution().0 as usize;
     let Some(surface) = reflector_surface(mesh, camera, Optic::Reflect)?.projection(
         SurfaceScreenMap::Projective,
+        SurfaceRays::Interpolated,
         n as u32,
         n as u32,
     )?

@@ -123,4 +123,4 @@ pub fn image(
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

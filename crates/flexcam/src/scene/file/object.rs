@@ -12,7 +12,7 @@ use super::raw::{Numbers, RawObject};
 use super::shape::{analytic_mesh, Shape, MAX_TESSELLATION};
 use super::source::Source;
 use crate::error::Result;
-use crate::projection::trilinear_builders::SurfaceScreenMap;
+use crate::projection::trilinear_builders::{SurfaceRays, SurfaceScreenMap};
 use crate::projection::ProjectionSpec;
 use crate::scene::loaders::{load_model, load_texture};
 use crate::scene::{CausticReflector, Finish, Material, Mesh, Object, Pattern, TrilinearReflector};
@@ -100,12 +100,14 @@ pub(super) fn convert(
 /// image, with screen map `trilinear_screen_map` (default affine) and refinement tolerance
 /// `trilinear_refine_px` (main-image pixels, default
 /// [`TrilinearReflector::DEFAULT_REFINE_PX`], 0 for none) and camera-mesh size
-/// `camera_triangles` (default automatic), and `reflection` (`"surface"`, the default, or
-/// `"env-map"`: the environment-map baseline). Errors, at the key: an object
+/// `camera_triangles` (default automatic), `reflection` (`"surface"`, the default, or
+/// `"env-map"`: the environment-map baseline) and `camera_rays` (`"interpolated"`, the
+/// default, or `"per-fragment"`: mirrors only). Errors, at the key: an object
 /// whose material is neither mirror nor glass, a scene whose projection is not perspective
 /// (the surface's screen positions are the main camera's image of the reflector), a
 /// `trilinear_screen_map` other than "projective" or "affine", a `reflection` other than
-/// "surface" or "env-map", a `trilinear_refine_px` that
+/// "surface" or "env-map", a `camera_rays` other than "interpolated" or "per-fragment" or
+/// "per-fragment" on glass, a `trilinear_refine_px` that
 /// is negative or not finite, a bad `camera_triangles` ([`camera_triangles`]), or any of
 /// these keys without `trilinear_reflector = true`.
 pub(super) fn trilinear_reflector(
@@ -154,6 +156,17 @@ pub(super) fn trilinear_reflector(
             }
         },
     };
+    let camera_rays = match &raw.camera_rays {
+        None => SurfaceRays::Interpolated,
+        Some(name) => match name.get_ref().as_str() {
+            "interpolated" => SurfaceRays::Interpolated,
+            "per-fragment" => SurfaceRays::PerFragment,
+            other => {
+                let expected = ["interpolated", "per-fragment"];
+                return Err(src.unknown(&name.span(), "camera_rays", other, &expected));
+            }
+        },
+    };
     let enabled = raw
         .trilinear_reflector
         .as_ref()
@@ -183,6 +196,12 @@ pub(super) fn trilinear_reflector(
                 "`camera_triangles` needs `trilinear_reflector = true`",
             ));
         }
+        if let Some(name) = &raw.camera_rays {
+            return Err(src.error(
+                &name.span(),
+                "`camera_rays` needs `trilinear_reflector = true`",
+            ));
+        }
         return Ok(None);
     };
     if let Some(part) = parts
@@ -197,6 +216,19 @@ pub(super) fn trilinear_reflector(
                 surface_name(part.material.finish)
             ),
         ));
+    }
+    if let (Some(name), SurfaceRays::PerFragment) = (&raw.camera_rays, camera_rays) {
+        if let Some(part) = parts.iter().find(|p| p.material.finish != Finish::Mirror) {
+            return Err(src.error(
+                &name.span(),
+                format!(
+                    "`camera_rays = \"per-fragment\"` needs material \"mirror\" (per-fragment \
+                     refraction has no bound yet), but \"{}\" is {}",
+                    part.name,
+                    surface_name(part.material.finish)
+                ),
+            ));
+        }
     }
     if !matches!(projection, ProjectionSpec::Perspective { .. }) {
         return Err(src.error(
@@ -213,6 +245,7 @@ pub(super) fn trilinear_reflector(
         refine_px,
         camera_triangles,
         env_map,
+        camera_rays,
     }))
 }
 

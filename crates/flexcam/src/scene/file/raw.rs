@@ -502,6 +502,7 @@ pub struct RawObject {
     pub trilinear_refine_px: Option<Spanned<f64>>,
     pub camera_triangles: Option<Spanned<u32>>,
     pub reflection: Option<Spanned<String>>,
+    pub camera_rays: Option<Spanned<String>>,
     pub caustics: Option<Spanned<bool>>,
     pub caustic_map: Option<Spanned<i64>>,
     pub displacement: Option<Spanned<super::displacement::RawDisplacement>>,

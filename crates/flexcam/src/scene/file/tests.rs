@@ -1486,6 +1486,64 @@ fn camera_triangles_key() {
 }
 
 #[test]
+fn camera_rays_key() {
+    use crate::projection::trilinear_builders::SurfaceRays;
+    let object = |material: &str, extra: &str| {
+        format!("{CAMERA}[[object]]\nshape = \"sphere\"\nmaterial = \"{material}\"\n{extra}\n")
+    };
+    let rays = |extra: &str| {
+        scene(&object(
+            "mirror",
+            &format!("trilinear_reflector = true\n{extra}"),
+        ))
+        .trilinear_reflectors[0]
+            .camera_rays
+    };
+    assert_eq!(rays(""), SurfaceRays::Interpolated);
+    assert_eq!(
+        rays("camera_rays = \"interpolated\""),
+        SurfaceRays::Interpolated
+    );
+    assert_eq!(
+        rays("camera_rays = \"per-fragment\""),
+        SurfaceRays::PerFragment
+    );
+    assert_error_at(
+        &object(
+            "mirror",
+            "trilinear_reflector = true\ncamera_rays = \"exact\"",
+        ),
+        10,
+        15,
+        "unknown camera_rays \"exact\"; expected one of: interpolated, per-fragment",
+    );
+    assert_error_at(
+        &object(
+            "glass",
+            "trilinear_reflector = true\ncamera_rays = \"per-fragment\"",
+        ),
+        10,
+        15,
+        "`camera_rays = \"per-fragment\"` needs material \"mirror\"",
+    );
+    assert_error_at(
+        &object("mirror", "camera_rays = \"per-fragment\""),
+        9,
+        15,
+        "`camera_rays` needs `trilinear_reflector = true`",
+    );
+    // Glass keeps its interpolated rays.
+    let glass = scene(&object(
+        "glass",
+        "trilinear_reflector = true\ncamera_rays = \"interpolated\"",
+    ));
+    assert_eq!(
+        glass.trilinear_reflectors[0].camera_rays,
+        SurfaceRays::Interpolated
+    );
+}
+
+#[test]
 fn trilinear_refine_px_key() {
     use crate::scene::TrilinearReflector;
     let mirror = |extra: &str| {

@@ -24,5 +24,7 @@ mod visualisation;
 pub use camera::GridCamera;
 pub use grid::{between_surfaces, screen_grid, GridVertex, MAX_GRID_CELLS};
 pub(crate) use reflector::vertex_normals;
-pub use reflector::{reflector_surface, vertex_ray, Optic, ReflectorSurface, SurfaceScreenMap};
+pub use reflector::{
+    reflector_surface, vertex_ray, Optic, ReflectorSurface, SurfaceRays, SurfaceScreenMap,
+};
 pub use visualisation::{inward_sphere, DetailInContext, TwoViews};

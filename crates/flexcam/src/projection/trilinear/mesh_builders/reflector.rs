@@ -17,7 +17,7 @@ use crate::geometry::optics::{reflect, refract};
 use crate::geometry::MeshView;
 use crate::projection::trilinear::is_degenerate_screen_triangle;
 use crate::projection::{
-    AnalyticInverse, ImagePoint, Perspective, Projection, Trilinear, TrilinearMesh,
+    AnalyticInverse, FragmentMirror, ImagePoint, Perspective, Projection, Trilinear, TrilinearMesh,
 };
 
 /// What the reflector does to the eye's rays.
@@ -82,6 +82,18 @@ pub enum SurfaceScreenMap {
     Affine,
 }
 
+/// Which rays a reflector surface sends (scene-file key `camera_rays`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum SurfaceRays {
+    /// The vertex rays interpolated barycentrically (Vallance 2005, 7.2.2; the camera
+    /// triangles of Hou et al. 2006, section 2). The default.
+    #[default]
+    Interpolated,
+    /// The eye's ray reflected per screen point about the interpolated vertex normals (Hou
+    /// et al. 2006, 3.1: [`FragmentMirror`]); mirrors only.
+    PerFragment,
+}
+
 /// A reflection or refraction surface and what was left out of it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ReflectorSurface {
@@ -94,22 +106,30 @@ pub struct ReflectorSurface {
     pub weights: Vec<f64>,
     /// Reflector triangles left out (see [`reflector_surface`]).
     pub dropped: usize,
+    /// The unit shading normal of each mesh vertex (the reflector's, as the ray caster
+    /// interpolates them), for [`SurfaceRays::PerFragment`].
+    pub shading_normals: Vec<DVec3>,
+    /// The eye whose rays the surface reflects or refracts.
+    pub eye: DVec3,
 }
 
 impl ReflectorSurface {
     /// The surface as a trilinear projection of `width` x `height` pixels with screen map
     /// `map` (for [`SurfaceScreenMap::Affine`] with the vertex rays normalised, the thesis's
-    /// surface); `None` when it has no triangles. Errors: those of [`Trilinear::new`].
+    /// surface) and rays `rays` (per fragment: the surface's [`FragmentMirror`], which only a
+    /// mirror's surface may ask for); `None` when it has no triangles. Errors: those of
+    /// [`Trilinear::new`].
     pub fn projection(
         &self,
         map: SurfaceScreenMap,
+        rays: SurfaceRays,
         width: u32,
         height: u32,
     ) -> Result<Option<Trilinear>> {
         if self.mesh.triangles.is_empty() {
             return Ok(None);
         }
-        match map {
+        let projection = match map {
             SurfaceScreenMap::Affine => {
                 let mut unit = self.mesh.clone();
                 unit.normals.iter_mut().for_each(|r| *r = r.normalize());
@@ -118,8 +138,16 @@ impl ReflectorSurface {
             SurfaceScreenMap::Projective => {
                 Trilinear::with_screen_weights(&self.mesh, &self.weights, width, height)
             }
+        }?;
+        match rays {
+            SurfaceRays::Interpolated => Ok(Some(projection)),
+            SurfaceRays::PerFragment => projection
+                .with_fragment_mirror(FragmentMirror {
+                    eye: self.eye,
+                    normals: self.shading_normals.clone(),
+                })
+                .map(Some),
         }
-        .map(Some)
     }
 }
 
@@ -215,6 +243,7 @@ pub fn reflector_surface<'a>(
 
     let mut mesh = TrilinearMesh::default();
     let mut weights = Vec::new();
+    let mut shading_normals = Vec::new();
     let mut new_index = vec![u32::MAX; vertices.len()];
     for &(_, triangle) in &kept {
         let mapped = triangle.map(|k| {
@@ -227,6 +256,7 @@ pub fn reflector_surface<'a>(
                     mesh.normals.push(v.direction);
                     mesh.screen.push(v.screen);
                     weights.push(v.weight);
+                    shading_normals.push(v.normal);
                 }
             }
             *slot
@@ -237,6 +267,8 @@ pub fn reflector_surface<'a>(
         dropped: reflector.triangles.len() - mesh.triangles.len(),
         mesh,
         weights,
+        shading_normals,
+        eye,
     })
 }
 

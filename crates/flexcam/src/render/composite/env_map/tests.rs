@@ -11,7 +11,7 @@ use crate::scene::{self, Scene};
 /// `scene` at `size` by `method` (reflectors composited) and by the ray caster's exact
 /// mirror: the id agreement and relative RGB error of the whole frame, and the relative RGB
 /// error over the pixels where the exact render sees object `id`.
-fn errors(scene: &Scene, size: (u32, u32), method: Method, id: u32) -> (f64, f64, f64) {
+pub(crate) fn errors(scene: &Scene, size: (u32, u32), method: Method, id: u32) -> (f64, f64, f64) {
     let (projection, _) = calibrate::build(&scene.projection, size.0, size.1).unwrap();
     let prepared = PreparedScene::new(scene);
     let render = |method, composite_reflectors| {
