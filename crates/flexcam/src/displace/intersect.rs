@@ -25,7 +25,10 @@
 //! grazing a micro-triangle's plane closer than `micro::GRAZING` do not hit
 //! it), so the ray enters every box on the way to it. Traversal is front to back: children are visited in
 //! order of their boxes' entry distance, and a child whose entry lies beyond the best hit so
-//! far is skipped. A leaf tests its micro-triangle exactly as the brute-force reference
+//! far is skipped. A node two levels above the leaves whose children's boxes are not kept
+//! displaces its fifteen micro-vertices once and bounds each child by the box of its six
+//! (exact, where the box above is conservative). A leaf tests its micro-triangle exactly as
+//! the brute-force reference
 //! ([`MicroGrid::intersect`](super::micro::MicroGrid::intersect)) does, on bit-identical
 //! micro-vertices, with the same tie rule ([`MicroHit::before`]), so the two find the same
 //! hit: same `t`, micro-triangle and barycentrics.
@@ -105,29 +108,33 @@ impl Node {
     /// The four children in the order of the scene contract: `(a, ab, ac)`, `(ab, b, bc)`,
     /// `(ac, bc, c)`, `(ac, ab, bc)`.
     fn children(&self) -> [Node; 4] {
+        let midpoints = self.midpoints();
+        [0, 1, 2, 3].map(|k| self.child(k, midpoints))
+    }
+
+    /// Its edge midpoints `[ab, bc, ca]` (undisplaced), which its children's corners are
+    /// made of.
+    #[inline]
+    fn midpoints(&self) -> [BaseVertex; 3] {
         let [a, b, c] = self.v;
-        let [ga, gb, gc] = self.g;
-        let (ab, bc, ca) = (a.midpoint(b), b.midpoint(c), c.midpoint(a));
-        let mid = |p: [u32; 2], q: [u32; 2]| [(p[0] + q[0]) / 2, (p[1] + q[1]) / 2];
-        let (gab, gbc, gca) = (mid(ga, gb), mid(gb, gc), mid(gc, ga));
-        [
-            Node {
-                v: [a, ab, ca],
-                g: [ga, gab, gca],
-            },
-            Node {
-                v: [ab, b, bc],
-                g: [gab, gb, gbc],
-            },
-            Node {
-                v: [ca, bc, c],
-                g: [gca, gbc, gc],
-            },
-            Node {
-                v: [ca, ab, bc],
-                g: [gca, gab, gbc],
-            },
-        ]
+        [a.midpoint(b), b.midpoint(c), c.midpoint(a)]
+    }
+
+    /// Child `k` of [`Node::children`], from the node's `midpoints`: built only for the
+    /// children a ray descends into.
+    #[inline]
+    fn child(&self, k: usize, [ab, bc, ca]: [BaseVertex; 3]) -> Node {
+        let [a, b, c] = self.v;
+        let v = match k {
+            0 => [a, ab, ca],
+            1 => [ab, b, bc],
+            2 => [ca, bc, c],
+            _ => [ca, ab, bc],
+        };
+        Node {
+            v,
+            g: child_grids(self.g)[k],
+        }
     }
 
     /// Whether the node's grid triangle holds the point `p / 3` (grid units), edges included.
@@ -139,20 +146,69 @@ impl Node {
         let s = [side(g[0], g[1]), side(g[1], g[2]), side(g[2], g[0])];
         s.iter().all(|&x| x >= 0) || s.iter().all(|&x| x <= 0)
     }
+}
 
-    /// The micro-triangle this leaf is, and its vertices' displaced positions `displaced`
-    /// (in the order of `v`) put in that triangle's order.
-    fn micro_triangle(&self, displaced: [DVec3; 3]) -> (MicroTriangle, [DVec3; 3]) {
-        let i = self.g.iter().map(|g| g[0]).min().unwrap_or(0);
-        let j = self.g.iter().map(|g| g[1]).min().unwrap_or(0);
-        let up = self.g.contains(&[i, j]);
-        let triangle = MicroTriangle { i, j, up };
-        let positions = triangle.vertices().map(|g| {
-            let k = self.g.iter().position(|&x| x == g).unwrap_or(0);
-            displaced[k]
-        });
-        (triangle, positions)
+/// The grid corners of the four children of the node with grid corners `[a, b, c]`, in the
+/// order of [`Node::children`].
+fn child_grids([a, b, c]: [[u32; 2]; 3]) -> [[[u32; 2]; 3]; 4] {
+    let mid = |p: [u32; 2], q: [u32; 2]| [(p[0] + q[0]) / 2, (p[1] + q[1]) / 2];
+    let (ab, bc, ca) = (mid(a, b), mid(b, c), mid(c, a));
+    [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ca, ab, bc]]
+}
+
+/// The micro-triangle of the leaf with grid corners `g`, and its vertices' displaced
+/// positions `displaced` (in the order of `g`) put in that triangle's order.
+fn micro_triangle(g: [[u32; 2]; 3], displaced: [DVec3; 3]) -> (MicroTriangle, [DVec3; 3]) {
+    let i = g.iter().map(|g| g[0]).min().unwrap_or(0);
+    let j = g.iter().map(|g| g[1]).min().unwrap_or(0);
+    let up = g.contains(&[i, j]);
+    let triangle = MicroTriangle { i, j, up };
+    let positions = triangle.vertices().map(|v| {
+        let k = g.iter().position(|&x| x == v).unwrap_or(0);
+        displaced[k]
+    });
+    (triangle, positions)
+}
+
+/// Keeps `found` in `best` if it comes first ([`MicroHit::before`]).
+#[inline]
+fn keep(best: &mut Option<MicroHit>, found: Option<MicroHit>) {
+    if let Some(hit) = found {
+        if best.is_none_or(|b| hit.before(&b)) {
+            *best = Some(hit);
+        }
     }
+}
+
+/// Tests the four leaves below a node with grid corners `g` whose six micro-vertices,
+/// displaced, are `[a, b, c, ab, bc, ca]` (corners, then edge midpoints), without boxes (a
+/// box costs about what its triangle test does). The best hit does not depend on the order
+/// of the tests ([`MicroHit::before`]).
+fn test_leaves(
+    ray: &Ray,
+    g: [[u32; 2]; 3],
+    [a, b, c, ab, bc, ca]: [DVec3; 6],
+    best: &mut Option<MicroHit>,
+) {
+    let corners = [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ca, ab, bc]];
+    for (grid, displaced) in child_grids(g).into_iter().zip(corners) {
+        let (triangle, positions) = micro_triangle(grid, displaced);
+        keep(best, hit_micro_triangle(ray, triangle, positions));
+    }
+}
+
+/// The world box of a node just above the leaves from its six displaced micro-vertices: the
+/// exact box of its four micro-triangles (their convex hull's), widened by 1e-8 of the
+/// largest distance along an axis from `origin`, the ray's origin, to its faces. A reported
+/// hit lies within `2e-10` times its distance from the origin of its micro-triangle (module
+/// docs), and that distance is at most `sqrt(3)` times the widening's base (plus the
+/// error), so the ray enters the widened box on the way to every hit in it; the allowance
+/// also covers the rounding of the slab distances.
+fn leaf_parent_box(points: &[DVec3; 6], origin: DVec3) -> [DVec3; 2] {
+    let lo = points.iter().fold(DVec3::INFINITY, |m, &p| m.min(p));
+    let hi = points.iter().fold(DVec3::NEG_INFINITY, |m, &p| m.max(p));
+    let slack = DVec3::splat(1e-8 * (origin - lo).abs().max((origin - hi).abs()).max_element());
+    [lo - slack, hi + slack]
 }
 
 /// A ray in the base triangle's frame, for slab tests.
@@ -178,15 +234,19 @@ impl LocalRay {
     }
 }
 
+/// A ray that enters a triangle's kept root box, in that triangle's frame: what
+/// [`enters_root`] found, for [`DisplacedTriangle::intersect_entered`].
+pub struct RootEntry(LocalRay);
+
 /// Whether `ray` enters a triangle's kept root box `root` (the first of its
 /// [`DisplacedTriangle::top_boxes`], in its `frame`): the test
 /// [`DisplacedTriangle::intersect`] starts with, without the triangle's corners, so that a
 /// caller can skip fetching them for the many triangles a ray reaches only in their world
-/// box. `false` means no hit.
-pub fn enters_root(frame: &Frame, root: &CachedBox, ray: &Ray) -> bool {
+/// box. `None` means no hit.
+pub fn enters_root(frame: &Frame, root: &CachedBox, ray: &Ray) -> Option<RootEntry> {
     let [lo, hi] = *root;
     let local = LocalRay::new(frame, ray);
-    slab_entry(&local, [lo.as_dvec3(), hi.as_dvec3()], f64::INFINITY).is_some()
+    slab_entry(&local, [lo.as_dvec3(), hi.as_dvec3()], f64::INFINITY).map(|_| RootEntry(local))
 }
 
 impl<'a> DisplacedTriangle<'a> {
@@ -270,11 +330,23 @@ impl<'a> DisplacedTriangle<'a> {
             return None;
         }
         let local = LocalRay::new(&self.frame, ray);
-        let root = self.root();
-        let mut best = None;
-        if slab_entry(&local, self.box_of(&root, 0), f64::INFINITY).is_some() {
-            self.visit(ray, &local, &root, 0, 0, &mut best);
+        let root = match self.boxes.first() {
+            Some(&[lo, hi]) => [lo.as_dvec3(), hi.as_dvec3()],
+            None => self.node_box(&self.root()),
+        };
+        slab_entry(&local, root, f64::INFINITY)?;
+        self.intersect_entered(ray, &RootEntry(local))
+    }
+
+    /// [`DisplacedTriangle::intersect`] for a ray [`enters_root`] let through with this
+    /// triangle's frame and root box (those it was made [`with_boxes`](Self::with_boxes)
+    /// of): the same hit, without testing the root box again.
+    pub fn intersect_entered(&self, ray: &Ray, entry: &RootEntry) -> Option<MicroHit> {
+        if !(ray.origin.is_finite() && ray.direction.is_finite()) || ray.direction == DVec3::ZERO {
+            return None;
         }
+        let mut best = None;
+        self.visit(ray, &entry.0, &self.root(), 0, 0, &mut best);
         best
     }
 
@@ -307,15 +379,6 @@ impl<'a> DisplacedTriangle<'a> {
         }
     }
 
-    /// The box of `node`, the node with index `index` in its level order: kept or computed.
-    #[inline]
-    fn box_of(&self, node: &Node, index: usize) -> [DVec3; 2] {
-        match self.boxes.get(index) {
-            Some(&[lo, hi]) => [lo.as_dvec3(), hi.as_dvec3()],
-            None => self.node_box(node),
-        }
-    }
-
     /// Descends into `node` (at subdivision `depth`, with index `index` in the level order
     /// of [`DisplacedTriangle::boxes`], its box already entered).
     fn visit(
@@ -328,56 +391,85 @@ impl<'a> DisplacedTriangle<'a> {
         best: &mut Option<MicroHit>,
     ) {
         let level = self.displacement.level();
-        let keep = |best: &mut Option<MicroHit>, found: Option<MicroHit>| {
-            if let Some(hit) = found {
-                if best.is_none_or(|b| hit.before(&b)) {
-                    *best = Some(hit);
-                }
-            }
-        };
+        let displace = |v: &BaseVertex| self.displacement.displace(v);
         if depth == level {
-            let (triangle, positions) =
-                node.micro_triangle(node.v.map(|v| self.displacement.displace(&v)));
+            let (triangle, positions) = micro_triangle(node.g, node.v.map(|v| displace(&v)));
             keep(best, hit_micro_triangle(ray, triangle, positions));
             return;
         }
-        let children = node.children();
+        let midpoints = node.midpoints();
         if depth + 1 == level {
-            // The four leaves share six micro-vertices: displace each once and test the
-            // leaves without boxes (a box costs about what its triangle test does). The best
-            // hit does not depend on the order of the tests (`MicroHit::before`).
-            let [a, b, c] = node.v.map(|v| self.displacement.displace(&v));
-            let [ab, bc, ca] = [children[0].v[1], children[1].v[2], children[0].v[2]]
-                .map(|v| self.displacement.displace(&v));
-            let corners = [[a, ab, ca], [ab, b, bc], [ca, bc, c], [ca, ab, bc]];
-            for (child, displaced) in children.iter().zip(corners) {
-                let (triangle, positions) = child.micro_triangle(displaced);
-                keep(best, hit_micro_triangle(ray, triangle, positions));
-            }
+            // The four leaves share six micro-vertices: displace each once.
+            let [a, b, c] = node.v.map(|v| displace(&v));
+            let [ab, bc, ca] = midpoints.map(|v| displace(&v));
+            test_leaves(ray, node.g, [a, b, c, ab, bc, ca], best);
             return;
         }
         // Index of the first child in the level order of the next depth.
         let first = 4 * index + 1;
-        let mut order: [(f64, usize); 4] = [(f64::INFINITY, 4); 4];
-        let mut count = 0;
-        for (k, child) in children.iter().enumerate() {
-            let limit = best.map_or(f64::INFINITY, |b| b.t);
-            if let Some(entry) = slab_entry(local, self.box_of(child, first + k), limit) {
-                let mut at = count;
-                while at > 0 && order[at - 1].0 > entry {
-                    order[at] = order[at - 1];
-                    at -= 1;
-                }
-                order[at] = (entry, k);
-                count += 1;
-            }
+        if depth + 2 == level && self.boxes.len() <= first {
+            self.visit_leaf_parents(ray, node, midpoints, best);
+            return;
         }
+        let limit = best.map_or(f64::INFINITY, |b| b.t);
+        let (order, count) = front_to_back(|k| {
+            let entry = |b| slab_entry(local, b, limit);
+            match self.boxes.get(first + k) {
+                Some(&[lo, hi]) => entry([lo.as_dvec3(), hi.as_dvec3()]),
+                None => entry(self.node_box(&node.child(k, midpoints))),
+            }
+        });
         for &(entry, k) in &order[..count] {
             // Ties with the best hit stay: a hit at equal t may win on the triangle order.
             if best.is_some_and(|b| entry > b.t) {
                 break;
             }
-            self.visit(ray, local, &children[k], depth + 1, first + k, best);
+            let child = node.child(k, midpoints);
+            self.visit(ray, local, &child, depth + 1, first + k, best);
+        }
+    }
+
+    /// Descends into `node`, two levels above the leaves, whose children's boxes are not
+    /// kept: its fifteen micro-vertices are displaced once each (a midpoint is symmetric bit
+    /// for bit, so the children sharing an inner edge share its midpoint), and each child's
+    /// exact box of its six ([`leaf_parent_box`]) takes the place of [`Self::node_box`],
+    /// which costs about as much as displacing them (a height range over the node's uv
+    /// rectangle) and bounds them more loosely. Children are visited front to back, pruned
+    /// beyond the best hit, as in [`Self::visit`].
+    fn visit_leaf_parents(
+        &self,
+        ray: &Ray,
+        node: &Node,
+        [ab, bc, ca]: [BaseVertex; 3],
+        best: &mut Option<MicroHit>,
+    ) {
+        let [a, b, c] = node.v;
+        let d = |v: BaseVertex| self.displacement.displace(&v);
+        let (da, db, dc, dab, dbc, dca) = (d(a), d(b), d(c), d(ab), d(bc), d(ca));
+        // The inner edges (of the middle child), each shared with one corner child.
+        let (ab_ca, ab_bc, bc_ca) = (d(ab.midpoint(ca)), d(ab.midpoint(bc)), d(bc.midpoint(ca)));
+        let six: [[DVec3; 6]; 4] = [
+            [da, dab, dca, d(a.midpoint(ab)), ab_ca, d(ca.midpoint(a))],
+            [dab, db, dbc, d(ab.midpoint(b)), d(b.midpoint(bc)), ab_bc],
+            [dca, dbc, dc, bc_ca, d(bc.midpoint(c)), d(c.midpoint(ca))],
+            [dca, dab, dbc, ab_ca, ab_bc, bc_ca],
+        ];
+        let world = LocalRay {
+            origin: ray.origin,
+            direction: ray.direction,
+            t_min: ray.t_min,
+            t_max: ray.t_max,
+            slack: 0.0,
+        };
+        let limit = best.map_or(f64::INFINITY, |b| b.t);
+        let (order, count) =
+            front_to_back(|k| slab_entry(&world, leaf_parent_box(&six[k], ray.origin), limit));
+        let grids = child_grids(node.g);
+        for &(entry, k) in &order[..count] {
+            if best.is_some_and(|b| entry > b.t) {
+                break;
+            }
+            test_leaves(ray, grids[k], six[k], best);
         }
     }
 
@@ -468,6 +560,26 @@ fn uv_height_range(height: &HeightField, v: &[BaseVertex; 3]) -> [f64; 2] {
     let hi = v[0].uv.max(v[1].uv).max(v[2].uv);
     let slack = DVec2::splat(1e-12) * (DVec2::ONE + lo.abs().max(hi.abs()));
     height.range(lo - slack, hi + slack)
+}
+
+/// The children `k` (0 to 3) whose boxes the ray enters, `entry(k)` giving where, as
+/// `(entry, k)` nearest first, and how many there are.
+#[inline]
+fn front_to_back(entry: impl Fn(usize) -> Option<f64>) -> ([(f64, usize); 4], usize) {
+    let mut order: [(f64, usize); 4] = [(f64::INFINITY, 4); 4];
+    let mut count = 0;
+    for k in 0..4 {
+        if let Some(t) = entry(k) {
+            let mut at = count;
+            while at > 0 && order[at - 1].0 > t {
+                order[at] = order[at - 1];
+                at -= 1;
+            }
+            order[at] = (t, k);
+            count += 1;
+        }
+    }
+    (order, count)
 }
 
 /// Where the ray enters `[lo, hi]` within its interval and before `limit`, if it does.

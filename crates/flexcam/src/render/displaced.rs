@@ -6,8 +6,8 @@
 //! The triangles of displaced objects are left out of the prepared scene's triangle BVH, so
 //! that its f32 inner loop stays as it is; queries ([`PreparedScene::intersect`] and the
 //! others) search both, the triangle BVH first, then this set up to the hit found there. The
-//! set is a binary tree over the shells' boxes (median splits of the box centres along the
-//! widest axis, leaves of at most [`LEAF`] base triangles), searched in f64 front to back.
+//! set is a binary tree over the shells' boxes (binned surface-area-heuristic splits, leaves
+//! of at most [`LEAF`] base triangles), searched in f64 front to back.
 //! Memory per base triangle: its object and index, a share of the tree's boxes (about 80
 //! bytes in all); the micro-geometry is recomputed per ray from the mesh.
 //!
@@ -144,7 +144,7 @@ impl DisplacedSet {
         }
         let mut nodes = Vec::with_capacity(2 * boxed.len() / LEAF + 1);
         if !boxed.is_empty() {
-            build(&mut boxed, 0, &mut nodes);
+            build(&mut boxed, 0, 0, &mut nodes);
         }
         let mut items = Vec::with_capacity(boxed.len());
         let mut boxes = Vec::new();
@@ -221,9 +221,7 @@ impl DisplacedSet {
         self.closest_by(ray, limit, any, |item, displacement, bounded| {
             let boxes =
                 &self.boxes[item.first_box as usize..(item.first_box + item.box_count) as usize];
-            if !enters_root(&item.frame, &boxes[0], bounded) {
-                return None;
-            }
+            let entry = enters_root(&item.frame, &boxes[0], bounded)?;
             DisplacedTriangle::with_boxes(
                 base_corners(
                     &scene.objects[item.object as usize].mesh,
@@ -233,7 +231,7 @@ impl DisplacedSet {
                 item.frame,
                 boxes,
             )
-            .intersect(bounded)
+            .intersect_entered(bounded, &entry)
             .map(|micro| (micro.t, micro))
         })
         .map(|(object, triangle, micro)| DisplacedHit {
@@ -343,8 +341,17 @@ impl DisplacedSet {
     }
 }
 
-/// Builds the subtree over `items` (stored from item `offset` on), appending its nodes.
-fn build(items: &mut [([u32; 2], DVec3, DVec3)], offset: usize, nodes: &mut Vec<Node>) {
+/// Builds the subtree over `items` (stored from item `offset` on, at tree depth `depth`),
+/// appending its nodes: binned surface-area-heuristic splits ([`sah_split`]), or the median
+/// of the box centres along their widest axis where the heuristic finds none or the tree is
+/// [`SAH_DEPTH`] deep (median splits halve the count, so the tree stays under [`STACK`]
+/// deep).
+fn build(
+    items: &mut [([u32; 2], DVec3, DVec3)],
+    offset: usize,
+    depth: usize,
+    nodes: &mut Vec<Node>,
+) {
     let (lo, hi) = items.iter().fold(
         (DVec3::INFINITY, DVec3::NEG_INFINITY),
         |(lo, hi), &(_, a, b)| (lo.min(a), hi.max(b)),
@@ -366,31 +373,98 @@ fn build(items: &mut [([u32; 2], DVec3, DVec3)], offset: usize, nodes: &mut Vec<
             (lo.min(c), hi.max(c))
         },
     );
-    let extent = c_hi - c_lo;
-    let axis = if extent.x >= extent.y && extent.x >= extent.z {
-        0
-    } else if extent.y >= extent.z {
-        1
-    } else {
-        2
+    let mid = match (depth < SAH_DEPTH)
+        .then(|| sah_split(items, c_lo, c_hi))
+        .flatten()
+    {
+        Some(mid) => mid,
+        None => {
+            let extent = c_hi - c_lo;
+            let axis = if extent.x >= extent.y && extent.x >= extent.z {
+                0
+            } else if extent.y >= extent.z {
+                1
+            } else {
+                2
+            };
+            let mid = items.len() / 2;
+            items.select_nth_unstable_by(mid, |p, q| {
+                let (cp, cq) = (p.1[axis] + p.2[axis], q.1[axis] + q.2[axis]);
+                cp.total_cmp(&cq).then(p.0.cmp(&q.0))
+            });
+            mid
+        }
     };
-    let mid = items.len() / 2;
-    items.select_nth_unstable_by(mid, |p, q| {
-        let (cp, cq) = (p.1[axis] + p.2[axis], q.1[axis] + q.2[axis]);
-        cp.total_cmp(&cq).then(p.0.cmp(&q.0))
-    });
     let (left, right) = items.split_at_mut(mid);
-    build(left, offset, nodes);
+    build(left, offset, depth + 1, nodes);
     let second = nodes.len() as u32;
-    build(right, offset + mid, nodes);
+    build(right, offset + mid, depth + 1, nodes);
     nodes[slot].index = second;
     nodes[slot].count = 0;
+}
+
+/// Depth below which [`build`] splits by the surface area heuristic.
+const SAH_DEPTH: usize = 20;
+/// Bins per axis of [`sah_split`].
+const BINS: usize = 16;
+
+/// Half the surface area of the box `[lo, hi]` (0 for an empty one).
+fn half_area(lo: DVec3, hi: DVec3) -> f64 {
+    let d = (hi - lo).max(DVec3::ZERO);
+    d.x * d.y + d.y * d.z + d.z * d.x
+}
+
+/// The binned surface-area-heuristic split of `items` (box centres within `[c_lo, c_hi]`):
+/// over [`BINS`] bins of the centres along each axis, the boundary that minimises the sum
+/// over both sides of box area times count. Partitions `items` (stably ordered by their
+/// index within each side) and returns the size of the first side; `None` when every centre
+/// falls in one bin on every axis.
+fn sah_split(items: &mut [([u32; 2], DVec3, DVec3)], c_lo: DVec3, c_hi: DVec3) -> Option<usize> {
+    let extent = c_hi - c_lo;
+    let bin = |item: &([u32; 2], DVec3, DVec3), axis: usize| -> usize {
+        let c = (item.1[axis] + item.2[axis]) * 0.5;
+        let x = (c - c_lo[axis]) / extent[axis] * BINS as f64;
+        (x as usize).min(BINS - 1)
+    };
+    let mut best: Option<(f64, usize, usize)> = None;
+    for axis in 0..3 {
+        if extent[axis].is_nan() || extent[axis] <= 0.0 {
+            continue;
+        }
+        let mut counts = [0usize; BINS];
+        let mut boxes = [(DVec3::INFINITY, DVec3::NEG_INFINITY); BINS];
+        for item in items.iter() {
+            let b = bin(item, axis);
+            counts[b] += 1;
+            boxes[b] = (boxes[b].0.min(item.1), boxes[b].1.max(item.2));
+        }
+        // Cost of the left side of each boundary, accumulated from the left.
+        let mut left = [0.0f64; BINS];
+        let (mut lo, mut hi, mut n) = (DVec3::INFINITY, DVec3::NEG_INFINITY, 0);
+        for ((cost, &(b_lo, b_hi)), &count) in left.iter_mut().zip(&boxes).zip(&counts) {
+            (lo, hi, n) = (lo.min(b_lo), hi.max(b_hi), n + count);
+            *cost = half_area(lo, hi) * n as f64;
+        }
+        let (mut lo, mut hi, mut n) = (DVec3::INFINITY, DVec3::NEG_INFINITY, 0);
+        for k in (1..BINS).rev() {
+            (lo, hi, n) = (lo.min(boxes[k].0), hi.max(boxes[k].1), n + counts[k]);
+            let cost = left[k - 1] + half_area(lo, hi) * n as f64;
+            if n > 0 && n < items.len() && best.is_none_or(|(c, _, _)| cost < c) {
+                best = Some((cost, axis, k));
+            }
+        }
+    }
+    let (_, axis, boundary) = best?;
+    items.sort_by_key(|item| (bin(item, axis) >= boundary, item.0));
+    Some(items.partition_point(|item| bin(item, axis) < boundary))
 }
 
 /// A ray's slab-test constants in f64.
 struct Slabs {
     origin: DVec3,
     inv: DVec3,
+    /// Whether a direction component is zero (its reciprocal infinite).
+    axis_parallel: bool,
 }
 
 impl Slabs {
@@ -399,16 +473,34 @@ impl Slabs {
             && ray.direction.is_finite()
             && ray.direction != DVec3::ZERO
             && ray.t_min <= ray.t_max;
+        let inv = ray.direction.recip();
         valid.then(|| Slabs {
             origin: ray.origin,
-            inv: ray.direction.recip(),
+            inv,
+            axis_parallel: !inv.is_finite(),
         })
     }
 
     /// Where the ray enters the node's box within `[t_min, t_max]`, if it does. The boxes
     /// already hold their shells' rounding allowance; a zero direction component gives an
     /// infinite reciprocal, and the origin test by the sign of the NaN-free products.
+    #[inline]
     fn entry(&self, node: &Node, t_min: f64, t_max: f64) -> Option<f64> {
+        if self.axis_parallel {
+            return self.entry_axis_parallel(node, t_min, t_max);
+        }
+        // No zero direction component: every product is finite, and the maxima and minima
+        // over the axes are those of the per-axis loop below, bit for bit.
+        let t0 = (node.lo - self.origin) * self.inv;
+        let t1 = (node.hi - self.origin) * self.inv;
+        let near = t0.min(t1).max_element().max(t_min);
+        let far = t0.max(t1).min_element().min(t_max);
+        let slack = 1e-12 * far.abs().max(near.abs());
+        (near <= far + slack).then_some(near)
+    }
+
+    /// [`Slabs::entry`] for a ray with a zero direction component.
+    fn entry_axis_parallel(&self, node: &Node, t_min: f64, t_max: f64) -> Option<f64> {
         let mut near = t_min;
         let mut far = t_max;
         for k in 0..3 {

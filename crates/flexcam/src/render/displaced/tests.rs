@@ -313,3 +313,34 @@ fn levels_of_detail_coarsen_within_one_shared_bound() {
     assert_eq!(lods.select(LodSelection::Distance, 0, near, 0.0), 0);
     assert_eq!(lods.select(LodSelection::Distance, 0, DVec3::ZERO, 0.0), 4);
 }
+
+/// Coincident shells (every centre in one bin on every axis) have no heuristic split: the
+/// build falls back to median splits, which keep the tree shallower than the traversal
+/// stack and every shell in exactly one leaf.
+#[test]
+fn coincident_shells_split_at_the_median() {
+    let count = 1000u32;
+    let mut items: Vec<([u32; 2], DVec3, DVec3)> = (0..count)
+        .map(|i| ([i, 0], DVec3::ZERO, DVec3::ONE))
+        .collect();
+    assert!(sah_split(&mut items, DVec3::splat(0.5), DVec3::splat(0.5)).is_none());
+    let mut nodes = Vec::new();
+    build(&mut items, 0, 0, &mut nodes);
+    let mut seen = vec![0; count as usize];
+    let mut deepest = 0;
+    let mut stack = vec![(0u32, 1usize)];
+    while let Some((i, depth)) = stack.pop() {
+        let node = nodes[i as usize];
+        deepest = deepest.max(depth);
+        if node.count > 0 {
+            assert!(node.count as usize <= LEAF);
+            for item in &items[node.index as usize..(node.index + node.count) as usize] {
+                seen[item.0[0] as usize] += 1;
+            }
+        } else {
+            stack.extend([(i + 1, depth + 1), (node.index, depth + 1)]);
+        }
+    }
+    assert!(seen.iter().all(|&n| n == 1));
+    assert!(deepest < STACK, "depth {deepest}");
+}
