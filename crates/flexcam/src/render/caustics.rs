@@ -68,8 +68,9 @@ use super::composite::{main_camera, perspective_as_trilinear, Reflector};
 use crate::error::Result;
 use crate::projection::Projection;
 use crate::render::prepared::PreparedScene;
-use crate::render::{Counter, Method, Outputs, RenderOptions, Rendered, Shading};
+use crate::render::{frame_name, Counter, Method, Outputs, RenderOptions, Rendered, Shading};
 use crate::scene::{Finish, Light, Scene};
+use crate::try_alloc;
 
 /// Whether [`add`] has caustics to add: the scene names caustic mirrors and the shading is
 /// `lit` (flat shading shows base colours, without light).
@@ -83,7 +84,7 @@ pub(super) fn wanted(scene: &Scene, options: &RenderOptions) -> bool {
 /// `caustic_photons` (map texels holding a photon), `caustic_triangles` (caustic triangles
 /// splatted), `caustic_pixels` (eye pixels lit by a caustic) and `caustic_ms`. Errors: a
 /// method without a photon map, a main projection that is not perspective, a light inside
-/// a mirror's bounding sphere.
+/// a mirror's bounding sphere, memory that cannot be had (module `try_alloc`).
 pub(super) fn add(
     prepared: &PreparedScene,
     projection: &dyn Projection,
@@ -95,7 +96,9 @@ pub(super) fn add(
     let source = PhotonSource::of(options.method)?;
     let eye = main_camera(scene, projection)?;
     let frame = &mut rendered.frame;
-    let mut irradiance = vec![Vec3::ZERO; frame.color.len()];
+    let mut irradiance = try_alloc::zeroed(frame.color.len(), || {
+        format!("the caustics of {}", frame_name(frame.width, frame.height))
+    })?;
     let (mut photons, mut triangles) = (0u64, 0u64);
     for caustic in &scene.caustics {
         let tint = Reflector::of(scene, caustic.id)?.tint;
@@ -118,7 +121,7 @@ pub(super) fn add(
                 &frame.depth,
                 &caustic_triangles,
                 &mut irradiance,
-            );
+            )?;
         }
     }
     let albedo = albedo(prepared, projection, options)?;

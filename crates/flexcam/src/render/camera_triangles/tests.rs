@@ -72,7 +72,7 @@ fn against_raycast(
 ) -> (Comparison, f64, Stats) {
     let projection = scene.projection.build(size.0, size.1).unwrap();
     let prepared = PreparedScene::new(scene);
-    let (reference, _) = raycast::render(&prepared, projection.as_ref(), options);
+    let (reference, _) = raycast::render(&prepared, projection.as_ref(), options).unwrap();
     let (frame, stats) = render(&prepared, projection.as_ref(), options).unwrap();
     let inside = id_agreement_inside(&frame, &reference);
     (compare(&frame, &reference).unwrap(), inside, stats)
@@ -176,7 +176,7 @@ fn bounds_hold_every_fragment_of_diverging_rays() {
 fn fragments_in_bounds(name: &str, projection: &Trilinear, scene: &Scene) -> usize {
     let (width, height) = projection.resolution();
     let cameras = Camera::all(projection);
-    let owners = owners::owners(&cameras, width, height);
+    let owners = owners::owners(&cameras, width, height).unwrap();
     let geometry = SceneGeometry::new(scene);
     let mut checked = 0;
     for (c, camera) in cameras.iter().enumerate() {
