@@ -210,11 +210,11 @@ impl Frame {
     }
 
     /// Makes this frame `width` x `height` with the buffers of `outputs` for a renderer that
-    /// overwrites every pixel: a frame of that size and those buffers (each holding `width
-    /// * height` pixels, the unwanted ones empty) is kept as it is, contents and all, so a
-    /// caller drawing frame after frame pays neither its allocation nor the first touch of
-    /// its pages again; any other is replaced by [`Frame::zeroed`]. On failure (no memory)
-    /// the frame is left as it was.
+    /// overwrites every pixel: a frame of that size and those buffers (each holding
+    /// `width * height` pixels, the unwanted ones empty) is kept as it is, contents and all,
+    /// so a caller drawing frame after frame pays neither its allocation nor the first touch
+    /// of its pages again; any other is replaced by [`Frame::zeroed`]. On failure (no
+    /// memory) the frame is left as it was.
     pub(crate) fn fit(&mut self, width: u32, height: u32, outputs: Outputs) -> Result<()> {
         let n = width as usize * height as usize;
         let fits = (self.width, self.height) == (width, height)
