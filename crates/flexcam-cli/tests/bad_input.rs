@@ -557,3 +557,36 @@ fn a_correspondence_behind_the_eye_is_refused_or_shown_in_the_residual() {
         fs::remove_file(dir.path().join("out.png")).unwrap();
     }
 }
+
+#[test]
+fn trilinear_surface_normals_are_refused_at_the_obj_line() {
+    let dir = TempDir::new().unwrap();
+    let obj = |normal: &str| {
+        format!(
+            "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0.5 1\nvn 0 0 -1\n{normal}\n\
+             vn 0 0 -1\nf 1/1/1 2/2/2 3/3/3\n"
+        )
+    };
+    let scene = "[image]\nwidth = 8\nheight = 6\n\n[projection]\ntype = \"trilinear\"\n\
+                 surface = \"s.obj\"\n";
+    write(&dir, "scene.toml", scene);
+    for (normal, expected) in [
+        (
+            "vn nan 0 -1",
+            "flexcam: s.obj:8:1: `vn` value nan is not a finite number",
+        ),
+        (
+            "vn 0 0 0",
+            "flexcam: s.obj:8:1: `vn` has zero length: every vertex of a trilinear surface \
+             needs a ray direction",
+        ),
+    ] {
+        write(&dir, "s.obj", obj(normal));
+        refused(
+            &dir,
+            &["render", "scene.toml", "-o", "out.png"],
+            1,
+            expected,
+        );
+    }
+}

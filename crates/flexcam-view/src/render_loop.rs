@@ -28,7 +28,7 @@ use flexcam::projection::{
     View,
 };
 use flexcam::render::{self, Frame, Method, Outputs, PreparedScene, RenderOptions, Shading};
-use flexcam::{Error, Result};
+use flexcam::{try_alloc, Error, Result};
 use glam::DVec2;
 
 /// How the view renders: the final method, shading and samples per pixel (those of the
@@ -360,7 +360,7 @@ fn run_ladder(shared: &Shared, job: &Job) -> Result<()> {
             ms,
             width: frame.width,
             height: frame.height,
-            rgba: Arc::new(rgba(&frame, job.settings.shading)),
+            rgba: Arc::new(rgba(&frame, job.settings.shading)?),
         };
         let mut state = shared.lock();
         if stage == Stage::Final {
@@ -415,21 +415,23 @@ fn render_stage(shared: &Shared, job: &Job, stage: Stage) -> Result<Frame> {
     rendered.map(|r| r.frame)
 }
 
-/// 8-bit RGBA of `frame`'s colour, encoded as a PNG of `shading` is.
-pub fn rgba(frame: &Frame, shading: Shading) -> Vec<u8> {
+/// 8-bit RGBA of `frame`'s colour, encoded as a PNG of `shading` is. Fails when its memory
+/// cannot be had.
+pub fn rgba(frame: &Frame, shading: Shading) -> Result<Vec<u8>> {
     let encoding = ColorEncoding::of_shading(shading);
-    frame
-        .color
-        .iter()
-        .flat_map(|c| {
-            [
-                encode_channel(c.x, encoding),
-                encode_channel(c.y, encoding),
-                encode_channel(c.z, encoding),
-                255,
-            ]
-        })
-        .collect()
+    let mut bytes = Vec::new();
+    try_alloc::reserve(&mut bytes, frame.color.len() * 4, || {
+        format!("the shown {} x {} image", frame.width, frame.height)
+    })?;
+    bytes.extend(frame.color.iter().flat_map(|c| {
+        [
+            encode_channel(c.x, encoding),
+            encode_channel(c.y, encoding),
+            encode_channel(c.z, encoding),
+            255,
+        ]
+    }));
+    Ok(bytes)
 }
 
 /// A projection that sees nothing once its job is stale: lets a running ray-cast stage end

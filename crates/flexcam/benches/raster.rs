@@ -28,13 +28,14 @@ fn panorama(c: &mut Criterion) {
     let prepared = PreparedScene::new(&scene);
     let raster = InverseRaster::new(&prepared, projection.as_ref(), &options)
         .unwrap_or_else(|e| panic!("raster: {e}"));
-    let mut frame = raster.render().0;
+    let mut frame = raster.render().unwrap().0;
     group.bench_function("raster_frame", |b| {
         b.iter(|| raster.render_into(&mut frame))
     });
     group.bench_function("raster_first_frame", |b| {
         b.iter(|| {
-            InverseRaster::new(&prepared, projection.as_ref(), &options).map(|fresh| fresh.render())
+            InverseRaster::new(&prepared, projection.as_ref(), &options)
+                .and_then(|fresh| fresh.render())
         })
     });
     group.bench_function("raycast_frame", |b| {

@@ -20,6 +20,7 @@ pub mod image_io;
 pub mod projection;
 pub mod render;
 pub mod scene;
+pub mod try_alloc;
 
 pub use error::{Error, Result};
 

@@ -241,7 +241,8 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
             outputs: Outputs::COLOR,
             ..RenderOptions::default()
         };
-        let rendered = render::render(&prepared, projection.as_ref(), &options)?;
+        let rendered = render::render(&prepared, projection.as_ref(), &options)
+            .map_err(|e| e.or_in_file(&args.scene))?;
         warnings.extend(rendered.warnings);
         let frame = rendered.frame;
         if let Some(&id) = frame_outputs.get(index) {

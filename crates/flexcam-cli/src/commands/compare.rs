@@ -118,7 +118,8 @@ fn compare_renders(args: &CompareArgs) -> Result<bool> {
     let result = compare(&frame, &reference_frame)?;
 
     if let Some(id) = diff {
-        let image = difference_image(&frame, &reference_frame);
+        let image =
+            difference_image(&frame, &reference_frame).map_err(|e| e.or_in_file(&loaded.source))?;
         outputs.stage(id, |tmp| {
             image_io::write_color_png(&image, tmp, ColorEncoding::Linear)
         })?;
@@ -253,9 +254,10 @@ fn check_thresholds(args: &CompareArgs, c: &Comparison) -> Result<()> {
     Ok(())
 }
 
-/// Red where the object ids differ; elsewhere the colour difference amplified 4x.
-fn difference_image(frame: &Frame, reference: &Frame) -> Frame {
-    let mut diff = Frame::new(frame.width, frame.height, Vec3::ZERO);
+/// Red where the object ids differ; elsewhere the colour difference amplified 4x. Fails when
+/// its memory cannot be had.
+fn difference_image(frame: &Frame, reference: &Frame) -> Result<Frame> {
+    let mut diff = Frame::try_new(frame.width, frame.height, Vec3::ZERO)?;
     for (i, out) in diff.color.iter_mut().enumerate() {
         *out = if frame.ids[i] != reference.ids[i] {
             Vec3::new(1.0, 0.0, 0.0)
@@ -263,5 +265,5 @@ fn difference_image(frame: &Frame, reference: &Frame) -> Frame {
             ((frame.color[i] - reference.color[i]).abs() * 4.0).min(Vec3::ONE)
         };
     }
-    diff
+    Ok(diff)
 }

@@ -9,7 +9,7 @@ use flexcam::image_io::{self, OutputSet, StMapFormat};
 use flexcam::projection::ray_map::ray_map;
 use flexcam::render::{st_map, PreparedScene, StPoints};
 use flexcam::scene::{self, Overrides};
-use flexcam::{Error, Result};
+use flexcam::{try_alloc, Error, Result};
 
 use super::scene_args::{print_warnings, SceneArgs};
 
@@ -85,7 +85,7 @@ pub fn run(args: &RaymapArgs) -> Result<()> {
     super::declare_scene_inputs(&mut outputs, &loaded.scene.inputs)?;
     let projection = loaded.projection.as_ref();
     if let Some(id) = rays {
-        let map = ray_map(projection);
+        let map = ray_map(projection).map_err(|e| e.or_in_file(&loaded.source))?;
         outputs.stage(id, |tmp| image_io::write_ray_map_exr(&map, tmp))?;
     }
     if let (Some((id, format)), Some(source)) = (stmap, &args.reference) {
@@ -98,8 +98,15 @@ pub fn run(args: &RaymapArgs) -> Result<()> {
                 StPoints::FirstHit(&prepared)
             }
         };
-        let map = st_map(projection, reference.projection.as_ref(), points)
-            .map_err(|e| e.or_in_file(&reference.source))?;
+        // The map is of the scene's image: memory it cannot have is the scene's.
+        let map = st_map(projection, reference.projection.as_ref(), points).map_err(|e| {
+            let file = if try_alloc::is_out_of_memory(&e) {
+                &loaded.source
+            } else {
+                &reference.source
+            };
+            e.or_in_file(file)
+        })?;
         outputs.stage(id, |tmp| image_io::write_stmap(&map, tmp, format))?;
     }
     outputs.commit()?;

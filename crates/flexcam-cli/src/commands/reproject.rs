@@ -48,7 +48,8 @@ pub fn run(args: &ReprojectArgs) -> Result<()> {
         loaded.projection.as_ref(),
         args.spp,
         loaded.scene.image.background,
-    );
+    )
+    .map_err(|e| e.or_in_file(&loaded.source))?;
     outputs.stage(output, |tmp| {
         image_io::write_color_png(&frame, tmp, ColorEncoding::Srgb)
     })?;

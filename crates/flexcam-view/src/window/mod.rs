@@ -405,7 +405,7 @@ impl App {
 /// linear encoding unchanged (round(255 * v / 255) = v).
 fn write_screenshot(image: &egui::ColorImage, out: &std::path::Path) -> Result<()> {
     let [width, height] = image.size;
-    let mut frame = Frame::new(width as u32, height as u32, Vec3::ZERO);
+    let mut frame = Frame::try_new(width as u32, height as u32, Vec3::ZERO)?;
     for (pixel, color) in frame.color.iter_mut().zip(&image.pixels) {
         *pixel = Vec3::new(
             f32::from(color.r()),

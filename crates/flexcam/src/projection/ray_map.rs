@@ -13,6 +13,8 @@ use rayon::prelude::*;
 
 use super::projector::{quadratic_tangent, Projector};
 use super::Projection;
+use crate::error::Result;
+use crate::try_alloc;
 
 /// Where a pixel's projector starts and ends, with its unit directions there.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,32 +46,35 @@ pub struct RayMap {
     pub curved: bool,
 }
 
-/// The ray map of `projection`: the projector through each pixel's centre.
-pub fn ray_map(projection: &dyn Projection) -> RayMap {
+/// The ray map of `projection`: the projector through each pixel's centre. Fails when the
+/// map's memory cannot be had (module `try_alloc`).
+pub fn ray_map(projection: &dyn Projection) -> Result<RayMap> {
     let (width, height) = projection.resolution();
     let pixels = width as usize * height as usize;
-    let rays: Vec<(Option<PixelRay>, bool)> = (0..pixels)
-        .into_par_iter()
-        .map(|i| {
+    let mut rays = try_alloc::filled(pixels, None, || {
+        format!("the ray map of the {width} x {height} image")
+    })?;
+    let curved = rays
+        .par_iter_mut()
+        .enumerate()
+        .map(|(i, ray)| {
             let pixel = DVec2::new(
                 (i % width as usize) as f64 + 0.5,
                 (i / width as usize) as f64 + 0.5,
             );
-            match projection.projector(pixel) {
-                Some(projector) => (
-                    pixel_ray(&projector),
-                    !matches!(projector, Projector::Straight(_)),
-                ),
-                None => (None, false),
-            }
+            let Some(projector) = projection.projector(pixel) else {
+                return false;
+            };
+            *ray = pixel_ray(&projector);
+            !matches!(projector, Projector::Straight(_))
         })
-        .collect();
-    RayMap {
+        .reduce(|| false, |a, b| a || b);
+    Ok(RayMap {
         width,
         height,
-        curved: rays.iter().any(|(_, curved)| *curved),
-        rays: rays.into_iter().map(|(ray, _)| ray).collect(),
-    }
+        curved,
+        rays,
+    })
 }
 
 /// The start and end of `projector` with their unit directions (see [`PixelRay`]), or `None`

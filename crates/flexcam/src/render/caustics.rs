@@ -70,8 +70,11 @@ use super::composite::{
 use crate::error::Result;
 use crate::projection::Projection;
 use crate::render::prepared::PreparedScene;
-use crate::render::{Counter, Method, Outputs, RenderOptions, Rendered, Shading, Stats};
+use crate::render::{
+    frame_name, Counter, Method, Outputs, RenderOptions, Rendered, Shading, Stats,
+};
 use crate::scene::{Finish, Light, Scene};
+use crate::try_alloc;
 
 /// Whether [`add`] has caustics to add: the scene names caustic mirrors and the shading is
 /// `lit` (flat shading shows base colours, without light).
@@ -88,7 +91,7 @@ pub(super) fn wanted(scene: &Scene, options: &RenderOptions) -> bool {
 /// `caustic_camera_triangles`, `caustic_bounding_fragments`, `caustic_rendered_fragments`
 /// and `caustic_overdraw` (bounding over rendered: Table 1's caustics row). Errors: a
 /// method without a photon map, a main projection that is not perspective, a light inside
-/// a mirror's bounding sphere.
+/// a mirror's bounding sphere, memory that cannot be had (module `try_alloc`).
 pub(super) fn add(
     prepared: &PreparedScene,
     projection: &dyn Projection,
@@ -100,7 +103,9 @@ pub(super) fn add(
     let source = PhotonSource::of(options.method)?;
     let eye = main_camera(scene, projection)?;
     let frame = &mut rendered.frame;
-    let mut irradiance = vec![Vec3::ZERO; frame.color.len()];
+    let mut irradiance = try_alloc::zeroed(frame.color.len(), || {
+        format!("the caustics of {}", frame_name(frame.width, frame.height))
+    })?;
     let (mut photons, mut triangles) = (0u64, 0u64);
     let mut maps = Stats::new();
     for caustic in &scene.caustics {
@@ -125,7 +130,7 @@ pub(super) fn add(
                 &frame.depth,
                 &caustic_triangles,
                 &mut irradiance,
-            );
+            )?;
         }
     }
     let albedo = albedo(prepared, projection, options)?;

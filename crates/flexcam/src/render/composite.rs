@@ -150,7 +150,7 @@ fn with_renderer(
                     let rays = entry.camera_rays;
                     let reflection = match surface_projection(&mirror, map, rays, &camera)? {
                         Some(surface) => through(&surface)?.0,
-                        None => Frame::new(image.width, image.height, scene.image.background),
+                        None => Frame::try_new(image.width, image.height, scene.image.background)?,
                     };
                     let split = FresnelSplit::new(prepared, id, camera.clone());
                     let mixed =
@@ -601,7 +601,7 @@ pub struct FresnelMix {
 /// At every pixel of `main` that sees object `id`, the ray caster's glass colour made from
 /// the images through the refraction and reflection surfaces: `tint (1 - R) refraction +
 /// R reflection` by the pixel's [`GlassSplit`] (other pixels hold `refraction` unchanged).
-/// Errors: frames of different sizes.
+/// Errors: frames of different sizes; memory that cannot be had for the mixed frame.
 pub fn fresnel_mix(
     main: &Frame,
     id: u32,
@@ -614,27 +614,25 @@ pub fn fresnel_mix(
         check_size(main, other)?;
     }
     let width = main.width as usize;
-    let mixed: Vec<(Vec3, u64)> = (0..main.ids.len())
-        .into_par_iter()
-        .map(|k| {
-            let (through, mirrored) = (refraction.color[k], reflection.color[k]);
+    let mut frame = refraction.try_clone()?;
+    let rays = frame
+        .color
+        .par_iter_mut()
+        .enumerate()
+        .map(|(k, color)| {
             if main.ids[k] != id {
-                return (through, 0);
+                return 0;
             }
-            let color = match split.at((k % width) as u32, (k / width) as u32) {
+            let (through, mirrored) = (refraction.color[k], reflection.color[k]);
+            *color = match split.at((k % width) as u32, (k / width) as u32) {
                 GlassSplit::Fresnel(r) => tint * (1.0 - r) * through + r * mirrored,
                 GlassSplit::TotalReflection => mirrored,
                 GlassSplit::Missed => tint * through,
             };
-            (color, 1)
+            1
         })
-        .collect();
-    let mut frame = refraction.clone();
-    frame.color = mixed.iter().map(|&(c, _)| c).collect();
-    Ok(FresnelMix {
-        frame,
-        rays: mixed.iter().map(|&(_, n)| n).sum(),
-    })
+        .sum();
+    Ok(FresnelMix { frame, rays })
 }
 
 /// Fails unless `other` has `main`'s size.

@@ -74,7 +74,7 @@ impl Method {
             return transitions::render(prepared, projection, options, shading);
         }
         match self {
-            Method::Raycast => Ok(raycast::render(prepared, projection, options)),
+            Method::Raycast => raycast::render(prepared, projection, options),
             Method::Raster => raster::render(prepared, projection, options),
             Method::Trilinear => {
                 let trilinear = projection.trilinear().ok_or_else(|| {

@@ -18,6 +18,7 @@ use glam::Vec3;
 
 use crate::error::Result;
 use crate::projection::Projection;
+use crate::try_alloc;
 
 /// How surfaces are shaded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -152,17 +153,40 @@ pub struct Frame {
 }
 
 impl Frame {
-    /// A frame filled with `background`, infinite depth and id 0.
+    /// A frame filled with `background`, infinite depth and id 0. Panics when the memory
+    /// cannot be had; a frame whose size comes from the input is made by
+    /// [`Frame::try_new`].
     pub fn new(width: u32, height: u32, background: Vec3) -> Self {
+        Frame::try_new(width, height, background).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// [`Frame::new`] that fails, naming the bytes asked for, when the memory cannot be had
+    /// (module `try_alloc`).
+    pub fn try_new(width: u32, height: u32, background: Vec3) -> Result<Self> {
         let n = width as usize * height as usize;
-        Frame {
+        let what = || frame_name(width, height);
+        Ok(Frame {
             width,
             height,
-            color: vec![background; n],
-            depth: vec![f32::INFINITY; n],
-            ids: vec![0; n],
+            color: try_alloc::filled(n, background, what)?,
+            depth: try_alloc::filled(n, f32::INFINITY, what)?,
+            ids: try_alloc::zeroed(n, what)?,
             surface: Vec::new(),
-        }
+        })
+    }
+
+    /// A copy of this frame that fails, naming the bytes asked for, when the memory cannot be
+    /// had (module `try_alloc`).
+    pub(crate) fn try_clone(&self) -> Result<Frame> {
+        let what = || frame_name(self.width, self.height);
+        Ok(Frame {
+            width: self.width,
+            height: self.height,
+            color: try_alloc::copied(&self.color, what)?,
+            depth: try_alloc::copied(&self.depth, what)?,
+            ids: try_alloc::copied(&self.ids, what)?,
+            surface: try_alloc::copied(&self.surface, what)?,
+        })
     }
 
     /// A frame of zero bits in every channel (black, depth 0, id 0), for a renderer that
@@ -174,28 +198,31 @@ impl Frame {
     /// Large buffers are mapped with transparent huge pages where the system allows
     /// ([`huge_pages::advise_huge_pages`]): far fewer page faults on that first touch.
     /// Only the buffers `outputs` asks for are allocated (the others are empty).
-    pub(crate) fn zeroed(width: u32, height: u32, outputs: Outputs) -> Self {
+    /// Fails, naming the bytes asked for, when the memory cannot be had (module `try_alloc`).
+    pub(crate) fn zeroed(width: u32, height: u32, outputs: Outputs) -> Result<Self> {
         let n = width as usize * height as usize;
+        let what = || frame_name(width, height);
         let mut frame = Frame {
             width,
             height,
-            color: bytemuck::zeroed_vec(n),
-            depth: bytemuck::zeroed_vec(Outputs::len(outputs.depth, n)),
-            ids: bytemuck::zeroed_vec(Outputs::len(outputs.ids, n)),
+            color: try_alloc::zeroed(n, what)?,
+            depth: try_alloc::zeroed(Outputs::len(outputs.depth, n), what)?,
+            ids: try_alloc::zeroed(Outputs::len(outputs.ids, n), what)?,
             surface: Vec::new(),
         };
         huge_pages::advise_huge_pages(&mut frame.color);
         huge_pages::advise_huge_pages(&mut frame.depth);
         huge_pages::advise_huge_pages(&mut frame.ids);
-        frame
+        Ok(frame)
     }
 
     /// Makes this frame `width` x `height` with the buffers of `outputs` for a renderer that
-    /// overwrites every pixel: a frame of that size and those buffers (each holding `width
-    /// * height` pixels, the unwanted ones empty) is kept as it is, contents and all, so a
-    /// caller drawing frame after frame pays neither its allocation nor the first touch of
-    /// its pages again; any other is replaced by [`Frame::zeroed`].
-    pub(crate) fn fit(&mut self, width: u32, height: u32, outputs: Outputs) {
+    /// overwrites every pixel: a frame of that size and those buffers (each holding
+    /// `width * height` pixels, the unwanted ones empty) is kept as it is, contents and all,
+    /// so a caller drawing frame after frame pays neither its allocation nor the first touch
+    /// of its pages again; any other is replaced by [`Frame::zeroed`]. On failure (no
+    /// memory) the frame is left as it was.
+    pub(crate) fn fit(&mut self, width: u32, height: u32, outputs: Outputs) -> Result<()> {
         let n = width as usize * height as usize;
         let fits = (self.width, self.height) == (width, height)
             && [self.color.len(), self.depth.len(), self.ids.len()]
@@ -205,8 +232,9 @@ impl Frame {
                     Outputs::len(outputs.ids, n),
                 ];
         if !fits {
-            *self = Frame::zeroed(width, height, outputs);
+            *self = Frame::zeroed(width, height, outputs)?;
         }
+        Ok(())
     }
 
     /// Drops the buffers `outputs` does not ask for.
@@ -223,6 +251,11 @@ impl Frame {
     }
 }
 
+/// How the errors of a failed buffer allocation name a frame-sized buffer.
+pub(crate) fn frame_name(width: u32, height: u32) -> String {
+    format!("the {width} x {height} frame")
+}
+
 /// A rendered frame and what rendering it counted.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Rendered {
@@ -237,8 +270,9 @@ pub struct Rendered {
 
 /// Renders `prepared` through `projection` as `options` say: the one entry point of every
 /// method. Fails, rather than producing a wrong image, when the method cannot render that
-/// projection (with one line naming why), on zero samples per pixel, or on a crop window
-/// that is empty or does not fit in the image.
+/// projection (with one line naming why), on zero samples per pixel, on a crop window that
+/// is empty or does not fit in the image, or when the memory of a frame-sized buffer cannot
+/// be had (the bytes and the buffer named: module `try_alloc`).
 ///
 /// ```
 /// use flexcam::render::{self, Method, PreparedScene, RenderOptions, Shading};
@@ -278,7 +312,7 @@ pub fn render(
     let window = (options.crop)
         .unwrap_or_else(|| PixelWindow::whole(rendered.frame.width, rendered.frame.height));
     let (surface, unresolved) =
-        surface::layers(prepared, projection, &rendered.frame, window, options.spp);
+        surface::layers(prepared, projection, &rendered.frame, window, options.spp)?;
     rendered.frame.surface = surface;
     rendered
         .counters
@@ -306,7 +340,7 @@ fn render_buffers(
                 ..*options
             };
             let mut rendered = render_buffers(prepared, projection, &whole)?;
-            rendered.frame = window.cut(&rendered.frame);
+            rendered.frame = window.cut(&rendered.frame)?;
             return Ok(rendered);
         }
     }

@@ -113,16 +113,17 @@ pub fn exit_direction(projector: &Projector) -> Option<DVec3> {
 
 /// The photo seen through `projection`, `spp` samples per pixel (at least 1), pixels without
 /// a projector set to `background`. Only the colour of the frame is meaningful (depth is
-/// infinite and ids 0: the photo is at infinity).
+/// infinite and ids 0: the photo is at infinity). Fails only when the frame's memory cannot
+/// be had (module `try_alloc`).
 pub fn reproject(
     photo: &EquirectPhoto,
     projection: &dyn Projection,
     spp: u32,
     background: Vec3,
-) -> Frame {
+) -> Result<Frame> {
     let (width, height) = projection.resolution();
     let pattern = SamplePattern::new(spp);
-    let mut frame = Frame::new(width, height, background);
+    let mut frame = Frame::try_new(width, height, background)?;
     frame
         .color
         .par_chunks_mut(width as usize)
@@ -145,7 +146,7 @@ pub fn reproject(
                 }
             }
         });
-    frame
+    Ok(frame)
 }
 
 #[cfg(test)]
@@ -226,7 +227,7 @@ mod tests {
         let (w, h) = (64, 32);
         let photo = noise_photo(w, h);
         let camera = whole_sphere(DVec3::NEG_Z, (w, h));
-        let out = reproject(&photo, camera.as_ref(), 1, Vec3::ZERO);
+        let out = reproject(&photo, camera.as_ref(), 1, Vec3::ZERO).unwrap();
         let worst = out
             .color
             .iter()
@@ -236,7 +237,7 @@ mod tests {
         assert!(worst < 1e-4, "{worst}");
         // Turned by 90 degrees to +x: column x shows the photo's column x + W/4.
         let turned = whole_sphere(DVec3::X, (w, h));
-        let out = reproject(&photo, turned.as_ref(), 1, Vec3::ZERO);
+        let out = reproject(&photo, turned.as_ref(), 1, Vec3::ZERO).unwrap();
         for (y, x) in [(3usize, 5usize), (20, 60)] {
             let want = photo.image.pixels[y * w as usize + (x + w as usize / 4) % w as usize];
             let got = out.color[y * w as usize + x];
@@ -250,7 +251,7 @@ mod tests {
         // the top-left corner along (x, y, z) = (1, 1, -1) (left of +x is -z).
         let photo = direction_photo(720, 360);
         let camera = perspective(DVec3::X, 90.0, (20, 20));
-        let out = reproject(&photo, camera.as_ref(), 1, Vec3::ZERO);
+        let out = reproject(&photo, camera.as_ref(), 1, Vec3::ZERO).unwrap();
         let colour = |lon: f64, lat: f64| {
             Vec3::new((lon / 360.0 + 0.5) as f32, (lat / 180.0 + 0.5) as f32, 0.5)
         };
@@ -316,8 +317,8 @@ mod tests {
     fn supersampling_averages_the_pattern() {
         let photo = noise_photo(32, 16);
         let camera = perspective(DVec3::NEG_Z, 60.0, (6, 4));
-        let one = reproject(&photo, camera.as_ref(), 1, Vec3::ZERO);
-        let many = reproject(&photo, camera.as_ref(), 16, Vec3::ZERO);
+        let one = reproject(&photo, camera.as_ref(), 1, Vec3::ZERO).unwrap();
+        let many = reproject(&photo, camera.as_ref(), 16, Vec3::ZERO).unwrap();
         let pattern = SamplePattern::new(16);
         let corner = DVec2::new(2.0, 1.0);
         let want = pattern

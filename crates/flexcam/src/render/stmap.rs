@@ -30,7 +30,8 @@ use crate::error::{Error, Result};
 use crate::projection::projector::{quadratic_arc_length, quadratic_point, Projector};
 use crate::projection::ray_map::pixel_ray;
 use crate::projection::{ImagePoint, Projection};
-use crate::render::PreparedScene;
+use crate::render::{frame_name, PreparedScene};
+use crate::try_alloc;
 
 /// Which scene point a pixel of the projection stands for (see the module documentation).
 #[derive(Clone, Copy)]
@@ -67,7 +68,7 @@ const FAR: f64 = 1e9;
 
 /// The STMap of `projection` against `reference` for the scene points `points`. Errors: a
 /// reference camera without an inverse (the line names its kind), a negative or non-finite
-/// distance.
+/// distance, memory that cannot be had for the map (module `try_alloc`).
 pub fn st_map(
     projection: &dyn Projection,
     reference: &dyn Projection,
@@ -91,30 +92,33 @@ pub fn st_map(
     }
     let (width, height) = projection.resolution();
     let (ref_w, ref_h) = reference.resolution();
-    let st = (0..width as usize * height as usize)
-        .into_par_iter()
-        .map_init(Vec::new, |images, i| {
-            let pixel = DVec2::new(
-                (i % width as usize) as f64 + 0.5,
-                (i / width as usize) as f64 + 0.5,
-            );
-            let projector = projection.projector(pixel)?;
-            let (point, on_surface) = scene_point(&projector, points)?;
-            images.clear();
-            inverse.project(point, images);
-            let seen = nearest_inside(images, (ref_w, ref_h))?;
-            if let (StPoints::FirstHit(scene), true) = (points, on_surface) {
-                let hit = first_hit(scene, &reference.projector(seen.pixel)?)?;
-                if hit.point().distance(point) > HIDDEN_TOLERANCE * hit.depth {
-                    return None;
-                }
+    let mut st = try_alloc::filled(width as usize * height as usize, None, || {
+        format!("the STMap of {}", frame_name(width, height))
+    })?;
+    let st_of = |images: &mut Vec<ImagePoint>, i: usize| {
+        let pixel = DVec2::new(
+            (i % width as usize) as f64 + 0.5,
+            (i / width as usize) as f64 + 0.5,
+        );
+        let projector = projection.projector(pixel)?;
+        let (point, on_surface) = scene_point(&projector, points)?;
+        images.clear();
+        inverse.project(point, images);
+        let seen = nearest_inside(images, (ref_w, ref_h))?;
+        if let (StPoints::FirstHit(scene), true) = (points, on_surface) {
+            let hit = first_hit(scene, &reference.projector(seen.pixel)?)?;
+            if hit.point().distance(point) > HIDDEN_TOLERANCE * hit.depth {
+                return None;
             }
-            Some(DVec2::new(
-                seen.pixel.x / ref_w as f64,
-                1.0 - seen.pixel.y / ref_h as f64,
-            ))
-        })
-        .collect();
+        }
+        Some(DVec2::new(
+            seen.pixel.x / ref_w as f64,
+            1.0 - seen.pixel.y / ref_h as f64,
+        ))
+    };
+    st.par_iter_mut()
+        .enumerate()
+        .for_each_init(Vec::new, |images, (i, slot)| *slot = st_of(images, i));
     Ok(StMap { width, height, st })
 }
 

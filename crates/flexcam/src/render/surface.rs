@@ -15,14 +15,18 @@
 //! where its polygonal approximation covers the pixel and the exact object does not), get
 //! [`SurfacePoint::NONE`]; the latter are counted (`surface_unresolved`).
 
+use std::collections::BTreeSet;
+
 use glam::{DVec2, Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::raycast::{first_hit, ProjectorHit, SamplePattern};
 use super::shading::{normals, texture_coordinates, Normals};
+use crate::error::Result;
 use crate::projection::Projection;
-use crate::render::{Frame, PixelWindow, PreparedScene};
+use crate::render::{frame_name, Frame, PixelWindow, PreparedScene};
 use crate::scene::Mesh;
+use crate::try_alloc;
 
 /// What a pixel shows, in world space.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -59,19 +63,29 @@ pub const DEPTH_TOLERANCE: f64 = 1e-3;
 
 /// The surface layers of `frame`, which is `window` of `projection`'s image rendered from
 /// `prepared` with `spp` samples (its depth and ids filled), and how many pixels with an
-/// object id had no surface at their depth (see the module documentation).
+/// object id had no surface at their depth (see the module documentation). Fails when the
+/// layers' memory cannot be had (module `try_alloc`).
 pub(super) fn layers(
     prepared: &PreparedScene,
     projection: &dyn Projection,
     frame: &Frame,
     window: PixelWindow,
     spp: u32,
-) -> (Vec<SurfacePoint>, u64) {
+) -> Result<(Vec<SurfacePoint>, u64)> {
     let objects = &prepared.scene().objects;
     // One view per object the frame shows, hiding every other object (sharing the BVH).
-    let mut shown: Vec<u32> = frame.ids.iter().copied().filter(|&id| id != 0).collect();
-    shown.sort_unstable();
-    shown.dedup();
+    let shown = frame
+        .ids
+        .par_iter()
+        .filter(|&&id| id != 0)
+        .fold(BTreeSet::new, |mut ids, &id| {
+            ids.insert(id);
+            ids
+        })
+        .reduce(BTreeSet::new, |mut a, b| {
+            a.extend(b);
+            a
+        });
     let views: Vec<(u32, Option<PreparedScene>)> = shown
         .into_iter()
         .map(|id| {
@@ -82,12 +96,19 @@ pub(super) fn layers(
     let pattern = SamplePattern::new(spp);
     let offset = pattern.offsets[pattern.centre];
     let width = frame.width as usize;
-    let points: Vec<(SurfacePoint, bool)> = (0..frame.ids.len())
-        .into_par_iter()
-        .map(|i| {
+    let mut points = try_alloc::filled(frame.ids.len(), SurfacePoint::NONE, || {
+        format!(
+            "the surface layers of {}",
+            frame_name(frame.width, frame.height)
+        )
+    })?;
+    let unresolved = points
+        .par_iter_mut()
+        .enumerate()
+        .map(|(i, point)| {
             let id = frame.ids[i];
             if id == 0 {
-                return (SurfacePoint::NONE, false);
+                return 0;
             }
             let view = views
                 .binary_search_by_key(&id, |(id, _)| *id)
@@ -104,16 +125,15 @@ pub(super) fn layers(
                     .then(|| surface_point(view, &found))
             });
             match found {
-                Some(point) => (point, false),
-                None => (SurfacePoint::NONE, true),
+                Some(found) => {
+                    *point = found;
+                    0
+                }
+                None => 1,
             }
         })
-        .collect();
-    let unresolved = points.iter().filter(|(_, missed)| *missed).count() as u64;
-    (
-        points.into_iter().map(|(point, _)| point).collect(),
-        unresolved,
-    )
+        .sum();
+    Ok((points, unresolved))
 }
 
 /// A view of `prepared` showing object `index` alone.
@@ -307,7 +327,7 @@ mod tests {
             };
             assert_eq!(
                 bits(&crop.unwrap().frame.surface),
-                bits(&window.cut(&whole.frame).surface),
+                bits(&window.cut(&whole.frame).unwrap().surface),
                 "{method}"
             );
         }

@@ -9,7 +9,8 @@
 //! triangles, not pixels, and a window of their work is the whole of it for most scenes.
 
 use crate::error::{Error, Result};
-use crate::render::Frame;
+use crate::render::{frame_name, Frame};
+use crate::try_alloc;
 
 /// Columns `x0..x1` and rows `y0..y1` of an image (pixel (0, 0) the top-left).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -63,30 +64,32 @@ impl PixelWindow {
     }
 
     /// The window's pixels of `frame` (a frame of the whole image), buffers not held left
-    /// empty.
-    pub(crate) fn cut(&self, frame: &Frame) -> Frame {
-        Frame {
+    /// empty. Fails when the memory cannot be had (module `try_alloc`).
+    pub(crate) fn cut(&self, frame: &Frame) -> Result<Frame> {
+        Ok(Frame {
             width: self.width(),
             height: self.height(),
-            color: self.rows(&frame.color, frame.width),
-            depth: self.rows(&frame.depth, frame.width),
-            ids: self.rows(&frame.ids, frame.width),
-            surface: self.rows(&frame.surface, frame.width),
-        }
+            color: self.rows(&frame.color, frame.width)?,
+            depth: self.rows(&frame.depth, frame.width)?,
+            ids: self.rows(&frame.ids, frame.width)?,
+            surface: self.rows(&frame.surface, frame.width)?,
+        })
     }
 
     /// The window's part of `buffer`, an image `width` pixels wide row by row (empty for an
     /// empty buffer).
-    fn rows<T: Copy>(&self, buffer: &[T], width: u32) -> Vec<T> {
+    fn rows<T: Copy>(&self, buffer: &[T], width: u32) -> Result<Vec<T>> {
+        let mut rows = Vec::new();
         if buffer.is_empty() {
-            return Vec::new();
+            return Ok(rows);
         }
         let (x0, x1) = (self.x0 as usize, self.x1 as usize);
-        (self.y0 as usize..self.y1 as usize)
-            .flat_map(|y| {
-                let row = y * width as usize;
-                buffer[row + x0..row + x1].iter().copied()
-            })
-            .collect()
+        let what = || frame_name(self.width(), self.height());
+        try_alloc::reserve(&mut rows, (x1 - x0) * self.height() as usize, what)?;
+        for y in self.y0 as usize..self.y1 as usize {
+            let row = y * width as usize;
+            rows.extend_from_slice(&buffer[row + x0..row + x1]);
+        }
+        Ok(rows)
     }
 }

@@ -14,6 +14,7 @@ use std::path::Path;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::error::{Error, Result};
+use crate::try_alloc::format_bytes;
 
 /// Estimated bytes per scene triangle, everything a render holds for it: vertices,
 /// indices, the world-space copy, the acceleration structure.
@@ -117,15 +118,6 @@ pub fn check_image(width: u32, height: u32) -> Result<()> {
     )
 }
 
-/// `bytes` for people: "9.1 GB", "512.0 MB", "900 bytes" (decimal units).
-pub fn format_bytes(bytes: u64) -> String {
-    let units = [("TB", 1e12), ("GB", 1e9), ("MB", 1e6), ("kB", 1e3)];
-    match units.iter().find(|(_, size)| bytes as f64 >= *size) {
-        Some((unit, size)) => format!("{:.1} {unit}", bytes as f64 / size),
-        None => format!("{bytes} bytes"),
-    }
-}
-
 /// Parses a size as `--max-memory` takes it: a number of bytes, optionally with a decimal
 /// (k, M, G, T) or binary (KiB, MiB, GiB, TiB) unit, case-insensitive, `B` optional:
 /// `8G`, `512MiB`, `1.5GB`, `1000000`.
@@ -177,13 +169,6 @@ mod tests {
         assert!(parse_size("0").is_err());
         assert!(parse_size("8X").unwrap_err().contains("unknown unit"));
         assert!(parse_size("G").is_err());
-    }
-
-    #[test]
-    fn bytes_format_in_decimal_units() {
-        assert_eq!(format_bytes(9_100_000_000), "9.1 GB");
-        assert_eq!(format_bytes(900), "900 bytes");
-        assert_eq!(format_bytes(1_500_000), "1.5 MB");
     }
 
     #[test]

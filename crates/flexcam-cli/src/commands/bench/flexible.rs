@@ -206,15 +206,15 @@ fn panorama(repeat: u32) -> Result<()> {
     let build = start.elapsed().as_secs_f64();
     // A new renderer per frame: the pixel projectors are computed during the frame.
     let (first, _) = measure(repeat, || {
-        InverseRaster::new(&prepared, projection, &flat)?.render();
+        InverseRaster::new(&prepared, projection, &flat)?.render()?;
         Ok(())
     })?;
     // Later frames, and the wall-clock milliseconds of the two stages (building the pieces;
     // filling and shading them) of the median frame, from the renderer's own counters.
     let later = |options: &RenderOptions| {
         let raster = InverseRaster::new(&prepared, projection, options)?;
-        let mut frame = raster.render().0;
-        let (timing, stats) = measure(repeat, || Ok(raster.render_into(&mut frame)))?;
+        let mut frame = raster.render()?.0;
+        let (timing, stats) = measure(repeat, || raster.render_into(&mut frame))?;
         let stages = ["raster_pieces_ms", "raster_fill_ms"].map(|name| match stats.get(name) {
             Some(Counter::Value(ms)) => *ms,
             _ => f64::NAN,

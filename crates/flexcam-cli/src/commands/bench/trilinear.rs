@@ -316,7 +316,7 @@ impl<'a> Renderers<'a> {
         let kept = if kept {
             let mut frame = Frame::new(1, 1, glam::Vec3::ZERO);
             let (raycast, _) = measure(repeat, || {
-                Ok(raycast_into(self.caster, &mut frame, &projection, &options))
+                raycast_into(self.caster, &mut frame, &projection, &options)
             })?;
             let (trilinear, _) = into_kept(unclipped)?;
             let (clipped, _) = into_kept(CurveOptions::ADAPTIVE)?;

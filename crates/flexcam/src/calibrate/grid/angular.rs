@@ -24,10 +24,11 @@
 use glam::DVec3;
 use nalgebra::{DMatrix, DVector};
 
+use super::blocked_cholesky::Factor;
 use super::{Correspondence, System};
 
 /// Iterations at most per start; each is one Cholesky factorisation of the 3 x nodes system
-/// per damping trial.
+/// per damping trial (by blocks, module `blocked_cholesky`).
 const MAX_ITERATIONS: usize = 60;
 
 /// Iteration stops when one step lowers the cost by less than this fraction of it.
@@ -178,7 +179,7 @@ pub(super) fn minimise(
             for i in 0..damped.nrows() {
                 damped[(i, i)] *= 1.0 + damping;
             }
-            let Some(factor) = damped.cholesky() else {
+            let Some(factor) = Factor::new(damped) else {
                 damping *= 10.0;
                 continue;
             };

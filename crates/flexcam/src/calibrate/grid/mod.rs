@@ -86,6 +86,7 @@ use crate::error::Result;
 use crate::projection::flexible::{Correspondence, ProjectorGrid, Starts};
 
 mod angular;
+mod blocked_cholesky;
 mod camera_matrix;
 mod central;
 mod curved;

@@ -1,6 +1,7 @@
 use glam::{DVec2, DVec3};
 use nalgebra::{DMatrix, DVector};
 
+use super::blocked_cholesky::Factor;
 use super::{Correspondence, FitReport, PRIOR_SPREAD, PRIOR_WEIGHT};
 use crate::error::{Error, Result};
 use crate::projection::flexible::ProjectorGrid;
@@ -271,7 +272,7 @@ impl<'a> System<'a> {
         for i in 0..matrix.nrows() {
             matrix[(i, i)] += lambda;
         }
-        let factor = matrix.cholesky().ok_or_else(|| {
+        let factor = Factor::new(matrix).ok_or_else(|| {
             Error::new("projector grid fit: the least-squares system is singular")
         })?;
         // The scale constraint g^T y = |g|^2 (g: the prior over the constrained nodes) through

@@ -6,15 +6,19 @@ use std::path::Path;
 use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
+use crate::file_read::{read_regular, MAX_DATA_FILE_BYTES};
 use crate::projection::TrilinearMesh;
 
 impl TrilinearMesh {
     /// Loads a trilinear projection mesh from an OBJ file: `v` = base point, `vn` = ray
     /// direction, `vt` = screen position; every face corner needs all three. Polygons are
     /// triangulated as fans and points and lines ignored (tobj's single-index GPU options);
-    /// all objects and groups of the file form one mesh. Errors name the file. The mesh is
-    /// not validated here: [`crate::projection::ProjectionSpec::build`] does that.
+    /// all objects and groups of the file form one mesh. Errors name the file, and the line
+    /// of a `vn` of zero length (no ray direction). The mesh is not validated further here:
+    /// [`crate::projection::ProjectionSpec::build`] does that.
     pub fn load_obj(path: &Path) -> Result<TrilinearMesh> {
+        let text = read_regular(path, "trilinear surface", MAX_DATA_FILE_BYTES)?;
+        check_ray_directions(path, &text)?;
         let (models, _materials) = tobj::load_obj(path, &tobj::GPU_LOAD_OPTIONS)
             .map_err(|e| Error::in_file(path, format!("cannot read trilinear surface OBJ: {e}")))?;
         let mut mesh = TrilinearMesh::default();
@@ -27,6 +31,30 @@ impl TrilinearMesh {
         }
         Ok(mesh)
     }
+}
+
+/// Fails at the first `vn` line of `text` (the OBJ file at `path`) whose direction is zero:
+/// every vertex of a trilinear surface needs a ray direction, and the mesh's own check could
+/// name only the vertex (tobj renumbers them), not the line. Lines whose numbers do not read
+/// are tobj's to refuse.
+fn check_ray_directions(path: &Path, text: &[u8]) -> Result<()> {
+    for (number, line) in text.split(|&b| b == b'\n').enumerate() {
+        let line = String::from_utf8_lossy(line);
+        let mut words = line.split_whitespace();
+        if words.next() != Some("vn") {
+            continue;
+        }
+        let values: Vec<f64> = words.filter_map(|w| w.parse().ok()).collect();
+        if values.len() == 3 && values.iter().all(|&v| v == 0.0) {
+            return Err(Error::at(
+                path,
+                number + 1,
+                1,
+                "`vn` has zero length: every vertex of a trilinear surface needs a ray direction",
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Appends one OBJ object's vertices and triangles to `mesh`, offsetting its indices.
@@ -119,6 +147,25 @@ mod tests {
             );
             assert!(text.contains("f v/vt/vn"), "{text}");
         }
+    }
+
+    /// A zero ray direction is refused at its `vn` line, not at the vertex the mesh check
+    /// would name.
+    #[test]
+    fn a_zero_ray_direction_is_an_error_at_its_line() {
+        let file = obj_file(
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nvn 0 0.0 -0\n\
+             f 1/1/1 2/2/2 3/3/1\n",
+        );
+        let e = TrilinearMesh::load_obj(file.path()).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            format!(
+                "{}:8:1: `vn` has zero length: every vertex of a trilinear surface needs a ray \
+                 direction",
+                file.path().display()
+            )
+        );
     }
 
     #[test]

@@ -14,8 +14,10 @@
 use glam::DVec2;
 
 use super::camera::Camera;
+use crate::error::Result;
 use crate::render::scan::{spans, FillRule, Polygon, Scratch, NO_PRIMITIVE};
-use crate::render::trilinear::{plane_hit, GBuffer, SceneGeometry};
+use crate::render::trilinear::{band_name, plane_hit, GBuffer, SceneGeometry};
+use crate::try_alloc;
 
 /// The fragments of some shapes: how many the bounds produced and how many were rendered.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -48,13 +50,15 @@ pub struct BandBuffer {
 }
 
 impl BandBuffer {
-    /// A buffer for bands of up to `rows` rows of an image `width` pixels wide.
-    pub fn new(width: u32, rows: u32) -> BandBuffer {
-        BandBuffer {
-            hits: GBuffer::new(width, rows),
-            last: vec![NO_PRIMITIVE; width as usize * rows as usize],
+    /// A buffer for bands of up to `rows` rows of an image `width` pixels wide. Fails when
+    /// its memory cannot be had.
+    pub fn new(width: u32, rows: u32) -> Result<BandBuffer> {
+        let n = width as usize * rows as usize;
+        Ok(BandBuffer {
+            hits: GBuffer::new(width, rows)?,
+            last: try_alloc::filled(n, NO_PRIMITIVE, || band_name(width, rows))?,
             scratch: Scratch::default(),
-        }
+        })
     }
 
     /// Empties the buffer for rows `rows`.

@@ -135,7 +135,9 @@ impl<'a> CameraTriangleRenderer<'a> {
     }
 
     /// Renders the scene through `projection`'s camera triangles. Errors: more than one
-    /// sample per pixel; more than 2^32 camera or scene triangles (the fragment keys).
+    /// sample per pixel; more than 2^32 camera or scene triangles (the fragment keys);
+    /// memory that cannot be had for the frame, its pixels' owners or the band buffers
+    /// (module `try_alloc`).
     pub fn render(
         &self,
         projection: &Trilinear,
@@ -158,7 +160,7 @@ impl<'a> CameraTriangleRenderer<'a> {
         let start = Instant::now();
         let (width, height) = projection.resolution();
         let cameras = Camera::all(projection);
-        let owners = owners::owners(&cameras, width, height);
+        let owners = owners::owners(&cameras, width, height)?;
         let owner_ms = start.elapsed().as_secs_f64() * 1e3;
 
         let start = Instant::now();
@@ -166,7 +168,7 @@ impl<'a> CameraTriangleRenderer<'a> {
         let bound_ms = start.elapsed().as_secs_f64() * 1e3;
 
         let start = Instant::now();
-        let mut frame = Frame::zeroed(width, height, Outputs::ALL);
+        let mut frame = Frame::zeroed(width, height, Outputs::ALL)?;
         let stage = Stage {
             cameras: &cameras,
             owners: &owners,
@@ -204,7 +206,7 @@ impl<'a> CameraTriangleRenderer<'a> {
                     shade_s: shading.elapsed().as_secs_f64(),
                 }
             },
-        );
+        )?;
         let wall = start.elapsed().as_secs_f64() * 1e3;
         let busy = done.draw_s + done.shade_s;
         let drawing = if busy > 0.0 { done.draw_s / busy } else { 1.0 };

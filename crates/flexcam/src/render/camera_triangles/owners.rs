@@ -13,6 +13,9 @@ use glam::DVec2;
 use rayon::prelude::*;
 
 use super::camera::Camera;
+use crate::error::Result;
+use crate::render::frame_name;
+use crate::try_alloc;
 
 /// No camera triangle covers the pixel.
 pub const NONE: u32 = u32::MAX;
@@ -20,11 +23,18 @@ pub const NONE: u32 = u32::MAX;
 /// How far outside a screen triangle (in its barycentrics) a pixel centre still counts.
 const EDGE_TOLERANCE: f64 = 1e-9;
 
-/// The owner of every pixel of a `width` x `height` image, row-major.
-pub fn owners(cameras: &[Camera], width: u32, height: u32) -> Vec<u32> {
-    let mut out = vec![NONE; width as usize * height as usize];
+/// The owner of every pixel of a `width` x `height` image, row-major. Fails when the
+/// memory cannot be had.
+pub fn owners(cameras: &[Camera], width: u32, height: u32) -> Result<Vec<u32>> {
+    let n = width as usize * height as usize;
+    let mut out = try_alloc::filled(n, NONE, || {
+        format!(
+            "the camera triangle of each pixel of {}",
+            frame_name(width, height)
+        )
+    })?;
     if width == 0 {
-        return out;
+        return Ok(out);
     }
     let boxes: Vec<((u32, u32), (u32, u32))> = cameras
         .iter()
@@ -62,5 +72,5 @@ pub fn owners(cameras: &[Camera], width: u32, height: u32) -> Vec<u32> {
                 }
             }
         });
-    out
+    Ok(out)
 }

@@ -73,7 +73,7 @@ fn against_raycast(
 ) -> (Comparison, f64, Stats) {
     let projection = scene.projection.build(size.0, size.1).unwrap();
     let prepared = PreparedScene::new(scene);
-    let (reference, _) = raycast::render(&prepared, projection.as_ref(), options);
+    let (reference, _) = raycast::render(&prepared, projection.as_ref(), options).unwrap();
     let (frame, stats) = render(&prepared, projection.as_ref(), options).unwrap();
     let inside = id_agreement_inside(&frame, &reference);
     (compare(&frame, &reference).unwrap(), inside, stats)
@@ -183,7 +183,7 @@ pub(super) fn mirror_surface(name: &str, rays: SurfaceRays) -> (Trilinear, Scene
 pub(super) fn fragments_in_bounds(name: &str, projection: &Trilinear, scene: &Scene) -> usize {
     let (width, height) = projection.resolution();
     let cameras = Camera::all(projection);
-    let owners = owners::owners(&cameras, width, height);
+    let owners = owners::owners(&cameras, width, height).unwrap();
     let geometry = SceneGeometry::new(scene);
     let mut checked = 0;
     for (c, camera) in cameras.iter().enumerate() {

@@ -18,6 +18,7 @@ use crate::render::prepared::PreparedScene;
 use crate::render::shading::normals;
 use crate::render::{Frame, Method, Outputs, RenderOptions, Shading, Stats};
 use crate::scene::{CausticReflector, Finish, Mesh, Scene};
+use crate::try_alloc;
 
 /// How a photon-location map is made: through the mirror's camera triangles by a method
 /// that renders trilinear projections, or exactly by tracing every texel's ray.
@@ -76,7 +77,7 @@ impl PhotonMap {
     /// The map of `caustic`'s mirror lit from `light`, made as `source` says. The scene's
     /// trilinear reflectors and caustics play no part (the map's renders are plain).
     /// Errors: those of [`light_camera`]; a mirror that is not one (see [`Reflector::of`]);
-    /// the method's own.
+    /// the method's own; memory that cannot be had for the map (module `try_alloc`).
     pub fn render(
         prepared: &PreparedScene,
         caustic: &CausticReflector,
@@ -88,7 +89,7 @@ impl PhotonMap {
         let reflector = Reflector::of(scene, caustic.id)?;
         let camera = light_camera(light, &reflector.mesh, caustic.map_size)?;
         let (photons, counters) = match source {
-            PhotonSource::Exact => (exact(prepared, caustic.id, &camera), Stats::new()),
+            PhotonSource::Exact => (exact(prepared, caustic.id, &camera)?, Stats::new()),
             PhotonSource::Surface(method) => through_surface(
                 prepared,
                 caustic.id,
@@ -247,7 +248,7 @@ fn through_surface(
         n as u32,
     )?
     else {
-        return Ok((vec![None; n * n], Stats::new()));
+        return Ok((photons(n, |_| None)?, Stats::new()));
     };
     let mut diffuse = plain_scene(scene);
     for object in &mut diffuse.objects {
@@ -279,7 +280,7 @@ fn through_surface(
             id: receiver,
         })
     };
-    Ok(((0..n * n).into_par_iter().map(photon).collect(), counters))
+    Ok((photons(n, photon)?, counters))
 }
 
 /// `scene` without trilinear reflectors or caustics: what a map's renders see.
@@ -294,7 +295,7 @@ fn plain_scene(scene: &Scene) -> Scene {
 /// whole scene; where its first hit is the mirror, reflected about the mirror's interpolated
 /// shading normal there (as the ray caster's mirror reflects) and traced through the scene
 /// without the mirror.
-fn exact(prepared: &PreparedScene, id: u32, camera: &Perspective) -> Vec<Option<Photon>> {
+fn exact(prepared: &PreparedScene, id: u32, camera: &Perspective) -> Result<Vec<Option<Photon>>> {
     let scene = prepared.scene();
     let others = prepared.view(without(scene, id));
     let n = camera.resolution().0 as usize;
@@ -321,5 +322,19 @@ fn exact(prepared: &PreparedScene, id: u32, camera: &Perspective) -> Vec<Option<
             id: receiver,
         })
     };
-    (0..n * n).into_par_iter().map(photon).collect()
+    photons(n, photon)
+}
+
+/// The photons of an `n` x `n` map, texel `k` (row-major) holding `photon(k)`, found in
+/// parallel. Fails when the map's memory cannot be had (module `try_alloc`).
+fn photons(
+    n: usize,
+    photon: impl Fn(usize) -> Option<Photon> + Sync,
+) -> Result<Vec<Option<Photon>>> {
+    let mut photons = try_alloc::filled(n * n, None, || format!("a {n} x {n} photon map"))?;
+    photons
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(k, slot)| *slot = photon(k));
+    Ok(photons)
 }

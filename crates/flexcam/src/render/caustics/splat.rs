@@ -13,7 +13,10 @@ use glam::{DVec2, Vec3};
 use rayon::prelude::*;
 
 use super::photon_map::CausticTriangle;
+use crate::error::Result;
 use crate::projection::{Perspective, Projection, SingleImage};
+use crate::render::frame_name;
+use crate::try_alloc;
 
 /// Relative depth difference within which a pixel sees the caustic triangle's surface (a
 /// chord of a curved receiver lies up to its sagitta inside it).
@@ -26,34 +29,42 @@ const CHUNK: usize = 4096;
 /// rows from the top) at the pixels whose id in `ids` is the triangle's receiver and whose
 /// depth in `depth` is the triangle's (module doc). Degenerate cases: a triangle with a
 /// corner on or behind the eye's plane is not drawn (a caustic on the eye's side of the
-/// image plane is not seen); one seen edge on covers no pixel centre.
+/// image plane is not seen); one seen edge on covers no pixel centre. Fails when the
+/// memory of the per-thread sums (one value per pixel each) cannot be had.
 pub(in crate::render) fn splat(
     eye: &Perspective,
     ids: &[u32],
     depth: &[f32],
     triangles: &[CausticTriangle],
     irradiance: &mut [Vec3],
-) {
+) -> Result<()> {
     let (width, height) = eye.resolution();
     let pixels = irradiance.len();
     let sum = triangles
         .par_chunks(CHUNK)
         .fold(
-            || vec![Vec3::ZERO; pixels],
-            |mut out, chunk| {
+            || {
+                try_alloc::zeroed(pixels, || {
+                    format!("the caustics of {}", frame_name(width, height))
+                })
+            },
+            |out: Result<Vec<Vec3>>, chunk| {
+                let mut out = out?;
                 for triangle in chunk {
                     draw(eye, (width, height), ids, depth, triangle, &mut out);
                 }
-                out
+                Ok(out)
             },
         )
-        .reduce_with(|mut a, b| {
+        .reduce_with(|a, b| {
+            let (mut a, b) = (a?, b?);
             a.iter_mut().zip(&b).for_each(|(x, y)| *x += *y);
-            a
+            Ok(a)
         });
     if let Some(sum) = sum {
-        irradiance.iter_mut().zip(&sum).for_each(|(x, y)| *x += *y);
+        irradiance.iter_mut().zip(&sum?).for_each(|(x, y)| *x += *y);
     }
+    Ok(())
 }
 
 /// Draws one caustic triangle into `out`.

@@ -185,7 +185,7 @@ fn camera_triangle_caustic_matches_the_exact_one() {
     let irradiance = |source| {
         let triangles = map_of(&scene, source).caustic_triangles(reflected);
         let mut e = vec![Vec3::ZERO; main.color.len()];
-        splat(&eye, &main.ids, &main.depth, &triangles, &mut e);
+        splat(&eye, &main.ids, &main.depth, &triangles, &mut e).unwrap();
         e
     };
     let [ours, exact] = SOURCES.map(irradiance);
@@ -322,7 +322,7 @@ fn splat_counts_a_shared_edge_once_and_tests_depth() {
     }
     depth[9] *= 0.5;
     let mut e = vec![Vec3::ZERO; 64];
-    splat(&eye, &ids, &depth, &triangles, &mut e);
+    splat(&eye, &ids, &depth, &triangles, &mut e).unwrap();
     for (k, v) in e.iter().enumerate() {
         let want = if k == 9 { 0.0 } else { 1.0 };
         assert_eq!(v.x, want, "pixel {k}");

@@ -105,20 +105,20 @@ pub fn image(
     let centre = ((lo + hi) / 2.0).as_dvec3();
     let cube = CubeMap::render(others, centre, width.max(height), options)?;
     let background = others.scene().image.background;
-    let color: Vec<Vec3> = (0..width as usize * height as usize)
-        .into_par_iter()
-        .map(|k| {
+    let mut frame = Frame::try_new(width, height, background)?;
+    frame
+        .color
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(k, color)| {
             let pixel = DVec2::new(
                 (k % width as usize) as f64 + 0.5,
                 (k / width as usize) as f64 + 0.5,
             );
-            surface
-                .ray(pixel)
-                .map_or(background, |ray| cube.lookup(ray.direction))
-        })
-        .collect();
-    let mut frame = Frame::new(width, height, background);
-    frame.color = color;
+            if let Some(ray) = surface.ray(pixel) {
+                *color = cube.lookup(ray.direction);
+            }
+        });
     Ok((frame, Stats::new()))
 }
 

@@ -15,8 +15,10 @@ use rayon::prelude::*;
 
 use super::coverage::{cover, Bins};
 use super::fragment::{Shader, TrianglePlane, Visible};
+use crate::error::Result;
 use crate::render::scan::RasterStats;
-use crate::render::Frame;
+use crate::render::{frame_name, Frame};
+use crate::try_alloc;
 
 /// Rows per band: small enough for many parallel tasks on the part of a panorama a model
 /// covers, large enough that few screen triangles (mostly one or two pixels) reach two.
@@ -90,7 +92,8 @@ impl Written {
 /// where fragments land and read only where written this frame, so it needs no clearing)
 /// and writes the image of `size` pixels into `frame`
 /// (resized): visible pixels shaded by `shader`, others `background` at infinite depth with
-/// id 0.
+/// id 0. Fails when the memory for a larger frame or z-buffer cannot be had (module
+/// `try_alloc`); `frame` is then left empty (0 x 0).
 pub fn fill_and_shade(
     shader: &Shader<'_>,
     bins: &[Bins],
@@ -98,20 +101,19 @@ pub fn fill_and_shade(
     frame: &mut Frame,
     size: (u32, u32),
     background: Vec3,
-) -> FillCounts {
+) -> Result<FillCounts> {
     let (width, height) = size;
     let n = width as usize * height as usize;
-    (frame.width, frame.height) = size;
-    frame.color.resize(n, background);
-    frame.depth.resize(n, f32::INFINITY);
-    frame.ids.resize(n, 0);
-    zbuffer.resize(n, Visible::NONE);
+    if let Err(e) = resize(frame, zbuffer, size, background) {
+        *frame = Frame::new(0, 0, background);
+        return Err(e);
+    }
     if n == 0 {
-        return FillCounts::default();
+        return Ok(FillCounts::default());
     }
     let row = width as usize;
     let chunk = BAND_ROWS as usize * row;
-    frame
+    Ok(frame
         .color
         .par_chunks_mut(chunk)
         .zip(frame.depth.par_chunks_mut(chunk))
@@ -170,5 +172,25 @@ pub fn fill_and_shade(
             }
             counts
         })
-        .reduce(FillCounts::default, |a, b| a + b)
+        .reduce(FillCounts::default, |a, b| a + b))
+}
+
+/// `frame` and `zbuffer` resized to `size` pixels (the new pixels of `frame` are
+/// `background`, infinite depth, id 0; those of `zbuffer` [`Visible::NONE`]).
+fn resize(
+    frame: &mut Frame,
+    zbuffer: &mut Vec<Visible>,
+    (width, height): (u32, u32),
+    background: Vec3,
+) -> Result<()> {
+    let n = width as usize * height as usize;
+    let what = || frame_name(width, height);
+    try_alloc::resize(&mut frame.color, n, background, what)?;
+    try_alloc::resize(&mut frame.depth, n, f32::INFINITY, what)?;
+    try_alloc::resize(&mut frame.ids, n, 0, what)?;
+    try_alloc::resize(zbuffer, n, Visible::NONE, || {
+        format!("the z-buffer of {}", frame_name(width, height))
+    })?;
+    (frame.width, frame.height) = (width, height);
+    Ok(())
 }

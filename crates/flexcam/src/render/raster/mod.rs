@@ -210,17 +210,19 @@ impl<'a> InverseRaster<'a> {
     }
 
     /// Renders one frame: colour, depth (the ray caster's distance along the projector) and
-    /// object ids, with the counters of every stage.
-    pub fn render(&self) -> (Frame, Stats) {
+    /// object ids, with the counters of every stage. Fails only when the memory of the frame
+    /// or the z-buffer cannot be had (module `try_alloc`).
+    pub fn render(&self) -> Result<(Frame, Stats)> {
         let mut frame = Frame::new(0, 0, self.scene.image.background);
-        let stats = self.render_into(&mut frame);
-        (frame, stats)
+        let stats = self.render_into(&mut frame)?;
+        Ok((frame, stats))
     }
 
     /// [`InverseRaster::render`] into `frame`, whose buffers are resized to the image and
     /// overwritten: a sequence of frames (an animation, a viewer, the throughput bench)
-    /// reusing one `frame` allocates no image buffer after the first.
-    pub fn render_into(&self, frame: &mut Frame) -> Stats {
+    /// reusing one `frame` allocates no image buffer after the first. Fails as
+    /// [`InverseRaster::render`] does.
+    pub fn render_into(&self, frame: &mut Frame) -> Result<Stats> {
         let start = Instant::now();
         // Every frame overwrites the buffers, so ones left by a panicked frame are as good
         // as any.
@@ -251,6 +253,7 @@ impl<'a> InverseRaster<'a> {
             self.scene.image.background,
         );
         drop(buffers);
+        let filled = filled?;
         let fill_ms = start.elapsed().as_secs_f64() * 1e3 - pieces_ms;
         let mut stats = Stats::new();
         filled
@@ -286,7 +289,7 @@ impl<'a> InverseRaster<'a> {
         ] {
             stats.insert(name, Counter::Value(value));
         }
-        stats
+        Ok(stats)
     }
 
     /// Steps 1 to 3 of the module documentation: the vertex images of every object into

@@ -16,8 +16,9 @@ const SETTINGS: [&str; 2] = ["raster_uniform", "raster_tolerance_px"];
 
 /// Renders `projection` by the analytic inverse: a single view directly, several view by
 /// view. The stats of several views are summed (times and counts), settings kept once.
-/// Errors: those of [`InverseRaster::new`] for any view; a scene triangle touching a view's
-/// keep-clear region (one line naming the object and the region).
+/// Errors: those of [`InverseRaster::new`] and [`InverseRaster::render`] for any view; a
+/// scene triangle touching a view's keep-clear region (one line naming the object and the
+/// region); memory that cannot be had for the whole frame.
 pub fn render(
     prepared: &PreparedScene,
     projection: &dyn Projection,
@@ -25,17 +26,18 @@ pub fn render(
 ) -> Result<(Frame, Stats)> {
     let views = projection.views();
     if views.is_empty() {
-        return Ok(InverseRaster::new(prepared, projection, options)?.render());
+        return InverseRaster::new(prepared, projection, options)?.render();
     }
     let scene = prepared.scene();
     for region in views.iter().filter_map(|v| v.keep_clear) {
         refuse_touching(scene, projection.kind(), &region)?;
     }
     let (width, height) = projection.resolution();
-    let mut frame = Frame::new(width, height, scene.image.background);
+    let mut frame = Frame::try_new(width, height, scene.image.background)?;
     let mut stats = Stats::new();
     for view in &views {
-        let (part, part_stats) = InverseRaster::new(prepared, view.projection, options)?.render();
+        let (part, part_stats) =
+            InverseRaster::new(prepared, view.projection, options)?.render()?;
         paste(&mut frame, &part, view.offset);
         for (name, counter) in part_stats {
             let merged = match (stats.get(name), counter) {

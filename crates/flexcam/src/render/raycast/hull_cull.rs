@@ -185,8 +185,9 @@ mod tests {
                     spp,
                     ..RenderOptions::default()
                 };
-                let (culled, stats) = raycast::render(&caster, &projection, &options);
-                let (plain, plain_stats) = raycast::render(&caster, &NoHull(&projection), &options);
+                let (culled, stats) = raycast::render(&caster, &projection, &options).unwrap();
+                let (plain, plain_stats) =
+                    raycast::render(&caster, &NoHull(&projection), &options).unwrap();
                 let what = format!("segments {segments:?}, spp {spp}");
                 assert_frames_equal(&culled, &plain, &what);
                 for key in ["primary_rays", "secondary_rays", "shadow_rays"] {

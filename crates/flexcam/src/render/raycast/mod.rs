@@ -21,6 +21,7 @@ pub use self::pick::{pick, Picked};
 pub(crate) use self::sampling::SamplePattern;
 
 use self::pieces::polyline_segment;
+use crate::error::Result;
 use crate::geometry::Ray;
 use crate::projection::Projection;
 use crate::render::prepared::{Hit32, PreparedScene};
@@ -66,16 +67,17 @@ impl PreparedScene {
 
 /// Renders `projection` (colour, depth and object ids) with `options` into a new frame
 /// (see [`render_into`]). The frame starts as zeroed memory
-/// (`Frame::zeroed`), not cleared to the background: every pixel is written.
+/// (`Frame::zeroed`), not cleared to the background: every pixel is written. Fails only
+/// when the frame's memory cannot be had.
 pub fn render(
     scene: &PreparedScene,
     projection: &dyn Projection,
     options: &RenderOptions,
-) -> (Frame, Stats) {
+) -> Result<(Frame, Stats)> {
     let window = window_of(projection, options);
-    let mut frame = Frame::zeroed(window.width(), window.height(), options.outputs);
-    let stats = render_into(scene, &mut frame, projection, options);
-    (frame, stats)
+    let mut frame = Frame::zeroed(window.width(), window.height(), options.outputs)?;
+    let stats = render_into(scene, &mut frame, projection, options)?;
+    Ok((frame, stats))
 }
 
 /// Renders `projection` (colour, depth and object ids) with `options` into `frame`, every
@@ -86,14 +88,15 @@ pub fn render(
 /// its size) is replaced by one of the right size. `options.spp = 0` counts as one
 /// sample. See `shade` for what the depth and id of a pixel are. With `options.crop` the
 /// frame is the window's (a window that fits in the image: `render::render` checks it).
+/// Fails only when a new frame's memory cannot be had (`frame` is then left as it was).
 pub fn render_into(
     scene: &PreparedScene,
     frame: &mut Frame,
     projection: &dyn Projection,
     options: &RenderOptions,
-) -> Stats {
+) -> Result<Stats> {
     let window = window_of(projection, options);
-    frame.fit(window.width(), window.height(), options.outputs);
+    frame.fit(window.width(), window.height(), options.outputs)?;
     let mut stats = tiles::render(scene, projection, options, window, frame);
     stats.insert(
         "bvh_build_ms",
@@ -113,7 +116,7 @@ pub fn render_into(
             crate::render::Counter::Count(displaced.len() as u64),
         );
     }
-    stats
+    Ok(stats)
 }
 
 /// The pixels `options` asks for: its crop window, or the whole image.

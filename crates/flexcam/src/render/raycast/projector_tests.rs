@@ -48,7 +48,9 @@ fn render(source: VolumeSource, shading: Shading) -> Frame {
         shading,
         ..RenderOptions::default()
     };
-    raycast::render(&PreparedScene::new(&scene), &projection, &options).0
+    raycast::render(&PreparedScene::new(&scene), &projection, &options)
+        .unwrap()
+        .0
 }
 
 fn straight(shading: Shading) -> Frame {
@@ -238,7 +240,7 @@ fn segments_outside_the_scene_box_are_culled_without_changing_any_hit() {
         shading: Shading::Lit,
         ..RenderOptions::default()
     };
-    let frame = raycast::render(&caster, &projection, &options).0;
+    let frame = raycast::render(&caster, &projection, &options).unwrap().0;
     let mut tracer = Tracer::new(&caster, &options);
     for y in 0..h {
         for x in 0..w {

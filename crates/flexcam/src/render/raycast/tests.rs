@@ -129,7 +129,7 @@ fn trace(
 ) -> (Vec3, f32, u32) {
     let mut camera = Parallel::new(1, 1, (0.0, 0.0), direction);
     camera.corner = origin - DVec3::new(0.5, -0.5, 0.0);
-    let (frame, _) = raycast::render(&PreparedScene::new(scene), &camera, options);
+    let (frame, _) = raycast::render(&PreparedScene::new(scene), &camera, options).unwrap();
     (frame.color[0], frame.depth[0], frame.ids[0])
 }
 
@@ -191,7 +191,7 @@ fn pixels_without_a_projector_get_the_background() {
     let scene = red_wall(1);
     let mut camera = Parallel::new(3, 1, (0.0, 0.0), DVec3::NEG_Z);
     camera.blind = 1.0;
-    let (frame, stats) = raycast::render(&PreparedScene::new(&scene), &camera, &flat(8));
+    let (frame, stats) = raycast::render(&PreparedScene::new(&scene), &camera, &flat(8)).unwrap();
     assert_eq!(frame.color, vec![scene.image.background, RED, RED]);
     assert_eq!(frame.depth[0], f32::INFINITY);
     assert_eq!(frame.ids, vec![0, 1, 1]);
@@ -276,7 +276,7 @@ fn facing_mirrors_run_out_of_bounces() {
     assert_eq!(color, scene.image.background);
     let mut camera = Parallel::new(1, 1, (0.0, 0.0), DVec3::new(0.1, 0.0, -1.0));
     camera.corner.z = 0.5;
-    let (frame, stats) = raycast::render(&PreparedScene::new(&scene), &camera, &options);
+    let (frame, stats) = raycast::render(&PreparedScene::new(&scene), &camera, &options).unwrap();
     assert_eq!(frame.color[0], scene.image.background);
     assert_eq!(stats["secondary_rays"], Counter::Count(8));
 }
@@ -424,7 +424,8 @@ fn lit_shadows_cost_shadow_rays_and_darken() {
         &PreparedScene::new(&scene),
         &Parallel::new(8, 8, (-4.0, 4.0), DVec3::NEG_Z),
         &lit,
-    );
+    )
+    .unwrap();
     let Counter::Count(shadow) = stats["shadow_rays"] else {
         panic!()
     };
@@ -465,7 +466,7 @@ fn rendering_is_deterministic_across_thread_counts_and_reports_progress() {
             .num_threads(threads)
             .build()
             .unwrap();
-        pool.install(|| raycast::render(&caster, &camera, &options))
+        pool.install(|| raycast::render(&caster, &camera, &options).unwrap())
     };
     let (one, stats_one) = render_with(1);
     let (many, stats_many) = render_with(4);
@@ -503,11 +504,11 @@ fn rendering_into_a_kept_frame_matches_a_new_frame() {
             spp,
             ..flat(8)
         };
-        let (fresh, fresh_stats) = raycast::render(&caster, &camera, &options);
+        let (fresh, fresh_stats) = raycast::render(&caster, &camera, &options).unwrap();
         assert!(fresh.ids.contains(&0) && fresh.ids.contains(&3));
         let mut kept = Frame::new(3, 2, Vec3::ONE);
         for _ in 0..2 {
-            let stats = raycast::render_into(&caster, &mut kept, &camera, &options);
+            let stats = raycast::render_into(&caster, &mut kept, &camera, &options).unwrap();
             assert_eq!(kept, fresh);
             assert_eq!(stats["rays_cast"], fresh_stats["rays_cast"]);
             kept.color.fill(Vec3::splat(7.0));
@@ -535,12 +536,13 @@ fn supersampling_averages_colour_and_keeps_the_centre_sample_aov() {
     let scene = scene(vec![left, right], vec![]);
     let caster = PreparedScene::new(&scene);
     let camera = Parallel::new(1, 1, (0.0, 0.0), DVec3::NEG_Z);
-    let (one, _) = raycast::render(&caster, &camera, &flat(8));
+    let (one, _) = raycast::render(&caster, &camera, &flat(8)).unwrap();
     assert_eq!(
         one.color[0], BLUE,
         "spp 1 samples exactly the centre x = 0.5"
     );
-    let (four, stats) = raycast::render(&caster, &camera, &RenderOptions { spp: 4, ..flat(8) });
+    let (four, stats) =
+        raycast::render(&caster, &camera, &RenderOptions { spp: 4, ..flat(8) }).unwrap();
     assert!((four.color[0] - Vec3::new(0.5, 0.0, 0.5)).length() < 1e-6);
     // The two samples nearest the centre tie; the lower index (x = 0.375) is red.
     assert_eq!((four.ids[0], four.depth[0]), (1, 10.0));
@@ -554,7 +556,8 @@ fn empty_scene_renders_background_and_reports_build_stats() {
         &PreparedScene::new(&scene),
         &Parallel::new(2, 2, (0.0, 0.0), DVec3::NEG_Z),
         &flat(8),
-    );
+    )
+    .unwrap();
     assert!(frame.color.iter().all(|&c| c == scene.image.background));
     assert_eq!(stats["bvh_nodes"], Counter::Count(0));
     assert_eq!(stats["triangles"], Counter::Count(0));
@@ -617,7 +620,7 @@ fn packet_rendering_equals_single_ray_rendering() {
     for camera in &cameras {
         for shading in [Shading::Flat, Shading::Lit] {
             let options = RenderOptions { shading, ..flat(8) };
-            let (packets, _) = raycast::render(&caster, camera.as_ref(), &options);
+            let (packets, _) = raycast::render(&caster, camera.as_ref(), &options).unwrap();
             let single = render_single_rays(&caster, camera.as_ref(), &options);
             assert_eq!(packets.ids, single.ids, "{}", camera.kind());
             let bits = |f: &Frame| {

@@ -15,6 +15,7 @@ use rayon::prelude::*;
 
 use super::bins;
 use super::polygon::PolygonBatch;
+use crate::error::Result;
 use crate::render::Frame;
 
 /// Pixels per band (see [`band_rows_for`]): a band-local buffer of 24 to 32 bytes a pixel
@@ -43,14 +44,15 @@ pub struct FrameRows<'a> {
 /// indices of the shapes of `polygons` reaching the band in input order and the band's rows
 /// of the frame; `state` is per-thread scratch made by `init` (band-local buffers reused
 /// from band to band). Returns the sum of the results. Renderers draw each band's shapes
-/// into their own band buffer (see [`super::spans`]) and shade it into the rows.
+/// into their own band buffer (see [`super::spans`]) and shade it into the rows. Fails when
+/// `init` fails (its buffers' memory cannot be had); the frame's rows are then partly drawn.
 pub fn for_each_band<const N: usize, S, C>(
     frame: &mut Frame,
     polygons: &PolygonBatch<N>,
     band_rows: u32,
-    init: impl Fn() -> S + Sync + Send,
+    init: impl Fn() -> Result<S> + Sync + Send,
     band: impl Fn(&mut S, &[usize], FrameRows<'_>) -> C + Sync + Send,
-) -> C
+) -> Result<C>
 where
     C: Default + Send + std::ops::Add<Output = C>,
 {
@@ -66,6 +68,7 @@ where
         .zip(bins)
         .enumerate()
         .map_init(init, |state, (i, (((color, depth), ids), bin))| {
+            let state = state.as_mut().map_err(|e| e.clone())?;
             let first = i as u32 * band_rows;
             let rows = (first, first + (color.len() / width as usize) as u32);
             let out = FrameRows {
@@ -75,7 +78,7 @@ where
                 depth,
                 ids,
             };
-            band(state, &bin, out)
+            Ok(band(state, &bin, out))
         })
-        .reduce(C::default, |a, b| a + b)
+        .try_reduce(C::default, |a, b| Ok(a + b))
 }

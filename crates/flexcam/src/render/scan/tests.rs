@@ -840,7 +840,11 @@ fn raster_bands_drawn_by_spans_are_the_rows_of_the_serial_target() {
                 fragments
             };
             let fragments = pool
-                .install(|| for_each_band(&mut frame, &shapes, band_rows, Scratch::default, band));
+                .install(|| {
+                    let init = || Ok(Scratch::default());
+                    for_each_band(&mut frame, &shapes, band_rows, init, band)
+                })
+                .unwrap();
             assert!(frame == expected, "{threads} threads, {band_rows} rows");
             assert_eq!(fragments, serial_stats.fragments);
         }

@@ -33,7 +33,8 @@ use crate::render::prepared::PreparedScene;
 use crate::render::raycast::pieces::polyline_segment;
 use crate::render::raycast::SamplePattern;
 use crate::render::shading::trace::HitShader;
-use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
+use crate::render::{frame_name, Counter, Frame, RenderOptions, Shading, Stats};
+use crate::try_alloc;
 
 /// What `--shading transitions` and `transition-lit` show, and the transition function's
 /// user constant `D` (see [`crate::displace::transition`]).
@@ -181,7 +182,8 @@ impl<'a> Renderer<'a> {
 }
 
 /// Renders `projection` with displaced objects shaded by the transition system (module
-/// docs). Errors: a projection with quadratic projectors.
+/// docs). Errors: a projection with quadratic projectors; memory that cannot be had for the
+/// frame or its rows of samples (module `try_alloc`).
 pub(in crate::render) fn render(
     prepared: &PreparedScene,
     projection: &dyn Projection,
@@ -203,6 +205,8 @@ pub(in crate::render) fn render(
         .as_ref()
         .map(|set| set.transition_data(&prepared.scene));
     let table_ms = start.elapsed().as_secs_f64() * 1e3;
+    // The frame first: a frame whose memory cannot be had fails before any work.
+    let mut frame = Frame::zeroed(width, height, options.outputs)?;
     let pattern = SamplePattern::new(options.spp);
     let lit_options = RenderOptions {
         shading: Shading::Lit,
@@ -227,22 +231,24 @@ pub(in crate::render) fn render(
                 weights: DVec3::ZERO,
             };
             let scale = 1.0 / pattern.offsets.len() as f32;
-            let samples = (0..width)
-                .map(|x| {
-                    let mut color = Vec3::ZERO;
-                    let mut centre = (Vec3::ZERO, f32::INFINITY, 0);
-                    for (k, offset) in pattern.offsets.iter().enumerate() {
-                        let sample = renderer.sample(DVec2::new(x as f64, y as f64) + *offset);
-                        color += sample.0;
-                        if k == pattern.centre {
-                            centre = sample;
-                        }
+            let mut samples = Vec::new();
+            try_alloc::reserve(&mut samples, width as usize, || {
+                format!("a row of samples of {}", frame_name(width, height))
+            })?;
+            samples.extend((0..width).map(|x| {
+                let mut color = Vec3::ZERO;
+                let mut centre = (Vec3::ZERO, f32::INFINITY, 0);
+                for (k, offset) in pattern.offsets.iter().enumerate() {
+                    let sample = renderer.sample(DVec2::new(x as f64, y as f64) + *offset);
+                    color += sample.0;
+                    if k == pattern.centre {
+                        centre = sample;
                     }
-                    (color * scale, centre.1, centre.2)
-                })
-                .collect();
+                }
+                (color * scale, centre.1, centre.2)
+            }));
             let counts = renderer.lit.counts;
-            (
+            Ok((
                 samples,
                 [
                     renderer.primary_rays,
@@ -252,10 +258,9 @@ pub(in crate::render) fn render(
                 ],
                 renderer.weights,
                 renderer.levels,
-            )
+            ))
         })
-        .collect();
-    let mut frame = Frame::zeroed(width, height, options.outputs);
+        .collect::<Result<_>>()?;
     let mut totals = [0u64; 4];
     let mut weights = DVec3::ZERO;
     let mut levels = [0u64; LOD_PERCENTS.len()];

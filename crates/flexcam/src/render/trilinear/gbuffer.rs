@@ -17,7 +17,15 @@
 
 use super::hit_terms::{self, Terms, TERMS};
 use super::resolve::Resolver;
+use crate::error::Result;
 use crate::render::scan::{spans, FillRule, Polygon, RasterStats, Scratch, Span, NO_PRIMITIVE};
+use crate::try_alloc;
+
+/// How the errors of a failed buffer allocation name a band buffer of `rows` rows of an
+/// image `width` pixels wide.
+pub(in crate::render) fn band_name(width: u32, rows: u32) -> String {
+    format!("a band buffer of {width} x {rows} pixels")
+}
 
 /// The drawn state of one band of rows: per pixel the winner's depth, key and scene
 /// barycentrics. Camera-triangle rendering keeps its winners in the same buffer (its
@@ -37,16 +45,18 @@ pub struct GBuffer {
 }
 
 impl GBuffer {
-    /// A buffer for bands of up to `rows` rows of an image `width` pixels wide.
-    pub fn new(width: u32, rows: u32) -> GBuffer {
+    /// A buffer for bands of up to `rows` rows of an image `width` pixels wide. Fails when
+    /// its memory cannot be had.
+    pub fn new(width: u32, rows: u32) -> Result<GBuffer> {
         let n = width as usize * rows as usize;
-        GBuffer {
+        let what = || band_name(width, rows);
+        Ok(GBuffer {
             width,
             rows: (0, 0),
-            depth: vec![f64::INFINITY; n],
-            keys: vec![NO_PRIMITIVE; n],
-            barycentrics: vec![[0.0; 2]; n],
-        }
+            depth: try_alloc::filled(n, f64::INFINITY, what)?,
+            keys: try_alloc::filled(n, NO_PRIMITIVE, what)?,
+            barycentrics: try_alloc::zeroed(n, what)?,
+        })
     }
 
     /// Empties the buffer for rows `rows` of the image (at most as many rows as it was made

@@ -52,7 +52,7 @@ use std::time::Instant;
 use glam::{DVec2, DVec3, Vec3};
 
 pub use curves::{CurveMode, CurveOptions};
-pub(in crate::render) use gbuffer::GBuffer;
+pub(in crate::render) use gbuffer::{band_name, GBuffer};
 pub use polygons::{project_all, projection_triangles};
 pub(crate) use resolve::plane_hit;
 pub use scene_geometry::SceneGeometry;
@@ -70,7 +70,8 @@ use crate::render::raycast::SamplePattern;
 use crate::render::scan::{band_rows_for, for_each_band, RasterStats, Scratch};
 use crate::render::shading::triangle_color::TriangleColor;
 use crate::render::shading::TextureFilter;
-use crate::render::{Counter, Frame, Outputs, RenderOptions, Shading, Stats};
+use crate::render::{frame_name, Counter, Frame, Outputs, RenderOptions, Shading, Stats};
+use crate::try_alloc;
 
 /// A prepared scene made ready for trilinear rendering: its triangles in f64 and the flat base
 /// colour of each, built once for any number of renders; shading (shadows, mirrors, glass)
@@ -112,7 +113,7 @@ impl<'a> TrilinearRenderer<'a> {
         curves: CurveOptions,
     ) -> Result<(Frame, Stats)> {
         let (width, height) = projection.resolution();
-        let mut frame = Frame::zeroed(width, height, Outputs::ALL);
+        let mut frame = Frame::zeroed(width, height, Outputs::ALL)?;
         let stats = self.render_into(&mut frame, projection, options, curves)?;
         Ok((frame, stats))
     }
@@ -127,7 +128,8 @@ impl<'a> TrilinearRenderer<'a> {
     /// (`SamplePattern`): the pixel averages its samples' colours and reports the depth and
     /// id of the sample nearest its centre, as the ray caster does. Errors: a mesh of more
     /// than 2^32 projection triangles or a scene of more than 2^32 triangles (the fragment
-    /// keys); `frame` is then left as it was.
+    /// keys), `frame` then left as it was; memory that cannot be had for a new frame, the
+    /// scratch frame of several samples or the band buffers (module `try_alloc`).
     pub fn render_into(
         &self,
         frame: &mut Frame,
@@ -182,8 +184,8 @@ impl<'a> TrilinearRenderer<'a> {
 
         let maps: Vec<ScreenMap> = triangles.iter().map(|t| t.map).collect();
         let pattern = SamplePattern::new(options.spp);
-        frame.fit(width, height, Outputs::ALL);
-        let mut samples = Samples::new(frame, &pattern);
+        frame.fit(width, height, Outputs::ALL)?;
+        let mut samples = Samples::new(frame, &pattern)?;
         let flat_colors = (options.shading == Shading::Flat).then_some(&self.flat_colors[..]);
         let mut raster = RasterStats::default();
         let (mut raster_ms, mut shade_ms) = (0.0, 0.0);
@@ -218,7 +220,7 @@ impl<'a> TrilinearRenderer<'a> {
                 samples.target(),
                 batch,
                 band_rows,
-                || (GBuffer::new(width, band_rows), Scratch::default()),
+                || Ok((GBuffer::new(width, band_rows)?, Scratch::default())),
                 |(buffer, scratch), shapes, rows| {
                     let start = Instant::now();
                     buffer.start_band(rows.rows);
@@ -235,7 +237,7 @@ impl<'a> TrilinearRenderer<'a> {
                         shade_s: finishing.elapsed().as_secs_f64(),
                     }
                 },
-            );
+            )?;
             raster.add(&done.raster);
             samples.add(done.counts);
             // The pass's wall time, split by the CPU time its bands spent drawing and shading.
@@ -335,18 +337,23 @@ struct Samples<'a> {
 }
 
 impl<'a> Samples<'a> {
-    fn new(out: &'a mut Frame, pattern: &SamplePattern) -> Samples<'a> {
-        let scratch = (pattern.offsets.len() > 1).then(|| {
-            let frame = Frame::zeroed(out.width, out.height, Outputs::ALL);
-            (frame, bytemuck::zeroed_vec(out.color.len()))
-        });
-        Samples {
+    /// Fails when the scratch frame's memory cannot be had.
+    fn new(out: &'a mut Frame, pattern: &SamplePattern) -> Result<Samples<'a>> {
+        let scratch = if pattern.offsets.len() > 1 {
+            let (width, height) = (out.width, out.height);
+            let frame = Frame::zeroed(width, height, Outputs::ALL)?;
+            let sum = try_alloc::zeroed(out.color.len(), || frame_name(width, height))?;
+            Some((frame, sum))
+        } else {
+            None
+        };
+        Ok(Samples {
             out,
             scratch,
             count: 0,
             centre: pattern.centre,
             counts: ShadeCounts::default(),
-        }
+        })
     }
 
     /// The frame the next sample is drawn into (every pixel of it is overwritten).

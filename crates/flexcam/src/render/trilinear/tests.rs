@@ -36,7 +36,7 @@ fn against_raycast(
 ) -> (Comparison, Stats) {
     let projection = Trilinear::new(mesh, size.0, size.1).unwrap();
     let prepared = PreparedScene::new(scene);
-    let (reference, _) = raycast::render(&prepared, &projection, options);
+    let (reference, _) = raycast::render(&prepared, &projection, options).unwrap();
     let (frame, stats) = TrilinearRenderer::new(&prepared)
         .render(&projection, options, curves)
         .unwrap();
@@ -428,7 +428,7 @@ fn no_cracks_between_adjacent_projection_triangles() {
     let (frame, _) = TrilinearRenderer::new(&prepared)
         .render(&projection, &flat(), CurveOptions::ADAPTIVE)
         .unwrap();
-    let (reference, _) = raycast::render(&prepared, &projection, &flat());
+    let (reference, _) = raycast::render(&prepared, &projection, &flat()).unwrap();
     let uncovered: Vec<usize> = (0..frame.ids.len())
         .filter(|&i| reference.ids[i] != 0 && frame.ids[i] == 0)
         .collect();
