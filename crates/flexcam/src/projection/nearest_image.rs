@@ -7,8 +7,8 @@
 //! The miss at pixel p is the vector r(p) = (X - q) / |X - s| from q, the point of p's
 //! projector nearest X, to X, over X's distance from the projector's start s: the sine of
 //! the angle at which the projector misses X, seen from its start (zero where it passes
-//! through X). The search samples r over a grid of about [`SAMPLES`] positions per image
-//! side, then refines the [`STARTS`] best by Levenberg-Marquardt on |r|^2 with central
+//! through X). The search samples r over a grid of about 48 (`SAMPLES`) positions per image
+//! side, then refines the 4 (`STARTS`) best by Levenberg-Marquardt on |r|^2 with central
 //! differences, inside the image, and keeps the least miss.
 //!
 //! Degenerate cases: a projection with no projector anywhere on the sample grid gives
