@@ -223,6 +223,18 @@ fn unbounded_counts_and_memory_are_refused_before_allocating() {
         "[[object]]\nshape = \"mesh\"\nfile = \"huge.glb\"\n",
         "flexcam: huge.glb: malformed GLB: its header claims 4294967295 bytes, the file holds 20",
     );
+    // A GLB whose header claims fewer bytes than the header (found by fuzzing: the gltf
+    // crate's length arithmetic underflowed).
+    let mut glb = b"glTF".to_vec();
+    glb.extend(2u32.to_le_bytes());
+    glb.extend(0u32.to_le_bytes());
+    glb.extend([0u8; 8]);
+    write(&dir, "short.glb", &glb);
+    scene_refused(
+        &dir,
+        "[[object]]\nshape = \"mesh\"\nfile = \"short.glb\"\n",
+        "flexcam: short.glb: malformed GLB: its header claims 0 bytes, less than the header's own 12",
+    );
 
     // Ten teapots at the largest tessellation, against a budget of 1 GB.
     let teapots = "[[object]]\nshape = \"teapot\"\ntessellation = 1024\n".repeat(10);

@@ -132,8 +132,12 @@ fn check_named_file(base: &Path, uri: &str, what: &str) -> Result<()> {
     }
 }
 
+/// A GLB header's size: magic, version and total length, 4 bytes each.
+const GLB_HEADER_BYTES: u32 = 12;
+
 /// Fails when a GLB header claims more bytes than the file holds (the gltf crate's reader
-/// would allocate the claimed length first).
+/// would allocate the claimed length first) or fewer than the 12-byte header itself (the
+/// crate subtracts the header's size from the claim, which underflows).
 fn check_glb_length(bytes: &[u8]) -> Result<()> {
     let Some(claimed) = bytes
         .strip_prefix(b"glTF")
@@ -142,6 +146,12 @@ fn check_glb_length(bytes: &[u8]) -> Result<()> {
     else {
         return Ok(());
     };
+    if claimed < GLB_HEADER_BYTES {
+        return Err(Error::new(format!(
+            "malformed GLB: its header claims {claimed} bytes, less than the header's own \
+             {GLB_HEADER_BYTES}"
+        )));
+    }
     if claimed as usize > bytes.len() {
         return Err(Error::new(format!(
             "malformed GLB: its header claims {claimed} bytes, the file holds {}",
