@@ -212,29 +212,31 @@ fn unbounded_counts_and_memory_are_refused_before_allocating() {
          --method raycast)",
     );
 
-    // A 20-byte GLB whose header claims 4 GiB.
-    let mut glb = b"glTF".to_vec();
-    glb.extend(2u32.to_le_bytes());
-    glb.extend(u32::MAX.to_le_bytes());
-    glb.extend([0u8; 8]);
-    write(&dir, "huge.glb", &glb);
-    scene_refused(
-        &dir,
-        "[[object]]\nshape = \"mesh\"\nfile = \"huge.glb\"\n",
-        "flexcam: huge.glb: malformed GLB: its header claims 4294967295 bytes, the file holds 20",
-    );
-    // A GLB whose header claims fewer bytes than the header (found by fuzzing: the gltf
-    // crate's length arithmetic underflowed).
-    let mut glb = b"glTF".to_vec();
-    glb.extend(2u32.to_le_bytes());
-    glb.extend(0u32.to_le_bytes());
-    glb.extend([0u8; 8]);
-    write(&dir, "short.glb", &glb);
-    scene_refused(
-        &dir,
-        "[[object]]\nshape = \"mesh\"\nfile = \"short.glb\"\n",
-        "flexcam: short.glb: malformed GLB: its header claims 0 bytes, less than the header's own 12",
-    );
+    // A 20-byte GLB whose header claims 4 GiB; one whose header claims fewer bytes than the
+    // header (found by fuzzing: the gltf crate's length arithmetic underflowed).
+    for (file, claimed, message) in [
+        (
+            "huge.glb",
+            u32::MAX,
+            "its header claims 4294967295 bytes, the file holds 20",
+        ),
+        (
+            "short.glb",
+            0,
+            "its header claims 0 bytes, less than the header's own 12",
+        ),
+    ] {
+        let mut glb = b"glTF".to_vec();
+        glb.extend(2u32.to_le_bytes());
+        glb.extend(claimed.to_le_bytes());
+        glb.extend([0u8; 8]);
+        write(&dir, file, &glb);
+        scene_refused(
+            &dir,
+            &format!("[[object]]\nshape = \"mesh\"\nfile = \"{file}\"\n"),
+            &format!("flexcam: {file}: malformed GLB: {message}"),
+        );
+    }
 
     // Ten teapots at the largest tessellation, against a budget of 1 GB.
     let teapots = "[[object]]\nshape = \"teapot\"\ntessellation = 1024\n".repeat(10);
