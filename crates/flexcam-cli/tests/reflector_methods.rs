@@ -7,7 +7,7 @@
 use tempfile::TempDir;
 
 mod common;
-use common::run_json;
+use common::{run_json, run_ok};
 
 /// A plane mirror (4 x 4 quads, facing +z) reflecting a cube and a checker floor; not one
 /// of the example scenes.
@@ -184,4 +184,71 @@ fn camera_triangles_render_reflector_scenes_with_either_bound() {
         report["id_agreement"].as_f64().unwrap() >= 0.995,
         "{report}"
     );
+}
+
+/// The perspective camera `(position, look_at)` of the plane mirror scene as a key of a
+/// flexible `animate` table.
+fn animation_key(time: f64, position: &str) -> String {
+    format!(
+        "\n[[animation.key]]\ntime = {time}\n[animation.key.projection]\ntype = \"flexible\"\n\
+         preset = \"perspective\"\nposition = {position}\nlook_at = [0.0, 1.2, -1.0]\n\
+         fov = 60.0\n"
+    )
+}
+
+/// Mean absolute difference of two 8-bit images' RGB, in [0, 1].
+fn mean_rgb_difference(a: &std::path::Path, b: &std::path::Path) -> f64 {
+    let (a, b) = (
+        image::open(a).unwrap().to_rgb8(),
+        image::open(b).unwrap().to_rgb8(),
+    );
+    assert_eq!(a.dimensions(), b.dimensions());
+    let sum: f64 = a
+        .as_raw()
+        .iter()
+        .zip(b.as_raw())
+        .map(|(&x, &y)| f64::from(x.abs_diff(y)))
+        .sum();
+    sum / (255.0 * a.as_raw().len() as f64)
+}
+
+/// An animated reflector scene composites each frame through that frame's camera: frame 1
+/// of `animate` (the second key, a camera moved to the left) matches `render` of the scene
+/// with that camera, by every method that composites reflectors. Before, the composite took
+/// its camera from the scene's `[projection]`, so the fast methods drew every frame from the
+/// first camera.
+#[test]
+fn animated_reflector_frames_use_each_frames_camera() {
+    let dir = TempDir::new().unwrap();
+    let (first, moved) = ("[0.5, 1.5, 4.0]", "[-1.5, 2.0, 3.5]");
+    let animated = format!(
+        "{PLANE_MIRROR}\n[animation]\nframes = 2\nfps = 1.0\n{}{}",
+        animation_key(0.0, first),
+        animation_key(1.0, moved)
+    );
+    std::fs::write(dir.path().join("animated.toml"), animated).unwrap();
+    let still = PLANE_MIRROR.replace(
+        &format!("position = {first}"),
+        &format!("position = {moved}"),
+    );
+    assert_ne!(still, PLANE_MIRROR);
+    std::fs::write(dir.path().join("moved.toml"), still).unwrap();
+    for method in ["raycast", "trilinear", "camera-triangles"] {
+        let frames = format!("{method}-#.png");
+        let moved_png = format!("{method}-moved.png");
+        let flat = ["--method", method, "--shading", "flat"];
+        let animate = [
+            &["animate", "animated.toml", "-o", &frames, "--frames", "1"],
+            &flat[..],
+        ];
+        run_ok(&dir, &animate.concat());
+        let render = [&["render", "moved.toml", "-o", &moved_png], &flat[..]];
+        run_ok(&dir, &render.concat());
+        let path = |name: &str| dir.path().join(name);
+        let difference = mean_rgb_difference(&path(&format!("{method}-1.png")), &path(&moved_png));
+        assert!(
+            difference < 0.002,
+            "{method}: mean RGB difference {difference}"
+        );
+    }
 }

@@ -34,11 +34,12 @@ use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 
 use self::camera_mesh::camera_mesh;
+pub use self::main_camera::main_camera;
 use crate::error::{Error, Result};
 use crate::projection::trilinear_builders::{
     reflector_surface, Optic, ReflectorSurface, SurfaceRays, SurfaceScreenMap,
 };
-use crate::projection::{Perspective, Projection, ProjectionSpec, Trilinear, TrilinearMesh};
+use crate::projection::{Perspective, Projection, Trilinear, TrilinearMesh};
 use crate::render::prepared::PreparedScene;
 use crate::render::shading::normals;
 use crate::render::shading::trace::specular;
@@ -65,7 +66,7 @@ type Renderer<'a> =
 /// reflector that has such edges) and `reflector_render_ms` (surface refinement, building
 /// and rendering).
 ///
-/// Errors: the renderer's; a scene projection that is not perspective (the main camera);
+/// Errors: the renderer's; a main view that is not a pinhole ([`main_camera`]);
 /// a reflector id that no object has, or whose material is not mirror or glass.
 fn with_renderer(
     prepared: &PreparedScene,
@@ -321,18 +322,6 @@ pub fn perspective_as_trilinear(camera: &Perspective) -> Result<Trilinear> {
 /// Forward distance of [`perspective_as_trilinear`]'s base points from the eye, relative to
 /// `1 + ` the eye's largest coordinate.
 const NEAR: f64 = 1e-6;
-
-/// The main camera: the scene's perspective projection at `main`'s resolution.
-pub fn main_camera(scene: &Scene, main: &dyn Projection) -> Result<Perspective> {
-    let ProjectionSpec::Perspective { frame, fov } = &scene.projection else {
-        return Err(Error::new(format!(
-            "trilinear reflectors need a perspective projection (the main camera), not {}",
-            scene.projection.kind()
-        )));
-    };
-    let (width, height) = main.resolution();
-    Perspective::new(frame, *fov, width, height)
-}
 
 /// A reflector object: its parts' meshes merged, its optic and its base colour.
 #[derive(Debug, Clone)]
@@ -648,6 +637,7 @@ fn check_size(main: &Frame, other: &Frame) -> Result<()> {
 
 pub mod camera_mesh;
 pub mod env_map;
+pub mod main_camera;
 pub mod refine;
 #[cfg(test)]
 mod tests;

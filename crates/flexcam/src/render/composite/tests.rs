@@ -1,6 +1,7 @@
 use glam::{DVec3, Vec3};
 
 use super::*;
+use crate::projection::ProjectionSpec;
 use crate::render::compare::{compare, Comparison};
 use crate::render::Method;
 use crate::scene::reflector_fixtures::{
