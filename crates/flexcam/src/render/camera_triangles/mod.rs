@@ -260,7 +260,7 @@ impl<'a> CameraTriangleRenderer<'a> {
                                 .iter()
                                 .map(|p| Vertex::new(p.x, p.y, 0.0, [])),
                         );
-                        batch.push(vertices, scene.owners[k].id, ((c as u64) << 32) | k as u64);
+                        batch.push(vertices, ((c as u64) << 32) | k as u64);
                         counts.regions += 1;
                     };
                     if method.cull && method.bound == Bound::Tight {

@@ -160,7 +160,7 @@ mod tests {
         cover(&triangle, (0, SIZE.1), SIZE.0, |x, y| ours.push((x, y)));
         let mut target = Target::new(SIZE.0, SIZE.1, Vec3::ZERO);
         let mut batch = PolygonBatch::<0>::new();
-        batch.push(&corners.map(|p| Vertex::new(p.x, p.y, 0.0, [])), 1, 7);
+        batch.push(&corners.map(|p| Vertex::new(p.x, p.y, 0.0, [])), 7);
         rasterize(&mut target, &batch, FillRule::NonZero, &|_| Vec3::ONE);
         let theirs = (0..SIZE.1)
             .flat_map(|y| (0..SIZE.0).map(move |x| (x, y)))

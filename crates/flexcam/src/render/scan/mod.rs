@@ -41,7 +41,7 @@ pub use polygon::{Polygon, PolygonBatch, Vertex, LIMIT, NO_PRIMITIVE};
 pub use reference::{rasterize, rasterize_parallel, rasterize_parallel_resolved, BAND_ROWS};
 pub use stats::RasterStats;
 #[cfg(test)]
-pub use target::{Fragment, Target};
+pub use target::{id_of, Fragment, Target};
 
 use rayon::prelude::*;
 

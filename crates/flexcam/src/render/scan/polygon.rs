@@ -49,8 +49,6 @@ impl<const N: usize> Vertex<N> {
 #[derive(Debug, Clone, Copy)]
 pub struct Polygon<'a, const N: usize> {
     pub vertices: &'a [Vertex<N>],
-    /// Written into the target's id buffer where the shape is visible.
-    pub object: u32,
     /// Breaks depth ties (smaller wins) and tells the shader which primitive a fragment
     /// belongs to. Give every shape its own key for an image independent of input order.
     pub primitive: u64,
@@ -121,12 +119,11 @@ pub struct PolygonBatch<const N: usize> {
     shapes: Vec<Shape>,
 }
 
-/// Where one shape's vertices lie in the batch, and its keys.
+/// Where one shape's vertices lie in the batch, and its primitive key.
 #[derive(Debug, Clone, Copy)]
 struct Shape {
     start: usize,
     end: usize,
-    object: u32,
     primitive: u64,
 }
 
@@ -140,13 +137,12 @@ impl<const N: usize> PolygonBatch<N> {
     }
 
     /// Appends a shape (see [`Polygon`]).
-    pub fn push(&mut self, vertices: &[Vertex<N>], object: u32, primitive: u64) {
+    pub fn push(&mut self, vertices: &[Vertex<N>], primitive: u64) {
         let start = self.vertices.len();
         self.vertices.extend_from_slice(vertices);
         self.shapes.push(Shape {
             start,
             end: self.vertices.len(),
-            object,
             primitive,
         });
     }
@@ -183,16 +179,11 @@ impl<const N: usize> PolygonBatch<N> {
         self.shapes.len()
     }
 
-    pub fn is_empty(&self) -> bool {
-        self.shapes.is_empty()
-    }
-
     /// Shape `i`, `i < len()`.
     pub fn get(&self, i: usize) -> Polygon<'_, N> {
         let s = self.shapes[i];
         Polygon {
             vertices: &self.vertices[s.start..s.end],
-            object: s.object,
             primitive: s.primitive,
         }
     }

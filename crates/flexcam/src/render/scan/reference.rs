@@ -102,7 +102,6 @@ fn draw<const N: usize>(
                 x,
                 y: span.y,
                 varying: span.at(x),
-                object: polygon.object,
                 primitive: polygon.primitive,
             };
             counts.fragments += 1;

@@ -1,6 +1,7 @@
 //! The depth-tested render target of the reference rasteriser (`super::reference`): colour,
-//! depth, object id and the winning primitive per pixel, cut into horizontal bands that can
-//! be written in parallel.
+//! depth and the winning primitive per pixel, cut into horizontal bands that can be written
+//! in parallel. Its frame's id buffer names the winning primitive ([`id_of`]); the renderers
+//! find an object's id from the primitive key themselves.
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -9,6 +10,17 @@ use super::interpolate::Varying;
 use super::NO_PRIMITIVE;
 use crate::render::Frame;
 
+/// The id the target's frame holds for the winning primitive key: the key's low 32 bits plus
+/// one (wrapping), 0 where nothing was drawn, so that two frames of the same shapes have
+/// equal id buffers exactly when the same primitives won (for keys below `u32::MAX`).
+pub fn id_of(primitive: u64) -> u32 {
+    if primitive == NO_PRIMITIVE {
+        0
+    } else {
+        (primitive as u32).wrapping_add(1)
+    }
+}
+
 /// One covered pixel centre of one shape, as handed to the shader.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Fragment<const N: usize> {
@@ -16,8 +28,7 @@ pub struct Fragment<const N: usize> {
     pub y: u32,
     /// Depth and attributes interpolated at the pixel centre.
     pub varying: Varying<N>,
-    /// The shape's object id and primitive key (see [`super::Polygon`]).
-    pub object: u32,
+    /// The shape's primitive key (see [`super::Polygon`]).
     pub primitive: u64,
 }
 
@@ -28,12 +39,11 @@ pub struct Target {
     height: u32,
     color: Vec<Vec3>,
     depth: Vec<f64>,
-    ids: Vec<u32>,
     primitives: Vec<u64>,
 }
 
 impl Target {
-    /// An empty target: `background` colour, infinite depth, id 0, no primitive.
+    /// An empty target: `background` colour, infinite depth, no primitive.
     pub fn new(width: u32, height: u32, background: Vec3) -> Self {
         let n = width as usize * height as usize;
         Target {
@@ -41,7 +51,6 @@ impl Target {
             height,
             color: filled(n, background),
             depth: filled(n, f64::INFINITY),
-            ids: filled(n, 0),
             primitives: filled(n, NO_PRIMITIVE),
         }
     }
@@ -53,11 +62,6 @@ impl Target {
     /// Row-major depths; `f64::INFINITY` where nothing was drawn.
     pub fn depth(&self) -> &[f64] {
         &self.depth
-    }
-
-    /// Row-major object ids; 0 where nothing was drawn.
-    pub fn ids(&self) -> &[u32] {
-        &self.ids
     }
 
     /// The primitive key of the fragment visible at pixel `(x, y)` (inside the target);
@@ -82,7 +86,7 @@ impl Target {
             height: self.height,
             color: self.color,
             depth: self.depth.par_iter().map(|&d| d as f32).collect(),
-            ids: self.ids,
+            ids: self.primitives.par_iter().map(|&p| id_of(p)).collect(),
             surface: Vec::new(),
         }
     }
@@ -94,7 +98,6 @@ impl Target {
             rows: (0, self.height),
             color: &mut self.color,
             depth: &mut self.depth,
-            ids: &mut self.ids,
             primitives: &mut self.primitives,
         }
     }
@@ -106,17 +109,15 @@ impl Target {
         self.color
             .chunks_mut(n)
             .zip(self.depth.chunks_mut(n))
-            .zip(self.ids.chunks_mut(n))
             .zip(self.primitives.chunks_mut(n))
             .enumerate()
-            .map(|(i, (((color, depth), ids), primitives))| {
+            .map(|(i, ((color, depth), primitives))| {
                 let first = (i * n / width as usize) as u32;
                 Band {
                     width,
                     rows: (first, first + (color.len() / width as usize) as u32),
                     color,
                     depth,
-                    ids,
                     primitives,
                 }
             })
@@ -138,14 +139,13 @@ pub(super) struct Band<'a> {
     pub rows: (u32, u32),
     color: &'a mut [Vec3],
     depth: &'a mut [f64],
-    ids: &'a mut [u32],
     primitives: &'a mut [u64],
 }
 
 impl<'a> Band<'a> {
     /// The z-test: the fragment wins when `(depth, primitive)` is lexicographically smaller
     /// than the stored pair, so the result does not depend on the order of distinct shapes.
-    /// On a win the shader is run and colour, depth, id and key are written. `fragment` must
+    /// On a win the shader is run and colour, depth and key are written. `fragment` must
     /// lie in the band; its depth is finite (see [`super::LIMIT`]).
     pub fn test_and_write<const N: usize>(
         &mut self,
@@ -159,7 +159,6 @@ impl<'a> Band<'a> {
         if wins {
             self.color[i] = shader(fragment);
             self.depth[i] = depth;
-            self.ids[i] = fragment.object;
             self.primitives[i] = fragment.primitive;
         }
         wins

@@ -34,7 +34,6 @@ fn shape(points: &[(f64, f64)]) -> Vec<Vertex<0>> {
 fn poly<const N: usize>(vertices: &[Vertex<N>]) -> Polygon<'_, N> {
     Polygon {
         vertices,
-        object: 1,
         primitive: 0,
     }
 }
@@ -474,7 +473,7 @@ fn raster_span_steps_reproduce_the_interpolated_values() {
 
 /// Random overlapping triangles and polygons with varying depths (some tied), and a few
 /// lines, each with its own primitive key.
-fn scene(seed: u64, count: usize, w: f64, h: f64) -> Vec<(Vec<Vertex<2>>, u32, u64)> {
+fn scene(seed: u64, count: usize, w: f64, h: f64) -> Vec<(Vec<Vertex<2>>, u64)> {
     let mut rng = Rng(seed);
     (0..count)
         .map(|i| {
@@ -493,15 +492,15 @@ fn scene(seed: u64, count: usize, w: f64, h: f64) -> Vec<(Vec<Vertex<2>>, u32, u
                     Vertex::new(p.x, p.y, depth, [rng.next(), rng.next()])
                 })
                 .collect();
-            (vertices, (i % 7) as u32 + 1, i as u64)
+            (vertices, i as u64)
         })
         .collect()
 }
 
-fn batch(shapes: &[(Vec<Vertex<2>>, u32, u64)]) -> PolygonBatch<2> {
+fn batch(shapes: &[(Vec<Vertex<2>>, u64)]) -> PolygonBatch<2> {
     let mut batch = PolygonBatch::new();
-    for (vertices, object, primitive) in shapes {
-        batch.push(vertices, *object, *primitive);
+    for (vertices, primitive) in shapes {
+        batch.push(vertices, *primitive);
     }
     batch
 }
@@ -629,22 +628,21 @@ fn raster_degenerate_inputs_never_panic() {
     let mut batch = PolygonBatch::<2>::new();
     let v = |x: f64, y: f64| Vertex::new(x, y, 1.0, [0.0, 0.0]);
     // Zero area: collinear, and all vertices equal.
-    batch.push(&[v(1.0, 1.0), v(5.0, 5.0), v(9.0, 9.0)], 1, 0);
-    batch.push(&[v(3.5, 3.5); 4], 1, 1);
+    batch.push(&[v(1.0, 1.0), v(5.0, 5.0), v(9.0, 9.0)], 0);
+    batch.push(&[v(3.5, 3.5); 4], 1);
     // Entirely off-screen.
-    batch.push(&[v(-20.0, -20.0), v(-10.0, -20.0), v(-10.0, -5.0)], 1, 2);
-    batch.push(&[v(100.0, 2.0), v(120.0, 2.0), v(110.0, 9.0)], 1, 3);
+    batch.push(&[v(-20.0, -20.0), v(-10.0, -20.0), v(-10.0, -5.0)], 2);
+    batch.push(&[v(100.0, 2.0), v(120.0, 2.0), v(110.0, 9.0)], 3);
     // NaN, infinite and beyond-LIMIT components: skipped.
-    batch.push(&[v(1.0, 1.0), v(f64::NAN, 5.0), v(9.0, 2.0)], 1, 4);
-    batch.push(&[v(1.0, 1.0), v(5.0, f64::INFINITY), v(9.0, 2.0)], 1, 5);
-    batch.push(&[v(1.0, 1.0), v(5.0, 2e300), v(9.0, 2.0)], 1, 6);
+    batch.push(&[v(1.0, 1.0), v(f64::NAN, 5.0), v(9.0, 2.0)], 4);
+    batch.push(&[v(1.0, 1.0), v(5.0, f64::INFINITY), v(9.0, 2.0)], 5);
+    batch.push(&[v(1.0, 1.0), v(5.0, 2e300), v(9.0, 2.0)], 6);
     batch.push(
         &[
             v(1.0, 1.0),
             Vertex::new(5.0, 5.0, f64::NAN, [0.0, 0.0]),
             v(9.0, 2.0),
         ],
-        1,
         7,
     );
     batch.push(
@@ -653,12 +651,11 @@ fn raster_degenerate_inputs_never_panic() {
             Vertex::new(5.0, 5.0, 0.0, [0.0, f64::NAN]),
             v(9.0, 2.0),
         ],
-        1,
         8,
     );
     // Too few vertices: skipped.
-    batch.push(&[v(1.0, 1.0)], 1, 9);
-    batch.push(&[], 1, 10);
+    batch.push(&[v(1.0, 1.0)], 9);
+    batch.push(&[], 10);
     let mut target = Target::new(16, 12, Vec3::ZERO);
     let stats = rasterize(&mut target, &batch, FillRule::EvenOdd, &|_| Vec3::ONE);
     assert_eq!((stats.polygons, stats.lines, stats.skipped), (4, 0, 7));
@@ -672,13 +669,15 @@ fn raster_degenerate_inputs_never_panic() {
             Vertex::new(3.0 * big, -big, big, [1.0, 0.0]),
             Vertex::new(-big, 3.0 * big, big, [0.0, 1.0]),
         ],
-        3,
         0,
     );
     let mut target = Target::new(16, 12, Vec3::ZERO);
     let stats = rasterize_parallel(&mut target, &huge, FillRule::NonZero, 5, &|_| Vec3::ONE);
     assert_eq!(stats.covered, 16 * 12);
-    assert!(target.depth().iter().all(|d| d.is_finite()) && target.ids().iter().all(|&id| id == 3));
+    assert!(
+        target.depth().iter().all(|d| d.is_finite())
+            && (0..12).all(|y| (0..16).all(|x| target.primitive(x, y) == Some(0)))
+    );
     // Empty targets.
     for (w, h) in [(0, 0), (0, 5), (5, 0)] {
         let mut empty = Target::new(w, h, Vec3::ZERO);
@@ -708,19 +707,18 @@ fn raster_stats_and_frame() {
         .map(|&(x, y)| Vertex::new(x, y, d, []))
         .collect()
     };
-    batch.push(&square(0.0, 0.0, 2.0), 1, 0);
-    batch.push(&square(2.0, 2.0, 1.0), 2, 1);
+    batch.push(&square(0.0, 0.0, 2.0), 0);
+    batch.push(&square(2.0, 2.0, 1.0), 1);
     batch.push(
         &[
             Vertex::new(0.5, 7.5, 0.5, []),
             Vertex::new(7.5, 7.5, 0.5, []),
         ],
-        3,
         2,
     );
     let mut target = Target::new(8, 8, Vec3::ZERO);
     let stats = rasterize(&mut target, &batch, FillRule::EvenOdd, &|f| {
-        Vec3::splat(f.object as f32)
+        Vec3::splat((f.primitive + 1) as f32)
     });
     assert_eq!((stats.polygons, stats.lines, stats.skipped), (2, 1, 0));
     assert_eq!(
@@ -764,8 +762,8 @@ fn raster_stage_rewrites_depth_or_discards_before_the_z_test() {
         [(0.0, 0.0), (8.0, 0.0), (8.0, 4.0), (0.0, 4.0)].map(|(x, y)| Vertex::new(x, y, depth, []))
     };
     let mut batch = PolygonBatch::<0>::new();
-    batch.push(&square(3.0), 1, 0);
-    batch.push(&square(5.0), 2, 1);
+    batch.push(&square(3.0), 0);
+    batch.push(&square(5.0), 1);
     let mut merged = PolygonBatch::<0>::new();
     merged.append(&batch);
     assert_eq!(merged.len(), 2);
@@ -784,8 +782,8 @@ fn raster_stage_rewrites_depth_or_discards_before_the_z_test() {
     assert_eq!((stats.fragments, stats.discarded), (64, 16));
     for y in 0..4 {
         for x in 0..8 {
-            let expected = if x < 4 { 2 } else { 1 };
-            assert_eq!(target.ids()[(y * 8 + x) as usize], expected, "({x}, {y})");
+            let expected = if x < 4 { 1 } else { 0 };
+            assert_eq!(target.primitive(x, y), Some(expected), "({x}, {y})");
         }
     }
 }
@@ -818,7 +816,6 @@ fn raster_bands_drawn_by_spans_are_the_rows_of_the_serial_target() {
                                 x,
                                 y: span.y,
                                 varying: span.at(x),
-                                object: polygon.object,
                                 primitive: polygon.primitive,
                             };
                             fragments += 1;
@@ -826,8 +823,12 @@ fn raster_bands_drawn_by_spans_are_the_rows_of_the_serial_target() {
                             let (depth, key, _, _) = zbuffer[i];
                             let d = fragment.varying.depth;
                             if d < depth || (d == depth && fragment.primitive < key) {
-                                zbuffer[i] =
-                                    (d, fragment.primitive, fragment.object, shade(&fragment));
+                                zbuffer[i] = (
+                                    d,
+                                    fragment.primitive,
+                                    id_of(fragment.primitive),
+                                    shade(&fragment),
+                                );
                             }
                         }
                     });

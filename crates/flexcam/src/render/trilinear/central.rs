@@ -213,7 +213,8 @@ impl CentralProjection {
         }
     }
 
-    /// The depth `t0` at which the rays meet.
+    /// The depth `t0` at which the rays meet (read by the tests).
+    #[cfg(test)]
     pub fn depth(&self) -> f64 {
         self.depth
     }

@@ -210,7 +210,7 @@ impl Drawn {
                     Vertex::new(pixel.x, pixel.y, p.t, terms.at(map, p.u, p.v))
                 }));
                 let key = (u64::from(shape.projection) << 32) | k as u64;
-                polygons.push(&pixels, scene.owners[k].id, key);
+                polygons.push(&pixels, key);
             }
         }
         polygons

@@ -96,13 +96,16 @@ impl VolumeBounds {
 
     /// The planes (bit `k` for plane `k`) that `point` lies strictly beyond, by more than the
     /// margin (module doc). A scene triangle whose vertices' masks have a common bit is
-    /// outside the volume.
+    /// outside the volume. The cull itself calls [`VolumeBounds::outside_of`]; this form is
+    /// the tests' reference.
+    #[cfg(test)]
     pub fn outside(&self, point: DVec3) -> u32 {
         self.outside_of(point, self.all_planes())
     }
 
-    /// [`VolumeBounds::outside`] among the planes `planes` only (the bits of the others are
-    /// zero). The cull passes the planes that still cut the box of the point's cluster
+    /// The planes among `planes` (bit `k` for plane `k`; the bits of the others are zero)
+    /// that `point` lies strictly beyond, by more than the margin (module doc). A scene
+    /// triangle whose vertices' masks have a common bit is outside the volume. The cull passes the planes that still cut the box of the point's cluster
     /// ([`VolumeBounds::box_side`]): the box lies wholly inside the others, so the point is
     /// beyond none of them and the mask is the full one, at the cost of a few planes
     /// instead of all.
@@ -166,14 +169,10 @@ impl VolumeBounds {
         BoxSide::Within(within)
     }
 
-    /// The number of bounding planes found.
-    pub fn len(&self) -> usize {
+    /// The number of bounding planes found (the tests' count of them).
+    #[cfg(test)]
+    fn len(&self) -> usize {
         self.count
-    }
-
-    /// Whether no bounding plane was found (nothing can be culled).
-    pub fn is_empty(&self) -> bool {
-        self.count == 0
     }
 }
 
