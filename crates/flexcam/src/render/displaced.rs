@@ -144,7 +144,15 @@ impl DisplacedSet {
                     (triangle, shell.frame(), shell.kept_boxes())
                 })
                 .collect();
-            for (triangle, frame, KeptBoxes { boxes, bounds: [lo, hi] }) in kept {
+            for (
+                triangle,
+                frame,
+                KeptBoxes {
+                    boxes,
+                    bounds: [lo, hi],
+                },
+            ) in kept
+            {
                 let bound = bounds[index].get_or_insert([DVec3::INFINITY, DVec3::NEG_INFINITY]);
                 *bound = [bound[0].min(lo), bound[1].max(hi)];
                 boxed.push(([shells.len() as u32, 0], lo, hi));

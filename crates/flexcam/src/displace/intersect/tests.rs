@@ -102,7 +102,13 @@ fn check(case: &Case, grid: &MicroGrid, ray: &Ray) -> Result<(), TestCaseError> 
             computed.frame(),
             boxes,
         );
-        prop_assert_eq!(stored.intersect(ray), brute, "{} boxes, ray {:?}", kind, ray);
+        prop_assert_eq!(
+            stored.intersect(ray),
+            brute,
+            "{} boxes, ray {:?}",
+            kind,
+            ray
+        );
     }
     Ok(())
 }
