@@ -1,6 +1,7 @@
 //! Exact ray tracing of a displaced base triangle through a min/max hierarchy over its
 //! subdivision, after Smits, Shirley and Stark 2000 ("Direct ray tracing of displacement
-//! mapped triangles"), with nothing stored per triangle.
+//! mapped triangles"), with nothing stored per triangle or with the boxes of the top of the
+//! hierarchy kept ([`DisplacedTriangle::kept_boxes`]: exact up to level 6).
 //!
 //! The hierarchy is the recursion of the 4-to-1 subdivision itself: a node is a sub-triangle
 //! at some level, its children the four triangles its edge midpoints cut it into, its leaves
@@ -27,23 +28,49 @@
 //! order of their boxes' entry distance, and a child whose entry lies beyond the best hit so
 //! far is skipped. A node two levels above the leaves whose children's boxes are not kept
 //! displaces its fifteen micro-vertices once and bounds each child by the box of its six
-//! (exact, where the box above is conservative). A leaf tests its micro-triangle exactly as
+//! (exact, where the box above is conservative).
+//!
+//! The prepared scene keeps the boxes of the top of the hierarchy per base triangle
+//! ([`DisplacedTriangle::kept_boxes`]): up to level 6 the exact boxes of the nodes' displaced
+//! micro-vertices, computed once from all of them, down to depth 4 (at level 5 the nodes
+//! just above the leaves); a ray tests a node's four kept child boxes at once in f32
+//! (`WideRay`, widened so that it enters every child the f64 test would) and computes only
+//! what lies below them. A leaf tests its micro-triangle exactly as
 //! the brute-force reference
 //! ([`MicroGrid::intersect`](super::micro::MicroGrid::intersect)) does, on bit-identical
 //! micro-vertices, with the same tie rule ([`MicroHit::before`]), so the two find the same
 //! hit: same `t`, micro-triangle and barycentrics.
 
-use glam::{DVec2, DVec3, Vec3};
+use glam::{DVec2, DVec3, Vec3, Vec4};
 
 use super::height::HeightField;
-use super::micro::{hit_micro_triangle, BaseVertex, Displacement, MicroHit, MicroTriangle};
+use super::micro::{
+    hit_micro_triangle, BaseVertex, Displacement, MicroGrid, MicroHit, MicroTriangle,
+};
 use crate::geometry::Ray;
 
-/// Deepest level of the hierarchy whose node boxes [`DisplacedTriangle::top_boxes`] keeps
-/// (`1 + 4 + 16 + 64` boxes, 2,040 bytes per base triangle in f32).
-const CACHED_DEPTH: u32 = 3;
+/// Deepest level of the hierarchy whose exact node boxes [`DisplacedTriangle::kept_boxes`]
+/// keeps (`1 + 4 + 16 + 64 + 256` boxes, 8,184 bytes per base triangle in f32).
+const EXACT_DEPTH: u32 = 4;
+/// Highest subdivision level whose kept boxes are exact: they are computed from every
+/// micro-vertex (2,145 per base triangle at level 6, 8,385 at level 7).
+const EXACT_LEVEL: u32 = 6;
+/// Deepest level of the hierarchy whose conservative node boxes (levels above
+/// [`EXACT_LEVEL`]) [`DisplacedTriangle::kept_boxes`] keeps (`1 + 4 + 16 + 64` boxes, 2,040
+/// bytes per base triangle), each a height range over a uv rectangle.
+const CONSERVATIVE_DEPTH: u32 = 3;
 
-/// A node box in f32, rounded outward from the f64 box (see [`DisplacedTriangle::top_boxes`]).
+/// What the prepared scene keeps of a base triangle ([`DisplacedTriangle::kept_boxes`]).
+#[derive(Debug, Clone)]
+pub struct KeptBoxes {
+    /// Boxes of the hierarchy's top nodes, in level order, in the triangle's frame.
+    pub boxes: Vec<CachedBox>,
+    /// A world box containing every micro-triangle displaced by any fraction from 0 to the
+    /// displacement's (the undisplaced micro-triangles included).
+    pub bounds: [DVec3; 2],
+}
+
+/// A node box in f32, rounded outward from the f64 box (see [`DisplacedTriangle::kept_boxes`]).
 pub type CachedBox = [Vec3; 2];
 
 /// A base triangle (vertices with positions, normals and uv) and its displacement.
@@ -211,27 +238,145 @@ fn leaf_parent_box(points: &[DVec3; 6], origin: DVec3) -> [DVec3; 2] {
     [lo - slack, hi + slack]
 }
 
+/// The box of the micro-vertices `local` (in the frame, grid point `(i, j)` at `i * side +
+/// j`) of the node with grid corners `g` at subdivision `depth` of `level`: its
+/// micro-triangles' (so their convex hulls'). Records it, and those of its descendants, at
+/// their places in the level order (`index` its own) where `out` holds them.
+fn exact_box(
+    local: &[DVec3],
+    side: usize,
+    g: [[u32; 2]; 3],
+    depth: u32,
+    level: u32,
+    index: usize,
+    out: &mut [[DVec3; 2]],
+) -> [DVec3; 2] {
+    let found = if depth == level {
+        let p = g.map(|[i, j]| local[i as usize * side + j as usize]);
+        [p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2])]
+    } else {
+        let mut found = [DVec3::INFINITY, DVec3::NEG_INFINITY];
+        for (k, child) in child_grids(g).into_iter().enumerate() {
+            let [lo, hi] = exact_box(local, side, child, depth + 1, level, 4 * index + 1 + k, out);
+            found = [found[0].min(lo), found[1].max(hi)];
+        }
+        found
+    };
+    // Deeper nodes' level-order places lie beyond the kept ones.
+    if let Some(slot) = out.get_mut(index) {
+        *slot = found;
+    }
+    found
+}
+
 /// A ray in the base triangle's frame, for slab tests.
 struct LocalRay {
     origin: DVec3,
     direction: DVec3,
+    /// The direction's reciprocal (infinite where a component is zero: not used there).
+    inv: DVec3,
     t_min: f64,
     t_max: f64,
     /// How much every box is widened for this ray (module docs).
     slack: f64,
+    /// The ray in f32 for the kept boxes, where the triangle has them and f32 holds it.
+    wide: Option<WideRay>,
 }
 
 impl LocalRay {
     fn new(frame: &Frame, ray: &Ray) -> LocalRay {
         let origin = frame.local(ray.origin);
+        let slack = 1e-8 * origin.abs().max_element();
+        LocalRay::with(origin, frame.direction(ray.direction), ray, slack)
+    }
+
+    /// The ray from `origin` along `direction` over `ray`'s interval, boxes widened by
+    /// `slack`.
+    fn with(origin: DVec3, direction: DVec3, ray: &Ray, slack: f64) -> LocalRay {
         LocalRay {
             origin,
-            direction: frame.direction(ray.direction),
+            direction,
+            inv: direction.recip(),
             t_min: ray.t_min,
             t_max: ray.t_max,
-            slack: 1e-8 * origin.abs().max_element(),
+            slack,
+            wide: None,
         }
     }
+
+    /// The same ray with its f32 form ([`WideRay`]) for a triangle whose kept root box is
+    /// `root`, if it has kept boxes.
+    fn with_root(self, root: Option<&CachedBox>) -> LocalRay {
+        let wide = root.and_then(|root| WideRay::new(&self, root));
+        LocalRay { wide, ..self }
+    }
+}
+
+/// A [`LocalRay`] in f32, each component splatted over four lanes, to test the four kept
+/// boxes of a node's children at once ([`wide_entries`]).
+///
+/// Conservative: with `u = 2^-24`, each slab distance `(lo - s - o) / d` computed in f32
+/// (the box plane moved out by `s`, the origin rounded, the reciprocal rounded twice, the
+/// difference and the product rounded) is off by at most `4.1 u (M + |o| + s) / |d|`, `M` the
+/// largest coordinate of the triangle's root box (every kept box lies in it) and `|o|` the
+/// origin's; so with `s = 2^-20 (M + |o|)` plus the [`LocalRay`]'s own slack, the computed
+/// entry is at most, and the exit at least, those of the box widened by that slack alone,
+/// and a child the f64 test would enter is entered, at no later distance.
+#[derive(Debug, Clone, Copy)]
+struct WideRay {
+    origin: [Vec4; 3],
+    inv: [Vec4; 3],
+    /// `t_min` rounded down.
+    t_min: f32,
+    t_max: f64,
+    /// How much every box is widened for this ray (above).
+    slack: Vec4,
+}
+
+impl WideRay {
+    /// `local` in f32, for the triangle with kept root box `root`; `None` where f32 would
+    /// not hold the test (a zero or tiny direction component, huge coordinates or slab
+    /// distances), which then takes the f64 test.
+    fn new(local: &LocalRay, root: &CachedBox) -> Option<WideRay> {
+        let reach = root[0].abs().max(root[1].abs()).max_element() as f64
+            + local.origin.abs().max_element();
+        let inv = local.inv.abs().max_element();
+        if !(inv.is_finite() && reach * inv.max(1.0) < 1e30) {
+            return None;
+        }
+        let splat = |v: DVec3| [v.x, v.y, v.z].map(|x| Vec4::splat(x as f32));
+        Some(WideRay {
+            origin: splat(local.origin),
+            inv: splat(local.inv),
+            t_min: f32_below(local.t_min),
+            t_max: local.t_max,
+            slack: Vec4::splat(f32_above(reach * (1.0 / 1048576.0) + local.slack)),
+        })
+    }
+}
+
+/// Where the ray enters each of the four boxes `boxes` (a node's kept children) within its
+/// interval and before `limit`, at or before the f64 test's entry ([`WideRay`]); infinite
+/// for a box it misses.
+#[inline]
+fn wide_entries(ray: &WideRay, boxes: &[CachedBox], limit: f64) -> [f32; 4] {
+    let lane = |side: usize, axis: usize| {
+        Vec4::new(
+            boxes[0][side][axis],
+            boxes[1][side][axis],
+            boxes[2][side][axis],
+            boxes[3][side][axis],
+        )
+    };
+    let mut near = Vec4::splat(ray.t_min);
+    let mut far = Vec4::splat(f32_above(ray.t_max.min(limit)));
+    for axis in 0..3 {
+        let t0 = (lane(0, axis) - ray.slack - ray.origin[axis]) * ray.inv[axis];
+        let t1 = (lane(1, axis) + ray.slack - ray.origin[axis]) * ray.inv[axis];
+        near = near.max(t0.min(t1));
+        far = far.min(t0.max(t1));
+    }
+    Vec4::select(near.cmple(far), near, Vec4::INFINITY).to_array()
 }
 
 /// A ray that enters a triangle's kept root box, in that triangle's frame: what
@@ -239,14 +384,15 @@ impl LocalRay {
 pub struct RootEntry(LocalRay);
 
 /// Whether `ray` enters a triangle's kept root box `root` (the first of its
-/// [`DisplacedTriangle::top_boxes`], in its `frame`): the test
+/// [`DisplacedTriangle::kept_boxes`], in its `frame`): the test
 /// [`DisplacedTriangle::intersect`] starts with, without the triangle's corners, so that a
 /// caller can skip fetching them for the many triangles a ray reaches only in their world
 /// box. `None` means no hit.
 pub fn enters_root(frame: &Frame, root: &CachedBox, ray: &Ray) -> Option<RootEntry> {
     let [lo, hi] = *root;
     let local = LocalRay::new(frame, ray);
-    slab_entry(&local, [lo.as_dvec3(), hi.as_dvec3()], f64::INFINITY).map(|_| RootEntry(local))
+    slab_entry(&local, [lo.as_dvec3(), hi.as_dvec3()], f64::INFINITY)?;
+    Some(RootEntry(local.with_root(Some(root))))
 }
 
 impl<'a> DisplacedTriangle<'a> {
@@ -263,7 +409,7 @@ impl<'a> DisplacedTriangle<'a> {
     }
 
     /// The same triangle with its frame and top node boxes kept from
-    /// [`DisplacedTriangle::frame`] and [`DisplacedTriangle::top_boxes`] of it, so that a
+    /// [`DisplacedTriangle::frame`] and [`DisplacedTriangle::kept_boxes`] of it, so that a
     /// ray pays one slab test per kept box instead of computing it: same hits.
     pub fn with_boxes(
         corners: [BaseVertex; 3],
@@ -284,17 +430,34 @@ impl<'a> DisplacedTriangle<'a> {
         self.frame
     }
 
-    /// The boxes of its internal nodes down to depth `min(L - 1, 3)` (a leaf-parent's
-    /// children are tested directly, without boxes), in level order, each rounded outward to
-    /// f32 (so it still contains its node's micro-geometry): `1`, `5`, `21` or `85` boxes, at
-    /// most 2,040 bytes. These are the boxes nearly every ray reaching the triangle opens; they are
-    /// the costliest to compute per ray (wide uv rectangles, a wide spread of normals).
-    pub fn top_boxes(&self) -> Vec<CachedBox> {
+    /// The boxes the prepared scene keeps: those of its internal nodes down to depth `min(L -
+    /// 1, 4)` (a leaf-parent's children are tested directly, without boxes), in level order,
+    /// each rounded outward to f32 (so it still contains its node's micro-geometry): `1`,
+    /// `5`, `21`, `85` or `341` boxes, at most 8,184 bytes. Up to level [`EXACT_LEVEL`] they
+    /// are exact: the boxes of the node's displaced micro-vertices, computed once here from
+    /// all of them ([`Self::exact_boxes`]), so a ray enters far fewer nodes than through the
+    /// conservative boxes (positions, normal cone, height range over the node's uv
+    /// rectangle) the hierarchy computes per ray. Above it they are those conservative boxes,
+    /// down to depth 3 ([`Self::conservative_boxes`]).
+    pub fn kept_boxes(&self) -> KeptBoxes {
+        if self.displacement.level() <= EXACT_LEVEL {
+            self.exact_boxes()
+        } else {
+            KeptBoxes {
+                boxes: self.conservative_boxes(),
+                bounds: self.bounds(),
+            }
+        }
+    }
+
+    /// The conservative boxes of its internal nodes down to depth `min(L - 1, 3)`, in level
+    /// order, as [`Self::node_box`] computes them per ray, rounded outward to f32.
+    fn conservative_boxes(&self) -> Vec<CachedBox> {
         let depth = self
             .displacement
             .level()
             .saturating_sub(1)
-            .min(CACHED_DEPTH);
+            .min(CONSERVATIVE_DEPTH);
         let mut level = vec![self.root()];
         let mut out = Vec::new();
         for d in 0..=depth {
@@ -304,6 +467,51 @@ impl<'a> DisplacedTriangle<'a> {
             }
         }
         out
+    }
+
+    /// The exact boxes of its internal nodes down to depth `min(L - 1, 4)`, in level order,
+    /// and its world bounds ([`KeptBoxes`]), from every micro-vertex ([`MicroGrid`]: the
+    /// micro-vertices the hierarchy tests, bit for bit). A node's box is that of the
+    /// displaced micro-vertices of its micro-triangles in the frame (their convex hull's, so
+    /// every micro-triangle's), widened as [`Self::node_box`] is for the rounding of the
+    /// frame transform (1e-9 of the node's extent plus 1e-14 of the frame origin's distance
+    /// from the world origin), then rounded outward to f32.
+    fn exact_boxes(&self) -> KeptBoxes {
+        let level = self.displacement.level();
+        let depth = level.saturating_sub(1).min(EXACT_DEPTH);
+        let grid = MicroGrid::new(&self.corners, self.displacement);
+        let n = 1u32 << level;
+        let side = n as usize + 1;
+        let mut local = vec![DVec3::ZERO; side * side];
+        let mut world = [DVec3::INFINITY, DVec3::NEG_INFINITY];
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let (vertex, displaced) = (grid.vertex([i, j]), grid.displaced([i, j]));
+                local[i as usize * side + j as usize] = self.frame.local(displaced);
+                world = [
+                    world[0].min(displaced).min(vertex.position),
+                    world[1].max(displaced).max(vertex.position),
+                ];
+            }
+        }
+        let far = self.frame.origin.abs().max_element();
+        let widen = |[lo, hi]: [DVec3; 2]| {
+            let reach = lo.abs().max(hi.abs()).max_element();
+            let slack = DVec3::splat(1e-9 * reach + 1e-14 * far);
+            [lo - slack, hi + slack]
+        };
+        let mut exact = vec![[DVec3::ZERO; 2]; ((1usize << (2 * (depth + 1))) - 1) / 3];
+        let root = self.root();
+        exact_box(&local, side, root.g, 0, level, 0, &mut exact);
+        let boxes = exact.into_iter().map(|b| outward(widen(b))).collect();
+        // The world box of the undisplaced and displaced micro-vertices holds every partly
+        // displaced one (on the segment between the two, up to rounding).
+        let reach = world[0].abs().max(world[1].abs()).max_element();
+        let slack = DVec3::splat(1e-9 * (world[1] - world[0]).max_element() + 1e-14 * reach);
+        KeptBoxes {
+            boxes,
+            bounds: [world[0] - slack, world[1] + slack],
+        }
     }
 
     /// A world-space box `[min, max]` containing every micro-triangle.
@@ -335,7 +543,7 @@ impl<'a> DisplacedTriangle<'a> {
             None => self.node_box(&self.root()),
         };
         slab_entry(&local, root, f64::INFINITY)?;
-        self.intersect_entered(ray, &RootEntry(local))
+        self.intersect_entered(ray, &RootEntry(local.with_root(self.boxes.first())))
     }
 
     /// [`DisplacedTriangle::intersect`] for a ray [`enters_root`] let through with this
@@ -412,13 +620,20 @@ impl<'a> DisplacedTriangle<'a> {
             return;
         }
         let limit = best.map_or(f64::INFINITY, |b| b.t);
-        let (order, count) = front_to_back(|k| {
-            let entry = |b| slab_entry(local, b, limit);
-            match self.boxes.get(first + k) {
-                Some(&[lo, hi]) => entry([lo.as_dvec3(), hi.as_dvec3()]),
-                None => entry(self.node_box(&node.child(k, midpoints))),
+        let kept = self.boxes.get(first..first + 4);
+        let (order, count) = match (&local.wide, kept) {
+            (Some(wide), Some(kept)) => {
+                let entries = wide_entries(wide, kept, limit);
+                front_to_back(|k| (entries[k] < f32::INFINITY).then_some(entries[k] as f64))
             }
-        });
+            _ => front_to_back(|k| {
+                let entry = |b| slab_entry(local, b, limit);
+                match kept {
+                    Some(kept) => entry(kept[k].map(|v| v.as_dvec3())),
+                    None => entry(self.node_box(&node.child(k, midpoints))),
+                }
+            }),
+        };
         for &(entry, k) in &order[..count] {
             // Ties with the best hit stay: a hit at equal t may win on the triangle order.
             if best.is_some_and(|b| entry > b.t) {
@@ -454,13 +669,7 @@ impl<'a> DisplacedTriangle<'a> {
             [dca, dbc, dc, bc_ca, d(bc.midpoint(c)), d(c.midpoint(ca))],
             [dca, dab, dbc, ab_ca, ab_bc, bc_ca],
         ];
-        let world = LocalRay {
-            origin: ray.origin,
-            direction: ray.direction,
-            t_min: ray.t_min,
-            t_max: ray.t_max,
-            slack: 0.0,
-        };
+        let world = LocalRay::with(ray.origin, ray.direction, ray, 0.0);
         let limit = best.map_or(f64::INFINITY, |b| b.t);
         let (order, count) =
             front_to_back(|k| slab_entry(&world, leaf_parent_box(&six[k], ray.origin), limit));
@@ -501,28 +710,35 @@ impl<'a> DisplacedTriangle<'a> {
 
 /// The f32 box containing the f64 box `[lo, hi]`.
 fn outward([lo, hi]: [DVec3; 2]) -> CachedBox {
-    // Rounding to nearest may land inside: step out by at least one unit in the last place.
-    let step = |x: f32| x.abs() * f32::EPSILON + f32::MIN_POSITIVE;
-    let down = |x: f64| {
-        let f = x as f32;
-        if f as f64 > x {
-            f - step(f)
-        } else {
-            f
-        }
-    };
-    let up = |x: f64| {
-        let f = x as f32;
-        if (f as f64) < x {
-            f + step(f)
-        } else {
-            f
-        }
-    };
     [
-        Vec3::new(down(lo.x), down(lo.y), down(lo.z)),
-        Vec3::new(up(hi.x), up(hi.y), up(hi.z)),
+        Vec3::new(f32_below(lo.x), f32_below(lo.y), f32_below(lo.z)),
+        Vec3::new(f32_above(hi.x), f32_above(hi.y), f32_above(hi.z)),
     ]
+}
+
+/// One unit in the last place of `x` or more: rounding to nearest may land inside.
+fn f32_step(x: f32) -> f32 {
+    x.abs() * f32::EPSILON + f32::MIN_POSITIVE
+}
+
+/// An f32 at or below `x`.
+fn f32_below(x: f64) -> f32 {
+    let f = x as f32;
+    if f as f64 > x {
+        f - f32_step(f)
+    } else {
+        f
+    }
+}
+
+/// An f32 at or above `x`.
+fn f32_above(x: f64) -> f32 {
+    let f = x as f32;
+    if (f as f64) < x {
+        f + f32_step(f)
+    } else {
+        f
+    }
 }
 
 /// Component bounds of every normal below a node with corner normals `n` (module docs).
@@ -597,11 +813,12 @@ fn slab_entry(ray: &LocalRay, [lo, hi]: [DVec3; 2], limit: f64) -> Option<f64> {
             }
             continue;
         }
-        let (t0, t1) = ((lo[k] - o) / d, (hi[k] - o) / d);
+        let (t0, t1) = ((lo[k] - o) * ray.inv[k], (hi[k] - o) * ray.inv[k]);
         near = near.max(t0.min(t1));
         far = far.min(t0.max(t1));
     }
-    // Rounding of the slab distances is covered by the boxes' slack.
+    // Rounding of the slab distances (a few units in the last place of each, relative: the
+    // reciprocal and the product) is covered by the boxes' slack.
     (near <= far).then_some(near)
 }
 

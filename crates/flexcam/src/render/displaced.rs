@@ -9,7 +9,11 @@
 //! set is a binary tree over the shells' boxes (binned surface-area-heuristic splits, leaves
 //! of at most [`LEAF`] base triangles), searched in f64 front to back.
 //! Memory per base triangle: its object and index, a share of the tree's boxes (about 80
-//! bytes in all); the micro-geometry is recomputed per ray from the mesh.
+//! bytes in all), its frame (96 bytes) and the kept f32 boxes of the top of its hierarchy
+//! ([`DisplacedTriangle::kept_boxes`]: exact up to level 6, at most 341 boxes, 8,184 bytes,
+//! from level 5 on); the micro-geometry below them is recomputed per ray from the mesh. Its
+//! shell box is the exact world box of its micro-vertices, undisplaced and displaced, up to
+//! level 6.
 //!
 //! The prepared scene's queries over this set are in `render::prepared::displaced_hits`.
 //! A hit is reported on the base triangle, as any hit is: `triangle` is the base triangle,
@@ -25,7 +29,9 @@ use std::time::Instant;
 
 use glam::DVec3;
 
-use crate::displace::intersect::enters_root;
+use rayon::prelude::*;
+
+use crate::displace::intersect::{enters_root, KeptBoxes};
 use crate::displace::{base_corners, CachedBox, DisplacedTriangle, Displacement, Frame, MicroHit};
 use crate::geometry::Ray;
 use crate::scene::Scene;
@@ -68,7 +74,7 @@ pub(in crate::render) struct DisplacedSet {
     displacements: Vec<Option<Displacement>>,
     /// Base triangles in tree order.
     items: Vec<Item>,
-    /// The kept node boxes of every item ([`DisplacedTriangle::top_boxes`]).
+    /// The kept node boxes of every item ([`DisplacedTriangle::kept_boxes`]).
     boxes: Vec<CachedBox>,
     /// Depth-first: an interior node's first child follows it, `second` is the other.
     nodes: Vec<Node>,
@@ -128,18 +134,29 @@ impl DisplacedSet {
             let Some(displacement) = displacement else {
                 continue;
             };
-            for triangle in 0..object.mesh.triangles.len() {
-                let shell =
-                    DisplacedTriangle::new(base_corners(&object.mesh, triangle), displacement);
-                let [lo, hi] = shell.bounds();
+            // Each base triangle's boxes are its own (exact ones displace every micro-vertex
+            // once): built in parallel, kept in scene order.
+            let kept: Vec<_> = (0..object.mesh.triangles.len())
+                .into_par_iter()
+                .map(|triangle| {
+                    let shell =
+                        DisplacedTriangle::new(base_corners(&object.mesh, triangle), displacement);
+                    (triangle, shell.frame(), shell.kept_boxes())
+                })
+                .collect();
+            for (
+                triangle,
+                frame,
+                KeptBoxes {
+                    boxes,
+                    bounds: [lo, hi],
+                },
+            ) in kept
+            {
                 let bound = bounds[index].get_or_insert([DVec3::INFINITY, DVec3::NEG_INFINITY]);
                 *bound = [bound[0].min(lo), bound[1].max(hi)];
                 boxed.push(([shells.len() as u32, 0], lo, hi));
-                shells.push((
-                    [index as u32, triangle as u32],
-                    shell.frame(),
-                    shell.top_boxes(),
-                ));
+                shells.push(([index as u32, triangle as u32], frame, boxes));
             }
         }
         let mut nodes = Vec::with_capacity(2 * boxed.len() / LEAF + 1);

@@ -1,7 +1,7 @@
 use glam::{DVec2, DVec3};
 use proptest::prelude::*;
 
-use super::DisplacedTriangle;
+use super::{DisplacedTriangle, KeptBoxes, Node};
 use crate::displace::{
     BaseVertex, Displacement, HeightField, HeightMap, MicroGrid, Procedural, Wave,
 };
@@ -53,13 +53,18 @@ fn height_field() -> impl Strategy<Value = HeightField> {
 }
 
 fn case() -> impl Strategy<Value = Case> {
+    case_in(0..=5)
+}
+
+/// A case at a subdivision level in `levels`.
+fn case_in(levels: std::ops::RangeInclusive<u32>) -> impl Strategy<Value = Case> {
     (
         [vec3(), vec3(), vec3()],
         [vec3(), vec3(), vec3()],
         [(unit(), unit()), (unit(), unit()), (unit(), unit())],
         height_field(),
         -0.6..0.6f64,
-        0u32..=5,
+        levels,
     )
         .prop_filter_map(
             "degenerate base triangle",
@@ -86,12 +91,25 @@ fn case() -> impl Strategy<Value = Case> {
 /// micro-triangle.
 fn check(case: &Case, grid: &MicroGrid, ray: &Ray) -> Result<(), TestCaseError> {
     let computed = DisplacedTriangle::new(case.corners, &case.displacement);
-    let boxes = computed.top_boxes();
-    let stored =
-        DisplacedTriangle::with_boxes(case.corners, &case.displacement, computed.frame(), &boxes);
+    let exact = computed.exact_boxes().boxes;
+    let conservative = computed.conservative_boxes();
     let brute = grid.intersect(ray);
     prop_assert_eq!(computed.intersect(ray), brute, "ray {:?}", ray);
-    prop_assert_eq!(stored.intersect(ray), brute, "stored boxes, ray {:?}", ray);
+    for (boxes, kind) in [(&exact, "exact"), (&conservative, "conservative")] {
+        let stored = DisplacedTriangle::with_boxes(
+            case.corners,
+            &case.displacement,
+            computed.frame(),
+            boxes,
+        );
+        prop_assert_eq!(
+            stored.intersect(ray),
+            brute,
+            "{} boxes, ray {:?}",
+            kind,
+            ray
+        );
+    }
     Ok(())
 }
 
@@ -139,6 +157,56 @@ proptest! {
             // Through an edge's midpoint, crossing it.
             let mid = (p0 + p1) * 0.5;
             check(&case, &grid, &Ray::new(mid + normal + origins[1] * 0.5, -(normal + origins[1] * 0.5)))?;
+        }
+    }
+
+    /// Every kept exact box holds the micro-triangles of its node (in the triangle's frame)
+    /// and is their box up to the f32 rounding: so the test fails for a box that is only
+    /// conservative. The world bounds hold every micro-vertex undisplaced, displaced and
+    /// half displaced.
+    #[test]
+    fn exact_boxes_hold_their_micro_triangles_and_no_more(case in case_in(0..=6)) {
+        let grid = MicroGrid::new(&case.corners, &case.displacement);
+        let triangle = DisplacedTriangle::new(case.corners, &case.displacement);
+        let KeptBoxes { boxes, bounds: [w_lo, w_hi] } = triangle.exact_boxes();
+        let depth = case.displacement.level().saturating_sub(1).min(4);
+        prop_assert_eq!(boxes.len(), ((1usize << (2 * (depth + 1))) - 1) / 3);
+        // The nodes in level order, down to the deepest kept depth.
+        let mut nodes = vec![triangle.root()];
+        let mut start = 0;
+        while nodes.len() < boxes.len() {
+            let next: Vec<Node> = nodes[start..].iter().flat_map(Node::children).collect();
+            start = nodes.len();
+            nodes.extend(next);
+        }
+        for (node, &[lo, hi]) in nodes.iter().zip(&boxes) {
+            let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+            let mut found = [DVec3::INFINITY, DVec3::NEG_INFINITY];
+            for micro in grid.triangles() {
+                let centroid = [0, 1].map(|k| micro.vertices().iter().map(|g| g[k] as i64).sum::<i64>());
+                if !node.holds(centroid) {
+                    continue;
+                }
+                for p in grid.positions(micro).map(|p| triangle.frame.local(p)) {
+                    prop_assert!(p.cmpge(lo).all() && p.cmple(hi).all(), "{} outside [{}, {}]", p, lo, hi);
+                    found = [found[0].min(p), found[1].max(p)];
+                }
+            }
+            let tolerance = 1e-6 * (1.0 + found[0].abs().max(found[1].abs()).max_element());
+            prop_assert!(
+                (found[0] - lo).max_element() <= tolerance && (hi - found[1]).max_element() <= tolerance,
+                "[{}, {}] wider than its micro-triangles' [{}, {}]", lo, hi, found[0], found[1]
+            );
+        }
+        let half = case.displacement.with_fraction(0.5);
+        let n = 1u32 << case.displacement.level();
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let vertex = grid.vertex([i, j]);
+                for p in [vertex.position, grid.displaced([i, j]), half.displace(&vertex)] {
+                    prop_assert!(p.cmpge(w_lo).all() && p.cmple(w_hi).all(), "{} outside [{}, {}]", p, w_lo, w_hi);
+                }
+            }
         }
     }
 
@@ -210,4 +278,77 @@ fn misses_and_bad_rays() {
         DisplacedTriangle::new(flat, &d).intersect(&ray),
         MicroGrid::new(&flat, &d).intersect(&ray)
     );
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+
+    /// Level 6 (4,096 micro-triangles): the kept exact boxes reach depth 4, and the nodes
+    /// below them are bounded from their displaced micro-vertices per ray
+    /// (`visit_leaf_parents`); same hits as brute force.
+    #[test]
+    fn same_hits_as_brute_force_at_level_6(
+        case in case_in(6..=6),
+        origins in proptest::collection::vec(vec3(), 12),
+        weights in proptest::collection::vec((0.0..1.0f64, 0.0..1.0f64, -1.2..0.2f64), 12),
+    ) {
+        let grid = MicroGrid::new(&case.corners, &case.displacement);
+        let [a, b, c] = case.corners.map(|v| v.position);
+        let normal = (b - a).cross(c - a).normalize();
+        let scale = case.displacement_scale();
+        for (origin, &(s, t, depth)) in origins.iter().zip(&weights) {
+            let (s, t) = if s + t > 1.0 { (1.0 - s, 1.0 - t) } else { (s, t) };
+            let target = a + s * (b - a) + t * (c - a) + normal * depth * scale;
+            let from = target + *origin * 3.0;
+            check(&case, &grid, &Ray::new(from, target - from))?;
+        }
+    }
+}
+
+/// Rays along the frame's axes (zero direction components: the kept boxes' f64 test, the
+/// f32 one cannot hold them) and oblique ones (the f32 test) through a triangle whose frame
+/// is the world's: the same hits as brute force, with exact and conservative kept boxes.
+#[test]
+fn axis_parallel_rays_through_kept_boxes() {
+    let waves = vec![
+        Wave {
+            amplitude: 1.0,
+            frequency: [3, 1],
+            phase: 0.5,
+        },
+        Wave {
+            amplitude: 0.4,
+            frequency: [-2, 5],
+            phase: 0.0,
+        },
+    ];
+    let height = HeightField::Procedural(Procedural::waves(waves).unwrap());
+    let v = |p: [f64; 3], n: [f64; 3], uv: [f64; 2]| BaseVertex {
+        position: DVec3::from(p),
+        normal: DVec3::from(n).normalize(),
+        uv: DVec2::from(uv),
+    };
+    let corners = [
+        v([0.0; 3], [0.1, 0.0, 1.0], [0.0, 0.0]),
+        v([1.0, 0.0, 0.0], [0.0, 0.1, 1.0], [1.0, 0.0]),
+        v([0.0, 1.0, 0.0], [-0.1, 0.0, 1.0], [0.0, 1.0]),
+    ];
+    for level in [3, 5] {
+        let case = Case {
+            corners,
+            displacement: Displacement::new(height.clone(), 0.1, 1.0, level).unwrap(),
+        };
+        let grid = MicroGrid::new(&case.corners, &case.displacement);
+        for i in 0..24 {
+            for j in 0..24 - i {
+                let (x, y) = ((i as f64 + 0.3) / 24.0, (j as f64 + 0.6) / 24.0);
+                let from = DVec3::new(x, y, 1.0);
+                for direction in [DVec3::NEG_Z, DVec3::new(0.05, -0.02, -1.0)] {
+                    check(&case, &grid, &Ray::new(from, direction)).unwrap();
+                }
+                let side = DVec3::new(-1.0, y, -0.05 * x);
+                check(&case, &grid, &Ray::new(side, DVec3::X)).unwrap();
+            }
+        }
+    }
 }
