@@ -514,10 +514,18 @@ impl<'a> DisplacedTriangle<'a> {
         }
     }
 
-    /// A world-space box `[min, max]` containing every micro-triangle.
+    /// A world-space box `[min, max]` containing every micro-triangle, undisplaced, displaced
+    /// or displaced by any fraction in between: the root's conservative box joined with the
+    /// base triangle (the undisplaced micro-vertices lie on it, and the root's height range
+    /// need not reach `h_max`, where the offset is 0), so it holds the segments between the
+    /// two too.
     pub fn bounds(&self) -> [DVec3; 2] {
         let [lo, hi] = self.node_box(&self.root());
-        let mut out = [DVec3::INFINITY, DVec3::NEG_INFINITY];
+        let base = self.corners.map(|v| v.position);
+        let mut out = [
+            base[0].min(base[1]).min(base[2]),
+            base[0].max(base[1]).max(base[2]),
+        ];
         for k in 0..8 {
             let corner = DVec3::new(
                 if k & 1 == 0 { lo.x } else { hi.x },

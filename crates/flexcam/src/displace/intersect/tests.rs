@@ -210,14 +210,21 @@ proptest! {
         }
     }
 
-    /// Every displaced micro-vertex lies inside the triangle's world bounds.
+    /// Every micro-vertex, undisplaced, displaced and half displaced, lies inside the
+    /// triangle's conservative world bounds (the shell box above the exact levels), also
+    /// where the triangle's heights stay below the map's maximum.
     #[test]
     fn bounds_contain_every_micro_vertex(case in case()) {
         let grid = MicroGrid::new(&case.corners, &case.displacement);
         let [lo, hi] = DisplacedTriangle::new(case.corners, &case.displacement).bounds();
-        for tri in grid.triangles() {
-            for p in grid.positions(tri) {
-                prop_assert!(p.cmpge(lo).all() && p.cmple(hi).all(), "{} outside [{}, {}]", p, lo, hi);
+        let half = case.displacement.with_fraction(0.5);
+        let n = 1u32 << case.displacement.level();
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let vertex = grid.vertex([i, j]);
+                for p in [vertex.position, grid.displaced([i, j]), half.displace(&vertex)] {
+                    prop_assert!(p.cmpge(lo).all() && p.cmple(hi).all(), "{} outside [{}, {}]", p, lo, hi);
+                }
             }
         }
     }
@@ -350,5 +357,42 @@ fn axis_parallel_rays_through_kept_boxes() {
                 check(&case, &grid, &Ray::new(side, DVec3::X)).unwrap();
             }
         }
+    }
+}
+
+/// A base triangle whose heights all stay below the map's maximum (the bright texel lies
+/// elsewhere): its conservative box sits below the base plane, yet [`DisplacedTriangle::
+/// bounds`] must still hold the undisplaced triangle, which the transition system traces.
+#[test]
+fn bounds_hold_the_undisplaced_triangle_below_the_maps_maximum() {
+    // 16 x 16 texels, the bright one in row 2, column 10; the triangle's uvs reach columns
+    // 1 to 5 and rows 10 to 14 (v = 1 the top row), apart at every level of the pyramid.
+    let mut values = vec![0.0f32; 256];
+    values[2 * 16 + 10] = 1.0;
+    let map = HeightField::Map(HeightMap::from_values(16, 16, values).unwrap());
+    let d = Displacement::new(map, 0.5, 1.0, 7).unwrap();
+    let v = |p: [f64; 3], uv: [f64; 2]| BaseVertex {
+        position: DVec3::from(p),
+        normal: DVec3::Z,
+        uv: DVec2::from(uv),
+    };
+    let corners = [
+        v([0.0; 3], [0.1, 0.1]),
+        v([1.0, 0.0, 0.0], [0.3, 0.1]),
+        v([0.0, 1.0, 0.0], [0.1, 0.3]),
+    ];
+    let triangle = DisplacedTriangle::new(corners, &d);
+    let [lo, hi] = triangle.bounds();
+    let root = triangle.node_box(&triangle.root());
+    assert!(
+        root[1].z < 0.0,
+        "the root's conservative box is below the base: {root:?}"
+    );
+    for c in &corners {
+        let p = c.position;
+        assert!(
+            p.cmpge(lo).all() && p.cmple(hi).all(),
+            "{p} outside [{lo}, {hi}]"
+        );
     }
 }
