@@ -11,7 +11,7 @@ for mode in slice tessellate; do
     case $mode in slice) figure=8-9 ;; *) figure=8-10 ;; esac
     $plot "$csv" "$out/trilinear-figure$figure.svg" --where mode=$mode --x factor \
         --y rgb_error --series configuration --log-x --log-y --x-label "factor ($mode)" \
-        --y-label "relative RGB error" --title "Figure $figure: --curves $mode per configuration"
+        --y-label "relative RGB error" --title "Figure $(echo $figure | tr - .): --curves $mode per configuration"
 done
 $plot "$csv" "$out/trilinear-figure8-11.svg" --where configuration=mean --x factor \
     --y rgb_error,thesis_rgb_error --series mode --log-x --log-y --x-label factor \
