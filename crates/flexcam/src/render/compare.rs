@@ -1,14 +1,13 @@
 //! Image agreement between two renders of the same scene, projection and resolution: how the
 //! fast renderers are held to the ray-cast reference, in tests and in `flexcam compare`.
 //!
-//! Three measures:
+//! Four measures:
 //! - **id agreement**: the fraction of pixels whose object id (0 = background) is the same in
 //!   both frames; it counts silhouette and visibility errors.
 //! - **depth error**: over the pixels where both frames hit the same object, the largest and
 //!   the mean of `|d - d_ref| / d_ref`; it counts geometric error inside shapes.
 //! - **relative RGB error** (the measure of Vallance 2005, ch. 8): the mean over pixels and channels
 //!   of `|c - c_ref|`, divided by the mean over pixels and channels of `c_ref`.
-//!
 //! - **interior id agreement** ([`interior_id_agreement`]): the id agreement over the pixels
 //!   away from id edges (the reference's 3 x 3 neighbourhood holds one id). Which side of a
 //!   silhouette an edge pixel's centre falls on is a sub-pixel matter on which two exact
@@ -134,8 +133,8 @@ pub fn compare(frame: &Frame, reference: &Frame) -> Result<Comparison> {
 /// ```
 /// use flexcam::render::interior_id_agreement;
 ///
-/// // 4 x 3: the middle row's two inner pixels are interior (one id around each); the
-/// // frame differs only at an edge pixel (x = 3), which does not count.
+/// // 4 x 3: of the middle row's inner pixels only x = 1 is interior (x = 2 touches id 2);
+/// // the frame differs only in column x = 3, at the edge, which does not count.
 /// let reference = [1u32, 1, 1, 2, 1, 1, 1, 2, 1, 1, 1, 2];
 /// let frame = [1u32, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 2];
 /// assert_eq!(interior_id_agreement(4, 3, &frame, &reference)?, (1.0, 1));
