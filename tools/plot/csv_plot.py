@@ -3,10 +3,12 @@
 
     python3 tools/plot/csv_plot.py IN.csv OUT.svg --x COL --y COL[,COL...] [--series COL[,COL...]]
         [--log-x] [--log-y] [--title TEXT[,TEXT...]] [--x-label TEXT] [--y-label TEXT[,TEXT...]]
+        [--where COL=VALUE ...]
 
 Each --y column is one panel, side by side; rows are grouped into series by the values of the
---series columns. Used for docs/images/camtri-figure6.svg and camtri-figure7.svg from
-`flexcam bench camera-triangles --figure 6|7 --csv FILE` (docs/camera-triangles.md).
+--series columns; --where (repeatable) keeps only the rows whose column COL is VALUE. Used for docs/images/camtri-figure6.svg and camtri-figure7.svg from
+`flexcam bench camera-triangles --figure 6|7 --csv FILE` (docs/camera-triangles.md), and by
+tools/plot/trilinear-studies.sh for `flexcam bench trilinear --study` (docs/trilinear-raster.md).
 """
 
 import argparse
@@ -29,7 +31,15 @@ def main(argv=None):
     parser.add_argument("--title", default="", help="comma-separated: one per panel")
     parser.add_argument("--x-label")
     parser.add_argument("--y-label", help="comma-separated: one per panel")
+    parser.add_argument("--where", action="append", default=[], metavar="COL=VALUE",
+                        help="keep only rows whose COL is VALUE (repeatable)")
     args = parser.parse_args(argv)
+    where = []
+    for condition in args.where:
+        column, equals, value = condition.partition("=")
+        if not equals or not column:
+            parser.error("--where needs COL=VALUE, got %r" % condition)
+        where.append((column, value))
     ys = args.y.split(",")
     titles = args.title.split(",") if args.title else [""] * len(ys)
     y_labels = args.y_label.split(",") if args.y_label else ys
@@ -37,7 +47,7 @@ def main(argv=None):
         parser.error("--title and --y-label need one entry per --y column")
     series = [c for c in args.series.split(",") if c]
     try:
-        panels = [dict(series=csv_series(args.csv, args.x, y, series),
+        panels = [dict(series=csv_series(args.csv, args.x, y, series, where),
                        x_label=args.x_label or args.x, y_label=label, title=title,
                        log_x=args.log_x, log_y=args.log_y)
                   for y, label, title in zip(ys, y_labels, titles)]

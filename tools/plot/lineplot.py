@@ -173,18 +173,21 @@ def figure(panels, width=420, height=300):
             % (width * len(panels), height, width * len(panels), height, "\n".join(body)))
 
 
-def csv_series(path, x, y, series):
+def csv_series(path, x, y, series, where=()):
     """The series of the CSV file at `path`: rows grouped by the values of the columns
     `series` (a list; their values joined by ", " name the series, in order of first
-    appearance), each the points (float(row[x]), float(row[y])) in file order."""
+    appearance), each the points (float(row[x]), float(row[y])) in file order. `where` is a
+    list of (column, value) pairs: only rows whose cells equal every value count."""
     groups = {}
     with open(path, newline="") as f:
         reader = csv.DictReader(f)
-        for column in [x, y] + list(series):
+        for column in [x, y] + list(series) + [c for c, _ in where]:
             if column not in (reader.fieldnames or []):
                 raise ValueError("%s: no column %r (columns: %s)"
                                  % (path, column, ", ".join(reader.fieldnames or [])))
         for row in reader:
+            if any(row[c] != v for c, v in where):
+                continue
             name = ", ".join(row[c] for c in series) if series else y
             groups.setdefault(name, []).append((float(row[x]), float(row[y])))
     return list(groups.items())

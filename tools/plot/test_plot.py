@@ -100,6 +100,34 @@ class CsvPlot(unittest.TestCase):
             self.assertNotEqual(bad.returncode, 0)
             self.assertIn("no column 'nope'", bad.stderr)
 
+    def test_where_keeps_only_the_matching_rows(self):
+        with tempfile.TemporaryDirectory() as d:
+            data = os.path.join(d, "t.csv")
+            with open(data, "w") as f:
+                f.write("configuration,mode,factor,rgb_error\n"
+                        "a,slice,1,0.5\na,slice,10,0.1\na,tessellate,1,0.6\n"
+                        "mean,slice,1,0.4\nmean,slice,10,0.2\nmean,tessellate,1,0.7\n")
+            self.assertEqual(csv_series(data, "factor", "rgb_error", ["configuration"],
+                                        [("mode", "slice")]),
+                             [("a", [(1, 0.5), (10, 0.1)]), ("mean", [(1, 0.4), (10, 0.2)])])
+            self.assertEqual(csv_series(data, "factor", "rgb_error", ["mode"],
+                                        [("configuration", "mean"), ("mode", "tessellate")]),
+                             [("tessellate", [(1, 0.7)])])
+            with self.assertRaises(ValueError):
+                csv_series(data, "factor", "rgb_error", [], [("nope", "x")])
+            tool = os.path.join(HERE, "csv_plot.py")
+            out = os.path.join(d, "t.svg")
+            subprocess.run([sys.executable, tool, data, out, "--x", "factor", "--y",
+                            "rgb_error", "--series", "mode", "--where", "configuration=mean"],
+                           check=True)
+            root = ET.parse(out).getroot()
+            # slice has two points (a polyline), tessellate one (a marker alone).
+            self.assertEqual(len(root.findall(".//%spolyline" % SVG)), 1)
+            bad = subprocess.run([sys.executable, tool, data, out, "--x", "factor", "--y",
+                                  "rgb_error", "--where", "mode"], capture_output=True, text=True)
+            self.assertNotEqual(bad.returncode, 0)
+            self.assertIn("COL=VALUE", bad.stderr)
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -43,20 +43,11 @@ fn trilinear_against_raycast(scene: &str) -> (serde_json::Value, f64) {
     );
     let (method, reference) = (ids(&dir, "t.png"), ids(&dir, "r.png"));
     let (width, height) = reference.dimensions();
-    let (mut interior, mut agree) = (0u64, 0u64);
-    for y in 1..height.saturating_sub(1) {
-        for x in 1..width.saturating_sub(1) {
-            let id = reference.get_pixel(x, y)[0];
-            let uniform = (y - 1..=y + 1)
-                .all(|j| (x - 1..=x + 1).all(|i| reference.get_pixel(i, j)[0] == id));
-            if uniform {
-                interior += 1;
-                agree += u64::from(method.get_pixel(x, y)[0] == id);
-            }
-        }
-    }
+    let (agreement, interior) =
+        flexcam::render::interior_id_agreement(width, height, method.as_raw(), reference.as_raw())
+            .unwrap();
     assert!(interior > 0, "{scene}: no interior pixel");
-    (stats, agree as f64 / interior as f64)
+    (stats, agreement)
 }
 
 /// One configuration of Vallance 2005, appendix C (`scenes/appendix-c/NAME.toml`: the view

@@ -58,24 +58,14 @@ pub fn ids(path: &Path) -> (u32, u32, Vec<u16>) {
 }
 
 /// The fraction of pixels away from object edges (the reference's 3 x 3 neighbourhood has
-/// one id) whose ids agree, and how many such pixels there are.
+/// one id) whose ids agree, and how many such pixels there are
+/// (`flexcam::render::interior_id_agreement` of the two `--ids` PNGs).
 pub fn interior_agreement(reference: &Path, other: &Path) -> (f64, usize) {
     let (w, h, a) = ids(reference);
     let (w2, h2, b) = ids(other);
     assert_eq!((w, h), (w2, h2));
-    let at = |x: u32, y: u32| a[(y * w + x) as usize];
-    let (mut interior, mut agree) = (0usize, 0usize);
-    for y in 1..h - 1 {
-        for x in 1..w - 1 {
-            let id = at(x, y);
-            let uniform = (y - 1..=y + 1).all(|v| (x - 1..=x + 1).all(|u| at(u, v) == id));
-            if uniform {
-                interior += 1;
-                agree += usize::from(b[(y * w + x) as usize] == id);
-            }
-        }
-    }
-    (agree as f64 / interior as f64, interior)
+    let (agreement, interior) = flexcam::render::interior_id_agreement(w, h, &b, &a).unwrap();
+    (agreement, interior as usize)
 }
 
 /// The path of `scenes/cameras/NAME`.

@@ -1,13 +1,17 @@
 //! Image agreement between two renders of the same scene, projection and resolution: how the
 //! fast renderers are held to the ray-cast reference, in tests and in `flexcam compare`.
 //!
-//! Three measures:
+//! Four measures:
 //! - **id agreement**: the fraction of pixels whose object id (0 = background) is the same in
 //!   both frames; it counts silhouette and visibility errors.
 //! - **depth error**: over the pixels where both frames hit the same object, the largest and
 //!   the mean of `|d - d_ref| / d_ref`; it counts geometric error inside shapes.
 //! - **relative RGB error** (the measure of Vallance 2005, ch. 8): the mean over pixels and channels
 //!   of `|c - c_ref|`, divided by the mean over pixels and channels of `c_ref`.
+//! - **interior id agreement** ([`interior_id_agreement`]): the id agreement over the pixels
+//!   away from id edges (the reference's 3 x 3 neighbourhood holds one id). Which side of a
+//!   silhouette an edge pixel's centre falls on is a sub-pixel matter on which two exact
+//!   renderers may differ; inside shapes they must not.
 //!
 //! Degenerate cases: two empty frames agree perfectly (agreement 1, errors 0); a reference
 //! that is black everywhere gives a relative RGB error of 0 when the test frame is black too
@@ -116,6 +120,61 @@ pub fn compare(frame: &Frame, reference: &Frame) -> Result<Comparison> {
     })
 }
 
+/// The fraction of the pixels away from id edges whose ids agree, and how many such pixels
+/// there are: a pixel counts when the `reference` ids over its 3 x 3 neighbourhood are all
+/// the same (so the image's border rows and columns never count). `ids` and `reference` are
+/// row-major `width` x `height` id images: a [`Frame`]'s `ids`, or the 16-bit ids of an
+/// `--ids` PNG.
+///
+/// Degenerate cases: an image narrower or lower than 3 pixels, or one with an id edge
+/// through every neighbourhood, has no interior pixel: agreement 1 over 0 pixels (the caller
+/// decides whether 0 pixels is a failure). Fails when either buffer is not `width x height`.
+///
+/// ```
+/// use flexcam::render::interior_id_agreement;
+///
+/// // 4 x 3: of the middle row's inner pixels only x = 1 is interior (x = 2 touches id 2);
+/// // the frame differs only in column x = 3, at the edge, which does not count.
+/// let reference = [1u32, 1, 1, 2, 1, 1, 1, 2, 1, 1, 1, 2];
+/// let frame = [1u32, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 2];
+/// assert_eq!(interior_id_agreement(4, 3, &frame, &reference)?, (1.0, 1));
+/// # Ok::<(), flexcam::Error>(())
+/// ```
+pub fn interior_id_agreement<T: Copy + PartialEq>(
+    width: u32,
+    height: u32,
+    ids: &[T],
+    reference: &[T],
+) -> Result<(f64, u64)> {
+    let (w, h) = (width as usize, height as usize);
+    let expected = w.checked_mul(h);
+    if [ids.len(), reference.len()].map(Some) != [expected; 2] {
+        return Err(Error::new(format!(
+            "cannot compare ids: {} and {} ids for a {width}x{height} image",
+            ids.len(),
+            reference.len()
+        )));
+    }
+    let (mut interior, mut same) = (0u64, 0u64);
+    for y in 1..h.saturating_sub(1) {
+        for x in 1..w.saturating_sub(1) {
+            let id = reference[y * w + x];
+            let uniform =
+                (y - 1..=y + 1).all(|v| (x - 1..=x + 1).all(|u| reference[v * w + u] == id));
+            if uniform {
+                interior += 1;
+                same += u64::from(ids[y * w + x] == id);
+            }
+        }
+    }
+    let agreement = if interior == 0 {
+        1.0
+    } else {
+        same as f64 / interior as f64
+    };
+    Ok((agreement, interior))
+}
+
 /// `|d - d_ref| / d_ref`, absolute where the reference depth is zero; infinite where exactly
 /// one of the two is infinite.
 fn relative_depth_error(depth: f32, reference: f32) -> f64 {
@@ -180,6 +239,47 @@ mod tests {
         assert!((c.depth_mean - 0.05).abs() < 1e-6);
         // |diff| per channel summed: 0 + 1.5 + 3 + 0 over 12 reference units.
         assert!((c.relative_rgb_error - 4.5 / 12.0).abs() < 1e-12);
+    }
+
+    /// Only pixels whose reference neighbourhood holds one id count; the border never does.
+    #[test]
+    fn interior_agreement_counts_pixels_away_from_id_edges() {
+        // 5 x 4, id 1 left of x = 3, id 2 from x = 3: interior pixels are (1, 1), (1, 2)
+        // (id 1) and none of id 2 (its column 3 touches id 1, column 4 is the border).
+        let reference: Vec<u32> = (0..20).map(|i| if i % 5 < 3 { 1 } else { 2 }).collect();
+        assert_eq!(
+            interior_id_agreement(5, 4, &reference, &reference).unwrap(),
+            (1.0, 2)
+        );
+        let mut frame = reference.clone();
+        frame[6] = 7; // (1, 1): interior, now wrong
+        frame[8] = 7; // (3, 1): at the edge, ignored
+        frame[0] = 7; // the border, ignored
+        assert_eq!(
+            interior_id_agreement(5, 4, &frame, &reference).unwrap(),
+            (0.5, 2)
+        );
+        // 16-bit ids (an --ids PNG) work alike.
+        let small: Vec<u16> = reference.iter().map(|&i| i as u16).collect();
+        assert_eq!(
+            interior_id_agreement(5, 4, &small, &small).unwrap(),
+            (1.0, 2)
+        );
+    }
+
+    /// Too small an image has no interior: agreement 1 over 0 pixels; wrong lengths fail.
+    #[test]
+    fn interior_agreement_degenerate_cases() {
+        for (w, h) in [(0, 0), (2, 5), (5, 2)] {
+            let ids = vec![1u32; w * h];
+            assert_eq!(
+                interior_id_agreement(w as u32, h as u32, &ids, &ids).unwrap(),
+                (1.0, 0)
+            );
+        }
+        let e = interior_id_agreement(3, 3, &[0u32; 9], &[0u32; 8]).unwrap_err();
+        assert!(e.to_string().contains("9 and 8 ids for a 3x3"), "{e}");
+        assert!(interior_id_agreement(u32::MAX, u32::MAX, &[0u8], &[0u8]).is_err());
     }
 
     #[test]

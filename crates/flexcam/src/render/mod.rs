@@ -422,7 +422,7 @@ mod warning;
 mod window;
 
 pub use camera_triangles::{Bound as CameraTriangleBound, Options as CameraTriangleOptions};
-pub use compare::{compare, Comparison};
+pub use compare::{compare, interior_id_agreement, Comparison};
 pub use displaced::LodSelection;
 pub use method::Method;
 pub use prepared::{Hit, PreparedScene};

@@ -25,7 +25,8 @@ pub enum BenchCommand {
     /// throughput of --method raster on a 1280 x 720 panorama of a 123,554-triangle scene.
     Flexible(flexible::FlexibleArgs),
     /// Chapter 8 and appendix D of Vallance 2005: ray casting vs trilinear rasterisation of random
-    /// scenes and of the cube-floor scene through 2 to 50 projection triangles.
+    /// scenes and of the cube-floor scene through 2 to 50 projection triangles; with --study,
+    /// Table 8.1's examples, the appendix C configurations or the tessellation factors.
     Trilinear(trilinear::TrilinearArgs),
     /// Table 6.2 of Ramsey 2005: simplification of polygon meshes (teapot
     /// tessellations, closed tori, the repository's OBJ models) with tau = 0.99 and 1 % of

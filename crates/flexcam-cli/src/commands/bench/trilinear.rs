@@ -23,8 +23,20 @@
 //! frames of a program that draws frame after frame into one frame it keeps, both renderers
 //! alike (`bench_support::raycast_into`, `TrilinearRenderer::render_into` without and with
 //! clipping), and compares them like for like.
+//!
+//! `--study` runs one of the chapter 8 studies instead (modules [`examples`],
+//! [`configurations`], [`tessellation`]): a markdown table on stdout, and as CSV with
+//! `--csv FILE` (plotted by `tools/plot/trilinear-studies.sh`).
 
-use clap::Args;
+mod configurations;
+mod examples;
+mod study;
+mod tessellation;
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+use flexcam::image_io::{self, OutputSet};
 use flexcam::projection::{Trilinear, TrilinearMesh};
 use flexcam::render::bench_support::workloads::trilinear::{
     fan_grid, random_grid, random_triangles,
@@ -45,9 +57,74 @@ pub struct TrilinearArgs {
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100))]
     repeat: u32,
     /// A fast subset: random scenes of 1 and 640 triangles through 2, 18 and 50 projections
-    /// at 1 and 256^2 pixels, and the cube-floor scene through 2, 18 and 50 projections.
+    /// at 1 and 256^2 pixels, and the cube-floor scene through 2, 18 and 50 projections;
+    /// with `--study tessellation`, the factors 1, 10 and 100 alone.
     #[arg(long)]
     quick: bool,
+    /// Run a study of chapter 8 instead: `examples` (Table 8.1, every row), `configurations`
+    /// (the appendix C shape configurations, Tables D.4-D.17) or `tessellation` (curve
+    /// following per tessellation factor, Figures 8.9-8.12, Tables D.18-D.31).
+    #[arg(long, value_enum)]
+    study: Option<Study>,
+    /// Write the study's table as CSV to FILE.
+    #[arg(long, value_name = "FILE", requires = "study")]
+    csv: Option<PathBuf>,
+    /// Image width of every render of the study (default: the thesis's; the height keeps
+    /// the thesis's aspect ratio).
+    #[arg(long, requires = "study", value_parser = clap::value_parser!(u32).range(3..=4096))]
+    size: Option<u32>,
+    /// The folder of the example scenes the studies load (`trilinear-*.toml`,
+    /// `reflect-*.toml`, `refract-lens.toml`, `appendix-c/`).
+    #[arg(long, value_name = "DIR", default_value = "scenes")]
+    scenes: PathBuf,
+}
+
+/// A study of chapter 8 (`--study`).
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+enum Study {
+    Examples,
+    Configurations,
+    Tessellation,
+}
+
+/// Runs `study`: prints its table and writes it as CSV where asked (nothing is written when
+/// a render fails).
+fn run_study(study: Study, args: &TrilinearArgs) -> Result<()> {
+    let mut outputs = OutputSet::new();
+    let csv_output = args
+        .csv
+        .as_deref()
+        .map(|path| outputs.output("the CSV output", path, &["csv"]))
+        .transpose()?;
+    let (scenes, size, repeat) = (args.scenes.as_path(), args.size, args.repeat);
+    let (title, table) = match study {
+        Study::Examples => (
+            "Table 8.1 (Vallance 2005): every example, ray caster (raycast) and trilinear \
+             rasteriser of the same frame",
+            examples::run(scenes, size, repeat)?,
+        ),
+        Study::Configurations => (
+            "Appendix C configurations (Tables D.4-D.17): one scene triangle through one \
+             folding projection triangle",
+            configurations::run(scenes, size, repeat)?,
+        ),
+        Study::Tessellation => (
+            "Tessellation factor (Figures 8.9-8.12, Tables D.18-D.31): --curves tessellate \
+             and slice against the ray caster",
+            tessellation::run(scenes, size, repeat, args.quick)?,
+        ),
+    };
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
+    println!(
+        "{title}; flat shading, {threads} threads, median of {repeat} after one warm-up; ms = \
+         median wall, cpu_ms = mean CPU of all threads; ids_interior = id agreement away \
+         from id edges\n"
+    );
+    print!("{}", table.markdown());
+    if let Some(id) = csv_output {
+        outputs.stage(id, |tmp| image_io::write_bytes(tmp, table.csv().as_bytes()))?;
+    }
+    outputs.commit()
 }
 
 /// Side lengths of the square images of appendix D (1 to 640^2 pixels).
@@ -101,6 +178,9 @@ struct Kept {
 
 /// Runs the benchmark and prints both tables.
 pub fn run(args: &TrilinearArgs) -> Result<()> {
+    if let Some(study) = args.study {
+        return run_study(study, args);
+    }
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let (sides, counts, cells): (&[u32], &[u32], &[u32]) = if args.quick {
         (&[1, 256], &[1, 640], &[1, 3, 5])

@@ -5,7 +5,7 @@ use glam::DVec2;
 
 use super::*;
 use crate::projection::trilinear_builders::SurfaceRays;
-use crate::render::compare::{compare, Comparison};
+use crate::render::compare::{compare, interior_id_agreement, Comparison};
 use crate::render::{raycast, Method};
 use crate::scene::{self, Scene};
 
@@ -45,24 +45,13 @@ pub(super) fn count(stats: &Stats, name: &str) -> u64 {
     }
 }
 
-/// The fraction of pixels away from id edges (the reference's id is the same over the
-/// pixel's 3 x 3 neighbourhood) whose ids agree.
+/// The fraction of pixels away from id edges whose ids agree
+/// ([`interior_id_agreement`]); there must be such pixels.
 fn id_agreement_inside(frame: &Frame, reference: &Frame) -> f64 {
-    let (w, h) = (reference.width as i64, reference.height as i64);
-    let (mut inside, mut same) = (0u64, 0u64);
-    for y in 1..h - 1 {
-        for x in 1..w - 1 {
-            let k = (y * w + x) as usize;
-            let id = reference.ids[k];
-            let interior = (-1..=1)
-                .all(|dy| (-1..=1).all(|dx| reference.ids[((y + dy) * w + x + dx) as usize] == id));
-            if interior {
-                inside += 1;
-                same += u64::from(frame.ids[k] == id);
-            }
-        }
-    }
-    same as f64 / inside.max(1) as f64
+    let (w, h) = (reference.width, reference.height);
+    let (agreement, pixels) = interior_id_agreement(w, h, &frame.ids, &reference.ids).unwrap();
+    assert!(pixels > 0, "no pixel away from id edges");
+    agreement
 }
 
 /// Renders `scene` at `size` by camera triangles and by the ray caster.
