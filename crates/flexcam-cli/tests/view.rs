@@ -438,10 +438,20 @@ fn dragging_distances_and_angles_of_presets() {
     let up = cross(right, forward);
     let slits_size = ("width = 800\nheight = 600", "width = 48\nheight = 36");
     // (scene, size, handle, drag, the changed line's start, its number at `index`, from the
-    // dragged point p).
+    // dragged point p, the eye, the view direction, right and up).
     type Value = fn(V3, V3, V3, V3, V3) -> f64;
+    type Case<'a> = (
+        &'a str,
+        (&'a str, &'a str),
+        &'a str,
+        f64,
+        f64,
+        &'a str,
+        usize,
+        Value,
+    );
     let along: Value = |p, eye, forward, _, _| dot(sub(p, eye), forward);
-    let cases: [(&str, (&str, &str), &str, f64, f64, &str, usize, Value); 6] = [
+    let cases: [Case; 6] = [
         (
             occlusion,
             SMALL_PRESET,
