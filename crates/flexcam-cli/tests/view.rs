@@ -313,7 +313,7 @@ fn dragging_a_projector_grid_node_adds_its_entry() {
 fn a_handle_moved_the_wrong_way_or_missing_is_one_error_line() {
     let text = include_str!("../../../scenes/flexible-panorama-edit.toml");
     for (script, expected) in [
-        ("drag near.3.2 1 1\n", "view.txt:1:1: no handle `near.3.2` (this projection's handles: position, look_at, rect.corner.0"),
+        ("drag near.3.2 1 1\n", "view.txt:1:1: no handle `near.3.2` (this projection's handles: position, look_at, clip.near, clip.far, rect.corner.0"),
         // A corner dragged past the opposite one: the edit is refused, naming the scene.
         ("drag rect.corner.0 60 0\nframe f.png\n", "view.txt:1:1: scene.toml:"),
     ] {
@@ -325,4 +325,293 @@ fn a_handle_moved_the_wrong_way_or_missing_is_one_error_line() {
         assert!(stderr.starts_with(&format!("flexcam: {expected}")), "{script:?}: {stderr}");
         assert!(!dir.path().join("f.png").exists());
     }
+}
+
+/// Drags `handle` by (`dx`, `dy`) pixels in a copy of scene file `text` whose image size
+/// `from` is replaced by `to` (the ray caster's frame): checks that the script's frame is
+/// `flexcam render` of the saved scene and differs from the unedited render, and returns
+/// the handle's numbers of `--list-handles` and the one line the drag changed.
+fn drag_one(
+    text: &str,
+    (from, to): (&str, &str),
+    handle: &str,
+    dx: f64,
+    dy: f64,
+) -> (Vec<f64>, String) {
+    let script = format!("drag {handle} {dx} {dy}\nframe f.png\nsave s.toml\n");
+    let dir = setup_scene(text, from, to, &script);
+    let listed = listed(&dir, handle);
+    let line = run_and_changed_line(&dir);
+    frame_renders_the_saved_scene(&dir, &[]);
+    run_ok(&dir, &["render", "scene.toml", "-o", "original.png"]);
+    assert_ne!(read(&dir, "f.png"), read(&dir, "original.png"), "{handle}");
+    (listed, line)
+}
+
+type V3 = [f64; 3];
+
+fn sub(a: V3, b: V3) -> V3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn dot(a: V3, b: V3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn unit(a: V3) -> V3 {
+    let l = dot(a, a).sqrt();
+    [a[0] / l, a[1] / l, a[2] / l]
+}
+
+fn cross(a: V3, b: V3) -> V3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Where a script's drag by (`dx`, `dy`) puts a world handle listed as `listed` (point,
+/// step of a pixel right, step of a pixel down).
+fn dragged(listed: &[f64], dx: f64, dy: f64) -> V3 {
+    std::array::from_fn(|k| listed[k] + listed[3 + k] * dx + listed[6 + k] * dy)
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() < 1e-12
+}
+
+/// The eye, view direction and image right of the preset scenes (eye (0, 5.5, 7) looking
+/// at (0, 0.4, 0), up +y).
+fn preset_frame() -> (V3, V3, V3) {
+    let eye = [0.0, 5.5, 7.0];
+    let forward = unit(sub([0.0, 0.4, 0.0], eye));
+    (eye, forward, unit(cross(forward, [0.0, 1.0, 0.0])))
+}
+
+const SMALL_PRESET: (&str, &str) = ("width = 240\nheight = 180", "width = 48\nheight = 36");
+
+#[test]
+fn dragging_image_keys_of_presets() {
+    let magnifier = include_str!("../../../scenes/flexible-magnifier.toml");
+    let occlusion = include_str!("../../../scenes/flexible-occlusion.toml");
+    // 48 x 36: x moves u by dx / 48, y moves v by -dy / 36; the magnifier's radius is a
+    // fraction of the shorter side, 36.
+    for (text, handle, dx, dy, key, expected) in [
+        (magnifier, "center", 6.0, -9.0, "center =", vec![0.625, 0.8]),
+        (
+            magnifier,
+            "radius",
+            3.0,
+            0.0,
+            "radius =",
+            vec![0.3 + 3.0 / 36.0],
+        ),
+        (occlusion, "pole", -12.0, 4.5, "pole =", vec![0.25, 0.425]),
+    ] {
+        let (_, line) = drag_one(text, SMALL_PRESET, handle, dx, dy);
+        assert!(line.starts_with(key), "{handle}: {line}");
+        let numbers = numbers_in(line.split('#').next().unwrap());
+        assert_eq!(numbers.len(), expected.len(), "{line}");
+        assert!(
+            numbers.iter().zip(&expected).all(|(a, b)| close(*a, *b)),
+            "{line}"
+        );
+    }
+}
+
+#[test]
+fn dragging_distances_and_angles_of_presets() {
+    let occlusion = include_str!("../../../scenes/flexible-occlusion.toml");
+    let depth = include_str!("../../../scenes/flexible-depth-transition.toml");
+    let ortho_persp = include_str!("../../../scenes/flexible-ortho-near-persp-far.toml");
+    let slits = include_str!("../../../scenes/flexible-crossed-slits.toml");
+    let orthographic = ortho_persp
+        .replace(
+            "preset = \"ortho_near_persp_far\"",
+            "preset = \"orthographic\"",
+        )
+        .replace("fov = 50.0", "width = 8.0")
+        .replace("transition = 8.0 ", "# transition = 8.0 ")
+        .replace("style = \"piecewise\"", "");
+    let (eye, forward, right) = preset_frame();
+    let up = cross(right, forward);
+    let slits_size = ("width = 800\nheight = 600", "width = 48\nheight = 36");
+    // (scene, size, handle, drag, the changed line's start, its number at `index`, from the
+    // dragged point p, the eye, the view direction, right and up).
+    type Value = fn(V3, V3, V3, V3, V3) -> f64;
+    type Case<'a> = (
+        &'a str,
+        (&'a str, &'a str),
+        &'a str,
+        f64,
+        f64,
+        &'a str,
+        usize,
+        Value,
+    );
+    let along: Value = |p, eye, forward, _, _| dot(sub(p, eye), forward);
+    let cases: [Case; 6] = [
+        (
+            occlusion,
+            SMALL_PRESET,
+            "transition",
+            0.0,
+            -5.0,
+            "transition =",
+            0,
+            along,
+        ),
+        (
+            occlusion,
+            SMALL_PRESET,
+            "clip.far",
+            2.0,
+            8.0,
+            "clip =",
+            1,
+            along,
+        ),
+        (
+            depth,
+            SMALL_PRESET,
+            "transitions.0",
+            0.0,
+            6.0,
+            "transitions =",
+            0,
+            along,
+        ),
+        (
+            ortho_persp,
+            SMALL_PRESET,
+            "fov",
+            10.0,
+            0.0,
+            "fov =",
+            0,
+            |p, eye, forward, right, _| {
+                let v = sub(p, eye);
+                2.0 * dot(v, right).atan2(dot(v, forward)).to_degrees()
+            },
+        ),
+        (
+            slits,
+            slits_size,
+            "v_fov",
+            0.0,
+            -6.0,
+            "v_fov =",
+            0,
+            |p, eye, forward, _, up| {
+                let v = sub(p, eye);
+                2.0 * dot(v, up).atan2(dot(v, forward)).to_degrees()
+            },
+        ),
+        (
+            orthographic.as_str(),
+            SMALL_PRESET,
+            "width",
+            7.0,
+            0.0,
+            "width =",
+            0,
+            |p, eye, _, right, _| 2.0 * dot(sub(p, eye), right),
+        ),
+    ];
+    for (text, size, handle, dx, dy, key, index, value) in cases {
+        let (listed, line) = drag_one(text, size, handle, dx, dy);
+        assert!(line.starts_with(key), "{handle}: {line}");
+        let numbers = numbers_in(line.split('#').next().unwrap());
+        let p = dragged(&listed, dx, dy);
+        let expected = value(p, eye, forward, right, up);
+        assert!(
+            close(numbers[index], expected),
+            "{handle}: {line}, expected {expected}"
+        );
+    }
+}
+
+#[test]
+fn dragging_a_point_of_the_mcop_path() {
+    let text = include_str!("../../../scenes/flexible-mcop.toml");
+    let (listed, line) = drag_one(text, SMALL_PRESET, "path.1", 5.0, 5.0);
+    assert!(line.starts_with("path ="), "{line}");
+    let numbers = numbers_in(&line);
+    assert_eq!(numbers.len(), 9, "{line}");
+    assert_eq!(&numbers[..3], &[-7.0, 3.0, 0.0]);
+    assert_eq!(&numbers[6..], &[0.0, 3.0, 7.0]);
+    let p = dragged(&listed, 5.0, 5.0);
+    assert!((0..3).all(|k| close(numbers[3 + k], p[k])), "{line}: {p:?}");
+}
+
+/// The point at arc-length fraction `s` of the polyline through `points` (closed: back to
+/// the first), as the panorama's curves are parameterised.
+fn polyline_at(points: &[[f64; 2]], closed: bool, s: f64) -> [f64; 2] {
+    let mut pieces: Vec<_> = points.windows(2).map(|w| (w[0], w[1])).collect();
+    if closed {
+        pieces.push((points[points.len() - 1], points[0]));
+    }
+    let length = |(a, b): ([f64; 2], [f64; 2])| (b[0] - a[0]).hypot(b[1] - a[1]);
+    let total: f64 = pieces.iter().map(|&p| length(p)).sum();
+    let mut walked = 0.0;
+    for &(a, b) in &pieces {
+        let l = length((a, b));
+        if walked + l >= s * total {
+            let t = (s * total - walked) / l;
+            return [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+        }
+        walked += l;
+    }
+    unreachable!("s = {s} past the end")
+}
+
+#[test]
+fn dragging_outline_and_profile_points_over_the_image() {
+    let text = include_str!("../../../scenes/flexible-panorama-custom.toml").replace(
+        "{ at = 0.5, shape = \"segment\", elevation = [-50.0, 50.0] }",
+        "{ at = 0.5, points = [[1.0, -1.2], [1.0, 1.2]] }",
+    );
+    let size = ("width = 320\nheight = 160", "width = 64\nheight = 32");
+    let outline = [
+        [0.0, -1.0],
+        [-0.7, -0.7],
+        [-1.0, 0.0],
+        [-0.6, 0.8],
+        [0.6, 0.8],
+        [1.0, 0.0],
+        [0.7, -0.7],
+    ];
+    // Outline vertex 3 sits on the middle row at the column of its arc-length fraction;
+    // 4 pixels right, it turns to the direction of the outline's point there (length 1).
+    let (listed, line) = drag_one(&text, size, "outline.3", 4.0, 0.0);
+    assert_eq!(listed.len(), 2);
+    assert!(close(listed[1], 16.0), "{listed:?}");
+    let s3 = listed[0] / 64.0;
+    let at = polyline_at(&outline, true, s3);
+    assert!(close(at[0], -0.6) && close(at[1], 0.8), "{at:?}");
+    let toward = polyline_at(&outline, true, (listed[0] + 4.0) / 64.0);
+    let length = toward[0].hypot(toward[1]);
+    let numbers = numbers_in(&line);
+    assert!(line.starts_with("outline ="), "{line}");
+    assert_eq!(numbers.len(), 14, "{line}");
+    assert!(
+        close(numbers[6], toward[0] / length) && close(numbers[7], toward[1] / length),
+        "{line}: {toward:?}"
+    );
+    // Profile vertex 1 of the front profile: the top of column 1/2; 6 pixels down it turns
+    // to the profile's point at v = 1 - 6 / 32, keeping its length.
+    let (listed, line) = drag_one(&text, size, "profile.1.1", 0.0, 6.0);
+    assert!(
+        close(listed[0], 32.0) && close(listed[1], 0.0),
+        "{listed:?}"
+    );
+    let numbers = numbers_in(line.split('#').next().unwrap());
+    let toward = polyline_at(&[[1.0, -1.2], [1.0, 1.2]], false, 1.0 - 6.0 / 32.0);
+    let scale = 1.2f64.hypot(1.0) / toward[0].hypot(toward[1]);
+    assert_eq!(numbers.len(), 5, "{line}");
+    assert!(
+        close(numbers[3], toward[0] * scale) && close(numbers[4], toward[1] * scale),
+        "{line}: {toward:?}"
+    );
 }

@@ -15,15 +15,22 @@
 //! | `S.corner.K` | corner K of a `bilinear` surface | `corners[K]` |
 //! | `S.R.C` | control point of row R, column C of a `bezier` / `bspline` patch | `control[R][C]` |
 //! | `projector.C.R.start`, `projector.C.R.end` | node (column C, row R) of a projector grid | that node's `start` / `end` in `projectors.projector` (the entry is added when missing) |
-//! | `outline.K`, `profile.K` (`outline.I.K`, `profile.I.K` in `outlines[I]`, `profiles[I]`) | point K of a panorama's `points` outline (in the eye's horizontal plane) or profile (in the vertical half-plane ahead), at unit distance around the eye | that point; the drag moves it within its plane |
+//! | `fov`, `h_fov`, `v_fov` | the point at half the angle right of (`v_fov`: above) a preset's view axis, at the look-at distance | the angle: twice that of the dragged point |
+//! | `width` | half the width right of the look-at point (orthographic, oblique, pushbroom presets) | twice the dragged point's distance right of the axis |
+//! | `clip.near`, `clip.far`, `transition`, `transitions.K` | the point at that distance along the view axis | the dragged point's distance along the axis |
+//! | `path.K` | point K of an mcop camera path | that point |
+//! | `pole`, `center`, `radius` | over the image: the occlusion pole, the magnifier's centre and the point of its circle right of it | u right, v up (`radius`: by the shorter image side) |
+//! | `outline.K`, `profile.K` (`outline.I.K`, `profile.I.K` in `outlines[I]`, `profiles[I]`) | over the image: vertex K of a panorama's `points` outline (at the column of its arc-length fraction) or profile (at the row of its fraction) | that vertex: it turns about the eye, keeping its length, to the direction of the curve's point under the pointer |
 //! | `rect.corner.K` | corner K (0 bottom left, counter-clockwise) of `perspective_rect`, over the image | its two numbers |
 //! | `rect.center` | the rectangle's centre, over the image | all four numbers |
 //!
 //! Nodes of a grid with `fit` or `aim` are placed before the fit and the aims (the order the
 //! scene format runs them in), so a fit may move a dragged node again.
 
+use std::sync::Arc;
+
 use flexcam::calibrate::build_flexible;
-use flexcam::projection::flexible::{Volume, VolumeSource};
+use flexcam::projection::flexible::{PanoramaShape, Reparam, Volume, VolumeSource};
 use flexcam::projection::{CameraBasis, ProjectionSpec};
 use flexcam::scene::file::edit::float_array;
 use flexcam::{Error, Result};
@@ -138,16 +145,37 @@ enum Edit {
     Offset { path: ValuePath, base: DVec3 },
     /// The start (or end) of projector-grid node (`col`, `row`).
     Node { col: usize, row: usize, end: bool },
-    /// A 2-vector of a panorama curve: the point's camera-local components `axes` (0
-    /// right, 1 up, 2 forward) around the eye of `basis`, the rest 0.
-    Planar {
+    /// A vertex (a 2-vector) of a panorama's outline (`outline`) or profile: it turns
+    /// about the eye, keeping its length, to the direction of the curve's point (the
+    /// blended outline, or profile, of `shape`) under the pointer.
+    Curve {
         path: ValuePath,
-        basis: CameraBasis,
-        axes: (usize, usize),
+        shape: Arc<PanoramaShape>,
+        outline: bool,
     },
-    /// Numbers of `perspective_rect`: the u values at `u` move with x, the v values at `v`
-    /// with y (v up).
-    Rect { u: Vec<usize>, v: Vec<usize> },
+    /// A number, or numbers of an array, moved over the image: number i grows by f dx for
+    /// each (i, f) of `x`, by f dy for each of `y`.
+    Image {
+        path: ValuePath,
+        x: Vec<(usize, f64)>,
+        y: Vec<(usize, f64)>,
+    },
+    /// A number that is `factor` times the point's distance from `origin` along `axis`
+    /// (unit).
+    Along {
+        path: ValuePath,
+        origin: DVec3,
+        axis: DVec3,
+        factor: f64,
+    },
+    /// An angle in degrees: twice the point's angle from `forward` towards `axis` (unit,
+    /// perpendicular), seen from `origin`.
+    Angle {
+        path: ValuePath,
+        origin: DVec3,
+        axis: DVec3,
+        forward: DVec3,
+    },
 }
 
 /// The numbers of a numeric array value.
@@ -164,7 +192,7 @@ fn vector(value: &Value) -> Option<DVec3> {
 }
 
 /// Every handle of `session`'s projection, in a fixed order: camera frame, surfaces,
-/// projector grid, perspective rectangle.
+/// projector grid, preset keys, panorama vertices, perspective rectangle.
 pub fn handles(session: &Session) -> Vec<Handle> {
     let mut out = Vec::new();
     for key in ["position", "look_at"] {
@@ -191,64 +219,263 @@ pub fn handles(session: &Session) -> Vec<Handle> {
         }
     }
     grid_nodes(session, &mut out);
+    preset_keys(session, &mut out);
     panorama_points(session, &mut out);
     rect(session, &mut out);
     out
 }
 
-/// The points of a shape-defined panorama's `points` outlines and profiles, at unit
-/// distance around the eye: an outline's (right, forward) point in the horizontal plane of
-/// the eye, a profile's (distance, height) point in the vertical half-plane ahead.
+/// The vertices of a shape-defined panorama's `points` outlines and profiles, over the
+/// image where the panorama shows them: outline vertex K at the column of its arc-length
+/// fraction (through the window of a panorama of less than a full turn) and the row of its
+/// outline's `at` (the middle row for the single `outline`); profile vertex K at the row of
+/// its fraction and the column of its profile's `at` (the middle column for the single
+/// `profile`). None under a re-parameterisation other than the linear one.
 fn panorama_points(session: &Session, out: &mut Vec<Handle>) {
-    let Some(basis) = session
-        .camera()
-        .ok()
-        .and_then(|f| CameraBasis::new(&f).ok())
-    else {
+    let ProjectionSpec::Flexible(spec) = session.spec() else {
         return;
     };
-    for (single, list, axes) in [
-        ("outline", "outlines", (0, 2)),
-        ("profile", "profiles", (2, 1)),
+    let VolumeSource::Panorama(panorama) = &spec.source else {
+        return;
+    };
+    if !matches!(spec.reparam, None | Some(Reparam::Linear)) {
+        return;
+    }
+    let shape = &panorama.shape;
+    let (width, height) = session.size();
+    for (single, list, outline) in [
+        ("outline", "outlines", true),
+        ("profile", "profiles", false),
     ] {
-        let mut curves = vec![(single.to_string(), ValuePath::key(single).child("points"))];
+        let attached = if outline {
+            shape.outlines()
+        } else {
+            shape.profiles()
+        };
+        let mut curves = vec![(single.to_string(), ValuePath::key(single), 0.5)];
         let count = session
             .value(list)
             .and_then(Value::as_array)
             .map_or(0, |a| a.len());
-        for i in 0..count {
-            let path = ValuePath::key(list).index(i).child("points");
-            curves.push((format!("{single}.{i}"), path));
+        for (i, curve) in attached.iter().enumerate().take(count) {
+            let path = ValuePath::key(list).index(i);
+            curves.push((format!("{single}.{i}"), path, curve.at));
         }
-        for (name, path) in curves {
-            let count = path
-                .get(session)
-                .and_then(Value::as_array)
-                .map_or(0, |a| a.len());
-            for k in 0..count {
-                let point = path.index(k);
-                let Some([a, b]) = point
-                    .get(session)
-                    .and_then(numbers)
-                    .and_then(|n| <[f64; 2]>::try_from(n).ok())
-                else {
-                    continue;
+        for (name, curve, at) in curves {
+            let path = curve.child("points");
+            let Some(points) = path.get(session).and_then(Value::as_array) else {
+                continue;
+            };
+            let Some(points) = points
+                .iter()
+                .map(|p| numbers(p).and_then(|n| <[f64; 2]>::try_from(n).ok()))
+                .collect::<Option<Vec<_>>>()
+            else {
+                continue;
+            };
+            for (k, s) in vertex_fractions(&points, outline).into_iter().enumerate() {
+                let uv = if outline {
+                    DVec2::new(shape.column(s), at)
+                } else {
+                    DVec2::new(at, s)
                 };
-                let mut local = DVec3::ZERO;
-                local[axes.0] = a;
-                local[axes.1] = b;
                 out.push(Handle {
                     name: format!("{name}.{k}"),
-                    place: Place::World(basis.origin + basis.to_world(local)),
-                    net: Some((name.clone(), 0, k)),
-                    edit: Edit::Planar {
-                        path: point,
-                        basis,
-                        axes,
+                    place: Place::Image(image_pixel(uv, width, height)),
+                    net: None,
+                    edit: Edit::Curve {
+                        path: path.index(k),
+                        shape: Arc::clone(shape),
+                        outline,
                     },
                 });
             }
         }
+    }
+}
+
+/// The arc-length fraction of each of `points` along their polyline (closed: back to the
+/// first point), as the panorama's curves are parameterised; none for a polyline of zero
+/// length (which does not build).
+fn vertex_fractions(points: &[[f64; 2]], closed: bool) -> Vec<f64> {
+    let point = |p: &[f64; 2]| DVec2::from_array(*p);
+    let mut walked = vec![0.0];
+    for w in points.windows(2) {
+        walked.push(walked[walked.len() - 1] + (point(&w[1]) - point(&w[0])).length());
+    }
+    let mut total = walked[walked.len() - 1];
+    if let (true, Some(first), Some(last)) = (closed, points.first(), points.last()) {
+        total += (point(first) - point(last)).length();
+    }
+    if !(total > 0.0 && total.is_finite()) {
+        return Vec::new();
+    }
+    walked.into_iter().map(|w| w / total).collect()
+}
+
+/// The pixel position (x right, y down) of image parameters `uv` (v up).
+fn image_pixel(uv: DVec2, width: u32, height: u32) -> DVec2 {
+    DVec2::new(uv.x * f64::from(width), (1.0 - uv.y) * f64::from(height))
+}
+
+/// The handles of a flexible projection's own keys, where the scene file sets them (names
+/// as the keys): angles (`fov`, `h_fov`: the point at half the angle right of the view
+/// axis; `v_fov`: above it; at the look-at distance from the eye), the `width` of the
+/// orthographic, oblique and pushbroom presets (half of it right of the look-at point),
+/// distances along the view axis (`clip.near`, `clip.far`, also of shape-defined
+/// panoramas; `transition`, `transitions.K`), the mcop camera path's points (`path.K`, the
+/// only handles of an mcop besides the frame's), and over the image the occlusion `pole`, the magnifier's `center` and `radius` (the point
+/// of its circle right of the centre).
+fn preset_keys(session: &Session, out: &mut Vec<Handle>) {
+    let ProjectionSpec::Flexible(spec) = session.spec() else {
+        return;
+    };
+    let preset = match &spec.source {
+        VolumeSource::Preset(_) => session.value("preset").and_then(Value::as_str),
+        VolumeSource::Panorama(_) => None,
+        _ => return,
+    };
+    let number = |key: &str| {
+        let value = session.value(key)?;
+        value
+            .as_float()
+            .or_else(|| value.as_integer().map(|i| i as f64))
+    };
+    let (width, height) = session.size();
+    let (w, h) = (f64::from(width), f64::from(height));
+    if preset.is_some() {
+        let count = session
+            .value("path")
+            .and_then(Value::as_array)
+            .map_or(0, |a| a.len());
+        for k in 0..count {
+            let p = ValuePath::key("path").index(k);
+            let at = p.get(session).and_then(vector);
+            out.extend(world(format!("path.{k}"), at, Edit::Point(p)));
+        }
+        for key in ["pole", "center"] {
+            let Some([u, v]) = session
+                .value(key)
+                .and_then(numbers)
+                .and_then(|n| <[f64; 2]>::try_from(n).ok())
+            else {
+                continue;
+            };
+            let at = image_pixel(DVec2::new(u, v), width, height);
+            out.push(Handle {
+                name: key.into(),
+                place: Place::Image(at),
+                net: None,
+                edit: Edit::Image {
+                    path: ValuePath::key(key),
+                    x: vec![(0, 1.0 / w)],
+                    y: vec![(1, -1.0 / h)],
+                },
+            });
+            if let (Some(radius), "center") = (number("radius"), key) {
+                // The radius is a fraction of the shorter image side.
+                let side = w.min(h);
+                out.push(Handle {
+                    name: "radius".into(),
+                    place: Place::Image(at + DVec2::X * radius * side),
+                    net: None,
+                    edit: Edit::Image {
+                        path: ValuePath::key("radius"),
+                        x: vec![(0, 1.0 / side)],
+                        y: Vec::new(),
+                    },
+                });
+            }
+        }
+    }
+    // The mcop columns look along their own directions from the path, the axonometric and
+    // general linear cameras along their own keys', not along the frame's view axis.
+    if matches!(preset, Some("mcop" | "axonometric" | "glc")) {
+        return;
+    }
+    let Ok(frame) = session.camera() else {
+        return;
+    };
+    let Ok(basis) = CameraBasis::new(&frame) else {
+        return;
+    };
+    let origin = basis.origin;
+    let distance = (frame.look_at - frame.position).length();
+    let along = |name: &str, path: ValuePath, at: DVec3, axis: DVec3, factor: f64| Handle {
+        name: name.into(),
+        place: Place::World(at),
+        net: None,
+        edit: Edit::Along {
+            path,
+            origin,
+            axis,
+            factor,
+        },
+    };
+    let forward = basis.forward;
+    if let Some(clip) = session.value("clip").and_then(numbers) {
+        for (i, (end, d)) in ["near", "far"].into_iter().zip(clip).enumerate() {
+            let path = ValuePath::key("clip").index(i);
+            out.push(along(
+                &format!("clip.{end}"),
+                path,
+                origin + forward * d,
+                forward,
+                1.0,
+            ));
+        }
+    }
+    let Some(preset) = preset else {
+        return;
+    };
+    if let Some(t) = number("transition") {
+        let path = ValuePath::key("transition");
+        out.push(along(
+            "transition",
+            path,
+            origin + forward * t,
+            forward,
+            1.0,
+        ));
+    }
+    if let Some(list) = session.value("transitions").and_then(numbers) {
+        for (k, t) in list.into_iter().enumerate() {
+            let path = ValuePath::key("transitions").index(k);
+            let name = format!("transitions.{k}");
+            out.push(along(&name, path, origin + forward * t, forward, 1.0));
+        }
+    }
+    if let (Some(extent), "orthographic" | "oblique" | "pushbroom") = (number("width"), preset) {
+        // From the eye along `right` is as far as from the look-at point: factor 2.
+        let at = origin + forward * distance + basis.right * extent / 2.0;
+        out.push(along(
+            "width",
+            ValuePath::key("width"),
+            at,
+            basis.right,
+            2.0,
+        ));
+    }
+    for (key, axis) in [
+        ("fov", basis.right),
+        ("h_fov", basis.right),
+        ("v_fov", basis.up),
+    ] {
+        let Some(angle) = number(key) else {
+            continue;
+        };
+        let (sin, cos) = (angle.to_radians() / 2.0).sin_cos();
+        out.push(Handle {
+            name: key.into(),
+            place: Place::World(origin + distance * (axis * sin + forward * cos)),
+            net: None,
+            edit: Edit::Angle {
+                path: ValuePath::key(key),
+                origin,
+                axis,
+                forward,
+            },
+        });
     }
 }
 
@@ -362,32 +589,31 @@ fn rect(session: &Session, out: &mut Vec<Handle>) {
     let Some(r) = session.value("perspective_rect").and_then(numbers) else {
         return;
     };
-    let Ok([u0, v0, u1, v1]) = <[f64; 4]>::try_from(r) else {
+    let Ok(r) = <[f64; 4]>::try_from(r) else {
         return;
     };
     let (width, height) = session.size();
-    let pixel = |u: f64, v: f64| DVec2::new(u * f64::from(width), (1.0 - v) * f64::from(height));
+    let (du, dv) = (1.0 / f64::from(width), -1.0 / f64::from(height));
+    let edit = |u: &[usize], v: &[usize]| Edit::Image {
+        path: ValuePath::key("perspective_rect"),
+        x: u.iter().map(|&i| (i, du)).collect(),
+        y: v.iter().map(|&i| (i, dv)).collect(),
+    };
     let corners = [(0, 1), (2, 1), (2, 3), (0, 3)];
     for (k, (u, v)) in corners.into_iter().enumerate() {
-        let at = pixel([u0, v0, u1, v1][u], [u0, v0, u1, v1][v]);
         out.push(Handle {
             name: format!("rect.corner.{k}"),
-            place: Place::Image(at),
+            place: Place::Image(image_pixel(DVec2::new(r[u], r[v]), width, height)),
             net: None,
-            edit: Edit::Rect {
-                u: vec![u],
-                v: vec![v],
-            },
+            edit: edit(&[u], &[v]),
         });
     }
+    let centre = DVec2::new((r[0] + r[2]) / 2.0, (r[1] + r[3]) / 2.0);
     out.push(Handle {
         name: "rect.center".into(),
-        place: Place::Image(pixel((u0 + u1) / 2.0, (v0 + v1) / 2.0)),
+        place: Place::Image(image_pixel(centre, width, height)),
         net: None,
-        edit: Edit::Rect {
-            u: vec![0, 2],
-            v: vec![1, 3],
-        },
+        edit: edit(&[0, 2], &[1, 3]),
     });
 }
 
@@ -415,28 +641,89 @@ impl Handle {
                 let offset = at + d - *base;
                 Ok(vec![path.set(session, float_array(&offset.to_array()))?])
             }
-            (Edit::Planar { path, basis, axes }, Place::World(at), Place::World(d)) => {
-                // The drag's component out of the curve's plane is dropped.
-                let local = basis.to_local(at + d - basis.origin);
-                Ok(vec![path.set(
-                    session,
-                    float_array(&[local[axes.0], local[axes.1]]),
-                )?])
-            }
             (&Edit::Node { col, row, end }, Place::World(at), Place::World(d)) => {
                 Ok(vec![node_edit(session, col, row, end, at + d)])
             }
-            (Edit::Rect { u, v }, Place::Image(_), Place::Image(d)) => {
-                let path = ValuePath::key("perspective_rect");
-                let mut r = path.get(session).and_then(numbers).ok_or_else(wrong)?;
+            (
+                Edit::Curve {
+                    path,
+                    shape,
+                    outline,
+                },
+                Place::Image(at),
+                Place::Image(d),
+            ) => {
                 let (width, height) = session.size();
-                for &i in u {
-                    r[i] += d.x / f64::from(width);
+                let pointer = at + d;
+                let uv = DVec2::new(
+                    pointer.x / f64::from(width),
+                    1.0 - pointer.y / f64::from(height),
+                );
+                let toward = if *outline {
+                    shape.outline(uv)
+                } else {
+                    shape.profile(uv)
+                };
+                let old = path.get(session).and_then(numbers).ok_or_else(wrong)?;
+                let length = DVec2::new(old[0], old[1]).length();
+                // Degenerate: the curve passes through the eye under the pointer.
+                let direction = toward.try_normalize().ok_or_else(|| {
+                    Error::new(format!(
+                        "handle `{}`: the {} under the pointer is at the eye (no direction)",
+                        self.name,
+                        if *outline { "outline" } else { "profile" }
+                    ))
+                })?;
+                let moved = direction * length;
+                Ok(vec![path.set(session, float_array(&moved.to_array()))?])
+            }
+            (Edit::Image { path, x, y }, Place::Image(_), Place::Image(d)) => {
+                let value = path.get(session).ok_or_else(wrong)?;
+                let scalar = value
+                    .as_float()
+                    .or_else(|| value.as_integer().map(|i| i as f64));
+                let mut n = scalar
+                    .map(|n| vec![n])
+                    .or_else(|| numbers(value))
+                    .ok_or_else(wrong)?;
+                for &(i, f) in x {
+                    n[i] += f * d.x;
                 }
-                for &i in v {
-                    r[i] -= d.y / f64::from(height);
+                for &(i, f) in y {
+                    n[i] += f * d.y;
                 }
-                Ok(vec![path.set(session, float_array(&r))?])
+                let new = match scalar {
+                    Some(_) => Value::from(n[0]),
+                    None => float_array(&n),
+                };
+                Ok(vec![path.set(session, new)?])
+            }
+            (
+                Edit::Along {
+                    path,
+                    origin,
+                    axis,
+                    factor,
+                },
+                Place::World(at),
+                Place::World(d),
+            ) => {
+                let value = factor * (at + d - *origin).dot(*axis);
+                Ok(vec![path.set(session, Value::from(value))?])
+            }
+            (
+                Edit::Angle {
+                    path,
+                    origin,
+                    axis,
+                    forward,
+                },
+                Place::World(at),
+                Place::World(d),
+            ) => {
+                let v = at + d - *origin;
+                let angle = 2.0 * v.dot(*axis).atan2(v.dot(*forward)).to_degrees();
+                Ok(vec![path.set(session, Value::from(angle))?])
             }
             _ => Err(wrong()),
         }
@@ -603,6 +890,8 @@ mod tests {
             [
                 "position",
                 "look_at",
+                "clip.near",
+                "clip.far",
                 "rect.corner.0",
                 "rect.corner.1",
                 "rect.corner.2",
@@ -632,10 +921,12 @@ mod tests {
     }
 
     #[test]
-    fn outline_points_move_in_the_eye_s_horizontal_plane() {
+    fn outline_and_profile_vertices_sit_where_the_panorama_shows_them_and_turn_to_the_pointer() {
+        // A diamond outline from behind the eye (fractions 0, 1/4, 1/2, 3/4: each side is as
+        // long), and a second profile of two points in the front column.
         let (_dir, session) = session(
             "type = \"flexible\"\nposition = [0.0, 1.5, 0.0]\nlook_at = [0.0, 1.5, -1.0]\n\
-             outline = { points = [[0.0, -1.0], [-1.0, 0.0], [-0.6, 0.8], [0.6, 0.8], [1.0, 0.0]] }\n\
+             outline = { points = [[0.0, -1.0], [-1.0, 0.0], [0.0, 1.0], [1.0, 0.0]] }\n\
              profiles = [{ at = 0.0, shape = \"arc\" }, { at = 0.5, points = [[1.0, -1.0], [1.0, 1.0]] }]",
         );
         let list = handles(&session);
@@ -648,28 +939,151 @@ mod tests {
                 "outline.1",
                 "outline.2",
                 "outline.3",
-                "outline.4",
                 "profile.1.0",
                 "profile.1.1"
             ]
         );
-        // (right, forward) = (-0.6, 0.8): right is +x, forward -z.
-        let point = find(&list, "outline.2");
-        assert_eq!(point.place, Place::World(DVec3::new(-0.6, 1.5, -0.8)));
-        // A profile point (distance, height) lies ahead: (1, -1) is 1 forward, 1 down.
+        // 40 x 30: the single outline on the middle row, vertex K at column K / 4.
+        for (k, x) in [0.0, 10.0, 20.0, 30.0].into_iter().enumerate() {
+            let at = find(&list, &format!("outline.{k}")).place;
+            assert_eq!(at, Place::Image(DVec2::new(x, 15.0)), "outline.{k}");
+        }
+        // The profile at u = 1/2: its vertices at the bottom (v = 0) and top rows.
         assert_eq!(
             find(&list, "profile.1.0").place,
-            Place::World(DVec3::new(0.0, 0.5, -1.0))
+            Place::Image(DVec2::new(20.0, 30.0))
         );
-        // The drag's vertical part is dropped: the point stays in the horizontal plane.
-        let edits = point
-            .edits(&session, Place::World(DVec3::new(0.1, 0.3, -0.2)))
+        assert_eq!(
+            find(&list, "profile.1.1").place,
+            Place::Image(DVec2::new(20.0, 0.0))
+        );
+        // Outline vertex 1 dragged 5 pixels right: column 3/8, the diamond's point halfway
+        // from (-1, 0) to (0, 1); the vertex turns to its direction, keeping its length 1
+        // (the vertical part of the drag does not matter).
+        let edits = find(&list, "outline.1")
+            .edits(&session, Place::Image(DVec2::new(5.0, 4.0)))
             .unwrap();
         assert_eq!(edits[0].0, "outline.points");
-        let moved = numbers(edits[0].1.as_array().unwrap().get(2).unwrap()).unwrap();
+        let moved = numbers(edits[0].1.as_array().unwrap().get(1).unwrap()).unwrap();
+        let half = std::f64::consts::FRAC_1_SQRT_2;
         assert!(
-            (moved[0] + 0.5).abs() < 1e-15 && (moved[1] - 1.0).abs() < 1e-15,
+            (moved[0] + half).abs() < 1e-15 && (moved[1] - half).abs() < 1e-15,
             "{moved:?}"
         );
+        // Profile vertex 0 of the second profile dragged up to the middle row: that
+        // profile's point there is (1, 0); the vertex keeps its length sqrt 2.
+        let edits = find(&list, "profile.1.0")
+            .edits(&session, Place::Image(DVec2::new(0.0, -15.0)))
+            .unwrap();
+        assert_eq!(edits[0].0, "profiles");
+        let profile = edits[0].1.as_array().unwrap().get(1).unwrap();
+        let points = profile.as_inline_table().unwrap().get("points").unwrap();
+        let moved = numbers(points.as_array().unwrap().get(0).unwrap()).unwrap();
+        assert!(
+            (moved[0] - 2f64.sqrt()).abs() < 1e-15 && moved[1].abs() < 1e-15,
+            "{moved:?}"
+        );
+        // World moves are refused.
+        let world = Place::World(DVec3::X);
+        assert!(find(&list, "outline.0").edits(&session, world).is_err());
+    }
+
+    #[test]
+    fn vertex_fractions_follow_arc_length_and_a_zero_length_curve_has_none() {
+        let square = [[1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [0.0, 0.0]];
+        assert_eq!(vertex_fractions(&square, true), [0.0, 0.25, 0.5, 0.75]);
+        assert_eq!(
+            vertex_fractions(&square, false),
+            [0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0]
+        );
+        // Repeated points share a fraction; all in one point: no fractions.
+        let repeated = [[1.0, 0.0], [1.0, 0.0], [1.0, 2.0]];
+        assert_eq!(vertex_fractions(&repeated, false), [0.0, 0.0, 1.0]);
+        assert!(vertex_fractions(&[[1.0, 1.0], [1.0, 1.0]], true).is_empty());
+    }
+
+    #[test]
+    fn preset_angles_and_distances_move_with_their_points() {
+        let (_dir, session) = session(
+            "type = \"flexible\"\npreset = \"ortho_near_persp_far\"\n\
+             position = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\n\
+             fov = 60.0\ntransition = 2.0\nstyle = \"piecewise\"\nclip = [0.5, 10.0]",
+        );
+        let list = handles(&session);
+        assert_eq!(
+            names(&list),
+            [
+                "position",
+                "look_at",
+                "clip.near",
+                "clip.far",
+                "transition",
+                "fov"
+            ]
+        );
+        let at = |name: &str| match find(&list, name).place {
+            Place::World(p) => p,
+            Place::Image(_) => panic!("{name} is over the image"),
+        };
+        // Distances along the view axis (-z) from the eye at z = 3.
+        assert_eq!(at("clip.near"), DVec3::new(0.0, 0.0, 2.5));
+        assert_eq!(at("clip.far"), DVec3::new(0.0, 0.0, -7.0));
+        assert_eq!(at("transition"), DVec3::new(0.0, 0.0, 1.0));
+        // A drag's part across the axis is dropped: 1 further along it.
+        let edits = find(&list, "clip.far")
+            .edits(&session, Place::World(DVec3::new(0.3, 0.2, -1.0)))
+            .unwrap();
+        assert_eq!(edits[0].0, "clip");
+        assert_eq!(numbers(&edits[0].1), Some(vec![0.5, 11.0]));
+        // The fov point: 30 degrees right of the axis at the look-at distance 3.
+        let fov = at("fov");
+        let expected = DVec3::new(3.0 * 0.5, 0.0, 3.0 - 3.0 * 3f64.sqrt() / 2.0);
+        assert!((fov - expected).length() < 1e-15, "{fov}");
+        // Moved to 40 degrees right of the axis (at another distance): fov 80.
+        let target = DVec3::new(0.0, 0.0, 3.0)
+            + 2.0 * DVec3::new(40f64.to_radians().sin(), 0.0, -40f64.to_radians().cos());
+        let edits = find(&list, "fov")
+            .edits(&session, Place::World(target - fov))
+            .unwrap();
+        assert_eq!(edits[0].0, "fov");
+        let angle = edits[0].1.as_float().unwrap();
+        assert!((angle - 80.0).abs() < 1e-12, "{angle}");
+    }
+
+    #[test]
+    fn image_keys_of_presets_move_by_image_fractions() {
+        let (_dir, session) = session(
+            "type = \"flexible\"\npreset = \"magnifier\"\n\
+             position = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\n\
+             fov = 60.0\ncenter = [0.5, 0.5]\nradius = 0.2\nmagnification = 2.0",
+        );
+        let list = handles(&session);
+        assert_eq!(
+            names(&list),
+            ["position", "look_at", "center", "radius", "fov"]
+        );
+        // 40 x 30: the centre at (20, 15), the radius 0.2 of the shorter side (30) right.
+        assert_eq!(
+            find(&list, "center").place,
+            Place::Image(DVec2::new(20.0, 15.0))
+        );
+        assert_eq!(
+            find(&list, "radius").place,
+            Place::Image(DVec2::new(26.0, 15.0))
+        );
+        let edits = find(&list, "center")
+            .edits(&session, Place::Image(DVec2::new(4.0, -3.0)))
+            .unwrap();
+        let moved = numbers(&edits[0].1).unwrap();
+        assert!(
+            (moved[0] - 0.6).abs() < 1e-15 && (moved[1] - 0.6).abs() < 1e-15,
+            "{moved:?}"
+        );
+        let edits = find(&list, "radius")
+            .edits(&session, Place::Image(DVec2::new(3.0, 5.0)))
+            .unwrap();
+        assert_eq!(edits[0].0, "radius");
+        let radius = edits[0].1.as_float().unwrap();
+        assert!((radius - 0.3).abs() < 1e-15, "{radius}");
     }
 }

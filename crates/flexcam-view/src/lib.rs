@@ -1,11 +1,12 @@
 //! `flexcam view`: an interactive viewer in which a projection is designed live.
 //!
 //! Layers, each over the one below: [`camera`] (orbit, pan, dolly of a camera frame);
-//! [`session`] (a scene file, its prepared scene and the projection edited as the file's
-//! text); [`render_loop`] (a background thread rendering each state fast, then refining
-//! it); [`viewer`] (a session and its render loop, every action a person or a script takes);
-//! [`script`] (the `--script` language); and the window (eframe / egui), a thin layer over
-//! the viewer. Everything but the window runs without a display.
+//! [`session`] (a scene file, model or built-in scene, its prepared scene and the
+//! projection edited as the scene's text); [`render_loop`] (a background thread rendering
+//! each state fast, then refining it); [`viewer`] (a session and its render loop, every
+//! action a person or a script takes); [`script`] (the `--script` language); and the window
+//! (eframe / egui), a thin layer over the viewer. Everything but the window runs without a
+//! display.
 
 pub mod bench;
 pub mod camera;
@@ -28,7 +29,7 @@ pub use viewer::Viewer;
 /// What `flexcam view` was asked to do.
 #[derive(Debug, Clone)]
 pub struct Options {
-    /// The scene file.
+    /// What to view: a scene file, a model file (in its default scene) or `builtin:NAME`.
     pub scene: PathBuf,
     /// A script to run instead of waiting for a person (see [`script`]).
     pub script: Option<PathBuf>,

@@ -1,8 +1,10 @@
-//! A viewing session: a scene file, its prepared scene (built once, again only on a hot
-//! reload) and the projection being edited.
+//! A viewing session: a scene file (or a model file in its default scene, or a built-in
+//! scene), its prepared scene (built once, again only on a hot reload) and the projection
+//! being edited.
 //!
-//! The edited projection lives as the scene file's text, a toml_edit document (comments and
-//! layout kept). Every edit is applied to a copy of the document, whose `[image]` and
+//! The edited projection lives as the scene's text (the file's, the model's default
+//! scene's as `flexcam render MODEL` makes it, the built-in scene's), a toml_edit document
+//! (comments and layout kept). Every edit is applied to a copy of the document, whose `[image]` and
 //! `[projection]` are read again ([`scene::file::parse_projection`]) and built at the image
 //! size; only an edit that builds replaces the session's projection, so the last valid
 //! projection stays in place when an edit is refused. Since the projection is always what
@@ -21,23 +23,44 @@ use flexcam::render::PreparedScene;
 use flexcam::scene::file::edit::{
     float_array, parse_document, projection_value, set_projection_value,
 };
-use flexcam::scene::{self, Overrides};
+use flexcam::scene::{self, Overrides, Scene};
 use flexcam::{Error, Result};
 use glam::{DVec2, DVec3};
-use toml_edit::{DocumentMut, Value};
+use toml_edit::{DocumentMut, Item, Value};
 
 use flexcam::projection::CameraFrame;
 
-/// A scene file open for viewing and editing its projection.
+/// What a session views: the source its text came from, which decides where saving may
+/// write.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Origin {
+    /// A scene file: saving may write back into it.
+    SceneFile,
+    /// A model file (.obj, .gltf, .glb, .ply) in the default scene flexcam makes for it
+    /// (`flexcam render MODEL` draws the same): saving writes a new scene file naming the
+    /// model, never the model.
+    Model,
+    /// A built-in scene (`builtin:NAME`): saving writes a new scene file.
+    Builtin,
+}
+
+/// A scene open for viewing and editing its projection: a scene file, a model file in its
+/// default scene, or a built-in scene.
 pub struct Session {
+    /// The source as given: the scene file, the model file, or `builtin:NAME`.
     path: PathBuf,
+    origin: Origin,
+    /// The name the text is parsed under (errors name it; relative paths resolve from its
+    /// folder): the scene file, `MODEL (default scene)` beside the model, `builtin:NAME`.
+    text_path: PathBuf,
     document: DocumentMut,
     prepared: Arc<PreparedScene>,
     spec: ProjectionSpec,
     projection: Arc<dyn Projection>,
     width: u32,
     height: u32,
-    /// The scene file's modification time when it was read (hot reload compares it).
+    /// The source file's modification time when it was read (hot reload compares it; none
+    /// for a built-in scene).
     modified: Option<SystemTime>,
     /// Counts the changes of the projection or the scene: the render loop's job number.
     generation: u64,
@@ -52,39 +75,69 @@ pub struct Pick {
 }
 
 impl Session {
-    /// Opens the scene file at `path`: loads and prepares the scene, builds its projection.
-    /// A model file is refused: the session edits a scene file's text.
+    /// Opens `path`: a scene file, a model file (by its extension, in the default scene
+    /// `flexcam render` makes for it) or `builtin:NAME`. Loads and prepares the scene and
+    /// builds its projection.
     pub fn open(path: &Path) -> Result<Session> {
-        if scene::model_scene::is_model_file(path) {
-            return Err(Error::in_file(
-                path,
-                "the viewer opens scene files (.toml): render a model with `flexcam render`, \
-                 or view a scene that names it (shape = \"mesh\", file = ...)",
-            ));
-        }
         let source = path.to_str().ok_or_else(|| {
-            Error::in_file(
-                path,
-                "the viewer needs a scene file path that is valid UTF-8",
-            )
+            Error::in_file(path, "the viewer needs a scene path that is valid UTF-8")
         })?;
         let modified = modified_time(path);
-        let text = read_regular_text(path, "scene file", MAX_SCENE_FILE_BYTES)?;
-        let document = parse_document(&text, path)?;
-        let loaded = scene::load_with(source, &Overrides::default())?;
-        let spec = loaded.scene.projection.clone();
-        let prepared = Arc::new(PreparedScene::new(&loaded.scene));
+        let origin = if source.starts_with("builtin:") {
+            Origin::Builtin
+        } else if scene::model_scene::is_model_file(path) {
+            Origin::Model
+        } else {
+            Origin::SceneFile
+        };
+        let loaded = |source| -> Result<Loaded> {
+            let loaded = scene::load_with(source, &Overrides::default())?;
+            Ok((loaded.scene, loaded.projection, loaded.width, loaded.height))
+        };
+        let (text_path, text, (scene, projection, width, height)) = match origin {
+            Origin::Builtin => {
+                let text = scene::builtin::text(&source["builtin:".len()..])?;
+                (path.to_path_buf(), text.to_string(), loaded(source)?)
+            }
+            // The model is read once: its scene and the scene's text together.
+            Origin::Model => {
+                let request = scene::ModelRequest::default();
+                let (text, scene, _) = scene::model_scene::load_with_text(path, &[], &request)?;
+                let text_path = scene::model_scene::text_path(path);
+                (text_path, text, loaded_model(path, scene)?)
+            }
+            Origin::SceneFile => {
+                let text = read_regular_text(path, "scene file", MAX_SCENE_FILE_BYTES)?;
+                (path.to_path_buf(), text, loaded(source)?)
+            }
+        };
+        let document = parse_document(&text, &text_path)?;
+        let spec = scene.projection.clone();
+        let prepared = Arc::new(PreparedScene::new(&scene));
         Ok(Session {
             path: path.to_path_buf(),
+            origin,
+            text_path,
             document,
             prepared,
             spec,
-            projection: Arc::from(loaded.projection),
-            width: loaded.width,
-            height: loaded.height,
+            projection: Arc::from(projection),
+            width,
+            height,
             modified,
             generation: 1,
         })
+    }
+
+    /// What the session views.
+    pub fn origin(&self) -> Origin {
+        self.origin
+    }
+
+    /// The scene file saving writes back into: `None` for a model or a built-in scene (they
+    /// are saved as a new scene file).
+    pub fn scene_file(&self) -> Option<&Path> {
+        (self.origin == Origin::SceneFile).then_some(self.path.as_path())
     }
 
     pub fn path(&self) -> &Path {
@@ -134,7 +187,7 @@ impl Session {
     /// returns why and keeps the projection as it was.
     pub fn set(&mut self, key: &str, value: Value) -> Result<()> {
         let mut document = self.document.clone();
-        set_projection_value(&mut document, key, value, &self.path)?;
+        set_projection_value(&mut document, key, value, &self.text_path)?;
         self.apply(document)
     }
 
@@ -142,7 +195,7 @@ impl Session {
     pub fn set_all<K: AsRef<str>>(&mut self, values: &[(K, Value)]) -> Result<()> {
         let mut document = self.document.clone();
         for (key, value) in values {
-            set_projection_value(&mut document, key.as_ref(), value.clone(), &self.path)?;
+            set_projection_value(&mut document, key.as_ref(), value.clone(), &self.text_path)?;
         }
         self.apply(document)
     }
@@ -150,15 +203,15 @@ impl Session {
     /// Reads the projection of `document` and builds it; on success it becomes the session's.
     fn apply(&mut self, document: DocumentMut) -> Result<()> {
         let text = document.to_string();
-        let (image, spec) = scene::file::parse_projection(&text, &self.path)?;
+        let (image, spec) = scene::file::parse_projection(&text, &self.text_path)?;
         if (image.width, image.height) != (self.width, self.height) {
             return Err(Error::in_file(
-                &self.path,
+                &self.text_path,
                 "the image size changed: reload the scene to change it",
             ));
         }
         let (projection, _) = flexcam::calibrate::build(&spec, self.width, self.height)
-            .map_err(|e| e.or_in_file(&self.path))?;
+            .map_err(|e| e.or_in_file(&self.text_path))?;
         self.document = document;
         self.spec = spec;
         self.projection = Arc::from(projection);
@@ -184,7 +237,7 @@ impl Session {
                 up: vector("up").unwrap_or(DVec3::Y),
             }),
             _ => Err(Error::in_file(
-                &self.path,
+                &self.text_path,
                 format!(
                     "the {} projection has no `position` and `look_at` to move",
                     self.spec.kind()
@@ -205,9 +258,15 @@ impl Session {
     /// Writes the edited scene to `out` (the scene file itself, or a new file) keeping the
     /// file's comments and layout. Refused when the text would load a different projection
     /// from there (relative paths resolve from the file's folder). Never over a file the
-    /// scene reads (a model, a texture).
+    /// scene reads (a model, a texture): a model's session is saved as a new scene file,
+    /// whose object names the model relative to `out`'s folder (by its file name beside it,
+    /// else by its absolute path).
     pub fn save(&mut self, out: &Path) -> Result<()> {
-        let text = self.document.to_string();
+        let mut document = self.document.clone();
+        if self.origin == Origin::Model {
+            name_model(&mut document, &self.path, out)?;
+        }
+        let text = document.to_string();
         let (_, spec) = scene::file::parse_projection(&text, out).map_err(|e| {
             Error::in_file(
                 out,
@@ -226,12 +285,18 @@ impl Session {
         }
         let mut outputs = OutputSet::new();
         let id = outputs.output("the saved scene", out, &["toml"])?;
-        for file in self.prepared.scene().inputs.iter().skip(1) {
+        // Every file the scene reads, but the scene file itself (first of a scene file's
+        // inputs), which saving may write back into.
+        let own = usize::from(self.origin == Origin::SceneFile);
+        for file in self.prepared.scene().inputs.iter().skip(own) {
             outputs.input(&format!("the {}", file.what), &file.path)?;
+        }
+        if self.origin == Origin::Model {
+            outputs.input("the model file", &self.path)?;
         }
         outputs.stage(id, |tmp| image_io::write_bytes(tmp, text.as_bytes()))?;
         outputs.commit()?;
-        if same_file(out, &self.path) {
+        if self.scene_file().is_some_and(|own| same_file(out, own)) {
             self.modified = modified_time(&self.path);
         }
         Ok(())
@@ -300,6 +365,52 @@ pub(crate) fn scratch(projection: &str) -> (tempfile::TempDir, Session) {
     std::fs::write(&path, text).unwrap();
     let session = Session::open(&path).unwrap();
     (dir, session)
+}
+
+/// A loaded scene, its projection and the image size it is built at.
+type Loaded = (Scene, Box<dyn Projection>, u32, u32);
+
+/// The scene of model file `path` checked against the memory budget, with its projection
+/// built at the scene's image size (what [`scene::load_with`] does for a scene file).
+fn loaded_model(path: &Path, scene: Scene) -> Result<Loaded> {
+    let (width, height) = (scene.image.width, scene.image.height);
+    scene::check_budget(&scene, width, height, 0).map_err(|e| e.or_in_file(path))?;
+    let (projection, _) = flexcam::calibrate::build(&scene.projection, width, height)
+        .map_err(|e| e.or_in_file(path))?;
+    Ok((scene, projection, width, height))
+}
+
+/// Sets the `file` of `document`'s model object (the default scene's one object) to
+/// `model` as seen from the folder of `out`: its file name when `out` is beside it, else its
+/// absolute path.
+fn name_model(document: &mut DocumentMut, model: &Path, out: &Path) -> Result<()> {
+    let folder = |p: &Path| {
+        let parent = p.parent().filter(|f| !f.as_os_str().is_empty());
+        parent.unwrap_or(Path::new(".")).canonicalize().ok()
+    };
+    let absolute = model
+        .canonicalize()
+        .map_err(|e| Error::in_file(model, format!("cannot resolve the model's path: {e}")))?;
+    let beside = folder(out).is_some_and(|f| Some(f) == absolute.parent().map(Path::to_path_buf));
+    let named = if beside {
+        absolute.file_name().map(PathBuf::from).unwrap_or_default()
+    } else {
+        absolute.clone()
+    };
+    let named = named.to_str().ok_or_else(|| {
+        Error::in_file(
+            model,
+            "the model's path is not valid UTF-8: it cannot be named in a scene file",
+        )
+    })?;
+    let file = document
+        .get_mut("object")
+        .and_then(Item::as_array_of_tables_mut)
+        .and_then(|objects| objects.get_mut(0))
+        .and_then(|object| object.get_mut("file"))
+        .ok_or_else(|| Error::in_file(model, "the default scene has no model object"))?;
+    *file = toml_edit::value(named);
+    Ok(())
 }
 
 fn modified_time(path: &Path) -> Option<SystemTime> {

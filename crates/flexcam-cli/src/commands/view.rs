@@ -1,4 +1,5 @@
-//! `flexcam view`: the interactive viewer (crate `flexcam-view`) on a scene file.
+//! `flexcam view`: the interactive viewer (crate `flexcam-view`) on a scene file, a model
+//! file or a built-in scene.
 
 use std::path::PathBuf;
 
@@ -11,7 +12,9 @@ use super::scene_args::ShadingArg;
 /// Arguments of `flexcam view`.
 #[derive(Args, Debug)]
 pub struct ViewArgs {
-    /// The scene file (.toml) to view; saving writes the edited projection back into it.
+    /// What to view: a scene file (.toml; saving writes the edited projection back into
+    /// it), a model file (.obj, .gltf, .glb, .ply) in the default scene `flexcam render`
+    /// draws for it, or `builtin:NAME`; the last two are saved only as a new scene file.
     scene: PathBuf,
     /// Run the script's lines (`set KEY VALUE`, `method NAME`, `orbit DX DY`, `pan DX DY`,
     /// `dolly F`, `drag HANDLE DX DY`, `idle`, `frame OUT.png`, `window OUT.png`, `save

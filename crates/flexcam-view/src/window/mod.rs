@@ -12,7 +12,7 @@
 mod params;
 mod volume;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -237,8 +237,17 @@ impl App {
         });
     }
 
+    /// Saves to `to`, or (`None`) into the scene file: a model or built-in scene has none,
+    /// and is saved only as a new scene file (*Save as*), never over the model.
     fn save(&mut self, to: Option<PathBuf>) {
-        let out = to.unwrap_or_else(|| self.viewer.session().path().to_path_buf());
+        let session = self.viewer.session();
+        let Some(out) = to.or_else(|| session.scene_file().map(Path::to_path_buf)) else {
+            self.message = Some(format!(
+                "{} is not a scene file: save the edited scene as a new .toml file (Save as)",
+                session.path().display()
+            ));
+            return;
+        };
         let result = self.viewer.save(&out);
         self.message = Some(match result {
             Ok(()) => format!("saved {}", out.display()),

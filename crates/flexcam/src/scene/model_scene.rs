@@ -90,6 +90,17 @@ pub fn load(
     definitions: &[Definition],
     request: &ModelRequest,
 ) -> Result<(Scene, Option<Animation>)> {
+    load_with_text(path, definitions, request).map(|(_, scene, animation)| (scene, animation))
+}
+
+/// [`load`], also giving the default scene's text (before `definitions`): what `flexcam
+/// view` edits and saves as a new scene file. The text names the model by its file name,
+/// relative to [`text_path`].
+pub fn load_with_text(
+    path: &Path,
+    definitions: &[Definition],
+    request: &ModelRequest,
+) -> Result<(String, Scene, Option<Animation>)> {
     let in_model = |e: Error| Error::in_file(path, e.message);
     budget::check_model_file(path, 0).map_err(in_model)?;
     let model = load_model(path)?;
@@ -115,7 +126,10 @@ pub fn load(
     let (width, height) = image.size_with(request.width, request.height);
     file::validate_resolution(width, height).map_err(in_model)?;
     let text = scene_text(path, own, &view_for(width, height).map_err(in_model)?);
-    file::parse_defined_with_model(&text, &text_path, definitions, Some(model)).map_err(in_text)
+    let (scene, animation) =
+        file::parse_defined_with_model(&text, &text_path, definitions, Some(model))
+            .map_err(in_text)?;
+    Ok((text, scene, animation))
 }
 
 /// The camera a model is viewed through: the one `key` names, or by default the model's
@@ -158,7 +172,7 @@ fn own_size(camera: Option<&ModelCamera>) -> (u32, u32) {
 /// The name the scene text is parsed under: beside the model, so that its relative `file`
 /// resolves to the model, and apart from it, so that an error in the text is told from an
 /// error in the model file.
-fn text_path(model: &Path) -> PathBuf {
+pub fn text_path(model: &Path) -> PathBuf {
     let name = model
         .file_name()
         .map_or_else(|| "model".into(), |n| n.to_string_lossy().into_owned());
