@@ -110,11 +110,10 @@ impl Volume {
     /// ones are control nets, off the volume); for a mix of two volumes and a projector grid,
     /// whose own surfaces are mixed or interpolated, the volume's points at t = 0 and t = 1.
     pub fn control_surfaces(&self) -> Vec<ControlSurface<'_>> {
-        let own = |surfaces: &'_ [Surface]| surfaces.iter().map(ControlSurface::Own).collect();
         match self {
             Volume::Linear(v) => vec![ControlSurface::Own(&v.near), ControlSurface::Own(&v.far)],
-            Volume::Piecewise(v) => own(v.surfaces()),
-            Volume::Bezier(v) => own(v.surfaces()),
+            Volume::Piecewise(v) => v.surfaces().iter().map(ControlSurface::Own).collect(),
+            Volume::Bezier(v) => v.surfaces().iter().map(ControlSurface::Own).collect(),
             Volume::Interpolated(_) | Volume::Grid(_) => [0.0, 1.0]
                 .map(|t| ControlSurface::At { volume: self, t })
                 .into(),
