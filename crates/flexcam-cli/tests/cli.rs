@@ -1013,10 +1013,12 @@ fn perspective_rect_takes_cylindrical_and_equirectangular_cameras() {
             "position = [0.0, 1.5, 2.0]\nlook_at = [0.0, 1.0, 0.0]\nh_fov = 360.0\n\
              v_fov = {v_fov}\n"
         );
-        let scene = |head: &str| GOOD_SCENE.replace(
+        let scene = |head: &str| {
+            GOOD_SCENE.replace(
             "type = \"perspective\"\nposition = [0.0, 1.0, 5.0]\nlook_at = [0.0, 0.5, 0.0]\nfov = 60.0\n",
             &format!("{head}{projection}"),
-        );
+        )
+        };
         let camera = scene(&format!("type = \"{kind}\"\n"));
         let preset = scene(&format!("type = \"flexible\"\npreset = \"{kind}\"\n"));
         assert_ne!(camera, GOOD_SCENE);
@@ -1037,7 +1039,11 @@ fn perspective_rect_takes_cylindrical_and_equirectangular_cameras() {
             .zip(edited_preset.pixels())
             .filter(|(a, b)| a == b)
             .count();
-        assert!(same * 1000 >= 999 * 128 * 64, "{kind}: {same} of {}", 128 * 64);
+        assert!(
+            same * 1000 >= 999 * 128 * 64,
+            "{kind}: {same} of {}",
+            128 * 64
+        );
         let changed = edited
             .pixels()
             .zip(plain.pixels())

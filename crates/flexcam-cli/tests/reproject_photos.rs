@@ -74,13 +74,28 @@ fn agreement(dir: &TempDir, a: &str, b: &str) -> f64 {
 /// through the perspective scene and returns the agreement with the perspective render
 /// (percent). The photos have 3.8 (fisheye 4.7) times the perspective's pixels per degree,
 /// and both sides are antialiased, so that edges agree as well as flat areas.
-fn reprojected(dir: &TempDir, name: &str, projection: &str, size: (u32, u32), flags: &[&str]) -> f64 {
+fn reprojected(
+    dir: &TempDir,
+    name: &str,
+    projection: &str,
+    size: (u32, u32),
+    flags: &[&str],
+) -> f64 {
     let photo_scene = format!("{name}.toml");
     scene(dir, &photo_scene, projection, size);
     let photo = format!("{name}.png");
     run_ok(dir, &["render", &photo_scene, "--spp", "4", "-o", &photo]);
     let out = format!("{name}-persp.png");
-    let mut args = vec!["reproject", "--input", &photo, "persp.toml", "-o", &out, "--spp", "16"];
+    let mut args = vec![
+        "reproject",
+        "--input",
+        &photo,
+        "persp.toml",
+        "-o",
+        &out,
+        "--spp",
+        "16",
+    ];
     args.extend_from_slice(flags);
     run_ok(dir, &args);
     100.0 * agreement(dir, &out, "direct.png")
@@ -89,7 +104,12 @@ fn reprojected(dir: &TempDir, name: &str, projection: &str, size: (u32, u32), fl
 #[test]
 fn photos_of_each_projection_reproject_to_the_direct_view() {
     let dir = TempDir::new().unwrap();
-    scene(&dir, "persp.toml", "type = \"perspective\"\nfov = 60.0", (64, 48));
+    scene(
+        &dir,
+        "persp.toml",
+        "type = \"perspective\"\nfov = 60.0",
+        (64, 48),
+    );
     let args = ["render", "persp.toml", "--spp", "16", "-o", "direct.png"];
     run_ok(&dir, &args);
     let frame = ["--input-direction", DIRECTION, "--input-up", "0,1,0"];
@@ -98,7 +118,11 @@ fn photos_of_each_projection_reproject_to_the_direct_view() {
         "cyl",
         "type = \"cylindrical\"\nh_fov = 360.0\nv_fov = 120.0",
         (1440, 800),
-        &[&["--input-projection", "cylindrical", "--input-v-fov", "120"], &frame[..]].concat(),
+        &[
+            &["--input-projection", "cylindrical", "--input-v-fov", "120"],
+            &frame[..],
+        ]
+        .concat(),
     );
     let fisheye = reprojected(
         &dir,
@@ -116,7 +140,16 @@ fn photos_of_each_projection_reproject_to_the_direct_view() {
     );
     // The cylindrical photo read as if it were an equirectangular one of the same angles:
     // the rows are wrong.
-    let out = ["reproject", "--input", "cyl.png", "persp.toml", "-o", "wrong.png", "--spp", "16"];
+    let out = [
+        "reproject",
+        "--input",
+        "cyl.png",
+        "persp.toml",
+        "-o",
+        "wrong.png",
+        "--spp",
+        "16",
+    ];
     let out = [&out[..], &["--input-v-fov", "120"]].concat();
     run_ok(&dir, &[&out[..], &frame[..]].concat());
     let wrong = 100.0 * agreement(&dir, "wrong.png", "direct.png");
@@ -138,7 +171,12 @@ fn photos_of_each_projection_reproject_to_the_direct_view() {
 #[test]
 fn flags_of_another_kind_of_photo_are_refused() {
     let dir = TempDir::new().unwrap();
-    scene(&dir, "persp.toml", "type = \"perspective\"\nfov = 60.0", (32, 24));
+    scene(
+        &dir,
+        "persp.toml",
+        "type = \"perspective\"\nfov = 60.0",
+        (32, 24),
+    );
     run_ok(&dir, &["render", "persp.toml", "-o", "photo.png"]);
     for (flags, needle) in [
         (
@@ -150,14 +188,27 @@ fn flags_of_another_kind_of_photo_are_refused() {
             "--input-h-fov applies to --input-projection equirectangular or cylindrical",
         ),
         (&["--input-mapping", "equisolid"], "--input-mapping applies"),
-        (&["--input-direction", "1,2"], "--input-direction: needs 3 numbers"),
-        (&["--input-direction", "0,1,0"], "photo.png: read as a photo of type equirectangular"),
+        (
+            &["--input-direction", "1,2"],
+            "--input-direction: needs 3 numbers",
+        ),
+        (
+            &["--input-direction", "0,1,0"],
+            "photo.png: read as a photo of type equirectangular",
+        ),
         (
             &["--input-projection", "fisheye", "--input-fov", "400"],
             "fov",
         ),
     ] {
-        let mut args = vec!["reproject", "--input", "photo.png", "persp.toml", "-o", "o.png"];
+        let mut args = vec![
+            "reproject",
+            "--input",
+            "photo.png",
+            "persp.toml",
+            "-o",
+            "o.png",
+        ];
         args.extend_from_slice(flags);
         let out = run(&dir, &args);
         let stderr = String::from_utf8_lossy(&out.stderr);
@@ -166,7 +217,17 @@ fn flags_of_another_kind_of_photo_are_refused() {
         assert!(stderr.contains(needle), "{flags:?}: {stderr}");
         assert!(!dir.path().join("o.png").exists());
     }
-    let args = ["reproject", "--input", "photo.png", "persp.toml", "-o", "o.png"];
-    let out = run(&dir, &[&args[..], &["--input-projection", "cubic"]].concat());
+    let args = [
+        "reproject",
+        "--input",
+        "photo.png",
+        "persp.toml",
+        "-o",
+        "o.png",
+    ];
+    let out = run(
+        &dir,
+        &[&args[..], &["--input-projection", "cubic"]].concat(),
+    );
     assert_eq!(out.status.code(), Some(2));
 }

@@ -89,7 +89,10 @@ fn a_flexible_volume_is_written_with_its_materials() {
         stdout.contains("far_surface: 289 vertices, 512 triangles, 0 lines"),
         "{stdout}"
     );
-    assert!(stdout.contains("projectors: 98 vertices, 0 triangles, 49 lines"), "{stdout}");
+    assert!(
+        stdout.contains("projectors: 98 vertices, 0 triangles, 49 lines"),
+        "{stdout}"
+    );
     let obj = read_obj(&dir.path().join("twist.obj"));
     let names: Vec<&str> = obj.objects.iter().map(|o| o.0.as_str()).collect();
     assert_eq!(names, ["far_surface", "projectors", "image_grid"]);
@@ -112,7 +115,10 @@ fn a_flexible_volume_is_written_with_its_materials() {
 fn a_pinhole_is_drawn_as_rays_from_its_eye() {
     let dir = TempDir::new().unwrap();
     fs::write(dir.path().join("pinhole.toml"), PINHOLE).unwrap();
-    run_ok(&dir, &["volume", "pinhole.toml", "-o", "v.obj", "--projectors", "3"]);
+    run_ok(
+        &dir,
+        &["volume", "pinhole.toml", "-o", "v.obj", "--projectors", "3"],
+    );
     let obj = read_obj(&dir.path().join("v.obj"));
     let names: Vec<&str> = obj.objects.iter().map(|o| o.0.as_str()).collect();
     assert_eq!(names, ["projectors", "image_grid"]);
@@ -143,9 +149,8 @@ fn inputs_are_never_overwritten_and_bad_options_refused() {
     let model = "mtllib x.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n";
     fs::write(dir.path().join("m.obj"), model).unwrap();
     fs::write(dir.path().join("x.mtl"), "newmtl m\nKd 1 0 0\n").unwrap();
-    let scene = format!(
-        "{PINHOLE}\n[[object]]\nname = \"model\"\nshape = \"mesh\"\nfile = \"m.obj\"\n"
-    );
+    let scene =
+        format!("{PINHOLE}\n[[object]]\nname = \"model\"\nshape = \"mesh\"\nfile = \"m.obj\"\n");
     fs::write(dir.path().join("s.toml"), scene).unwrap();
     run_ok(&dir, &["render", "s.toml", "-o", "check.png"]);
     let before: Vec<Vec<u8>> = ["m.obj", "x.mtl", "s.toml"]
@@ -173,14 +178,20 @@ fn inputs_are_never_overwritten_and_bad_options_refused() {
         &["--reach", "0"],
         &["--tube-radius", "-1"],
     ] {
-        let out = run(&dir, &[&["volume", "s.toml", "-o", "bad.obj"], args].concat());
+        let out = run(
+            &dir,
+            &[&["volume", "s.toml", "-o", "bad.obj"], args].concat(),
+        );
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(1), "{args:?}: {stderr}");
         assert_eq!(stderr.lines().count(), 1, "{stderr}");
         assert!(!dir.path().join("bad.obj").exists());
         assert!(!dir.path().join("bad.mtl").exists());
     }
-    let out = run(&dir, &["volume", "s.toml", "-o", "bad.obj", "--projectors", "0"]);
+    let out = run(
+        &dir,
+        &["volume", "s.toml", "-o", "bad.obj", "--projectors", "0"],
+    );
     assert_eq!(out.status.code(), Some(2));
 }
 
@@ -206,7 +217,10 @@ fn the_tube_form_renders_beside_the_scene() {
         .replace("look_at = [0.0, 0.0, 0.0]", "look_at = [0.0, 1.0, 3.0]")
         + "\n[[object]]\nname = \"volume\"\nshape = \"mesh\"\nfile = \"v.obj\"\n";
     fs::write(dir.path().join("side.toml"), side).unwrap();
-    run_ok(&dir, &["render", "side.toml", "-o", "side.png", "--width", "160"]);
+    run_ok(
+        &dir,
+        &["render", "side.toml", "-o", "side.png", "--width", "160"],
+    );
     let image = image::open(dir.path().join("side.png")).unwrap().to_rgb8();
     let red = image
         .pixels()

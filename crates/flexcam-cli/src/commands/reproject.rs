@@ -163,7 +163,11 @@ pub fn run(args: &ReprojectArgs) -> Result<()> {
     let photo = Photo::new(image, projection, look, up).map_err(|e| {
         Error::in_file(
             &args.input,
-            format!("read as a photo of type {}: {}", projection.name(), e.message),
+            format!(
+                "read as a photo of type {}: {}",
+                projection.name(),
+                e.message
+            ),
         )
     })?;
     let loaded = args.scene.load()?;

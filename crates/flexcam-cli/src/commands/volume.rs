@@ -7,9 +7,7 @@ use std::path::PathBuf;
 use clap::Args;
 use flexcam::glam::{DVec2, DVec3};
 use flexcam::image_io::{self, OutputSet};
-use flexcam::projection::volume_geometry::{
-    PartKind, VolumeGeometry, VolumeOptions, MAX_SAMPLES,
-};
+use flexcam::projection::volume_geometry::{PartKind, VolumeGeometry, VolumeOptions, MAX_SAMPLES};
 use flexcam::projection::Projection;
 use flexcam::scene::Scene;
 use flexcam::{Error, Result};
@@ -82,8 +80,8 @@ pub fn run(args: &VolumeArgs) -> Result<()> {
         grid_at: args.grid_at,
         reach,
     };
-    let mut geometry = VolumeGeometry::of(projection, &options)
-        .map_err(|e| e.or_in_file(&loaded.source))?;
+    let mut geometry =
+        VolumeGeometry::of(projection, &options).map_err(|e| e.or_in_file(&loaded.source))?;
     if let Some(radius) = args.tube_radius {
         geometry = geometry
             .with_tubes(radius)

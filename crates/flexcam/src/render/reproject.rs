@@ -407,7 +407,10 @@ mod tests {
         // Above the top row's centre: the top row.
         let top = photo.sample(DVec2::new(2.5, 0.1));
         assert!((top - px(2, 0)).abs().max_element() < 1e-6);
-        assert_eq!(photo.look(DVec3::Y), Some(photo.sample(DVec2::new(4.0, 0.0))));
+        assert_eq!(
+            photo.look(DVec3::Y),
+            Some(photo.sample(DVec2::new(4.0, 0.0)))
+        );
         assert!(Photo::equirectangular(LinearImage {
             width: 0,
             height: 4,
@@ -466,7 +469,9 @@ mod tests {
             .flat_map(|y| (0..w).map(move |x| (x, y)))
             .map(|(x, y)| {
                 let centre = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-                camera.ray(centre).map_or(Vec3::ZERO, |r| world(r.direction))
+                camera
+                    .ray(centre)
+                    .map_or(Vec3::ZERO, |r| world(r.direction))
             })
             .collect();
         LinearImage {
@@ -531,7 +536,10 @@ mod tests {
                         fit: FisheyeFit::Inscribed,
                     },
                 },
-                PhotoProjection::Fisheye { fov: 180.0, mapping },
+                PhotoProjection::Fisheye {
+                    fov: 180.0,
+                    mapping,
+                },
                 (500, 400),
             ));
         }

@@ -2,9 +2,7 @@ use glam::{DVec2, DVec3};
 
 use super::*;
 use crate::projection::camera_basis::CameraBasis;
-use crate::projection::flexible::{
-    Blend, FlexibleSpec, Preset, PresetSpec, Surface, VolumeSource,
-};
+use crate::projection::flexible::{Blend, FlexibleSpec, Preset, PresetSpec, Surface, VolumeSource};
 use crate::projection::{CameraFrame, ProjectionSpec};
 
 fn frame() -> CameraFrame {
@@ -66,9 +64,12 @@ fn flexible(preset: Preset, clip: [f64; 2]) -> Box<dyn Projection> {
 #[test]
 fn a_pinhole_is_drawn_as_rays_from_its_eye() {
     let f = frame();
-    let camera = ProjectionSpec::Perspective { frame: f, fov: 60.0 }
-        .build(40, 30)
-        .unwrap();
+    let camera = ProjectionSpec::Perspective {
+        frame: f,
+        fov: 60.0,
+    }
+    .build(40, 30)
+    .unwrap();
     let g = VolumeGeometry::of(camera.as_ref(), &options(5)).unwrap();
     assert_eq!(names(&g), ["projectors", "image_grid"]);
     let rays = polylines(part(&g, "projectors"));
@@ -158,7 +159,11 @@ fn curved_projectors_are_drawn_in_steps() {
     };
     let spec = FlexibleSpec {
         source: VolumeSource::Blended {
-            surfaces: vec![rect(0.0, 0.0, 1.0), rect(-2.0, 1.5, 2.0), rect(-4.0, 0.0, 4.0)],
+            surfaces: vec![
+                rect(0.0, 0.0, 1.0),
+                rect(-2.0, 1.5, 2.0),
+                rect(-4.0, 0.0, 4.0),
+            ],
             blend: Blend::Bezier { segments: None },
         },
         reparam: None,
@@ -216,8 +221,14 @@ fn positions_without_projectors_are_skipped() {
 #[test]
 fn tubes_surround_the_segments() {
     let mut part = Part::new("p".to_string(), PartKind::Projectors, [1.0, 0.0, 0.0]);
-    part.add_polyline(&[DVec3::ZERO, DVec3::new(1.0, 2.0, 2.0), DVec3::new(1.0, 2.0, 2.0)]);
-    let g = VolumeGeometry { parts: vec![part] }.with_tubes(0.01).unwrap();
+    part.add_polyline(&[
+        DVec3::ZERO,
+        DVec3::new(1.0, 2.0, 2.0),
+        DVec3::new(1.0, 2.0, 2.0),
+    ]);
+    let g = VolumeGeometry { parts: vec![part] }
+        .with_tubes(0.01)
+        .unwrap();
     let tube = &g.parts[0];
     assert!(tube.segments.is_empty());
     assert_eq!(tube.triangles.len(), 8);
@@ -244,7 +255,10 @@ fn obj_and_mtl_text() {
     let triangles: usize = g.parts.iter().map(|p| p.triangles.len()).sum();
     let segments: usize = g.parts.iter().map(|p| p.segments.len()).sum();
     assert!(obj.starts_with("# made by a test\nmtllib v.mtl\n"), "{obj}");
-    assert_eq!((count("v "), count("f "), count("l ")), (points, triangles, segments));
+    assert_eq!(
+        (count("v "), count("f "), count("l ")),
+        (points, triangles, segments)
+    );
     assert_eq!(count("o "), 4);
     let mtl = g.mtl();
     for part in &g.parts {
@@ -290,6 +304,9 @@ fn options_out_of_range_are_refused() {
             ..options(3)
         },
     ] {
-        assert!(VolumeGeometry::of(camera.as_ref(), &bad).is_err(), "{bad:?}");
+        assert!(
+            VolumeGeometry::of(camera.as_ref(), &bad).is_err(),
+            "{bad:?}"
+        );
     }
 }
