@@ -187,7 +187,13 @@ impl VolumeGeometry {
             .parts
             .iter()
             .map(|part| {
+                // The lines' own vertices go with them; a part with triangles keeps its.
                 let mut tubes = Part {
+                    points: if part.triangles.is_empty() {
+                        Vec::new()
+                    } else {
+                        part.points.clone()
+                    },
                     segments: Vec::new(),
                     ..part.clone()
                 };
