@@ -36,7 +36,8 @@ enum Command {
     /// images).
     #[command(after_help = OUTPUTS_HELP)]
     Render(commands::render::RenderArgs),
-    /// Resample an equirectangular photo through a scene's projection into a PNG.
+    /// Resample a photo (equirectangular, cylindrical or fisheye) through a scene's projection
+    /// into a PNG.
     #[command(after_help = OUTPUTS_HELP)]
     Reproject(commands::reproject::ReprojectArgs),
     /// Render a scene's keyframed flexible camera to numbered PNG frames and/or a GIF.
@@ -76,6 +77,11 @@ enum Command {
     /// camera, as TOML.
     #[command(after_help = OUTPUTS_HELP)]
     ImportCameras(commands::import_cameras::ImportCamerasArgs),
+    /// Write a scene projection's viewing volume as geometry, OBJ with an MTL library: the
+    /// control surfaces of a flexible volume (meshes), a sample of projectors (lines) and the
+    /// image grid carried onto the volume (lines), each part its own material.
+    #[command(after_help = OUTPUTS_HELP)]
+    Volume(commands::volume::VolumeArgs),
     /// Open the interactive viewer on a scene file: design its projection live, or run a
     /// script of viewer commands.
     View(commands::view::ViewArgs),
@@ -105,6 +111,7 @@ fn main() -> ExitCode {
         Command::Simplify(args) => commands::simplify::run(&args),
         Command::ImportCameras(args) => commands::import_cameras::run(&args),
         Command::View(args) => commands::view::run(&args),
+        Command::Volume(args) => commands::volume::run(&args),
         Command::Bench(command) => commands::bench::run(&command),
     };
     match result {

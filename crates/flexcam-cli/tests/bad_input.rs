@@ -527,12 +527,12 @@ fn a_correspondence_behind_the_eye_is_refused_or_shown_in_the_residual() {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/flexible-projector-fit.toml"),
     )
     .unwrap();
-    let cube_top = "    { uv = [0.5, 0.6], point = [0.0, 1.0, 0.0] },";
-    assert!(example.contains(cube_top));
-    // The camera is at [0, 5.5, 7]: the cube top mirrored through it.
-    let behind = format!("{cube_top}\n    {{ uv = [0.5, 0.6], point = [0.0, 10.0, 14.0] }},");
+    let cube_centre = "    { uv = [0.5, 0.6], point = [0.0, 1.0, 0.0] },";
+    assert!(example.contains(cube_centre));
+    // The camera is at [0, 5.5, 7]: the cube's centre mirrored through it.
+    let behind = format!("{cube_centre}\n    {{ uv = [0.5, 0.6], point = [0.0, 10.0, 14.0] }},");
     for starts in ["kept", "eye", "pinhole", "free", "auto"] {
-        let scene = example.replace(cube_top, &behind).replace(
+        let scene = example.replace(cube_centre, &behind).replace(
             "interpolation = \"bilinear\"",
             &format!("interpolation = \"bilinear\"\nstarts = \"{starts}\""),
         );

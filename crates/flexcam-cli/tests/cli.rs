@@ -538,6 +538,19 @@ fn animated_scene(second_key_time: &str) -> String {
     )
 }
 
+/// `animate --help` describes every method `animate` accepts: all of `render`'s.
+#[test]
+fn animate_help_describes_every_method() {
+    let dir = TempDir::new().unwrap();
+    let out = run_ok(&dir, &["animate", "--help"]);
+    let help = String::from_utf8_lossy(&out.stdout);
+    let method = &help[help.find("--method").expect("a --method option")..];
+    let method = &method[..method.find("--shading").expect("--shading after it")];
+    for (name, _) in flexcam::render::Method::ALL {
+        assert!(method.contains(&format!("`{name}`")), "{name}: {method}");
+    }
+}
+
 #[test]
 fn animate_writes_numbered_frames_and_a_gif() {
     let dir = TempDir::new().unwrap();
@@ -986,6 +999,58 @@ fn perspective_rect_option_edits_the_panorama() {
         &dir,
         &["render", scene, "--perspective-rect", "0.4,0.3,0.6"],
     );
+}
+
+/// `--perspective-rect` takes `type = "cylindrical"` and `"equirectangular"` cameras as the
+/// flexible presets of the same names: the edited camera renders the same object ids as the
+/// edited preset, and differently from the unedited camera inside the rectangle's columns.
+#[test]
+fn perspective_rect_takes_cylindrical_and_equirectangular_cameras() {
+    let dir = TempDir::new().unwrap();
+    let rect = ["--perspective-rect", "0.3,0.2,0.7,0.8"];
+    for (kind, v_fov) in [("cylindrical", "100.0"), ("equirectangular", "120.0")] {
+        let projection = format!(
+            "position = [0.0, 1.5, 2.0]\nlook_at = [0.0, 1.0, 0.0]\nh_fov = 360.0\n\
+             v_fov = {v_fov}\n"
+        );
+        let scene = |head: &str| {
+            GOOD_SCENE.replace(
+            "type = \"perspective\"\nposition = [0.0, 1.0, 5.0]\nlook_at = [0.0, 0.5, 0.0]\nfov = 60.0\n",
+            &format!("{head}{projection}"),
+        )
+        };
+        let camera = scene(&format!("type = \"{kind}\"\n"));
+        let preset = scene(&format!("type = \"flexible\"\npreset = \"{kind}\"\n"));
+        assert_ne!(camera, GOOD_SCENE);
+        write(&dir, "camera.toml", &camera);
+        write(&dir, "preset.toml", &preset);
+        let ids = |scene: &str, extra: &[&str]| {
+            let mut args = vec!["render", scene, "--shading", "flat", "-o", "c.png"];
+            args.extend_from_slice(&["--ids", "ids.png", "--width", "128", "--height", "64"]);
+            args.extend_from_slice(extra);
+            run_ok(&dir, &args);
+            image::open(dir.path().join("ids.png")).unwrap().to_luma16()
+        };
+        let edited = ids("camera.toml", &rect);
+        let edited_preset = ids("preset.toml", &rect);
+        let plain = ids("camera.toml", &[]);
+        let same = edited
+            .pixels()
+            .zip(edited_preset.pixels())
+            .filter(|(a, b)| a == b)
+            .count();
+        assert!(
+            same * 1000 >= 999 * 128 * 64,
+            "{kind}: {same} of {}",
+            128 * 64
+        );
+        let changed = edited
+            .pixels()
+            .zip(plain.pixels())
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!(changed > 20, "{kind}: the edit changed {changed} pixels");
+    }
 }
 
 /// Renders `scene` flat at its own size; returns the colour and id PNG files' bytes.

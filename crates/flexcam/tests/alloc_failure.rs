@@ -7,7 +7,7 @@ use std::path::Path;
 use std::sync::Once;
 
 use flexcam::projection::ray_map::ray_map;
-use flexcam::render::{self, EquirectPhoto, LinearImage, Method, PreparedScene, RenderOptions};
+use flexcam::render::{self, LinearImage, Method, Photo, PreparedScene, RenderOptions};
 use flexcam::render::{Shading, StPoints, TransitionShading};
 use flexcam::scene::{load_with, LoadedScene, Overrides};
 use flexcam::try_alloc;
@@ -103,7 +103,7 @@ fn compositing_caustics_transitions_and_outputs_return_the_error() {
         e,
         "out of memory: cannot allocate 720.0 kB for the STMap of the 200 x 150 frame"
     );
-    let photo = EquirectPhoto::new(LinearImage {
+    let photo = Photo::equirectangular(LinearImage {
         width: 4,
         height: 2,
         pixels: vec![glam::Vec3::ONE; 8],

@@ -41,8 +41,11 @@ pub struct AnimateArgs {
     /// ratio).
     #[arg(long)]
     height: Option<u32>,
-    /// Rendering method: `raycast` (the reference, every projection) or `raster`
-    /// (projections with an analytic inverse).
+    /// Rendering method of every frame: `raycast` (the reference, every camera), `raster`
+    /// (rasterisation by the analytic inverse, cameras that have one), `trilinear` or
+    /// `camera-triangles` (a scene's trilinear reflectors, each frame's pinhole view and its
+    /// reflections rendered by that method; a camera either method cannot render is
+    /// refused with the reason).
     #[arg(long, default_value = "raycast", value_parser = method_names())]
     method: String,
     /// Shading: `flat` (base colours, exact) or `lit` (lights, shadows, reflections).

@@ -15,6 +15,7 @@ pub mod scene_args;
 pub mod scenes;
 pub mod simplify;
 pub mod view;
+pub mod volume;
 
 /// Reports a command's failure, one line on stderr, and gives exit status 1 (a render or
 /// input error; 2 is a usage error, found before any command runs).

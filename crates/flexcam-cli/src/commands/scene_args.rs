@@ -33,8 +33,8 @@ pub struct SceneArgs {
     #[arg(long)]
     pub height: Option<u32>,
     /// The local perspective edit of a shape-defined panorama (or the cubic, rounded_cubic,
-    /// cylindrical and equirectangular presets), as the scene key
-    /// `perspective_rect`: the rectangle of the
+    /// cylindrical and equirectangular presets, and the cylindrical and equirectangular
+    /// cameras, as those presets), as the scene key `perspective_rect`: the rectangle of the
     /// image domain (u right, v up, in [0, 1]; U0 > U1 across the seam) becomes a perspective
     /// view. Applied after the scene file's own rectangle, if any.
     #[arg(

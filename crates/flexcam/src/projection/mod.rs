@@ -42,6 +42,7 @@ mod stereo;
 #[cfg(test)]
 mod stereo_properties;
 mod trilinear;
+pub mod volume_geometry;
 mod vr180;
 
 pub use build_report::BuildReport;
@@ -170,6 +171,13 @@ pub trait Projection: Send + Sync {
     /// This projection as a trilinear mesh, for the renderers that need its triangles
     /// (`--method trilinear`); `None` for every other kind, the default.
     fn trilinear(&self) -> Option<&Trilinear> {
+        None
+    }
+
+    /// This projection as a flexible viewing volume, for what needs its control surfaces
+    /// (the volume's geometry, [`volume_geometry`]); `None` for every other kind, the
+    /// default.
+    fn flexible(&self) -> Option<&Flexible> {
         None
     }
 }

@@ -374,7 +374,7 @@ fn render_buffers(
 }
 
 /// A colour image in linear RGB, rows from the top: a photo to reproject
-/// ([`EquirectPhoto`]), as `image_io` reads it.
+/// ([`Photo`]), as `image_io` reads it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearImage {
     /// Width in pixels.
@@ -428,7 +428,7 @@ pub use method::Method;
 pub use prepared::{Hit, PreparedScene};
 pub use raster::Subdivision;
 pub use raycast::{pick, Picked};
-pub use reproject::{reproject, EquirectPhoto};
+pub use reproject::{reproject, Photo, PhotoProjection, PHOTO_PROJECTION_NAMES};
 pub use stmap::{st_map, StMap, StPoints};
 pub use surface::SurfacePoint;
 pub use transitions::TransitionShading;

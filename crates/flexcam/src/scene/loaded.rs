@@ -6,8 +6,8 @@ use std::time::Instant;
 
 use crate::error::{Error, Result};
 use crate::projection::flexible::panorama::edit_source;
-use crate::projection::flexible::FlexibleSpec;
-use crate::projection::{BuildReport, Projection, ProjectionSpec};
+use crate::projection::flexible::{FlexibleSpec, Preset, PresetSpec, VolumeSource};
+use crate::projection::{BuildReport, CameraFrame, Projection, ProjectionSpec};
 use crate::scene::file::Definition;
 use crate::scene::{self, budget, Scene};
 
@@ -109,18 +109,60 @@ pub fn check_budget(scene: &Scene, width: u32, height: u32, extra_bytes: u64) ->
     )
 }
 
-/// `projection` with the perspective edit `rect`.
+/// `projection` with the perspective edit `rect`: a flexible projection's volume edited
+/// ([`edit_source`]), or a `cylindrical` or `equirectangular` camera as the flexible preset of
+/// the same name (the same rays, out to the preset's default far clip) edited. Errors: any
+/// other projection, and those of [`edit_source`].
 fn perspective_rect(projection: &ProjectionSpec, rect: [f64; 4]) -> Result<ProjectionSpec> {
     let refuse = |why: String| Error::new(format!("--perspective-rect: {why}"));
-    let ProjectionSpec::Flexible(spec) = projection else {
-        return Err(refuse(format!(
-            "needs a flexible shape-defined panorama, the scene's projection is {}",
-            projection.kind()
-        )));
+    let as_preset = |preset: Preset, frame: &CameraFrame| {
+        VolumeSource::Preset(PresetSpec {
+            preset,
+            frame: *frame,
+            clip: None,
+        })
     };
-    let source = edit_source(&spec.source, rect).map_err(|e| refuse(e.message))?;
+    let (source, reparam) = match projection {
+        ProjectionSpec::Flexible(spec) => (spec.source.clone(), spec.reparam),
+        ProjectionSpec::Cylindrical {
+            frame,
+            h_fov,
+            v_fov,
+        } => (
+            as_preset(
+                Preset::Cylindrical {
+                    h_fov: *h_fov,
+                    v_fov: *v_fov,
+                },
+                frame,
+            ),
+            None,
+        ),
+        ProjectionSpec::Equirectangular {
+            frame,
+            h_fov,
+            v_fov,
+        } => (
+            as_preset(
+                Preset::Equirectangular {
+                    h_fov: *h_fov,
+                    v_fov: *v_fov,
+                },
+                frame,
+            ),
+            None,
+        ),
+        other => {
+            return Err(refuse(format!(
+                "needs a flexible shape-defined panorama or a cylindrical or equirectangular \
+                 camera, the scene's projection is {}",
+                other.kind()
+            )))
+        }
+    };
+    let source = edit_source(&source, rect).map_err(|e| refuse(e.message))?;
     Ok(ProjectionSpec::Flexible(Box::new(FlexibleSpec {
         source,
-        reparam: spec.reparam,
+        reparam,
     })))
 }

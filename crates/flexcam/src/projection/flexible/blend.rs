@@ -218,6 +218,11 @@ impl PiecewiseVolume {
         Ok(PiecewiseVolume { surfaces, knots })
     }
 
+    /// The control surfaces, near to far (each on the volume at its knot).
+    pub fn surfaces(&self) -> &[Surface] {
+        &self.surfaces
+    }
+
     /// The piece that `t` falls in: `i` with knots[i] <= t <= knots[i+1] (t below 0 or
     /// above 1 extrapolates the first or last piece), and the local parameter in it.
     fn piece(&self, t: f64) -> (usize, f64) {
@@ -305,6 +310,11 @@ impl BezierVolume {
             surfaces,
             polyline_weights,
         })
+    }
+
+    /// The control surfaces, near to far (the inner ones are control nets, off the volume).
+    pub fn surfaces(&self) -> &[Surface] {
+        &self.surfaces
     }
 
     /// The de Casteljau pyramid of the control points at (u, v) down to its last two points,

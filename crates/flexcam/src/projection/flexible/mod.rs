@@ -52,7 +52,7 @@ pub use projector_grid::{
     ProjectorGridSpec, Starts,
 };
 pub use reparam::Reparam;
-pub use volume::{InterpolatedVolume, Volume};
+pub use volume::{ControlSurface, InterpolatedVolume, Volume};
 
 use self::inverse::{BoundInverse, Inverse};
 use super::image_coords::Resolution;
@@ -366,5 +366,9 @@ impl Projection for Flexible {
 
     fn trilinear(&self) -> Option<&Trilinear> {
         None
+    }
+
+    fn flexible(&self) -> Option<&Flexible> {
+        Some(self)
     }
 }

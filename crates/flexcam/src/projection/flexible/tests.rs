@@ -103,14 +103,56 @@ fn perspective_is_u_x_over_z() {
 
 #[test]
 fn inverse_perspective_is_u_x_over_e_minus_z() {
-    // l_n = 2 at z = 1, l_f = 1 at z = 2: the projectors meet at e = 3.
-    let mut spec = preset(Preset::InversePerspective { fov: 90.0 }, Some([1.0, 2.0]));
-    if let VolumeSource::Preset(p) = &mut spec.source {
-        let forward = (p.frame.look_at - p.frame.position).normalize();
-        p.frame.look_at = p.frame.position + 3.0 * forward;
-    }
+    // l_n = 2 at z = 1, l_f = 1 at z = 2: the projectors meet at e = 3 (look_at, further
+    // along the same axis, only aims the camera).
+    let f = frame();
+    let converge = f.position + 3.0 * (f.look_at - f.position).normalize();
+    let spec = preset(
+        Preset::InversePerspective {
+            fov: 90.0,
+            converge,
+        },
+        Some([1.0, 2.0]),
+    );
     let oracle = |p: DVec3| DVec2::new(p.x, p.y) / (3.0 - p.z);
     check_uv_clipped_to_1_2(&spec, (8, 8), oracle);
+}
+
+/// The inverse perspective's projectors all end at `converge` (default clip: up to its
+/// depth), also off the view axis, where the volume leans towards it; `converge` on or
+/// behind the eye's plane is refused.
+#[test]
+fn inverse_perspective_projectors_meet_at_converge() {
+    let f = frame();
+    let basis = CameraBasis::new(&f).unwrap();
+    let converge = f.position + basis.to_world(DVec3::new(1.5, -0.5, 6.0));
+    let spec = preset(
+        Preset::InversePerspective {
+            fov: 70.0,
+            converge,
+        },
+        None,
+    );
+    let flexible = build(&spec, 12, 8);
+    for (x, y) in [(0.0, 0.0), (12.0, 8.0), (3.5, 6.25), (6.0, 4.0)] {
+        let end = flexible.point(DVec2::new(x, y), 1.0).unwrap();
+        assert!((end - converge).length() < 1e-12, "{x} {y}: {end}");
+    }
+    // The image centre's projector starts at the eye and runs straight to converge.
+    let start = flexible.point(DVec2::new(6.0, 4.0), 0.0).unwrap();
+    assert!((start - f.position).length() < 1e-12);
+    for depth in [0.0, -2.0] {
+        let behind = f.position + basis.to_world(DVec3::new(1.0, 0.0, depth));
+        let spec = preset(
+            Preset::InversePerspective {
+                fov: 70.0,
+                converge: behind,
+            },
+            None,
+        );
+        let e = Flexible::new(&spec, 12, 8).unwrap_err();
+        assert!(e.message.contains("must lie in front of the eye"), "{e}");
+    }
 }
 
 #[test]
@@ -316,7 +358,13 @@ fn builds_through_projection_spec_and_checks_parameters() {
     );
     assert!(e.unwrap_err().message.contains("clip"));
     let e = Flexible::new(
-        &preset(Preset::InversePerspective { fov: 60.0 }, Some([0.0, 100.0])),
+        &preset(
+            Preset::InversePerspective {
+                fov: 60.0,
+                converge: frame().look_at,
+            },
+            Some([0.0, 100.0]),
+        ),
         8,
         8,
     );
@@ -426,7 +474,10 @@ fn volumes_outside_the_analytic_class_have_no_inverse() {
 fn invertible() -> Vec<Flexible> {
     let mut all: Vec<Flexible> = [
         Preset::Perspective { fov: 80.0 },
-        Preset::InversePerspective { fov: 50.0 },
+        Preset::InversePerspective {
+            fov: 50.0,
+            converge: frame().look_at,
+        },
         Preset::Orthographic { width: 3.0 },
         Preset::Oblique {
             width: 3.0,

@@ -7,6 +7,7 @@
 use glam::{DVec2, DVec3};
 
 use super::blend::{BezierVolume, PiecewiseVolume};
+use super::control_surface::Surface;
 use super::linear_volume::{check_projectors, LinearVolume};
 use super::projector_grid::GridVolume;
 use crate::error::Result;
@@ -104,9 +105,48 @@ impl Volume {
         }
     }
 
+    /// The control surfaces, near to far, for drawing the volume: a linear volume's near
+    /// and far surfaces; a piecewise or Bezier volume's surfaces (a Bezier volume's inner
+    /// ones are control nets, off the volume); for a mix of two volumes and a projector grid,
+    /// whose own surfaces are mixed or interpolated, the volume's points at t = 0 and t = 1.
+    pub fn control_surfaces(&self) -> Vec<ControlSurface<'_>> {
+        match self {
+            Volume::Linear(v) => vec![ControlSurface::Own(&v.near), ControlSurface::Own(&v.far)],
+            Volume::Piecewise(v) => v.surfaces().iter().map(ControlSurface::Own).collect(),
+            Volume::Bezier(v) => v.surfaces().iter().map(ControlSurface::Own).collect(),
+            Volume::Interpolated(_) | Volume::Grid(_) => [0.0, 1.0]
+                .map(|t| ControlSurface::At { volume: self, t })
+                .into(),
+        }
+    }
+
     /// Errors when every projector on a 17 x 17 grid of (u, v) has zero length at t = 0
     /// and t = 1 (nothing can be seen: near and far surfaces coincide).
     pub fn check_projectors(&self) -> Result<()> {
         check_projectors(|uv, t| self.tangent(uv, t))
+    }
+}
+
+/// One control surface of a volume as [`Volume::control_surfaces`] gives it.
+#[derive(Debug, Clone, Copy)]
+pub enum ControlSurface<'a> {
+    /// A surface of the volume's own.
+    Own(&'a Surface),
+    /// The volume's points Q(u, v, t) at one t.
+    At {
+        /// The volume.
+        volume: &'a Volume,
+        /// Where along the projectors, in [0, 1].
+        t: f64,
+    },
+}
+
+impl ControlSurface<'_> {
+    /// The surface's point at (u, v).
+    pub fn point(&self, uv: DVec2) -> DVec3 {
+        match self {
+            ControlSurface::Own(surface) => surface.point(uv),
+            ControlSurface::At { volume, t } => volume.point(uv, *t),
+        }
     }
 }

@@ -62,7 +62,13 @@ fn invertible(frame: CameraFrame, fov: f64) -> Vec<(&'static str, ProjectionSpec
         ),
         (
             "flex inverse persp.",
-            flexible(Preset::InversePerspective { fov: 40.0 }, frame),
+            flexible(
+                Preset::InversePerspective {
+                    fov: 40.0,
+                    converge: frame.look_at,
+                },
+                frame,
+            ),
         ),
         (
             "flex oblique",

@@ -23,11 +23,12 @@ use crate::projection::flexible::{
 };
 
 /// Every key of a flexible table (besides `type`).
-pub(super) const KEYS: [&str; 42] = [
+pub(super) const KEYS: [&str; 43] = [
     "preset",
     "position",
     "look_at",
     "up",
+    "converge",
     "fov",
     "width",
     "h_fov",
@@ -91,7 +92,8 @@ const BLEND_NAMES: [&str; 2] = ["piecewise", "bezier"];
 /// re-parameterisations).
 fn preset_keys(name: &str) -> &'static [&'static str] {
     match name {
-        "perspective" | "inverse_perspective" | "fisheye" => &["fov"],
+        "perspective" | "fisheye" => &["fov"],
+        "inverse_perspective" => &["fov", "converge"],
         "orthographic" => &["width"],
         "off_axis" => &["fov", "shift"],
         "twist" => &["fov", "twist"],
@@ -465,6 +467,32 @@ fn preset_angle_map(src: &Source, raw: &RawProjection, name: &Spanned<String>) -
     Ok(reparam)
 }
 
+/// `converge` of the inverse perspective: the point its projectors meet. Required, with a
+/// message that says what to write: before it existed the projectors met at `look_at`, so a
+/// scene written then gets that point spelled out (`look_at` now only aims the camera).
+fn converge(required: &Required) -> Result<DVec3> {
+    let (src, raw) = (required.src, required.raw());
+    match &raw.converge {
+        Some(point) => src.dvec3(point, "converge"),
+        None => {
+            let old = raw.look_at.as_ref().map_or_else(
+                || "the point they should meet".to_string(),
+                |l| {
+                    let [x, y, z] = *l.get_ref();
+                    format!("[{x:?}, {y:?}, {z:?}] (this table's look_at, where they met before)")
+                },
+            );
+            Err(src.error(
+                &required.table.span(),
+                format!(
+                    "flexible inverse_perspective needs `converge = [x, y, z]`, the point its \
+                     projectors meet (look_at only aims the camera): add converge = {old}"
+                ),
+            ))
+        }
+    }
+}
+
 /// A preset with its camera frame and parameters (already checked to belong to it).
 fn preset(required: &Required, name: &str) -> Result<PresetSpec> {
     let src = required.src;
@@ -481,6 +509,7 @@ fn preset(required: &Required, name: &str) -> Result<PresetSpec> {
         },
         "inverse_perspective" => Preset::InversePerspective {
             fov: number(&raw.fov, "fov")?,
+            converge: converge(required)?,
         },
         "orthographic" => Preset::Orthographic {
             width: number(&raw.width, "width")?,

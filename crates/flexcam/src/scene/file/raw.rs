@@ -71,6 +71,8 @@ pub struct RawProjection {
     pub look_at: Option<Vec3Value>,
     #[serde(default, deserialize_with = "strict")]
     pub up: Option<Vec3Value>,
+    #[serde(default, deserialize_with = "strict")]
+    pub converge: Option<Vec3Value>,
     pub fov: Option<Spanned<f64>>,
     pub width: Option<Spanned<f64>>,
     pub h_fov: Option<Spanned<f64>>,
@@ -350,6 +352,7 @@ impl RawProjection {
             ("position", self.position.as_ref().map(Spanned::span)),
             ("look_at", self.look_at.as_ref().map(Spanned::span)),
             ("up", self.up.as_ref().map(Spanned::span)),
+            ("converge", self.converge.as_ref().map(Spanned::span)),
             ("fov", self.fov.as_ref().map(Spanned::span)),
             ("width", self.width.as_ref().map(Spanned::span)),
             ("h_fov", self.h_fov.as_ref().map(Spanned::span)),

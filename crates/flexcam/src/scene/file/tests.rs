@@ -5,6 +5,7 @@ use std::path::Path;
 use glam::{Affine3A, DVec3, Vec3};
 
 use super::*;
+use crate::projection::flexible::{Preset, VolumeSource};
 use crate::projection::ProjectionSpec;
 use crate::scene::{Finish, Light, Pattern};
 
@@ -322,6 +323,42 @@ fn new_flexible_presets_parse_with_their_keys() {
         let s = scene(&format!("{head}{body}"));
         assert_eq!(s.projection.kind(), "flexible", "{body}");
     }
+}
+
+/// `converge` of the inverse perspective: required, the missing key's message spelling out
+/// the line that keeps a scene written before it existed (its look_at); the projectors meet
+/// there, not at look_at; `converge` belongs to that preset only.
+#[test]
+fn inverse_perspective_needs_converge() {
+    let head = "[projection]\ntype = \"flexible\"\nposition = [0, 1, 5]\nlook_at = [0, 1, 0]\n";
+    let body = "preset = \"inverse_perspective\"\nfov = 40\n";
+    assert_error_at(
+        &format!("{head}{body}"),
+        1,
+        1,
+        "needs `converge = [x, y, z]`, the point its projectors meet (look_at only aims the \
+         camera): add converge = [0.0, 1.0, 0.0] (this table's look_at",
+    );
+    let s = scene(&format!("{head}{body}converge = [0, 1, -20]\n"));
+    let ProjectionSpec::Flexible(spec) = &s.projection else {
+        panic!("{:?}", s.projection);
+    };
+    let VolumeSource::Preset(p) = &spec.source else {
+        panic!("{:?}", spec.source);
+    };
+    assert_eq!(
+        p.preset,
+        Preset::InversePerspective {
+            fov: 40.0,
+            converge: DVec3::new(0.0, 1.0, -20.0),
+        }
+    );
+    assert_error_at(
+        &format!("{head}preset = \"perspective\"\nfov = 40\nconverge = [0, 1, -20]\n"),
+        7,
+        12,
+        "`converge` is not a parameter of flexible preset \"perspective\"",
+    );
 }
 
 #[test]

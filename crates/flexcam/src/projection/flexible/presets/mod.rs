@@ -5,8 +5,10 @@
 //! `position`), with U = 2u - 1 and V = 2v - 1 in [-1, 1] and control surfaces at the
 //! distances `clip = [n, f]` along the view direction (radii for the panoramas):
 //! - perspective: rectangles Q_d = d (U tan(fov/2), V tan(fov/2) H/W, 1);
-//! - inverse perspective: Q_d = ((e - d) U tan(fov/2), (e - d) V tan(fov/2) H/W, d), the
-//!   projectors converging at `look_at`, e = |look_at - position| (n < f <= e);
+//! - inverse perspective: Q_d = ((e - d) U tan(fov/2) + c_x d / e,
+//!   (e - d) V tan(fov/2) H/W + c_y d / e, d), the projectors converging at the point
+//!   `converge` = (c_x, c_y, e) (camera-local, e > 0 its depth; n < f <= e); `look_at` only
+//!   aims the camera, as for every other preset;
 //! - orthographic: Q_d = (U w/2, V w/2 H/W, d);
 //! - oblique: Q_d = (U w/2 - alpha d, V w/2 H/W - beta d, d): image (x + alpha z, y + beta z);
 //! - pushbroom: Q_d = (U w/2, V d tan(v_fov/2), d): projectors meet the slit y = z = 0;
@@ -82,11 +84,14 @@ pub enum Preset {
         /// Horizontal angle of view, degrees.
         fov: f64,
     },
-    /// Rectangles shrinking with distance, the projectors meeting at `look_at`: far things
+    /// Rectangles shrinking with distance, the projectors meeting at `converge`: far things
     /// look larger.
     InversePerspective {
         /// Horizontal angle at which the projectors converge, degrees.
         fov: f64,
+        /// The world point where the projectors meet, in front of the eye (its depth along
+        /// the view direction is where the volume ends).
+        converge: DVec3,
     },
     /// Parallel projectors along the view direction.
     Orthographic {
@@ -315,13 +320,11 @@ fn angle(preset: &Preset, key: &str, degrees: f64, max: UpTo) -> Result<f64> {
     angle_radians(&format!("flexible {}", preset.name()), key, degrees, max)
 }
 
-/// Where a preset's surfaces go: the camera basis, the clip distances and the distance
-/// from the eye to `look_at`.
+/// Where a preset's surfaces go: the camera basis and the clip distances.
 struct Placement {
     basis: CameraBasis,
     near: f64,
     far: f64,
-    focus: f64,
 }
 
 impl Placement {
@@ -353,9 +356,25 @@ impl Placement {
     }
 }
 
+/// The inverse perspective's `converge` in camera-local coordinates (x right, y up, z the
+/// depth along the view direction). Errors: a point on or behind the eye's plane (z <= 0:
+/// the projectors would meet behind the camera), or not finite.
+fn converge_local(basis: &CameraBasis, converge: DVec3) -> Result<DVec3> {
+    let local = basis.to_local(converge - basis.origin);
+    if !(local.is_finite() && local.z > 0.0) {
+        return Err(Error::new(format!(
+            "flexible inverse_perspective converge [{}, {}, {}] must lie in front of the eye \
+             (its depth along the view direction is {})",
+            converge.x, converge.y, converge.z, local.z
+        )));
+    }
+    Ok(local)
+}
+
 impl PresetSpec {
-    /// The camera basis and clip range. Errors: a degenerate frame, a clip range that is not
-    /// 0 <= near < far.
+    /// The camera basis and clip range (the inverse perspective's default ends at the depth
+    /// of `converge`). Errors: a degenerate frame, a clip range that is not 0 <= near < far,
+    /// an inverse perspective's `converge` not in front of the eye.
     fn placement(&self) -> Result<Placement> {
         let frame = match self.preset {
             Preset::Axonometric {
@@ -364,22 +383,17 @@ impl PresetSpec {
             _ => self.frame,
         };
         let basis = CameraBasis::new(&frame)?;
-        let focus = (frame.look_at - frame.position).length();
-        let [near, far] = self.clip.unwrap_or(match self.preset {
-            Preset::InversePerspective { .. } => [0.0, focus],
-            _ => [0.0, DEFAULT_FAR],
-        });
+        let default_far = match self.preset {
+            Preset::InversePerspective { converge, .. } => converge_local(&basis, converge)?.z,
+            _ => DEFAULT_FAR,
+        };
+        let [near, far] = self.clip.unwrap_or([0.0, default_far]);
         if !(near.is_finite() && far.is_finite() && 0.0 <= near && near < far) {
             return Err(Error::new(format!(
                 "flexible clip must be [near, far] with 0 <= near < far, got [{near}, {far}]"
             )));
         }
-        Ok(Placement {
-            basis,
-            near,
-            far,
-            focus,
-        })
+        Ok(Placement { basis, near, far })
     }
 
     /// The presets that are shape-defined panoramas, as those panoramas, with the preset's
@@ -502,7 +516,7 @@ impl PresetSpec {
     pub fn surfaces(&self, aspect: f64) -> Result<(Surface, Surface)> {
         let p = &self.preset;
         let place = self.placement()?;
-        let (b, near, far, focus) = (&place.basis, place.near, place.far, place.focus);
+        let (b, near, far) = (&place.basis, place.near, place.far);
         let centre = |d: f64| b.origin + d * b.forward;
         let rect = |d: f64, half: DVec2, shift: DVec2| place.rect(d, half, shift);
         let pair = |f: &dyn Fn(f64) -> Surface| (f(near), f(far));
@@ -537,15 +551,18 @@ impl PresetSpec {
                 let h = (0.5 * angle(p, "fov", fov, UpTo::Below(180.0))?).tan();
                 pair(&|d| rect(d, d * DVec2::new(h, h * aspect), DVec2::ZERO))
             }
-            Preset::InversePerspective { fov } => {
+            Preset::InversePerspective { fov, converge } => {
                 let h = (0.5 * angle(p, "fov", fov, UpTo::Below(180.0))?).tan();
-                if far > focus {
+                let c = converge_local(b, converge)?;
+                if far > c.z {
                     return Err(Error::new(format!(
                         "flexible inverse_perspective far clip {far} is beyond the point \
-                         the projectors meet (look_at, at distance {focus})"
+                         the projectors meet (converge, at depth {} along the view)",
+                        c.z
                     )));
                 }
-                pair(&|d| rect(d, (focus - d) * DVec2::new(h, h * aspect), DVec2::ZERO))
+                let towards = DVec2::new(c.x, c.y) / c.z;
+                pair(&|d| rect(d, (c.z - d) * DVec2::new(h, h * aspect), d * towards))
             }
             Preset::Orthographic { width } | Preset::Axonometric { width, .. } => {
                 let w = 0.5 * positive_length(&format!("flexible {}", p.name()), "width", width)?;
