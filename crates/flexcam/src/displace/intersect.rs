@@ -433,12 +433,12 @@ impl<'a> DisplacedTriangle<'a> {
     /// The boxes the prepared scene keeps: those of its internal nodes down to depth `min(L -
     /// 1, 4)` (a leaf-parent's children are tested directly, without boxes), in level order,
     /// each rounded outward to f32 (so it still contains its node's micro-geometry): `1`,
-    /// `5`, `21`, `85` or `341` boxes, at most 8,184 bytes. Up to level [`EXACT_LEVEL`] they
+    /// `5`, `21`, `85` or `341` boxes, at most 8,184 bytes. Up to level 6 (`EXACT_LEVEL`) they
     /// are exact: the boxes of the node's displaced micro-vertices, computed once here from
-    /// all of them ([`Self::exact_boxes`]), so a ray enters far fewer nodes than through the
+    /// all of them (`exact_boxes`), so a ray enters far fewer nodes than through the
     /// conservative boxes (positions, normal cone, height range over the node's uv
     /// rectangle) the hierarchy computes per ray. Above it they are those conservative boxes,
-    /// down to depth 3 ([`Self::conservative_boxes`]).
+    /// down to depth 3 (`conservative_boxes`).
     pub fn kept_boxes(&self) -> KeptBoxes {
         if self.displacement.level() <= EXACT_LEVEL {
             self.exact_boxes()
