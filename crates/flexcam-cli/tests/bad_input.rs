@@ -531,6 +531,8 @@ fn a_correspondence_behind_the_eye_is_refused_or_shown_in_the_residual() {
     assert!(example.contains(cube_centre));
     // The camera is at [0, 5.5, 7]: the cube's centre mirrored through it.
     let behind = format!("{cube_centre}\n    {{ uv = [0.5, 0.6], point = [0.0, 10.0, 14.0] }},");
+    // The error names the `[projection]` table's line (the fit is that table's).
+    let projection_line = 1 + example.lines().position(|l| l == "[projection]").unwrap();
     for starts in ["kept", "eye", "pinhole", "free", "auto"] {
         let scene = example.replace(cube_centre, &behind).replace(
             "interpolation = \"bilinear\"",
@@ -543,9 +545,11 @@ fn a_correspondence_behind_the_eye_is_refused_or_shown_in_the_residual() {
                 &dir,
                 &args,
                 1,
-                "flexcam: scene.toml:16:1: correspondence 6: no projector of the grid can reach \
-                 [0, 10, 14] at [0.5, 0.6] (the fitted projector points away from it; the \
-                 correspondences contradict each other)",
+                &format!(
+                    "flexcam: scene.toml:{projection_line}:1: correspondence 6: no projector of \
+                     the grid can reach [0, 10, 14] at [0.5, 0.6] (the fitted projector points \
+                     away from it; the correspondences contradict each other)"
+                ),
             );
             continue;
         }

@@ -37,8 +37,9 @@ pub struct ReprojectArgs {
     #[arg(help_heading = "Photo", long, value_name = "DEGREES")]
     input_h_fov: Option<f64>,
     /// Equirectangular photos: the latitude range down the photo; cylindrical photos: the
-    /// vertical angle at the photo's centre; degrees. Default: square pixels at the centre
-    /// (equirectangular 360 x 180 for a 2:1 photo).
+    /// vertical angle at the photo's centre; degrees. Default: for a whole equirectangular
+    /// panorama (no --input-h-fov) 180, whatever the photo's shape; otherwise square pixels
+    /// at the centre.
     #[arg(help_heading = "Photo", long, value_name = "DEGREES")]
     input_v_fov: Option<f64>,
     /// Fisheye photos: the angle across the image circle, degrees (default 180).
@@ -126,7 +127,10 @@ impl ReprojectArgs {
             },
             _ => PhotoProjection::Equirectangular {
                 h_fov,
-                v_fov: self.input_v_fov.unwrap_or(h_fov * aspect),
+                v_fov: self.input_v_fov.unwrap_or(match self.input_h_fov {
+                    None => 180.0,
+                    Some(_) => h_fov * aspect,
+                }),
             },
         })
     }
