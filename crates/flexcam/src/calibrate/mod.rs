@@ -9,6 +9,7 @@
 //! correspondences (through the projection layer's [`GridFitter`] seam), and returns the
 //! fits' residuals and warnings as a typed [`BuildReport`].
 
+mod fit_memo;
 pub mod grid;
 
 use std::cell::RefCell;
@@ -62,7 +63,9 @@ impl GridFitter for GridFit {
         correspondences: &[Correspondence],
         starts: Starts,
     ) -> Result<(ProjectorGrid, BuildReport)> {
-        let (grid, report) = grid::fit_with(prior, correspondences, starts)?;
+        let (grid, report) = fit_memo::fitted(prior, correspondences, starts, || {
+            grid::fit_with(prior, correspondences, starts)
+        })?;
         self.reports.borrow_mut().push(report);
         Ok((grid, build_report(&report)))
     }

@@ -94,6 +94,7 @@
 use glam::DVec3;
 use nalgebra::{DMatrix, DVector};
 
+use super::cholesky::Factor;
 use super::{Correspondence, FitReport};
 use crate::error::{Error, Result};
 use crate::projection::flexible::projector_grid::ProjectorGrid;
@@ -677,7 +678,7 @@ impl<'a> Problem<'a> {
         for i in 0..system.nrows() {
             system[(i, i)] += damping * normal[(i, i)].max(f64::MIN_POSITIVE);
         }
-        let delta = system.cholesky()?.solve(&-gradient);
+        let delta = Factor::new(system)?.solve(&-gradient);
         let nodes: Vec<Node> = state
             .nodes
             .iter()

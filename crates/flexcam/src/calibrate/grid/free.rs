@@ -170,6 +170,9 @@ struct Problem<'a> {
     /// over the square root of the node count (unit length); and its weight.
     slide: DVector<f64>,
     slide_weight: f64,
+    /// The slide penalty's matrix is `slide_root slide_root^T`: `slide` times the square
+    /// root of its weight.
+    slide_root: DVector<f64>,
     /// L: the rms distance from the prior's starts to the points.
     length: f64,
     /// l: the prior's mean projector length.
@@ -228,6 +231,7 @@ impl<'a> Problem<'a> {
             origins: prior.starts().to_vec(),
             slide,
             slide_weight: 0.0,
+            slide_root: DVector::zeros(n),
             length,
             scale,
             smooth: DMatrix::zeros(n, n),
@@ -246,6 +250,7 @@ impl<'a> Problem<'a> {
         let mean = (data.trace() / n as f64).max(f64::MIN_POSITIVE);
         problem.mu = smoothness * mean;
         problem.slide_weight = mean;
+        problem.slide_root = mean.sqrt() * &problem.slide;
         (problem.rows, problem.constant) = problem.second_differences();
         let (rows, constant, mu) = (&problem.rows, &problem.constant, problem.mu);
         problem.smooth = mu * rows.transpose() * rows;
@@ -311,7 +316,7 @@ impl<'a> Problem<'a> {
     fn freedom(&self, y: &DVector<f64>) -> f64 {
         let (data, _) = self.data_term(y);
         let (model, _) = self.linearise(y);
-        model
+        self.with_slide(model)
             .cholesky()
             .map_or(f64::INFINITY, |factor| factor.solve(&data).trace())
     }
@@ -473,12 +478,24 @@ impl<'a> Problem<'a> {
     /// The model's Gauss-Newton matrix and gradient at `y`: data, smoothness and the common
     /// slide's penalty, no pull (what the nodes are determined by).
     fn linearise_model(&self, y: &DVector<f64>) -> (DMatrix<f64>, DVector<f64>) {
+        let (matrix, gradient) = self.banded_model(y);
+        (self.with_slide(matrix), gradient)
+    }
+
+    /// [`Problem::linearise_model`] less the slide penalty's matrix (a rank-one term over
+    /// every start, outside the grid's band: [`Problem::slide_root`]).
+    fn banded_model(&self, y: &DVector<f64>) -> (DMatrix<f64>, DVector<f64>) {
         let (matrix, gradient) = self.data_term(y);
         let slide = self.slide_weight * &self.slide;
         (
-            matrix + &self.smooth + &slide * self.slide.transpose(),
+            matrix + &self.smooth,
             gradient + &self.smooth * y + &self.smooth_c + slide * self.slide.dot(y),
         )
+    }
+
+    /// `matrix` plus the slide penalty's matrix.
+    fn with_slide(&self, matrix: DMatrix<f64>) -> DMatrix<f64> {
+        matrix + &self.slide_root * self.slide_root.transpose()
     }
 }
 
@@ -505,12 +522,16 @@ impl LeastSquares for Problem<'_> {
     }
 
     fn linearise(&self, y: &DVector<f64>) -> (DMatrix<f64>, DVector<f64>) {
-        let (mut matrix, mut gradient) = self.linearise_model(y);
+        let (mut matrix, mut gradient) = self.banded_model(y);
         for i in 0..y.len() {
             matrix[(i, i)] += self.pull[i];
             gradient[i] += self.pull[i] * (y[i] - self.prior_y[i]);
         }
         (matrix, gradient)
+    }
+
+    fn rank_one(&self) -> Option<&DVector<f64>> {
+        Some(&self.slide_root)
     }
 }
 

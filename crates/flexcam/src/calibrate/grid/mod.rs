@@ -89,7 +89,9 @@ mod angular;
 mod blocked_cholesky;
 mod camera_matrix;
 mod central;
+mod cholesky;
 mod curved;
+mod envelope_cholesky;
 mod folds;
 mod free;
 

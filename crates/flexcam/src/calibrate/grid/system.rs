@@ -1,7 +1,7 @@
 use glam::{DVec2, DVec3};
 use nalgebra::{DMatrix, DVector};
 
-use super::blocked_cholesky::Factor;
+use super::cholesky::Factor;
 use super::{Correspondence, FitReport, PRIOR_SPREAD, PRIOR_WEIGHT};
 use crate::error::{Error, Result};
 use crate::projection::flexible::ProjectorGrid;
