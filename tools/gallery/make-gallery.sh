@@ -75,6 +75,25 @@ position = [0.0, 5.0, 9.0]
 look_at = [0.0, 0.5, 0.0]
 fov = 60.0')" -o "$out/detail-in-context-perspective.png"
 
+# Views through a ball: the trilinear grid, and beside it a 90-degree pinhole at the grid's
+# eye looking at a real mirror (glass) sphere of the ball's size and place, ray cast.
+ball_views=(
+  'mirror [0.4, 1.5, 1.6] [0.0, 1.0, 0.0]'
+)
+for view in "${ball_views[@]}"; do
+  optic=${view%% *}
+  eye=$(echo "$view" | sed 's/^[a-z]* \(\[[^]]*\]\) .*/\1/')
+  center=${view##* [}
+  center="[$center"
+  printf '\n[[object]]\nname = "ball"\nshape = "sphere"\nsize = 1.0\ntessellation = 96\nmaterial = "%s"\ncolor = [0.95, 0.95, 0.95]\ntranslate = %s\n' \
+    "$optic" "$center" >"$work/ball-$optic.toml"
+  render "scenes/trilinear-sphere-$optic.toml" --method trilinear -o "$out/sphere-$optic.png"
+  render "$(variant "scenes/trilinear-sphere-$optic.toml" "sphere-$optic-persp" "type = \"perspective\"
+position = $eye
+look_at = $center
+fov = 90.0" "\$r $work/ball-$optic.toml")" -o "$out/sphere-$optic-perspective.png"
+done
+
 # Funny mirror: beside it the same camera looking at a flat mirror box of the same size.
 mirror_view=$(sed -n '/^\[projection\]/,/^$/p' scenes/reflect-funny-mirror.toml | sed 1d)
 render scenes/reflect-funny-mirror.toml -o "$out/funny-mirror.png"

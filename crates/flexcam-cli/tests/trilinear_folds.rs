@@ -1,5 +1,7 @@
 //! `--method trilinear` on projection triangles whose rays fold or collapse, against the ray
-//! caster through the binary; and `flexcam project`, which lists every image of a point.
+//! caster through the binary (the appendix C configurations, the visualisation surfaces, the
+//! views through a mirror and a glass ball); and `flexcam project`, which lists every image
+//! of a point.
 
 use std::path::{Path, PathBuf};
 
@@ -125,6 +127,61 @@ fn inward_sphere_pole_rows_are_drawn_as_fans() {
     assert_eq!(stats["fallback_triangles"], 0, "{stats}");
     assert_eq!(stats["central_triangles"], 1104, "{stats}");
     assert!(agreement >= 0.995, "{agreement}");
+}
+
+/// The mirror ball of Figure 7.4 (`view = "sphere_mirror"`): its reflected rays diverge and
+/// never cross, so every projection triangle is drawn by its shapes.
+#[test]
+fn sphere_mirror_is_drawn_by_its_shapes() {
+    let (stats, agreement) = trilinear_against_raycast(&scene("trilinear-sphere-mirror.toml"));
+    assert_eq!(stats["projection_triangles"], 512, "{stats}");
+    assert_eq!(stats["fallback_triangles"], 0, "{stats}");
+    assert!(stats["shapes"].as_u64().unwrap() > 0, "{stats}");
+    assert!(agreement >= 0.995, "{agreement}");
+}
+
+/// `exact = true` renders the exact ball by ray casting, which the grid approaches: at the
+/// scenes' 16 x 16 grids the ids agree away from id edges on nearly every pixel; the exact
+/// view has no triangles to rasterise, so `--method trilinear` refuses it with one line.
+#[test]
+fn exact_balls_are_what_the_grids_approach() {
+    let dir = TempDir::new().unwrap();
+    for name in ["trilinear-sphere-mirror.toml"] {
+        let path = scene(name);
+        let flat = ["--shading", "flat", "-o", "x.png"];
+        run_ok(
+            &dir,
+            &[&["render", &path, "--ids", "grid.png"][..], &flat].concat(),
+        );
+        run_ok(
+            &dir,
+            &[
+                &["render", &path, "-D", "projection.exact=true"][..],
+                &["--ids", "exact.png"],
+                &flat,
+            ]
+            .concat(),
+        );
+        let (grid, exact) = (ids(&dir, "grid.png"), ids(&dir, "exact.png"));
+        let (width, height) = exact.dimensions();
+        let (agreement, interior) =
+            flexcam::render::interior_id_agreement(width, height, grid.as_raw(), exact.as_raw())
+                .unwrap();
+        assert!(interior > 10_000, "{name}: {interior}");
+        assert!(agreement >= 0.99, "{name}: {agreement}");
+        let args = [
+            "render",
+            &path,
+            "-D",
+            "projection.exact=true",
+            "--method",
+            "trilinear",
+        ];
+        let out = run(&dir, &args);
+        assert_eq!(out.status.code(), Some(1), "{name}");
+        let stderr = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(stderr.trim().lines().count(), 1, "{name}: {stderr}");
+    }
 }
 
 /// The lines of `flexcam project SCENE X,Y,Z` in `dir`: `x y depth` each.
