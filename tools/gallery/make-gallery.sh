@@ -79,6 +79,7 @@ fov = 60.0')" -o "$out/detail-in-context-perspective.png"
 # eye looking at a real mirror (glass) sphere of the ball's size and place, ray cast.
 ball_views=(
   'mirror [0.4, 1.5, 1.6] [0.0, 1.0, 0.0]'
+  'glass [0.3, 2.0, 2.6] [0.0, 1.6, 0.0]'
 )
 for view in "${ball_views[@]}"; do
   optic=${view%% *}

@@ -13,3 +13,6 @@ labels="relative RGB error,id agreement away from id edges"
 $plot "$dir/trilinear-sweep-reflection.csv" "$dir/trilinear-figure7-4-sweep.svg" --x n \
     --y rgb_error,ids_interior --log-x --log-y --x-label "N (N x N grid)" --y-label "$labels" \
     --title "Figure 7.4: mirror ball against N,Figure 7.4: mirror ball against N"
+$plot "$dir/trilinear-sweep-refraction.csv" "$dir/trilinear-sweep-refraction.svg" --x n \
+    --y rgb_error,ids_interior --log-x --log-y --x-label "N (N x N grid)" --y-label "$labels" \
+    --title "7.3.3: glass ball against N,7.3.3: glass ball against N"

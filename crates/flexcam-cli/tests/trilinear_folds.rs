@@ -140,13 +140,30 @@ fn sphere_mirror_is_drawn_by_its_shapes() {
     assert!(agreement >= 0.995, "{agreement}");
 }
 
+/// The glass ball (`view = "sphere_glass"`, 7.3.3) focuses its rays: where the rays of a
+/// projection triangle cross, its parametric triangle degenerates at that depth, and the
+/// pairs with scene triangles reaching across it are unprojectable: those projection
+/// triangles (151 of the 512) are ray cast (`fallback_triangles`), the rest drawn by shapes.
+#[test]
+fn sphere_glass_ray_casts_only_the_triangles_whose_rays_cross() {
+    let (stats, agreement) = trilinear_against_raycast(&scene("trilinear-sphere-glass.toml"));
+    let fallback = stats["fallback_triangles"].as_u64().unwrap();
+    assert!(fallback > 0 && fallback < 512 / 2, "{stats}");
+    assert!(stats["unprojectable"].as_u64().unwrap() > 0, "{stats}");
+    assert!(stats["shapes"].as_u64().unwrap() > 0, "{stats}");
+    assert!(agreement >= 0.995, "{agreement}");
+}
+
 /// `exact = true` renders the exact ball by ray casting, which the grid approaches: at the
 /// scenes' 16 x 16 grids the ids agree away from id edges on nearly every pixel; the exact
 /// view has no triangles to rasterise, so `--method trilinear` refuses it with one line.
 #[test]
 fn exact_balls_are_what_the_grids_approach() {
     let dir = TempDir::new().unwrap();
-    for name in ["trilinear-sphere-mirror.toml"] {
+    for name in [
+        "trilinear-sphere-mirror.toml",
+        "trilinear-sphere-glass.toml",
+    ] {
         let path = scene(name);
         let flat = ["--shading", "flat", "-o", "x.png"];
         run_ok(

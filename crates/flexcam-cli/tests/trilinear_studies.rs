@@ -257,6 +257,21 @@ fn reflection_sweep_converges_on_the_exact_mirror_ball() {
     assert_eq!(rows[2]["thesis_ms"], "-");
 }
 
+/// The refraction sweep: the glass ball's grid against the exact glass ball; the error falls
+/// with N, and the projection triangles whose rays cross inside the scene are counted.
+#[test]
+fn refraction_sweep_converges_on_the_exact_glass_ball() {
+    let rows = table("--sweep", "refraction", 96, &["--quick"], &SWEEP_COLUMNS);
+    let errors: Vec<f64> = rows.iter().map(|r| number(r, "rgb_error")).collect();
+    assert!(
+        errors[2] < errors[1] && errors[2] < errors[0] / 5.0,
+        "{errors:?}"
+    );
+    assert!(number(&rows[2], "ids_interior") >= 0.99, "{rows:?}");
+    let fallback: f64 = rows.iter().map(|r| number(r, "fallback_triangles")).sum();
+    assert!(fallback > 0.0, "{rows:?}");
+}
+
 /// `--csv` and `--size` need a study or a sweep, and a study and a sweep do not go together.
 #[test]
 fn csv_needs_one_table() {
