@@ -75,6 +75,10 @@ position = [0.0, 5.0, 9.0]
 look_at = [0.0, 0.5, 0.0]
 fov = 60.0')" -o "$out/detail-in-context-perspective.png"
 
+# Detail in context with an inverse-perspective focus (beside the same pinhole as above).
+render scenes/trilinear-detail-inverse-perspective.toml --method trilinear \
+  -o "$out/detail-inverse-perspective.png"
+
 # Views through a ball: the trilinear grid, and beside it a 90-degree pinhole at the grid's
 # eye looking at a real mirror (glass) sphere of the ball's size and place, ray cast.
 ball_views=(

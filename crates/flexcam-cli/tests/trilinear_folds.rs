@@ -154,6 +154,22 @@ fn sphere_glass_ray_casts_only_the_triangles_whose_rays_cross() {
     assert!(agreement >= 0.995, "{agreement}");
 }
 
+/// Detail in context with an inverse-perspective focus (6.1): the focus rays converge
+/// beyond the cube, and across the band they turn into the diverging context rays, so the
+/// band folds: its few projection triangles (32 of 512) whose parametric triangle
+/// degenerates where the floor lies are ray cast, the rest drawn by shapes.
+#[test]
+fn detail_in_context_inverse_perspective_focus() {
+    let (stats, agreement) =
+        trilinear_against_raycast(&scene("trilinear-detail-inverse-perspective.toml"));
+    assert!(stats["shapes"].as_u64().unwrap() > 1000, "{stats}");
+    assert!(
+        stats["fallback_triangles"].as_u64().unwrap() < 512 / 8,
+        "{stats}"
+    );
+    assert!(agreement >= 0.995, "{agreement}");
+}
+
 /// `exact = true` renders the exact ball by ray casting, which the grid approaches: at the
 /// scenes' 16 x 16 grids the ids agree away from id edges on nearly every pixel; the exact
 /// view has no triangles to rasterise, so `--method trilinear` refuses it with one line.

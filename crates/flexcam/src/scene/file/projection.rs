@@ -54,7 +54,7 @@ const UNSUPPORTED: [&str; 0] = [];
 const MESH_KEYS: [&str; 5] = ["surface", "points", "normals", "screen", "triangles"];
 
 /// Keys of a trilinear projection given as a grid (`grid` and its bases).
-const GRID_KEYS: [&str; 14] = [
+const GRID_KEYS: [&str; 16] = [
     "grid",
     "near",
     "far",
@@ -63,6 +63,8 @@ const GRID_KEYS: [&str; 14] = [
     "focus",
     "inset",
     "magnification",
+    "focus_view",
+    "converge",
     "first",
     "second",
     "band",

@@ -112,6 +112,7 @@ pub struct RawProjection {
     pub second: Option<Spanned<RawCamera>>,
     #[serde(default, deserialize_with = "strict")]
     pub band: Option<Spanned<[f64; 2]>>,
+    pub focus_view: Option<Spanned<String>>,
     pub sphere: Option<Spanned<RawSphere>>,
     pub ior: Option<Spanned<f64>>,
     pub exact: Option<Spanned<bool>>,
@@ -405,6 +406,7 @@ impl RawProjection {
             ("first", self.first.as_ref().map(Spanned::span)),
             ("second", self.second.as_ref().map(Spanned::span)),
             ("band", self.band.as_ref().map(Spanned::span)),
+            ("focus_view", self.focus_view.as_ref().map(Spanned::span)),
             ("sphere", self.sphere.as_ref().map(Spanned::span)),
             ("ior", self.ior.as_ref().map(Spanned::span)),
             ("exact", self.exact.as_ref().map(Spanned::span)),

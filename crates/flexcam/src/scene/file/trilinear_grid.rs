@@ -12,7 +12,8 @@ use super::raw::RawCamera;
 use super::source::Source;
 use crate::error::{Error, Result};
 use crate::projection::trilinear_builders::{
-    between_surfaces, screen_grid, BallOptic, BallView, DetailInContext, GridCamera, TwoViews,
+    between_surfaces, screen_grid, BallOptic, BallView, DetailInContext, FocusView, GridCamera,
+    TwoViews,
 };
 use crate::projection::{CameraFrame, ProjectionSpec};
 
@@ -20,12 +21,22 @@ use crate::projection::{CameraFrame, ProjectionSpec};
 const VIEWS: [(&str, &[&str]); 4] = [
     (
         "detail_in_context",
-        &["camera", "focus", "inset", "magnification"],
+        &[
+            "camera",
+            "focus",
+            "inset",
+            "magnification",
+            "focus_view",
+            "converge",
+        ],
     ),
     ("two_views", &["first", "second", "band"]),
     ("sphere_mirror", &["camera", "sphere", "exact"]),
     ("sphere_glass", &["camera", "sphere", "ior", "exact"]),
 ];
+
+/// The focus views of `detail_in_context` (`focus_view`).
+const FOCUS_VIEWS: [&str; 2] = ["orthographic", "inverse_perspective"];
 
 /// Keys of a grid over two control surfaces (besides `grid`).
 const SURFACE_KEYS: [&str; 2] = ["near", "far"];
@@ -103,7 +114,7 @@ pub(super) fn convert(required: &Required, cells: &Spanned<u32>) -> Result<Proje
 }
 
 /// The surface of `view = "detail_in_context"`: `camera`, `focus`, `inset`,
-/// `magnification`.
+/// `magnification`, and `focus_view` with its `converge`.
 fn detail_in_context(required: &Required) -> Result<DetailInContext> {
     let (src, raw) = (required.src, required.raw());
     let table = required.get(&raw.camera, "camera")?;
@@ -122,17 +133,41 @@ fn detail_in_context(required: &Required) -> Result<DetailInContext> {
         .magnification
         .as_ref()
         .map_or(Ok(3.0), |m| src.number(m, "magnification"))?;
-    DetailInContext::new(camera, focus, inset, magnification, distance).map_err(|e| {
-        let key = if e.message.contains("magnification") {
-            raw.magnification.as_ref().map(Spanned::span)
-        } else if e.message.contains("inset") {
-            raw.inset.as_ref().map(Spanned::span)
-        } else {
-            Some(table.span())
-        };
-        let at = key.unwrap_or_else(|| required.table.span());
-        src.error(&at, e.message)
-    })
+    let surface =
+        DetailInContext::new(camera, focus, inset, magnification, distance).map_err(|e| {
+            let key = if e.message.contains("magnification") {
+                raw.magnification.as_ref().map(Spanned::span)
+            } else if e.message.contains("inset") {
+                raw.inset.as_ref().map(Spanned::span)
+            } else {
+                Some(table.span())
+            };
+            let at = key.unwrap_or_else(|| required.table.span());
+            src.error(&at, e.message)
+        })?;
+    let inverse = match &raw.focus_view {
+        None => false,
+        Some(v) => match v.get_ref().as_str() {
+            "orthographic" => false,
+            "inverse_perspective" => true,
+            other => return Err(src.unknown(&v.span(), "focus_view", other, &FOCUS_VIEWS)),
+        },
+    };
+    match (&raw.converge, inverse) {
+        (Some(given), false) => Err(src.error(
+            &given.span(),
+            "`converge` is the point an inverse-perspective focus converges on: it needs \
+             focus_view = \"inverse_perspective\"",
+        )),
+        (None, false) => Ok(surface),
+        (_, true) => {
+            let given = required.get(&raw.converge, "converge")?;
+            let converge = src.dvec3(given, "converge")?;
+            surface
+                .with_focus_view(FocusView::InversePerspective { converge })
+                .map_err(|e| src.error(&given.span(), e.message))
+        }
+    }
 }
 
 /// The view of `view = "sphere_mirror"` (or `"sphere_glass"` when `glass`): `camera`,
@@ -311,6 +346,29 @@ mod tests {
     }
 
     #[test]
+    fn inverse_perspective_focus() {
+        let camera = "{ position = [0, 2, 6], look_at = [0, 1, 0], h_fov = 60, v_fov = 45 }";
+        let converge = DVec3::new(0.0, 1.0, -2.0);
+        let m = mesh(&format!(
+            "grid = 6\nview = \"detail_in_context\"\ncamera = {camera}\n\
+             focus_view = \"inverse_perspective\"\nconverge = [0, 1, -2]\n"
+        ));
+        // The focus centre (vertex 24) looks at the convergence point.
+        let to = converge - m.points[24];
+        assert!(to.cross(m.normals[24]).length() < 1e-12 * to.length());
+        assert!(to.dot(m.normals[24]) > 0.0);
+        let ortho = mesh(&format!(
+            "grid = 6\nview = \"detail_in_context\"\ncamera = {camera}\nfocus_view = \"orthographic\"\n"
+        ));
+        assert_eq!(
+            ortho,
+            mesh(&format!(
+                "grid = 6\nview = \"detail_in_context\"\ncamera = {camera}\n"
+            ))
+        );
+    }
+
+    #[test]
     fn view_errors_are_positioned() {
         let mirror = |rest: &str| {
             format!("grid = 2\nview = \"sphere_mirror\"\ncamera = {BALL_CAMERA}\n{rest}")
@@ -358,6 +416,33 @@ mod tests {
             7,
             9,
             "`exact` is not a parameter of view \"two_views\"",
+        );
+        let detail = |rest: &str| {
+            format!("grid = 2\nview = \"detail_in_context\"\ncamera = {{ position = [0, 2, 6], look_at = [0, 1, 0], h_fov = 60, v_fov = 45 }}\n{rest}")
+        };
+        error_at(
+            &detail("focus_view = \"fisheye\"\n"),
+            6,
+            14,
+            "unknown focus_view \"fisheye\"",
+        );
+        error_at(
+            &detail("converge = [0, 1, -2]\n"),
+            6,
+            12,
+            "needs focus_view = \"inverse_perspective\"",
+        );
+        error_at(
+            &detail("focus_view = \"inverse_perspective\"\n"),
+            1,
+            1,
+            "needs `converge`",
+        );
+        error_at(
+            &detail("focus_view = \"inverse_perspective\"\nconverge = [0, 2, 6]\n"),
+            7,
+            12,
+            "beyond the base plane",
         );
     }
 

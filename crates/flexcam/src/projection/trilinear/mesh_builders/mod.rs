@@ -31,4 +31,4 @@ pub(crate) use reflector::vertex_normals;
 pub use reflector::{
     reflector_surface, vertex_ray, Optic, ReflectorSurface, SurfaceRays, SurfaceScreenMap,
 };
-pub use visualisation::{inward_sphere, DetailInContext, TwoViews};
+pub use visualisation::{inward_sphere, DetailInContext, FocusView, TwoViews};
