@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use tempfile::TempDir;
 
 mod common;
-use common::{run, run_json, run_ok};
+use common::{interior_agreement, run, run_json, run_ok};
 
 fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
@@ -16,11 +16,6 @@ fn scenes_dir() -> PathBuf {
 
 fn scene(name: &str) -> String {
     scenes_dir().join(name).to_str().expect("UTF-8").to_string()
-}
-
-/// The ids PNG `name` in `dir`.
-fn ids(dir: &TempDir, name: &str) -> image::ImageBuffer<image::Luma<u16>, Vec<u16>> {
-    image::open(dir.path().join(name)).unwrap().into_luma16()
 }
 
 /// Renders `scene` flat with `--method trilinear` (its stats) and with the ray caster, and
@@ -43,11 +38,8 @@ fn trilinear_against_raycast(scene: &str) -> (serde_json::Value, f64) {
         &dir,
         &[&["render", scene, "--ids", "r.png"][..], &flat].concat(),
     );
-    let (method, reference) = (ids(&dir, "t.png"), ids(&dir, "r.png"));
-    let (width, height) = reference.dimensions();
     let (agreement, interior) =
-        flexcam::render::interior_id_agreement(width, height, method.as_raw(), reference.as_raw())
-            .unwrap();
+        interior_agreement(&dir.path().join("r.png"), &dir.path().join("t.png"));
     assert!(interior > 0, "{scene}: no interior pixel");
     (stats, agreement)
 }
@@ -155,18 +147,14 @@ fn sphere_glass_ray_casts_only_the_triangles_whose_rays_cross() {
 }
 
 /// Detail in context with an inverse-perspective focus (6.1): the focus rays converge
-/// beyond the cube, and across the band they turn into the diverging context rays, so the
-/// band folds: its few projection triangles (32 of 512) whose parametric triangle
-/// degenerates where the floor lies are ray cast, the rest drawn by shapes.
+/// beyond the cube, and across the band they turn into the diverging context rays; every
+/// projection triangle is drawn by its shapes.
 #[test]
 fn detail_in_context_inverse_perspective_focus() {
     let (stats, agreement) =
         trilinear_against_raycast(&scene("trilinear-detail-inverse-perspective.toml"));
     assert!(stats["shapes"].as_u64().unwrap() > 1000, "{stats}");
-    assert!(
-        stats["fallback_triangles"].as_u64().unwrap() < 512 / 8,
-        "{stats}"
-    );
+    assert_eq!(stats["fallback_triangles"], 0, "{stats}");
     assert!(agreement >= 0.995, "{agreement}");
 }
 
@@ -195,11 +183,8 @@ fn exact_balls_are_what_the_grids_approach() {
             ]
             .concat(),
         );
-        let (grid, exact) = (ids(&dir, "grid.png"), ids(&dir, "exact.png"));
-        let (width, height) = exact.dimensions();
         let (agreement, interior) =
-            flexcam::render::interior_id_agreement(width, height, grid.as_raw(), exact.as_raw())
-                .unwrap();
+            interior_agreement(&dir.path().join("exact.png"), &dir.path().join("grid.png"));
         assert!(interior > 10_000, "{name}: {interior}");
         assert!(agreement >= 0.99, "{name}: {agreement}");
         let args = [
