@@ -99,6 +99,16 @@ look_at = $center
 fov = 90.0" "\$r $work/ball-$optic.toml")" -o "$out/sphere-$optic-perspective.png"
 done
 
+# Multi-hit reflection: the mirror ball with a second one behind the camera, and beside it
+# the same 90-degree pinhole with both as real mirror spheres, ray cast.
+printf '\n[[object]]\nname = "ball"\nshape = "sphere"\nsize = 1.0\ntessellation = 96\nmaterial = "mirror"\ncolor = [0.95, 0.95, 0.95]\ntranslate = [0.0, 1.0, 0.0]\n\n[[object]]\nname = "second ball"\nshape = "sphere"\nsize = 1.2\ntessellation = 96\nmaterial = "mirror"\ncolor = [0.95, 0.95, 0.95]\ntranslate = [-0.6, 1.6, 3.6]\n' \
+  >"$work/balls-twice.toml"
+render scenes/trilinear-sphere-mirror-twice.toml --method trilinear -o "$out/sphere-mirror-twice.png"
+render "$(variant scenes/trilinear-sphere-mirror-twice.toml sphere-twice-persp 'type = "perspective"
+position = [0.4, 1.5, 1.6]
+look_at = [0.0, 1.0, 0.0]
+fov = 90.0' "\$r $work/balls-twice.toml")" -o "$out/sphere-mirror-twice-perspective.png"
+
 # Funny mirror: beside it the same camera looking at a flat mirror box of the same size.
 mirror_view=$(sed -n '/^\[projection\]/,/^$/p' scenes/reflect-funny-mirror.toml | sed 1d)
 render scenes/reflect-funny-mirror.toml -o "$out/funny-mirror.png"

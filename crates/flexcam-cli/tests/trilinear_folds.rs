@@ -158,6 +158,17 @@ fn detail_in_context_inverse_perspective_focus() {
     assert!(agreement >= 0.995, "{agreement}");
 }
 
+/// Multi-hit reflection (7.2.3): the mirror ball with a second mirror ball (`second_sphere`)
+/// behind the camera; the rays that meet it are reflected again. Drawn by the trilinear
+/// rasteriser, agreeing with the ray caster of the same grid.
+#[test]
+fn sphere_mirror_twice_agrees_with_the_ray_caster() {
+    let (stats, agreement) =
+        trilinear_against_raycast(&scene("trilinear-sphere-mirror-twice.toml"));
+    assert!(stats["shapes"].as_u64().unwrap() > 1000, "{stats}");
+    assert!(agreement >= 0.995, "{agreement}");
+}
+
 /// `exact = true` renders the exact ball by ray casting, which the grid approaches: at the
 /// scenes' 16 x 16 grids the ids agree away from id edges on nearly every pixel; the exact
 /// view has no triangles to rasterise, so `--method trilinear` refuses it with one line.

@@ -54,7 +54,7 @@ const UNSUPPORTED: [&str; 0] = [];
 const MESH_KEYS: [&str; 5] = ["surface", "points", "normals", "screen", "triangles"];
 
 /// Keys of a trilinear projection given as a grid (`grid` and its bases).
-const GRID_KEYS: [&str; 16] = [
+const GRID_KEYS: [&str; 17] = [
     "grid",
     "near",
     "far",
@@ -69,6 +69,7 @@ const GRID_KEYS: [&str; 16] = [
     "second",
     "band",
     "sphere",
+    "second_sphere",
     "ior",
     "exact",
 ];

@@ -114,6 +114,7 @@ pub struct RawProjection {
     pub band: Option<Spanned<[f64; 2]>>,
     pub focus_view: Option<Spanned<String>>,
     pub sphere: Option<Spanned<RawSphere>>,
+    pub second_sphere: Option<Spanned<RawSphere>>,
     pub ior: Option<Spanned<f64>>,
     pub exact: Option<Spanned<bool>>,
     #[serde(default, deserialize_with = "strict")]
@@ -276,7 +277,7 @@ pub struct RawCamera {
 }
 
 /// `sphere = { center = [x, y, z], radius = r }`: the ball of a trilinear grid's view
-/// through a ball (`view = "sphere_mirror"` or `"sphere_glass"`).
+/// through a ball (`view = "sphere_mirror"` or `"sphere_glass"`), and `second_sphere`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawSphere {
@@ -408,6 +409,10 @@ impl RawProjection {
             ("band", self.band.as_ref().map(Spanned::span)),
             ("focus_view", self.focus_view.as_ref().map(Spanned::span)),
             ("sphere", self.sphere.as_ref().map(Spanned::span)),
+            (
+                "second_sphere",
+                self.second_sphere.as_ref().map(Spanned::span),
+            ),
             ("ior", self.ior.as_ref().map(Spanned::span)),
             ("exact", self.exact.as_ref().map(Spanned::span)),
             ("shift", self.shift.as_ref().map(Spanned::span)),

@@ -31,7 +31,10 @@ const VIEWS: [(&str, &[&str]); 4] = [
         ],
     ),
     ("two_views", &["first", "second", "band"]),
-    ("sphere_mirror", &["camera", "sphere", "exact"]),
+    (
+        "sphere_mirror",
+        &["camera", "sphere", "second_sphere", "exact"],
+    ),
     ("sphere_glass", &["camera", "sphere", "ior", "exact"]),
 ];
 
@@ -171,7 +174,8 @@ fn detail_in_context(required: &Required) -> Result<DetailInContext> {
 }
 
 /// The view of `view = "sphere_mirror"` (or `"sphere_glass"` when `glass`): `camera`,
-/// `sphere = { center, radius }` and, for glass, `ior` (default 1.5).
+/// `sphere = { center, radius }` and, for a mirror, `second_sphere`, for glass, `ior`
+/// (default 1.5).
 fn ball_view(required: &Required, glass: bool) -> Result<BallView> {
     let (src, raw) = (required.src, required.raw());
     let table = required.get(&raw.camera, "camera")?;
@@ -185,7 +189,7 @@ fn ball_view(required: &Required, glass: bool) -> Result<BallView> {
     } else {
         BallOptic::Mirror
     };
-    BallView::new(camera, center, radius, optic).map_err(|e| {
+    let view = BallView::new(camera, center, radius, optic).map_err(|e| {
         let at = if e.message.starts_with("ior") {
             raw.ior
                 .as_ref()
@@ -196,7 +200,14 @@ fn ball_view(required: &Required, glass: bool) -> Result<BallView> {
             table.span()
         };
         src.error(&at, e.message)
-    })
+    })?;
+    let Some(second) = &raw.second_sphere else {
+        return Ok(view);
+    };
+    let center = src.dvec3(&second.get_ref().center, "center")?;
+    let radius = src.number(&second.get_ref().radius, "radius")?;
+    view.with_second_ball(center, radius)
+        .map_err(|e| src.error(&second.span(), e.message))
 }
 
 /// A camera table: `position`, `look_at`, `up` (default +y) and either `h_fov` and `v_fov`
@@ -384,6 +395,20 @@ mod tests {
             "`ior` is not a parameter of view \"sphere_mirror\"",
         );
         error_at(&glass("ior = 0.5\n"), 7, 7, "ior must be at least 1");
+        error_at(
+            &mirror(&format!(
+                "{SPHERE}\nsecond_sphere = {{ center = [1.5, 1, 0], radius = 1.0 }}\n"
+            )),
+            7,
+            17,
+            "overlaps the first",
+        );
+        error_at(
+            &glass("second_sphere = { center = [0, 1, 9], radius = 1.0 }\n"),
+            7,
+            17,
+            "`second_sphere` is not a parameter of view \"sphere_glass\"",
+        );
         error_at(
             &mirror("sphere = { center = [0, 1, 0], radius = -1.0 }\n"),
             6,

@@ -40,6 +40,10 @@ pub enum BallOptic {
 ///   rounding puts the exit just past the critical angle (rays grazing the sphere), the
 ///   leaving ray is the grazing limit, tangent to the sphere at `q`.
 ///
+/// With a second mirror ball ([`BallView::with_second_ball`]; 7.2.3, multi-hit reflection)
+/// a reflected ray that meets it is reflected once more, from that point; a ray is followed
+/// through two hits at the most (one that would come back to the first ball is not).
+///
 /// Nothing between the eye and the ball, nor inside the glass, is seen: the view starts on
 /// the sphere. Degenerate cases, all errors of [`BallView::new`]: a camera with parallel rays
 /// (the thesis's view has a view point); a radius that is not finite and positive, or a
@@ -54,6 +58,8 @@ pub struct BallView {
     center: DVec3,
     radius: f64,
     optic: BallOptic,
+    /// A second mirror ball: centre and radius.
+    second: Option<(DVec3, f64)>,
 }
 
 impl BallView {
@@ -92,6 +98,7 @@ impl BallView {
             center,
             radius,
             optic,
+            second: None,
         };
         for corner in [DVec2::ZERO, DVec2::X, DVec2::Y, DVec2::ONE] {
             if view.ray(corner).is_none() {
@@ -105,18 +112,55 @@ impl BallView {
         Ok(view)
     }
 
+    /// The same view with a second mirror ball of `radius` around `center`, off which the
+    /// reflected rays that meet it are reflected again. Errors: a glass ball view (its rays
+    /// are refracted, not reflected); a radius that is not finite and positive or a centre
+    /// that is not finite; a second ball that overlaps the first or holds the eye.
+    pub fn with_second_ball(self, center: DVec3, radius: f64) -> Result<Self> {
+        if self.optic != BallOptic::Mirror {
+            return Err(Error::new(
+                "a second ball needs view = \"sphere_mirror\": it reflects the first ball's \
+                 reflections",
+            ));
+        }
+        if !center.is_finite() || !radius.is_finite() || radius <= 0.0 {
+            return Err(Error::new(format!(
+                "the second ball needs a finite centre and a positive radius, got centre \
+                 {center}, radius {radius}"
+            )));
+        }
+        if center.distance(self.center) < radius + self.radius {
+            return Err(Error::new(format!(
+                "the second ball (centre {center}, radius {radius}) overlaps the first"
+            )));
+        }
+        if center.distance(self.eye) <= radius {
+            return Err(Error::new(format!(
+                "the camera at {} is inside the second ball (centre {center}, radius {radius})",
+                self.eye
+            )));
+        }
+        Ok(BallView {
+            second: Some((center, radius)),
+            ..self
+        })
+    }
+
     /// The exact ray of the view at screen position `screen` (base point on the sphere, unit
     /// direction), or `None` where the camera's ray misses the ball (never inside the view's
     /// screen square, see the type's doc).
     pub fn ray(&self, screen: DVec2) -> Option<GridVertex> {
         let d = self.camera.vertex(screen).direction.normalize();
-        let p = self.first_hit(self.eye, d)?;
+        let p = sphere_hit(self.center, self.radius, self.eye, d)?;
         let n = (p - self.center) / self.radius;
         match self.optic {
-            BallOptic::Mirror => Some(GridVertex {
-                point: p,
-                direction: reflect(d, n).normalize(),
-            }),
+            BallOptic::Mirror => {
+                let first = GridVertex {
+                    point: p,
+                    direction: reflect(d, n).normalize(),
+                };
+                Some(self.second_hit(first))
+            }
             BallOptic::Glass { ior } => {
                 // Entering: the normal faces the arriving ray (d . n <= 0 at a first hit);
                 // refraction into a denser medium always exists.
@@ -146,24 +190,40 @@ impl BallView {
         })
     }
 
-    /// The first point where the ray from `origin` along unit `d` meets the sphere (the
-    /// tangent point of a grazing ray), or `None` when it misses.
-    fn first_hit(&self, origin: DVec3, d: DVec3) -> Option<DVec3> {
-        let to_origin = origin - self.center;
-        let b = d.dot(to_origin);
-        let c = to_origin.length_squared() - self.radius * self.radius;
-        let discriminant = b * b - c;
-        if discriminant < 0.0 {
-            return None;
+    /// `ray` reflected off the second ball where it meets it; `ray` itself without a second
+    /// ball or where it misses.
+    fn second_hit(&self, ray: GridVertex) -> GridVertex {
+        let Some((center, radius)) = self.second else {
+            return ray;
+        };
+        match sphere_hit(center, radius, ray.point, ray.direction) {
+            Some(q) => GridVertex {
+                point: q,
+                direction: reflect(ray.direction, (q - center) / radius).normalize(),
+            },
+            None => ray,
         }
-        // The nearer root, in the form without cancellation (origin outside: c > 0, b < 0).
-        let far = -b + discriminant.sqrt();
-        if far <= 0.0 {
-            return None;
-        }
-        let t = c / far;
-        (t >= 0.0).then_some(origin + t * d)
     }
+}
+
+/// The first point where the ray from `origin` (outside the sphere) along unit `d` meets the
+/// sphere of `radius` around `center` (the tangent point of a grazing ray), or `None` when it
+/// misses.
+fn sphere_hit(center: DVec3, radius: f64, origin: DVec3, d: DVec3) -> Option<DVec3> {
+    let to_origin = origin - center;
+    let b = d.dot(to_origin);
+    let c = to_origin.length_squared() - radius * radius;
+    let discriminant = b * b - c;
+    if discriminant < 0.0 {
+        return None;
+    }
+    // The nearer root, in the form without cancellation (origin outside: c > 0, b < 0).
+    let far = -b + discriminant.sqrt();
+    if far <= 0.0 {
+        return None;
+    }
+    let t = c / far;
+    (t >= 0.0).then_some(origin + t * d)
 }
 
 /// The exact view through a ball at a given image size: every pixel's ray computed from the

@@ -127,6 +127,7 @@ fn grazing_rays_are_tangent_or_miss() {
             center: CENTER,
             radius: 1.0,
             optic,
+            second: None,
         };
         if let Some(v) = view.ray(DVec2::splat(0.5)) {
             let n = (v.point - CENTER).normalize();
@@ -134,6 +135,62 @@ fn grazing_rays_are_tangent_or_miss() {
             assert!((v.direction.length() - 1.0).abs() < 1e-12);
         }
     }
+}
+
+/// A second mirror ball 2 beyond the eye on the line from the first ball's centre, 0.6 to
+/// the side: the reflections off the middle of the first ball meet it, those off its rim
+/// do not.
+fn second_center() -> DVec3 {
+    EYE + 2.0 * (EYE - CENTER).normalize() + DVec3::new(0.6, 0.0, 0.0)
+}
+
+#[test]
+fn second_ball_reflects_the_reflections_that_meet_it() {
+    let (one, c2, r2) = (mirror(), second_center(), 0.7);
+    let two = one.with_second_ball(c2, r2).unwrap();
+    let (mut met, mut missed) = (0, 0);
+    for s in screens() {
+        let first = one.ray(s).unwrap();
+        let v = two.ray(s).unwrap();
+        // Where the first reflection meets the second ball, solved here on its own.
+        let o = first.point - c2;
+        let b = first.direction.dot(o);
+        let disc = b * b - o.length_squared() + r2 * r2;
+        if disc > 1e-9 && b < 0.0 {
+            met += 1;
+            let q = first.point + (-b - disc.sqrt()) * first.direction;
+            assert!(v.point.distance(q) < 1e-12, "{s}");
+            let n = (q - c2) / r2;
+            assert!(
+                (first.direction.dot(n) + v.direction.dot(n)).abs() < 1e-12,
+                "{s}"
+            );
+            assert!(
+                (first.direction - v.direction).cross(n).length() < 1e-12,
+                "{s}"
+            );
+        } else if disc < -1e-9 || b > 0.0 {
+            missed += 1;
+            assert_eq!(v, first, "{s}");
+        }
+    }
+    assert!(met > 0 && missed > 0, "{met} {missed}");
+}
+
+#[test]
+fn degenerate_second_balls_are_errors() {
+    let message = |r: Result<BallView>| r.unwrap_err().message;
+    let c2 = second_center();
+    assert!(message(glass(1.5).with_second_ball(c2, 0.7)).contains("sphere_mirror"));
+    for (center, radius) in [(c2, 0.0), (c2, f64::INFINITY), (DVec3::NAN, 0.7)] {
+        assert!(message(mirror().with_second_ball(center, radius)).contains("positive radius"));
+    }
+    let touching = CENTER + DVec3::new(1.6, 0.0, 0.0);
+    assert!(message(mirror().with_second_ball(touching, 0.7)).contains("overlaps"));
+    assert!(mirror()
+        .with_second_ball(touching + DVec3::new(0.2, 0.0, 0.0), 0.7)
+        .is_ok());
+    assert!(message(mirror().with_second_ball(EYE, 0.1)).contains("inside the second ball"));
 }
 
 #[test]
