@@ -75,6 +75,40 @@ position = [0.0, 5.0, 9.0]
 look_at = [0.0, 0.5, 0.0]
 fov = 60.0')" -o "$out/detail-in-context-perspective.png"
 
+# Detail in context with an inverse-perspective focus (beside the same pinhole as above).
+render scenes/trilinear-detail-inverse-perspective.toml --method trilinear \
+  -o "$out/detail-inverse-perspective.png"
+
+# Views through a ball: the trilinear grid, and beside it a 90-degree pinhole at the grid's
+# eye looking at a real mirror (glass) sphere of the ball's size and place, ray cast.
+ball_views=(
+  'mirror [0.4, 1.5, 1.6] [0.0, 1.0, 0.0]'
+  'glass [0.3, 2.0, 2.6] [0.0, 1.6, 0.0]'
+)
+for view in "${ball_views[@]}"; do
+  optic=${view%% *}
+  eye=$(echo "$view" | sed 's/^[a-z]* \(\[[^]]*\]\) .*/\1/')
+  center=${view##* [}
+  center="[$center"
+  printf '\n[[object]]\nname = "ball"\nshape = "sphere"\nsize = 1.0\ntessellation = 96\nmaterial = "%s"\ncolor = [0.95, 0.95, 0.95]\ntranslate = %s\n' \
+    "$optic" "$center" >"$work/ball-$optic.toml"
+  render "scenes/trilinear-sphere-$optic.toml" --method trilinear -o "$out/sphere-$optic.png"
+  render "$(variant "scenes/trilinear-sphere-$optic.toml" "sphere-$optic-persp" "type = \"perspective\"
+position = $eye
+look_at = $center
+fov = 90.0" "\$r $work/ball-$optic.toml")" -o "$out/sphere-$optic-perspective.png"
+done
+
+# Multi-hit reflection: the mirror ball with a second one behind the camera, and beside it
+# the same 90-degree pinhole with both as real mirror spheres, ray cast.
+printf '\n[[object]]\nname = "ball"\nshape = "sphere"\nsize = 1.0\ntessellation = 96\nmaterial = "mirror"\ncolor = [0.95, 0.95, 0.95]\ntranslate = [0.0, 1.0, 0.0]\n\n[[object]]\nname = "second ball"\nshape = "sphere"\nsize = 1.2\ntessellation = 96\nmaterial = "mirror"\ncolor = [0.95, 0.95, 0.95]\ntranslate = [-0.6, 1.6, 3.6]\n' \
+  >"$work/balls-twice.toml"
+render scenes/trilinear-sphere-mirror-twice.toml --method trilinear -o "$out/sphere-mirror-twice.png"
+render "$(variant scenes/trilinear-sphere-mirror-twice.toml sphere-twice-persp 'type = "perspective"
+position = [0.4, 1.5, 1.6]
+look_at = [0.0, 1.0, 0.0]
+fov = 90.0' "\$r $work/balls-twice.toml")" -o "$out/sphere-mirror-twice-perspective.png"
+
 # Funny mirror: beside it the same camera looking at a flat mirror box of the same size.
 mirror_view=$(sed -n '/^\[projection\]/,/^$/p' scenes/reflect-funny-mirror.toml | sed 1d)
 render scenes/reflect-funny-mirror.toml -o "$out/funny-mirror.png"

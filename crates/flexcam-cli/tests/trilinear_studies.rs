@@ -19,14 +19,25 @@ fn scenes() -> String {
         .into_owned()
 }
 
-/// Runs `study` at width `size` with one timed render per cell, and returns the CSV's rows
+/// Runs `--study study` at width `size` with one timed render per cell, and returns the CSV's rows
 /// as column -> cell maps, after checking the header and that stdout prints the same
 /// columns as a markdown table.
 fn study(study: &str, size: u32, extra: &[&str], columns: &[&str]) -> Vec<HashMap<String, String>> {
+    table("--study", study, size, extra, columns)
+}
+
+/// As [`study`], for `flag` (`--study` or `--sweep`) with value `study`.
+fn table(
+    flag: &str,
+    study: &str,
+    size: u32,
+    extra: &[&str],
+    columns: &[&str],
+) -> Vec<HashMap<String, String>> {
     let dir = TempDir::new().unwrap();
     let scenes = scenes();
     let size = size.to_string();
-    let mut args = vec!["bench", "trilinear", "--study", study, "--size", &size];
+    let mut args = vec!["bench", "trilinear", flag, study, "--size", &size];
     args.extend_from_slice(&["--repeat", "1", "--scenes", &scenes, "--csv", "t.csv"]);
     args.extend_from_slice(extra);
     let stdout = String::from_utf8(run_ok(&dir, &args).stdout).unwrap();
@@ -201,6 +212,85 @@ fn tessellation_factors_converge_on_the_ray_caster() {
     }
     for row in rows.iter().filter(|r| r["configuration"] != "mean") {
         assert!(number(row, "ids_interior") >= 0.9, "{row:?}");
+    }
+}
+
+const SWEEP_COLUMNS: [&str; 12] = [
+    "n",
+    "projections",
+    "width",
+    "height",
+    "trilinear_ms",
+    "raycast_ms",
+    "ids_interior",
+    "interior_pixels",
+    "rgb_error",
+    "shapes",
+    "fallback_triangles",
+    "thesis_ms",
+];
+
+/// Figure 7.4's sweep: the mirror ball's N x N grid against the exact mirror ball, N = 1, 4
+/// and 16 at 96 x 72 pixels: the relative RGB error falls with N (about as 1 / N^2: more
+/// than 20 times from 1 to 16) and the ids agree away from id edges ever more; the mirror
+/// rays never cross, so nothing is ray cast.
+#[test]
+fn reflection_sweep_converges_on_the_exact_mirror_ball() {
+    let rows = table("--sweep", "reflection", 96, &["--quick"], &SWEEP_COLUMNS);
+    let ns: Vec<&str> = rows.iter().map(|r| r["n"].as_str()).collect();
+    assert_eq!(ns, ["1", "4", "16"]);
+    let errors: Vec<f64> = rows.iter().map(|r| number(r, "rgb_error")).collect();
+    assert!(errors[1] < errors[0] && errors[2] < errors[1], "{errors:?}");
+    assert!(errors[2] < errors[0] / 20.0, "{errors:?}");
+    let ids: Vec<f64> = rows.iter().map(|r| number(r, "ids_interior")).collect();
+    assert!(ids[0] <= ids[2] && ids[2] >= 0.995, "{ids:?}");
+    for (row, n) in rows.iter().zip([1.0, 4.0, 16.0]) {
+        assert_eq!(number(row, "projections"), 2.0 * n * n, "{row:?}");
+        assert_eq!(
+            (row["width"].as_str(), row["height"].as_str()),
+            ("96", "72")
+        );
+        assert_eq!(row["fallback_triangles"], "0", "{row:?}");
+        assert!(number(row, "interior_pixels") > 1000.0, "{row:?}");
+    }
+    assert_eq!(rows[0]["thesis_ms"], "24.4");
+    assert_eq!(rows[2]["thesis_ms"], "-");
+}
+
+/// The refraction sweep: the glass ball's grid against the exact glass ball; the error falls
+/// with N, and the projection triangles whose rays cross inside the scene are counted.
+#[test]
+fn refraction_sweep_converges_on_the_exact_glass_ball() {
+    let rows = table("--sweep", "refraction", 96, &["--quick"], &SWEEP_COLUMNS);
+    let errors: Vec<f64> = rows.iter().map(|r| number(r, "rgb_error")).collect();
+    assert!(
+        errors[2] < errors[1] && errors[2] < errors[0] / 5.0,
+        "{errors:?}"
+    );
+    assert!(number(&rows[2], "ids_interior") >= 0.99, "{rows:?}");
+    let fallback: f64 = rows.iter().map(|r| number(r, "fallback_triangles")).sum();
+    assert!(fallback > 0.0, "{rows:?}");
+}
+
+/// `--csv` and `--size` need a study or a sweep, and a study and a sweep do not go together.
+#[test]
+fn csv_needs_one_table() {
+    let dir = TempDir::new().unwrap();
+    for args in [
+        &["bench", "trilinear", "--csv", "t.csv"][..],
+        &["bench", "trilinear", "--size", "64"],
+        &[
+            "bench",
+            "trilinear",
+            "--study",
+            "examples",
+            "--sweep",
+            "reflection",
+        ],
+    ] {
+        let out = run(&dir, args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(!dir.path().join("t.csv").exists());
     }
 }
 

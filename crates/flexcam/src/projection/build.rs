@@ -8,6 +8,7 @@ use super::linear::{Orthographic, Perspective};
 use super::ods::ods;
 use super::opencv::Opencv;
 use super::panoramic::{Cylindrical, Equirectangular};
+use super::trilinear::mesh_builders::BallProjection;
 use super::trilinear::Trilinear;
 use super::vr180::vr180;
 use super::{BuildReport, Projection, ProjectionSpec};
@@ -93,6 +94,7 @@ impl ProjectionSpec {
             } => Box::new(ods(frame, *ipd, *pole_merge, width, height)?),
             ProjectionSpec::Vr180 { frame, ipd } => Box::new(vr180(frame, *ipd, width, height)?),
             ProjectionSpec::Trilinear(mesh) => Box::new(Trilinear::new(mesh, width, height)?),
+            ProjectionSpec::ExactBall(view) => Box::new(BallProjection::new(*view, width, height)),
             ProjectionSpec::Flexible(spec) => {
                 Box::new(Flexible::build(spec, width, height, fitter, report)?)
             }

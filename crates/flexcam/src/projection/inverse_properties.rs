@@ -67,6 +67,7 @@ fn frame_of(spec: &ProjectionSpec) -> CameraFrame {
         | ProjectionSpec::MappedFisheye { .. }
         | ProjectionSpec::DomeMaster { .. }
         | ProjectionSpec::Trilinear(_)
+        | ProjectionSpec::ExactBall(_)
         | ProjectionSpec::Flexible(_) => {
             unreachable!(
                 "not generated (calibrated_properties, stereo_properties, fisheye_properties)"
@@ -102,6 +103,7 @@ fn must_be_imaged(spec: &ProjectionSpec, point: DVec3) -> bool {
         | ProjectionSpec::MappedFisheye { .. }
         | ProjectionSpec::DomeMaster { .. }
         | ProjectionSpec::Trilinear(_)
+        | ProjectionSpec::ExactBall(_)
         | ProjectionSpec::Flexible(_) => false,
     }
 }

@@ -310,6 +310,10 @@ pub enum ProjectionSpec {
     },
     /// A mesh of trilinear projection triangles.
     Trilinear(TrilinearMesh),
+    /// The exact view through a ball that a trilinear grid `view = "sphere_mirror"` or
+    /// `"sphere_glass"` samples (scene key `exact = true`): every pixel's ray from the ball
+    /// itself, ray cast only.
+    ExactBall(trilinear_builders::BallView),
     /// A parametric viewing volume between control surfaces (Brosz 2011); boxed, as it is
     /// much larger than the other variants.
     Flexible(Box<FlexibleSpec>),
@@ -329,7 +333,7 @@ impl ProjectionSpec {
             ProjectionSpec::OpencvFisheye { .. } => "opencv_fisheye",
             ProjectionSpec::Ods { .. } => "ods",
             ProjectionSpec::Vr180 { .. } => "vr180",
-            ProjectionSpec::Trilinear(_) => "trilinear",
+            ProjectionSpec::Trilinear(_) | ProjectionSpec::ExactBall(_) => "trilinear",
             ProjectionSpec::Flexible(_) => "flexible",
         }
     }

@@ -25,17 +25,19 @@
 //! clipping), and compares them like for like.
 //!
 //! `--study` runs one of the chapter 8 studies instead (modules [`examples`],
-//! [`configurations`], [`tessellation`]): a markdown table on stdout, and as CSV with
-//! `--csv FILE` (plotted by `tools/plot/trilinear-studies.sh`).
+//! [`configurations`], [`tessellation`]), and `--sweep` the Figure 7.4 sweep of a view through
+//! a mirror or glass ball against N (module [`sweep`]): a markdown table on stdout, and as
+//! CSV with `--csv FILE` (plotted by `tools/plot/trilinear-studies.sh`).
 
 mod configurations;
 mod examples;
 mod study;
+mod sweep;
 mod tessellation;
 
 use std::path::PathBuf;
 
-use clap::{Args, ValueEnum};
+use clap::{ArgGroup, Args, ValueEnum};
 use flexcam::image_io::{self, OutputSet};
 use flexcam::projection::{Trilinear, TrilinearMesh};
 use flexcam::render::bench_support::workloads::trilinear::{
@@ -52,13 +54,15 @@ use super::timing::measure;
 
 /// Arguments of `flexcam bench trilinear`.
 #[derive(Args, Debug)]
+#[command(group(ArgGroup::new("table").args(["study", "sweep"])))]
 pub struct TrilinearArgs {
     /// Timed renders per cell, after one warm-up render; the median is reported.
     #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100))]
     repeat: u32,
     /// A fast subset: random scenes of 1 and 640 triangles through 2, 18 and 50 projections
     /// at 1 and 256^2 pixels, and the cube-floor scene through 2, 18 and 50 projections;
-    /// with `--study tessellation`, the factors 1, 10 and 100 alone.
+    /// with `--study tessellation`, the factors 1, 10 and 100 alone; with `--sweep`, the
+    /// grids N = 1, 4 and 16 alone.
     #[arg(long)]
     quick: bool,
     /// Run a study of chapter 8 instead: `examples` (Table 8.1, every row), `configurations`
@@ -66,14 +70,19 @@ pub struct TrilinearArgs {
     /// following per tessellation factor, Figures 8.9-8.12, Tables D.18-D.31).
     #[arg(long, value_enum)]
     study: Option<Study>,
-    /// Write the study's table as CSV to FILE.
-    #[arg(long, value_name = "FILE", requires = "study")]
+    /// Run the Figure 7.4 sweep instead: the view through a mirror ball (`reflection`) or a
+    /// glass ball (`refraction`) as an N x N trilinear grid, N = 1 to 32, against the exact
+    /// ball ray cast (object-id agreement away from id edges, relative RGB error).
+    #[arg(long, value_enum)]
+    sweep: Option<sweep::Sweep>,
+    /// Write the study's or sweep's table as CSV to FILE.
+    #[arg(long, value_name = "FILE", requires = "table")]
     csv: Option<PathBuf>,
-    /// Image width of every render of the study (default: the thesis's; the height keeps
-    /// the thesis's aspect ratio).
-    #[arg(long, requires = "study", value_parser = clap::value_parser!(u32).range(3..=4096))]
+    /// Image width of every render of the study or sweep (default: the thesis's, or for a
+    /// sweep the scene's 320; the height keeps that aspect ratio).
+    #[arg(long, requires = "table", value_parser = clap::value_parser!(u32).range(3..=4096))]
     size: Option<u32>,
-    /// The folder of the example scenes the studies load (`trilinear-*.toml`,
+    /// The folder of the example scenes the studies and sweeps load (`trilinear-*.toml`,
     /// `reflect-*.toml`, `refract-lens.toml`, `appendix-c/`).
     #[arg(long, value_name = "DIR", default_value = "scenes")]
     scenes: PathBuf,
@@ -87,9 +96,16 @@ enum Study {
     Tessellation,
 }
 
-/// Runs `study`: prints its table and writes it as CSV where asked (nothing is written when
-/// a render fails).
-fn run_study(study: Study, args: &TrilinearArgs) -> Result<()> {
+/// What `--study` or `--sweep` runs.
+#[derive(Clone, Copy)]
+enum Tabled {
+    Study(Study),
+    Sweep(sweep::Sweep),
+}
+
+/// Runs a study or sweep: prints its table and writes it as CSV where asked (nothing is
+/// written when a render fails).
+fn run_study(tabled: Tabled, args: &TrilinearArgs) -> Result<()> {
     let mut outputs = OutputSet::new();
     let csv_output = args
         .csv
@@ -97,22 +113,28 @@ fn run_study(study: Study, args: &TrilinearArgs) -> Result<()> {
         .map(|path| outputs.output("the CSV output", path, &["csv"]))
         .transpose()?;
     let (scenes, size, repeat) = (args.scenes.as_path(), args.size, args.repeat);
-    let (title, table) = match study {
-        Study::Examples => (
-            "Table 8.1 (Vallance 2005): every example, ray caster (raycast) and trilinear \
+    let (title, table) = match tabled {
+        Tabled::Sweep(which) => (
+            which.title(),
+            sweep::run(which, scenes, size, repeat, args.quick)?,
+        ),
+        Tabled::Study(study) => match study {
+            Study::Examples => (
+                "Table 8.1 (Vallance 2005): every example, ray caster (raycast) and trilinear \
              rasteriser of the same frame",
-            examples::run(scenes, size, repeat)?,
-        ),
-        Study::Configurations => (
-            "Appendix C configurations (Tables D.4-D.17): one scene triangle through one \
+                examples::run(scenes, size, repeat)?,
+            ),
+            Study::Configurations => (
+                "Appendix C configurations (Tables D.4-D.17): one scene triangle through one \
              folding projection triangle",
-            configurations::run(scenes, size, repeat)?,
-        ),
-        Study::Tessellation => (
-            "Tessellation factor (Figures 8.9-8.12, Tables D.18-D.31): --curves tessellate \
+                configurations::run(scenes, size, repeat)?,
+            ),
+            Study::Tessellation => (
+                "Tessellation factor (Figures 8.9-8.12, Tables D.18-D.31): --curves tessellate \
              and slice against the ray caster",
-            tessellation::run(scenes, size, repeat, args.quick)?,
-        ),
+                tessellation::run(scenes, size, repeat, args.quick)?,
+            ),
+        },
     };
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
@@ -179,7 +201,10 @@ struct Kept {
 /// Runs the benchmark and prints both tables.
 pub fn run(args: &TrilinearArgs) -> Result<()> {
     if let Some(study) = args.study {
-        return run_study(study, args);
+        return run_study(Tabled::Study(study), args);
+    }
+    if let Some(which) = args.sweep {
+        return run_study(Tabled::Sweep(which), args);
     }
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let (sides, counts, cells): (&[u32], &[u32], &[u32]) = if args.quick {

@@ -54,7 +54,7 @@ const UNSUPPORTED: [&str; 0] = [];
 const MESH_KEYS: [&str; 5] = ["surface", "points", "normals", "screen", "triangles"];
 
 /// Keys of a trilinear projection given as a grid (`grid` and its bases).
-const GRID_KEYS: [&str; 11] = [
+const GRID_KEYS: [&str; 17] = [
     "grid",
     "near",
     "far",
@@ -63,9 +63,15 @@ const GRID_KEYS: [&str; 11] = [
     "focus",
     "inset",
     "magnification",
+    "focus_view",
+    "converge",
     "first",
     "second",
     "band",
+    "sphere",
+    "second_sphere",
+    "ior",
+    "exact",
 ];
 
 /// Parameters of the single-viewpoint projections, shared by all of them.
@@ -163,7 +169,7 @@ pub(super) fn convert(
         value.as_ref().map_or(Ok(default), |v| src.number(v, key))
     };
     Ok(match kind {
-        Kind::Trilinear => ProjectionSpec::Trilinear(trilinear(src, &required, base_dir)?),
+        Kind::Trilinear => trilinear(src, &required, base_dir)?,
         Kind::Flexible => ProjectionSpec::Flexible(Box::new(super::flexible::convert(&required)?)),
         Kind::Perspective => ProjectionSpec::Perspective {
             frame: camera_frame(src, &required)?,
@@ -220,8 +226,9 @@ fn pole_merge(required: &Required) -> Result<Option<[f64; 2]>> {
     }
 }
 
-/// A trilinear mesh from `surface = "file.obj"`, from the inline arrays, or from `grid`.
-fn trilinear(src: &Source, required: &Required, base_dir: &Path) -> Result<TrilinearMesh> {
+/// A trilinear mesh from `surface = "file.obj"`, from the inline arrays, or from `grid` (or
+/// the exact view a grid samples, `exact = true`).
+fn trilinear(src: &Source, required: &Required, base_dir: &Path) -> Result<ProjectionSpec> {
     let raw = required.raw();
     let present = raw.present_keys();
     if let Some(cells) = &raw.grid {
@@ -251,7 +258,9 @@ fn trilinear(src: &Source, required: &Required, base_dir: &Path) -> Result<Trili
         }
         let path = src.existing_file(surface, base_dir, "trilinear surface")?;
         crate::scene::loaders::check_obj_file(&path)?;
-        return TrilinearMesh::load_obj(&path).map_err(|e| e.or_in_file(&path));
+        return TrilinearMesh::load_obj(&path)
+            .map(ProjectionSpec::Trilinear)
+            .map_err(|e| e.or_in_file(&path));
     }
     if raw.points.is_none() {
         return Err(src.error(
@@ -289,7 +298,7 @@ fn trilinear(src: &Source, required: &Required, base_dir: &Path) -> Result<Trili
             format!("triangle {i} {t:?} refers to a vertex beyond the {n} `points` (indices start at 0)"),
         ));
     }
-    Ok(TrilinearMesh {
+    Ok(ProjectionSpec::Trilinear(TrilinearMesh {
         points: points
             .get_ref()
             .iter()
@@ -306,5 +315,5 @@ fn trilinear(src: &Source, required: &Required, base_dir: &Path) -> Result<Trili
             .map(|&s| DVec2::from_array(s))
             .collect(),
         triangles: triangles.get_ref().clone(),
-    })
+    }))
 }

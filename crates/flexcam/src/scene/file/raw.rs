@@ -112,6 +112,11 @@ pub struct RawProjection {
     pub second: Option<Spanned<RawCamera>>,
     #[serde(default, deserialize_with = "strict")]
     pub band: Option<Spanned<[f64; 2]>>,
+    pub focus_view: Option<Spanned<String>>,
+    pub sphere: Option<Spanned<RawSphere>>,
+    pub second_sphere: Option<Spanned<RawSphere>>,
+    pub ior: Option<Spanned<f64>>,
+    pub exact: Option<Spanned<bool>>,
     #[serde(default, deserialize_with = "strict")]
     pub shift: Option<Spanned<[f64; 2]>>,
     pub twist: Option<Spanned<f64>>,
@@ -271,6 +276,16 @@ pub struct RawCamera {
     pub height: Option<Spanned<f64>>,
 }
 
+/// `sphere = { center = [x, y, z], radius = r }`: the ball of a trilinear grid's view
+/// through a ball (`view = "sphere_mirror"` or `"sphere_glass"`), and `second_sphere`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSphere {
+    #[serde(deserialize_with = "strict")]
+    pub center: Vec3Value,
+    pub radius: Spanned<f64>,
+}
+
 /// `near = { surface = "...", ... }` / `far`: a flexible projection's control surface, the
 /// union of every surface type's parameters.
 #[derive(Debug, Deserialize)]
@@ -392,6 +407,14 @@ impl RawProjection {
             ("first", self.first.as_ref().map(Spanned::span)),
             ("second", self.second.as_ref().map(Spanned::span)),
             ("band", self.band.as_ref().map(Spanned::span)),
+            ("focus_view", self.focus_view.as_ref().map(Spanned::span)),
+            ("sphere", self.sphere.as_ref().map(Spanned::span)),
+            (
+                "second_sphere",
+                self.second_sphere.as_ref().map(Spanned::span),
+            ),
+            ("ior", self.ior.as_ref().map(Spanned::span)),
+            ("exact", self.exact.as_ref().map(Spanned::span)),
             ("shift", self.shift.as_ref().map(Spanned::span)),
             ("twist", self.twist.as_ref().map(Spanned::span)),
             ("azimuth", self.azimuth.as_ref().map(Spanned::span)),

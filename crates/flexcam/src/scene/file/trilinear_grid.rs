@@ -1,6 +1,7 @@
 //! `grid = N` in a trilinear `[projection]`: a regular screen grid of projection triangles
 //! over a base given by two control surfaces (`near`, `far`) or by a visualisation surface
-//! (`view`): see scenes/README.md.
+//! or a view through a ball (`view`); with `exact = true` a view through a ball is the exact
+//! view the grid samples instead: see scenes/README.md.
 
 use glam::{DVec2, DVec3};
 use toml::Spanned;
@@ -11,25 +12,41 @@ use super::raw::RawCamera;
 use super::source::Source;
 use crate::error::{Error, Result};
 use crate::projection::trilinear_builders::{
-    between_surfaces, screen_grid, DetailInContext, GridCamera, TwoViews,
+    between_surfaces, screen_grid, BallOptic, BallView, DetailInContext, FocusView, GridCamera,
+    TwoViews,
 };
-use crate::projection::{CameraFrame, TrilinearMesh};
+use crate::projection::{CameraFrame, ProjectionSpec};
 
-/// The visualisation surfaces `view` may name, with the keys (besides `grid` and `view`)
-/// each takes.
-const VIEWS: [(&str, &[&str]); 2] = [
+/// The views `view` may name, with the keys (besides `grid` and `view`) each takes.
+const VIEWS: [(&str, &[&str]); 4] = [
     (
         "detail_in_context",
-        &["camera", "focus", "inset", "magnification"],
+        &[
+            "camera",
+            "focus",
+            "inset",
+            "magnification",
+            "focus_view",
+            "converge",
+        ],
     ),
     ("two_views", &["first", "second", "band"]),
+    (
+        "sphere_mirror",
+        &["camera", "sphere", "second_sphere", "exact"],
+    ),
+    ("sphere_glass", &["camera", "sphere", "ior", "exact"]),
 ];
+
+/// The focus views of `detail_in_context` (`focus_view`).
+const FOCUS_VIEWS: [&str; 2] = ["orthographic", "inverse_perspective"];
 
 /// Keys of a grid over two control surfaces (besides `grid`).
 const SURFACE_KEYS: [&str; 2] = ["near", "far"];
 
-/// The mesh of a trilinear projection table that has `grid`.
-pub(super) fn convert(required: &Required, cells: &Spanned<u32>) -> Result<TrilinearMesh> {
+/// The projection of a trilinear projection table that has `grid`: its mesh, or with
+/// `exact = true` the exact view through a ball.
+pub(super) fn convert(required: &Required, cells: &Spanned<u32>) -> Result<ProjectionSpec> {
     let src = required.src;
     let raw = required.raw();
     let present: Vec<_> = raw
@@ -38,12 +55,14 @@ pub(super) fn convert(required: &Required, cells: &Spanned<u32>) -> Result<Trili
         .filter(|(key, _)| *key != "grid" && *key != "view")
         .collect();
     let at_table = |e: Error| src.error(&required.table.span(), e.message);
+    let n = *cells.get_ref();
+    let mut exact = None;
     let mesh = match &raw.view {
         None => {
             src.reject_foreign_key(present, &SURFACE_KEYS, "grids over surfaces (no `view`)")?;
             let near = surface(src, required.get(&raw.near, "near")?, "near")?;
             let far = surface(src, required.get(&raw.far, "far")?, "far")?;
-            screen_grid(*cells.get_ref(), between_surfaces(&near, &far))
+            screen_grid(n, between_surfaces(&near, &far))
         }
         Some(view) => {
             let name = view.get_ref().as_str();
@@ -52,61 +71,143 @@ pub(super) fn convert(required: &Required, cells: &Spanned<u32>) -> Result<Trili
                 return Err(src.unknown(&view.span(), "view", name, &names));
             };
             src.reject_foreign_key(present, keys, &format!("view \"{name}\""))?;
-            if name == "detail_in_context" {
-                let table = required.get(&raw.camera, "camera")?;
-                let (camera, frame) = camera(src, table)?;
-                // The magnification holds at the camera's look-at distance.
-                let distance = frame.look_at.distance(frame.position);
-                let focus = match &raw.focus {
-                    Some(f) => DVec2::from_array(src.vector(f, "focus")?),
-                    None => DVec2::splat(0.5),
-                };
-                let inset = raw
-                    .inset
-                    .as_ref()
-                    .map_or(Ok([0.15, 0.35]), |i| src.vector(i, "inset"))?;
-                let magnification = raw
-                    .magnification
-                    .as_ref()
-                    .map_or(Ok(3.0), |m| src.number(m, "magnification"))?;
-                let surface = DetailInContext::new(camera, focus, inset, magnification, distance)
-                    .map_err(|e| {
-                    let key = if e.message.contains("magnification") {
-                        raw.magnification.as_ref().map(Spanned::span)
-                    } else if e.message.contains("inset") {
-                        raw.inset.as_ref().map(Spanned::span)
-                    } else {
-                        Some(table.span())
-                    };
-                    let at = key.unwrap_or_else(|| required.table.span());
-                    src.error(&at, e.message)
-                })?;
-                screen_grid(*cells.get_ref(), |s| surface.vertex(s))
-            } else {
-                let (first, _) = camera(src, required.get(&raw.first, "first")?)?;
-                let (second, _) = camera(src, required.get(&raw.second, "second")?)?;
-                let band = raw
-                    .band
-                    .as_ref()
-                    .map_or(Ok([0.4, 0.6]), |b| src.vector(b, "band"))?;
-                let surface = TwoViews::new(first, second, band).map_err(|e| {
-                    let at = raw
+            match name {
+                "detail_in_context" => {
+                    let surface = detail_in_context(required)?;
+                    screen_grid(n, |s| surface.vertex(s))
+                }
+                "two_views" => {
+                    let (first, _) = camera(src, required.get(&raw.first, "first")?)?;
+                    let (second, _) = camera(src, required.get(&raw.second, "second")?)?;
+                    let band = raw
                         .band
                         .as_ref()
-                        .map_or(required.table.span(), Spanned::span);
-                    src.error(&at, e.message)
-                })?;
-                screen_grid(*cells.get_ref(), |s| surface.vertex(s))
+                        .map_or(Ok([0.4, 0.6]), |b| src.vector(b, "band"))?;
+                    let surface = TwoViews::new(first, second, band).map_err(|e| {
+                        let at = raw
+                            .band
+                            .as_ref()
+                            .map_or(required.table.span(), Spanned::span);
+                        src.error(&at, e.message)
+                    })?;
+                    screen_grid(n, |s| surface.vertex(s))
+                }
+                _ => {
+                    let view = ball_view(required, name == "sphere_glass")?;
+                    if raw.exact.as_ref().is_some_and(|e| *e.get_ref()) {
+                        exact = Some(view);
+                    }
+                    screen_grid(n, |s| view.vertex(s))
+                }
             }
         }
     };
-    mesh.map_err(|e| {
+    let mesh = mesh.map_err(|e| {
         if e.message.starts_with("grid must have") {
             src.error(&cells.span(), e.message)
         } else {
             at_table(e)
         }
+    })?;
+    // The grid is built with `exact` too: its size is checked the same way.
+    Ok(match exact {
+        Some(view) => ProjectionSpec::ExactBall(view),
+        None => ProjectionSpec::Trilinear(mesh),
     })
+}
+
+/// The surface of `view = "detail_in_context"`: `camera`, `focus`, `inset`,
+/// `magnification`, and `focus_view` with its `converge`.
+fn detail_in_context(required: &Required) -> Result<DetailInContext> {
+    let (src, raw) = (required.src, required.raw());
+    let table = required.get(&raw.camera, "camera")?;
+    let (camera, frame) = camera(src, table)?;
+    // The magnification holds at the camera's look-at distance.
+    let distance = frame.look_at.distance(frame.position);
+    let focus = match &raw.focus {
+        Some(f) => DVec2::from_array(src.vector(f, "focus")?),
+        None => DVec2::splat(0.5),
+    };
+    let inset = raw
+        .inset
+        .as_ref()
+        .map_or(Ok([0.15, 0.35]), |i| src.vector(i, "inset"))?;
+    let magnification = raw
+        .magnification
+        .as_ref()
+        .map_or(Ok(3.0), |m| src.number(m, "magnification"))?;
+    let surface =
+        DetailInContext::new(camera, focus, inset, magnification, distance).map_err(|e| {
+            let key = if e.message.contains("magnification") {
+                raw.magnification.as_ref().map(Spanned::span)
+            } else if e.message.contains("inset") {
+                raw.inset.as_ref().map(Spanned::span)
+            } else {
+                Some(table.span())
+            };
+            let at = key.unwrap_or_else(|| required.table.span());
+            src.error(&at, e.message)
+        })?;
+    let inverse = match &raw.focus_view {
+        None => false,
+        Some(v) => match v.get_ref().as_str() {
+            "orthographic" => false,
+            "inverse_perspective" => true,
+            other => return Err(src.unknown(&v.span(), "focus_view", other, &FOCUS_VIEWS)),
+        },
+    };
+    match (&raw.converge, inverse) {
+        (Some(given), false) => Err(src.error(
+            &given.span(),
+            "`converge` is the point an inverse-perspective focus converges on: it needs \
+             focus_view = \"inverse_perspective\"",
+        )),
+        (None, false) => Ok(surface),
+        (_, true) => {
+            let given = required.get(&raw.converge, "converge")?;
+            let converge = src.dvec3(given, "converge")?;
+            surface
+                .with_focus_view(FocusView::InversePerspective { converge })
+                .map_err(|e| src.error(&given.span(), e.message))
+        }
+    }
+}
+
+/// The view of `view = "sphere_mirror"` (or `"sphere_glass"` when `glass`): `camera`,
+/// `sphere = { center, radius }` and, for a mirror, `second_sphere`, for glass, `ior`
+/// (default 1.5).
+fn ball_view(required: &Required, glass: bool) -> Result<BallView> {
+    let (src, raw) = (required.src, required.raw());
+    let table = required.get(&raw.camera, "camera")?;
+    let (camera, _) = camera(src, table)?;
+    let sphere = required.get(&raw.sphere, "sphere")?;
+    let center = src.dvec3(&sphere.get_ref().center, "center")?;
+    let radius = src.number(&sphere.get_ref().radius, "radius")?;
+    let optic = if glass {
+        let ior = raw.ior.as_ref().map_or(Ok(1.5), |i| src.number(i, "ior"))?;
+        BallOptic::Glass { ior }
+    } else {
+        BallOptic::Mirror
+    };
+    let view = BallView::new(camera, center, radius, optic).map_err(|e| {
+        let at = if e.message.starts_with("ior") {
+            raw.ior
+                .as_ref()
+                .map_or(required.table.span(), Spanned::span)
+        } else if e.message.starts_with("the ball needs") {
+            sphere.span()
+        } else {
+            table.span()
+        };
+        src.error(&at, e.message)
+    })?;
+    let Some(second) = &raw.second_sphere else {
+        return Ok(view);
+    };
+    let center = src.dvec3(&second.get_ref().center, "center")?;
+    let radius = src.number(&second.get_ref().radius, "radius")?;
+    view.with_second_ball(center, radius)
+        .map_err(|e| src.error(&second.span(), e.message))
 }
 
 /// A camera table: `position`, `look_at`, `up` (default +y) and either `h_fov` and `v_fov`
@@ -215,6 +316,158 @@ mod tests {
         assert!(
             (m.points[0].y - 2.0).abs() < 1.0,
             "the bottom row is the first view"
+        );
+    }
+
+    /// A pinhole 3 from a unit ball at (0, 1, 0) (angular radius 19.5 degrees) whose view's
+    /// corners are 12.4 degrees off its axis.
+    const BALL_CAMERA: &str =
+        "{ position = [0, 1, 3], look_at = [0, 1, 0], h_fov = 20, v_fov = 15 }";
+    const SPHERE: &str = "sphere = { center = [0, 1, 0], radius = 1.0 }";
+
+    #[test]
+    fn grid_views_through_a_ball() {
+        let m = mesh(&format!(
+            "grid = 4\nview = \"sphere_mirror\"\ncamera = {BALL_CAMERA}\n{SPHERE}\n"
+        ));
+        assert_eq!((m.points.len(), m.triangles.len()), (25, 32));
+        for (p, n) in m.points.iter().zip(&m.normals) {
+            assert!(((*p - DVec3::Y).length() - 1.0).abs() < 1e-12);
+            assert!((n.length() - 1.0).abs() < 1e-12);
+        }
+        // The central ray meets the ball head on and comes straight back.
+        assert!((m.points[12] - DVec3::new(0.0, 1.0, 1.0)).length() < 1e-12);
+        assert!((m.normals[12] - DVec3::Z).length() < 1e-12);
+        // Glass: the central ray goes straight through and leaves at the far side.
+        let m = mesh(&format!(
+            "grid = 4\nview = \"sphere_glass\"\ncamera = {BALL_CAMERA}\n{SPHERE}\nior = 1.6\n"
+        ));
+        assert!((m.points[12] - DVec3::new(0.0, 1.0, -1.0)).length() < 1e-12);
+        assert!((m.normals[12] - DVec3::NEG_Z).length() < 1e-12);
+        // `exact = true`: the view itself, not its grid.
+        let text = format!(
+            "[projection]\ntype = \"trilinear\"\ngrid = 4\nview = \"sphere_glass\"\n\
+             camera = {BALL_CAMERA}\n{SPHERE}\nexact = true\n"
+        );
+        let scene = parse(&text, Path::new("dir/s.toml")).unwrap();
+        assert!(matches!(scene.projection, ProjectionSpec::ExactBall(_)));
+        assert_eq!(scene.projection.kind(), "trilinear");
+        let exact = scene.projection.build(32, 24).unwrap();
+        assert!(exact.trilinear().is_none() && exact.ray(DVec2::new(16.0, 12.0)).is_some());
+    }
+
+    #[test]
+    fn inverse_perspective_focus() {
+        let camera = "{ position = [0, 2, 6], look_at = [0, 1, 0], h_fov = 60, v_fov = 45 }";
+        let converge = DVec3::new(0.0, 1.0, -2.0);
+        let m = mesh(&format!(
+            "grid = 6\nview = \"detail_in_context\"\ncamera = {camera}\n\
+             focus_view = \"inverse_perspective\"\nconverge = [0, 1, -2]\n"
+        ));
+        // The focus centre (vertex 24) looks at the convergence point.
+        let to = converge - m.points[24];
+        assert!(to.cross(m.normals[24]).length() < 1e-12 * to.length());
+        assert!(to.dot(m.normals[24]) > 0.0);
+        let ortho = mesh(&format!(
+            "grid = 6\nview = \"detail_in_context\"\ncamera = {camera}\nfocus_view = \"orthographic\"\n"
+        ));
+        assert_eq!(
+            ortho,
+            mesh(&format!(
+                "grid = 6\nview = \"detail_in_context\"\ncamera = {camera}\n"
+            ))
+        );
+    }
+
+    #[test]
+    fn view_errors_are_positioned() {
+        let mirror = |rest: &str| {
+            format!("grid = 2\nview = \"sphere_mirror\"\ncamera = {BALL_CAMERA}\n{rest}")
+        };
+        let glass = |rest: &str| {
+            format!("grid = 2\nview = \"sphere_glass\"\ncamera = {BALL_CAMERA}\n{SPHERE}\n{rest}")
+        };
+        error_at(&mirror(""), 1, 1, "needs `sphere`");
+        error_at(
+            &mirror(&format!("{SPHERE}\nior = 1.5\n")),
+            7,
+            7,
+            "`ior` is not a parameter of view \"sphere_mirror\"",
+        );
+        error_at(&glass("ior = 0.5\n"), 7, 7, "ior must be at least 1");
+        error_at(
+            &mirror(&format!(
+                "{SPHERE}\nsecond_sphere = {{ center = [1.5, 1, 0], radius = 1.0 }}\n"
+            )),
+            7,
+            17,
+            "overlaps the first",
+        );
+        error_at(
+            &glass("second_sphere = { center = [0, 1, 9], radius = 1.0 }\n"),
+            7,
+            17,
+            "`second_sphere` is not a parameter of view \"sphere_glass\"",
+        );
+        error_at(
+            &mirror("sphere = { center = [0, 1, 0], radius = -1.0 }\n"),
+            6,
+            10,
+            "positive radius",
+        );
+        let ball = |camera: &str| {
+            format!("grid = 2\nview = \"sphere_mirror\"\ncamera = {camera}\n{SPHERE}\n")
+        };
+        error_at(
+            &ball("{ position = [0, 1, 3], look_at = [0, 1, 0], h_fov = 60, v_fov = 45 }"),
+            5,
+            10,
+            "misses the ball",
+        );
+        error_at(
+            &ball("{ position = [0, 1, 0.5], look_at = [0, 1, 0], h_fov = 20, v_fov = 15 }"),
+            5,
+            10,
+            "inside the ball",
+        );
+        error_at(
+            &ball("{ position = [0, 1, 3], look_at = [0, 1, 0], width = 1, height = 1 }"),
+            5,
+            10,
+            "needs a pinhole camera",
+        );
+        error_at(
+            &format!("grid = 2\nview = \"two_views\"\nfirst = {BALL_CAMERA}\nsecond = {BALL_CAMERA}\nexact = true\n"),
+            7,
+            9,
+            "`exact` is not a parameter of view \"two_views\"",
+        );
+        let detail = |rest: &str| {
+            format!("grid = 2\nview = \"detail_in_context\"\ncamera = {{ position = [0, 2, 6], look_at = [0, 1, 0], h_fov = 60, v_fov = 45 }}\n{rest}")
+        };
+        error_at(
+            &detail("focus_view = \"fisheye\"\n"),
+            6,
+            14,
+            "unknown focus_view \"fisheye\"",
+        );
+        error_at(
+            &detail("converge = [0, 1, -2]\n"),
+            6,
+            12,
+            "needs focus_view = \"inverse_perspective\"",
+        );
+        error_at(
+            &detail("focus_view = \"inverse_perspective\"\n"),
+            1,
+            1,
+            "needs `converge`",
+        );
+        error_at(
+            &detail("focus_view = \"inverse_perspective\"\nconverge = [0, 2, 6]\n"),
+            7,
+            12,
+            "beyond the base plane",
         );
     }
 

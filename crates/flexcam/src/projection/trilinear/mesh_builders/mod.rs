@@ -10,21 +10,25 @@
 //!   spherical base; [`inward_sphere`] is the mapping surface of section 6.3).
 //! - [`DetailInContext`] and [`TwoViews`]: the visualisation surfaces of sections 6.1 and
 //!   6.2, defined over [`GridCamera`]s.
+//! - [`BallView`]: a pinhole's view through a mirror or glass ball (7.4, 7.3.3), as a grid
+//!   and exactly ([`BallProjection`], the grid's limit, its reference).
 //! - [`reflector_surface`]: the reflection and refraction surfaces of chapter 7, built from a
 //!   reflector mesh and the main camera, so that the image through them is already in the
 //!   main image's coordinates.
 //!
 //! See docs/trilinear-surfaces.md for the design and the degenerate cases.
 
+mod ball;
 mod camera;
 mod grid;
 mod reflector;
 mod visualisation;
 
+pub use ball::{BallOptic, BallProjection, BallView};
 pub use camera::GridCamera;
 pub use grid::{between_surfaces, screen_grid, GridVertex, MAX_GRID_CELLS};
 pub(crate) use reflector::vertex_normals;
 pub use reflector::{
     reflector_surface, vertex_ray, Optic, ReflectorSurface, SurfaceRays, SurfaceScreenMap,
 };
-pub use visualisation::{inward_sphere, DetailInContext, TwoViews};
+pub use visualisation::{inward_sphere, DetailInContext, FocusView, TwoViews};

@@ -35,18 +35,47 @@ use crate::projection::flexible::{PolarFrame, SpherePatch, Surface};
 ///
 /// Radii are in screen units (the width and height of the image are both 1). Nothing
 /// nearer than the base plane (forward distance `d`) is seen, in the context too.
+///
+/// With [`FocusView::InversePerspective`] (6.1's other focus, set by
+/// [`DetailInContext::with_focus_view`]) the focus rays are not parallel but converge on a
+/// point `c` beyond the base plane: `dir(f)` above becomes `g(s) = (c - b(s)) / ((c - b(s)) .
+/// forward)` with `b(s)` the base point (forward component 1, as the camera's directions), so
+/// every focus ray passes through `c`, and an object between the base plane and `c` is seen
+/// from around it: faces turned away from the camera's axis come into view, the far side
+/// larger than the near. Beyond `c` the focus rays have crossed (the focus image of what lies
+/// there is turned half round); the band blends `g(s)` into the perspective directions as
+/// before, and may fold there too.
+///
 /// Degenerate cases, all errors: an orthographic camera (there is no perspective context);
 /// `magnification` or `distance` not finite or not positive; `inner` not positive or
-/// `outer <= inner`; a focus that is not finite.
+/// `outer <= inner`; a focus that is not finite; a convergence point that is not finite or
+/// not beyond the base plane (forward distance from the eye at most `d`: the focus rays
+/// would diverge or start at it).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DetailInContext {
     camera: GridCamera,
     eye: DVec3,
+    forward: DVec3,
     focus: DVec2,
     inner: f64,
     outer: f64,
     /// Forward distance of the base plane from the eye.
     base: f64,
+    focus_view: FocusView,
+}
+
+/// The rays inside a detail-in-context focus.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub enum FocusView {
+    /// Parallel rays along the camera's ray through the focus: an orthographic view. The
+    /// default.
+    #[default]
+    Orthographic,
+    /// Rays converging on the world point `converge`: an inverse perspective view.
+    InversePerspective {
+        /// The point every focus ray passes through.
+        converge: DVec3,
+    },
 }
 
 impl DetailInContext {
@@ -85,11 +114,30 @@ impl DetailInContext {
         Ok(DetailInContext {
             camera,
             eye: basis.origin,
+            forward: basis.forward,
             focus,
             inner,
             outer,
             base: distance / magnification,
+            focus_view: FocusView::Orthographic,
         })
+    }
+
+    /// The same view with the focus rays of `focus_view`. Errors: a convergence point that
+    /// is not finite or not beyond the base plane.
+    pub fn with_focus_view(self, focus_view: FocusView) -> Result<Self> {
+        if let FocusView::InversePerspective { converge } = focus_view {
+            let depth = (converge - self.eye).dot(self.forward);
+            if !converge.is_finite() || depth <= self.base {
+                return Err(Error::new(format!(
+                    "detail_in_context converge must lie beyond the base plane (forward \
+                     distance {} from the eye, the look-at distance over the \
+                     magnification), got {converge} at forward distance {depth}",
+                    self.base
+                )));
+            }
+        }
+        Ok(DetailInContext { focus_view, ..self })
     }
 
     /// The weight of the perspective direction at screen distance `r` from the focus: 0 in
@@ -107,11 +155,20 @@ impl DetailInContext {
     /// The base point and ray at `screen` (the formula of the type's doc).
     pub fn vertex(&self, screen: DVec2) -> GridVertex {
         let here = self.camera.vertex(screen).direction;
-        let axis = self.camera.vertex(self.focus).direction;
+        let point = self.eye + self.base * here;
+        let inner = match self.focus_view {
+            FocusView::Orthographic => self.camera.vertex(self.focus).direction,
+            FocusView::InversePerspective { converge } => {
+                // Forward component 1 like `here`; positive, as `converge` lies beyond the
+                // base plane.
+                let to = converge - point;
+                to / to.dot(self.forward)
+            }
+        };
         let w = self.weight((screen - self.focus).length());
         GridVertex {
-            point: self.eye + self.base * here,
-            direction: axis + w * (here - axis),
+            point,
+            direction: inner + w * (here - inner),
         }
     }
 }
@@ -300,6 +357,67 @@ mod tests {
         }
     }
 
+    /// The point the inverse-perspective focus of [`inverse`] converges on: 2 beyond the
+    /// look-at distance on the camera's ray through the focus, nudged off it.
+    fn converge() -> DVec3 {
+        EYE + 7.0 * camera().vertex(FOCUS).direction + DVec3::new(0.1, -0.05, 0.0)
+    }
+
+    fn inverse() -> DetailInContext {
+        detail()
+            .with_focus_view(FocusView::InversePerspective {
+                converge: converge(),
+            })
+            .unwrap()
+    }
+
+    #[test]
+    fn inverse_perspective_focus_rays_meet_at_the_convergence_point() {
+        let view = inverse();
+        for s in [
+            FOCUS,
+            FOCUS + DVec2::new(0.06, -0.03),
+            FOCUS + DVec2::new(0.0, 0.0999),
+        ] {
+            let v = view.vertex(s);
+            let to = converge() - v.point;
+            assert!(to.cross(v.direction).length() < 1e-12 * to.length(), "{s}");
+            assert!(to.dot(v.direction) > 0.0, "{s}: ahead of the base point");
+            let on_plane = EYE + 2.0 * camera().vertex(s).direction;
+            assert!((v.point - on_plane).length() < 1e-12, "base plane at {s}");
+        }
+        // Seen from around: two focus rays that start apart on the base plane come together.
+        let (a, b) = (
+            view.vertex(FOCUS),
+            view.vertex(FOCUS + DVec2::new(0.08, 0.0)),
+        );
+        let gap = |t: f64| (a.point + t * a.direction).distance(b.point + t * b.direction);
+        assert!(gap(2.0) < gap(0.0) && gap(4.0) < gap(2.0));
+        // The context is still the camera's perspective view.
+        let s = DVec2::new(0.95, 0.1);
+        assert!((view.vertex(s).direction - camera().vertex(s).direction).length() < 1e-15);
+        // The orthographic focus is the default, and with_focus_view(Orthographic) gives it.
+        assert_eq!(
+            inverse().with_focus_view(FocusView::Orthographic).unwrap(),
+            detail()
+        );
+    }
+
+    #[test]
+    fn inverse_perspective_convergence_must_lie_beyond_the_base_plane() {
+        let at_plane = EYE + 2.0 * camera().vertex(FOCUS).direction;
+        for converge in [at_plane, EYE, EYE - DVec3::Z, DVec3::NAN] {
+            let e = detail()
+                .with_focus_view(FocusView::InversePerspective { converge })
+                .unwrap_err();
+            assert!(e.message.contains("beyond the base plane"), "{e}");
+        }
+        let beyond = at_plane + 1e-6 * camera().vertex(FOCUS).direction;
+        assert!(detail()
+            .with_focus_view(FocusView::InversePerspective { converge: beyond })
+            .is_ok());
+    }
+
     #[test]
     fn detail_in_context_degenerate_parameters_are_errors() {
         let (c, f) = (camera(), DVec2::splat(0.5));
@@ -410,16 +528,18 @@ mod tests {
                 }
             }
 
-            /// Project a point seen through the detail-in-context mesh, cast the ray at each
-            /// image position found: the ray reaches the point, and one of the images is the
+            /// Project a point seen through the detail-in-context mesh (either focus), cast
+            /// the ray at each image position found: the ray reaches the point, and one of the images is the
             /// pixel and depth the point was made from.
             #[test]
             fn detail_in_context_projection_round_trips(
                 sx in 1.0..63.0f64,
                 sy in 1.0..63.0f64,
                 t in 0.0..10.0f64,
+                inverse_focus in proptest::bool::ANY,
             ) {
-                let mesh = screen_grid(6, |s| detail().vertex(s)).unwrap();
+                let view = if inverse_focus { inverse() } else { detail() };
+                let mesh = screen_grid(6, |s| view.vertex(s)).unwrap();
                 let trilinear = Trilinear::new(&mesh, 64, 64).unwrap();
                 let pixel = DVec2::new(sx, sy);
                 let point = trilinear.ray(pixel).unwrap().at(t);
