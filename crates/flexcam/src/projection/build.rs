@@ -2,7 +2,7 @@
 
 use super::dome_master::dome_master;
 use super::fisheye::Fisheye;
-use super::flexible::{Flexible, GridFitter};
+use super::flexible::{build_projection, GridFitter};
 use super::kannala_brandt::KannalaBrandt;
 use super::linear::{Orthographic, Perspective};
 use super::ods::ods;
@@ -94,7 +94,7 @@ impl ProjectionSpec {
             ProjectionSpec::Vr180 { frame, ipd } => Box::new(vr180(frame, *ipd, width, height)?),
             ProjectionSpec::Trilinear(mesh) => Box::new(Trilinear::new(mesh, width, height)?),
             ProjectionSpec::Flexible(spec) => {
-                Box::new(Flexible::build(spec, width, height, fitter, report)?)
+                build_projection(spec, width, height, fitter, report)?
             }
         })
     }

@@ -1,7 +1,8 @@
 //! `[projection] type = "flexible"`: a named preset placed by a camera frame, two explicit
 //! control surfaces `near` and `far`, or a list `surfaces` blended in t (`blend`, `knots`,
 //! `segments`), a shape-defined panorama (`outline`/`outlines` and `profile`/`profiles`,
-//! module `panorama`), with an optional re-parameterisation.
+//! module `panorama`), with an optional re-parameterisation; or `pieces`, several such
+//! projections each owning an image rectangle (module `pieces`).
 
 use std::f64::consts::PI;
 use std::ops::Range;
@@ -23,7 +24,7 @@ use crate::projection::flexible::{
 };
 
 /// Every key of a flexible table (besides `type`).
-pub(super) const KEYS: [&str; 43] = [
+pub(super) const KEYS: [&str; 44] = [
     "preset",
     "position",
     "look_at",
@@ -67,6 +68,7 @@ pub(super) const KEYS: [&str; 43] = [
     "center",
     "radius",
     "magnification",
+    "pieces",
 ];
 
 /// Keys every preset accepts (but `up` for the axonometric one, which is always +y).
@@ -119,12 +121,28 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
     let src = required.src;
     let raw = required.raw();
     let reparam = reparam(src, raw)?;
-    // `projectors` goes with any volume of straight projectors; the checks below are for
-    // the keys of the volume itself.
+    if let Some(list) = &raw.pieces {
+        let present = raw.present_keys();
+        reject_keys(
+            src,
+            &present,
+            |key| key == "pieces",
+            || {
+                "projections made of `pieces` (they take only `pieces`; each piece has its own keys)".to_string()
+            },
+        )?;
+        return Ok(FlexibleSpec {
+            source: super::pieces::convert(src, list, convert)?,
+            reparam: None,
+        });
+    }
+    // `projectors` goes with any volume of straight projectors, `rect` is a piece's
+    // rectangle (module `pieces`; refused elsewhere by the projection's key list); the
+    // checks below are for the keys of the volume itself.
     let present: Vec<_> = raw
         .present_keys()
         .into_iter()
-        .filter(|(key, _)| *key != "projectors")
+        .filter(|(key, _)| *key != "projectors" && *key != "rect")
         .collect();
     let source = match &raw.preset {
         Some(name) => {

@@ -63,8 +63,9 @@ pub struct RawImage {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawProjection {
+    /// Required everywhere but in the `pieces` of a flexible projection, which are flexible.
     #[serde(rename = "type")]
-    pub kind: Spanned<String>,
+    pub kind: Option<Spanned<String>>,
     #[serde(default, deserialize_with = "strict")]
     pub position: Option<Vec3Value>,
     #[serde(default, deserialize_with = "strict")]
@@ -162,6 +163,9 @@ pub struct RawProjection {
     pub pixel_aspect: Option<Spanned<[f64; 2]>>,
     pub polynomial: Option<Spanned<Vec<f64>>>,
     pub tilt: Option<Spanned<f64>>,
+    pub pieces: Option<Spanned<Vec<Spanned<RawProjection>>>>,
+    #[serde(default, deserialize_with = "strict")]
+    pub rect: Option<Spanned<[f64; 4]>>,
 }
 
 /// `outline = { ... }`, `profile`, and the entries of `outlines` / `profiles` (with `at`): a
@@ -457,6 +461,8 @@ impl RawProjection {
             ),
             ("polynomial", self.polynomial.as_ref().map(Spanned::span)),
             ("tilt", self.tilt.as_ref().map(Spanned::span)),
+            ("pieces", self.pieces.as_ref().map(Spanned::span)),
+            ("rect", self.rect.as_ref().map(Spanned::span)),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))

@@ -1,0 +1,268 @@
+//! The chapter 6 projections of Brosz 2011 from the command line: the discontinuous
+//! (`pieces`) examples raster like the ray caster, piece by piece; pieces that are the
+//! halves of a perspective render that perspective's pixels; bad pieces are refused with
+//! one line naming the file, the place and the pieces or keys at fault.
+
+mod common;
+
+use std::fs;
+use std::path::Path;
+
+use common::{interior_agreement, run, run_json, run_ok};
+use tempfile::TempDir;
+
+fn example(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// `--method raster` against the ray caster on the piece examples (flat shading): every
+/// piece is drawn by its own inverse into its tile.
+#[test]
+fn piece_examples_raster_like_the_ray_caster() {
+    let dir = TempDir::new().unwrap();
+    for name in [
+        "flexible-single-centre.toml",
+        "flexible-collage.toml",
+        "flexible-glc-mosaic.toml",
+    ] {
+        let report = run_json(
+            &dir,
+            &[
+                "compare",
+                &example(name),
+                "--method",
+                "raster",
+                "--shading",
+                "flat",
+                "--json",
+            ],
+        );
+        let agreement = report["id_agreement"].as_f64().unwrap();
+        let depth = report["depth_mean"].as_f64().unwrap();
+        let rgb = report["relative_rgb_error"].as_f64().unwrap();
+        assert!(agreement >= 0.9995, "{name}: id agreement {agreement}");
+        assert!(depth < 1e-4, "{name}: mean relative depth error {depth}");
+        assert!(rgb < 0.001, "{name}: relative RGB error {rgb}");
+    }
+}
+
+const OBJECTS: &str = "\n[[object]]\nname = \"floor\"\nshape = \"plane\"\nsize = [8.0, 8.0]\n\
+                       tessellation = 8\n\n[[object]]\nname = \"cube\"\nshape = \"box\"\n\
+                       size = [2.0, 2.0, 2.0]\ntranslate = [0.0, 1.0, 0.0]\n\
+                       rotate = [0.0, 30.0, 0.0]\n";
+
+const FRAME: &str = "position = [1.0, 4.0, 6.0]\nlook_at = [0.0, 0.5, 0.0]\n";
+
+/// A perspective of 70 degrees, and the same as two off-axis pieces, the halves of its
+/// window (each 2 atan(tan 35 / 2) wide, shifted a half-width out), give the same ids at
+/// every pixel by ray casting, and raster like it.
+#[test]
+fn off_axis_halves_render_the_perspective() {
+    let dir = TempDir::new().unwrap();
+    let image = "[image]\nwidth = 120\nheight = 90\n";
+    fs::write(
+        dir.path().join("whole.toml"),
+        format!("{image}\n[projection]\ntype = \"perspective\"\n{FRAME}fov = 70.0\n{OBJECTS}"),
+    )
+    .unwrap();
+    let half = 2.0 * (0.5 * 35f64.to_radians().tan()).atan().to_degrees();
+    let piece = |rect: &str, shift: f64| {
+        format!(
+            "\n[[projection.pieces]]\nrect = {rect}\npreset = \"off_axis\"\n{FRAME}\
+             fov = {half:?}\nshift = [{shift:?}, 0.0]\n"
+        )
+    };
+    fs::write(
+        dir.path().join("split.toml"),
+        format!(
+            "{image}\n[projection]\ntype = \"flexible\"\n{}{}{OBJECTS}",
+            piece("[0.0, 0.0, 0.5, 1.0]", -1.0),
+            piece("[0.5, 0.0, 1.0, 1.0]", 1.0)
+        ),
+    )
+    .unwrap();
+    for (scene, method) in [
+        ("whole.toml", "raycast"),
+        ("split.toml", "raycast"),
+        ("split.toml", "raster"),
+    ] {
+        let ids = format!("{scene}-{method}-ids.png");
+        run_ok(
+            &dir,
+            &[
+                "render",
+                scene,
+                "--method",
+                method,
+                "--shading",
+                "flat",
+                "--ids",
+                &ids,
+                "-o",
+                "out.png",
+            ],
+        );
+    }
+    let path = |name: &str| dir.path().join(name);
+    let (w, h, whole) = common::ids(&path("whole.toml-raycast-ids.png"));
+    let (_, _, split) = common::ids(&path("split.toml-raycast-ids.png"));
+    let same = whole.iter().zip(&split).filter(|(a, b)| a == b).count();
+    assert!(
+        same as f64 >= 0.9995 * f64::from(w * h),
+        "{same} of {} pixels",
+        w * h
+    );
+    let (interior, pixels) = interior_agreement(
+        &path("whole.toml-raycast-ids.png"),
+        &path("split.toml-raster-ids.png"),
+    );
+    assert!(pixels > 5000, "{pixels}");
+    assert!(
+        interior >= 0.999,
+        "raster of the pieces vs the perspective: {interior}"
+    );
+}
+
+/// Runs `render scene.toml` with `text` as the scene and asserts exit status 1, exactly the
+/// one line `expected` on stderr and no output.
+fn refused(dir: &TempDir, text: &str, args: &[&str], expected: &str) {
+    fs::write(dir.path().join("scene.toml"), text).unwrap();
+    let mut all = vec!["render", "scene.toml", "-o", "out.png"];
+    all.extend(args);
+    let out = run(dir, &all);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr, format!("flexcam: {expected}\n"));
+    assert!(!dir.path().join("out.png").exists());
+}
+
+/// A flexible projection of `pieces` (the text after `type`), 40 x 30.
+fn pieces_scene(pieces: &str) -> String {
+    format!(
+        "[image]\nwidth = 40\nheight = 30\n\n[projection]\ntype = \"flexible\"\n{pieces}{OBJECTS}"
+    )
+}
+
+/// A perspective piece owning `rect`.
+fn perspective_piece(rect: &str) -> String {
+    format!("\n[[projection.pieces]]\nrect = {rect}\npreset = \"perspective\"\n{FRAME}fov = 50.0\n")
+}
+
+#[test]
+fn bad_pieces_are_refused_at_their_place() {
+    let dir = TempDir::new().unwrap();
+    let two = |a: &str, b: &str| pieces_scene(&(perspective_piece(a) + &perspective_piece(b)));
+    refused(
+        &dir,
+        &two("[0.0, 0.0, 0.6, 1.0]", "[0.5, 0.0, 1.0, 1.0]"),
+        &[],
+        "scene.toml:16:8: piece 2's rect [0.5, 0.0, 1.0, 1.0] overlaps piece 1's rect \
+         [0.0, 0.0, 0.6, 1.0]: pieces may only touch",
+    );
+    refused(
+        &dir,
+        &two("[0.0, 0.0, 0.5, 1.0]", "[0.5, 0.0, 1.0, 1.2]"),
+        &[],
+        "scene.toml:16:8: piece 2: a piece's `rect` must be [u0, v0, u1, v1] with \
+         0 <= u0 < u1 <= 1 and 0 <= v0 < v1 <= 1, got [0.5, 0.0, 1.0, 1.2]",
+    );
+    refused(
+        &dir,
+        &pieces_scene("pieces = []\n"),
+        &[],
+        "scene.toml:7:10: `pieces` must hold 1 to 64 pieces, got 0",
+    );
+    let many = format!(
+        "pieces = [{}]\n",
+        vec!["{ rect = [0.0, 0.0, 1.0, 1.0] }"; 65].join(", ")
+    );
+    refused(
+        &dir,
+        &pieces_scene(&many),
+        &[],
+        "scene.toml:7:10: `pieces` must hold 1 to 64 pieces, got 65",
+    );
+    refused(
+        &dir,
+        &pieces_scene("pieces = [{ preset = \"perspective\", fov = 50.0 }]\n"),
+        &[],
+        "scene.toml:7:11: piece 1 needs `rect = [u0, v0, u1, v1]`, the image rectangle it owns",
+    );
+    refused(
+        &dir,
+        &pieces_scene("pieces = [{ type = \"perspective\", rect = [0.0, 0.0, 1.0, 1.0] }]\n"),
+        &[],
+        "scene.toml:7:20: piece 1 is a flexible projection: leave out `type` or write \
+         type = \"flexible\", not \"perspective\"",
+    );
+    refused(
+        &dir,
+        &pieces_scene(
+            "pieces = [{ rect = [0.0, 0.0, 1.0, 1.0], pieces = [{ rect = [0.0, 0.0, 1.0, 1.0] }] }]\n",
+        ),
+        &[],
+        "scene.toml:7:51: piece 1 holds `pieces` of its own: pieces do not nest",
+    );
+    refused(
+        &dir,
+        &pieces_scene(&format!(
+            "reparam = \"polar\"\n{}",
+            perspective_piece("[0.0, 0.0, 1.0, 1.0]")
+        )),
+        &[],
+        "scene.toml:7:11: `reparam` is not a parameter of flexible projections made of \
+         `pieces` (they take only `pieces`; each piece has its own keys)",
+    );
+    refused(
+        &dir,
+        &pieces_scene(
+            &perspective_piece("[0.0, 0.0, 1.0, 1.0]")
+                .replace("fov = 50.0", "fov = 50.0\nwidth = 2.0"),
+        ),
+        &[],
+        "scene.toml:14:9: `width` is not a parameter of flexible preset \"perspective\" (it \
+         takes: preset, position, look_at, up, clip, reparam, fov)",
+    );
+    // `rect` belongs to pieces only.
+    refused(
+        &dir,
+        &format!("[projection]\ntype = \"flexible\"\nrect = [0.0, 0.0, 1.0, 1.0]\npreset = \"perspective\"\n{FRAME}fov = 50.0\n"),
+        &[],
+        "scene.toml:3:8: `rect` is not a parameter of flexible projections (they take: preset, \
+         position, look_at, up, converge, fov, width, h_fov, v_fov, clip, shear, \
+         slit_distance, near, far, surfaces, blend, knots, segments, reparam, max_latitude, \
+         shift, twist, azimuth, elevation, generators, projectors, corner_radius, outline, \
+         outlines, profile, profiles, perspective_rect, transition, transitions, fovs, style, \
+         pole, strength, path, directions, center, radius, magnification, pieces)",
+    );
+    // At build time: a sliver of no whole pixel, and the raster's refusal naming the piece.
+    refused(
+        &dir,
+        &two("[0.0, 0.0, 0.5, 1.0]", "[0.5, 0.0, 0.51, 1.0]"),
+        &[],
+        "scene.toml:5:1: piece 2: rect [0.5, 0.0, 0.51, 1.0] covers no whole pixel of a 40x30 \
+         image (its edges snap to the same pixel boundary)",
+    );
+    let curved = format!(
+        "{}\n[[projection.pieces]]\nrect = [0.5, 0.0, 1.0, 1.0]\npreset = \"ortho_near_persp_far\"\n\
+         {FRAME}fov = 50.0\ntransition = 3.0\nclip = [0.0, 20.0]\n",
+        perspective_piece("[0.0, 0.0, 0.5, 1.0]")
+    );
+    // Ray casting draws it.
+    fs::write(dir.path().join("scene.toml"), pieces_scene(&curved)).unwrap();
+    run_ok(&dir, &["render", "scene.toml", "-o", "out.png"]);
+    fs::remove_file(dir.path().join("out.png")).unwrap();
+    refused(
+        &dir,
+        &pieces_scene(&curved),
+        &["--method", "raster"],
+        "scene.toml: method raster needs a projection with an analytic inverse; flexible has \
+         none: piece 2 (rect [0.5, 0.0, 1.0, 1.0]) has no analytic inverse: its projectors \
+         are polylines through more than two control surfaces, with no closed-form inverse \
+         (use --method raycast)",
+    );
+}
