@@ -1,7 +1,8 @@
 //! The chapter 6 projections of Brosz 2011 from the command line: the discontinuous
 //! (`pieces`) examples raster like the ray caster, piece by piece; pieces that are the
-//! halves of a perspective render that perspective's pixels; bad pieces are refused with
-//! one line naming the file, the place and the pieces or keys at fault.
+//! halves of a perspective render that perspective's pixels; the NURBS example renders by
+//! ray casting and the raster says why it cannot; bad pieces and bad NURBS surfaces are
+//! refused with one line naming the file, the place and the pieces or keys at fault.
 
 mod common;
 
@@ -264,5 +265,101 @@ fn bad_pieces_are_refused_at_their_place() {
          none: piece 2 (rect [0.5, 0.0, 1.0, 1.0]) has no analytic inverse: its projectors \
          are polylines through more than two control surfaces, with no closed-form inverse \
          (use --method raycast)",
+    );
+}
+
+/// `scenes/flexible-nurbs.toml` renders by ray casting; the raster refuses it with the
+/// reason.
+#[test]
+fn the_nurbs_example_renders_and_the_raster_says_why_not() {
+    let dir = TempDir::new().unwrap();
+    let scene = example("flexible-nurbs.toml");
+    let stats = run_json(
+        &dir,
+        &[
+            "render", &scene, "--width", "64", "--height", "48", "-o", "n.png", "--stats", "-",
+        ],
+    );
+    assert!(stats.is_object());
+    let out = run(
+        &dir,
+        &["render", &scene, "--method", "raster", "-o", "out.png"],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        stderr.contains(
+            "flexible has none: its near and far control surfaces are outside the scanline class"
+        ),
+        "{stderr}"
+    );
+}
+
+/// A flexible projection from `near` (a NURBS table's keys after `surface = "nurbs"`) to a
+/// rectangle.
+fn nurbs_scene(near: &str) -> String {
+    format!(
+        "[image]\nwidth = 40\nheight = 30\n\n[projection]\ntype = \"flexible\"\n\
+         near = {{ surface = \"nurbs\", {near} }}\n\
+         far = {{ surface = \"rectangle\", center = [0.0, 0.0, -5.0], u_axis = [4.0, 0.0, 0.0], v_axis = [0.0, 3.0, 0.0] }}\n{OBJECTS}"
+    )
+}
+
+const GRID: &str = "control = [[[-1.0, -1.0, 0.0], [0.0, -1.0, 0.0], [1.0, -1.0, 0.0]], \
+                    [[-1.0, 1.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]]], degree = [2, 1]";
+
+#[test]
+fn bad_nurbs_surfaces_are_refused_at_the_key() {
+    let dir = TempDir::new().unwrap();
+    fs::write(dir.path().join("scene.toml"), nurbs_scene(GRID)).unwrap();
+    run_ok(&dir, &["render", "scene.toml", "-o", "ok.png"]);
+    let cases = [
+        (
+            format!("{GRID}, u_knots = [0.0, 0.0, 1.0, 0.5, 1.0, 1.0]"),
+            "scene.toml:7:179: near nurbs surface u knots must not decrease: knot 4 (0.5) is \
+             below knot 3 (1)",
+        ),
+        (
+            format!("{GRID}, u_knots = [0.0, 0.0, 1.0, 1.0]"),
+            "scene.toml:7:179: near nurbs surface needs 6 u knots (3 control points + degree \
+             2 + 1), got 4",
+        ),
+        (
+            format!("{GRID}, v_knots = [0.0, 0.0, 0.0, 0.0]"),
+            "scene.toml:7:179: near nurbs surface v knots leave an empty parameter range: \
+             knots 2 and 3 (degree + 1 from each end) are both 0",
+        ),
+        (
+            format!("{GRID}, weights = [[1.0, -1.0, 1.0], [1.0, 1.0, 1.0]]"),
+            "scene.toml:7:179: near nurbs surface weights must be positive and finite, got -1",
+        ),
+        (
+            format!("{GRID}, weights = [[1.0, 1.0], [1.0, 1.0]]"),
+            "scene.toml:7:179: near nurbs surface weights must have the control grid's shape \
+             (2 rows of 3), got 2 rows of 2",
+        ),
+        (
+            GRID.replace("[2, 1]", "[3, 1]"),
+            "scene.toml:7:39: near nurbs surface of degree [3, 1] needs 4 to 64 control \
+             points along u and 2 to 64 along v, got 2 rows of 3",
+        ),
+        (
+            GRID.replace("[2, 1]", "[2, 9]"),
+            "scene.toml:7:161: near nurbs surface degree along v must be in 1..=7, got 9",
+        ),
+        (
+            GRID.replace("[2, 1]", "[2, -1]"),
+            "scene.toml:7:161: near nurbs surface degree must be [u, v] in 1..=7, got [2, -1]",
+        ),
+    ];
+    for (near, expected) in cases {
+        refused(&dir, &nurbs_scene(&near), &[], expected);
+    }
+    let row = format!("[{}]", vec!["[0.0, 0.0, 0.0]"; 65].join(", "));
+    refused(
+        &dir,
+        &nurbs_scene(&format!("control = [{row}, {row}]")),
+        &[],
+        "scene.toml:7:39: near nurbs surface takes at most 64 x 64 control points",
     );
 }

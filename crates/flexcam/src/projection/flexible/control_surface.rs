@@ -10,6 +10,7 @@ use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
 
+pub use super::nurbs::{NurbsPatch, NurbsSpec};
 pub use super::panorama::PanoramaSurface;
 pub use super::patch::{BSplinePatch, BezierPatch};
 pub use super::presets::{PathSurface, PinchedRectangle};
@@ -148,6 +149,9 @@ pub enum Surface {
     Bezier(Box<BezierPatch>),
     /// A uniform cubic B-spline patch.
     BSpline(BSplinePatch),
+    /// A NURBS patch: any degree up to 7, knots and weights (boxed: a control grid and two
+    /// knot vectors).
+    Nurbs(Box<NurbsPatch>),
     /// A shape-defined panorama surface: outlines and profiles by arc length (boxed: it
     /// holds a camera basis).
     Panorama(Box<PanoramaSurface>),
@@ -211,6 +215,7 @@ impl Surface {
             }
             Surface::Bezier(b) => b.point(uv),
             Surface::BSpline(b) => b.point(uv),
+            Surface::Nurbs(n) => n.point(uv),
             Surface::Panorama(p) => p.point(uv),
             Surface::Pinched(p) => p.point(uv),
             Surface::Path(p) => p.point(uv),
@@ -228,6 +233,7 @@ impl Surface {
             Surface::Line { .. } => "line",
             Surface::Bezier(_) => "bezier",
             Surface::BSpline(_) => "bspline",
+            Surface::Nurbs(_) => "nurbs",
             Surface::Panorama(_) => "panorama",
             Surface::Pinched(_) => "pinched",
             Surface::Path(_) => "path",
@@ -260,6 +266,7 @@ impl Surface {
             | Surface::Cylinder(_)
             | Surface::Bezier(_)
             | Surface::BSpline(_)
+            | Surface::Nurbs(_)
             | Surface::Panorama(_)
             | Surface::Pinched(_)
             | Surface::Path(_) => None,
@@ -281,6 +288,7 @@ impl Surface {
             Surface::Line { start, end, .. } => finite(&[*start, *end]),
             Surface::Bezier(b) => finite(b.control.as_flattened()),
             Surface::BSpline(b) => finite(b.control()),
+            Surface::Nurbs(n) => n.is_finite(),
             Surface::Panorama(p) => {
                 p.validate()?;
                 true

@@ -106,6 +106,7 @@ fn affine(s: &Surface) -> Option<Affine> {
         | Surface::Cylinder(_)
         | Surface::Bezier(_)
         | Surface::BSpline(_)
+        | Surface::Nurbs(_)
         | Surface::Panorama(_)
         | Surface::Pinched(_)
         | Surface::Path(_) => None,

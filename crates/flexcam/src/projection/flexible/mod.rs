@@ -8,6 +8,7 @@
 //! - [`blend`]: volumes of two or more surfaces blended in t, piecewise-linear (polyline
 //!   projectors) or Bernstein (Bezier projectors);
 //! - `patch`: bicubic Bezier and uniform cubic B-spline control surfaces;
+//! - [`nurbs`]: NURBS control surfaces (degree, knots, weights);
 //! - [`reparam`]: pixel <-> (u, v) (linear, polar fisheye, lens-like, equisolid, Mercator);
 //! - [`presets`]: named volumes from a camera frame (perspective, pushbroom, crossed slits, ...);
 //! - [`projector_grid`]: a volume interpolated from a grid of placed projectors (5.2), aimed
@@ -30,6 +31,7 @@ pub mod control_surface;
 pub mod interpolate;
 mod inverse;
 mod linear_volume;
+pub mod nurbs;
 pub mod panorama;
 mod patch;
 pub mod pieces;
@@ -45,7 +47,8 @@ use glam::{DVec2, DVec3};
 pub use animation::{Animation, Easing, Keyframe};
 pub use blend::{BezierVolume, PiecewiseVolume};
 pub use control_surface::{
-    BSplinePatch, BezierPatch, CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface,
+    BSplinePatch, BezierPatch, CylinderPatch, LineParam, NurbsPatch, NurbsSpec, PolarFrame,
+    SpherePatch, Surface,
 };
 pub use linear_volume::LinearVolume;
 pub use panorama::{PanoramaShape, PanoramaSpec};

@@ -317,6 +317,11 @@ pub struct RawSurface {
     pub along: Option<Spanned<String>>,
     #[serde(default, deserialize_with = "strict")]
     pub control: Option<Spanned<Vec<Vec<[f64; 3]>>>>,
+    pub weights: Option<Spanned<Vec<Vec<f64>>>>,
+    #[serde(default, deserialize_with = "strict")]
+    pub degree: Option<Spanned<[i64; 2]>>,
+    pub u_knots: Option<Spanned<Vec<f64>>>,
+    pub v_knots: Option<Spanned<Vec<f64>>>,
 }
 
 impl RawSurface {
@@ -342,6 +347,10 @@ impl RawSurface {
             ("end", self.end.as_ref().map(Spanned::span)),
             ("along", self.along.as_ref().map(Spanned::span)),
             ("control", self.control.as_ref().map(Spanned::span)),
+            ("weights", self.weights.as_ref().map(Spanned::span)),
+            ("degree", self.degree.as_ref().map(Spanned::span)),
+            ("u_knots", self.u_knots.as_ref().map(Spanned::span)),
+            ("v_knots", self.v_knots.as_ref().map(Spanned::span)),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))
