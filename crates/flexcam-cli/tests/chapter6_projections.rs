@@ -238,7 +238,7 @@ fn bad_pieces_are_refused_at_their_place() {
          slit_distance, near, far, surfaces, blend, knots, segments, reparam, max_latitude, \
          shift, twist, azimuth, elevation, generators, projectors, corner_radius, outline, \
          outlines, profile, profiles, perspective_rect, transition, transitions, fovs, style, \
-         pole, strength, path, directions, center, radius, magnification, pieces)",
+         pole, strength, path, directions, center, radius, magnification, deep, pieces)",
     );
     // At build time: a sliver of no whole pixel, and the raster's refusal naming the piece.
     refused(
@@ -361,5 +361,80 @@ fn bad_nurbs_surfaces_are_refused_at_the_key() {
         &nurbs_scene(&format!("control = [{row}, {row}]")),
         &[],
         "scene.toml:7:39: near nurbs surface takes at most 64 x 64 control points",
+    );
+}
+
+/// `scenes/flexible-long-scene.toml` renders by ray casting and differs from the plain
+/// pushbroom only around its deep areas; bad deep areas are refused at `deep`.
+#[test]
+fn the_long_scene_example_renders_and_bad_deep_areas_are_refused() {
+    let dir = TempDir::new().unwrap();
+    let scene = example("flexible-long-scene.toml");
+    let text = fs::read_to_string(&scene).unwrap();
+    let pushbroom = text
+        .replace("preset = \"long_scene\"", "preset = \"pushbroom\"")
+        .lines()
+        .filter(|line| !line.starts_with("deep = "))
+        .collect::<Vec<_>>()
+        .join("\n");
+    fs::write(dir.path().join("long.toml"), &text).unwrap();
+    fs::write(dir.path().join("pushbroom.toml"), pushbroom).unwrap();
+    for name in ["long", "pushbroom"] {
+        run_ok(
+            &dir,
+            &[
+                "render",
+                &format!("{name}.toml"),
+                "--width",
+                "360",
+                "--height",
+                "90",
+                "--ids",
+                &format!("{name}-ids.png"),
+                "-o",
+                &format!("{name}.png"),
+            ],
+        );
+    }
+    let (w, h, long) = common::ids(&dir.path().join("long-ids.png"));
+    let (_, _, pushbroom) = common::ids(&dir.path().join("pushbroom-ids.png"));
+    // Columns by their difference: the image ends (no deep area near) agree; the columns
+    // of the deep areas (u = 0.3 and 0.7, 0.08 wide) off their middles see the side
+    // streets (the middle column itself is the pushbroom's).
+    let differs =
+        |x: u32| (0..h).any(|y| long[(y * w + x) as usize] != pushbroom[(y * w + x) as usize]);
+    assert!((0..10).chain(w - 10..w).all(|x| !differs(x)));
+    assert!(differs(3 * w / 10 + 10) && differs(7 * w / 10 - 10));
+    let out = run(
+        &dir,
+        &["render", "long.toml", "--method", "raster", "-o", "out.png"],
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("outside the scanline class"));
+
+    let folded = text.replace("clip = [0.0, 25.0]", "clip = [0.0, 45.0]");
+    let line = folded
+        .lines()
+        .position(|l| l.starts_with("deep = "))
+        .unwrap()
+        + 1;
+    refused(
+        &dir,
+        &folded,
+        &[],
+        &format!(
+            "scene.toml:{line}:8: flexible long_scene: deep area 1 and deep area 2 fold the far \
+             surface (their fans cross before the far clip at 45): narrow the fov, the far clip \
+             or the area"
+        ),
+    );
+    let overlapping = text.replace("[0.7, 0.08, 50.0]", "[0.36, 0.08, 50.0]");
+    refused(
+        &dir,
+        &overlapping,
+        &[],
+        &format!(
+            "scene.toml:{line}:8: flexible long_scene deep areas 1 and 2 touch or overlap: \
+             leave a gap of facade between them"
+        ),
     );
 }

@@ -13,7 +13,7 @@ use glam::{DVec2, DVec3};
 pub use super::nurbs::{NurbsPatch, NurbsSpec};
 pub use super::panorama::PanoramaSurface;
 pub use super::patch::{BSplinePatch, BezierPatch};
-pub use super::presets::{PathSurface, PinchedRectangle};
+pub use super::presets::{PathSurface, PinchedRectangle, WarpedRectangle};
 use crate::error::{Error, Result};
 
 /// `axis` and `front` count as parallel when the sine of their angle is below this.
@@ -161,6 +161,9 @@ pub enum Surface {
     /// The columns of a multiple-centre-of-projection camera path at one distance (built by
     /// the `mcop` preset only).
     Path(Box<PathSurface>),
+    /// A rectangle with u re-parameterised piecewise-linearly: the long scene's far surface
+    /// (built by that preset only).
+    Warped(Box<WarpedRectangle>),
 }
 
 /// Linear interpolation of a parameter range at `s` in [0, 1].
@@ -219,6 +222,7 @@ impl Surface {
             Surface::Panorama(p) => p.point(uv),
             Surface::Pinched(p) => p.point(uv),
             Surface::Path(p) => p.point(uv),
+            Surface::Warped(w) => w.point(uv),
         }
     }
 
@@ -237,6 +241,7 @@ impl Surface {
             Surface::Panorama(_) => "panorama",
             Surface::Pinched(_) => "pinched",
             Surface::Path(_) => "path",
+            Surface::Warped(_) => "warped",
         }
     }
 
@@ -269,7 +274,8 @@ impl Surface {
             | Surface::Nurbs(_)
             | Surface::Panorama(_)
             | Surface::Pinched(_)
-            | Surface::Path(_) => None,
+            | Surface::Path(_)
+            | Surface::Warped(_) => None,
         }
     }
 
@@ -295,6 +301,7 @@ impl Surface {
             }
             Surface::Pinched(p) => p.is_finite(),
             Surface::Path(p) => p.is_finite(),
+            Surface::Warped(w) => w.is_finite(),
             Surface::Sphere(s) => {
                 check_radius(s.radius)?;
                 check_span("longitude", s.longitude)?;

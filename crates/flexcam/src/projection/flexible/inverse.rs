@@ -109,7 +109,8 @@ fn affine(s: &Surface) -> Option<Affine> {
         | Surface::Nurbs(_)
         | Surface::Panorama(_)
         | Surface::Pinched(_)
-        | Surface::Path(_) => None,
+        | Surface::Path(_)
+        | Surface::Warped(_) => None,
     }
 }
 

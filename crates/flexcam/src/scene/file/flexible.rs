@@ -16,7 +16,7 @@ use super::raw::{RawProjection, RawSurface};
 use super::source::Source;
 use crate::error::Result;
 use crate::projection::flexible::presets::{
-    DepthStyle, Magnifier, DEPTH_STYLE_NAMES, PRESET_NAMES,
+    DeepArea, DepthStyle, Magnifier, DEPTH_STYLE_NAMES, PRESET_NAMES,
 };
 use crate::projection::flexible::reparam::{DEFAULT_MERCATOR_LATITUDE, REPARAM_NAMES};
 use crate::projection::flexible::{
@@ -24,7 +24,7 @@ use crate::projection::flexible::{
 };
 
 /// Every key of a flexible table (besides `type`).
-pub(super) const KEYS: [&str; 44] = [
+pub(super) const KEYS: [&str; 45] = [
     "preset",
     "position",
     "look_at",
@@ -68,6 +68,7 @@ pub(super) const KEYS: [&str; 44] = [
     "center",
     "radius",
     "magnification",
+    "deep",
     "pieces",
 ];
 
@@ -111,6 +112,7 @@ fn preset_keys(name: &str) -> &'static [&'static str] {
         "depth_transition" => &["fovs", "transitions", "style"],
         "occlusion" => &["fov", "transition", "pole", "strength"],
         "mcop" => &["directions", "path", "v_fov"],
+        "long_scene" => &["width", "v_fov", "deep"],
         "magnifier" => &["fov", "center", "radius", "magnification"],
         _ => &["h_fov", "v_fov"],
     }
@@ -632,6 +634,20 @@ fn preset(required: &Required, name: &str) -> Result<PresetSpec> {
                 v_fov: optional(&raw.v_fov, "v_fov", 60.0)?,
             }
         }
+        "long_scene" => Preset::LongScene {
+            width: number(&raw.width, "width")?,
+            v_fov: number(&raw.v_fov, "v_fov")?,
+            deep: match &raw.deep {
+                None => Vec::new(),
+                Some(d) => {
+                    src.all_finite(d.get_ref().as_flattened(), d, "deep")?;
+                    d.get_ref()
+                        .iter()
+                        .map(|&[center, width, fov]| DeepArea { center, width, fov })
+                        .collect()
+                }
+            },
+        },
         _ => Preset::Magnifier {
             fov: number(&raw.fov, "fov")?,
             lens: Magnifier {
@@ -665,7 +681,7 @@ fn style(src: &Source, raw: &RawProjection) -> Result<DepthStyle> {
 }
 
 /// Builds the volume and map of the presets whose parameters are only checked then (the
-/// depth transitions, occlusion, mcop, magnifier) at a nominal aspect ratio, so that a bad value is
+/// depth transitions, occlusion, mcop, long scene, magnifier) at a nominal aspect ratio, so that a bad value is
 /// reported at its key: the first present key (the preset's own, then `up`, `clip`,
 /// `position`, `look_at`) named in the message, else the preset name.
 fn check_preset(src: &Source, raw: &RawProjection, spec: &PresetSpec) -> Result<()> {
@@ -675,6 +691,7 @@ fn check_preset(src: &Source, raw: &RawProjection, spec: &PresetSpec) -> Result<
             | Preset::DepthTransition { .. }
             | Preset::Occlusion { .. }
             | Preset::Mcop { .. }
+            | Preset::LongScene { .. }
             | Preset::Magnifier { .. }
     );
     if !checked_late {

@@ -163,6 +163,8 @@ pub struct RawProjection {
     pub pixel_aspect: Option<Spanned<[f64; 2]>>,
     pub polynomial: Option<Spanned<Vec<f64>>>,
     pub tilt: Option<Spanned<f64>>,
+    #[serde(default, deserialize_with = "strict")]
+    pub deep: Option<Spanned<Vec<[f64; 3]>>>,
     pub pieces: Option<Spanned<Vec<Spanned<RawProjection>>>>,
     #[serde(default, deserialize_with = "strict")]
     pub rect: Option<Spanned<[f64; 4]>>,
@@ -470,6 +472,7 @@ impl RawProjection {
             ),
             ("polynomial", self.polynomial.as_ref().map(Spanned::span)),
             ("tilt", self.tilt.as_ref().map(Spanned::span)),
+            ("deep", self.deep.as_ref().map(Spanned::span)),
             ("pieces", self.pieces.as_ref().map(Spanned::span)),
             ("rect", self.rect.as_ref().map(Spanned::span)),
         ]
