@@ -6,27 +6,9 @@ use glam::{DVec2, DVec3};
 use proptest::prelude::*;
 
 use super::*;
-use crate::projection::flexible::{Preset, PresetSpec, Reparam, VolumeSource};
-use crate::projection::{CameraFrame, ProjectionSpec};
-
-fn frame() -> CameraFrame {
-    CameraFrame {
-        position: DVec3::new(1.0, 2.0, 3.0),
-        look_at: DVec3::new(-2.0, 1.0, 0.0),
-        up: DVec3::Y,
-    }
-}
-
-fn preset(preset: Preset, clip: Option<[f64; 2]>) -> FlexibleSpec {
-    FlexibleSpec {
-        source: VolumeSource::Preset(PresetSpec {
-            preset,
-            frame: frame(),
-            clip,
-        }),
-        reparam: None,
-    }
-}
+use crate::projection::flexible::tests::{frame, preset};
+use crate::projection::flexible::{Preset, Reparam, VolumeSource};
+use crate::projection::ProjectionSpec;
 
 fn pieces(list: Vec<Piece>) -> ProjectionSpec {
     ProjectionSpec::Flexible(Box::new(FlexibleSpec {
@@ -308,7 +290,7 @@ fn example(name: &str) -> Box<dyn Projection> {
 
 /// The line of `ray` as a point on it and a unit direction, to compare rays whatever their
 /// start and length.
-fn line(ray: Ray) -> (glam::DVec3, glam::DVec3) {
+fn line(ray: Ray) -> (DVec3, DVec3) {
     let d = ray.direction.normalize();
     // The point of the line nearest the origin.
     (ray.origin - d * ray.origin.dot(d), d)
@@ -339,8 +321,8 @@ fn the_glc_mosaic_shares_its_edge_rays() {
     );
     let step = (a.0 - b.0).length() + (a.1 - b.1).length();
     assert!(step > 1e-4, "{step}");
-    let forward = glam::DVec3::new(0.0, -0.25, -1.0).normalize();
-    let eye = glam::DVec3::new(0.0, 1.6, 6.0) - forward;
+    let forward = DVec3::new(0.0, -0.25, -1.0).normalize();
+    let eye = DVec3::new(0.0, 1.6, 6.0) - forward;
     for pixel in [
         DVec2::new(170.5, 10.5),
         DVec2::new(240.0, 80.0),
@@ -361,7 +343,7 @@ fn the_glc_mosaic_shares_its_edge_rays() {
 #[test]
 fn the_single_centre_example_has_one_centre() {
     let p = example("flexible-single-centre.toml");
-    let eye = glam::DVec3::new(0.0, 2.5, 7.0);
+    let eye = DVec3::new(0.0, 2.5, 7.0);
     for y in (0..240).step_by(7) {
         for x in (0..320).step_by(11) {
             let ray = p
