@@ -183,6 +183,33 @@ for scene in trilinear-fan trilinear-grid-cylinder trilinear-two-views reflect-s
 done
 "$flexcam" animate scenes/flexible-animation.toml --gif "$out/flexible-animation.gif" >/dev/null
 
+# Chapter 6 (docs/flexible.md): the pieces examples, Digital Cubism's NURBS surfaces and the
+# long scene, each beside a pinhole (the single-centre eye; the GLC mosaic's eye over its
+# whole image plane; the NURBS near arc's centre) or, for the long scene, the pushbroom.
+for scene in flexible-single-centre flexible-collage flexible-glc-mosaic flexible-nurbs \
+  flexible-long-scene; do
+  render "scenes/$scene.toml" -o "$out/$scene.png"
+done
+render "$(variant scenes/flexible-single-centre.toml centre-persp 'type = "perspective"
+position = [0.0, 2.5, 7.0]
+look_at = [0.0, 1.0, 0.0]
+fov = 60.0')" -o "$out/flexible-single-centre-perspective.png"
+render "$(variant scenes/flexible-glc-mosaic.toml mosaic-persp 'type = "perspective"
+position = [0.0, 1.8425356250363332, 6.970142500145332]
+look_at = [0.0, -0.6574643749636668, -3.029857499854668]
+fov = 112.61986494804043')" -o "$out/flexible-glc-mosaic-perspective.png"
+render "$(variant scenes/flexible-nurbs.toml nurbs-persp 'type = "perspective"
+position = [0.0, 1.5, 6.0]
+look_at = [0.0, 1.0, 0.0]
+fov = 90.0')" -o "$out/flexible-nurbs-perspective.png"
+render "$(variant scenes/flexible-long-scene.toml street-pushbroom 'type = "flexible"
+preset = "pushbroom"
+position = [0.0, 2.5, 3.0]
+look_at = [0.0, 2.5, 0.0]
+width = 100.0
+v_fov = 90.0
+clip = [0.0, 25.0]')" -o "$out/flexible-long-scene-pushbroom.png"
+
 # Renderers: the difference images of `flexcam compare` (id mismatches red).
 "$flexcam" compare scenes/trilinear-fan.toml --method trilinear --width 300 --height 200 \
   --diff "$out/diff-trilinear-fan.png" >/dev/null

@@ -7,7 +7,7 @@ mod common;
 use std::fs;
 use std::path::Path;
 
-use common::{run, run_ok};
+use common::{run, run_ok, scene_example};
 use tempfile::TempDir;
 
 /// A pinhole at [0, 2, 6] over a box of size 2 at the origin.
@@ -28,14 +28,6 @@ shape = "box"
 size = [2.0, 2.0, 2.0]
 color = [0.8, 0.8, 0.8]
 "#;
-
-fn example(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../scenes")
-        .join(name)
-        .to_string_lossy()
-        .into_owned()
-}
 
 /// The OBJ's objects: name, vertices (the file's, numbered from 1 across objects) and the
 /// `l` segments of that object as vertex pairs.
@@ -78,7 +70,7 @@ fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
 #[test]
 fn a_flexible_volume_is_written_with_its_materials() {
     let dir = TempDir::new().unwrap();
-    let scene = example("flexible-twist.toml");
+    let scene = scene_example("flexible-twist.toml");
     let out = run_ok(&dir, &["volume", &scene, "-o", "twist.obj"]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(

@@ -68,6 +68,15 @@ pub fn interior_agreement(reference: &Path, other: &Path) -> (f64, usize) {
     (agreement, interior as usize)
 }
 
+/// The path of `scenes/NAME`.
+pub fn scene_example(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../scenes")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
 /// The path of `scenes/cameras/NAME`.
 pub fn camera_example(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))

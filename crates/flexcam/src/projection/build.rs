@@ -2,7 +2,7 @@
 
 use super::dome_master::dome_master;
 use super::fisheye::Fisheye;
-use super::flexible::{Flexible, GridFitter};
+use super::flexible::{build_projection, GridFitter};
 use super::kannala_brandt::KannalaBrandt;
 use super::linear::{Orthographic, Perspective};
 use super::ods::ods;
@@ -96,7 +96,7 @@ impl ProjectionSpec {
             ProjectionSpec::Trilinear(mesh) => Box::new(Trilinear::new(mesh, width, height)?),
             ProjectionSpec::ExactBall(view) => Box::new(BallProjection::new(*view, width, height)),
             ProjectionSpec::Flexible(spec) => {
-                Box::new(Flexible::build(spec, width, height, fitter, report)?)
+                build_projection(spec, width, height, fitter, report)?
             }
         })
     }

@@ -10,9 +10,10 @@ use std::f64::consts::PI;
 
 use glam::{DVec2, DVec3};
 
+pub use super::nurbs::{NurbsPatch, NurbsSpec};
 pub use super::panorama::PanoramaSurface;
 pub use super::patch::{BSplinePatch, BezierPatch};
-pub use super::presets::{PathSurface, PinchedRectangle};
+pub use super::presets::{PathSurface, PinchedRectangle, WarpedRectangle};
 use crate::error::{Error, Result};
 
 /// `axis` and `front` count as parallel when the sine of their angle is below this.
@@ -148,6 +149,9 @@ pub enum Surface {
     Bezier(Box<BezierPatch>),
     /// A uniform cubic B-spline patch.
     BSpline(BSplinePatch),
+    /// A NURBS patch: any degree up to 7, knots and weights (boxed: a control grid and two
+    /// knot vectors).
+    Nurbs(Box<NurbsPatch>),
     /// A shape-defined panorama surface: outlines and profiles by arc length (boxed: it
     /// holds a camera basis).
     Panorama(Box<PanoramaSurface>),
@@ -157,6 +161,9 @@ pub enum Surface {
     /// The columns of a multiple-centre-of-projection camera path at one distance (built by
     /// the `mcop` preset only).
     Path(Box<PathSurface>),
+    /// A rectangle with u re-parameterised piecewise-linearly: the long scene's far surface
+    /// (built by that preset only).
+    Warped(Box<WarpedRectangle>),
 }
 
 /// Linear interpolation of a parameter range at `s` in [0, 1].
@@ -211,9 +218,11 @@ impl Surface {
             }
             Surface::Bezier(b) => b.point(uv),
             Surface::BSpline(b) => b.point(uv),
+            Surface::Nurbs(n) => n.point(uv),
             Surface::Panorama(p) => p.point(uv),
             Surface::Pinched(p) => p.point(uv),
             Surface::Path(p) => p.point(uv),
+            Surface::Warped(w) => w.point(uv),
         }
     }
 
@@ -228,9 +237,11 @@ impl Surface {
             Surface::Line { .. } => "line",
             Surface::Bezier(_) => "bezier",
             Surface::BSpline(_) => "bspline",
+            Surface::Nurbs(_) => "nurbs",
             Surface::Panorama(_) => "panorama",
             Surface::Pinched(_) => "pinched",
             Surface::Path(_) => "path",
+            Surface::Warped(_) => "warped",
         }
     }
 
@@ -260,9 +271,11 @@ impl Surface {
             | Surface::Cylinder(_)
             | Surface::Bezier(_)
             | Surface::BSpline(_)
+            | Surface::Nurbs(_)
             | Surface::Panorama(_)
             | Surface::Pinched(_)
-            | Surface::Path(_) => None,
+            | Surface::Path(_)
+            | Surface::Warped(_) => None,
         }
     }
 
@@ -281,12 +294,14 @@ impl Surface {
             Surface::Line { start, end, .. } => finite(&[*start, *end]),
             Surface::Bezier(b) => finite(b.control.as_flattened()),
             Surface::BSpline(b) => finite(b.control()),
+            Surface::Nurbs(n) => n.is_finite(),
             Surface::Panorama(p) => {
                 p.validate()?;
                 true
             }
             Surface::Pinched(p) => p.is_finite(),
             Surface::Path(p) => p.is_finite(),
+            Surface::Warped(w) => w.is_finite(),
             Surface::Sphere(s) => {
                 check_radius(s.radius)?;
                 check_span("longitude", s.longitude)?;

@@ -106,9 +106,11 @@ fn affine(s: &Surface) -> Option<Affine> {
         | Surface::Cylinder(_)
         | Surface::Bezier(_)
         | Surface::BSpline(_)
+        | Surface::Nurbs(_)
         | Surface::Panorama(_)
         | Surface::Pinched(_)
-        | Surface::Path(_) => None,
+        | Surface::Path(_)
+        | Surface::Warped(_) => None,
     }
 }
 

@@ -8,6 +8,7 @@
 //! - [`blend`]: volumes of two or more surfaces blended in t, piecewise-linear (polyline
 //!   projectors) or Bernstein (Bezier projectors);
 //! - `patch`: bicubic Bezier and uniform cubic B-spline control surfaces;
+//! - [`nurbs`]: NURBS control surfaces (degree, knots, weights);
 //! - [`reparam`]: pixel <-> (u, v) (linear, polar fisheye, lens-like, equisolid, Mercator);
 //! - [`presets`]: named volumes from a camera frame (perspective, pushbroom, crossed slits, ...);
 //! - [`projector_grid`]: a volume interpolated from a grid of placed projectors (5.2), aimed
@@ -16,7 +17,9 @@
 //! - `inverse`: (u, v, t) from a scene point for the analytic class (parallel planes, nested
 //!   spheres, coaxial cylinders);
 //! - [`blend`]: Q = a Q1 + (1 - a) Q2, interpolation and extrapolation between volumes;
-//! - [`animation`]: keyframed flexible cameras, a blend of neighbouring keys per frame.
+//! - [`animation`]: keyframed flexible cameras, a blend of neighbouring keys per frame;
+//! - [`pieces`]: discontinuous projections, several flexible projections each owning an
+//!   image rectangle.
 //!
 //! A pixel's projector starts on the near (first) surface and reaches the far (last) surface at
 //! t = 1; t is limited to [0, 1] (the per-projector near and far clip of the framework).
@@ -28,8 +31,10 @@ pub mod control_surface;
 pub mod interpolate;
 mod inverse;
 mod linear_volume;
+pub mod nurbs;
 pub mod panorama;
 mod patch;
+pub mod pieces;
 pub mod presets;
 pub mod projector_grid;
 pub mod reparam;
@@ -42,10 +47,12 @@ use glam::{DVec2, DVec3};
 pub use animation::{Animation, Easing, Keyframe};
 pub use blend::{BezierVolume, PiecewiseVolume};
 pub use control_surface::{
-    BSplinePatch, BezierPatch, CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface,
+    BSplinePatch, BezierPatch, CylinderPatch, LineParam, NurbsPatch, NurbsSpec, PolarFrame,
+    SpherePatch, Surface,
 };
 pub use linear_volume::LinearVolume;
 pub use panorama::{PanoramaShape, PanoramaSpec};
+pub use pieces::{FlexiblePieces, Piece};
 pub use presets::{DepthStyle, Magnifier, McopPath, Preset, PresetSpec};
 pub use projector_grid::{
     Aim, Correspondence, GridFitter, GridInterpolation, GridVolume, NodeProjector, ProjectorGrid,
@@ -101,6 +108,11 @@ pub enum VolumeSource {
         /// The grid's size, aims and fitting.
         grid: ProjectorGridSpec,
     },
+    /// Several flexible projections, each owning a rectangle of the image (module
+    /// [`pieces`]): a projection of its own ([`FlexiblePieces`]), not one volume, so it is
+    /// built by [`build_projection`] and refused where one volume is needed (an
+    /// interpolation, an animation key, a projector grid's base).
+    Pieces(Vec<Piece>),
 }
 
 /// How the control surfaces of [`VolumeSource::Blended`] are blended in t.
@@ -208,6 +220,29 @@ impl Flexible {
     }
 }
 
+/// The projection `spec` describes: a [`FlexiblePieces`] for `pieces`, else a
+/// [`Flexible`] (see [`Flexible::build`]).
+pub fn build_projection(
+    spec: &FlexibleSpec,
+    width: u32,
+    height: u32,
+    fitter: Option<&dyn GridFitter>,
+    report: &mut BuildReport,
+) -> Result<Box<dyn Projection>> {
+    Ok(match &spec.source {
+        VolumeSource::Pieces(_) if spec.reparam.is_some() => {
+            return Err(Error::new(
+                "a flexible projection made of `pieces` takes no `reparam` of its own: each \
+                 piece has its own",
+            ))
+        }
+        VolumeSource::Pieces(pieces) => Box::new(FlexiblePieces::build(
+            pieces, width, height, fitter, report,
+        )?),
+        _ => Box::new(Flexible::build(spec, width, height, fitter, report)?),
+    })
+}
+
 /// Why `volume` has no analytic inverse when `Inverse::classify` finds none: the scanline
 /// class of Brosz 2011 (7.3) is two control surfaces of one type with a closed-form inverse
 /// whose depth follows from the point (parallel planes, nested spheres, coaxial cylinders),
@@ -280,6 +315,12 @@ fn build_volume(
                 )));
             }
             (interpolate::interpolate(*weight, a, b)?, map_a)
+        }
+        VolumeSource::Pieces(_) => {
+            return Err(Error::new(
+                "a flexible projection made of `pieces` is not one volume: it cannot be \
+                 interpolated, animated or the base of a projector grid",
+            ))
         }
         VolumeSource::ProjectorGrid { base, grid } => {
             let (base_volume, base_reparam) = build_volume(base, aspect, fitter, report)?;

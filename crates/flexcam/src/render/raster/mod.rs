@@ -70,7 +70,7 @@ use self::pixel_rays::PixelRays;
 use self::refine::{Node, Refiner};
 use self::seam::{covers_a_centre, place, Placement};
 use crate::error::{Error, Result};
-use crate::projection::{Charted, Projection};
+use crate::projection::{Charted, NoInverse, Projection};
 use crate::render::prepared::PreparedScene;
 use crate::render::{Counter, Frame, RenderOptions, Shading, Stats};
 use crate::scene::{Finish, Scene};
@@ -143,18 +143,23 @@ impl std::ops::AddAssign for PieceCounts {
     }
 }
 
+/// The one-line refusal of method raster for a projection of `kind` without an inverse.
+fn no_inverse(kind: &str, none: NoInverse) -> Error {
+    let why = none
+        .reason
+        .map_or_else(String::new, |reason| format!(": {reason}"));
+    Error::new(format!(
+        "method raster needs a projection with an analytic inverse; {kind} has none{why} \
+         (use --method raycast)"
+    ))
+}
+
 /// The projection's charted inverse, or the one-line refusal of method raster.
 pub fn supported_chart(projection: &dyn Projection) -> Result<Charted<'_>> {
     let kind = projection.kind();
-    let inverse = projection.inverse().map_err(|none| {
-        let why = none
-            .reason
-            .map_or_else(String::new, |reason| format!(": {reason}"));
-        Error::new(format!(
-            "method raster needs a projection with an analytic inverse; {kind} has none{why} \
-             (use --method raycast)"
-        ))
-    })?;
+    let inverse = projection
+        .inverse()
+        .map_err(|none| no_inverse(kind, none))?;
     let charted = inverse.charted().ok_or_else(|| {
         Error::new(format!(
             "method raster needs a projection with an analytic inverse it can fill triangles \

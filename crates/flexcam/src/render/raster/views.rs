@@ -15,7 +15,8 @@ use crate::scene::Scene;
 const SETTINGS: [&str; 2] = ["raster_uniform", "raster_tolerance_px"];
 
 /// Renders `projection` by the analytic inverse: a single view directly, several view by
-/// view. The stats of several views are summed (times and counts), settings kept once.
+/// view (the eyes of a stereo pair, the pieces of a discontinuous flexible projection; the
+/// pixels outside every view keep the background). The stats of several views are summed (times and counts), settings kept once.
 /// Errors: those of [`InverseRaster::new`] and [`InverseRaster::render`] for any view; a
 /// scene triangle touching a view's keep-clear region (one line naming the object and the
 /// region); memory that cannot be had for the whole frame.
@@ -27,6 +28,11 @@ pub fn render(
     let views = projection.views();
     if views.is_empty() {
         return InverseRaster::new(prepared, projection, options)?.render();
+    }
+    // A projection of views without an inverse (a piece without one) is refused whole,
+    // with its own reason, before any view is drawn.
+    if let Err(none) = projection.inverse() {
+        return Err(super::no_inverse(projection.kind(), none));
     }
     let scene = prepared.scene();
     for region in views.iter().filter_map(|v| v.keep_clear) {

@@ -125,7 +125,11 @@ fn keyframe(
             projection: *projection,
         }),
         other => Err(src.error(
-            &key.projection.get_ref().kind.span(),
+            &key.projection
+                .get_ref()
+                .kind
+                .as_ref()
+                .map_or(key.projection.span(), Spanned::span),
             format!(
                 "animation keys need type = \"flexible\" (only flexible volumes can be \
                  interpolated), not \"{}\"",

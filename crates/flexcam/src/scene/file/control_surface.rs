@@ -8,12 +8,14 @@ use toml::Spanned;
 use super::raw::RawSurface;
 use super::source::Source;
 use crate::error::{Error, Result};
+use crate::projection::flexible::nurbs::MAX_CONTROL;
 use crate::projection::flexible::{
-    BSplinePatch, BezierPatch, CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface,
+    BSplinePatch, BezierPatch, CylinderPatch, LineParam, NurbsPatch, NurbsSpec, PolarFrame,
+    SpherePatch, Surface,
 };
 
 /// The surface type names of scene files.
-const SURFACE_NAMES: [&str; 9] = [
+const SURFACE_NAMES: [&str; 10] = [
     "rectangle",
     "bilinear",
     "sphere",
@@ -23,6 +25,7 @@ const SURFACE_NAMES: [&str; 9] = [
     "line",
     "bezier",
     "bspline",
+    "nurbs",
 ];
 
 /// A bicubic Bezier surface from `control[row][column]`. Errors: not 4 rows of 4 points.
@@ -57,6 +60,7 @@ fn surface_keys(name: &str) -> &'static [&'static str] {
         "cylinder" => &["center", "radius", "angle", "height", "axis", "front"],
         "point" => &["point"],
         "bezier" | "bspline" => &["control"],
+        "nurbs" => &["control", "weights", "degree", "u_knots", "v_knots"],
         _ => &["start", "end", "along"],
     }
 }
@@ -179,6 +183,7 @@ pub(super) fn surface(src: &Source, table: &Spanned<RawSurface>, which: &str) ->
             },
         }),
         "point" => Surface::Point(need(&raw.point, "point")?),
+        "nurbs" => nurbs(src, table, which)?,
         "bezier" | "bspline" => {
             let c = raw.control.as_ref().ok_or_else(|| {
                 src.error(
@@ -233,4 +238,101 @@ pub(super) fn surface(src: &Source, table: &Spanned<RawSurface>, which: &str) ->
         src.error(&at, format!("{which} {}", e.message))
     })?;
     Ok(surface)
+}
+
+/// A NURBS surface table: `control` (required), `weights`, `degree` (default [3, 3]),
+/// `u_knots` and `v_knots` (default clamped uniform). Counts beyond [`MAX_CONTROL`] are
+/// refused before anything is built; every other error of [`NurbsPatch::new`] is reported
+/// at the key it concerns (knots at their list, weights at theirs, counts at `control`).
+fn nurbs(src: &Source, table: &Spanned<RawSurface>, which: &str) -> Result<Surface> {
+    let raw = table.get_ref();
+    let c = raw.control.as_ref().ok_or_else(|| {
+        src.error(
+            &table.span(),
+            format!("{which} nurbs surface needs `control`"),
+        )
+    })?;
+    let rows = c.get_ref();
+    if rows.len() > MAX_CONTROL || rows.iter().any(|row| row.len() > MAX_CONTROL) {
+        return Err(src.error(
+            &c.span(),
+            format!(
+                "{which} nurbs surface takes at most {MAX_CONTROL} x {MAX_CONTROL} control points"
+            ),
+        ));
+    }
+    src.all_finite(rows.concat().as_flattened(), c, "control")?;
+    let degree = match &raw.degree {
+        None => [3, 3],
+        Some(d) => {
+            let [p, q] = *d.get_ref();
+            let fit = |x: i64| usize::try_from(x).ok().filter(|&x| x <= MAX_CONTROL);
+            match (fit(p), fit(q)) {
+                (Some(p), Some(q)) => [p, q],
+                _ => {
+                    return Err(src.error(
+                        &d.span(),
+                        format!(
+                            "{which} nurbs surface degree must be [u, v] in 1..=7, got [{p}, {q}]"
+                        ),
+                    ))
+                }
+            }
+        }
+    };
+    let list = |v: &Option<Spanned<Vec<f64>>>, key: &str| -> Result<Option<Vec<f64>>> {
+        v.as_ref()
+            .map(|k| {
+                if k.get_ref().len() > 2 * MAX_CONTROL {
+                    return Err(src.error(
+                        &k.span(),
+                        format!("`{key}` holds at most {} knots", 2 * MAX_CONTROL),
+                    ));
+                }
+                src.all_finite(k.get_ref(), k, key)?;
+                Ok(k.get_ref().clone())
+            })
+            .transpose()
+    };
+    let weights = match &raw.weights {
+        None => None,
+        Some(w) => {
+            if w.get_ref().len() > MAX_CONTROL || w.get_ref().iter().any(|r| r.len() > MAX_CONTROL)
+            {
+                return Err(src.error(
+                    &w.span(),
+                    format!("`weights` holds at most {MAX_CONTROL} x {MAX_CONTROL} numbers"),
+                ));
+            }
+            src.all_finite(&w.get_ref().concat(), w, "weights")?;
+            Some(w.get_ref().clone())
+        }
+    };
+    let spec = NurbsSpec {
+        control: rows
+            .iter()
+            .map(|row| row.iter().map(|p| DVec3::from_array(*p)).collect())
+            .collect(),
+        weights,
+        degree,
+        u_knots: list(&raw.u_knots, "u_knots")?,
+        v_knots: list(&raw.v_knots, "v_knots")?,
+    };
+    NurbsPatch::new(spec)
+        .map(|patch| Surface::Nurbs(Box::new(patch)))
+        .map_err(|e| {
+            let m = &e.message;
+            let at = if m.contains(" u knot") {
+                raw.u_knots.as_ref().map(Spanned::span)
+            } else if m.contains(" v knot") {
+                raw.v_knots.as_ref().map(Spanned::span)
+            } else if m.contains("weights") {
+                raw.weights.as_ref().map(Spanned::span)
+            } else if m.contains("degree along") {
+                raw.degree.as_ref().map(Spanned::span)
+            } else {
+                None
+            };
+            src.error(&at.unwrap_or(c.span()), format!("{which} {m}"))
+        })
 }

@@ -1,7 +1,8 @@
 //! `[projection] type = "flexible"`: a named preset placed by a camera frame, two explicit
 //! control surfaces `near` and `far`, or a list `surfaces` blended in t (`blend`, `knots`,
 //! `segments`), a shape-defined panorama (`outline`/`outlines` and `profile`/`profiles`,
-//! module `panorama`), with an optional re-parameterisation.
+//! module `panorama`), with an optional re-parameterisation; or `pieces`, several such
+//! projections each owning an image rectangle (module `pieces`).
 
 use std::f64::consts::PI;
 use std::ops::Range;
@@ -15,7 +16,7 @@ use super::raw::{RawProjection, RawSurface};
 use super::source::Source;
 use crate::error::Result;
 use crate::projection::flexible::presets::{
-    DepthStyle, Magnifier, DEPTH_STYLE_NAMES, PRESET_NAMES,
+    DeepArea, DepthStyle, Magnifier, DEPTH_STYLE_NAMES, PRESET_NAMES,
 };
 use crate::projection::flexible::reparam::{DEFAULT_MERCATOR_LATITUDE, REPARAM_NAMES};
 use crate::projection::flexible::{
@@ -23,7 +24,7 @@ use crate::projection::flexible::{
 };
 
 /// Every key of a flexible table (besides `type`).
-pub(super) const KEYS: [&str; 43] = [
+pub(super) const KEYS: [&str; 45] = [
     "preset",
     "position",
     "look_at",
@@ -67,6 +68,8 @@ pub(super) const KEYS: [&str; 43] = [
     "center",
     "radius",
     "magnification",
+    "deep",
+    "pieces",
 ];
 
 /// Keys every preset accepts (but `up` for the axonometric one, which is always +y).
@@ -109,6 +112,7 @@ fn preset_keys(name: &str) -> &'static [&'static str] {
         "depth_transition" => &["fovs", "transitions", "style"],
         "occlusion" => &["fov", "transition", "pole", "strength"],
         "mcop" => &["directions", "path", "v_fov"],
+        "long_scene" => &["width", "v_fov", "deep"],
         "magnifier" => &["fov", "center", "radius", "magnification"],
         _ => &["h_fov", "v_fov"],
     }
@@ -119,12 +123,28 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
     let src = required.src;
     let raw = required.raw();
     let reparam = reparam(src, raw)?;
-    // `projectors` goes with any volume of straight projectors; the checks below are for
-    // the keys of the volume itself.
+    if let Some(list) = &raw.pieces {
+        let present = raw.present_keys();
+        reject_keys(
+            src,
+            &present,
+            |key| key == "pieces",
+            || {
+                "projections made of `pieces` (they take only `pieces`; each piece has its own keys)".to_string()
+            },
+        )?;
+        return Ok(FlexibleSpec {
+            source: super::pieces::convert(src, list, convert)?,
+            reparam: None,
+        });
+    }
+    // `projectors` goes with any volume of straight projectors, `rect` is a piece's
+    // rectangle (module `pieces`; refused elsewhere by the projection's key list); the
+    // checks below are for the keys of the volume itself.
     let present: Vec<_> = raw
         .present_keys()
         .into_iter()
-        .filter(|(key, _)| *key != "projectors")
+        .filter(|(key, _)| *key != "projectors" && *key != "rect")
         .collect();
     let source = match &raw.preset {
         Some(name) => {
@@ -614,6 +634,20 @@ fn preset(required: &Required, name: &str) -> Result<PresetSpec> {
                 v_fov: optional(&raw.v_fov, "v_fov", 60.0)?,
             }
         }
+        "long_scene" => Preset::LongScene {
+            width: number(&raw.width, "width")?,
+            v_fov: number(&raw.v_fov, "v_fov")?,
+            deep: match &raw.deep {
+                None => Vec::new(),
+                Some(d) => {
+                    src.all_finite(d.get_ref().as_flattened(), d, "deep")?;
+                    d.get_ref()
+                        .iter()
+                        .map(|&[center, width, fov]| DeepArea { center, width, fov })
+                        .collect()
+                }
+            },
+        },
         _ => Preset::Magnifier {
             fov: number(&raw.fov, "fov")?,
             lens: Magnifier {
@@ -647,7 +681,7 @@ fn style(src: &Source, raw: &RawProjection) -> Result<DepthStyle> {
 }
 
 /// Builds the volume and map of the presets whose parameters are only checked then (the
-/// depth transitions, occlusion, mcop, magnifier) at a nominal aspect ratio, so that a bad value is
+/// depth transitions, occlusion, mcop, long scene, magnifier) at a nominal aspect ratio, so that a bad value is
 /// reported at its key: the first present key (the preset's own, then `up`, `clip`,
 /// `position`, `look_at`) named in the message, else the preset name.
 fn check_preset(src: &Source, raw: &RawProjection, spec: &PresetSpec) -> Result<()> {
@@ -657,6 +691,7 @@ fn check_preset(src: &Source, raw: &RawProjection, spec: &PresetSpec) -> Result<
             | Preset::DepthTransition { .. }
             | Preset::Occlusion { .. }
             | Preset::Mcop { .. }
+            | Preset::LongScene { .. }
             | Preset::Magnifier { .. }
     );
     if !checked_late {

@@ -16,6 +16,7 @@ mod flexible;
 mod light;
 mod object;
 mod panorama;
+mod pieces;
 mod projection;
 mod projection_table;
 mod projector_grid;

@@ -152,9 +152,24 @@ pub(super) fn convert(
     image_size: [u32; 2],
 ) -> Result<ProjectionSpec> {
     let raw = table.get_ref();
-    let name = raw.kind.get_ref();
-    let kind = Kind::parse(name)
-        .ok_or_else(|| src.unknown(&raw.kind.span(), "projection type", name, &all_type_names()))?;
+    let type_name = raw.kind.as_ref().ok_or_else(|| {
+        src.error(
+            &table.span(),
+            format!(
+                "missing field `type` (the projection type: one of {})",
+                all_type_names().join(", ")
+            ),
+        )
+    })?;
+    let name = type_name.get_ref();
+    let kind = Kind::parse(name).ok_or_else(|| {
+        src.unknown(
+            &type_name.span(),
+            "projection type",
+            name,
+            &all_type_names(),
+        )
+    })?;
     src.reject_foreign_key(
         raw.present_keys(),
         &kind.keys(),

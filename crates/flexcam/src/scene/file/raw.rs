@@ -63,8 +63,9 @@ pub struct RawImage {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawProjection {
+    /// Required everywhere but in the `pieces` of a flexible projection, which are flexible.
     #[serde(rename = "type")]
-    pub kind: Spanned<String>,
+    pub kind: Option<Spanned<String>>,
     #[serde(default, deserialize_with = "strict")]
     pub position: Option<Vec3Value>,
     #[serde(default, deserialize_with = "strict")]
@@ -167,6 +168,11 @@ pub struct RawProjection {
     pub pixel_aspect: Option<Spanned<[f64; 2]>>,
     pub polynomial: Option<Spanned<Vec<f64>>>,
     pub tilt: Option<Spanned<f64>>,
+    #[serde(default, deserialize_with = "strict")]
+    pub deep: Option<Spanned<Vec<[f64; 3]>>>,
+    pub pieces: Option<Spanned<Vec<Spanned<RawProjection>>>>,
+    #[serde(default, deserialize_with = "strict")]
+    pub rect: Option<Spanned<[f64; 4]>>,
 }
 
 /// `outline = { ... }`, `profile`, and the entries of `outlines` / `profiles` (with `at`): a
@@ -328,6 +334,11 @@ pub struct RawSurface {
     pub along: Option<Spanned<String>>,
     #[serde(default, deserialize_with = "strict")]
     pub control: Option<Spanned<Vec<Vec<[f64; 3]>>>>,
+    pub weights: Option<Spanned<Vec<Vec<f64>>>>,
+    #[serde(default, deserialize_with = "strict")]
+    pub degree: Option<Spanned<[i64; 2]>>,
+    pub u_knots: Option<Spanned<Vec<f64>>>,
+    pub v_knots: Option<Spanned<Vec<f64>>>,
 }
 
 impl RawSurface {
@@ -353,6 +364,10 @@ impl RawSurface {
             ("end", self.end.as_ref().map(Spanned::span)),
             ("along", self.along.as_ref().map(Spanned::span)),
             ("control", self.control.as_ref().map(Spanned::span)),
+            ("weights", self.weights.as_ref().map(Spanned::span)),
+            ("degree", self.degree.as_ref().map(Spanned::span)),
+            ("u_knots", self.u_knots.as_ref().map(Spanned::span)),
+            ("v_knots", self.v_knots.as_ref().map(Spanned::span)),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))
@@ -480,6 +495,9 @@ impl RawProjection {
             ),
             ("polynomial", self.polynomial.as_ref().map(Spanned::span)),
             ("tilt", self.tilt.as_ref().map(Spanned::span)),
+            ("deep", self.deep.as_ref().map(Spanned::span)),
+            ("pieces", self.pieces.as_ref().map(Spanned::span)),
+            ("rect", self.rect.as_ref().map(Spanned::span)),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))

@@ -39,6 +39,8 @@
 //! - occlusion camera: perspective to the distortion plane, then bent towards a pole
 //!   ([`occlusion`]);
 //! - MCOP: the columns of a camera path ([`mcop`]);
+//! - long scene: the pushbroom with its far surface re-parameterised so that deep areas are
+//!   seen in perspective ([`long_scene`]);
 //! - magnifier: the perspective volume under a circular magnifying re-parameterisation
 //!   ([`lens`]).
 //!
@@ -49,6 +51,7 @@ mod axonometric;
 pub mod depth_transition;
 mod glc;
 pub mod lens;
+pub mod long_scene;
 pub mod mcop;
 pub mod occlusion;
 #[cfg(test)]
@@ -73,6 +76,7 @@ use crate::error::{Error, Result};
 use depth_transition::Station;
 pub use depth_transition::{DepthStyle, DEPTH_STYLE_NAMES};
 pub use lens::Magnifier;
+pub use long_scene::{DeepArea, WarpedRectangle};
 pub use mcop::{McopPath, PathSurface};
 pub use occlusion::PinchedRectangle;
 
@@ -233,6 +237,17 @@ pub enum Preset {
         /// Vertical angle of each column's fan, degrees.
         v_fov: f64,
     },
+    /// A pushbroom of slit length `width` whose far surface spreads the projectors of the
+    /// `deep` areas into perspective fans (Agarwala et al.'s long scenes); see
+    /// [`long_scene`].
+    LongScene {
+        /// Length of the slit, world units.
+        width: f64,
+        /// Vertical angle of each column's fan, degrees.
+        v_fov: f64,
+        /// The areas seen in perspective across.
+        deep: Vec<DeepArea>,
+    },
     /// The perspective of `fov` seen through a circular magnifying lens; see [`lens`].
     Magnifier {
         /// Horizontal angle of view, degrees.
@@ -243,7 +258,7 @@ pub enum Preset {
 }
 
 /// The preset names of scene files, in order.
-pub const PRESET_NAMES: [&str; 20] = [
+pub const PRESET_NAMES: [&str; 21] = [
     "perspective",
     "inverse_perspective",
     "orthographic",
@@ -263,6 +278,7 @@ pub const PRESET_NAMES: [&str; 20] = [
     "depth_transition",
     "occlusion",
     "mcop",
+    "long_scene",
     "magnifier",
 ];
 
@@ -301,6 +317,7 @@ impl Preset {
             Preset::DepthTransition { .. } => "depth_transition",
             Preset::Occlusion { .. } => "occlusion",
             Preset::Mcop { .. } => "mcop",
+            Preset::LongScene { .. } => "long_scene",
             Preset::Magnifier { .. } => "magnifier",
         }
     }
@@ -579,6 +596,25 @@ impl PresetSpec {
                 let w = 0.5 * positive_length("flexible pushbroom", "width", width)?;
                 let t = (0.5 * angle(p, "v_fov", v_fov, UpTo::Below(180.0))?).tan();
                 pair(&|d| rect(d, DVec2::new(w, d * t), DVec2::ZERO))
+            }
+            Preset::LongScene {
+                width,
+                v_fov,
+                ref deep,
+            } => {
+                let w = positive_length("flexible long_scene", "width", width)?;
+                let t = (0.5 * angle(p, "v_fov", v_fov, UpTo::Below(180.0))?).tan();
+                let knots = long_scene::far_knots(w, near, far, deep)?;
+                let far_surface = WarpedRectangle {
+                    corner: centre(far) - far * t * b.up,
+                    along: b.right,
+                    v_edge: 2.0 * far * t * b.up,
+                    knots,
+                };
+                (
+                    rect(near, DVec2::new(0.5 * w, near * t), DVec2::ZERO),
+                    Surface::Warped(Box::new(far_surface)),
+                )
             }
             Preset::CrossedSlits {
                 fov,
