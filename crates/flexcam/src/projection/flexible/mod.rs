@@ -169,7 +169,7 @@ impl Flexible {
         let inverse = match classified {
             Ok(Some(solver)) => Ok(BoundInverse {
                 solver,
-                reparam,
+                reparam: reparam.clone(),
                 resolution,
             }),
             Ok(None) => Err(NoInverse {
@@ -193,8 +193,8 @@ impl Flexible {
     }
 
     /// The re-parameterisation in use.
-    pub fn reparam(&self) -> Reparam {
-        self.reparam
+    pub fn reparam(&self) -> &Reparam {
+        &self.reparam
     }
 
     /// The (u, v) of continuous pixel position `pixel`, `None` outside the map's domain.
@@ -293,7 +293,7 @@ fn build_volume(
             (Volume::Grid(Box::new(volume)), base_reparam)
         }
     };
-    let reparam = spec.reparam.unwrap_or(default_reparam);
+    let reparam = spec.reparam.clone().unwrap_or(default_reparam);
     reparam.validate()?;
     Ok((volume, reparam))
 }

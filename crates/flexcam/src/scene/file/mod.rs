@@ -13,6 +13,8 @@ pub mod edit;
 mod fisheye_projection;
 mod fitted_grid;
 mod flexible;
+#[cfg(test)]
+mod flexible_map_tests;
 mod light;
 mod object;
 mod panorama;
@@ -20,6 +22,7 @@ mod projection;
 mod projection_table;
 mod projector_grid;
 mod raw;
+mod reparam_grid;
 mod shape;
 mod source;
 mod strict;

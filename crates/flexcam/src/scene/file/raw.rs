@@ -94,6 +94,7 @@ pub struct RawProjection {
     pub knots: Option<Spanned<Vec<f64>>>,
     pub segments: Option<Spanned<u32>>,
     pub reparam: Option<Spanned<String>>,
+    pub reparam_grid: Option<Spanned<RawReparamGrid>>,
     pub max_latitude: Option<Spanned<f64>>,
     #[serde(default, deserialize_with = "strict")]
     pub clip: Option<Spanned<[f64; 2]>>,
@@ -162,6 +163,19 @@ pub struct RawProjection {
     pub pixel_aspect: Option<Spanned<[f64; 2]>>,
     pub polynomial: Option<Spanned<Vec<f64>>>,
     pub tilt: Option<Spanned<f64>>,
+}
+
+/// `reparam_grid = { ... }` of a flexible projection with `reparam = "grid"`: the samples of
+/// a user-defined map, inline (`uv`) or in a text file (`file`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawReparamGrid {
+    #[serde(deserialize_with = "strict")]
+    pub size: Spanned<[u32; 2]>,
+    #[serde(default, deserialize_with = "strict")]
+    pub uv: Option<Spanned<Vec<Spanned<[f64; 2]>>>>,
+    pub file: Option<Spanned<String>>,
+    pub interpolation: Option<Spanned<String>>,
 }
 
 /// `outline = { ... }`, `profile`, and the entries of `outlines` / `profiles` (with `at`): a
@@ -370,6 +384,10 @@ impl RawProjection {
             ("knots", self.knots.as_ref().map(Spanned::span)),
             ("segments", self.segments.as_ref().map(Spanned::span)),
             ("reparam", self.reparam.as_ref().map(Spanned::span)),
+            (
+                "reparam_grid",
+                self.reparam_grid.as_ref().map(Spanned::span),
+            ),
             (
                 "max_latitude",
                 self.max_latitude.as_ref().map(Spanned::span),

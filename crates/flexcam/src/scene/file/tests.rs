@@ -231,7 +231,7 @@ fn flexible_presets_and_surfaces_parse() {
     let ProjectionSpec::Flexible(spec) = &s.projection else {
         panic!("not flexible");
     };
-    assert_eq!(spec.reparam.map(|r| r.name()), Some("lens"));
+    assert_eq!(spec.reparam.as_ref().map(|r| r.name()), Some("lens"));
     scene(
         "[projection]\ntype = \"flexible\"\n\
          near = { surface = \"line\", start = [-1, 0, 0], end = [1, 0, 0] }\n\
