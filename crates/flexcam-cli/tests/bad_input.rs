@@ -620,7 +620,7 @@ fn line_column(text: &str, needle: &str) -> (usize, usize) {
 }
 
 #[test]
-fn flexible_maps_are_refused_at_their_place() {
+fn flexible_maps_and_blends_are_refused_at_their_place() {
     let dir = TempDir::new().unwrap();
     let head = "[image]\nwidth = 8\nheight = 6\n\n[projection]\ntype = \"flexible\"\n";
     let perspective = "preset = \"perspective\"\nposition = [0, 0, 3]\nlook_at = [0, 0, 0]\n\
@@ -683,6 +683,41 @@ fn flexible_maps_are_refused_at_their_place() {
              control surfaces (point, rectangle): it reads v as the angle off a fisheye's axis \
              and u as the azimuth, which needs a sphere or hemisphere among them (use reparam \
              = \"linear\" or \"grid\")"
+        ),
+    );
+    // A static blend: a weight that is not a number, a part that is not flexible.
+    let blend = |weight: &str, second_type: &str| {
+        format!(
+            "{head}[projection.interpolate]\nweight = {weight}\n\
+             [projection.interpolate.first]\ntype = \"flexible\"\n{perspective}\
+             [projection.interpolate.second]\ntype = \"{second_type}\"\n\
+             position = [0, 0, 3]\nlook_at = [0, 0, 0]\nfov = 180\n{}",
+            if second_type == "flexible" {
+                "preset = \"fisheye\"\n"
+            } else {
+                ""
+            }
+        )
+    };
+    let scene = blend("nan", "flexible");
+    write(&dir, "scene.toml", &scene);
+    let (line, column) = line_column(&scene, "nan");
+    refused(
+        &dir,
+        &render,
+        1,
+        &format!("flexcam: scene.toml:{line}:{column}: `weight` must be a finite number, not NaN"),
+    );
+    let scene = blend("0.5", "fisheye");
+    write(&dir, "scene.toml", &scene);
+    let (line, column) = line_column(&scene, "\"fisheye\"");
+    refused(
+        &dir,
+        &render,
+        1,
+        &format!(
+            "flexcam: scene.toml:{line}:{column}: `interpolate`'s `first` and `second` need \
+             type = \"flexible\" (only flexible volumes can be interpolated), not \"fisheye\""
         ),
     );
 }

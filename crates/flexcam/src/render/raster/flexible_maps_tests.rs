@@ -1,6 +1,6 @@
 //! Method raster against the ray caster on flexible projections whose inverse goes through a
-//! user-defined grid map (Newton's method): the ids agree at every pixel away from object
-//! edges.
+//! user-defined grid map (Newton's method) or a static blend of two volumes (eq. 6.1): the
+//! ids agree at every pixel away from object edges.
 
 use std::path::Path;
 
@@ -95,5 +95,22 @@ fn a_grid_map_rasterises_as_it_ray_casts() {
             uv.join(", ")
         );
         agrees_away_from_edges(interpolation, &scene(&projection));
+    }
+}
+
+#[test]
+fn static_blends_and_extrapolations_rasterise_as_they_ray_cast() {
+    // Perspective with pushbroom (fig. 4.5), interpolated and extrapolated both ways, the
+    // pushbroom's width chosen so that no extrapolated cross-section turns over between the
+    // clip planes (where one does, the projectors cross and raster refuses the volume).
+    for (weight, width) in [(0.3, 4.0), (1.4, 1.5), (-0.3, 10.0)] {
+        let projection = format!(
+            "type = \"flexible\"\n[projection.interpolate]\nweight = {weight}\n\
+             [projection.interpolate.first]\n{PERSPECTIVE}clip = [0.5, 10.0]\n\
+             [projection.interpolate.second]\ntype = \"flexible\"\npreset = \"pushbroom\"\n\
+             position = [0.0, 2.5, 5.0]\nlook_at = [0.0, 0.4, 0.0]\nwidth = {width}\n\
+             v_fov = 60.0\nclip = [0.5, 10.0]\n"
+        );
+        agrees_away_from_edges(&format!("weight {weight}"), &scene(&projection));
     }
 }

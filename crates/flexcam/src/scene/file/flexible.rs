@@ -25,7 +25,7 @@ use crate::projection::flexible::{
 };
 
 /// Every key of a flexible table (besides `type`).
-pub(super) const KEYS: [&str; 44] = [
+pub(super) const KEYS: [&str; 45] = [
     "preset",
     "position",
     "look_at",
@@ -46,6 +46,7 @@ pub(super) const KEYS: [&str; 44] = [
     "segments",
     "reparam",
     "reparam_grid",
+    "interpolate",
     "max_latitude",
     "shift",
     "twist",

@@ -1,12 +1,12 @@
-//! Scene-file tests of the user-defined grid map (`reparam = "grid"`) and the refusal of
-//! spherical maps on flat surfaces.
+//! Scene-file tests of the user-defined grid map (`reparam = "grid"`), the refusal of
+//! spherical maps on flat surfaces, and the static blend `[projection.interpolate]`.
 
 use std::path::Path;
 
 use super::tests::{assert_error_at, scene};
 use super::*;
 use crate::projection::flexible::reparam::SampleInterpolation;
-use crate::projection::flexible::{FlexibleSpec, Reparam};
+use crate::projection::flexible::{FlexibleSpec, Reparam, VolumeSource};
 use crate::projection::ProjectionSpec;
 
 const HEAD: &str = "[projection]\ntype = \"flexible\"\npreset = \"perspective\"\n\
@@ -139,4 +139,78 @@ fn spherical_maps_on_flat_surfaces_are_refused_naming_both() {
                    near = { surface = \"point\", point = [0, 0, 0] }\n\
                    far = { surface = \"hemisphere\", center = [0, 0, 0], radius = 5, axis = [0, 0, -1], front = [1, 0, 0] }\n";
     assert_eq!(flexible(fisheye).reparam, Some(Reparam::Polar));
+}
+
+/// `[projection.interpolate]` of `weight` between a perspective and `second` (the lines of a
+/// flexible table after `type`).
+fn blend(weight: &str, second: &str) -> String {
+    format!(
+        "[projection]\ntype = \"flexible\"\n[projection.interpolate]\nweight = {weight}\n\
+         [projection.interpolate.first]\n{}\n[projection.interpolate.second]\n\
+         type = \"flexible\"\n{second}",
+        &HEAD["[projection]\n".len()..]
+    )
+}
+
+const FISHEYE: &str =
+    "preset = \"fisheye\"\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\nfov = 180\n";
+
+const PUSHBROOM: &str = "preset = \"pushbroom\"\nposition = [0, 0, 5]\nlook_at = [0, 0, 0]\n\
+                         width = 3\nv_fov = 60\n";
+
+#[test]
+fn static_blends_parse_with_any_weight() {
+    for weight in ["0.25", "1.5", "-0.75"] {
+        let spec = flexible(&blend(weight, PUSHBROOM));
+        let VolumeSource::Interpolated {
+            weight: a,
+            first,
+            second,
+        } = spec.source
+        else {
+            panic!("not a blend");
+        };
+        assert_eq!(a, weight.parse::<f64>().unwrap());
+        assert!(matches!(first.source, VolumeSource::Preset(_)));
+        assert!(matches!(second.source, VolumeSource::Preset(_)));
+    }
+}
+
+#[test]
+fn bad_static_blends_are_refused_at_their_place() {
+    let text = blend("nan", FISHEYE);
+    refused_at(&text, "nan", "`weight`");
+    let text = blend("0.5", FISHEYE).replace(
+        "[projection.interpolate]",
+        "fov = 40\n[projection.interpolate]",
+    );
+    refused_at(
+        &text,
+        "40\n[projection.interpolate]",
+        "`fov` is not a parameter of flexible projections given by `interpolate`",
+    );
+    let text = blend("0.5", FISHEYE).replace(
+        "type = \"flexible\"\npreset = \"fisheye\"",
+        "type = \"fisheye\"",
+    );
+    refused_at(
+        &text,
+        "\"fisheye\"",
+        "`interpolate`'s `first` and `second` need type = \"flexible\"",
+    );
+    // An orthographic view and its mirror through the eye: halfway every projector vanishes.
+    let ortho = |z: &str| {
+        format!(
+            "preset = \"orthographic\"\nposition = [0, 0, 0]\nlook_at = [0, 0, {z}]\nwidth = 2\n\
+             clip = [0, 1]\n"
+        )
+    };
+    let text = format!(
+        "[projection]\ntype = \"flexible\"\n[projection.interpolate]\nweight = 0.5\n\
+         [projection.interpolate.first]\ntype = \"flexible\"\n{}\
+         [projection.interpolate.second]\ntype = \"flexible\"\n{}",
+        ortho("1"),
+        ortho("-1")
+    );
+    refused_at(&text, "[projection.interpolate]\n", "interpolation");
 }

@@ -15,6 +15,7 @@ mod fitted_grid;
 mod flexible;
 #[cfg(test)]
 mod flexible_map_tests;
+mod interpolate;
 mod light;
 mod object;
 mod panorama;

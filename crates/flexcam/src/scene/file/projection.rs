@@ -164,9 +164,10 @@ pub(super) fn convert(
     };
     Ok(match kind {
         Kind::Trilinear => ProjectionSpec::Trilinear(trilinear(src, &required, base_dir)?),
-        Kind::Flexible => {
-            ProjectionSpec::Flexible(Box::new(super::flexible::convert(&required, base_dir)?))
-        }
+        Kind::Flexible => ProjectionSpec::Flexible(Box::new(match &raw.interpolate {
+            Some(blend) => super::interpolate::convert(src, table, blend, base_dir, image_size)?,
+            None => super::flexible::convert(&required, base_dir)?,
+        })),
         Kind::Perspective => ProjectionSpec::Perspective {
             frame: camera_frame(src, &required)?,
             fov: src.number(required.get(&raw.fov, "fov")?, "fov")?,

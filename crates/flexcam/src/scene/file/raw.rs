@@ -95,6 +95,7 @@ pub struct RawProjection {
     pub segments: Option<Spanned<u32>>,
     pub reparam: Option<Spanned<String>>,
     pub reparam_grid: Option<Spanned<RawReparamGrid>>,
+    pub interpolate: Option<Spanned<RawInterpolate>>,
     pub max_latitude: Option<Spanned<f64>>,
     #[serde(default, deserialize_with = "strict")]
     pub clip: Option<Spanned<[f64; 2]>>,
@@ -163,6 +164,16 @@ pub struct RawProjection {
     pub pixel_aspect: Option<Spanned<[f64; 2]>>,
     pub polynomial: Option<Spanned<Vec<f64>>>,
     pub tilt: Option<Spanned<f64>>,
+}
+
+/// `[projection.interpolate]` of a flexible projection: `weight` Q1 + (1 - `weight`) Q2 of the
+/// flexible projection tables `first` and `second`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawInterpolate {
+    pub weight: Spanned<f64>,
+    pub first: Box<Spanned<RawProjection>>,
+    pub second: Box<Spanned<RawProjection>>,
 }
 
 /// `reparam_grid = { ... }` of a flexible projection with `reparam = "grid"`: the samples of
@@ -388,6 +399,7 @@ impl RawProjection {
                 "reparam_grid",
                 self.reparam_grid.as_ref().map(Spanned::span),
             ),
+            ("interpolate", self.interpolate.as_ref().map(Spanned::span)),
             (
                 "max_latitude",
                 self.max_latitude.as_ref().map(Spanned::span),
