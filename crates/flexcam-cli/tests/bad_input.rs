@@ -720,4 +720,27 @@ fn flexible_maps_and_blends_are_refused_at_their_place() {
              type = \"flexible\" (only flexible volumes can be interpolated), not \"fisheye\""
         ),
     );
+    // The blend itself renders, by raycast; raster names the reason it cannot.
+    write(&dir, "scene.toml", blend("0.5", "flexible"));
+    refused(
+        &dir,
+        &[
+            "render",
+            "scene.toml",
+            "--method",
+            "raster",
+            "-o",
+            "out.png",
+        ],
+        1,
+        "flexcam: scene.toml: method raster needs a projection with an analytic inverse; \
+         flexible has none: it interpolates volumes on different re-parameterisations, with no \
+         closed-form inverse (use --method raycast)",
+    );
+    let out = run(&dir, &render);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }

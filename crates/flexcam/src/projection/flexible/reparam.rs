@@ -155,28 +155,35 @@ impl Reparam {
 
     /// The (u, v) of continuous pixel position `pixel`, or `None` outside the map's domain
     /// (outside the image for linear and Mercator, outside the unit circle for the polar
-    /// maps).
+    /// maps, outside [0, 1]^2 for every map's (u, v)).
     pub fn to_uv(&self, resolution: &Resolution, pixel: DVec2) -> Option<DVec2> {
+        let inside = match self {
+            Reparam::Polar | Reparam::Lens | Reparam::Equisolid { .. } => {
+                resolution.centred(pixel).length() <= circle_radius(resolution)
+            }
+            Reparam::Grid(_) => in_domain(image_position(resolution, pixel)),
+            _ => true,
+        };
+        let uv = self.to_uv_continued(resolution, pixel);
+        (inside && in_domain(uv)).then_some(uv)
+    }
+
+    /// [`Reparam::to_uv`] without its domain: the polar maps continue beyond the circle
+    /// (v = |p| above 1; the equisolid map holds v at its value for 180 degrees off the
+    /// axis, where its formula ends), a grid map beyond the image by its border cells, and
+    /// (u, v) may leave [0, 1]^2. So two volumes on different maps can be blended over the
+    /// whole image (see `volume::remapped`).
+    pub fn to_uv_continued(&self, resolution: &Resolution, pixel: DVec2) -> DVec2 {
         let size = resolution.size();
-        let uv = match self {
-            Reparam::Linear => DVec2::new(pixel.x / size.x, 1.0 - pixel.y / size.y),
+        match self {
+            Reparam::Linear => image_position(resolution, pixel),
             Reparam::Magnifier(m) => {
-                let p = m.sample_position(resolution, pixel);
-                DVec2::new(p.x / size.x, 1.0 - p.y / size.y)
+                image_position(resolution, m.sample_position(resolution, pixel))
             }
-            Reparam::Grid(grid) => {
-                let st = DVec2::new(pixel.x / size.x, 1.0 - pixel.y / size.y);
-                if !in_domain(st) {
-                    return None;
-                }
-                grid.uv(st)
-            }
+            Reparam::Grid(grid) => grid.uv(image_position(resolution, pixel)),
             Reparam::Polar | Reparam::Lens | Reparam::Equisolid { .. } => {
                 let p = resolution.centred(pixel) / circle_radius(resolution);
                 let r = p.length();
-                if r > 1.0 {
-                    return None;
-                }
                 let v = match *self {
                     Reparam::Lens => 0.25 * r + 0.75 * r * r,
                     Reparam::Equisolid { max_angle } => {
@@ -207,8 +214,7 @@ impl Reparam {
                 let latitude = (py * max_latitude.sin()).clamp(-1.0, 1.0).asin();
                 DVec2::new(pixel.x / size.x, 0.5 * (latitude / max_latitude + 1.0))
             }
-        };
-        in_domain(uv).then_some(uv)
+        }
     }
 
     /// The continuous pixel position of `uv` (inverse of [`Reparam::to_uv`]); `None` outside
@@ -304,6 +310,13 @@ impl Reparam {
         }
         range
     }
+}
+
+/// The image position (s, t) = (x / W, 1 - y / H) of pixel position `pixel`: the linear
+/// map's (u, v), a grid map's argument.
+fn image_position(resolution: &Resolution, pixel: DVec2) -> DVec2 {
+    let size = resolution.size();
+    DVec2::new(pixel.x / size.x, 1.0 - pixel.y / size.y)
 }
 
 /// Whether `uv` lies in the closed domain [0, 1]^2.
