@@ -117,7 +117,7 @@ fn keyframe(
     image: &ImageSettings,
 ) -> Result<Keyframe> {
     let time = src.number(&key.time, "time")?;
-    let projection = super::interpolate::flexible_part(
+    let projection = super::projection::flexible_part(
         src,
         &key.projection,
         base_dir,

@@ -4,8 +4,6 @@
 //! `type = "flexible"` projection table. Projections on different re-parameterisations blend
 //! on the image's own domain (fig. 6.16).
 
-use std::path::Path;
-
 use toml::Spanned;
 
 use super::raw::{RawInterpolate, RawProjection};
@@ -13,16 +11,17 @@ use super::source::Source;
 use crate::calibrate;
 use crate::error::Result;
 use crate::projection::flexible::{FlexibleSpec, VolumeSource};
-use crate::projection::ProjectionSpec;
 
-/// Converts the flexible table `table` whose `interpolate` is `blend`, and builds it at
-/// `image_size` so that a pair that cannot be blended is reported at the table.
+/// Converts the flexible table `table` whose `interpolate` is `blend`, its `first` and
+/// `second` tables by `part` (the projection table reader, passed in because it is the one
+/// that calls this), and builds it at `image_size` so that a pair that cannot be blended is
+/// reported at the table.
 pub(super) fn convert(
     src: &Source,
     table: &Spanned<RawProjection>,
     blend: &Spanned<RawInterpolate>,
-    base_dir: &Path,
     image_size: [u32; 2],
+    part: impl Fn(&Spanned<RawProjection>, &str) -> Result<FlexibleSpec>,
 ) -> Result<FlexibleSpec> {
     if let Some((key, span)) = table
         .get_ref()
@@ -41,15 +40,8 @@ pub(super) fn convert(
     }
     let raw = blend.get_ref();
     let weight = src.number(&raw.weight, "weight")?;
-    let part = |part: &Spanned<RawProjection>| {
-        flexible_part(
-            src,
-            part,
-            base_dir,
-            image_size,
-            "`interpolate`'s `first` and `second` need",
-        )
-    };
+    let part =
+        |table: &Spanned<RawProjection>| part(table, "`interpolate`'s `first` and `second` need");
     let spec = FlexibleSpec {
         source: VolumeSource::Interpolated {
             weight,
@@ -62,26 +54,4 @@ pub(super) fn convert(
     calibrate::build_flexible(&spec, width, height)
         .map_err(|e| src.error(&blend.span(), e.message))?;
     Ok(spec)
-}
-
-/// The flexible projection of table `table` (within another table), or an error at its
-/// `type` beginning with `who` (what needs a flexible one).
-pub(super) fn flexible_part(
-    src: &Source,
-    table: &Spanned<RawProjection>,
-    base_dir: &Path,
-    image_size: [u32; 2],
-    who: &str,
-) -> Result<FlexibleSpec> {
-    match super::projection::convert(src, table, base_dir, image_size)? {
-        ProjectionSpec::Flexible(projection) => Ok(*projection),
-        other => Err(src.error(
-            &table.get_ref().kind.span(),
-            format!(
-                "{who} type = \"flexible\" (only flexible volumes can be interpolated), not \
-                 \"{}\"",
-                other.kind()
-            ),
-        )),
-    }
 }
