@@ -608,3 +608,139 @@ fn trilinear_surface_normals_are_refused_at_the_obj_line() {
         );
     }
 }
+
+/// The 1-based line and column of the first `needle` in `text`.
+fn line_column(text: &str, needle: &str) -> (usize, usize) {
+    let offset = text
+        .find(needle)
+        .unwrap_or_else(|| panic!("{needle} not in {text}"));
+    let before = &text[..offset];
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    (before.matches('\n').count() + 1, offset - line_start + 1)
+}
+
+#[test]
+fn flexible_maps_and_blends_are_refused_at_their_place() {
+    let dir = TempDir::new().unwrap();
+    let head = "[image]\nwidth = 8\nheight = 6\n\n[projection]\ntype = \"flexible\"\n";
+    let perspective = "preset = \"perspective\"\nposition = [0, 0, 3]\nlook_at = [0, 0, 0]\n\
+                       fov = 60\n";
+    let render = ["render", "scene.toml", "-o", "out.png"];
+    // A grid map in a file: a folding cell at its first sample, a bad value at itself.
+    write(
+        &dir,
+        "scene.toml",
+        format!(
+            "{head}{perspective}reparam = \"grid\"\n\
+             reparam_grid = {{ size = [3, 2], file = \"g.txt\" }}\n"
+        ),
+    );
+    write(&dir, "g.txt", "# u v\n0 0  0.4 0  1 0\n0 1  1.6 1  1 1\n");
+    refused(
+        &dir,
+        &render,
+        1,
+        "flexcam: g.txt:2:6: uv grid cell (1, 0) (column, row from the bottom left) folds: \
+         its map is not one-to-one there",
+    );
+    write(&dir, "g.txt", "# u v\n0 0  0.4 0  1 0\n0 1  x 1  1 1\n");
+    refused(
+        &dir,
+        &render,
+        1,
+        "flexcam: g.txt:3:6: uv grid value `x` is not a finite number",
+    );
+    // The same fold inline: at the sample in the scene.
+    let scene = format!(
+        "{head}{perspective}reparam = \"grid\"\nreparam_grid = {{ size = [3, 2], \
+         uv = [[0, 0], [0.4, 0], [1, 0], [0, 1], [1.6, 1], [1, 1]] }}\n"
+    );
+    write(&dir, "scene.toml", &scene);
+    let (line, column) = line_column(&scene, "[0.4, 0]");
+    refused(
+        &dir,
+        &render,
+        1,
+        &format!(
+            "flexcam: scene.toml:{line}:{column}: uv grid cell (1, 0) (column, row from the \
+             bottom left) folds: its map is not one-to-one there"
+        ),
+    );
+    // A polar map on flat surfaces names both.
+    let scene = format!(
+        "{head}near = {{ surface = \"point\", point = [0, 0, 3] }}\n\
+         far = {{ surface = \"rectangle\", center = [0, 0, -3], u_axis = [2, 0, 0], \
+         v_axis = [0, 1.5, 0] }}\nreparam = \"polar\"\n"
+    );
+    write(&dir, "scene.toml", &scene);
+    let (line, column) = line_column(&scene, "\"polar\"");
+    refused(
+        &dir,
+        &render,
+        1,
+        &format!(
+            "flexcam: scene.toml:{line}:{column}: reparam \"polar\" does not go with flat \
+             control surfaces (point, rectangle): it reads v as the angle off a fisheye's axis \
+             and u as the azimuth, which needs a sphere or hemisphere among them (use reparam \
+             = \"linear\" or \"grid\")"
+        ),
+    );
+    // A static blend: a weight that is not a number, a part that is not flexible.
+    let blend = |weight: &str, second_type: &str| {
+        format!(
+            "{head}[projection.interpolate]\nweight = {weight}\n\
+             [projection.interpolate.first]\ntype = \"flexible\"\n{perspective}\
+             [projection.interpolate.second]\ntype = \"{second_type}\"\n\
+             position = [0, 0, 3]\nlook_at = [0, 0, 0]\nfov = 180\n{}",
+            if second_type == "flexible" {
+                "preset = \"fisheye\"\n"
+            } else {
+                ""
+            }
+        )
+    };
+    let scene = blend("nan", "flexible");
+    write(&dir, "scene.toml", &scene);
+    let (line, column) = line_column(&scene, "nan");
+    refused(
+        &dir,
+        &render,
+        1,
+        &format!("flexcam: scene.toml:{line}:{column}: `weight` must be a finite number, not NaN"),
+    );
+    let scene = blend("0.5", "fisheye");
+    write(&dir, "scene.toml", &scene);
+    let (line, column) = line_column(&scene, "\"fisheye\"");
+    refused(
+        &dir,
+        &render,
+        1,
+        &format!(
+            "flexcam: scene.toml:{line}:{column}: `interpolate`'s `first` and `second` need \
+             type = \"flexible\" (only flexible volumes can be interpolated), not \"fisheye\""
+        ),
+    );
+    // The blend itself renders, by raycast; raster names the reason it cannot.
+    write(&dir, "scene.toml", blend("0.5", "flexible"));
+    refused(
+        &dir,
+        &[
+            "render",
+            "scene.toml",
+            "--method",
+            "raster",
+            "-o",
+            "out.png",
+        ],
+        1,
+        "flexcam: scene.toml: method raster needs a projection with an analytic inverse; \
+         flexible has none: it interpolates volumes on different re-parameterisations, with no \
+         closed-form inverse (use --method raycast)",
+    );
+    let out = run(&dir, &render);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

@@ -123,7 +123,7 @@ fn perspective_rect(projection: &ProjectionSpec, rect: [f64; 4]) -> Result<Proje
         })
     };
     let (source, reparam) = match projection {
-        ProjectionSpec::Flexible(spec) => (spec.source.clone(), spec.reparam),
+        ProjectionSpec::Flexible(spec) => (spec.source.clone(), spec.reparam.clone()),
         ProjectionSpec::Cylindrical {
             frame,
             h_fov,

@@ -44,22 +44,26 @@ const FLAT: f64 = 1e-12;
 impl Inverse {
     /// The chart of this volume under `reparam` on an image of `resolution`, or `None` when
     /// the extended inverse is not continuous in a way a chart describes (see the module).
-    pub fn chart(&self, reparam: Reparam, resolution: &Resolution) -> Option<InverseChart> {
+    pub fn chart(&self, reparam: &Reparam, resolution: &Resolution) -> Option<InverseChart> {
         match self {
             Inverse::Planes { near, far, normal } => {
-                // The magnifier (the identity outside its circle) and the equiangular map
-                // (monotonic in x and in y) are homeomorphisms of the image plane onto their
-                // images: they keep the extended inverse continuous.
+                // The magnifier (the identity outside its circle), the equiangular map
+                // (monotonic in x and in y) and a grid map (one-to-one, continued beyond the
+                // image by its border cells) are homeomorphisms of the image plane onto
+                // their images: they keep the extended inverse continuous.
                 matches!(
                     reparam,
-                    Reparam::Linear | Reparam::Magnifier(_) | Reparam::Equiangular { .. }
+                    Reparam::Linear
+                        | Reparam::Magnifier(_)
+                        | Reparam::Equiangular { .. }
+                        | Reparam::Grid(_)
                 )
                 .then_some(())?;
                 planes_chart(near, far, *normal)
             }
             Inverse::Spheres { near, .. } => spheres_chart(near, reparam, resolution),
             Inverse::Cylinders { near, far } => {
-                (reparam == Reparam::Linear).then_some(())?;
+                (*reparam == Reparam::Linear).then_some(())?;
                 cylinders_chart(near, far, resolution)
             }
             Inverse::Panorama(lookup) => lookup.chart(reparam, resolution),
@@ -110,7 +114,7 @@ fn period(range: [f64; 2], resolution: &Resolution) -> f64 {
 
 fn spheres_chart(
     near: &SpherePatch,
-    reparam: Reparam,
+    reparam: &Reparam,
     resolution: &Resolution,
 ) -> Option<InverseChart> {
     let (v_lo, v_hi) = reparam.v_range(resolution)?;
@@ -135,7 +139,7 @@ fn spheres_chart(
             finite.then_some(())?;
             Some(period(near.longitude, resolution))
         }
-        Reparam::Magnifier(_) | Reparam::Equiangular { .. } => return None,
+        Reparam::Magnifier(_) | Reparam::Equiangular { .. } | Reparam::Grid(_) => return None,
         Reparam::Polar | Reparam::Lens | Reparam::Equisolid { .. } => {
             let full = ((near.longitude[1] - near.longitude[0]).abs() - 2.0 * PI).abs() <= FLAT;
             let start = near.latitude[0];

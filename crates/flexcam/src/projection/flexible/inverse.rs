@@ -316,7 +316,7 @@ impl AnalyticInverse for BoundInverse {
     /// The analytic class under the maps that keep the extended inverse continuous (see
     /// the `chart` module); `None` otherwise.
     fn charted(&self) -> Option<Charted<'_>> {
-        let chart = self.solver.chart(self.reparam, &self.resolution)?;
+        let chart = self.solver.chart(&self.reparam, &self.resolution)?;
         Some(Charted { chart, map: self })
     }
 }

@@ -28,6 +28,8 @@ pub mod animation;
 pub mod blend;
 mod chart;
 pub mod control_surface;
+#[cfg(test)]
+mod cross_map_tests;
 pub mod interpolate;
 mod inverse;
 mod linear_volume;
@@ -59,7 +61,7 @@ pub use projector_grid::{
     ProjectorGridSpec, Starts,
 };
 pub use reparam::Reparam;
-pub use volume::{ControlSurface, InterpolatedVolume, Volume};
+pub use volume::{ControlSurface, InterpolatedVolume, RemappedVolume, Volume};
 
 use self::inverse::{BoundInverse, Inverse};
 use super::image_coords::Resolution;
@@ -90,10 +92,11 @@ pub enum VolumeSource {
         /// How they are blended in t.
         blend: Blend,
     },
-    /// `weight` Q1 + (1 - `weight`) Q2 of two flexible projections (module [`interpolate`]);
-    /// both must end up with the same re-parameterisation (their own or the preset's).
+    /// `weight` Q1 + (1 - `weight`) Q2 of two flexible projections (module [`interpolate`]),
+    /// on their shared re-parameterisation, or, where their maps differ, on the image's
+    /// own domain (each volume seen through its own map, [`RemappedVolume`]).
     Interpolated {
-        /// The share of `first`, in [0, 1].
+        /// The share of `first`; outside [0, 1] the blend extrapolates.
         weight: f64,
         /// The projection weighted by `weight`.
         first: Box<FlexibleSpec>,
@@ -156,8 +159,8 @@ impl Flexible {
     /// Builds the volume. Errors: an empty image; a bad preset parameter or camera frame; an
     /// invalid surface; control surfaces that coincide everywhere; bad knots or segments of
     /// a blended volume (see [`PiecewiseVolume::new`], [`BezierVolume::new`]); a map latitude
-    /// out of range; an interpolation of volumes with different re-parameterisations or a
-    /// non-finite weight; a projector grid with correspondences (see [`Flexible::build`]).
+    /// out of range; a non-finite interpolation weight; a projector grid with
+    /// correspondences (see [`Flexible::build`]).
     pub fn new(spec: &FlexibleSpec, width: u32, height: u32) -> Result<Self> {
         Self::build(spec, width, height, None, &mut BuildReport::default())
     }
@@ -172,8 +175,7 @@ impl Flexible {
         report: &mut BuildReport,
     ) -> Result<Self> {
         let resolution = Resolution::new(width, height)?;
-        let aspect = f64::from(height) / f64::from(width);
-        let (volume, reparam) = build_volume(spec, aspect, fitter, report)?;
+        let (volume, reparam) = build_volume(spec, &resolution, fitter, report)?;
         let classified = match &volume {
             Volume::Linear(v) => Inverse::classify(&v.near, &v.far),
             _ => Ok(None),
@@ -181,7 +183,7 @@ impl Flexible {
         let inverse = match classified {
             Ok(Some(solver)) => Ok(BoundInverse {
                 solver,
-                reparam,
+                reparam: reparam.clone(),
                 resolution,
             }),
             Ok(None) => Err(NoInverse {
@@ -205,8 +207,8 @@ impl Flexible {
     }
 
     /// The re-parameterisation in use.
-    pub fn reparam(&self) -> Reparam {
-        self.reparam
+    pub fn reparam(&self) -> &Reparam {
+        &self.reparam
     }
 
     /// The (u, v) of continuous pixel position `pixel`, `None` outside the map's domain.
@@ -258,8 +260,12 @@ fn no_inverse_reason(volume: &Volume) -> &'static str {
              closed-form inverse"
         }
         Volume::Bezier(_) => "its projectors are Bezier curves, with no closed-form inverse",
-        Volume::Interpolated(_) => {
+        Volume::Interpolated(v) if !matches!(v.first, Volume::Remapped(_)) => {
             "it interpolates two volumes of different structure, with no closed-form inverse"
+        }
+        Volume::Interpolated(_) | Volume::Remapped(_) => {
+            "it interpolates volumes on different re-parameterisations, with no closed-form \
+             inverse"
         }
         Volume::Grid(_) => {
             "its projectors are interpolated from a projector grid's nodes, with no \
@@ -268,15 +274,17 @@ fn no_inverse_reason(volume: &Volume) -> &'static str {
     }
 }
 
-/// The volume and re-parameterisation of `spec` for an image of aspect ratio
-/// `aspect` = height / width.
+/// The volume and re-parameterisation of `spec` for an image of `resolution`.
 /// Projector grids with correspondences are fitted by `fitter` (see [`GridVolume::build`]).
+/// Two volumes with different re-parameterisations are interpolated on the image's own
+/// domain (each a [`RemappedVolume`], the blend's map linear).
 fn build_volume(
     spec: &FlexibleSpec,
-    aspect: f64,
+    resolution: &Resolution,
     fitter: Option<&dyn GridFitter>,
     report: &mut BuildReport,
 ) -> Result<(Volume, Reparam)> {
+    let aspect = f64::from(resolution.height) / f64::from(resolution.width);
     let linear = |near, far| LinearVolume::new(near, far).map(|v| Volume::Linear(Box::new(v)));
     let (volume, default_reparam) = match &spec.source {
         VolumeSource::Preset(p) => (p.volume(aspect)?, p.preset.default_reparam()),
@@ -303,18 +311,21 @@ fn build_volume(
             first,
             second,
         } => {
-            let (a, map_a) = build_volume(first, aspect, fitter, report)?;
-            let (b, map_b) = build_volume(second, aspect, fitter, report)?;
-            if map_a != map_b {
-                return Err(Error::new(format!(
-                    "flexible interpolation needs both volumes on one (u, v) domain: they \
-                     have different re-parameterisations ({} and {}); give both the same \
-                     `reparam`",
-                    describe(&map_a),
-                    describe(&map_b)
-                )));
+            let (a, map_a) = build_volume(first, resolution, fitter, report)?;
+            let (b, map_b) = build_volume(second, resolution, fitter, report)?;
+            if map_a == map_b {
+                (interpolate::interpolate(*weight, a, b)?, map_a)
+            } else {
+                let remap = |volume, map| {
+                    Volume::Remapped(Box::new(RemappedVolume {
+                        volume,
+                        map,
+                        resolution: *resolution,
+                    }))
+                };
+                let (a, b) = (remap(a, map_a), remap(b, map_b));
+                (interpolate::interpolate(*weight, a, b)?, Reparam::Linear)
             }
-            (interpolate::interpolate(*weight, a, b)?, map_a)
         }
         VolumeSource::Pieces(_) => {
             return Err(Error::new(
@@ -323,7 +334,7 @@ fn build_volume(
             ))
         }
         VolumeSource::ProjectorGrid { base, grid } => {
-            let (base_volume, base_reparam) = build_volume(base, aspect, fitter, report)?;
+            let (base_volume, base_reparam) = build_volume(base, resolution, fitter, report)?;
             let Volume::Linear(linear) = &base_volume else {
                 return Err(Error::new(
                     "a projector grid starts from a volume with straight projectors (a preset \
@@ -334,21 +345,9 @@ fn build_volume(
             (Volume::Grid(Box::new(volume)), base_reparam)
         }
     };
-    let reparam = spec.reparam.unwrap_or(default_reparam);
+    let reparam = spec.reparam.clone().unwrap_or(default_reparam);
     reparam.validate()?;
     Ok((volume, reparam))
-}
-
-/// A re-parameterisation's name with its latitude, for messages.
-fn describe(reparam: &Reparam) -> String {
-    match reparam {
-        Reparam::Mercator { max_latitude } | Reparam::EqualArea { max_latitude } => format!(
-            "{} to {} degrees",
-            reparam.name(),
-            max_latitude.to_degrees()
-        ),
-        _ => reparam.name().to_string(),
-    }
 }
 
 impl Projection for Flexible {

@@ -6,17 +6,23 @@
 //! y up, scaled so that the circle inscribed in the shorter image side is the unit circle
 //! (the notes' correction: the thesis says [0, 1] and atan). Mercator scales x by the width
 //! and y by the height, each to [-1, 1].
+//!
+//! Module `grid`: user-defined maps given by a grid of samples.
+
+pub mod grid;
 
 use std::f64::consts::{FRAC_PI_4, PI};
+use std::sync::Arc;
 
 use glam::DVec2;
 
+pub use self::grid::{GridProblem, SampleInterpolation, UvGrid};
 use super::super::image_coords::Resolution;
 use super::presets::Magnifier;
 use crate::error::{Error, Result};
 
 /// A pixel <-> (u, v) map.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Reparam {
     /// u = x / W, v = 1 - y / H: the image is the domain, v up.
     Linear,
@@ -68,10 +74,14 @@ pub enum Reparam {
     /// The linear map seen through a circular magnifying lens (the `magnifier` preset's
     /// map; [`Magnifier`]): identity outside the circle.
     Magnifier(Magnifier),
+    /// A user-defined map: (u, v) interpolated from a grid of samples over the image
+    /// positions s = x / W, t = 1 - y / H (module `grid`); pixels whose (u, v) falls outside
+    /// [0, 1]^2 see nothing.
+    Grid(Arc<UvGrid>),
 }
 
 /// The names used in scene files, in order.
-pub const REPARAM_NAMES: [&str; 7] = [
+pub const REPARAM_NAMES: [&str; 8] = [
     "linear",
     "polar",
     "lens",
@@ -79,6 +89,7 @@ pub const REPARAM_NAMES: [&str; 7] = [
     "equal_area",
     "equisolid",
     "equiangular",
+    "grid",
 ];
 
 /// The default top latitude of the Mercator map, degrees.
@@ -96,6 +107,7 @@ impl Reparam {
             Reparam::Mercator { .. } => "mercator",
             Reparam::EqualArea { .. } => "equal_area",
             Reparam::Magnifier(_) => "magnifier",
+            Reparam::Grid(_) => "grid",
         }
     }
 
@@ -143,21 +155,35 @@ impl Reparam {
 
     /// The (u, v) of continuous pixel position `pixel`, or `None` outside the map's domain
     /// (outside the image for linear and Mercator, outside the unit circle for the polar
-    /// maps).
+    /// maps, outside [0, 1]^2 for every map's (u, v)).
     pub fn to_uv(&self, resolution: &Resolution, pixel: DVec2) -> Option<DVec2> {
-        let size = resolution.size();
-        let uv = match self {
-            Reparam::Linear => DVec2::new(pixel.x / size.x, 1.0 - pixel.y / size.y),
-            Reparam::Magnifier(m) => {
-                let p = m.sample_position(resolution, pixel);
-                DVec2::new(p.x / size.x, 1.0 - p.y / size.y)
+        let inside = match self {
+            Reparam::Polar | Reparam::Lens | Reparam::Equisolid { .. } => {
+                resolution.centred(pixel).length() <= circle_radius(resolution)
             }
+            Reparam::Grid(_) => in_domain(image_position(resolution, pixel)),
+            _ => true,
+        };
+        let uv = self.to_uv_continued(resolution, pixel);
+        (inside && in_domain(uv)).then_some(uv)
+    }
+
+    /// [`Reparam::to_uv`] without its domain: the polar maps continue beyond the circle
+    /// (v = |p| above 1; the equisolid map holds v at its value for 180 degrees off the
+    /// axis, where its formula ends), a grid map beyond the image by its border cells, and
+    /// (u, v) may leave [0, 1]^2. So two volumes on different maps can be blended over the
+    /// whole image (see `volume::remapped`).
+    pub fn to_uv_continued(&self, resolution: &Resolution, pixel: DVec2) -> DVec2 {
+        let size = resolution.size();
+        match self {
+            Reparam::Linear => image_position(resolution, pixel),
+            Reparam::Magnifier(m) => {
+                image_position(resolution, m.sample_position(resolution, pixel))
+            }
+            Reparam::Grid(grid) => grid.uv(image_position(resolution, pixel)),
             Reparam::Polar | Reparam::Lens | Reparam::Equisolid { .. } => {
                 let p = resolution.centred(pixel) / circle_radius(resolution);
                 let r = p.length();
-                if r > 1.0 {
-                    return None;
-                }
                 let v = match *self {
                     Reparam::Lens => 0.25 * r + 0.75 * r * r,
                     Reparam::Equisolid { max_angle } => {
@@ -188,8 +214,7 @@ impl Reparam {
                 let latitude = (py * max_latitude.sin()).clamp(-1.0, 1.0).asin();
                 DVec2::new(pixel.x / size.x, 0.5 * (latitude / max_latitude + 1.0))
             }
-        };
-        in_domain(uv).then_some(uv)
+        }
     }
 
     /// The continuous pixel position of `uv` (inverse of [`Reparam::to_uv`]); `None` outside
@@ -204,13 +229,18 @@ impl Reparam {
     /// [`Reparam::to_pixel`] extended beyond [0, 1]^2 by the same formulas. `None` where
     /// they are undefined: a lens-like v below -1/48 (no real radius), an equisolid angle
     /// |v| max_angle beyond 180 degrees (where the map folds back), a Mercator latitude
-    /// (2v - 1) max_latitude of 90 degrees or more.
+    /// (2v - 1) max_latitude of 90 degrees or more, a (u, v) whose grid inverse does not
+    /// converge (see [`UvGrid::st`]).
     pub fn to_pixel_unbounded(&self, resolution: &Resolution, uv: DVec2) -> Option<DVec2> {
         let size = resolution.size();
         let pixel = match self {
             Reparam::Linear => DVec2::new(uv.x * size.x, (1.0 - uv.y) * size.y),
             Reparam::Magnifier(m) => {
                 m.pixel_of(resolution, DVec2::new(uv.x * size.x, (1.0 - uv.y) * size.y))
+            }
+            Reparam::Grid(grid) => {
+                let st = grid.st(uv)?;
+                DVec2::new(st.x * size.x, (1.0 - st.y) * size.y)
             }
             Reparam::Polar | Reparam::Lens | Reparam::Equisolid { .. } => {
                 let r = match *self {
@@ -262,9 +292,11 @@ impl Reparam {
             | Reparam::Mercator { .. }
             | Reparam::EqualArea { .. }
             | Reparam::Equiangular { .. } => 1,
-            Reparam::Polar | Reparam::Lens | Reparam::Equisolid { .. } | Reparam::Magnifier(_) => {
-                resolution.width
-            }
+            Reparam::Polar
+            | Reparam::Lens
+            | Reparam::Equisolid { .. }
+            | Reparam::Magnifier(_)
+            | Reparam::Grid(_) => resolution.width,
         };
         let mut range: Option<(f64, f64)> = None;
         for y in 0..resolution.height {
@@ -278,6 +310,13 @@ impl Reparam {
         }
         range
     }
+}
+
+/// The image position (s, t) = (x / W, 1 - y / H) of pixel position `pixel`: the linear
+/// map's (u, v), a grid map's argument.
+fn image_position(resolution: &Resolution, pixel: DVec2) -> DVec2 {
+    let size = resolution.size();
+    DVec2::new(pixel.x / size.x, 1.0 - pixel.y / size.y)
 }
 
 /// Whether `uv` lies in the closed domain [0, 1]^2.
@@ -309,6 +348,69 @@ mod tests {
 
     fn res() -> Resolution {
         Resolution::new(200, 100).unwrap()
+    }
+
+    /// A grid map that squeezes the image towards its centre column and bends the rows.
+    fn bent_grid(interpolation: SampleInterpolation) -> Reparam {
+        let samples = (0..5)
+            .flat_map(|j| (0..6).map(move |i| (i, j)))
+            .map(|(i, j)| {
+                let (s, t) = (f64::from(i) / 5.0, f64::from(j) / 4.0);
+                DVec2::new(0.5 + 0.4 * (PI * (s - 0.5)).sin(), t * (0.9 + 0.1 * s))
+            })
+            .collect();
+        Reparam::Grid(Arc::new(UvGrid::new(6, 5, samples, interpolation).unwrap()))
+    }
+
+    #[test]
+    fn a_grid_of_the_image_positions_is_the_linear_map() {
+        let samples = (0..3)
+            .flat_map(|j| (0..3).map(move |i| DVec2::new(f64::from(i), f64::from(j)) / 2.0))
+            .collect();
+        let grid = UvGrid::new(3, 3, samples, SampleInterpolation::Bicubic).unwrap();
+        let map = Reparam::Grid(Arc::new(grid));
+        assert_eq!(map.name(), "grid");
+        for pixel in [
+            DVec2::new(0.0, 100.0),
+            DVec2::new(73.25, 31.5),
+            DVec2::new(200.0, 0.0),
+        ] {
+            let (a, b) = (
+                map.to_uv(&res(), pixel).unwrap(),
+                Reparam::Linear.to_uv(&res(), pixel).unwrap(),
+            );
+            assert!((a - b).length() < 1e-15, "{pixel}");
+        }
+        assert_eq!(map.to_uv(&res(), DVec2::new(-0.5, 50.0)), None);
+        // Beyond the image the inverse continues the map.
+        let outside = map
+            .to_pixel_unbounded(&res(), DVec2::new(-0.25, 1.5))
+            .unwrap();
+        assert!(
+            (outside - DVec2::new(-50.0, -50.0)).length() < 1e-9,
+            "{outside}"
+        );
+    }
+
+    #[test]
+    fn a_grid_map_sees_nothing_where_its_uv_leaves_the_domain() {
+        // u runs from -0.5 to 1.5 across the image: the outer quarters see nothing.
+        let samples = vec![
+            DVec2::new(-0.5, 0.0),
+            DVec2::new(1.5, 0.0),
+            DVec2::new(-0.5, 1.0),
+            DVec2::new(1.5, 1.0),
+        ];
+        let grid = UvGrid::new(2, 2, samples, SampleInterpolation::Bilinear).unwrap();
+        let map = Reparam::Grid(Arc::new(grid));
+        assert_eq!(map.to_uv(&res(), DVec2::new(20.0, 50.0)), None);
+        let uv = map.to_uv(&res(), DVec2::new(100.0, 50.0)).unwrap();
+        assert!((uv - DVec2::splat(0.5)).length() < 1e-15);
+        let (lo, hi) = map.v_range(&res()).unwrap();
+        assert!(
+            (lo - 0.005).abs() < 1e-15 && (hi - 0.995).abs() < 1e-15,
+            "{lo} {hi}"
+        );
     }
 
     #[test]
@@ -466,6 +568,8 @@ mod tests {
             Reparam::EqualArea {
                 max_latitude: 0.5 * PI,
             },
+            bent_grid(SampleInterpolation::Bilinear),
+            bent_grid(SampleInterpolation::Bicubic),
         ];
         for map in maps {
             for pixel in [

@@ -1,8 +1,9 @@
 //! The viewing volume Q(u, v, t) of a flexible projection, whatever its projectors: one type
 //! over the straight volume between two surfaces ([`LinearVolume`]), the blended volumes
 //! with polyline or Bezier projectors (module `blend`), the mix of two volumes
-//! ([`InterpolatedVolume`]) and the projector grid (module `projector_grid`). Everything that
-//! only needs Q and dQ/dt works with all of them.
+//! ([`InterpolatedVolume`]), a volume moved onto the image's domain to be mixed with one on
+//! another map ([`RemappedVolume`]) and the projector grid (module `projector_grid`).
+//! Everything that only needs Q and dQ/dt works with all of them.
 
 use glam::{DVec2, DVec3};
 
@@ -15,8 +16,10 @@ use crate::geometry::Ray;
 use crate::projection::{Projector, ProjectorHull};
 
 mod interpolated;
+mod remapped;
 pub(super) use interpolated::mix;
 pub use interpolated::{InterpolatedVolume, MIXED_SEGMENTS};
+pub use remapped::RemappedVolume;
 
 /// A viewing volume.
 #[derive(Debug, Clone, PartialEq)]
@@ -30,6 +33,9 @@ pub enum Volume {
     /// a Q1 + (1 - a) Q2 of two volumes that do not blend into a simpler one (module
     /// `interpolate`).
     Interpolated(Box<InterpolatedVolume>),
+    /// A volume on the image's domain through its own re-parameterisation, for a mix with
+    /// a volume on another (module `remapped`).
+    Remapped(Box<RemappedVolume>),
     /// Straight or quadratic projectors interpolated from a grid of placed or fitted node
     /// projectors (module `projector_grid`).
     Grid(Box<GridVolume>),
@@ -43,6 +49,7 @@ impl Volume {
             Volume::Piecewise(v) => v.point(uv, t),
             Volume::Bezier(v) => v.point(uv, t),
             Volume::Interpolated(v) => v.point(uv, t),
+            Volume::Remapped(v) => v.volume.point(v.own_uv(uv), t),
             Volume::Grid(v) => v.grid.point(uv, t),
         }
     }
@@ -54,6 +61,7 @@ impl Volume {
             Volume::Piecewise(v) => v.tangent(uv, t),
             Volume::Bezier(v) => v.tangent(uv, t),
             Volume::Interpolated(v) => v.tangent(uv, t),
+            Volume::Remapped(v) => v.volume.tangent(v.own_uv(uv), t),
             Volume::Grid(v) => v.grid.tangent(uv, t),
         }
     }
@@ -61,21 +69,46 @@ impl Volume {
     /// The projector of (u, v) when it is a straight ray; `None` when it has zero length or
     /// is curved (see [`Volume::projector`]).
     pub fn ray(&self, uv: DVec2) -> Option<Ray> {
+        self.sees(uv).then(|| self.ray_continued(uv)).flatten()
+    }
+
+    /// The projector of (u, v), straight or curved; `None` when it has zero length.
+    pub fn projector(&self, uv: DVec2) -> Option<Projector> {
+        self.sees(uv)
+            .then(|| self.projector_continued(uv))
+            .flatten()
+    }
+
+    /// Whether the volume sees (u, v): everywhere but where a remapped volume's own map has
+    /// no (u, v) (outside a fisheye's circle); a mix sees where either of its volumes does.
+    pub fn sees(&self, uv: DVec2) -> bool {
+        match self {
+            Volume::Remapped(v) => v.sees(uv),
+            Volume::Interpolated(v) => v.first.sees(uv) || v.second.sees(uv),
+            Volume::Linear(_) | Volume::Piecewise(_) | Volume::Bezier(_) | Volume::Grid(_) => true,
+        }
+    }
+
+    /// [`Volume::ray`] where the volume does not see (u, v) too (a remapped volume
+    /// continued beyond its map's domain), for mixing.
+    pub fn ray_continued(&self, uv: DVec2) -> Option<Ray> {
         match self {
             Volume::Linear(v) => v.ray(uv),
             Volume::Interpolated(v) => v.ray(uv),
+            Volume::Remapped(v) => v.volume.ray_continued(v.own_uv(uv)),
             Volume::Grid(v) => v.grid.ray(uv),
             Volume::Piecewise(_) | Volume::Bezier(_) => None,
         }
     }
 
-    /// The projector of (u, v), straight or curved; `None` when it has zero length.
-    pub fn projector(&self, uv: DVec2) -> Option<Projector> {
+    /// [`Volume::projector`] where the volume does not see (u, v) too, for mixing.
+    pub fn projector_continued(&self, uv: DVec2) -> Option<Projector> {
         match self {
             Volume::Linear(v) => v.ray(uv).map(Projector::Straight),
             Volume::Piecewise(v) => v.projector(uv),
             Volume::Bezier(v) => v.projector(uv),
             Volume::Interpolated(v) => v.projector(uv),
+            Volume::Remapped(v) => v.volume.projector_continued(v.own_uv(uv)),
             Volume::Grid(v) => v.grid.projector(uv),
         }
     }
@@ -87,7 +120,7 @@ impl Volume {
         match self {
             Volume::Piecewise(v) => v.projector_into(uv, out),
             Volume::Bezier(v) => v.projector_into(uv, out),
-            Volume::Linear(_) | Volume::Interpolated(_) | Volume::Grid(_) => {
+            Volume::Linear(_) | Volume::Interpolated(_) | Volume::Remapped(_) | Volume::Grid(_) => {
                 *out = self.projector(uv)
             }
         }
@@ -101,7 +134,9 @@ impl Volume {
         match self {
             Volume::Piecewise(v) => v.projector_hull(lo, hi),
             Volume::Bezier(v) => v.projector_hull(lo, hi),
-            Volume::Linear(_) | Volume::Interpolated(_) | Volume::Grid(_) => None,
+            Volume::Linear(_) | Volume::Interpolated(_) | Volume::Remapped(_) | Volume::Grid(_) => {
+                None
+            }
         }
     }
 
@@ -114,7 +149,7 @@ impl Volume {
             Volume::Linear(v) => vec![ControlSurface::Own(&v.near), ControlSurface::Own(&v.far)],
             Volume::Piecewise(v) => v.surfaces().iter().map(ControlSurface::Own).collect(),
             Volume::Bezier(v) => v.surfaces().iter().map(ControlSurface::Own).collect(),
-            Volume::Interpolated(_) | Volume::Grid(_) => [0.0, 1.0]
+            Volume::Interpolated(_) | Volume::Remapped(_) | Volume::Grid(_) => [0.0, 1.0]
                 .map(|t| ControlSurface::At { volume: self, t })
                 .into(),
         }

@@ -40,6 +40,8 @@
 mod band_fill;
 mod clip;
 mod coverage;
+#[cfg(test)]
+mod flexible_maps_tests;
 mod fragment;
 mod pixel_rays;
 mod refine;

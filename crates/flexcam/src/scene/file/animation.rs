@@ -13,7 +13,6 @@ use super::source::Source;
 use crate::calibrate;
 use crate::error::Result;
 use crate::projection::flexible::{Animation, Easing, FlexibleSpec, Keyframe, VolumeSource};
-use crate::projection::ProjectionSpec;
 use crate::scene::ImageSettings;
 
 /// Frames per second when `fps` is absent.
@@ -118,23 +117,12 @@ fn keyframe(
     image: &ImageSettings,
 ) -> Result<Keyframe> {
     let time = src.number(&key.time, "time")?;
-    let image_size = [image.width, image.height];
-    match super::projection::convert(src, &key.projection, base_dir, image_size)? {
-        ProjectionSpec::Flexible(projection) => Ok(Keyframe {
-            time,
-            projection: *projection,
-        }),
-        other => Err(src.error(
-            &key.projection
-                .get_ref()
-                .kind
-                .as_ref()
-                .map_or(key.projection.span(), Spanned::span),
-            format!(
-                "animation keys need type = \"flexible\" (only flexible volumes can be \
-                 interpolated), not \"{}\"",
-                other.kind()
-            ),
-        )),
-    }
+    let projection = super::projection::flexible_part(
+        src,
+        &key.projection,
+        base_dir,
+        [image.width, image.height],
+        "animation keys need",
+    )?;
+    Ok(Keyframe { time, projection })
 }

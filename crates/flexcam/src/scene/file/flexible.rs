@@ -6,6 +6,7 @@
 
 use std::f64::consts::PI;
 use std::ops::Range;
+use std::path::Path;
 
 use glam::{DVec2, DVec3};
 use toml::Spanned;
@@ -20,11 +21,12 @@ use crate::projection::flexible::presets::{
 };
 use crate::projection::flexible::reparam::{DEFAULT_MERCATOR_LATITUDE, REPARAM_NAMES};
 use crate::projection::flexible::{
-    BezierVolume, Blend, FlexibleSpec, PiecewiseVolume, Preset, PresetSpec, Reparam, VolumeSource,
+    BezierVolume, Blend, FlexibleSpec, PiecewiseVolume, Preset, PresetSpec, Reparam, Surface,
+    VolumeSource,
 };
 
 /// Every key of a flexible table (besides `type`).
-pub(super) const KEYS: [&str; 45] = [
+pub(super) const KEYS: [&str; 47] = [
     "preset",
     "position",
     "look_at",
@@ -44,6 +46,8 @@ pub(super) const KEYS: [&str; 45] = [
     "knots",
     "segments",
     "reparam",
+    "reparam_grid",
+    "interpolate",
     "max_latitude",
     "shift",
     "twist",
@@ -73,18 +77,27 @@ pub(super) const KEYS: [&str; 45] = [
 ];
 
 /// Keys every preset accepts (but `up` for the axonometric one, which is always +y).
-const PRESET_COMMON: [&str; 6] = ["preset", "position", "look_at", "up", "clip", "reparam"];
+const PRESET_COMMON: [&str; 7] = [
+    "preset",
+    "position",
+    "look_at",
+    "up",
+    "clip",
+    "reparam",
+    "reparam_grid",
+];
 
 /// Keys of a flexible table given by a near and a far surface.
-const SURFACE_KEYS: [&str; 4] = ["near", "far", "reparam", "max_latitude"];
+const SURFACE_KEYS: [&str; 5] = ["near", "far", "reparam", "reparam_grid", "max_latitude"];
 
 /// Keys of a flexible table given by a list of surfaces blended in t.
-const BLEND_KEYS: [&str; 6] = [
+const BLEND_KEYS: [&str; 7] = [
     "surfaces",
     "blend",
     "knots",
     "segments",
     "reparam",
+    "reparam_grid",
     "max_latitude",
 ];
 
@@ -118,11 +131,11 @@ fn preset_keys(name: &str) -> &'static [&'static str] {
     }
 }
 
-/// Converts a flexible projection table.
-pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
+/// Converts a flexible projection table; a grid map's file is found in `base_dir`.
+pub(super) fn convert(required: &Required, base_dir: &Path) -> Result<FlexibleSpec> {
     let src = required.src;
     let raw = required.raw();
-    let reparam = reparam(src, raw)?;
+    let reparam = reparam(src, raw, base_dir)?;
     if let Some(list) = &raw.pieces {
         let present = raw.present_keys();
         reject_keys(
@@ -134,7 +147,7 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
             },
         )?;
         return Ok(FlexibleSpec {
-            source: super::pieces::convert(src, list, convert)?,
+            source: super::pieces::convert(src, list, |piece| convert(piece, base_dir))?,
             reparam: None,
         });
     }
@@ -162,12 +175,12 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
             let common = |key: &str| {
                 PRESET_COMMON.contains(&key)
                     && !(key == "up" && name.get_ref() == "axonometric")
-                    && !(key == "reparam" && name.get_ref() == "magnifier")
+                    && !(key.starts_with("reparam") && name.get_ref() == "magnifier")
             };
             let allowed = |key: &str| {
                 common(key)
                     || own.contains(&key)
-                    || (key == "max_latitude" && reparam.is_some_and(|r| has_latitude(&r)))
+                    || (key == "max_latitude" && reparam.as_ref().is_some_and(has_latitude))
             };
             reject_keys(src, &present, allowed, || {
                 let takes: Vec<&str> = PRESET_COMMON
@@ -208,13 +221,18 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
                 &present,
                 |key| BLEND_KEYS.contains(&key),
                 || {
-                    "projections given by `surfaces` (they take: surfaces, blend, knots, \
-                     segments, reparam, max_latitude)"
-                        .to_string()
+                    format!(
+                        "projections given by `surfaces` (they take: {})",
+                        BLEND_KEYS.join(", ")
+                    )
                 },
             )?;
             let list = required.get(&raw.surfaces, "surfaces")?;
-            blended(src, raw, list)?
+            let source = blended(src, raw, list)?;
+            if let VolumeSource::Blended { surfaces, .. } = &source {
+                reparam_needs_curved(src, raw, surfaces)?;
+            }
+            source
         }
         None => {
             reject_keys(
@@ -222,21 +240,21 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
                 &present,
                 |key| SURFACE_KEYS.contains(&key),
                 || {
-                    "projections without a `preset` (they take: near, far, reparam, \
-                     max_latitude)"
-                        .to_string()
+                    format!(
+                        "projections without a `preset` (they take: {})",
+                        SURFACE_KEYS.join(", ")
+                    )
                 },
             )?;
             let near = required.get(&raw.near, "near (or a preset)")?;
             let far = required.get(&raw.far, "far")?;
-            VolumeSource::Surfaces {
-                near: surface(src, near, "near")?,
-                far: surface(src, far, "far")?,
-            }
+            let (near, far) = (surface(src, near, "near")?, surface(src, far, "far")?);
+            reparam_needs_curved(src, raw, &[near.clone(), far.clone()])?;
+            VolumeSource::Surfaces { near, far }
         }
     };
-    if let (Some(at), Some(r)) = (&raw.max_latitude, reparam) {
-        if !has_latitude(&r) {
+    if let (Some(at), Some(r)) = (&raw.max_latitude, &reparam) {
+        if !has_latitude(r) {
             return Err(src.error(
                 &at.span(),
                 "`max_latitude` belongs to reparam = \"mercator\" or \"equal_area\"",
@@ -255,7 +273,7 @@ pub(super) fn convert(required: &Required) -> Result<FlexibleSpec> {
             }
             // The map the built projection takes (`build_volume`): the given one, else the
             // preset's own, else linear.
-            let uv_map = reparam.unwrap_or(match &source {
+            let uv_map = reparam.clone().unwrap_or_else(|| match &source {
                 VolumeSource::Preset(p) => p.preset.default_reparam(),
                 _ => Reparam::Linear,
             });
@@ -416,8 +434,54 @@ fn reparam_matches_preset(
     ))
 }
 
-/// `reparam` (and `max_latitude`); `None` when absent.
-fn reparam(src: &Source, raw: &RawProjection) -> Result<Option<Reparam>> {
+/// An error at the `reparam` key where its map reads (u, v) as angles on a sphere (the polar
+/// maps: the angle off the axis and the azimuth; the latitude maps: latitude and longitude)
+/// but every one of the explicit control surfaces `surfaces` is flat (a rectangle, bilinear
+/// patch, point or line), so the image would be of no projection.
+fn reparam_needs_curved(src: &Source, raw: &RawProjection, surfaces: &[Surface]) -> Result<()> {
+    let Some(map) = &raw.reparam else {
+        return Ok(());
+    };
+    let reads = match map.get_ref().as_str() {
+        "polar" | "lens" => "v as the angle off a fisheye's axis and u as the azimuth",
+        "mercator" | "equal_area" => "v as a latitude and u as a longitude",
+        _ => return Ok(()),
+    };
+    let flat = |s: &Surface| {
+        matches!(
+            s,
+            Surface::Rectangle { .. }
+                | Surface::Bilinear { .. }
+                | Surface::Point(_)
+                | Surface::Line { .. }
+        )
+    };
+    if !surfaces.iter().all(flat) {
+        return Ok(());
+    }
+    let kinds: Vec<&str> = surfaces.iter().map(Surface::kind).collect();
+    Err(src.error(
+        &map.span(),
+        format!(
+            "reparam \"{}\" does not go with flat control surfaces ({}): it reads {reads}, \
+             which needs a sphere or hemisphere among them (use reparam = \"linear\" or \
+             \"grid\")",
+            map.get_ref(),
+            kinds.join(", ")
+        ),
+    ))
+}
+
+/// `reparam` (with `max_latitude` or `reparam_grid`); `None` when absent. A grid map's file
+/// is found in `base_dir`.
+fn reparam(src: &Source, raw: &RawProjection, base_dir: &Path) -> Result<Option<Reparam>> {
+    let is_grid = raw.reparam.as_ref().is_some_and(|r| r.get_ref() == "grid");
+    if let (Some(table), false) = (&raw.reparam_grid, is_grid) {
+        return Err(src.error(
+            &table.span(),
+            "`reparam_grid` belongs to reparam = \"grid\"",
+        ));
+    }
     let Some(name) = &raw.reparam else {
         return Ok(None);
     };
@@ -425,6 +489,16 @@ fn reparam(src: &Source, raw: &RawProjection) -> Result<Option<Reparam>> {
         "linear" => Reparam::Linear,
         "polar" => Reparam::Polar,
         "lens" => Reparam::Lens,
+        "grid" => {
+            let table = raw.reparam_grid.as_ref().ok_or_else(|| {
+                src.error(
+                    &name.span(),
+                    "reparam = \"grid\" needs `reparam_grid = { size = [columns, rows], uv = \
+                     [[u, v], ...] }` (or `file = \"...\"` instead of `uv`)",
+                )
+            })?;
+            super::reparam_grid::convert(src, table, base_dir)?
+        }
         "equisolid" | "equiangular" => preset_angle_map(src, raw, name)?,
         map @ ("mercator" | "equal_area") => {
             let (default, make): (f64, fn(f64) -> Reparam) = if map == "mercator" {

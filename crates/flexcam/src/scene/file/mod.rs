@@ -13,6 +13,9 @@ pub mod edit;
 mod fisheye_projection;
 mod fitted_grid;
 mod flexible;
+#[cfg(test)]
+mod flexible_map_tests;
+mod interpolate;
 mod light;
 mod object;
 mod panorama;
@@ -21,6 +24,7 @@ mod projection;
 mod projection_table;
 mod projector_grid;
 mod raw;
+mod reparam_grid;
 mod shape;
 mod source;
 mod strict;

@@ -34,12 +34,13 @@ use crate::projection::flexible::panorama::{
 use crate::projection::flexible::VolumeSource;
 
 /// The keys of a panorama table (besides `type` and `projectors`).
-pub(super) const KEYS: [&str; 12] = [
+pub(super) const KEYS: [&str; 13] = [
     "position",
     "look_at",
     "up",
     "clip",
     "reparam",
+    "reparam_grid",
     "max_latitude",
     "outline",
     "outlines",

@@ -11,6 +11,7 @@ use super::projection_table::{camera_frame, Required};
 use super::raw::{ProjectionTypeProbe, RawProjection};
 use super::source::Source;
 use crate::error::Result;
+use crate::projection::flexible::FlexibleSpec;
 use crate::projection::{ProjectionSpec, TrilinearMesh};
 
 /// The projection types this parser converts.
@@ -185,7 +186,14 @@ pub(super) fn convert(
     };
     Ok(match kind {
         Kind::Trilinear => trilinear(src, &required, base_dir)?,
-        Kind::Flexible => ProjectionSpec::Flexible(Box::new(super::flexible::convert(&required)?)),
+        Kind::Flexible => ProjectionSpec::Flexible(Box::new(match &raw.interpolate {
+            Some(blend) => {
+                super::interpolate::convert(src, table, blend, image_size, |part, who| {
+                    flexible_part(src, part, base_dir, image_size, who)
+                })?
+            }
+            None => super::flexible::convert(&required, base_dir)?,
+        })),
         Kind::Perspective => ProjectionSpec::Perspective {
             frame: camera_frame(src, &required)?,
             fov: src.number(required.get(&raw.fov, "fov")?, "fov")?,
@@ -331,4 +339,30 @@ fn trilinear(src: &Source, required: &Required, base_dir: &Path) -> Result<Proje
             .collect(),
         triangles: triangles.get_ref().clone(),
     }))
+}
+
+/// The flexible projection of table `table` (within another table), or an error at its
+/// `type` beginning with `who` (what needs a flexible one).
+pub(super) fn flexible_part(
+    src: &Source,
+    table: &Spanned<RawProjection>,
+    base_dir: &Path,
+    image_size: [u32; 2],
+    who: &str,
+) -> Result<FlexibleSpec> {
+    match convert(src, table, base_dir, image_size)? {
+        ProjectionSpec::Flexible(projection) => Ok(*projection),
+        other => Err(src.error(
+            &table
+                .get_ref()
+                .kind
+                .as_ref()
+                .map_or(table.span(), Spanned::span),
+            format!(
+                "{who} type = \"flexible\" (only flexible volumes can be interpolated), not \
+                 \"{}\"",
+                other.kind()
+            ),
+        )),
+    }
 }

@@ -95,6 +95,8 @@ pub struct RawProjection {
     pub knots: Option<Spanned<Vec<f64>>>,
     pub segments: Option<Spanned<u32>>,
     pub reparam: Option<Spanned<String>>,
+    pub reparam_grid: Option<Spanned<RawReparamGrid>>,
+    pub interpolate: Option<Spanned<RawInterpolate>>,
     pub max_latitude: Option<Spanned<f64>>,
     #[serde(default, deserialize_with = "strict")]
     pub clip: Option<Spanned<[f64; 2]>>,
@@ -173,6 +175,29 @@ pub struct RawProjection {
     pub pieces: Option<Spanned<Vec<Spanned<RawProjection>>>>,
     #[serde(default, deserialize_with = "strict")]
     pub rect: Option<Spanned<[f64; 4]>>,
+}
+
+/// `[projection.interpolate]` of a flexible projection: `weight` Q1 + (1 - `weight`) Q2 of the
+/// flexible projection tables `first` and `second`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawInterpolate {
+    pub weight: Spanned<f64>,
+    pub first: Box<Spanned<RawProjection>>,
+    pub second: Box<Spanned<RawProjection>>,
+}
+
+/// `reparam_grid = { ... }` of a flexible projection with `reparam = "grid"`: the samples of
+/// a user-defined map, inline (`uv`) or in a text file (`file`).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawReparamGrid {
+    #[serde(deserialize_with = "strict")]
+    pub size: Spanned<[u32; 2]>,
+    #[serde(default, deserialize_with = "strict")]
+    pub uv: Option<Spanned<Vec<Spanned<[f64; 2]>>>>,
+    pub file: Option<Spanned<String>>,
+    pub interpolation: Option<Spanned<String>>,
 }
 
 /// `outline = { ... }`, `profile`, and the entries of `outlines` / `profiles` (with `at`): a
@@ -400,6 +425,11 @@ impl RawProjection {
             ("knots", self.knots.as_ref().map(Spanned::span)),
             ("segments", self.segments.as_ref().map(Spanned::span)),
             ("reparam", self.reparam.as_ref().map(Spanned::span)),
+            (
+                "reparam_grid",
+                self.reparam_grid.as_ref().map(Spanned::span),
+            ),
+            ("interpolate", self.interpolate.as_ref().map(Spanned::span)),
             (
                 "max_latitude",
                 self.max_latitude.as_ref().map(Spanned::span),

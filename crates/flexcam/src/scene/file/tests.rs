@@ -231,7 +231,7 @@ fn flexible_presets_and_surfaces_parse() {
     let ProjectionSpec::Flexible(spec) = &s.projection else {
         panic!("not flexible");
     };
-    assert_eq!(spec.reparam.map(|r| r.name()), Some("lens"));
+    assert_eq!(spec.reparam.as_ref().map(|r| r.name()), Some("lens"));
     scene(
         "[projection]\ntype = \"flexible\"\n\
          near = { surface = \"line\", start = [-1, 0, 0], end = [1, 0, 0] }\n\
@@ -1280,10 +1280,21 @@ fn animation_errors_have_positions() {
         8,
         "animation keys need type = \"flexible\"",
     );
+    // Keys on different maps blend on the image's domain (fig. 6.16).
     let fisheye = animation_key("1", "40").replace("perspective", "fisheye");
+    parse_text(&format!("{head}{}{fisheye}", animation_key("0", "40"))).unwrap();
+    // An orthographic view and its mirror through the eye: halfway, every projector
+    // vanishes.
+    let mirrored = |time: &str, z: &str| {
+        format!(
+            "[[animation.key]]\ntime = {time}\n[animation.key.projection]\ntype = \"flexible\"\n\
+             preset = \"orthographic\"\nposition = [0, 0, 0]\nlook_at = [0, 0, {z}]\nwidth = 2\n\
+             clip = [0, 1]\n"
+        )
+    };
     assert_error_at(
-        &format!("{head}{}{fisheye}", animation_key("0", "40")),
-        18,
+        &format!("{head}{}{}", mirrored("0", "1"), mirrored("1", "-1")),
+        19,
         1,
         "keys 0 and 1 cannot be interpolated",
     );

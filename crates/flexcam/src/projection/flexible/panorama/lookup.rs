@@ -313,8 +313,8 @@ impl PanoramaInverse {
     /// once every 1 / (s1 - s0) widths for a window [s0, s1] of the outline): the seam
     /// period and the poles up and down the axis through the eye, with the clearance left
     /// by the highest and lowest pixel-centre rows.
-    pub fn chart(&self, reparam: Reparam, resolution: &Resolution) -> Option<InverseChart> {
-        (reparam == Reparam::Linear).then_some(())?;
+    pub fn chart(&self, reparam: &Reparam, resolution: &Resolution) -> Option<InverseChart> {
+        (*reparam == Reparam::Linear).then_some(())?;
         let (v_lo, v_hi) = reparam.v_range(resolution)?;
         let (rho_lo, rho_hi) = self.distance_bounds();
         // The elevation of row v over all u is atan2(P_y, rho P_x) for a blend P of the

@@ -10,7 +10,7 @@ use crate::projection::Projector;
 /// a Q1 + (1 - a) Q2, evaluated point by point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct InterpolatedVolume {
-    /// a: the share of `first`, in [0, 1].
+    /// a: the share of `first`; outside [0, 1] the mix extrapolates.
     pub weight: f64,
     /// Q1.
     pub first: Volume,
@@ -39,9 +39,14 @@ impl InterpolatedVolume {
 
     /// When both projectors of (u, v) are straight, so is the blend: origin and direction
     /// mix the same way (t in [0, 1] for both). `None` when either has no ray or the blend has
-    /// zero length.
+    /// zero length. A volume that does not see (u, v) itself (a remapped fisheye outside its
+    /// circle) takes part with its continuation; the caller decides whether the mix sees it
+    /// ([`Volume::sees`]).
     pub fn ray(&self, uv: DVec2) -> Option<Ray> {
-        let (a, b) = (self.first.ray(uv)?, self.second.ray(uv)?);
+        let (a, b) = (
+            self.first.ray_continued(uv)?,
+            self.second.ray_continued(uv)?,
+        );
         let direction = mix(self.weight, a.direction, b.direction);
         if direction == DVec3::ZERO || !direction.is_finite() {
             return None;
@@ -63,7 +68,10 @@ impl InterpolatedVolume {
     /// knots fall on those steps, an approximation elsewhere). `None` where either volume has
     /// no projector.
     pub fn projector(&self, uv: DVec2) -> Option<Projector> {
-        let (a, b) = (self.first.projector(uv)?, self.second.projector(uv)?);
+        let (a, b) = (
+            self.first.projector_continued(uv)?,
+            self.second.projector_continued(uv)?,
+        );
         if let (Projector::Straight(_), Projector::Straight(_)) = (&a, &b) {
             return self.ray(uv).map(Projector::Straight);
         }
