@@ -201,7 +201,7 @@ fn bad_pieces_are_refused_at_their_place() {
         ),
         &[],
         "scene.toml:14:9: `width` is not a parameter of flexible preset \"perspective\" (it \
-         takes: preset, position, look_at, up, clip, reparam, fov)",
+         takes: preset, position, look_at, up, clip, reparam, reparam_grid, fov)",
     );
     // `rect` belongs to pieces only.
     refused(
@@ -210,8 +210,8 @@ fn bad_pieces_are_refused_at_their_place() {
         &[],
         "scene.toml:3:8: `rect` is not a parameter of flexible projections (they take: preset, \
          position, look_at, up, converge, fov, width, h_fov, v_fov, clip, shear, \
-         slit_distance, near, far, surfaces, blend, knots, segments, reparam, max_latitude, \
-         shift, twist, azimuth, elevation, generators, projectors, corner_radius, outline, \
+         slit_distance, near, far, surfaces, blend, knots, segments, reparam, reparam_grid, \
+         interpolate, max_latitude, shift, twist, azimuth, elevation, generators, projectors, corner_radius, outline, \
          outlines, profile, profiles, perspective_rect, transition, transitions, fovs, style, \
          pole, strength, path, directions, center, radius, magnification, deep, pieces)",
     );

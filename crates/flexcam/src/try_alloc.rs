@@ -1,6 +1,7 @@
 //! Fallible allocation of the buffers whose size comes from the input: frames (image width x
 //! height, times the samples per pixel where a renderer keeps a frame per sample), their
-//! depth, id and surface layers, z-buffers, band buffers, caustic maps, environment-map faces.
+//! depth, id and surface layers, z-buffers, band buffers, caustic maps, environment-map faces,
+//! and the image writers' sample buffers (8- and 16-bit bytes, EXR channels).
 //!
 //! The memory budget (`scene::budget`) refuses a scene whose estimate exceeds it before
 //! anything is allocated, but memory taken by other processes meanwhile can still make an
@@ -55,6 +56,21 @@ pub fn copied<T: Clone>(values: &[T], what: impl FnOnce() -> String) -> Result<V
     reserve(&mut copy, values.len(), what)?;
     copy.extend_from_slice(values);
     Ok(copy)
+}
+
+/// The `len` items of `items` in a vector allocated fallibly (an image writer's samples, say).
+/// `len` is the number of items: more would grow the vector by `Vec`'s own (aborting)
+/// allocation, fewer leave spare capacity.
+pub fn collected<T>(
+    len: usize,
+    items: impl IntoIterator<Item = T>,
+    what: impl FnOnce() -> String,
+) -> Result<Vec<T>> {
+    let mut values = Vec::new();
+    reserve(&mut values, len, what)?;
+    values.extend(items);
+    debug_assert_eq!(values.len(), len);
+    Ok(values)
 }
 
 /// Makes room in `values` for `additional` more elements (exactly, as
@@ -146,6 +162,7 @@ mod tests {
         reserve(&mut values, 100, what).unwrap();
         assert!(values.capacity() >= 101);
         assert!(zeroed::<u8>(0, what).unwrap().is_empty());
+        assert_eq!(collected(3, [1u16, 2, 3], what).unwrap(), [1, 2, 3]);
     }
 
     /// More than the address space can hold fails with the bytes and the buffer named,
@@ -162,6 +179,16 @@ mod tests {
         let mut values = vec![1u64, 2];
         let e = resize(&mut values, usize::MAX / 16, 0, || "the z-buffer".into()).unwrap_err();
         assert!(e.message.ends_with("for the z-buffer"), "{e}");
+        // An image writer's samples: the iterator is never started.
+        let e = collected(usize::MAX / 4, std::iter::repeat(0u32), || {
+            "the 8-bit RGB bytes of the 9 x 9 image".into()
+        })
+        .unwrap_err();
+        assert!(
+            e.message
+                .ends_with("for the 8-bit RGB bytes of the 9 x 9 image"),
+            "{e}"
+        );
         assert_eq!(values, [1, 2]);
         let e = filled(usize::MAX / 2, 0u32, || "ids".into()).unwrap_err();
         assert!(is_out_of_memory(&e), "{e}");

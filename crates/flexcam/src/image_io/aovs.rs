@@ -11,7 +11,7 @@
 
 use std::path::Path;
 
-use super::float::{rgb_channels, vector_channels, write_exr, ExrSamples};
+use super::float::{rgb_channels, scalar_channel, vector_channels, write_exr, ExrSamples};
 use crate::error::{Error, Result};
 use crate::render::Frame;
 
@@ -25,28 +25,24 @@ pub fn write_aovs_exr(frame: &Frame, path: &Path) -> Result<()> {
             "the AOV file needs a frame rendered with depth and ids",
         ));
     }
-    let mut channels = rgb_channels(frame);
-    channels.push(("Z", ExrSamples::F32(frame.depth.clone())));
-    channels.push(("id", ExrSamples::U32(frame.ids.clone())));
+    let mut channels = rgb_channels(frame)?;
+    channels.push(("Z", scalar_channel(&frame.depth, |z| *z)?));
+    let ids =
+        crate::try_alloc::copied(&frame.ids, || format!("an OpenEXR channel of {pixels} ids"))?;
+    channels.push(("id", ExrSamples::U32(ids)));
     let surface = &frame.surface;
     if !surface.is_empty() {
         channels.extend(vector_channels(["N.X", "N.Y", "N.Z"], surface, |s| {
             s.normal.to_array()
-        }));
+        })?);
         channels.extend(vector_channels(["Ng.X", "Ng.Y", "Ng.Z"], surface, |s| {
             s.geometric_normal.to_array()
-        }));
+        })?);
         channels.extend(vector_channels(["P.X", "P.Y", "P.Z"], surface, |s| {
             s.position.to_array()
-        }));
-        channels.push((
-            "uv.U",
-            ExrSamples::F32(surface.iter().map(|s| s.uv.x).collect()),
-        ));
-        channels.push((
-            "uv.V",
-            ExrSamples::F32(surface.iter().map(|s| s.uv.y).collect()),
-        ));
+        })?);
+        channels.push(("uv.U", scalar_channel(surface, |s| s.uv.x)?));
+        channels.push(("uv.V", scalar_channel(surface, |s| s.uv.y)?));
     }
     write_exr((frame.width, frame.height), path, "aovs", channels)
 }

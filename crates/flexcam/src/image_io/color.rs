@@ -62,7 +62,7 @@ pub fn write_color(
             (frame.width, frame.height),
             path,
             "color",
-            rgb_channels(frame),
+            rgb_channels(frame)?,
         ),
         ColorFormat::Pfm => write_pfm(frame, path, 3, bytemuck::cast_slice(&frame.color)),
     }
@@ -75,11 +75,11 @@ pub fn encode_channel16(c: f32, encoding: ColorEncoding) -> u16 {
 
 /// Writes the colour of `frame` as a 16-bit RGB PNG at `path`.
 fn write_color_png16(frame: &Frame, path: &Path, encoding: ColorEncoding) -> Result<()> {
-    let samples: Vec<u16> = frame
-        .color
-        .iter()
-        .flat_map(|c| c.to_array().map(|v| encode_channel16(v, encoding)))
-        .collect();
+    let samples = crate::try_alloc::collected(
+        3 * frame.color.len(),
+        (frame.color.iter()).flat_map(|c| c.to_array().map(|v| encode_channel16(v, encoding))),
+        || super::samples_of("16-bit RGB samples", frame),
+    )?;
     let buffer = image::ImageBuffer::<image::Rgb<u16>, Vec<u16>>::from_raw(
         frame.width,
         frame.height,

@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use super::extension;
-use super::float::{write_exr, write_pfm, ExrSamples};
+use super::float::{scalar_channel, write_exr, write_pfm};
 use crate::error::{Error, Result};
 use crate::render::Frame;
 
@@ -44,7 +44,7 @@ pub fn write_depth(frame: &Frame, path: &Path, format: DepthFormat) -> Result<()
 }
 
 fn write_depth_exr(frame: &Frame, path: &Path) -> Result<()> {
-    let depth = ExrSamples::F32(frame.depth.clone());
+    let depth = scalar_channel(&frame.depth, |z| *z)?;
     write_exr(
         (frame.width, frame.height),
         path,

@@ -46,24 +46,29 @@ pub fn write_exr(
         .map_err(|e| crate::error::Error::new(format!("cannot write OpenEXR: {e}")))
 }
 
-/// The red, green and blue channels of the linear colour of `frame`, for [`write_exr`].
-pub fn rgb_channels(frame: &Frame) -> Vec<(&'static str, ExrSamples)> {
-    let channel = |k: usize| ExrSamples::F32(frame.color.iter().map(|c| c[k]).collect());
-    vec![("R", channel(0)), ("G", channel(1)), ("B", channel(2))]
+/// The red, green and blue channels of the linear colour of `frame`, for [`write_exr`]
+/// (allocated fallibly).
+pub fn rgb_channels(frame: &Frame) -> Result<Vec<(&'static str, ExrSamples)>> {
+    vector_channels(["R", "G", "B"], &frame.color, |c| c.to_array())
+}
+
+/// One EXR channel of `value` at each of `pixels`, allocated fallibly.
+pub fn scalar_channel<T>(pixels: &[T], value: impl Fn(&T) -> f32) -> Result<ExrSamples> {
+    let samples = crate::try_alloc::collected(pixels.len(), pixels.iter().map(value), || {
+        format!("an OpenEXR channel of {} samples", pixels.len())
+    })?;
+    Ok(ExrSamples::F32(samples))
 }
 
 /// The channels `LAYER.X`, `LAYER.Y`, `LAYER.Z` (names given in `names`) of one vector a
-/// pixel, for [`write_exr`].
+/// pixel, for [`write_exr`] (allocated fallibly).
 pub fn vector_channels<T>(
     names: [&'static str; 3],
     pixels: &[T],
     vector: impl Fn(&T) -> [f32; 3],
-) -> Vec<(&'static str, ExrSamples)> {
+) -> Result<Vec<(&'static str, ExrSamples)>> {
     (0..3)
-        .map(|k| {
-            let samples = pixels.iter().map(|p| vector(p)[k]).collect();
-            (names[k], ExrSamples::F32(samples))
-        })
+        .map(|k| Ok((names[k], scalar_channel(pixels, |p| vector(p)[k])?)))
         .collect()
 }
 

@@ -18,10 +18,12 @@ pub struct GifFrames {
 impl GifFrames {
     /// Appends the colour of `frame`.
     pub fn push(&mut self, frame: &Frame, encoding: ColorEncoding) -> Result<()> {
-        let rgba: Vec<u8> = rgb_bytes(frame, encoding)
-            .chunks_exact(3)
-            .flat_map(|rgb| [rgb[0], rgb[1], rgb[2], 255])
-            .collect();
+        let rgba = crate::try_alloc::collected(
+            4 * frame.color.len(),
+            (rgb_bytes(frame, encoding)?.chunks_exact(3))
+                .flat_map(|rgb| [rgb[0], rgb[1], rgb[2], 255]),
+            || super::samples_of("8-bit RGBA bytes", frame),
+        )?;
         let image = image::RgbaImage::from_raw(frame.width, frame.height, rgba)
             .ok_or_else(|| Error::new("colour buffer does not match the image size"))?;
         self.frames.push(image);

@@ -85,13 +85,20 @@ pub fn encode_channel(c: f32, encoding: ColorEncoding) -> u8 {
     (255.0 * encoded(c, encoding)).round() as u8
 }
 
-/// The 8-bit RGB bytes of the colour of `frame`, row by row from the top.
-fn rgb_bytes(frame: &Frame, encoding: ColorEncoding) -> Vec<u8> {
-    frame
-        .color
-        .iter()
-        .flat_map(|c: &Vec3| c.to_array().map(|v| encode_channel(v, encoding)))
-        .collect()
+/// The 8-bit RGB bytes of the colour of `frame`, row by row from the top (allocated
+/// fallibly: an error names the bytes).
+fn rgb_bytes(frame: &Frame, encoding: ColorEncoding) -> crate::error::Result<Vec<u8>> {
+    let bytes =
+        (frame.color.iter()).flat_map(|c: &Vec3| c.to_array().map(|v| encode_channel(v, encoding)));
+    crate::try_alloc::collected(3 * frame.color.len(), bytes, || {
+        samples_of("8-bit RGB bytes", frame)
+    })
+}
+
+/// Names an image writer's buffer for an allocation error: "the 8-bit RGB bytes of the
+/// 800 x 600 image".
+fn samples_of(what: &str, frame: &Frame) -> String {
+    format!("the {what} of the {} x {} image", frame.width, frame.height)
 }
 
 /// The inverse of the sRGB transfer curve: an encoded value in [0, 1] to linear.

@@ -3,13 +3,14 @@
 
 use std::path::Path;
 
-use super::{rgb_bytes, ColorEncoding};
+use super::{rgb_bytes, samples_of, ColorEncoding};
 use crate::error::{Error, Result};
 use crate::render::Frame;
+use crate::try_alloc;
 
 /// Writes the colour of `frame` as an 8-bit RGB PNG at `path`.
 pub fn write_color_png(frame: &Frame, path: &Path, encoding: ColorEncoding) -> Result<()> {
-    write_rgb8_png(frame, path, &rgb_bytes(frame, encoding))
+    write_rgb8_png(frame, path, &rgb_bytes(frame, encoding)?)
 }
 
 /// Writes `bytes`, 8-bit RGB of the size of `frame`, as a PNG at `path`.
@@ -28,14 +29,16 @@ fn write_rgb8_png(frame: &Frame, path: &Path, bytes: &[u8]) -> Result<()> {
 /// Writes object ids as a 16-bit grayscale PNG at `path` (0 = background); ids above 65535
 /// are an error rather than silently wrapping.
 pub fn write_ids_png(frame: &Frame, path: &Path) -> Result<()> {
-    let ids: Vec<u16> = frame
-        .ids
-        .iter()
-        .map(|&id| {
-            u16::try_from(id)
-                .map_err(|_| Error::new(format!("object id {id} does not fit a 16-bit PNG")))
-        })
-        .collect::<Result<_>>()?;
+    if let Some(id) = frame.ids.iter().find(|&&id| u16::try_from(id).is_err()) {
+        return Err(Error::new(format!(
+            "object id {id} does not fit a 16-bit PNG"
+        )));
+    }
+    let ids = try_alloc::collected(
+        frame.ids.len(),
+        frame.ids.iter().map(|&id| id as u16),
+        || samples_of("16-bit ids", frame),
+    )?;
     let buffer =
         image::ImageBuffer::<image::Luma<u16>, Vec<u16>>::from_raw(frame.width, frame.height, ids)
             .ok_or_else(|| Error::new("id buffer does not match the image size"))?;
@@ -63,10 +66,10 @@ pub fn id_preview_color(id: u32) -> [u8; 3] {
 
 /// Writes object ids as an 8-bit RGB PNG at `path`, each id in its [`id_preview_color`].
 pub fn write_ids_preview_png(frame: &Frame, path: &Path) -> Result<()> {
-    let bytes: Vec<u8> = frame
-        .ids
-        .iter()
-        .flat_map(|&id| id_preview_color(id))
-        .collect();
+    let bytes = try_alloc::collected(
+        3 * frame.ids.len(),
+        frame.ids.iter().flat_map(|&id| id_preview_color(id)),
+        || samples_of("id preview bytes", frame),
+    )?;
     write_rgb8_png(frame, path, &bytes)
 }

@@ -19,7 +19,7 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::extension;
-use super::float::{vector_channels, write_exr, ExrSamples};
+use super::float::{scalar_channel, vector_channels, write_exr, ExrSamples};
 use crate::error::{Error, Result};
 use crate::projection::ray_map::{PixelRay, RayMap};
 use crate::render::StMap;
@@ -34,25 +34,25 @@ pub fn write_ray_map_exr(map: &RayMap, path: &Path) -> Result<()> {
         ["origin.X", "origin.Y", "origin.Z"],
         rays,
         vector(|r| r.origin),
-    );
+    )?;
     channels.extend(vector_channels(
         ["direction.X", "direction.Y", "direction.Z"],
         rays,
         vector(|r| r.direction),
-    ));
+    )?);
     if map.curved {
         channels.extend(vector_channels(
             ["exit_origin.X", "exit_origin.Y", "exit_origin.Z"],
             rays,
             vector(|r| r.exit_origin),
-        ));
+        )?);
         channels.extend(vector_channels(
             ["exit_direction.X", "exit_direction.Y", "exit_direction.Z"],
             rays,
             vector(|r| r.exit_direction),
-        ));
+        )?);
     }
-    channels.push(("A", alpha(rays)));
+    channels.push(("A", alpha(rays)?));
     write_exr((map.width, map.height), path, "rays", channels)
 }
 
@@ -93,12 +93,19 @@ pub fn write_stmap(map: &StMap, path: &Path, format: StMapFormat) -> Result<()> 
 /// Writes `map` as a 16-bit RGBA PNG at `path`.
 fn write_stmap_png(map: &StMap, path: &Path) -> Result<()> {
     let code = |v: f64| (v.clamp(0.0, 1.0) * 65535.0).round() as u16;
-    let samples: Vec<u16> = (map.st.iter())
-        .flat_map(|st| match st {
+    let samples = crate::try_alloc::collected(
+        4 * map.st.len(),
+        (map.st.iter()).flat_map(|st| match st {
             Some(st) => [code(st.x), code(st.y), 0, u16::MAX],
             None => [0; 4],
-        })
-        .collect();
+        }),
+        || {
+            format!(
+                "the 16-bit samples of the {} x {} STMap",
+                map.width, map.height
+            )
+        },
+    )?;
     image::ImageBuffer::<image::Rgba<u16>, Vec<u16>>::from_raw(map.width, map.height, samples)
         .ok_or_else(|| Error::new("STMap does not match its image size"))?
         .save_with_format(path, image::ImageFormat::Png)
@@ -108,28 +115,17 @@ fn write_stmap_png(map: &StMap, path: &Path) -> Result<()> {
 /// Writes `map` as the STMap OpenEXR at `path`.
 fn write_stmap_exr(map: &StMap, path: &Path) -> Result<()> {
     let st = &map.st;
-    let channel = |k: usize| {
-        ExrSamples::F32(
-            st.iter()
-                .map(|st| st.map_or(0.0, |st| st[k] as f32))
-                .collect(),
-        )
-    };
+    let channel = |k: usize| scalar_channel(st, |st| st.map_or(0.0, |st| st[k] as f32));
     let channels = vec![
-        ("R", channel(0)),
-        ("G", channel(1)),
-        ("B", ExrSamples::F32(vec![0.0; st.len()])),
-        ("A", alpha(st)),
+        ("R", channel(0)?),
+        ("G", channel(1)?),
+        ("B", scalar_channel(st, |_| 0.0)?),
+        ("A", alpha(st)?),
     ];
     write_exr((map.width, map.height), path, "stmap", channels)
 }
 
 /// 1 where a pixel has a value, 0 where it has none.
-fn alpha<T>(values: &[Option<T>]) -> ExrSamples {
-    ExrSamples::F32(
-        values
-            .iter()
-            .map(|v| if v.is_some() { 1.0 } else { 0.0 })
-            .collect(),
-    )
+fn alpha<T>(values: &[Option<T>]) -> Result<ExrSamples> {
+    scalar_channel(values, |v| if v.is_some() { 1.0 } else { 0.0 })
 }
