@@ -106,14 +106,8 @@ fn off_axis_halves_render_the_perspective() {
 /// Runs `render scene.toml` with `text` as the scene and asserts exit status 1, exactly the
 /// one line `expected` on stderr and no output.
 fn refused(dir: &TempDir, text: &str, args: &[&str], expected: &str) {
-    fs::write(dir.path().join("scene.toml"), text).unwrap();
-    let mut all = vec!["render", "scene.toml", "-o", "out.png"];
-    all.extend(args);
-    let out = run(dir, &all);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let stderr = common::refused_scene(dir, text, args);
     assert_eq!(stderr, format!("flexcam: {expected}\n"));
-    assert!(!dir.path().join("out.png").exists());
 }
 
 /// A flexible projection of `pieces` (the text after `type`), 40 x 30.

@@ -7,6 +7,8 @@ use std::path::Path;
 use assert_cmd::Command;
 use tempfile::TempDir;
 
+mod common;
+
 /// The audit's correspondences: eye (0, 5.5, 7), look_at (0.8, 0, 0.5), fov 52, 4:3, points
 /// 4 to 12 from the eye, written to 6 decimals.
 const AUDIT_FIT: &str = "fit = [
@@ -93,4 +95,47 @@ fn the_audit_correspondences_fit_from_every_near_surface() {
             String::from_utf8_lossy(&render.stderr)
         );
     }
+}
+
+/// A scene the fuzzer kept in `fuzz/slow/` (the repository root's, from this crate).
+fn slow_scene(name: &str) -> String {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fuzz/slow")
+        .join(name);
+    path.to_str().expect("a UTF-8 path").to_owned()
+}
+
+/// Two mutated copies of `flexible-projector-fit-curved.toml` whose data leave a node nearly
+/// open: every Levenberg-Marquardt run of the curved fit crept along the flat valley for its
+/// 2,000 steps and each restart, lowering the cost by rounding, started another round (171
+/// runs, 17.5 s in the release binary, for the second). Runs now stop when they stall and a
+/// restart must gain 1e-3 of the cost: the first keeps its residual (0.30701070 degrees rms
+/// before, 0.30701080 after) in 7,666 iterations, the second is refused in its one line.
+#[test]
+fn curved_fits_on_nearly_open_data_stop_when_they_stall() {
+    let dir = TempDir::new().unwrap();
+    let scene = slow_scene("curved-fit-slow-unit.toml");
+    let args = ["render", &scene, "--width", "32", "--height", "24"];
+    let stats = common::run_json(
+        &dir,
+        &[&args[..], &["--stats", "-", "-o", "a.png"]].concat(),
+    );
+    let iterations = stats["fit_curved_iterations"].as_f64().unwrap();
+    assert!(iterations <= 10_000.0, "{stats}");
+    let rms = stats["fit_rms_angle_deg"].as_f64().unwrap();
+    assert!((rms - 0.307_010_7).abs() < 1e-6, "{stats}");
+
+    let scene = slow_scene("curved-fit-17s.toml");
+    let out = common::run(&dir, &["render", &scene, "-o", "b.png"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.starts_with(&format!(
+            "flexcam: {scene}:17:1: curved projector grid fit: the correspondences do not \
+             determine the end and tangent of node (2, 2)"
+        )),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("b.png").exists());
 }

@@ -4,10 +4,9 @@
 
 mod common;
 
-use std::fs;
 use std::path::Path;
 
-use common::{run, run_json};
+use common::run_json;
 use tempfile::TempDir;
 
 fn example(name: &str) -> String {
@@ -49,15 +48,8 @@ fn stereo_example_scenes_raster_like_the_ray_caster() {
 /// Runs `render scene.toml` with `text` as the scene and asserts the one-line refusal
 /// containing `expected`, exit status 1, and no output.
 fn refused(dir: &TempDir, text: &str, args: &[&str], expected: &str) {
-    fs::write(dir.path().join("scene.toml"), text).unwrap();
-    let mut all = vec!["render", "scene.toml", "-o", "out.png"];
-    all.extend(args);
-    let out = run(dir, &all);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    let stderr = common::refused_scene(dir, text, args);
     assert!(stderr.contains(expected), "{stderr}");
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(!dir.path().join("out.png").exists());
 }
 
 const FLOOR: &str = "\n[[object]]\nname = \"floor\"\nshape = \"plane\"\nsize = [4.0, 4.0]\n";

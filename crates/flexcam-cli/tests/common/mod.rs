@@ -38,6 +38,20 @@ pub fn run_json(dir: &TempDir, args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&run_ok(dir, args).stdout).expect("stdout is one JSON object")
 }
 
+/// Writes `text` as `scene.toml` in `dir` and renders it to `out.png` with `args` added;
+/// fails the test unless flexcam refused it with exit code 1, one line on stderr and no
+/// image written. Returns that line (with its newline).
+pub fn refused_scene(dir: &TempDir, text: &str, args: &[&str]) -> String {
+    std::fs::write(dir.path().join("scene.toml"), text).expect("scene written");
+    let all = [&["render", "scene.toml", "-o", "out.png"][..], args].concat();
+    let out = run(dir, &all);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(!dir.path().join("out.png").exists());
+    stderr
+}
+
 /// Deterministic uniform numbers in [0, 1) from `seed` (SplitMix64).
 pub fn uniform(seed: u64) -> impl FnMut() -> f64 {
     let mut state = seed;

@@ -77,9 +77,21 @@ static MEMO: Mutex<FitMemo> = Mutex::new(FitMemo {
 });
 
 /// This process's kept fit of `prior` to `correspondences` with `starts`, or `fit()`'s, kept
-/// when it succeeds. The lock is not held while fitting, so fits on several threads run
-/// together (two threads fitting the same inputs both fit, and keep one copy each).
+/// when it succeeds.
 pub(super) fn fitted(
+    prior: &ProjectorGrid,
+    correspondences: &[Correspondence],
+    starts: Starts,
+    fit: impl FnOnce() -> Result<(ProjectorGrid, FitReport)>,
+) -> Result<(ProjectorGrid, FitReport)> {
+    fitted_in(&MEMO, prior, correspondences, starts, fit)
+}
+
+/// `memo`'s kept fit of `prior` to `correspondences` with `starts`, or `fit()`'s, kept when
+/// it succeeds. The lock is not held while fitting, so fits on several threads run together
+/// (two threads fitting the same inputs both fit, and keep one copy each).
+fn fitted_in(
+    memo: &Mutex<FitMemo>,
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
     starts: Starts,
@@ -87,7 +99,7 @@ pub(super) fn fitted(
 ) -> Result<(ProjectorGrid, FitReport)> {
     // A poisoned lock only means another thread panicked while holding it; the entries are
     // whole (each is pushed complete).
-    let memo = || MEMO.lock().unwrap_or_else(PoisonError::into_inner);
+    let memo = || memo.lock().unwrap_or_else(PoisonError::into_inner);
     if let Some(result) = memo().get(prior, correspondences, starts) {
         return Ok(result);
     }
@@ -118,54 +130,38 @@ mod tests {
         }
     }
 
-    /// `memo`'s kept fit, or `fit()`'s, kept (as [`fitted`] does with the process's).
-    fn through(
-        memo: &mut FitMemo,
-        prior: &ProjectorGrid,
-        data: &[Correspondence],
-        starts: Starts,
-        fit: impl FnOnce() -> Result<(ProjectorGrid, FitReport)>,
-    ) -> Result<(ProjectorGrid, FitReport)> {
-        if let Some(result) = memo.get(prior, data, starts) {
-            return Ok(result);
-        }
-        let result = fit()?;
-        memo.insert(prior, data, starts, result.clone());
-        Ok(result)
-    }
-
     #[test]
     fn a_fit_is_kept_until_its_inputs_change() {
-        let mut memo = FitMemo::default();
+        let memo = Mutex::new(FitMemo::default());
         let calls = Cell::new(0);
         let fit = |x: f64| {
             calls.set(calls.get() + 1);
             Ok((grid(x), FitReport::default()))
         };
         let (prior, data) = (grid(0.0), [point(-2.0)]);
-        let first = through(&mut memo, &prior, &data, Starts::Auto, || fit(1.0)).unwrap();
-        let again = through(&mut memo, &prior, &data, Starts::Auto, || fit(2.0)).unwrap();
+        let first = fitted_in(&memo, &prior, &data, Starts::Auto, || fit(1.0)).unwrap();
+        let again = fitted_in(&memo, &prior, &data, Starts::Auto, || fit(2.0)).unwrap();
         assert_eq!(
             (calls.get(), &first.0, &again.0),
             (1, &grid(1.0), &grid(1.0))
         );
         // Another starts model, another point, another prior: each fitted anew.
-        through(&mut memo, &prior, &data, Starts::Eye, || fit(3.0)).unwrap();
-        through(&mut memo, &prior, &[point(-3.0)], Starts::Auto, || fit(4.0)).unwrap();
-        through(&mut memo, &grid(0.5), &data, Starts::Auto, || fit(5.0)).unwrap();
+        fitted_in(&memo, &prior, &data, Starts::Eye, || fit(3.0)).unwrap();
+        fitted_in(&memo, &prior, &[point(-3.0)], Starts::Auto, || fit(4.0)).unwrap();
+        fitted_in(&memo, &grid(0.5), &data, Starts::Auto, || fit(5.0)).unwrap();
         assert_eq!(calls.get(), 4);
         // A NaN input never matches itself.
         let nan = [point(f64::NAN)];
-        through(&mut memo, &prior, &nan, Starts::Auto, || fit(6.0)).unwrap();
-        through(&mut memo, &prior, &nan, Starts::Auto, || fit(6.0)).unwrap();
+        fitted_in(&memo, &prior, &nan, Starts::Auto, || fit(6.0)).unwrap();
+        fitted_in(&memo, &prior, &nan, Starts::Auto, || fit(6.0)).unwrap();
         assert_eq!(calls.get(), 6);
     }
 
     #[test]
     fn failures_are_not_kept_and_the_least_recently_used_fit_goes_first() {
-        let mut memo = FitMemo::default();
+        let memo = Mutex::new(FitMemo::default());
         let prior = grid(0.0);
-        let failed = through(&mut memo, &prior, &[point(-2.0)], Starts::Auto, || {
+        let failed = fitted_in(&memo, &prior, &[point(-2.0)], Starts::Auto, || {
             Err(crate::error::Error::new("no"))
         });
         assert!(failed.is_err());
@@ -174,19 +170,19 @@ mod tests {
             calls.set(calls.get() + 1);
             Ok((grid(1.0), FitReport::default()))
         };
-        through(&mut memo, &prior, &[point(-2.0)], Starts::Auto, fit).unwrap();
-        through(&mut memo, &prior, &[point(-3.0)], Starts::Auto, fit).unwrap();
+        fitted_in(&memo, &prior, &[point(-2.0)], Starts::Auto, fit).unwrap();
+        fitted_in(&memo, &prior, &[point(-3.0)], Starts::Auto, fit).unwrap();
         assert_eq!(calls.get(), 2);
         // Using the first again makes the second the least recently used.
-        through(&mut memo, &prior, &[point(-2.0)], Starts::Auto, fit).unwrap();
+        fitted_in(&memo, &prior, &[point(-2.0)], Starts::Auto, fit).unwrap();
         for k in 0..CAPACITY - 1 {
             let data = [point(-4.0 - k as f64)];
-            through(&mut memo, &prior, &data, Starts::Auto, fit).unwrap();
+            fitted_in(&memo, &prior, &data, Starts::Auto, fit).unwrap();
         }
         assert_eq!(calls.get(), 1 + CAPACITY);
-        through(&mut memo, &prior, &[point(-2.0)], Starts::Auto, fit).unwrap();
+        fitted_in(&memo, &prior, &[point(-2.0)], Starts::Auto, fit).unwrap();
         assert_eq!(calls.get(), 1 + CAPACITY);
-        through(&mut memo, &prior, &[point(-3.0)], Starts::Auto, fit).unwrap();
+        fitted_in(&memo, &prior, &[point(-3.0)], Starts::Auto, fit).unwrap();
         assert_eq!(calls.get(), 2 + CAPACITY);
     }
 }

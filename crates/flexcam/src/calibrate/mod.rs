@@ -95,6 +95,9 @@ fn build_report(fit: &FitReport) -> BuildReport {
     if let Some(smoothness) = fit.smoothness {
         counters.push(("fit_smoothness", smoothness));
     }
+    if let Some(iterations) = fit.curved_iterations {
+        counters.push(("fit_curved_iterations", iterations as f64));
+    }
     if let Some(eye) = eye {
         counters.extend([
             ("fit_eye_x", eye.x),

@@ -48,8 +48,9 @@
 //! depth strictly inside (0, 1); a depth at 0 or 1 is held). The iteration starts from the
 //! straight fit (tangents along its directions), folded nodes are then repaired (below), and
 //! each run stops when no step lowers the cost (the
-//! damping exceeds [`MAX_DAMPING`]: converged to rounding), at a cost of 0, or after
-//! [`MAX_ITERATIONS`] steps. The Gauss-Newton matrix is formed from a dense Jacobian (three
+//! damping exceeds [`MAX_DAMPING`]: converged to rounding), at a cost of 0, when it stalls
+//! (the cost fell by under [`STALL`] of itself over the last [`STALL_WINDOW`] steps), or
+//! after [`MAX_ITERATIONS`] steps. The Gauss-Newton matrix is formed from a dense Jacobian (three
 //! rows per correspondence, four columns per node) by one matrix product, so that Bezier
 //! grids, where every correspondence weights every node, take about a second, not minutes.
 //!
@@ -66,7 +67,7 @@
 //! folded node, or one whose mirror does not lower the cost, is left to [`Problem::reseat`]
 //! (where the residual is above rounding: restarts with every length scaled by 1.25 and 0.8,
 //! and with the three nodes carrying most of the residual put back on the straight fit,
-//! kept if the cost drops), which repaired Bezier seed 14 (two nodes turned 0.8 and 1.0
+//! kept if the cost drops by over [`RESTART_GAIN`] of itself), which repaired Bezier seed 14 (two nodes turned 0.8 and 1.0
 //! rad, not folded); bilinear and Bezier seed 12 (lengths short together, a shallow valley)
 //! are not repaired and are left to the report's residual (0.62 and 0.0028 degrees).
 //! Tried and not kept: a continuation in the data (from the straight start's own projectors
@@ -90,6 +91,8 @@
 //! matched at t = 1 with the miss in the residual; too few or uninformative correspondences
 //! (above); a fitted projector of zero length (the errors of
 //! [`ProjectorGrid::set_projector`]).
+
+use std::cell::Cell;
 
 use glam::DVec3;
 use nalgebra::{DMatrix, DVector};
@@ -122,6 +125,20 @@ const ROUNDING: f64 = 1e-16;
 
 /// The most Levenberg-Marquardt steps.
 const MAX_ITERATIONS: usize = 2000;
+
+/// Iterations over which a run's progress is measured for [`STALL`].
+const STALL_WINDOW: usize = 100;
+
+/// A run stops when its cost fell by less than this fraction of itself over the last
+/// [`STALL_WINDOW`] iterations: at that rate the rest of [`MAX_ITERATIONS`] would lower it by
+/// at most 2e-5 of itself (measured: on data that leave a node nearly open, the iteration
+/// creeps along the flat valley, each run taking all its steps).
+const STALL: f64 = 1e-6;
+
+/// The fraction of the cost by which a restart of [`Problem::unfold`] or [`Problem::reseat`]
+/// must lower it to be kept: runs ended by [`STALL`] in one flat valley differ by less, and
+/// keeping such a restart would only start another round.
+const RESTART_GAIN: f64 = 1e-3;
 
 /// The damping (relative to the curvature) beyond which no step lowers the cost: converged,
 /// to rounding.
@@ -168,6 +185,8 @@ struct Problem<'a> {
     held: Vec<bool>,
     /// The prior term's centre and the iteration's start (the straight fit).
     anchor: Vec<Node>,
+    /// Levenberg-Marquardt iterations so far, over every run (for the report).
+    iterations: Cell<usize>,
 }
 
 /// Fits the end directions, tangents and lengths (those the data determine; the others keep
@@ -256,6 +275,7 @@ impl<'a> Problem<'a> {
             held: vec![false; free.len()],
             free,
             anchor,
+            iterations: Cell::new(0),
         }
     }
 
@@ -387,7 +407,8 @@ impl<'a> Problem<'a> {
             let better = [true, false].into_iter().find_map(|tangent| {
                 let candidate = mirrored(tangent);
                 let candidate_cost = self.cost(&candidate, 0.0);
-                (candidate_cost < cost).then_some((candidate, candidate_cost))
+                (candidate_cost < (1.0 - RESTART_GAIN) * cost)
+                    .then_some((candidate, candidate_cost))
             });
             let Some(better) = better else {
                 break;
@@ -443,7 +464,9 @@ impl<'a> Problem<'a> {
                 })
                 .min_by(|a, b| a.1.total_cmp(&b.1));
             match best {
-                Some((candidate, c)) if c < cost => (state, cost) = (candidate, c),
+                Some((candidate, c)) if c < (1.0 - RESTART_GAIN) * cost => {
+                    (state, cost) = (candidate, c)
+                }
                 _ => break,
             }
         }
@@ -479,7 +502,14 @@ impl<'a> Problem<'a> {
         let mut lambda = None;
         let mut damping = 0.1;
         let mut cost = f64::INFINITY;
-        for _ in 0..MAX_ITERATIONS {
+        let mut costs = Vec::with_capacity(MAX_ITERATIONS);
+        'run: for iteration in 0..MAX_ITERATIONS {
+            if iteration > STALL_WINDOW
+                && costs[iteration - 1 - STALL_WINDOW] - cost <= STALL * cost
+            {
+                break;
+            }
+            self.iterations.set(self.iterations.get() + 1);
             let (jacobian, residuals) = self.linearise(&state);
             let mut normal = gram(&jacobian);
             let mut gradient = jacobian.tr_mul(&residuals);
@@ -504,12 +534,13 @@ impl<'a> Problem<'a> {
                 }
                 damping *= 10.0;
                 if damping > MAX_DAMPING {
-                    return state;
+                    break 'run;
                 }
             }
             if cost == 0.0 {
                 break;
             }
+            costs.push(cost);
         }
         state
     }
@@ -722,7 +753,10 @@ impl<'a> Problem<'a> {
                 off.atan2((on - p[0]).length()).to_degrees()
             })
             .collect();
-        FitReport::from_angles(&angles, grid.starts().len() - self.free.len())
+        FitReport {
+            curved_iterations: Some(self.iterations.get()),
+            ..FitReport::from_angles(&angles, grid.starts().len() - self.free.len())
+        }
     }
 }
 

@@ -166,6 +166,9 @@ pub struct FitReport {
     /// The free fit's smoothness weight, relative to its data term's mean diagonal, as the
     /// data chose it (module `free::weight`); `None` for the other models.
     pub smoothness: Option<f64>,
+    /// The curved fit's Levenberg-Marquardt iterations, over every run of its restarts
+    /// (module `curved`); `None` for the straight fits.
+    pub curved_iterations: Option<usize>,
 }
 
 impl FitReport {
