@@ -98,11 +98,13 @@ fn drag(
     (dragging, result)
 }
 
-/// The volume view filling the rest of `ui`.
+/// The volume view filling the rest of `ui`; adds its rectangle and where it draws each
+/// handle to `layout`.
 pub fn volume_view(
     ui: &mut egui::Ui,
     viewer: &mut Viewer,
     active: &mut Option<String>,
+    layout: &mut Layout,
 ) -> Result<()> {
     let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
     let painter = ui.painter_at(rect);
@@ -127,6 +129,8 @@ pub fn volume_view(
         .clone()
         .or_else(|| nearest(&points, response.hover_pos()));
     draw_handles(&painter, &points, hot.as_deref());
+    layout.volume = Some(rect);
+    layout.handles.extend(points);
     let delta = response.drag_delta();
     if !dragging && response.dragged_by(egui::PointerButton::Primary) {
         viewer.volume_camera().orbit(
@@ -146,15 +150,15 @@ pub fn volume_view(
 }
 
 /// The image handles over the image drawn at `rect` (`scale` screen pixels per image pixel),
-/// and their drag. Returns whether a handle is being dragged (then the image's own drag,
-/// the orbit, does not apply) and the drag's result.
+/// and their drag; adds where it draws them to `layout`. Returns whether a handle is being
+/// dragged (then the image's own drag, the orbit, does not apply) and the drag's result.
 pub fn image_handles(
     ui: &egui::Ui,
     response: &egui::Response,
-    rect: Rect,
-    scale: f32,
+    (rect, scale): (Rect, f32),
     viewer: &mut Viewer,
     active: &mut Option<String>,
+    layout: &mut Layout,
 ) -> (bool, Result<()>) {
     let (handles, _) = viewer.volume();
     let points: Vec<(String, Pos2)> = handles
@@ -190,5 +194,39 @@ pub fn image_handles(
         .clone()
         .or_else(|| nearest(&points, response.hover_pos()));
     draw_handles(&painter, &points, hot.as_deref());
+    layout.handles.extend(points);
     result
+}
+
+/// Where a frame drew the image, the volume view and the handles (window points): what a
+/// script's `layout` line writes, so that its `pointer` lines can aim at them.
+#[derive(Debug, Default)]
+pub struct Layout {
+    pub image: Option<Rect>,
+    pub volume: Option<Rect>,
+    pub handles: Vec<(String, Pos2)>,
+}
+
+impl Layout {
+    /// The text of a `layout` file at `pixels_per_point`: `image X0 Y0 X1 Y1`, `volume X0
+    /// Y0 X1 Y1` (the rectangles' corners) and `handle NAME X Y`, in window pixels.
+    pub fn text(&self, pixels_per_point: f32) -> String {
+        let px = |v: f32| v * pixels_per_point;
+        let mut text = String::new();
+        for (name, rect) in [("image", self.image), ("volume", self.volume)] {
+            if let Some(r) = rect {
+                text += &format!(
+                    "{name} {} {} {} {}\n",
+                    px(r.min.x),
+                    px(r.min.y),
+                    px(r.max.x),
+                    px(r.max.y)
+                );
+            }
+        }
+        for (name, p) in &self.handles {
+            text += &format!("handle {name} {} {}\n", px(p.x), px(p.y));
+        }
+        text
+    }
 }
