@@ -4,10 +4,7 @@
 
 mod common;
 
-use std::path::Path;
-use std::process::Command as Process;
-
-use common::{run, run_ok};
+use common::{numbers_in, run, run_ok, run_with_display, setup_scene};
 use tempfile::TempDir;
 
 const CUBE_FLOOR: &str = include_str!("../../../scenes/cube-floor.toml");
@@ -119,30 +116,11 @@ fn invalid_edit_keeps_the_last_valid_projection_message() {
 fn window_screenshot_under_a_display() {
     // The drag runs through the window's script path too (the volume view drawn).
     let dir = setup("set fov 60\ndrag position 3 2\nidle\nwindow w.png\nframe f.png\n");
-    let flexcam = assert_cmd::cargo::cargo_bin("flexcam");
     let args = [&VIEW[..], &["--shading", "flat", "--refine-spp", "1"]].concat();
-    let has_display = std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty());
-    let mut command = if has_display {
-        Process::new(&flexcam)
-    } else if which("xvfb-run") {
-        let mut c = Process::new("xvfb-run");
-        c.args(["-a", "-s", "-screen 0 1280x1024x24"]).arg(&flexcam);
-        c
-    } else {
-        println!("skipped: no DISPLAY and no xvfb-run to open a virtual display");
+    let Some(out) = run_with_display(&dir, &args) else {
         return;
     };
-    let out = command
-        .current_dir(dir.path())
-        .args(args)
-        .env("LIBGL_ALWAYS_SOFTWARE", "1")
-        .output()
-        .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
-    if !out.status.success() && stderr.contains("cannot open the viewer's window") {
-        println!("skipped: the display cannot be opened: {stderr}");
-        return;
-    }
     assert!(out.status.success(), "{stderr}");
     let shot = image::open(dir.path().join("w.png")).unwrap().to_rgb8();
     let frame = image::open(dir.path().join("f.png")).unwrap().to_rgb8();
@@ -152,23 +130,6 @@ fn window_screenshot_under_a_display() {
     let centre = frame.get_pixel(frame.width() / 2, frame.height() / 2);
     let near = |p: &image::Rgb<u8>| p.0.iter().zip(centre.0).all(|(&a, b)| a.abs_diff(b) <= 2);
     assert!(shot.pixels().any(near), "{centre:?}");
-}
-
-fn which(program: &str) -> bool {
-    std::env::var_os("PATH").is_some_and(|paths| {
-        std::env::split_paths(&paths).any(|dir| Path::new(&dir).join(program).is_file())
-    })
-}
-
-/// A folder holding `scene.toml` (scene file `text` with its image size `from` replaced by
-/// `to`) and `view.txt` (`script`).
-fn setup_scene(text: &str, from: &str, to: &str, script: &str) -> TempDir {
-    let dir = TempDir::new().unwrap();
-    let scene = text.replace(from, to);
-    assert_ne!(scene, text);
-    std::fs::write(dir.path().join("scene.toml"), scene).unwrap();
-    std::fs::write(dir.path().join("view.txt"), script).unwrap();
-    dir
 }
 
 /// The numbers after `NAME KIND` on handle `name`'s line of `--list-handles`.
@@ -199,13 +160,6 @@ fn run_and_changed_line(dir: &TempDir) -> String {
         .collect();
     assert_eq!(changed.len(), 1, "{changed:?}");
     changed[0].clone()
-}
-
-/// The numbers of `text` (a line of a scene file), in order.
-fn numbers_in(text: &str) -> Vec<f64> {
-    text.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == 'e'))
-        .filter_map(|w| w.parse().ok())
-        .collect()
 }
 
 #[test]

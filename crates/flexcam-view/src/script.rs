@@ -421,10 +421,17 @@ mod tests {
         assert!(matches!(commands[14], Command::Scroll(-120.0)));
         assert!(matches!(&commands[15], Command::Layout(p) if p == Path::new("l.txt")));
         // Each window line alone opens the window; the others do not.
-        for line in ["pointer release 1 2", "scroll 3", "layout l.txt", "window w.png"] {
+        for line in [
+            "pointer release 1 2",
+            "scroll 3",
+            "layout l.txt",
+            "window w.png",
+        ] {
             assert!(parse(line).unwrap().needs_window(), "{line}");
         }
-        assert!(!parse("idle\nframe f.png\nsave s.toml").unwrap().needs_window());
+        assert!(!parse("idle\nframe f.png\nsave s.toml")
+            .unwrap()
+            .needs_window());
     }
 
     #[test]
@@ -457,7 +464,10 @@ mod tests {
                 "pointer press 1\n",
                 "s.view:1:8: `pointer` takes 3 or 4 arguments",
             ),
-            ("scroll\n", "s.view:1:7: `scroll` takes 1 argument(s): scroll DY"),
+            (
+                "scroll\n",
+                "s.view:1:7: `scroll` takes 1 argument(s): scroll DY",
+            ),
         ];
         for (text, expected) in cases {
             let message = parse(text).unwrap_err().to_string();

@@ -58,6 +58,7 @@ pub fn run(viewer: Viewer, script: Option<Script>) -> Result<()> {
         save_as: String::new(),
         dragged: [None, None],
         layout: Layout::default(),
+        previous_layout: Layout::default(),
         last_poll: Instant::now(),
         script: script.map(|script| ScriptRun {
             script,
@@ -112,8 +113,10 @@ struct App {
     /// The handle being dragged, if any, in the volume view and over the image (each
     /// view's own, so that one view's idle pointer does not end the other's drag).
     dragged: [Option<String>; 2],
-    /// Where the frame being drawn put the image, the volume view and the handles.
+    /// Where the frame being drawn put the image, the volume view and the handles, and
+    /// where the frame before it did.
     layout: Layout,
+    previous_layout: Layout,
     last_poll: Instant,
     script: Option<ScriptRun>,
     outcome: Arc<Mutex<Option<Error>>>,
@@ -133,7 +136,7 @@ impl eframe::App for App {
         let ctx = ui.ctx().clone();
         self.poll_reload();
         self.upload_frame(&ctx);
-        self.layout = Layout::default();
+        self.previous_layout = std::mem::take(&mut self.layout);
         egui::Panel::bottom("status").show(ui, |ui| {
             ui.label(&self.status);
             if let Some(message) = &self.message {
@@ -460,6 +463,8 @@ impl App {
                 };
                 done
             }
+            // The panels settle over a frame or two (egui sizes them from the frame before).
+            Command::Layout(_) if self.layout != self.previous_layout => return,
             Command::Layout(out) => write_layout(&self.layout.text(ctx.pixels_per_point()), out),
             command => script::run_line(&mut self.viewer, command),
         };

@@ -200,7 +200,7 @@ pub fn image_handles(
 
 /// Where a frame drew the image, the volume view and the handles (window points): what a
 /// script's `layout` line writes, so that its `pointer` lines can aim at them.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, PartialEq)]
 pub struct Layout {
     pub image: Option<Rect>,
     pub volume: Option<Rect>,
