@@ -569,3 +569,172 @@ fn dragging_outline_and_profile_points_over_the_image() {
         "{line}: {toward:?}"
     );
 }
+
+/// `text` with each `(from, to)` replaced (each must be there).
+fn edited(text: &str, replacements: &[(&str, &str)]) -> String {
+    replacements
+        .iter()
+        .fold(text.to_string(), |text, (from, to)| {
+            assert!(text.contains(from), "{from}");
+            text.replace(from, to)
+        })
+}
+
+/// The numbers of a changed scene line before its comment.
+fn line_numbers(line: &str) -> Vec<f64> {
+    numbers_in(line.split('#').next().unwrap())
+}
+
+fn scale(a: V3, k: f64) -> V3 {
+    [a[0] * k, a[1] * k, a[2] * k]
+}
+
+fn add(a: V3, b: V3) -> V3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+#[test]
+fn dragging_the_shift_twist_and_slit_of_presets() {
+    let ortho_persp = include_str!("../../../scenes/flexible-ortho-near-persp-far.toml");
+    let off_axis = edited(
+        ortho_persp,
+        &[
+            ("preset = \"ortho_near_persp_far\"", "preset = \"off_axis\""),
+            ("transition = 8.0 ", "shift = [0.2, -0.1] "),
+            ("style = \"piecewise\"", ""),
+        ],
+    );
+    let twist = include_str!("../../../scenes/flexible-twist.toml");
+    let slits = include_str!("../../../scenes/flexible-crossed-slits.toml");
+    let (eye, forward, right) = preset_frame();
+    let up = cross(right, forward);
+    // off_axis: the window's centre seen from the eye, in half-widths (tan 25 degrees at
+    // unit distance) and half-heights (times 36 / 48).
+    let (listed, line) = drag_one(&off_axis, SMALL_PRESET, "shift", 6.0, 4.0);
+    assert!(line.starts_with("shift ="), "{line}");
+    let v = sub(dragged(&listed, 6.0, 4.0), eye);
+    let t = 25f64.to_radians().tan();
+    let expected = [
+        dot(v, right) / dot(v, forward) / t,
+        dot(v, up) / dot(v, forward) / (t * 0.75),
+    ];
+    let numbers = line_numbers(&line);
+    assert!(
+        close(numbers[0], expected[0]) && close(numbers[1], expected[1]),
+        "{line}: {expected:?}"
+    );
+    // The listed point is the old window's centre at the look-at distance.
+    let distance = dot(sub([0.0, 0.4, 0.0], eye), forward);
+    let centre = add(
+        add(eye, scale(forward, distance)),
+        add(
+            scale(right, distance * 0.2 * t),
+            scale(up, -distance * 0.1 * t * 0.75),
+        ),
+    );
+    assert!(
+        (0..3).all(|k| (listed[k] - centre[k]).abs() < 1e-12),
+        "{listed:?}"
+    );
+    // twist: the far rectangle's right edge turned about the axis (far clip 20 m); the
+    // dragged point's angle about it, counter-clockwise from the right seen from the eye.
+    let size = ("width = 320\nheight = 240", "width = 48\nheight = 36");
+    let (listed, line) = drag_one(twist, size, "twist", -5.0, -8.0);
+    assert!(line.starts_with("twist ="), "{line}");
+    let v = sub(dragged(&listed, -5.0, -8.0), add(eye, scale(forward, 20.0)));
+    let expected = dot(v, up).atan2(dot(v, right)).to_degrees();
+    assert!(expected > 60.0, "up and left turns it further: {expected}");
+    assert!(
+        close(line_numbers(&line)[0], expected),
+        "{line}: {expected}"
+    );
+    // crossed_slits: the horizontal slit's distance along the axis.
+    let size = ("width = 800\nheight = 600", "width = 48\nheight = 36");
+    let (listed, line) = drag_one(slits, size, "slit_distance", 0.0, 5.0);
+    assert!(line.starts_with("slit_distance ="), "{line}");
+    let expected = dot(sub(dragged(&listed, 0.0, 5.0), eye), forward);
+    assert!(
+        close(line_numbers(&line)[0], expected),
+        "{line}: {expected}"
+    );
+}
+
+#[test]
+fn dragging_view_angles_generators_and_directions_of_presets() {
+    let depth = include_str!("../../../scenes/flexible-depth-transition.toml");
+    let ortho_persp = include_str!("../../../scenes/flexible-ortho-near-persp-far.toml");
+    let mcop = include_str!("../../../scenes/flexible-mcop.toml");
+    let (eye, forward, right) = preset_frame();
+    let up = cross(right, forward);
+    // depth_transition: view 1 runs from the transition at 8 m (half-width 8 tan 30, where
+    // view 0 ends) to the far clip at 30 m; its edge passes the dragged point there.
+    let (listed, line) = drag_one(depth, SMALL_PRESET, "fovs.1", 9.0, 0.0);
+    assert!(line.starts_with("fovs ="), "{line}");
+    let p = dragged(&listed, 9.0, 0.0);
+    let start = 8.0 * 30f64.to_radians().tan();
+    let expected = 2.0
+        * ((dot(sub(p, eye), right) - start) / (30.0 - 8.0))
+            .atan()
+            .to_degrees();
+    let numbers = line_numbers(&line);
+    assert_eq!(numbers[0], 60.0, "{line}");
+    assert!(close(numbers[1], expected), "{line}: {expected}");
+    // glc: generator 1's end, at local depth 1, moved across the axis.
+    let glc = edited(
+        ortho_persp,
+        &[
+            ("preset = \"ortho_near_persp_far\"", "preset = \"glc\""),
+            ("fov = 50.0", "width = 2.0"),
+            (
+                "transition = 8.0 ",
+                "generators = [[-0.5, -0.5, -1.0, -1.0], [0.5, -0.5, 1.0, -1.0], [-0.5, 0.5, -1.0, 1.0]] ",
+            ),
+            ("style = \"piecewise\"", ""),
+        ],
+    );
+    let (listed, line) = drag_one(&glc, SMALL_PRESET, "generators.1.end", 5.0, -3.0);
+    assert!(line.starts_with("generators ="), "{line}");
+    let local = sub(dragged(&listed, 5.0, -3.0), add(eye, forward));
+    let numbers = line_numbers(&line);
+    assert_eq!(numbers.len(), 12, "{line}");
+    assert_eq!(&numbers[..6], &[-0.5, -0.5, -1.0, -1.0, 0.5, -0.5]);
+    assert_eq!(&numbers[8..], &[-0.5, 0.5, -1.0, 1.0]);
+    assert!(
+        close(numbers[6], dot(local, right)) && close(numbers[7], dot(local, up)),
+        "{line}: {local:?}"
+    );
+    // mcop: direction 1 is twice the dragged point less path point 1.
+    let (listed, line) = drag_one(mcop, SMALL_PRESET, "directions.1", 4.0, -3.0);
+    assert!(line.starts_with("directions ="), "{line}");
+    let direction = scale(sub(dragged(&listed, 4.0, -3.0), [-4.95, 3.0, 4.95]), 2.0);
+    let numbers = line_numbers(&line);
+    assert_eq!(numbers.len(), 9, "{line}");
+    assert_eq!(&numbers[..3], &[7.0, -2.0, 0.0]);
+    assert_eq!(&numbers[6..], &[0.0, -2.0, -7.0]);
+    assert!(
+        (0..3).all(|k| close(numbers[3 + k], direction[k])),
+        "{line}: {direction:?}"
+    );
+}
+
+#[test]
+fn dragging_the_strength_and_magnification_over_the_image() {
+    let occlusion = include_str!("../../../scenes/flexible-occlusion.toml");
+    let magnifier = include_str!("../../../scenes/flexible-magnifier.toml");
+    // 48 x 36: the strength's point sits strength image widths right of the pole.
+    let (listed, line) = drag_one(occlusion, SMALL_PRESET, "strength", 6.0, 2.0);
+    assert!(close(listed[0], 0.5 * 48.0 + 0.12 * 48.0), "{listed:?}");
+    assert!(line.starts_with("strength ="), "{line}");
+    assert!(close(line_numbers(&line)[0], 0.12 + 6.0 / 48.0), "{line}");
+    // The magnification's point: the radius (0.3 of 36 pixels) over the magnification (3)
+    // above the centre; 3 pixels further up, the radius over that height.
+    let (listed, line) = drag_one(magnifier, SMALL_PRESET, "magnification", 1.0, -3.0);
+    let centre_y = (1.0 - 0.55) * 36.0;
+    assert!(close(listed[1], centre_y - 10.8 / 3.0), "{listed:?}");
+    assert!(line.starts_with("magnification ="), "{line}");
+    let expected = 10.8 / (centre_y - (listed[1] - 3.0));
+    assert!(
+        close(line_numbers(&line)[0], expected),
+        "{line}: {expected}"
+    );
+}

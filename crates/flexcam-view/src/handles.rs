@@ -27,6 +27,8 @@
 //! Nodes of a grid with `fit` or `aim` are placed before the fit and the aims (the order the
 //! scene format runs them in), so a fit may move a dragged node again.
 
+mod preset_shape;
+
 use std::sync::Arc;
 
 use flexcam::calibrate::build_flexible;
@@ -176,6 +178,11 @@ enum Edit {
         axis: DVec3,
         forward: DVec3,
     },
+    /// A preset key that shapes the projectors otherwise (module `preset_shape`).
+    Shape {
+        path: ValuePath,
+        shape: preset_shape::Shape,
+    },
 }
 
 /// The numbers of a numeric array value.
@@ -220,6 +227,7 @@ pub fn handles(session: &Session) -> Vec<Handle> {
     }
     grid_nodes(session, &mut out);
     preset_keys(session, &mut out);
+    preset_shape::handles(session, &mut out);
     panorama_points(session, &mut out);
     rect(session, &mut out);
     out
@@ -724,6 +732,16 @@ impl Handle {
                 let v = at + d - *origin;
                 let angle = 2.0 * v.dot(*axis).atan2(v.dot(*forward)).to_degrees();
                 Ok(vec![path.set(session, Value::from(angle))?])
+            }
+            (Edit::Shape { path, shape }, at, d) => {
+                let to = match (at, d) {
+                    (Place::World(at), Place::World(d)) => Place::World(at + d),
+                    (Place::Image(at), Place::Image(d)) => Place::Image(at + d),
+                    _ => return Err(wrong()),
+                };
+                let old = path.get(session).ok_or_else(wrong)?;
+                let value = shape.value(&self.name, old, to).ok_or_else(wrong)??;
+                Ok(vec![path.set(session, value)?])
             }
             _ => Err(wrong()),
         }
