@@ -458,7 +458,7 @@ mod tests {
             ),
             (
                 "pointer press 1 2 side\n",
-                "s.view:1:21: unknown button `side` (left, right, middle)",
+                "s.view:1:19: unknown button `side` (left, right, middle)",
             ),
             (
                 "pointer press 1\n",

@@ -321,3 +321,152 @@ pub(super) fn handles(session: &Session, out: &mut Vec<Handle>) {
         _ => {}
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::handles;
+    use super::*;
+    use crate::session::scratch as session;
+
+    /// The handle `name` of the scratch session on `projection` dragged by `delta`: the
+    /// edited key's new value, or the error.
+    fn drag(projection: &str, name: &str, delta: Place) -> Result<Value> {
+        let (_dir, session) = session(projection);
+        let list = handles(&session);
+        let handle = list.iter().find(|h| h.name == name).unwrap();
+        let mut edits = handle.edits(&session, delta)?;
+        assert_eq!(edits.len(), 1);
+        Ok(edits.remove(0).1)
+    }
+
+    /// Whether world handle place `at` is within 1e-12 of `p` (tan 45 degrees is 1 to
+    /// rounding).
+    fn near(at: Place, p: DVec3) -> bool {
+        matches!(at, Place::World(at) if (at - p).length() < 1e-12)
+    }
+
+    const FRAME: &str = "type = \"flexible\"\nposition = [0.0, 0.0, 3.0]\n\
+        look_at = [0.0, 0.0, 0.0]\nclip = [0.5, 10.0]\n";
+
+    #[test]
+    fn the_shift_point_is_the_window_centre_and_refuses_the_eye_plane() {
+        let projection = format!("{FRAME}preset = \"off_axis\"\nfov = 90.0\nshift = [0.5, 0.0]");
+        let (_dir, s) = session(&projection);
+        let list = handles(&s);
+        let shift = list.iter().find(|h| h.name == "shift").unwrap();
+        // tan 45 = 1: half a half-width right of the axis at the look-at distance 3.
+        assert!(
+            near(shift.place, DVec3::new(1.5, 0.0, 0.0)),
+            "{:?}",
+            shift.place
+        );
+        // Moved up by 0.75 at that depth: 0.75 / 3 over the half-height tan 45 * 30 / 40.
+        let value = drag(
+            &projection,
+            "shift",
+            Place::World(DVec3::new(0.0, 0.75, 0.0)),
+        );
+        let shift = numbers(&value.unwrap()).unwrap();
+        assert!(
+            (shift[0] - 0.5).abs() < 1e-12 && (shift[1] - 0.25 / 0.75).abs() < 1e-12,
+            "{shift:?}"
+        );
+        // Degenerate: dragged onto the eye's plane (depth 0), then behind it.
+        for z in [3.0, 4.0] {
+            let delta = Place::World(DVec3::new(-1.5, 0.0, z));
+            let error = drag(&projection, "shift", delta).unwrap_err();
+            assert!(error.to_string().contains("in front of the eye"), "{error}");
+        }
+    }
+
+    #[test]
+    fn the_twist_turns_to_the_nearest_angle_and_refuses_the_axis() {
+        let projection = format!("{FRAME}preset = \"twist\"\nfov = 90.0\ntwist = 170.0");
+        // The far edge's middle: far clip 10 along -z from the eye, at 10 tan 45 from the
+        // axis, turned by 170 degrees.
+        let (_dir, s) = session(&projection);
+        let list = handles(&s);
+        let Place::World(at) = list.iter().find(|h| h.name == "twist").unwrap().place else {
+            panic!("a world handle")
+        };
+        let (sin, cos) = 170f64.to_radians().sin_cos();
+        let expected = DVec3::new(10.0 * cos, 10.0 * sin, -7.0);
+        assert!((at - expected).length() < 1e-12, "{at}");
+        // Dragged past 180 to -170 degrees of atan2: written as 190, the turn nearest 170.
+        let (sin, cos) = (-170f64).to_radians().sin_cos();
+        let to = DVec3::new(10.0 * cos, 10.0 * sin, -7.0);
+        let value = drag(&projection, "twist", Place::World(to - at)).unwrap();
+        assert!((value.as_float().unwrap() - 190.0).abs() < 1e-9, "{value}");
+        // Degenerate: onto the view axis.
+        let to = DVec3::new(0.0, 0.0, -7.0);
+        let error = drag(&projection, "twist", Place::World(to - at)).unwrap_err();
+        assert!(error.to_string().contains("onto the view axis"), "{error}");
+    }
+
+    #[test]
+    fn the_magnification_is_the_radius_over_the_height_and_refuses_the_centre() {
+        let projection = format!(
+            "{FRAME}preset = \"magnifier\"\nfov = 60.0\ncenter = [0.5, 0.5]\nradius = 0.4\n\
+             magnification = 2.0"
+        );
+        // 40 x 30: the radius 12 pixels, the point 6 above the centre (20, 15).
+        let (_dir, s) = session(&projection);
+        let list = handles(&s);
+        let at = list.iter().find(|h| h.name == "magnification").unwrap();
+        assert_eq!(at.place, Place::Image(DVec2::new(20.0, 9.0)));
+        let value = drag(
+            &projection,
+            "magnification",
+            Place::Image(DVec2::new(3.0, -2.0)),
+        );
+        assert_eq!(value.unwrap().as_float(), Some(12.0 / 8.0));
+        // Degenerate: onto the centre's row, and below it.
+        for dy in [6.0, 10.0] {
+            let delta = Place::Image(DVec2::new(0.0, dy));
+            let error = drag(&projection, "magnification", delta).unwrap_err();
+            assert!(
+                error.to_string().contains("above the lens centre"),
+                "{error}"
+            );
+        }
+        // A world move of an image handle is refused.
+        let world = Place::World(DVec3::X);
+        assert!(drag(&projection, "magnification", world).is_err());
+    }
+
+    #[test]
+    fn each_view_of_a_depth_transition_has_its_angle_at_its_end() {
+        let projection = format!(
+            "{FRAME}preset = \"depth_transition\"\nfovs = [90.0, 0.0001, 90.0]\n\
+             transitions = [2.0, 4.0]"
+        );
+        let (_dir, s) = session(&projection);
+        let list = handles(&s);
+        let at = |name: &str| list.iter().find(|h| h.name == name).unwrap().place;
+        // View 0 from (0.5, 0.5) to depth 2 (half-width 2), view 1 nearly parallel to
+        // depth 4, view 2 widening at 45 degrees to the far clip 10: 2 + 6.
+        assert!(
+            near(at("fovs.0"), DVec3::new(2.0, 0.0, 1.0)),
+            "{:?}",
+            at("fovs.0")
+        );
+        let Place::World(p) = at("fovs.1") else {
+            panic!()
+        };
+        assert!((p - DVec3::new(2.0, 0.0, -1.0)).length() < 1e-5, "{p}");
+        let Place::World(p) = at("fovs.2") else {
+            panic!()
+        };
+        assert!((p - DVec3::new(8.0, 0.0, -7.0)).length() < 1e-5, "{p}");
+        // View 1's end dragged 2 right: its edge rises 2 over its 2 of depth, 90 degrees.
+        let value = drag(
+            &projection,
+            "fovs.1",
+            Place::World(DVec3::new(2.0, 0.0, 0.5)),
+        );
+        // (The edit is of the whole `fovs` array, this view's angle changed.)
+        let fovs = numbers(&value.unwrap()).unwrap();
+        assert_eq!((fovs[0], fovs[2]), (90.0, 90.0));
+        assert!((fovs[1] - 90.0).abs() < 1e-3, "{fovs:?}");
+    }
+}
