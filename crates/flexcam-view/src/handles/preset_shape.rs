@@ -78,7 +78,7 @@ impl Shape {
                 let depth = v.dot(forward);
                 // Degenerate: at or behind the eye's plane, the point has no direction
                 // through the window.
-                if !(depth > 0.0) {
+                if depth.is_nan() || depth <= 0.0 {
                     return Some(Err(Error::new(format!(
                         "handle `{name}`: drag it in front of the eye (it is the window's centre seen from the eye)"
                     ))));
@@ -144,7 +144,7 @@ impl Shape {
             (&Shape::Ratio { centre, length }, Place::Image(p)) => {
                 let height = centre.y - p.y;
                 // Degenerate: at or below the centre the ratio is infinite or negative.
-                if !(height > 0.0) {
+                if height.is_nan() || height <= 0.0 {
                     return Some(Err(Error::new(format!(
                         "handle `{name}`: drag it above the lens centre"
                     ))));
