@@ -594,7 +594,7 @@ fn add(a: V3, b: V3) -> V3 {
 }
 
 #[test]
-fn dragging_the_shift_twist_and_slit_of_presets() {
+fn dragging_the_shift_twist_convergence_and_slit_of_presets() {
     let ortho_persp = include_str!("../../../scenes/flexible-ortho-near-persp-far.toml");
     let off_axis = edited(
         ortho_persp,
@@ -648,6 +648,26 @@ fn dragging_the_shift_twist_and_slit_of_presets() {
         close(line_numbers(&line)[0], expected),
         "{line}: {expected}"
     );
+    // inverse_perspective: the point the projectors meet at (the far clip defaults to
+    // its depth).
+    let inverse = edited(
+        ortho_persp,
+        &[
+            (
+                "preset = \"ortho_near_persp_far\"",
+                "preset = \"inverse_perspective\"",
+            ),
+            ("transition = 8.0 ", "converge = [0.0, -1.5, -3.0] "),
+            ("clip = [0.0, 30.0]", ""),
+            ("style = \"piecewise\"", ""),
+        ],
+    );
+    let (listed, line) = drag_one(&inverse, SMALL_PRESET, "converge", 7.0, -4.0);
+    assert!(line.starts_with("converge ="), "{line}");
+    assert_eq!(&listed[..3], &[0.0, -1.5, -3.0]);
+    let p = dragged(&listed, 7.0, -4.0);
+    let numbers = line_numbers(&line);
+    assert!((0..3).all(|k| close(numbers[k], p[k])), "{line}: {p:?}");
     // crossed_slits: the horizontal slit's distance along the axis.
     let size = ("width = 800\nheight = 600", "width = 48\nheight = 36");
     let (listed, line) = drag_one(slits, size, "slit_distance", 0.0, 5.0);

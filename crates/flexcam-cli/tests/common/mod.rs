@@ -236,8 +236,11 @@ intensity = 1.0
 /// Runs `flexcam ARGS` in `dir` where the viewer's window can open: under the display of
 /// `DISPLAY`, or a virtual one from `xvfb-run` when there is none (Mesa's software OpenGL
 /// either way). `None`, having printed a line starting `skipped:` (which .ci/run refuses),
-/// only when no display can be opened.
+/// only when no display can be opened. One at a time in a test binary: `xvfb-run -a`
+/// started in parallel can pick the same display number and fail.
 pub fn run_with_display(dir: &TempDir, args: &[&str]) -> Option<Output> {
+    static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let flexcam = assert_cmd::cargo::cargo_bin("flexcam");
     let has_display = std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty());
     let mut command = if has_display {

@@ -5,6 +5,7 @@
 //! | --- | --- | --- |
 //! | `shift` | off_axis: the shifted window's centre at the look-at distance | both numbers: the direction from the eye to the dragged point, in half-widths and half-heights of the window |
 //! | `twist` | twist: the middle of the far rectangle's right edge, turned | the angle of the dragged point about the view axis, counter-clockwise from the right as seen from the eye, the turn nearest the old one |
+//! | `converge` | inverse_perspective: the world point the projectors meet at | that point |
 //! | `slit_distance` | crossed_slits: the horizontal slit's point on the view axis | the dragged point's distance along the axis |
 //! | `fovs.K` | depth_transition: where view K ends (the next transition or the far clip), its right edge | the angle of view K: its edge through the dragged point's distance right of the axis at that depth, from where view K starts |
 //! | `generators.K.start`, `generators.K.end` | glc: generator ray K's points at local depth 0 and 1 | that point's two numbers: the dragged point across the view axis at that depth |
@@ -219,6 +220,12 @@ pub(super) fn handles(session: &Session, out: &mut Vec<Handle>) {
                 shape,
             ));
         }
+        &Preset::InversePerspective { converge, .. } => out.push(Handle {
+            name: "converge".into(),
+            place: Place::World(converge),
+            net: None,
+            edit: Edit::Point(key("converge")),
+        }),
         &Preset::CrossedSlits { slit_distance, .. } => out.push(Handle {
             name: "slit_distance".into(),
             place: Place::World(o + slit_distance * forward),
