@@ -106,6 +106,26 @@ fn same_scene(dir: &TempDir, a: &str, b: &str, tolerance: f64) -> Vec<String> {
         .collect()
 }
 
+/// Checks that the script's `f.png` is what `flexcam render p.toml ARGS` writes.
+fn frame_renders_p(dir: &TempDir, args: &[&str]) {
+    run_ok(
+        dir,
+        &[&["render", "p.toml"][..], args, &["-o", "r.png"]].concat(),
+    );
+    assert_eq!(
+        std::fs::read(dir.path().join("f.png")).unwrap(),
+        std::fs::read(dir.path().join("r.png")).unwrap()
+    );
+}
+
+/// A folder holding scene file `text` with its image size `from` made `to`, and the
+/// window's layout on it; `None` when no display can be opened (skipped).
+fn open((text, from, to): (&str, &str, &str)) -> Option<(TempDir, Layout)> {
+    let dir = setup_scene(text, from, to, "");
+    let layout = layout_of(&dir)?;
+    Some((dir, layout))
+}
+
 /// The position nearest `at` in whole pixels.
 fn whole(at: [f64; 2]) -> [f64; 2] {
     [at[0].round(), at[1].round()]
@@ -114,9 +134,8 @@ fn whole(at: [f64; 2]) -> [f64; 2] {
 #[test]
 fn a_pointer_drag_of_a_volume_handle_is_the_drag_line() {
     let text = include_str!("../../../scenes/flexible-patches.toml");
-    let size = ("width = 320\nheight = 240", "width = 64\nheight = 48");
-    let dir = setup_scene(text, size.0, size.1, "");
-    let Some(layout) = layout_of(&dir) else {
+    let (from, to) = ("width = 320\nheight = 240", "width = 64\nheight = 48");
+    let Some((dir, layout)) = open((text, from, to)) else {
         return;
     };
     // The handle farthest from every other, with room about it for the move (so that the
@@ -159,19 +178,14 @@ fn a_pointer_drag_of_a_volume_handle_is_the_drag_line() {
     // another order, equal to rounding.
     let changed = same_scene(&dir, "p.toml", "d.toml", 1e-9);
     assert_eq!(changed.len(), 1, "{name}: {changed:?}");
-    run_ok(&dir, &["render", "p.toml", "-o", "r.png"]);
-    assert_eq!(
-        std::fs::read(dir.path().join("f.png")).unwrap(),
-        std::fs::read(dir.path().join("r.png")).unwrap()
-    );
+    frame_renders_p(&dir, &[]);
 }
 
 #[test]
 fn a_pointer_drag_of_an_image_handle_is_the_drag_line() {
     let text = include_str!("../../../scenes/flexible-panorama-edit.toml");
-    let size = ("width = 320\nheight = 160", "width = 192\nheight = 96");
-    let dir = setup_scene(text, size.0, size.1, "");
-    let Some(layout) = layout_of(&dir) else {
+    let (from, to) = ("width = 320\nheight = 160", "width = 192\nheight = 96");
+    let Some((dir, layout)) = open((text, from, to)) else {
         return;
     };
     let (_, at) = layout
@@ -205,22 +219,14 @@ fn a_pointer_drag_of_an_image_handle_is_the_drag_line() {
     let changed = same_scene(&dir, "p.toml", "d.toml", 1e-6);
     assert_eq!(changed.len(), 1, "{changed:?}");
     assert!(changed[0].starts_with("perspective_rect ="), "{changed:?}");
-    run_ok(
-        &dir,
-        &["render", "p.toml", "--method", "raster", "-o", "r.png"],
-    );
-    assert_eq!(
-        std::fs::read(dir.path().join("f.png")).unwrap(),
-        std::fs::read(dir.path().join("r.png")).unwrap()
-    );
+    frame_renders_p(&dir, &["--method", "raster"]);
 }
 
 #[test]
 fn a_click_picks_and_pointer_orbit_pan_and_wheel_are_the_script_moves() {
     let text = include_str!("../../../scenes/cube-floor.toml");
-    let size = ("width = 800\nheight = 800", "width = 96\nheight = 64");
-    let dir = setup_scene(text, size.0, size.1, "");
-    let Some(layout) = layout_of(&dir) else {
+    let (from, to) = ("width = 800\nheight = 800", "width = 96\nheight = 64");
+    let Some((dir, layout)) = open((text, from, to)) else {
         return;
     };
     let [x0, y0, x1, y1] = layout.image;
@@ -279,9 +285,5 @@ fn a_click_picks_and_pointer_orbit_pan_and_wheel_are_the_script_moves() {
     let changed = same_scene(&dir, "p.toml", "d.toml", 1e-5);
     assert_eq!(changed.len(), 2, "{changed:?}");
     assert!(changed[0].starts_with("position =") && changed[1].starts_with("look_at ="));
-    run_ok(&dir, &["render", "p.toml", "-o", "r.png"]);
-    assert_eq!(
-        std::fs::read(dir.path().join("f.png")).unwrap(),
-        std::fs::read(dir.path().join("r.png")).unwrap()
-    );
+    frame_renders_p(&dir, &[]);
 }
