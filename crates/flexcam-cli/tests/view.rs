@@ -594,7 +594,7 @@ fn add(a: V3, b: V3) -> V3 {
 }
 
 #[test]
-fn dragging_the_shift_twist_convergence_and_slit_of_presets() {
+fn dragging_the_shift_shear_twist_convergence_and_slit_of_presets() {
     let ortho_persp = include_str!("../../../scenes/flexible-ortho-near-persp-far.toml");
     let off_axis = edited(
         ortho_persp,
@@ -635,6 +635,28 @@ fn dragging_the_shift_twist_convergence_and_slit_of_presets() {
     assert!(
         (0..3).all(|k| (listed[k] - centre[k]).abs() < 1e-12),
         "{listed:?}"
+    );
+    // oblique: the image centre's projector, minus the direction from the eye (right, up
+    // over forward).
+    let oblique = edited(
+        &off_axis,
+        &[
+            ("preset = \"off_axis\"", "preset = \"oblique\""),
+            ("fov = 50.0", "width = 8.0"),
+            ("shift = [0.2, -0.1]", "shear = [0.2, -0.1]"),
+        ],
+    );
+    let (listed, line) = drag_one(&oblique, SMALL_PRESET, "shear", -5.0, 3.0);
+    assert!(line.starts_with("shear ="), "{line}");
+    let v = sub(dragged(&listed, -5.0, 3.0), eye);
+    let expected = [
+        -dot(v, right) / dot(v, forward),
+        -dot(v, up) / dot(v, forward),
+    ];
+    let numbers = line_numbers(&line);
+    assert!(
+        close(numbers[0], expected[0]) && close(numbers[1], expected[1]),
+        "{line}: {expected:?}"
     );
     // twist: the far rectangle's right edge turned about the axis (far clip 20 m); the
     // dragged point's angle about it, counter-clockwise from the right seen from the eye.

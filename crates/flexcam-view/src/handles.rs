@@ -23,7 +23,7 @@
 //! | `outline.K`, `profile.K` (`outline.I.K`, `profile.I.K` in `outlines[I]`, `profiles[I]`) | over the image: vertex K of a panorama's `points` outline (at the column of its arc-length fraction) or profile (at the row of its fraction) | that vertex: it turns about the eye, keeping its length, to the direction of the curve's point under the pointer |
 //! | `rect.corner.K` | corner K (0 bottom left, counter-clockwise) of `perspective_rect`, over the image | its two numbers |
 //! | `rect.center` | the rectangle's centre, over the image | all four numbers |
-//! | `shift`, `twist`, `converge`, `slit_distance`, `fovs.K`, `generators.K.start` / `.end`, `directions.K`, `strength`, `magnification` | the preset keys that shape the projectors otherwise (module `preset_shape`) | that key |
+//! | `shift`, `shear`, `twist`, `converge`, `slit_distance`, `fovs.K`, `generators.K.start` / `.end`, `directions.K`, `strength`, `magnification` | the preset keys that shape the projectors otherwise (module `preset_shape`) | that key |
 //!
 //! Nodes of a grid with `fit` or `aim` are placed before the fit and the aims (the order the
 //! scene format runs them in), so a fit may move a dragged node again.

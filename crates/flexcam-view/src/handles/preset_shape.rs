@@ -4,6 +4,7 @@
 //! | name | point | edits |
 //! | --- | --- | --- |
 //! | `shift` | off_axis: the shifted window's centre at the look-at distance | both numbers: the direction from the eye to the dragged point, in half-widths and half-heights of the window |
+//! | `shear` | oblique: the image centre's projector at the look-at distance (the projectors run along the view direction less `a` right and `b` up) | both numbers: minus the direction from the eye to the dragged point, right and up over forward |
 //! | `twist` | twist: the middle of the far rectangle's right edge, turned | the angle of the dragged point about the view axis, counter-clockwise from the right as seen from the eye, the turn nearest the old one |
 //! | `converge` | inverse_perspective: the world point the projectors meet at | that point |
 //! | `slit_distance` | crossed_slits: the horizontal slit's point on the view axis | the dragged point's distance along the axis |
@@ -14,7 +15,7 @@
 //! | `magnification` | over the image: magnifier, the point the radius over the magnification above the lens centre | the radius over the dragged point's height above the centre |
 //!
 //! Degenerate drags are refused with a message (the last valid projection kept): a `shift`
-//! point dragged to or behind the eye's plane, a `twist` point dragged onto the view axis
+//! or `shear` point dragged to or behind the eye's plane, a `twist` point dragged onto the view axis
 //! (no angle), a `magnification` point dragged to or below the lens centre.
 
 use flexcam::projection::flexible::panorama::DEFAULT_FAR;
@@ -32,7 +33,8 @@ use crate::session::Session;
 #[derive(Debug, Clone, PartialEq)]
 pub(super) enum Shape {
     /// `[sx, sy]`: the direction from `origin` to the point, over `forward` and divided by
-    /// `half` (the window's half-extents at unit distance) along `right` and `up`.
+    /// `half` along `right` and `up` (an off_axis shift: `half` the window's half-extents
+    /// at unit distance; an oblique shear: `half` = (-1, -1)).
     Shift {
         origin: DVec3,
         axes: [DVec3; 3],
@@ -81,7 +83,7 @@ impl Shape {
                 // through the window.
                 if depth.is_nan() || depth <= 0.0 {
                     return Some(Err(Error::new(format!(
-                        "handle `{name}`: drag it in front of the eye (it is the window's centre seen from the eye)"
+                        "handle `{name}`: drag it in front of the eye (it is a direction from the eye)"
                     ))));
                 }
                 let shift = DVec2::new(v.dot(right), v.dot(up)) / depth / half;
@@ -198,6 +200,20 @@ pub(super) fn handles(session: &Session, out: &mut Vec<Handle>) {
             out.push(shaped(
                 "shift".into(),
                 key("shift"),
+                Place::World(at),
+                shape,
+            ));
+        }
+        &Preset::Oblique { shear, .. } => {
+            let at = o + distance * (forward - shear.x * right - shear.y * up);
+            let shape = Shape::Shift {
+                origin: o,
+                axes: [right, up, forward],
+                half: DVec2::NEG_ONE,
+            };
+            out.push(shaped(
+                "shear".into(),
+                key("shear"),
                 Place::World(at),
                 shape,
             ));
