@@ -13,6 +13,7 @@
 //! frame (as the windowing system's would be), so they reach the handlers above through
 //! egui's own hit testing; `layout` writes where the last frame drew what they aim at.
 
+mod layout;
 mod params;
 mod volume;
 
@@ -29,7 +30,7 @@ use glam::{DVec2, Vec3};
 use crate::camera::Navigate;
 use crate::script::{self, Button, Command, PointerAction, Script};
 use crate::viewer::Viewer;
-use volume::Layout;
+use layout::Layout;
 
 /// Degrees of orbit per pixel dragged, and per arrow-key press.
 const ORBIT_DEG_PER_PX: f64 = 0.3;
@@ -465,7 +466,7 @@ impl App {
             }
             // The panels settle over a frame or two (egui sizes them from the frame before).
             Command::Layout(_) if self.layout != self.previous_layout => return,
-            Command::Layout(out) => write_layout(&self.layout.text(ctx.pixels_per_point()), out),
+            Command::Layout(out) => self.layout.write(ctx.pixels_per_point(), out),
             command => script::run_line(&mut self.viewer, command),
         };
         let Some(run) = &mut self.script else { return };
@@ -531,17 +532,6 @@ fn scroll_event(dy: f64) -> egui::Event {
         modifiers: egui::Modifiers::NONE,
         source: egui::MouseWheelSource::Wheel,
     }
-}
-
-/// Writes a `layout` line's text at `out`.
-fn write_layout(text: &str, out: &Path) -> Result<()> {
-    let mut outputs = image_io::OutputSet::new();
-    let id = outputs.output("the layout", out, &["txt"])?;
-    outputs.stage(id, |tmp| {
-        std::fs::write(tmp, text)
-            .map_err(|e| Error::new(format!("cannot write {}: {e}", out.display())))
-    })?;
-    outputs.commit()
 }
 
 /// Writes a screenshot as an 8-bit RGB PNG (alpha dropped): each byte goes through the

@@ -8,6 +8,7 @@ use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke};
 use flexcam::Result;
 use glam::DVec2;
 
+use super::layout::Layout;
 use crate::handles::Place;
 use crate::viewer::Viewer;
 use crate::volume_view::Kind;
@@ -196,37 +197,4 @@ pub fn image_handles(
     draw_handles(&painter, &points, hot.as_deref());
     layout.handles.extend(points);
     result
-}
-
-/// Where a frame drew the image, the volume view and the handles (window points): what a
-/// script's `layout` line writes, so that its `pointer` lines can aim at them.
-#[derive(Debug, Default, PartialEq)]
-pub struct Layout {
-    pub image: Option<Rect>,
-    pub volume: Option<Rect>,
-    pub handles: Vec<(String, Pos2)>,
-}
-
-impl Layout {
-    /// The text of a `layout` file at `pixels_per_point`: `image X0 Y0 X1 Y1`, `volume X0
-    /// Y0 X1 Y1` (the rectangles' corners) and `handle NAME X Y`, in window pixels.
-    pub fn text(&self, pixels_per_point: f32) -> String {
-        let px = |v: f32| v * pixels_per_point;
-        let mut text = String::new();
-        for (name, rect) in [("image", self.image), ("volume", self.volume)] {
-            if let Some(r) = rect {
-                text += &format!(
-                    "{name} {} {} {} {}\n",
-                    px(r.min.x),
-                    px(r.min.y),
-                    px(r.max.x),
-                    px(r.max.y)
-                );
-            }
-        }
-        for (name, p) in &self.handles {
-            text += &format!("handle {name} {} {}\n", px(p.x), px(p.y));
-        }
-        text
-    }
 }
