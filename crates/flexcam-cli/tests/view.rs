@@ -4,10 +4,7 @@
 
 mod common;
 
-use std::path::Path;
-use std::process::Command as Process;
-
-use common::{run, run_ok};
+use common::{numbers_in, run, run_ok, run_with_display, setup_scene};
 use tempfile::TempDir;
 
 const CUBE_FLOOR: &str = include_str!("../../../scenes/cube-floor.toml");
@@ -119,30 +116,11 @@ fn invalid_edit_keeps_the_last_valid_projection_message() {
 fn window_screenshot_under_a_display() {
     // The drag runs through the window's script path too (the volume view drawn).
     let dir = setup("set fov 60\ndrag position 3 2\nidle\nwindow w.png\nframe f.png\n");
-    let flexcam = assert_cmd::cargo::cargo_bin("flexcam");
     let args = [&VIEW[..], &["--shading", "flat", "--refine-spp", "1"]].concat();
-    let has_display = std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty());
-    let mut command = if has_display {
-        Process::new(&flexcam)
-    } else if which("xvfb-run") {
-        let mut c = Process::new("xvfb-run");
-        c.args(["-a", "-s", "-screen 0 1280x1024x24"]).arg(&flexcam);
-        c
-    } else {
-        println!("skipped: no DISPLAY and no xvfb-run to open a virtual display");
+    let Some(out) = run_with_display(&dir, &args) else {
         return;
     };
-    let out = command
-        .current_dir(dir.path())
-        .args(args)
-        .env("LIBGL_ALWAYS_SOFTWARE", "1")
-        .output()
-        .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
-    if !out.status.success() && stderr.contains("cannot open the viewer's window") {
-        println!("skipped: the display cannot be opened: {stderr}");
-        return;
-    }
     assert!(out.status.success(), "{stderr}");
     let shot = image::open(dir.path().join("w.png")).unwrap().to_rgb8();
     let frame = image::open(dir.path().join("f.png")).unwrap().to_rgb8();
@@ -152,23 +130,6 @@ fn window_screenshot_under_a_display() {
     let centre = frame.get_pixel(frame.width() / 2, frame.height() / 2);
     let near = |p: &image::Rgb<u8>| p.0.iter().zip(centre.0).all(|(&a, b)| a.abs_diff(b) <= 2);
     assert!(shot.pixels().any(near), "{centre:?}");
-}
-
-fn which(program: &str) -> bool {
-    std::env::var_os("PATH").is_some_and(|paths| {
-        std::env::split_paths(&paths).any(|dir| Path::new(&dir).join(program).is_file())
-    })
-}
-
-/// A folder holding `scene.toml` (scene file `text` with its image size `from` replaced by
-/// `to`) and `view.txt` (`script`).
-fn setup_scene(text: &str, from: &str, to: &str, script: &str) -> TempDir {
-    let dir = TempDir::new().unwrap();
-    let scene = text.replace(from, to);
-    assert_ne!(scene, text);
-    std::fs::write(dir.path().join("scene.toml"), scene).unwrap();
-    std::fs::write(dir.path().join("view.txt"), script).unwrap();
-    dir
 }
 
 /// The numbers after `NAME KIND` on handle `name`'s line of `--list-handles`.
@@ -199,13 +160,6 @@ fn run_and_changed_line(dir: &TempDir) -> String {
         .collect();
     assert_eq!(changed.len(), 1, "{changed:?}");
     changed[0].clone()
-}
-
-/// The numbers of `text` (a line of a scene file), in order.
-fn numbers_in(text: &str) -> Vec<f64> {
-    text.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == 'e'))
-        .filter_map(|w| w.parse().ok())
-        .collect()
 }
 
 #[test]
@@ -613,5 +567,216 @@ fn dragging_outline_and_profile_points_over_the_image() {
     assert!(
         close(numbers[3], toward[0] * scale) && close(numbers[4], toward[1] * scale),
         "{line}: {toward:?}"
+    );
+}
+
+/// `text` with each `(from, to)` replaced (each must be there).
+fn edited(text: &str, replacements: &[(&str, &str)]) -> String {
+    replacements
+        .iter()
+        .fold(text.to_string(), |text, (from, to)| {
+            assert!(text.contains(from), "{from}");
+            text.replace(from, to)
+        })
+}
+
+/// The numbers of a changed scene line before its comment.
+fn line_numbers(line: &str) -> Vec<f64> {
+    numbers_in(line.split('#').next().unwrap())
+}
+
+fn scale(a: V3, k: f64) -> V3 {
+    [a[0] * k, a[1] * k, a[2] * k]
+}
+
+fn add(a: V3, b: V3) -> V3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+#[test]
+fn dragging_the_shift_shear_twist_convergence_and_slit_of_presets() {
+    let ortho_persp = include_str!("../../../scenes/flexible-ortho-near-persp-far.toml");
+    let off_axis = edited(
+        ortho_persp,
+        &[
+            ("preset = \"ortho_near_persp_far\"", "preset = \"off_axis\""),
+            ("transition = 8.0 ", "shift = [0.2, -0.1] "),
+            ("style = \"piecewise\"", ""),
+        ],
+    );
+    let twist = include_str!("../../../scenes/flexible-twist.toml");
+    let slits = include_str!("../../../scenes/flexible-crossed-slits.toml");
+    let (eye, forward, right) = preset_frame();
+    let up = cross(right, forward);
+    // off_axis: the window's centre seen from the eye, in half-widths (tan 25 degrees at
+    // unit distance) and half-heights (times 36 / 48).
+    let (listed, line) = drag_one(&off_axis, SMALL_PRESET, "shift", 6.0, 4.0);
+    assert!(line.starts_with("shift ="), "{line}");
+    let v = sub(dragged(&listed, 6.0, 4.0), eye);
+    let t = 25f64.to_radians().tan();
+    let expected = [
+        dot(v, right) / dot(v, forward) / t,
+        dot(v, up) / dot(v, forward) / (t * 0.75),
+    ];
+    let numbers = line_numbers(&line);
+    assert!(
+        close(numbers[0], expected[0]) && close(numbers[1], expected[1]),
+        "{line}: {expected:?}"
+    );
+    // The listed point is the old window's centre at the look-at distance.
+    let distance = dot(sub([0.0, 0.4, 0.0], eye), forward);
+    let centre = add(
+        add(eye, scale(forward, distance)),
+        add(
+            scale(right, distance * 0.2 * t),
+            scale(up, -distance * 0.1 * t * 0.75),
+        ),
+    );
+    assert!(
+        (0..3).all(|k| (listed[k] - centre[k]).abs() < 1e-12),
+        "{listed:?}"
+    );
+    // oblique: the image centre's projector, minus the direction from the eye (right, up
+    // over forward).
+    let oblique = edited(
+        &off_axis,
+        &[
+            ("preset = \"off_axis\"", "preset = \"oblique\""),
+            ("fov = 50.0", "width = 8.0"),
+            ("shift = [0.2, -0.1]", "shear = [0.2, -0.1]"),
+        ],
+    );
+    let (listed, line) = drag_one(&oblique, SMALL_PRESET, "shear", -5.0, 3.0);
+    assert!(line.starts_with("shear ="), "{line}");
+    let v = sub(dragged(&listed, -5.0, 3.0), eye);
+    let expected = [
+        -dot(v, right) / dot(v, forward),
+        -dot(v, up) / dot(v, forward),
+    ];
+    let numbers = line_numbers(&line);
+    assert!(
+        close(numbers[0], expected[0]) && close(numbers[1], expected[1]),
+        "{line}: {expected:?}"
+    );
+    // twist: the far rectangle's right edge turned about the axis (far clip 20 m); the
+    // dragged point's angle about it, counter-clockwise from the right seen from the eye.
+    let size = ("width = 320\nheight = 240", "width = 48\nheight = 36");
+    let (listed, line) = drag_one(twist, size, "twist", -5.0, -8.0);
+    assert!(line.starts_with("twist ="), "{line}");
+    let v = sub(dragged(&listed, -5.0, -8.0), add(eye, scale(forward, 20.0)));
+    let expected = dot(v, up).atan2(dot(v, right)).to_degrees();
+    assert!(expected > 60.0, "up and left turns it further: {expected}");
+    assert!(
+        close(line_numbers(&line)[0], expected),
+        "{line}: {expected}"
+    );
+    // inverse_perspective: the point the projectors meet at (the far clip defaults to
+    // its depth).
+    let inverse = edited(
+        ortho_persp,
+        &[
+            (
+                "preset = \"ortho_near_persp_far\"",
+                "preset = \"inverse_perspective\"",
+            ),
+            ("transition = 8.0 ", "converge = [0.0, -1.5, -3.0] "),
+            ("clip = [0.0, 30.0]", ""),
+            ("style = \"piecewise\"", ""),
+        ],
+    );
+    let (listed, line) = drag_one(&inverse, SMALL_PRESET, "converge", 7.0, -4.0);
+    assert!(line.starts_with("converge ="), "{line}");
+    assert_eq!(&listed[..3], &[0.0, -1.5, -3.0]);
+    let p = dragged(&listed, 7.0, -4.0);
+    let numbers = line_numbers(&line);
+    assert!((0..3).all(|k| close(numbers[k], p[k])), "{line}: {p:?}");
+    // crossed_slits: the horizontal slit's distance along the axis.
+    let size = ("width = 800\nheight = 600", "width = 48\nheight = 36");
+    let (listed, line) = drag_one(slits, size, "slit_distance", 0.0, 5.0);
+    assert!(line.starts_with("slit_distance ="), "{line}");
+    let expected = dot(sub(dragged(&listed, 0.0, 5.0), eye), forward);
+    assert!(
+        close(line_numbers(&line)[0], expected),
+        "{line}: {expected}"
+    );
+}
+
+#[test]
+fn dragging_view_angles_generators_and_directions_of_presets() {
+    let depth = include_str!("../../../scenes/flexible-depth-transition.toml");
+    let ortho_persp = include_str!("../../../scenes/flexible-ortho-near-persp-far.toml");
+    let mcop = include_str!("../../../scenes/flexible-mcop.toml");
+    let (eye, forward, right) = preset_frame();
+    let up = cross(right, forward);
+    // depth_transition: view 1 runs from the transition at 8 m (half-width 8 tan 30, where
+    // view 0 ends) to the far clip at 30 m; its edge passes the dragged point there.
+    let (listed, line) = drag_one(depth, SMALL_PRESET, "fovs.1", 9.0, 0.0);
+    assert!(line.starts_with("fovs ="), "{line}");
+    let p = dragged(&listed, 9.0, 0.0);
+    let start = 8.0 * 30f64.to_radians().tan();
+    let expected = 2.0
+        * ((dot(sub(p, eye), right) - start) / (30.0 - 8.0))
+            .atan()
+            .to_degrees();
+    let numbers = line_numbers(&line);
+    assert_eq!(numbers[0], 60.0, "{line}");
+    assert!(close(numbers[1], expected), "{line}: {expected}");
+    // glc: generator 1's end, at local depth 1, moved across the axis.
+    let glc = edited(
+        ortho_persp,
+        &[
+            ("preset = \"ortho_near_persp_far\"", "preset = \"glc\""),
+            ("fov = 50.0", "width = 2.0"),
+            (
+                "transition = 8.0 ",
+                "generators = [[-0.5, -0.5, -1.0, -1.0], [0.5, -0.5, 1.0, -1.0], [-0.5, 0.5, -1.0, 1.0]] ",
+            ),
+            ("style = \"piecewise\"", ""),
+        ],
+    );
+    let (listed, line) = drag_one(&glc, SMALL_PRESET, "generators.1.end", 5.0, -3.0);
+    assert!(line.starts_with("generators ="), "{line}");
+    let local = sub(dragged(&listed, 5.0, -3.0), add(eye, forward));
+    let numbers = line_numbers(&line);
+    assert_eq!(numbers.len(), 12, "{line}");
+    assert_eq!(&numbers[..6], &[-0.5, -0.5, -1.0, -1.0, 0.5, -0.5]);
+    assert_eq!(&numbers[8..], &[-0.5, 0.5, -1.0, 1.0]);
+    assert!(
+        close(numbers[6], dot(local, right)) && close(numbers[7], dot(local, up)),
+        "{line}: {local:?}"
+    );
+    // mcop: direction 1 is twice the dragged point less path point 1.
+    let (listed, line) = drag_one(mcop, SMALL_PRESET, "directions.1", 4.0, -3.0);
+    assert!(line.starts_with("directions ="), "{line}");
+    let direction = scale(sub(dragged(&listed, 4.0, -3.0), [-4.95, 3.0, 4.95]), 2.0);
+    let numbers = line_numbers(&line);
+    assert_eq!(numbers.len(), 9, "{line}");
+    assert_eq!(&numbers[..3], &[7.0, -2.0, 0.0]);
+    assert_eq!(&numbers[6..], &[0.0, -2.0, -7.0]);
+    assert!(
+        (0..3).all(|k| close(numbers[3 + k], direction[k])),
+        "{line}: {direction:?}"
+    );
+}
+
+#[test]
+fn dragging_the_strength_and_magnification_over_the_image() {
+    let occlusion = include_str!("../../../scenes/flexible-occlusion.toml");
+    let magnifier = include_str!("../../../scenes/flexible-magnifier.toml");
+    // 48 x 36: the strength's point sits strength image widths right of the pole.
+    let (listed, line) = drag_one(occlusion, SMALL_PRESET, "strength", 6.0, 2.0);
+    assert!(close(listed[0], 0.5 * 48.0 + 0.12 * 48.0), "{listed:?}");
+    assert!(line.starts_with("strength ="), "{line}");
+    assert!(close(line_numbers(&line)[0], 0.12 + 6.0 / 48.0), "{line}");
+    // The magnification's point: the radius (0.3 of 36 pixels) over the magnification (3)
+    // above the centre; 3 pixels further up, the radius over that height.
+    let (listed, line) = drag_one(magnifier, SMALL_PRESET, "magnification", 1.0, -3.0);
+    let centre_y = (1.0 - 0.55) * 36.0;
+    assert!(close(listed[1], centre_y - 10.8 / 3.0), "{listed:?}");
+    assert!(line.starts_with("magnification ="), "{line}");
+    let expected = 10.8 / (centre_y - (listed[1] - 3.0));
+    assert!(
+        close(line_numbers(&line)[0], expected),
+        "{line}: {expected}"
     );
 }

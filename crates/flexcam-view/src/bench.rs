@@ -9,6 +9,7 @@ use flexcam::scene::file::edit::parse_document;
 use flexcam::{Error, Result};
 use toml_edit::{value, Value};
 
+use crate::camera::Navigate;
 use crate::render_loop::Settings;
 use crate::viewer::Viewer;
 
@@ -70,6 +71,15 @@ pub fn drag_handle(
     count: usize,
 ) -> Result<DragReport> {
     frames(path, count, |viewer, _| viewer.drag(name, dx, dy))
+}
+
+/// Opens the scene file at `path`, waits for its first refinement, then orbits the camera
+/// by (`yaw`, `pitch`) degrees (as a script's `orbit`) `count` times, waiting after each for
+/// the frame's first stage: the camera moved as a mouse drag in the image moves it.
+pub fn orbit(path: &Path, (yaw, pitch): (f64, f64), count: usize) -> Result<DragReport> {
+    frames(path, count, |viewer, _| {
+        viewer.move_camera(|c| c.orbit(yaw, pitch))
+    })
 }
 
 /// Runs `count` edits (`edit(viewer, k)`), each waited for until its first stage is shown.

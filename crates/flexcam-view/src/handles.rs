@@ -23,9 +23,12 @@
 //! | `outline.K`, `profile.K` (`outline.I.K`, `profile.I.K` in `outlines[I]`, `profiles[I]`) | over the image: vertex K of a panorama's `points` outline (at the column of its arc-length fraction) or profile (at the row of its fraction) | that vertex: it turns about the eye, keeping its length, to the direction of the curve's point under the pointer |
 //! | `rect.corner.K` | corner K (0 bottom left, counter-clockwise) of `perspective_rect`, over the image | its two numbers |
 //! | `rect.center` | the rectangle's centre, over the image | all four numbers |
+//! | `shift`, `shear`, `twist`, `converge`, `slit_distance`, `fovs.K`, `generators.K.start` / `.end`, `directions.K`, `strength`, `magnification` | the preset keys that shape the projectors otherwise (module `preset_shape`) | that key |
 //!
 //! Nodes of a grid with `fit` or `aim` are placed before the fit and the aims (the order the
 //! scene format runs them in), so a fit may move a dragged node again.
+
+mod preset_shape;
 
 use std::sync::Arc;
 
@@ -176,6 +179,11 @@ enum Edit {
         axis: DVec3,
         forward: DVec3,
     },
+    /// A preset key that shapes the projectors otherwise (module `preset_shape`).
+    Shape {
+        path: ValuePath,
+        shape: preset_shape::Shape,
+    },
 }
 
 /// The numbers of a numeric array value.
@@ -220,6 +228,7 @@ pub fn handles(session: &Session) -> Vec<Handle> {
     }
     grid_nodes(session, &mut out);
     preset_keys(session, &mut out);
+    preset_shape::handles(session, &mut out);
     panorama_points(session, &mut out);
     rect(session, &mut out);
     out
@@ -725,6 +734,16 @@ impl Handle {
                 let angle = 2.0 * v.dot(*axis).atan2(v.dot(*forward)).to_degrees();
                 Ok(vec![path.set(session, Value::from(angle))?])
             }
+            (Edit::Shape { path, shape }, at, d) => {
+                let to = match (at, d) {
+                    (Place::World(at), Place::World(d)) => Place::World(at + d),
+                    (Place::Image(at), Place::Image(d)) => Place::Image(at + d),
+                    _ => return Err(wrong()),
+                };
+                let old = path.get(session).ok_or_else(wrong)?;
+                let value = shape.value(&self.name, old, to).ok_or_else(wrong)??;
+                Ok(vec![path.set(session, value)?])
+            }
             _ => Err(wrong()),
         }
     }
@@ -1060,7 +1079,14 @@ mod tests {
         let list = handles(&session);
         assert_eq!(
             names(&list),
-            ["position", "look_at", "center", "radius", "fov"]
+            [
+                "position",
+                "look_at",
+                "center",
+                "radius",
+                "fov",
+                "magnification"
+            ]
         );
         // 40 x 30: the centre at (20, 15), the radius 0.2 of the shorter side (30) right.
         assert_eq!(

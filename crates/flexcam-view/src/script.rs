@@ -40,6 +40,46 @@ pub enum Command {
     Window(PathBuf),
     /// `save OUT.toml`: write the edited scene.
     Save(PathBuf),
+    /// `pointer press|move|release X Y [BUTTON]`: a raw pointer event at window pixel
+    /// (X, Y), fed to the window's next frame as a mouse would (window only).
+    Pointer {
+        action: PointerAction,
+        x: f64,
+        y: f64,
+        button: Button,
+    },
+    /// `scroll DY`: a mouse wheel turned by DY points (positive: up) where the pointer is
+    /// (window only).
+    Scroll(f64),
+    /// `layout OUT.txt`: write where the window draws the image, the volume view and each
+    /// handle, in window pixels (window only).
+    Layout(PathBuf),
+}
+
+/// What a `pointer` line does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PointerAction {
+    Press,
+    Move,
+    Release,
+}
+
+/// The mouse button of a `pointer` line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Button {
+    Left,
+    Right,
+    Middle,
+}
+
+impl Command {
+    /// Whether the command acts on the window (a script with one opens it).
+    pub fn needs_window(&self) -> bool {
+        matches!(
+            self,
+            Command::Window(_) | Command::Pointer { .. } | Command::Scroll(_) | Command::Layout(_)
+        )
+    }
 }
 
 /// A command and where it is: 1-based line and the column of its first word.
@@ -89,11 +129,10 @@ impl Script {
         })
     }
 
-    /// Whether the script needs the window (it has a `window` line).
+    /// Whether the script needs the window (it has a `window`, `pointer`, `scroll` or
+    /// `layout` line).
     pub fn needs_window(&self) -> bool {
-        self.lines
-            .iter()
-            .any(|l| matches!(l.command, Command::Window(_)))
+        self.lines.iter().any(|l| l.command.needs_window())
     }
 
     /// An error of the command at `line`, as one line naming the script, line and column.
@@ -226,12 +265,55 @@ fn parse_command(line: &str, words: &[(usize, &str)]) -> std::result::Result<Com
             count(1, "save OUT.toml")?;
             Command::Save(path(args[0])?)
         }
+        "layout" => {
+            count(1, "layout OUT.txt")?;
+            Command::Layout(path(args[0])?)
+        }
+        "scroll" => {
+            count(1, "scroll DY")?;
+            Command::Scroll(number(args[0])?)
+        }
+        "pointer" => {
+            let usage = "pointer press|move|release X Y [left|right|middle]";
+            if !(3..=4).contains(&args.len()) {
+                let column = args.get(4).map_or(column + name.len(), |w| w.0);
+                return Err((column, format!("`pointer` takes 3 or 4 arguments: {usage}")));
+            }
+            let action = match args[0].1 {
+                "press" => PointerAction::Press,
+                "move" => PointerAction::Move,
+                "release" => PointerAction::Release,
+                other => {
+                    return Err((
+                        args[0].0,
+                        format!("unknown pointer action `{other}` (press, move, release)"),
+                    ))
+                }
+            };
+            let button = match args.get(3).map(|w| w.1) {
+                None | Some("left") => Button::Left,
+                Some("right") => Button::Right,
+                Some("middle") => Button::Middle,
+                Some(other) => {
+                    return Err((
+                        args[3].0,
+                        format!("unknown button `{other}` (left, right, middle)"),
+                    ))
+                }
+            };
+            Command::Pointer {
+                action,
+                x: number(args[1])?,
+                y: number(args[2])?,
+                button,
+            }
+        }
         other => {
             return Err((
                 column,
                 format!(
                     "unknown command `{other}` (available: set, method, orbit, pan, dolly, \
-                     drag, idle, frame, window, save)"
+                     drag, idle, frame, window, save, pointer, scroll, layout)"
                 ),
             ))
         }
@@ -254,7 +336,8 @@ fn parse_value(text: &str) -> std::result::Result<Value, String> {
     }
 }
 
-/// Runs `line` on `viewer`; `window` is the window's to run ([`run_headless`] refuses it).
+/// Runs `line` on `viewer`; the lines that act on the window are the window's to run
+/// ([`run_headless`] refuses them).
 pub fn run_line(viewer: &mut Viewer, command: &Command) -> Result<()> {
     match command {
         Command::Set { key, value } => viewer.set(key, value.clone()),
@@ -268,8 +351,10 @@ pub fn run_line(viewer: &mut Viewer, command: &Command) -> Result<()> {
         Command::Drag { handle, dx, dy } => viewer.drag(handle, *dx, *dy),
         Command::Idle => viewer.idle(),
         Command::Frame(out) => viewer.write_frame(out),
-        Command::Window(_) => Err(Error::new("`window` needs the window")),
         Command::Save(out) => viewer.save(out),
+        Command::Window(_) | Command::Pointer { .. } | Command::Scroll(_) | Command::Layout(_) => {
+            Err(Error::new("this line needs the window"))
+        }
     }
 }
 
@@ -294,11 +379,12 @@ mod tests {
         let script = parse(
             "# a comment\n\nset fov 100\nset position [0, 1, 5.5]\nset preset cubic\n\
              method raster\norbit 10 -5\npan 0.1 0\ndolly 0.5\ndrag p0 3 4\nidle\n\
-             frame out.png\n  window w.png\nsave out.toml\n",
+             frame out.png\n  window w.png\nsave out.toml\npointer press 10 20.5\n\
+             pointer move 30 -4 right\nscroll -120\nlayout l.txt\n",
         )
         .unwrap();
         let commands: Vec<_> = script.lines.iter().map(|l| l.command.clone()).collect();
-        assert_eq!(commands.len(), 12);
+        assert_eq!(commands.len(), 16);
         let set = |c: &Command| match c {
             Command::Set { key, value } => format!("{key}={value}"),
             other => panic!("{other:?}"),
@@ -314,6 +400,38 @@ mod tests {
         assert!(matches!(&commands[10], Command::Window(p) if p == Path::new("w.png")));
         assert_eq!((script.lines[10].line, script.lines[10].column), (13, 3));
         assert!(script.needs_window());
+        assert!(matches!(
+            commands[12],
+            Command::Pointer {
+                action: PointerAction::Press,
+                x: 10.0,
+                y: 20.5,
+                button: Button::Left
+            }
+        ));
+        assert!(matches!(
+            commands[13],
+            Command::Pointer {
+                action: PointerAction::Move,
+                x: 30.0,
+                y: -4.0,
+                button: Button::Right
+            }
+        ));
+        assert!(matches!(commands[14], Command::Scroll(-120.0)));
+        assert!(matches!(&commands[15], Command::Layout(p) if p == Path::new("l.txt")));
+        // Each window line alone opens the window; the others do not.
+        for line in [
+            "pointer release 1 2",
+            "scroll 3",
+            "layout l.txt",
+            "window w.png",
+        ] {
+            assert!(parse(line).unwrap().needs_window(), "{line}");
+        }
+        assert!(!parse("idle\nframe f.png\nsave s.toml")
+            .unwrap()
+            .needs_window());
     }
 
     #[test]
@@ -334,6 +452,22 @@ mod tests {
                 "s.view:1:7: the dolly factor must be positive, got 0",
             ),
             ("orbit 1 inf\n", "s.view:1:9: expected a number, got `inf`"),
+            (
+                "pointer hold 1 2\n",
+                "s.view:1:9: unknown pointer action `hold` (press, move, release)",
+            ),
+            (
+                "pointer press 1 2 side\n",
+                "s.view:1:19: unknown button `side` (left, right, middle)",
+            ),
+            (
+                "pointer press 1\n",
+                "s.view:1:8: `pointer` takes 3 or 4 arguments",
+            ),
+            (
+                "scroll\n",
+                "s.view:1:7: `scroll` takes 1 argument(s): scroll DY",
+            ),
         ];
         for (text, expected) in cases {
             let message = parse(text).unwrap_err().to_string();

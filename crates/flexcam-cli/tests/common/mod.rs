@@ -246,3 +246,62 @@ type = "directional"
 direction = [-0.3, -1.0, -0.5]
 intensity = 1.0
 "#;
+
+/// Runs `flexcam ARGS` in `dir` where the viewer's window can open: under the display of
+/// `DISPLAY`, or a virtual one from `xvfb-run` when there is none (Mesa's software OpenGL
+/// either way). `None`, having printed a line starting `skipped:` (which .ci/run refuses),
+/// only when no display can be opened. One at a time in a test binary: `xvfb-run -a`
+/// started in parallel can pick the same display number and fail.
+pub fn run_with_display(dir: &TempDir, args: &[&str]) -> Option<Output> {
+    static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let flexcam = assert_cmd::cargo::cargo_bin("flexcam");
+    let has_display = std::env::var_os("DISPLAY").is_some_and(|d| !d.is_empty());
+    let mut command = if has_display {
+        std::process::Command::new(&flexcam)
+    } else if on_path("xvfb-run") {
+        let mut c = std::process::Command::new("xvfb-run");
+        c.args(["-a", "-s", "-screen 0 1280x1024x24"]).arg(&flexcam);
+        c
+    } else {
+        println!("skipped: no DISPLAY and no xvfb-run to open a virtual display");
+        return None;
+    };
+    let out = command
+        .current_dir(dir.path())
+        .args(args)
+        .env("LIBGL_ALWAYS_SOFTWARE", "1")
+        .output()
+        .expect("flexcam runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() && stderr.contains("cannot open the viewer's window") {
+        println!("skipped: the display cannot be opened: {stderr}");
+        return None;
+    }
+    Some(out)
+}
+
+/// Whether `program` is a file in a folder of `PATH`.
+fn on_path(program: &str) -> bool {
+    std::env::var_os("PATH").is_some_and(|paths| {
+        std::env::split_paths(&paths).any(|dir| Path::new(&dir).join(program).is_file())
+    })
+}
+
+/// A folder holding `scene.toml` (scene file `text` with its image size `from` replaced by
+/// `to`) and `view.txt` (`script`).
+pub fn setup_scene(text: &str, from: &str, to: &str, script: &str) -> TempDir {
+    let dir = TempDir::new().unwrap();
+    let scene = text.replace(from, to);
+    assert_ne!(scene, text);
+    std::fs::write(dir.path().join("scene.toml"), scene).unwrap();
+    std::fs::write(dir.path().join("view.txt"), script).unwrap();
+    dir
+}
+
+/// The numbers of `text` (a line of a scene file), in order.
+pub fn numbers_in(text: &str) -> Vec<f64> {
+    text.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == 'e'))
+        .filter_map(|w| w.parse().ok())
+        .collect()
+}

@@ -8,7 +8,12 @@
 //! `+` / `-` dolly; a click picks the object and world point under the pointer; Ctrl+S
 //! saves into the scene file. Handles (dots in the volume view, and over the image for a
 //! panorama's perspective rectangle) are dragged with the left button.
+//!
+//! A script's `pointer` and `scroll` lines are raw input events handed to egui before a
+//! frame (as the windowing system's would be), so they reach the handlers above through
+//! egui's own hit testing; `layout` writes where the last frame drew what they aim at.
 
+mod layout;
 mod params;
 mod volume;
 
@@ -23,8 +28,9 @@ use flexcam::{Error, Result};
 use glam::{DVec2, Vec3};
 
 use crate::camera::Navigate;
-use crate::script::{self, Command, Script};
+use crate::script::{self, Button, Command, PointerAction, Script};
 use crate::viewer::Viewer;
+use layout::Layout;
 
 /// Degrees of orbit per pixel dragged, and per arrow-key press.
 const ORBIT_DEG_PER_PX: f64 = 0.3;
@@ -52,11 +58,14 @@ pub fn run(viewer: Viewer, script: Option<Script>) -> Result<()> {
         message: None,
         save_as: String::new(),
         dragged: [None, None],
+        layout: Layout::default(),
+        previous_layout: Layout::default(),
         last_poll: Instant::now(),
         script: script.map(|script| ScriptRun {
             script,
             next: 0,
             screenshot: None,
+            input: Input::Idle,
         }),
         outcome: Arc::clone(&outcome),
     };
@@ -80,6 +89,18 @@ struct ScriptRun {
     next: usize,
     /// The screenshot asked for by the current `window` line, once it has arrived.
     screenshot: Option<Arc<Mutex<Option<Arc<egui::ColorImage>>>>>,
+    /// The input event of the current `pointer` or `scroll` line.
+    input: Input,
+}
+
+/// Where the input event of a script's `pointer` or `scroll` line is.
+enum Input {
+    /// None is waiting.
+    Idle,
+    /// Made, to be handed to egui before the next frame.
+    Queued(egui::Event),
+    /// Handed to egui: the frame that is being drawn handles it.
+    Delivered,
 }
 
 struct App {
@@ -93,17 +114,30 @@ struct App {
     /// The handle being dragged, if any, in the volume view and over the image (each
     /// view's own, so that one view's idle pointer does not end the other's drag).
     dragged: [Option<String>; 2],
+    /// Where the frame being drawn put the image, the volume view and the handles, and
+    /// where the frame before it did.
+    layout: Layout,
+    previous_layout: Layout,
     last_poll: Instant,
     script: Option<ScriptRun>,
     outcome: Arc<Mutex<Option<Error>>>,
 }
 
 impl eframe::App for App {
+    /// Hands a script's `pointer` or `scroll` event to egui, before the frame that handles it.
+    fn raw_input_hook(&mut self, _ctx: &egui::Context, raw_input: &mut egui::RawInput) {
+        let Some(run) = &mut self.script else { return };
+        if let Input::Queued(event) = &run.input {
+            raw_input.events.push(event.clone());
+            run.input = Input::Delivered;
+        }
+    }
+
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         let ctx = ui.ctx().clone();
         self.poll_reload();
         self.upload_frame(&ctx);
-        self.step_script(&ctx);
+        self.previous_layout = std::mem::take(&mut self.layout);
         egui::Panel::bottom("status").show(ui, |ui| {
             ui.label(&self.status);
             if let Some(message) = &self.message {
@@ -120,11 +154,18 @@ impl eframe::App for App {
             .default_size(VOLUME_PANEL)
             .show(ui, |ui| {
                 ui.label("Viewing volume: drag a dot to move it, elsewhere to orbit");
-                let result = volume::volume_view(ui, &mut self.viewer, &mut self.dragged[0]);
+                let result = volume::volume_view(
+                    ui,
+                    &mut self.viewer,
+                    &mut self.dragged[0],
+                    &mut self.layout,
+                );
                 self.report_error(result);
             });
         egui::CentralPanel::default().show(ui, |ui| self.image_panel(ui));
         self.keys(&ctx);
+        // After the panels: a `pointer` line's event has been handled by this frame.
+        self.step_script(&ctx);
         if !self.viewer.render_loop().is_refined() || self.script.is_some() {
             ctx.request_repaint_after(Duration::from_millis(15));
         } else {
@@ -267,16 +308,17 @@ impl App {
             .min(1.0);
         let size = egui::vec2(width as f32 * scale, height as f32 * scale);
         let (rect, response) = ui.allocate_exact_size(size, egui::Sense::click_and_drag());
+        self.layout.image = Some(rect);
         let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
         ui.painter()
             .image(texture.id(), rect, uv, egui::Color32::WHITE);
         let (on_handle, result) = volume::image_handles(
             ui,
             &response,
-            rect,
-            scale,
+            (rect, scale),
             &mut self.viewer,
             &mut self.dragged[1],
+            &mut self.layout,
         );
         self.report_error(result);
         // A drag that moves a handle does not also orbit or pan.
@@ -316,15 +358,21 @@ impl App {
         }
     }
 
+    /// Shows what pixel position `pixel` sees; a script run also prints it on standard
+    /// output (one line), so that a scripted click can be checked.
     fn pick(&mut self, pixel: DVec2) {
-        self.message = Some(match self.viewer.session().pick(pixel) {
+        let message = match self.viewer.session().pick(pixel) {
             Ok(Some(p)) => format!(
                 "pixel ({:.0}, {:.0}): object {} \"{}\" at ({:.4}, {:.4}, {:.4})",
                 pixel.x, pixel.y, p.id, p.name, p.point.x, p.point.y, p.point.z
             ),
             Ok(None) => format!("pixel ({:.0}, {:.0}): background", pixel.x, pixel.y),
             Err(e) => e.to_string(),
-        });
+        };
+        if self.script.is_some() {
+            println!("{message}");
+        }
+        self.message = Some(message);
     }
 
     fn keys(&mut self, ctx: &egui::Context) {
@@ -398,6 +446,27 @@ impl App {
                     write_screenshot(&image, out)
                 }
             },
+            &Command::Pointer {
+                action,
+                x,
+                y,
+                button,
+            } => {
+                let event = pointer_event(ctx, action, (x, y), button);
+                let Some(done) = input_step(run, ctx, event) else {
+                    return;
+                };
+                done
+            }
+            &Command::Scroll(dy) => {
+                let Some(done) = input_step(run, ctx, scroll_event(dy)) else {
+                    return;
+                };
+                done
+            }
+            // The panels settle over a frame or two (egui sizes them from the frame before).
+            Command::Layout(_) if self.layout != self.previous_layout => return,
+            Command::Layout(out) => self.layout.write(ctx.pixels_per_point(), out),
             command => script::run_line(&mut self.viewer, command),
         };
         let Some(run) = &mut self.script else { return };
@@ -407,6 +476,61 @@ impl App {
                 Some(run.script.error_at(&line, &e));
             ctx.send_viewport_cmd(egui::ViewportCommand::Close);
         }
+    }
+}
+
+/// Steps a script's `pointer` or `scroll` line whose event is `event`: queues it for the
+/// next frame, then waits for the frame that handled it (and, for a wheel's turn, which
+/// egui spreads over frames, until all of it has been handled). `None` while waiting.
+fn input_step(run: &mut ScriptRun, ctx: &egui::Context, event: egui::Event) -> Option<Result<()>> {
+    match run.input {
+        Input::Idle => {
+            run.input = Input::Queued(event);
+            ctx.request_repaint();
+            None
+        }
+        Input::Queued(_) => None,
+        Input::Delivered if ctx.input(|i| i.is_scrolling()) => None,
+        Input::Delivered => {
+            run.input = Input::Idle;
+            Some(Ok(()))
+        }
+    }
+}
+
+/// The egui event of a `pointer` line at window pixel `(x, y)` (made points).
+fn pointer_event(
+    ctx: &egui::Context,
+    action: PointerAction,
+    (x, y): (f64, f64),
+    button: Button,
+) -> egui::Event {
+    let scale = ctx.pixels_per_point();
+    let pos = egui::pos2(x as f32 / scale, y as f32 / scale);
+    let button = match button {
+        Button::Left => egui::PointerButton::Primary,
+        Button::Right => egui::PointerButton::Secondary,
+        Button::Middle => egui::PointerButton::Middle,
+    };
+    match action {
+        PointerAction::Move => egui::Event::PointerMoved(pos),
+        PointerAction::Press | PointerAction::Release => egui::Event::PointerButton {
+            pos,
+            button,
+            pressed: action == PointerAction::Press,
+            modifiers: egui::Modifiers::NONE,
+        },
+    }
+}
+
+/// The egui event of a `scroll` line: the wheel turned by `dy` points.
+fn scroll_event(dy: f64) -> egui::Event {
+    egui::Event::MouseWheel {
+        unit: egui::MouseWheelUnit::Point,
+        delta: egui::vec2(0.0, dy as f32),
+        phase: egui::TouchPhase::Move,
+        modifiers: egui::Modifiers::NONE,
+        source: egui::MouseWheelSource::Wheel,
     }
 }
 

@@ -8,6 +8,7 @@ use eframe::egui::{self, Color32, Pos2, Rect, Sense, Stroke};
 use flexcam::Result;
 use glam::DVec2;
 
+use super::layout::Layout;
 use crate::handles::Place;
 use crate::viewer::Viewer;
 use crate::volume_view::Kind;
@@ -98,11 +99,13 @@ fn drag(
     (dragging, result)
 }
 
-/// The volume view filling the rest of `ui`.
+/// The volume view filling the rest of `ui`; adds its rectangle and where it draws each
+/// handle to `layout`.
 pub fn volume_view(
     ui: &mut egui::Ui,
     viewer: &mut Viewer,
     active: &mut Option<String>,
+    layout: &mut Layout,
 ) -> Result<()> {
     let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::click_and_drag());
     let painter = ui.painter_at(rect);
@@ -127,6 +130,8 @@ pub fn volume_view(
         .clone()
         .or_else(|| nearest(&points, response.hover_pos()));
     draw_handles(&painter, &points, hot.as_deref());
+    layout.volume = Some(rect);
+    layout.handles.extend(points);
     let delta = response.drag_delta();
     if !dragging && response.dragged_by(egui::PointerButton::Primary) {
         viewer.volume_camera().orbit(
@@ -146,15 +151,15 @@ pub fn volume_view(
 }
 
 /// The image handles over the image drawn at `rect` (`scale` screen pixels per image pixel),
-/// and their drag. Returns whether a handle is being dragged (then the image's own drag,
-/// the orbit, does not apply) and the drag's result.
+/// and their drag; adds where it draws them to `layout`. Returns whether a handle is being
+/// dragged (then the image's own drag, the orbit, does not apply) and the drag's result.
 pub fn image_handles(
     ui: &egui::Ui,
     response: &egui::Response,
-    rect: Rect,
-    scale: f32,
+    (rect, scale): (Rect, f32),
     viewer: &mut Viewer,
     active: &mut Option<String>,
+    layout: &mut Layout,
 ) -> (bool, Result<()>) {
     let (handles, _) = viewer.volume();
     let points: Vec<(String, Pos2)> = handles
@@ -190,5 +195,6 @@ pub fn image_handles(
         .clone()
         .or_else(|| nearest(&points, response.hover_pos()));
     draw_handles(&painter, &points, hot.as_deref());
+    layout.handles.extend(points);
     result
 }

@@ -3,12 +3,14 @@
 //! `flexcam_view::bench`), on cube-floor through invertible cameras and on the
 //! 123,554-triangle teapot-dense scene as an equirectangular panorama; and while a handle
 //! of a flexible volume on cube-floor is dragged (handles and volume sketch made again each
-//! frame, as in the window).
+//! frame, as in the window). With `--presets`: cube-floor through every flexible preset
+//! while the camera orbits (the line says which stage showed the frames: `raster` for the
+//! presets with an analytic inverse).
 
 use clap::Args;
 use flexcam::scene::builtin;
 use flexcam::{Error, Result};
-use flexcam_view::bench::{drag, drag_handle, scene_variant};
+use flexcam_view::bench::{drag, drag_handle, orbit, scene_variant};
 use toml_edit::Value;
 
 /// Arguments of `flexcam bench view`.
@@ -17,6 +19,10 @@ pub struct ViewBenchArgs {
     /// Frames (edits) per case.
     #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(2..=100_000))]
     frames: u32,
+    /// Instead of the default cases: cube-floor through every flexible preset, the camera
+    /// orbiting half a degree a frame.
+    #[arg(long)]
+    presets: bool,
 }
 
 /// The viewer's image size in the frame-rate target.
@@ -37,6 +43,8 @@ enum Drag {
     Key(&'static str, f64, f64),
     /// A handle, by these pixels a frame (as `drag` in a script).
     Handle(&'static str, f64, f64),
+    /// The camera, by these degrees a frame (as `orbit` in a script).
+    Orbit(f64, f64),
 }
 
 fn vector(v: [f64; 3]) -> Value {
@@ -98,6 +106,124 @@ fn cases() -> Vec<Case> {
     ]
 }
 
+/// Cube-floor's camera frame and a clip range that holds the scene, then `keys`: the
+/// projection of a preset case.
+fn preset(name: &'static str, keys: Vec<(&'static str, Value)>) -> Case {
+    let mut all = vec![
+        ("type", Value::from("flexible")),
+        ("preset", Value::from(name)),
+        ("position", vector([0.0, 5.5, 7.0])),
+        ("look_at", vector([0.0, 0.4, 0.0])),
+    ];
+    if name != "inverse_perspective" {
+        all.push((
+            "clip",
+            flexcam::scene::file::edit::float_array(&[0.0, 30.0]),
+        ));
+    }
+    all.extend(keys);
+    Case {
+        name,
+        builtin: "cube-floor",
+        keys: all,
+        drag: Drag::Orbit(0.5, 0.0),
+    }
+}
+
+/// Cube-floor through every flexible preset (keys as in the example scenes of
+/// scenes/README.md).
+fn preset_cases() -> Vec<Case> {
+    let n = Value::from;
+    let array = |v: &[f64]| flexcam::scene::file::edit::float_array(v);
+    let rows = |rows: &[&[f64]]| Value::Array(rows.iter().map(|r| array(r)).collect());
+    vec![
+        preset("perspective", vec![("fov", n(50.0))]),
+        preset(
+            "inverse_perspective",
+            vec![("fov", n(50.0)), ("converge", vector([0.0, -1.5, -3.0]))],
+        ),
+        preset("orthographic", vec![("width", n(8.0))]),
+        preset(
+            "oblique",
+            vec![("width", n(8.0)), ("shear", array(&[0.2, 0.1]))],
+        ),
+        preset("pushbroom", vec![("width", n(8.0)), ("v_fov", n(50.0))]),
+        preset(
+            "crossed_slits",
+            vec![("fov", n(60.0)), ("slit_distance", n(-3.0))],
+        ),
+        preset("cylindrical", vec![("h_fov", n(360.0)), ("v_fov", n(90.0))]),
+        preset("equirectangular", Vec::new()),
+        preset("cubic", Vec::new()),
+        preset("rounded_cubic", vec![("corner_radius", n(0.5))]),
+        preset("fisheye", vec![("fov", n(180.0))]),
+        preset(
+            "off_axis",
+            vec![("fov", n(50.0)), ("shift", array(&[0.2, 0.1]))],
+        ),
+        preset("twist", vec![("fov", n(50.0)), ("twist", n(60.0))]),
+        preset(
+            "axonometric",
+            vec![
+                ("width", n(8.0)),
+                ("azimuth", n(45.0)),
+                ("elevation", n(35.264)),
+            ],
+        ),
+        preset(
+            "glc",
+            vec![
+                ("width", n(2.0)),
+                (
+                    "generators",
+                    rows(&[
+                        &[-0.5, -0.5, -1.0, -1.0],
+                        &[0.5, -0.5, 1.0, -1.0],
+                        &[-0.5, 0.5, -1.0, 1.0],
+                    ]),
+                ),
+            ],
+        ),
+        preset(
+            "ortho_near_persp_far",
+            vec![("fov", n(50.0)), ("transition", n(8.0))],
+        ),
+        preset(
+            "depth_transition",
+            vec![
+                ("fovs", array(&[60.0, 20.0])),
+                ("transitions", array(&[8.0])),
+            ],
+        ),
+        preset(
+            "occlusion",
+            vec![
+                ("fov", n(60.0)),
+                ("transition", n(6.0)),
+                ("pole", array(&[0.5, 0.55])),
+                ("strength", n(0.12)),
+            ],
+        ),
+        preset(
+            "mcop",
+            vec![(
+                "path",
+                rows(&[&[-7.0, 3.0, 0.0], &[-4.95, 3.0, 4.95], &[0.0, 3.0, 7.0]]),
+            )],
+        ),
+        preset("long_scene", vec![("width", n(8.0)), ("v_fov", n(50.0))]),
+        preset(
+            "magnifier",
+            vec![
+                ("fov", n(60.0)),
+                ("center", array(&[0.5, 0.55])),
+                ("radius", n(0.3)),
+                ("magnification", n(3.0)),
+            ],
+        ),
+    ]
+}
+
 /// Runs `flexcam bench view`: one line per case.
 pub fn run(args: &ViewBenchArgs) -> Result<()> {
     let dir = std::env::temp_dir().join(format!("flexcam-bench-view-{}", std::process::id()));
@@ -113,7 +239,12 @@ fn run_cases(args: &ViewBenchArgs, dir: &std::path::Path) -> Result<()> {
         "viewer frame rate at {} x {}, one edit per frame ({} frames)",
         SIZE.0, SIZE.1, args.frames
     );
-    for (i, case) in cases().into_iter().enumerate() {
+    let cases = if args.presets {
+        preset_cases()
+    } else {
+        cases()
+    };
+    for (i, case) in cases.into_iter().enumerate() {
         let replace = !case.keys.is_empty();
         let text = scene_variant(builtin::text(case.builtin)?, SIZE, &case.keys, replace)?;
         let path = dir.join(format!("case{i}.toml"));
@@ -130,6 +261,10 @@ fn run_cases(args: &ViewBenchArgs, dir: &std::path::Path) -> Result<()> {
             Drag::Handle(name, dx, dy) => (
                 drag_handle(&path, name, (dx, dy), n as usize)?,
                 format!("{name} by ({dx}, {dy}) px"),
+            ),
+            Drag::Orbit(yaw, pitch) => (
+                orbit(&path, (yaw, pitch), n as usize)?,
+                format!("orbit ({yaw}, {pitch}) deg"),
             ),
         };
         println!(
