@@ -125,8 +125,11 @@ struct App {
 
 impl eframe::App for App {
     /// Hands a script's `pointer` or `scroll` event to egui, before the frame that handles it.
-    fn raw_input_hook(&mut self, _ctx: &egui::Context, raw_input: &mut egui::RawInput) {
+    fn raw_input_hook(&mut self, ctx: &egui::Context, raw_input: &mut egui::RawInput) {
         let Some(run) = &mut self.script else { return };
+        // A script's press and release at one place make a click however long the frames
+        // between them take on a loaded machine (egui counts at most 0.8 s by default).
+        ctx.options_mut(|o| o.input_options.max_click_duration = f64::INFINITY);
         if let Input::Queued(event) = &run.input {
             raw_input.events.push(event.clone());
             run.input = Input::Delivered;
