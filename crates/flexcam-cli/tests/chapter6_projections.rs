@@ -284,19 +284,24 @@ fn piecewise_depth_volumes_raster_like_the_ray_caster() {
         (along - f64::from(rendered)).abs() < 1e-5 * along,
         "{along} against {rendered}"
     );
-    let out = run(
-        &dir,
-        &["render", &depth, "--method", "raster", "-o", "q.png"],
-    );
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1));
+    let stderr = raster_refusal(&dir, &depth);
     assert!(
         stderr.contains(
-            "its projectors are Bezier curves, with no closed-form inverse (use \
-                         --method raycast)"
+            "its projectors are Bezier curves, with no closed-form inverse (use --method \
+             raycast)"
         ),
         "{stderr}"
     );
+}
+
+/// The stderr of `render SCENE --method raster`, which must fail with exit status 1.
+fn raster_refusal(dir: &TempDir, scene: &str) -> String {
+    let out = run(
+        dir,
+        &["render", scene, "--method", "raster", "-o", "out.png"],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 /// `scenes/flexible-nurbs.toml` renders by ray casting; the raster refuses it with the
@@ -312,12 +317,7 @@ fn the_nurbs_example_renders_and_the_raster_says_why_not() {
         ],
     );
     assert!(stats.is_object());
-    let out = run(
-        &dir,
-        &["render", &scene, "--method", "raster", "-o", "out.png"],
-    );
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1));
+    let stderr = raster_refusal(&dir, &scene);
     assert!(
         stderr.contains(
             "flexible has none: its near and far control surfaces are outside the scanline class"

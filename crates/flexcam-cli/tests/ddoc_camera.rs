@@ -20,21 +20,8 @@ fn example_with(map_line: &str) -> String {
 
 /// Renders `scene` by ray casting, flat, and returns its ids.
 fn ids(dir: &TempDir, scene: &str, name: &str) -> Vec<u16> {
-    let ids = format!("{name}-ids.png");
-    run_ok(
-        dir,
-        &[
-            "render",
-            scene,
-            "--shading",
-            "flat",
-            "-o",
-            &format!("{name}.png"),
-            "--ids",
-            &ids,
-        ],
-    );
-    common::ids(&dir.path().join(ids)).2
+    common::render_flat(dir, scene, name);
+    common::ids(&dir.path().join(format!("{name}-ids.png"))).2
 }
 
 /// The two balls (ids 4 and 5) are hidden behind the pillar in the perspective, and the
