@@ -12,7 +12,7 @@
 //!
 //! - Shape-defined panoramas whose outlines and profiles (and their blends) are star-shaped
 //!   around the eye: lookup tables of the curves' angles (module `panorama::lookup`).
-//! - Polyline projectors through three or more affine surfaces in parallel planes at
+//! - Polyline projectors through two or more affine surfaces in parallel planes at
 //!   strictly monotonic offsets along the normal (the piecewise depth transitions, the
 //!   orthographic-near / perspective-far volume): the depth p.n picks the segment, whose
 //!   parallel-planes inverse gives (u, v) and its local t, mapped to the volume's t by the

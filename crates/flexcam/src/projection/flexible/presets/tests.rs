@@ -603,7 +603,8 @@ proptest! {
 }
 
 /// Both piecewise depth volumes have a chart for the raster; a transition whose station
-/// degenerates (perspective views meeting at a point inside the volume) has none.
+/// degenerates (perspective views meeting at a point inside the volume) has none; surfaces
+/// going back, not flat or not parallel have no layered inverse.
 #[test]
 fn piecewise_depth_volumes_have_a_chart() {
     for preset in piecewise_depth_presets() {
@@ -618,9 +619,31 @@ fn piecewise_depth_volumes_have_a_chart() {
         u_edge: DVec3::new(2.0 * h, 0.0, 0.0),
         v_edge: DVec3::new(0.0, 2.0 * h, 0.0),
     };
+    use super::super::inverse::Inverse;
+    let knots = [0.0, 0.5, 1.0];
     let pinched = vec![rect(0.0, 1.0), rect(2.0, 0.0), rect(4.0, 1.0)];
-    let inverse = super::super::inverse::Inverse::classify_layers(&pinched, &[0.0, 0.5, 1.0]);
-    let inverse = inverse.expect("parallel planes in order");
+    let inverse = Inverse::classify_layers(&pinched, &knots).expect("parallel planes in order");
     let resolution = crate::projection::image_coords::Resolution::new(16, 12).unwrap();
     assert!(inverse.chart(&Reparam::Linear, &resolution).is_none());
+    // No inverse: planes that go back along the axis (a projector would cross a depth
+    // twice), a surface that is not flat, planes that are not parallel.
+    let back = vec![rect(0.0, 1.0), rect(4.0, 2.0), rect(2.0, 3.0)];
+    assert!(Inverse::classify_layers(&back, &knots).is_none());
+    let bent = Surface::Bilinear {
+        corners: [
+            DVec3::new(-1.0, -1.0, 2.0),
+            DVec3::new(1.0, -1.0, 2.0),
+            DVec3::new(1.0, 1.0, 3.0),
+            DVec3::new(-1.0, 1.0, 2.0),
+        ],
+    };
+    let curved = vec![rect(0.0, 1.0), bent, rect(4.0, 1.0)];
+    assert!(Inverse::classify_layers(&curved, &knots).is_none());
+    let tilted = Surface::Rectangle {
+        corner: DVec3::new(-1.0, -1.0, 4.0),
+        u_edge: DVec3::new(2.0, 0.0, 1.0),
+        v_edge: DVec3::new(0.0, 2.0, 0.0),
+    };
+    let turned = vec![rect(0.0, 1.0), rect(2.0, 1.0), tilted];
+    assert!(Inverse::classify_layers(&turned, &knots).is_none());
 }
