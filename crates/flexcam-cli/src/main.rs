@@ -82,6 +82,12 @@ enum Command {
     /// image grid carried onto the volume (lines), each part its own material.
     #[command(after_help = OUTPUTS_HELP)]
     Volume(commands::volume::VolumeArgs),
+    /// Write the displacement map of a scene's depth-discontinuity occlusion camera
+    /// (`preset = "ddoc"`) as a PFM for its `map` key: the depth of its reference
+    /// perspective is ray cast, and the far samples at each depth discontinuity (near side
+    /// within z_near, far side beyond z_far) are pushed away from it towards the occluded side.
+    #[command(after_help = OUTPUTS_HELP)]
+    DdocMap(commands::ddoc_map::DdocMapArgs),
     /// Open the interactive viewer on a scene file: design its projection live, or run a
     /// script of viewer commands.
     View(commands::view::ViewArgs),
@@ -112,6 +118,7 @@ fn main() -> ExitCode {
         Command::ImportCameras(args) => commands::import_cameras::run(&args),
         Command::View(args) => commands::view::run(&args),
         Command::Volume(args) => commands::volume::run(&args),
+        Command::DdocMap(args) => commands::ddoc_map::run(&args),
         Command::Bench(command) => commands::bench::run(&command),
     };
     match result {

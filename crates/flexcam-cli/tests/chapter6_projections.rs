@@ -207,7 +207,8 @@ fn bad_pieces_are_refused_at_their_place() {
          slit_distance, near, far, surfaces, blend, knots, segments, reparam, reparam_grid, \
          interpolate, max_latitude, shift, twist, azimuth, elevation, generators, projectors, corner_radius, outline, \
          outlines, profile, profiles, perspective_rect, transition, transitions, fovs, style, \
-         pole, strength, path, directions, center, radius, magnification, deep, pieces)",
+         pole, strength, path, directions, center, radius, magnification, deep, pieces, \
+         z_near, z_far, map)",
     );
     // At build time: a sliver of no whole pixel, and the raster's refusal naming the piece.
     refused(
@@ -219,10 +220,10 @@ fn bad_pieces_are_refused_at_their_place() {
     );
     let curved = format!(
         "{}\n[[projection.pieces]]\nrect = [0.5, 0.0, 1.0, 1.0]\npreset = \"ortho_near_persp_far\"\n\
-         {FRAME}fov = 50.0\ntransition = 3.0\nclip = [0.0, 20.0]\n",
+         {FRAME}fov = 50.0\ntransition = 3.0\nclip = [0.0, 20.0]\nstyle = \"quadratic\"\n",
         perspective_piece("[0.0, 0.0, 0.5, 1.0]")
     );
-    // Ray casting draws it.
+    // Ray casting draws it (a quadratic volume: no inverse).
     fs::write(dir.path().join("scene.toml"), pieces_scene(&curved)).unwrap();
     run_ok(&dir, &["render", "scene.toml", "-o", "out.png"]);
     fs::remove_file(dir.path().join("out.png")).unwrap();
@@ -232,9 +233,69 @@ fn bad_pieces_are_refused_at_their_place() {
         &["--method", "raster"],
         "scene.toml: method raster needs a projection with an analytic inverse; flexible has \
          none: piece 2 (rect [0.5, 0.0, 1.0, 1.0]) has no analytic inverse: its projectors \
-         are polylines through more than two control surfaces, with no closed-form inverse \
-         (use --method raycast)",
+         are Bezier curves, with no closed-form inverse (use --method raycast)",
     );
+}
+
+/// Polyline projectors through parallel planes raster like the ray caster: the
+/// orthographic-near / perspective-far example and the depth-transition example made
+/// piecewise (`common::raster_agrees`); its own quadratic style is refused with the reason.
+#[test]
+fn piecewise_depth_volumes_raster_like_the_ray_caster() {
+    let dir = TempDir::new().unwrap();
+    raster_agrees(
+        &dir,
+        &[&scene_example("flexible-ortho-near-persp-far.toml")],
+    );
+    let depth = scene_example("flexible-depth-transition.toml");
+    raster_agrees(&dir, &[&depth, "-D", "projection.style=piecewise"]);
+    // `project` takes the point `pick` finds at a pixel back to that pixel, with the depth
+    // `render --depth` writes there (the arc length along the polyline projector).
+    let ortho = scene_example("flexible-ortho-near-persp-far.toml");
+    let picked = run_json(&dir, &["pick", &ortho, "100.5,120.5", "--json"]);
+    let p = picked["point"].as_array().unwrap();
+    let xyz = format!("{},{},{}", p[0], p[1], p[2]);
+    let projected = run_json(&dir, &["project", &ortho, &xyz, "--json"]);
+    let image = &projected["images"][0];
+    assert!(
+        (image["x"].as_f64().unwrap() - 100.5).abs() < 1e-6,
+        "{projected}"
+    );
+    assert!(
+        (image["y"].as_f64().unwrap() - 120.5).abs() < 1e-6,
+        "{projected}"
+    );
+    run_ok(
+        &dir,
+        &["render", &ortho, "--depth", "depth.pfm", "-o", "d.png"],
+    );
+    let pfm = fs::read(dir.path().join("depth.pfm")).unwrap();
+    let header = "Pf\n240 180\n-1.0\n".len();
+    let at = header + ((180 - 1 - 120) * 240 + 100) * 4;
+    let rendered = f32::from_le_bytes(pfm[at..at + 4].try_into().unwrap());
+    let along = image["depth"].as_f64().unwrap();
+    assert!(
+        (along - f64::from(rendered)).abs() < 1e-5 * along,
+        "{along} against {rendered}"
+    );
+    let stderr = raster_refusal(&dir, &depth);
+    assert!(
+        stderr.contains(
+            "its projectors are Bezier curves, with no closed-form inverse (use --method \
+             raycast)"
+        ),
+        "{stderr}"
+    );
+}
+
+/// The stderr of `render SCENE --method raster`, which must fail with exit status 1.
+fn raster_refusal(dir: &TempDir, scene: &str) -> String {
+    let out = run(
+        dir,
+        &["render", scene, "--method", "raster", "-o", "out.png"],
+    );
+    assert_eq!(out.status.code(), Some(1));
+    String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
 /// `scenes/flexible-nurbs.toml` renders by ray casting; the raster refuses it with the
@@ -250,12 +311,7 @@ fn the_nurbs_example_renders_and_the_raster_says_why_not() {
         ],
     );
     assert!(stats.is_object());
-    let out = run(
-        &dir,
-        &["render", &scene, "--method", "raster", "-o", "out.png"],
-    );
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1));
+    let stderr = raster_refusal(&dir, &scene);
     assert!(
         stderr.contains(
             "flexible has none: its near and far control surfaces are outside the scanline class"
@@ -334,7 +390,8 @@ fn bad_nurbs_surfaces_are_refused_at_the_key() {
 }
 
 /// `scenes/flexible-long-scene.toml` renders by ray casting and differs from the plain
-/// pushbroom only around its deep areas; bad deep areas are refused at `deep`.
+/// pushbroom only around its deep areas, rasters like the ray caster; bad deep areas are
+/// refused at `deep`.
 #[test]
 fn the_long_scene_example_renders_and_bad_deep_areas_are_refused() {
     let dir = TempDir::new().unwrap();
@@ -374,11 +431,9 @@ fn the_long_scene_example_renders_and_bad_deep_areas_are_refused() {
         |x: u32| (0..h).any(|y| long[(y * w + x) as usize] != pushbroom[(y * w + x) as usize]);
     assert!((0..10).chain(w - 10..w).all(|x| !differs(x)));
     assert!(differs(3 * w / 10 + 10) && differs(7 * w / 10 - 10));
-    let out = run(
-        &dir,
-        &["render", "long.toml", "--method", "raster", "-o", "out.png"],
-    );
-    assert!(String::from_utf8_lossy(&out.stderr).contains("outside the scanline class"));
+    // Its far surface is piecewise linear in u: raster draws it by the inverse of each
+    // piece, as the ray caster sees it.
+    raster_agrees(&dir, &["long.toml"]);
 
     let folded = text.replace("clip = [0.0, 25.0]", "clip = [0.0, 45.0]");
     let line = folded

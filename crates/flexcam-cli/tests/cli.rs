@@ -1055,23 +1055,10 @@ fn perspective_rect_takes_cylindrical_and_equirectangular_cameras() {
 
 /// Renders `scene` flat at its own size; returns the colour and id PNG files' bytes.
 fn flat_render_bytes(dir: &TempDir, scene: &str, name: &str) -> (Vec<u8>, Vec<u8>) {
-    let (color, ids) = (format!("{name}.png"), format!("{name}-ids.png"));
-    run_ok(
-        dir,
-        &[
-            "render",
-            scene,
-            "--shading",
-            "flat",
-            "-o",
-            &color,
-            "--ids",
-            &ids,
-        ],
-    );
+    common::render_flat(dir, scene, name);
     (
-        fs::read(dir.path().join(&color)).unwrap(),
-        fs::read(dir.path().join(&ids)).unwrap(),
+        fs::read(dir.path().join(format!("{name}.png"))).unwrap(),
+        fs::read(dir.path().join(format!("{name}-ids.png"))).unwrap(),
     )
 }
 

@@ -3,6 +3,7 @@
 pub mod animate;
 pub mod bench;
 pub mod compare;
+pub mod ddoc_map;
 pub mod fit;
 pub mod frame_list;
 pub mod import_cameras;

@@ -3,7 +3,7 @@
 //! triangle's cubic, Vallance 2005, chapter 3).
 
 use clap::Args;
-use flexcam::projection::ImagePoint;
+use flexcam::projection::{ImagePoint, Projector};
 use flexcam::{Error, Result};
 use glam::{DVec2, DVec3};
 use serde_json::json;
@@ -27,9 +27,9 @@ pub struct ProjectArgs {
 }
 
 /// One image of the point: its continuous pixel position (x right, y down, pixel (x, y)
-/// covering [x, x + 1) x [y, y + 1)), the distance along its pixel's ray from the ray's
-/// origin (what `render --depth` writes there when nothing is in front) and the ray
-/// parameter.
+/// covering [x, x + 1) x [y, y + 1)), the distance along its pixel's ray (or polyline
+/// projector) from its start (what `render --depth` writes there when nothing is in front)
+/// and the ray parameter (a flexible volume's t).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Image {
     pixel: DVec2,
@@ -78,14 +78,16 @@ pub fn run(args: &ProjectArgs) -> Result<()> {
             p.x >= 0.0 && p.y >= 0.0 && p.x <= size.x && p.y <= size.y
         })
         .map(|&ImagePoint { pixel, t }| {
-            let speed = projection
-                .ray(pixel)
-                .map_or(1.0, |ray| ray.direction.length());
-            Image {
-                pixel,
-                depth: t * speed,
-                t,
-            }
+            let depth = match projection.projector(pixel) {
+                Some(Projector::Polyline(points)) => arc_length_to(&points, point),
+                _ => {
+                    let speed = projection
+                        .ray(pixel)
+                        .map_or(1.0, |ray| ray.direction.length());
+                    t * speed
+                }
+            };
+            Image { pixel, depth, t }
         })
         .collect();
     images.sort_by(|a, b| a.depth.total_cmp(&b.depth));
@@ -108,4 +110,26 @@ pub fn run(args: &ProjectArgs) -> Result<()> {
             .collect()
     };
     super::print_stdout(&text)
+}
+
+/// The arc length along polyline projector `points` from its start to `point`, which lies on
+/// it: the lengths of the segments before the one nearest `point`, plus the distance along
+/// that one (the depth the ray caster gives a hit there).
+fn arc_length_to(points: &[DVec3], point: DVec3) -> f64 {
+    let nearest = |a: DVec3, b: DVec3| {
+        let d = b - a;
+        let s = if d == DVec3::ZERO {
+            0.0
+        } else {
+            ((point - a).dot(d) / d.length_squared()).clamp(0.0, 1.0)
+        };
+        (a + s * d).distance(point)
+    };
+    let k = (0..points.len() - 1)
+        .min_by(|&i, &j| {
+            nearest(points[i], points[i + 1]).total_cmp(&nearest(points[j], points[j + 1]))
+        })
+        .unwrap_or(0);
+    let before: f64 = points[..=k].windows(2).map(|w| w[0].distance(w[1])).sum();
+    before + points[k].distance(point)
 }

@@ -82,6 +82,24 @@ pub fn interior_agreement(reference: &Path, other: &Path) -> (f64, usize) {
     (agreement, interior as usize)
 }
 
+/// Renders `scene` flat into `NAME.png` and its ids into `NAME-ids.png` in `dir`.
+pub fn render_flat(dir: &TempDir, scene: &str, name: &str) {
+    let (color, ids) = (format!("{name}.png"), format!("{name}-ids.png"));
+    run_ok(
+        dir,
+        &[
+            "render",
+            scene,
+            "--shading",
+            "flat",
+            "-o",
+            &color,
+            "--ids",
+            &ids,
+        ],
+    );
+}
+
 /// The path of `scenes/NAME`.
 pub fn scene_example(name: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -485,7 +485,8 @@ mod tests {
                     spp: 4,
                     ..flat(Method::Raster)
                 }),
-                "method raster renders one sample per pixel; got --spp 4"
+                "method raster renders one sample per pixel; got --spp 4 (use --spp 1, or \
+                 --method raycast for more samples)"
             );
             assert_eq!(
                 render(RenderOptions {

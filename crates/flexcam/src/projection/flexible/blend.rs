@@ -223,6 +223,11 @@ impl PiecewiseVolume {
         &self.surfaces
     }
 
+    /// The t of each control surface, increasing from 0 to 1.
+    pub fn knots(&self) -> &[f64] {
+        &self.knots
+    }
+
     /// The piece that `t` falls in: `i` with knots[i] <= t <= knots[i+1] (t below 0 or
     /// above 1 extrapolates the first or last piece), and the local parameter in it.
     fn piece(&self, t: f64) -> (usize, f64) {

@@ -7,6 +7,10 @@
 //!   the image is at infinity). A volume whose cross-section degenerates strictly inside it
 //!   (a crossed-slits volume with its slit between the near and far surfaces) has no chart:
 //!   the image flips there.
+//! - Polyline volumes between parallel planes: the first segment's near clip and the last
+//!   one's far clip, when no cross-section degenerates or flips inside (stations included).
+//! - A warped far rectangle (the long scene): the parallel-planes chart of each piece of
+//!   the warp, which must all be the same, with cross-sections of one orientation.
 //! - Nested spheres: the image depends only on the direction from the centre; the poles
 //!   +-axis are singular, the longitude wraps every 360 degrees (linear and Mercator maps).
 //!   With the polar maps the longitude is the azimuth of the image, continuous when the
@@ -24,7 +28,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use glam::DVec3;
 
 use super::control_surface::{lerp_range, CylinderPatch, SpherePatch};
-use super::inverse::{Affine, Inverse};
+use super::inverse::{Affine, Inverse, Layer, WarpPiece};
 use super::reparam::Reparam;
 use crate::geometry::solve_quadratic;
 use crate::projection::chart::{axis_poles, HalfSpace, InverseChart};
@@ -47,18 +51,7 @@ impl Inverse {
     pub fn chart(&self, reparam: &Reparam, resolution: &Resolution) -> Option<InverseChart> {
         match self {
             Inverse::Planes { near, far, normal } => {
-                // The magnifier (the identity outside its circle), the equiangular map
-                // (monotonic in x and in y) and a grid map (one-to-one, continued beyond the
-                // image by its border cells) are homeomorphisms of the image plane onto
-                // their images: they keep the extended inverse continuous.
-                matches!(
-                    reparam,
-                    Reparam::Linear
-                        | Reparam::Magnifier(_)
-                        | Reparam::Equiangular { .. }
-                        | Reparam::Grid(_)
-                )
-                .then_some(())?;
+                planar_map(reparam).then_some(())?;
                 planes_chart(near, far, *normal)
             }
             Inverse::Spheres { near, .. } => spheres_chart(near, reparam, resolution),
@@ -67,7 +60,85 @@ impl Inverse {
                 cylinders_chart(near, far, resolution)
             }
             Inverse::Panorama(lookup) => lookup.chart(reparam, resolution),
+            Inverse::Layers { segments, normal } => {
+                planar_map(reparam).then_some(())?;
+                layers_chart(segments, *normal)
+            }
+            Inverse::Warped {
+                near,
+                pieces,
+                normal,
+            } => {
+                planar_map(reparam).then_some(())?;
+                warped_chart(near, pieces, *normal)
+            }
         }
+    }
+}
+
+/// Whether `reparam` keeps the extended inverse of a volume between planes continuous: the
+/// linear map, and the magnifier (the identity outside its circle), the equiangular map
+/// (monotonic in x and in y) and a grid map (one-to-one, continued beyond the image by its
+/// border cells), homeomorphisms of the image plane onto their images.
+fn planar_map(reparam: &Reparam) -> bool {
+    matches!(
+        reparam,
+        Reparam::Linear | Reparam::Magnifier(_) | Reparam::Equiangular { .. } | Reparam::Grid(_)
+    )
+}
+
+/// The chart of a polyline volume between parallel planes: every segment's
+/// parallel-planes chart must exist (no cross-section degenerates inside a segment), every
+/// inner surface's cross-section must have area, and all of one orientation (the image does
+/// not flip at a station); triangles are clipped to the first segment's near end and the last
+/// one's far end.
+fn layers_chart(segments: &[Layer], n: DVec3) -> Option<InverseChart> {
+    let charts = segments
+        .iter()
+        .map(|l| planes_chart(&l.near, &l.far, n))
+        .collect::<Option<Vec<_>>>()?;
+    let area = |s: &Affine| s.b.cross(s.c).dot(n);
+    let inner: Vec<f64> = segments[1..].iter().map(|l| area(&l.near)).collect();
+    let scale = segments
+        .iter()
+        .flat_map(|l| [area(&l.near).abs(), area(&l.far).abs()])
+        .fold(0.0, f64::max);
+    let ends = [
+        area(&segments[0].near),
+        area(&segments[segments.len() - 1].far),
+    ];
+    let positive = inner.first().map_or(ends[0] + ends[1] > 0.0, |a| *a > 0.0);
+    let oriented = |a: f64| if positive { a > 0.0 } else { a < 0.0 };
+    let ok = inner.iter().all(|a| a.abs() > FLAT * scale && oriented(*a))
+        && ends.iter().all(|a| a.abs() <= FLAT * scale || oriented(*a));
+    ok.then_some(())?;
+    let lower = charts.first()?.clip.first()?.to_owned();
+    let upper = charts.last()?.clip.last()?.to_owned();
+    Some(InverseChart {
+        clip: vec![lower, upper],
+        ..InverseChart::default()
+    })
+}
+
+/// The chart of a warped volume: every piece's parallel-planes chart, all the same (t
+/// depends on p . n alone, so their clip planes are), and every piece's cross-section of one
+/// orientation, so that the pieces join into one continuous, unfolded image.
+fn warped_chart(near: &Affine, pieces: &[WarpPiece], n: DVec3) -> Option<InverseChart> {
+    let charts = pieces
+        .iter()
+        .map(|piece| planes_chart(near, &piece.far, n))
+        .collect::<Option<Vec<_>>>()?;
+    let orientation = |far: &Affine| {
+        let (b, c) = (near.b.lerp(far.b, 0.5), near.c.lerp(far.c, 0.5));
+        b.cross(c).dot(n) > 0.0
+    };
+    let first = orientation(&pieces.first()?.far);
+    let same = charts.windows(2).all(|w| w[0] == w[1])
+        && pieces.iter().all(|p| orientation(&p.far) == first);
+    if same {
+        charts.into_iter().next()
+    } else {
+        None
     }
 }
 

@@ -13,7 +13,7 @@ use glam::{DVec2, DVec3};
 pub use super::nurbs::{NurbsPatch, NurbsSpec};
 pub use super::panorama::PanoramaSurface;
 pub use super::patch::{BSplinePatch, BezierPatch};
-pub use super::presets::{PathSurface, PinchedRectangle, WarpedRectangle};
+pub use super::presets::{DisplacedRectangle, PathSurface, PinchedRectangle, WarpedRectangle};
 use crate::error::{Error, Result};
 
 /// `axis` and `front` count as parallel when the sine of their angle is below this.
@@ -164,6 +164,9 @@ pub enum Surface {
     /// A rectangle with u re-parameterised piecewise-linearly: the long scene's far surface
     /// (built by that preset only).
     Warped(Box<WarpedRectangle>),
+    /// A rectangle at parameters moved by a displacement map: the depth-discontinuity
+    /// occlusion camera's far surfaces (built by the `ddoc` preset only).
+    Displaced(Box<DisplacedRectangle>),
 }
 
 /// Linear interpolation of a parameter range at `s` in [0, 1].
@@ -223,6 +226,7 @@ impl Surface {
             Surface::Pinched(p) => p.point(uv),
             Surface::Path(p) => p.point(uv),
             Surface::Warped(w) => w.point(uv),
+            Surface::Displaced(d) => d.point(uv),
         }
     }
 
@@ -242,6 +246,7 @@ impl Surface {
             Surface::Pinched(_) => "pinched",
             Surface::Path(_) => "path",
             Surface::Warped(_) => "warped",
+            Surface::Displaced(_) => "displaced",
         }
     }
 
@@ -275,7 +280,8 @@ impl Surface {
             | Surface::Panorama(_)
             | Surface::Pinched(_)
             | Surface::Path(_)
-            | Surface::Warped(_) => None,
+            | Surface::Warped(_)
+            | Surface::Displaced(_) => None,
         }
     }
 
@@ -302,6 +308,7 @@ impl Surface {
             Surface::Pinched(p) => p.is_finite(),
             Surface::Path(p) => p.is_finite(),
             Surface::Warped(w) => w.is_finite(),
+            Surface::Displaced(d) => d.is_finite(),
             Surface::Sphere(s) => {
                 check_radius(s.radius)?;
                 check_span("longitude", s.longitude)?;

@@ -12,6 +12,17 @@
 //!
 //! - Shape-defined panoramas whose outlines and profiles (and their blends) are star-shaped
 //!   around the eye: lookup tables of the curves' angles (module `panorama::lookup`).
+//! - Polyline projectors through two or more affine surfaces in parallel planes at
+//!   strictly monotonic offsets along the normal (the piecewise depth transitions, the
+//!   orthographic-near / perspective-far volume): the depth p.n picks the segment, whose
+//!   parallel-planes inverse gives (u, v) and its local t, mapped to the volume's t by the
+//!   segment's knots. Neighbouring segments share their surface, so the inverse is
+//!   continuous across it.
+//! - An affine near surface and a warped rectangle (the long scene's far surface, u
+//!   re-parameterised piecewise-linearly) in parallel planes: each piece of the warp is an
+//!   affine far surface, so t follows from p.n as for parallel planes, then (u, v) from the
+//!   2 x 2 solve of the piece whose u range holds the solution (the pieces meet
+//!   continuously at the knots, so a point on a knot gets the same answer from both).
 //!
 //! Anything else has no inverse ([`Inverse::classify`] gives `None`, or for a panorama the
 //! reason).
@@ -23,7 +34,9 @@ use std::f64::consts::PI;
 
 use glam::{DMat2, DVec2, DVec3};
 
-use super::control_surface::{CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface};
+use super::control_surface::{
+    CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface, WarpedRectangle,
+};
 use super::panorama::lookup::{self, PanoramaInverse};
 use super::reparam::Reparam;
 use crate::error::Result;
@@ -61,6 +74,55 @@ pub(super) enum Inverse {
     },
     /// Shape-defined panoramas by lookup tables (module `panorama::lookup`).
     Panorama(Box<PanoramaInverse>),
+    /// Polyline projectors through affine surfaces in parallel planes: one parallel-planes
+    /// inverse per segment, in order along the projectors.
+    Layers {
+        segments: Vec<Layer>,
+        normal: DVec3,
+    },
+    /// An affine near surface and a warped far rectangle: one parallel-planes inverse per
+    /// piece of the warp.
+    Warped {
+        near: Affine,
+        pieces: Vec<WarpPiece>,
+        normal: DVec3,
+    },
+}
+
+/// One piece of a warped far rectangle: its u range and the affine surface it is there
+/// (extended beyond the range).
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct WarpPiece {
+    pub u: [f64; 2],
+    pub far: Affine,
+}
+
+/// One segment of a polyline volume between parallel planes: its surfaces and the volume's
+/// t at each.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Layer {
+    pub near: Affine,
+    pub far: Affine,
+    pub t: [f64; 2],
+}
+
+/// The pieces of `w`: between knots (u_a, x_a) and (u_b, x_b), x(u) = x_a + (u - u_a) s with
+/// s = (x_b - x_a) / (u_b - u_a), so the surface is corner + x(u) along + v v_edge.
+fn warp_pieces(w: &WarpedRectangle) -> Vec<WarpPiece> {
+    w.knots
+        .windows(2)
+        .map(|k| {
+            let slope = (k[1].y - k[0].y) / (k[1].x - k[0].x);
+            WarpPiece {
+                u: [k[0].x, k[1].x],
+                far: Affine {
+                    a: w.corner + (k[0].y - k[0].x * slope) * w.along,
+                    b: slope * w.along,
+                    c: w.v_edge,
+                },
+            }
+        })
+        .collect()
 }
 
 fn affine(s: &Surface) -> Option<Affine> {
@@ -110,7 +172,8 @@ fn affine(s: &Surface) -> Option<Affine> {
         | Surface::Panorama(_)
         | Surface::Pinched(_)
         | Surface::Path(_)
-        | Surface::Warped(_) => None,
+        | Surface::Warped(_)
+        | Surface::Displaced(_) => None,
     }
 }
 
@@ -144,7 +207,75 @@ impl Inverse {
         if let (Surface::Panorama(n), Surface::Panorama(f)) = (near, far) {
             return PanoramaInverse::new(n, f).map(|p| Some(Inverse::Panorama(Box::new(p))));
         }
+        if let Surface::Warped(w) = far {
+            return Ok(Inverse::classify_warped(near, w));
+        }
         Ok(Inverse::classify_analytic(near, far))
+    }
+
+    /// The inverse of the polyline volume through `surfaces` at `knots` when every pair of
+    /// neighbours makes parallel planes of one normal (either sign) and the surfaces' offsets
+    /// along it are strictly monotonic; `None` otherwise.
+    pub fn classify_layers(surfaces: &[Surface], knots: &[f64]) -> Option<Inverse> {
+        let mut normal: Option<DVec3> = None;
+        let mut segments = Vec::with_capacity(surfaces.len().saturating_sub(1));
+        for (pair, t) in surfaces.windows(2).zip(knots.windows(2)) {
+            let Some(Inverse::Planes {
+                near,
+                far,
+                normal: n,
+            }) = Inverse::classify_analytic(&pair[0], &pair[1])
+            else {
+                return None;
+            };
+            let n = match normal {
+                None => n,
+                Some(m) if same(m, n, 1.0) || same(m, -n, 1.0) => m,
+                Some(_) => return None,
+            };
+            normal = Some(n);
+            segments.push(Layer {
+                near,
+                far,
+                t: [t[0], t[1]],
+            });
+        }
+        let normal = normal?;
+        let gaps: Vec<f64> = segments
+            .iter()
+            .map(|l| (l.far.a - l.near.a).dot(normal))
+            .collect();
+        let monotonic = gaps.iter().all(|g| *g > 0.0) || gaps.iter().all(|g| *g < 0.0);
+        monotonic.then_some(Inverse::Layers { segments, normal })
+    }
+
+    /// An affine `near` and the warped `far` when every piece of the warp makes parallel
+    /// planes with `near`, all of one normal.
+    fn classify_warped(near: &Surface, far: &WarpedRectangle) -> Option<Inverse> {
+        let pieces = warp_pieces(far);
+        let mut normal = None;
+        for piece in &pieces {
+            let f = piece.far;
+            let rectangle = Surface::Rectangle {
+                corner: f.a,
+                u_edge: f.b,
+                v_edge: f.c,
+            };
+            let Some(Inverse::Planes { normal: n, .. }) =
+                Inverse::classify_analytic(near, &rectangle)
+            else {
+                return None;
+            };
+            if normal.is_some_and(|m: DVec3| !same(m, n, 1.0)) {
+                return None;
+            }
+            normal = Some(n);
+        }
+        Some(Inverse::Warped {
+            near: affine(near)?,
+            pieces,
+            normal: normal?,
+        })
     }
 
     /// The closed-form cases: nested spheres, coaxial cylinders, parallel planes.
@@ -207,8 +338,40 @@ impl Inverse {
             Inverse::Spheres { near, far } => spheres(near, far, p),
             Inverse::Cylinders { near, far } => cylinders(near, far, p),
             Inverse::Panorama(lookup) => lookup.solve(p),
+            Inverse::Warped {
+                near,
+                pieces,
+                normal,
+            } => warped(near, pieces, *normal, p),
+            Inverse::Layers { segments, normal } => layers(segments, *normal, p),
         }
     }
+}
+
+/// The parallel-planes solution of the first segment that reaches p's depth (the last one
+/// beyond them all, the first one before them, so that the solution extends beyond the
+/// volume), its local t mapped to the volume's.
+fn layers(segments: &[Layer], n: DVec3, p: DVec3) -> Option<(DVec2, f64)> {
+    let last = segments.len() - 1;
+    let k = segments
+        .iter()
+        .position(|l| (p - l.near.a).dot(n) / (l.far.a - l.near.a).dot(n) <= 1.0 + EDGE)
+        .unwrap_or(last);
+    let layer = &segments[k];
+    let (uv, s) = planes(&layer.near, &layer.far, n, p)?;
+    Some((uv, layer.t[0] + s * (layer.t[1] - layer.t[0])))
+}
+
+/// The parallel-planes solution of the piece whose u range holds it (the first piece open
+/// below, the last above, so that the solution extends beyond the volume).
+fn warped(near: &Affine, pieces: &[WarpPiece], n: DVec3, p: DVec3) -> Option<(DVec2, f64)> {
+    let last = pieces.len() - 1;
+    pieces.iter().enumerate().find_map(|(k, piece)| {
+        let (uv, t) = planes(near, &piece.far, n, p)?;
+        let above = k == 0 || uv.x >= piece.u[0] - EDGE;
+        let below = k == last || uv.x <= piece.u[1] + EDGE;
+        (above && below).then_some((uv, t))
+    })
 }
 
 fn planes(near: &Affine, far: &Affine, n: DVec3, p: DVec3) -> Option<(DVec2, f64)> {

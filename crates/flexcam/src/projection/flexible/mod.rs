@@ -14,8 +14,8 @@
 //! - [`projector_grid`]: a volume interpolated from a grid of placed projectors (5.2), aimed
 //!   at point correspondences by a [`GridFitter`] (the fit itself is `crate::calibrate`'s);
 //! - [`panorama`]: shape-defined panoramas (ch. 9), outlines and profiles by arc length;
-//! - `inverse`: (u, v, t) from a scene point for the analytic class (parallel planes, nested
-//!   spheres, coaxial cylinders);
+//! - `inverse`: (u, v, t) from a scene point for the analytic class (parallel planes, a
+//!   plane and a piecewise-linearly warped plane, nested spheres, coaxial cylinders);
 //! - [`blend`]: Q = a Q1 + (1 - a) Q2, interpolation and extrapolation between volumes;
 //! - [`animation`]: keyframed flexible cameras, a blend of neighbouring keys per frame;
 //! - [`pieces`]: discontinuous projections, several flexible projections each owning an
@@ -178,6 +178,7 @@ impl Flexible {
         let (volume, reparam) = build_volume(spec, &resolution, fitter, report)?;
         let classified = match &volume {
             Volume::Linear(v) => Inverse::classify(&v.near, &v.far),
+            Volume::Piecewise(v) => Ok(Inverse::classify_layers(v.surfaces(), v.knots())),
             _ => Ok(None),
         };
         let inverse = match classified {
@@ -253,11 +254,20 @@ fn no_inverse_reason(volume: &Volume) -> &'static str {
     match volume {
         Volume::Linear(_) => {
             "its near and far control surfaces are outside the scanline class (planes \
-             sharing a normal, nested spheres or coaxial cylinders, both of one type)"
+             sharing a normal, a plane and a long scene's warped plane, nested spheres or \
+             coaxial cylinders)"
+        }
+        Volume::Piecewise(v)
+            if v.surfaces()
+                .iter()
+                .any(|s| matches!(s, Surface::Displaced(_))) =>
+        {
+            "its far control surfaces are displaced by a sampled map (the depth-discontinuity \
+             occlusion camera), whose inverse has no closed form"
         }
         Volume::Piecewise(_) => {
-            "its projectors are polylines through more than two control surfaces, with no \
-             closed-form inverse"
+            "its projectors are polylines through control surfaces that are not all flat, \
+             parallel and in order along the projectors, with no closed-form inverse"
         }
         Volume::Bezier(_) => "its projectors are Bezier curves, with no closed-form inverse",
         Volume::Interpolated(v) if !matches!(v.first, Volume::Remapped(_)) => {

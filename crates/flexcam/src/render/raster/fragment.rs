@@ -5,10 +5,16 @@
 //! subdivision.
 //!
 //! The depth is the ray caster's: `t |direction|`, the distance along the projector from its
-//! origin. Fragments whose projector meets the plane outside the projector's range (behind a
-//! perspective eye, t outside [0, 1] of a flexible volume: the per-projector near and far
-//! clip), or runs parallel to it, are discarded. Barycentrics just outside the triangle (a
-//! silhouette pixel the polygon covers but the exact image does not) are clamped onto it.
+//! origin (for a polyline projector the length of the segments before the one that meets the
+//! plane, plus the distance along that one). Fragments whose projector meets the plane
+//! outside the projector's range (behind a perspective eye, t outside [0, 1] of a flexible
+//! volume: the per-projector near and far clip), or runs parallel to it, are discarded.
+//! Barycentrics just outside the triangle (a silhouette pixel the polygon covers but the
+//! exact image does not) are clamped onto it.
+//!
+//! A polyline may meet the triangle's plane in several segments; the fragment takes the first
+//! segment that meets it inside the triangle, else (a silhouette pixel) the first that meets
+//! the plane at all.
 //!
 //! Shading is deferred: fragments are only reconstructed and z-tested, and each pixel's
 //! visible fragment is shaded once afterwards ([`Shader::shade`]), from the values its one
@@ -18,7 +24,9 @@ use glam::{DVec3, Vec2, Vec3};
 
 use super::pixel_rays::PixelRays;
 use crate::geometry::Ray;
+use crate::projection::Projector;
 use crate::render::prepared::{Hit, PreparedScene};
+use crate::render::raycast::pieces::{length_before, polyline_segment};
 use crate::render::scan::NO_PRIMITIVE;
 use crate::render::shading::{base_color, TextureFilter};
 use crate::render::{RenderOptions, Shading};
@@ -46,11 +54,13 @@ pub struct Shader<'a> {
 }
 
 /// A pixel's nearest fragment so far: its exact depth (the ray caster's distance along the
-/// projector), ray parameter, primitive key and clamped barycentrics, all from the one
-/// reconstruction of the fragment ([`Shader::fragment`]), kept for shading.
+/// projector), the segment of the projector it lies on (0 for a straight one) and the ray
+/// parameter on it, primitive key and clamped barycentrics, all from the one reconstruction
+/// of the fragment ([`Shader::fragment`]), kept for shading.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Visible {
     pub depth: f64,
+    pub segment: usize,
     pub t: f64,
     pub key: u64,
     pub barycentric: Vec2,
@@ -60,6 +70,7 @@ impl Visible {
     /// No fragment: beaten by any.
     pub const NONE: Visible = Visible {
         depth: f64::INFINITY,
+        segment: 0,
         t: f64::INFINITY,
         key: NO_PRIMITIVE,
         barycentric: Vec2::ZERO,
@@ -84,10 +95,32 @@ impl Shader<'_> {
     /// reconstructed from the pixel's projector, or `None` to discard it (see
     /// [`TrianglePlane::hit`]; also a pixel without a projector).
     pub fn fragment(&self, x: u32, y: u32, key: u64, plane: &mut TrianglePlane) -> Option<Visible> {
-        let ray = self.rays.get(x, y)?;
-        let (t, u, v) = plane.hit(ray)?;
+        let (segment, before, ray, (t, u, v)) = match self.rays.get(x, y)? {
+            Projector::Straight(ray) => (0, 0.0, *ray, plane.hit(ray)?),
+            Projector::Polyline(points) => {
+                let hits = (0..points.len() - 1).filter_map(|k| {
+                    let ray = polyline_segment(points, k);
+                    plane.hit_unclamped(&ray).map(|hit| (k, ray, hit))
+                });
+                let mut first = None;
+                let mut inside = None;
+                for (k, ray, (t, u, v)) in hits {
+                    if u >= 0.0 && v >= 0.0 && u + v <= 1.0 {
+                        inside = Some((k, ray, (t, u, v)));
+                        break;
+                    }
+                    first = first.or(Some((k, ray, (t, u, v))));
+                }
+                let (k, ray, (t, u, v)) = inside.or(first)?;
+                let (u, v) = clamp(u, v);
+                (k, length_before(points, k), ray, (t, u, v))
+            }
+            // Curved projectors have no inverse, so they are never rasterised.
+            Projector::QuadraticBezier(_) => return None,
+        };
         Some(Visible {
-            depth: t * ray.direction.length(),
+            depth: before + t * ray.direction.length(),
+            segment,
             t,
             key,
             barycentric: Vec2::new(u as f32, v as f32),
@@ -114,7 +147,12 @@ impl Shader<'_> {
             );
             (color, 0)
         };
-        match (self.options.shading, self.caster, self.rays.get(x, y)) {
+        let ray = match self.rays.get(x, y) {
+            Some(Projector::Straight(ray)) => Some(*ray),
+            Some(Projector::Polyline(points)) => Some(polyline_segment(points, visible.segment)),
+            _ => None,
+        };
+        match (self.options.shading, self.caster, ray) {
             (Shading::Flat, _, _) if flat => base(),
             (_, Some(caster), Some(ray)) => {
                 let hit = Hit {
@@ -123,7 +161,7 @@ impl Shader<'_> {
                     triangle,
                     barycentric: visible.barycentric,
                 };
-                caster.shade_hit(ray, hit, self.options)
+                caster.shade_hit(&ray, hit, self.options)
             }
             // Unreachable by construction (the caster exists whenever shading needs it, and
             // a visible fragment's pixel has a projector); the base colour is the safe
@@ -180,6 +218,13 @@ impl TrianglePlane {
     /// every depth test. Such a hit counts, as in the ray caster, only where the origin lies
     /// inside the triangle (unclamped barycentrics).
     pub fn hit(&mut self, ray: &Ray) -> Option<(f64, f64, f64)> {
+        let (t, u, v) = self.hit_unclamped(ray)?;
+        let (u, v) = clamp(u, v);
+        Some((t, u, v))
+    }
+
+    /// [`TrianglePlane::hit`] before the barycentrics are clamped onto the triangle.
+    pub fn hit_unclamped(&mut self, ray: &Ray) -> Option<(f64, f64, f64)> {
         let (e1, e2) = (self.e1, self.e2);
         let p = ray.direction.cross(e2);
         let det = e1.dot(p);
@@ -210,12 +255,18 @@ impl TrianglePlane {
         if t <= 0.0 && !(u_plane >= 0.0 && v_plane >= 0.0 && u_plane + v_plane <= 1.0) {
             return None;
         }
-        let (mut u, mut v) = (u_plane.max(0.0), v_plane.max(0.0));
-        if u + v > 1.0 {
-            let sum = u + v;
-            (u, v) = (u / sum, v / sum);
-        }
-        Some((t, u, v))
+        Some((t, u_plane, v_plane))
+    }
+}
+
+/// Barycentrics (u, v) clamped onto the triangle: negative ones to 0, then a sum above 1
+/// scaled down to 1.
+fn clamp(u: f64, v: f64) -> (f64, f64) {
+    let (u, v) = (u.max(0.0), v.max(0.0));
+    if u + v > 1.0 {
+        (u / (u + v), v / (u + v))
+    } else {
+        (u, v)
     }
 }
 

@@ -147,9 +147,13 @@ impl std::ops::AddAssign for PieceCounts {
 
 /// The one-line refusal of method raster for a projection of `kind` without an inverse.
 fn no_inverse(kind: &str, none: NoInverse) -> Error {
-    let why = none
-        .reason
-        .map_or_else(String::new, |reason| format!(": {reason}"));
+    let why = none.reason.map_or_else(
+        || {
+            ": it maps pixels to rays only, with no inverse from a scene point to its pixel"
+                .to_string()
+        },
+        |reason| format!(": {reason}"),
+    );
     Error::new(format!(
         "method raster needs a projection with an analytic inverse; {kind} has none{why} \
          (use --method raycast)"
@@ -172,7 +176,8 @@ pub fn supported_chart(projection: &dyn Projection) -> Result<Charted<'_>> {
     let chart = &charted.chart;
     if chart.clip.len() > clip::MAX_PLANES {
         return Err(Error::new(format!(
-            "method raster: {kind} projection clips by {} planes, at most {} are supported",
+            "method raster: {kind} projection clips by {} planes, at most {} are supported \
+             (use --method raycast)",
             chart.clip.len(),
             clip::MAX_PLANES
         )));
@@ -192,7 +197,8 @@ impl<'a> InverseRaster<'a> {
         options.subdivision.validate()?;
         if options.spp != 1 {
             return Err(Error::new(format!(
-                "method raster renders one sample per pixel; got --spp {}",
+                "method raster renders one sample per pixel; got --spp {} (use --spp 1, or \
+                 --method raycast for more samples)",
                 options.spp
             )));
         }

@@ -2,37 +2,37 @@
 //! renderer: each fragment of the rasteriser reconstructs its scene point exactly by
 //! intersecting its pixel's projector with the plane of its scene triangle (see the
 //! `fragment` module), and looking the projector up is much cheaper than evaluating a
-//! nonlinear projection per fragment.
+//! nonlinear projection per fragment. Projectors are straight rays, or polylines for the
+//! polyline volumes between parallel planes that have an inverse.
 //!
-//! The image is cut into square tiles of [`TILE`] pixels; a tile's rays are computed the first
-//! time a fragment needs one of them (by whichever thread gets there first), so pixels that no
-//! scene triangle covers (the sky of a panorama) never cost a ray, and every later frame of
-//! the same projection finds them ready.
+//! The image is cut into square tiles of [`TILE`] pixels; a tile's projectors are computed
+//! the first time a fragment needs one of them (by whichever thread gets there first), so
+//! pixels that no scene triangle covers (the sky of a panorama) never cost a projector, and
+//! every later frame of the same projection finds them ready.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::OnceLock;
 
 use glam::{DVec2, DVec3};
 
-use crate::geometry::Ray;
-use crate::projection::Projection;
+use crate::projection::{Projection, Projector};
 
 /// Tile edge in pixels: a tile spans two bands of the fill (`band_fill::BAND_ROWS`, 8 rows),
 /// so a tile is computed by one thread and read by at most two.
 const TILE: u32 = 16;
 
-/// The centre rays of a projection's image, computed tile by tile on first use; `None` where
-/// the projection has no ray (outside a fisheye's circle).
+/// The centre projectors of a projection's image, computed tile by tile on first use;
+/// `None` where the projection has none (outside a fisheye's circle) or it has zero length.
 pub struct PixelRays<'a> {
     projection: &'a dyn Projection,
     size: (u32, u32),
     tiles_x: u32,
-    tiles: Vec<OnceLock<Box<[Option<Ray>]>>>,
+    tiles: Vec<OnceLock<Box<[Option<Projector>]>>>,
     computed: AtomicU64,
 }
 
 impl<'a> PixelRays<'a> {
-    /// The (still empty) rays of `projection`'s image.
+    /// The (still empty) projectors of `projection`'s image.
     pub fn new(projection: &'a dyn Projection) -> Self {
         let (width, height) = projection.resolution();
         let tiles_x = width.div_ceil(TILE);
@@ -46,8 +46,8 @@ impl<'a> PixelRays<'a> {
         }
     }
 
-    /// The ray through the centre of pixel `(x, y)` (inside the image).
-    pub fn get(&self, x: u32, y: u32) -> Option<&Ray> {
+    /// The projector through the centre of pixel `(x, y)` (inside the image).
+    pub fn get(&self, x: u32, y: u32) -> Option<&Projector> {
         let (tx, ty) = (x / TILE, y / TILE);
         let tile = self.tiles[(ty * self.tiles_x + tx) as usize].get_or_init(|| self.tile(tx, ty));
         tile[((y % TILE) * TILE + x % TILE) as usize].as_ref()
@@ -58,8 +58,8 @@ impl<'a> PixelRays<'a> {
         self.computed.load(Ordering::Relaxed)
     }
 
-    /// The rays of tile `(tx, ty)`, row-major; `None` past the image's edge.
-    fn tile(&self, tx: u32, ty: u32) -> Box<[Option<Ray>]> {
+    /// The projectors of tile `(tx, ty)`, row-major; `None` past the image's edge.
+    fn tile(&self, tx: u32, ty: u32) -> Box<[Option<Projector>]> {
         self.computed.fetch_add(1, Ordering::Relaxed);
         let (width, height) = self.size;
         (0..TILE * TILE)
@@ -69,9 +69,11 @@ impl<'a> PixelRays<'a> {
                     return None;
                 }
                 let centre = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-                self.projection
-                    .ray(centre)
-                    .filter(|r| r.direction != DVec3::ZERO)
+                self.projection.projector(centre).filter(|p| match p {
+                    Projector::Straight(r) => r.direction != DVec3::ZERO,
+                    Projector::Polyline(points) => points.windows(2).any(|w| w[0] != w[1]),
+                    Projector::QuadraticBezier(_) => true,
+                })
             })
             .collect()
     }
@@ -96,7 +98,7 @@ mod tests {
         let rays = PixelRays::new(projection.as_ref());
         assert_eq!(rays.computed_tiles(), 0);
         for (x, y) in [(0, 0), (39, 19), (20, 10), (33, 2)] {
-            let want = projection.ray(DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5));
+            let want = projection.projector(DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5));
             assert_eq!(rays.get(x, y), want.as_ref(), "({x}, {y})");
         }
         // Corners outside the fisheye's circle have no ray.

@@ -214,7 +214,8 @@ fn projections_without_a_chart_are_refused_in_one_line() {
         e.message,
         "method raster needs a projection with an analytic inverse; flexible has none: its \
          near and far control surfaces are outside the scanline class (planes sharing a \
-         normal, nested spheres or coaxial cylinders, both of one type) (use --method raycast)"
+         normal, a plane and a long scene's warped plane, nested spheres or coaxial \
+         cylinders) (use --method raycast)"
     );
 }
 

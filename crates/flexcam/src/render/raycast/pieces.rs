@@ -17,6 +17,15 @@ pub(in crate::render) fn polyline_segment(points: &[DVec3], k: usize) -> Ray {
     }
 }
 
+/// The length of polyline `points` before its segment `k`: the sum of the lengths of
+/// segments 0 to k - 1, in order. Computed only for the segment that hits, not as the search
+/// passes each segment (most projectors hit nothing).
+pub(in crate::render) fn length_before(points: &[DVec3], k: usize) -> f64 {
+    points[..=k]
+        .windows(2)
+        .fold(0.0, |sum, pair| sum + (pair[1] - pair[0]).length())
+}
+
 /// Pieces the curve is cut into for the BVH search: more pieces give thinner fattened chords
 /// (the padding falls as 1/PIECES^2), boxes that fewer triangles overlap, and fewer triangles
 /// tested beyond the first hit, but more traversals and more piece boxes in the tile culls.

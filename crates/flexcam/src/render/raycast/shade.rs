@@ -9,7 +9,7 @@
 use glam::{DVec3, Vec3};
 
 use super::hull_cull::LiveParts;
-use super::pieces::polyline_segment;
+use super::pieces::{length_before, polyline_segment};
 use crate::geometry::Ray;
 use crate::projection::projector::{quadratic_arc_length, quadratic_point, quadratic_tangent};
 use crate::projection::Projector;
@@ -43,14 +43,6 @@ pub(super) fn tangent_ray(p: &[DVec3; 3], s: f64) -> Ray {
     }
 }
 
-/// The length of polyline `points` before its segment `k`: the sum of the lengths of
-/// segments 0 to k - 1, in order. Computed only for the segment that hits, not as the search
-/// passes each segment (most projectors hit nothing).
-pub(super) fn length_before(points: &[DVec3], k: usize) -> f64 {
-    points[..=k]
-        .windows(2)
-        .fold(0.0, |sum, pair| sum + (pair[1] - pair[0]).length())
-}
 /// Traces primary rays of one render; counts what it casts.
 pub(super) struct Tracer<'a> {
     /// Shades the hits and counts every ray cast.

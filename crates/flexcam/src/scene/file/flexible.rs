@@ -7,6 +7,7 @@
 use std::f64::consts::PI;
 use std::ops::Range;
 use std::path::Path;
+use std::sync::Arc;
 
 use glam::{DVec2, DVec3};
 use toml::Spanned;
@@ -17,7 +18,7 @@ use super::raw::{RawProjection, RawSurface};
 use super::source::Source;
 use crate::error::Result;
 use crate::projection::flexible::presets::{
-    DeepArea, DepthStyle, Magnifier, DEPTH_STYLE_NAMES, PRESET_NAMES,
+    DdocMap, DeepArea, DepthStyle, Magnifier, DEPTH_STYLE_NAMES, PRESET_NAMES,
 };
 use crate::projection::flexible::reparam::{DEFAULT_MERCATOR_LATITUDE, REPARAM_NAMES};
 use crate::projection::flexible::{
@@ -26,7 +27,7 @@ use crate::projection::flexible::{
 };
 
 /// Every key of a flexible table (besides `type`).
-pub(super) const KEYS: [&str; 47] = [
+pub(super) const KEYS: [&str; 50] = [
     "preset",
     "position",
     "look_at",
@@ -74,6 +75,9 @@ pub(super) const KEYS: [&str; 47] = [
     "magnification",
     "deep",
     "pieces",
+    "z_near",
+    "z_far",
+    "map",
 ];
 
 /// Keys every preset accepts (but `up` for the axonometric one, which is always +y).
@@ -127,6 +131,7 @@ fn preset_keys(name: &str) -> &'static [&'static str] {
         "mcop" => &["directions", "path", "v_fov"],
         "long_scene" => &["width", "v_fov", "deep"],
         "magnifier" => &["fov", "center", "radius", "magnification"],
+        "ddoc" => &["fov", "z_near", "z_far", "map"],
         _ => &["h_fov", "v_fov"],
     }
 }
@@ -195,7 +200,7 @@ pub(super) fn convert(required: &Required, base_dir: &Path) -> Result<FlexibleSp
                     takes.join(", ")
                 )
             })?;
-            let source = VolumeSource::Preset(preset(required, name.get_ref())?);
+            let source = VolumeSource::Preset(preset(required, name.get_ref(), base_dir)?);
             match &raw.perspective_rect {
                 None => source,
                 Some(rect) => super::panorama::perspective_rect(src, &source, rect)?,
@@ -587,8 +592,9 @@ fn converge(required: &Required) -> Result<DVec3> {
     }
 }
 
-/// A preset with its camera frame and parameters (already checked to belong to it).
-fn preset(required: &Required, name: &str) -> Result<PresetSpec> {
+/// A preset with its camera frame and parameters (already checked to belong to it); a
+/// `ddoc` map file is found in `base_dir`.
+fn preset(required: &Required, name: &str, base_dir: &Path) -> Result<PresetSpec> {
     let src = required.src;
     let raw = required.raw();
     let number = |v: &Option<Spanned<f64>>, key: &str| -> Result<f64> {
@@ -722,6 +728,18 @@ fn preset(required: &Required, name: &str) -> Result<PresetSpec> {
                 }
             },
         },
+        "ddoc" => Preset::Ddoc {
+            fov: number(&raw.fov, "fov")?,
+            z_near: number(&raw.z_near, "z_near")?,
+            z_far: number(&raw.z_far, "z_far")?,
+            map: match &raw.map {
+                None => None,
+                Some(name) => {
+                    let path = src.existing_file(name, base_dir, "ddoc map")?;
+                    Some(Arc::new(DdocMap::read(&path)?))
+                }
+            },
+        },
         _ => Preset::Magnifier {
             fov: number(&raw.fov, "fov")?,
             lens: Magnifier {
@@ -755,7 +773,7 @@ fn style(src: &Source, raw: &RawProjection) -> Result<DepthStyle> {
 }
 
 /// Builds the volume and map of the presets whose parameters are only checked then (the
-/// depth transitions, occlusion, mcop, long scene, magnifier) at a nominal aspect ratio, so that a bad value is
+/// depth transitions, occlusion, mcop, long scene, magnifier, ddoc) at a nominal aspect ratio, so that a bad value is
 /// reported at its key: the first present key (the preset's own, then `up`, `clip`,
 /// `position`, `look_at`) named in the message, else the preset name.
 fn check_preset(src: &Source, raw: &RawProjection, spec: &PresetSpec) -> Result<()> {
@@ -767,6 +785,7 @@ fn check_preset(src: &Source, raw: &RawProjection, spec: &PresetSpec) -> Result<
             | Preset::Mcop { .. }
             | Preset::LongScene { .. }
             | Preset::Magnifier { .. }
+            | Preset::Ddoc { .. }
     );
     if !checked_late {
         return Ok(());

@@ -175,6 +175,9 @@ pub struct RawProjection {
     pub pieces: Option<Spanned<Vec<Spanned<RawProjection>>>>,
     #[serde(default, deserialize_with = "strict")]
     pub rect: Option<Spanned<[f64; 4]>>,
+    pub z_near: Option<Spanned<f64>>,
+    pub z_far: Option<Spanned<f64>>,
+    pub map: Option<Spanned<String>>,
 }
 
 /// `[projection.interpolate]` of a flexible projection: `weight` Q1 + (1 - `weight`) Q2 of the
@@ -528,6 +531,9 @@ impl RawProjection {
             ("deep", self.deep.as_ref().map(Spanned::span)),
             ("pieces", self.pieces.as_ref().map(Spanned::span)),
             ("rect", self.rect.as_ref().map(Spanned::span)),
+            ("z_near", self.z_near.as_ref().map(Spanned::span)),
+            ("z_far", self.z_far.as_ref().map(Spanned::span)),
+            ("map", self.map.as_ref().map(Spanned::span)),
         ]
         .into_iter()
         .filter_map(|(key, span)| Some((key, span?)))

@@ -201,7 +201,7 @@ fn a_piece_without_an_inverse_is_named() {
                 Preset::OrthoNearPerspFar {
                     fov: 40.0,
                     transition: 2.0,
-                    style: crate::projection::flexible::DepthStyle::Piecewise,
+                    style: crate::projection::flexible::DepthStyle::Quadratic,
                 },
                 Some([0.0, 10.0]),
             ),
@@ -213,7 +213,7 @@ fn a_piece_without_an_inverse_is_named() {
         reason.starts_with("piece 2 (rect [0.5, 0.0, 1.0, 1.0])"),
         "{reason}"
     );
-    assert!(reason.contains("polylines"), "{reason}");
+    assert!(reason.contains("Bezier curves"), "{reason}");
 }
 
 /// A perspective half, an orthographic quarter and a twisted quarter, with a gap: every

@@ -251,6 +251,51 @@ mod tests {
         assert!(spread < 0.0, "{spread}");
     }
 
+    /// Two deep areas 0.08 image widths wide at u = 0.3 and 0.7, seen at 30 degrees.
+    fn two_streets() -> Flexible {
+        let area = |center| DeepArea {
+            center,
+            width: 0.08,
+            fov: 30.0,
+        };
+        street(vec![area(0.3), area(0.7)], None)
+    }
+
+    proptest::proptest! {
+        /// The inverse of the long scene (a parallel-planes inverse per piece of the far
+        /// surface) returns every point Q(u, v, t) of the volume to its pixel and t, in the
+        /// deep areas, on their edges (the knots) and between them.
+        #[test]
+        fn the_inverse_returns_each_volume_point_to_its_pixel(
+            x in 0.0f64..720.0,
+            y in 0.0f64..180.0,
+            t in 0.001f64..1.0,
+            knot in proptest::bool::ANY,
+        ) {
+            let long = two_streets();
+            // Half the cases exactly on a knot column (an area's edge, 0.3 - 0.04 of 720).
+            let x = if knot { 187.2 } else { x };
+            let pixel = DVec2::new(x, y);
+            let point = long.point(pixel, t).unwrap();
+            let inverse = long.inverse().unwrap();
+            let mut images = Vec::new();
+            inverse.project(point, &mut images);
+            proptest::prop_assert_eq!(images.len(), 1);
+            let image = images[0];
+            proptest::prop_assert!((image.pixel - pixel).length() < 1e-6, "{} {}", image.pixel, pixel);
+            proptest::prop_assert!((image.t - t).abs() < 1e-9, "{} {}", image.t, t);
+        }
+    }
+
+    /// Raster has a continuous chart for the long scene: the pieces agree on their clip
+    /// planes and orientation.
+    #[test]
+    fn the_long_scene_has_a_chart() {
+        let long = two_streets();
+        let charted = long.inverse().unwrap().charted();
+        assert!(charted.is_some());
+    }
+
     #[test]
     fn without_deep_areas_the_far_surface_is_the_pushbroom_s() {
         let knots = far_knots(10.0, 0.0, 30.0, &[]).unwrap();

@@ -41,6 +41,8 @@
 //! - MCOP: the columns of a camera path ([`mcop`]);
 //! - long scene: the pushbroom with its far surface re-parameterised so that deep areas are
 //!   seen in perspective ([`long_scene`]);
+//! - depth-discontinuity occlusion camera: the perspective whose far samples are moved by a
+//!   displacement map, bending between two depths ([`ddoc`]);
 //! - magnifier: the perspective volume under a circular magnifying re-parameterisation
 //!   ([`lens`]).
 //!
@@ -48,6 +50,7 @@
 //! start where the single-viewpoint projections start theirs.
 
 mod axonometric;
+pub mod ddoc;
 pub mod depth_transition;
 mod glc;
 pub mod lens;
@@ -73,6 +76,7 @@ use super::panorama::{OutlineShape, PanoramaShape, PanoramaSpec, ProfileShape};
 use super::reparam::Reparam;
 use super::volume::Volume;
 use crate::error::{Error, Result};
+pub use ddoc::{DdocMap, DisplacedRectangle};
 use depth_transition::Station;
 pub use depth_transition::{DepthStyle, DEPTH_STYLE_NAMES};
 pub use lens::Magnifier;
@@ -248,6 +252,19 @@ pub enum Preset {
         /// The areas seen in perspective across.
         deep: Vec<DeepArea>,
     },
+    /// The depth-discontinuity occlusion camera: the perspective of `fov` up to `z_near`,
+    /// its samples beyond `z_far` seen displaced by `map` (`None`: no displacement, the
+    /// perspective), the projectors bending in between; see [`ddoc`].
+    Ddoc {
+        /// Horizontal angle of view, degrees.
+        fov: f64,
+        /// Distance where the bend starts, world units.
+        z_near: f64,
+        /// Distance where the displacement is complete, world units.
+        z_far: f64,
+        /// The displacement of the far samples, image fractions.
+        map: Option<Arc<DdocMap>>,
+    },
     /// The perspective of `fov` seen through a circular magnifying lens; see [`lens`].
     Magnifier {
         /// Horizontal angle of view, degrees.
@@ -258,7 +275,7 @@ pub enum Preset {
 }
 
 /// The preset names of scene files, in order.
-pub const PRESET_NAMES: [&str; 21] = [
+pub const PRESET_NAMES: [&str; 22] = [
     "perspective",
     "inverse_perspective",
     "orthographic",
@@ -280,6 +297,7 @@ pub const PRESET_NAMES: [&str; 21] = [
     "mcop",
     "long_scene",
     "magnifier",
+    "ddoc",
 ];
 
 /// A preset placed in the scene.
@@ -319,6 +337,7 @@ impl Preset {
             Preset::Mcop { .. } => "mcop",
             Preset::LongScene { .. } => "long_scene",
             Preset::Magnifier { .. } => "magnifier",
+            Preset::Ddoc { .. } => "ddoc",
         }
     }
 
@@ -518,6 +537,42 @@ impl PresetSpec {
                     Some(knots),
                 )?))
             }
+            Preset::Ddoc {
+                fov,
+                z_near,
+                z_far,
+                map,
+            } => {
+                let tan = half_tan("fov", *fov)?;
+                ddoc::check_depths(*z_near, *z_far)?;
+                let (near, far) = (place.near, place.far);
+                if !(near < *z_near && *z_far < far) {
+                    return Err(Error::new(format!(
+                        "flexible ddoc z_near and z_far must lie strictly between the near and \
+                         far clip distances ({near}, {far}), got {z_near} and {z_far}"
+                    )));
+                }
+                let half = |d: f64| DVec2::new(d * tan, d * tan * aspect);
+                let rect = |d: f64| place.rect(d, half(d), DVec2::ZERO);
+                let displaced = |d: f64| match map {
+                    None => rect(d),
+                    Some(map) => {
+                        let [corner, u_edge, v_edge] = place.rect_edges(d, half(d), DVec2::ZERO);
+                        Surface::Displaced(Box::new(DisplacedRectangle {
+                            corner,
+                            u_edge,
+                            v_edge,
+                            map: map.clone(),
+                        }))
+                    }
+                };
+                let surfaces = vec![rect(near), rect(*z_near), displaced(*z_far), displaced(far)];
+                let knots = place.knots(&[near, *z_near, *z_far, far]);
+                Ok(Volume::Piecewise(PiecewiseVolume::new(
+                    surfaces,
+                    Some(knots),
+                )?))
+            }
             _ => {
                 let (near, far) = self.surfaces(aspect)?;
                 Ok(Volume::Linear(Box::new(LinearVolume::new(near, far)?)))
@@ -540,7 +595,8 @@ impl PresetSpec {
         Ok(match *p {
             Preset::OrthoNearPerspFar { .. }
             | Preset::DepthTransition { .. }
-            | Preset::Occlusion { .. } => {
+            | Preset::Occlusion { .. }
+            | Preset::Ddoc { .. } => {
                 return Err(Error::new(format!(
                     "flexible {} is made of more than two control surfaces",
                     p.name()

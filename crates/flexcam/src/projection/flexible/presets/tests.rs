@@ -446,7 +446,7 @@ fn curved_presets_are_refused_by_method_raster() {
         Preset::DepthTransition {
             fovs: vec![60.0, 30.0],
             transitions: vec![5.0],
-            style: DepthStyle::Piecewise,
+            style: DepthStyle::Quadratic,
         },
         Preset::Occlusion {
             fov: 60.0,
@@ -463,4 +463,187 @@ fn curved_presets_are_refused_by_method_raster() {
             "{e}"
         );
     }
+}
+
+fn ddoc(map: Option<DdocMap>) -> Flexible {
+    let preset = Preset::Ddoc {
+        fov: 60.0,
+        z_near: 4.0,
+        z_far: 8.0,
+        map: map.map(Arc::new),
+    };
+    flexible(preset, [0.5, 20.0], 40, 30)
+}
+
+fn constant_map(d: DVec2) -> DdocMap {
+    DdocMap::new(4, 3, vec![d; 12]).unwrap()
+}
+
+/// With a zero map (or none) every projector of the DDOC lies on the perspective's ray: the
+/// directions of its three segments agree with the perspective preset's to 1e-9, and it
+/// starts where the perspective does.
+#[test]
+fn a_zero_ddoc_map_is_the_perspective() {
+    let perspective = flexible(Preset::Perspective { fov: 60.0 }, [0.5, 20.0], 40, 30);
+    for f in [ddoc(Some(constant_map(DVec2::ZERO))), ddoc(None)] {
+        for (x, y) in [(0.5, 0.5), (13.25, 7.5), (20.0, 15.0), (39.5, 29.5)] {
+            let pixel = DVec2::new(x, y);
+            let ray = perspective.ray(pixel).unwrap();
+            let Some(Projector::Polyline(points)) = f.projector(pixel) else {
+                panic!("a polyline projector at {pixel}");
+            };
+            assert_eq!(points.len(), 4);
+            assert!(close(points[0], ray.origin), "{pixel}");
+            let d = ray.direction.normalize();
+            for w in points.windows(2) {
+                let s = (w[1] - w[0]).normalize();
+                assert!((s - d).length() < 1e-9, "{pixel}: {s} against {d}");
+            }
+            assert!(close(points[3], ray.origin + ray.direction), "{pixel}");
+        }
+    }
+}
+
+/// A constant map m: up to z_near the projector is the perspective's; from z_far on it is
+/// the perspective ray through image position q - m (a line through the eye).
+#[test]
+fn a_ddoc_map_moves_the_far_samples() {
+    let m = DVec2::new(0.05, -0.02);
+    let f = ddoc(Some(constant_map(m)));
+    let perspective = flexible(Preset::Perspective { fov: 60.0 }, [0.5, 20.0], 40, 30);
+    let b = basis();
+    for (x, y) in [(3.5, 4.5), (20.0, 15.0), (35.25, 28.0)] {
+        let pixel = DVec2::new(x, y);
+        let Some(Projector::Polyline(points)) = f.projector(pixel) else {
+            panic!("a polyline projector at {pixel}");
+        };
+        let own = perspective.ray(pixel).unwrap();
+        let depth = |p: DVec3| b.to_local(p - b.origin).z;
+        let on = |ray: &crate::geometry::Ray, p: DVec3| {
+            let t = (depth(p) - depth(ray.origin)) / b.to_local(ray.direction).z;
+            close(ray.at(t), p)
+        };
+        assert!(on(&own, points[1]) && (depth(points[1]) - 4.0).abs() < 1e-9);
+        // q - m in pixels: u right, v up (y down).
+        let moved = pixel - DVec2::new(m.x * 40.0, -m.y * 30.0);
+        let far = perspective.ray(moved).unwrap();
+        assert!(on(&far, points[2]) && on(&far, points[3]), "{pixel}");
+        assert!((depth(points[2]) - 8.0).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn ddoc_parameters_are_checked_and_raster_refused_with_the_reason() {
+    let cases = [
+        ((4.0, 3.0), "0 < z_near < z_far"),
+        ((0.2, 8.0), "strictly between the near and far clip"),
+        ((4.0, 30.0), "strictly between the near and far clip"),
+    ];
+    for ((z_near, z_far), expected) in cases {
+        let preset = Preset::Ddoc {
+            fov: 60.0,
+            z_near,
+            z_far,
+            map: None,
+        };
+        let e = spec(preset, [0.5, 20.0])
+            .volume(ASPECT)
+            .unwrap_err()
+            .message;
+        assert!(e.contains(expected), "{e} (expected {expected})");
+    }
+    let e = supported_chart(&ddoc(Some(constant_map(DVec2::ZERO)))).unwrap_err();
+    assert!(
+        e.message.contains("displaced by a sampled map")
+            && e.message.ends_with("(use --method raycast)"),
+        "{e}"
+    );
+}
+
+/// The piecewise depth volumes: polylines through coaxial rectangles.
+fn piecewise_depth_presets() -> [Preset; 2] {
+    [
+        Preset::OrthoNearPerspFar {
+            fov: 50.0,
+            transition: 4.0,
+            style: DepthStyle::Piecewise,
+        },
+        Preset::DepthTransition {
+            fovs: vec![60.0, 20.0, 45.0],
+            transitions: vec![5.0, 9.0],
+            style: DepthStyle::Piecewise,
+        },
+    ]
+}
+
+proptest! {
+    /// The inverse of a polyline volume between parallel planes (one parallel-planes inverse
+    /// per segment, picked by depth) returns every point Q(u, v, t) to its pixel and t, also
+    /// on the stations where the segments meet.
+    #[test]
+    fn piecewise_depth_inverse_returns_each_point_to_its_pixel(
+        x in 0.0f64..40.0,
+        y in 0.0f64..30.0,
+        t in 0.0f64..1.0,
+        on_station in proptest::bool::ANY,
+        which in 0usize..2,
+    ) {
+        let preset = piecewise_depth_presets()[which].clone();
+        // clip [1, 20]: the transition at 4 m is at t = 3 / 19.
+        let t = if on_station { 3.0 / 19.0 } else { t };
+        let f = flexible(preset, [1.0, 20.0], 40, 30);
+        let pixel = DVec2::new(x, y);
+        let point = f.point(pixel, t).unwrap();
+        let mut images = Vec::new();
+        f.inverse().unwrap().project(point, &mut images);
+        prop_assert_eq!(images.len(), 1);
+        prop_assert!((images[0].pixel - pixel).length() < 1e-6, "{} {}", images[0].pixel, pixel);
+        prop_assert!((images[0].t - t).abs() < 1e-9, "{} {}", images[0].t, t);
+    }
+}
+
+/// Both piecewise depth volumes have a chart for the raster; a transition whose station
+/// degenerates (perspective views meeting at a point inside the volume) has none; surfaces
+/// going back, not flat or not parallel have no layered inverse.
+#[test]
+fn piecewise_depth_volumes_have_a_chart() {
+    for preset in piecewise_depth_presets() {
+        let f = flexible(preset, [1.0, 20.0], 16, 12);
+        assert!(supported_chart(&f).is_ok());
+    }
+    // A near station of width 0 inside the volume (clip from 0 with a first view ending at
+    // the eye's own point is the only way to reach it through a preset): surfaces given by
+    // hand instead, a rectangle, a point and a rectangle along one axis.
+    let rect = |z: f64, h: f64| Surface::Rectangle {
+        corner: DVec3::new(-h, -h, z),
+        u_edge: DVec3::new(2.0 * h, 0.0, 0.0),
+        v_edge: DVec3::new(0.0, 2.0 * h, 0.0),
+    };
+    use super::super::inverse::Inverse;
+    let knots = [0.0, 0.5, 1.0];
+    let pinched = vec![rect(0.0, 1.0), rect(2.0, 0.0), rect(4.0, 1.0)];
+    let inverse = Inverse::classify_layers(&pinched, &knots).expect("parallel planes in order");
+    let resolution = crate::projection::image_coords::Resolution::new(16, 12).unwrap();
+    assert!(inverse.chart(&Reparam::Linear, &resolution).is_none());
+    // No inverse: planes that go back along the axis (a projector would cross a depth
+    // twice), a surface that is not flat, planes that are not parallel.
+    let back = vec![rect(0.0, 1.0), rect(4.0, 2.0), rect(2.0, 3.0)];
+    assert!(Inverse::classify_layers(&back, &knots).is_none());
+    let bent = Surface::Bilinear {
+        corners: [
+            DVec3::new(-1.0, -1.0, 2.0),
+            DVec3::new(1.0, -1.0, 2.0),
+            DVec3::new(1.0, 1.0, 3.0),
+            DVec3::new(-1.0, 1.0, 2.0),
+        ],
+    };
+    let curved = vec![rect(0.0, 1.0), bent, rect(4.0, 1.0)];
+    assert!(Inverse::classify_layers(&curved, &knots).is_none());
+    let tilted = Surface::Rectangle {
+        corner: DVec3::new(-1.0, -1.0, 4.0),
+        u_edge: DVec3::new(2.0, 0.0, 1.0),
+        v_edge: DVec3::new(0.0, 2.0, 0.0),
+    };
+    let turned = vec![rect(0.0, 1.0), rect(2.0, 1.0), tilted];
+    assert!(Inverse::classify_layers(&turned, &knots).is_none());
 }
