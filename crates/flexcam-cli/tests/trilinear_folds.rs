@@ -165,8 +165,9 @@ fn sphere_glass_splits_the_pairs_whose_rays_cross() {
 }
 
 /// Detail in context with the base plane inside the scene (`magnification = 1.5`: the plane
-/// 6.7 from the eye, the floor reaching through it), either focus: no parametric triangle
-/// degenerates there (nothing is split), but floor vertices lying on the base plane get
+/// 6.7 from the eye, the floor reaching through it), either focus (the inverse focus's
+/// converging rays degenerate inside the scene, and its pairs there are split): floor
+/// vertices lying on the base plane get
 /// cubics whose roots lost to infinity differ in number from their neighbours' by rounding
 /// (rays parallel in the focus, a smoothstep weight of nearly 0 at its edge: `a` and `b`
 /// vanish or nearly), so their pairs are unprojectable (`OpenAtInfinity`) and those
@@ -183,7 +184,6 @@ fn detail_in_context_with_the_base_plane_inside_the_scene() {
         let dir = TempDir::new().unwrap();
         let path = variant(&dir, name, from, "magnification = 1.5");
         let (stats, agreement) = trilinear_against_raycast(&path);
-        assert_eq!(stats["split_pairs"], 0, "{name}: {stats}");
         assert!(
             stats["unprojectable"].as_u64().unwrap() > 0,
             "{name}: {stats}"

@@ -215,7 +215,7 @@ fn tessellation_factors_converge_on_the_ray_caster() {
     }
 }
 
-const SWEEP_COLUMNS: [&str; 12] = [
+const SWEEP_COLUMNS: [&str; 13] = [
     "n",
     "projections",
     "width",
