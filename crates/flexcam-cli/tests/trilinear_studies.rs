@@ -215,7 +215,7 @@ fn tessellation_factors_converge_on_the_ray_caster() {
     }
 }
 
-const SWEEP_COLUMNS: [&str; 12] = [
+const SWEEP_COLUMNS: [&str; 13] = [
     "n",
     "projections",
     "width",
@@ -226,6 +226,7 @@ const SWEEP_COLUMNS: [&str; 12] = [
     "interior_pixels",
     "rgb_error",
     "shapes",
+    "split_pairs",
     "fallback_triangles",
     "thesis_ms",
 ];
@@ -258,7 +259,8 @@ fn reflection_sweep_converges_on_the_exact_mirror_ball() {
 }
 
 /// The refraction sweep: the glass ball's grid against the exact glass ball; the error falls
-/// with N, and the projection triangles whose rays cross inside the scene are counted.
+/// with N, and the pairs reaching across a depth where the rays of a projection triangle
+/// cross inside the scene are split there and counted, none ray cast.
 #[test]
 fn refraction_sweep_converges_on_the_exact_glass_ball() {
     let rows = table("--sweep", "refraction", 96, &["--quick"], &SWEEP_COLUMNS);
@@ -268,8 +270,10 @@ fn refraction_sweep_converges_on_the_exact_glass_ball() {
         "{errors:?}"
     );
     assert!(number(&rows[2], "ids_interior") >= 0.99, "{rows:?}");
+    let split: f64 = rows.iter().map(|r| number(r, "split_pairs")).sum();
+    assert!(split > 0.0, "{rows:?}");
     let fallback: f64 = rows.iter().map(|r| number(r, "fallback_triangles")).sum();
-    assert!(fallback > 0.0, "{rows:?}");
+    assert_eq!(fallback, 0.0, "{rows:?}");
 }
 
 /// `--csv` and `--size` need a study or a sweep, and a study and a sweep do not go together.

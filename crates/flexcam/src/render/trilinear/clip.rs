@@ -50,6 +50,22 @@ pub fn clip_outline(points: &mut Vec<OutlinePoint>, scratch: &mut Vec<OutlinePoi
     }
 }
 
+/// Clips the closed outline `points` to the half-space where `inside` (affine in the
+/// outline's coordinates along every chord, as depth `t` and the barycentrics are) is
+/// `>= 0`, in place; `scratch` is reused storage. Where the outline's crossings with the
+/// clip plane are outline points themselves (anchors), the cut passes through them exactly.
+pub fn clip_to(
+    points: &mut Vec<OutlinePoint>,
+    scratch: &mut Vec<OutlinePoint>,
+    inside: impl Fn(&OutlinePoint) -> f64,
+) {
+    if points.iter().all(|p| inside(p) >= 0.0) {
+        return;
+    }
+    clip_half_space(points, scratch, inside);
+    std::mem::swap(points, scratch);
+}
+
 /// Whether `p` is in every one of [`HALF_SPACES`]: the same tests, written out so that the
 /// common case (an outline wholly inside) needs no call through the table.
 fn inside_every_half_space(p: &OutlinePoint) -> bool {
@@ -64,7 +80,7 @@ fn inside_every_half_space(p: &OutlinePoint) -> bool {
 fn clip_half_space(
     points: &[OutlinePoint],
     out: &mut Vec<OutlinePoint>,
-    inside: fn(&OutlinePoint) -> f64,
+    inside: impl Fn(&OutlinePoint) -> f64,
 ) {
     out.clear();
     let Some(&last) = points.last() else {

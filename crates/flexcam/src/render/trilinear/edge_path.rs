@@ -192,13 +192,15 @@ fn clear_of_roots([c2, c1, c0]: [f64; 3], lo: f64, hi: f64) -> bool {
 /// `2^levels` segments). The test at the middle depth alone can miss a curve that crosses its
 /// chord there (an S shape); the images of straight edges under a trilinear projection are
 /// rational curves of low degree in `t`, and the first split already removes such a crossing
-/// unless it sits exactly at the middle.
+/// unless it sits exactly at the middle. The first `forced` levels bisect without the test
+/// (near a degenerate depth the image swings far out and back within a piece, and the
+/// middle alone misses it: `degenerate_band`).
 pub fn refine(
     path: &EdgePath,
     map: &ScreenMap,
     (a, b): (OutlinePoint, OutlinePoint),
     tolerance: f64,
-    levels: u32,
+    (levels, forced): (u32, u32),
     out: &mut Vec<OutlinePoint>,
 ) {
     let t = 0.5 * (a.t + b.t);
@@ -206,7 +208,7 @@ pub fn refine(
         return;
     }
     if let Some(middle) = path.at(t) {
-        refine_around(path, map, (a, middle, b), tolerance, levels, out);
+        refine_around(path, map, (a, middle, b), tolerance, (levels, forced), out);
     }
 }
 
@@ -218,7 +220,7 @@ pub fn refine_around(
     map: &ScreenMap,
     (a, middle, b): (OutlinePoint, OutlinePoint, OutlinePoint),
     tolerance: f64,
-    levels: u32,
+    (levels, forced): (u32, u32),
     out: &mut Vec<OutlinePoint>,
 ) {
     if levels == 0 || middle.t == a.t || middle.t == b.t {
@@ -229,12 +231,13 @@ pub fn refine_around(
         map.pixel(b.u, b.v),
         map.pixel(middle.u, middle.v),
     );
-    if distance_to_segment(pm, pa, pb) <= tolerance {
+    if forced == 0 && distance_to_segment(pm, pa, pb) <= tolerance {
         return;
     }
-    refine(path, map, (a, middle), tolerance, levels - 1, out);
+    let next = (levels - 1, forced.saturating_sub(1));
+    refine(path, map, (a, middle), tolerance, next, out);
     out.push(middle);
-    refine(path, map, (middle, b), tolerance, levels - 1, out);
+    refine(path, map, (middle, b), tolerance, next, out);
 }
 
 /// Euclidean distance from `p` to the segment `a b` (to `a` when the segment is a point).
@@ -456,7 +459,7 @@ mod tests {
         };
         let (a, b) = (path.at(0.5).unwrap(), path.at(6.0).unwrap());
         let mut out = Vec::new();
-        refine(&path, &map, (a, b), 0.25, 10, &mut out);
+        refine(&path, &map, (a, b), 0.25, (10, 0), &mut out);
         assert!(!out.is_empty(), "the image of this edge is curved");
         // Every chord is within the tolerance at densely sampled depths.
         let mut points = vec![a];
@@ -476,7 +479,7 @@ mod tests {
         }
         // With no levels nothing is added; a straight image (orthographic) needs no sample.
         out.clear();
-        refine(&path, &map, (a, b), 0.25, 0, &mut out);
+        refine(&path, &map, (a, b), 0.25, (0, 0), &mut out);
         assert!(out.is_empty());
     }
 }

@@ -17,10 +17,11 @@
 //! Projection triangles whose rays fold are drawn so too (the sweep by depth covers each pixel
 //! once, see `projection::trilinear::point_projection::fold`); those whose rays meet in one
 //! point are drawn as central projections (`central`), and those with two equal vertices,
-//! which sweep no volume, as strips of one ray each (`ray_fan`). Unprojectable pairs (see
-//! `projection::Unprojectable`, and pairs with a shape reaching across a depth where the
-//! parametric triangle degenerates) are counted and their projection triangle is ray cast
-//! instead, so they never silently vanish; docs/trilinear-raster.md lists these cases.
+//! which sweep no volume, as strips of one ray each (`ray_fan`). A pair with a shape reaching
+//! across a depth where the parametric triangle degenerates is split at the depths around it
+//! (`degenerate_band`). Unprojectable pairs (see `projection::Unprojectable`) are counted and
+//! their projection triangle is ray cast instead, so they never silently vanish;
+//! docs/trilinear-raster.md lists these cases.
 
 mod central;
 mod clip;
@@ -28,6 +29,7 @@ mod clip;
 mod cull_tests;
 mod cull_tree;
 mod curves;
+mod degenerate_band;
 mod edge_path;
 mod gbuffer;
 mod hit_terms;
@@ -127,8 +129,8 @@ impl<'a> TrilinearRenderer<'a> {
     /// and rasterised, resolved and shaded once per sample of the ray caster's pattern
     /// (`SamplePattern`): the pixel averages its samples' colours and reports the depth and
     /// id of the sample nearest its centre, as the ray caster does. Errors: a mesh of more
-    /// than 2^32 projection triangles or a scene of more than 2^32 triangles (the fragment
-    /// keys), `frame` then left as it was; memory that cannot be had for a new frame, the
+    /// than 2^31 projection triangles or a scene of more than 2^32 triangles (the fragment
+    /// keys, whose top bit is `resolve::PIXEL_TESTED`), `frame` then left as it was; memory that cannot be had for a new frame, the
     /// scratch frame of several samples or the band buffers (module `try_alloc`).
     pub fn render_into(
         &self,
@@ -138,11 +140,11 @@ impl<'a> TrilinearRenderer<'a> {
         curves: CurveOptions,
     ) -> Result<Stats> {
         let mesh = projection.mesh();
-        if u32::try_from(mesh.triangles.len()).is_err()
+        if mesh.triangles.len() > (u32::MAX >> 1) as usize
             || u32::try_from(self.scene.triangles.len()).is_err()
         {
             return Err(Error::new(
-                "the trilinear method handles at most 2^32 projection and scene triangles",
+                "the trilinear method handles at most 2^31 projection and 2^32 scene triangles",
             ));
         }
         let start = Instant::now();
@@ -153,8 +155,8 @@ impl<'a> TrilinearRenderer<'a> {
         // is exact). Two kinds are not. One whose rays meet in one point at a depth the
         // scene reaches (its parametric triangle degenerates there, `degenerates_before`,
         // and the plane through the point is imaged at infinity) is drawn as a central
-        // projection (`central`); where it degenerates otherwise (to a segment), only the
-        // pairs with a shape reaching across that depth are ray cast (`polygons`). One that
+        // projection (`central`); where it degenerates otherwise (to a segment), the pairs
+        // with a shape reaching across that depth are split there (`degenerate_band`). One that
         // sweeps a surface, not a volume, projects no scene point and is drawn as a fan of
         // rays where two of its vertices are equal (`ray_fan`); the pixels of the others
         // are ray cast, and their pairs are not projected.

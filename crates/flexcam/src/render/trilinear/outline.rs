@@ -19,8 +19,13 @@ pub enum Sampling<'a> {
     Anchors,
     /// The given depths (the shape's slices, ascending), where they fall on the edge.
     Slices(&'a [f64]),
-    /// Bisection to the screen tolerance, at most `levels` deep (`edge_path::refine`).
-    Adaptive { tolerance: f64, levels: u32 },
+    /// Bisection to the screen tolerance, at most `levels` deep, the first `forced` levels
+    /// whatever the tolerance (`edge_path::refine`).
+    Adaptive {
+        tolerance: f64,
+        levels: u32,
+        forced: u32,
+    },
 }
 
 /// One projection triangle as the outline tracer needs it.
@@ -46,7 +51,8 @@ pub struct ProjectionTriangle {
     pub fan: Option<RayFan>,
     /// The depths at which its parametric triangle degenerates, first and last
     /// (`ProjectionTriangleCache::degenerate_depths`): a shape reaching across them has an
-    /// outline through infinity, and its pair is ray cast instead.
+    /// outline through infinity, and its pair is split at the depths around them
+    /// (`degenerate_band`).
     pub degenerate: Option<(f64, f64)>,
 }
 
@@ -70,8 +76,9 @@ impl ProjectionTriangle {
     }
 }
 
-/// At most one view-plane anchor and two crossings with each of three edge surfaces.
-const MAX_ANCHORS: usize = 7;
+/// At most one view-plane anchor, two crossings with each of three edge surfaces and the two
+/// ends of a degenerate band.
+const MAX_ANCHORS: usize = 9;
 
 /// The crossings of one scene triangle's three edges with one projection triangle's three
 /// edge surfaces (scene-space clipping's anchors), shared by every polygon edge of the
@@ -89,6 +96,9 @@ pub struct EdgeCrossings {
     quadratics: [[Option<CrossingQuadratic>; 3]; 3],
     /// Its roots, once a polygon edge needed them.
     roots: [[Option<Roots>; 3]; 3],
+    /// Depths at which every edge is anchored as well (the ends of a degenerate band, where
+    /// the outline is cut: `degenerate_band`).
+    depths: [Option<f64>; 2],
 }
 
 impl EdgeCrossings {
@@ -97,6 +107,17 @@ impl EdgeCrossings {
         EdgeCrossings {
             quadratics: [[None; 3]; 3],
             roots: [[None; 3]; 3],
+            depths: [None; 2],
+        }
+    }
+
+    /// The same crossings, with every polygon edge also anchored at the depths `lo` and
+    /// `hi` where it passes them (exact outline points there, so that a cut at either depth
+    /// passes through them).
+    pub fn anchored_at(self, (lo, hi): (f64, f64)) -> EdgeCrossings {
+        EdgeCrossings {
+            depths: [Some(lo), Some(hi)],
+            ..self
         }
     }
 
@@ -197,7 +218,7 @@ pub fn trace_outline(
 }
 
 /// The anchor depths strictly between `from` and `to`, in travel order (unused slots `None`):
-/// `t = 0` and the crossings of scene edge `edge` in `crossings`.
+/// `t = 0`, the crossings of scene edge `edge` in `crossings` and its anchoring depths.
 fn anchors(
     crossings: &mut EdgeCrossings,
     edge: SceneEdge,
@@ -214,6 +235,7 @@ fn anchors(
         }
     };
     crossings.each(edge, (lo, hi), &mut keep);
+    crossings.depths.iter().flatten().for_each(|&t| keep(t));
     keep(0.0);
     let slots = &mut found[..count];
     slots.sort_by(|x, y| x.unwrap_or(0.0).total_cmp(&y.unwrap_or(0.0)));
@@ -260,9 +282,18 @@ fn sample_piece(
                 out[before..].reverse();
             }
         }
-        Sampling::Adaptive { tolerance, levels } => {
-            refine_around(path, &triangle.map, (a, middle, b), tolerance, levels, out)
-        }
+        Sampling::Adaptive {
+            tolerance,
+            levels,
+            forced,
+        } => refine_around(
+            path,
+            &triangle.map,
+            (a, middle, b),
+            tolerance,
+            (levels, forced),
+            out,
+        ),
     }
 }
 

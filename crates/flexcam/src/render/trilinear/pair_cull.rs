@@ -39,6 +39,12 @@ pub struct PairCounts {
     /// Pairs (or tessellated sub-triangles) that could not be cut into shapes; their
     /// projection triangle is ray cast instead.
     pub unprojectable: u64,
+    /// Pairs with a shape reaching across a depth where the projection triangle's
+    /// parametric triangle degenerates, drawn split there (`degenerate_band`).
+    pub split_pairs: u64,
+    /// Pairs of such a projection triangle with no shapes (a scene vertex at the degenerate
+    /// depth itself), drawn pixel tested at every depth (`degenerate_band`).
+    pub tested_pairs: u64,
     /// Shapes formed.
     pub shapes: u64,
     /// Shapes with nothing left after clipping.
@@ -60,6 +66,8 @@ impl PairCounts {
         self.culled_outside += o.culled_outside;
         self.culled_zero_area += o.culled_zero_area;
         self.unprojectable += o.unprojectable;
+        self.split_pairs += o.split_pairs;
+        self.tested_pairs += o.tested_pairs;
         self.shapes += o.shapes;
         self.clipped_away += o.clipped_away;
         self.skipped_behind += o.skipped_behind;
@@ -77,6 +85,8 @@ impl PairCounts {
             ("culled_outside", self.culled_outside),
             ("culled_zero_area", self.culled_zero_area),
             ("unprojectable", self.unprojectable),
+            ("split_pairs", self.split_pairs),
+            ("tested_pairs", self.tested_pairs),
             ("shapes", self.shapes),
             ("clipped_away", self.clipped_away),
             ("skipped_behind", self.skipped_behind),

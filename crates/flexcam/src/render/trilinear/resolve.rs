@@ -26,6 +26,11 @@
 //!   fragment (`+ CRACK_FILL_DEPTH`), so that it never hides an exact fragment.
 //! - Behind the view plane, or a projector parallel to the plane: discarded.
 //!
+//! A polygon keyed with [`PIXEL_TESTED`] (the band of a pair split at a degenerate depth,
+//! `degenerate_band`) is not an outline of its scene triangle but a superset of where it may
+//! be seen: its fragments inside the triangle are exact hits like any other, and every
+//! fragment outside it is discarded (no neighbour, no crack filler: the pixel need not be
+//! near the triangle at all). The flag is taken off the key of a kept fragment.
 
 use glam::{DVec2, DVec3};
 
@@ -36,6 +41,10 @@ use crate::geometry::Ray;
 /// Added to the depth of crack fillers: behind any exact fragment (depths are ray
 /// parameters, far below this for any scene within the rasteriser's limits).
 pub(super) const CRACK_FILL_DEPTH: f64 = 1e200;
+
+/// The bit of a polygon's key that marks it as pixel tested (module doc). Keys are
+/// `projection << 32 | scene triangle`, and projection indices are far below `2^31`.
+pub(super) const PIXEL_TESTED: u64 = 1 << 63;
 
 /// Finds the hit of a keyed fragment (module doc).
 pub struct Resolver<'a> {
@@ -132,8 +141,9 @@ impl Resolver<'_> {
     ) -> Option<(u64, f64, DVec2)> {
         let (t, b1, b2) = solved;
         match Stage::of(solved) {
-            Stage::Exact => Some((key, t, DVec2::new(b1, b2))),
+            Stage::Exact => Some((key & !PIXEL_TESTED, t, DVec2::new(b1, b2))),
             Stage::Discarded => None,
+            Stage::Outside if key & PIXEL_TESTED != 0 => None,
             Stage::Outside => self.hit(key, self.position(x, y)).map(|hit| {
                 let behind = if hit.exact { 0.0 } else { CRACK_FILL_DEPTH };
                 (hit.key, hit.t + behind, hit.barycentric)

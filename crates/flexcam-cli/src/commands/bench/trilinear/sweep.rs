@@ -6,8 +6,9 @@
 //! and measured against the exact view (`-D projection.exact=true`: every pixel's ray from the
 //! ball itself) ray cast: object-id agreement away from id edges and the thesis's relative
 //! RGB error, against N. The interpolated rays' error falls about as 1 / N^2. The glass
-//! ball focuses its rays: the projection triangles whose rays cross where scene triangles lie
-//! are ray cast by the trilinear renderer (`fallback_triangles`, docs/trilinear-surfaces.md).
+//! ball focuses its rays: the pairs reaching across the depth where the rays of a projection
+//! triangle cross are split there by the trilinear renderer (`split_pairs`,
+//! docs/trilinear-raster.md); `fallback_triangles` counts what is still ray cast.
 
 use std::path::Path;
 
@@ -78,6 +79,7 @@ pub const COLUMNS: &[&str] = &[
     "interior_pixels",
     "rgb_error",
     "shapes",
+    "split_pairs",
     "fallback_triangles",
     "thesis_ms",
 ];
@@ -131,6 +133,7 @@ pub fn run(
             m.interior.1.to_string(),
             fixed(m.comparison.relative_rgb_error, 6),
             m.count("shapes").to_string(),
+            m.count("split_pairs").to_string(),
             m.count("fallback_triangles").to_string(),
             thesis,
         ]);
