@@ -67,8 +67,9 @@
 //! folded node, or one whose mirror does not lower the cost, is left to [`Problem::reseat`]
 //! (where the residual is above rounding: restarts with every length scaled by 1.25 and 0.8,
 //! and with the three nodes carrying most of the residual put back on the straight fit,
-//! kept if the cost drops by over [`RESTART_GAIN`] of itself), which repaired Bezier seed 14 (two nodes turned 0.8 and 1.0
-//! rad, not folded); bilinear and Bezier seed 12 (lengths short together, a shallow valley)
+//! kept if the cost drops by over [`RESTART_GAIN`] of itself), which repaired Bezier seed 14
+//! (two nodes turned 0.8 and 1.0 rad, not folded); bilinear and Bezier seed 12 (lengths short
+//! together, a shallow valley)
 //! are not repaired and are left to the report's residual (0.62 and 0.0028 degrees).
 //! Tried and not kept: a continuation in the data (from the straight start's own projectors
 //! to the points in 8 stages) with steps limited to 0.2 rad (the same 9 grids), and an
@@ -380,7 +381,7 @@ impl<'a> Problem<'a> {
     /// end's direction (an angle a off it becomes pi - a, on the same side: the tangent was
     /// folded), and if that does not lower the cost, the end's direction across the plane
     /// perpendicular to the tangent instead (the end was folded), solves again from there and
-    /// keeps the result when its cost is lower; at most [`MAX_UNFOLDS`] rounds.
+    /// keeps the result when it [`improves`] the cost; at most [`MAX_UNFOLDS`] rounds.
     fn unfold(&self, mut state: State) -> State {
         let mut cost = self.cost(&state, 0.0);
         for _ in 0..MAX_UNFOLDS {
@@ -407,8 +408,7 @@ impl<'a> Problem<'a> {
             let better = [true, false].into_iter().find_map(|tangent| {
                 let candidate = mirrored(tangent);
                 let candidate_cost = self.cost(&candidate, 0.0);
-                (candidate_cost < (1.0 - RESTART_GAIN) * cost)
-                    .then_some((candidate, candidate_cost))
+                improves(candidate_cost, cost).then_some((candidate, candidate_cost))
             });
             let Some(better) = better else {
                 break;
@@ -423,8 +423,8 @@ impl<'a> Problem<'a> {
     /// scaled by each of [`RESCALES`] (a minimum with the lengths off together: bilinear and
     /// Bezier seed 12), and the [`RESEAT_NODES`] nodes that carry most of the residual put
     /// back on the straight fit (a few nodes turned wrong: Bezier seed 14), each solved and
-    /// unfolded; keeps the lowest cost, repeats while the cost drops (at most
-    /// [`MAX_RESEATS`] rounds).
+    /// unfolded; keeps the lowest cost where it [`improves`] on the last, repeats while it
+    /// does (at most [`MAX_RESEATS`] rounds).
     fn reseat(&self, mut state: State) -> State {
         let mut cost = self.cost(&state, 0.0);
         for _ in 0..MAX_RESEATS {
@@ -464,9 +464,7 @@ impl<'a> Problem<'a> {
                 })
                 .min_by(|a, b| a.1.total_cmp(&b.1));
             match best {
-                Some((candidate, c)) if c < (1.0 - RESTART_GAIN) * cost => {
-                    (state, cost) = (candidate, c)
-                }
+                Some((candidate, c)) if improves(c, cost) => (state, cost) = (candidate, c),
                 _ => break,
             }
         }
@@ -758,6 +756,12 @@ impl<'a> Problem<'a> {
             ..FitReport::from_angles(&angles, grid.starts().len() - self.free.len())
         }
     }
+}
+
+/// Whether a restart's cost `candidate` lowers `cost` by over [`RESTART_GAIN`] of it, so
+/// that [`Problem::unfold`] and [`Problem::reseat`] keep it.
+fn improves(candidate: f64, cost: f64) -> bool {
+    candidate < (1.0 - RESTART_GAIN) * cost
 }
 
 /// J^T J, by a blocked matrix product (nalgebra's `tr_mul` forms it entry by entry, column
