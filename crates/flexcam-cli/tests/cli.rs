@@ -904,6 +904,46 @@ fn bench_trilinear_quick_prints_both_tables() {
     assert!(e.contains("--repeat"), "{e}");
 }
 
+/// `bench displaced --part table-8-1` prints Table 8.1's eleven rows, each with a time per
+/// camera position and the dissertation's three, and the transition system's speed-up over
+/// full displacement at both levels; nothing of the other parts.
+#[test]
+fn bench_displaced_table_8_1_prints_every_method() {
+    let dir = TempDir::new().unwrap();
+    let args = [
+        "bench",
+        "displaced",
+        "--part",
+        "table-8-1",
+        "--size",
+        "24",
+        "--repeat",
+        "1",
+    ];
+    let text = String::from_utf8(run_ok(&dir, &args).stdout).unwrap();
+    let rows: Vec<&str> = text
+        .lines()
+        .filter(|l| l.contains(" | ") && !l.starts_with("method"))
+        .collect();
+    assert_eq!(rows.len(), 11, "{text}");
+    for row in &rows {
+        let numbers = row
+            .split_whitespace()
+            .filter(|w| w.parse::<f64>().is_ok_and(|v| v > 0.0))
+            .count();
+        // Three times and the dissertation's three figures.
+        assert_eq!(numbers, 6, "{row}");
+    }
+    assert!(rows[0].starts_with("fully detailed LOD"), "{text}");
+    assert!(rows[10].starts_with("transition system (3)"), "{text}");
+    assert_eq!(
+        text.matches("transition system against full displacement")
+            .count(),
+        2
+    );
+    assert!(!text.contains("Figure 8.1"), "{text}");
+}
+
 /// `bench flexible --part table --rows 1` prints Table 7.1's four tables with the one row
 /// asked for, times named as medians, and with `--hash` one frame hash per column.
 #[test]

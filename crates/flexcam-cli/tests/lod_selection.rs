@@ -1,6 +1,7 @@
-//! `flexcam render --lod footprint|distance|finest` on the displaced torus: which level of
-//! detail the displacing rays trace (the `lod_*_samples` counters), and what that does to
-//! the image against the detailed mesh's.
+//! `flexcam render --lod footprint|distance|finest|m100..m20` on the displaced torus: which
+//! level of detail the displacing rays trace (the `lod_*_samples` counters), and what that
+//! does to the image against the detailed mesh's; the transition flags refused without a
+//! transition shading.
 
 mod common;
 
@@ -97,28 +98,46 @@ fn each_rule_traces_its_levels_and_keeps_the_image() {
     }
 }
 
-/// `--lod` without a transition shading is refused in one line, writing nothing.
+/// A fixed level (`m60`, `m20`) puts every displacing sample on that level.
 #[test]
-fn lod_without_transition_shading_is_refused() {
+fn fixed_levels_trace_only_their_level() {
+    let dir = TempDir::new().unwrap();
+    for (lod, k) in [("m60", 2), ("m20", 4)] {
+        let stats = render(&dir, lod);
+        let levels = counts(&stats);
+        let total: u64 = levels.iter().sum();
+        assert!(total > 1000, "{lod}: the torus displaces: {levels:?}");
+        assert_eq!(levels[k], total, "{lod}: {levels:?}");
+    }
+}
+
+/// `--lod`, `--transition-method` and `--transition-d` without a transition shading are
+/// refused in one line naming the flag, writing nothing.
+#[test]
+fn transition_flags_without_transition_shading_are_refused() {
     let dir = TempDir::new().unwrap();
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/displaced-torus.toml");
-    let out = run(
-        &dir,
-        &[
-            "render",
-            scene.to_str().unwrap(),
-            "--lod",
-            "finest",
-            "-o",
-            "x.png",
-        ],
-    );
-    assert!(!out.status.success());
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(stderr.lines().count(), 1, "{stderr}");
-    assert!(
-        stderr.contains("--lod applies to --shading transitions and transition-lit only"),
-        "{stderr}"
-    );
-    assert!(!dir.path().join("x.png").exists());
+    for (flag, value) in [
+        ("--lod", "finest"),
+        ("--transition-method", "bump"),
+        ("--transition-d", "3"),
+    ] {
+        let out = run(
+            &dir,
+            &[
+                "render",
+                scene.to_str().unwrap(),
+                flag,
+                value,
+                "-o",
+                "x.png",
+            ],
+        );
+        assert!(!out.status.success());
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(stderr.lines().count(), 1, "{stderr}");
+        let expected = format!("{flag} applies to --shading transitions and transition-lit only");
+        assert!(stderr.contains(&expected), "{stderr}");
+        assert!(!dir.path().join("x.png").exists());
+    }
 }

@@ -7,7 +7,7 @@ use clap::{Args, ValueEnum};
 use flexcam::image_io::{self, ColorEncoding, ColorFormat, DepthFormat, OutputSet, PngBits};
 use flexcam::render::{
     self, Counter, LodSelection, Method, Outputs, PixelWindow, PreparedScene, RenderOptions,
-    Shading, TransitionShading,
+    Shading, TransitionMethod, TransitionShading,
 };
 use flexcam::Result;
 
@@ -69,9 +69,16 @@ pub struct RenderArgs {
     /// of detail of a displaced object (its progressive mesh at 100, 80, 60, 40 or 20 % of
     /// its faces): `footprint` (default: the coarsest whose texture deviation is at most half
     /// the ray's footprint), `distance` (the dissertation's rule by the distance from the
-    /// ray's origin) or `finest` (always the detailed mesh).
+    /// ray's origin), `finest` (always the detailed mesh), or one level for every ray:
+    /// `m100`, `m80`, `m60`, `m40`, `m20` (the dissertation's names; `m100` is `finest`).
     #[arg(help_heading = "Rendering", long, value_enum, value_name = "RULE")]
     lod: Option<LodArg>,
+    /// The method of `--shading transitions` and `transition-lit` on displaced objects:
+    /// `auto` (default: the transition function's choice per ray) or one method for every
+    /// ray, `displacement`, `redistributed-bump`, `bump` (the height field's normals, not
+    /// redistributed) or `brdf`: the rows of the dissertation's Table 8.1.
+    #[arg(help_heading = "Rendering", long, value_enum, value_name = "METHOD")]
+    transition_method: Option<TransitionMethodArg>,
     /// Write the depth along each pixel's ray (.exr or .pfm; +inf where nothing is hit).
     #[arg(help_heading = "Outputs", long, value_name = "FILE")]
     depth: Option<PathBuf>,
@@ -171,21 +178,27 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
     let progress = RenderProgress::new();
     let report = |done: u64, total: u64| progress.update(done, total);
-    let shading = match (args.shading.shading(), args.transition_d, args.lod) {
-        (shading, None, None) => shading,
-        (Shading::Transitions(t), d, lod) => Shading::Transitions(
-            TransitionShading::new(t.methods, d.unwrap_or(t.d()))?
-                .with_lod(lod.map_or(t.lod, LodArg::selection)),
+    let shading = match args.shading.shading() {
+        Shading::Transitions(t) => Shading::Transitions(
+            TransitionShading::new(t.methods, args.transition_d.unwrap_or(t.d()))?
+                .with_lod(args.lod.map_or(t.lod, LodArg::selection))
+                .with_method(
+                    args.transition_method
+                        .map_or(t.method, TransitionMethodArg::method),
+                ),
         ),
-        (_, Some(_), _) => {
-            return Err(flexcam::Error::new(
-                "--transition-d applies to --shading transitions and transition-lit only",
-            ))
-        }
-        (_, None, Some(_)) => {
-            return Err(flexcam::Error::new(
-                "--lod applies to --shading transitions and transition-lit only",
-            ))
+        shading => {
+            let given = [
+                ("--transition-d", args.transition_d.is_some()),
+                ("--lod", args.lod.is_some()),
+                ("--transition-method", args.transition_method.is_some()),
+            ];
+            if let Some((flag, _)) = given.iter().find(|(_, given)| *given) {
+                return Err(flexcam::Error::new(format!(
+                    "{flag} applies to --shading transitions and transition-lit only"
+                )));
+            }
+            shading
         }
     };
     let spp = args.spp.unwrap_or(loaded.scene.image.spp);
@@ -273,6 +286,11 @@ enum LodArg {
     Footprint,
     Distance,
     Finest,
+    M100,
+    M80,
+    M60,
+    M40,
+    M20,
 }
 
 impl LodArg {
@@ -281,6 +299,33 @@ impl LodArg {
             LodArg::Footprint => LodSelection::Footprint,
             LodArg::Distance => LodSelection::Distance,
             LodArg::Finest => LodSelection::Finest,
+            LodArg::M100 => LodSelection::Level(0),
+            LodArg::M80 => LodSelection::Level(1),
+            LodArg::M60 => LodSelection::Level(2),
+            LodArg::M40 => LodSelection::Level(3),
+            LodArg::M20 => LodSelection::Level(4),
+        }
+    }
+}
+
+/// `--transition-method` on the command line.
+#[derive(Clone, Copy, Debug, ValueEnum)]
+enum TransitionMethodArg {
+    Auto,
+    Displacement,
+    RedistributedBump,
+    Bump,
+    Brdf,
+}
+
+impl TransitionMethodArg {
+    fn method(self) -> TransitionMethod {
+        match self {
+            TransitionMethodArg::Auto => TransitionMethod::Auto,
+            TransitionMethodArg::Displacement => TransitionMethod::Displacement,
+            TransitionMethodArg::RedistributedBump => TransitionMethod::RedistributedBump,
+            TransitionMethodArg::Bump => TransitionMethod::Bump,
+            TransitionMethodArg::Brdf => TransitionMethod::Brdf,
         }
     }
 }

@@ -431,7 +431,7 @@ pub use raycast::{pick, Picked};
 pub use reproject::{reproject, Photo, PhotoProjection, PHOTO_PROJECTION_NAMES};
 pub use stmap::{st_map, StMap, StPoints};
 pub use surface::SurfacePoint;
-pub use transitions::TransitionShading;
+pub use transitions::{TransitionMethod, TransitionShading};
 pub use trilinear::{CurveMode, CurveOptions};
 pub use warning::RenderWarning;
 pub use window::PixelWindow;

@@ -1,7 +1,9 @@
 //! `flexcam bench displaced`: Figure 8.1 of Ramsey 2005 (Ray Tracing Displaced Models in a
 //! Level-of-Detail Hierarchy), time per frame of the displaced three-holed torus at
 //! subdivision levels 0 and up, beside the same micro-triangles given to the ray caster as an
-//! ordinary pre-tessellated mesh, in time and in peak memory.
+//! ordinary pre-tessellated mesh, in time and in peak memory; then Table 8.1's transition
+//! row (`transition_rows`) and the whole of Table 8.1 (`displaced_methods`), chosen by
+//! `--part`.
 //!
 //! The scene is `builtin:displaced-torus` (5,046 base triangles, procedural waves) with its
 //! level replaced per row; every frame is `--method raycast` at the same size and shading.
@@ -57,6 +59,11 @@ pub struct DisplacedArgs {
     /// Shading of every frame.
     #[arg(long, value_enum, default_value_t = BenchShading::Flat)]
     shading: BenchShading,
+    /// Which tables to run: `figure-8-1` (the level sweep), `transitions` (the transition
+    /// system against full displacement), `table-8-1` (every method of Table 8.1 at its
+    /// three camera positions), or `all`.
+    #[arg(long, value_enum, default_value_t = Part::All)]
+    part: Part,
     /// Internal: measure one cell (`displaced:LEVEL` or `tessellated:LEVEL`) in this process
     /// and print it as one line.
     #[arg(long, hide = true)]
@@ -70,6 +77,21 @@ pub enum BenchShading {
     Flat,
     /// Lights and shadow rays (micro-triangle normals).
     Lit,
+}
+
+/// `--part` of the bench.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Part {
+    /// Every table.
+    All,
+    /// Figure 8.1: the subdivision-level sweep beside the pre-tessellated mesh.
+    #[value(name = "figure-8-1")]
+    Figure81,
+    /// Table 8.1's transition row against full displacement, per `D` and LOD rule.
+    Transitions,
+    /// Table 8.1: every rendering method at the three camera positions.
+    #[value(name = "table-8-1")]
+    Table81,
 }
 
 /// One variant's measurements, in milliseconds and megabytes.
@@ -86,6 +108,20 @@ pub fn run(args: &DisplacedArgs) -> Result<()> {
         return measure_cell(args, cell);
     }
     let base = scene::load("builtin:displaced-torus")?;
+    if matches!(args.part, Part::All | Part::Figure81) {
+        level_sweep(args, &base)?;
+    }
+    if matches!(args.part, Part::All | Part::Transitions) {
+        transition_rows(args, &base)?;
+    }
+    if matches!(args.part, Part::All | Part::Table81) {
+        super::displaced_methods::table_8_1(args.size, args.repeat, &base)?;
+    }
+    Ok(())
+}
+
+/// Figure 8.1: the level sweep, each cell in a process of its own.
+fn level_sweep(args: &DisplacedArgs, base: &Scene) -> Result<()> {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
         "Figure 8.1 (Ramsey 2005): the displaced three-holed torus, {} base triangles, {s}x{s}, \
@@ -150,7 +186,7 @@ pub fn run(args: &DisplacedArgs) -> Result<()> {
          build ms: tessellation and BVH build of the tessellated mesh (the displaced set's own \
          build is under 100 ms)"
     );
-    transition_rows(args, &base)
+    Ok(())
 }
 
 /// Camera distances of the transition rows, as fractions of the scene's own: the near view
@@ -273,7 +309,7 @@ fn closer(projection: &ProjectionSpec, fraction: f64) -> Result<ProjectionSpec> 
 }
 
 /// `scene` with every displacement at subdivision `level`.
-fn with_level(scene: &Scene, level: u32) -> Scene {
+pub(super) fn with_level(scene: &Scene, level: u32) -> Scene {
     let mut scene = scene.clone();
     for object in &mut scene.objects {
         if let Some(spec) = &object.displacement {

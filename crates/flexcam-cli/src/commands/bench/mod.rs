@@ -2,6 +2,7 @@
 
 pub mod camera_triangles;
 pub mod displaced;
+mod displaced_methods;
 pub mod flexible;
 pub mod simplify;
 mod timing;
@@ -19,7 +20,8 @@ pub enum BenchCommand {
     CameraTriangles(camera_triangles::CameraTrianglesArgs),
     /// Figure 8.1 of Ramsey 2005: the displaced three-holed torus at subdivision levels 0 to
     /// 6, ray traced without tessellation, beside the same micro-triangles as a
-    /// pre-tessellated mesh (time and peak memory).
+    /// pre-tessellated mesh (time and peak memory); and Table 8.1: the transition system
+    /// against full displacement, and every rendering method at the three camera positions.
     Displaced(displaced::DisplacedArgs),
     /// Table 7.1 of Brosz 2011: quadratic vs 2 to 6 segment projectors at 800 x 800, and the
     /// throughput of --method raster on a 1280 x 720 panorama of a 123,554-triangle scene.

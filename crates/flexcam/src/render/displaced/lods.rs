@@ -37,6 +37,9 @@ pub enum LodSelection {
     Distance,
     /// Always the detailed mesh.
     Finest,
+    /// Always level `k` of [`LOD_PERCENTS`] (0 the detailed mesh, 4 `M20`; larger indices
+    /// mean the coarsest).
+    Level(usize),
 }
 
 /// One displaced object's place in the levels: its centre, size, bound and the texture
@@ -128,6 +131,7 @@ impl Lods {
         };
         match selection {
             LodSelection::Finest => 0,
+            LodSelection::Level(k) => k.min(LOD_PERCENTS.len() - 1),
             LodSelection::Footprint => {
                 let allowed = FOOTPRINT_SHARE * footprint;
                 (0..o.deviations.len())

@@ -23,6 +23,7 @@ use std::time::Instant;
 use glam::{DVec2, DVec3, Vec3};
 
 use crate::displace::progressive::LOD_PERCENTS;
+use crate::displace::transition::Blend;
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
@@ -45,6 +46,45 @@ pub struct TransitionShading {
     d_bits: u64,
     /// How rays that displace pick the level of detail they trace.
     pub lod: LodSelection,
+    /// The method every ray on a displaced object takes: the transition function's choice,
+    /// or one method forced everywhere (the rows of the dissertation's Table 8.1).
+    pub method: TransitionMethod,
+}
+
+/// Which method shades the rays that meet a displaced object.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum TransitionMethod {
+    /// The transition function's choice per ray (its blends included).
+    #[default]
+    Auto,
+    /// Full displacement everywhere.
+    Displacement,
+    /// Redistributed bump mapping everywhere: the undisplaced surface with the bump normals
+    /// redistributed to the displaced surface's visible normals (Becker and Max).
+    RedistributedBump,
+    /// Plain bump mapping everywhere: the undisplaced surface with the height field's own
+    /// normals, not redistributed (what redistribution corrects at grazing views).
+    Bump,
+    /// The BRDF table everywhere, on the undisplaced surface.
+    Brdf,
+}
+
+impl TransitionMethod {
+    /// The blend a forced method gives every ray; `None` for [`TransitionMethod::Auto`].
+    fn forced_blend(self) -> Option<Blend> {
+        let (brdf, bump, displacement) = match self {
+            TransitionMethod::Auto => return None,
+            TransitionMethod::Displacement => (0.0, 0.0, 1.0),
+            TransitionMethod::RedistributedBump | TransitionMethod::Bump => (0.0, 1.0, 0.0),
+            TransitionMethod::Brdf => (1.0, 0.0, 0.0),
+        };
+        Some(Blend {
+            brdf,
+            bump,
+            displacement,
+            fraction: displacement,
+        })
+    }
 }
 
 impl TransitionShading {
@@ -63,6 +103,7 @@ impl TransitionShading {
             methods,
             d_bits: d.to_bits(),
             lod: LodSelection::default(),
+            method: TransitionMethod::default(),
         })
     }
 
@@ -72,6 +113,7 @@ impl TransitionShading {
             methods,
             d_bits: Self::DEFAULT_D.to_bits(),
             lod: LodSelection::default(),
+            method: TransitionMethod::default(),
         }
     }
 
@@ -83,6 +125,11 @@ impl TransitionShading {
     /// With level-of-detail selection `lod`.
     pub fn with_lod(self, lod: LodSelection) -> TransitionShading {
         TransitionShading { lod, ..self }
+    }
+
+    /// With method `method` on displaced objects.
+    pub fn with_method(self, method: TransitionMethod) -> TransitionShading {
+        TransitionShading { method, ..self }
     }
 }
 
@@ -97,6 +144,7 @@ struct Renderer<'a> {
     d: f64,
     methods: bool,
     lod: LodSelection,
+    method: TransitionMethod,
     /// Samples that traced each level of detail (displacing ones only).
     levels: [u64; LOD_PERCENTS.len()],
     primary_rays: u64,
@@ -224,6 +272,7 @@ pub(in crate::render) fn render(
                 d: shading.d(),
                 methods: shading.methods,
                 lod: shading.lod,
+                method: shading.method,
                 levels: [0; LOD_PERCENTS.len()],
                 primary_rays: 0,
                 partial_rays: 0,

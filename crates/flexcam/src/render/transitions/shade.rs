@@ -17,7 +17,7 @@
 
 use glam::{DVec2, DVec3, Vec3};
 
-use super::Renderer;
+use super::{Renderer, TransitionMethod};
 use crate::displace::normal_distribution::rotate;
 use crate::displace::transition::{self, partial_view_angle, Blend};
 use crate::geometry::Ray;
@@ -133,8 +133,14 @@ impl<'a> Renderer<'a> {
         let frame = SurfaceFrame::at(object, hull.triangle, hull.barycentric.as_dvec2(), -view);
         let cos_view = frame.normal.dot(view).clamp(0.0, 1.0);
         let footprint = super::footprint::footprint(self.projection, pixel, ray.at(hull.t));
-        let t = transition::value(tables.relief(), footprint, self.d, cos_view);
-        let blend = transition::blend(t);
+        let blend = self.method.forced_blend().unwrap_or_else(|| {
+            transition::blend(transition::value(
+                tables.relief(),
+                footprint,
+                self.d,
+                cos_view,
+            ))
+        });
         let step = (blend.fraction * PARTIAL_STEPS as f64).round() as usize;
         let level = if step == 0 {
             0
@@ -202,12 +208,16 @@ impl<'a> Renderer<'a> {
         let phi_v = local_view.y.atan2(local_view.x);
         let mut bump = tables.chart.normal(frame.uv);
         bump.y *= frame.v_sign;
-        let moved = tables.redistribution.map(
-            rotate(bump, -phi_v),
-            partial_view_angle(theta_v, s),
-            theta_v,
-        );
-        let normal = frame.world(rotate(moved, phi_v));
+        let normal = if self.method == TransitionMethod::Bump {
+            frame.world(bump)
+        } else {
+            let moved = tables.redistribution.map(
+                rotate(bump, -phi_v),
+                partial_view_angle(theta_v, s),
+                theta_v,
+            );
+            frame.world(rotate(moved, phi_v))
+        };
         let reflect = |to_light: DVec3| {
             let bump_term = normal.dot(to_light).max(0.0);
             let brdf_term = if blend.brdf > 0.0 {
