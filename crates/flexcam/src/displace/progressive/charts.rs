@@ -37,6 +37,8 @@ struct Chart {
     faces: Vec<u32>,
     /// Area-weighted normal sum (its direction is the chart's normal).
     normal: DVec3,
+    /// Its triangles' total area.
+    area: f64,
     perimeter: f64,
     version: u32,
 }
@@ -48,6 +50,7 @@ fn merge(topology: &Topology, target: usize) -> Vec<u32> {
         .map(|f| Chart {
             faces: vec![f as u32],
             normal: topology.normals[f] * topology.areas[f],
+            area: topology.areas[f],
             perimeter: topology
                 .edges(f as u32)
                 .iter()
@@ -57,7 +60,9 @@ fn merge(topology: &Topology, target: usize) -> Vec<u32> {
         })
         .collect();
     let mut live = n;
-    // (cost bits, chart a, chart b, version a, version b), cheapest first.
+    // (cost bits, chart a, chart b, version a, version b), cheapest first. Whether the
+    // merged chart is a disc depends on the two charts alone, so it is asked only of the
+    // pair popped (their versions unchanged since the push), not of every pair pushed.
     let mut heap = BinaryHeap::new();
     let push = |heap: &mut BinaryHeap<_>, charts: &[Chart], chart_of: &[u32], a: u32, b: u32| {
         if let Some(c) = merge_cost(topology, charts, chart_of, a, b) {
@@ -83,16 +88,26 @@ fn merge(topology: &Topology, target: usize) -> Vec<u32> {
         if charts[a as usize].version != va || charts[b as usize].version != vb {
             continue;
         }
+        let faces = charts[a as usize]
+            .faces
+            .iter()
+            .chain(&charts[b as usize].faces);
+        let inside = |f: u32| f != NONE && (chart_of[f as usize] == a || chart_of[f as usize] == b);
+        if !is_disc(topology, faces.copied(), inside) {
+            continue;
+        }
         // Merge b into a.
         let moved = std::mem::take(&mut charts[b as usize].faces);
         let shared = shared_length(topology, &chart_of, &moved, a);
         for &f in &moved {
             chart_of[f as usize] = a;
         }
-        let (nb, pb) = (charts[b as usize].normal, charts[b as usize].perimeter);
+        let b_chart = &charts[b as usize];
+        let (nb, ab, pb) = (b_chart.normal, b_chart.area, b_chart.perimeter);
         let chart = &mut charts[a as usize];
         chart.faces.extend(moved);
         chart.normal += nb;
+        chart.area += ab;
         chart.perimeter += pb - 2.0 * shared;
         chart.version += 1;
         charts[b as usize].version += 1;
@@ -133,7 +148,9 @@ fn neighbours(topology: &Topology, chart_of: &[u32], faces: &[u32]) -> Vec<u32> 
 }
 
 /// The cost of merging charts `a` and `b` (module documentation), or `None` when the merged
-/// chart would not be a disc with at least three corners.
+/// chart would have fewer than three corners (whether it is a disc is asked when the pair
+/// is popped). The planarity `sum A_i (1 - N . N_i)` is `A - |S|`, `A` the pair's area and
+/// `S = sum A_i N_i` (so `N = S / |S|`): both are kept per chart.
 fn merge_cost(
     topology: &Topology,
     charts: &[Chart],
@@ -142,16 +159,11 @@ fn merge_cost(
     b: u32,
 ) -> Option<f64> {
     let (ca, cb) = (&charts[a as usize], &charts[b as usize]);
-    let faces: Vec<u32> = ca.faces.iter().chain(&cb.faces).copied().collect();
-    let inside = |f: u32| f != NONE && (chart_of[f as usize] == a || chart_of[f as usize] == b);
-    if !is_disc(topology, &faces, inside) || corner_count(topology, chart_of, &faces, a, b) < 3 {
+    let faces = ca.faces.iter().chain(&cb.faces).copied();
+    if corner_count(topology, chart_of, faces, a, b) < 3 {
         return None;
     }
-    let normal = (ca.normal + cb.normal).normalize_or_zero();
-    let planarity: f64 = faces
-        .iter()
-        .map(|&f| topology.areas[f as usize] * (1.0 - normal.dot(topology.normals[f as usize])))
-        .sum();
+    let planarity = ca.area + cb.area - (ca.normal + cb.normal).length();
     let perimeter =
         ca.perimeter + cb.perimeter - 2.0 * shared_length(topology, chart_of, &cb.faces, a);
     Some(planarity.max(0.0) + perimeter * perimeter / (4.0 * std::f64::consts::PI))
@@ -160,13 +172,16 @@ fn merge_cost(
 /// Whether `faces` (those `inside` says are in) form a topological disc: Euler
 /// characteristic 1 and every vertex on at most one boundary run (0 or 2 boundary edges),
 /// which together leave one boundary loop, no handle and no pinched vertex.
-pub fn is_disc(topology: &Topology, faces: &[u32], inside: impl Fn(u32) -> bool) -> bool {
-    if faces.is_empty() {
-        return false;
-    }
+pub fn is_disc(
+    topology: &Topology,
+    faces: impl IntoIterator<Item = u32>,
+    inside: impl Fn(u32) -> bool,
+) -> bool {
     let mut edges: HashSet<(u32, u32)> = HashSet::new();
     let mut vertices: HashMap<u32, u32> = HashMap::new();
-    for &f in faces {
+    let mut count = 0i64;
+    for f in faces {
+        count += 1;
         for (v, w) in topology.edges(f) {
             edges.insert(key(v, w));
             vertices.entry(v).or_insert(0);
@@ -176,13 +191,19 @@ pub fn is_disc(topology: &Topology, faces: &[u32], inside: impl Fn(u32) -> bool)
             }
         }
     }
-    let euler = vertices.len() as i64 - edges.len() as i64 + faces.len() as i64;
-    euler == 1 && vertices.values().all(|&c| c == 0 || c == 2)
+    let euler = vertices.len() as i64 - edges.len() as i64 + count;
+    count > 0 && euler == 1 && vertices.values().all(|&c| c == 0 || c == 2)
 }
 
 /// The corners of charts `a` and `b` merged (`faces` their faces): boundary vertices whose
 /// faces belong to three or more charts, the outside counting as one.
-fn corner_count(topology: &Topology, chart_of: &[u32], faces: &[u32], a: u32, b: u32) -> usize {
+fn corner_count(
+    topology: &Topology,
+    chart_of: &[u32],
+    faces: impl IntoIterator<Item = u32>,
+    a: u32,
+    b: u32,
+) -> usize {
     let label = |f: u32| match f {
         NONE => NONE - 1,
         f if chart_of[f as usize] == b => a,
@@ -190,7 +211,7 @@ fn corner_count(topology: &Topology, chart_of: &[u32], faces: &[u32], a: u32, b:
     };
     let mut seen: HashSet<u32> = HashSet::new();
     let mut count = 0;
-    for &f in faces {
+    for f in faces {
         for v in topology.triangles[f as usize] {
             if !seen.insert(v) {
                 continue;
@@ -353,7 +374,7 @@ fn straighten_run(topology: &Topology, chart_of: &mut [u32], a: u32, b: u32, sta
             .filter(|&f| new_label(f) == label)
             .collect();
         let inside = |g: u32| g != NONE && component.get(&g).is_some_and(|_| new_label(g) == label);
-        if !is_disc(topology, &side, inside) {
+        if !is_disc(topology, side.iter().copied(), inside) {
             return;
         }
     }

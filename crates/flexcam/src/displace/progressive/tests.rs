@@ -47,7 +47,10 @@ fn charts_are_discs_and_cover_the_mesh() {
                 .filter(|&f| pm.charts[f as usize] == c)
                 .collect();
             let inside = |g: u32| g != topology::NONE && pm.charts[g as usize] == c;
-            assert!(is_disc(&pm.topology, &faces, inside), "{name}: chart {c}");
+            assert!(
+                is_disc(&pm.topology, faces.iter().copied(), inside),
+                "{name}: chart {c}"
+            );
         }
     }
 }
