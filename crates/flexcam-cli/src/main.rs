@@ -97,6 +97,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    restore_broken_pipe_default();
     let parsed = accept_negative_values(Cli::command())
         .try_get_matches()
         .and_then(|matches| Cli::from_arg_matches(&matches));
@@ -124,6 +125,18 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => commands::fail(&e),
+    }
+}
+
+/// Gives SIGPIPE its default action back (Rust's runtime ignores it, which turns a write to
+/// a closed pipe into a panic in `println!`): `flexcam scenes | head` then ends as other
+/// command-line tools do, quietly, when the reader stops reading.
+fn restore_broken_pipe_default() {
+    #[cfg(unix)]
+    // SAFETY: called first in `main`, before any thread is started; SIG_DFL is a valid action
+    // for SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
 

@@ -135,6 +135,26 @@ fn scenes_lists_the_required_builtins() {
     );
 }
 
+/// Output into a pipe whose reader has gone (`flexcam scenes | head -0`) ends the program
+/// as SIGPIPE ends other tools, without a panic message.
+#[cfg(unix)]
+#[test]
+fn a_closed_output_pipe_ends_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_flexcam"))
+        .arg("scenes")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert_eq!(out.status.signal(), Some(13), "{:?} {stderr}", out.status);
+}
+
 #[test]
 fn flat_render_with_all_outputs_and_stats_on_stdout() {
     let dir = good_scene_in("s.toml");
