@@ -132,7 +132,8 @@ fn examples_table_has_every_row_of_table_8_1() {
         assert!(number(row, "rgb_error") < 0.05, "{what}");
         assert!(number(row, "raycast_ms") > 0.0 && number(row, "trilinear_ms") > 0.0);
     }
-    // The swept rows have the thesis's 2 n^2 projections: the fan grid and the lens cells.
+    // The swept rows have the thesis's 2 n^2 projections: the mirror ball's grid and the
+    // lens cells.
     for (k, n) in (1..=5).enumerate() {
         for first in [3, 10] {
             let row = &rows[first + k];

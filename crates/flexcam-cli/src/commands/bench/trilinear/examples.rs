@@ -8,10 +8,10 @@
 //!   `trilinear-inward-sphere.toml`: the visualisation surfaces of chapter 6 (our grids are
 //!   finer than the thesis's 18, 6 and 200 projections: the column `projections` says how
 //!   many ours has).
-//! - 7.4 (b)-(f): the cube-floor scene through the 1 x 1 to 5 x 5 fan grid (2 to 50
-//!   projections) of the timing tables, for the thesis's cube reflected in a sphere through
-//!   1 x 1 to 5 x 5 surfaces; 7.4 (sphere): `reflect-sphere-cube.toml`, the reflection itself
-//!   (the sphere's own refined surface, not an N x N grid).
+//! - 7.4 (b)-(f): the thesis's cube reflected in a sphere through 1 x 1 to 5 x 5 surfaces:
+//!   `trilinear-sphere-mirror.toml` (the view through a mirror ball) with `grid` 1 to 5 (2 to
+//!   50 projections); 7.4 (sphere): `reflect-sphere-cube.toml`, the reflection composited
+//!   into a perspective view (the sphere's own refined surface, not an N x N grid).
 //! - 7.5 `reflect-funny-mirror.toml` (the 5 x 5 mirror with perturbed normals).
 //! - 7.6 (b)-(f): `refract-lens.toml` with its lens made of 1 x 1 to 5 x 5 cells (2 to 50
 //!   projections, `trilinear_refine_px = 0`: the cells alone, as in the thesis).
@@ -22,9 +22,9 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use flexcam::projection::{Projection, Trilinear};
-use flexcam::render::bench_support::workloads::trilinear::fan_grid;
+use flexcam::projection::Projection;
 use flexcam::render::{CurveOptions, PreparedScene};
+use flexcam::scene::file::Definition;
 use flexcam::scene::{self, Mesh, Scene};
 use flexcam::{Error, Result};
 use glam::Vec3;
@@ -36,8 +36,8 @@ use super::study::{against, fixed, reference, Table};
 enum Source {
     /// A scene file of the scenes folder, through its own projection.
     File(&'static str),
-    /// The cube-floor scene through the `n x n` fan grid.
-    Fan(u32),
+    /// `trilinear-sphere-mirror.toml` as an `n x n` grid (`projection.grid = n`).
+    MirrorBall(u32),
     /// `refract-lens.toml` with an `n x n`-cell lens and no refinement.
     Lens(u32),
 }
@@ -86,11 +86,36 @@ const EXAMPLES: [Example; 15] = [
         (600, 600),
         (200, 40518.0, 1242.0),
     ),
-    row("7.4 (b)", Source::Fan(1), (800, 800), (2, 177926.0, 24.4)),
-    row("7.4 (c)", Source::Fan(2), (800, 800), (8, 177926.0, 70.1)),
-    row("7.4 (d)", Source::Fan(3), (800, 800), (18, 177926.0, 150.1)),
-    row("7.4 (e)", Source::Fan(4), (800, 800), (32, 177926.0, 230.2)),
-    row("7.4 (f)", Source::Fan(5), (800, 800), (50, 177926.0, 360.7)),
+    row(
+        "7.4 (b)",
+        Source::MirrorBall(1),
+        (800, 800),
+        (2, 177926.0, 24.4),
+    ),
+    row(
+        "7.4 (c)",
+        Source::MirrorBall(2),
+        (800, 800),
+        (8, 177926.0, 70.1),
+    ),
+    row(
+        "7.4 (d)",
+        Source::MirrorBall(3),
+        (800, 800),
+        (18, 177926.0, 150.1),
+    ),
+    row(
+        "7.4 (e)",
+        Source::MirrorBall(4),
+        (800, 800),
+        (32, 177926.0, 230.2),
+    ),
+    row(
+        "7.4 (f)",
+        Source::MirrorBall(5),
+        (800, 800),
+        (50, 177926.0, 360.7),
+    ),
     row(
         "7.4 (sphere)",
         Source::File("reflect-sphere-cube.toml"),
@@ -216,11 +241,12 @@ fn load(
     let file = |name: &str| scene::load(&scenes.join(name).to_string_lossy());
     let (name, scene) = match source {
         Source::File(name) => (name.to_string(), file(name)?),
-        Source::Fan(n) => {
-            let scene = scene::load("builtin:cube-floor")?;
-            let projection: Box<dyn Projection> =
-                Box::new(Trilinear::new(&fan_grid(n)?, width, height)?);
-            return Ok((format!("cube-floor fan {n}x{n}"), scene, projection));
+        Source::MirrorBall(n) => {
+            let name = "trilinear-sphere-mirror.toml";
+            let grid = format!("projection.grid={n}").parse::<Definition>()?;
+            let path = scenes.join(name);
+            let scene = scene::load_defined(&path.to_string_lossy(), &[grid])?;
+            (format!("{name} {n}x{n}"), scene)
         }
         Source::Lens(n) => {
             let mut scene = file("refract-lens.toml")?;
