@@ -95,7 +95,7 @@ pub fn tight_in(
     emit: &mut impl FnMut(&Convex),
 ) {
     let plane = camera.plane_near((q[0] + q[1] + q[2]) / 3.0);
-    tight(camera, plane.as_ref(), q, sub, depth, emit)
+    tight(camera, plane, q, sub, depth, emit)
 }
 
 /// The four quarters of `sub` (corners, then the middle one), in the order the tight bound
@@ -117,7 +117,7 @@ pub fn misses(camera: &Camera, sub: [DVec2; 3], points: &[DVec3]) -> bool {
         return false;
     };
     let centre = points.iter().sum::<DVec3>() / points.len().max(1) as f64;
-    [camera.plane_near(centre).as_ref(), camera.plane()]
+    [camera.plane_near(centre), camera.plane()]
         .into_iter()
         .flatten()
         .any(|plane| misses_on(plane, &directions, sub, points))
@@ -157,11 +157,7 @@ fn separated(points: &[DVec2], t: [DVec2; 3]) -> bool {
     if points.iter().any(|p| !p.is_finite()) {
         return false;
     }
-    let orient = cross(t[0], t[1], t[2]).signum();
-    let edge_out = (0..3).any(|i| {
-        let (a, b) = (t[i], t[(i + 1) % 3]);
-        points.iter().all(|&p| cross(a, b, p) * orient < 0.0)
-    });
+    let edge_out = outside_an_edge(points, t);
     let lo = t[0].min(t[1]).min(t[2]);
     let hi = t[0].max(t[1]).max(t[2]);
     let axis_out = points.iter().all(|p| p.x < lo.x)
@@ -169,6 +165,16 @@ fn separated(points: &[DVec2], t: [DVec2; 3]) -> bool {
         || points.iter().all(|p| p.y < lo.y)
         || points.iter().all(|p| p.y > hi.y);
     edge_out || axis_out
+}
+
+/// Whether all `points` (finite) lie strictly outside one edge of triangle `t` (either
+/// orientation): then their convex hull misses `t`.
+fn outside_an_edge(points: &[DVec2], t: [DVec2; 3]) -> bool {
+    let orient = cross(t[0], t[1], t[2]).signum();
+    (0..3).any(|i| {
+        let (a, b) = (t[i], t[(i + 1) % 3]);
+        points.iter().all(|&p| cross(a, b, p) * orient < 0.0)
+    })
 }
 
 /// Projections farther than this from the camera triangle (in barycentrics) make no bound:
@@ -302,12 +308,15 @@ fn tight(
     depth: u32,
     emit: &mut impl FnMut(&Convex),
 ) {
-    let region = camera
-        .cone(sub)
-        .and_then(|directions| {
-            let plane = plane.filter(|p| p.one_sided(&directions))?;
-            nine(plane, q, &directions)
-        })
+    let points = camera.cone(sub).and_then(|directions| {
+        let plane = plane.filter(|p| p.one_sided(&directions))?;
+        nine(plane, q, &directions)
+    });
+    if points.is_some_and(|points| outside_an_edge(&points, sub)) {
+        // The hull lies beyond a line of `sub`: nothing of the piece sees the triangle.
+        return;
+    }
+    let region = points
         .map(|points| Convex::hull(&points).clip_to_triangle(sub))
         .unwrap_or_else(|| Convex::from_points(&sub).clip_to_triangle(CORNERS));
     if region.points().len() < 3 {
@@ -318,7 +327,11 @@ fn tight(
         return emit_in_camera(camera, &region, emit);
     }
     for quarter in quarters(sub) {
-        tight(camera, plane, q, quarter, depth + 1, emit);
+        // A quarter's rays are among the piece's, so its region lies in the piece's: a
+        // quarter that the region misses sees nothing of the triangle.
+        if !outside_an_edge(region.points(), quarter) {
+            tight(camera, plane, q, quarter, depth + 1, emit);
+        }
     }
 }
 
