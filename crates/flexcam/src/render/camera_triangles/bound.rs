@@ -105,41 +105,76 @@ pub fn quarters([a, b, c]: [DVec2; 3]) -> [[DVec2; 3]; 4] {
     [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]]
 }
 
-/// Whether the convex hull of `points` projected along the corner directions of the
-/// sub-triangle `sub` of the camera triangle misses `sub` (so nothing inside that hull is
-/// seen by it): the culling of section 2.4 for a box (its eight corners) or a triangle, on
-/// the plane near the points and on the camera plane (either hull that misses proves it),
-/// for the whole camera triangle ([`CORNERS`]) or a piece of it (a piece is itself a
-/// camera triangle: its corner rays are the camera's rays there). `false` where no hull
-/// bounds the region.
-pub fn misses(camera: &Camera, sub: [DVec2; 3], points: &[DVec3]) -> bool {
-    let Some(directions) = camera.cone(sub) else {
-        return false;
-    };
-    let centre = points.iter().sum::<DVec3>() / points.len().max(1) as f64;
-    [camera.plane_near(centre), camera.plane()]
-        .into_iter()
-        .flatten()
-        .any(|plane| misses_on(plane, &directions, sub, points))
+/// The culling of section 2.4 for one piece `sub` of a camera triangle (the whole camera
+/// triangle, [`CORNERS`], or a piece of its quartering: a piece is itself a camera
+/// triangle, its corner rays the camera's rays there), for any number of point sets (a
+/// box's eight corners, or a triangle): [`PieceTest::misses`]. The piece's cone of
+/// directions is found once, and the projections along it onto a plane once per plane (the
+/// camera plane, and the last plane near the points, which neighbouring clusters share).
+pub struct PieceTest<'a> {
+    camera: &'a Camera,
+    sub: [DVec2; 3],
+    directions: Option<[DVec3; 3]>,
+    /// The projections onto the camera plane, once computed (`None` inside: the plane is
+    /// crossed from both sides, or a direction is parallel to it).
+    base: Option<Option<[AlongDirection; 3]>>,
+    /// The last near plane used and its projections.
+    near: Option<(*const CameraPlane, Option<[AlongDirection; 3]>)>,
 }
 
-/// [`misses`] on one plane.
-fn misses_on(
-    plane: &CameraPlane,
-    directions: &[DVec3; 3],
-    sub: [DVec2; 3],
-    points: &[DVec3],
-) -> bool {
-    if !plane.one_sided(directions) {
-        return false;
+impl<'a> PieceTest<'a> {
+    pub fn new(camera: &'a Camera, sub: [DVec2; 3]) -> PieceTest<'a> {
+        PieceTest {
+            camera,
+            sub,
+            directions: camera.cone(sub),
+            base: None,
+            near: None,
+        }
     }
-    let Some(along) = alongs(plane, directions) else {
-        return false;
-    };
+
+    /// Whether the convex hull of `points` projected along the piece's directions misses
+    /// the piece (so nothing inside that hull is seen by it), on the plane near the points
+    /// or on the camera plane (either hull that misses proves it); `false` where no hull
+    /// bounds the region.
+    pub fn misses(&mut self, points: &[DVec3]) -> bool {
+        let Some(directions) = self.directions else {
+            return false;
+        };
+        let along = |plane: &CameraPlane| {
+            plane
+                .one_sided(&directions)
+                .then(|| alongs(plane, &directions))
+                .flatten()
+        };
+        let centre = points.iter().sum::<DVec3>() / points.len().max(1) as f64;
+        if let Some(plane) = self.camera.plane_near(centre) {
+            let along = match self.near {
+                Some((last, along)) if std::ptr::eq(last, plane) => along,
+                _ => {
+                    let made = along(plane);
+                    self.near = Some((plane, made));
+                    made
+                }
+            };
+            if along.is_some_and(|a| misses_along(&a, self.sub, points)) {
+                return true;
+            }
+        }
+        let Some(plane) = self.camera.plane() else {
+            return false;
+        };
+        let along = *self.base.get_or_insert_with(|| along(plane));
+        along.is_some_and(|a| misses_along(&a, self.sub, points))
+    }
+}
+
+/// [`PieceTest::misses`] with the projections onto one plane.
+fn misses_along(along: &[AlongDirection; 3], sub: [DVec2; 3], points: &[DVec3]) -> bool {
     let mut projected = [DVec2::ZERO; 24];
     let mut n = 0;
     for &q in points.iter().take(8) {
-        for a in &along {
+        for a in along {
             match near(a.project(q)) {
                 Some(p) => projected[n] = p,
                 None => return false,

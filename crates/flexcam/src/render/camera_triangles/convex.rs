@@ -203,12 +203,7 @@ mod tests {
     /// Clipping by a line that has the whole polygon on its left keeps it as it is.
     #[test]
     fn clipping_by_a_line_outside_keeps_the_polygon() {
-        let square = Convex::from_points(&[
-            DVec2::ZERO,
-            DVec2::X,
-            DVec2::ONE,
-            DVec2::Y,
-        ]);
+        let square = Convex::from_points(&[DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y]);
         let kept = square.clip(DVec2::new(-1.0, 0.0), DVec2::new(-1.0, -1.0));
         assert_eq!(kept.points(), square.points());
         assert!(square

@@ -279,11 +279,10 @@ impl<'a> CameraTriangleRenderer<'a> {
                             );
                         }
                     } else {
+                        let mut test = bound::PieceTest::new(camera, camera::CORNERS);
                         for cluster in &scene.clusters {
                             let size = cluster.triangles.len() as u64;
-                            if method.cull
-                                && bound::misses(camera, camera::CORNERS, &cluster.box_corners)
-                            {
+                            if method.cull && test.misses(&cluster.box_corners) {
                                 counts.culled += size;
                                 continue;
                             }

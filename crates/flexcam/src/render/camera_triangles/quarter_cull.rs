@@ -1,7 +1,7 @@
 //! Object culling per quarter of the camera triangle (Hou et al. 2006, 2.4, carried down the
 //! tight bound's quartering): the camera triangle is quartered recursively while clusters of
 //! scene triangles survive, each piece testing only the clusters its parent kept
-//! ([`bound::misses`] on the piece: a piece is itself a camera triangle, with a narrower
+//! ([`bound::PieceTest`] on the piece: a piece is itself a camera triangle, with a narrower
 //! cone of rays), and each scene triangle of a cluster that survives down to a piece is
 //! bounded from that piece on ([`bound::tight_in`]). A small scene triangle far from most of
 //! a wide camera triangle then costs the quartering of the pieces near it only, shared by
@@ -99,8 +99,9 @@ pub fn pieces(
 ) -> u64 {
     buffers.kept.clear();
     buffers.pieces.clear();
+    let mut test = bound::PieceTest::new(camera, CORNERS);
     for (clusters, corners) in &groups.groups {
-        if !bound::misses(camera, CORNERS, corners) {
+        if !test.misses(corners) {
             buffers
                 .kept
                 .extend(clusters.start as u32..clusters.end as u32);
@@ -131,9 +132,10 @@ fn descend(
     buffers: &mut Buffers,
 ) {
     let start = buffers.kept.len();
+    let mut test = bound::PieceTest::new(camera, sub);
     for i in parent {
         let c = buffers.kept[i];
-        if !bound::misses(camera, sub, &scene.clusters[c as usize].box_corners) {
+        if !test.misses(&scene.clusters[c as usize].box_corners) {
             buffers.kept.push(c);
         }
     }

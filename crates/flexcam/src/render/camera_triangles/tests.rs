@@ -257,7 +257,11 @@ fn culling_drops_no_fragment() {
         .map(|name| {
             let scene = load(name);
             let projection = scene.projection.build(96, 72).unwrap();
-            (name.to_string(), projection.trilinear().unwrap().clone(), scene)
+            (
+                name.to_string(),
+                projection.trilinear().unwrap().clone(),
+                scene,
+            )
         })
         .collect();
     for name in ["reflect-sphere-cube", "reflect-funny-mirror"] {
