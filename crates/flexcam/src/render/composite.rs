@@ -480,6 +480,7 @@ impl<'a> ExactPixels<'a> {
     pub fn uncovered(&self, frame: &Frame, id: u32, surface: Option<&Trilinear>) -> Vec<usize> {
         let width = frame.width as usize;
         (0..frame.ids.len())
+            .into_par_iter()
             .filter(|&k| {
                 frame.ids[k] == id
                     && surface.is_none_or(|s| s.locate(pixel_centre(k, width)).is_none())

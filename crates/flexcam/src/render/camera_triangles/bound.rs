@@ -95,7 +95,7 @@ pub fn tight_in(
     emit: &mut impl FnMut(&Convex),
 ) {
     let plane = camera.plane_near((q[0] + q[1] + q[2]) / 3.0);
-    tight(camera, plane.as_ref(), q, sub, depth, emit)
+    tight(camera, plane, q, sub, depth, emit)
 }
 
 /// The four quarters of `sub` (corners, then the middle one), in the order the tight bound
@@ -105,41 +105,76 @@ pub fn quarters([a, b, c]: [DVec2; 3]) -> [[DVec2; 3]; 4] {
     [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]]
 }
 
-/// Whether the convex hull of `points` projected along the corner directions of the
-/// sub-triangle `sub` of the camera triangle misses `sub` (so nothing inside that hull is
-/// seen by it): the culling of section 2.4 for a box (its eight corners) or a triangle, on
-/// the plane near the points and on the camera plane (either hull that misses proves it),
-/// for the whole camera triangle ([`CORNERS`]) or a piece of it (a piece is itself a
-/// camera triangle: its corner rays are the camera's rays there). `false` where no hull
-/// bounds the region.
-pub fn misses(camera: &Camera, sub: [DVec2; 3], points: &[DVec3]) -> bool {
-    let Some(directions) = camera.cone(sub) else {
-        return false;
-    };
-    let centre = points.iter().sum::<DVec3>() / points.len().max(1) as f64;
-    [camera.plane_near(centre).as_ref(), camera.plane()]
-        .into_iter()
-        .flatten()
-        .any(|plane| misses_on(plane, &directions, sub, points))
+/// The culling of section 2.4 for one piece `sub` of a camera triangle (the whole camera
+/// triangle, [`CORNERS`], or a piece of its quartering: a piece is itself a camera
+/// triangle, its corner rays the camera's rays there), for any number of point sets (a
+/// box's eight corners, or a triangle): [`PieceTest::misses`]. The piece's cone of
+/// directions is found once, and the projections along it onto a plane once per plane (the
+/// camera plane, and the last plane near the points, which neighbouring clusters share).
+pub struct PieceTest<'a> {
+    camera: &'a Camera,
+    sub: [DVec2; 3],
+    directions: Option<[DVec3; 3]>,
+    /// The projections onto the camera plane, once computed (`None` inside: the plane is
+    /// crossed from both sides, or a direction is parallel to it).
+    base: Option<Option<[AlongDirection; 3]>>,
+    /// The last near plane used and its projections.
+    near: Option<(*const CameraPlane, Option<[AlongDirection; 3]>)>,
 }
 
-/// [`misses`] on one plane.
-fn misses_on(
-    plane: &CameraPlane,
-    directions: &[DVec3; 3],
-    sub: [DVec2; 3],
-    points: &[DVec3],
-) -> bool {
-    if !plane.one_sided(directions) {
-        return false;
+impl<'a> PieceTest<'a> {
+    pub fn new(camera: &'a Camera, sub: [DVec2; 3]) -> PieceTest<'a> {
+        PieceTest {
+            camera,
+            sub,
+            directions: camera.cone(sub),
+            base: None,
+            near: None,
+        }
     }
-    let Some(along) = alongs(plane, directions) else {
-        return false;
-    };
+
+    /// Whether the convex hull of `points` projected along the piece's directions misses
+    /// the piece (so nothing inside that hull is seen by it), on the plane near the points
+    /// or on the camera plane (either hull that misses proves it); `false` where no hull
+    /// bounds the region.
+    pub fn misses(&mut self, points: &[DVec3]) -> bool {
+        let Some(directions) = self.directions else {
+            return false;
+        };
+        let along = |plane: &CameraPlane| {
+            plane
+                .one_sided(&directions)
+                .then(|| alongs(plane, &directions))
+                .flatten()
+        };
+        let centre = points.iter().sum::<DVec3>() / points.len().max(1) as f64;
+        if let Some(plane) = self.camera.plane_near(centre) {
+            let along = match self.near {
+                Some((last, along)) if std::ptr::eq(last, plane) => along,
+                _ => {
+                    let made = along(plane);
+                    self.near = Some((plane, made));
+                    made
+                }
+            };
+            if along.is_some_and(|a| misses_along(&a, self.sub, points)) {
+                return true;
+            }
+        }
+        let Some(plane) = self.camera.plane() else {
+            return false;
+        };
+        let along = *self.base.get_or_insert_with(|| along(plane));
+        along.is_some_and(|a| misses_along(&a, self.sub, points))
+    }
+}
+
+/// [`PieceTest::misses`] with the projections onto one plane.
+fn misses_along(along: &[AlongDirection; 3], sub: [DVec2; 3], points: &[DVec3]) -> bool {
     let mut projected = [DVec2::ZERO; 24];
     let mut n = 0;
     for &q in points.iter().take(8) {
-        for a in &along {
+        for a in along {
             match near(a.project(q)) {
                 Some(p) => projected[n] = p,
                 None => return false,
@@ -157,11 +192,7 @@ fn separated(points: &[DVec2], t: [DVec2; 3]) -> bool {
     if points.iter().any(|p| !p.is_finite()) {
         return false;
     }
-    let orient = cross(t[0], t[1], t[2]).signum();
-    let edge_out = (0..3).any(|i| {
-        let (a, b) = (t[i], t[(i + 1) % 3]);
-        points.iter().all(|&p| cross(a, b, p) * orient < 0.0)
-    });
+    let edge_out = outside_an_edge(points, t);
     let lo = t[0].min(t[1]).min(t[2]);
     let hi = t[0].max(t[1]).max(t[2]);
     let axis_out = points.iter().all(|p| p.x < lo.x)
@@ -169,6 +200,16 @@ fn separated(points: &[DVec2], t: [DVec2; 3]) -> bool {
         || points.iter().all(|p| p.y < lo.y)
         || points.iter().all(|p| p.y > hi.y);
     edge_out || axis_out
+}
+
+/// Whether all `points` (finite) lie strictly outside one edge of triangle `t` (either
+/// orientation): then their convex hull misses `t`.
+fn outside_an_edge(points: &[DVec2], t: [DVec2; 3]) -> bool {
+    let orient = cross(t[0], t[1], t[2]).signum();
+    (0..3).any(|i| {
+        let (a, b) = (t[i], t[(i + 1) % 3]);
+        points.iter().all(|&p| cross(a, b, p) * orient < 0.0)
+    })
 }
 
 /// Projections farther than this from the camera triangle (in barycentrics) make no bound:
@@ -302,12 +343,15 @@ fn tight(
     depth: u32,
     emit: &mut impl FnMut(&Convex),
 ) {
-    let region = camera
-        .cone(sub)
-        .and_then(|directions| {
-            let plane = plane.filter(|p| p.one_sided(&directions))?;
-            nine(plane, q, &directions)
-        })
+    let points = camera.cone(sub).and_then(|directions| {
+        let plane = plane.filter(|p| p.one_sided(&directions))?;
+        nine(plane, q, &directions)
+    });
+    if points.is_some_and(|points| outside_an_edge(&points, sub)) {
+        // The hull lies beyond a line of `sub`: nothing of the piece sees the triangle.
+        return;
+    }
+    let region = points
         .map(|points| Convex::hull(&points).clip_to_triangle(sub))
         .unwrap_or_else(|| Convex::from_points(&sub).clip_to_triangle(CORNERS));
     if region.points().len() < 3 {
@@ -318,7 +362,11 @@ fn tight(
         return emit_in_camera(camera, &region, emit);
     }
     for quarter in quarters(sub) {
-        tight(camera, plane, q, quarter, depth + 1, emit);
+        // A quarter's rays are among the piece's, so its region lies in the piece's: a
+        // quarter that the region misses sees nothing of the triangle.
+        if !outside_an_edge(region.points(), quarter) {
+            tight(camera, plane, q, quarter, depth + 1, emit);
+        }
     }
 }
 

@@ -42,7 +42,7 @@ const GRAZING_SINE: f64 = 1e-9;
 pub const CORNERS: [DVec2; 3] = [DVec2::ZERO, DVec2::X, DVec2::Y];
 
 /// A camera triangle: its rays, its pixels and its camera plane.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Camera {
     pub map: ScreenMap,
     cache: ProjectionTriangleCache,
@@ -165,19 +165,16 @@ impl CameraPlane {
 /// onto. Where the rays diverge, the camera plane itself may be crossed from both sides
 /// (rays grazing the reflector), yet far enough along the rays the cone always crosses the
 /// plane of its corner rays' points from one side (unless the directions are coplanar).
-#[derive(Debug, Clone, Copy)]
+///
+/// Each choice keeps its plane and the camera its central ray, built once: every (camera,
+/// scene triangle) pair and every culled cluster picks a plane.
+#[derive(Debug, Clone, Default)]
 struct PlaneChoices {
-    s: [f64; GRID_STEPS],
-    len: usize,
-}
-
-impl Default for PlaneChoices {
-    fn default() -> Self {
-        PlaneChoices {
-            s: [0.0; GRID_STEPS],
-            len: 0,
-        }
-    }
+    s: Vec<f64>,
+    planes: Vec<CameraPlane>,
+    /// The interpolated ray at the camera triangle's centroid, whose parameter at a point
+    /// picks the plane ([`Camera::plane_near`]).
+    central: Option<Ray>,
 }
 
 /// Points of the grid of ray parameters: `s = scale * GRID_RATIO^i`, `i` from
@@ -207,28 +204,46 @@ impl PlaneChoices {
             let plane = camera.plane_at(s)?;
             plane
                 .one_sided(&directions)
-                .then(|| plane.min_sine(&directions))
+                .then(|| (plane, plane.min_sine(&directions)))
         };
         let mut out = PlaneChoices::default();
-        let sines: Vec<(f64, f64)> = grid.filter_map(|s| Some((s, steepness(s)?))).collect();
-        let steep = sines.iter().any(|&(_, sine)| sine >= STEEP_SINE);
-        for &(s, sine) in &sines {
+        let sines: Vec<(f64, CameraPlane, f64)> = grid
+            .filter_map(|s| {
+                let (plane, sine) = steepness(s)?;
+                Some((s, plane, sine))
+            })
+            .collect();
+        let steep = sines.iter().any(|&(_, _, sine)| sine >= STEEP_SINE);
+        for &(s, plane, sine) in &sines {
             if sine >= STEEP_SINE || !steep {
-                out.s[out.len] = s;
-                out.len += 1;
+                out.s.push(s);
+                out.planes.push(plane);
             }
+        }
+        if !out.s.is_empty() {
+            out.central = Some(camera.interpolated_ray(DVec2::splat(1.0 / 3.0)));
         }
         out
     }
 
-    /// The choice nearest `s` in ratio (the smallest for `s <= 0`), `None` if there is none.
-    fn nearest(&self, s: f64) -> Option<f64> {
-        let choices = &self.s[..self.len];
+    /// The plane of the choice nearest `s` in ratio (the smallest for `s <= 0`), `None` if
+    /// there is none.
+    fn nearest(&self, s: f64) -> Option<&CameraPlane> {
+        let choices = &self.s;
         let above = choices.partition_point(|&c| c < s);
-        match (above.checked_sub(1).map(|i| choices[i]), choices.get(above)) {
-            (Some(below), Some(&above)) => Some(if s * s <= below * above { below } else { above }),
-            (below, above) => below.or(above.copied()),
-        }
+        let index = match (above.checked_sub(1), choices.get(above)) {
+            (Some(below), Some(&at)) => {
+                if s * s <= choices[below] * at {
+                    below
+                } else {
+                    above
+                }
+            }
+            (Some(below), None) => below,
+            (None, Some(_)) => above,
+            (None, None) => return None,
+        };
+        Some(&self.planes[index])
     }
 }
 
@@ -295,16 +310,12 @@ impl Camera {
     /// ratio), else the camera plane. Projecting along diverging rays onto a plane near the
     /// points moves them little, so their hull is small; the cone of the corner rays crosses
     /// every choice from one side.
-    pub fn plane_near(&self, centre: DVec3) -> Option<CameraPlane> {
-        if self.choices.len == 0 {
-            return self.plane;
-        }
-        let ray = self.interpolated_ray(DVec2::splat(1.0 / 3.0));
+    pub fn plane_near(&self, centre: DVec3) -> Option<&CameraPlane> {
+        let Some(ray) = &self.choices.central else {
+            return self.plane.as_ref();
+        };
         let s = (centre - ray.origin).dot(ray.direction) / ray.direction.length_squared();
-        self.choices
-            .nearest(s)
-            .and_then(|s| self.plane_at(s))
-            .or(self.plane)
+        self.choices.nearest(s)
     }
 
     /// The ray at barycentrics `b` (`None`: a per-fragment mirror's eye at its origin).

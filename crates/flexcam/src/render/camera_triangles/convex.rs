@@ -39,7 +39,7 @@ impl Convex {
         }
         sorted[..n].copy_from_slice(&points[..n]);
         let sorted = &mut sorted[..n];
-        sorted.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+        sort_lexicographic(sorted);
         let mut chain = [DVec2::ZERO; 2 * CAPACITY];
         let mut k = 0;
         for &p in sorted.iter() {
@@ -79,8 +79,12 @@ impl Convex {
     /// The part on the left of the directed line `a -> b` (the line included)
     /// (Sutherland-Hodgman).
     pub fn clip(&self, a: DVec2, b: DVec2) -> Convex {
-        let mut out = Convex::EMPTY;
         let side = |p: DVec2| cross(a, b, p);
+        if self.points().iter().all(|&p| side(p) >= 0.0) {
+            // Nothing to cut: the loop below would copy every vertex and add none.
+            return *self;
+        }
+        let mut out = Convex::EMPTY;
         for i in 0..self.len {
             let (p, q) = (self.points[i], self.points[(i + 1) % self.len]);
             let (sp, sq) = (side(p), side(q));
@@ -141,6 +145,30 @@ impl Convex {
     }
 }
 
+/// Sorts `points` by `x`, then `y`, in the order of `f64::total_cmp` (an insertion sort on
+/// integer keys: the hulls here have at most 16 points, and the comparator of
+/// `sort_by` costs more than the sort).
+fn sort_lexicographic(points: &mut [DVec2]) {
+    let key = |p: DVec2| (total_key(p.x), total_key(p.y));
+    for i in 1..points.len() {
+        let p = points[i];
+        let k = key(p);
+        let mut j = i;
+        while j > 0 && key(points[j - 1]) > k {
+            points[j] = points[j - 1];
+            j -= 1;
+        }
+        points[j] = p;
+    }
+}
+
+/// An integer ordered as `f64::total_cmp` orders `x`.
+#[inline]
+fn total_key(x: f64) -> i64 {
+    let bits = x.to_bits() as i64;
+    bits ^ ((((bits >> 63) as u64) >> 1) as i64)
+}
+
 /// Twice the signed area of `a b c` (positive counter-clockwise).
 pub fn cross(a: DVec2, b: DVec2, c: DVec2) -> f64 {
     (b - a).perp_dot(c - a)
@@ -149,6 +177,40 @@ pub fn cross(a: DVec2, b: DVec2, c: DVec2) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// The hull's sort orders points as sorting by `total_cmp` on `x`, then `y` does
+        /// (signed zeros, equal coordinates and infinities included).
+        #[test]
+        fn sort_matches_total_cmp(
+            raw in proptest::collection::vec((0usize..6, 0usize..6), 0..16)
+        ) {
+            let values = [-1.5, -0.0, 0.0, 2.0, f64::INFINITY, f64::NEG_INFINITY];
+            let points: Vec<DVec2> =
+                raw.iter().map(|&(x, y)| DVec2::new(values[x], values[y])).collect();
+            let mut ours = points.clone();
+            sort_lexicographic(&mut ours);
+            let mut theirs = points;
+            theirs.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+            let bits = |p: &[DVec2]| -> Vec<(u64, u64)> {
+                p.iter().map(|q| (q.x.to_bits(), q.y.to_bits())).collect()
+            };
+            prop_assert_eq!(bits(&ours), bits(&theirs));
+        }
+    }
+
+    /// Clipping by a line that has the whole polygon on its left keeps it as it is.
+    #[test]
+    fn clipping_by_a_line_outside_keeps_the_polygon() {
+        let square = Convex::from_points(&[DVec2::ZERO, DVec2::X, DVec2::ONE, DVec2::Y]);
+        let kept = square.clip(DVec2::new(-1.0, 0.0), DVec2::new(-1.0, -1.0));
+        assert_eq!(kept.points(), square.points());
+        assert!(square
+            .clip(DVec2::new(-1.0, 0.0), DVec2::new(-1.0, 1.0))
+            .points()
+            .is_empty());
+    }
 
     #[test]
     fn hull_of_a_square_with_inner_points() {

@@ -75,6 +75,7 @@ impl Default for Options {
 pub struct CameraTriangleRenderer<'a> {
     prepared: &'a PreparedScene,
     scene: SceneGeometry,
+    groups: quarter_cull::Groups,
     flat_colors: Vec<Option<TriangleColor>>,
 }
 
@@ -129,6 +130,7 @@ impl<'a> CameraTriangleRenderer<'a> {
         let flat_colors = trilinear::flat_colors(prepared, &geometry);
         CameraTriangleRenderer {
             prepared,
+            groups: quarter_cull::Groups::new(&geometry),
             scene: geometry,
             flat_colors,
         }
@@ -264,7 +266,7 @@ impl<'a> CameraTriangleRenderer<'a> {
                         counts.regions += 1;
                     };
                     if method.cull && method.bound == Bound::Tight {
-                        counts.pairs = quarter_cull::pieces(camera, scene, buffers);
+                        counts.pairs = quarter_cull::pieces(camera, scene, &self.groups, buffers);
                         counts.culled = scene.triangles.len() as u64 - counts.pairs;
                         for piece in &buffers.pieces {
                             let k = piece.triangle as usize;
@@ -277,11 +279,10 @@ impl<'a> CameraTriangleRenderer<'a> {
                             );
                         }
                     } else {
+                        let mut test = bound::PieceTest::new(camera, camera::CORNERS);
                         for cluster in &scene.clusters {
                             let size = cluster.triangles.len() as u64;
-                            if method.cull
-                                && bound::misses(camera, camera::CORNERS, &cluster.box_corners)
-                            {
+                            if method.cull && test.misses(&cluster.box_corners) {
                                 counts.culled += size;
                                 continue;
                             }

@@ -246,6 +246,72 @@ fn culling_keeps_the_image() {
     assert!(count(&culled_stats, "pairs") < count(&all_stats, "pairs"));
 }
 
+/// Culling (cluster groups, clusters per quarter) and the tight bound's quartering (a
+/// quarter that its parent's region misses is skipped) drop no fragment: with and without
+/// culling every trilinear scene and the mirror spheres' diverging rays render the same
+/// frame from the same rendered fragments.
+#[test]
+fn culling_drops_no_fragment() {
+    let mut cases: Vec<(String, Trilinear, Scene)> = TRILINEAR_SCENES
+        .iter()
+        .map(|name| {
+            let scene = load(name);
+            let projection = scene.projection.build(96, 72).unwrap();
+            (
+                name.to_string(),
+                projection.trilinear().unwrap().clone(),
+                scene,
+            )
+        })
+        .collect();
+    for name in ["reflect-sphere-cube", "reflect-funny-mirror"] {
+        let (projection, scene) = mirror_surface(name, SurfaceRays::Interpolated);
+        cases.push((name.to_string(), projection, scene));
+    }
+    for (name, projection, scene) in &cases {
+        let prepared = PreparedScene::new(scene);
+        let renderer = CameraTriangleRenderer::new(&prepared);
+        let flat = options(Shading::Flat, Bound::Tight);
+        let with = |cull| {
+            let method = Options {
+                cull,
+                ..Options::default()
+            };
+            renderer.render(projection, &flat, method).unwrap()
+        };
+        let ((culled, culled_stats), (all, all_stats)) = (with(true), with(false));
+        assert_eq!(culled, all, "{name}");
+        assert_eq!(
+            count(&culled_stats, "rendered_fragments"),
+            count(&all_stats, "rendered_fragments"),
+            "{name}"
+        );
+        assert!(count(&culled_stats, "rendered_fragments") > 100, "{name}");
+    }
+}
+
+/// A cluster group's box holds the box of each of its clusters, and the groups cover the
+/// clusters once, in order.
+#[test]
+fn cluster_groups_hold_their_clusters() {
+    let scene = load("trilinear-detail-in-context");
+    let geometry = SceneGeometry::new(&scene);
+    let groups = quarter_cull::Groups::new(&geometry);
+    let mut next = 0;
+    for (clusters, corners) in groups.iter() {
+        assert_eq!(clusters.start, next);
+        next = clusters.end;
+        let (lo, hi) = (corners[0], corners[7]);
+        for cluster in &geometry.clusters[clusters.clone()] {
+            for corner in cluster.box_corners {
+                assert!(corner.cmpge(lo).all() && corner.cmple(hi).all());
+            }
+        }
+    }
+    assert_eq!(next, geometry.clusters.len());
+    assert!(groups.iter().count() > 1);
+}
+
 #[test]
 fn refuses_what_it_cannot_render() {
     let scene = scene::load("builtin:cube-floor").unwrap();
