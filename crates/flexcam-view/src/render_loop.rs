@@ -22,7 +22,7 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::Instant;
 
-use flexcam::image_io::{encode_channel, ColorEncoding};
+use flexcam::image_io::ColorEncoding;
 use flexcam::projection::{
     AnalyticInverse, NoInverse, Projection, ProjectionSpec, Projector, ProjectorHull, Trilinear,
     View,
@@ -30,6 +30,9 @@ use flexcam::projection::{
 use flexcam::render::{self, Frame, Method, Outputs, PreparedScene, RenderOptions, Shading};
 use flexcam::{try_alloc, Error, Result};
 use glam::DVec2;
+use rayon::prelude::*;
+
+use crate::display_bytes::Encoder;
 
 /// How the view renders: the final method, shading and samples per pixel (those of the
 /// `flexcam render` the final frame matches) and the supersampling of the idle refinement.
@@ -415,22 +418,23 @@ fn render_stage(shared: &Shared, job: &Job, stage: Stage) -> Result<Frame> {
     rendered.map(|r| r.frame)
 }
 
-/// 8-bit RGBA of `frame`'s colour, encoded as a PNG of `shading` is. Fails when its memory
-/// cannot be had.
+/// 8-bit RGBA of `frame`'s colour, encoded as a PNG of `shading` is (the same bytes, by
+/// [`Encoder`]), rows in parallel. Fails when its memory cannot be had.
 pub fn rgba(frame: &Frame, shading: Shading) -> Result<Vec<u8>> {
-    let encoding = ColorEncoding::of_shading(shading);
+    let encoder = Encoder::of(ColorEncoding::of_shading(shading));
     let mut bytes = Vec::new();
-    try_alloc::reserve(&mut bytes, frame.color.len() * 4, || {
+    try_alloc::resize(&mut bytes, frame.color.len() * 4, 0, || {
         format!("the shown {} x {} image", frame.width, frame.height)
     })?;
-    bytes.extend(frame.color.iter().flat_map(|c| {
-        [
-            encode_channel(c.x, encoding),
-            encode_channel(c.y, encoding),
-            encode_channel(c.z, encoding),
-            255,
-        ]
-    }));
+    let row = (frame.width as usize).max(1);
+    bytes
+        .par_chunks_mut(row * 4)
+        .zip(frame.color.par_chunks(row))
+        .for_each(|(out, colors)| {
+            for (out, c) in out.chunks_exact_mut(4).zip(colors) {
+                out.copy_from_slice(&[encoder.byte(c.x), encoder.byte(c.y), encoder.byte(c.z), 255]);
+            }
+        });
     Ok(bytes)
 }
 

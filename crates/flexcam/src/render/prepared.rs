@@ -16,8 +16,9 @@
 //! their meshes by `Arc`, so neither preparing nor a view copies a mesh), and leave out the
 //! triangles of the objects they hide by a `TriangleMask` the queries honour.
 
+use std::any::Any;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
 use glam::{DVec3, Vec2};
@@ -78,6 +79,11 @@ pub struct PreparedScene {
     /// The displaced objects, whose triangles the BVH leaves out ([`crate::render::displaced`]);
     /// `None` when there are none.
     pub(in crate::render) displaced: Option<Arc<DisplacedSet>>,
+    /// Working memory a renderer leaves for the next render of this scene
+    /// ([`PreparedScene::keep_spare`]): the raster's z-buffer, bins and pixel projectors, so
+    /// that a sequence of frames (a viewer editing its projection) does not allocate and
+    /// page-fault them again every frame.
+    spare: Mutex<Option<Box<dyn Any + Send>>>,
 }
 
 /// Secondary-ray offset relative to the scene's largest coordinate magnitude: 2^-16, about
@@ -176,6 +182,7 @@ impl PreparedScene {
             bvh_builds: AtomicU64::new(1),
             curve_triangles: Arc::default(),
             displaced: DisplacedSet::new(scene),
+            spare: Mutex::default(),
         }
     }
 
@@ -221,6 +228,7 @@ impl PreparedScene {
             bvh_builds: AtomicU64::new(0),
             curve_triangles: Arc::clone(&self.curve_triangles),
             displaced,
+            spare: Mutex::default(),
         }
     }
 
@@ -228,6 +236,30 @@ impl PreparedScene {
     #[inline]
     pub(in crate::render) fn shows(&self, stored: usize) -> bool {
         self.shown.as_ref().is_none_or(|mask| mask.keeps(stored))
+    }
+
+    /// The working memory of type `T` the last renderer left ([`PreparedScene::keep_spare`]),
+    /// if any; `None` also while another renderer holds it (it then allocates its own).
+    pub(in crate::render) fn take_spare<T: Any + Send>(&self) -> Option<T> {
+        let mut spare = self
+            .spare
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        match spare.take()?.downcast::<T>() {
+            Ok(kept) => Some(*kept),
+            Err(other) => {
+                *spare = Some(other);
+                None
+            }
+        }
+    }
+
+    /// Leaves `memory` for the next renderer of this scene (replacing what was left).
+    pub(in crate::render) fn keep_spare<T: Any + Send>(&self, memory: T) {
+        *self
+            .spare
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner) = Some(Box::new(memory));
     }
 
     /// The scene this was prepared from.
