@@ -11,7 +11,8 @@
 //! 3. a supersampled ray-cast refinement, for the window only, when the view's method is the
 //!    ray caster and `refine_spp` is above its samples per pixel.
 //!
-//! Submitting a new job cancels the running one: ray-cast stages see the projection through
+//! Each stage after the first starts once the job has been the newest for [`SETTLE`] more
+//! (a drag's next edit makes it stale first). Submitting a new job cancels the running one: ray-cast stages see the projection through
 //! [`Cancellable`], which answers "no projector" to every pixel once the job is stale, so a
 //! cancelled stage ends at the cost of a loop over the remaining pixels; other stages run to
 //! their (short) end. A stale stage's frame is dropped. The renderers run on rayon's pool,
@@ -20,7 +21,7 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use flexcam::image_io::ColorEncoding;
 use flexcam::projection::{
@@ -308,7 +309,33 @@ impl Shared {
     fn is_stale(&self, generation: u64) -> bool {
         self.newest.load(Ordering::SeqCst) != generation
     }
+
+    /// Waits up to `time` for a job newer than `job` (or the loop's end); whether one came.
+    fn superseded_within(&self, job: &Job, time: Duration) -> bool {
+        let deadline = Instant::now() + time;
+        let mut state = self.lock();
+        loop {
+            if state.quit || self.is_stale(job.generation) {
+                return true;
+            }
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                return false;
+            }
+            state = (self.changed.wait_timeout(state, left))
+                .unwrap_or_else(|e| e.into_inner())
+                .0;
+        }
+    }
 }
+
+/// How long a job's later stages wait after its first frame is shown, for an edit that
+/// would make them stale: while something is dragged the next edit comes within a few
+/// milliseconds of a shown frame, and a final ray-cast stage started in between would only
+/// be cancelled, after allocating its frame and tracing rays on every core the next
+/// preview needs. Small against the later stages themselves (a final frame of a 1280 x 720
+/// view takes hundreds of milliseconds).
+const SETTLE: Duration = Duration::from_millis(40);
 
 /// The worker thread: takes the newest job and runs its ladder, stage by stage, until a
 /// newer job arrives or the loop is dropped.
@@ -341,8 +368,11 @@ fn work(shared: &Shared) {
 /// failed preview is skipped (the final stage says what the method refuses); a failed final
 /// stage ends the ladder with its error.
 fn run_ladder(shared: &Shared, job: &Job) -> Result<()> {
-    for stage in stages(job.projection.as_ref(), &job.settings) {
-        if shared.is_stale(job.generation) {
+    for (k, stage) in stages(job.projection.as_ref(), &job.settings)
+        .into_iter()
+        .enumerate()
+    {
+        if shared.is_stale(job.generation) || (k > 0 && shared.superseded_within(job, SETTLE)) {
             return Ok(());
         }
         let start = Instant::now();
