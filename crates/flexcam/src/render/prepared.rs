@@ -21,13 +21,14 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
-use glam::{DVec3, Vec2};
+use glam::{DVec3, Vec2, Vec3};
 
 use crate::geometry::{intersect_triangle, Ray};
 use crate::render::bvh::curve_triangle::CurveTriangle;
 use crate::render::bvh::triangle::FastRay;
 use crate::render::bvh::{AllTriangles, Bvh, BvhHit, Keep, TriangleMask};
 use crate::render::displaced::DisplacedSet;
+use crate::render::shading::face_normal;
 use crate::scene::Scene;
 
 mod displaced_hits;
@@ -79,6 +80,10 @@ pub struct PreparedScene {
     /// The displaced objects, whose triangles the BVH leaves out ([`crate::render::displaced`]);
     /// `None` when there are none.
     pub(in crate::render) displaced: Option<Arc<DisplacedSet>>,
+    /// The unit face normal of every stored triangle ([`crate::render::shading::face_normal`]),
+    /// in the numbering of `first_triangle`: the lit shading of each hit reads it instead
+    /// of computing it.
+    face_normals: Arc<[Vec3]>,
     /// Working memory a renderer leaves for the next render of this scene
     /// ([`PreparedScene::keep_spare`]): the raster's z-buffer, bins and pixel projectors, so
     /// that a sequence of frames (a viewer editing its projection) does not allocate and
@@ -171,7 +176,12 @@ impl PreparedScene {
             groups.resize(triangles.len(), group);
         }
         let bvh = Bvh::build_grouped(&triangles, |id| groups[id as usize]);
+        let face_normals = (scene.objects.iter())
+            .filter(|o| o.displacement.is_none())
+            .flat_map(|o| (0..o.mesh.triangles.len()).map(move |t| face_normal(o, t)))
+            .collect();
         PreparedScene {
+            face_normals,
             bvh: Arc::new(bvh),
             shown: None,
             scene: scene.clone(),
@@ -227,6 +237,7 @@ impl PreparedScene {
             build_ms: self.build_ms,
             bvh_builds: AtomicU64::new(0),
             curve_triangles: Arc::clone(&self.curve_triangles),
+            face_normals: Arc::clone(&self.face_normals),
             displaced,
             spare: Mutex::default(),
         }
@@ -236,6 +247,13 @@ impl PreparedScene {
     #[inline]
     pub(in crate::render) fn shows(&self, stored: usize) -> bool {
         self.shown.as_ref().is_none_or(|mask| mask.keeps(stored))
+    }
+
+    /// The unit face normal of triangle `triangle` of object index `object` (an object the
+    /// BVH holds: not a displaced one), as [`crate::render::shading::face_normal`] gives it.
+    #[inline]
+    pub(in crate::render) fn face_normal(&self, object: usize, triangle: usize) -> Vec3 {
+        self.face_normals[self.first_triangle[object] as usize + triangle]
     }
 
     /// The working memory of type `T` the last renderer left ([`PreparedScene::keep_spare`]),
