@@ -12,10 +12,10 @@
 //!    ray caster and `refine_spp` is above its samples per pixel.
 //!
 //! Each stage after the first starts once the job has been the newest for [`SETTLE`] more
-//! (a drag's next edit makes it stale first). Submitting a new job cancels the running one: ray-cast stages see the projection through
-//! [`Cancellable`], which answers "no projector" to every pixel once the job is stale, so a
-//! cancelled stage ends at the cost of a loop over the remaining pixels; other stages run to
-//! their (short) end. A stale stage's frame is dropped. The renderers run on rayon's pool,
+//! (a drag's next edit makes it stale first). Submitting a new job cancels the running one:
+//! ray-cast stages see the projection through [`Cancellable`], which answers "no projector"
+//! to every pixel once the job is stale, so a cancelled stage ends at the cost of a loop over
+//! the remaining pixels; other stages run to their (short) end. A stale stage's frame is dropped. The renderers run on rayon's pool,
 //! never on the caller's thread, so a window stays responsive during a refinement.
 
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -462,7 +462,12 @@ pub fn rgba(frame: &Frame, shading: Shading) -> Result<Vec<u8>> {
         .zip(frame.color.par_chunks(row))
         .for_each(|(out, colors)| {
             for (out, c) in out.chunks_exact_mut(4).zip(colors) {
-                out.copy_from_slice(&[encoder.byte(c.x), encoder.byte(c.y), encoder.byte(c.z), 255]);
+                out.copy_from_slice(&[
+                    encoder.byte(c.x),
+                    encoder.byte(c.y),
+                    encoder.byte(c.z),
+                    255,
+                ]);
             }
         });
     Ok(bytes)

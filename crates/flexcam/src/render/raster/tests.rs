@@ -229,7 +229,11 @@ fn frames_reusing_an_earlier_renderers_memory_are_fresh_frames() {
     let prepared = PreparedScene::new(&scene);
     for (k, (name, spec)) in invertible(frame, fov).into_iter().enumerate() {
         let size = if k % 2 == 0 { (48, 32) } else { (40, 44) };
-        let shading = if k % 3 == 0 { Shading::Lit } else { Shading::Flat };
+        let shading = if k % 3 == 0 {
+            Shading::Lit
+        } else {
+            Shading::Flat
+        };
         let options = RenderOptions {
             shading,
             ..flat(Subdivision::default())
@@ -239,7 +243,11 @@ fn frames_reusing_an_earlier_renderers_memory_are_fresh_frames() {
             .render(&prepared, projection.as_ref(), &options)
             .unwrap()
             .0;
-        assert_eq!(reused, render(Method::Raster, &scene, &spec, size, &options), "{name}");
+        assert_eq!(
+            reused,
+            render(Method::Raster, &scene, &spec, size, &options),
+            "{name}"
+        );
     }
 }
 
