@@ -11,18 +11,19 @@
 //! 3. a supersampled ray-cast refinement, for the window only, when the view's method is the
 //!    ray caster and `refine_spp` is above its samples per pixel.
 //!
-//! Submitting a new job cancels the running one: ray-cast stages see the projection through
-//! [`Cancellable`], which answers "no projector" to every pixel once the job is stale, so a
-//! cancelled stage ends at the cost of a loop over the remaining pixels; other stages run to
-//! their (short) end. A stale stage's frame is dropped. The renderers run on rayon's pool,
+//! Each stage after the first starts once the job has been the newest for [`SETTLE`] more
+//! (a drag's next edit makes it stale first). Submitting a new job cancels the running one:
+//! ray-cast stages see the projection through [`Cancellable`], which answers "no projector"
+//! to every pixel once the job is stale, so a cancelled stage ends at the cost of a loop over
+//! the remaining pixels; other stages run to their (short) end. A stale stage's frame is dropped. The renderers run on rayon's pool,
 //! never on the caller's thread, so a window stays responsive during a refinement.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
-use flexcam::image_io::{encode_channel, ColorEncoding};
+use flexcam::image_io::ColorEncoding;
 use flexcam::projection::{
     AnalyticInverse, NoInverse, Projection, ProjectionSpec, Projector, ProjectorHull, Trilinear,
     View,
@@ -30,6 +31,9 @@ use flexcam::projection::{
 use flexcam::render::{self, Frame, Method, Outputs, PreparedScene, RenderOptions, Shading};
 use flexcam::{try_alloc, Error, Result};
 use glam::DVec2;
+use rayon::prelude::*;
+
+use crate::display_bytes::Encoder;
 
 /// How the view renders: the final method, shading and samples per pixel (those of the
 /// `flexcam render` the final frame matches) and the supersampling of the idle refinement.
@@ -305,7 +309,33 @@ impl Shared {
     fn is_stale(&self, generation: u64) -> bool {
         self.newest.load(Ordering::SeqCst) != generation
     }
+
+    /// Waits up to `time` for a job newer than `job` (or the loop's end); whether one came.
+    fn superseded_within(&self, job: &Job, time: Duration) -> bool {
+        let deadline = Instant::now() + time;
+        let mut state = self.lock();
+        loop {
+            if state.quit || self.is_stale(job.generation) {
+                return true;
+            }
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                return false;
+            }
+            state = (self.changed.wait_timeout(state, left))
+                .unwrap_or_else(|e| e.into_inner())
+                .0;
+        }
+    }
 }
+
+/// How long a job's later stages wait after its first frame is shown, for an edit that
+/// would make them stale: while something is dragged the next edit comes within a few
+/// milliseconds of a shown frame, and a final ray-cast stage started in between would only
+/// be cancelled, after allocating its frame and tracing rays on every core the next
+/// preview needs. Small against the later stages themselves (a final frame of a 1280 x 720
+/// view takes hundreds of milliseconds).
+const SETTLE: Duration = Duration::from_millis(40);
 
 /// The worker thread: takes the newest job and runs its ladder, stage by stage, until a
 /// newer job arrives or the loop is dropped.
@@ -338,8 +368,11 @@ fn work(shared: &Shared) {
 /// failed preview is skipped (the final stage says what the method refuses); a failed final
 /// stage ends the ladder with its error.
 fn run_ladder(shared: &Shared, job: &Job) -> Result<()> {
-    for stage in stages(job.projection.as_ref(), &job.settings) {
-        if shared.is_stale(job.generation) {
+    for (k, stage) in stages(job.projection.as_ref(), &job.settings)
+        .into_iter()
+        .enumerate()
+    {
+        if shared.is_stale(job.generation) || (k > 0 && shared.superseded_within(job, SETTLE)) {
             return Ok(());
         }
         let start = Instant::now();
@@ -415,22 +448,28 @@ fn render_stage(shared: &Shared, job: &Job, stage: Stage) -> Result<Frame> {
     rendered.map(|r| r.frame)
 }
 
-/// 8-bit RGBA of `frame`'s colour, encoded as a PNG of `shading` is. Fails when its memory
-/// cannot be had.
+/// 8-bit RGBA of `frame`'s colour, encoded as a PNG of `shading` is (the same bytes, by
+/// [`Encoder`]), rows in parallel. Fails when its memory cannot be had.
 pub fn rgba(frame: &Frame, shading: Shading) -> Result<Vec<u8>> {
-    let encoding = ColorEncoding::of_shading(shading);
+    let encoder = Encoder::of(ColorEncoding::of_shading(shading));
     let mut bytes = Vec::new();
-    try_alloc::reserve(&mut bytes, frame.color.len() * 4, || {
+    try_alloc::resize(&mut bytes, frame.color.len() * 4, 0, || {
         format!("the shown {} x {} image", frame.width, frame.height)
     })?;
-    bytes.extend(frame.color.iter().flat_map(|c| {
-        [
-            encode_channel(c.x, encoding),
-            encode_channel(c.y, encoding),
-            encode_channel(c.z, encoding),
-            255,
-        ]
-    }));
+    let row = (frame.width as usize).max(1);
+    bytes
+        .par_chunks_mut(row * 4)
+        .zip(frame.color.par_chunks(row))
+        .for_each(|(out, colors)| {
+            for (out, c) in out.chunks_exact_mut(4).zip(colors) {
+                out.copy_from_slice(&[
+                    encoder.byte(c.x),
+                    encoder.byte(c.y),
+                    encoder.byte(c.z),
+                    255,
+                ]);
+            }
+        });
     Ok(bytes)
 }
 

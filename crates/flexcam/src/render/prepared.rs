@@ -16,17 +16,19 @@
 //! their meshes by `Arc`, so neither preparing nor a view copies a mesh), and leave out the
 //! triangles of the objects they hide by a `TriangleMask` the queries honour.
 
+use std::any::Any;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, OnceLock};
+use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Instant;
 
-use glam::{DVec3, Vec2};
+use glam::{DVec3, Vec2, Vec3};
 
 use crate::geometry::{intersect_triangle, Ray};
 use crate::render::bvh::curve_triangle::CurveTriangle;
 use crate::render::bvh::triangle::FastRay;
 use crate::render::bvh::{AllTriangles, Bvh, BvhHit, Keep, TriangleMask};
 use crate::render::displaced::DisplacedSet;
+use crate::render::shading::face_normal;
 use crate::scene::Scene;
 
 mod displaced_hits;
@@ -78,6 +80,15 @@ pub struct PreparedScene {
     /// The displaced objects, whose triangles the BVH leaves out ([`crate::render::displaced`]);
     /// `None` when there are none.
     pub(in crate::render) displaced: Option<Arc<DisplacedSet>>,
+    /// The unit face normal of every stored triangle ([`crate::render::shading::face_normal`]),
+    /// in the numbering of `first_triangle`: the lit shading of each hit reads it instead
+    /// of computing it.
+    face_normals: Arc<[Vec3]>,
+    /// Working memory a renderer leaves for the next render of this scene
+    /// ([`PreparedScene::keep_spare`]): the raster's z-buffer, bins and pixel projectors, so
+    /// that a sequence of frames (a viewer editing its projection) does not allocate and
+    /// page-fault them again every frame.
+    spare: Mutex<Option<Box<dyn Any + Send>>>,
 }
 
 /// Secondary-ray offset relative to the scene's largest coordinate magnitude: 2^-16, about
@@ -165,7 +176,12 @@ impl PreparedScene {
             groups.resize(triangles.len(), group);
         }
         let bvh = Bvh::build_grouped(&triangles, |id| groups[id as usize]);
+        let face_normals = (scene.objects.iter())
+            .filter(|o| o.displacement.is_none())
+            .flat_map(|o| (0..o.mesh.triangles.len()).map(move |t| face_normal(o, t)))
+            .collect();
         PreparedScene {
+            face_normals,
             bvh: Arc::new(bvh),
             shown: None,
             scene: scene.clone(),
@@ -176,6 +192,7 @@ impl PreparedScene {
             bvh_builds: AtomicU64::new(1),
             curve_triangles: Arc::default(),
             displaced: DisplacedSet::new(scene),
+            spare: Mutex::default(),
         }
     }
 
@@ -220,7 +237,9 @@ impl PreparedScene {
             build_ms: self.build_ms,
             bvh_builds: AtomicU64::new(0),
             curve_triangles: Arc::clone(&self.curve_triangles),
+            face_normals: Arc::clone(&self.face_normals),
             displaced,
+            spare: Mutex::default(),
         }
     }
 
@@ -228,6 +247,37 @@ impl PreparedScene {
     #[inline]
     pub(in crate::render) fn shows(&self, stored: usize) -> bool {
         self.shown.as_ref().is_none_or(|mask| mask.keeps(stored))
+    }
+
+    /// The unit face normal of triangle `triangle` of object index `object` (an object the
+    /// BVH holds: not a displaced one), as [`crate::render::shading::face_normal`] gives it.
+    #[inline]
+    pub(in crate::render) fn face_normal(&self, object: usize, triangle: usize) -> Vec3 {
+        self.face_normals[self.first_triangle[object] as usize + triangle]
+    }
+
+    /// The working memory of type `T` the last renderer left ([`PreparedScene::keep_spare`]),
+    /// if any; `None` also while another renderer holds it (it then allocates its own).
+    pub(in crate::render) fn take_spare<T: Any + Send>(&self) -> Option<T> {
+        let mut spare = self
+            .spare
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        match spare.take()?.downcast::<T>() {
+            Ok(kept) => Some(*kept),
+            Err(other) => {
+                *spare = Some(other);
+                None
+            }
+        }
+    }
+
+    /// Leaves `memory` for the next renderer of this scene (replacing what was left).
+    pub(in crate::render) fn keep_spare<T: Any + Send>(&self, memory: T) {
+        *self
+            .spare
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner) = Some(Box::new(memory));
     }
 
     /// The scene this was prepared from.

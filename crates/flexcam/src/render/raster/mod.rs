@@ -30,7 +30,10 @@
 //! An [`InverseRaster`] is meant to render many frames of one projection (an animation of
 //! the scene, an interactive viewer): the pixel projectors, the BVH, the bins and the
 //! z-buffer are kept between frames, and [`InverseRaster::render_into`] reuses the caller's
-//! frame.
+//! frame. When it is dropped, its z-buffer, bins and projector tiles are left with the
+//! prepared scene ([`PreparedScene::keep_spare`]) for the next renderer of that scene, so
+//! frames of a projection that changes every frame (a viewer's drag) reuse that memory
+//! too, their projectors being computed again into it.
 //!
 //! Supported: every projection with an `InverseChart` (perspective, orthographic,
 //! fisheye, equirectangular, cylindrical, and the flexible volumes described in
@@ -68,7 +71,7 @@ pub use views::render;
 use self::band_fill::{fill_and_shade, BAND_ROWS};
 use self::coverage::{Bins, ScreenTriangle};
 use self::fragment::{key, Shader, Visible};
-use self::pixel_rays::PixelRays;
+use self::pixel_rays::{PixelRays, Tile};
 use self::refine::{Node, Refiner};
 use self::seam::{covers_a_centre, place, Placement};
 use crate::error::{Error, Result};
@@ -84,6 +87,7 @@ const CHUNK: usize = 2048;
 /// (filled in as frames need them), the buffers frames reuse and, when shading needs rays,
 /// the prepared scene they are traced through.
 pub struct InverseRaster<'a> {
+    prepared: &'a PreparedScene,
     scene: &'a Scene,
     projection: &'a dyn Projection,
     /// The projection's continuous inverse and its chart, looked up once.
@@ -94,6 +98,13 @@ pub struct InverseRaster<'a> {
     setup_ms: f64,
     /// The buffers of a frame, kept from frame to frame (cleared, not reallocated).
     buffers: Mutex<Buffers>,
+}
+
+/// The memory a renderer leaves for the next renderer of the same prepared scene.
+#[derive(Default)]
+struct Spare {
+    buffers: Buffers,
+    tiles: Vec<Tile>,
 }
 
 /// What a frame writes besides the caller's frame, kept by the renderer.
@@ -185,6 +196,19 @@ pub fn supported_chart(projection: &dyn Projection) -> Result<Charted<'_>> {
     Ok(charted)
 }
 
+impl Drop for InverseRaster<'_> {
+    /// Leaves the z-buffer, bins and projector tiles to the next renderer of the scene.
+    fn drop(&mut self) {
+        let buffers = std::mem::take(
+            self.buffers
+                .get_mut()
+                .unwrap_or_else(std::sync::PoisonError::into_inner),
+        );
+        let tiles = self.rays.take_tiles();
+        self.prepared.keep_spare(Spare { buffers, tiles });
+    }
+}
+
 impl<'a> InverseRaster<'a> {
     /// Prepares `prepared` and `projection` with `options`. Errors: a projection outside
     /// the supported class, an invalid subdivision, more than one sample per pixel.
@@ -204,14 +228,16 @@ impl<'a> InverseRaster<'a> {
         }
         let start = Instant::now();
         let scene = prepared.scene();
-        let rays = PixelRays::new(projection);
+        let spare = prepared.take_spare::<Spare>().unwrap_or_default();
+        let rays = PixelRays::reusing(projection, spare.tiles);
         let specular = scene
             .objects
             .iter()
             .any(|o| !matches!(o.material.finish, Finish::Diffuse | Finish::Emissive));
         let caster = (options.shading == Shading::Lit || specular).then_some(prepared);
         Ok(InverseRaster {
-            buffers: Mutex::default(),
+            buffers: Mutex::new(spare.buffers),
+            prepared,
             scene,
             projection,
             inverse,

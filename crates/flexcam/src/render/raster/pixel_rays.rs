@@ -8,10 +8,13 @@
 //! The image is cut into square tiles of [`TILE`] pixels; a tile's projectors are computed
 //! the first time a fragment needs one of them (by whichever thread gets there first), so
 //! pixels that no scene triangle covers (the sky of a panorama) never cost a projector, and
-//! every later frame of the same projection finds them ready.
+//! every later frame of the same projection finds them ready. A renderer of another
+//! projection (the next frame of a viewer whose projection is being edited) can take over
+//! the tiles' memory ([`PixelRays::take_tiles`], [`PixelRays::reusing`]) and overwrite it,
+//! instead of allocating and page-faulting 70 bytes a pixel again.
 
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::OnceLock;
+use std::sync::{Mutex, OnceLock};
 
 use glam::{DVec2, DVec3};
 
@@ -21,19 +24,26 @@ use crate::projection::{Projection, Projector};
 /// so a tile is computed by one thread and read by at most two.
 const TILE: u32 = 16;
 
+/// The projectors of one tile, row-major.
+pub type Tile = Box<[Option<Projector>]>;
+
 /// The centre projectors of a projection's image, computed tile by tile on first use;
 /// `None` where the projection has none (outside a fisheye's circle) or it has zero length.
 pub struct PixelRays<'a> {
     projection: &'a dyn Projection,
     size: (u32, u32),
     tiles_x: u32,
-    tiles: Vec<OnceLock<Box<[Option<Projector>]>>>,
+    tiles: Vec<OnceLock<Tile>>,
     computed: AtomicU64,
+    /// Tiles of an earlier renderer, overwritten before they are read.
+    spare: Mutex<Vec<Tile>>,
 }
 
 impl<'a> PixelRays<'a> {
-    /// The (still empty) projectors of `projection`'s image.
-    pub fn new(projection: &'a dyn Projection) -> Self {
+    /// The (still empty) projectors of `projection`'s image, computed into the memory of
+    /// `spare` tiles (those of another projection, whose projectors are all overwritten)
+    /// before new tiles are allocated.
+    pub fn reusing(projection: &'a dyn Projection, spare: Vec<Tile>) -> Self {
         let (width, height) = projection.resolution();
         let tiles_x = width.div_ceil(TILE);
         let count = tiles_x as usize * height.div_ceil(TILE) as usize;
@@ -43,7 +53,20 @@ impl<'a> PixelRays<'a> {
             tiles_x,
             tiles: (0..count).map(|_| OnceLock::new()).collect(),
             computed: AtomicU64::new(0),
+            spare: Mutex::new(spare),
         }
+    }
+
+    /// The memory of every tile, computed or spare, for [`PixelRays::reusing`]; leaves every
+    /// tile to be computed again.
+    pub fn take_tiles(&mut self) -> Vec<Tile> {
+        let spare = self
+            .spare
+            .get_mut()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        let mut tiles = std::mem::take(spare);
+        tiles.extend(self.tiles.iter_mut().filter_map(OnceLock::take));
+        tiles
     }
 
     /// The projector through the centre of pixel `(x, y)` (inside the image).
@@ -58,24 +81,35 @@ impl<'a> PixelRays<'a> {
         self.computed.load(Ordering::Relaxed)
     }
 
-    /// The projectors of tile `(tx, ty)`, row-major; `None` past the image's edge.
-    fn tile(&self, tx: u32, ty: u32) -> Box<[Option<Projector>]> {
+    /// The projectors of tile `(tx, ty)`, row-major; `None` past the image's edge. Written
+    /// into a spare tile's memory when there is one (every entry overwritten).
+    fn tile(&self, tx: u32, ty: u32) -> Tile {
         self.computed.fetch_add(1, Ordering::Relaxed);
+        let spare = self
+            .spare
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .pop();
+        let mut tile = spare.unwrap_or_else(|| (0..TILE * TILE).map(|_| None).collect());
         let (width, height) = self.size;
-        (0..TILE * TILE)
-            .map(|k| {
-                let (x, y) = (tx * TILE + k % TILE, ty * TILE + k / TILE);
-                if x >= width || y >= height {
-                    return None;
-                }
-                let centre = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-                self.projection.projector(centre).filter(|p| match p {
-                    Projector::Straight(r) => r.direction != DVec3::ZERO,
-                    Projector::Polyline(points) => points.windows(2).any(|w| w[0] != w[1]),
-                    Projector::QuadraticBezier(_) => true,
-                })
-            })
-            .collect()
+        for (k, out) in (0..TILE * TILE).zip(tile.iter_mut()) {
+            let (x, y) = (tx * TILE + k % TILE, ty * TILE + k / TILE);
+            if x >= width || y >= height {
+                *out = None;
+                continue;
+            }
+            let centre = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            self.projection.projector_into(centre, out);
+            let seen = out.as_ref().is_some_and(|p| match p {
+                Projector::Straight(r) => r.direction != DVec3::ZERO,
+                Projector::Polyline(points) => points.windows(2).any(|w| w[0] != w[1]),
+                Projector::QuadraticBezier(_) => true,
+            });
+            if !seen {
+                *out = None;
+            }
+        }
+        tile
     }
 }
 
@@ -95,7 +129,7 @@ mod tests {
         let projection = ProjectionSpec::Fisheye { frame, fov: 180.0 }
             .build(40, 20)
             .unwrap();
-        let rays = PixelRays::new(projection.as_ref());
+        let rays = PixelRays::reusing(projection.as_ref(), Vec::new());
         assert_eq!(rays.computed_tiles(), 0);
         for (x, y) in [(0, 0), (39, 19), (20, 10), (33, 2)] {
             let want = projection.projector(DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5));
@@ -107,5 +141,52 @@ mod tests {
         assert_eq!(rays.computed_tiles(), 4);
         rays.get(1, 1);
         assert_eq!(rays.computed_tiles(), 4);
+    }
+
+    /// Tiles taken over from another projection's projectors (straight rays, then polylines
+    /// of a flexible volume, then straight again) are overwritten whole: every projector is
+    /// the new projection's, `None` included, as a fresh set of tiles gives.
+    #[test]
+    fn reused_tiles_hold_the_new_projections_projectors() {
+        let frame = CameraFrame {
+            position: DVec3::new(0.3, 0.2, 3.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+        };
+        let flexible = crate::projection::flexible::FlexibleSpec {
+            source: crate::projection::flexible::VolumeSource::Preset(
+                crate::projection::flexible::PresetSpec {
+                    preset: crate::projection::flexible::Preset::CrossedSlits {
+                        fov: 70.0,
+                        v_fov: None,
+                        slit_distance: -2.0,
+                    },
+                    frame,
+                    clip: None,
+                },
+            ),
+            reparam: None,
+        };
+        let specs = [
+            ProjectionSpec::Perspective { frame, fov: 60.0 },
+            ProjectionSpec::Flexible(Box::new(flexible)),
+            ProjectionSpec::Fisheye { frame, fov: 180.0 },
+        ];
+        let mut spare = Vec::new();
+        for spec in specs {
+            let projection = spec.build(40, 20).unwrap();
+            let mut rays = PixelRays::reusing(projection.as_ref(), spare);
+            for y in 0..20 {
+                for x in 0..40 {
+                    let centre = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                    let fresh = PixelRays::reusing(projection.as_ref(), Vec::new());
+                    assert_eq!(rays.get(x, y), fresh.get(x, y), "{spec:?} ({x}, {y})");
+                    let want = projection.projector(centre);
+                    assert_eq!(rays.get(x, y).is_some(), want.is_some(), "({x}, {y})");
+                }
+            }
+            spare = rays.take_tiles();
+            assert_eq!(spare.len(), 6);
+        }
     }
 }

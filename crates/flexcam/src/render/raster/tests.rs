@@ -219,6 +219,38 @@ fn projections_without_a_chart_are_refused_in_one_line() {
     );
 }
 
+/// Renderers of one prepared scene hand their z-buffer, bins and projector tiles on
+/// ([`PreparedScene::keep_spare`]): each frame of a sequence through every invertible
+/// projection, at two sizes, lit and flat, is the frame a fresh prepared scene renders.
+#[test]
+fn frames_reusing_an_earlier_renderers_memory_are_fresh_frames() {
+    let scene = scene::load("builtin:cube-floor").unwrap();
+    let (frame, fov) = scene_camera(&scene);
+    let prepared = PreparedScene::new(&scene);
+    for (k, (name, spec)) in invertible(frame, fov).into_iter().enumerate() {
+        let size = if k % 2 == 0 { (48, 32) } else { (40, 44) };
+        let shading = if k % 3 == 0 {
+            Shading::Lit
+        } else {
+            Shading::Flat
+        };
+        let options = RenderOptions {
+            shading,
+            ..flat(Subdivision::default())
+        };
+        let projection = spec.build(size.0, size.1).unwrap();
+        let reused = Method::Raster
+            .render(&prepared, projection.as_ref(), &options)
+            .unwrap()
+            .0;
+        assert_eq!(
+            reused,
+            render(Method::Raster, &scene, &spec, size, &options),
+            "{name}"
+        );
+    }
+}
+
 #[test]
 fn bad_options_are_refused() {
     let scene = scene::load("builtin:cube-floor").unwrap();

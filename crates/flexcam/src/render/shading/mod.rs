@@ -91,10 +91,33 @@ pub fn position(object: &Object, triangle: usize, barycentric: Vec2) -> Vec3 {
 /// [`crate::scene::Mesh::append`]) and an interpolated normal that cancels to zero falls back
 /// to the face normal.
 pub fn normals(object: &Object, triangle: usize, barycentric: Vec2, incoming: Vec3) -> Normals {
+    normals_of_face(
+        object,
+        triangle,
+        face_normal(object, triangle),
+        barycentric,
+        incoming,
+    )
+}
+
+/// The unit face normal of triangle `triangle` of `object` by its winding (counter-clockwise
+/// vertices seen from the front); zero for a zero-area triangle.
+pub fn face_normal(object: &Object, triangle: usize) -> Vec3 {
+    let [p0, p1, p2] = corners(object, triangle).map(|i| object.mesh.positions[i]);
+    (p1 - p0).cross(p2 - p0).normalize_or_zero()
+}
+
+/// [`normals`] given the triangle's [`face_normal`] `face` (kept per triangle by a caller
+/// shading many hits, so that each hit does not compute it again).
+pub fn normals_of_face(
+    object: &Object,
+    triangle: usize,
+    face: Vec3,
+    barycentric: Vec2,
+    incoming: Vec3,
+) -> Normals {
     let mesh = &object.mesh;
     let corners = corners(object, triangle);
-    let [p0, p1, p2] = corners.map(|i| mesh.positions[i]);
-    let face = (p1 - p0).cross(p2 - p0).normalize_or_zero();
     let Normals {
         geometric,
         front_face,

@@ -22,7 +22,7 @@ use glam::{DVec3, Vec3};
 use crate::geometry::optics::{reflect, refract};
 use crate::geometry::Ray;
 use crate::render::prepared::{Hit, PreparedScene};
-use crate::render::shading::{base_color, normals, Normals, TextureFilter};
+use crate::render::shading::{base_color, normals_of_face, Normals, TextureFilter};
 use crate::render::{RenderOptions, Shading};
 use crate::scene::{Finish, Light};
 
@@ -253,9 +253,10 @@ impl<'a> HitShader<'a> {
             return Normals::of_face(face, ray.direction.as_vec3());
         }
         let object = &self.caster.scene.objects[hit.object];
-        normals(
+        normals_of_face(
             object,
             hit.triangle,
+            self.caster.face_normal(hit.object, hit.triangle),
             hit.barycentric,
             ray.direction.as_vec3(),
         )
