@@ -132,6 +132,12 @@ impl CameraMatrix {
         (det.abs() > 0.0 && eye.is_finite()).then_some(eye)
     }
 
+    /// P, row by row, its sign such that the points lie at positive depth (the third row's
+    /// value at them): P = lambda K R [I | -E] with lambda > 0 where the camera is a pinhole.
+    pub(super) fn rows_facing(&self) -> [[f64; 4]; 3] {
+        self.rows.map(|row| row.map(|v| v * self.facing))
+    }
+
     /// The direction from the eye of the projector of image position `uv`, towards the
     /// points (unnormalised; affine in (u, v)).
     pub(super) fn direction(&self, uv: DVec2) -> DVec3 {

@@ -41,10 +41,11 @@
 //! pinhole and no eye at which the free directions solve. Data that are merely
 //! inconsistent (two eyes' points mixed) get the pinhole's least-squares fit.
 
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DVec2, DVec3};
 use nalgebra::{Matrix3, SymmetricEigen};
 
 use super::camera_matrix::CameraMatrix;
+use super::pinhole_camera::{ImageShape, PinholeCamera};
 use super::{blended, prior_directions, targets, Correspondence, FitReport, System};
 use crate::error::{Error, Result};
 use crate::projection::flexible::projector_grid::ProjectorGrid;
@@ -111,10 +112,23 @@ pub(super) fn fit_pinhole(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport, DVec3)> {
-    let ((grid, _), eye) = Setup::new(prior, correspondences)?
-        .pinhole_fit()
-        .ok_or_else(undetermined)?;
-    finish(&grid, correspondences, eye, prior, true)
+    let setup = Setup::new(prior, correspondences)?;
+    let camera = PinholeCamera::fit(correspondences, ImageShape::of_prior(prior))
+        .map_err(|why| Error::new(format!("projector grid fit: {why}")))?;
+    let ((grid, _), eye) = setup
+        .camera_grid(camera.eye(), |uv| camera.direction(uv))
+        .ok_or_else(|| {
+            Error::new(
+                "projector grid fit: the fitted pinhole camera's projectors do not reach \
+                 every point in front of their starts",
+            )
+        })?;
+    let (grid, report, eye) = finish(&grid, correspondences, eye, prior, true)?;
+    let report = FitReport {
+        focal_from_prior: camera.focal_from_prior(),
+        ..report
+    };
+    Ok((grid, report, eye))
 }
 
 /// What both direction fields of a central fit share: the checked data, their extent and
@@ -158,7 +172,13 @@ impl<'a> Setup<'a> {
             extent,
             starts: [
                 prior_centre(prior),
-                CameraMatrix::fit(correspondences).and_then(|c| c.eye()),
+                CameraMatrix::fit(correspondences)
+                    .and_then(|c| c.eye())
+                    .or_else(|| {
+                        PinholeCamera::fit(correspondences, ImageShape::of_prior(prior))
+                            .ok()
+                            .map(|c| c.eye())
+                    }),
             ],
         })
     }
@@ -187,11 +207,21 @@ impl<'a> Setup<'a> {
     /// lengthened into view, with its eye; `None` where the data determine no camera.
     fn pinhole_fit(&self) -> Option<((ProjectorGrid, FitReport), DVec3)> {
         let camera = CameraMatrix::fit(self.correspondences)?;
-        let eye = camera.eye()?;
+        self.camera_grid(camera.eye()?, |uv| camera.direction(uv))
+    }
+
+    /// The grid of the camera at `eye` whose projector through (u, v) has the direction
+    /// `direction(uv)`, its node directions scaled to the prior's mean length and
+    /// lengthened into view, with the eye; `None` where a point stays behind.
+    fn camera_grid(
+        &self,
+        eye: DVec3,
+        direction: impl Fn(DVec2) -> DVec3,
+    ) -> Option<((ProjectorGrid, FitReport), DVec3)> {
         let (cols, rows) = self.prior.size();
         let mut dirs: Vec<DVec3> = (0..rows)
             .flat_map(|row| (0..cols).map(move |col| (col, row)))
-            .map(|(col, row)| camera.direction(self.prior.node_uv(col, row)))
+            .map(|(col, row)| direction(self.prior.node_uv(col, row)))
             .collect();
         let mean = |d: &[DVec3]| d.iter().map(|v| v.length()).sum::<f64>() / d.len() as f64;
         let scale = mean(&prior_directions(self.prior)) / mean(&dirs);
@@ -488,7 +518,6 @@ fn starts_moved(
 
 #[cfg(test)]
 mod tests {
-    use glam::DVec2;
     use proptest::prelude::*;
 
     use super::super::{fit_with, FittedStarts, Starts};

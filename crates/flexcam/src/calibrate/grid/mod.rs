@@ -94,6 +94,7 @@ mod curved;
 mod envelope_cholesky;
 mod folds;
 mod free;
+mod pinhole_camera;
 
 use checks::{
     miss_seen_from, prior_directions, report_of, straight_undetermined, thinly_weighted_nodes,
@@ -169,6 +170,9 @@ pub struct FitReport {
     /// The curved fit's Levenberg-Marquardt iterations, over every run of its restarts
     /// (module `curved`); `None` for the straight fits.
     pub curved_iterations: Option<usize>,
+    /// Whether the pinhole model's focal length is the prior's: the data (points on a plane
+    /// seen face on) leave it undetermined (module `pinhole_camera`).
+    pub focal_from_prior: bool,
 }
 
 impl FitReport {
@@ -202,7 +206,16 @@ impl FitReport {
     /// A warning for the user when some node left the prior by far or is undetermined:
     /// the residual, measured at the correspondences only, may then hide a wrong image.
     pub fn warning(&self) -> Option<String> {
-        node_warning(self.wild_nodes, self.sparse_nodes)
+        let focal = self.focal_from_prior.then(|| {
+            "the correspondences (points on one plane seen nearly face on) do not determine \
+             the pinhole camera's focal length: the prior's is kept, and the distance to the \
+             plane follows from it"
+                .to_string()
+        });
+        match (node_warning(self.wild_nodes, self.sparse_nodes), focal) {
+            (Some(nodes), Some(focal)) => Some(format!("{focal}; {nodes}")),
+            (nodes, focal) => nodes.or(focal),
+        }
     }
 }
 
