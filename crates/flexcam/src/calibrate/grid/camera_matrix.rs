@@ -8,7 +8,8 @@
 //!
 //! Degenerate data (the points all on one plane, or the image positions on one line) leave
 //! the matrix undetermined: [`CameraMatrix::fit`] answers `None`, and the caller names the
-//! cause.
+//! cause. The central fit's pinhole field is this camera's; `starts = "pinhole"` is the
+//! square-pixel camera of module `pinhole_camera`, which this one starts where it exists.
 
 use glam::{DMat3, DVec2, DVec3};
 use nalgebra::{DMatrix, DVector, SymmetricEigen};

@@ -18,7 +18,9 @@
 //! and the free node directions (3 a node) at an eye found as below. Free directions meet
 //! sparse data exactly in many ways, most of them bent between the points, so six points
 //! determine the pinhole where the free field needs points enough for every node.
-//! `starts = "pinhole"` is the pinhole field alone ([`fit_pinhole`]).
+//! `starts = "pinhole"` is the field of a pinhole camera of square pixels, its principal
+//! point at the image centre (module `pinhole_camera`: 7 unknowns, determined by points on
+//! one plane too), alone ([`fit_pinhole`]).
 //!
 //! The free field's E is found by variable projection: for a given E the directions are the
 //! linear fit's of module `grid` (starts at E, solved twice, the second centred on the
@@ -26,7 +28,8 @@
 //! the blended directions and the points seen from E, with central-difference derivatives
 //! in E (three unknowns; each residual is two small linear solves). It starts from the
 //! point nearest to the prior's node projectors (the prior's own eye, for a perspective
-//! prior) and from the pinhole's eye, and keeps the better. The grid at the found eye is
+//! prior) and from the pinhole's eye (the square-pixel camera's where the camera matrix is
+//! undetermined), and keeps the better. The grid at the found eye is
 //! then fitted by `fit` with its starts at E. The starts are moved along their projectors to
 //! the prior's near distance s (the prior's mean start parameter seen from its own eye, 0
 //! when the prior has none), less where a point lies nearer the eye than that.
@@ -39,7 +42,10 @@
 //! extent when E moves in some direction: so few points that they absorb any move of E);
 //! image positions all on one line (points on one line through the eye among them); no
 //! pinhole and no eye at which the free directions solve. Data that are merely
-//! inconsistent (two eyes' points mixed) get the pinhole's least-squares fit.
+//! inconsistent (two eyes' points mixed) get the pinhole's least-squares fit. The
+//! square-pixel camera of `starts = "pinhole"` has its own degenerate cases (module
+//! `pinhole_camera`): points on one line, a plane seen edge-on; a plane seen face on leaves
+//! only its focal length free (the prior's is kept, [`FitReport::focal_from_prior`]).
 
 use glam::{DMat3, DVec2, DVec3};
 use nalgebra::{Matrix3, SymmetricEigen};

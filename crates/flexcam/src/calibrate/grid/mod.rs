@@ -49,8 +49,9 @@
 //! with the directions, every projector through it (module `central`: a pinhole camera's
 //! affine direction field where that explains the data, else free node directions); `Free`
 //! fits every node's start too (module `free`: projections with no common eye, such as
-//! pushbroom and crossed slits); `Pinhole` is one pinhole camera, its 3 x 4 matrix fitted
-//! by its reprojection error in the image (module `camera_matrix`). `Auto`, the default,
+//! pushbroom and crossed slits); `Pinhole` is one pinhole camera of square pixels, its
+//! principal point at the image centre (focal length and pose), fitted
+//! by its reprojection error in the image (module `pinhole_camera`). `Auto`, the default,
 //! keeps what the nested choice (`select::nested_fit`) gives where that meets the data
 //! exactly: the starts kept when they meet the data and the data determine the free
 //! directions, an exact eye fit where they do not, the free starts where neither is exact
