@@ -345,10 +345,12 @@ fn fits_of_noisy_pinhole_clicks() {
 #[test]
 fn auto_images_noisy_pinhole_clicks_as_the_camera_does() {
     // Seeds 2 and 4 of the table: the eye fit once drove its eye off to infinity and the
-    // free starts folded the grid (70 % and 63 %, 88 % and 94 % of the pixels); `auto` now
-    // takes the pinhole, and every model returns a fit.
+    // free starts folded the grid (70 % and 63 %, 88 % and 94 % of the pixels); seed 14's
+    // clicks lie nearly all on the floor, where the camera matrix is undetermined (76 % with
+    // the kept starts) and the square-pixel pinhole is not. `auto` now takes the pinhole,
+    // and every model returns a fit.
     let dir = TempDir::new().unwrap();
-    for seed in [2, 4] {
+    for seed in [2, 4, 14] {
         let case = case(&dir, seed, Truth::Pinhole);
         let (percent, model) = fitted(&dir, &case, None).unwrap();
         assert!(percent >= 97.0, "seed {seed}: {percent} % ({model})");

@@ -15,8 +15,9 @@
 //! the points are not coplanar, split into K R (Gram-Schmidt from its third row) with f the
 //! mean of its two focal lengths; and the homography from the points' best plane to the
 //! image (Zhang 2000): with K = diag(f, f, 1), the columns h1, h2 of H ~ K (r1 r2 t) give
-//! r1 . r2 = 0 and |r1| = |r2|, two equations linear in 1 / f^2, solved by least squares;
-//! the pose then from K^-1 H's columns, (r1, r2) made orthonormal.
+//! r1 . r2 = 0 and |r1| = |r2|, two equations linear in 1 / f^2, solved by least squares
+//! (the prior's focal length where they give none within `FOCAL_RANGE` of it); the pose
+//! then from K^-1 H's columns, (r1, r2) made orthonormal.
 //!
 //! Degenerate cases ([`Undetermined`], each tested): fewer than 4 points (7 unknowns, 2
 //! equations a point); the points all on one line or at one position (no plane: the camera
@@ -25,7 +26,9 @@
 //! the points in front. The focal length alone is unobservable when the points lie on a
 //! plane seen face on (fronto-parallel: a larger f and a farther eye give the same image);
 //! where its standard error exceeds `FOCAL_SPREAD` of its value (or the normal matrix is
-//! singular), the fit keeps the prior's focal length, fits the pose alone and says so
+//! singular), the fit keeps the prior's focal length, fits the pose alone (from the best
+//! pose, its eye's distance from the points' centre scaled by the focal lengths' ratio, and
+//! from the homography with the prior's focal length) and says so
 //! ([`PinholeCamera::focal_from_prior`]).
 
 use glam::{DMat3, DVec2, DVec3};
@@ -49,6 +52,12 @@ const MAX_ITERATIONS: usize = 100;
 /// The focal length is taken as undetermined when its standard error exceeds this fraction
 /// of its value.
 const FOCAL_SPREAD: f64 = 0.25;
+
+/// The homography's focal length is taken as a start only within this factor of the
+/// prior's: beyond it the data (a plane seen nearly face on) hardly determine it, and a far
+/// start (a focal length of thousands of image widths, an eye as far) is where the descent
+/// would stay.
+const FOCAL_RANGE: f64 = 100.0;
 
 /// The least noise (image widths) the focal length's standard error is computed with: exact
 /// data miss by rounding only, and a focal length they leave free must still show as free.
@@ -177,7 +186,7 @@ impl PinholeCamera {
         if let Some(camera) = CameraMatrix::fit(correspondences) {
             starts.extend(data.from_camera_matrix(&camera));
         }
-        starts.extend(data.from_homography());
+        starts.extend(data.from_homography(None));
         let (best, _) = starts
             .into_iter()
             .filter_map(|start| data.refine(start, true))
@@ -186,11 +195,20 @@ impl PinholeCamera {
         if !data.focal_undetermined(&best) {
             return Ok(data.camera(best, false));
         }
-        let fixed = Pose {
+        // The prior's focal length, from the best pose with its distance scaled by the
+        // focal lengths' ratio (the same image of a plane seen face on through the points'
+        // centre), and from the homography with that focal length.
+        let rescaled = Pose {
             focal: shape.focal,
+            eye: best.eye * (shape.focal / best.focal),
             ..best
         };
-        let (pose, _) = data.refine(fixed, false).ok_or(Undetermined::NotInFront)?;
+        let (pose, _) = [Some(rescaled), data.from_homography(Some(shape.focal))]
+            .into_iter()
+            .flatten()
+            .filter_map(|start| data.refine(start, false))
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .ok_or(Undetermined::NotInFront)?;
         Ok(data.camera(pose, true))
     }
 
@@ -349,9 +367,11 @@ impl Data {
     }
 
     /// The start from the homography between the points' best plane and the image (module
-    /// docs), the prior's focal length where the two equations give no positive 1 / f^2
-    /// (a plane seen face on, or noise); `None` where the homography is undetermined.
-    fn from_homography(&self) -> Option<Pose> {
+    /// docs) with the focal length `focal`, or where `None` the one the homography gives:
+    /// the prior's where the two equations give no positive 1 / f^2 or one more than
+    /// `FOCAL_RANGE` times the prior's or less than its inverse (a plane seen face on, or
+    /// noise); `None` where the homography is undetermined.
+    fn from_homography(&self, focal: Option<f64>) -> Option<Pose> {
         let handedness = self.shape.handedness;
         let [e1, e2, _] = self.axes;
         let plane: Vec<DVec2> = self
@@ -372,11 +392,12 @@ impl Data {
         ];
         let b = [h1.z * h2.z, h1.z * h1.z - h2.z * h2.z];
         let w = -(a[0] * b[0] + a[1] * b[1]) / (a[0] * a[0] + a[1] * a[1]);
-        let focal = if w > 0.0 && w.is_finite() {
+        let ratio = 1.0 / (w.sqrt() * self.shape.focal);
+        let focal = focal.unwrap_or(if (1.0 / FOCAL_RANGE..=FOCAL_RANGE).contains(&ratio) {
             1.0 / w.sqrt()
         } else {
             self.shape.focal
-        };
+        });
         let unscaled = |v: DVec3| DVec3::new(v.x / focal, v.y / focal, v.z);
         let (a1, a2, a3) = (unscaled(h1), unscaled(h2), unscaled(h3));
         // The plane's centre (the origin) in front: c_z = lambda a3.z > 0.

@@ -275,3 +275,40 @@ proptest! {
         prop_assert!(recovered(&fitted, &truth, &data), "{fitted:?}\n{truth:?}");
     }
 }
+
+#[test]
+fn the_fit_says_when_it_keeps_the_priors_focal_length() {
+    let prior = ProjectorGrid::sample(
+        &perspective(60.0, [1.0, 40.0]),
+        (3, 3),
+        GridInterpolation::Bilinear,
+    )
+    .unwrap();
+    let truth = camera(DVec3::new(0.0, 0.0, 6.0), DVec3::ZERO, 0.3, 1.3, 1.0);
+    let face_on = on_plane(&truth, &lattice(), DVec3::ZERO, DVec3::Z);
+    let (_, report) = super::super::fit_with(
+        &prior,
+        &face_on,
+        crate::projection::flexible::Starts::Pinhole,
+    )
+    .unwrap();
+    assert!(report.focal_from_prior, "{report:?}");
+    assert!(report.rms_angle_deg < 1e-6, "{report:?}");
+    let warning = report.warning().unwrap();
+    assert!(warning.contains("focal length"), "{warning}");
+    // Tilted, the plane determines it, and there is nothing to say.
+    let floor = on_plane(
+        &truth,
+        &lattice(),
+        DVec3::new(0.0, -1.0, 0.0),
+        DVec3::new(0.0, 1.0, 0.6).normalize(),
+    );
+    let (_, report) =
+        super::super::fit_with(&prior, &floor, crate::projection::flexible::Starts::Pinhole)
+            .unwrap();
+    assert!(
+        !report.focal_from_prior && report.warning().is_none(),
+        "{report:?}"
+    );
+    assert!(report.rms_angle_deg < 1e-6, "{report:?}");
+}
