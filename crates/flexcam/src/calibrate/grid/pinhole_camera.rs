@@ -31,6 +31,8 @@
 //! from the homography with the prior's focal length) and says so
 //! ([`PinholeCamera::focal_from_prior`]).
 
+use std::cmp::Ordering;
+
 use glam::{DMat3, DVec2, DVec3};
 use nalgebra::{DMatrix, DVector, Matrix3, SymmetricEigen};
 
@@ -184,9 +186,9 @@ impl PinholeCamera {
         let data = Data::new(correspondences, shape)?;
         let mut starts = Vec::with_capacity(2);
         if let Some(camera) = CameraMatrix::fit(correspondences) {
-            starts.extend(data.from_camera_matrix(&camera));
+            starts.extend(data.start_of_camera_matrix(&camera));
         }
-        starts.extend(data.from_homography(None));
+        starts.extend(data.start_of_homography(None));
         let (best, _) = starts
             .into_iter()
             .filter_map(|start| data.refine(start, true))
@@ -203,7 +205,7 @@ impl PinholeCamera {
             eye: best.eye * (shape.focal / best.focal),
             ..best
         };
-        let (pose, _) = [Some(rescaled), data.from_homography(Some(shape.focal))]
+        let (pose, _) = [Some(rescaled), data.start_of_homography(Some(shape.focal))]
             .into_iter()
             .flatten()
             .filter_map(|start| data.refine(start, false))
@@ -300,7 +302,7 @@ impl Data {
         let mean = image.iter().copied().sum::<DVec2>() / n;
         let flat: Vec<DVec3> = image.iter().map(|q| (*q - mean).extend(0.0)).collect();
         let (image_spreads, _) = principal_axes(&flat);
-        if !(image_spreads[1] > FLAT * image_spreads[0]) {
+        if image_spreads[1].partial_cmp(&(FLAT * image_spreads[0])) != Some(Ordering::Greater) {
             return Err(Undetermined::ImageOnOneLine);
         }
         Ok(Data {
@@ -333,7 +335,7 @@ impl Data {
     /// The start from the general camera matrix `camera` (module docs), its handedness the
     /// prior's unless its rotation would then be a reflection; `None` where it is no
     /// camera (a singular left block).
-    fn from_camera_matrix(&self, camera: &CameraMatrix) -> Option<Pose> {
+    fn start_of_camera_matrix(&self, camera: &CameraMatrix) -> Option<Pose> {
         let rows = camera.rows_facing();
         let eye = (camera.eye()? - self.centre) / self.scale;
         let handedness = self.shape.handedness;
@@ -371,7 +373,7 @@ impl Data {
     /// the prior's where the two equations give no positive 1 / f^2 or one more than
     /// `FOCAL_RANGE` times the prior's or less than its inverse (a plane seen face on, or
     /// noise); `None` where the homography is undetermined.
-    fn from_homography(&self, focal: Option<f64>) -> Option<Pose> {
+    fn start_of_homography(&self, focal: Option<f64>) -> Option<Pose> {
         let handedness = self.shape.handedness;
         let [e1, e2, _] = self.axes;
         let plane: Vec<DVec2> = self
@@ -423,7 +425,7 @@ impl Data {
         let mut r = Vec::with_capacity(2 * self.points.len());
         for (k, p) in self.points.iter().enumerate() {
             let c = pose.rotation * (*p - pose.eye);
-            if !(c.z > 0.0) {
+            if c.z.partial_cmp(&0.0) != Some(Ordering::Greater) {
                 return None;
             }
             let q = self.seen(k, pose.handedness);
@@ -526,7 +528,10 @@ impl Data {
         let spare = r.len().saturating_sub(7).max(1) as f64;
         let variance = (r.iter().map(|v| v * v).sum::<f64>() / spare).max(NOISE_FLOOR.powi(2));
         let spread = (variance * inverse[(0, 0)]).sqrt();
-        !(spread <= FOCAL_SPREAD)
+        !matches!(
+            spread.partial_cmp(&FOCAL_SPREAD),
+            Some(Ordering::Less | Ordering::Equal)
+        )
     }
 }
 
@@ -581,9 +586,7 @@ fn homography(plane: &[DVec2], image: &[DVec2]) -> Option<Matrix3<f64>> {
     let mut order: Vec<usize> = (0..9).collect();
     order.sort_by(|&i, &j| eigen.eigenvalues[i].total_cmp(&eigen.eigenvalues[j]));
     let second = eigen.eigenvalues[order[1]];
-    if second.partial_cmp(&(FLAT * eigen.eigenvalues[order[8]]))
-        != Some(std::cmp::Ordering::Greater)
-    {
+    if second.partial_cmp(&(FLAT * eigen.eigenvalues[order[8]])) != Some(Ordering::Greater) {
         return None;
     }
     let v = eigen.eigenvectors.column(order[0]);
