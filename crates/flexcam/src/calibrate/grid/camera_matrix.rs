@@ -34,7 +34,7 @@ pub(super) struct CameraMatrix {
 
 /// A similarity taking points to their centroid at the origin and a mean distance of
 /// sqrt(dimension) (Hartley's normalisation).
-fn normalisation<const N: usize>(points: &[[f64; N]]) -> ([f64; N], f64) {
+pub(super) fn normalisation<const N: usize>(points: &[[f64; N]]) -> ([f64; N], f64) {
     let n = points.len() as f64;
     let mut centre = [0.0; N];
     for p in points {

@@ -36,7 +36,7 @@ use std::cmp::Ordering;
 use glam::{DMat3, DVec2, DVec3};
 use nalgebra::{DMatrix, DVector, Matrix3, SymmetricEigen};
 
-use super::camera_matrix::CameraMatrix;
+use super::camera_matrix::{normalisation, CameraMatrix};
 use super::Correspondence;
 use crate::projection::flexible::ProjectorGrid;
 
@@ -569,6 +569,12 @@ fn rotation_of(turn: DVec3) -> DMat3 {
 /// error, by the direct linear transform on normalised coordinates; `None` where the
 /// second least eigenvalue is at rounding level too (the positions do not determine it).
 fn homography(plane: &[DVec2], image: &[DVec2]) -> Option<Matrix3<f64>> {
+    // Hartley's normalisation: centroids at the origin, mean distance sqrt(2).
+    let similarity = |points: &[DVec2]| {
+        let arrays: Vec<[f64; 2]> = points.iter().map(|p| p.to_array()).collect();
+        let (centre, scale) = normalisation(&arrays);
+        (scale.is_finite() && scale > 0.0).then_some((DVec2::from_array(centre), scale))
+    };
     let (pc, ps) = similarity(plane)?;
     let (ic, is) = similarity(image)?;
     let mut a = DMatrix::<f64>::zeros(2 * plane.len(), 9);
@@ -597,16 +603,6 @@ fn homography(plane: &[DVec2], image: &[DVec2]) -> Option<Matrix3<f64>> {
     let h = t_image_inverse * normalised * t_plane;
     let norm = h.norm();
     (norm > 0.0 && norm.is_finite()).then(|| h / norm)
-}
-
-/// The centroid of `points` and the scale taking their mean distance from it to sqrt(2)
-/// (Hartley's normalisation); `None` where they coincide.
-fn similarity(points: &[DVec2]) -> Option<(DVec2, f64)> {
-    let n = points.len() as f64;
-    let centre = points.iter().copied().sum::<DVec2>() / n;
-    let mean = points.iter().map(|p| (*p - centre).length()).sum::<f64>() / n;
-    let scale = std::f64::consts::SQRT_2 / mean;
-    (scale.is_finite() && scale > 0.0).then_some((centre, scale))
 }
 
 #[cfg(test)]
