@@ -7,7 +7,8 @@
 //! prints the table of seeds x models; run it with
 //! `cargo test --release -p flexcam-cli --test fit_painting -- --ignored --nocapture`
 //! (`FIT_PAINTING_SEEDS=1..20` picks the seeds, `FIT_PAINTING_MODELS=kept,eye,free,pinhole,auto`
-//! the columns).
+//! the columns, `FIT_PAINTING_TRUTH=warped` a painting-like distortion of each camera as the
+//! truth instead of the camera itself).
 
 mod common;
 
@@ -43,11 +44,99 @@ struct Case {
     seed: u64,
 }
 
+/// The kind of true camera the clicks are taken from (`FIT_PAINTING_TRUTH`).
+#[derive(Clone, Copy, PartialEq)]
+enum Truth {
+    /// A perspective camera (`pinhole`, the default).
+    Pinhole,
+    /// A painting-like distortion of it (`warped`, [`warped_projection`]).
+    Warped,
+}
+
+impl Truth {
+    /// The kind `FIT_PAINTING_TRUTH` names (`pinhole` where unset).
+    fn from_env() -> Truth {
+        match std::env::var("FIT_PAINTING_TRUTH").as_deref() {
+            Ok("warped") => Truth::Warped,
+            Ok("pinhole") | Err(_) => Truth::Pinhole,
+            Ok(other) => panic!("FIT_PAINTING_TRUTH: `pinhole` or `warped`, not `{other}`"),
+        }
+    }
+}
+
+/// A perspective camera's placement: eye, the point looked at, the horizontal field of view
+/// in degrees.
+struct Placement {
+    eye: [f64; 3],
+    look_at: [f64; 3],
+    fov: f64,
+}
+
+/// The `[projection]` of a painting-like distortion of the perspective camera `camera`: a
+/// 5 x 5 bilinear projector grid whose nodes are the camera's, each node's image position
+/// (x, y in [-1, 1] across the image) moved to (x, y) (1 + k (x^2 + y^2) / 2) + (0, b x^2)
+/// (a barrel or pincushion distortion and a bent horizon) and its projector shifted
+/// sideways by e x world units (no common eye: a painter who moved while drawing), with k
+/// in [-0.25, 0.25], b in [-0.15, 0.15] and e in [-0.6, 0.6] drawn from `next`.
+fn warped_projection(camera: &Placement, next: &mut impl FnMut() -> f64) -> String {
+    let (k, b, e) = (0.5 * next() - 0.25, 0.3 * next() - 0.15, 1.2 * next() - 0.6);
+    let sub = |a: [f64; 3], c: [f64; 3]| [a[0] - c[0], a[1] - c[1], a[2] - c[2]];
+    let unit = |a: [f64; 3]| {
+        let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+        [a[0] / l, a[1] / l, a[2] / l]
+    };
+    let cross = |a: [f64; 3], c: [f64; 3]| {
+        [
+            a[1] * c[2] - a[2] * c[1],
+            a[2] * c[0] - a[0] * c[2],
+            a[0] * c[1] - a[1] * c[0],
+        ]
+    };
+    let forward = unit(sub(camera.look_at, camera.eye));
+    let right = unit(cross(forward, [0.0, 1.0, 0.0]));
+    let up = cross(right, forward);
+    let half_width = (0.5 * camera.fov).to_radians().tan();
+    let half_height = half_width * f64::from(SIZE[1]) / f64::from(SIZE[0]);
+    let (near, far) = (0.5, 40.0);
+    let mut nodes = String::new();
+    for row in 0..5 {
+        for col in 0..5 {
+            let (x, y) = (f64::from(col) / 2.0 - 1.0, f64::from(row) / 2.0 - 1.0);
+            let grow = 1.0 + k * (x * x + y * y) / 2.0;
+            let (x, y) = (x * grow, y * grow + b * x * x);
+            let at = |depth: f64| -> String {
+                let p: Vec<String> = (0..3)
+                    .map(|i| {
+                        camera.eye[i]
+                            + depth
+                                * (forward[i] + x * half_width * right[i] + y * half_height * up[i])
+                            + e * x * right[i]
+                    })
+                    .map(|v| v.to_string())
+                    .collect();
+                format!("[{}]", p.join(", "))
+            };
+            nodes += &format!(
+                "    {{ node = [{col}, {row}], start = {}, end = {} }},\n",
+                at(near),
+                at(far)
+            );
+        }
+    }
+    format!(
+        "[projection]\ntype = \"flexible\"\npreset = \"perspective\"\nposition = {:?}\n\
+         look_at = {:?}\nfov = {}\nclip = [{near}, {far}]\n\n[projection.projectors]\n\
+         size = [5, 5]\ninterpolation = \"bilinear\"\nprojector = [\n{nodes}]\n",
+        camera.eye, camera.look_at, camera.fov
+    )
+}
+
 /// Seed `seed`'s true camera (eye 7 to 10 from the scene's centre, 3 to 7 up, within 50
-/// degrees of +z, a field of view of 45 to 70 degrees) and 15 to 60 of its clicks, each at a
+/// degrees of +z, a field of view of 45 to 70 degrees; for [`Truth::Warped`] its
+/// painting-like distortion, [`warped_projection`]) and 15 to 60 of its clicks, each at a
 /// random pixel where the camera sees an object, the pixel then moved by normal noise of 1
 /// to 2 px (one standard deviation per seed) and kept in the image.
-fn case(dir: &TempDir, seed: u64) -> Case {
+fn case(dir: &TempDir, seed: u64, kind: Truth) -> Case {
     let mut next = uniform(seed);
     let azimuth = (100.0 * next() - 50.0_f64).to_radians();
     let (distance, height) = (7.0 + 3.0 * next(), 3.0 + 4.0 * next());
@@ -55,15 +144,19 @@ fn case(dir: &TempDir, seed: u64) -> Case {
     let fov = 45.0 + 25.0 * next();
     let count = 15 + (next() * 46.0) as usize;
     let noise = 1.0 + next();
-    let truth = format!(
-        "[projection]\ntype = \"perspective\"\nposition = [{}, {height}, {}]\nlook_at = [{}, \
-         {}, {}]\nfov = {fov}\n",
-        distance * azimuth.sin(),
-        distance * azimuth.cos(),
-        look_at[0],
-        look_at[1],
-        look_at[2],
-    );
+    let camera = Placement {
+        eye: [distance * azimuth.sin(), height, distance * azimuth.cos()],
+        look_at,
+        fov,
+    };
+    let truth = match kind {
+        Truth::Pinhole => format!(
+            "[projection]\ntype = \"perspective\"\nposition = {:?}\nlook_at = {:?}\n\
+             fov = {fov}\n",
+            camera.eye, camera.look_at,
+        ),
+        Truth::Warped => warped_projection(&camera, &mut next),
+    };
     std::fs::write(
         dir.path().join("truth.toml"),
         format!("{}{truth}{OBJECTS}", image_table()),
@@ -219,6 +312,7 @@ fn fitted(dir: &TempDir, case: &Case, starts: Option<&str>) -> Result<(f64, Stri
 #[ignore = "a few minutes: prints the table of seeds x models (docs/fitting.md, \"Choosing the model on clicked data\")"]
 fn fits_of_noisy_pinhole_clicks() {
     let seeds = std::env::var("FIT_PAINTING_SEEDS").unwrap_or_else(|_| "1..20".into());
+    let kind = Truth::from_env();
     let (first, last) = seeds.split_once("..").unwrap();
     let models = std::env::var("FIT_PAINTING_MODELS")
         .unwrap_or_else(|_| "kept,eye,free,pinhole,auto".into());
@@ -228,7 +322,7 @@ fn fits_of_noisy_pinhole_clicks() {
     let dir = TempDir::new().unwrap();
     let mut worst = vec![f64::INFINITY; models.len()];
     for seed in first.parse::<u64>().unwrap()..=last.parse().unwrap() {
-        let case = case(&dir, seed);
+        let case = case(&dir, seed, kind);
         let mut row = format!("| {seed} | {} | {:.2} |", case.count, case.noise);
         for (i, model) in models.iter().enumerate() {
             match fitted(&dir, &case, Some(model)) {
@@ -251,11 +345,13 @@ fn fits_of_noisy_pinhole_clicks() {
 #[test]
 fn auto_images_noisy_pinhole_clicks_as_the_camera_does() {
     // Seeds 2 and 4 of the table: the eye fit once drove its eye off to infinity and the
-    // free starts folded the grid (70 % and 63 %, 88 % and 94 % of the pixels); `auto` now
-    // takes the pinhole, and every model returns a fit.
+    // free starts folded the grid (70 % and 63 %, 88 % and 94 % of the pixels); seed 14's
+    // clicks lie nearly all on the floor, where the camera matrix is undetermined (76 % with
+    // the kept starts) and the square-pixel pinhole is not. `auto` now takes the pinhole,
+    // and every model returns a fit.
     let dir = TempDir::new().unwrap();
-    for seed in [2, 4] {
-        let case = case(&dir, seed);
+    for seed in [2, 4, 14] {
+        let case = case(&dir, seed, Truth::Pinhole);
         let (percent, model) = fitted(&dir, &case, None).unwrap();
         assert!(percent >= 97.0, "seed {seed}: {percent} % ({model})");
         assert_eq!(model, "P", "seed {seed}");
@@ -270,7 +366,7 @@ fn two_eyes_clicks_get_a_fit_from_every_model() {
     // Seed 2's clicks, every other one replaced by seed 5's (another camera): no eye meets
     // them, and each model still returns its least-squares fit and residual.
     let dir = TempDir::new().unwrap();
-    let (a, b) = (case(&dir, 2), case(&dir, 5));
+    let (a, b) = (case(&dir, 2, Truth::Pinhole), case(&dir, 5, Truth::Pinhole));
     let lines = |c: &Case| -> Vec<String> {
         c.fit
             .lines()
@@ -309,7 +405,7 @@ fn two_eyes_clicks_get_a_fit_from_every_model() {
 #[test]
 fn pick_reports_the_object_the_ids_image_shows() {
     let dir = TempDir::new().unwrap();
-    case(&dir, 1);
+    case(&dir, 1, Truth::Pinhole);
     run_ok(
         &dir,
         &["render", "truth.toml", "-o", "t.png", "--ids", "t-ids.png"],

@@ -92,6 +92,9 @@ fn build_report(fit: &FitReport) -> BuildReport {
     counters.push(("fit_starts_free", f64::from(u8::from(free))));
     let pinhole = matches!(fit.starts, FittedStarts::Pinhole(_));
     counters.push(("fit_starts_pinhole", f64::from(u8::from(pinhole))));
+    if fit.focal_from_prior {
+        counters.push(("fit_focal_from_prior", 1.0));
+    }
     if let Some(smoothness) = fit.smoothness {
         counters.push(("fit_smoothness", smoothness));
     }

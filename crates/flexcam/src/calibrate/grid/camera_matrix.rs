@@ -8,7 +8,8 @@
 //!
 //! Degenerate data (the points all on one plane, or the image positions on one line) leave
 //! the matrix undetermined: [`CameraMatrix::fit`] answers `None`, and the caller names the
-//! cause.
+//! cause. The central fit's pinhole field is this camera's; `starts = "pinhole"` is the
+//! square-pixel camera of module `pinhole_camera`, which this one starts where it exists.
 
 use glam::{DMat3, DVec2, DVec3};
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
@@ -33,7 +34,7 @@ pub(super) struct CameraMatrix {
 
 /// A similarity taking points to their centroid at the origin and a mean distance of
 /// sqrt(dimension) (Hartley's normalisation).
-fn normalisation<const N: usize>(points: &[[f64; N]]) -> ([f64; N], f64) {
+pub(super) fn normalisation<const N: usize>(points: &[[f64; N]]) -> ([f64; N], f64) {
     let n = points.len() as f64;
     let mut centre = [0.0; N];
     for p in points {
@@ -130,6 +131,12 @@ impl CameraMatrix {
         let p4 = DVec3::new(self.rows[0][3], self.rows[1][3], self.rows[2][3]);
         let eye = -(m.inverse() * p4);
         (det.abs() > 0.0 && eye.is_finite()).then_some(eye)
+    }
+
+    /// P, row by row, its sign such that the points lie at positive depth (the third row's
+    /// value at them): P = lambda K R [I | -E] with lambda > 0 where the camera is a pinhole.
+    pub(super) fn rows_facing(&self) -> [[f64; 4]; 3] {
+        self.rows.map(|row| row.map(|v| v * self.facing))
     }
 
     /// The direction from the eye of the projector of image position `uv`, towards the

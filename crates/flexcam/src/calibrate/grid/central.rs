@@ -18,7 +18,9 @@
 //! and the free node directions (3 a node) at an eye found as below. Free directions meet
 //! sparse data exactly in many ways, most of them bent between the points, so six points
 //! determine the pinhole where the free field needs points enough for every node.
-//! `starts = "pinhole"` is the pinhole field alone ([`fit_pinhole`]).
+//! `starts = "pinhole"` is the field of a pinhole camera of square pixels, its principal
+//! point at the image centre (module `pinhole_camera`: 7 unknowns, determined by points on
+//! one plane too), alone ([`fit_pinhole`]).
 //!
 //! The free field's E is found by variable projection: for a given E the directions are the
 //! linear fit's of module `grid` (starts at E, solved twice, the second centred on the
@@ -26,7 +28,8 @@
 //! the blended directions and the points seen from E, with central-difference derivatives
 //! in E (three unknowns; each residual is two small linear solves). It starts from the
 //! point nearest to the prior's node projectors (the prior's own eye, for a perspective
-//! prior) and from the pinhole's eye, and keeps the better. The grid at the found eye is
+//! prior) and from the pinhole's eye (the square-pixel camera's where the camera matrix is
+//! undetermined), and keeps the better. The grid at the found eye is
 //! then fitted by `fit` with its starts at E. The starts are moved along their projectors to
 //! the prior's near distance s (the prior's mean start parameter seen from its own eye, 0
 //! when the prior has none), less where a point lies nearer the eye than that.
@@ -39,12 +42,16 @@
 //! extent when E moves in some direction: so few points that they absorb any move of E);
 //! image positions all on one line (points on one line through the eye among them); no
 //! pinhole and no eye at which the free directions solve. Data that are merely
-//! inconsistent (two eyes' points mixed) get the pinhole's least-squares fit.
+//! inconsistent (two eyes' points mixed) get the pinhole's least-squares fit. The
+//! square-pixel camera of `starts = "pinhole"` has its own degenerate cases (module
+//! `pinhole_camera`): points on one line, a plane seen edge-on; a plane seen face on leaves
+//! only its focal length free (the prior's is kept, [`FitReport::focal_from_prior`]).
 
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DVec2, DVec3};
 use nalgebra::{Matrix3, SymmetricEigen};
 
 use super::camera_matrix::CameraMatrix;
+use super::pinhole_camera::{ImageShape, PinholeCamera};
 use super::{blended, prior_directions, targets, Correspondence, FitReport, System};
 use crate::error::{Error, Result};
 use crate::projection::flexible::projector_grid::ProjectorGrid;
@@ -111,10 +118,23 @@ pub(super) fn fit_pinhole(
     prior: &ProjectorGrid,
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport, DVec3)> {
-    let ((grid, _), eye) = Setup::new(prior, correspondences)?
-        .pinhole_fit()
-        .ok_or_else(undetermined)?;
-    finish(&grid, correspondences, eye, prior, true)
+    let setup = Setup::new(prior, correspondences)?;
+    let camera = PinholeCamera::fit(correspondences, ImageShape::of_prior(prior))
+        .map_err(|why| Error::new(format!("projector grid fit: {why}")))?;
+    let ((grid, _), eye) = setup
+        .camera_grid(camera.eye(), |uv| camera.direction(uv))
+        .ok_or_else(|| {
+            Error::new(
+                "projector grid fit: the fitted pinhole camera's projectors do not reach \
+                 every point in front of their starts",
+            )
+        })?;
+    let (grid, report, eye) = finish(&grid, correspondences, eye, prior, true)?;
+    let report = FitReport {
+        focal_from_prior: camera.focal_from_prior(),
+        ..report
+    };
+    Ok((grid, report, eye))
 }
 
 /// What both direction fields of a central fit share: the checked data, their extent and
@@ -158,7 +178,13 @@ impl<'a> Setup<'a> {
             extent,
             starts: [
                 prior_centre(prior),
-                CameraMatrix::fit(correspondences).and_then(|c| c.eye()),
+                CameraMatrix::fit(correspondences)
+                    .and_then(|c| c.eye())
+                    .or_else(|| {
+                        PinholeCamera::fit(correspondences, ImageShape::of_prior(prior))
+                            .ok()
+                            .map(|c| c.eye())
+                    }),
             ],
         })
     }
@@ -187,11 +213,21 @@ impl<'a> Setup<'a> {
     /// lengthened into view, with its eye; `None` where the data determine no camera.
     fn pinhole_fit(&self) -> Option<((ProjectorGrid, FitReport), DVec3)> {
         let camera = CameraMatrix::fit(self.correspondences)?;
-        let eye = camera.eye()?;
+        self.camera_grid(camera.eye()?, |uv| camera.direction(uv))
+    }
+
+    /// The grid of the camera at `eye` whose projector through (u, v) has the direction
+    /// `direction(uv)`, its node directions scaled to the prior's mean length and
+    /// lengthened into view, with the eye; `None` where a point stays behind.
+    fn camera_grid(
+        &self,
+        eye: DVec3,
+        direction: impl Fn(DVec2) -> DVec3,
+    ) -> Option<((ProjectorGrid, FitReport), DVec3)> {
         let (cols, rows) = self.prior.size();
         let mut dirs: Vec<DVec3> = (0..rows)
             .flat_map(|row| (0..cols).map(move |col| (col, row)))
-            .map(|(col, row)| camera.direction(self.prior.node_uv(col, row)))
+            .map(|(col, row)| direction(self.prior.node_uv(col, row)))
             .collect();
         let mean = |d: &[DVec3]| d.iter().map(|v| v.length()).sum::<f64>() / d.len() as f64;
         let scale = mean(&prior_directions(self.prior)) / mean(&dirs);
@@ -488,7 +524,6 @@ fn starts_moved(
 
 #[cfg(test)]
 mod tests {
-    use glam::DVec2;
     use proptest::prelude::*;
 
     use super::super::{fit_with, FittedStarts, Starts};

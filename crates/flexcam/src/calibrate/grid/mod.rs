@@ -49,8 +49,9 @@
 //! with the directions, every projector through it (module `central`: a pinhole camera's
 //! affine direction field where that explains the data, else free node directions); `Free`
 //! fits every node's start too (module `free`: projections with no common eye, such as
-//! pushbroom and crossed slits); `Pinhole` is one pinhole camera, its 3 x 4 matrix fitted
-//! by its reprojection error in the image (module `camera_matrix`). `Auto`, the default,
+//! pushbroom and crossed slits); `Pinhole` is one pinhole camera of square pixels, its
+//! principal point at the image centre (focal length and pose), fitted
+//! by its reprojection error in the image (module `pinhole_camera`). `Auto`, the default,
 //! keeps what the nested choice (`select::nested_fit`) gives where that meets the data
 //! exactly: the starts kept when they meet the data and the data determine the free
 //! directions, an exact eye fit where they do not, the free starts where neither is exact
@@ -94,6 +95,7 @@ mod curved;
 mod envelope_cholesky;
 mod folds;
 mod free;
+mod pinhole_camera;
 
 use checks::{
     miss_seen_from, prior_directions, report_of, straight_undetermined, thinly_weighted_nodes,
@@ -169,6 +171,9 @@ pub struct FitReport {
     /// The curved fit's Levenberg-Marquardt iterations, over every run of its restarts
     /// (module `curved`); `None` for the straight fits.
     pub curved_iterations: Option<usize>,
+    /// Whether the pinhole model's focal length is the prior's: the data (points on a plane
+    /// seen face on) leave it undetermined (module `pinhole_camera`).
+    pub focal_from_prior: bool,
 }
 
 impl FitReport {
@@ -202,7 +207,16 @@ impl FitReport {
     /// A warning for the user when some node left the prior by far or is undetermined:
     /// the residual, measured at the correspondences only, may then hide a wrong image.
     pub fn warning(&self) -> Option<String> {
-        node_warning(self.wild_nodes, self.sparse_nodes)
+        let focal = self.focal_from_prior.then(|| {
+            "the correspondences (points on one plane seen nearly face on) do not determine \
+             the pinhole camera's focal length: the prior's is kept, and the distance to the \
+             plane follows from it"
+                .to_string()
+        });
+        match (node_warning(self.wild_nodes, self.sparse_nodes), focal) {
+            (Some(nodes), Some(focal)) => Some(format!("{focal}; {nodes}")),
+            (nodes, focal) => nodes.or(focal),
+        }
     }
 }
 

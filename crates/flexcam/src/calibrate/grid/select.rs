@@ -64,7 +64,7 @@ pub(super) fn clearly_better(
 }
 
 /// `Starts::Auto`: [`nested_fit`]'s choice where the grid is curved, or where it is exact
-/// and the data determine it or no pinhole fits them (too few points, all on one plane):
+/// and the data determine it or no pinhole fits them (too few points, all on one line):
 /// exact data keep their model, bit for bit. Inexact data: the four models (kept starts, one
 /// eye, free starts, one pinhole camera) are judged by their held-out misses
 /// ([`held_out_misses`]: each fitted without a fifth of the points, measured at that fifth),

@@ -30,8 +30,8 @@ pub enum Starts {
     Eye,
     /// Every node's start is fitted with the directions.
     Free,
-    /// One pinhole camera (an eye and the affine direction field of a 3 x 4 camera matrix,
-    /// 11 unknowns): the model of a painting drawn in true perspective.
+    /// One pinhole camera of square pixels, its principal point at the image centre (focal
+    /// length and pose, 7 unknowns): the model of a painting drawn in true perspective.
     Pinhole,
     /// Exact data: the kept starts where they meet the data and determine the directions,
     /// else the eye where it meets the data exactly or clearly better, else the free starts
