@@ -45,13 +45,16 @@
 //! inconsistent (two eyes' points mixed) get the pinhole's least-squares fit. The
 //! square-pixel camera of `starts = "pinhole"` has its own degenerate cases (module
 //! `pinhole_camera`): points on one line, a plane seen edge-on; a plane seen face on leaves
-//! only its focal length free (the prior's is kept, [`FitReport::focal_from_prior`]).
+//! only its focal length free (the prior's is kept, [`FitReport::focal_from_prior`]); data
+//! that keep a point behind every square-pixel camera reached (inconsistent data, such as a
+//! point behind the eye) get the general camera matrix's fit instead
+//! ([`FitReport::general_camera`]).
 
 use glam::{DMat3, DVec2, DVec3};
 use nalgebra::{Matrix3, SymmetricEigen};
 
 use super::camera_matrix::CameraMatrix;
-use super::pinhole_camera::{ImageShape, PinholeCamera};
+use super::pinhole_camera::{ImageShape, PinholeCamera, Undetermined};
 use super::{blended, prior_directions, targets, Correspondence, FitReport, System};
 use crate::error::{Error, Result};
 use crate::projection::flexible::projector_grid::ProjectorGrid;
@@ -119,8 +122,22 @@ pub(super) fn fit_pinhole(
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport, DVec3)> {
     let setup = Setup::new(prior, correspondences)?;
-    let camera = PinholeCamera::fit(correspondences, ImageShape::of_prior(prior))
-        .map_err(|why| Error::new(format!("projector grid fit: {why}")))?;
+    let camera = match PinholeCamera::fit(correspondences, ImageShape::of_prior(prior)) {
+        Ok(camera) => camera,
+        Err(Undetermined::NotInFront) => {
+            // Merely inconsistent data (a point behind every square-pixel camera the starts
+            // reach): the general camera matrix's least-squares fit, which may move the eye
+            // until every point is in front, and the report says so.
+            let ((grid, _), eye) = setup.pinhole_fit().ok_or_else(undetermined)?;
+            let (grid, report, eye) = finish(&grid, correspondences, eye, prior, true)?;
+            let report = FitReport {
+                general_camera: true,
+                ..report
+            };
+            return Ok((grid, report, eye));
+        }
+        Err(why) => return Err(Error::new(format!("projector grid fit: {why}"))),
+    };
     let ((grid, _), eye) = setup
         .camera_grid(camera.eye(), |uv| camera.direction(uv))
         .ok_or_else(|| {

@@ -174,6 +174,10 @@ pub struct FitReport {
     /// Whether the pinhole model's focal length is the prior's: the data (points on a plane
     /// seen face on) leave it undetermined (module `pinhole_camera`).
     pub focal_from_prior: bool,
+    /// Whether `starts = "pinhole"` fitted the general camera matrix (11 unknowns: aspect,
+    /// skew and principal point free) because no square-pixel camera keeps every
+    /// correspondence's point in front of it (inconsistent data).
+    pub general_camera: bool,
 }
 
 impl FitReport {
@@ -213,10 +217,21 @@ impl FitReport {
              plane follows from it"
                 .to_string()
         });
-        match (node_warning(self.wild_nodes, self.sparse_nodes), focal) {
-            (Some(nodes), Some(focal)) => Some(format!("{focal}; {nodes}")),
-            (nodes, focal) => nodes.or(focal),
-        }
+        let general = self.general_camera.then(|| {
+            "no pinhole camera of square pixels sees every correspondence's point in front of \
+             it: the general camera matrix (aspect, skew and principal point free) is fitted \
+             instead"
+                .to_string()
+        });
+        let parts: Vec<String> = [
+            general,
+            focal,
+            node_warning(self.wild_nodes, self.sparse_nodes),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        (!parts.is_empty()).then(|| parts.join("; "))
     }
 }
 
