@@ -10,7 +10,6 @@
 
 pub mod bench;
 pub mod camera;
-mod display_bytes;
 pub mod handles;
 pub mod render_loop;
 pub mod script;

@@ -23,7 +23,7 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use flexcam::image_io::ColorEncoding;
+use flexcam::image_io::{ByteEncoder, ColorEncoding};
 use flexcam::projection::{
     AnalyticInverse, NoInverse, Projection, ProjectionSpec, Projector, ProjectorHull, Trilinear,
     View,
@@ -32,8 +32,6 @@ use flexcam::render::{self, Frame, Method, Outputs, PreparedScene, RenderOptions
 use flexcam::{try_alloc, Error, Result};
 use glam::DVec2;
 use rayon::prelude::*;
-
-use crate::display_bytes::Encoder;
 
 /// How the view renders: the final method, shading and samples per pixel (those of the
 /// `flexcam render` the final frame matches) and the supersampling of the idle refinement.
@@ -449,9 +447,9 @@ fn render_stage(shared: &Shared, job: &Job, stage: Stage) -> Result<Frame> {
 }
 
 /// 8-bit RGBA of `frame`'s colour, encoded as a PNG of `shading` is (the same bytes, by
-/// [`Encoder`]), rows in parallel. Fails when its memory cannot be had.
+/// [`ByteEncoder`]), rows in parallel. Fails when its memory cannot be had.
 pub fn rgba(frame: &Frame, shading: Shading) -> Result<Vec<u8>> {
-    let encoder = Encoder::of(ColorEncoding::of_shading(shading));
+    let encoder = ByteEncoder::of(ColorEncoding::of_shading(shading));
     let mut bytes = Vec::new();
     try_alloc::resize(&mut bytes, frame.color.len() * 4, 0, || {
         format!("the shown {} x {} image", frame.width, frame.height)

@@ -7,6 +7,7 @@
 //! committed all together or not at all.
 
 mod aovs;
+mod byte_encoder;
 mod color;
 mod depth;
 mod float;
@@ -24,6 +25,7 @@ use glam::Vec3;
 use crate::render::{Frame, Shading};
 
 pub use aovs::write_aovs_exr;
+pub use byte_encoder::ByteEncoder;
 pub use color::{encode_channel16, write_color, ColorFormat, PngBits};
 pub use depth::{write_depth, DepthFormat};
 pub use gif::GifFrames;
@@ -88,8 +90,8 @@ pub fn encode_channel(c: f32, encoding: ColorEncoding) -> u8 {
 /// The 8-bit RGB bytes of the colour of `frame`, row by row from the top (allocated
 /// fallibly: an error names the bytes).
 fn rgb_bytes(frame: &Frame, encoding: ColorEncoding) -> crate::error::Result<Vec<u8>> {
-    let bytes =
-        (frame.color.iter()).flat_map(|c: &Vec3| c.to_array().map(|v| encode_channel(v, encoding)));
+    let encoder = ByteEncoder::of(encoding);
+    let bytes = (frame.color.iter()).flat_map(|c: &Vec3| c.to_array().map(|v| encoder.byte(v)));
     crate::try_alloc::collected(3 * frame.color.len(), bytes, || {
         samples_of("8-bit RGB bytes", frame)
     })
