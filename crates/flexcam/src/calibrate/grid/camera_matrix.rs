@@ -14,7 +14,7 @@
 use glam::{DMat3, DVec2, DVec3};
 use nalgebra::{DMatrix, DVector, SymmetricEigen};
 
-use super::Correspondence;
+use super::{dense_lm, Correspondence};
 
 /// The data are taken as degenerate when the direct linear transform's second least
 /// eigenvalue is below this fraction of its largest (a second camera matrix meets them).
@@ -187,16 +187,11 @@ fn residuals(p: &DVector<f64>, uv: &[[f64; 2]], x: &[[f64; 4]]) -> Option<(Vec<f
     cost.is_finite().then_some((r, cost))
 }
 
-/// Levenberg-Marquardt on the reprojection error from `start`, P kept at unit length
-/// (the scale is no unknown: the damping holds the step off it).
+/// Levenberg-Marquardt on the reprojection error from `start` (module `dense_lm`), P kept
+/// at unit length (the scale is no unknown: the damping holds the step off it).
 fn refine(start: DVector<f64>, uv: &[[f64; 2]], x: &[[f64; 4]]) -> DVector<f64> {
-    let Some((mut r, mut cost)) = residuals(&start, uv, x) else {
-        return start;
-    };
-    let mut p = start;
-    let mut damping = 1e-3;
-    for _ in 0..MAX_ITERATIONS {
-        let mut j = DMatrix::<f64>::zeros(r.len(), 12);
+    let jacobian = |p: &DVector<f64>| {
+        let mut j = DMatrix::<f64>::zeros(2 * x.len(), 12);
         for (k, h) in x.iter().enumerate() {
             let row = |i: usize| (0..4).map(|c| p[4 * i + c] * h[c]).sum::<f64>();
             let w = row(2);
@@ -208,34 +203,16 @@ fn refine(start: DVector<f64>, uv: &[[f64; 2]], x: &[[f64; 4]]) -> DVector<f64> 
                 j[(2 * k + 1, 8 + c)] = -pv * h[c] / w;
             }
         }
-        let jtj = j.transpose() * &j;
-        let jtr = j.transpose() * DVector::from_column_slice(&r);
-        let mut improved = false;
-        for _ in 0..12 {
-            let mut damped = jtj.clone();
-            for i in 0..12 {
-                damped[(i, i)] += damping * jtj[(i, i)].max(1e-12);
-            }
-            let Some(step) = damped.cholesky().map(|ch| ch.solve(&jtr)) else {
-                damping *= 10.0;
-                continue;
-            };
-            let next = (&p - step).normalize();
-            if let Some((r_next, next_cost)) = residuals(&next, uv, x) {
-                if next_cost < cost {
-                    improved = cost - next_cost > 1e-15 * cost;
-                    (p, r, cost) = (next, r_next, next_cost);
-                    damping = (damping * 0.1).max(1e-12);
-                    break;
-                }
-            }
-            damping *= 10.0;
-        }
-        if !improved {
-            break;
-        }
-    }
-    p
+        j
+    };
+    let fitted = dense_lm::minimise(
+        start.clone(),
+        MAX_ITERATIONS,
+        |p| residuals(p, uv, x).map(|(r, _)| r),
+        jacobian,
+        |p, step| Some((p - step).normalize()),
+    );
+    fitted.map_or(start, |(p, _)| p)
 }
 
 #[cfg(test)]

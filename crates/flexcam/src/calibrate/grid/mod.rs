@@ -92,6 +92,7 @@ mod camera_matrix;
 mod central;
 mod cholesky;
 mod curved;
+mod dense_lm;
 mod envelope_cholesky;
 mod folds;
 mod free;

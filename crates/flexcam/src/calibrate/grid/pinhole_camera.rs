@@ -34,10 +34,10 @@
 use std::cmp::Ordering;
 
 use glam::{DMat3, DVec2, DVec3};
-use nalgebra::{DMatrix, DVector, Matrix3, SymmetricEigen};
+use nalgebra::{DMatrix, Matrix3, SymmetricEigen};
 
 use super::camera_matrix::{normalisation, CameraMatrix};
-use super::Correspondence;
+use super::{dense_lm, Correspondence};
 use crate::projection::flexible::ProjectorGrid;
 
 /// The fewest correspondences: 7 unknowns, 2 equations a point.
@@ -465,26 +465,13 @@ impl Data {
     /// where `free_focal`, else kept; the pose reached and its sum of squared residuals, or
     /// `None` where `start` has a point behind it.
     fn refine(&self, start: Pose, free_focal: bool) -> Option<(Pose, f64)> {
-        let cost_of = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>();
-        let mut r = self.residuals(&start)?;
-        let (mut pose, mut cost) = (start, cost_of(&r));
         let first = usize::from(!free_focal);
-        let unknowns = 7 - first;
-        let mut damping = 1e-3;
-        for _ in 0..MAX_ITERATIONS {
-            let j = self.jacobian(&pose).columns(first, unknowns).into_owned();
-            let jtj = j.transpose() * &j;
-            let jtr = j.transpose() * DVector::from_column_slice(&r);
-            let mut improved = false;
-            for _ in 0..12 {
-                let mut damped = jtj.clone();
-                for i in 0..unknowns {
-                    damped[(i, i)] += damping * jtj[(i, i)].max(1e-12);
-                }
-                let Some(step) = damped.cholesky().map(|ch| ch.solve(&jtr)) else {
-                    damping *= 10.0;
-                    continue;
-                };
+        dense_lm::minimise(
+            start,
+            MAX_ITERATIONS,
+            |pose| self.residuals(pose),
+            |pose| self.jacobian(pose).columns(first, 7 - first).into_owned(),
+            |pose, step| {
                 let mut full = [0.0; 7];
                 full[first..].copy_from_slice(step.as_slice());
                 let turn = DVec3::new(-full[1], -full[2], -full[3]);
@@ -494,24 +481,9 @@ impl Data {
                     eye: pose.eye - DVec3::new(full[4], full[5], full[6]),
                     handedness: pose.handedness,
                 };
-                if next.focal > 0.0 {
-                    if let Some(r_next) = self.residuals(&next) {
-                        let next_cost = cost_of(&r_next);
-                        if next_cost < cost {
-                            improved = cost - next_cost > 1e-15 * cost;
-                            (pose, r, cost) = (next, r_next, next_cost);
-                            damping = (damping * 0.1).max(1e-12);
-                            break;
-                        }
-                    }
-                }
-                damping *= 10.0;
-            }
-            if !improved {
-                break;
-            }
-        }
-        Some((pose, cost))
+                (next.focal > 0.0).then_some(next)
+            },
+        )
     }
 
     /// Whether the data leave `pose`'s focal length undetermined: its standard error (the
