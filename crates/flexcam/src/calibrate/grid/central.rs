@@ -50,6 +50,8 @@
 //! point behind the eye) get the general camera matrix's fit instead
 //! ([`FitReport::general_camera`]).
 
+use std::cell::OnceCell;
+
 use glam::{DMat3, DVec2, DVec3};
 use nalgebra::{Matrix3, SymmetricEigen};
 
@@ -155,12 +157,12 @@ pub(super) fn fit_pinhole(
 }
 
 /// What both direction fields of a central fit share: the checked data, their extent and
-/// the starting eyes of the descent.
+/// the general camera matrix of the correspondences, fitted once when first asked for.
 struct Setup<'a> {
     prior: &'a ProjectorGrid,
     correspondences: &'a [Correspondence],
     extent: f64,
-    starts: [Option<DVec3>; 2],
+    camera: OnceCell<Option<CameraMatrix>>,
 }
 
 impl<'a> Setup<'a> {
@@ -193,17 +195,16 @@ impl<'a> Setup<'a> {
             prior,
             correspondences,
             extent,
-            starts: [
-                prior_centre(prior),
-                CameraMatrix::fit(correspondences)
-                    .and_then(|c| c.eye())
-                    .or_else(|| {
-                        PinholeCamera::fit(correspondences, ImageShape::of_prior(prior))
-                            .ok()
-                            .map(|c| c.eye())
-                    }),
-            ],
+            camera: OnceCell::new(),
         })
+    }
+
+    /// The general camera matrix of the correspondences (module `camera_matrix`), `None`
+    /// where they determine none.
+    fn camera(&self) -> Option<&CameraMatrix> {
+        self.camera
+            .get_or_init(|| CameraMatrix::fit(self.correspondences))
+            .as_ref()
     }
 
     /// The variable-projection problem of the free directions.
@@ -215,9 +216,17 @@ impl<'a> Setup<'a> {
         }
     }
 
-    /// The eye of least cost descended to from either starting eye.
+    /// The eye of least cost descended to from either starting eye: the prior's centre and
+    /// the camera matrix's eye (the square-pixel camera's where the camera matrix has none).
     fn best(&self, problem: &Problem) -> Option<DVec3> {
-        self.starts
+        let pinhole_eye = || {
+            self.camera().and_then(|c| c.eye()).or_else(|| {
+                PinholeCamera::fit(self.correspondences, ImageShape::of_prior(self.prior))
+                    .ok()
+                    .map(|c| c.eye())
+            })
+        };
+        [prior_centre(self.prior), pinhole_eye()]
             .into_iter()
             .flatten()
             .filter_map(|start| problem.descend(start))
@@ -229,7 +238,7 @@ impl<'a> Setup<'a> {
     /// position determine, where the free directions need points enough for every node),
     /// lengthened into view, with its eye; `None` where the data determine no camera.
     fn pinhole_fit(&self) -> Option<((ProjectorGrid, FitReport), DVec3)> {
-        let camera = CameraMatrix::fit(self.correspondences)?;
+        let camera = self.camera()?;
         self.camera_grid(camera.eye()?, |uv| camera.direction(uv))
     }
 
