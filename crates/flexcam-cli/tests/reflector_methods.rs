@@ -252,3 +252,73 @@ fn animated_reflector_frames_use_each_frames_camera() {
         );
     }
 }
+
+/// Objects that move (`orbit`) are where each frame's time puts them, by every method that
+/// composites reflectors: frame 1 of `animate` (a quarter turn of the cube about the vertical
+/// line through the origin, so that the mirror shows it from another side) matches `render`
+/// of a still scene with the cube placed there, and frame 0 is the file as written, byte for
+/// byte.
+#[test]
+fn moving_objects_are_where_each_frames_time_puts_them() {
+    let dir = mirror_scene();
+    let cube = "translate = [0.7, 0.5, 1.2]\nrotate = [0.0, 30.0, 0.0]\n";
+    assert!(PLANE_MIRROR.contains(cube));
+    // A quarter turn about +y (period 4 s, frame 1 of 1 frame per second) takes (x, y, z) to
+    // (z, y, -x) and adds 90 degrees to the cube's turn about y.
+    let orbiting = PLANE_MIRROR.replace(
+        cube,
+        &format!("{cube}orbit = {{ center = [0.0, 0.0, 0.0], period = 4.0 }}\n"),
+    );
+    let animated = format!("{orbiting}\n[animation]\nframes = 2\nfps = 1.0\n");
+    std::fs::write(dir.path().join("animated.toml"), animated).unwrap();
+    let moved = PLANE_MIRROR.replace(
+        cube,
+        "translate = [1.2, 0.5, -0.7]\nrotate = [0.0, 120.0, 0.0]\n",
+    );
+    std::fs::write(dir.path().join("moved.toml"), moved).unwrap();
+    let path = |name: &str| dir.path().join(name);
+    for method in ["raycast", "trilinear", "camera-triangles"] {
+        let frames = format!("{method}-#.png");
+        let (moved_png, still_png) = (format!("{method}-moved.png"), format!("{method}-still.png"));
+        let flat = ["--method", method, "--shading", "flat"];
+        run_ok(
+            &dir,
+            &[&["animate", "animated.toml", "-o", &frames][..], &flat].concat(),
+        );
+        run_ok(
+            &dir,
+            &[&["render", "moved.toml", "-o", &moved_png][..], &flat].concat(),
+        );
+        run_ok(
+            &dir,
+            &[&["render", "mirror.toml", "-o", &still_png][..], &flat].concat(),
+        );
+        let difference = mean_rgb_difference(&path(&format!("{method}-1.png")), &path(&moved_png));
+        assert!(
+            difference < 0.002,
+            "{method}: mean RGB difference {difference}"
+        );
+        // The cube did move: frame 1 is not the still scene.
+        let unmoved = mean_rgb_difference(&path(&format!("{method}-1.png")), &path(&still_png));
+        assert!(
+            unmoved > 0.01,
+            "{method}: frame 1 is the still scene ({unmoved})"
+        );
+    }
+    run_ok(&dir, &["render", "mirror.toml", "-o", "time0.png"]);
+    run_ok(
+        &dir,
+        &[
+            "animate",
+            "animated.toml",
+            "-o",
+            "lit-#.png",
+            "--frames",
+            "0",
+        ],
+    );
+    assert_eq!(
+        std::fs::read(path("time0.png")).unwrap(),
+        std::fs::read(path("lit-0.png")).unwrap()
+    );
+}

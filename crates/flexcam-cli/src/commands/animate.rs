@@ -1,6 +1,6 @@
-//! `flexcam animate`: render every frame of a scene's keyframed flexible camera
-//! (`[animation]`) to a numbered PNG sequence and/or an animated GIF. Nothing is written
-//! unless every frame renders.
+//! `flexcam animate`: render every frame of a scene's `[animation]` (a keyframed flexible
+//! camera, objects that move along their `orbit`, or both) to a numbered PNG sequence and/or
+//! an animated GIF. Nothing is written unless every frame renders.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -23,7 +23,8 @@ use crate::OutputTarget;
 /// Arguments of `flexcam animate`.
 #[derive(Args, Debug)]
 pub struct AnimateArgs {
-    /// A scene file (.toml) with an `[animation]` table.
+    /// A scene file (.toml) with an `[animation]` table: camera keys, objects with an
+    /// `orbit`, or both.
     scene: PathBuf,
     /// Numbered frames: the run of `#` in the file name becomes the zero-padded frame
     /// number, from 0 (e.g. `frames/out_####.png`); 8-bit PNG, or linear float `.exr` or
@@ -217,8 +218,13 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     scene::check_budget(&scene, width, height, gif_bytes).map_err(|e| e.or_in_file(&args.scene))?;
 
     let encoding = ColorEncoding::of_shading(args.shading.shading());
-    // The scene is static: one prepared scene (one BVH) for every frame.
-    let prepared = PreparedScene::new(&scene);
+    // A still scene is prepared once (one BVH) for every frame; one whose objects move is
+    // prepared anew at each frame's time.
+    let still = scene.motions.is_empty().then(|| PreparedScene::new(&scene));
+    // Without camera keys every frame is seen through the scene's own projection.
+    let (fixed_projection, _) = flexcam::calibrate::build(&scene.projection, width, height)
+        .map_err(|e| e.or_in_file(&args.scene))?;
+    let (mut bvh_builds, mut bvh_build_ms) = (0, 0.0);
     let load_ms = load_start.elapsed().as_secs_f64() * 1e3;
     let render_start = Instant::now();
     let progress = RenderProgress::new();
@@ -226,9 +232,23 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     let mut warnings = Vec::new();
     let spp = args.spp.unwrap_or(scene.image.spp);
     for (index, &frame_number) in chosen.iter().enumerate() {
-        let spec = ProjectionSpec::Flexible(Box::new(animation.projection(frame_number)));
-        let (projection, _) = flexcam::calibrate::build(&spec, width, height)
-            .map_err(|e| e.or_in_file(&args.scene))?;
+        let keyed = match animation.projection(frame_number) {
+            Some(spec) => Some(
+                flexcam::calibrate::build(&ProjectionSpec::Flexible(Box::new(spec)), width, height)
+                    .map_err(|e| e.or_in_file(&args.scene))?
+                    .0,
+            ),
+            None => None,
+        };
+        let projection = keyed.as_ref().unwrap_or(&fixed_projection);
+        let moved;
+        let prepared = match &still {
+            Some(prepared) => prepared,
+            None => {
+                moved = PreparedScene::new(&scene.at_time(animation.time(frame_number)));
+                &moved
+            }
+        };
         let done_before = index as u64;
         let report = |done: u64, total: u64| {
             progress.update(
@@ -244,9 +264,13 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
             outputs: Outputs::COLOR,
             ..RenderOptions::default()
         };
-        let rendered = render::render(&prepared, projection.as_ref(), &options)
+        let rendered = render::render(prepared, projection.as_ref(), &options)
             .map_err(|e| e.or_in_file(&args.scene))?;
         warnings.extend(rendered.warnings);
+        if still.is_none() {
+            bvh_builds += prepared.bvh_builds();
+            bvh_build_ms += prepared.bvh_build_ms();
+        }
         let frame = rendered.frame;
         if let Some(&id) = frame_outputs.get(index) {
             outputs.stage(id, |tmp| {
@@ -266,12 +290,19 @@ pub fn run(args: &AnimateArgs) -> Result<()> {
     }
     let mut counters = Stats::new();
     counters.insert("frames", Counter::Count(u64::from(rendered_frames)));
-    counters.insert("bvh_builds", Counter::Count(prepared.bvh_builds()));
-    counters.insert("bvh_build_ms", Counter::Value(prepared.bvh_build_ms()));
+    if let Some(still) = &still {
+        bvh_builds += still.bvh_builds();
+        bvh_build_ms += still.bvh_build_ms();
+    }
+    counters.insert("bvh_builds", Counter::Count(bvh_builds));
+    counters.insert("bvh_build_ms", Counter::Value(bvh_build_ms));
     let facts = RunFacts {
         method: method.name(),
         scene: &args.scene.to_string_lossy(),
-        projection: "flexible",
+        projection: match animation.keys() {
+            [] => scene.projection.kind(),
+            _ => "flexible",
+        },
         shading: args.shading.name(),
         width,
         height,

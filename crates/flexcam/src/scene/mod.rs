@@ -6,12 +6,14 @@ pub mod displacement;
 mod light;
 mod material;
 mod mesh;
+mod motion;
 pub mod texel;
 
 pub use displacement::DisplacementSpec;
 pub use light::Light;
 pub use material::{Finish, Material, Pattern, Texture};
 pub use mesh::Mesh;
+pub use motion::{ObjectMotion, Orbit};
 
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -107,6 +109,9 @@ pub struct Scene {
     /// light (scene-file key `caustics`; added in `lit` shading by [`crate::render::render`]).
     /// Empty: no caustics.
     pub caustics: Vec<CausticReflector>,
+    /// The objects that move over an animation's time (scene-file key `orbit`); a render
+    /// shows time 0, `flexcam animate` each frame's [`Scene::at_time`]. Empty: a still scene.
+    pub motions: Vec<ObjectMotion>,
     /// Every file the scene was read from (the scene file, models and the files they name,
     /// textures, surfaces), so that a command can refuse to write over any of them. Empty
     /// for built-in scenes (they name no files) and scenes built in code.

@@ -2,7 +2,9 @@
 //! hold a time and a flexible projection; frame f is shown at time f / fps, and between two
 //! keys the volume is their blend Q = a Q_i + (1 - a) Q_{i+1} ([`super::blend`]), with a
 //! going from 1 to 0 linearly in time or along the smoothstep 3s^2 - 2s^3 (zero speed at
-//! every key). Before the first key and after the last the camera holds still.
+//! every key). Before the first key and after the last the camera holds still. An animation
+//! without keys is a timeline alone (frames and their times): its camera is the scene's own
+//! projection, and what moves are the scene's objects ([`crate::scene::Orbit`]).
 
 use super::{FlexibleSpec, VolumeSource};
 use crate::error::{Error, Result};
@@ -25,7 +27,7 @@ pub struct Keyframe {
     pub projection: FlexibleSpec,
 }
 
-/// A keyframed camera over `frames` frames at `fps` frames per second.
+/// A keyframed camera (or none) over `frames` frames at `fps` frames per second.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Animation {
     frames: u32,
@@ -36,7 +38,7 @@ pub struct Animation {
 
 impl Animation {
     /// Errors (one line each, naming the key by its index from 0): no frames; `fps` not
-    /// finite and positive; no keys; a key time that is not finite, or not later than the
+    /// finite and positive; a key time that is not finite, or not later than the
     /// key before it.
     pub fn new(frames: u32, fps: f64, easing: Easing, keys: Vec<Keyframe>) -> Result<Self> {
         if frames == 0 {
@@ -46,9 +48,6 @@ impl Animation {
             return Err(Error::new(format!(
                 "animation fps must be a positive number, got {fps}"
             )));
-        }
-        if keys.is_empty() {
-            return Err(Error::new("animation needs at least one key"));
         }
         for (i, key) in keys.iter().enumerate() {
             if !key.time.is_finite() {
@@ -84,7 +83,7 @@ impl Animation {
         self.fps
     }
 
-    /// The keys, in time order.
+    /// The keys, in time order; empty when the camera is the scene's projection.
     pub fn keys(&self) -> &[Keyframe] {
         &self.keys
     }
@@ -95,34 +94,37 @@ impl Animation {
     }
 
     /// The projection at `time`: the key itself at (or outside) the ends and at key times,
-    /// else the blend of the two keys around it with weight a on the earlier one.
-    pub fn projection_at(&self, time: f64) -> FlexibleSpec {
+    /// else the blend of the two keys around it with weight a on the earlier one; `None`
+    /// without keys (the scene's own projection).
+    pub fn projection_at(&self, time: f64) -> Option<FlexibleSpec> {
         let after = self.keys.partition_point(|k| k.time <= time);
         let (Some(before), Some(next)) = (after.checked_sub(1), self.keys.get(after)) else {
-            let end = if after == 0 { 0 } else { self.keys.len() - 1 };
-            return self.keys[end].projection.clone();
+            let end = after
+                .saturating_sub(1)
+                .min(self.keys.len().saturating_sub(1));
+            return self.keys.get(end).map(|key| key.projection.clone());
         };
         let (a, b) = (&self.keys[before], next);
         let s = (time - a.time) / (b.time - a.time);
         if s == 0.0 {
-            return a.projection.clone();
+            return Some(a.projection.clone());
         }
         let s = match self.easing {
             Easing::Linear => s,
             Easing::Smooth => s * s * (3.0 - 2.0 * s),
         };
-        FlexibleSpec {
+        Some(FlexibleSpec {
             source: VolumeSource::Interpolated {
                 weight: 1.0 - s,
                 first: Box::new(a.projection.clone()),
                 second: Box::new(b.projection.clone()),
             },
             reparam: None,
-        }
+        })
     }
 
-    /// The projection of frame `frame`.
-    pub fn projection(&self, frame: u32) -> FlexibleSpec {
+    /// The projection of frame `frame` (`None` without keys).
+    pub fn projection(&self, frame: u32) -> Option<FlexibleSpec> {
         self.projection_at(self.time(frame))
     }
 }
@@ -165,15 +167,16 @@ mod tests {
         let keys = vec![key(1.0, 40.0), key(2.0, 60.0), key(4.0, 90.0)];
         let a = Animation::new(10, 2.0, Easing::Linear, keys.clone()).unwrap();
         assert_eq!(a.time(3), 1.5);
-        assert_eq!(a.projection_at(0.0), keys[0].projection);
-        assert_eq!(a.projection_at(1.0), keys[0].projection);
-        assert_eq!(a.projection_at(2.0), keys[1].projection);
-        assert_eq!(a.projection_at(4.0), keys[2].projection);
-        assert_eq!(a.projection_at(9.0), keys[2].projection);
+        assert_eq!(a.projection_at(0.0).unwrap(), keys[0].projection);
+        assert_eq!(a.projection_at(1.0).unwrap(), keys[0].projection);
+        assert_eq!(a.projection_at(2.0).unwrap(), keys[1].projection);
+        assert_eq!(a.projection_at(4.0).unwrap(), keys[2].projection);
+        assert_eq!(a.projection_at(9.0).unwrap(), keys[2].projection);
         // Between keys: the weight on the earlier key falls linearly from 1 to 0.
-        assert_eq!(weight(&a.projection_at(1.5)), 0.5);
-        assert_eq!(weight(&a.projection_at(3.5)), 0.25);
-        let VolumeSource::Interpolated { first, second, .. } = a.projection(7).source else {
+        assert_eq!(weight(&a.projection_at(1.5).unwrap()), 0.5);
+        assert_eq!(weight(&a.projection_at(3.5).unwrap()), 0.25);
+        let VolumeSource::Interpolated { first, second, .. } = a.projection(7).unwrap().source
+        else {
             panic!("frame 7 (3.5 s) lies between keys 1 and 2");
         };
         assert_eq!(
@@ -187,8 +190,15 @@ mod tests {
         let a =
             Animation::new(5, 1.0, Easing::Smooth, vec![key(0.0, 40.0), key(4.0, 80.0)]).unwrap();
         // s = 1/4: 3 s^2 - 2 s^3 = 0.15625.
-        assert!((weight(&a.projection_at(1.0)) - (1.0 - 0.15625)).abs() < 1e-15);
-        assert_eq!(weight(&a.projection_at(2.0)), 0.5);
+        assert!((weight(&a.projection_at(1.0).unwrap()) - (1.0 - 0.15625)).abs() < 1e-15);
+        assert_eq!(weight(&a.projection_at(2.0).unwrap()), 0.5);
+    }
+
+    #[test]
+    fn without_keys_the_camera_is_the_scenes_own() {
+        let a = Animation::new(4, 2.0, Easing::Linear, Vec::new()).unwrap();
+        assert_eq!((a.frames(), a.time(3)), (4, 1.5));
+        assert_eq!(a.projection(3), None);
     }
 
     #[test]
@@ -197,7 +207,6 @@ mod tests {
         assert!(e(0, 24.0, vec![key(0.0, 40.0)]).message.contains("frames"));
         assert!(e(3, 0.0, vec![key(0.0, 40.0)]).message.contains("fps"));
         assert!(e(3, f64::NAN, vec![key(0.0, 40.0)]).message.contains("fps"));
-        assert!(e(3, 24.0, vec![]).message.contains("at least one key"));
         let m = e(3, 24.0, vec![key(1.0, 40.0), key(1.0, 50.0)]).message;
         assert!(m.contains("key 1 time 1 must be later"), "{m}");
         let m = e(3, 24.0, vec![key(f64::INFINITY, 40.0)]).message;

@@ -37,12 +37,20 @@
 //! angle at `v`), plus the distance from `v` to that nearest point over `v`'s pixel
 //! footprint. The largest over the vertices must stay within the tolerance.
 //!
+//! Both sizes are remembered ([`Chosen`]): the last few reflectors' camera meshes are kept,
+//! each with a copy of the reflector mesh, the size asked for and, for the automatic size,
+//! the camera, optic and tolerance it was searched with; a render that asks again with equal
+//! inputs (the frames of an animation whose reflector does not move, a viewer's re-renders)
+//! reuses the result instead of simplifying anew, as the paper builds its camera mesh once.
+//! The inputs are compared exactly, so a moved or edited reflector is simplified again.
+//!
 //! Degenerate cases: a tolerance of 0 (no refinement) keeps the reflector's own mesh, as
 //! does a reflector that [`coarse_triangles`] cannot simplify (not an oriented manifold:
 //! the given size refuses it instead, naming the defect), one of fewer than
 //! `2 MIN_AUTO_TRIANGLES` triangles, or one whose vertices the camera sees none of.
 
 use std::borrow::Cow;
+use std::sync::{Arc, Mutex, PoisonError};
 
 use glam::{DVec2, DVec3};
 
@@ -80,14 +88,16 @@ pub fn camera_mesh<'a>(
 ) -> Result<CameraMesh<'a>> {
     match entry.camera_triangles {
         Some(n) if n < reflector.triangles.len() => {
-            let mesh = coarse_triangles(reflector, n, SEED).map_err(|e| {
-                Error::new(format!(
-                    "reflector {}: cannot simplify its mesh to {n} camera triangles: {e}",
-                    entry.id
-                ))
+            let mesh = Chosen::remembered(reflector, Request::Size(n), || {
+                coarse_triangles(reflector, n, SEED).map(Some).map_err(|e| {
+                    Error::new(format!(
+                        "reflector {}: cannot simplify its mesh to {n} camera triangles: {e}",
+                        entry.id
+                    ))
+                })
             })?;
             Ok(CameraMesh {
-                mesh: Cow::Owned(mesh),
+                mesh: mesh.map_or(Cow::Borrowed(reflector), |m| Cow::Owned((*m).clone())),
                 refine: false,
             })
         }
@@ -95,14 +105,94 @@ pub fn camera_mesh<'a>(
             mesh: Cow::Borrowed(reflector),
             refine: false,
         }),
-        None if automatic => Ok(CameraMesh {
-            mesh: automatic_size(reflector, camera, optic, entry.refine_px),
-            refine: true,
-        }),
+        None if automatic => {
+            let request = Request::Automatic {
+                camera: camera.clone(),
+                optic,
+                tolerance_px: entry.refine_px,
+            };
+            let mesh = Chosen::remembered(reflector, request, || {
+                Ok(
+                    match automatic_size(reflector, camera, optic, entry.refine_px) {
+                        Cow::Owned(coarse) => Some(coarse),
+                        Cow::Borrowed(_) => None,
+                    },
+                )
+            })?;
+            Ok(CameraMesh {
+                mesh: mesh.map_or(Cow::Borrowed(reflector), |m| Cow::Owned((*m).clone())),
+                refine: true,
+            })
+        }
         None => Ok(CameraMesh {
             mesh: Cow::Borrowed(reflector),
             refine: true,
         }),
+    }
+}
+
+/// What a camera mesh was chosen for, besides the reflector's mesh.
+#[derive(Debug, Clone, PartialEq)]
+enum Request {
+    /// A given number of triangles.
+    Size(usize),
+    /// The automatic size for this camera, optic and tolerance (module doc).
+    Automatic {
+        camera: Perspective,
+        optic: Optic,
+        tolerance_px: f64,
+    },
+}
+
+/// A remembered choice: the reflector mesh and request it answers, and the coarse mesh
+/// chosen (`None`: the reflector's own mesh).
+struct Chosen {
+    reflector: Arc<Mesh>,
+    request: Request,
+    coarse: Option<Arc<Mesh>>,
+}
+
+/// How many choices are remembered (the most recent first).
+const REMEMBERED: usize = 4;
+
+/// The remembered choices, most recent first.
+static CHOSEN: Mutex<Vec<Chosen>> = Mutex::new(Vec::new());
+
+impl Chosen {
+    /// The camera mesh for `reflector` and `request`: a remembered one whose inputs are
+    /// equal, else `choose()`'s, remembered unless it is an error. A poisoned lock (a panic
+    /// elsewhere while it was held) is taken as it is: the list holds only complete entries.
+    fn remembered(
+        reflector: &Mesh,
+        request: Request,
+        choose: impl FnOnce() -> Result<Option<Mesh>>,
+    ) -> Result<Option<Arc<Mesh>>> {
+        let lock = || CHOSEN.lock().unwrap_or_else(PoisonError::into_inner);
+        {
+            let mut chosen = lock();
+            let hit = chosen
+                .iter()
+                .position(|c| c.request == request && *c.reflector == *reflector);
+            if let Some(k) = hit {
+                let entry = chosen.remove(k);
+                let coarse = entry.coarse.clone();
+                chosen.insert(0, entry);
+                return Ok(coarse);
+            }
+        }
+        // Chosen without the lock held: other renders go on meanwhile.
+        let coarse = choose()?.map(Arc::new);
+        let mut chosen = lock();
+        chosen.insert(
+            0,
+            Chosen {
+                reflector: Arc::new(reflector.clone()),
+                request,
+                coarse: coarse.clone(),
+            },
+        );
+        chosen.truncate(REMEMBERED);
+        Ok(coarse)
     }
 }
 

@@ -103,6 +103,7 @@ fn scene(objects: Vec<Object>, lights: Vec<Light>) -> Scene {
         base_dir: None,
         trilinear_reflectors: Vec::new(),
         caustics: Vec::new(),
+        motions: Vec::new(),
         inputs: Vec::new(),
     }
 }

@@ -40,6 +40,7 @@ pub fn teapot_scene(faces: u32) -> (Scene, usize) {
         lights: Vec::new(),
         trilinear_reflectors: Vec::new(),
         caustics: Vec::new(),
+        motions: Vec::new(),
         inputs: Vec::new(),
         image: ImageSettings {
             width: TABLE_SIZE,

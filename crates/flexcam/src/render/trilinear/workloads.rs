@@ -111,6 +111,7 @@ pub fn random_triangles(count: u32, seed: u64) -> Scene {
         base_dir: None,
         trilinear_reflectors: Vec::new(),
         caustics: Vec::new(),
+        motions: Vec::new(),
         inputs: Vec::new(),
     }
 }

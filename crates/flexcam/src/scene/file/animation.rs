@@ -1,6 +1,6 @@
-//! `[animation]`: a keyframed flexible camera, `frames` frames at `fps` frames per second,
-//! with `[[animation.key]]` tables that each hold a `time` (seconds) and a flexible
-//! `projection` table. Every key and every blend of neighbouring keys is built here, at the
+//! `[animation]`: `frames` frames at `fps` frames per second, with `[[animation.key]]` tables
+//! that each hold a `time` (seconds) and a flexible `projection` table (a keyframed camera),
+//! or none when objects move (`orbit`) and the camera is the scene's `[projection]`. Every key and every blend of neighbouring keys is built here, at the
 //! scene's image size, so that an incompatible pair is reported at its key before any frame
 //! is rendered.
 
@@ -22,12 +22,14 @@ pub const DEFAULT_FPS: f64 = 24.0;
 /// frame's output is named before the first is rendered, and a GIF holds them all.
 pub const MAX_FRAMES: u32 = 100_000;
 
-/// Converts and checks the `[animation]` table.
+/// Converts and checks the `[animation]` table; `moving_objects`: some object has an `orbit`
+/// (then the keys may be left out).
 pub(super) fn convert(
     src: &Source,
     table: &Spanned<RawAnimation>,
     base_dir: &Path,
     image: &ImageSettings,
+    moving_objects: bool,
 ) -> Result<Animation> {
     let raw = table.get_ref();
     let frames = *raw.frames.get_ref();
@@ -56,10 +58,11 @@ pub(super) fn convert(
             }
         },
     };
-    if raw.key.is_empty() {
+    if raw.key.is_empty() && !moving_objects {
         return Err(src.error(
             &table.span(),
-            "[animation] needs at least one [[animation.key]] with a `time` and a `projection`",
+            "[animation] needs at least one [[animation.key]] with a `time` and a `projection`, \
+             or an object that moves (`orbit`)",
         ));
     }
     let mut keys: Vec<Keyframe> = Vec::with_capacity(raw.key.len());

@@ -17,6 +17,7 @@ mod flexible;
 mod flexible_map_tests;
 mod interpolate;
 mod light;
+mod motion;
 mod object;
 mod panorama;
 mod pieces;
@@ -161,6 +162,7 @@ fn parse_source(src: Source) -> Result<(Scene, Option<Animation>)> {
     let mut objects = Vec::new();
     let mut trilinear_reflectors = Vec::new();
     let mut caustics = Vec::new();
+    let mut motions = Vec::new();
     for (index, table) in raw.object.iter().enumerate() {
         let id =
             u32::try_from(index + 1).map_err(|_| src.error(&table.span(), "too many objects"))?;
@@ -171,6 +173,9 @@ fn parse_source(src: Source) -> Result<(Scene, Option<Animation>)> {
         }
         if let Some(caustic) = object::caustic_reflector(&src, table, id, &parts, &projection)? {
             caustics.push(caustic);
+        }
+        if let Some(orbit) = &table.get_ref().orbit {
+            motions.push(motion::convert(&src, orbit, id)?);
         }
         objects.extend(parts);
     }
@@ -197,7 +202,7 @@ fn parse_source(src: Source) -> Result<(Scene, Option<Animation>)> {
     let animation = raw
         .animation
         .as_ref()
-        .map(|table| animation::convert(&src, table, &base_dir, &image))
+        .map(|table| animation::convert(&src, table, &base_dir, &image, !motions.is_empty()))
         .transpose()?;
     let scene = Scene {
         objects,
@@ -207,6 +212,7 @@ fn parse_source(src: Source) -> Result<(Scene, Option<Animation>)> {
         base_dir: Some(base_dir),
         trilinear_reflectors,
         caustics: caustics.into_iter().map(|(c, _)| c).collect(),
+        motions,
         inputs: src.into_inputs(),
     };
     Ok((scene, animation))

@@ -29,7 +29,7 @@ pub struct RawScene {
     pub animation: Option<Spanned<RawAnimation>>,
 }
 
-/// `[animation]`: a keyframed flexible camera.
+/// `[animation]`: frames over time, with a keyframed flexible camera and/or moving objects.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawAnimation {
@@ -586,6 +586,7 @@ pub struct RawObject {
     pub caustics: Option<Spanned<bool>>,
     pub caustic_map: Option<Spanned<i64>>,
     pub displacement: Option<Spanned<super::displacement::RawDisplacement>>,
+    pub orbit: Option<Spanned<super::motion::RawOrbit>>,
 }
 
 /// `checker = { color = [...], size = ... }`.

@@ -3,11 +3,12 @@
 //! camera triangle counts.
 //!
 //! The scene (`teapot_scene`; `scenes/camtri-teapot.toml` is its 10-ball layout with a
-//! 256-triangle camera mesh at time 0): Newell's teapot (992 triangles) as a mirror, its
+//! 256-triangle camera mesh, an `animate` scene): Newell's teapot (992 triangles) as a mirror, its
 //! camera mesh simplified to the paper's 100, 256 or 512 triangles (`camera_triangles`),
 //! balls of 80 triangles orbiting it at their own speeds (5 to 20 balls: the paper's 400 to
-//! 1,600 scene triangles) and a floor of 2 triangles, at 800 x 600. Every timed render is the
-//! next frame (1/24 s later): the balls are moved, the scene prepared anew and the whole
+//! 1,600 scene triangles; each ball's `orbit` about the teapot's vertical axis) and a floor of
+//! 2 triangles, at 800 x 600. Every timed render is the next frame (1/24 s later): the balls
+//! are moved ([`Scene::at_time`]), the scene prepared anew and the whole
 //! frame rendered (main view by the trilinear method, the teapot's reflection by camera
 //! triangles, tight bound), so the time is that of a dynamic scene. "No acceleration" turns
 //! off the culling of section 2.4 (clusters of scene triangles per camera triangle, and per
@@ -18,14 +19,12 @@
 
 use std::f32::consts::TAU;
 use std::path::Path;
-use std::sync::Arc;
 
 use flexcam::render::{
     self, CameraTriangleBound, CameraTriangleOptions, Method, PreparedScene, RenderOptions, Shading,
 };
 use flexcam::scene::{self, Scene};
 use flexcam::Result;
-use glam::{Affine3A, Mat3};
 
 use super::measures::{count, value};
 use super::Settings;
@@ -43,7 +42,7 @@ const STAGES: [&str; 4] = [
 ];
 
 /// Frames per second of the animation the timed renders step through.
-const FPS: f32 = 24.0;
+const FPS: f64 = 24.0;
 
 /// The paper's grid: scene triangles, camera triangles, frames per second without and with
 /// acceleration (GeForce 7800 GT).
@@ -110,38 +109,15 @@ checker = {{ color = [0.1, 0.1, 0.1], size = 0.5 }}
 "#
     );
     for k in 0..balls {
-        let (position, radius, colour, _) = ball(k, balls);
+        let (position, radius, colour, speed) = ball(k, balls);
+        let period = TAU / speed;
         text += &format!(
             "\n[[object]]\nname = \"ball{k}\"\nshape = \"sphere\"\nsize = {radius}\n\
-             tessellation = 10\ncolor = {colour:?}\ntranslate = {position:?}\n"
+             tessellation = 10\ncolor = {colour:?}\ntranslate = {position:?}\n\
+             orbit = {{ center = [0.0, 0.0, 0.0], period = {period:?} }}\n"
         );
     }
     scene::file::parse(&text, Path::new("bench:camera-triangles-teapot"))
-}
-
-/// `scene` (of [`teapot_scene`] with `balls` balls) at `time` seconds: each ball turned
-/// about the vertical axis through the teapot by its speed times `time`.
-fn at_time(scene: &Scene, balls: u32, time: f32) -> Scene {
-    let mut moved = scene.clone();
-    for object in &mut moved.objects {
-        let Some(k) = object
-            .name
-            .strip_prefix("ball")
-            .and_then(|k| k.parse().ok())
-        else {
-            continue;
-        };
-        let turn = Mat3::from_rotation_y(ball(k, balls).3 * time);
-        let mesh = Arc::make_mut(&mut object.mesh);
-        for p in &mut mesh.positions {
-            *p = turn * *p;
-        }
-        for n in &mut mesh.normals {
-            *n = turn * *n;
-        }
-        object.world_to_object *= Affine3A::from_mat3(turn.transpose());
-    }
-    moved
 }
 
 /// One cell of the figure, without and with acceleration.
@@ -206,7 +182,7 @@ pub fn run(settings: &Settings) -> Result<Vec<Row>> {
             };
             let mut frame = 0u32;
             let (timing, rendered) = measure(settings.repeat, || {
-                let moved = at_time(&scene, balls, frame as f32 / FPS);
+                let moved = scene.at_time(f64::from(frame) / FPS);
                 frame += 1;
                 render::render(&PreparedScene::new(&moved), main.as_ref(), &options)
             })?;

@@ -123,3 +123,46 @@ fn closest_point_is_the_nearest_of_the_triangle() {
         );
     }
 }
+
+/// A remembered camera mesh is the one a fresh simplification gives, and a reflector that
+/// moved (or a request that changed) is simplified anew, not given the remembered mesh.
+#[test]
+fn remembered_camera_meshes_are_those_of_their_own_inputs() {
+    let (ball, camera) = ball(20);
+    let given = TrilinearReflector {
+        camera_triangles: Some(64),
+        ..TrilinearReflector::new(1)
+    };
+    let fresh = coarse_triangles(&ball.mesh, 64, SEED).unwrap();
+    for _ in 0..2 {
+        let chosen = camera_mesh(&ball.mesh, &given, &camera, Optic::Reflect, true).unwrap();
+        assert_eq!(*chosen.mesh, fresh);
+    }
+    let mut moved = ball.mesh.clone();
+    moved.transform(&glam::Affine3A::from_translation(glam::Vec3::new(
+        0.25, 0.0, 0.0,
+    )));
+    let chosen = camera_mesh(&moved, &given, &camera, Optic::Reflect, true).unwrap();
+    assert_eq!(*chosen.mesh, coarse_triangles(&moved, 64, SEED).unwrap());
+    let other_size = TrilinearReflector {
+        camera_triangles: Some(32),
+        ..given
+    };
+    let chosen = camera_mesh(&ball.mesh, &other_size, &camera, Optic::Reflect, true).unwrap();
+    assert_eq!(
+        *chosen.mesh,
+        coarse_triangles(&ball.mesh, 32, SEED).unwrap()
+    );
+    // The automatic size, remembered per camera: the same choice as a first search.
+    let tolerant = TrilinearReflector {
+        refine_px: 4.0,
+        ..TrilinearReflector::new(1)
+    };
+    let first = camera_mesh(&ball.mesh, &tolerant, &camera, Optic::Reflect, true).unwrap();
+    let again = camera_mesh(&ball.mesh, &tolerant, &camera, Optic::Reflect, true).unwrap();
+    assert_eq!(first.mesh, again.mesh);
+    assert_eq!(
+        *first.mesh,
+        automatic_size(&ball.mesh, &camera, Optic::Reflect, 4.0).into_owned()
+    );
+}
