@@ -272,7 +272,8 @@ impl Forced {
     /// depth or bound gives `true` (bisected, as every piece of such a triangle was before
     /// the distance test).
     pub fn applies(&self, a: f64, b: f64) -> bool {
-        let (lo, hi) = (a.min(b), a.max(b));
+        // Not `f64::min`, which passes over a NaN.
+        let (lo, hi) = if a < b { (a, b) } else { (b, a) };
         let beyond = lo - self.around.1;
         self.levels > 0 && !(beyond > 0.0 && beyond >= NEAR_DEGENERATE * (hi - lo))
     }
@@ -362,6 +363,33 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Forced levels apply to a piece reaching the degenerate depths or before them, and
+    /// to one beyond them by less than `NEAR_DEGENERATE` times its extent; not without
+    /// levels, nor to a piece far beyond; a NaN depth keeps them (the old rule).
+    #[test]
+    fn forced_levels_apply_near_and_before_the_degenerate_depths() {
+        let forced = Forced {
+            levels: 5,
+            around: (1.0, 2.0),
+        };
+        assert!(!Forced::NONE.applies(0.0, 1.0));
+        assert!(forced.applies(0.5, 1.5), "reaching");
+        assert!(forced.applies(1.2, 1.8), "between");
+        assert!(forced.applies(0.1, 0.2), "before");
+        assert!(forced.applies(3.0, 2.5), "beyond by less than 4 extents");
+        assert!(!forced.applies(4.0, 4.5), "beyond by 4 extents");
+        assert!(!forced.applies(100.0, 110.0), "far beyond");
+        assert!(forced.applies(f64::NAN, 110.0));
+        assert!(forced.applies(100.0, f64::NAN));
+        assert!(!Forced {
+            levels: 0,
+            ..forced
+        }
+        .applies(0.5, 1.5));
+        assert_eq!(forced.next().levels, 4);
+        assert_eq!(Forced::NONE.next(), Forced::NONE);
     }
 
     /// The roots strictly inside `(lo, hi)`, in the solver's order.

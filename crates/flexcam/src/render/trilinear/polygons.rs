@@ -704,6 +704,78 @@ pub(super) mod tests {
         }
     }
 
+    proptest! {
+        /// Soundness of the skip beyond a domain line: every shape [`is_outside_domain`]
+        /// says to skip, traced (every sampling, scene-space clipping on, as the skip
+        /// requires) and clipped, leaves nothing. Scene triangles reach well past the
+        /// projection triangle's domain; `outside_shapes_occur` checks that such shapes do
+        /// occur.
+        #[test]
+        fn a_shape_beyond_a_domain_line_clips_to_nothing(
+            corners in proptest::array::uniform3(
+                (-6.0..6.0f64, -6.0..6.0f64, 0.5..8.0f64)
+            ),
+        ) {
+            let (triangle, cache) = test_triangle();
+            let scene = corners.map(|(x, y, z)| DVec3::new(x, y, z));
+            let Ok(shapes) = project_triangle(&cache, scene) else { return Ok(()) };
+            let range = depth_range(shapes.iter().filter(is_drawn));
+            let (mut outline, mut scratch, mut depths) = (Vec::new(), Vec::new(), Vec::new());
+            for shape in shapes.iter().filter(is_drawn) {
+                let skipped = EdgeCrossings::new(&triangle, scene, range);
+                if !is_outside_domain(&shape, &skipped, triangle.degenerate) {
+                    continue;
+                }
+                slice_depths(&shape, 8, &mut depths);
+                for (sampling, _) in modes(&depths).into_iter().filter(|(_, clipping)| *clipping) {
+                    let mut crossings = EdgeCrossings::new(&triangle, scene, range);
+                    outline.clear();
+                    let mode = (sampling, true);
+                    trace_outline(&triangle, &shape, scene, mode, &mut crossings, &mut outline);
+                    clip_outline(&mut outline, &mut scratch);
+                    prop_assert!(outline.is_empty(), "{:?} {:?}", shape.vertices, outline);
+                }
+            }
+        }
+    }
+
+    /// The proptest's triangle sees shapes beyond a domain line (the skip is exercised); a
+    /// shape inside is not skipped, crossings formed without scene-space clipping skip
+    /// nothing, and a shape reaching a degenerate depth is not skipped.
+    #[test]
+    fn outside_shapes_occur() {
+        let (triangle, cache) = test_triangle();
+        // Far to the side of the triangle's rays (x beyond every ray at these depths).
+        let outside = [
+            DVec3::new(9.0, 0.0, 2.0),
+            DVec3::new(10.0, 0.5, 2.5),
+            DVec3::new(9.5, -0.5, 3.0),
+        ];
+        let inside = [
+            DVec3::new(-0.1, -0.1, 2.0),
+            DVec3::new(0.2, -0.1, 2.5),
+            DVec3::new(0.0, 0.2, 3.0),
+        ];
+        let in_domain =
+            |s: &Shape| (s.vertices.iter()).all(|x| x.u > 0.0 && x.v > 0.0 && x.u + x.v < 1.0);
+        for (scene, outside) in [(outside, true), (inside, false)] {
+            let shapes = project_triangle(&cache, scene).expect("projectable");
+            let range = depth_range(shapes.iter().filter(is_drawn));
+            let crossings = EdgeCrossings::new(&triangle, scene, range);
+            // The shapes beyond the domain (outside), or wholly in it (inside).
+            let drawn: Vec<Shape> = (shapes.iter().filter(is_drawn))
+                .filter(|s| outside || in_domain(s))
+                .collect();
+            assert!(!drawn.is_empty(), "{scene:?}");
+            let skipped = |c: &EdgeCrossings, degenerate| {
+                drawn.iter().any(|s| is_outside_domain(s, c, degenerate))
+            };
+            assert_eq!(skipped(&crossings, None), outside, "{scene:?}");
+            assert!(!skipped(&EdgeCrossings::none(), None));
+            assert!(!skipped(&crossings, Some((0.0, f64::INFINITY))));
+        }
+    }
+
     /// A projection triangle with directions of unequal slopes (rays that do not meet), so
     /// that scene vertices have one or three images.
     pub(in crate::render::trilinear) fn test_triangle(
