@@ -5,7 +5,10 @@
 use glam::DVec3;
 
 use super::central::CentralProjection;
-use super::edge_path::{refine_around, CrossingQuadratic, EdgePath, EdgeSurface, OutlinePoint};
+use super::clip::DOMAIN_MARGIN;
+use super::edge_path::{
+    refine_around, CrossingQuadratic, EdgePath, EdgeSurface, Forced, OutlinePoint,
+};
 use super::ray_fan::RayFan;
 use super::screen_map::ScreenMap;
 use super::volume_bounds::VolumeBounds;
@@ -20,11 +23,11 @@ pub enum Sampling<'a> {
     /// The given depths (the shape's slices, ascending), where they fall on the edge.
     Slices(&'a [f64]),
     /// Bisection to the screen tolerance, at most `levels` deep, the first `forced` levels
-    /// whatever the tolerance (`edge_path::refine`).
+    /// whatever the tolerance on pieces near the degenerate depths (`edge_path::refine`).
     Adaptive {
         tolerance: f64,
         levels: u32,
-        forced: u32,
+        forced: Forced,
     },
 }
 
@@ -99,6 +102,9 @@ pub struct EdgeCrossings {
     /// Depths at which every edge is anchored as well (the ends of a degenerate band, where
     /// the outline is cut: `degenerate_band`).
     depths: [Option<f64>; 2],
+    /// Whether the quadratics were formed (scene-space clipping): without them nothing is
+    /// known about the crossings, and [`EdgeCrossings::misses`] says so.
+    formed: bool,
 }
 
 impl EdgeCrossings {
@@ -108,6 +114,7 @@ impl EdgeCrossings {
             quadratics: [[None; 3]; 3],
             roots: [[None; 3]; 3],
             depths: [None; 2],
+            formed: false,
         }
     }
 
@@ -127,7 +134,10 @@ impl EdgeCrossings {
     /// (`lo >= hi`: no vertex, or all at one depth) has no polygon edge with a depth strictly
     /// between its ends, so no crossing is kept; a non-finite bound tests nothing clear.
     pub fn new(triangle: &ProjectionTriangle, scene: [DVec3; 3], (lo, hi): (f64, f64)) -> Self {
-        let mut crossings = EdgeCrossings::none();
+        let mut crossings = EdgeCrossings {
+            formed: true,
+            ..EdgeCrossings::none()
+        };
         for edge in [SceneEdge::V1V2, SceneEdge::V1V3, SceneEdge::V2V3] {
             let [a, b] = edge.vertices().map(|k| scene[k as usize]);
             for (slot, surface) in crossings.quadratics[edge.index()]
@@ -139,6 +149,18 @@ impl EdgeCrossings {
             }
         }
         crossings
+    }
+
+    /// Whether scene edge `edge` provably does not cross edge surface number `surface` (of
+    /// [`ProjectionTriangle::surfaces`]) at a depth strictly between `from` and `to` (a
+    /// polygon edge's, inside the depth range the crossings were formed for): its
+    /// quadratic is clear of roots there ([`CrossingQuadratic::clear_between`]). `false`
+    /// whenever that is not known: crossings formed without scene-space clipping
+    /// ([`EdgeCrossings::none`]).
+    pub fn misses(&self, edge: SceneEdge, surface: usize, from: f64, to: f64) -> bool {
+        self.formed
+            && self.quadratics[edge.index()][surface]
+                .is_none_or(|q| q.clear_between(from.min(to), from.max(to)))
     }
 
     /// Calls `keep` with the crossings of scene edge `edge` that may lie strictly between
@@ -169,6 +191,49 @@ pub fn depth_range<'a>(shapes: impl IntoIterator<Item = Shape<'a>>) -> (f64, f64
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| {
             (lo.min(x.t), hi.max(x.t))
         })
+}
+
+/// Whether the outline [`trace_outline`] would give for `shape` lies wholly beyond one
+/// domain line, past the clip's margin, so that clipping leaves nothing and tracing it can
+/// be skipped. The test of the pair cull (`polygons::cull`), per shape: every vertex image
+/// strictly beyond the line `u = 0`, `v = 0` or `u + v = 1` by more than
+/// [`DOMAIN_MARGIN`], and no polygon edge crossing that line's edge surface within its
+/// depths (`crossings`, those of [`EdgeCrossings::new`] for the shapes of `shape`'s pair:
+/// each edge's image is then a continuous curve in `(u, v)` that keeps to one side of the
+/// line, as its ends do, and so does the closed outline and its inside).
+///
+/// Degenerate cases: a shape whose depths reach a depth in `degenerate` (where the
+/// projection triangle's parametric triangle degenerates) is never skipped: its edges'
+/// images may pass through infinity there and come back on the other side of a line
+/// without crossing it; crossings formed without scene-space clipping know nothing and skip
+/// nothing; a NaN coordinate is not beyond a line. Rounding: a point the tracer computes
+/// may land within the margin of a line its quadratic says the edge does not cross
+/// ([`CrossingQuadratic::clear_between`] keeps `1e-9` of the terms' size off zero), where
+/// the clip would have kept a sliver some `1e-9` of the triangle wide, covering no pixel
+/// centre but by coincidence.
+pub fn is_outside_domain(
+    shape: &Shape,
+    crossings: &EdgeCrossings,
+    degenerate: Option<(f64, f64)>,
+) -> bool {
+    let (lo, hi) = depth_range([*shape]);
+    if degenerate.is_some_and(|(first, last)| lo <= last && hi >= first) {
+        return false;
+    }
+    // In the order of the edge surfaces ([`ProjectionTriangle::surfaces`]).
+    let beyond: [fn(&ShapeVertex) -> bool; 3] = [
+        |x| x.u < -DOMAIN_MARGIN,
+        |x| x.v < -DOMAIN_MARGIN,
+        |x| x.u + x.v > 1.0 + DOMAIN_MARGIN,
+    ];
+    let n = shape.len();
+    beyond.iter().enumerate().any(|(surface, beyond)| {
+        shape.vertices.iter().all(beyond)
+            && (0..n).all(|i| {
+                let (from, to) = (shape.vertices[i].t, shape.vertices[(i + 1) % n].t);
+                crossings.misses(shape.edges[i], surface, from, to)
+            })
+    })
 }
 
 /// Appends the outline of `shape` (of the scene triangle with vertices `scene`) to `out`:

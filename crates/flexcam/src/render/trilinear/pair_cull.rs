@@ -52,6 +52,9 @@ pub struct PairCounts {
     /// Of `clipped_away`, the shapes known to be clipped away before their outline was
     /// traced: every vertex behind the view plane (`polygons::is_behind`).
     pub skipped_behind: u64,
+    /// Of `clipped_away`, the shapes known to be clipped away before their outline was
+    /// traced because it lies beyond a domain line (`outline::is_outside_domain`).
+    pub skipped_outside: u64,
     /// Outline points of the shapes drawn (after clipping).
     pub outline_points: u64,
 }
@@ -71,6 +74,7 @@ impl PairCounts {
         self.shapes += o.shapes;
         self.clipped_away += o.clipped_away;
         self.skipped_behind += o.skipped_behind;
+        self.skipped_outside += o.skipped_outside;
         self.outline_points += o.outline_points;
     }
 
@@ -90,6 +94,7 @@ impl PairCounts {
             ("shapes", self.shapes),
             ("clipped_away", self.clipped_away),
             ("skipped_behind", self.skipped_behind),
+            ("skipped_outside", self.skipped_outside),
             ("outline_points", self.outline_points),
         ] {
             stats.insert(name, Counter::Count(value));

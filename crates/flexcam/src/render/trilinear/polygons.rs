@@ -12,10 +12,11 @@ use super::central;
 use super::clip::clip_outline;
 use super::curves::{CurveMode, CurveOptions, ADAPTIVE_TOLERANCE_PX};
 use super::degenerate_band::DegenerateBand;
-use super::edge_path::{EdgePath, OutlinePoint};
+use super::edge_path::{EdgePath, Forced, OutlinePoint};
 use super::hit_terms::TERMS;
 use super::outline::{
-    depth_range, slice_depths, trace_outline, EdgeCrossings, ProjectionTriangle, Sampling,
+    depth_range, is_outside_domain, slice_depths, trace_outline, EdgeCrossings, ProjectionTriangle,
+    Sampling,
 };
 use super::pair_cull::{live_pairs, LivePair, LivePairs, PairCounts, VertexCache};
 use super::resolve::PIXEL_TESTED;
@@ -68,8 +69,10 @@ pub fn projection_triangles(projection: &Trilinear) -> Vec<ProjectionTriangle> {
 /// image swings far out and back within one piece, and the test at the middle alone can
 /// miss it (measured on the crossing rays above cube-floor's cube, the test
 /// `projection_triangles_degenerating_inside_the_scene_are_split_there`: 0.0064 relative
-/// RGB error with none, 0.0005 with 3, exact with 5). Slicing takes `2 << FORCED_LEVELS`
-/// slices there at least (10: 0.001; 50: exact).
+/// RGB error with none, 0.0005 with 3, exact with 5), on the pieces of an edge near the
+/// degenerate depths ([`Forced`]: a piece far from them, relative to its depth extent, is
+/// bisected by the tolerance alone). Slicing takes `2 << FORCED_LEVELS` slices there at
+/// least (10: 0.001; 50: exact).
 const FORCED_LEVELS: u32 = 5;
 
 /// Live pairs per parallel work item of the drawing half. Pairs differ in cost by orders of
@@ -424,7 +427,7 @@ impl Pair<'_> {
                     Sampling::Adaptive {
                         tolerance: ADAPTIVE_TOLERANCE_PX,
                         levels,
-                        forced: self.forced_levels().min(levels),
+                        forced: self.forced(levels),
                     }
                 }
             };
@@ -514,9 +517,21 @@ impl Pair<'_> {
         }
     }
 
-    /// The bisection levels of adaptive sampling taken whatever the tolerance: in a
-    /// projection triangle whose parametric triangle degenerates at some depth
-    /// ([`FORCED_LEVELS`]), none elsewhere.
+    /// The bisection levels of adaptive sampling at most `levels` deep taken whatever the
+    /// tolerance near the depths where the projection triangle's parametric triangle
+    /// degenerates ([`FORCED_LEVELS`], [`Forced`]), none in a triangle that does not.
+    fn forced(&self, levels: u32) -> Forced {
+        match self.triangle.degenerate {
+            Some(around) => Forced {
+                levels: FORCED_LEVELS.min(levels),
+                around,
+            },
+            None => Forced::NONE,
+        }
+    }
+
+    /// The least slices' bisection levels in a projection triangle whose parametric
+    /// triangle degenerates at some depth ([`FORCED_LEVELS`]), none elsewhere.
     fn forced_levels(&self) -> u32 {
         if self.triangle.degenerate.is_some() {
             FORCED_LEVELS
@@ -584,8 +599,8 @@ impl Pair<'_> {
     /// Traces, clips and appends one shape, each vertex with the hit terms of its projector;
     /// `crossings` are those of [`Pair::crossings`] for the shapes of `scene`, with the band
     /// they are anchored at: a shape reaching it is cut into its parts before and beyond it
-    /// ([`DegenerateBand::cut`]). A shape behind the view plane ([`is_behind`]) is counted
-    /// as clipped away without tracing.
+    /// ([`DegenerateBand::cut`]). A shape behind the view plane ([`is_behind`]) or beyond
+    /// a domain line ([`is_outside_domain`]) is counted as clipped away without tracing.
     fn draw_shape(
         &self,
         shape: &Shape,
@@ -599,6 +614,11 @@ impl Pair<'_> {
         if is_behind(shape) {
             out.counts.clipped_away += 1;
             out.counts.skipped_behind += 1;
+            return;
+        }
+        if is_outside_domain(shape, crossings, self.triangle.degenerate) {
+            out.counts.clipped_away += 1;
+            out.counts.skipped_outside += 1;
             return;
         }
         scratch.outline.clear();
@@ -645,7 +665,7 @@ pub(super) mod tests {
         let adaptive = Sampling::Adaptive {
             tolerance: ADAPTIVE_TOLERANCE_PX,
             levels: 8,
-            forced: 0,
+            forced: Forced::NONE,
         };
         [Sampling::Anchors, Sampling::Slices(depths), adaptive]
             .map(|sampling| [(sampling, true), (sampling, false)])
@@ -681,6 +701,78 @@ pub(super) mod tests {
                     prop_assert!(outline.is_empty(), "{:?} {:?}", shape.vertices, outline);
                 }
             }
+        }
+    }
+
+    proptest! {
+        /// Soundness of the skip beyond a domain line: every shape [`is_outside_domain`]
+        /// says to skip, traced (every sampling, scene-space clipping on, as the skip
+        /// requires) and clipped, leaves nothing. Scene triangles reach well past the
+        /// projection triangle's domain; `outside_shapes_occur` checks that such shapes do
+        /// occur.
+        #[test]
+        fn a_shape_beyond_a_domain_line_clips_to_nothing(
+            corners in proptest::array::uniform3(
+                (-6.0..6.0f64, -6.0..6.0f64, 0.5..8.0f64)
+            ),
+        ) {
+            let (triangle, cache) = test_triangle();
+            let scene = corners.map(|(x, y, z)| DVec3::new(x, y, z));
+            let Ok(shapes) = project_triangle(&cache, scene) else { return Ok(()) };
+            let range = depth_range(shapes.iter().filter(is_drawn));
+            let (mut outline, mut scratch, mut depths) = (Vec::new(), Vec::new(), Vec::new());
+            for shape in shapes.iter().filter(is_drawn) {
+                let skipped = EdgeCrossings::new(&triangle, scene, range);
+                if !is_outside_domain(&shape, &skipped, triangle.degenerate) {
+                    continue;
+                }
+                slice_depths(&shape, 8, &mut depths);
+                for (sampling, _) in modes(&depths).into_iter().filter(|(_, clipping)| *clipping) {
+                    let mut crossings = EdgeCrossings::new(&triangle, scene, range);
+                    outline.clear();
+                    let mode = (sampling, true);
+                    trace_outline(&triangle, &shape, scene, mode, &mut crossings, &mut outline);
+                    clip_outline(&mut outline, &mut scratch);
+                    prop_assert!(outline.is_empty(), "{:?} {:?}", shape.vertices, outline);
+                }
+            }
+        }
+    }
+
+    /// The proptest's triangle sees shapes beyond a domain line (the skip is exercised); a
+    /// shape inside is not skipped, crossings formed without scene-space clipping skip
+    /// nothing, and a shape reaching a degenerate depth is not skipped.
+    #[test]
+    fn outside_shapes_occur() {
+        let (triangle, cache) = test_triangle();
+        // Far to the side of the triangle's rays (x beyond every ray at these depths).
+        let outside = [
+            DVec3::new(9.0, 0.0, 2.0),
+            DVec3::new(10.0, 0.5, 2.5),
+            DVec3::new(9.5, -0.5, 3.0),
+        ];
+        let inside = [
+            DVec3::new(-0.1, -0.1, 2.0),
+            DVec3::new(0.2, -0.1, 2.5),
+            DVec3::new(0.0, 0.2, 3.0),
+        ];
+        let in_domain =
+            |s: &Shape| (s.vertices.iter()).all(|x| x.u > 0.0 && x.v > 0.0 && x.u + x.v < 1.0);
+        for (scene, outside) in [(outside, true), (inside, false)] {
+            let shapes = project_triangle(&cache, scene).expect("projectable");
+            let range = depth_range(shapes.iter().filter(is_drawn));
+            let crossings = EdgeCrossings::new(&triangle, scene, range);
+            // The shapes beyond the domain (outside), or wholly in it (inside).
+            let drawn: Vec<Shape> = (shapes.iter().filter(is_drawn))
+                .filter(|s| outside || in_domain(s))
+                .collect();
+            assert!(!drawn.is_empty(), "{scene:?}");
+            let skipped = |c: &EdgeCrossings, degenerate| {
+                drawn.iter().any(|s| is_outside_domain(s, c, degenerate))
+            };
+            assert_eq!(skipped(&crossings, None), outside, "{scene:?}");
+            assert!(!skipped(&EdgeCrossings::none(), None));
+            assert!(!skipped(&crossings, Some((0.0, f64::INFINITY))));
         }
     }
 
