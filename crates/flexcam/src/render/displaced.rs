@@ -1,7 +1,8 @@
 //! Displaced objects in the prepared scene: every base triangle of a displaced object is a
 //! leaf of its own bounding volume hierarchy, bounded by its displacement shell, and traced
-//! exactly through the min/max hierarchy of [`crate::displace::DisplacedTriangle`]; nothing is
-//! tessellated.
+//! exactly through the min/max hierarchy of [`crate::displace::DisplacedTriangle`]; no
+//! micro-triangle mesh is built (up to level 5 the displaced micro-vertices are kept, not
+//! their triangles, normals, texture coordinates or a tree over them).
 //!
 //! The triangles of displaced objects are left out of the prepared scene's triangle BVH, so
 //! that its f32 inner loop stays as it is; queries ([`PreparedScene::intersect`] and the
@@ -11,7 +12,10 @@
 //! Memory per base triangle: its object and index, a share of the tree's boxes (about 80
 //! bytes in all), its frame (96 bytes) and the kept f32 boxes of the top of its hierarchy
 //! ([`DisplacedTriangle::kept_boxes`]: exact up to level 6, at most 341 boxes, 8,184 bytes,
-//! from level 5 on); the micro-geometry below them is recomputed per ray from the mesh. Its
+//! from level 5 on), and up to level 5 its displaced micro-vertices in f64 (`(2^L + 1) (2^L +
+//! 2) / 2` of 24 bytes: 13,464 bytes at level 5), which the hierarchy reads instead of
+//! displacing them per ray; above level 5 the micro-geometry below the kept boxes is
+//! recomputed per ray from the mesh. Its
 //! shell box is the exact world box of its micro-vertices, undisplaced and displaced, up to
 //! level 6.
 //!
@@ -94,15 +98,18 @@ struct Node {
     count: u32,
 }
 
-/// A displaced base triangle: object index, triangle index, the frame of its node boxes and
-/// where its kept boxes are in [`DisplacedSet::boxes`].
-#[derive(Debug, Clone, Copy)]
+/// A displaced base triangle: object index, triangle index, the frame of its node boxes,
+/// where its kept boxes are in [`DisplacedSet::boxes`], and its kept displaced micro-vertices
+/// (up to level 5; empty above: [`KeptBoxes`]), in an allocation of their own as
+/// `kept_boxes` made them, so that building the set never holds two copies.
+#[derive(Debug, Clone)]
 pub(in crate::render) struct Item {
     pub object: u32,
     pub triangle: u32,
     first_box: u32,
     box_count: u32,
     frame: Frame,
+    points: Box<[DVec3]>,
 }
 
 /// A hit on a displaced base triangle.
@@ -150,13 +157,14 @@ impl DisplacedSet {
                 KeptBoxes {
                     boxes,
                     bounds: [lo, hi],
+                    points,
                 },
             ) in kept
             {
                 let bound = bounds[index].get_or_insert([DVec3::INFINITY, DVec3::NEG_INFINITY]);
                 *bound = [bound[0].min(lo), bound[1].max(hi)];
                 boxed.push(([shells.len() as u32, 0], lo, hi));
-                shells.push(([index as u32, triangle as u32], frame, boxes));
+                shells.push(([index as u32, triangle as u32], frame, boxes, points));
             }
         }
         let mut nodes = Vec::with_capacity(2 * boxed.len() / LEAF + 1);
@@ -166,13 +174,14 @@ impl DisplacedSet {
         let mut items = Vec::with_capacity(boxed.len());
         let mut boxes = Vec::new();
         for ([shell, _], _, _) in boxed {
-            let &([object, triangle], frame, ref top) = &shells[shell as usize];
+            let ([object, triangle], frame, top, micro) = &mut shells[shell as usize];
             items.push(Item {
-                object,
-                triangle,
+                object: *object,
+                triangle: *triangle,
                 first_box: boxes.len() as u32,
                 box_count: top.len() as u32,
-                frame,
+                frame: *frame,
+                points: std::mem::take(micro).into_boxed_slice(),
             });
             boxes.extend_from_slice(top);
         }
@@ -247,6 +256,7 @@ impl DisplacedSet {
                 displacement,
                 item.frame,
                 boxes,
+                &item.points,
             )
             .intersect_entered(bounded, &entry)
             .map(|micro| (micro.t, micro))
