@@ -620,9 +620,14 @@ impl<'a> DisplacedTriangle<'a> {
 
     /// The displaced vertices of micro-triangle `triangle` (in [`MicroTriangle::vertices`]
     /// order), bit for bit those the intersection tests: found by descending the subdivision
-    /// into the child that holds it, `L` steps.
+    /// into the child that holds it, `L` steps, or read from the kept micro-vertices.
     pub fn positions(&self, triangle: MicroTriangle) -> [DVec3; 3] {
         let target = triangle.vertices();
+        let n = 1u32 << self.displacement.level();
+        let on_grid = |&[i, j]: &[u32; 2]| i.checked_add(j).is_some_and(|s| s <= n);
+        if !self.points.is_empty() && target.iter().all(on_grid) {
+            return target.map(|g| self.points[stored_index(n, g)]);
+        }
         // Three times the target's centroid, in grid units: integer and strictly inside.
         let centroid = [0, 1].map(|k| target.iter().map(|g| g[k] as i64).sum::<i64>());
         let mut node = self.root();

@@ -80,6 +80,10 @@ pub(in crate::render) struct DisplacedSet {
     items: Vec<Item>,
     /// The kept node boxes of every item ([`DisplacedTriangle::kept_boxes`]).
     boxes: Vec<CachedBox>,
+    /// Per object of the scene: where its base triangles start in `places`.
+    first_shell: Vec<usize>,
+    /// Per displaced base triangle in scene order (object, then triangle): its item's index.
+    places: Vec<u32>,
     /// Depth-first: an interior node's first child follows it, `second` is the other.
     nodes: Vec<Node>,
     /// Per object: the union of its shells' boxes, if it is displaced.
@@ -136,8 +140,10 @@ impl DisplacedSet {
         let mut shells = Vec::new();
         let mut boxed = Vec::new();
         let mut bounds = vec![None; scene.objects.len()];
+        let mut first_shell = Vec::with_capacity(scene.objects.len());
         for (index, (object, displacement)) in scene.objects.iter().zip(&displacements).enumerate()
         {
+            first_shell.push(shells.len());
             let Some(displacement) = displacement else {
                 continue;
             };
@@ -173,7 +179,9 @@ impl DisplacedSet {
         }
         let mut items = Vec::with_capacity(boxed.len());
         let mut boxes = Vec::new();
+        let mut places = vec![0; shells.len()];
         for ([shell, _], _, _) in boxed {
+            places[shell as usize] = items.len() as u32;
             let ([object, triangle], frame, top, micro) = &mut shells[shell as usize];
             items.push(Item {
                 object: *object,
@@ -189,6 +197,8 @@ impl DisplacedSet {
             displacements,
             items,
             boxes,
+            first_shell,
+            places,
             nodes,
             bounds,
             transition: OnceLock::new(),
@@ -226,7 +236,10 @@ impl DisplacedSet {
         self.displacements[object].as_ref()
     }
 
-    /// Base triangle `triangle` of object `object` (displaced) with its displacement.
+    /// Base triangle `triangle` of object `object` (displaced) with its displacement (the
+    /// object's, [`DisplacedSet::displacement`]), with the frame, boxes and micro-vertices
+    /// the set keeps of it, as its queries trace it (the same hits and positions as without
+    /// them, read rather than computed).
     pub fn triangle<'a>(
         &'a self,
         scene: &Scene,
@@ -234,10 +247,28 @@ impl DisplacedSet {
         triangle: usize,
         displacement: &'a Displacement,
     ) -> DisplacedTriangle<'a> {
-        DisplacedTriangle::new(
-            base_corners(&scene.objects[object].mesh, triangle),
-            displacement,
-        )
+        let corners = base_corners(&scene.objects[object].mesh, triangle);
+        let item = self
+            .first_shell
+            .get(object)
+            .and_then(|first| self.places.get(first + triangle))
+            .and_then(|&place| self.items.get(place as usize))
+            .filter(|item| (item.object, item.triangle) == (object as u32, triangle as u32));
+        match item {
+            Some(item) => DisplacedTriangle::with_boxes(
+                corners,
+                displacement,
+                item.frame,
+                self.item_boxes(item),
+                &item.points,
+            ),
+            None => DisplacedTriangle::new(corners, displacement),
+        }
+    }
+
+    /// The kept node boxes of `item`.
+    fn item_boxes(&self, item: &Item) -> &[CachedBox] {
+        &self.boxes[item.first_box as usize..(item.first_box + item.box_count) as usize]
     }
 
     /// The nearest micro-triangle hit of `ray` with `t` in `[ray.t_min, min(ray.t_max,
@@ -245,8 +276,7 @@ impl DisplacedSet {
     /// the first hit found.
     pub fn closest(&self, scene: &Scene, ray: &Ray, limit: f64, any: bool) -> Option<DisplacedHit> {
         self.closest_by(ray, limit, any, |item, displacement, bounded| {
-            let boxes =
-                &self.boxes[item.first_box as usize..(item.first_box + item.box_count) as usize];
+            let boxes = self.item_boxes(item);
             let entry = enters_root(&item.frame, &boxes[0], bounded)?;
             DisplacedTriangle::with_boxes(
                 base_corners(

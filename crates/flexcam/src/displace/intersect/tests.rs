@@ -229,6 +229,13 @@ proptest! {
                 }
             }
         }
+        // Micro-triangle positions read from the kept micro-vertices, and descended to
+        // without them, are the brute force's.
+        let stored = DisplacedTriangle::with_boxes(case.corners, &case.displacement, triangle.frame(), &boxes, &points);
+        for micro in grid.triangles() {
+            prop_assert_eq!(stored.positions(micro), grid.positions(micro));
+            prop_assert_eq!(triangle.positions(micro), grid.positions(micro));
+        }
     }
 
     /// Every micro-vertex, undisplaced, displaced and half displaced, lies inside the
