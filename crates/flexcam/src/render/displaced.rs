@@ -14,8 +14,9 @@
 //! ([`DisplacedTriangle::kept_boxes`]: exact up to level 6, at most 341 boxes, 8,184 bytes,
 //! from level 5 on), and up to level 5 its displaced micro-vertices in f64 (`(2^L + 1) (2^L +
 //! 2) / 2` of 24 bytes: 13,464 bytes at level 5), which the hierarchy reads instead of
-//! displacing them per ray; above level 5 the micro-geometry below the kept boxes is
-//! recomputed per ray from the mesh. Its
+//! displacing them per ray, and shading reads (found by its place in scene order, 4
+//! bytes); above level 5 the micro-geometry below the kept boxes is recomputed per ray from
+//! the mesh. Its
 //! shell box is the exact world box of its micro-vertices, undisplaced and displaced, up to
 //! level 6.
 //!
