@@ -55,6 +55,11 @@ const EXACT_DEPTH: u32 = 4;
 /// Highest subdivision level whose kept boxes are exact: they are computed from every
 /// micro-vertex (2,145 per base triangle at level 6, 8,385 at level 7).
 const EXACT_LEVEL: u32 = 6;
+/// Highest subdivision level whose displaced micro-vertices [`DisplacedTriangle::kept_boxes`]
+/// keeps (561 per base triangle at level 5, 13,464 bytes in f64): the levels whose exact
+/// kept boxes reach the nodes just above the micro-triangles, so that a ray descends by the
+/// kept boxes alone and tests the kept micro-vertices, computing none.
+const STORED_LEVEL: u32 = EXACT_DEPTH + 1;
 /// Deepest level of the hierarchy whose conservative node boxes (levels above
 /// [`EXACT_LEVEL`]) [`DisplacedTriangle::kept_boxes`] keeps (`1 + 4 + 16 + 64` boxes, 2,040
 /// bytes per base triangle), each a height range over a uv rectangle.
@@ -68,6 +73,23 @@ pub struct KeptBoxes {
     /// A world box containing every micro-triangle displaced by any fraction from 0 to the
     /// displacement's (the undisplaced micro-triangles included).
     pub bounds: [DVec3; 2],
+    /// Up to level 5 (`STORED_LEVEL`) every displaced micro-vertex in world space, bit for
+    /// bit the hierarchy's, grid point `(i, j)` at [`stored_index`]; empty above.
+    pub points: Vec<DVec3>,
+}
+
+/// Where grid point `(i, j)` (`i + j <= n`) of a base triangle subdivided into `n` rows is
+/// in [`KeptBoxes::points`]: row `i` (of `n + 1 - i` points) after the rows before it.
+#[inline]
+pub fn stored_index(n: u32, [i, j]: [u32; 2]) -> usize {
+    let (n, i, j) = (n as usize, i as usize, j as usize);
+    i * (2 * n + 3 - i) / 2 + j
+}
+
+/// How many micro-vertices a base triangle subdivided into `n` rows has.
+fn stored_count(n: u32) -> usize {
+    let n = n as usize;
+    (n + 1) * (n + 2) / 2
 }
 
 /// A node box in f32, rounded outward from the f64 box (see [`DisplacedTriangle::kept_boxes`]).
@@ -83,6 +105,9 @@ pub struct DisplacedTriangle<'a> {
     /// of node `i` at `4 i + 1 ..= 4 i + 4`); the boxes of deeper nodes, or all of them when
     /// this is empty, are computed per ray.
     boxes: &'a [CachedBox],
+    /// Every displaced micro-vertex ([`KeptBoxes::points`]), where `boxes` holds every
+    /// internal node's box; otherwise empty, and the micro-vertices are computed per ray.
+    points: &'a [DVec3],
 }
 
 /// The orthonormal frame a base triangle's node boxes are expressed in: `origin` and the
@@ -405,23 +430,33 @@ impl<'a> DisplacedTriangle<'a> {
             displacement,
             frame: Frame::new(corners.map(|v| v.position)),
             boxes: &[],
+            points: &[],
         }
     }
 
-    /// The same triangle with its frame and top node boxes kept from
-    /// [`DisplacedTriangle::frame`] and [`DisplacedTriangle::kept_boxes`] of it, so that a
-    /// ray pays one slab test per kept box instead of computing it: same hits.
+    /// The same triangle with its frame, top node boxes and displaced micro-vertices kept
+    /// from [`DisplacedTriangle::frame`] and [`DisplacedTriangle::kept_boxes`] of it, so
+    /// that a ray pays one slab test per kept box instead of computing it, and reads the
+    /// micro-vertices instead of displacing them: same hits. `points` are used only where
+    /// there are as many as the triangle has micro-vertices and `boxes` holds the box of
+    /// every node above the micro-triangles (as `kept_boxes` keeps them); `&[]` computes
+    /// them per ray.
     pub fn with_boxes(
         corners: [BaseVertex; 3],
         displacement: &'a Displacement,
         frame: Frame,
         boxes: &'a [CachedBox],
+        points: &'a [DVec3],
     ) -> Self {
+        let level = displacement.level();
+        let internal = ((1usize << (2 * level)) - 1) / 3;
+        let usable = points.len() == stored_count(1 << level) && boxes.len() >= internal;
         DisplacedTriangle {
             corners,
             displacement,
             frame,
             boxes,
+            points: if usable { points } else { &[] },
         }
     }
 
@@ -430,10 +465,13 @@ impl<'a> DisplacedTriangle<'a> {
         self.frame
     }
 
-    /// The boxes the prepared scene keeps: those of its internal nodes down to depth `min(L -
+    /// What the prepared scene keeps: the boxes of its internal nodes down to depth `min(L -
     /// 1, 4)` (a leaf-parent's children are tested directly, without boxes), in level order,
     /// each rounded outward to f32 (so it still contains its node's micro-geometry): `1`,
-    /// `5`, `21`, `85` or `341` boxes, at most 8,184 bytes. Up to level 6 (`EXACT_LEVEL`) they
+    /// `5`, `21`, `85` or `341` boxes, at most 8,184 bytes; and up to level 5
+    /// (`STORED_LEVEL`) its displaced micro-vertices (at most 561, 13,464 bytes), which
+    /// every ray would otherwise recompute from the corners (midpoints with their
+    /// normalisations, height samples). Up to level 6 (`EXACT_LEVEL`) the boxes
     /// are exact: the boxes of the node's displaced micro-vertices, computed once here from
     /// all of them (`exact_boxes`), so a ray enters far fewer nodes than through the
     /// conservative boxes (positions, normal cone, height range over the node's uv
@@ -446,6 +484,7 @@ impl<'a> DisplacedTriangle<'a> {
             KeptBoxes {
                 boxes: self.conservative_boxes(),
                 bounds: self.bounds(),
+                points: Vec::new(),
             }
         }
     }
@@ -484,9 +523,17 @@ impl<'a> DisplacedTriangle<'a> {
         let side = n as usize + 1;
         let mut local = vec![DVec3::ZERO; side * side];
         let mut world = [DVec3::INFINITY, DVec3::NEG_INFINITY];
+        let mut points = Vec::with_capacity(if level <= STORED_LEVEL {
+            side * (side + 1) / 2
+        } else {
+            0
+        });
         for i in 0..=n {
             for j in 0..=n - i {
                 let (vertex, displaced) = (grid.vertex([i, j]), grid.displaced([i, j]));
+                if level <= STORED_LEVEL {
+                    points.push(displaced);
+                }
                 local[i as usize * side + j as usize] = self.frame.local(displaced);
                 world = [
                     world[0].min(displaced).min(vertex.position),
@@ -511,6 +558,7 @@ impl<'a> DisplacedTriangle<'a> {
         KeptBoxes {
             boxes,
             bounds: [world[0] - slack, world[1] + slack],
+            points,
         }
     }
 
@@ -562,15 +610,24 @@ impl<'a> DisplacedTriangle<'a> {
             return None;
         }
         let mut best = None;
-        self.visit(ray, &entry.0, &self.root(), 0, 0, &mut best);
+        if self.points.is_empty() {
+            self.visit(ray, &entry.0, &self.root(), 0, 0, &mut best);
+        } else {
+            self.visit_stored(ray, &entry.0, self.root().g, 0, 0, &mut best);
+        }
         best
     }
 
     /// The displaced vertices of micro-triangle `triangle` (in [`MicroTriangle::vertices`]
     /// order), bit for bit those the intersection tests: found by descending the subdivision
-    /// into the child that holds it, `L` steps.
+    /// into the child that holds it, `L` steps, or read from the kept micro-vertices.
     pub fn positions(&self, triangle: MicroTriangle) -> [DVec3; 3] {
         let target = triangle.vertices();
+        let n = 1u32 << self.displacement.level();
+        let on_grid = |&[i, j]: &[u32; 2]| i.checked_add(j).is_some_and(|s| s <= n);
+        if !self.points.is_empty() && target.iter().all(on_grid) {
+            return target.map(|g| self.points[stored_index(n, g)]);
+        }
         // Three times the target's centroid, in grid units: integer and strictly inside.
         let centroid = [0, 1].map(|k| target.iter().map(|g| g[k] as i64).sum::<i64>());
         let mut node = self.root();
@@ -628,18 +685,10 @@ impl<'a> DisplacedTriangle<'a> {
             return;
         }
         let limit = best.map_or(f64::INFINITY, |b| b.t);
-        let kept = self.boxes.get(first..first + 4);
-        let (order, count) = match (&local.wide, kept) {
-            (Some(wide), Some(kept)) => {
-                let entries = wide_entries(wide, kept, limit);
-                front_to_back(|k| (entries[k] < f32::INFINITY).then_some(entries[k] as f64))
-            }
-            _ => front_to_back(|k| {
-                let entry = |b| slab_entry(local, b, limit);
-                match kept {
-                    Some(kept) => entry(kept[k].map(|v| v.as_dvec3())),
-                    None => entry(self.node_box(&node.child(k, midpoints))),
-                }
+        let (order, count) = match self.boxes.get(first..first + 4) {
+            Some(kept) => kept_order(local, kept, limit),
+            None => front_to_back(|k| {
+                slab_entry(local, self.node_box(&node.child(k, midpoints)), limit)
             }),
         };
         for &(entry, k) in &order[..count] {
@@ -649,6 +698,47 @@ impl<'a> DisplacedTriangle<'a> {
             }
             let child = node.child(k, midpoints);
             self.visit(ray, local, &child, depth + 1, first + k, best);
+        }
+    }
+
+    /// [`Self::visit`] where the kept boxes reach every internal node and the displaced
+    /// micro-vertices are kept (`points`): descends into the node with grid corners `g` by
+    /// its kept children's boxes and tests the micro-triangles on the kept micro-vertices,
+    /// the same as `visit` computes, bit for bit.
+    fn visit_stored(
+        &self,
+        ray: &Ray,
+        local: &LocalRay,
+        g: [[u32; 2]; 3],
+        depth: u32,
+        index: usize,
+        best: &mut Option<MicroHit>,
+    ) {
+        let level = self.displacement.level();
+        let n = 1u32 << level;
+        let at = |p: [u32; 2]| self.points[stored_index(n, p)];
+        if depth == level {
+            let (triangle, positions) = micro_triangle(g, g.map(at));
+            keep(best, hit_micro_triangle(ray, triangle, positions));
+            return;
+        }
+        let grids = child_grids(g);
+        if depth + 1 == level {
+            // The middle child is (ca, ab, bc).
+            let [ca, ab, bc] = grids[3];
+            let [a, b, c] = g;
+            test_leaves(ray, g, [a, b, c, ab, bc, ca].map(at), best);
+            return;
+        }
+        let first = 4 * index + 1;
+        let limit = best.map_or(f64::INFINITY, |b| b.t);
+        // `with_boxes` keeps points only where every internal node's box is kept.
+        let (order, count) = kept_order(local, &self.boxes[first..first + 4], limit);
+        for &(entry, k) in &order[..count] {
+            if best.is_some_and(|b| entry > b.t) {
+                break;
+            }
+            self.visit_stored(ray, local, grids[k], depth + 1, first + k, best);
         }
     }
 
@@ -784,6 +874,20 @@ fn uv_height_range(height: &HeightField, v: &[BaseVertex; 3]) -> [f64; 2] {
     let hi = v[0].uv.max(v[1].uv).max(v[2].uv);
     let slack = DVec2::splat(1e-12) * (DVec2::ONE + lo.abs().max(hi.abs()));
     height.range(lo - slack, hi + slack)
+}
+
+/// The children whose kept boxes `kept` the ray enters within its interval and before
+/// `limit`, nearest first ([`front_to_back`]): all four at once in f32 where the ray has its
+/// f32 form ([`WideRay`]), each in f64 otherwise.
+#[inline]
+fn kept_order(local: &LocalRay, kept: &[CachedBox], limit: f64) -> ([(f64, usize); 4], usize) {
+    match &local.wide {
+        Some(wide) => {
+            let entries = wide_entries(wide, kept, limit);
+            front_to_back(|k| (entries[k] < f32::INFINITY).then_some(entries[k] as f64))
+        }
+        None => front_to_back(|k| slab_entry(local, kept[k].map(|v| v.as_dvec3()), limit)),
+    }
 }
 
 /// The children `k` (0 to 3) whose boxes the ray enters, `entry(k)` giving where, as

@@ -1,7 +1,8 @@
 //! Displaced objects in the prepared scene: every base triangle of a displaced object is a
 //! leaf of its own bounding volume hierarchy, bounded by its displacement shell, and traced
-//! exactly through the min/max hierarchy of [`crate::displace::DisplacedTriangle`]; nothing is
-//! tessellated.
+//! exactly through the min/max hierarchy of [`crate::displace::DisplacedTriangle`]; no
+//! micro-triangle mesh is built (up to level 5 the displaced micro-vertices are kept, not
+//! their triangles, normals, texture coordinates or a tree over them).
 //!
 //! The triangles of displaced objects are left out of the prepared scene's triangle BVH, so
 //! that its f32 inner loop stays as it is; queries ([`PreparedScene::intersect`] and the
@@ -11,7 +12,11 @@
 //! Memory per base triangle: its object and index, a share of the tree's boxes (about 80
 //! bytes in all), its frame (96 bytes) and the kept f32 boxes of the top of its hierarchy
 //! ([`DisplacedTriangle::kept_boxes`]: exact up to level 6, at most 341 boxes, 8,184 bytes,
-//! from level 5 on); the micro-geometry below them is recomputed per ray from the mesh. Its
+//! from level 5 on), and up to level 5 its displaced micro-vertices in f64 (`(2^L + 1) (2^L +
+//! 2) / 2` of 24 bytes: 13,464 bytes at level 5), which the hierarchy reads instead of
+//! displacing them per ray, and shading reads (found by its place in scene order, 4
+//! bytes); above level 5 the micro-geometry below the kept boxes is recomputed per ray from
+//! the mesh. Its
 //! shell box is the exact world box of its micro-vertices, undisplaced and displaced, up to
 //! level 6.
 //!
@@ -76,6 +81,10 @@ pub(in crate::render) struct DisplacedSet {
     items: Vec<Item>,
     /// The kept node boxes of every item ([`DisplacedTriangle::kept_boxes`]).
     boxes: Vec<CachedBox>,
+    /// Per object of the scene: where its base triangles start in `places`.
+    first_shell: Vec<usize>,
+    /// Per displaced base triangle in scene order (object, then triangle): its item's index.
+    places: Vec<u32>,
     /// Depth-first: an interior node's first child follows it, `second` is the other.
     nodes: Vec<Node>,
     /// Per object: the union of its shells' boxes, if it is displaced.
@@ -94,15 +103,18 @@ struct Node {
     count: u32,
 }
 
-/// A displaced base triangle: object index, triangle index, the frame of its node boxes and
-/// where its kept boxes are in [`DisplacedSet::boxes`].
-#[derive(Debug, Clone, Copy)]
+/// A displaced base triangle: object index, triangle index, the frame of its node boxes,
+/// where its kept boxes are in [`DisplacedSet::boxes`], and its kept displaced micro-vertices
+/// (up to level 5; empty above: [`KeptBoxes`]), in an allocation of their own as
+/// `kept_boxes` made them, so that building the set never holds two copies.
+#[derive(Debug, Clone)]
 pub(in crate::render) struct Item {
     pub object: u32,
     pub triangle: u32,
     first_box: u32,
     box_count: u32,
     frame: Frame,
+    points: Box<[DVec3]>,
 }
 
 /// A hit on a displaced base triangle.
@@ -129,8 +141,10 @@ impl DisplacedSet {
         let mut shells = Vec::new();
         let mut boxed = Vec::new();
         let mut bounds = vec![None; scene.objects.len()];
+        let mut first_shell = Vec::with_capacity(scene.objects.len());
         for (index, (object, displacement)) in scene.objects.iter().zip(&displacements).enumerate()
         {
+            first_shell.push(shells.len());
             let Some(displacement) = displacement else {
                 continue;
             };
@@ -150,13 +164,14 @@ impl DisplacedSet {
                 KeptBoxes {
                     boxes,
                     bounds: [lo, hi],
+                    points,
                 },
             ) in kept
             {
                 let bound = bounds[index].get_or_insert([DVec3::INFINITY, DVec3::NEG_INFINITY]);
                 *bound = [bound[0].min(lo), bound[1].max(hi)];
                 boxed.push(([shells.len() as u32, 0], lo, hi));
-                shells.push(([index as u32, triangle as u32], frame, boxes));
+                shells.push(([index as u32, triangle as u32], frame, boxes, points));
             }
         }
         let mut nodes = Vec::with_capacity(2 * boxed.len() / LEAF + 1);
@@ -165,14 +180,17 @@ impl DisplacedSet {
         }
         let mut items = Vec::with_capacity(boxed.len());
         let mut boxes = Vec::new();
+        let mut places = vec![0; shells.len()];
         for ([shell, _], _, _) in boxed {
-            let &([object, triangle], frame, ref top) = &shells[shell as usize];
+            places[shell as usize] = items.len() as u32;
+            let ([object, triangle], frame, top, micro) = &mut shells[shell as usize];
             items.push(Item {
-                object,
-                triangle,
+                object: *object,
+                triangle: *triangle,
                 first_box: boxes.len() as u32,
                 box_count: top.len() as u32,
-                frame,
+                frame: *frame,
+                points: std::mem::take(micro).into_boxed_slice(),
             });
             boxes.extend_from_slice(top);
         }
@@ -180,6 +198,8 @@ impl DisplacedSet {
             displacements,
             items,
             boxes,
+            first_shell,
+            places,
             nodes,
             bounds,
             transition: OnceLock::new(),
@@ -217,7 +237,10 @@ impl DisplacedSet {
         self.displacements[object].as_ref()
     }
 
-    /// Base triangle `triangle` of object `object` (displaced) with its displacement.
+    /// Base triangle `triangle` of object `object` (displaced) with its displacement (the
+    /// object's, [`DisplacedSet::displacement`]), with the frame, boxes and micro-vertices
+    /// the set keeps of it, as its queries trace it (the same hits and positions as without
+    /// them, read rather than computed).
     pub fn triangle<'a>(
         &'a self,
         scene: &Scene,
@@ -225,10 +248,28 @@ impl DisplacedSet {
         triangle: usize,
         displacement: &'a Displacement,
     ) -> DisplacedTriangle<'a> {
-        DisplacedTriangle::new(
-            base_corners(&scene.objects[object].mesh, triangle),
-            displacement,
-        )
+        let corners = base_corners(&scene.objects[object].mesh, triangle);
+        let item = self
+            .first_shell
+            .get(object)
+            .and_then(|first| self.places.get(first + triangle))
+            .and_then(|&place| self.items.get(place as usize))
+            .filter(|item| (item.object, item.triangle) == (object as u32, triangle as u32));
+        match item {
+            Some(item) => DisplacedTriangle::with_boxes(
+                corners,
+                displacement,
+                item.frame,
+                self.item_boxes(item),
+                &item.points,
+            ),
+            None => DisplacedTriangle::new(corners, displacement),
+        }
+    }
+
+    /// The kept node boxes of `item`.
+    fn item_boxes(&self, item: &Item) -> &[CachedBox] {
+        &self.boxes[item.first_box as usize..(item.first_box + item.box_count) as usize]
     }
 
     /// The nearest micro-triangle hit of `ray` with `t` in `[ray.t_min, min(ray.t_max,
@@ -236,8 +277,7 @@ impl DisplacedSet {
     /// the first hit found.
     pub fn closest(&self, scene: &Scene, ray: &Ray, limit: f64, any: bool) -> Option<DisplacedHit> {
         self.closest_by(ray, limit, any, |item, displacement, bounded| {
-            let boxes =
-                &self.boxes[item.first_box as usize..(item.first_box + item.box_count) as usize];
+            let boxes = self.item_boxes(item);
             let entry = enters_root(&item.frame, &boxes[0], bounded)?;
             DisplacedTriangle::with_boxes(
                 base_corners(
@@ -247,6 +287,7 @@ impl DisplacedSet {
                 displacement,
                 item.frame,
                 boxes,
+                &item.points,
             )
             .intersect_entered(bounded, &entry)
             .map(|micro| (micro.t, micro))

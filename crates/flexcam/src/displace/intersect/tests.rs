@@ -1,7 +1,7 @@
 use glam::{DVec2, DVec3};
 use proptest::prelude::*;
 
-use super::{DisplacedTriangle, KeptBoxes, Node};
+use super::{stored_index, DisplacedTriangle, KeptBoxes, Node};
 use crate::displace::{
     BaseVertex, Displacement, HeightField, HeightMap, MicroGrid, Procedural, Wave,
 };
@@ -86,22 +86,37 @@ fn case_in(levels: std::ops::RangeInclusive<u32>) -> impl Strategy<Value = Case>
         )
 }
 
-/// The same hit, bit for bit, from the hierarchy (computing every node box per ray, and with
-/// the top levels' boxes stored as the prepared scene stores them) and from testing every
-/// micro-triangle.
+/// The same hit, bit for bit, from the hierarchy (computing every node box per ray, with
+/// the top levels' boxes stored as the prepared scene stores them, and with the displaced
+/// micro-vertices stored too up to level 5) and from testing every micro-triangle.
 fn check(case: &Case, grid: &MicroGrid, ray: &Ray) -> Result<(), TestCaseError> {
     let computed = DisplacedTriangle::new(case.corners, &case.displacement);
-    let exact = computed.exact_boxes().boxes;
+    let KeptBoxes {
+        boxes: exact,
+        points,
+        ..
+    } = computed.exact_boxes();
     let conservative = computed.conservative_boxes();
     let brute = grid.intersect(ray);
     prop_assert_eq!(computed.intersect(ray), brute, "ray {:?}", ray);
-    for (boxes, kind) in [(&exact, "exact"), (&conservative, "conservative")] {
+    let variants: [(&[_], &[_], &str); 3] = [
+        (&exact, &[], "exact"),
+        (&exact, &points, "exact with micro-vertices"),
+        (&conservative, &[], "conservative"),
+    ];
+    for (boxes, points, kind) in variants {
         let stored = DisplacedTriangle::with_boxes(
             case.corners,
             &case.displacement,
             computed.frame(),
             boxes,
+            points,
         );
+        if kind == "exact with micro-vertices" {
+            // Kept up to level 5, and then used.
+            let level = case.displacement.level();
+            prop_assert_eq!(stored.points.is_empty(), level > 5, "level {}", level);
+        }
         prop_assert_eq!(
             stored.intersect(ray),
             brute,
@@ -163,12 +178,13 @@ proptest! {
     /// Every kept exact box holds the micro-triangles of its node (in the triangle's frame)
     /// and is their box up to the f32 rounding: so the test fails for a box that is only
     /// conservative. The world bounds hold every micro-vertex undisplaced, displaced and
-    /// half displaced.
+    /// half displaced. The kept micro-vertices (up to level 5) are the displaced ones, bit
+    /// for bit, each once at its place.
     #[test]
     fn exact_boxes_hold_their_micro_triangles_and_no_more(case in case_in(0..=6)) {
         let grid = MicroGrid::new(&case.corners, &case.displacement);
         let triangle = DisplacedTriangle::new(case.corners, &case.displacement);
-        let KeptBoxes { boxes, bounds: [w_lo, w_hi] } = triangle.exact_boxes();
+        let KeptBoxes { boxes, bounds: [w_lo, w_hi], points } = triangle.exact_boxes();
         let depth = case.displacement.level().saturating_sub(1).min(4);
         prop_assert_eq!(boxes.len(), ((1usize << (2 * (depth + 1))) - 1) / 3);
         // The nodes in level order, down to the deepest kept depth.
@@ -200,13 +216,25 @@ proptest! {
         }
         let half = case.displacement.with_fraction(0.5);
         let n = 1u32 << case.displacement.level();
+        let kept = case.displacement.level() <= 5;
+        prop_assert_eq!(points.len(), if kept { ((n + 1) * (n + 2) / 2) as usize } else { 0 });
         for i in 0..=n {
             for j in 0..=n - i {
                 let vertex = grid.vertex([i, j]);
                 for p in [vertex.position, grid.displaced([i, j]), half.displace(&vertex)] {
                     prop_assert!(p.cmpge(w_lo).all() && p.cmple(w_hi).all(), "{} outside [{}, {}]", p, w_lo, w_hi);
                 }
+                if kept {
+                    prop_assert_eq!(points[stored_index(n, [i, j])], grid.displaced([i, j]));
+                }
             }
+        }
+        // Micro-triangle positions read from the kept micro-vertices, and descended to
+        // without them, are the brute force's.
+        let stored = DisplacedTriangle::with_boxes(case.corners, &case.displacement, triangle.frame(), &boxes, &points);
+        for micro in grid.triangles() {
+            prop_assert_eq!(stored.positions(micro), grid.positions(micro));
+            prop_assert_eq!(triangle.positions(micro), grid.positions(micro));
         }
     }
 
