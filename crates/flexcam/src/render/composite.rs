@@ -46,7 +46,7 @@ use crate::render::shading::trace::specular;
 use crate::render::{
     Counter, Frame, Method, Outputs, RenderOptions, RenderWarning, Rendered, Shading, Stats,
 };
-use crate::scene::{Finish, Mesh, Object, Scene, TrilinearReflector};
+use crate::scene::{Finish, Mesh, Object, ReflectionImage, Scene, TrilinearReflector};
 
 /// A way of rendering a scene through a projection: a [`Method`] alone, or the trilinear
 /// method with its main view through [`perspective_as_trilinear`].
@@ -123,17 +123,38 @@ fn with_renderer(
         triangles += surface.mesh.triangles.len();
         dropped += surface.dropped;
         let projection = surface_projection(&surface, map, entry.camera_rays, &camera)?;
+        let mut missed = None;
         if let Some(projection) = &projection {
             let others = prepared.view(without(scene, id));
-            let through = |surface: &Trilinear| {
-                if entry.env_map {
-                    env_map::image(&others, surface, &reflector.mesh, options)
-                } else {
-                    renderer(&others, surface, options)
-                }
+            let main_view = &frame;
+            let through = |surface: &Trilinear| -> Result<(Frame, Stats, Option<Vec<usize>>)> {
+                Ok(match entry.reflection {
+                    ReflectionImage::Surface => {
+                        let (image, counters) = renderer(&others, surface, options)?;
+                        (image, counters, None)
+                    }
+                    ReflectionImage::EnvMap => {
+                        let (image, counters) =
+                            env_map::image(&others, surface, &reflector.mesh, options)?;
+                        (image, counters, None)
+                    }
+                    ReflectionImage::Atlas => {
+                        let view = atlas::View {
+                            prepared,
+                            others: &others,
+                            id,
+                            main: main_view,
+                            camera: &camera,
+                        };
+                        let (image, counters, missed) = view.image(surface, options, renderer)?;
+                        (image, counters, Some(missed))
+                    }
+                })
             };
-            let (image, counters) = through(projection)?;
+            let (image, counters, through_missed) = through(projection)?;
+            missed = through_missed;
             add_camera_triangle_counts(&mut stats, &counters);
+            add_atlas_counts(&mut stats, &counters);
             pixels += match (options.shading, reflector.optic) {
                 (Shading::Flat, _) => paste(&mut frame, id, &image, Vec3::ONE)?,
                 (Shading::Lit | Shading::Transitions(_), Optic::Reflect) => {
@@ -161,7 +182,10 @@ fn with_renderer(
                 }
             };
         }
-        let uncovered = exact.uncovered(&frame, id, projection.as_ref());
+        let uncovered = match missed {
+            Some(missed) => missed,
+            None => exact.uncovered(&frame, id, projection.as_ref()),
+        };
         uncovered_pixels += uncovered.len();
         if options.cast_reflector_gaps {
             exact.cast(&mut frame, &uncovered);
@@ -202,6 +226,24 @@ fn with_renderer(
 /// `shade_ms` as `surface_pairs`, `surface_raster_ms` and `surface_shade_ms` (the main view
 /// has its own), and
 /// sets `overdraw` to bounding over rendered fragments of all surfaces so far.
+/// Adds the atlas counters of a reflector image made through its texture atlas
+/// (`atlas_width`, `atlas_height`, `atlas_cell_px` of the last atlas, `atlas_missed_pixels`
+/// summed over reflectors); nothing for other images.
+fn add_atlas_counts(stats: &mut Stats, surface: &Stats) {
+    for name in ["atlas_width", "atlas_height", "atlas_cell_px"] {
+        if let Some(&value) = surface.get(name) {
+            stats.insert(name, value);
+        }
+    }
+    if let Some(Counter::Count(missed)) = surface.get("atlas_missed_pixels") {
+        let before = match stats.get("atlas_missed_pixels") {
+            Some(Counter::Count(n)) => *n,
+            _ => 0,
+        };
+        stats.insert("atlas_missed_pixels", Counter::Count(before + missed));
+    }
+}
+
 pub(super) fn add_camera_triangle_counts(stats: &mut Stats, surface: &Stats) {
     const SUMMED: [(&str, &str); 10] = [
         ("camera_triangles", "camera_triangles"),
@@ -636,6 +678,7 @@ fn check_size(main: &Frame, other: &Frame) -> Result<()> {
     Ok(())
 }
 
+pub mod atlas;
 pub mod camera_mesh;
 pub mod env_map;
 pub mod main_camera;

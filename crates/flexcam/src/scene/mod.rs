@@ -144,14 +144,27 @@ pub struct TrilinearReflector {
     /// the size automatically and refines the result by [`Self::refine_px`]
     /// (docs/camera-triangles.md).
     pub camera_triangles: Option<usize>,
-    /// Reflect (refract) an environment cube map rendered from the reflector's centre
-    /// instead of rendering through the surface (scene-file key `reflection = "env-map"`):
-    /// the baseline camera triangles are measured against (docs/camera-triangles.md).
-    pub env_map: bool,
+    /// How the image through the reflector's surface is made (scene-file key `reflection`).
+    pub reflection: ReflectionImage,
     /// The rays of the reflector's surface (scene-file key `camera_rays`): the vertex rays
     /// interpolated (the default), or per fragment, the eye's ray reflected about the
     /// interpolated vertex normals (mirrors; docs/camera-triangles.md).
     pub camera_rays: SurfaceRays,
+}
+
+/// How a trilinear reflector's reflection (refraction) image is made (scene-file key
+/// `reflection`; docs/camera-triangles.md).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum ReflectionImage {
+    /// Rendered through the surface in main-image pixels (`"surface"`, the default).
+    #[default]
+    Surface,
+    /// An environment cube map rendered from the reflector's centre, looked up along the
+    /// surface's rays (`"env-map"`): the baseline camera triangles are measured against.
+    EnvMap,
+    /// Rendered through the surface into the joint texture atlas of its camera triangles,
+    /// which is then mapped onto the reflector by normal shooting (`"atlas"`).
+    Atlas,
 }
 
 /// A mirror whose reflection of each point light is rendered as a caustic (Hou, Wei, Shum and
@@ -183,7 +196,7 @@ impl TrilinearReflector {
             screen_map: SurfaceScreenMap::default(),
             refine_px: Self::DEFAULT_REFINE_PX,
             camera_triangles: None,
-            env_map: false,
+            reflection: ReflectionImage::Surface,
             camera_rays: SurfaceRays::Interpolated,
         }
     }

@@ -15,7 +15,9 @@ use crate::error::Result;
 use crate::projection::trilinear_builders::{SurfaceRays, SurfaceScreenMap};
 use crate::projection::ProjectionSpec;
 use crate::scene::loaders::{load_model, load_texture};
-use crate::scene::{CausticReflector, Finish, Material, Mesh, Object, Pattern, TrilinearReflector};
+use crate::scene::{
+    CausticReflector, Finish, Material, Mesh, Object, Pattern, ReflectionImage, TrilinearReflector,
+};
 
 /// Surface names as written in scene files.
 const MATERIALS: [&str; 4] = ["diffuse", "mirror", "glass", "emissive"];
@@ -101,12 +103,13 @@ pub(super) fn convert(
 /// `trilinear_refine_px` (main-image pixels, default
 /// [`TrilinearReflector::DEFAULT_REFINE_PX`], 0 for none) and camera-mesh size
 /// `camera_triangles` (default automatic), `reflection` (`"surface"`, the default, or
-/// `"env-map"`: the environment-map baseline) and `camera_rays` (`"interpolated"`, the
+/// `"env-map"`: the environment-map baseline, or `"atlas"`: the camera triangles' joint texture
+/// atlas) and `camera_rays` (`"interpolated"`, the
 /// default, or `"per-fragment"`: mirrors only). Errors, at the key: an object
 /// whose material is neither mirror nor glass, a scene whose projection is not perspective
 /// (the surface's screen positions are the main camera's image of the reflector), a
 /// `trilinear_screen_map` other than "projective" or "affine", a `reflection` other than
-/// "surface" or "env-map", a `camera_rays` other than "interpolated" or "per-fragment" or
+/// "surface", "env-map" or "atlas", a `camera_rays` other than "interpolated" or "per-fragment" or
 /// "per-fragment" on glass, a `trilinear_refine_px` that
 /// is negative or not finite, a bad `camera_triangles` ([`camera_triangles`]), or any of
 /// these keys without `trilinear_reflector = true`.
@@ -145,13 +148,14 @@ pub(super) fn trilinear_reflector(
         }
     };
     let camera_triangles = camera_triangles(src, table, parts)?;
-    let env_map = match &raw.reflection {
-        None => false,
+    let reflection = match &raw.reflection {
+        None => ReflectionImage::Surface,
         Some(name) => match name.get_ref().as_str() {
-            "surface" => false,
-            "env-map" => true,
+            "surface" => ReflectionImage::Surface,
+            "env-map" => ReflectionImage::EnvMap,
+            "atlas" => ReflectionImage::Atlas,
             other => {
-                let expected = ["env-map", "surface"];
+                let expected = ["atlas", "env-map", "surface"];
                 return Err(src.unknown(&name.span(), "reflection", other, &expected));
             }
         },
@@ -244,7 +248,7 @@ pub(super) fn trilinear_reflector(
         screen_map,
         refine_px,
         camera_triangles,
-        env_map,
+        reflection,
         camera_rays,
     }))
 }

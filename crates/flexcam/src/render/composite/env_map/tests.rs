@@ -6,7 +6,7 @@ use crate::calibrate;
 use crate::render::compare::compare;
 use crate::render::prepared::PreparedScene;
 use crate::render::{Frame, Method, RenderOptions, Shading};
-use crate::scene::{self, Scene};
+use crate::scene::{self, ReflectionImage, Scene};
 
 /// `scene` at `size` by `method` (reflectors composited) and by the ray caster's exact
 /// mirror: the id agreement and relative RGB error of the whole frame, and the relative RGB
@@ -58,7 +58,7 @@ fn example(name: &str) -> Scene {
 }
 
 fn with_env_map(mut scene: Scene) -> Scene {
-    scene.trilinear_reflectors[0].env_map = true;
+    scene.trilinear_reflectors[0].reflection = ReflectionImage::EnvMap;
     scene
 }
 
@@ -89,7 +89,7 @@ fn a_distant_environment_is_reflected_as_camera_triangles_reflect_it() {
     "#;
     let scene = scene::file::parse(text, Path::new("room.toml")).unwrap();
     let mut surface = scene.clone();
-    surface.trilinear_reflectors[0].env_map = false;
+    surface.trilinear_reflectors[0].reflection = ReflectionImage::Surface;
     for method in [Method::Raycast, Method::CameraTriangles] {
         let (_, _, env) = errors(&scene, (120, 90), method, 1);
         let (_, _, camera_triangles) = errors(&surface, (120, 90), method, 1);
