@@ -171,13 +171,7 @@ impl<'a> HitShader<'a> {
     /// Lit shading of `hit` on `ray`, which has bounced `bounce` times and weighs `weight`.
     fn lit(&mut self, ray: &Ray, hit: Hit, bounce: u32, weight: f32) -> Vec3 {
         let object = &self.caster.scene.objects[hit.object];
-        let normals = self.normals(ray, &hit);
-        let base = base_color(
-            object,
-            hit.triangle,
-            hit.barycentric,
-            TextureFilter::Bilinear,
-        );
+        let (normals, base) = self.lit_surface(ray, &hit);
         let position = ray.at(hit.t);
         match object.material.finish {
             Finish::Emissive => base,
@@ -243,13 +237,7 @@ impl<'a> HitShader<'a> {
                 colors[lane] = self.lit(ray, hit, 0, 1.0);
                 continue;
             }
-            let normals = self.normals(ray, &hit);
-            let base = base_color(
-                object,
-                hit.triangle,
-                hit.barycentric,
-                TextureFilter::Bilinear,
-            );
+            let (normals, base) = self.lit_surface(ray, &hit);
             let point = DiffusePoint::new(ray, ray.at(hit.t), &normals, base);
             colors[lane] = point.unshadowed(&self.caster.scene.lights);
             points[lane] = Some(point);
@@ -296,6 +284,19 @@ impl<'a> HitShader<'a> {
             }
         }
         color
+    }
+
+    /// What lit shading reads of the surface at `hit`: its normals as seen along `ray` and
+    /// its base colour (bilinear texels).
+    fn lit_surface(&self, ray: &Ray, hit: &Hit) -> (Normals, Vec3) {
+        let object = &self.caster.scene.objects[hit.object];
+        let base = base_color(
+            object,
+            hit.triangle,
+            hit.barycentric,
+            TextureFilter::Bilinear,
+        );
+        (self.normals(ray, hit), base)
     }
 
     /// The normals at `hit` as seen along `ray`.
