@@ -180,6 +180,13 @@ pub fn fill_and_shade(
                             }
                         }
                     }
+                    if pixels.iter().all(Option::is_none) {
+                        // Nothing drawn here (the sky beside a model): no shading call.
+                        for i in quad.into_iter().flatten() {
+                            (colors[i], depths[i], ids[i]) = (background, f32::INFINITY, 0);
+                        }
+                        continue;
+                    }
                     let (shaded, rays) = shader.shade4(pixels);
                     counts.shading_rays += rays;
                     for lane in 0..4 {
