@@ -396,6 +396,9 @@ fn run_ladder(shared: &Shared, job: &Job) -> Result<()> {
         let mut state = shared.lock();
         if stage == Stage::Final {
             state.final_frame = Some((job.generation, frame));
+        } else if let Ok(frame) = Arc::try_unwrap(frame) {
+            // Shown and no longer needed: the next raster preview draws into its memory.
+            render::recycle_frame(&job.prepared, frame);
         }
         state.shown = Some(shown);
         state.shown_count += 1;
@@ -408,6 +411,12 @@ fn run_ladder(shared: &Shared, job: &Job) -> Result<()> {
 fn render_stage(shared: &Shared, job: &Job, stage: Stage) -> Result<Frame> {
     let settings = &job.settings;
     let (method, spp, outputs) = match stage {
+        // Depth and ids too (the raster draws them anyway), so that the frame comes back
+        // whole to the raster's next preview ([`render::recycle_frame`]).
+        Stage::Preview {
+            method: Method::Raster,
+            ..
+        } => (Method::Raster, 1, Outputs::ALL),
         Stage::Preview { method, .. } => (method, 1, Outputs::COLOR),
         Stage::Final => (settings.method, settings.spp, Outputs::COLOR),
         Stage::Refine { spp } => (Method::Raycast, spp, Outputs::COLOR),

@@ -426,7 +426,7 @@ pub use compare::{compare, interior_id_agreement, Comparison};
 pub use displaced::LodSelection;
 pub use method::Method;
 pub use prepared::{Hit, PreparedScene};
-pub use raster::Subdivision;
+pub use raster::{recycle_frame, Subdivision};
 pub use raycast::{pick, Picked};
 pub use reproject::{reproject, Photo, PhotoProjection, PHOTO_PROJECTION_NAMES};
 pub use stmap::{st_map, StMap, StPoints};

@@ -117,6 +117,11 @@ fn occluded_shown(bvh: &Bvh, ray: &FastRay, mask: &TriangleMask) -> bool {
     bvh.occluded(ray, mask)
 }
 
+#[inline(never)]
+fn occluded4_shown(bvh: &Bvh, rays: [Option<&FastRay>; 4], mask: &TriangleMask) -> [bool; 4] {
+    bvh.occluded4(rays, mask)
+}
+
 /// The secondary-ray offset of `scene`: [`OFFSET_SCALE`] of its largest coordinate magnitude.
 fn offset_of(scene: &Scene) -> f64 {
     let extent = scene
@@ -429,6 +434,35 @@ impl PreparedScene {
             None => self.bvh.occluded(&r, &AllTriangles),
             Some(mask) => occluded_shown(&self.bvh, &r, mask),
         }) || self.displaced_occludes(ray)
+    }
+
+    /// [`PreparedScene::occluded`] of four rays at once (`None`: no ray, answered `false`),
+    /// with identical answers: coherent shadow rays (a 2x2 quad's, towards one light) share
+    /// one BVH traversal ([`Bvh::occluded4`]).
+    pub(in crate::render) fn occluded4(&self, rays: [Option<&Ray>; 4]) -> [bool; 4] {
+        // Spelled out, as in `intersect4_f32`: `array::map` here costs a closure call a ray.
+        let fast = [
+            rays[0].and_then(FastRay::new),
+            rays[1].and_then(FastRay::new),
+            rays[2].and_then(FastRay::new),
+            rays[3].and_then(FastRay::new),
+        ];
+        let lanes = [
+            fast[0].as_ref(),
+            fast[1].as_ref(),
+            fast[2].as_ref(),
+            fast[3].as_ref(),
+        ];
+        let blocked = match &self.shown {
+            None => self.bvh.occluded4(lanes, &AllTriangles),
+            Some(mask) => occluded4_shown(&self.bvh, lanes, mask),
+        };
+        if self.displaced.is_none() {
+            return blocked;
+        }
+        std::array::from_fn(|i| {
+            blocked[i] || rays[i].is_some_and(|ray| self.displaced_occludes(ray))
+        })
     }
 
     /// A ray leaving surface point `point` (geometric normal `normal`) along `direction`,

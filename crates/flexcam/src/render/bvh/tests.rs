@@ -267,7 +267,8 @@ fn coincident_triangles_build_a_bounded_tree() {
         .all(|c| c.count as usize <= MAX_LEAF));
 }
 
-/// `closest4` must give bit for bit what `closest` gives ray by ray.
+/// `closest4` must give bit for bit what `closest` gives ray by ray, and `occluded4` what
+/// `occluded` does.
 fn assert_packet_matches(bvh: &Bvh, rays: [Option<FastRay>; 4], what: &str) -> usize {
     let key = |h: Option<BvhHit>| {
         h.map(|h| {
@@ -280,13 +281,64 @@ fn assert_packet_matches(bvh: &Bvh, rays: [Option<FastRay>; 4], what: &str) -> u
         })
     };
     let got = bvh.closest4([0, 1, 2, 3].map(|i| rays[i].as_ref()), &AllTriangles);
+    let blocked = bvh.occluded4([0, 1, 2, 3].map(|i| rays[i].as_ref()), &AllTriangles);
     let mut hits = 0;
-    for (r, got) in rays.iter().zip(got) {
+    for ((r, got), blocked) in rays.iter().zip(got).zip(blocked) {
         let expected = r.as_ref().and_then(|r| bvh.closest(r, &AllTriangles));
         assert_eq!(key(got), key(expected), "{what}");
+        let single = r.as_ref().is_some_and(|r| bvh.occluded(r, &AllTriangles));
+        assert_eq!(blocked, single, "{what}: any hit");
         hits += usize::from(expected.is_some());
     }
     hits
+}
+
+/// Shadow rays of 2x2 quads of surface points towards a point light (segments ending at
+/// the light) and a directional one (parallel rays): `occluded4` answers each as `occluded`
+/// does, through soups where some are blocked and some are not, and with masks.
+#[test]
+fn shadow_packets_are_blocked_exactly_as_single_rays() {
+    let mut rng = Rng(23);
+    let (mut blocked, mut free) = (0, 0);
+    for n in [5, 200, 5000] {
+        let triangles = soup(&mut rng, n);
+        let bvh = Bvh::build(&triangles);
+        let mask = TriangleMask::by_id(&bvh, |id| id % 3 != 1);
+        for k in 0..400 {
+            let light = rng.vec(14.0).as_dvec3();
+            let corner = rng.vec(12.0).as_dvec3();
+            let step = [1e-3, 0.05, 0.5][k % 3];
+            let rays = [(0.0, 0.0), (step, 0.0), (0.0, step), (step, step)].map(|(x, z)| {
+                let from = corner + DVec3::new(x, 0.0, z);
+                let ray = if k % 2 == 0 {
+                    Ray {
+                        t_max: 1.0,
+                        ..Ray::new(from, light - from)
+                    }
+                } else {
+                    Ray::new(from, light)
+                };
+                FastRay::new(&ray)
+            });
+            let lanes = [0, 1, 2, 3].map(|i| rays[i].as_ref());
+            let got = bvh.occluded4(lanes, &AllTriangles);
+            let masked = bvh.occluded4(lanes, &mask);
+            for (r, (got, masked)) in rays.iter().zip(got.into_iter().zip(masked)) {
+                let r = r.as_ref().unwrap();
+                assert_eq!(got, bvh.occluded(r, &AllTriangles), "soup {n}, quad {k}");
+                assert_eq!(masked, bvh.occluded(r, &mask), "soup {n}, quad {k}, masked");
+                if got {
+                    blocked += 1;
+                } else {
+                    free += 1;
+                }
+            }
+        }
+    }
+    assert!(
+        blocked > 500 && free > 500,
+        "{blocked} blocked, {free} free"
+    );
 }
 
 #[test]

@@ -420,12 +420,38 @@ impl Bvh {
     /// primary rays); the rays' direction signs must agree on every axis, else (or when a
     /// ray is `None`) each ray is traced alone.
     pub fn closest4<K: Keep>(&self, rays: [Option<&FastRay>; 4], keep: &K) -> [Option<BvhHit>; 4] {
+        self.packet::<false, K>(rays, keep)
+    }
+
+    /// Whether each of four rays hits a triangle `keep` keeps in its interval, exactly as
+    /// [`Bvh::occluded`] answers ray by ray, by one traversal shared by the four (a ray
+    /// drops out at its first hit): four coherent shadow rays (a 2x2 quad's, towards one
+    /// light). Traced one by one as for [`Bvh::closest4`].
+    pub fn occluded4<K: Keep>(&self, rays: [Option<&FastRay>; 4], keep: &K) -> [bool; 4] {
+        let hits = self.packet::<true, K>(rays, keep);
+        // Spelled out: `array::map` is not inlined here.
+        [
+            hits[0].is_some(),
+            hits[1].is_some(),
+            hits[2].is_some(),
+            hits[3].is_some(),
+        ]
+    }
+
+    /// [`Bvh::closest4`] or, with `ANY`, [`Bvh::occluded4`]'s hits: one packet traversal
+    /// when the four rays are present and agree in their direction signs, else ray by ray.
+    #[inline(always)]
+    fn packet<const ANY: bool, K: Keep>(
+        &self,
+        rays: [Option<&FastRay>; 4],
+        keep: &K,
+    ) -> [Option<BvhHit>; 4] {
         match rays {
             [Some(a), Some(b), Some(c), Some(d)] if same_signs([a, b, c, d]) => {
-                self.traverse4([a, b, c, d], keep)
+                self.traverse4::<ANY, K>([a, b, c, d], keep)
             }
             [a, b, c, d] => {
-                let single = |r: Option<&FastRay>| r.and_then(|r| self.closest(r, keep));
+                let single = |r: Option<&FastRay>| r.and_then(|r| self.traverse::<ANY, K>(r, keep));
                 [single(a), single(b), single(c), single(d)]
             }
         }
@@ -436,8 +462,18 @@ impl Bvh {
     /// winning leaf is always visited (its boxes pass the same slab test, at a `t_max` no
     /// smaller than the winning `t`), and which other leaves are visited, or in what order,
     /// does not change that minimum.
+    ///
+    /// With `ANY` a ray stops at its first hit, and the traversal when all four have one:
+    /// whether a ray hits anything does not depend on which leaves the others open, since
+    /// every leaf holding a triangle it hits is one it enters. A finished lane's `t_max`
+    /// becomes minus infinity, so it enters no box and no leaf after (its far bound is
+    /// minus infinity, or NaN once the slack is added, and no entry compares below either).
     #[inline(always)]
-    fn traverse4<K: Keep>(&self, rays: [&FastRay; 4], keep: &K) -> [Option<BvhHit>; 4] {
+    fn traverse4<const ANY: bool, K: Keep>(
+        &self,
+        rays: [&FastRay; 4],
+        keep: &K,
+    ) -> [Option<BvhHit>; 4] {
         if self.triangles.is_empty() {
             return [None; 4];
         }
@@ -472,10 +508,17 @@ impl Bvh {
                                 best[r] = Some((first + i, hit));
                                 best_index[r] = first + i;
                             }
+                            if ANY {
+                                t_max_lanes[r] = f32::NEG_INFINITY;
+                                break;
+                            }
                         }
                     }
                 }
                 t_max = Vec4::from_array(t_max_lanes);
+                if ANY && best.iter().all(Option::is_some) {
+                    return best.map(|b| self.finish(b));
+                }
             } else {
                 let node = &self.nodes[current.index as usize];
                 let kept = keep.kept_children(current.index as usize);

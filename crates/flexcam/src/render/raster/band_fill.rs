@@ -24,6 +24,10 @@ use crate::try_alloc;
 /// covers, large enough that few screen triangles (mostly one or two pixels) reach two.
 pub const BAND_ROWS: u32 = 8;
 
+/// The pixels of a 2x2 quad, as (column, row) offsets from its top left, in the lane order
+/// of the quad's shading.
+const QUAD: [(usize, usize); 4] = [(0, 0), (1, 0), (0, 1), (1, 1)];
+
 /// What filling and shading did.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct FillCounts {
@@ -157,18 +161,48 @@ pub fn fill_and_shade(
                     }
                 });
             }
-            let pixels = colors.iter_mut().zip(depths).zip(ids).enumerate();
-            for (i, ((color, depth), id)) in pixels {
-                if !written.get(i) {
-                    (*color, *depth, *id) = (background, f32::INFINITY, 0);
-                    continue;
+            // Shaded in 2x2 quads (the last row of an odd band alone), so that the shadow
+            // rays of neighbouring pixels are traced together.
+            let band_rows = visible.len() / row;
+            for top in (0..band_rows).step_by(2) {
+                for left in (0..row).step_by(2) {
+                    // The quad's pixel indices in the band, where inside it; loops rather
+                    // than `array::map`, which is not inlined here.
+                    let mut quad = [None; 4];
+                    let mut pixels = [None; 4];
+                    for (lane, (dx, dy)) in QUAD.into_iter().enumerate() {
+                        let (x, y) = (left + dx, top + dy);
+                        if x < row && y < band_rows {
+                            let i = y * row + x;
+                            quad[lane] = Some(i);
+                            if written.get(i) {
+                                pixels[lane] = Some((x as u32, first + y as u32, &visible[i]));
+                            }
+                        }
+                    }
+                    if pixels.iter().all(Option::is_none) {
+                        // Nothing drawn here (the sky beside a model): no shading call.
+                        for i in quad.into_iter().flatten() {
+                            (colors[i], depths[i], ids[i]) = (background, f32::INFINITY, 0);
+                        }
+                        continue;
+                    }
+                    let (shaded, rays) = shader.shade4(pixels);
+                    counts.shading_rays += rays;
+                    for lane in 0..4 {
+                        let Some(i) = quad[lane] else {
+                            continue;
+                        };
+                        if pixels[lane].is_some() {
+                            let slot = &visible[i];
+                            (colors[i], depths[i], ids[i]) =
+                                (shaded[lane], slot.depth as f32, shader.id(slot.key));
+                            counts.covered += 1;
+                        } else {
+                            (colors[i], depths[i], ids[i]) = (background, f32::INFINITY, 0);
+                        }
+                    }
                 }
-                let slot = &visible[i];
-                let (x, y) = ((i % row) as u32, first + (i / row) as u32);
-                let (shaded, rays) = shader.shade(x, y, slot);
-                (*color, *depth, *id) = (shaded, slot.depth as f32, shader.id(slot.key));
-                counts.covered += 1;
-                counts.shading_rays += rays;
             }
             counts
         })

@@ -28,9 +28,10 @@ use crate::projection::Projector;
 use crate::render::prepared::{Hit, PreparedScene};
 use crate::render::raycast::pieces::{length_before, polyline_segment};
 use crate::render::scan::NO_PRIMITIVE;
+use crate::render::shading::trace::{shows_base_color, HitShader};
 use crate::render::shading::{base_color, TextureFilter};
 use crate::render::{RenderOptions, Shading};
-use crate::scene::{Finish, Object};
+use crate::scene::Object;
 
 /// The primitive key of triangle `triangle` of object index `object`: objects in the high
 /// half, so keys order like (object, triangle).
@@ -132,42 +133,82 @@ impl Shader<'_> {
         self.objects[unkey(key).0].id
     }
 
-    /// The colour of pixel `(x, y)` whose visible fragment is `visible`, and the rays its
-    /// shading cast.
-    pub fn shade(&self, x: u32, y: u32, visible: &Visible) -> (Vec3, u64) {
-        let (object_index, triangle) = unkey(visible.key);
-        let object = &self.objects[object_index];
-        let flat = matches!(object.material.finish, Finish::Diffuse | Finish::Emissive);
-        let base = || {
-            let color = base_color(
-                object,
-                triangle,
-                visible.barycentric,
-                TextureFilter::Nearest,
-            );
-            (color, 0)
-        };
-        let ray = match self.rays.get(x, y) {
-            Some(Projector::Straight(ray)) => Some(*ray),
-            Some(Projector::Polyline(points)) => Some(polyline_segment(points, visible.segment)),
-            _ => None,
-        };
-        match (self.options.shading, self.caster, ray) {
-            (Shading::Flat, _, _) if flat => base(),
-            (_, Some(caster), Some(ray)) => {
-                let hit = Hit {
-                    t: visible.t,
-                    object: object_index,
-                    triangle,
-                    barycentric: visible.barycentric,
-                };
-                caster.shade_hit(&ray, hit, self.options)
+    /// The colours of up to four pixels `(x, y)` with their visible fragments (a 2x2 quad;
+    /// `None`: no fragment there), each what the ray caster's shading gives its reconstructed
+    /// hit ([`HitShader::shade_hits4`], which traces the quad's shadow rays together) or, in
+    /// flat shading of a surface that shows its base colour, that colour; and the number of
+    /// rays their shading cast.
+    ///
+    /// Out of line: inlined, it takes the fill's inlining budget from the fragments'
+    /// reconstruction ([`Shader::fragment`]), which then costs more than the call does.
+    #[inline(never)]
+    pub fn shade4(&self, pixels: [Option<(u32, u32, &Visible)>; 4]) -> ([Vec3; 4], u64) {
+        let mut colors = [Vec3::ZERO; 4];
+        let mut traced = [None; 4];
+        let mut rays = [None; 4];
+        for lane in 0..4 {
+            let Some((x, y, visible)) = pixels[lane] else {
+                continue;
+            };
+            match self.traced_hit(x, y, visible) {
+                Some((ray, hit)) => {
+                    rays[lane] = Some(ray);
+                    traced[lane] = Some(hit);
+                }
+                None => colors[lane] = self.base(visible),
             }
-            // Unreachable by construction (the caster exists whenever shading needs it, and
-            // a visible fragment's pixel has a projector); the base colour is the safe
-            // answer.
-            _ => base(),
         }
+        let Some(caster) = self.caster.filter(|_| traced.iter().any(Option::is_some)) else {
+            return (colors, 0);
+        };
+        let lane = |k: usize| Some((rays[k].as_ref()?, traced[k]?));
+        let hits = [lane(0), lane(1), lane(2), lane(3)];
+        let mut shader = HitShader::new(caster, self.options);
+        let shaded = shader.shade_hits4(hits);
+        for lane in 0..4 {
+            if traced[lane].is_some() {
+                colors[lane] = shaded[lane];
+            }
+        }
+        let counts = shader.counts;
+        (colors, counts.secondary + counts.shadow)
+    }
+
+    /// The primary ray and hit through which the ray caster shades pixel `(x, y)` whose
+    /// visible fragment is `visible`; `None` where the fragment's flat base colour is its
+    /// colour (flat shading of a surface that shows it). The caster exists whenever shading
+    /// needs it, and a visible fragment's pixel has a projector (`None` otherwise too: the
+    /// base colour is the safe answer).
+    fn traced_hit(&self, x: u32, y: u32, visible: &Visible) -> Option<(Ray, Hit)> {
+        let (object, triangle) = unkey(visible.key);
+        let finish = self.objects[object].material.finish;
+        if self.options.shading == Shading::Flat && shows_base_color(finish) {
+            return None;
+        }
+        self.caster?;
+        let ray = match self.rays.get(x, y)? {
+            Projector::Straight(ray) => *ray,
+            Projector::Polyline(points) => polyline_segment(points, visible.segment),
+            Projector::QuadraticBezier(_) => return None,
+        };
+        let hit = Hit {
+            t: visible.t,
+            object,
+            triangle,
+            barycentric: visible.barycentric,
+        };
+        Some((ray, hit))
+    }
+
+    /// The flat base colour of `visible`'s surface at its barycentrics (nearest texels).
+    fn base(&self, visible: &Visible) -> Vec3 {
+        let (object, triangle) = unkey(visible.key);
+        base_color(
+            &self.objects[object],
+            triangle,
+            visible.barycentric,
+            TextureFilter::Nearest,
+        )
     }
 }
 

@@ -98,6 +98,8 @@ pub struct InverseRaster<'a> {
     setup_ms: f64,
     /// The buffers of a frame, kept from frame to frame (cleared, not reallocated).
     buffers: Mutex<Buffers>,
+    /// A recycled frame ([`recycle_frame`]) for [`InverseRaster::render`].
+    spare_frame: Mutex<Option<Frame>>,
 }
 
 /// The memory a renderer leaves for the next renderer of the same prepared scene.
@@ -105,6 +107,21 @@ pub struct InverseRaster<'a> {
 struct Spare {
     buffers: Buffers,
     tiles: Vec<Tile>,
+    /// A frame its caller is done with ([`recycle_frame`]), for the next
+    /// [`InverseRaster::render`] to draw into.
+    frame: Option<Frame>,
+}
+
+/// Leaves `frame`, one its caller is done with (a viewer's preview, once shown), for the
+/// next raster render of `prepared` to draw into: a sequence of frames (a viewer's drag)
+/// then does not allocate and page-fault a frame every time (18 bytes a pixel with depth
+/// and ids; a frame rendered for colour alone brings back its colour buffer). Every pixel of
+/// it is overwritten. Dropped when a renderer of the scene is running (it keeps its own
+/// memory) or leaves its memory after this.
+pub fn recycle_frame(prepared: &PreparedScene, frame: Frame) {
+    let mut spare = prepared.take_spare::<Spare>().unwrap_or_default();
+    spare.frame = Some(frame);
+    prepared.keep_spare(spare);
 }
 
 /// What a frame writes besides the caller's frame, kept by the renderer.
@@ -205,7 +222,16 @@ impl Drop for InverseRaster<'_> {
                 .unwrap_or_else(std::sync::PoisonError::into_inner),
         );
         let tiles = self.rays.take_tiles();
-        self.prepared.keep_spare(Spare { buffers, tiles });
+        let frame = self
+            .spare_frame
+            .get_mut()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .take();
+        self.prepared.keep_spare(Spare {
+            buffers,
+            tiles,
+            frame,
+        });
     }
 }
 
@@ -237,6 +263,7 @@ impl<'a> InverseRaster<'a> {
         let caster = (options.shading == Shading::Lit || specular).then_some(prepared);
         Ok(InverseRaster {
             buffers: Mutex::new(spare.buffers),
+            spare_frame: Mutex::new(spare.frame),
             prepared,
             scene,
             projection,
@@ -249,10 +276,23 @@ impl<'a> InverseRaster<'a> {
     }
 
     /// Renders one frame: colour, depth (the ray caster's distance along the projector) and
-    /// object ids, with the counters of every stage. Fails only when the memory of the frame
-    /// or the z-buffer cannot be had (module `try_alloc`).
+    /// object ids, with the counters of every stage, into a recycled frame ([`recycle_frame`])
+    /// when there is one. Fails only when the memory of the frame or the z-buffer cannot be
+    /// had (module `try_alloc`).
     pub fn render(&self) -> Result<(Frame, Stats)> {
-        let mut frame = Frame::new(0, 0, self.scene.image.background);
+        let recycled = self
+            .spare_frame
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+            .take();
+        let mut frame = match recycled {
+            // `render_into` overwrites colour, depth and ids; no other layer is drawn.
+            Some(mut frame) => {
+                frame.surface.clear();
+                frame
+            }
+            None => Frame::new(0, 0, self.scene.image.background),
+        };
         let stats = self.render_into(&mut frame)?;
         Ok((frame, stats))
     }

@@ -220,8 +220,10 @@ fn projections_without_a_chart_are_refused_in_one_line() {
 }
 
 /// Renderers of one prepared scene hand their z-buffer, bins and projector tiles on
-/// ([`PreparedScene::keep_spare`]): each frame of a sequence through every invertible
-/// projection, at two sizes, lit and flat, is the frame a fresh prepared scene renders.
+/// ([`PreparedScene::keep_spare`]), and every other frame is drawn into the frame before it
+/// ([`recycle_frame`]: the last one's pixels, of another size, and without depth and ids
+/// half of the time): each frame of a sequence through every invertible projection, at
+/// two sizes, lit and flat, is the frame a fresh prepared scene renders.
 #[test]
 fn frames_reusing_an_earlier_renderers_memory_are_fresh_frames() {
     let scene = scene::load("builtin:cube-floor").unwrap();
@@ -248,6 +250,13 @@ fn frames_reusing_an_earlier_renderers_memory_are_fresh_frames() {
             render(Method::Raster, &scene, &spec, size, &options),
             "{name}"
         );
+        if k % 4 < 2 {
+            let mut spent = reused;
+            if k % 4 == 1 {
+                (spent.depth, spent.ids) = (Vec::new(), Vec::new());
+            }
+            recycle_frame(&prepared, spent);
+        }
     }
 }
 

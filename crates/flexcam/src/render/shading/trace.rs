@@ -171,13 +171,7 @@ impl<'a> HitShader<'a> {
     /// Lit shading of `hit` on `ray`, which has bounced `bounce` times and weighs `weight`.
     fn lit(&mut self, ray: &Ray, hit: Hit, bounce: u32, weight: f32) -> Vec3 {
         let object = &self.caster.scene.objects[hit.object];
-        let normals = self.normals(ray, &hit);
-        let base = base_color(
-            object,
-            hit.triangle,
-            hit.barycentric,
-            TextureFilter::Bilinear,
-        );
+        let (normals, base) = self.lit_surface(ray, &hit);
         let position = ray.at(hit.t);
         match object.material.finish {
             Finish::Emissive => base,
@@ -217,34 +211,92 @@ impl<'a> HitShader<'a> {
         }
     }
 
-    /// Ambient plus Lambert and Phong from each light that a shadow ray reaches.
-    fn direct(&mut self, ray: &Ray, position: DVec3, normals: &Normals, base: Vec3) -> Vec3 {
-        let view = ray.direction.normalize();
-        let normal = normals.shading.as_dvec3();
-        let geometric = normals.geometric.as_dvec3();
-        let shade = |to_light: DVec3| {
-            let cos = normal.dot(to_light) as f32;
-            let highlight = reflect(-to_light, normal).dot(-view).max(0.0) as f32;
-            base * cos + Vec3::splat(SPECULAR * highlight.powi(SHININESS))
-        };
-        if self.caster.scene.lights.is_empty() {
-            return base * AMBIENT + shade(-view);
+    /// The colours of up to four primary rays with their first hits (a 2x2 pixel quad;
+    /// `None`: no pixel there), each exactly what [`HitShader::shade_hit`] gives it, with
+    /// the same rays counted: the shadow rays of the diffuse hits towards each light are
+    /// traced four at a time ([`PreparedScene::occluded4`]), which coherent rays (those of
+    /// neighbouring pixels towards one light) make cheaper.
+    pub(in crate::render) fn shade_hits4(&mut self, hits: [Option<(&Ray, Hit)>; 4]) -> [Vec3; 4] {
+        let background = self.caster.scene.image.background;
+        let mut colors = [background; 4];
+        if self.shading == Shading::Flat {
+            for (color, hit) in colors.iter_mut().zip(hits) {
+                if let Some((ray, hit)) = hit {
+                    *color = self.flat(ray, hit);
+                }
+            }
+            return colors;
         }
-        let mut color = base * AMBIENT;
-        for light in &self.caster.scene.lights {
-            let (to_light, t_max, radiance) = light_from(light, position);
-            let unit = to_light.normalize_or_zero();
-            if normal.dot(unit) <= 0.0 {
+        let mut points: [Option<DiffusePoint>; 4] = [None; 4];
+        for lane in 0..4 {
+            let Some((ray, hit)) = hits[lane] else {
+                continue;
+            };
+            let object = &self.caster.scene.objects[hit.object];
+            if object.material.finish != Finish::Diffuse {
+                colors[lane] = self.lit(ray, hit, 0, 1.0);
                 continue;
             }
-            let mut shadow = self.caster.spawn(position, geometric, to_light);
-            shadow.t_max = t_max;
-            self.counts.shadow += 1;
-            if !self.caster.occluded(&shadow) {
-                color += radiance * shade(unit);
+            let (normals, base) = self.lit_surface(ray, &hit);
+            let point = DiffusePoint::new(ray, ray.at(hit.t), &normals, base);
+            colors[lane] = point.unshadowed(&self.caster.scene.lights);
+            points[lane] = Some(point);
+        }
+        // Loops over the lanes rather than `array::map`, which is not inlined here.
+        let mut rays: [Option<Ray>; 4] = [None; 4];
+        let mut added = [Vec3::ZERO; 4];
+        for light in &self.caster.scene.lights {
+            for lane in 0..4 {
+                rays[lane] = None;
+                if let Some(point) = &points[lane] {
+                    if let Some((ray, light_adds)) = point.light(self.caster, light) {
+                        rays[lane] = Some(ray);
+                        added[lane] = light_adds;
+                        self.counts.shadow += 1;
+                    }
+                }
+            }
+            let blocked = self.caster.occluded4([
+                rays[0].as_ref(),
+                rays[1].as_ref(),
+                rays[2].as_ref(),
+                rays[3].as_ref(),
+            ]);
+            for lane in 0..4 {
+                if rays[lane].is_some() && !blocked[lane] {
+                    colors[lane] += added[lane];
+                }
+            }
+        }
+        colors
+    }
+
+    /// Ambient plus Lambert and Phong from each light that a shadow ray reaches.
+    fn direct(&mut self, ray: &Ray, position: DVec3, normals: &Normals, base: Vec3) -> Vec3 {
+        let point = DiffusePoint::new(ray, position, normals, base);
+        let mut color = point.unshadowed(&self.caster.scene.lights);
+        for light in &self.caster.scene.lights {
+            if let Some((shadow, added)) = point.light(self.caster, light) {
+                self.counts.shadow += 1;
+                if !self.caster.occluded(&shadow) {
+                    color += added;
+                }
             }
         }
         color
+    }
+
+    /// What lit shading reads of the surface at `hit`: its normals as seen along `ray` and
+    /// its base colour (bilinear texels).
+    fn lit_surface(&self, ray: &Ray, hit: &Hit) -> (Normals, Vec3) {
+        let object = &self.caster.scene.objects[hit.object];
+        let base = base_color(
+            object,
+            hit.triangle,
+            hit.barycentric,
+            TextureFilter::Bilinear,
+        );
+        (self.normals(ray, hit), base)
     }
 
     /// The normals at `hit` as seen along `ray`.
@@ -260,6 +312,65 @@ impl<'a> HitShader<'a> {
             hit.barycentric,
             ray.direction.as_vec3(),
         )
+    }
+}
+
+/// A diffuse surface point as lit shading sees it, split from its shadow rays so that
+/// those of several points can be traced together ([`HitShader::shade_hits4`]): its colour
+/// is [`DiffusePoint::unshadowed`] plus, light by light in the scene's order, what
+/// [`DiffusePoint::light`] adds where the shadow ray is not blocked.
+#[derive(Debug, Clone, Copy)]
+struct DiffusePoint {
+    position: DVec3,
+    /// The unit direction of the primary ray.
+    view: DVec3,
+    /// The shading and geometric normals.
+    normal: DVec3,
+    geometric: DVec3,
+    base: Vec3,
+}
+
+impl DiffusePoint {
+    fn new(ray: &Ray, position: DVec3, normals: &Normals, base: Vec3) -> DiffusePoint {
+        DiffusePoint {
+            position,
+            view: ray.direction.normalize(),
+            normal: normals.shading.as_dvec3(),
+            geometric: normals.geometric.as_dvec3(),
+            base,
+        }
+    }
+
+    /// Lambert and a white Phong highlight for a unit direction `to_light`.
+    #[inline]
+    fn shade(&self, to_light: DVec3) -> Vec3 {
+        let cos = self.normal.dot(to_light) as f32;
+        let highlight = reflect(-to_light, self.normal).dot(-self.view).max(0.0) as f32;
+        self.base * cos + Vec3::splat(SPECULAR * highlight.powi(SHININESS))
+    }
+
+    /// The colour before any light's shadowed term: the ambient term, plus the unshadowed
+    /// headlight along the ray when the scene has no `lights`.
+    fn unshadowed(&self, lights: &[Light]) -> Vec3 {
+        if lights.is_empty() {
+            self.base * AMBIENT + self.shade(-self.view)
+        } else {
+            self.base * AMBIENT
+        }
+    }
+
+    /// The shadow ray towards `light` (spawned off the surface through `caster`) and what
+    /// the light adds when nothing blocks it; `None` where the light is behind the shading
+    /// normal (no ray is cast).
+    fn light(&self, caster: &PreparedScene, light: &Light) -> Option<(Ray, Vec3)> {
+        let (to_light, t_max, radiance) = light_from(light, self.position);
+        let unit = to_light.normalize_or_zero();
+        if self.normal.dot(unit) <= 0.0 {
+            return None;
+        }
+        let mut shadow = caster.spawn(self.position, self.geometric, to_light);
+        shadow.t_max = t_max;
+        Some((shadow, radiance * self.shade(unit)))
     }
 }
 
