@@ -219,17 +219,28 @@ fn child_grids([a, b, c]: [[u32; 2]; 3]) -> [[[u32; 2]; 3]; 4] {
 }
 
 /// The micro-triangle of the leaf with grid corners `g`, and its vertices' displaced
-/// positions `displaced` (in the order of `g`) put in that triangle's order.
+/// positions `displaced` (in the order of `g`) put in that triangle's order. Spelled out
+/// (no iterators): it runs for every micro-triangle a ray tests.
+#[inline]
 fn micro_triangle(g: [[u32; 2]; 3], displaced: [DVec3; 3]) -> (MicroTriangle, [DVec3; 3]) {
-    let i = g.iter().map(|g| g[0]).min().unwrap_or(0);
-    let j = g.iter().map(|g| g[1]).min().unwrap_or(0);
-    let up = g.contains(&[i, j]);
+    let i = g[0][0].min(g[1][0]).min(g[2][0]);
+    let j = g[0][1].min(g[1][1]).min(g[2][1]);
+    let up = g[0] == [i, j] || g[1] == [i, j] || g[2] == [i, j];
     let triangle = MicroTriangle { i, j, up };
-    let positions = triangle.vertices().map(|v| {
-        let k = g.iter().position(|&x| x == v).unwrap_or(0);
-        displaced[k]
-    });
-    (triangle, positions)
+    // The position of the first corner of `g` at `v` (the first corner's if none is).
+    let at = |v: [u32; 2]| {
+        if g[0] == v {
+            displaced[0]
+        } else if g[1] == v {
+            displaced[1]
+        } else if g[2] == v {
+            displaced[2]
+        } else {
+            displaced[0]
+        }
+    };
+    let [p, q, r] = triangle.vertices();
+    (triangle, [at(p), at(q), at(r)])
 }
 
 /// Keeps `found` in `best` if it comes first ([`MicroHit::before`]).
