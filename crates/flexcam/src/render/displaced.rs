@@ -15,7 +15,8 @@
 //! from level 5 on), and up to level 5 its displaced micro-vertices in f64 (`(2^L + 1) (2^L +
 //! 2) / 2` of 24 bytes: 13,464 bytes at level 5), which the hierarchy reads instead of
 //! displacing them per ray, and shading reads (found by its place in scene order, 4
-//! bytes); above level 5 the micro-geometry below the kept boxes is recomputed per ray from
+//! bytes), within a cap ([`KEPT_POINTS_BUDGET`]: base triangles past it are traced as above
+//! level 5); above level 5 the micro-geometry below the kept boxes is recomputed per ray from
 //! the mesh. Its
 //! shell box is the exact world box of its micro-vertices, undisplaced and displaced, up to
 //! level 6.
