@@ -86,6 +86,16 @@ pub fn stored_index(n: u32, [i, j]: [u32; 2]) -> usize {
     i * (2 * n + 3 - i) / 2 + j
 }
 
+/// Bytes of the displaced micro-vertices [`DisplacedTriangle::kept_boxes`] keeps per base
+/// triangle at subdivision `level`: 13,464 at level 5, 0 above it (none kept).
+pub fn kept_point_bytes(level: u32) -> usize {
+    if level <= STORED_LEVEL {
+        stored_count(1 << level) * std::mem::size_of::<DVec3>()
+    } else {
+        0
+    }
+}
+
 /// How many micro-vertices a base triangle subdivided into `n` rows has.
 fn stored_count(n: u32) -> usize {
     let n = n as usize;
@@ -209,17 +219,28 @@ fn child_grids([a, b, c]: [[u32; 2]; 3]) -> [[[u32; 2]; 3]; 4] {
 }
 
 /// The micro-triangle of the leaf with grid corners `g`, and its vertices' displaced
-/// positions `displaced` (in the order of `g`) put in that triangle's order.
+/// positions `displaced` (in the order of `g`) put in that triangle's order. Spelled out
+/// (no iterators): it runs for every micro-triangle a ray tests.
+#[inline]
 fn micro_triangle(g: [[u32; 2]; 3], displaced: [DVec3; 3]) -> (MicroTriangle, [DVec3; 3]) {
-    let i = g.iter().map(|g| g[0]).min().unwrap_or(0);
-    let j = g.iter().map(|g| g[1]).min().unwrap_or(0);
-    let up = g.contains(&[i, j]);
+    let i = g[0][0].min(g[1][0]).min(g[2][0]);
+    let j = g[0][1].min(g[1][1]).min(g[2][1]);
+    let up = g[0] == [i, j] || g[1] == [i, j] || g[2] == [i, j];
     let triangle = MicroTriangle { i, j, up };
-    let positions = triangle.vertices().map(|v| {
-        let k = g.iter().position(|&x| x == v).unwrap_or(0);
-        displaced[k]
-    });
-    (triangle, positions)
+    // The position of the first corner of `g` at `v` (the first corner's if none is).
+    let at = |v: [u32; 2]| {
+        if g[0] == v {
+            displaced[0]
+        } else if g[1] == v {
+            displaced[1]
+        } else if g[2] == v {
+            displaced[2]
+        } else {
+            displaced[0]
+        }
+    };
+    let [p, q, r] = triangle.vertices();
+    (triangle, [at(p), at(q), at(r)])
 }
 
 /// Keeps `found` in `best` if it comes first ([`MicroHit::before`]).
@@ -295,6 +316,7 @@ fn exact_box(
 }
 
 /// A ray in the base triangle's frame, for slab tests.
+#[derive(Clone)]
 struct LocalRay {
     origin: DVec3,
     direction: DVec3,
@@ -306,6 +328,9 @@ struct LocalRay {
     slack: f64,
     /// The ray in f32 for the kept boxes, where the triangle has them and f32 holds it.
     wide: Option<WideRay>,
+    /// Whether the search stops at the first hit found (any hit: a shadow ray's question)
+    /// instead of looking on for the nearest.
+    first: bool,
 }
 
 impl LocalRay {
@@ -326,6 +351,7 @@ impl LocalRay {
             t_max: ray.t_max,
             slack,
             wide: None,
+            first: false,
         }
     }
 
@@ -448,9 +474,7 @@ impl<'a> DisplacedTriangle<'a> {
         boxes: &'a [CachedBox],
         points: &'a [DVec3],
     ) -> Self {
-        let level = displacement.level();
-        let internal = ((1usize << (2 * level)) - 1) / 3;
-        let usable = points.len() == stored_count(1 << level) && boxes.len() >= internal;
+        let usable = StoredTriangle::new(displacement.level(), boxes, points).is_some();
         DisplacedTriangle {
             corners,
             displacement,
@@ -590,7 +614,7 @@ impl<'a> DisplacedTriangle<'a> {
     /// The first micro-triangle hit with `t` in `[ray.t_min, ray.t_max]`, from either side;
     /// the same hit as [`MicroGrid::intersect`](super::micro::MicroGrid::intersect).
     pub fn intersect(&self, ray: &Ray) -> Option<MicroHit> {
-        if !(ray.origin.is_finite() && ray.direction.is_finite()) || ray.direction == DVec3::ZERO {
+        if !valid(ray) {
             return None;
         }
         let local = LocalRay::new(&self.frame, ray);
@@ -599,23 +623,32 @@ impl<'a> DisplacedTriangle<'a> {
             None => self.node_box(&self.root()),
         };
         slab_entry(&local, root, f64::INFINITY)?;
-        self.intersect_entered(ray, &RootEntry(local.with_root(self.boxes.first())))
+        self.intersect_entered(ray, &RootEntry(local.with_root(self.boxes.first())), false)
     }
 
     /// [`DisplacedTriangle::intersect`] for a ray [`enters_root`] let through with this
     /// triangle's frame and root box (those it was made [`with_boxes`](Self::with_boxes)
-    /// of): the same hit, without testing the root box again.
-    pub fn intersect_entered(&self, ray: &Ray, entry: &RootEntry) -> Option<MicroHit> {
-        if !(ray.origin.is_finite() && ray.direction.is_finite()) || ray.direction == DVec3::ZERO {
+    /// of): the same hit, without testing the root box again. With `any`, the first hit
+    /// found instead (there is one exactly when there is a nearest one).
+    pub fn intersect_entered(&self, ray: &Ray, entry: &RootEntry, any: bool) -> Option<MicroHit> {
+        if let Some(stored) = self.stored() {
+            return stored.intersect_entered(ray, entry, any);
+        }
+        if !valid(ray) {
             return None;
         }
+        let local = LocalRay {
+            first: any,
+            ..entry.0.clone()
+        };
         let mut best = None;
-        if self.points.is_empty() {
-            self.visit(ray, &entry.0, &self.root(), 0, 0, &mut best);
-        } else {
-            self.visit_stored(ray, &entry.0, self.root().g, 0, 0, &mut best);
-        }
+        self.visit(ray, &local, &self.root(), 0, 0, &mut best);
         best
+    }
+
+    /// Its kept boxes and micro-vertices, where it has both for every node.
+    fn stored(&self) -> Option<StoredTriangle<'a>> {
+        StoredTriangle::new(self.displacement.level(), self.boxes, self.points)
     }
 
     /// The displaced vertices of micro-triangle `triangle` (in [`MicroTriangle::vertices`]
@@ -670,6 +703,9 @@ impl<'a> DisplacedTriangle<'a> {
             keep(best, hit_micro_triangle(ray, triangle, positions));
             return;
         }
+        if local.first && best.is_some() {
+            return;
+        }
         let midpoints = node.midpoints();
         if depth + 1 == level {
             // The four leaves share six micro-vertices: displace each once.
@@ -681,7 +717,7 @@ impl<'a> DisplacedTriangle<'a> {
         // Index of the first child in the level order of the next depth.
         let first = 4 * index + 1;
         if depth + 2 == level && self.boxes.len() <= first {
-            self.visit_leaf_parents(ray, node, midpoints, best);
+            self.visit_leaf_parents(ray, local, node, midpoints, best);
             return;
         }
         let limit = best.map_or(f64::INFINITY, |b| b.t);
@@ -696,49 +732,11 @@ impl<'a> DisplacedTriangle<'a> {
             if best.is_some_and(|b| entry > b.t) {
                 break;
             }
+            if local.first && best.is_some() {
+                return;
+            }
             let child = node.child(k, midpoints);
             self.visit(ray, local, &child, depth + 1, first + k, best);
-        }
-    }
-
-    /// [`Self::visit`] where the kept boxes reach every internal node and the displaced
-    /// micro-vertices are kept (`points`): descends into the node with grid corners `g` by
-    /// its kept children's boxes and tests the micro-triangles on the kept micro-vertices,
-    /// the same as `visit` computes, bit for bit.
-    fn visit_stored(
-        &self,
-        ray: &Ray,
-        local: &LocalRay,
-        g: [[u32; 2]; 3],
-        depth: u32,
-        index: usize,
-        best: &mut Option<MicroHit>,
-    ) {
-        let level = self.displacement.level();
-        let n = 1u32 << level;
-        let at = |p: [u32; 2]| self.points[stored_index(n, p)];
-        if depth == level {
-            let (triangle, positions) = micro_triangle(g, g.map(at));
-            keep(best, hit_micro_triangle(ray, triangle, positions));
-            return;
-        }
-        let grids = child_grids(g);
-        if depth + 1 == level {
-            // The middle child is (ca, ab, bc).
-            let [ca, ab, bc] = grids[3];
-            let [a, b, c] = g;
-            test_leaves(ray, g, [a, b, c, ab, bc, ca].map(at), best);
-            return;
-        }
-        let first = 4 * index + 1;
-        let limit = best.map_or(f64::INFINITY, |b| b.t);
-        // `with_boxes` keeps points only where every internal node's box is kept.
-        let (order, count) = kept_order(local, &self.boxes[first..first + 4], limit);
-        for &(entry, k) in &order[..count] {
-            if best.is_some_and(|b| entry > b.t) {
-                break;
-            }
-            self.visit_stored(ray, local, grids[k], depth + 1, first + k, best);
         }
     }
 
@@ -752,6 +750,7 @@ impl<'a> DisplacedTriangle<'a> {
     fn visit_leaf_parents(
         &self,
         ray: &Ray,
+        local: &LocalRay,
         node: &Node,
         [ab, bc, ca]: [BaseVertex; 3],
         best: &mut Option<MicroHit>,
@@ -773,7 +772,7 @@ impl<'a> DisplacedTriangle<'a> {
             front_to_back(|k| slab_entry(&world, leaf_parent_box(&six[k], ray.origin), limit));
         let grids = child_grids(node.g);
         for &(entry, k) in &order[..count] {
-            if best.is_some_and(|b| entry > b.t) {
+            if best.is_some_and(|b| entry > b.t || local.first) {
                 break;
             }
             test_leaves(ray, grids[k], six[k], best);
@@ -932,6 +931,98 @@ fn slab_entry(ray: &LocalRay, [lo, hi]: [DVec3; 2], limit: f64) -> Option<f64> {
     // Rounding of the slab distances (a few units in the last place of each, relative: the
     // reciprocal and the product) is covered by the boxes' slack.
     (near <= far).then_some(near)
+}
+
+/// A base triangle's kept boxes and displaced micro-vertices where they reach every node
+/// above the micro-triangles (up to level 5, [`DisplacedTriangle::kept_boxes`]): all a ray
+/// needs to trace it exactly, by grid corners alone, with neither its corners nor its
+/// displacement (no midpoint, no height is computed).
+#[derive(Debug, Clone, Copy)]
+pub struct StoredTriangle<'a> {
+    level: u32,
+    boxes: &'a [CachedBox],
+    points: &'a [DVec3],
+}
+
+impl<'a> StoredTriangle<'a> {
+    /// The triangle at subdivision `level` with kept `boxes` and micro-vertices `points` (as
+    /// [`DisplacedTriangle::kept_boxes`] keeps them); `None` unless there are as many points
+    /// as it has micro-vertices and a box for every node above the micro-triangles.
+    pub fn new(level: u32, boxes: &'a [CachedBox], points: &'a [DVec3]) -> Option<Self> {
+        let internal = ((1usize << (2 * level)) - 1) / 3;
+        let usable = points.len() == stored_count(1 << level) && boxes.len() >= internal;
+        usable.then_some(StoredTriangle {
+            level,
+            boxes,
+            points,
+        })
+    }
+
+    /// [`DisplacedTriangle::intersect_entered`] of the triangle these were kept from: the
+    /// same hit, bit for bit (with `any`, a hit exactly when there is one).
+    pub fn intersect_entered(&self, ray: &Ray, entry: &RootEntry, any: bool) -> Option<MicroHit> {
+        if !valid(ray) {
+            return None;
+        }
+        let mut best = None;
+        let n = 1u32 << self.level;
+        self.visit(
+            ray,
+            &entry.0,
+            any,
+            [[0, 0], [n, 0], [0, n]],
+            (0, 0),
+            &mut best,
+        );
+        best
+    }
+
+    /// Descends into the node with grid corners `g` at `depth` (level-order index `index`)
+    /// by its kept children's boxes, front to back, as [`DisplacedTriangle::visit`] does,
+    /// and tests the micro-triangles on the kept micro-vertices, the same as `visit`
+    /// computes, bit for bit; with `first`, stops at the first hit.
+    fn visit(
+        &self,
+        ray: &Ray,
+        local: &LocalRay,
+        first: bool,
+        g: [[u32; 2]; 3],
+        (depth, index): (u32, usize),
+        best: &mut Option<MicroHit>,
+    ) {
+        let n = 1u32 << self.level;
+        let at = |p: [u32; 2]| self.points[stored_index(n, p)];
+        if depth == self.level {
+            let (triangle, positions) = micro_triangle(g, [at(g[0]), at(g[1]), at(g[2])]);
+            keep(best, hit_micro_triangle(ray, triangle, positions));
+            return;
+        }
+        let grids = child_grids(g);
+        if depth + 1 == self.level {
+            // The middle child is (ca, ab, bc).
+            let [ca, ab, bc] = grids[3];
+            let [a, b, c] = g;
+            let six = [at(a), at(b), at(c), at(ab), at(bc), at(ca)];
+            test_leaves(ray, g, six, best);
+            return;
+        }
+        let next = 4 * index + 1;
+        let limit = best.map_or(f64::INFINITY, |b| b.t);
+        // `new` keeps points only where every internal node's box is kept.
+        let (order, count) = kept_order(local, &self.boxes[next..next + 4], limit);
+        for &(entry, k) in &order[..count] {
+            if best.is_some_and(|b| entry > b.t || first) {
+                break;
+            }
+            self.visit(ray, local, first, grids[k], (depth + 1, next + k), best);
+        }
+    }
+}
+
+/// Whether `ray` can hit anything: a finite origin and a finite, non-zero direction.
+#[inline]
+fn valid(ray: &Ray) -> bool {
+    ray.origin.is_finite() && ray.direction.is_finite() && ray.direction != DVec3::ZERO
 }
 
 #[cfg(test)]

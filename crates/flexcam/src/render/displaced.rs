@@ -15,7 +15,8 @@
 //! from level 5 on), and up to level 5 its displaced micro-vertices in f64 (`(2^L + 1) (2^L +
 //! 2) / 2` of 24 bytes: 13,464 bytes at level 5), which the hierarchy reads instead of
 //! displacing them per ray, and shading reads (found by its place in scene order, 4
-//! bytes); above level 5 the micro-geometry below the kept boxes is recomputed per ray from
+//! bytes), within a cap ([`KEPT_POINTS_BUDGET`]: base triangles past it are traced as above
+//! level 5); above level 5 the micro-geometry below the kept boxes is recomputed per ray from
 //! the mesh. Its
 //! shell box is the exact world box of its micro-vertices, undisplaced and displaced, up to
 //! level 6.
@@ -36,15 +37,18 @@ use glam::DVec3;
 
 use rayon::prelude::*;
 
-use crate::displace::intersect::{enters_root, KeptBoxes};
+use crate::displace::intersect::{enters_root, kept_point_bytes, KeptBoxes, StoredTriangle};
 use crate::displace::{base_corners, CachedBox, DisplacedTriangle, Displacement, Frame, MicroHit};
 use crate::geometry::Ray;
-use crate::scene::Scene;
+use crate::scene::{budget, Scene};
 
 /// Most base triangles per leaf.
 const LEAF: usize = 2;
 /// Traversal stack size: more than the depth of a median-split tree over `u32` items.
 const STACK: usize = 40;
+/// Most bytes of kept displaced micro-vertices per set (also at most a quarter of the
+/// memory budget, [`budget::max_memory`]): 19,937 base triangles at level 5.
+pub const KEPT_POINTS_BUDGET: usize = 256 << 20;
 
 mod lods;
 mod tables;
@@ -126,8 +130,19 @@ pub(in crate::render) struct DisplacedHit {
 }
 
 impl DisplacedSet {
-    /// The set of `scene`'s displaced objects; `None` when it has none.
+    /// The set of `scene`'s displaced objects; `None` when it has none. Displaced
+    /// micro-vertices are kept within [`KEPT_POINTS_BUDGET`] or a quarter of the memory
+    /// budget, whichever is less ([`DisplacedSet::with_point_budget`]).
     pub fn new(scene: &Scene) -> Option<Arc<DisplacedSet>> {
+        let budget = usize::try_from(budget::max_memory() / 4).unwrap_or(usize::MAX);
+        DisplacedSet::with_point_budget(scene, KEPT_POINTS_BUDGET.min(budget))
+    }
+
+    /// [`DisplacedSet::new`] keeping the displaced micro-vertices of base triangles (levels
+    /// up to 5: [`DisplacedTriangle::kept_boxes`]) in scene order while their total stays
+    /// within `budget` bytes; the others are traced by displacing their micro-vertices per
+    /// ray, as above level 5: the same hits, slower.
+    pub fn with_point_budget(scene: &Scene, budget: usize) -> Option<Arc<DisplacedSet>> {
         let displacements: Vec<Option<Displacement>> = scene
             .objects
             .iter()
@@ -142,20 +157,32 @@ impl DisplacedSet {
         let mut boxed = Vec::new();
         let mut bounds = vec![None; scene.objects.len()];
         let mut first_shell = Vec::with_capacity(scene.objects.len());
+        let mut budget_left = budget;
         for (index, (object, displacement)) in scene.objects.iter().zip(&displacements).enumerate()
         {
             first_shell.push(shells.len());
             let Some(displacement) = displacement else {
                 continue;
             };
+            // The first `with_points` base triangles keep their micro-vertices (the budget).
+            let count = object.mesh.triangles.len();
+            let with_points = match kept_point_bytes(displacement.level()) {
+                0 => 0,
+                bytes => count.min(budget_left / bytes),
+            };
+            budget_left -= with_points * kept_point_bytes(displacement.level());
             // Each base triangle's boxes are its own (exact ones displace every micro-vertex
             // once): built in parallel, kept in scene order.
-            let kept: Vec<_> = (0..object.mesh.triangles.len())
+            let kept: Vec<_> = (0..count)
                 .into_par_iter()
                 .map(|triangle| {
                     let shell =
                         DisplacedTriangle::new(base_corners(&object.mesh, triangle), displacement);
-                    (triangle, shell.frame(), shell.kept_boxes())
+                    let mut kept = shell.kept_boxes();
+                    if triangle >= with_points {
+                        kept.points = Vec::new();
+                    }
+                    (triangle, shell.frame(), kept)
                 })
                 .collect();
             for (
@@ -279,18 +306,22 @@ impl DisplacedSet {
         self.closest_by(ray, limit, any, |item, displacement, bounded| {
             let boxes = self.item_boxes(item);
             let entry = enters_root(&item.frame, &boxes[0], bounded)?;
-            DisplacedTriangle::with_boxes(
-                base_corners(
-                    &scene.objects[item.object as usize].mesh,
-                    item.triangle as usize,
-                ),
-                displacement,
-                item.frame,
-                boxes,
-                &item.points,
-            )
-            .intersect_entered(bounded, &entry)
-            .map(|micro| (micro.t, micro))
+            // Kept micro-vertices need neither the corners nor the displacement.
+            let micro = match StoredTriangle::new(displacement.level(), boxes, &item.points) {
+                Some(stored) => stored.intersect_entered(bounded, &entry, any),
+                None => DisplacedTriangle::with_boxes(
+                    base_corners(
+                        &scene.objects[item.object as usize].mesh,
+                        item.triangle as usize,
+                    ),
+                    displacement,
+                    item.frame,
+                    boxes,
+                    &item.points,
+                )
+                .intersect_entered(bounded, &entry, any),
+            }?;
+            Some((micro.t, micro))
         })
         .map(|(object, triangle, micro)| DisplacedHit {
             object,

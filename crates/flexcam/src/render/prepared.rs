@@ -54,6 +54,10 @@ pub(in crate::render) struct Hit32 {
     pub object: usize,
     pub triangle: usize,
     pub barycentric: Vec2,
+    /// `t` in f64 where the search that found the hit was already the exact one (displaced
+    /// objects, whose barycentrics are then exact too): [`PreparedScene::refine`] keeps it
+    /// instead of searching again.
+    pub exact_t: Option<f64>,
 }
 
 /// A scene prepared for rendering by any method (see the module documentation).
@@ -403,6 +407,7 @@ impl PreparedScene {
             object,
             triangle: (found.id - self.first_triangle[object]) as usize,
             barycentric: Vec2::new(found.hit.u, found.hit.v),
+            exact_t: None,
         }
     }
 

@@ -1,7 +1,7 @@
 use glam::{DVec2, DVec3};
 use proptest::prelude::*;
 
-use super::{stored_index, DisplacedTriangle, KeptBoxes, Node};
+use super::{enters_root, stored_index, DisplacedTriangle, KeptBoxes, Node};
 use crate::displace::{
     BaseVertex, Displacement, HeightField, HeightMap, MicroGrid, Procedural, Wave,
 };
@@ -124,6 +124,25 @@ fn check(case: &Case, grid: &MicroGrid, ray: &Ray) -> Result<(), TestCaseError> 
             kind,
             ray
         );
+        // The any-hit search (shadow rays) finds a hit exactly when there is one, and no
+        // nearer one than the nearest.
+        let any = enters_root(&computed.frame(), &boxes[0], ray)
+            .and_then(|entry| stored.intersect_entered(ray, &entry, true));
+        prop_assert_eq!(
+            any.is_some(),
+            brute.is_some(),
+            "{} any, ray {:?}",
+            kind,
+            ray
+        );
+        if let (Some(any), Some(brute)) = (any, brute) {
+            prop_assert!(
+                any.t >= brute.t && any.t <= ray.t_max,
+                "{} any, ray {:?}",
+                kind,
+                ray
+            );
+        }
     }
     Ok(())
 }

@@ -3,6 +3,7 @@ use std::path::Path;
 use glam::{DVec2, DVec3};
 
 use super::*;
+use crate::displace::intersect::kept_point_bytes;
 use crate::displace::{MicroGrid, MicroTriangle};
 use crate::projection::Projection;
 use crate::render::shading::Normals;
@@ -137,6 +138,12 @@ fn prepared_scene_hits_exactly_the_micro_triangles_brute_force_finds() {
                     ..ray
                 };
                 assert!(prepared.occluded(&segment));
+                // Nothing lies before the nearest hit: the any-hit search finds nothing there.
+                let before = Ray {
+                    t_max: t * 0.9999,
+                    ..ray
+                };
+                assert!(!prepared.occluded(&before), "{ray:?}");
             }
             (want, got) => panic!("{ray:?}: brute force {want:?}, prepared {got:?}"),
         }
@@ -145,6 +152,40 @@ fn prepared_scene_hits_exactly_the_micro_triangles_brute_force_finds() {
         }
     }
     assert!(displaced > 300 && plain > 20, "{displaced} {plain}");
+}
+
+#[test]
+fn a_point_budget_keeps_micro_vertices_in_scene_order_and_the_same_hits() {
+    let scene = parse(SCENE, Path::new("displaced-test.toml")).unwrap();
+    let full = DisplacedSet::with_point_budget(&scene, usize::MAX).unwrap();
+    // "waves" (72 base triangles at level 3) keeps 40, "bumps" (50 at level 2) none; a
+    // budget of 0 keeps none.
+    let budget = 40 * kept_point_bytes(3) + kept_point_bytes(2) - 1;
+    let capped = DisplacedSet::with_point_budget(&scene, budget).unwrap();
+    let none = DisplacedSet::with_point_budget(&scene, 0).unwrap();
+    let kept = |set: &DisplacedSet, object: u32| {
+        let items = set.items.iter().filter(|item| item.object == object);
+        items.filter(|item| !item.points.is_empty()).count()
+    };
+    assert_eq!([kept(&full, 0), kept(&full, 1)], [72, 50]);
+    assert_eq!([kept(&capped, 0), kept(&capped, 1)], [40, 0]);
+    assert_eq!([kept(&none, 0), kept(&none, 1)], [0, 0]);
+    let key = |hit: Option<DisplacedHit>| hit.map(|h| (h.object, h.triangle, h.micro));
+    let mut hits = 0;
+    for ray in rays() {
+        let want = key(full.closest(&scene, &ray, f64::INFINITY, false));
+        for set in [&capped, &none] {
+            assert_eq!(
+                key(set.closest(&scene, &ray, f64::INFINITY, false)),
+                want,
+                "{ray:?}"
+            );
+            let any = set.closest(&scene, &ray, f64::INFINITY, true);
+            assert_eq!(any.is_some(), want.is_some(), "{ray:?}");
+        }
+        hits += usize::from(want.is_some());
+    }
+    assert!(hits > 300, "{hits}");
 }
 
 #[test]

@@ -19,6 +19,7 @@ impl PreparedScene {
             object: found.object,
             triangle: found.triangle,
             barycentric: self.base_barycentric(&found).as_vec2(),
+            exact_t: Some(found.micro.t),
         }
     }
 
@@ -60,11 +61,21 @@ impl PreparedScene {
             .is_some_and(|set| set.closest(&self.scene, ray, f64::INFINITY, true).is_some())
     }
 
-    /// The f64 hit of `ray` on displaced base triangle `found` (searched again in f64); `None`
+    /// The f64 hit of `ray` on displaced base triangle `found`: as the displaced search found
+    /// it (`exact_t`, the same hit as searching the base triangle again: the nearest within
+    /// it, which the search bounded beyond it did not miss), or searched again in f64; `None`
     /// when `found` is not on a displaced object.
     pub(in crate::render) fn refine_displaced(&self, ray: &Ray, found: Hit32) -> Option<Hit> {
         let set = self.displaced.as_ref()?;
         let displacement = set.displacement(found.object)?;
+        if let Some(t) = found.exact_t {
+            return Some(Hit {
+                t,
+                object: found.object,
+                triangle: found.triangle,
+                barycentric: found.barycentric,
+            });
+        }
         let hit = set
             .triangle(&self.scene, found.object, found.triangle, displacement)
             .intersect(ray);
