@@ -478,3 +478,100 @@ fn emit_pixels(region: &Convex, emit: &mut impl FnMut(&Convex)) {
         emit(&region.dilated(MARGIN_PX));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::projection::trilinear_builders::SurfaceRays;
+    use crate::projection::Trilinear;
+    use crate::render::camera_triangles::tests::{load, mirror_surface};
+    use crate::render::trilinear::SceneGeometry;
+    use crate::scene::Scene;
+
+    /// Every piece of the tight bound's quartering (down to depth 3) gets from the
+    /// [`CornerView`]s handed down the nine points that projecting along its own cone gives,
+    /// bit for bit, or none where that gives none: on trilinear scenes and on a mirror
+    /// sphere's diverging rays (planes along the rays).
+    #[test]
+    fn corner_views_give_each_piece_its_nine_points() {
+        let mut cases: Vec<(Trilinear, Scene)> = ["trilinear-fan", "trilinear-grid-cylinder"]
+            .iter()
+            .map(|name| {
+                let scene = load(name);
+                let projection = scene.projection.build(96, 72).unwrap();
+                (projection.trilinear().unwrap().clone(), scene)
+            })
+            .collect();
+        cases.push(mirror_surface(
+            "reflect-sphere-cube",
+            SurfaceRays::Interpolated,
+        ));
+        for (projection, scene) in &cases {
+            let geometry = SceneGeometry::new(scene);
+            let cameras = Camera::all(projection);
+            let (mut pieces, mut with_points) = (0, 0);
+            // About 3,000 pairs: every camera, every `step`-th triangle from an offset
+            // that differs per camera.
+            let step = (cameras.len() * geometry.triangles.len() / 3000).max(1);
+            for (c, camera) in cameras.iter().enumerate() {
+                for k in (c % step..geometry.triangles.len()).step_by(step) {
+                    let q = geometry.corners(k);
+                    let plane = camera.plane_near((q[0] + q[1] + q[2]) / 3.0);
+                    let views = CORNERS.map(|b| CornerView::of(camera, plane, &q, b).unwrap());
+                    check(
+                        camera,
+                        plane,
+                        &q,
+                        CORNERS,
+                        views,
+                        0,
+                        &mut pieces,
+                        &mut with_points,
+                    );
+                }
+            }
+            assert!(
+                pieces > 10_000 && with_points > 1_000,
+                "{pieces} {with_points}"
+            );
+        }
+    }
+
+    /// Compares the piece `sub` and its quarters down to depth 3.
+    #[allow(clippy::too_many_arguments)]
+    fn check(
+        camera: &Camera,
+        plane: Option<&CameraPlane>,
+        q: &[DVec3; 3],
+        sub: [DVec2; 3],
+        views: [CornerView; 3],
+        depth: u32,
+        pieces: &mut usize,
+        with_points: &mut usize,
+    ) {
+        let direct = camera.cone(sub).and_then(|directions| {
+            let plane = plane.filter(|p| p.one_sided(&directions))?;
+            nine(plane, q, &directions)
+        });
+        let bits = |p: Option<[DVec2; 9]>| p.map(|p| p.map(|x| (x.x.to_bits(), x.y.to_bits())));
+        assert_eq!(bits(CornerView::nine(&views)), bits(direct), "{sub:?}");
+        *pieces += 1;
+        *with_points += usize::from(direct.is_some());
+        if depth == 3 {
+            return;
+        }
+        let mids = midpoints(sub).map(|b| CornerView::of(camera, plane, q, b).unwrap());
+        for (quarter, views) in quarters(sub).into_iter().zip(split(views, mids)) {
+            check(
+                camera,
+                plane,
+                q,
+                quarter,
+                views,
+                depth + 1,
+                pieces,
+                with_points,
+            );
+        }
+    }
+}
