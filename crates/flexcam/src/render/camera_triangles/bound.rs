@@ -36,7 +36,7 @@
 
 use glam::{DVec2, DVec3};
 
-use super::camera::{AlongDirection, Camera, CameraPlane, CORNERS};
+use super::camera::{same_side, AlongDirection, Camera, CameraPlane, CORNERS};
 use super::convex::{cross, Convex};
 use crate::render::trilinear::plane_hit;
 
@@ -95,14 +95,87 @@ pub fn tight_in(
     emit: &mut impl FnMut(&Convex),
 ) {
     let plane = camera.plane_near((q[0] + q[1] + q[2]) / 3.0);
-    tight(camera, plane, q, sub, depth, emit)
+    let views = sub.map(|b| CornerView::of(camera, plane, q, b));
+    let views = views
+        .iter()
+        .all(Option::is_some)
+        .then(|| views.map(Option::unwrap));
+    tight(camera, plane, q, sub, views, depth, emit)
 }
 
 /// The four quarters of `sub` (corners, then the middle one), in the order the tight bound
 /// visits them.
-pub fn quarters([a, b, c]: [DVec2; 3]) -> [[DVec2; 3]; 4] {
-    let (ab, bc, ca) = ((a + b) / 2.0, (b + c) / 2.0, (c + a) / 2.0);
+pub fn quarters(sub: [DVec2; 3]) -> [[DVec2; 3]; 4] {
+    split(sub, midpoints(sub))
+}
+
+/// The midpoints of the sides `ab`, `bc`, `ca` of `[a, b, c]`.
+fn midpoints([a, b, c]: [DVec2; 3]) -> [DVec2; 3] {
+    [(a + b) / 2.0, (b + c) / 2.0, (c + a) / 2.0]
+}
+
+/// The corners of the four quarters of a triangle (of [`quarters`]) from what belongs to its
+/// corners and to its sides' [`midpoints`].
+fn split<T: Copy>([a, b, c]: [T; 3], [ab, bc, ca]: [T; 3]) -> [[T; 3]; 4] {
     [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]]
+}
+
+/// What the tight bound uses of one corner of a piece, for one scene triangle and plane,
+/// where the piece's cone is its corners' directions ([`Camera::corner_direction`]): the
+/// side of the plane the corner's direction crosses, and the scene triangle's corners
+/// projected along it. A corner is shared by up to six pieces of a quartering (a piece's
+/// quarters take its corners and its sides' midpoints), so each is computed once and
+/// handed down; the values are those [`nine`] computes for each piece.
+#[derive(Debug, Clone, Copy)]
+struct CornerView {
+    /// [`CameraPlane::side`] of the direction (`0` without a plane).
+    side: i32,
+    /// The projections (`None` where the direction is parallel to the plane or one is
+    /// beyond [`FAR`]).
+    projected: Option<[DVec2; 3]>,
+}
+
+impl CornerView {
+    /// The view from corner `b` (`None` for a per-fragment mirror: its cone is per piece).
+    fn of(
+        camera: &Camera,
+        plane: Option<&CameraPlane>,
+        q: &[DVec3; 3],
+        b: DVec2,
+    ) -> Option<CornerView> {
+        let d = camera.corner_direction(b)?;
+        let Some(plane) = plane else {
+            return Some(CornerView {
+                side: 0,
+                projected: None,
+            });
+        };
+        let projected = plane.along(d).and_then(|a| {
+            Some([
+                near(a.project(q[0]))?,
+                near(a.project(q[1]))?,
+                near(a.project(q[2]))?,
+            ])
+        });
+        Some(CornerView {
+            side: plane.side(d),
+            projected,
+        })
+    }
+
+    /// The nine points of a piece with these corners (as [`nine`] orders them), `None`
+    /// where its cone is not [`same_side`] or a projection failed.
+    fn nine(views: &[CornerView; 3]) -> Option<[DVec2; 9]> {
+        if !same_side(views.map(|v| v.side)) {
+            return None;
+        }
+        let p = [
+            views[0].projected?,
+            views[1].projected?,
+            views[2].projected?,
+        ];
+        Some(std::array::from_fn(|k| p[k % 3][k / 3]))
+    }
 }
 
 /// The culling of section 2.4 for one piece `sub` of a camera triangle (the whole camera
@@ -334,19 +407,24 @@ fn encloses(g: [DVec2; 3]) -> bool {
     (c.iter().all(|&x| x > tiny)) || (c.iter().all(|&x| x < -tiny))
 }
 
-/// The tight bound on the sub-triangle `sub` of the camera triangle (module doc).
+/// The tight bound on the sub-triangle `sub` of the camera triangle (module doc), with the
+/// [`CornerView`]s of its corners where its cone is theirs.
 fn tight(
     camera: &Camera,
     plane: Option<&CameraPlane>,
     q: &[DVec3; 3],
     sub: [DVec2; 3],
+    views: Option<[CornerView; 3]>,
     depth: u32,
     emit: &mut impl FnMut(&Convex),
 ) {
-    let points = camera.cone(sub).and_then(|directions| {
-        let plane = plane.filter(|p| p.one_sided(&directions))?;
-        nine(plane, q, &directions)
-    });
+    let points = match &views {
+        Some(views) => CornerView::nine(views),
+        None => camera.cone(sub).and_then(|directions| {
+            let plane = plane.filter(|p| p.one_sided(&directions))?;
+            nine(plane, q, &directions)
+        }),
+    };
     if points.is_some_and(|points| outside_an_edge(&points, sub)) {
         // The hull lies beyond a line of `sub`: nothing of the piece sees the triangle.
         return;
@@ -361,11 +439,18 @@ fn tight(
     if depth >= MAX_DEPTH || pixels < MIN_SPLIT_PIXELS || covers(camera, q, sub) {
         return emit_in_camera(camera, &region, emit);
     }
-    for quarter in quarters(sub) {
+    let mids = midpoints(sub);
+    let quarter_views = views.and_then(|views| {
+        let mid_views = mids.map(|b| CornerView::of(camera, plane, q, b));
+        let mid_views = [mid_views[0]?, mid_views[1]?, mid_views[2]?];
+        Some(split(views, mid_views))
+    });
+    for (i, quarter) in split(sub, mids).into_iter().enumerate() {
         // A quarter's rays are among the piece's, so its region lies in the piece's: a
         // quarter that the region misses sees nothing of the triangle.
         if !outside_an_edge(region.points(), quarter) {
-            tight(camera, plane, q, quarter, depth + 1, emit);
+            let views = quarter_views.map(|v| v[i]);
+            tight(camera, plane, q, quarter, views, depth + 1, emit);
         }
     }
 }
@@ -391,5 +476,102 @@ fn emit_in_camera(camera: &Camera, region: &Convex, emit: &mut impl FnMut(&Conve
 fn emit_pixels(region: &Convex, emit: &mut impl FnMut(&Convex)) {
     if region.points().len() >= 3 {
         emit(&region.dilated(MARGIN_PX));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::projection::trilinear_builders::SurfaceRays;
+    use crate::projection::Trilinear;
+    use crate::render::camera_triangles::tests::{load, mirror_surface};
+    use crate::render::trilinear::SceneGeometry;
+    use crate::scene::Scene;
+
+    /// Every piece of the tight bound's quartering (down to depth 3) gets from the
+    /// [`CornerView`]s handed down the nine points that projecting along its own cone gives,
+    /// bit for bit, or none where that gives none: on trilinear scenes and on a mirror
+    /// sphere's diverging rays (planes along the rays).
+    #[test]
+    fn corner_views_give_each_piece_its_nine_points() {
+        let mut cases: Vec<(Trilinear, Scene)> = ["trilinear-fan", "trilinear-grid-cylinder"]
+            .iter()
+            .map(|name| {
+                let scene = load(name);
+                let projection = scene.projection.build(96, 72).unwrap();
+                (projection.trilinear().unwrap().clone(), scene)
+            })
+            .collect();
+        cases.push(mirror_surface(
+            "reflect-sphere-cube",
+            SurfaceRays::Interpolated,
+        ));
+        for (projection, scene) in &cases {
+            let geometry = SceneGeometry::new(scene);
+            let cameras = Camera::all(projection);
+            let (mut pieces, mut with_points) = (0, 0);
+            // About 3,000 pairs: every camera, every `step`-th triangle from an offset
+            // that differs per camera.
+            let step = (cameras.len() * geometry.triangles.len() / 3000).max(1);
+            for (c, camera) in cameras.iter().enumerate() {
+                for k in (c % step..geometry.triangles.len()).step_by(step) {
+                    let q = geometry.corners(k);
+                    let plane = camera.plane_near((q[0] + q[1] + q[2]) / 3.0);
+                    let views = CORNERS.map(|b| CornerView::of(camera, plane, &q, b).unwrap());
+                    check(
+                        camera,
+                        plane,
+                        &q,
+                        CORNERS,
+                        views,
+                        0,
+                        &mut pieces,
+                        &mut with_points,
+                    );
+                }
+            }
+            assert!(
+                pieces > 10_000 && with_points > 1_000,
+                "{pieces} {with_points}"
+            );
+        }
+    }
+
+    /// Compares the piece `sub` and its quarters down to depth 3.
+    #[allow(clippy::too_many_arguments)]
+    fn check(
+        camera: &Camera,
+        plane: Option<&CameraPlane>,
+        q: &[DVec3; 3],
+        sub: [DVec2; 3],
+        views: [CornerView; 3],
+        depth: u32,
+        pieces: &mut usize,
+        with_points: &mut usize,
+    ) {
+        let direct = camera.cone(sub).and_then(|directions| {
+            let plane = plane.filter(|p| p.one_sided(&directions))?;
+            nine(plane, q, &directions)
+        });
+        let bits = |p: Option<[DVec2; 9]>| p.map(|p| p.map(|x| (x.x.to_bits(), x.y.to_bits())));
+        assert_eq!(bits(CornerView::nine(&views)), bits(direct), "{sub:?}");
+        *pieces += 1;
+        *with_points += usize::from(direct.is_some());
+        if depth == 3 {
+            return;
+        }
+        let mids = midpoints(sub).map(|b| CornerView::of(camera, plane, q, b).unwrap());
+        for (quarter, views) in quarters(sub).into_iter().zip(split(views, mids)) {
+            check(
+                camera,
+                plane,
+                q,
+                quarter,
+                views,
+                depth + 1,
+                pieces,
+                with_points,
+            );
+        }
     }
 }

@@ -115,16 +115,19 @@ impl CameraPlane {
     /// projection of the cone from the point, and the projections of a point along the cone
     /// lie in the convex hull of its projections along `directions`.
     pub fn one_sided(&self, directions: &[DVec3; 3]) -> bool {
-        let n = self.normal.length();
-        let signs = directions.map(|d| {
-            let s = self.normal.dot(d);
-            if s.abs() <= GRAZING_SINE * n * d.length() || !s.is_finite() {
-                0
-            } else {
-                s.signum() as i32
-            }
-        });
-        signs[0] != 0 && signs.iter().all(|&s| s == signs[0])
+        same_side(directions.map(|d| self.side(d)))
+    }
+
+    /// The side of the plane (`1` or `-1`, by its normal) that direction `d` crosses it
+    /// towards, `0` where `d` is parallel to it (within [`GRAZING_SINE`]) or not finite.
+    #[inline]
+    pub fn side(&self, d: DVec3) -> i32 {
+        let s = self.normal.dot(d);
+        if s.abs() <= GRAZING_SINE * self.normal.length() * d.length() || !s.is_finite() {
+            0
+        } else {
+            s.signum() as i32
+        }
     }
 
     /// The smallest sine of the angle between the plane and `directions`.
@@ -157,6 +160,12 @@ impl CameraPlane {
         let m = d - n * n.dot(d);
         (m.length() > GRAZING_SINE * d.length()).then(|| DVec2::new(m.dot(self.e1), m.dot(self.e2)))
     }
+}
+
+/// Whether the sides of [`CameraPlane::side`] for the directions of a cone are one side: its
+/// every direction crosses the plane from there ([`CameraPlane::one_sided`]).
+pub fn same_side(sides: [i32; 3]) -> bool {
+    sides[0] != 0 && sides.iter().all(|&s| s == sides[0])
 }
 
 /// The ray parameters `s` (on a geometric grid) whose planes [`Camera::plane_at`] the cone
@@ -351,5 +360,13 @@ impl Camera {
             None => Some(sub.map(|c| self.cache.trinorm(c.x, c.y))),
             Some(mirror) => mirror_cone::cone(mirror, sub),
         }
+    }
+
+    /// The ray direction at barycentrics `b` where the cone of a piece is its corners'
+    /// directions (interpolated rays: [`Camera::cone`] of a piece with corner `b` has this
+    /// direction for it); `None` for a per-fragment mirror, whose cone is the piece's own.
+    #[inline]
+    pub fn corner_direction(&self, b: DVec2) -> Option<DVec3> {
+        self.mirror.is_none().then(|| self.cache.trinorm(b.x, b.y))
     }
 }
