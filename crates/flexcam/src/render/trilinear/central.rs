@@ -75,6 +75,10 @@ pub struct CentralProjection {
     /// largest coefficient sum in `sides`) times the sum of the absolute values of the
     /// components of `u`, `v` and `w` (at least their lengths).
     box_scale: f64,
+    /// The near cone's half-spaces of [`ClipPoint::sides`] (bits 0 to 4) as `normal . y +
+    /// offset >= 0`, each `(normal, |normal|, offset)` with the normal's components' absolute
+    /// values: what [`Self::box_side`] reads at every node of the cull tree, formed once.
+    near_half_spaces: [(DVec3, DVec3, f64); 5],
 }
 
 /// A scene triangle reaching the focus: its image through a central projection is not a
@@ -123,6 +127,8 @@ impl CentralProjection {
             v,
             w,
             box_scale: (2.0 + DOMAIN_MARGIN) * (terms[0] + terms[1] + terms[2]),
+            near_half_spaces: near_half_spaces(u, v, w)
+                .map(|(normal, offset)| (normal, normal.abs(), offset)),
         })
     }
 
@@ -162,9 +168,9 @@ impl CentralProjection {
         let margin =
             BOX_MARGIN * (self.box_scale * (y.abs().element_sum() + half.element_sum()) + 1.0);
         let (mut outside, mut inside) = (0, 0);
-        for (k, (normal, offset)) in self.near_half_spaces().into_iter().enumerate() {
+        for (k, &(normal, size, offset)) in self.near_half_spaces.iter().enumerate() {
             let middle = normal.dot(y) + offset;
-            let reach = normal.abs().dot(half);
+            let reach = size.dot(half);
             // The near cone's half-space `k`, and the far cone's that is its negation
             // (`k + 5` for the domain planes, 8 for `w >= 0`; none for the view plane).
             let far = match k {
@@ -187,19 +193,6 @@ impl CentralProjection {
         } else {
             BoxSide::Within(active & !inside)
         }
-    }
-
-    /// The near cone's half-spaces of [`ClipPoint::sides`] (bits 0 to 4) as `normal . y +
-    /// offset >= 0`; the far cone's are the first three and the last turned round.
-    fn near_half_spaces(&self) -> [(DVec3, f64); 5] {
-        let m = DOMAIN_MARGIN;
-        [
-            (self.u + m * self.w, 0.0),
-            (self.v + m * self.w, 0.0),
-            ((1.0 + m) * self.w - self.u - self.v, 0.0),
-            (-self.w, 1.0),
-            (self.w, 0.0),
-        ]
     }
 
     /// The point `y = X - F` with its homogeneous coordinates `u w`, `v w` and `w` (module
@@ -367,6 +360,20 @@ fn push_distinct(out: &mut Vec<ClipPoint>, p: ClipPoint) {
     if out.last().map(|q| q.y) != Some(p.y) {
         out.push(p);
     }
+}
+
+/// The near cone's half-spaces of [`ClipPoint::sides`] (bits 0 to 4) for the terms `u`,
+/// `v`, `w` of a [`CentralProjection`], as `normal . y + offset >= 0`; the far cone's are
+/// the first three and the last turned round.
+fn near_half_spaces(u: DVec3, v: DVec3, w: DVec3) -> [(DVec3, f64); 5] {
+    let m = DOMAIN_MARGIN;
+    [
+        (u + m * w, 0.0),
+        (v + m * w, 0.0),
+        ((1.0 + m) * w - u - v, 0.0),
+        (-w, 1.0),
+        (w, 0.0),
+    ]
 }
 
 #[cfg(test)]
