@@ -213,7 +213,7 @@ pub fn live_pairs(
     if let Some(central) = &triangle.central {
         return central_live_pairs(central, index, scene, cache);
     }
-    let bounds = &triangle.bounds;
+    let bounds = triangle.bounds();
     let projector = triangle.map.cache();
     cache.next_generation();
     let (mut live, mut counts) = no_pairs_yet(index, scene);
@@ -221,7 +221,7 @@ pub fn live_pairs(
     kept.clear();
     counts.culled_tree = scene
         .tree
-        .visit(bounds, |cluster, cutting| kept.push((cluster, cutting)));
+        .visit(&bounds, |cluster, cutting| kept.push((cluster, cutting)));
     counts.culled_volume = counts.culled_tree;
     kept.sort_unstable();
     let generation = cache.generation;
