@@ -136,10 +136,26 @@ impl<const N: usize> PolygonBatch<N> {
         }
     }
 
+    /// An empty batch with room for `vertices` vertices in `shapes` shapes: a caller that
+    /// knows the sizes up front pays no regrowth (each a copy of the batch so far into
+    /// fresh memory).
+    pub fn with_capacity(vertices: usize, shapes: usize) -> Self {
+        PolygonBatch {
+            vertices: Vec::with_capacity(vertices),
+            shapes: Vec::with_capacity(shapes),
+        }
+    }
+
     /// Appends a shape (see [`Polygon`]).
     pub fn push(&mut self, vertices: &[Vertex<N>], primitive: u64) {
+        self.push_from(vertices.iter().copied(), primitive);
+    }
+
+    /// Appends a shape whose vertices `vertices` yields, written straight into the batch
+    /// (no staging buffer).
+    pub fn push_from(&mut self, vertices: impl IntoIterator<Item = Vertex<N>>, primitive: u64) {
         let start = self.vertices.len();
-        self.vertices.extend_from_slice(vertices);
+        self.vertices.extend(vertices);
         self.shapes.push(Shape {
             start,
             end: self.vertices.len(),

@@ -50,7 +50,7 @@ use crate::projection::ProjectionTriangleCache;
 pub const MEETING_TOL: f64 = 1e-9;
 
 /// How far (relative to the scale of its terms) a box's least or greatest value of a
-/// half-space must be from zero for [`CentralProjection::box_side`] to decide for every
+/// half-space must be from zero for [`BoxTest::side`] to decide for every
 /// point in the box: far above the rounding of the two ways the value is computed (per
 /// vertex and per box), so the box test never contradicts the vertices' own.
 const BOX_MARGIN: f64 = 1e-9;
@@ -71,10 +71,22 @@ pub struct CentralProjection {
     u: DVec3,
     v: DVec3,
     w: DVec3,
-    /// The scale of the half-spaces' terms for [`Self::box_side`]'s margin: `(2 + m)` (the
-    /// largest coefficient sum in `sides`) times the sum of the absolute values of the
-    /// components of `u`, `v` and `w` (at least their lengths).
-    box_scale: f64,
+}
+
+/// The box test of a [`CentralProjection`] ([`BoxTest::side`]), its terms formed once per
+/// cull rather than at every node of the cull tree, and kept out of the projection itself
+/// (every projection triangle carries one's room, whose memory a small frame pays for).
+#[derive(Debug, Clone, Copy)]
+pub struct BoxTest {
+    focus: DVec3,
+    /// The scale of the half-spaces' terms for the margin: `(2 + m)` (the largest
+    /// coefficient sum in `sides`) times the sum of the absolute values of the components of
+    /// `u`, `v` and `w` (at least their lengths).
+    scale: f64,
+    /// The near cone's half-spaces of [`ClipPoint::sides`] (bits 0 to 4) as `normal . y +
+    /// offset >= 0`, each `(normal, |normal|, offset)` with the absolute values of the
+    /// normal's components.
+    near_half_spaces: [(DVec3, DVec3, f64); 5],
 }
 
 /// A scene triangle reaching the focus: its image through a central projection is not a
@@ -115,14 +127,12 @@ impl CentralProjection {
         let (gu, gv) = (e2.cross(normal) / area2, normal.cross(e1) / area2);
         let to_focus = focus - p[0];
         let (u, v) = (gu + gu.dot(to_focus) * w, gv + gv.dot(to_focus) * w);
-        let terms = [u, v, w].map(|a| a.abs().element_sum());
         Some(CentralProjection {
             focus,
             depth,
             u,
             v,
             w,
-            box_scale: (2.0 + DOMAIN_MARGIN) * (terms[0] + terms[1] + terms[2]),
         })
     }
 
@@ -147,59 +157,16 @@ impl CentralProjection {
     /// starts.
     pub const ALL_SIDES: u32 = NEAR_CONE | FAR_CONE;
 
-    /// The hierarchical form of [`Self::culled`] for `cull_tree`: [`BoxSide::Outside`] only
-    /// when every point of the axis-aligned box (centre and half-extents) is outside one
-    /// half-space of each cone by more than [`BOX_MARGIN`] of the scale, so that every
-    /// scene vertex in it has those bits in its [`Self::outside`] mask and every triangle
-    /// in it would be culled one by one too (the tree culls no pair the vertices keep).
-    /// Otherwise [`BoxSide::Within`] the half-spaces of `active` that do not hold the whole
-    /// box by that margin (no point below can be outside the others). Degenerate boxes: a
-    /// box of zero extent is tested like any other; one with a non-finite coordinate is
-    /// never outside (its comparisons fail).
-    pub fn box_side(&self, centre: DVec3, half: DVec3, active: u32) -> BoxSide {
-        let y = centre - self.focus;
-        // The sums of absolute values bound the lengths (no square root per node).
-        let margin =
-            BOX_MARGIN * (self.box_scale * (y.abs().element_sum() + half.element_sum()) + 1.0);
-        let (mut outside, mut inside) = (0, 0);
-        for (k, (normal, offset)) in self.near_half_spaces().into_iter().enumerate() {
-            let middle = normal.dot(y) + offset;
-            let reach = normal.abs().dot(half);
-            // The near cone's half-space `k`, and the far cone's that is its negation
-            // (`k + 5` for the domain planes, 8 for `w >= 0`; none for the view plane).
-            let far = match k {
-                0..=2 => 1 << (k + 5),
-                4 => 1 << 8,
-                _ => 0,
-            };
-            if middle + reach < -margin {
-                outside |= 1 << k;
-                inside |= far;
-            }
-            if middle - reach > margin {
-                inside |= 1 << k;
-                outside |= far;
-            }
+    /// The terms of its box test ([`BoxTest::side`]), for one cull.
+    pub fn box_test(&self) -> BoxTest {
+        let (u, v, w) = (self.u, self.v, self.w);
+        let terms = [u, v, w].map(|a| a.abs().element_sum());
+        BoxTest {
+            focus: self.focus,
+            scale: (2.0 + DOMAIN_MARGIN) * (terms[0] + terms[1] + terms[2]),
+            near_half_spaces: near_half_spaces(u, v, w)
+                .map(|(normal, offset)| (normal, normal.abs(), offset)),
         }
-        let outside = outside & active;
-        if outside & NEAR_CONE != 0 && outside & FAR_CONE != 0 {
-            BoxSide::Outside
-        } else {
-            BoxSide::Within(active & !inside)
-        }
-    }
-
-    /// The near cone's half-spaces of [`ClipPoint::sides`] (bits 0 to 4) as `normal . y +
-    /// offset >= 0`; the far cone's are the first three and the last turned round.
-    fn near_half_spaces(&self) -> [(DVec3, f64); 5] {
-        let m = DOMAIN_MARGIN;
-        [
-            (self.u + m * self.w, 0.0),
-            (self.v + m * self.w, 0.0),
-            ((1.0 + m) * self.w - self.u - self.v, 0.0),
-            (-self.w, 1.0),
-            (self.w, 0.0),
-        ]
     }
 
     /// The point `y = X - F` with its homogeneous coordinates `u w`, `v w` and `w` (module
@@ -369,6 +336,63 @@ fn push_distinct(out: &mut Vec<ClipPoint>, p: ClipPoint) {
     }
 }
 
+impl BoxTest {
+    /// The hierarchical form of [`CentralProjection::culled`] for `cull_tree`:
+    /// [`BoxSide::Outside`] only when every point of the axis-aligned box (centre and
+    /// half-extents) is outside one half-space of each cone by more than [`BOX_MARGIN`] of
+    /// the scale, so that every scene vertex in it has those bits in its
+    /// [`CentralProjection::outside`] mask and every triangle in it would be culled one by
+    /// one too (the tree culls no pair the vertices keep). Otherwise [`BoxSide::Within`] the
+    /// half-spaces of `active` that do not hold the whole box by that margin (no point below
+    /// can be outside the others). Degenerate boxes: a box of zero extent is tested like any
+    /// other; one with a non-finite coordinate is never outside (its comparisons fail).
+    pub fn side(&self, centre: DVec3, half: DVec3, active: u32) -> BoxSide {
+        let y = centre - self.focus;
+        // The sums of absolute values bound the lengths (no square root per node).
+        let margin = BOX_MARGIN * (self.scale * (y.abs().element_sum() + half.element_sum()) + 1.0);
+        let (mut outside, mut inside) = (0, 0);
+        for (k, &(normal, size, offset)) in self.near_half_spaces.iter().enumerate() {
+            let middle = normal.dot(y) + offset;
+            let reach = size.dot(half);
+            // The near cone's half-space `k`, and the far cone's that is its negation
+            // (`k + 5` for the domain planes, 8 for `w >= 0`; none for the view plane).
+            let far = match k {
+                0..=2 => 1 << (k + 5),
+                4 => 1 << 8,
+                _ => 0,
+            };
+            if middle + reach < -margin {
+                outside |= 1 << k;
+                inside |= far;
+            }
+            if middle - reach > margin {
+                inside |= 1 << k;
+                outside |= far;
+            }
+        }
+        let outside = outside & active;
+        if outside & NEAR_CONE != 0 && outside & FAR_CONE != 0 {
+            BoxSide::Outside
+        } else {
+            BoxSide::Within(active & !inside)
+        }
+    }
+}
+
+/// The near cone's half-spaces of [`ClipPoint::sides`] (bits 0 to 4) for the terms `u`,
+/// `v`, `w` of a [`CentralProjection`], as `normal . y + offset >= 0`; the far cone's are
+/// the first three and the last turned round.
+fn near_half_spaces(u: DVec3, v: DVec3, w: DVec3) -> [(DVec3, f64); 5] {
+    let m = DOMAIN_MARGIN;
+    [
+        (u + m * w, 0.0),
+        (v + m * w, 0.0),
+        ((1.0 + m) * w - u - v, 0.0),
+        (-w, 1.0),
+        (w, 0.0),
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -455,8 +479,11 @@ mod tests {
         let all = CentralProjection::ALL_SIDES;
         // The cones open along the base's normal (z): a box far to the side of the focus.
         let side = focus + V(20.0, 0.0, 0.0);
-        assert_eq!(c.box_side(side, V(1.0, 1.0, 1.0), all), BoxSide::Outside);
-        let BoxSide::Within(active) = c.box_side(focus, V(0.5, 0.5, 0.5), all) else {
+        assert_eq!(
+            c.box_test().side(side, V(1.0, 1.0, 1.0), all),
+            BoxSide::Outside
+        );
+        let BoxSide::Within(active) = c.box_test().side(focus, V(0.5, 0.5, 0.5), all) else {
             panic!("a box around the focus is culled");
         };
         assert_eq!(
@@ -466,10 +493,10 @@ mod tests {
         );
         let infinite = V(f64::INFINITY, 1.0, 1.0);
         assert!(matches!(
-            c.box_side(side, infinite, all),
+            c.box_test().side(side, infinite, all),
             BoxSide::Within(_)
         ));
-        let point = c.box_side(side, DVec3::ZERO, all) == BoxSide::Outside;
+        let point = c.box_test().side(side, DVec3::ZERO, all) == BoxSide::Outside;
         assert_eq!(point, CentralProjection::culled(c.outside(side)));
         assert!(point);
     }
@@ -582,7 +609,7 @@ mod tests {
                 .map(|f| centre + f * half)
                 .collect();
             let masks: Vec<u16> = points.iter().map(|&x| c.outside(x)).collect();
-            match c.box_side(centre, half, CentralProjection::ALL_SIDES) {
+            match c.box_test().side(centre, half, CentralProjection::ALL_SIDES) {
                 BoxSide::Outside => {
                     let common = masks.iter().fold(u16::MAX, |m, &x| m & x);
                     prop_assert!(CentralProjection::culled(common), "{masks:?}");

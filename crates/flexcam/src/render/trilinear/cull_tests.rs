@@ -95,7 +95,7 @@ fn kept_one_by_one(triangles: &[ProjectionTriangle], scene: &SceneGeometry) -> V
                 None => {
                     let common = vertices
                         .iter()
-                        .fold(u32::MAX, |m, &x| m & triangle.bounds.outside(x));
+                        .fold(u32::MAX, |m, &x| m & triangle.bounds().outside(x));
                     common != 0
                 }
             };

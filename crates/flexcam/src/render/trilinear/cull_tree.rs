@@ -141,7 +141,7 @@ impl CullTree {
     /// [`Self::visit`] with any box test: `side` tells of a node's box (centre and
     /// half-extents) whether everything in it is culled, given the planes (bit mask) that
     /// still cut its parent's box, `all` at the root. For the central projections' cones
-    /// (`CentralProjection::box_side`), which are no volume bounds.
+    /// (`BoxTest::side`), which are no volume bounds.
     pub fn visit_boxes(
         &self,
         all: u32,

@@ -38,8 +38,11 @@ pub struct ProjectionTriangle {
     /// The surfaces swept by the three edges, in the order of their domain lines `u = 0`
     /// (vertices 1-3), `v = 0` (vertices 1-2) and `u + v = 1` (vertices 2-3).
     pub surfaces: [EdgeSurface; 3],
-    /// Bounding planes of the volume its rays sweep at `t >= 0` (the cull).
-    pub bounds: VolumeBounds,
+    /// Its base points and ray directions, from which the cull forms its bounding planes
+    /// ([`Self::bounds`]) once per render: stored, the planes (about 850 bytes) made the
+    /// projection triangles the largest piece of fresh memory a small frame touches.
+    base: [DVec3; 3],
+    directions: [DVec3; 3],
     /// Whether the renderer ray casts its pixels instead of projecting the scene into it
     /// (set by the renderer, which knows the scene's depth; false from [`Self::new`]): it
     /// then has no live pairs.
@@ -70,12 +73,18 @@ impl ProjectionTriangle {
                 EdgeSurface::new(vertex(0), vertex(1)),
                 EdgeSurface::new(vertex(1), vertex(2)),
             ],
-            bounds: VolumeBounds::new(p, n),
+            base: p,
+            directions: n,
             ray_cast: false,
             central: None,
             fan: None,
             degenerate: map.cache().degenerate_depths(),
         }
+    }
+
+    /// Bounding planes of the volume its rays sweep at `t >= 0` (the cull).
+    pub fn bounds(&self) -> VolumeBounds {
+        VolumeBounds::new(self.base, self.directions)
     }
 }
 

@@ -213,7 +213,7 @@ pub fn live_pairs(
     if let Some(central) = &triangle.central {
         return central_live_pairs(central, index, scene, cache);
     }
-    let bounds = &triangle.bounds;
+    let bounds = triangle.bounds();
     let projector = triangle.map.cache();
     cache.next_generation();
     let (mut live, mut counts) = no_pairs_yet(index, scene);
@@ -221,7 +221,7 @@ pub fn live_pairs(
     kept.clear();
     counts.culled_tree = scene
         .tree
-        .visit(bounds, |cluster, cutting| kept.push((cluster, cutting)));
+        .visit(&bounds, |cluster, cutting| kept.push((cluster, cutting)));
     counts.culled_volume = counts.culled_tree;
     kept.sort_unstable();
     let generation = cache.generation;
@@ -290,8 +290,9 @@ fn no_pairs_yet(index: u32, scene: &SceneGeometry) -> (LivePairs, PairCounts) {
 /// region) cover only loosely, so the scene's triangles are culled by the cones' own
 /// planes instead ([`CentralProjection::culled`]), hierarchically as the volume cull: the
 /// tree skips the subtrees whose boxes are outside one plane of each cone
-/// ([`CentralProjection::box_side`], which culls no pair the vertices keep), and the
-/// triangles of the clusters left are tested by their vertices' masks, each computed once.
+/// ([`BoxTest::side`](super::central::BoxTest::side), which culls no pair the vertices
+/// keep), and the triangles of the clusters left are tested by their vertices' masks, each
+/// computed once.
 /// No cubic is solved: the pairs' `solved` are [`NOT_SOLVED`].
 fn central_live_pairs(
     central: &CentralProjection,
@@ -303,9 +304,10 @@ fn central_live_pairs(
     let (mut live, mut counts) = no_pairs_yet(index, scene);
     let mut kept = std::mem::take(&mut cache.clusters);
     kept.clear();
+    let box_test = central.box_test();
     counts.culled_tree = scene.tree.visit_boxes(
         CentralProjection::ALL_SIDES,
-        |centre, half, active| central.box_side(centre, half, active),
+        |centre, half, active| box_test.side(centre, half, active),
         |cluster, _| kept.push((cluster, 0)),
     );
     counts.culled_volume = counts.culled_tree;

@@ -222,8 +222,10 @@ impl Drawn {
         triangles: &[ProjectionTriangle],
         scene: &SceneGeometry,
     ) -> PolygonBatch<TERMS> {
-        let mut polygons = PolygonBatch::new();
-        let mut pixels = Vec::new();
+        let mut polygons = PolygonBatch::with_capacity(
+            parts.iter().map(|part| part.points.len()).sum(),
+            parts.iter().map(|part| part.shapes.len()).sum(),
+        );
         for part in parts {
             let mut start = 0;
             for shape in &part.shapes {
@@ -233,14 +235,13 @@ impl Drawn {
                 let map = &triangles[shape.projection as usize].map;
                 // Only pairs with a plane are drawn (`draw_pairs`).
                 let terms = scene.hit_terms[k].expect("a drawn scene triangle has a plane");
-                pixels.clear();
-                pixels.extend(outline.iter().map(|p| {
+                let pixels = outline.iter().map(|p| {
                     let pixel = map.pixel(p.u, p.v);
                     Vertex::new(pixel.x, pixel.y, p.t, terms.at(map, p.u, p.v))
-                }));
+                });
                 let tested = if shape.tested { PIXEL_TESTED } else { 0 };
                 let key = (u64::from(shape.projection) << 32) | k as u64 | tested;
-                polygons.push(&pixels, key);
+                polygons.push_from(pixels, key);
             }
         }
         polygons
