@@ -678,6 +678,22 @@ fn check_size(main: &Frame, other: &Frame) -> Result<()> {
     Ok(())
 }
 
+/// The exact reference of a reflector scene's render: `scene` without trilinear reflectors
+/// (its mirrors and glass by exact secondary rays), ray cast flat through `main`.
+#[cfg(test)]
+pub fn exact_flat_reference(scene: &Scene, main: &dyn Projection) -> Frame {
+    let mut exact = scene.clone();
+    exact.trilinear_reflectors.clear();
+    let options = RenderOptions {
+        method: Method::Raycast,
+        shading: Shading::Flat,
+        ..RenderOptions::default()
+    };
+    crate::render::render(&PreparedScene::new(&exact), main, &options)
+        .unwrap()
+        .frame
+}
+
 pub mod atlas;
 pub mod camera_mesh;
 pub mod env_map;

@@ -404,20 +404,9 @@ fn application_scenes_match_the_exact_ray_caster() {
             &options(Shading::Flat, Bound::Tight),
         )
         .unwrap();
-        let mut exact = scene.clone();
-        exact.trilinear_reflectors.clear();
-        let reference = crate::render::render(
-            &PreparedScene::new(&exact),
-            main.as_ref(),
-            &RenderOptions {
-                method: Method::Raycast,
-                shading: Shading::Flat,
-                ..RenderOptions::default()
-            },
-        )
-        .unwrap();
-        let inside = id_agreement_inside(&ours.frame, &reference.frame);
-        let c = compare(&ours.frame, &reference.frame).unwrap();
+        let reference = crate::render::composite::exact_flat_reference(&scene, main.as_ref());
+        let inside = id_agreement_inside(&ours.frame, &reference);
+        let c = compare(&ours.frame, &reference).unwrap();
         println!("{name}: ids inside {inside:.5}, {c:?}");
         assert!(inside >= 0.99, "{name}: {inside}");
         assert!(c.relative_rgb_error < max_rgb, "{name}: {c:?}");

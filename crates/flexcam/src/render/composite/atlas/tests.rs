@@ -75,18 +75,8 @@ fn atlas_reflections_match_the_exact_ray_caster() {
         };
         let ours =
             crate::render::render(&PreparedScene::new(&scene), main.as_ref(), &options).unwrap();
-        let mut exact = scene.clone();
-        exact.trilinear_reflectors.clear();
-        let reference = crate::render::render(
-            &PreparedScene::new(&exact),
-            main.as_ref(),
-            &RenderOptions {
-                method: Method::Raycast,
-                ..options
-            },
-        )
-        .unwrap();
-        let c = compare(&ours.frame, &reference.frame).unwrap();
+        let reference = super::super::exact_flat_reference(&scene, main.as_ref());
+        let c = compare(&ours.frame, &reference).unwrap();
         let counter = |key: &str| match ours.counters.get(key) {
             Some(Counter::Count(n)) => *n,
             other => panic!("{name} {key}: {other:?}"),
