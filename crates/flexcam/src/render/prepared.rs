@@ -367,12 +367,7 @@ impl PreparedScene {
             self.fast_unless_outside(rays[2]),
             self.fast_unless_outside(rays[3]),
         ];
-        let fast_rays = [
-            fast[0].as_ref(),
-            fast[1].as_ref(),
-            fast[2].as_ref(),
-            fast[3].as_ref(),
-        ];
+        let fast_rays = fast.each_ref().map(Option::as_ref);
         let found = match &self.shown {
             None => self.bvh.closest4(fast_rays, &AllTriangles),
             Some(mask) => closest4_shown(&self.bvh, fast_rays, mask),
@@ -452,12 +447,7 @@ impl PreparedScene {
             rays[2].and_then(FastRay::new),
             rays[3].and_then(FastRay::new),
         ];
-        let lanes = [
-            fast[0].as_ref(),
-            fast[1].as_ref(),
-            fast[2].as_ref(),
-            fast[3].as_ref(),
-        ];
+        let lanes = fast.each_ref().map(Option::as_ref);
         let blocked = match &self.shown {
             None => self.bvh.occluded4(lanes, &AllTriangles),
             Some(mask) => occluded4_shown(&self.bvh, lanes, mask),
