@@ -144,6 +144,27 @@ pub trait Projection: Send + Sync {
         *out = self.projector(pixel);
     }
 
+    /// Sets `out[j * stride + i]` to [`Projection::projector`] of pixel position
+    /// `(columns[i], rows[j])`, for every column `i` and row `j` (`out` holds at least
+    /// `(rows.len() - 1) * stride + columns.len()` entries; the others are left alone). The
+    /// same projectors as one [`Projection::projector_into`] call per position, which the
+    /// default makes; a projection whose projector is separable in x and y (longitude by
+    /// column, latitude by row) computes its trigonometry once per column and per row
+    /// instead of per pixel: the raster's pixel projectors for a whole tile come from here.
+    fn projector_grid_into(
+        &self,
+        columns: &[f64],
+        rows: &[f64],
+        stride: usize,
+        out: &mut [Option<Projector>],
+    ) {
+        for (j, &y) in rows.iter().enumerate() {
+            for (i, &x) in columns.iter().enumerate() {
+                self.projector_into(DVec2::new(x, y), &mut out[j * stride + i]);
+            }
+        }
+    }
+
     /// A bound on the projectors of every sample position in the closed pixel-space
     /// rectangle `[lo, hi]`, each of which has a projector (see [`ProjectorHull`]): lets a
     /// renderer cull a whole tile at once. `None` (the default) where the projection cannot

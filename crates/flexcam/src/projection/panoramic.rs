@@ -12,8 +12,8 @@ use super::chart::{axis_poles, InverseChart};
 use super::image_coords::Resolution;
 use super::params::{angle_radians, UpTo};
 use super::{
-    AnalyticInverse, BranchImage, CameraFrame, ImagePoint, NoInverse, Projection, SingleImage,
-    Trilinear,
+    AnalyticInverse, BranchImage, CameraFrame, ImagePoint, NoInverse, Projection, Projector,
+    SingleImage, Trilinear,
 };
 use crate::error::Result;
 use crate::geometry::Ray;
@@ -90,6 +90,34 @@ impl Projection for Equirectangular {
         let h = lat.cos() * horizontal(lon);
         let direction = self.basis.to_world(DVec3::new(h.x, lat.sin(), h.y));
         Some(Ray::new(self.basis.origin, direction))
+    }
+
+    /// Longitude depends on the column alone and latitude on the row alone: their sines and
+    /// cosines are taken once per column and per row, then combined exactly as
+    /// [`Equirectangular::ray`] combines them (the same bits).
+    fn projector_grid_into(
+        &self,
+        columns: &[f64],
+        rows: &[f64],
+        stride: usize,
+        out: &mut [Option<Projector>],
+    ) {
+        let longitudes: Vec<DVec2> = columns
+            .iter()
+            .map(|&x| {
+                horizontal(self.resolution.centred(DVec2::new(x, 0.0)).x * self.radians_per_pixel.x)
+            })
+            .collect();
+        for (j, &y) in rows.iter().enumerate() {
+            let lat = self.resolution.centred(DVec2::new(0.0, y)).y * self.radians_per_pixel.y;
+            let (sin, cos) = (lat.sin(), lat.cos());
+            for (i, h) in longitudes.iter().enumerate() {
+                let h = cos * *h;
+                let direction = self.basis.to_world(DVec3::new(h.x, sin, h.y));
+                out[j * stride + i] =
+                    Some(Projector::Straight(Ray::new(self.basis.origin, direction)));
+            }
+        }
     }
 
     fn inverse(&self) -> std::result::Result<&dyn AnalyticInverse, NoInverse> {
@@ -191,6 +219,35 @@ impl Projection for Cylindrical {
         Some(Ray::new(self.basis.origin, direction))
     }
 
+    /// Longitude depends on the column alone: its sine and cosine are taken once per column
+    /// and combined with each row's height exactly as [`Cylindrical::ray`] does (the same
+    /// bits).
+    fn projector_grid_into(
+        &self,
+        columns: &[f64],
+        rows: &[f64],
+        stride: usize,
+        out: &mut [Option<Projector>],
+    ) {
+        let longitudes: Vec<DVec2> = columns
+            .iter()
+            .map(|&x| {
+                horizontal(self.resolution.centred(DVec2::new(x, 0.0)).x * self.radians_per_pixel)
+            })
+            .collect();
+        for (j, &y) in rows.iter().enumerate() {
+            let height = self.resolution.centred(DVec2::new(0.0, y)).y * self.height_per_pixel;
+            for (i, h) in longitudes.iter().enumerate() {
+                let direction = self
+                    .basis
+                    .to_world(DVec3::new(h.x, height, h.y))
+                    .normalize();
+                out[j * stride + i] =
+                    Some(Projector::Straight(Ray::new(self.basis.origin, direction)));
+            }
+        }
+    }
+
     fn inverse(&self) -> std::result::Result<&dyn AnalyticInverse, NoInverse> {
         Ok(self)
     }
@@ -232,6 +289,61 @@ impl SingleImage for Cylindrical {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    /// The projectors of a grid of positions, as `projector_grid_into` writes them into a
+    /// buffer of `stride` columns, against one `projector` call per position: equal bit
+    /// for bit, and the entries past each row's columns untouched.
+    fn grid_is_per_pixel(projection: &dyn Projection, columns: &[f64], rows: &[f64]) {
+        let stride = columns.len() + 2;
+        let marker = Some(Projector::Straight(Ray::new(DVec3::ONE, DVec3::ONE)));
+        let mut out = vec![marker.clone(); rows.len() * stride];
+        projection.projector_grid_into(columns, rows, stride, &mut out);
+        for (j, &y) in rows.iter().enumerate() {
+            for (i, &x) in columns.iter().enumerate() {
+                let want = projection.projector(DVec2::new(x, y));
+                assert_eq!(out[j * stride + i], want, "({x}, {y})");
+            }
+            for i in columns.len()..stride {
+                assert_eq!(out[j * stride + i], marker);
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(300))]
+        /// Per-column and per-row trigonometry gives the per-pixel projectors exactly, at
+        /// any field of view, frame and image size, including positions outside the image.
+        #[test]
+        fn grid_projectors_are_the_per_pixel_ones(
+            h_fov in 1.0f64..=360.0,
+            v_fov in 1.0f64..179.0,
+            (width, height) in (1u32..400, 1u32..300),
+            look in (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0),
+            x0 in -20.0f64..420.0,
+            y0 in -20.0f64..320.0,
+        ) {
+            let look_at = DVec3::new(look.0, look.1, look.2);
+            prop_assume!(look_at.length() > 0.1 && look_at.cross(DVec3::Y).length() > 0.05);
+            let frame = CameraFrame { position: DVec3::ZERO, look_at, up: DVec3::Y };
+            let columns: Vec<f64> = (0..7).map(|i| x0 + 1.37 * f64::from(i)).collect();
+            let rows: Vec<f64> = (0..5).map(|j| y0 + 0.91 * f64::from(j)).collect();
+            let e = Equirectangular::new(&frame, h_fov, v_fov, width, height).unwrap();
+            grid_is_per_pixel(&e, &columns, &rows);
+            let c = Cylindrical::new(&frame, h_fov, v_fov, width, height).unwrap();
+            grid_is_per_pixel(&c, &columns, &rows);
+        }
+    }
+
+    /// Degenerate grids: no columns or no rows write nothing.
+    #[test]
+    fn empty_grids_write_nothing() {
+        let e = Equirectangular::new(&frame(), 360.0, 180.0, 36, 18).unwrap();
+        let mut out = vec![None; 4];
+        e.projector_grid_into(&[], &[1.5, 2.5], 2, &mut out);
+        e.projector_grid_into(&[1.5, 2.5], &[], 2, &mut out);
+        assert!(out.iter().all(Option::is_none));
+    }
 
     fn frame() -> CameraFrame {
         CameraFrame {

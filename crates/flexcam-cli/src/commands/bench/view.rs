@@ -23,6 +23,10 @@ pub struct ViewBenchArgs {
     /// orbiting half a degree a frame.
     #[arg(long)]
     presets: bool,
+    /// Only the cases whose name contains this text (e.g. `equirectangular`, `fisheye`);
+    /// refused when none does.
+    #[arg(long, value_name = "TEXT")]
+    case: Option<String>,
 }
 
 /// The viewer's image size in the frame-rate target.
@@ -243,6 +247,23 @@ fn run_cases(args: &ViewBenchArgs, dir: &std::path::Path) -> Result<()> {
         preset_cases()
     } else {
         cases()
+    };
+    let cases: Vec<Case> = match &args.case {
+        None => cases,
+        Some(text) => {
+            let names: Vec<&str> = cases.iter().map(|c| c.name).collect();
+            let chosen: Vec<Case> = cases
+                .into_iter()
+                .filter(|c| c.name.contains(text.as_str()))
+                .collect();
+            if chosen.is_empty() {
+                return Err(Error::new(format!(
+                    "--case {text:?} names no case; the cases are: {}",
+                    names.join("; ")
+                )));
+            }
+            chosen
+        }
     };
     for (i, case) in cases.into_iter().enumerate() {
         let replace = !case.keys.is_empty();

@@ -16,7 +16,7 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, OnceLock};
 
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 
 use crate::projection::{Projection, Projector};
 
@@ -92,19 +92,22 @@ impl<'a> PixelRays<'a> {
             .pop();
         let mut tile = spare.unwrap_or_else(|| (0..TILE * TILE).map(|_| None).collect());
         let (width, height) = self.size;
+        let (x0, y0) = (tx * TILE, ty * TILE);
+        let centres =
+            |from: u32, to: u32| -> Vec<f64> { (from..to).map(|v| f64::from(v) + 0.5).collect() };
+        let columns = centres(x0, (x0 + TILE).min(width));
+        let rows = centres(y0, (y0 + TILE).min(height));
+        self.projection
+            .projector_grid_into(&columns, &rows, TILE as usize, &mut tile);
         for (k, out) in (0..TILE * TILE).zip(tile.iter_mut()) {
-            let (x, y) = (tx * TILE + k % TILE, ty * TILE + k / TILE);
-            if x >= width || y >= height {
-                *out = None;
-                continue;
-            }
-            let centre = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-            self.projection.projector_into(centre, out);
-            let seen = out.as_ref().is_some_and(|p| match p {
-                Projector::Straight(r) => r.direction != DVec3::ZERO,
-                Projector::Polyline(points) => points.windows(2).any(|w| w[0] != w[1]),
-                Projector::QuadraticBezier(_) => true,
-            });
+            let (x, y) = (x0 + k % TILE, y0 + k / TILE);
+            let seen = x < width
+                && y < height
+                && out.as_ref().is_some_and(|p| match p {
+                    Projector::Straight(r) => r.direction != DVec3::ZERO,
+                    Projector::Polyline(points) => points.windows(2).any(|w| w[0] != w[1]),
+                    Projector::QuadraticBezier(_) => true,
+                });
             if !seen {
                 *out = None;
             }
@@ -117,6 +120,7 @@ impl<'a> PixelRays<'a> {
 mod tests {
     use super::*;
     use crate::projection::{CameraFrame, ProjectionSpec};
+    use glam::DVec2;
 
     #[test]
     fn rays_are_the_projections_and_computed_only_where_asked() {
