@@ -5,7 +5,10 @@
 //! A job (a prepared scene, a projection and the view's settings) goes through a ladder of
 //! stages ([`stages`]):
 //! 1. a preview by the fast method: `trilinear` for trilinear projections, `raster` for
-//!    projections with an analytic inverse, otherwise the ray caster at a reduced size;
+//!    projections with an analytic inverse, otherwise the ray caster at a reduced size; a
+//!    raster preview is drawn at the size that fits one 60 Hz display frame
+//!    ([`PREVIEW_BUDGET_MS`], judged by the last raster preview's time per pixel), and
+//!    when that is reduced, again at full size as the next stage;
 //! 2. the final frame: the view's method at the scene's size and samples per pixel, the frame
 //!    `flexcam render` draws with the same method, shading and `--spp`;
 //! 3. a supersampled ray-cast refinement, for the window only, when the view's method is the
@@ -103,18 +106,25 @@ pub struct Shown {
     pub rgba: Arc<Vec<u8>>,
 }
 
-/// The stages a job goes through, in order (see the module docs).
-pub fn stages(projection: &dyn Projection, settings: &Settings) -> Vec<Stage> {
+/// The stages a job goes through, in order (see the module docs); `raster_ms_per_pixel` is
+/// the wall time per pixel of the last raster preview of the loop, if any.
+pub fn stages(
+    projection: &dyn Projection,
+    settings: &Settings,
+    raster_ms_per_pixel: Option<f64>,
+) -> Vec<Stage> {
     let mut ladder = Vec::new();
     if settings.method == Method::Raycast {
-        ladder.push(Stage::Preview {
-            method: fast_method(projection),
-            scale: if fast_method(projection) == Method::Raycast {
-                preview_scale(projection.resolution())
-            } else {
-                1
-            },
-        });
+        let method = fast_method(projection);
+        let scale = match method {
+            Method::Raycast => preview_scale(projection.resolution()),
+            Method::Raster => budget_scale(projection.resolution(), raster_ms_per_pixel),
+            _ => 1,
+        };
+        ladder.push(Stage::Preview { method, scale });
+        if scale > 1 && method != Method::Raycast {
+            ladder.push(Stage::Preview { method, scale: 1 });
+        }
     }
     ladder.push(Stage::Final);
     if settings.method == Method::Raycast && settings.refine_spp > settings.spp {
@@ -148,6 +158,31 @@ fn preview_scale((width, height): (u32, u32)) -> u32 {
 /// The most pixels of a ray-cast preview (a quarter of 1280 x 720).
 const PREVIEW_PIXELS: u64 = 230_400;
 
+/// The wall time a raster preview aims at: one frame of a 60 Hz display, so that a drag
+/// keeps up with the pointer.
+pub const PREVIEW_BUDGET_MS: f64 = 1000.0 / 60.0;
+
+/// The largest raster preview divisor of the image sides: half size still shows the
+/// composition being designed, and below it the scene's fixed costs per frame (projecting
+/// every vertex, building the pieces) rather than the pixels set the time.
+const MAX_BUDGET_SCALE: u32 = 2;
+
+/// The divisor of the image sides for a raster preview: the smallest (1 to
+/// [`MAX_BUDGET_SCALE`]) whose pixels, at `ms_per_pixel` each, fit [`PREVIEW_BUDGET_MS`];
+/// 1 before any raster preview was timed. A time per pixel measured on a reduced frame
+/// carries that frame's fixed costs (the scene's vertices are projected whatever the size),
+/// so it overestimates a larger frame: the scale errs towards smaller previews, never
+/// towards missing the budget.
+fn budget_scale((width, height): (u32, u32), ms_per_pixel: Option<f64>) -> u32 {
+    let Some(cost) = ms_per_pixel.filter(|c| c.is_finite() && *c > 0.0) else {
+        return 1;
+    };
+    let pixels = f64::from(width) * f64::from(height);
+    (1..=MAX_BUDGET_SCALE)
+        .find(|&s| cost * pixels / f64::from(s * s) <= PREVIEW_BUDGET_MS)
+        .unwrap_or(MAX_BUDGET_SCALE)
+}
+
 /// The render loop: a worker thread and what it shares with its owner.
 pub struct RenderLoop {
     shared: Arc<Shared>,
@@ -173,6 +208,8 @@ struct State {
     done: Option<(u64, Option<Error>)>,
     /// Changes whenever `shown` does (for a display to see that it must upload).
     shown_count: u64,
+    /// Wall milliseconds per pixel of the last raster preview (see [`budget_scale`]).
+    raster_ms_per_pixel: Option<f64>,
     quit: bool,
 }
 
@@ -366,7 +403,8 @@ fn work(shared: &Shared) {
 /// failed preview is skipped (the final stage says what the method refuses); a failed final
 /// stage ends the ladder with its error.
 fn run_ladder(shared: &Shared, job: &Job) -> Result<()> {
-    for (k, stage) in stages(job.projection.as_ref(), &job.settings)
+    let raster_ms_per_pixel = shared.lock().raster_ms_per_pixel;
+    for (k, stage) in stages(job.projection.as_ref(), &job.settings, raster_ms_per_pixel)
         .into_iter()
         .enumerate()
     {
@@ -394,6 +432,14 @@ fn run_ladder(shared: &Shared, job: &Job) -> Result<()> {
             rgba: Arc::new(rgba(&frame, job.settings.shading)?),
         };
         let mut state = shared.lock();
+        if let Stage::Preview {
+            method: Method::Raster,
+            ..
+        } = stage
+        {
+            let pixels = f64::from(frame.width) * f64::from(frame.height);
+            state.raster_ms_per_pixel = Some(ms / pixels.max(1.0));
+        }
         if stage == Stage::Final {
             state.final_frame = Some((job.generation, frame));
         } else if let Ok(frame) = Arc::try_unwrap(frame) {
@@ -535,5 +581,108 @@ impl Projection for Cancellable<'_> {
 
     fn trilinear(&self) -> Option<&Trilinear> {
         self.inner.trilinear()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use flexcam::projection::CameraFrame;
+    use glam::DVec3;
+
+    fn perspective(width: u32, height: u32) -> Arc<dyn Projection> {
+        let frame = CameraFrame {
+            position: DVec3::new(0.0, 1.0, 5.0),
+            look_at: DVec3::ZERO,
+            up: DVec3::Y,
+        };
+        let projection = ProjectionSpec::Perspective { frame, fov: 60.0 }
+            .build(width, height)
+            .unwrap();
+        Arc::from(projection)
+    }
+
+    /// The smallest divisor that fits the budget; full size before anything was timed, and
+    /// for a time that is no time (zero, negative, not finite); at most the cap.
+    #[test]
+    fn raster_previews_shrink_to_fit_one_display_frame() {
+        let size = (1280, 720);
+        let pixels = 1280.0 * 720.0;
+        let per_pixel = |ms: f64| Some(ms / pixels);
+        assert_eq!(budget_scale(size, None), 1);
+        assert_eq!(budget_scale(size, per_pixel(10.0)), 1);
+        assert_eq!(budget_scale(size, per_pixel(PREVIEW_BUDGET_MS)), 1);
+        assert_eq!(budget_scale(size, per_pixel(20.0)), 2);
+        assert_eq!(budget_scale(size, per_pixel(4.0 * PREVIEW_BUDGET_MS)), 2);
+        assert_eq!(budget_scale(size, per_pixel(84.0)), MAX_BUDGET_SCALE);
+        assert_eq!(budget_scale(size, per_pixel(1e6)), MAX_BUDGET_SCALE);
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert_eq!(budget_scale(size, Some(bad)), 1, "{bad}");
+        }
+        // A one-pixel image is never divided below the budget it already fits.
+        assert_eq!(budget_scale((1, 1), per_pixel(84.0)), 1);
+    }
+
+    /// A reduced raster preview is followed by the full-size one, then the final frame and
+    /// the refinement; a preview that fits stays alone at full size.
+    #[test]
+    fn a_reduced_preview_is_followed_by_the_full_size_one() {
+        let projection = perspective(1280, 720);
+        let settings = Settings::DEFAULT;
+        let slow = Some(84.0 / (1280.0 * 720.0));
+        let raster = |scale| Stage::Preview {
+            method: Method::Raster,
+            scale,
+        };
+        assert_eq!(
+            stages(projection.as_ref(), &settings, slow),
+            vec![raster(2), raster(1), Stage::Final, Stage::Refine { spp: 4 }]
+        );
+        assert_eq!(
+            stages(projection.as_ref(), &settings, None),
+            vec![raster(1), Stage::Final, Stage::Refine { spp: 4 }]
+        );
+        // Another final method has no preview to shrink.
+        let direct = Settings {
+            method: Method::Raster,
+            ..settings
+        };
+        assert_eq!(
+            stages(projection.as_ref(), &direct, slow),
+            vec![Stage::Final]
+        );
+    }
+
+    /// The render loop times each raster preview (for the next job's scale).
+    #[test]
+    fn the_loop_times_raster_previews() {
+        let scene = flexcam::scene::builtin::load("cube-floor").unwrap();
+        let prepared = Arc::new(PreparedScene::new(&scene));
+        let render_loop = RenderLoop::new();
+        let frame = CameraFrame {
+            position: DVec3::new(0.0, 5.5, 7.0),
+            look_at: DVec3::new(0.0, 0.4, 0.0),
+            up: DVec3::Y,
+        };
+        let spec = ProjectionSpec::Perspective { frame, fov: 50.0 };
+        let projection: Arc<dyn Projection> = Arc::from(spec.build(64, 48).unwrap());
+        render_loop.submit(Job {
+            generation: 1,
+            prepared: Arc::clone(&prepared),
+            spec: spec.clone(),
+            projection,
+            settings: Settings::DEFAULT,
+        });
+        let shown = render_loop.wait_shown(1).unwrap();
+        assert_eq!(
+            shown.stage,
+            Stage::Preview {
+                method: Method::Raster,
+                scale: 1
+            }
+        );
+        render_loop.wait_refined().unwrap();
+        let timed = render_loop.shared.lock().raster_ms_per_pixel;
+        assert!(timed.is_some_and(|t| t > 0.0), "{timed:?}");
     }
 }
