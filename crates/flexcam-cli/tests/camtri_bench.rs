@@ -54,9 +54,10 @@ fn csv(path: &std::path::Path) -> (Vec<String>, Vec<Vec<String>>) {
 
 /// Table 1: three reflection tessellations x two bounds x culling off and on, the caustics
 /// row with its photon map's camera triangles and an overdraw that is bounding over
-/// rendered, and the 5,000-triangle target line.
+/// rendered, the visualisation row's 400 camera triangles around the walker, and the
+/// 5,000-triangle target line.
 #[test]
-fn table_1_has_reflection_and_caustics_rows() {
+fn table_1_has_reflection_caustics_and_visualisation_rows() {
     let dir = TempDir::new().unwrap();
     let out = bench(&dir, &[]);
     let reflection = out
@@ -79,6 +80,22 @@ fn table_1_has_reflection_and_caustics_rows() {
     assert!((row[4] - row[2] / row[3]).abs() < 0.01, "{caustics}");
     assert!(row[7] > 0.0, "cpu ms: {caustics}");
     assert_eq!(&row[8..], [400.0, 2.0, 945962.0, 475852.0, 2.0, 35.0]);
+    let (_, visualisation) = out
+        .split_once("Table 1, visualization")
+        .expect("visualisation row");
+    let row: Vec<f64> = visualisation
+        .lines()
+        .nth(2)
+        .unwrap()
+        .split(['|', ' '])
+        .filter_map(|c| c.parse().ok())
+        .collect();
+    assert_eq!(row.len(), 14, "{visualisation}");
+    // The 400 camera triangles around the walker (6,864 triangles) and the floor (2).
+    assert_eq!(&row[..2], [400.0, 6866.0], "{visualisation}");
+    assert!(row[3] > 0.0 && row[2] >= row[3], "{visualisation}");
+    assert!((row[4] - row[2] / row[3]).abs() < 0.01, "{visualisation}");
+    assert_eq!(&row[8..], [400.0, 6841.0, 213248.0, 213248.0, 1.0, 46.0]);
     assert!(out.contains("Mirror sphere over"), "{out}");
     assert!(out.contains("CPU time of all threads"), "{out}");
 }
