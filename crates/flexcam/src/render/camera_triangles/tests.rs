@@ -91,23 +91,27 @@ fn trilinear_scenes_match_the_ray_caster() {
     }
 }
 
+/// `scene` at `size` by camera triangles, flat, with the paper's bound and the tight one.
+fn both_bounds(scene: &Scene, size: (u32, u32)) -> ((Frame, Stats), (Frame, Stats)) {
+    let projection = scene.projection.build(size.0, size.1).unwrap();
+    let prepared = PreparedScene::new(scene);
+    let run = |bound| {
+        render(
+            &prepared,
+            projection.as_ref(),
+            &options(Shading::Flat, bound),
+        )
+        .unwrap()
+    };
+    (run(Bound::Paper), run(Bound::Tight))
+}
+
 /// The paper's bound and the tight bound give the same rendered fragments (both are exact),
 /// hence the same image; the tight one rasterises fewer bounding fragments.
 #[test]
 fn both_bounds_render_the_same_fragments() {
     for name in TRILINEAR_SCENES {
-        let scene = load(name);
-        let projection = scene.projection.build(160, 120).unwrap();
-        let prepared = PreparedScene::new(&scene);
-        let run = |bound| {
-            render(
-                &prepared,
-                projection.as_ref(),
-                &options(Shading::Flat, bound),
-            )
-        };
-        let (paper, paper_stats) = run(Bound::Paper).unwrap();
-        let (tight, tight_stats) = run(Bound::Tight).unwrap();
+        let ((paper, paper_stats), (tight, tight_stats)) = both_bounds(&load(name), (160, 120));
         assert_eq!(paper, tight, "{name}");
         assert_eq!(
             count(&paper_stats, "rendered_fragments"),
@@ -436,17 +440,7 @@ fn visualisation_around_a_figure_matches_the_ray_caster() {
         assert!(c.depth_mean < 1e-4, "{c:?}");
         assert!(c.relative_rgb_error < 0.005, "{c:?}");
     }
-    let projection = scene.projection.build(width, height).unwrap();
-    let prepared = PreparedScene::new(&scene);
-    let run = |bound| {
-        render(
-            &prepared,
-            projection.as_ref(),
-            &options(Shading::Flat, bound),
-        )
-    };
-    let ((paper, paper_stats), (tight, tight_stats)) =
-        (run(Bound::Paper).unwrap(), run(Bound::Tight).unwrap());
+    let ((paper, paper_stats), (tight, tight_stats)) = both_bounds(&scene, (width, height));
     assert_eq!(paper, tight);
     assert!(count(&tight_stats, "bounding_fragments") < count(&paper_stats, "bounding_fragments"));
     // The walker (object 1) in the middle row of each view: the back at the image's left

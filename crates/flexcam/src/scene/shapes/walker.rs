@@ -36,72 +36,38 @@ impl Part {
             axes: Mat3::from_cols(side * across, half * along, depth * third),
         }
     }
+
+    /// The part's mesh: a unit [`sphere`] of `tessellation` mapped onto the ellipsoid.
+    fn mesh(&self, tessellation: u32) -> Mesh {
+        let mut ellipsoid = sphere(1.0, tessellation);
+        ellipsoid.transform(&Affine3A::from_mat3_translation(self.axes, self.centre));
+        ellipsoid
+    }
 }
 
 /// The figure's parts: head, torso, pelvis, the arms (upper arm, forearm with the hand) and
 /// the legs (thigh, shin, foot). Height 1, feet on y = 0, facing +z; the left leg (+x) and
 /// the right arm (-x) swing forward.
+#[rustfmt::skip]
 fn parts() -> [Part; 13] {
     [
         Part::upright([0.0, 0.915, 0.01], [0.055, 0.075, 0.065]),
         Part::upright([0.0, 0.70, 0.0], [0.135, 0.165, 0.08]),
         Part::upright([0.0, 0.535, 0.0], [0.115, 0.075, 0.078]),
-        // Right arm, forward: shoulder, elbow, hand.
+        // Right arm, forward: shoulder to elbow, elbow to hand (from, to, side, depth, overlap).
         Part::limb([-0.135, 0.795, 0.0], [-0.15, 0.63, 0.07], 0.04, 0.04, 0.03),
-        Part::limb(
-            [-0.15, 0.63, 0.07],
-            [-0.155, 0.49, 0.175],
-            0.032,
-            0.032,
-            0.025,
-        ),
+        Part::limb([-0.15, 0.63, 0.07], [-0.155, 0.49, 0.175], 0.032, 0.032, 0.025),
         // Left arm, back.
         Part::limb([0.135, 0.795, 0.0], [0.15, 0.63, -0.07], 0.04, 0.04, 0.03),
-        Part::limb(
-            [0.15, 0.63, -0.07],
-            [0.155, 0.46, -0.13],
-            0.032,
-            0.032,
-            0.025,
-        ),
-        // Left leg, forward: hip, knee, ankle, toe.
+        Part::limb([0.15, 0.63, -0.07], [0.155, 0.46, -0.13], 0.032, 0.032, 0.025),
+        // Left leg, forward: hip to knee, knee to ankle, ankle to toe.
         Part::limb([0.07, 0.50, 0.0], [0.075, 0.27, 0.085], 0.062, 0.062, 0.04),
-        Part::limb(
-            [0.075, 0.27, 0.085],
-            [0.075, 0.045, 0.125],
-            0.045,
-            0.045,
-            0.03,
-        ),
-        Part::limb(
-            [0.075, 0.045, 0.125],
-            [0.08, 0.018, 0.255],
-            0.035,
-            0.028,
-            0.03,
-        ),
+        Part::limb([0.075, 0.27, 0.085], [0.075, 0.045, 0.125], 0.045, 0.045, 0.03),
+        Part::limb([0.075, 0.045, 0.125], [0.08, 0.018, 0.255], 0.035, 0.028, 0.03),
         // Right leg, back, its heel raised.
-        Part::limb(
-            [-0.07, 0.50, 0.0],
-            [-0.075, 0.265, -0.06],
-            0.062,
-            0.062,
-            0.04,
-        ),
-        Part::limb(
-            [-0.075, 0.265, -0.06],
-            [-0.075, 0.075, -0.195],
-            0.045,
-            0.045,
-            0.03,
-        ),
-        Part::limb(
-            [-0.075, 0.075, -0.195],
-            [-0.08, 0.018, -0.07],
-            0.035,
-            0.028,
-            0.03,
-        ),
+        Part::limb([-0.07, 0.50, 0.0], [-0.075, 0.265, -0.06], 0.062, 0.062, 0.04),
+        Part::limb([-0.075, 0.265, -0.06], [-0.075, 0.075, -0.195], 0.045, 0.045, 0.03),
+        Part::limb([-0.075, 0.075, -0.195], [-0.08, 0.018, -0.07], 0.035, 0.028, 0.03),
     ]
 }
 
@@ -123,9 +89,7 @@ pub const WALKER_PARTS: u32 = 13;
 pub fn walker(height: f32, tessellation: u32) -> Mesh {
     let mut mesh = Mesh::default();
     for part in parts() {
-        let mut ellipsoid = sphere(1.0, tessellation);
-        ellipsoid.transform(&Affine3A::from_mat3_translation(part.axes, part.centre));
-        mesh.append(&ellipsoid);
+        mesh.append(&part.mesh(tessellation));
     }
     // A uniform scale leaves the normals as they are (and keeps them at height 0).
     let height = height.abs();
@@ -140,18 +104,6 @@ mod tests {
     use super::super::test_support::*;
     use super::*;
 
-    /// The parts as separate meshes, for per-part checks.
-    fn part_meshes(tessellation: u32) -> Vec<(Part, Mesh)> {
-        parts()
-            .into_iter()
-            .map(|part| {
-                let mut mesh = sphere(1.0, tessellation);
-                mesh.transform(&Affine3A::from_mat3_translation(part.axes, part.centre));
-                (part, mesh)
-            })
-            .collect()
-    }
-
     #[test]
     fn walker_counts_and_shape() {
         for n in [3, 8, 24] {
@@ -163,7 +115,8 @@ mod tests {
         }
         assert_eq!(walker(1.8, 24).triangle_count(), 6864);
         // Each part is a closed ellipsoid whose normals point away from its centre.
-        for (part, mesh) in part_meshes(16) {
+        for part in parts() {
+            let mesh = part.mesh(16);
             assert!(is_closed(&mesh));
             assert_outward(&mesh, |_| part.centre);
         }

@@ -141,18 +141,22 @@ mod tests {
             let boundary = edges.values().filter(|&&c| c == 1).count();
             assert_eq!(boundary, 4 * n as usize);
             assert!(edges.values().all(|&c| c == 1 || c == 2));
-            // Counter-clockwise screen triangles of total area 1.
-            let area: f64 = mesh
-                .triangles
-                .iter()
-                .map(|t| {
-                    let [a, b, c] = t.map(|k| mesh.screen[k as usize]);
-                    0.5 * (b - a).perp_dot(c - a)
-                })
-                .inspect(|&a| assert!(a > 0.0))
-                .sum();
-            assert!((area - 1.0).abs() < 1e-12);
+            assert_cells_tile_the_screen(&mesh);
         }
+    }
+
+    /// Asserts counter-clockwise screen triangles of total area 1.
+    fn assert_cells_tile_the_screen(mesh: &TrilinearMesh) {
+        let area: f64 = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|k| mesh.screen[k as usize]);
+                0.5 * (b - a).perp_dot(c - a)
+            })
+            .inspect(|&a| assert!(a > 0.0))
+            .sum();
+        assert!((area - 1.0).abs() < 1e-12);
     }
 
     #[test]
@@ -182,16 +186,7 @@ mod tests {
         assert_eq!(mesh.triangles.len(), 2 * 5 * 2);
         assert_eq!(mesh.screen[6 + 5], DVec2::new(1.0, 0.5));
         assert_eq!(mesh.screen[2 * 6 + 1], DVec2::new(0.2, 1.0));
-        let area: f64 = mesh
-            .triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|k| mesh.screen[k as usize]);
-                0.5 * (b - a).perp_dot(c - a)
-            })
-            .inspect(|&a| assert!(a > 0.0))
-            .sum();
-        assert!((area - 1.0).abs() < 1e-12);
+        assert_cells_tile_the_screen(&mesh);
         assert_eq!(
             screen_grid_cells(4, 4, flat).unwrap(),
             screen_grid(4, flat).unwrap()
