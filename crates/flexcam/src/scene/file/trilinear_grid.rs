@@ -308,13 +308,15 @@ mod tests {
     fn grid_over_surfaces() {
         let m = mesh(&format!("grid = 4\n{SURFACES}"));
         assert_eq!((m.points.len(), m.triangles.len()), (25, 32));
-        let m = mesh(&format!("grid = [5, 2]\n{SURFACES}"));
-        assert_eq!((m.points.len(), m.triangles.len()), (18, 20));
         assert_eq!(m.screen[24], DVec2::ONE);
         // Inward rays: from the sphere to its centre.
         for (p, n) in m.points.iter().zip(&m.normals) {
             assert!((*p + *n - DVec3::Y).length() < 1e-12);
         }
+        // Columns x rows: 6 x 3 vertices, the last at the screen's corner.
+        let m = mesh(&format!("grid = [5, 2]\n{SURFACES}"));
+        assert_eq!((m.points.len(), m.triangles.len()), (18, 20));
+        assert_eq!(m.screen[17], DVec2::ONE);
     }
 
     #[test]
