@@ -52,11 +52,33 @@ fn csv(path: &std::path::Path) -> (Vec<String>, Vec<Vec<String>>) {
     (lines.next().unwrap(), lines.collect())
 }
 
+/// The numbers of Table 1's row `name` (an application scene) in the bench's output:
+/// camera and scene triangles, bounding and rendered fragments, overdraw, ms, fps, cpu ms,
+/// then the paper's six; checks that there are fragments and that the overdraw is bounding
+/// over rendered.
+fn application_row(out: &str, name: &str) -> Vec<f64> {
+    let (_, section) = out
+        .split_once(&format!("Table 1, {name}"))
+        .unwrap_or_else(|| panic!("no {name} row: {out}"));
+    let row: Vec<f64> = section
+        .lines()
+        .nth(2)
+        .unwrap()
+        .split(['|', ' '])
+        .filter_map(|c| c.parse().ok())
+        .collect();
+    assert_eq!(row.len(), 14, "{section}");
+    assert!(row[3] > 0.0 && row[2] >= row[3], "{section}");
+    assert!((row[4] - row[2] / row[3]).abs() < 0.01, "{section}");
+    row
+}
+
 /// Table 1: three reflection tessellations x two bounds x culling off and on, the caustics
 /// row with its photon map's camera triangles and an overdraw that is bounding over
-/// rendered, and the 5,000-triangle target line.
+/// rendered, the visualisation row's 400 camera triangles around the walker, and the
+/// 5,000-triangle target line.
 #[test]
-fn table_1_has_reflection_and_caustics_rows() {
+fn table_1_has_reflection_caustics_and_visualisation_rows() {
     let dir = TempDir::new().unwrap();
     let out = bench(&dir, &[]);
     let reflection = out
@@ -64,21 +86,17 @@ fn table_1_has_reflection_and_caustics_rows() {
         .filter(|l| l.contains(" paper ") || l.contains(" tight "))
         .count();
     assert_eq!(reflection, 12, "{out}");
-    let (_, caustics) = out.split_once("Table 1, caustics").expect("caustics row");
-    let row: Vec<f64> = caustics
-        .lines()
-        .nth(2)
-        .unwrap()
-        .split(['|', ' '])
-        .filter_map(|c| c.parse().ok())
-        .collect();
-    // camera, scene, bounding, rendered, overdraw, ms, fps, cpu ms, then the paper's six.
-    assert_eq!(row.len(), 14, "{caustics}");
-    assert!(row[0] > 0.0, "camera triangles: {caustics}");
-    assert!(row[3] > 0.0 && row[2] >= row[3], "{caustics}");
-    assert!((row[4] - row[2] / row[3]).abs() < 0.01, "{caustics}");
-    assert!(row[7] > 0.0, "cpu ms: {caustics}");
-    assert_eq!(&row[8..], [400.0, 2.0, 945962.0, 475852.0, 2.0, 35.0]);
+    let caustics = application_row(&out, "caustics");
+    assert!(caustics[0] > 0.0, "camera triangles: {out}");
+    assert!(caustics[7] > 0.0, "cpu ms: {out}");
+    assert_eq!(&caustics[8..], [400.0, 2.0, 945962.0, 475852.0, 2.0, 35.0]);
+    let visualisation = application_row(&out, "visualization");
+    // The 400 camera triangles around the walker (6,864 triangles) and the floor (2).
+    assert_eq!(&visualisation[..2], [400.0, 6866.0], "{out}");
+    assert_eq!(
+        &visualisation[8..],
+        [400.0, 6841.0, 213248.0, 213248.0, 1.0, 46.0]
+    );
     assert!(out.contains("Mirror sphere over"), "{out}");
     assert!(out.contains("CPU time of all threads"), "{out}");
 }

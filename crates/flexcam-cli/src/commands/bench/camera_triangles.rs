@@ -11,6 +11,9 @@
 //!   512 x 512, lit: the photon map's camera triangles (the mirror's reflection surface seen
 //!   from the light), its bounding and rendered fragments and overdraw (`caustic_*` stats),
 //!   and the whole frame's time.
+//! - Table 1, visualisation: `camtri-visualisation.toml` (a walker of 6,864 triangles on a
+//!   floor, seen through a trilinear projection of 400 camera triangles around it) at 800 x
+//!   600, flat: the camera triangles, fragments and overdraw of the frame, rendered directly.
 //! - A mirror sphere over a floor of about 5,000 scene triangles at 800 x 600: the whole
 //!   frame by camera triangles against `--method raycast` (true mirror), and the agreement
 //!   of the reflector's pixels with the exact reflection (`measures`).
@@ -61,8 +64,8 @@ pub struct CameraTrianglesArgs {
     /// Image height of every render (default: the paper's, 600, or 480 for caustics).
     #[arg(long, requires = "width", value_parser = clap::value_parser!(u32).range(1..=16384))]
     height: Option<u32>,
-    /// The folder of the example scenes (`camtri-*.toml`) that the caustics row and Figure 6
-    /// load.
+    /// The folder of the example scenes (`camtri-*.toml`) that the caustics and visualisation
+    /// rows and Figure 6 load.
     #[arg(long, value_name = "DIR", default_value = "scenes")]
     scenes: PathBuf,
 }
@@ -176,7 +179,7 @@ pub fn run(args: &CameraTrianglesArgs) -> Result<()> {
     outputs.commit()
 }
 
-/// Table 1's reflection and caustics rows, then the 5,000-triangle target.
+/// Table 1's reflection, caustics and visualisation rows, then the 5,000-triangle target.
 fn table1(settings: &Settings) -> Result<()> {
     let (width, height) = settings.size((800, 600));
     println!(
@@ -239,38 +242,88 @@ fn table1(settings: &Settings) -> Result<()> {
             }
         }
     }
-    caustics(settings)?;
+    application_row(settings, &CAUSTICS)?;
+    application_row(settings, &VISUALISATION)?;
     five_thousand(settings.repeat, width, height)
 }
 
-/// The paper's caustics row: scene triangles, camera triangles, bounding and rendered
-/// fragments, overdraw, frames per second (640 x 480, photon map 512 x 512).
-const PAPER_CAUSTICS: (u64, u64, u64, u64, f64, f64) = (2, 400, 945_962, 475_852, 2.0, 35.0);
+/// A Table 1 row of an application scene from the `--scenes` folder: the paper's figures
+/// are scene triangles, camera triangles, bounding and rendered fragments, overdraw and
+/// frames per second (GeForce 7800 GT).
+struct ApplicationRow {
+    /// The row's name in the title line (`Table 1, NAME:`).
+    name: &'static str,
+    /// The scene file.
+    file: &'static str,
+    /// `-D` edits of the scene.
+    defines: &'static [&'static str],
+    /// The paper's image size.
+    size: (u32, u32),
+    shading: Shading,
+    /// What the title line says is measured, after the scene and size.
+    measured: &'static str,
+    /// The prefix of the stats that hold the camera triangles and their fragments.
+    stats: &'static str,
+    paper: (u64, u64, u64, u64, f64, f64),
+}
 
 /// Table 1's caustics row (module doc).
-fn caustics(settings: &Settings) -> Result<()> {
-    let (width, height) = settings.size((640, 480));
-    let path = settings.scenes.join("camtri-caustics.toml");
-    let map = "object.mirror.caustic_map=512".parse()?;
-    let (scene, _) = scene::load_file(&path, &[map], &scene::ModelRequest::default())?;
+const CAUSTICS: ApplicationRow = ApplicationRow {
+    name: "caustics",
+    file: "camtri-caustics.toml",
+    defines: &["object.mirror.caustic_map=512"],
+    size: (640, 480),
+    shading: Shading::Lit,
+    measured: "photon map 512 x 512, lit; camera triangles, fragments and overdraw of the \
+               photon map's render through the mirror's camera triangles (caustic_* stats); \
+               time of the whole frame (main view, the mirror's reflection, the photon map, \
+               splatting)",
+    stats: "caustic_",
+    paper: (2, 400, 945_962, 475_852, 2.0, 35.0),
+};
+
+/// Table 1's visualisation row (module doc).
+const VISUALISATION: ApplicationRow = ApplicationRow {
+    name: "visualization",
+    file: "camtri-visualisation.toml",
+    defines: &[],
+    size: (800, 600),
+    shading: Shading::Flat,
+    measured: "flat shading; the whole frame is the trilinear projection of 400 camera \
+               triangles around the walker, rendered directly by camera triangles",
+    stats: "",
+    paper: (6_841, 400, 213_248, 213_248, 1.0, 46.0),
+};
+
+/// Renders `row`'s scene by camera triangles and prints its title, header and row beside
+/// the paper's figures.
+fn application_row(settings: &Settings, row: &ApplicationRow) -> Result<()> {
+    let (width, height) = settings.size(row.size);
+    let path = settings.scenes.join(row.file);
+    let defines = row
+        .defines
+        .iter()
+        .map(|d| d.parse())
+        .collect::<Result<Vec<_>>>()?;
+    let (scene, _) = scene::load_file(&path, &defines, &scene::ModelRequest::default())?;
     let prepared = PreparedScene::new(&scene);
     let main = scene.projection.build(width, height)?;
     let options = RenderOptions {
         method: Method::CameraTriangles,
-        shading: Shading::Lit,
+        shading: row.shading,
         ..RenderOptions::default()
     };
     let (timing, rendered) = timed_render(settings.repeat, &prepared, main.as_ref(), &options)?;
     let c = &rendered.counters;
+    let stat = |name: &str| format!("{}{name}", row.stats);
     let ms = timing.median_ms();
-    let paper = PAPER_CAUSTICS;
+    let paper = row.paper;
     println!();
     println!(
-        "Table 1, caustics: {} at {width} x {height}, photon map 512 x 512, lit; camera \
-         triangles, fragments and overdraw of the photon map's render through the mirror's \
-         camera triangles (caustic_* stats); time of the whole frame (main view, the mirror's \
-         reflection, the photon map, splatting); median of {} renders.",
+        "Table 1, {}: {} at {width} x {height}, {}; median of {} renders.",
+        row.name,
         path.display(),
+        row.measured,
         settings.repeat
     );
     println!(
@@ -280,11 +333,11 @@ fn caustics(settings: &Settings) -> Result<()> {
     );
     println!(
         "{:>7} {:>6} | {:>10} {:>9} {:>8.2} {:>7.1} {:>8.1} {:>7} | {:>13} {:>6} {:>10} {:>8} {:>8} {:>5}",
-        count(c, "caustic_camera_triangles"),
+        count(c, &stat("camera_triangles")),
         prepared_triangles(&scene),
-        count(c, "caustic_bounding_fragments"),
-        count(c, "caustic_rendered_fragments"),
-        value(c, "caustic_overdraw"),
+        count(c, &stat("bounding_fragments")),
+        count(c, &stat("rendered_fragments")),
+        value(c, &stat("overdraw")),
         ms,
         1e3 / ms,
         timing.cpu_text(1e3, 1),

@@ -91,23 +91,27 @@ fn trilinear_scenes_match_the_ray_caster() {
     }
 }
 
+/// `scene` at `size` by camera triangles, flat, with the paper's bound and the tight one.
+fn both_bounds(scene: &Scene, size: (u32, u32)) -> ((Frame, Stats), (Frame, Stats)) {
+    let projection = scene.projection.build(size.0, size.1).unwrap();
+    let prepared = PreparedScene::new(scene);
+    let run = |bound| {
+        render(
+            &prepared,
+            projection.as_ref(),
+            &options(Shading::Flat, bound),
+        )
+        .unwrap()
+    };
+    (run(Bound::Paper), run(Bound::Tight))
+}
+
 /// The paper's bound and the tight bound give the same rendered fragments (both are exact),
 /// hence the same image; the tight one rasterises fewer bounding fragments.
 #[test]
 fn both_bounds_render_the_same_fragments() {
     for name in TRILINEAR_SCENES {
-        let scene = load(name);
-        let projection = scene.projection.build(160, 120).unwrap();
-        let prepared = PreparedScene::new(&scene);
-        let run = |bound| {
-            render(
-                &prepared,
-                projection.as_ref(),
-                &options(Shading::Flat, bound),
-            )
-        };
-        let (paper, paper_stats) = run(Bound::Paper).unwrap();
-        let (tight, tight_stats) = run(Bound::Tight).unwrap();
+        let ((paper, paper_stats), (tight, tight_stats)) = both_bounds(&load(name), (160, 120));
         assert_eq!(paper, tight, "{name}");
         assert_eq!(
             count(&paper_stats, "rendered_fragments"),
@@ -411,5 +415,45 @@ fn application_scenes_match_the_exact_ray_caster() {
         assert!(inside >= 0.99, "{name}: {inside}");
         assert!(c.relative_rgb_error < max_rgb, "{name}: {c:?}");
         assert!(count(&ours.counters, "rendered_fragments") > 0, "{name}");
+    }
+}
+
+/// The visualisation around a figure (section 3.4, Figure 12): 400 camera triangles
+/// surround the walker, which is seen from the back, both sides and the front in one image,
+/// rendered by camera triangles as the ray caster renders the same projection (flat and
+/// lit; both bounds give the same image, the tight one with fewer bounding fragments).
+#[test]
+fn visualisation_around_a_figure_matches_the_ray_caster() {
+    let scene = load("camtri-visualisation");
+    let (width, height) = (192, 72);
+    for shading in [Shading::Flat, Shading::Lit] {
+        let (c, inside, stats) =
+            against_raycast(&scene, (width, height), &options(shading, Bound::Tight));
+        println!(
+            "camtri-visualisation {shading:?}: ids {:.5} (inside {inside:.5}), rgb {:.2e}, \
+             depth mean {:.2e}, overdraw {:?}",
+            c.id_agreement, c.relative_rgb_error, c.depth_mean, stats["overdraw"]
+        );
+        assert_eq!(count(&stats, "camera_triangles"), 400);
+        assert!(inside >= 0.99, "{inside} {c:?}");
+        assert!(c.id_agreement >= 0.98, "{c:?}");
+        assert!(c.depth_mean < 1e-4, "{c:?}");
+        assert!(c.relative_rgb_error < 0.005, "{c:?}");
+    }
+    let ((paper, paper_stats), (tight, tight_stats)) = both_bounds(&scene, (width, height));
+    assert_eq!(paper, tight);
+    assert!(count(&tight_stats, "bounding_fragments") < count(&paper_stats, "bounding_fragments"));
+    // The walker (object 1) in the middle row of each view: the back at the image's left
+    // and right edges, the sides at a quarter and three quarters, the front in the middle.
+    let walker = scene
+        .objects
+        .iter()
+        .find(|o| o.name == "walker")
+        .unwrap()
+        .id;
+    let row = (height / 2) as usize * width as usize;
+    for column in [0.02, 0.25, 0.5, 0.75, 0.98] {
+        let x = (column * f64::from(width)) as usize;
+        assert_eq!(tight.ids[row + x], walker, "column {column}");
     }
 }

@@ -103,7 +103,7 @@ pub struct RawProjection {
     #[serde(default, deserialize_with = "strict")]
     pub shear: Option<Spanned<[f64; 2]>>,
     pub slit_distance: Option<Spanned<f64>>,
-    pub grid: Option<Spanned<u32>>,
+    pub grid: Option<Spanned<Numbers>>,
     pub view: Option<Spanned<String>>,
     pub camera: Option<Spanned<RawCamera>>,
     #[serde(default, deserialize_with = "strict")]

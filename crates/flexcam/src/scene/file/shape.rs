@@ -14,18 +14,21 @@ pub(super) enum Shape {
     Cylinder,
     Torus,
     Teapot,
+    /// A walking figure ([`shapes::walker`]).
+    Walker,
     /// Loaded from a model file.
     Mesh,
 }
 
 /// Shape names as written in scene files.
-const SHAPES: [(&str, Shape); 7] = [
+const SHAPES: [(&str, Shape); 8] = [
     ("plane", Shape::Plane),
     ("box", Shape::Box),
     ("sphere", Shape::Sphere),
     ("cylinder", Shape::Cylinder),
     ("torus", Shape::Torus),
     ("teapot", Shape::Teapot),
+    ("walker", Shape::Walker),
     ("mesh", Shape::Mesh),
 ];
 
@@ -69,6 +72,7 @@ impl Shape {
             Shape::Cylinder => ("[radius, height]", &[0.5, 1.0]),
             Shape::Torus => ("[major radius, minor radius]", &[1.0, 0.25]),
             Shape::Teapot => ("a scale factor", &[1.0]),
+            Shape::Walker => ("a height", &[1.8]),
             Shape::Mesh => return None,
         };
         Some(SizeForm { written, default })
@@ -82,6 +86,7 @@ impl Shape {
             Shape::Plane | Shape::Box => Some((1, 1)),
             Shape::Sphere | Shape::Cylinder | Shape::Torus => Some((48, 3)),
             Shape::Teapot => Some((32, 4)),
+            Shape::Walker => Some((24, 3)),
             Shape::Mesh => None,
         }
     }
@@ -100,6 +105,8 @@ impl Shape {
             Shape::Cylinder => 4 * t.max(3),
             // 32 patches of n x n quads, n = max(t / 4, 1).
             Shape::Teapot => 64 * (t / 4).max(1).pow(2),
+            // One sphere's rows per part.
+            Shape::Walker => u64::from(shapes::WALKER_PARTS) * 2 * t * t,
             Shape::Mesh => 0,
         }
     }
@@ -122,6 +129,7 @@ pub(super) fn analytic_mesh(
         Shape::Cylinder => shapes::cylinder(a, b, tessellation),
         Shape::Torus => shapes::torus(a, b, tessellation),
         Shape::Teapot => shapes::teapot(a, tessellation),
+        Shape::Walker => shapes::walker(a, tessellation),
         Shape::Mesh => return None,
     })
 }

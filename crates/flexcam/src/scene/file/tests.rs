@@ -200,7 +200,7 @@ fn unknown_names_list_the_valid_ones() {
         &object("shape = \"cube\"\n"),
         7,
         9,
-        "expected one of: plane, box, sphere, cylinder, torus, teapot, mesh",
+        "expected one of: plane, box, sphere, cylinder, torus, teapot, walker, mesh",
     );
     assert_error_at(
         &object("shape = \"box\"\nmaterial = \"metal\"\n"),

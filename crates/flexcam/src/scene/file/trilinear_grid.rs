@@ -1,4 +1,5 @@
-//! `grid = N` in a trilinear `[projection]`: a regular screen grid of projection triangles
+//! `grid = N` (or `[columns, rows]`) in a trilinear `[projection]`: a regular screen grid of
+//! projection triangles
 //! over a base given by two control surfaces (`near`, `far`) or by a visualisation surface
 //! or a view through a ball (`view`); with `exact = true` a view through a ball is the exact
 //! view the grid samples instead: see scenes/README.md.
@@ -8,12 +9,12 @@ use toml::Spanned;
 
 use super::control_surface::surface;
 use super::projection_table::Required;
-use super::raw::RawCamera;
+use super::raw::{Numbers, RawCamera};
 use super::source::Source;
 use crate::error::{Error, Result};
 use crate::projection::trilinear_builders::{
-    between_surfaces, screen_grid, BallOptic, BallView, DetailInContext, FocusView, GridCamera,
-    TwoViews,
+    between_surfaces, screen_grid_cells, BallOptic, BallView, DetailInContext, FocusView,
+    GridCamera, TwoViews, MAX_GRID_CELLS,
 };
 use crate::projection::{CameraFrame, ProjectionSpec};
 
@@ -46,7 +47,7 @@ const SURFACE_KEYS: [&str; 2] = ["near", "far"];
 
 /// The projection of a trilinear projection table that has `grid`: its mesh, or with
 /// `exact = true` the exact view through a ball.
-pub(super) fn convert(required: &Required, cells: &Spanned<u32>) -> Result<ProjectionSpec> {
+pub(super) fn convert(required: &Required, cells: &Spanned<Numbers>) -> Result<ProjectionSpec> {
     let src = required.src;
     let raw = required.raw();
     let present: Vec<_> = raw
@@ -55,14 +56,14 @@ pub(super) fn convert(required: &Required, cells: &Spanned<u32>) -> Result<Proje
         .filter(|(key, _)| *key != "grid" && *key != "view")
         .collect();
     let at_table = |e: Error| src.error(&required.table.span(), e.message);
-    let n = *cells.get_ref();
+    let [columns, rows] = grid_cells(required.src, cells)?;
     let mut exact = None;
     let mesh = match &raw.view {
         None => {
             src.reject_foreign_key(present, &SURFACE_KEYS, "grids over surfaces (no `view`)")?;
             let near = surface(src, required.get(&raw.near, "near")?, "near")?;
             let far = surface(src, required.get(&raw.far, "far")?, "far")?;
-            screen_grid(n, between_surfaces(&near, &far))
+            screen_grid_cells(columns, rows, between_surfaces(&near, &far))
         }
         Some(view) => {
             let name = view.get_ref().as_str();
@@ -74,7 +75,7 @@ pub(super) fn convert(required: &Required, cells: &Spanned<u32>) -> Result<Proje
             match name {
                 "detail_in_context" => {
                     let surface = detail_in_context(required)?;
-                    screen_grid(n, |s| surface.vertex(s))
+                    screen_grid_cells(columns, rows, |s| surface.vertex(s))
                 }
                 "two_views" => {
                     let (first, _) = camera(src, required.get(&raw.first, "first")?)?;
@@ -90,30 +91,51 @@ pub(super) fn convert(required: &Required, cells: &Spanned<u32>) -> Result<Proje
                             .map_or(required.table.span(), Spanned::span);
                         src.error(&at, e.message)
                     })?;
-                    screen_grid(n, |s| surface.vertex(s))
+                    screen_grid_cells(columns, rows, |s| surface.vertex(s))
                 }
                 _ => {
                     let view = ball_view(required, name == "sphere_glass")?;
                     if raw.exact.as_ref().is_some_and(|e| *e.get_ref()) {
                         exact = Some(view);
                     }
-                    screen_grid(n, |s| view.vertex(s))
+                    screen_grid_cells(columns, rows, |s| view.vertex(s))
                 }
             }
         }
     };
-    let mesh = mesh.map_err(|e| {
-        if e.message.starts_with("grid must have") {
-            src.error(&cells.span(), e.message)
-        } else {
-            at_table(e)
-        }
-    })?;
+    // The cells were checked above: what remains is the base's.
+    let mesh = mesh.map_err(at_table)?;
     // The grid is built with `exact` too: its size is checked the same way.
     Ok(match exact {
         Some(view) => ProjectionSpec::ExactBall(view),
         None => ProjectionSpec::Trilinear(mesh),
     })
+}
+
+/// The cells of `grid`: one whole number `n` (n x n cells) or `[columns, rows]`, each from 1
+/// to [`MAX_GRID_CELLS`], refused at the value's span otherwise.
+fn grid_cells(src: &Source, cells: &Spanned<Numbers>) -> Result<[u32; 2]> {
+    let refuse = |what: String| src.error(&cells.span(), what);
+    let counts = match cells.get_ref().as_slice() {
+        [n] => [*n, *n],
+        [columns, rows] => [*columns, *rows],
+        other => {
+            return Err(refuse(format!(
+                "`grid` is a number of cells N or [columns, rows], got {} numbers",
+                other.len()
+            )))
+        }
+    };
+    let mut out = [0; 2];
+    for (slot, n) in out.iter_mut().zip(counts) {
+        if n.fract() != 0.0 || !(1.0..=f64::from(MAX_GRID_CELLS)).contains(&n) {
+            return Err(refuse(format!(
+                "grid must have 1..={MAX_GRID_CELLS} cells per side (whole numbers), got {n}"
+            )));
+        }
+        *slot = n as u32;
+    }
+    Ok(out)
 }
 
 /// The surface of `view = "detail_in_context"`: `camera`, `focus`, `inset`,
@@ -291,6 +313,10 @@ mod tests {
         for (p, n) in m.points.iter().zip(&m.normals) {
             assert!((*p + *n - DVec3::Y).length() < 1e-12);
         }
+        // Columns x rows: 6 x 3 vertices, the last at the screen's corner.
+        let m = mesh(&format!("grid = [5, 2]\n{SURFACES}"));
+        assert_eq!((m.points.len(), m.triangles.len()), (18, 20));
+        assert_eq!(m.screen[17], DVec2::ONE);
     }
 
     #[test]
@@ -474,6 +500,16 @@ mod tests {
     #[test]
     fn grid_errors_are_positioned() {
         error_at("grid = 0\nnear = { surface = \"point\", point = [0, 0, 0] }\nfar = { surface = \"point\", point = [0, 0, 1] }\n", 3, 8, "1..=256");
+        let points = "near = { surface = \"point\", point = [0, 0, 0] }\nfar = { surface = \"point\", point = [0, 0, 1] }\n";
+        error_at(&format!("grid = [20, 0]\n{points}"), 3, 8, "got 0");
+        error_at(&format!("grid = 2.5\n{points}"), 3, 8, "whole numbers");
+        error_at(
+            &format!("grid = [2, 3, 4]\n{points}"),
+            3,
+            8,
+            "[columns, rows]",
+        );
+
         error_at(
             &format!("grid = 2\nsurface = \"x.obj\"\n{SURFACES}"),
             4,

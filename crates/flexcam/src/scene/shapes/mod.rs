@@ -3,7 +3,7 @@
 //!
 //! Every shape has per-vertex unit normals pointing outward, texture coordinates in
 //! `[0,1]^2` and counter-clockwise triangles seen from outside; closed shapes (box, sphere,
-//! cylinder, torus) are closed once coincident positions are welded. Degenerate parameters
+//! cylinder, torus, each part of the walker) are closed once coincident positions are welded. Degenerate parameters
 //! never panic or produce NaN: tessellation is raised to each shape's minimum and negative
 //! sizes are taken by absolute value (the scene-file parser rejects them before this).
 
@@ -15,6 +15,7 @@ mod sphere;
 mod teapot;
 mod teapot_patches;
 mod torus;
+mod walker;
 
 #[cfg(test)]
 mod test_support;
@@ -25,3 +26,4 @@ pub use plane::plane;
 pub use sphere::sphere;
 pub use teapot::teapot;
 pub use torus::torus;
+pub use walker::{walker, WALKER_PARTS};

@@ -1,4 +1,4 @@
-//! A regular n x n grid of screen cells over a base surface.
+//! A regular grid of screen cells (n x n, or columns x rows) over a base surface.
 
 use glam::{DVec2, DVec3};
 
@@ -20,31 +20,45 @@ pub struct GridVertex {
     pub direction: DVec3,
 }
 
-/// A trilinear mesh of `n` x `n` screen cells covering the whole image, two projection
-/// triangles per cell, with `(n + 1)^2` shared vertices. Vertex `(i, j)` (column `i` from the
-/// left, row `j` from the bottom) has index `j (n + 1) + i`, screen position `(i / n, j / n)`
-/// and the base point and direction `vertex(screen)`. Cell `(i, j)` with lower-left vertex
-/// `a` is split along its rising diagonal into `[a, a + 1, a + n + 2]` and
-/// `[a, a + n + 2, a + n + 1]`, both counter-clockwise on screen.
+/// A trilinear mesh of `n` x `n` screen cells: [`screen_grid_cells`] with `n` columns and
+/// `n` rows.
+pub fn screen_grid(n: u32, vertex: impl Fn(DVec2) -> GridVertex) -> Result<TrilinearMesh> {
+    screen_grid_cells(n, n, vertex)
+}
+
+/// A trilinear mesh of `columns` x `rows` screen cells covering the whole image, two
+/// projection triangles per cell, with `(columns + 1) (rows + 1)` shared vertices. Vertex
+/// `(i, j)` (column `i` from the left, row `j` from the bottom) has index
+/// `j (columns + 1) + i`, screen position `(i / columns, j / rows)` and the base point and
+/// direction `vertex(screen)`. Cell `(i, j)` with lower-left vertex `a` is split along its
+/// rising diagonal into `[a, a + 1, a + columns + 2]` and `[a, a + columns + 2, a + columns
+/// + 1]`, both counter-clockwise on screen.
 ///
 /// Because neighbouring triangles share vertices, the ray field is continuous across every
 /// cell edge and the screen cells tile [0, 1]^2 without gaps or overlaps.
 ///
-/// Errors (degenerate cases): `n` outside 1..=[`MAX_GRID_CELLS`]; a vertex with a
-/// non-finite point or direction, or a zero direction (where the base's rays are undefined,
-/// e.g. where the two control surfaces of [`between_surfaces`] meet); the message names the
-/// vertex and its screen position.
-pub fn screen_grid(n: u32, vertex: impl Fn(DVec2) -> GridVertex) -> Result<TrilinearMesh> {
-    if !(1..=MAX_GRID_CELLS).contains(&n) {
-        return Err(Error::new(format!(
-            "grid must have 1..={MAX_GRID_CELLS} cells per side, got {n}"
-        )));
+/// Errors (degenerate cases): `columns` or `rows` outside 1..=[`MAX_GRID_CELLS`]; a vertex
+/// with a non-finite point or direction, or a zero direction (where the base's rays are
+/// undefined, e.g. where the two control surfaces of [`between_surfaces`] meet); the message
+/// names the vertex and its screen position.
+pub fn screen_grid_cells(
+    columns: u32,
+    rows: u32,
+    vertex: impl Fn(DVec2) -> GridVertex,
+) -> Result<TrilinearMesh> {
+    for n in [columns, rows] {
+        if !(1..=MAX_GRID_CELLS).contains(&n) {
+            return Err(Error::new(format!(
+                "grid must have 1..={MAX_GRID_CELLS} cells per side, got {n}"
+            )));
+        }
     }
-    let side = n + 1;
+    let side = columns + 1;
+    let cells = DVec2::new(f64::from(columns), f64::from(rows));
     let mut mesh = TrilinearMesh::default();
-    for j in 0..side {
+    for j in 0..=rows {
         for i in 0..side {
-            let screen = DVec2::new(f64::from(i), f64::from(j)) / f64::from(n);
+            let screen = DVec2::new(f64::from(i), f64::from(j)) / cells;
             let v = vertex(screen);
             if !v.point.is_finite() || !v.direction.is_finite() || v.direction == DVec3::ZERO {
                 return Err(Error::new(format!(
@@ -58,8 +72,8 @@ pub fn screen_grid(n: u32, vertex: impl Fn(DVec2) -> GridVertex) -> Result<Trili
             mesh.screen.push(screen);
         }
     }
-    for j in 0..n {
-        for i in 0..n {
+    for j in 0..rows {
+        for i in 0..columns {
             let a = j * side + i;
             mesh.triangles.push([a, a + 1, a + side + 1]);
             mesh.triangles.push([a, a + side + 1, a + side]);
@@ -127,18 +141,22 @@ mod tests {
             let boundary = edges.values().filter(|&&c| c == 1).count();
             assert_eq!(boundary, 4 * n as usize);
             assert!(edges.values().all(|&c| c == 1 || c == 2));
-            // Counter-clockwise screen triangles of total area 1.
-            let area: f64 = mesh
-                .triangles
-                .iter()
-                .map(|t| {
-                    let [a, b, c] = t.map(|k| mesh.screen[k as usize]);
-                    0.5 * (b - a).perp_dot(c - a)
-                })
-                .inspect(|&a| assert!(a > 0.0))
-                .sum();
-            assert!((area - 1.0).abs() < 1e-12);
+            assert_cells_tile_the_screen(&mesh);
         }
+    }
+
+    /// Asserts counter-clockwise screen triangles of total area 1.
+    fn assert_cells_tile_the_screen(mesh: &TrilinearMesh) {
+        let area: f64 = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|k| mesh.screen[k as usize]);
+                0.5 * (b - a).perp_dot(c - a)
+            })
+            .inspect(|&a| assert!(a > 0.0))
+            .sum();
+        assert!((area - 1.0).abs() < 1e-12);
     }
 
     #[test]
@@ -156,6 +174,26 @@ mod tests {
                     assert!((ray.origin - expected).length() < 1e-12);
                 }
             }
+        }
+    }
+
+    /// A grid of unequal sides: its vertex layout and counts, counter-clockwise cells that
+    /// tile the screen, and each side checked on its own.
+    #[test]
+    fn columns_and_rows_may_differ() {
+        let mesh = screen_grid_cells(5, 2, flat).unwrap();
+        assert_eq!(mesh.points.len(), 6 * 3);
+        assert_eq!(mesh.triangles.len(), 2 * 5 * 2);
+        assert_eq!(mesh.screen[6 + 5], DVec2::new(1.0, 0.5));
+        assert_eq!(mesh.screen[2 * 6 + 1], DVec2::new(0.2, 1.0));
+        assert_cells_tile_the_screen(&mesh);
+        assert_eq!(
+            screen_grid_cells(4, 4, flat).unwrap(),
+            screen_grid(4, flat).unwrap()
+        );
+        for (columns, rows) in [(0, 3), (3, 0), (MAX_GRID_CELLS + 1, 1)] {
+            let e = screen_grid_cells(columns, rows, flat).unwrap_err().message;
+            assert!(e.contains("1..=256"), "{e}");
         }
     }
 

@@ -3,7 +3,8 @@
 //! (Vallance 2005, chapters 6 and 7, calls the results surfaces to project through; re-exported
 //! as `projection::trilinear_builders`).
 //!
-//! - [`screen_grid`]: a regular n x n grid of screen cells (two projection triangles each,
+//! - [`screen_grid`]: a regular n x n grid of screen cells ([`screen_grid_cells`]: columns x
+//!   rows) (two projection triangles each,
 //!   shared vertices and ray directions) over any base given as a function from screen
 //!   position to a base point and ray direction ([`GridVertex`]); [`between_surfaces`] takes
 //!   the base from two control surfaces of a flexible volume (a bent, cylindrical or
@@ -26,7 +27,7 @@ mod visualisation;
 
 pub use ball::{BallOptic, BallProjection, BallView};
 pub use camera::GridCamera;
-pub use grid::{between_surfaces, screen_grid, GridVertex, MAX_GRID_CELLS};
+pub use grid::{between_surfaces, screen_grid, screen_grid_cells, GridVertex, MAX_GRID_CELLS};
 pub(crate) use reflector::vertex_normals;
 pub use reflector::{
     reflector_surface, vertex_ray, Optic, ReflectorSurface, SurfaceRays, SurfaceScreenMap,
