@@ -48,7 +48,9 @@ pub struct RenderArgs {
     shading: ShadingArg,
     /// The transition function's constant D for `--shading transitions` and
     /// `transition-lit` (default 2): relief of D + 1 pixel footprints or more seen head on is
-    /// displaced, below D - 1 the BRDF is used; larger D favours the cheaper methods.
+    /// displaced; below D - 1 footprints of relief, bumps wider than 2.7 footprints are bump
+    /// mapped and bumps of 2 footprints or less (the Nyquist limit) get the BRDF; larger D
+    /// favours the cheaper methods.
     #[arg(help_heading = "Rendering", long, value_name = "D")]
     transition_d: Option<f64>,
     /// Render only the pixels of columns X0..X1 and rows Y0..Y1 (pixel (0, 0) the top-left;

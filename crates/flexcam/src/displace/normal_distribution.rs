@@ -97,6 +97,41 @@ impl Chart {
         self.hi - self.lo
     }
 
+    /// The height field's mean wavelength (world units): `2 pi sigma_z / sigma_g`, the root
+    /// mean square of the heights about their mean over that of the slopes (the cells' edge
+    /// slopes, the gradients bump mapping shades with), which is the exact wavelength of a
+    /// single wave in any direction and, for a mixture, a wavelength weighted towards the
+    /// components that tilt the normals most. It is how far apart the bumps are, which
+    /// decides whether a footprint resolves them (the transition function's frequency term,
+    /// [`crate::displace::transition`]). A flat chart has no bumps: 0.
+    pub fn wavelength(&self) -> f64 {
+        let n = self.cells as i64;
+        let count = (n * n) as f64;
+        let mean = self.heights.iter().sum::<f64>() / count;
+        let height_square = self
+            .heights
+            .iter()
+            .map(|z| (z - mean) * (z - mean))
+            .sum::<f64>()
+            / count;
+        let cell = self.cell();
+        let mut slope_square = 0.0;
+        for j in 0..n {
+            for i in 0..n {
+                let z = self.z(i, j);
+                let along_u = (self.z(i + 1, j) - z) / cell.x;
+                let along_v = (self.z(i, j + 1) - z) / cell.y;
+                slope_square += along_u * along_u + along_v * along_v;
+            }
+        }
+        let slope_square = slope_square / count;
+        if slope_square > 0.0 {
+            2.0 * PI * (height_square / slope_square).sqrt()
+        } else {
+            0.0
+        }
+    }
+
     /// The height at node `(i, j)`, wrapping.
     fn z(&self, i: i64, j: i64) -> f64 {
         let n = self.cells as i64;

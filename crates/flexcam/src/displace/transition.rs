@@ -3,39 +3,68 @@
 //! between them, and partial displacement's corrected view angle.
 //!
 //! The dissertation's `T(d, theta_V) = (1/d - D) / cos(theta_V)` measures detail by the
-//! inverse distance `1/d` from a single eye point. Under a nonlinear projection there is no
-//! such point and no `1/d` law, so here the measure is the ray's own footprint: `w`, the
-//! width of the pixel's ray at the hit (the distance to the neighbouring pixels' rays,
-//! found through the projection), against the surface's relief `R` (highest minus lowest
-//! displacement, world units):
+//! inverse distance `1/d` from a single eye point, against `D = c f S` (a user constant
+//! times the bump map's frequency times its repeats over the surface). Under a nonlinear
+//! projection there is no such point and no `1/d` law, so here detail is measured against
+//! the ray's own footprint `w`: the width of the pixel's ray at the hit (the distance to the
+//! neighbouring pixels' rays, found through the projection). Two lengths of the height
+//! field are compared with it, each for the boundary it decides:
 //!
 //! ```text
-//! T = (R / w - D) / cos(theta_V),
+//! T_relief  = (R / w - D) / cos(theta_V)
+//! T_pattern = (lambda / w - (NYQUIST + 1)) / cos(theta_V)
+//! T = max(T_relief, min(T_pattern, -0.3))
 //! ```
 //!
-//! `R / w` being how many pixel footprints tall the bumps are, `D` a user constant in the
-//! same unit, `theta_V` the angle between the ray and the undisplaced surface's normal.
-//! Under a perspective camera `w` grows as `d` times the pixel's angle, so `R / w` is the
-//! dissertation's `1/d` scaled by the image's resolution: finer images keep displacement
-//! further away. The thresholds are the dissertation's `-1, -0.3, 0.3, 1`: below -1 the
-//! BRDF, up to -0.3 a blend of BRDF and bump intensities, up to 0.3 redistributed bump
-//! mapping, up to 1 partial displacement by `s` rising from 0 to 1, then full displacement.
-//! Every weight is continuous in `T`, so no method switches abruptly.
+//! `R` the relief (highest minus lowest displacement) and `lambda` the bumps' mean
+//! wavelength, both in world units; `D` a user constant; `theta_V` the angle between the ray
+//! and the undisplaced surface's normal. The thresholds are the dissertation's `-1, -0.3,
+//! 0.3, 1`: below -1 the BRDF, up to -0.3 a blend of BRDF and bump intensities, up to 0.3
+//! redistributed bump mapping, up to 1 partial displacement by `s` rising from 0 to 1, then
+//! full displacement.
 //!
-//! Degenerate cases: at grazing incidence (`cos(theta_V) = 0`) `T` is `+inf` where the
-//! relief is at least `D` footprints and `-inf` otherwise; a flat surface (`R = 0`) or an
-//! infinite footprint gives the BRDF wherever `D > 0`; NaN inputs give the BRDF.
+//! Why two lengths: bump mapping and displacement differ by where the surface is (its
+//! silhouette, what hides what, its shadows, the shift of the pattern seen obliquely), by at
+//! most the relief: `R / w` is how many pixel footprints tall the bumps are, and where it is
+//! above `D` displacement is needed. The BRDF and bump mapping differ by whether the pattern
+//! is drawn at all, which is the pattern's frequency against the pixels' (Becker and Max's
+//! `f S`): the dissertation's rule is that "when the spatial frequency of a feature exceeds
+//! the Nyquist limit (one half cycle per pixel), the BRDF should be used". `lambda / w` is
+//! how many footprints one bump spans; at [`NYQUIST`] (2) footprints or fewer `T_pattern` is
+//! at most -1 (the BRDF, the pattern's average), from 2.7 on it is above -0.3 (bump mapping
+//! draws the pattern); it is capped at -0.3, since the pattern's width alone never asks for
+//! displacement. Under a perspective camera `w` grows as `d` times the pixel's angle, so both
+//! ratios fall as the dissertation's `1/d`, scaled by the image's resolution. Every weight is
+//! continuous in `T`, and `T` in its inputs, so no method switches abruptly.
+//!
+//! Degenerate cases: at grazing incidence (`cos(theta_V) = 0`) each term is `+inf` where its
+//! ratio is at least its constant and `-inf` otherwise; a flat surface (`R = 0`, `lambda =
+//! 0`) or an infinite footprint gives the BRDF wherever `D > 0`; NaN inputs give the BRDF.
 
 /// The four thresholds of `T`.
 pub const THRESHOLDS: [f64; 4] = [-1.0, -0.3, 0.3, 1.0];
 
-/// `T` for relief `relief` over footprint `footprint` (same unit), user constant `d` and the
-/// cosine of the view angle (module docs).
-pub fn value(relief: f64, footprint: f64, d: f64, cos_view: f64) -> f64 {
-    let detail = relief / footprint - d;
+/// Footprints per bump wavelength at and below which the pattern is not drawn: the Nyquist
+/// limit, two samples per period (module docs).
+pub const NYQUIST: f64 = 2.0;
+
+/// `T` for relief `relief` and mean wavelength `wavelength` over footprint `footprint` (all
+/// three in world units), user constant `d` and the cosine of the view angle (module docs).
+pub fn value(relief: f64, wavelength: f64, footprint: f64, d: f64, cos_view: f64) -> f64 {
+    let by_relief = over_cos(relief / footprint - d, cos_view);
+    let by_pattern = over_cos(wavelength / footprint - (NYQUIST + 1.0), cos_view);
+    if by_relief.is_nan() || by_pattern.is_nan() {
+        return f64::NEG_INFINITY;
+    }
+    by_relief.max(by_pattern.min(THRESHOLDS[1]))
+}
+
+/// `detail / |cos|`: `+-inf` at `cos = 0` by the sign of `detail` (`+inf` at 0), NaN where
+/// either is NaN.
+fn over_cos(detail: f64, cos_view: f64) -> f64 {
     let cos = cos_view.abs();
     if detail.is_nan() || cos.is_nan() {
-        return f64::NEG_INFINITY;
+        return f64::NAN;
     }
     if cos == 0.0 {
         return if detail >= 0.0 {
@@ -143,18 +172,52 @@ mod tests {
 
     #[test]
     fn value_follows_relief_footprint_and_angle() {
+        // No pattern term (a wavelength of 0): the relief alone.
         // Three footprints of relief, D = 2, seen head on: T = 1.
-        assert!((value(0.3, 0.1, 2.0, 1.0) - 1.0).abs() < 1e-12);
+        assert!((value(0.3, 0.0, 0.1, 2.0, 1.0) - 1.0).abs() < 1e-12);
         // A wider footprint (further away) lowers T; grazing pushes it to the extremes.
-        assert!(value(0.3, 0.2, 2.0, 1.0) < value(0.3, 0.1, 2.0, 1.0));
-        assert!(value(0.3, 0.1, 2.0, 0.1) > value(0.3, 0.1, 2.0, 1.0));
-        assert!(value(0.1, 0.1, 2.0, 0.1) < value(0.1, 0.1, 2.0, 1.0));
-        assert_eq!(value(0.3, 0.1, 2.0, 0.0), f64::INFINITY);
-        assert_eq!(value(0.1, 0.1, 2.0, 0.0), f64::NEG_INFINITY);
+        assert!(value(0.3, 0.0, 0.2, 2.0, 1.0) < value(0.3, 0.0, 0.1, 2.0, 1.0));
+        assert!(value(0.3, 0.0, 0.1, 2.0, 0.1) > value(0.3, 0.0, 0.1, 2.0, 1.0));
+        assert!(value(0.1, 0.0, 0.1, 2.0, 0.1) < value(0.1, 0.0, 0.1, 2.0, 1.0));
+        assert_eq!(value(0.3, 0.0, 0.1, 2.0, 0.0), f64::INFINITY);
+        assert_eq!(value(0.1, 0.0, 0.1, 2.0, 0.0), f64::NEG_INFINITY);
         // Flat, an infinite footprint, NaN: the BRDF.
-        assert!(blend(value(0.0, 0.1, 2.0, 1.0)).brdf == 1.0);
-        assert!(blend(value(0.3, f64::INFINITY, 2.0, 1.0)).brdf == 1.0);
-        assert_eq!(value(f64::NAN, 0.1, 2.0, 1.0), f64::NEG_INFINITY);
+        assert!(blend(value(0.0, 0.0, 0.1, 2.0, 1.0)).brdf == 1.0);
+        assert!(blend(value(0.3, 0.5, f64::INFINITY, 2.0, 1.0)).brdf == 1.0);
+        assert_eq!(value(f64::NAN, 0.5, 0.1, 2.0, 1.0), f64::NEG_INFINITY);
+        assert_eq!(value(0.3, f64::NAN, 0.1, 2.0, 1.0), f64::NEG_INFINITY);
+    }
+
+    /// The pattern term: low relief whose bumps span more than 2.7 footprints is bump
+    /// mapped, at the Nyquist limit (2 footprints) and below it gets the BRDF, in between
+    /// the blend; it never asks for displacement, and where the relief asks for more it
+    /// gives way.
+    #[test]
+    fn resolved_patterns_are_bump_mapped() {
+        let low = 0.01;
+        let at = |wavelength: f64, cos: f64| blend(value(low, wavelength, 0.1, 2.0, cos));
+        assert_eq!(at(0.5, 1.0).bump, 1.0);
+        assert_eq!(at(0.28, 1.0).bump, 1.0);
+        assert_eq!(at(0.2, 1.0).brdf, 1.0);
+        assert_eq!(at(0.1, 1.0).brdf, 1.0);
+        let mid = at(0.235, 1.0);
+        assert!((mid.brdf - 0.5).abs() < 1e-9 && (mid.bump - 0.5).abs() < 1e-9);
+        // Grazing: a resolved pattern stays bump mapped, an unresolved one goes to the BRDF.
+        assert_eq!(at(0.5, 0.0).bump, 1.0);
+        assert_eq!(at(0.1, 0.0).brdf, 1.0);
+        assert_eq!(at(100.0, 1.0).displacement, 0.0);
+        // Tall relief displaces whatever the pattern.
+        assert_eq!(blend(value(0.5, 0.01, 0.1, 2.0, 1.0)).displacement, 1.0);
+        assert_eq!(blend(value(0.5, 100.0, 0.1, 2.0, 1.0)).displacement, 1.0);
+        // Continuous in the wavelength across the blend.
+        let mut last = at(0.15, 0.8);
+        let mut wavelength = 0.15;
+        while wavelength < 0.35 {
+            wavelength += 1e-5;
+            let b = at(wavelength, 0.8);
+            assert!((b.bump - last.bump).abs() < 1e-3, "jump at {wavelength}");
+            last = b;
+        }
     }
 
     #[test]

@@ -22,9 +22,12 @@ use std::time::Instant;
 
 use clap::{Args, ValueEnum};
 use flexcam::displace::{tessellate, Displacement};
+use flexcam::glam::Vec3;
+use flexcam::image_io::{encode_channel, ColorEncoding};
 use flexcam::projection::{CameraFrame, ProjectionSpec};
 use flexcam::render::{
-    render, Counter, LodSelection, PreparedScene, RenderOptions, Shading, TransitionShading,
+    render, Counter, Frame, LodSelection, PreparedScene, RenderOptions, Shading, TransitionMethod,
+    TransitionShading,
 };
 use flexcam::scene::{self, DisplacementSpec, Scene};
 use flexcam::{Error, Result};
@@ -201,14 +204,16 @@ const TRANSITION_DS: [f64; 3] = [TransitionShading::DEFAULT_D, 8.0, 32.0];
 /// lit`) at the near and the scene's view, level 5, in this process: Table 8.1's "transition
 /// system" row beside "displaced detailed", for each `D` of [`TRANSITION_DS`], with the
 /// displacing rays on the detailed mesh (`--lod finest`) and on the level of detail their
-/// footprint allows (`--lod footprint`).
+/// footprint allows (`--lod footprint`); and how far the `footprint` image is from full
+/// displacement's under the same shader ([`image_error`], untimed renders at
+/// [`ERROR_SPP`] samples per pixel).
 fn transition_rows(args: &DisplacedArgs, base: &Scene) -> Result<()> {
     println!(
         "Table 8.1 (Ramsey 2005): transition system (transition-lit) against full displacement \
          (lit), level 5; the dissertation's was over 4x faster at the near view"
     );
     println!(
-        "{:>6} {:>5} {:>13} {:>13} {:>8} {:>13} {:>8} | {:>6} {:>6} {:>6} | {:>7}",
+        "{:>6} {:>5} {:>13} {:>13} {:>8} {:>13} {:>8} | {:>6} {:>6} {:>6} | {:>7} | {:>6} {:>6}",
         "view",
         "D",
         "displaced ms",
@@ -219,7 +224,9 @@ fn transition_rows(args: &DisplacedArgs, base: &Scene) -> Result<()> {
         "BRDF",
         "bump",
         "disp.",
-        "coarser"
+        "coarser",
+        "error",
+        ">0.1"
     );
     let scene = with_level(base, 5);
     let prepared = PreparedScene::new(&scene);
@@ -235,6 +242,19 @@ fn transition_rows(args: &DisplacedArgs, base: &Scene) -> Result<()> {
             })
         };
         let (full, _) = time(Shading::Lit)?;
+        let image = |shading| {
+            let options = RenderOptions {
+                shading: Shading::Transitions(shading),
+                spp: ERROR_SPP,
+                ..RenderOptions::default()
+            };
+            render(&prepared, projection.as_ref(), &options).map(|r| r.frame)
+        };
+        let reference = image(
+            TransitionShading::with_default_d(false)
+                .with_method(TransitionMethod::Displacement)
+                .with_lod(LodSelection::Finest),
+        )?;
         for d in TRANSITION_DS {
             let shading = TransitionShading::new(false, d)?;
             let (finest, _) = time(Shading::Transitions(shading.with_lod(LodSelection::Finest)))?;
@@ -260,8 +280,13 @@ fn transition_rows(args: &DisplacedArgs, base: &Scene) -> Result<()> {
             } else {
                 "-".to_string()
             };
+            let (error, off) = image_error(
+                &image(shading.with_lod(LodSelection::Footprint))?,
+                &reference,
+                scene.image.background,
+            );
             println!(
-                "{name:>6} {d:>5} {:>13.1} {:>13.1} {:>8.2} {:>13.1} {:>8.2} | {:>5.0}% {:>5.0}% {:>5.0}% | {coarser:>7}",
+                "{name:>6} {d:>5} {:>13.1} {:>13.1} {:>8.2} {:>13.1} {:>8.2} | {:>5.0}% {:>5.0}% {:>5.0}% | {coarser:>7} | {error:>6.3} {:>5.1}%",
                 full.median_ms(),
                 finest.median_ms(),
                 full.median_ms() / finest.median_ms(),
@@ -270,6 +295,7 @@ fn transition_rows(args: &DisplacedArgs, base: &Scene) -> Result<()> {
                 100.0 * weights[0] / total,
                 100.0 * weights[1] / total,
                 100.0 * weights[2] / total,
+                100.0 * off,
             );
         }
     }
@@ -277,9 +303,43 @@ fn transition_rows(args: &DisplacedArgs, base: &Scene) -> Result<()> {
         "finest: --lod finest (the detailed mesh); footprint: --lod footprint (the default); \
          BRDF, bump, disp.: share of the samples on the displaced object by method weight; \
          coarser: share of the displacing samples that traced a coarser level; the tables and \
-         levels of detail are built once per prepared scene, in the first (warm-up) render"
+         levels of detail are built once per prepared scene, in the first (warm-up) render; \
+         error: the footprint image against full displacement's (transition-lit, \
+         --transition-method displacement --lod finest), both at {ERROR_SPP} samples per \
+         pixel, in sRGB codes / 255 over the pixels either shows the torus in: mean, and \
+         share above 0.1"
     );
     Ok(())
+}
+
+/// Samples per pixel of the renders [`image_error`] compares: enough that pixels are
+/// compared as averages, not as aliased samples of ridges a few pixels wide.
+const ERROR_SPP: u32 = 4;
+
+/// How far `image` is from `reference` (same size): per pixel the mean over the three
+/// channels of the absolute difference of their 8-bit sRGB codes over 255, over the pixels
+/// where either is not `background`; the mean, and the share of those pixels above 0.1.
+/// (0, 0) where both are all background.
+fn image_error(image: &Frame, reference: &Frame, background: Vec3) -> (f64, f64) {
+    let code = |c: &Vec3| {
+        c.to_array()
+            .map(|v| f64::from(encode_channel(v, ColorEncoding::Srgb)))
+    };
+    let (mut sum, mut above, mut count) = (0.0, 0usize, 0usize);
+    for (a, b) in image.color.iter().zip(&reference.color) {
+        if *a == background && *b == background {
+            continue;
+        }
+        let (ca, cb) = (code(a), code(b));
+        let error = (0..3).map(|k| (ca[k] - cb[k]).abs()).sum::<f64>() / (3.0 * 255.0);
+        sum += error;
+        above += usize::from(error > 0.1);
+        count += 1;
+    }
+    if count == 0 {
+        return (0.0, 0.0);
+    }
+    (sum / count as f64, above as f64 / count as f64)
 }
 
 /// The statistics keys of the samples per level of detail (`--stats` of `transition-lit`).
@@ -416,4 +476,27 @@ fn memory_kb(field: &str) -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with(field))?;
     line[field.len()..].split_whitespace().next()?.parse().ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Background pixels of both are left out; the others count by their channels' mean
+    /// code difference; all background or identical frames give 0.
+    #[test]
+    fn image_error_over_the_object_only() {
+        let background = Vec3::new(0.1, 0.2, 0.3);
+        let mut a = Frame::new(4, 1, background);
+        let mut b = Frame::new(4, 1, background);
+        assert_eq!(image_error(&a, &b, background), (0.0, 0.0));
+        a.color[0] = Vec3::ONE;
+        b.color[0] = Vec3::ZERO;
+        a.color[1] = Vec3::splat(0.5);
+        b.color[1] = Vec3::splat(0.5);
+        assert_eq!(image_error(&a, &a, background), (0.0, 0.0));
+        let (mean, above) = image_error(&a, &b, background);
+        assert!((mean - 0.5).abs() < 1e-12, "{mean}");
+        assert!((above - 0.5).abs() < 1e-12, "{above}");
+    }
 }

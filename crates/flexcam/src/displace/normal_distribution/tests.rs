@@ -38,6 +38,48 @@ fn refuses_bad_charts() {
     }
 }
 
+/// A single wave's wavelength is found in either direction at any world size and scale;
+/// crossed equal waves keep it; a finer wave shortens it (by the root mean square of the
+/// wavenumbers; the forward differences flatten a wave of 8 cells per period by 2.5 %);
+/// a flat chart has none.
+#[test]
+fn wavelength_of_waves() {
+    let chart = |waves: &[([i32; 2], f64)], size: DVec2, scale: f64| {
+        let waves = waves
+            .iter()
+            .map(|&(frequency, amplitude)| Wave {
+                amplitude,
+                frequency,
+                phase: 0.3,
+            })
+            .collect();
+        let height = HeightField::Procedural(Procedural::waves(waves).unwrap());
+        Chart::new(&height, scale, size, 128).unwrap()
+    };
+    let size = DVec2::new(2.0, 0.5);
+    for (waves, expected) in [
+        (vec![([4, 0], 1.0)], 0.5),
+        (vec![([0, 4], 1.0)], 0.125),
+        (
+            vec![([4, 0], 1.0), ([16, 0], 1.0)],
+            0.5 * (2.0_f64 / 17.0).sqrt(),
+        ),
+    ] {
+        for scale in [0.01, 3.0] {
+            let found = chart(&waves, size, scale).wavelength();
+            assert!(
+                (found / expected - 1.0).abs() < 0.03,
+                "{waves:?} at scale {scale}: {found}, not {expected}"
+            );
+        }
+    }
+    let square = DVec2::ONE;
+    let one = chart(&[([5, 0], 1.0)], square, 0.1).wavelength();
+    let crossed = chart(&[([5, 0], 1.0), ([0, 5], 1.0)], square, 0.1).wavelength();
+    assert!((crossed / one - 1.0).abs() < 1e-6 && (one - 0.2).abs() < 0.001);
+    assert_eq!(flat_chart().wavelength(), 0.0);
+}
+
 /// Every view's histogram is normalised; a flat field (and a zero scale) puts all of it in
 /// the middle bin, the pole.
 #[test]

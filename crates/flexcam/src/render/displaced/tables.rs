@@ -36,6 +36,7 @@ pub(in crate::render) struct ObjectTables {
     pub chart: Chart,
     pub redistribution: Redistribution,
     pub brdf: BrdfTable,
+    wavelength: f64,
     full: Displacement,
     partial: Vec<OnceLock<Displacement>>,
 }
@@ -52,6 +53,7 @@ impl ObjectTables {
         ObjectTables {
             redistribution: Redistribution::new(&distribution),
             brdf: BrdfTable::new(&distribution),
+            wavelength: chart.wavelength(),
             chart,
             full: displacement.clone(),
             partial: (0..=PARTIAL_STEPS).map(|_| OnceLock::new()).collect(),
@@ -61,6 +63,12 @@ impl ObjectTables {
     /// Highest minus lowest displacement (world units).
     pub fn relief(&self) -> f64 {
         self.chart.relief()
+    }
+
+    /// The bumps' mean wavelength (world units, [`Chart::wavelength`]), computed with the
+    /// chart.
+    pub fn wavelength(&self) -> f64 {
+        self.wavelength
     }
 
     /// The object's displacement at fraction `step / PARTIAL_STEPS` of its own, made on

@@ -88,8 +88,8 @@ impl TransitionMethod {
 }
 
 impl TransitionShading {
-    /// The default `D`: relief of 3 footprints or more seen head on is displaced, below 1
-    /// footprint the BRDF.
+    /// The default `D`: relief of 3 footprints or more seen head on is displaced; below 1
+    /// footprint of relief the bumps' width decides between bump mapping and the BRDF.
     pub const DEFAULT_D: f64 = 2.0;
 
     /// Errors: a `d` that is not finite.

@@ -136,6 +136,7 @@ impl<'a> Renderer<'a> {
         let blend = self.method.forced_blend().unwrap_or_else(|| {
             transition::blend(transition::value(
                 tables.relief(),
+                tables.wavelength(),
                 footprint,
                 self.d,
                 cos_view,
