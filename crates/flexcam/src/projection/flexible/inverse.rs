@@ -23,6 +23,10 @@
 //!   affine far surface, so t follows from p.n as for parallel planes, then (u, v) from the
 //!   2 x 2 solve of the piece whose u range holds the solution (the pieces meet
 //!   continuously at the knots, so a point on a knot gets the same answer from both).
+//! - Polyline projectors through similar rectangles in parallel planes whose parameters are
+//!   partly displaced by a sampled map (the depth-discontinuity occlusion camera): the
+//!   layered inverse, then the displacement undone by a safeguarded Newton iteration
+//!   (module `displaced_inverse`).
 //!
 //! Anything else has no inverse ([`Inverse::classify`] gives `None`, or for a panorama the
 //! reason).
@@ -37,6 +41,7 @@ use glam::{DMat2, DVec2, DVec3};
 use super::control_surface::{
     CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface, WarpedRectangle,
 };
+use super::displaced_inverse::DisplacedLayers;
 use super::panorama::lookup::{self, PanoramaInverse};
 use super::reparam::Reparam;
 use crate::error::Result;
@@ -87,6 +92,10 @@ pub(super) enum Inverse {
         pieces: Vec<WarpPiece>,
         normal: DVec3,
     },
+    /// Polyline projectors through similar rectangles in parallel planes, some of them
+    /// displaced by a sampled map (the depth-discontinuity occlusion camera): the layered
+    /// inverse of the rectangles, then the displacement undone by a contraction.
+    Displaced(Box<DisplacedLayers>),
 }
 
 /// One piece of a warped far rectangle: its u range and the affine surface it is there
@@ -344,6 +353,7 @@ impl Inverse {
                 normal,
             } => warped(near, pieces, *normal, p),
             Inverse::Layers { segments, normal } => layers(segments, *normal, p),
+            Inverse::Displaced(d) => d.solve_unbounded(p),
         }
     }
 }
@@ -352,6 +362,18 @@ impl Inverse {
 /// beyond them all, the first one before them, so that the solution extends beyond the
 /// volume), its local t mapped to the volume's.
 fn layers(segments: &[Layer], n: DVec3, p: DVec3) -> Option<(DVec2, f64)> {
+    let (k, uv, s) = layer_solution(segments, n, p)?;
+    let t = segments[k].t;
+    Some((uv, t[0] + s * (t[1] - t[0])))
+}
+
+/// The segment [`layers`] picks for `p`, its (u, v) and its local t (0 on the segment's near
+/// surface, 1 on its far one).
+pub(super) fn layer_solution(
+    segments: &[Layer],
+    n: DVec3,
+    p: DVec3,
+) -> Option<(usize, DVec2, f64)> {
     let last = segments.len() - 1;
     let k = segments
         .iter()
@@ -359,7 +381,7 @@ fn layers(segments: &[Layer], n: DVec3, p: DVec3) -> Option<(DVec2, f64)> {
         .unwrap_or(last);
     let layer = &segments[k];
     let (uv, s) = planes(&layer.near, &layer.far, n, p)?;
-    Some((uv, layer.t[0] + s * (layer.t[1] - layer.t[0])))
+    Some((k, uv, s))
 }
 
 /// The parallel-planes solution of the piece whose u range holds it (the first piece open
