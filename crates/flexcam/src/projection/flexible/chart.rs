@@ -76,9 +76,11 @@ impl Inverse {
                 planar_map(reparam).then_some(())?;
                 warped_chart(near, pieces, *normal)
             }
-            Inverse::Displaced(d) => {
+            Inverse::Displaced {
+                segments, normal, ..
+            } => {
                 planar_map(reparam).then_some(())?;
-                layers_chart(d.layers(), d.normal())
+                layers_chart(segments, *normal)
             }
         }
     }

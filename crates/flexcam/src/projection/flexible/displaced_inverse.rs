@@ -1,6 +1,7 @@
-//! The inverse of a polyline volume through similar rectangles in parallel planes whose
-//! parameters are partly displaced by one sampled map m: the depth-discontinuity occlusion
-//! camera (`presets::ddoc`), whose Q_zf and far rectangles are evaluated at q - m(q).
+//! The displacement part of the inverse of a polyline volume through similar rectangles in
+//! parallel planes whose parameters are partly displaced by one sampled map m
+//! (`Inverse::Displaced`): the depth-discontinuity occlusion camera (`presets::ddoc`), whose
+//! Q_zf and far rectangles are evaluated at q - m(q).
 //!
 //! Each surface i is the rectangle a_i + lambda_i B x (the same in-plane frame B, scaled by
 //! lambda_i >= 0) at x = q, or at x = q - m(q) where it is displaced (delta_i = 1). A point p
@@ -32,7 +33,6 @@ use std::sync::Arc;
 use glam::{DMat2, DVec2, DVec3};
 
 use super::control_surface::Surface;
-use super::inverse::{layer_solution, Inverse, Layer};
 use super::presets::DdocMap;
 use crate::error::{Error, Result};
 
@@ -52,12 +52,42 @@ const MAX_STEPS: usize = 300;
 /// Relative tolerance for "similar" cross-sections.
 const SIMILAR: f64 = 1e-9;
 
-/// The inverse of a partly displaced polyline volume (see the module).
+/// The surfaces with every displaced rectangle replaced by the rectangle itself, which of
+/// them were displaced, and their one map. Errors: none displaced, or by different maps.
+pub(super) fn undisplaced(surfaces: &[Surface]) -> Result<(Vec<Surface>, Vec<bool>, Arc<DdocMap>)> {
+    let mut map: Option<&Arc<DdocMap>> = None;
+    let mut displaced = Vec::with_capacity(surfaces.len());
+    let mut plain = Vec::with_capacity(surfaces.len());
+    for s in surfaces {
+        match s {
+            Surface::Displaced(d) => {
+                if map.is_some_and(|m| m != &d.map) {
+                    return Err(Error::new(
+                        "its control surfaces are displaced by different maps",
+                    ));
+                }
+                map = Some(&d.map);
+                displaced.push(true);
+                plain.push(Surface::Rectangle {
+                    corner: d.corner,
+                    u_edge: d.u_edge,
+                    v_edge: d.v_edge,
+                });
+            }
+            other => {
+                displaced.push(false);
+                plain.push(other.clone());
+            }
+        }
+    }
+    let map = map.ok_or_else(|| Error::new("none of its control surfaces is displaced"))?;
+    Ok((plain, displaced, map.clone()))
+}
+
+/// How a polyline volume's surfaces are displaced (see the module): per segment the weights
+/// that give h, the map and its slope.
 #[derive(Debug, Clone, PartialEq)]
-pub(super) struct DisplacedLayers {
-    /// The layered inverse of the undisplaced rectangles.
-    layers: Vec<Layer>,
-    normal: DVec3,
+pub(super) struct Displacement {
     /// Per segment, its two ends' (lambda, lambda delta): the cross-section's scale, and
     /// that scale where the surface is displaced (0 where not).
     weights: Vec<[(f64, f64); 2]>,
@@ -66,49 +96,13 @@ pub(super) struct DisplacedLayers {
     slope: f64,
 }
 
-impl DisplacedLayers {
-    /// The inverse of the polyline volume through `surfaces` at `knots`, some of them
-    /// displaced rectangles. Errors, each a reason the volume has no inverse: surfaces that
-    /// are not rectangles in parallel planes in order along the projectors, rectangles that
-    /// are not similar (one frame scaled), displaced surfaces of different maps, a map of
-    /// slope [`MAX_SLOPE`] or more.
-    pub fn classify(surfaces: &[Surface], knots: &[f64]) -> Result<DisplacedLayers> {
-        let mut map: Option<&Arc<DdocMap>> = None;
-        let mut displaced = Vec::with_capacity(surfaces.len());
-        let mut plain = Vec::with_capacity(surfaces.len());
-        for s in surfaces {
-            match s {
-                Surface::Displaced(d) => {
-                    if map.is_some_and(|m| m != &d.map) {
-                        return Err(Error::new(
-                            "its control surfaces are displaced by different maps",
-                        ));
-                    }
-                    map = Some(&d.map);
-                    displaced.push(true);
-                    plain.push(Surface::Rectangle {
-                        corner: d.corner,
-                        u_edge: d.u_edge,
-                        v_edge: d.v_edge,
-                    });
-                }
-                other => {
-                    displaced.push(false);
-                    plain.push(other.clone());
-                }
-            }
-        }
-        let Some(map) = map else {
-            return Err(Error::new("none of its control surfaces is displaced"));
-        };
-        let Some(Inverse::Layers { segments, normal }) = Inverse::classify_layers(&plain, knots)
-        else {
-            return Err(Error::new(
-                "its displaced control surfaces are not flat, parallel and in order along the \
-                 projectors",
-            ));
-        };
-        let scales = similar_scales(&segments).ok_or_else(|| {
+impl Displacement {
+    /// The displacement of the surfaces whose in-plane edges are `frames` (u edge, v edge,
+    /// in order along the projectors), `displaced` where flagged, by `map`. Errors, each a
+    /// reason the volume has no inverse: frames that are not one frame scaled by
+    /// lambda >= 0 (to 1e-9), a map of slope [`MAX_SLOPE`] or more.
+    pub fn new(frames: &[[DVec3; 2]], displaced: &[bool], map: Arc<DdocMap>) -> Result<Self> {
+        let scales = similar_scales(frames).ok_or_else(|| {
             Error::new(
                 "its control surfaces are not similar rectangles (one frame scaled), so the \
                  displacement does not separate from the depth",
@@ -123,32 +117,20 @@ impl DisplacedLayers {
             )));
         }
         let weight = |i: usize| (scales[i], if displaced[i] { scales[i] } else { 0.0 });
-        let weights = (0..segments.len())
-            .map(|k| [weight(k), weight(k + 1)])
+        let weights = (1..frames.len())
+            .map(|k| [weight(k - 1), weight(k)])
             .collect();
-        Ok(DisplacedLayers {
-            layers: segments,
-            normal,
+        Ok(Displacement {
             weights,
-            map: map.clone(),
+            map,
             slope,
         })
     }
 
-    /// The undisplaced rectangles' layered inverse, for the chart.
-    pub fn layers(&self) -> &[Layer] {
-        &self.layers
-    }
-
-    /// The planes' normal.
-    pub fn normal(&self) -> DVec3 {
-        self.normal
-    }
-
-    /// (u, v) and the volume's t of `p`, extended beyond the volume (the end segments
-    /// continued; h of the nearest end there). `None` where the cross-section is a point.
-    pub fn solve_unbounded(&self, p: DVec3) -> Option<(DVec2, f64)> {
-        let (k, w, local) = layer_solution(&self.layers, self.normal, p)?;
+    /// The pixel position q of a point on segment `k` at its local t `local` (continued
+    /// beyond [0, 1] with the h of the nearest end) whose undisplaced position is `w`.
+    /// `None` only if the iteration fails to converge (see [`undisplace`]).
+    pub fn undo(&self, k: usize, local: f64, w: DVec2) -> Option<DVec2> {
         let [(la, da), (lb, db)] = self.weights[k];
         let s = local.clamp(0.0, 1.0);
         let scale = (1.0 - s) * la + s * lb;
@@ -160,30 +142,21 @@ impl DisplacedLayers {
         } else {
             da / la
         };
-        let q = undisplace(&self.map, w, h, self.slope)?;
-        let t = self.layers[k].t;
-        Some((q, t[0] + local * (t[1] - t[0])))
+        undisplace(&self.map, w, h, self.slope)
     }
 }
 
-/// Each surface's scale lambda_i against the largest cross-section, when every rectangle
-/// is that one's frame scaled by lambda_i >= 0 (to [`SIMILAR`]); `None` otherwise.
-fn similar_scales(segments: &[Layer]) -> Option<Vec<f64>> {
-    let surfaces: Vec<_> = std::iter::once(&segments.first()?.near)
-        .chain(segments.iter().map(|l| &l.far))
-        .collect();
-    let size = |s: &&super::inverse::Affine| s.b.length() + s.c.length();
-    let reference = surfaces
+/// Each frame's scale lambda_i against the largest, when every frame is that one scaled by
+/// lambda_i >= 0 (to [`SIMILAR`]); `None` otherwise.
+fn similar_scales(frames: &[[DVec3; 2]]) -> Option<Vec<f64>> {
+    let size = |f: &[DVec3; 2]| f[0].length() + f[1].length();
+    let [b, c] = *frames.iter().max_by(|a, b| size(a).total_cmp(&size(b)))?;
+    let scale = b.length() + c.length();
+    frames
         .iter()
-        .max_by(|a, b| size(a).total_cmp(&size(b)))
-        .copied()?;
-    let scale = size(&reference);
-    let (b, c) = (reference.b, reference.c);
-    surfaces
-        .iter()
-        .map(|s| {
-            let lambda = (s.b.dot(b) + s.c.dot(c)) / (b.length_squared() + c.length_squared());
-            let off = (s.b - lambda * b).length() + (s.c - lambda * c).length();
+        .map(|[fb, fc]| {
+            let lambda = (fb.dot(b) + fc.dot(c)) / (b.length_squared() + c.length_squared());
+            let off = (*fb - lambda * b).length() + (*fc - lambda * c).length();
             (lambda >= 0.0 && off <= SIMILAR * scale).then_some(lambda)
         })
         .collect()

@@ -6,31 +6,18 @@ use std::sync::Arc;
 use glam::{DVec2, DVec3};
 use proptest::prelude::*;
 
-use super::displaced_inverse::{undisplace, DisplacedLayers, MAX_SLOPE, TOLERANCE};
+use super::displaced_inverse::{undisplace, MAX_SLOPE, TOLERANCE};
+use super::inverse::Inverse;
 use super::presets::DdocMap;
+use super::tests::frame;
 use super::*;
-use crate::projection::{CameraFrame, ImagePoint, Projection};
+use crate::projection::{ImagePoint, Projection};
 use crate::render::supported_chart;
 
 const SIZE: (u32, u32) = (40, 30);
 
-fn frame() -> CameraFrame {
-    CameraFrame {
-        position: DVec3::new(1.0, 2.0, 3.0),
-        look_at: DVec3::new(-2.0, 1.0, 0.0),
-        up: DVec3::Y,
-    }
-}
-
 fn build(preset: Preset, clip: [f64; 2]) -> Flexible {
-    let spec = FlexibleSpec {
-        source: VolumeSource::Preset(PresetSpec {
-            preset,
-            frame: frame(),
-            clip: Some(clip),
-        }),
-        reparam: None,
-    };
+    let spec = tests::preset(preset, Some(clip));
     Flexible::new(&spec, SIZE.0, SIZE.1).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -312,35 +299,43 @@ fn displaced_surfaces_that_do_not_separate_are_refused() {
         }))
     };
     let knots = [0.0, 0.5, 1.0];
-    let stretched = [
-        rect(1.0, 1.0, 1.0),
-        rect(2.0, 2.0, 2.0),
-        displaced(4.0, 4.0, 3.0, map(0.1)),
+    let cases = [
+        (
+            [1.0, 2.0, 4.0],
+            3.0,
+            [0.1, 0.1],
+            false,
+            "not similar rectangles",
+        ),
+        ([1.0, 2.0, 4.0], 4.0, [0.1, 0.2], true, "different maps"),
+        (
+            [1.0, 4.0, 2.0],
+            4.0,
+            [0.1, 0.1],
+            false,
+            "in order along the projectors",
+        ),
     ];
-    let e = DisplacedLayers::classify(&stretched, &knots)
-        .unwrap_err()
-        .message;
-    assert!(e.contains("not similar rectangles"), "{e}");
-    let two = [
-        rect(1.0, 1.0, 1.0),
-        displaced(2.0, 2.0, 2.0, map(0.1)),
-        displaced(4.0, 4.0, 4.0, map(0.2)),
-    ];
-    let e = DisplacedLayers::classify(&two, &knots).unwrap_err().message;
-    assert!(e.contains("different maps"), "{e}");
-    let back = [
-        rect(1.0, 1.0, 1.0),
-        rect(4.0, 2.0, 2.0),
-        displaced(2.0, 4.0, 4.0, map(0.1)),
-    ];
-    let e = DisplacedLayers::classify(&back, &knots)
-        .unwrap_err()
-        .message;
-    assert!(e.contains("in order along the projectors"), "{e}");
+    for (z, height, maps, middle_displaced, expected) in cases {
+        let middle = if middle_displaced {
+            displaced(z[1], 2.0, 2.0, map(maps[0]))
+        } else {
+            rect(z[1], 2.0, 2.0)
+        };
+        let surfaces = [
+            rect(z[0], 1.0, 1.0),
+            middle,
+            displaced(z[2], 4.0, height, map(maps[1])),
+        ];
+        let e = Inverse::classify_displaced(&surfaces, &knots)
+            .unwrap_err()
+            .message;
+        assert!(e.contains(expected), "{e} (expected {expected})");
+    }
     let fine = [
         rect(1.0, 1.0, 1.0),
         rect(2.0, 2.0, 2.0),
         displaced(4.0, 4.0, 4.0, map(0.1)),
     ];
-    assert!(DisplacedLayers::classify(&fine, &knots).is_ok());
+    assert!(Inverse::classify_displaced(&fine, &knots).is_ok());
 }

@@ -41,10 +41,10 @@ use glam::{DMat2, DVec2, DVec3};
 use super::control_surface::{
     CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface, WarpedRectangle,
 };
-use super::displaced_inverse::DisplacedLayers;
+use super::displaced_inverse::{undisplaced, Displacement};
 use super::panorama::lookup::{self, PanoramaInverse};
 use super::reparam::Reparam;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::projection::image_coords::Resolution;
 use crate::projection::{AnalyticInverse, Charted, ContinuousInverse, ImagePoint};
 
@@ -95,7 +95,11 @@ pub(super) enum Inverse {
     /// Polyline projectors through similar rectangles in parallel planes, some of them
     /// displaced by a sampled map (the depth-discontinuity occlusion camera): the layered
     /// inverse of the rectangles, then the displacement undone by a contraction.
-    Displaced(Box<DisplacedLayers>),
+    Displaced {
+        segments: Vec<Layer>,
+        normal: DVec3,
+        displacement: Box<Displacement>,
+    },
 }
 
 /// One piece of a warped far rectangle: its u range and the affine surface it is there
@@ -258,6 +262,32 @@ impl Inverse {
         monotonic.then_some(Inverse::Layers { segments, normal })
     }
 
+    /// The inverse of the polyline volume through `surfaces` at `knots`, some of them
+    /// displaced rectangles (module `displaced_inverse`). Errors, each a reason the volume
+    /// has no inverse: surfaces that are not rectangles in parallel planes in order along
+    /// the projectors, rectangles that are not similar (one frame scaled), displaced
+    /// surfaces of different maps, a map of slope `MAX_SLOPE` or more.
+    pub fn classify_displaced(surfaces: &[Surface], knots: &[f64]) -> Result<Inverse> {
+        let (plain, displaced, map) = undisplaced(surfaces)?;
+        let Some(Inverse::Layers { segments, normal }) = Inverse::classify_layers(&plain, knots)
+        else {
+            return Err(Error::new(
+                "its displaced control surfaces are not flat, parallel and in order along the \
+                 projectors",
+            ));
+        };
+        let frames: Vec<[DVec3; 2]> = std::iter::once(&segments[0].near)
+            .chain(segments.iter().map(|l| &l.far))
+            .map(|a| [a.b, a.c])
+            .collect();
+        let displacement = Displacement::new(&frames, &displaced, map)?;
+        Ok(Inverse::Displaced {
+            segments,
+            normal,
+            displacement: Box::new(displacement),
+        })
+    }
+
     /// An affine `near` and the warped `far` when every piece of the warp makes parallel
     /// planes with `near`, all of one normal.
     fn classify_warped(near: &Surface, far: &WarpedRectangle) -> Option<Inverse> {
@@ -353,7 +383,16 @@ impl Inverse {
                 normal,
             } => warped(near, pieces, *normal, p),
             Inverse::Layers { segments, normal } => layers(segments, *normal, p),
-            Inverse::Displaced(d) => d.solve_unbounded(p),
+            Inverse::Displaced {
+                segments,
+                normal,
+                displacement,
+            } => {
+                let (k, w, local) = layer_solution(segments, *normal, p)?;
+                let q = displacement.undo(k, local, w)?;
+                let t = segments[k].t;
+                Some((q, t[0] + local * (t[1] - t[0])))
+            }
         }
     }
 }
@@ -369,11 +408,7 @@ fn layers(segments: &[Layer], n: DVec3, p: DVec3) -> Option<(DVec2, f64)> {
 
 /// The segment [`layers`] picks for `p`, its (u, v) and its local t (0 on the segment's near
 /// surface, 1 on its far one).
-pub(super) fn layer_solution(
-    segments: &[Layer],
-    n: DVec3,
-    p: DVec3,
-) -> Option<(usize, DVec2, f64)> {
+fn layer_solution(segments: &[Layer], n: DVec3, p: DVec3) -> Option<(usize, DVec2, f64)> {
     let last = segments.len() - 1;
     let k = segments
         .iter()

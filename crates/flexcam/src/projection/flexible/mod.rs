@@ -67,7 +67,6 @@ pub use projector_grid::{
 pub use reparam::Reparam;
 pub use volume::{ControlSurface, InterpolatedVolume, RemappedVolume, Volume};
 
-use self::displaced_inverse::DisplacedLayers;
 use self::inverse::{BoundInverse, Inverse};
 use super::image_coords::Resolution;
 use super::{
@@ -188,8 +187,7 @@ impl Flexible {
                     .iter()
                     .any(|s| matches!(s, Surface::Displaced(_))) =>
             {
-                DisplacedLayers::classify(v.surfaces(), v.knots())
-                    .map(|d| Some(Inverse::Displaced(Box::new(d))))
+                Inverse::classify_displaced(v.surfaces(), v.knots()).map(Some)
             }
             Volume::Piecewise(v) => Ok(Inverse::classify_layers(v.surfaces(), v.knots())),
             _ => Ok(None),
