@@ -118,31 +118,54 @@ impl DdocMap {
     /// m(q): the map at image position `uv`, bilinear between pixel centres, the border
     /// samples beyond them.
     pub fn sample(&self, uv: DVec2) -> DVec2 {
-        self.sample_with_slope(uv).0
+        let cell = self.cell(uv);
+        cell.top().lerp(cell.bottom(), cell.fraction.y)
     }
 
     /// m(q) and its derivative at `uv`: columns dm/du and dm/dv of the bilinear patch there
     /// (zero across a border, beyond which the map is its border samples; on a line between
     /// cells, the next cell's in map pixels).
     pub fn sample_with_slope(&self, uv: DVec2) -> (DVec2, DMat2) {
+        let cell = self.cell(uv);
+        let [c00, c10, c01, c11] = cell.corners;
+        let (top, bottom) = (cell.top(), cell.bottom());
+        // d/du = W d/dx and d/dv = -H d/dy inside the map; nothing moves beyond it.
+        let du = if cell.inside[0] {
+            self.width as f64
+        } else {
+            0.0
+        };
+        let dv = if cell.inside[1] {
+            -(self.height as f64)
+        } else {
+            0.0
+        };
+        let along_x = (c10 - c00).lerp(c11 - c01, cell.fraction.y);
+        let slope = DMat2::from_cols(du * along_x, dv * (bottom - top));
+        (top.lerp(bottom, cell.fraction.y), slope)
+    }
+
+    /// The map cell around `uv`; a position that is not finite gets a cell of zeros (no
+    /// displacement, no slope).
+    fn cell(&self, uv: DVec2) -> Cell {
         let (w, h) = (self.width as usize, self.height as usize);
         let (x, y) = (uv.x * w as f64 - 0.5, (1.0 - uv.y) * h as f64 - 0.5);
         if !(x.is_finite() && y.is_finite()) {
-            return (DVec2::ZERO, DMat2::ZERO);
+            return Cell {
+                corners: [DVec2::ZERO; 4],
+                fraction: DVec2::ZERO,
+                inside: [false; 2],
+            };
         }
         let (cx, cy) = (x.clamp(0.0, (w - 1) as f64), y.clamp(0.0, (h - 1) as f64));
         let (x0, y0) = (cx.floor() as usize, cy.floor() as usize);
         let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
-        let (fx, fy) = (cx - x0 as f64, cy - y0 as f64);
         let at = |x: usize, y: usize| self.samples[y * w + x];
-        let top = at(x0, y0).lerp(at(x1, y0), fx);
-        let bottom = at(x0, y1).lerp(at(x1, y1), fx);
-        // d/du = W d/dx and d/dv = -H d/dy inside the map; nothing moves beyond it.
-        let du = if cx == x { w as f64 } else { 0.0 };
-        let dv = if cy == y { -(h as f64) } else { 0.0 };
-        let along_x = (at(x1, y0) - at(x0, y0)).lerp(at(x1, y1) - at(x0, y1), fy);
-        let slope = DMat2::from_cols(du * along_x, dv * (bottom - top));
-        (top.lerp(bottom, fy), slope)
+        Cell {
+            corners: [at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1)],
+            fraction: DVec2::new(cx - x0 as f64, cy - y0 as f64),
+            inside: [cx == x, cy == y],
+        }
     }
 
     /// The map's Lipschitz constant in image fractions, and the map pixel (from the top
@@ -327,6 +350,27 @@ impl DdocMap {
             })
             .collect();
         DdocMap::new(width, height, samples)
+    }
+}
+
+/// The map samples around a position: the corners (x0, y0), (x1, y0), (x0, y1), (x1, y1)
+/// (rows from the top), the position's fraction across the cell, and whether it lies inside
+/// the map's pixel centres along x and along y (not clamped onto the border).
+struct Cell {
+    corners: [DVec2; 4],
+    fraction: DVec2,
+    inside: [bool; 2],
+}
+
+impl Cell {
+    /// The value along the cell's top row at the position's x.
+    fn top(&self) -> DVec2 {
+        self.corners[0].lerp(self.corners[1], self.fraction.x)
+    }
+
+    /// The value along the cell's bottom row at the position's x.
+    fn bottom(&self) -> DVec2 {
+        self.corners[2].lerp(self.corners[3], self.fraction.x)
     }
 }
 
