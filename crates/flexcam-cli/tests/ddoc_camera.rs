@@ -1,13 +1,14 @@
 //! The depth-discontinuity occlusion camera (`preset = "ddoc"`) from the command line:
 //! `flexcam ddoc-map` writes the map of the example scene and the DDOC then shows the balls
 //! its pillar hides in the perspective view; a zero map renders the perspective's pixels;
-//! bad maps are refused with one line naming the file; `--method raster` says why not.
+//! bad maps are refused with one line naming the file; `--method raster` renders it like the
+//! ray caster and refuses a map steep enough to fold, saying why.
 
 mod common;
 
 use std::fs;
 
-use common::{run, run_ok, scene_example};
+use common::{raster_agrees, run, run_ok, scene_example};
 use tempfile::TempDir;
 
 /// The example scene's text with its `map` line replaced by `map_line` (empty: no map).
@@ -71,6 +72,19 @@ fn ddoc_map_reveals_what_the_pillar_hides() {
     // The example renders with it.
     let example = ids(&dir, &scene_example("flexible-ddoc.toml"), "example");
     assert_eq!(example, ddoc);
+}
+
+/// `--method raster` renders the example as the ray caster does (interior ids, relative RGB
+/// error: `common::raster_agrees`), balls revealed beside the pillar included.
+#[test]
+fn the_ddoc_rasters_like_the_ray_caster() {
+    let dir = TempDir::new().unwrap();
+    raster_agrees(&dir, &[&scene_example("flexible-ddoc.toml")]);
+    let raster = common::ids(&dir.path().join("raster-ids.png")).2;
+    for ball in [4, 5] {
+        let n = raster.iter().filter(|&&i| i == ball).count();
+        assert!(n > 200, "ball {ball}: {n} pixels");
+    }
 }
 
 /// A colour PFM of `w` x `h` samples `value` (little-endian).
@@ -169,21 +183,40 @@ fn bad_maps_and_bad_uses_are_refused_naming_the_file() {
             && line.contains("ddoc map \"missing.pfm\" is not a file"),
         "{line}"
     );
-    // Raster refuses with the reason and the method that works.
+    // Raster refuses a map steep enough to fold, with the reason and the method that works:
+    // two samples 0.5 apart across a two-pixel map, slope 2 x 0.5.
+    let mut steep = b"PF\n2 1\n-1.0\n".to_vec();
+    for v in [0.0f32, 0.0, 0.0, 0.5, 0.0, 0.0] {
+        steep.extend_from_slice(&v.to_le_bytes());
+    }
+    fs::write(dir.path().join("steep.pfm"), steep).unwrap();
+    fs::write(
+        dir.path().join("steep.toml"),
+        example_with("map = \"steep.pfm\"\n"),
+    )
+    .unwrap();
+    let line = refused(
+        &dir,
+        &[
+            "render",
+            "steep.toml",
+            "--method",
+            "raster",
+            "-o",
+            "out.png",
+        ],
+    );
+    assert!(
+        line.contains("its displacement map's slope reaches 1.000 (at map pixel (0, 0)")
+            && line.ends_with("(use --method raycast)\n"),
+        "{line}"
+    );
     fs::write(dir.path().join("ok.pfm"), pfm(2, 2, 0.0)).unwrap();
     fs::write(
         dir.path().join("ok.toml"),
         example_with("map = \"ok.pfm\"\n"),
     )
     .unwrap();
-    let line = refused(
-        &dir,
-        &["render", "ok.toml", "--method", "raster", "-o", "out.png"],
-    );
-    assert!(
-        line.contains("displaced by a sampled map") && line.ends_with("(use --method raycast)\n"),
-        "{line}"
-    );
     // ddoc-map needs a ddoc and a strength in range.
     let line = refused(
         &dir,

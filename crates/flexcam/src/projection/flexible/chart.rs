@@ -9,6 +9,10 @@
 //!   the image flips there.
 //! - Polyline volumes between parallel planes: the first segment's near clip and the last
 //!   one's far clip, when no cross-section degenerates or flips inside (stations included).
+//! - Polyline volumes partly displaced by a sampled map (the DDOC): the chart of their
+//!   undisplaced rectangles. The displacement moves no point across a clip plane (the
+//!   displaced surfaces stay in their planes) and, its slope being below 1, undoing it is a
+//!   continuous map of the image plane onto itself.
 //! - A warped far rectangle (the long scene): the parallel-planes chart of each piece of
 //!   the warp, which must all be the same, with cross-sections of one orientation.
 //! - Nested spheres: the image depends only on the direction from the centre; the poles
@@ -71,6 +75,12 @@ impl Inverse {
             } => {
                 planar_map(reparam).then_some(())?;
                 warped_chart(near, pieces, *normal)
+            }
+            Inverse::Displaced {
+                segments, normal, ..
+            } => {
+                planar_map(reparam).then_some(())?;
+                layers_chart(segments, *normal)
             }
         }
     }

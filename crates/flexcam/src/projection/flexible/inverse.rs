@@ -23,6 +23,10 @@
 //!   affine far surface, so t follows from p.n as for parallel planes, then (u, v) from the
 //!   2 x 2 solve of the piece whose u range holds the solution (the pieces meet
 //!   continuously at the knots, so a point on a knot gets the same answer from both).
+//! - Polyline projectors through similar rectangles in parallel planes whose parameters are
+//!   partly displaced by a sampled map (the depth-discontinuity occlusion camera): the
+//!   layered inverse, then the displacement undone by a safeguarded Newton iteration
+//!   (module `displaced_inverse`).
 //!
 //! Anything else has no inverse ([`Inverse::classify`] gives `None`, or for a panorama the
 //! reason).
@@ -37,9 +41,10 @@ use glam::{DMat2, DVec2, DVec3};
 use super::control_surface::{
     CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface, WarpedRectangle,
 };
+use super::displaced_inverse::{undisplaced, Displacement};
 use super::panorama::lookup::{self, PanoramaInverse};
 use super::reparam::Reparam;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::projection::image_coords::Resolution;
 use crate::projection::{AnalyticInverse, Charted, ContinuousInverse, ImagePoint};
 
@@ -86,6 +91,14 @@ pub(super) enum Inverse {
         near: Affine,
         pieces: Vec<WarpPiece>,
         normal: DVec3,
+    },
+    /// Polyline projectors through similar rectangles in parallel planes, some of them
+    /// displaced by a sampled map (the depth-discontinuity occlusion camera): the layered
+    /// inverse of the rectangles, then the displacement undone by a contraction.
+    Displaced {
+        segments: Vec<Layer>,
+        normal: DVec3,
+        displacement: Box<Displacement>,
     },
 }
 
@@ -249,6 +262,32 @@ impl Inverse {
         monotonic.then_some(Inverse::Layers { segments, normal })
     }
 
+    /// The inverse of the polyline volume through `surfaces` at `knots`, some of them
+    /// displaced rectangles (module `displaced_inverse`). Errors, each a reason the volume
+    /// has no inverse: surfaces that are not rectangles in parallel planes in order along
+    /// the projectors, rectangles that are not similar (one frame scaled), displaced
+    /// surfaces of different maps, a map of slope `MAX_SLOPE` or more.
+    pub fn classify_displaced(surfaces: &[Surface], knots: &[f64]) -> Result<Inverse> {
+        let (plain, displaced, map) = undisplaced(surfaces)?;
+        let Some(Inverse::Layers { segments, normal }) = Inverse::classify_layers(&plain, knots)
+        else {
+            return Err(Error::new(
+                "its displaced control surfaces are not flat, parallel and in order along the \
+                 projectors",
+            ));
+        };
+        let frames: Vec<[DVec3; 2]> = std::iter::once(&segments[0].near)
+            .chain(segments.iter().map(|l| &l.far))
+            .map(|a| [a.b, a.c])
+            .collect();
+        let displacement = Displacement::new(&frames, &displaced, map)?;
+        Ok(Inverse::Displaced {
+            segments,
+            normal,
+            displacement: Box::new(displacement),
+        })
+    }
+
     /// An affine `near` and the warped `far` when every piece of the warp makes parallel
     /// planes with `near`, all of one normal.
     fn classify_warped(near: &Surface, far: &WarpedRectangle) -> Option<Inverse> {
@@ -344,6 +383,16 @@ impl Inverse {
                 normal,
             } => warped(near, pieces, *normal, p),
             Inverse::Layers { segments, normal } => layers(segments, *normal, p),
+            Inverse::Displaced {
+                segments,
+                normal,
+                displacement,
+            } => {
+                let (k, w, local) = layer_solution(segments, *normal, p)?;
+                let q = displacement.undo(k, local, w)?;
+                let t = segments[k].t;
+                Some((q, t[0] + local * (t[1] - t[0])))
+            }
         }
     }
 }
@@ -352,6 +401,14 @@ impl Inverse {
 /// beyond them all, the first one before them, so that the solution extends beyond the
 /// volume), its local t mapped to the volume's.
 fn layers(segments: &[Layer], n: DVec3, p: DVec3) -> Option<(DVec2, f64)> {
+    let (k, uv, s) = layer_solution(segments, n, p)?;
+    let t = segments[k].t;
+    Some((uv, t[0] + s * (t[1] - t[0])))
+}
+
+/// The segment [`layers`] picks for `p`, its (u, v) and its local t (0 on the segment's near
+/// surface, 1 on its far one).
+fn layer_solution(segments: &[Layer], n: DVec3, p: DVec3) -> Option<(usize, DVec2, f64)> {
     let last = segments.len() - 1;
     let k = segments
         .iter()
@@ -359,7 +416,7 @@ fn layers(segments: &[Layer], n: DVec3, p: DVec3) -> Option<(DVec2, f64)> {
         .unwrap_or(last);
     let layer = &segments[k];
     let (uv, s) = planes(&layer.near, &layer.far, n, p)?;
-    Some((uv, layer.t[0] + s * (layer.t[1] - layer.t[0])))
+    Some((k, uv, s))
 }
 
 /// The parallel-planes solution of the piece whose u range holds it (the first piece open

@@ -15,7 +15,8 @@
 //!   at point correspondences by a [`GridFitter`] (the fit itself is `crate::calibrate`'s);
 //! - [`panorama`]: shape-defined panoramas (ch. 9), outlines and profiles by arc length;
 //! - `inverse`: (u, v, t) from a scene point for the analytic class (parallel planes, a
-//!   plane and a piecewise-linearly warped plane, nested spheres, coaxial cylinders);
+//!   plane and a piecewise-linearly warped plane, nested spheres, coaxial cylinders), and
+//!   `displaced_inverse`: the depth-discontinuity occlusion camera's, by a contraction;
 //! - [`blend`]: Q = a Q1 + (1 - a) Q2, interpolation and extrapolation between volumes;
 //! - [`animation`]: keyframed flexible cameras, a blend of neighbouring keys per frame;
 //! - [`pieces`]: discontinuous projections, several flexible projections each owning an
@@ -30,6 +31,9 @@ mod chart;
 pub mod control_surface;
 #[cfg(test)]
 mod cross_map_tests;
+mod displaced_inverse;
+#[cfg(test)]
+mod displaced_inverse_tests;
 pub mod interpolate;
 mod inverse;
 mod linear_volume;
@@ -178,6 +182,13 @@ impl Flexible {
         let (volume, reparam) = build_volume(spec, &resolution, fitter, report)?;
         let classified = match &volume {
             Volume::Linear(v) => Inverse::classify(&v.near, &v.far),
+            Volume::Piecewise(v)
+                if v.surfaces()
+                    .iter()
+                    .any(|s| matches!(s, Surface::Displaced(_))) =>
+            {
+                Inverse::classify_displaced(v.surfaces(), v.knots()).map(Some)
+            }
             Volume::Piecewise(v) => Ok(Inverse::classify_layers(v.surfaces(), v.knots())),
             _ => Ok(None),
         };
@@ -256,14 +267,6 @@ fn no_inverse_reason(volume: &Volume) -> &'static str {
             "its near and far control surfaces are outside the scanline class (planes \
              sharing a normal, a plane and a long scene's warped plane, nested spheres or \
              coaxial cylinders)"
-        }
-        Volume::Piecewise(v)
-            if v.surfaces()
-                .iter()
-                .any(|s| matches!(s, Surface::Displaced(_))) =>
-        {
-            "its far control surfaces are displaced by a sampled map (the depth-discontinuity \
-             occlusion camera), whose inverse has no closed form"
         }
         Volume::Piecewise(_) => {
             "its projectors are polylines through control surfaces that are not all flat, \

@@ -13,8 +13,9 @@
 //! exact image does not) are clamped onto it.
 //!
 //! A polyline may meet the triangle's plane in several segments; the fragment takes the first
-//! segment that meets it inside the triangle, else (a silhouette pixel) the first that meets
-//! the plane at all.
+//! segment that meets it inside the triangle, else (a silhouette pixel) the one that meets it
+//! nearest the triangle (the least barycentric overshoot), where the pixel's projector passes
+//! the triangle's edge, not where it crosses the plane far from the triangle.
 //!
 //! Shading is deferred: fragments are only reconstructed and z-tested, and each pixel's
 //! visible fragment is shaded once afterwards ([`Shader::shade`]), from the values its one
@@ -103,16 +104,19 @@ impl Shader<'_> {
                     let ray = polyline_segment(points, k);
                     plane.hit_unclamped(&ray).map(|hit| (k, ray, hit))
                 });
-                let mut first = None;
-                let mut inside = None;
+                // How far outside the triangle (u, v) lies: <= 0 inside.
+                let outside = |u: f64, v: f64| (-u).max(-v).max(u + v - 1.0);
+                let mut nearest: Option<(usize, Ray, (f64, f64, f64))> = None;
                 for (k, ray, (t, u, v)) in hits {
-                    if u >= 0.0 && v >= 0.0 && u + v <= 1.0 {
-                        inside = Some((k, ray, (t, u, v)));
+                    if outside(u, v) <= 0.0 {
+                        nearest = Some((k, ray, (t, u, v)));
                         break;
                     }
-                    first = first.or(Some((k, ray, (t, u, v))));
+                    if nearest.is_none_or(|(_, _, (_, a, b))| outside(u, v) < outside(a, b)) {
+                        nearest = Some((k, ray, (t, u, v)));
+                    }
                 }
-                let (k, ray, (t, u, v)) = inside.or(first)?;
+                let (k, ray, (t, u, v)) = nearest?;
                 let (u, v) = clamp(u, v);
                 (k, length_before(points, k), ray, (t, u, v))
             }

@@ -30,7 +30,7 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use glam::{DVec2, DVec3};
+use glam::{DMat2, DVec2, DVec3};
 
 use super::{Preset, PresetSpec};
 use crate::error::{Error, Result};
@@ -118,19 +118,84 @@ impl DdocMap {
     /// m(q): the map at image position `uv`, bilinear between pixel centres, the border
     /// samples beyond them.
     pub fn sample(&self, uv: DVec2) -> DVec2 {
+        let cell = self.cell(uv);
+        cell.top().lerp(cell.bottom(), cell.fraction.y)
+    }
+
+    /// m(q) and its derivative at `uv`: columns dm/du and dm/dv of the bilinear patch there
+    /// (zero across a border, beyond which the map is its border samples; on a line between
+    /// cells, the next cell's in map pixels).
+    pub fn sample_with_slope(&self, uv: DVec2) -> (DVec2, DMat2) {
+        let cell = self.cell(uv);
+        let [c00, c10, c01, c11] = cell.corners;
+        let (top, bottom) = (cell.top(), cell.bottom());
+        // d/du = W d/dx and d/dv = -H d/dy inside the map; nothing moves beyond it.
+        let du = if cell.inside[0] {
+            self.width as f64
+        } else {
+            0.0
+        };
+        let dv = if cell.inside[1] {
+            -(self.height as f64)
+        } else {
+            0.0
+        };
+        let along_x = (c10 - c00).lerp(c11 - c01, cell.fraction.y);
+        let slope = DMat2::from_cols(du * along_x, dv * (bottom - top));
+        (top.lerp(bottom, cell.fraction.y), slope)
+    }
+
+    /// The map cell around `uv`; a position that is not finite gets a cell of zeros (no
+    /// displacement, no slope).
+    fn cell(&self, uv: DVec2) -> Cell {
         let (w, h) = (self.width as usize, self.height as usize);
-        let x = (uv.x * w as f64 - 0.5).clamp(0.0, (w - 1) as f64);
-        let y = ((1.0 - uv.y) * h as f64 - 0.5).clamp(0.0, (h - 1) as f64);
+        let (x, y) = (uv.x * w as f64 - 0.5, (1.0 - uv.y) * h as f64 - 0.5);
         if !(x.is_finite() && y.is_finite()) {
-            return DVec2::ZERO;
+            return Cell {
+                corners: [DVec2::ZERO; 4],
+                fraction: DVec2::ZERO,
+                inside: [false; 2],
+            };
         }
-        let (x0, y0) = (x.floor() as usize, y.floor() as usize);
+        let (cx, cy) = (x.clamp(0.0, (w - 1) as f64), y.clamp(0.0, (h - 1) as f64));
+        let (x0, y0) = (cx.floor() as usize, cy.floor() as usize);
         let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
-        let (fx, fy) = (x - x0 as f64, y - y0 as f64);
         let at = |x: usize, y: usize| self.samples[y * w + x];
-        let top = at(x0, y0).lerp(at(x1, y0), fx);
-        let bottom = at(x0, y1).lerp(at(x1, y1), fx);
-        top.lerp(bottom, fy)
+        Cell {
+            corners: [at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1)],
+            fraction: DVec2::new(cx - x0 as f64, cy - y0 as f64),
+            inside: [cx == x, cy == y],
+        }
+    }
+
+    /// The map's Lipschitz constant in image fractions, and the map pixel (from the top
+    /// left) of the cell that reaches it: the largest spectral norm of dm/d(u, v) over the
+    /// map. Inside a cell the derivative is affine in the cell's coordinates, so the norm,
+    /// a convex function of it, is largest at a corner; every cell's four corner derivatives
+    /// are checked. While it is below 1, q - h m(q) is one-to-one for every h in [0, 1].
+    pub fn slope(&self) -> (f64, (u32, u32)) {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let at = |x: usize, y: usize| self.samples[y * w + x];
+        let (su, sv) = (w as f64, -(h as f64));
+        let mut worst = (0.0, (0, 0));
+        for y0 in 0..h.saturating_sub(1).max(1) {
+            for x0 in 0..w.saturating_sub(1).max(1) {
+                let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
+                let su = if x1 > x0 { su } else { 0.0 };
+                let sv = if y1 > y0 { sv } else { 0.0 };
+                let (top, bottom) = (at(x1, y0) - at(x0, y0), at(x1, y1) - at(x0, y1));
+                let (left, right) = (at(x0, y1) - at(x0, y0), at(x1, y1) - at(x1, y0));
+                for (along_x, along_y) in
+                    [(top, left), (top, right), (bottom, left), (bottom, right)]
+                {
+                    let norm = spectral_norm(DMat2::from_cols(su * along_x, sv * along_y));
+                    if norm > worst.0 {
+                        worst = (norm, (x0 as u32, y0 as u32));
+                    }
+                }
+            }
+        }
+        worst
     }
 
     /// The map in the PFM file `path` (see [`DdocMap::from_pfm`]). Errors name the file.
@@ -288,6 +353,27 @@ impl DdocMap {
     }
 }
 
+/// The map samples around a position: the corners (x0, y0), (x1, y0), (x0, y1), (x1, y1)
+/// (rows from the top), the position's fraction across the cell, and whether it lies inside
+/// the map's pixel centres along x and along y (not clamped onto the border).
+struct Cell {
+    corners: [DVec2; 4],
+    fraction: DVec2,
+    inside: [bool; 2],
+}
+
+impl Cell {
+    /// The value along the cell's top row at the position's x.
+    fn top(&self) -> DVec2 {
+        self.corners[0].lerp(self.corners[1], self.fraction.x)
+    }
+
+    /// The value along the cell's bottom row at the position's x.
+    fn bottom(&self) -> DVec2 {
+        self.corners[2].lerp(self.corners[3], self.fraction.x)
+    }
+}
+
 /// The four header tokens of a PFM and the bytes after the single whitespace byte that ends
 /// the header. Errors: a header that ends early or is not ASCII.
 fn pfm_header(bytes: &[u8]) -> Result<([&str; 4], &[u8])> {
@@ -337,6 +423,15 @@ pub fn check_depths(z_near: f64, z_far: f64) -> Result<()> {
             "flexible ddoc needs 0 < z_near < z_far, got z_near {z_near}, z_far {z_far}"
         )))
     }
+}
+
+/// The largest singular value of `m`.
+fn spectral_norm(m: DMat2) -> f64 {
+    let [a, b] = [m.x_axis, m.y_axis];
+    let frobenius = a.length_squared() + b.length_squared();
+    let det = m.determinant();
+    let gap = (frobenius * frobenius - 4.0 * det * det).max(0.0).sqrt();
+    (0.5 * (frobenius + gap)).sqrt()
 }
 
 /// `field` blurred by the unnormalised Gaussian exp(-r^2 / (2 sigma^2)), separably, cut
