@@ -26,8 +26,9 @@
 //! matrix's K R split with its own principal point (K's third column) and from the centred
 //! camera, and kept where it is clearly better by the nested least-squares rule of module
 //! `select` (`clearly_better`: its sum of squares lower by more than 4 noise variances per
-//! extra unknown, about a 2 % chance on data of a centred camera) and the data determine
-//! its principal point (standard errors at most `PRINCIPAL_SPREAD`). One plane does not
+//! extra unknown, about a 2 % chance on data of a centred camera) and its normal matrix is
+//! regular (the principal point trades against the rotation, so its spread may be large
+//! while the image is well met). One plane does not
 //! determine focal length and principal point together (Zhang's two equations for three
 //! unknowns), so coplanar points keep the centred camera.
 //!
@@ -67,10 +68,6 @@ const MAX_ITERATIONS: usize = 100;
 /// The focal length is taken as undetermined when its standard error exceeds this fraction
 /// of its value.
 const FOCAL_SPREAD: f64 = 0.25;
-
-/// The principal point is taken as undetermined when a coordinate's standard error exceeds
-/// this, in image widths.
-const PRINCIPAL_SPREAD: f64 = 0.02;
 
 /// The homography's focal length is taken as a start only within this factor of the
 /// prior's: beyond it the data (a plane seen nearly face on) hardly determine it, and a far
@@ -586,7 +583,7 @@ impl Data {
     /// The camera with its principal point fitted too (module docs), from the camera
     /// matrix's start `general` and from the centred camera `centred` (its sum of squares
     /// `centred_ss`), where the centred camera misses by more than `NOISE_FLOOR` (rms) and the
-    /// other is clearly better and determines its principal point; `None` where not.
+    /// other is clearly better with a regular normal matrix; `None` where not.
     fn off_centre(&self, general: Pose, centred: Pose, centred_ss: f64) -> Option<Pose> {
         let count = self.points.len();
         if centred_ss <= 2.0 * count as f64 * NOISE_FLOOR.powi(2) {
@@ -598,8 +595,10 @@ impl Data {
             .filter_map(|start| self.refine(start, Unknowns::Principal))
             .min_by(|a, b| a.1.total_cmp(&b.1))?;
         let better = clearly_better(count, 9, 2, ss, centred_ss);
-        let errors = self.standard_errors(&pose, Unknowns::Principal)?;
-        let determined = errors[7..].iter().all(|e| within(*e, PRINCIPAL_SPREAD));
+        // A singular normal matrix: the data determine no principal point. A large but
+        // finite spread is no reason to refuse it: the principal point trades against the
+        // rotation, which the image of the points hardly tells apart.
+        let determined = self.standard_errors(&pose, Unknowns::Principal).is_some();
         (better && determined).then_some(pose)
     }
 }
