@@ -473,7 +473,7 @@ mod tests {
     fn too_few_clicks_or_exact_level_gains_are_no_evidence() {
         assert!(!significantly_better(&[], &[]));
         assert!(!significantly_better(&[1.0], &[0.0]));
-        let exact = vec![EXACT_RMS_RAD; 10];
+        let exact = vec![0.5 * EXACT_RMS_RAD; 10];
         assert!(!significantly_better(&exact, &[0.0; 10]));
         // A gain equal at every click (no spread) counts once above exact-fit level.
         assert!(significantly_better(&[2.0; 10], &[1.0; 10]));
