@@ -8,7 +8,8 @@
 //! `cargo test --release -p flexcam-cli --test fit_painting -- --ignored --nocapture`
 //! (`FIT_PAINTING_SEEDS=1..20` picks the seeds, `FIT_PAINTING_MODELS=kept,eye,free,pinhole,auto`
 //! the columns, `FIT_PAINTING_TRUTH=warped` a painting-like distortion of each camera as the
-//! truth instead of the camera itself).
+//! truth instead of the camera itself, `FIT_PAINTING_TRUTH=cropped` the camera's image
+//! cropped off centre).
 
 mod common;
 
@@ -51,6 +52,8 @@ enum Truth {
     Pinhole,
     /// A painting-like distortion of it (`warped`, [`warped_projection`]).
     Warped,
+    /// Its image cropped off centre (`cropped`, [`cropped_projection`]).
+    Cropped,
 }
 
 impl Truth {
@@ -58,8 +61,11 @@ impl Truth {
     fn from_env() -> Truth {
         match std::env::var("FIT_PAINTING_TRUTH").as_deref() {
             Ok("warped") => Truth::Warped,
+            Ok("cropped") => Truth::Cropped,
             Ok("pinhole") | Err(_) => Truth::Pinhole,
-            Ok(other) => panic!("FIT_PAINTING_TRUTH: `pinhole` or `warped`, not `{other}`"),
+            Ok(other) => {
+                panic!("FIT_PAINTING_TRUTH: `pinhole`, `warped` or `cropped`, not `{other}`")
+            }
         }
     }
 }
@@ -131,9 +137,31 @@ fn warped_projection(camera: &Placement, next: &mut impl FnMut() -> f64) -> Stri
     )
 }
 
+/// The `[projection]` of the perspective camera `camera` cropped off centre: the window
+/// shifted by 0.2 to 0.5 half-widths and half-heights (each either way, drawn from `next`),
+/// so that the principal point lies 10 to 25 % of the image's width and height off its
+/// centre, the view direction unchanged (the `off_axis` preset).
+fn cropped_projection(camera: &Placement, next: &mut impl FnMut() -> f64) -> String {
+    let mut shift = || {
+        let size = 0.2 + 0.3 * next();
+        if next() < 0.5 {
+            -size
+        } else {
+            size
+        }
+    };
+    let shift = [shift(), shift()];
+    format!(
+        "[projection]\ntype = \"flexible\"\npreset = \"off_axis\"\nposition = {:?}\n\
+         look_at = {:?}\nfov = {}\nshift = {shift:?}\nclip = [0.5, 40.0]\n",
+        camera.eye, camera.look_at, camera.fov
+    )
+}
+
 /// Seed `seed`'s true camera (eye 7 to 10 from the scene's centre, 3 to 7 up, within 50
 /// degrees of +z, a field of view of 45 to 70 degrees; for [`Truth::Warped`] its
-/// painting-like distortion, [`warped_projection`]) and 15 to 60 of its clicks, each at a
+/// painting-like distortion, [`warped_projection`], for [`Truth::Cropped`] its image cropped
+/// off centre, [`cropped_projection`]) and 15 to 60 of its clicks, each at a
 /// random pixel where the camera sees an object, the pixel then moved by normal noise of 1
 /// to 2 px (one standard deviation per seed) and kept in the image.
 fn case(dir: &TempDir, seed: u64, kind: Truth) -> Case {
@@ -156,6 +184,7 @@ fn case(dir: &TempDir, seed: u64, kind: Truth) -> Case {
             camera.eye, camera.look_at,
         ),
         Truth::Warped => warped_projection(&camera, &mut next),
+        Truth::Cropped => cropped_projection(&camera, &mut next),
     };
     std::fs::write(
         dir.path().join("truth.toml"),

@@ -151,6 +151,7 @@ pub(super) fn fit_pinhole(
     let (grid, report, eye) = finish(&grid, correspondences, eye, prior, true)?;
     let report = FitReport {
         focal_from_prior: camera.focal_from_prior(),
+        principal_point: camera.principal_point().map(|uv| uv.to_array()),
         ..report
     };
     Ok((grid, report, eye))

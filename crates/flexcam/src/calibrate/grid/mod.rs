@@ -50,17 +50,20 @@
 //! affine direction field where that explains the data, else free node directions); `Free`
 //! fits every node's start too (module `free`: projections with no common eye, such as
 //! pushbroom and crossed slits); `Pinhole` is one pinhole camera of square pixels, its
-//! principal point at the image centre (focal length and pose), fitted
-//! by its reprojection error in the image (module `pinhole_camera`). `Auto`, the default,
+//! principal point at the image centre (focal length and pose) or off centre where the data
+//! clearly support it, fitted by its reprojection error in the image (module
+//! `pinhole_camera`). `Auto`, the default,
 //! keeps what the nested choice (`select::nested_fit`) gives where that meets the data
 //! exactly: the starts kept when they meet the data and the data determine the free
 //! directions, an exact eye fit where they do not, the free starts where neither is exact
 //! and the free fit is clearly better and determined. Inexact data (clicks on a painting)
-//! are fitted by every model and the model of least held-out misses taken (each fifth of
-//! the points measured against the fit of the other four fifths), never a grid that folds
-//! (module `folds`: projectors crossing among the points' depths) where another model's
-//! does not: the residual at the points rewards models that bend to the noise, the
-//! held-out misses do not.
+//! are fitted by every model and judged by their held-out misses (each fifth of the points
+//! measured against the fit of the other four fifths, the same fifths for every model): a
+//! richer model replaces a simpler one only where a paired test of the per-point
+//! differences finds its misses lower (`select::significantly_better`), and a grid that
+//! folds (module `folds`: projectors crossing among the points' depths) is never taken
+//! where another model's does not: the residual at the points rewards models that bend to
+//! the noise, the held-out misses do not.
 //!
 //! # Warnings (module `checks`)
 //!
@@ -179,6 +182,10 @@ pub struct FitReport {
     /// skew and principal point free) because no square-pixel camera keeps every
     /// correspondence's point in front of it (inconsistent data).
     pub general_camera: bool,
+    /// The pinhole model's principal point as an image position (u, v) where the data put
+    /// it off the image centre (a cropped painting; module `pinhole_camera`); `None` at the
+    /// centre and for the other models.
+    pub principal_point: Option<[f64; 2]>,
 }
 
 impl FitReport {
@@ -200,12 +207,16 @@ impl FitReport {
         }
     }
 
-    /// The model in words, for `flexcam fit`'s line and the written header: the starts, and
-    /// for the free fit the smoothness weight the data chose.
+    /// The model in words, for `flexcam fit`'s line and the written header: the starts, for
+    /// the free fit the smoothness weight the data chose, for a pinhole off centre its
+    /// principal point.
     pub fn model(&self) -> String {
-        match self.smoothness {
-            Some(weight) => format!("{}, smoothness {weight:e}", self.starts),
-            None => self.starts.to_string(),
+        match (self.smoothness, self.principal_point) {
+            (Some(weight), _) => format!("{}, smoothness {weight:e}", self.starts),
+            (None, Some([u, v])) => {
+                format!("{}, principal point at (u, v) = ({u}, {v})", self.starts)
+            }
+            (None, None) => self.starts.to_string(),
         }
     }
 

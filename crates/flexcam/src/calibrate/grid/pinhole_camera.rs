@@ -1,14 +1,16 @@
-//! One pinhole camera as a photograph or a perspective painting has it: square pixels, the
-//! principal point at the image centre and no skew, so that its focal length and pose (a
-//! rotation and the eye) are its 7 unknowns, fitted to point correspondences by the
-//! reprojection error in the image (click noise is the same for every point there).
+//! One pinhole camera as a photograph or a perspective painting has it: square pixels and no
+//! skew, the principal point at the image centre, so that its focal length and pose (a
+//! rotation and the eye) are its 7 unknowns, or off centre (a painting or photograph cropped
+//! off-centre) where the data support it, 9 unknowns; fitted to point correspondences by
+//! the reprojection error in the image (click noise is the same for every point there).
 //!
 //! Positions are measured in square image coordinates q = (u - 1/2, -h (v - 1/2) / a), in
 //! image widths: a is the image's aspect (width over height) and h its handedness (+1 where
 //! v runs up in a right-handed world, as in the presets), both read from the prior grid
 //! ([`ImageShape::of_prior`]: the flexible projection's fitter is not told the image size).
-//! The camera sees the point X at q = f (c_x, c_y) / c_z, c = R (X - E), with f > 0 and R a
-//! rotation, and c_z > 0 for every point in front of it.
+//! The camera sees the point X at q = f (c_x, c_y) / c_z + p, c = R (X - E), with f > 0, R a
+//! rotation, p the principal point (zero at the image centre), and c_z > 0 for every point
+//! in front of it.
 //!
 //! Starts, each refined by Levenberg-Marquardt (rotation updates as rotation vectors) and the
 //! one of least error kept: the general 3 x 4 camera matrix of module `camera_matrix` where
@@ -18,6 +20,17 @@
 //! r1 . r2 = 0 and |r1| = |r2|, two equations linear in 1 / f^2, solved by least squares
 //! (the prior's focal length where they give none within `FOCAL_RANGE` of it); the pose
 //! then from K^-1 H's columns, (r1, r2) made orthonormal.
+//!
+//! The principal point: where the points are not coplanar (the camera matrix exists) and
+//! the focal length is determined, the 9-unknown camera is fitted as well, from the camera
+//! matrix's K R split with its own principal point (K's third column) and from the centred
+//! camera, and kept where it is clearly better by the nested least-squares rule of module
+//! `select` (`clearly_better`: its sum of squares lower by more than 4 noise variances per
+//! extra unknown, about a 2 % chance on data of a centred camera) and its normal matrix is
+//! regular (the principal point trades against the rotation, so its spread may be large
+//! while the image is well met). One plane does not
+//! determine focal length and principal point together (Zhang's two equations for three
+//! unknowns), so coplanar points keep the centred camera.
 //!
 //! Degenerate cases ([`Undetermined`], each tested): fewer than 4 points (7 unknowns, 2
 //! equations a point); the points all on one line or at one position (no plane: the camera
@@ -37,6 +50,7 @@ use glam::{DMat3, DVec2, DVec3};
 use nalgebra::{DMatrix, Matrix3, SymmetricEigen};
 
 use super::camera_matrix::{normalisation, CameraMatrix};
+use super::select::clearly_better;
 use super::{dense_lm, Correspondence};
 use crate::projection::flexible::ProjectorGrid;
 
@@ -170,6 +184,9 @@ pub(super) struct PinholeCamera {
     /// World to camera: rows right, down (in square image coordinates) and forward.
     rotation: DMat3,
     eye: DVec3,
+    /// The principal point in square image coordinates of the camera's handedness (zero at
+    /// the image centre).
+    principal: DVec2,
     aspect: f64,
     handedness: f64,
     /// Whether the focal length is the prior's, the data leaving it undetermined.
@@ -184,18 +201,24 @@ impl PinholeCamera {
         shape: ImageShape,
     ) -> Result<PinholeCamera, Undetermined> {
         let data = Data::new(correspondences, shape)?;
-        let mut starts = Vec::with_capacity(2);
-        if let Some(camera) = CameraMatrix::fit(correspondences) {
-            starts.extend(data.start_of_camera_matrix(&camera));
-        }
-        starts.extend(data.start_of_homography(None));
-        let (best, _) = starts
+        let general = CameraMatrix::fit(correspondences)
+            .and_then(|camera| data.start_of_camera_matrix(&camera));
+        let centred = |pose: Pose| Pose {
+            principal: DVec2::ZERO,
+            ..pose
+        };
+        let starts = [general.map(centred), data.start_of_homography(None)];
+        let (best, best_ss) = starts
             .into_iter()
-            .filter_map(|start| data.refine(start, true))
+            .flatten()
+            .filter_map(|start| data.refine(start, Unknowns::Focal))
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .ok_or(Undetermined::NotInFront)?;
-        if !data.focal_undetermined(&best) {
-            return Ok(data.camera(best, false));
+        let chosen = general
+            .and_then(|start| data.off_centre(start, best, best_ss))
+            .unwrap_or(best);
+        if !data.focal_undetermined(&chosen) {
+            return Ok(data.camera(chosen, false));
         }
         // The prior's focal length, from the best pose with its distance scaled by the
         // focal lengths' ratio (the same image of a plane seen face on through the points'
@@ -208,7 +231,7 @@ impl PinholeCamera {
         let (pose, _) = [Some(rescaled), data.start_of_homography(Some(shape.focal))]
             .into_iter()
             .flatten()
-            .filter_map(|start| data.refine(start, false))
+            .filter_map(|start| data.refine(start, Unknowns::Pose))
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .ok_or(Undetermined::NotInFront)?;
         Ok(data.camera(pose, true))
@@ -231,21 +254,29 @@ impl PinholeCamera {
         self.focal_from_prior
     }
 
+    /// The principal point's image position (u, v), `None` where it is the image centre.
+    pub(super) fn principal_point(&self) -> Option<DVec2> {
+        (self.principal != DVec2::ZERO).then(|| self.uv_of(self.principal))
+    }
+
     /// The direction from the eye of the projector of image position `uv`, towards the
     /// points (unnormalised; affine in (u, v)).
     pub(super) fn direction(&self, uv: DVec2) -> DVec3 {
-        let q = DVec2::new(uv.x - 0.5, -self.handedness * (uv.y - 0.5) / self.aspect);
+        let q =
+            DVec2::new(uv.x - 0.5, -self.handedness * (uv.y - 0.5) / self.aspect) - self.principal;
         self.rotation.transpose() * DVec3::new(q.x / self.focal, q.y / self.focal, 1.0)
+    }
+
+    /// The image position (u, v) of the square image coordinates `q`.
+    fn uv_of(&self, q: DVec2) -> DVec2 {
+        DVec2::new(q.x + 0.5, 0.5 - self.handedness * self.aspect * q.y)
     }
 
     /// The image position of `point`, `None` where it is not in front of the camera.
     #[cfg(test)]
     pub(super) fn project(&self, point: DVec3) -> Option<DVec2> {
         let c = self.rotation * (point - self.eye);
-        (c.z > 0.0).then(|| {
-            let q = self.focal * DVec2::new(c.x, c.y) / c.z;
-            DVec2::new(q.x + 0.5, 0.5 - self.handedness * self.aspect * q.y)
-        })
+        (c.z > 0.0).then(|| self.uv_of(self.focal * DVec2::new(c.x, c.y) / c.z + self.principal))
     }
 }
 
@@ -255,7 +286,30 @@ struct Pose {
     focal: f64,
     rotation: DMat3,
     eye: DVec3,
+    /// In square image coordinates of the handedness `handedness`.
+    principal: DVec2,
     handedness: f64,
+}
+
+/// The unknowns a refinement fits: the pose (rotation, eye; 6), the focal length too (7), or
+/// the principal point too (9). Columns of [`Data::jacobian`]: focal length, rotation
+/// vector, eye, principal point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Unknowns {
+    Pose,
+    Focal,
+    Principal,
+}
+
+impl Unknowns {
+    /// The Jacobian's columns fitted.
+    fn columns(self) -> std::ops::Range<usize> {
+        match self {
+            Unknowns::Pose => 1..7,
+            Unknowns::Focal => 0..7,
+            Unknowns::Principal => 0..9,
+        }
+    }
 }
 
 /// The correspondences in normalised world coordinates (centroid at the origin, root mean
@@ -326,6 +380,7 @@ impl Data {
             focal: pose.focal,
             rotation: pose.rotation,
             eye: self.centre + self.scale * pose.eye,
+            principal: pose.principal,
             aspect: self.shape.aspect,
             handedness: pose.handedness,
             focal_from_prior,
@@ -333,8 +388,8 @@ impl Data {
     }
 
     /// The start from the general camera matrix `camera` (module docs), its handedness the
-    /// prior's unless its rotation would then be a reflection; `None` where it is no
-    /// camera (a singular left block).
+    /// prior's unless its rotation would then be a reflection, with the principal point of
+    /// its K R split; `None` where it is no camera (a singular left block).
     fn start_of_camera_matrix(&self, camera: &CameraMatrix) -> Option<Pose> {
         let rows = camera.rows_facing();
         let eye = (camera.eye()? - self.centre) / self.scale;
@@ -347,6 +402,7 @@ impl Data {
         let row_y = -handedness * (m1 - 0.5 * m2) / self.shape.aspect;
         let r3 = m2.try_normalize()?;
         let lambda = 1.0 / m2.length();
+        let principal = DVec2::new((lambda * row_x).dot(r3), (lambda * row_y).dot(r3));
         let q2 = lambda * row_y - (lambda * row_y).dot(r3) * r3;
         let fy = q2.length();
         let r2 = q2 / fy;
@@ -354,15 +410,16 @@ impl Data {
         let fx = q1.length();
         let r1 = q1 / fx;
         // A reflection: the data are of the other handedness (square image y flipped).
-        let (r2, handedness) = if r1.dot(r2.cross(r3)) < 0.0 {
-            (-r2, -handedness)
+        let (r2, principal, handedness) = if r1.dot(r2.cross(r3)) < 0.0 {
+            (-r2, DVec2::new(principal.x, -principal.y), -handedness)
         } else {
-            (r2, handedness)
+            (r2, principal, handedness)
         };
         let pose = Pose {
             focal: 0.5 * (fx + fy),
             rotation: DMat3::from_cols(r1, r2, r3).transpose(),
             eye,
+            principal,
             handedness,
         };
         (pose.focal.is_finite() && pose.focal > 0.0 && pose.rotation.is_finite()).then_some(pose)
@@ -414,6 +471,7 @@ impl Data {
             focal,
             rotation,
             eye,
+            principal: DVec2::ZERO,
             handedness,
         };
         (rotation.is_finite() && eye.is_finite()).then_some(pose)
@@ -429,16 +487,16 @@ impl Data {
                 return None;
             }
             let q = self.seen(k, pose.handedness);
-            r.push(pose.focal * c.x / c.z - q.x);
-            r.push(pose.focal * c.y / c.z - q.y);
+            r.push(pose.focal * c.x / c.z + pose.principal.x - q.x);
+            r.push(pose.focal * c.y / c.z + pose.principal.y - q.y);
         }
         r.iter().all(|v| v.is_finite()).then_some(r)
     }
 
-    /// The derivative of [`Data::residuals`] in (f, rotation vector, eye): 7 columns, the
-    /// rotation vector turning the camera frame as R <- exp([w]x) R.
+    /// The derivative of [`Data::residuals`] in (f, rotation vector, eye, principal point):
+    /// 9 columns, the rotation vector turning the camera frame as R <- exp([w]x) R.
     fn jacobian(&self, pose: &Pose) -> DMatrix<f64> {
-        let mut j = DMatrix::<f64>::zeros(2 * self.points.len(), 7);
+        let mut j = DMatrix::<f64>::zeros(2 * self.points.len(), 9);
         for (k, p) in self.points.iter().enumerate() {
             let c = pose.rotation * (*p - pose.eye);
             let f = pose.focal;
@@ -446,6 +504,8 @@ impl Data {
             let dy = DVec3::new(0.0, f / c.z, -f * c.y / (c.z * c.z));
             j[(2 * k, 0)] = c.x / c.z;
             j[(2 * k + 1, 0)] = c.y / c.z;
+            j[(2 * k, 7)] = 1.0;
+            j[(2 * k + 1, 8)] = 1.0;
             for axis in 0..3 {
                 let mut e = DVec3::ZERO;
                 e[axis] = 1.0;
@@ -461,24 +521,29 @@ impl Data {
         j
     }
 
-    /// Levenberg-Marquardt on the reprojection error from `start`, the focal length fitted
-    /// where `free_focal`, else kept; the pose reached and its sum of squared residuals, or
-    /// `None` where `start` has a point behind it.
-    fn refine(&self, start: Pose, free_focal: bool) -> Option<(Pose, f64)> {
-        let first = usize::from(!free_focal);
+    /// Levenberg-Marquardt on the reprojection error from `start`, fitting `unknowns` (the
+    /// others kept); the pose reached and its sum of squared residuals, or `None` where
+    /// `start` has a point behind it.
+    fn refine(&self, start: Pose, unknowns: Unknowns) -> Option<(Pose, f64)> {
+        let columns = unknowns.columns();
         dense_lm::minimise(
             start,
             MAX_ITERATIONS,
             |pose| self.residuals(pose),
-            |pose| self.jacobian(pose).columns(first, 7 - first).into_owned(),
+            |pose| {
+                self.jacobian(pose)
+                    .columns(columns.start, columns.len())
+                    .into_owned()
+            },
             |pose, step| {
-                let mut full = [0.0; 7];
-                full[first..].copy_from_slice(step.as_slice());
+                let mut full = [0.0; 9];
+                full[columns.clone()].copy_from_slice(step.as_slice());
                 let turn = DVec3::new(-full[1], -full[2], -full[3]);
                 let next = Pose {
                     focal: pose.focal - full[0],
                     rotation: rotation_of(turn) * pose.rotation,
                     eye: pose.eye - DVec3::new(full[4], full[5], full[6]),
+                    principal: pose.principal - DVec2::new(full[7], full[8]),
                     handedness: pose.handedness,
                 };
                 (next.focal > 0.0).then_some(next)
@@ -491,20 +556,59 @@ impl Data {
     /// entry, the focal length measured relative to its value) above `FOCAL_SPREAD`, or a
     /// singular normal matrix.
     fn focal_undetermined(&self, pose: &Pose) -> bool {
+        self.standard_errors(pose, Unknowns::Focal)
+            .is_none_or(|errors| !within(errors[0], FOCAL_SPREAD))
+    }
+
+    /// The standard errors of `pose`'s `unknowns` (the noise variance, at least
+    /// `NOISE_FLOOR` squared, times the inverse normal matrix's diagonal; the focal length
+    /// relative to its value), in the order of [`Data::jacobian`]'s columns from the first
+    /// fitted; `None` where the normal matrix is singular.
+    fn standard_errors(&self, pose: &Pose, unknowns: Unknowns) -> Option<Vec<f64>> {
+        let columns = unknowns.columns();
         let mut j = self.jacobian(pose);
         j.column_mut(0).scale_mut(pose.focal);
-        let Some(inverse) = (j.transpose() * &j).cholesky().map(|ch| ch.inverse()) else {
-            return true;
-        };
+        let j = j.columns(columns.start, columns.len()).into_owned();
+        let inverse = (j.transpose() * &j).cholesky()?.inverse();
         let r = self.residuals(pose).unwrap_or_default();
-        let spare = r.len().saturating_sub(7).max(1) as f64;
+        let spare = r.len().saturating_sub(columns.len()).max(1) as f64;
         let variance = (r.iter().map(|v| v * v).sum::<f64>() / spare).max(NOISE_FLOOR.powi(2));
-        let spread = (variance * inverse[(0, 0)]).sqrt();
-        !matches!(
-            spread.partial_cmp(&FOCAL_SPREAD),
-            Some(Ordering::Less | Ordering::Equal)
+        Some(
+            (0..columns.len())
+                .map(|i| (variance * inverse[(i, i)]).sqrt())
+                .collect(),
         )
     }
+
+    /// The camera with its principal point fitted too (module docs), from the camera
+    /// matrix's start `general` and from the centred camera `centred` (its sum of squares
+    /// `centred_ss`), where the centred camera misses by more than `NOISE_FLOOR` (rms) and the
+    /// other is clearly better with a regular normal matrix; `None` where not.
+    fn off_centre(&self, general: Pose, centred: Pose, centred_ss: f64) -> Option<Pose> {
+        let count = self.points.len();
+        if centred_ss <= 2.0 * count as f64 * NOISE_FLOOR.powi(2) {
+            // The centred camera meets the data: nothing for a principal point to explain.
+            return None;
+        }
+        let (pose, ss) = [general, centred]
+            .into_iter()
+            .filter_map(|start| self.refine(start, Unknowns::Principal))
+            .min_by(|a, b| a.1.total_cmp(&b.1))?;
+        let better = clearly_better(count, 9, 2, ss, centred_ss);
+        // A singular normal matrix: the data determine no principal point. A large but
+        // finite spread is no reason to refuse it: the principal point trades against the
+        // rotation, which the image of the points hardly tells apart.
+        let determined = self.standard_errors(&pose, Unknowns::Principal).is_some();
+        (better && determined).then_some(pose)
+    }
+}
+
+/// Whether `spread` is a number at most `bound`.
+fn within(spread: f64, bound: f64) -> bool {
+    matches!(
+        spread.partial_cmp(&bound),
+        Some(Ordering::Less | Ordering::Equal)
+    )
 }
 
 /// The eigenvalues of the covariance of `points` (about the origin), largest first, and

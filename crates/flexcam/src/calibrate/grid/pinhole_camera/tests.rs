@@ -23,6 +23,7 @@ fn camera(eye: DVec3, target: DVec3, roll: f64, focal: f64, handedness: f64) -> 
         focal,
         rotation: DMat3::from_cols(right, down, forward).transpose(),
         eye,
+        principal: DVec2::ZERO,
         aspect: SHAPE.aspect,
         handedness,
         focal_from_prior: false,
@@ -273,6 +274,56 @@ proptest! {
         let data = seen(&truth, &uvs, |k, _| depths[k] * distance);
         let fitted = PinholeCamera::fit(&data, SHAPE).unwrap();
         prop_assert!(recovered(&fitted, &truth, &data), "{fitted:?}\n{truth:?}");
+    }
+}
+
+/// `truth` cropped off centre: its principal point moved by `offset` (fractions of the
+/// image's width and height, each 10 to 25 % either way).
+fn cropped(truth: PinholeCamera, offset: DVec2) -> PinholeCamera {
+    PinholeCamera {
+        principal: DVec2::new(offset.x, -offset.y / SHAPE.aspect),
+        ..truth
+    }
+}
+
+/// Offsets of 10 to 25 % of the image's width and height, each either way.
+fn offsets() -> impl Strategy<Value = DVec2> {
+    (0.1f64..0.25, 0.1f64..0.25, any::<bool>(), any::<bool>()).prop_map(|(x, y, left, down)| {
+        DVec2::new(if left { -x } else { x }, if down { -y } else { y })
+    })
+}
+
+#[test]
+fn a_centred_camera_has_no_principal_point_to_report() {
+    let truth = camera(DVec3::new(-2.0, 3.0, 7.0), DVec3::ZERO, -0.2, 1.1, 1.0);
+    let data = seen(&truth, &lattice(), |k, _| 5.0 + (k * 3 % 7) as f64);
+    let fitted = PinholeCamera::fit(&data, SHAPE).unwrap();
+    assert_eq!(fitted.principal_point(), None);
+    let off = cropped(truth, DVec2::new(0.2, -0.15));
+    let data = seen(&off, &lattice(), |k, _| 5.0 + (k * 3 % 7) as f64);
+    let fitted = PinholeCamera::fit(&data, SHAPE).unwrap();
+    let uv = fitted.principal_point().unwrap();
+    assert!((uv - DVec2::new(0.7, 0.35)).length() < 1e-9, "{uv}");
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(200))]
+
+    #[test]
+    fn a_cropped_camera_comes_back_from_exact_points_off_a_plane(
+        (truth, uvs) in camera_and_uvs(),
+        offset in offsets(),
+        depths in prop::collection::vec(0.3f64..1.5, 40),
+    ) {
+        prop_assume!(spread(&uvs) && uvs.len() >= 8);
+        let truth = cropped(truth, offset);
+        let distance = truth.eye.length();
+        let data = seen(&truth, &uvs, |k, _| depths[k] * distance);
+        let fitted = PinholeCamera::fit(&data, SHAPE).unwrap();
+        prop_assert!(recovered(&fitted, &truth, &data), "{fitted:?}\n{truth:?}");
+        let uv = fitted.principal_point().unwrap();
+        let wanted = DVec2::new(0.5 + offset.x, 0.5 + offset.y);
+        prop_assert!((uv - wanted).length() < 1e-7, "{uv} against {wanted}");
     }
 }
 

@@ -31,12 +31,14 @@ pub enum Starts {
     /// Every node's start is fitted with the directions.
     Free,
     /// One pinhole camera of square pixels, its principal point at the image centre (focal
-    /// length and pose, 7 unknowns): the model of a painting drawn in true perspective.
+    /// length and pose, 7 unknowns) or, where the data clearly support it, off centre (a
+    /// cropped painting, 9 unknowns): the model of a painting drawn in true perspective.
     Pinhole,
     /// Exact data: the kept starts where they meet the data and determine the directions,
     /// else the eye where it meets the data exactly or clearly better, else the free starts
-    /// where they meet the data clearly better. Inexact data: the model (any of the four)
-    /// whose fits miss held-out points least, never a folded grid where another is not.
+    /// where they meet the data clearly better. Inexact data: the simplest model (pinhole,
+    /// eye, kept, free) that no richer one beats by a paired test of their held-out misses,
+    /// never a folded grid where another is not.
     #[default]
     Auto,
 }
