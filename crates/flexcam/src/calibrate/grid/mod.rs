@@ -99,6 +99,7 @@ mod dense_lm;
 mod envelope_cholesky;
 mod folds;
 mod free;
+mod nested_models;
 mod pinhole_camera;
 
 use checks::{

@@ -25,7 +25,7 @@
 //! the focal length is determined, the 9-unknown camera is fitted as well, from the camera
 //! matrix's K R split with its own principal point (K's third column) and from the centred
 //! camera, and kept where it is clearly better by the nested least-squares rule of module
-//! `select` (`clearly_better`: its sum of squares lower by more than 4 noise variances per
+//! `nested_models` (`clearly_better`: its sum of squares lower by more than 4 noise variances per
 //! extra unknown, about a 2 % chance on data of a centred camera) and its normal matrix is
 //! regular (the principal point trades against the rotation, so its spread may be large
 //! while the image is well met). One plane does not
@@ -50,7 +50,7 @@ use glam::{DMat3, DVec2, DVec3};
 use nalgebra::{DMatrix, Matrix3, SymmetricEigen};
 
 use super::camera_matrix::{normalisation, CameraMatrix};
-use super::select::clearly_better;
+use super::nested_models::clearly_better;
 use super::{dense_lm, Correspondence};
 use crate::projection::flexible::ProjectorGrid;
 

@@ -2,6 +2,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::folds::folded;
+use super::nested_models::clearly_better;
 use super::{
     central, constrained_nodes, fit, free, miss_seen_from, straight_undetermined, Correspondence,
     FitReport, FittedStarts, EXACT_RMS_RAD,
@@ -42,25 +43,6 @@ fn reporting_eye(
 /// Whether a fit's rms miss is at most `EXACT_RMS_RAD`.
 pub(super) fn exact(report: &FitReport) -> bool {
     report.rms_angle_deg.to_radians() <= EXACT_RMS_RAD
-}
-
-/// Whether a model with `unknowns` and the sum of squared misses `fewer_ss` should replace
-/// one with fewer (`unknowns - extra`) and `more_ss`: it must lower the sum by more than 4
-/// noise variances per extra unknown, the variance estimated from its own residual and its
-/// degrees of freedom (2 equations a correspondence less `unknowns`); never where it has no
-/// spare equations.
-pub(super) fn clearly_better(
-    count: usize,
-    unknowns: usize,
-    extra: usize,
-    ss: f64,
-    simpler_ss: f64,
-) -> bool {
-    let freedom = 2 * count;
-    if freedom <= unknowns {
-        return false;
-    }
-    simpler_ss > ss * (1.0 + 4.0 * extra as f64 / (freedom - unknowns) as f64)
 }
 
 /// `Starts::Auto`: [`nested_fit`]'s choice where the grid is curved, or where it is exact
