@@ -21,8 +21,9 @@
 //! (the prior's focal length where they give none within `FOCAL_RANGE` of it); the pose
 //! then from K^-1 H's columns, (r1, r2) made orthonormal.
 //!
-//! The principal point: where the points are not coplanar (the camera matrix exists) and
-//! the focal length is determined, the 9-unknown camera is fitted as well, from the camera
+//! The principal point: where there are at least `PRINCIPAL_MIN_POINTS` (9) points, not
+//! coplanar (the camera matrix exists), and the focal length is determined, the 9-unknown
+//! camera is fitted as well, from the camera
 //! matrix's K R split with its own principal point (K's third column) and from the centred
 //! camera, and kept where it is clearly better by the nested least-squares rule of module
 //! `nested_models` (`clearly_better`: its sum of squares lower by more than 4 noise variances per
@@ -586,6 +587,10 @@ impl Data {
     /// other is clearly better with a regular normal matrix; `None` where not.
     fn off_centre(&self, general: Pose, centred: Pose, centred_ss: f64) -> Option<Pose> {
         let count = self.points.len();
+        if count < PRINCIPAL_MIN_POINTS {
+            // Too few equations to tell a principal point from a far, narrow camera.
+            return None;
+        }
         if centred_ss <= 2.0 * count as f64 * NOISE_FLOOR.powi(2) {
             // The centred camera meets the data: nothing for a principal point to explain.
             return None;
@@ -602,6 +607,14 @@ impl Data {
         (better && determined).then_some(pose)
     }
 }
+
+/// The fewest correspondences whose equations (two each) are at least twice the
+/// off-centre camera's 9 unknowns: below it the principal point is not fitted. With fewer,
+/// a point the centred camera cannot keep in front (data contradicting each other) is met
+/// almost exactly by an eye moved far away along the contradiction with its principal point
+/// shifted, a silent and wrong fit, where the centred camera shows the contradiction in its
+/// residual.
+pub(super) const PRINCIPAL_MIN_POINTS: usize = 9;
 
 /// Whether `spread` is a number at most `bound`.
 fn within(spread: f64, bound: f64) -> bool {

@@ -306,6 +306,29 @@ fn a_centred_camera_has_no_principal_point_to_report() {
     assert!((uv - DVec2::new(0.7, 0.35)).length() < 1e-9, "{uv}");
 }
 
+/// Below `PRINCIPAL_MIN_POINTS` exact points of a cropped camera the principal point is not
+/// fitted (the centred camera's residual shows the crop); at it, it is recovered.
+#[test]
+fn a_principal_point_needs_nine_points() {
+    let off = cropped(
+        camera(DVec3::new(-2.0, 3.0, 7.0), DVec3::ZERO, -0.2, 1.1, 1.0),
+        DVec2::new(0.2, -0.15),
+    );
+    let all = seen(&off, &lattice(), |k, _| 5.0 + (k * 3 % 7) as f64);
+    assert!(all.len() > super::PRINCIPAL_MIN_POINTS);
+    let few = &all[..super::PRINCIPAL_MIN_POINTS - 1];
+    assert_eq!(
+        PinholeCamera::fit(few, SHAPE).unwrap().principal_point(),
+        None
+    );
+    let enough = &all[..super::PRINCIPAL_MIN_POINTS];
+    let uv = PinholeCamera::fit(enough, SHAPE)
+        .unwrap()
+        .principal_point()
+        .unwrap();
+    assert!((uv - DVec2::new(0.7, 0.35)).length() < 1e-9, "{uv}");
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(200))]
 
@@ -315,7 +338,7 @@ proptest! {
         offset in offsets(),
         depths in prop::collection::vec(0.3f64..1.5, 40),
     ) {
-        prop_assume!(spread(&uvs) && uvs.len() >= 8);
+        prop_assume!(spread(&uvs) && uvs.len() >= super::PRINCIPAL_MIN_POINTS);
         let truth = cropped(truth, offset);
         let distance = truth.eye.length();
         let data = seen(&truth, &uvs, |k, _| depths[k] * distance);
