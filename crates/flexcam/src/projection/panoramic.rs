@@ -35,6 +35,20 @@ pub(super) fn horizontal(lon: f64) -> DVec2 {
     DVec2::new(lon.sin(), lon.cos())
 }
 
+/// The horizontal unit direction of each image column `columns` (continuous x positions)
+/// of an image whose longitude is linear in x at `radians_per_pixel`: what a separable
+/// panorama's `projector_grid_into` computes once per column.
+fn column_directions(
+    resolution: &Resolution,
+    columns: &[f64],
+    radians_per_pixel: f64,
+) -> Vec<DVec2> {
+    columns
+        .iter()
+        .map(|&x| horizontal(resolution.centred(DVec2::new(x, 0.0)).x * radians_per_pixel))
+        .collect()
+}
+
 /// Longitude linear in x over `h_fov`, latitude linear in y over `v_fov` (top row at
 /// +v_fov/2). The defaults of the scene format, 360 x 180, image the whole sphere.
 #[derive(Debug, Clone, PartialEq)]
@@ -102,12 +116,7 @@ impl Projection for Equirectangular {
         stride: usize,
         out: &mut [Option<Projector>],
     ) {
-        let longitudes: Vec<DVec2> = columns
-            .iter()
-            .map(|&x| {
-                horizontal(self.resolution.centred(DVec2::new(x, 0.0)).x * self.radians_per_pixel.x)
-            })
-            .collect();
+        let longitudes = column_directions(&self.resolution, columns, self.radians_per_pixel.x);
         for (j, &y) in rows.iter().enumerate() {
             let lat = self.resolution.centred(DVec2::new(0.0, y)).y * self.radians_per_pixel.y;
             let (sin, cos) = (lat.sin(), lat.cos());
@@ -229,12 +238,7 @@ impl Projection for Cylindrical {
         stride: usize,
         out: &mut [Option<Projector>],
     ) {
-        let longitudes: Vec<DVec2> = columns
-            .iter()
-            .map(|&x| {
-                horizontal(self.resolution.centred(DVec2::new(x, 0.0)).x * self.radians_per_pixel)
-            })
-            .collect();
+        let longitudes = column_directions(&self.resolution, columns, self.radians_per_pixel);
         for (j, &y) in rows.iter().enumerate() {
             let height = self.resolution.centred(DVec2::new(0.0, y)).y * self.height_per_pixel;
             for (i, h) in longitudes.iter().enumerate() {
