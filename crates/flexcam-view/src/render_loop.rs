@@ -171,8 +171,8 @@ const MAX_BUDGET_SCALE: u32 = 2;
 /// [`MAX_BUDGET_SCALE`]) whose pixels, at `ms_per_pixel` each, fit [`PREVIEW_BUDGET_MS`];
 /// 1 before any raster preview was timed. A time per pixel measured on a reduced frame
 /// carries that frame's fixed costs (the scene's vertices are projected whatever the size),
-/// so it overestimates a larger frame: the scale errs towards smaller previews, never
-/// towards missing the budget.
+/// so it overestimates a larger frame: the scale errs towards smaller previews. At the
+/// largest divisor a preview may still miss the budget (fixed costs that do not shrink).
 fn budget_scale((width, height): (u32, u32), ms_per_pixel: Option<f64>) -> u32 {
     let Some(cost) = ms_per_pixel.filter(|c| c.is_finite() && *c > 0.0) else {
         return 1;
