@@ -23,6 +23,7 @@ use crate::geometry::Ray;
 use crate::projection::{Projection, Trilinear};
 use crate::render::prepared::{Hit, PreparedScene};
 use crate::render::scan::{FrameRows, NO_PRIMITIVE};
+use crate::render::shading::trace::HitShader;
 use crate::render::shading::triangle_color::TriangleColor;
 use crate::render::RenderOptions;
 
@@ -123,8 +124,9 @@ impl Shader<'_> {
     /// Each row is walked in runs of pixels won by the same key: a run of background is
     /// filled at once, and a run of one triangle seen through one projection triangle looks
     /// up its map, owner and colour once and walks its projector directions along the row
-    /// ([`Shader::flat_run`]). With fallback projection triangles every pixel is shaded on
-    /// its own ([`Shader::pixel`]).
+    /// ([`Shader::flat_run`]); a run without a flat colour (lit, or a mirror or glass) is
+    /// shaded four neighbours at a time ([`Shader::traced_run`]). With fallback projection
+    /// triangles every pixel is shaded on its own ([`Shader::pixel`]).
     pub fn rows(&self, drawn: &GBuffer, mut out: FrameRows<'_>) -> ShadeCounts {
         let any_fallback = self.fallback.iter().any(|&f| f);
         let (width, rows) = (drawn.width() as usize, drawn.rows());
@@ -153,7 +155,7 @@ impl Shader<'_> {
                             ShadeCounts::default()
                         }
                         Some(color) => self.flat_run(drawn, &run, &mut out, color),
-                        None => self.pixels(drawn, &run, &mut out, false),
+                        None => self.traced_run(drawn, &run, &mut out),
                     };
                 x0 = x1;
             }
@@ -175,6 +177,67 @@ impl Shader<'_> {
             let x = run.x0 + k as u32;
             let pixel = self.pixel(drawn, run.first + k, x, run.y, any_fallback);
             counts = counts + run.write(out, k, pixel);
+        }
+        counts
+    }
+
+    /// The pixels of `run` (no fallback) shaded as [`Shader::pixel`] shades them, four
+    /// neighbours at a time: the exact winners of a group are handed together to
+    /// [`HitShader::shade_hits4`], which gives each the colour and ray count
+    /// [`PreparedScene::shade_hit`] gives it and traces their shadow rays towards each
+    /// light as one packet (neighbours on one scene triangle send nearly parallel shadow
+    /// rays through the same nodes of the scene's hierarchy). Crack fillers and pixels
+    /// without a projector go through [`Shader::pixel`] one by one.
+    fn traced_run(&self, drawn: &GBuffer, run: &Run, out: &mut FrameRows<'_>) -> ShadeCounts {
+        let k_triangle = run.triangle();
+        let owner = self.resolver.scene.owners[k_triangle];
+        let map = self.resolver.maps.get(run.projection());
+        let mut counts = ShadeCounts::default();
+        for group in (0..run.len).step_by(4) {
+            let lanes = (run.len - group).min(4);
+            let mut traced: [Option<(Ray, Hit, f32)>; 4] = [None; 4];
+            for (lane, slot) in traced.iter_mut().enumerate().take(lanes) {
+                let k = group + lane;
+                let (i, x) = (run.first + k, run.x0 + k as u32);
+                let t = drawn.depth[i];
+                let projector = map
+                    .filter(|_| t < CRACK_FILL_DEPTH)
+                    .and_then(|map| map.projector(self.resolver.position(x, run.y)));
+                match projector {
+                    Some(projector) => {
+                        let hit = Hit {
+                            t,
+                            object: owner.object as usize,
+                            triangle: owner.triangle as usize,
+                            barycentric: Vec2::from(drawn.barycentrics[i]),
+                        };
+                        let depth = (t * projector.direction.length()) as f32;
+                        *slot = Some((projector.ray(), hit, depth));
+                    }
+                    None => {
+                        let p = self.pixel(drawn, i, x, run.y, false);
+                        counts = counts + run.write(out, k, p);
+                    }
+                }
+            }
+            if traced.iter().all(Option::is_none) {
+                continue;
+            }
+            let mut shader = HitShader::new(self.prepared, self.options);
+            let lane = |k: usize| traced[k].as_ref().map(|(ray, hit, _)| (ray, *hit));
+            let colors = shader.shade_hits4([lane(0), lane(1), lane(2), lane(3)]);
+            for (k, (traced, color)) in traced.iter().zip(colors).enumerate() {
+                if let Some((_, _, depth)) = traced {
+                    let pixel = Pixel {
+                        color,
+                        depth: *depth,
+                        id: owner.id,
+                        counts: ShadeCounts::default(),
+                    };
+                    run.write(out, group + k, pixel);
+                }
+            }
+            counts.shading_rays += shader.counts.secondary + shader.counts.shadow;
         }
         counts
     }
