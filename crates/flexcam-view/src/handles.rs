@@ -29,6 +29,7 @@
 //! scene format runs them in), so a fit may move a dragged node again.
 
 mod preset_shape;
+mod ranged;
 
 use std::sync::Arc;
 
@@ -184,6 +185,10 @@ enum Edit {
         path: ValuePath,
         shape: preset_shape::Shape,
     },
+    /// A number made by a rule of module `ranged`.
+    Ranged { path: ValuePath, rule: ranged::Rule },
+    /// The number `edit` makes, clamped to `range` (the key's valid range).
+    Clamped { edit: Box<Edit>, range: [f64; 2] },
 }
 
 /// The numbers of a numeric array value.
@@ -229,6 +234,7 @@ pub fn handles(session: &Session) -> Vec<Handle> {
     grid_nodes(session, &mut out);
     preset_keys(session, &mut out);
     preset_shape::handles(session, &mut out);
+    ranged::handles(session, &mut out);
     panorama_points(session, &mut out);
     rect(session, &mut out);
     out
@@ -632,26 +638,43 @@ impl Handle {
     /// Errors when the value to edit is gone (the projection changed since the handle was
     /// listed).
     pub fn edits(&self, session: &Session, delta: Place) -> Result<Vec<(String, Value)>> {
-        let wrong = || {
-            Error::new(format!(
-                "handle `{}` is moved {}",
-                self.name,
-                match self.place {
-                    Place::World(_) => "in the world (the volume view)",
-                    Place::Image(_) => "over the image",
-                }
-            ))
-        };
-        match (&self.edit, self.place, delta) {
+        if let (&Edit::Node { col, row, end }, Place::World(at), Place::World(d)) =
+            (&self.edit, self.place, delta)
+        {
+            return Ok(vec![node_edit(session, col, row, end, at + d)]);
+        }
+        let (path, value) = self.value(&self.edit, session, delta)?;
+        Ok(vec![path.set(session, value)?])
+    }
+
+    /// The error of a handle moved the wrong way (or whose value is gone).
+    fn wrong(&self) -> Error {
+        Error::new(format!(
+            "handle `{}` is moved {}",
+            self.name,
+            match self.place {
+                Place::World(_) => "in the world (the volume view)",
+                Place::Image(_) => "over the image",
+            }
+        ))
+    }
+
+    /// The value `edit` (this handle's, or one it wraps) sets and its new value for a move
+    /// by `delta`.
+    fn value<'e>(
+        &self,
+        edit: &'e Edit,
+        session: &Session,
+        delta: Place,
+    ) -> Result<(&'e ValuePath, Value)> {
+        let wrong = || self.wrong();
+        match (edit, self.place, delta) {
             (Edit::Point(path), Place::World(at), Place::World(d)) => {
-                Ok(vec![path.set(session, float_array(&(at + d).to_array()))?])
+                Ok((path, float_array(&(at + d).to_array())))
             }
             (Edit::Offset { path, base }, Place::World(at), Place::World(d)) => {
                 let offset = at + d - *base;
-                Ok(vec![path.set(session, float_array(&offset.to_array()))?])
-            }
-            (&Edit::Node { col, row, end }, Place::World(at), Place::World(d)) => {
-                Ok(vec![node_edit(session, col, row, end, at + d)])
+                Ok((path, float_array(&offset.to_array())))
             }
             (
                 Edit::Curve {
@@ -684,7 +707,7 @@ impl Handle {
                     ))
                 })?;
                 let moved = direction * length;
-                Ok(vec![path.set(session, float_array(&moved.to_array()))?])
+                Ok((path, float_array(&moved.to_array())))
             }
             (Edit::Image { path, x, y }, Place::Image(_), Place::Image(d)) => {
                 let value = path.get(session).ok_or_else(wrong)?;
@@ -705,7 +728,7 @@ impl Handle {
                     Some(_) => Value::from(n[0]),
                     None => float_array(&n),
                 };
-                Ok(vec![path.set(session, new)?])
+                Ok((path, new))
             }
             (
                 Edit::Along {
@@ -718,7 +741,7 @@ impl Handle {
                 Place::World(d),
             ) => {
                 let value = factor * (at + d - *origin).dot(*axis);
-                Ok(vec![path.set(session, Value::from(value))?])
+                Ok((path, Value::from(value)))
             }
             (
                 Edit::Angle {
@@ -732,20 +755,35 @@ impl Handle {
             ) => {
                 let v = at + d - *origin;
                 let angle = 2.0 * v.dot(*axis).atan2(v.dot(*forward)).to_degrees();
-                Ok(vec![path.set(session, Value::from(angle))?])
+                Ok((path, Value::from(angle)))
             }
             (Edit::Shape { path, shape }, at, d) => {
-                let to = match (at, d) {
-                    (Place::World(at), Place::World(d)) => Place::World(at + d),
-                    (Place::Image(at), Place::Image(d)) => Place::Image(at + d),
-                    _ => return Err(wrong()),
-                };
                 let old = path.get(session).ok_or_else(wrong)?;
-                let value = shape.value(&self.name, old, to).ok_or_else(wrong)??;
-                Ok(vec![path.set(session, value)?])
+                let value = shape.value(&self.name, old, moved(at, d).ok_or_else(wrong)?);
+                Ok((path, value.ok_or_else(wrong)??))
+            }
+            (Edit::Ranged { path, rule }, at, d) => {
+                let value = rule.value(&self.name, moved(at, d).ok_or_else(wrong)?);
+                Ok((path, Value::from(value.ok_or_else(wrong)??)))
+            }
+            (Edit::Clamped { edit, range }, _, _) => {
+                let (path, value) = self.value(edit, session, delta)?;
+                let n = value.as_float().ok_or_else(wrong)?;
+                // Not `f64::clamp`, which panics on a range made empty by the other numbers.
+                Ok((path, Value::from(n.max(range[0]).min(range[1]))))
             }
             _ => Err(wrong()),
         }
+    }
+}
+
+/// Where a handle at `at` moved by `d` goes; none when the move is not where it lives (the
+/// world or the image).
+fn moved(at: Place, d: Place) -> Option<Place> {
+    match (at, d) {
+        (Place::World(at), Place::World(d)) => Some(Place::World(at + d)),
+        (Place::Image(at), Place::Image(d)) => Some(Place::Image(at + d)),
+        _ => None,
     }
 }
 
