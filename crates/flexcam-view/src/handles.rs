@@ -24,6 +24,7 @@
 //! | `rect.corner.K` | corner K (0 bottom left, counter-clockwise) of `perspective_rect`, over the image | its two numbers |
 //! | `rect.center` | the rectangle's centre, over the image | all four numbers |
 //! | `shift`, `shear`, `twist`, `converge`, `slit_distance`, `fovs.K`, `generators.K.start` / `.end`, `directions.K`, `strength`, `magnification` | the preset keys that shape the projectors otherwise (module `preset_shape`) | that key |
+//! | `azimuth`, `elevation`, `corner_radius`, the mcop's `v_fov`, `deep.K.center` / `.width` / `.fov` | the preset keys whose drags are clamped to the key's valid range (module `ranged`) | that key |
 //!
 //! Nodes of a grid with `fit` or `aim` are placed before the fit and the aims (the order the
 //! scene format runs them in), so a fit may move a dragged node again.
@@ -338,9 +339,9 @@ fn image_pixel(uv: DVec2, width: u32, height: u32) -> DVec2 {
 /// axis; `v_fov`: above it; at the look-at distance from the eye), the `width` of the
 /// orthographic, oblique and pushbroom presets (half of it right of the look-at point),
 /// distances along the view axis (`clip.near`, `clip.far`, also of shape-defined
-/// panoramas; `transition`, `transitions.K`), the mcop camera path's points (`path.K`, the
-/// only handles of an mcop besides the frame's), and over the image the occlusion `pole`, the magnifier's `center` and `radius` (the point
-/// of its circle right of the centre).
+/// panoramas; `transition`, `transitions.K`), the mcop camera path's points (`path.K`), and
+/// over the image the occlusion `pole`, the magnifier's `center` and `radius` (the point of
+/// its circle right of the centre).
 fn preset_keys(session: &Session, out: &mut Vec<Handle>) {
     let ProjectionSpec::Flexible(spec) = session.spec() else {
         return;
