@@ -17,7 +17,7 @@
 //! | `projector.C.R.start`, `projector.C.R.end` | node (column C, row R) of a projector grid | that node's `start` / `end` in `projectors.projector` (the entry is added when missing) |
 //! | `fov`, `h_fov`, `v_fov` | the point at half the angle right of (`v_fov`: above) a preset's view axis, at the look-at distance | the angle: twice that of the dragged point |
 //! | `width` | half the width right of the look-at point (orthographic, oblique, pushbroom presets) | twice the dragged point's distance right of the axis |
-//! | `clip.near`, `clip.far`, `transition`, `transitions.K` | the point at that distance along the view axis | the dragged point's distance along the axis |
+//! | `clip.near`, `clip.far`, `transition`, `transitions.K`, `z_near`, `z_far` | the point at that distance along the view axis | the dragged point's distance along the axis |
 //! | `path.K` | point K of an mcop camera path | that point |
 //! | `pole`, `center`, `radius` | over the image: the occlusion pole, the magnifier's centre and the point of its circle right of it | u right, v up (`radius`: by the shorter image side) |
 //! | `outline.K`, `profile.K` (`outline.I.K`, `profile.I.K` in `outlines[I]`, `profiles[I]`) | over the image: vertex K of a panorama's `points` outline (at the column of its arc-length fraction) or profile (at the row of its fraction) | that vertex: it turns about the eye, keeping its length, to the direction of the curve's point under the pointer |
@@ -339,7 +339,7 @@ fn image_pixel(uv: DVec2, width: u32, height: u32) -> DVec2 {
 /// axis; `v_fov`: above it; at the look-at distance from the eye), the `width` of the
 /// orthographic, oblique and pushbroom presets (half of it right of the look-at point),
 /// distances along the view axis (`clip.near`, `clip.far`, also of shape-defined
-/// panoramas; `transition`, `transitions.K`), the mcop camera path's points (`path.K`), and
+/// panoramas; `transition`, `transitions.K`; the ddoc's `z_near`, `z_far`), the mcop camera path's points (`path.K`), and
 /// over the image the occlusion `pole`, the magnifier's `center` and `radius` (the point of
 /// its circle right of the centre).
 fn preset_keys(session: &Session, out: &mut Vec<Handle>) {
@@ -444,15 +444,12 @@ fn preset_keys(session: &Session, out: &mut Vec<Handle>) {
     let Some(preset) = preset else {
         return;
     };
-    if let Some(t) = number("transition") {
-        let path = ValuePath::key("transition");
-        out.push(along(
-            "transition",
-            path,
-            origin + forward * t,
-            forward,
-            1.0,
-        ));
+    // (Each preset has at most one of these: the ddoc its two bend distances.)
+    for key in ["transition", "z_near", "z_far"] {
+        if let Some(t) = number(key) {
+            let path = ValuePath::key(key);
+            out.push(along(key, path, origin + forward * t, forward, 1.0));
+        }
     }
     if let Some(list) = session.value("transitions").and_then(numbers) {
         for (k, t) in list.into_iter().enumerate() {
@@ -1106,6 +1103,37 @@ mod tests {
         assert_eq!(edits[0].0, "fov");
         let angle = edits[0].1.as_float().unwrap();
         assert!((angle - 80.0).abs() < 1e-12, "{angle}");
+    }
+
+    #[test]
+    fn the_ddoc_bend_distances_are_points_along_the_axis() {
+        let (_dir, session) = session(
+            "type = \"flexible\"\npreset = \"ddoc\"\n\
+             position = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\n\
+             fov = 60.0\nz_near = 2.0\nz_far = 4.0\nclip = [0.5, 10.0]",
+        );
+        let list = handles(&session);
+        assert_eq!(
+            names(&list),
+            [
+                "position",
+                "look_at",
+                "clip.near",
+                "clip.far",
+                "z_near",
+                "z_far",
+                "fov"
+            ]
+        );
+        assert_eq!(
+            find(&list, "z_far").place,
+            Place::World(DVec3::new(0.0, 0.0, -1.0))
+        );
+        let edits = find(&list, "z_near")
+            .edits(&session, Place::World(DVec3::new(0.4, 0.0, -0.5)))
+            .unwrap();
+        assert_eq!(edits[0].0, "z_near");
+        assert_eq!(edits[0].1.as_float(), Some(2.5));
     }
 
     #[test]
