@@ -805,21 +805,19 @@ fn dragging_the_clamped_keys_of_presets() {
     let expected = v[1].atan2(v[0].hypot(v[2])).to_degrees();
     assert!(line.starts_with("elevation ="), "{line}");
     assert!(close(line_values(&line)[0], expected), "{line}: {expected}");
-    // corner_radius: the eye at (0, 1.5, 0) looks along -z at distance 1; the corner's
-    // middle is sqrt 2 - r (sqrt 2 - 1) along the front-right diagonal.
+    // corner_radius: the eye at (0, 1.5, 0) looks along -z, the far clip at 60; the
+    // corner's middle is 60 (sqrt 2 - r (sqrt 2 - 1)) along the front-right diagonal.
     let cubic = include_str!("../../../scenes/flexible-panorama-cubic.toml");
     let cubic_size = ("width = 320\nheight = 120", "width = 48\nheight = 18");
-    // (At 48 pixels wide a pixel of the volume view is about 0.9 along the diagonal, which
-    // spans only sqrt 2 - 1 from r = 1 to r = 0: a fifth of a pixel.)
-    let (listed, line) = drag_one(cubic, cubic_size, "corner_radius", -0.2, 0.0);
-    let p = sub(dragged(&listed, -0.2, 0.0), [0.0, 1.5, 0.0]);
-    let s = (p[0] - p[2]) / 2f64.sqrt();
+    let (listed, line) = drag_one(cubic, cubic_size, "corner_radius", -4.0, 0.0);
+    let p = sub(dragged(&listed, -4.0, 0.0), [0.0, 1.5, 0.0]);
+    let s = (p[0] - p[2]) / 2f64.sqrt() / 60.0;
     let expected = (2f64.sqrt() - s) / (2f64.sqrt() - 1.0);
     assert!(line.starts_with("corner_radius ="), "{line}");
     assert!(close(line_values(&line)[0], expected), "{line}: {expected}");
     assert!(expected > 0.3 && expected < 1.0, "{expected}");
     // Dragged past the circle (r above 1): kept at 1.
-    let (_, line) = drag_one(cubic, cubic_size, "corner_radius", -4.0, 0.0);
+    let (_, line) = drag_one(cubic, cubic_size, "corner_radius", -400.0, 0.0);
     assert_eq!(line_values(&line)[0], 1.0, "{line}");
     // The mcop's v_fov: the middle column (path point 1, its two segments equally long)
     // looks along directions[1]; twice the angle above it, up being +y made perpendicular.

@@ -5,7 +5,7 @@
 //! | --- | --- | --- |
 //! | `azimuth` | axonometric: the point half the eye's distance from `look_at`, level with it, towards the eye | the dragged point's angle about +y through `look_at`, from +z towards +x, the turn nearest the old one |
 //! | `elevation` | axonometric: the eye (`look_at` plus the eye's distance along the view's direction) | the dragged point's angle above the level plane through `look_at`, within [-89.9, 89.9] |
-//! | `corner_radius` | rounded_cubic: the middle of the front-right rounded corner, the outline scaled to the look-at distance | the radius that puts that middle at the dragged point's distance along the diagonal, within [0, 1] |
+//! | `corner_radius` | rounded_cubic: the middle of the front-right rounded corner, the outline scaled to the far clip (without `clip`: the look-at distance) | the radius that puts that middle at the dragged point's distance along the diagonal, within [0, 1] |
 //! | `v_fov` | mcop: the middle column's point at half the angle above its look direction, at the look-at distance | twice the dragged point's angle above that direction, within [0.1, 179.9] |
 //! | `deep.K.center`, `deep.K.width` | over the image: long_scene deep area K's middle, and its right edge, on the middle row | its centre by x over the image width; its width by twice that; kept a pixel inside the image |
 //! | `deep.K.fov` | long_scene: deep area K's right edge on the far surface (the edge projector's end), level with the eye | the angle whose edge projector, from the area's edge on the slit, passes the dragged point's distance right of the axis at the far clip, within [0.1, 179.9] |
@@ -151,12 +151,16 @@ pub(super) fn handles(session: &Session, out: &mut Vec<Handle>) {
             let Ok(b) = CameraBasis::new(frame) else {
                 return;
             };
+            // At the far clip (the look-at distance without one): a panorama's look-at
+            // point is often close to the eye, where the corner's whole range would be a
+            // few pixels of the volume view.
+            let scale = preset.clip.map_or(distance, |[_, far]| far);
             let diagonal = (b.right + b.forward) / SQRT_2;
-            let at = b.origin + distance * corner_middle(corner_radius) * diagonal;
+            let at = b.origin + scale * corner_middle(corner_radius) * diagonal;
             let rule = Rule::Corner {
                 origin: b.origin,
                 diagonal,
-                scale: distance,
+                scale,
             };
             let edit = Edit::Ranged {
                 path: key("corner_radius"),
@@ -388,7 +392,7 @@ mod tests {
         }
         // The corner dragged past the square's corner (radius below 0) and into the eye.
         let rounded = fill(ROUNDED, &[("R", 0.3)]);
-        for (k, expected) in [(3.0, 0.0), (0.0, 1.0)] {
+        for (k, expected) in [(70.0, 0.0), (0.0, 1.0)] {
             let to = Place::World(DVec3::new(k, 1.5, -k));
             assert_eq!(drag_to(&rounded, "corner_radius", to).unwrap(), expected);
         }
@@ -438,11 +442,11 @@ mod tests {
         assert!(error.unwrap_err().to_string().contains("no angle"));
         let error = drag_to(&axonometric, "elevation", Place::World(look_at));
         assert!(error.unwrap_err().to_string().contains("no direction"));
-        // The square's corner (radius 0) at the look-at distance 2: (2, 2) right-forward.
+        // The square's corner (radius 0) at the far clip 60: (60, 60) right-forward.
         let square = fill(ROUNDED, &[("R", 0.0)]);
         assert!(near(
             place(&square, "corner_radius"),
-            DVec3::new(2.0, 1.5, -2.0)
+            DVec3::new(60.0, 1.5, -60.0)
         ));
         // 40 x 30: deep area 1 (0.7, 0.1) on the middle row, its right edge at 0.75.
         let long = fill(LONG, &[("C", 0.7), ("W", 0.1), ("F", 30.0)]);
