@@ -780,3 +780,78 @@ fn dragging_the_strength_and_magnification_over_the_image() {
         "{line}: {expected}"
     );
 }
+
+/// The numbers of a changed scene line, before its comment.
+fn line_values(line: &str) -> Vec<f64> {
+    numbers_in(line.split('#').next().unwrap())
+}
+
+#[test]
+fn dragging_the_clamped_keys_of_presets() {
+    let isometric = include_str!("../../../scenes/flexible-isometric.toml");
+    let iso_size = ("width = 320\nheight = 240", "width = 48\nheight = 36");
+    let look_at = [0.0, 0.5, 0.0];
+    // azimuth: the dragged point's angle about +y through look_at, from +z towards +x.
+    let (listed, line) = drag_one(isometric, iso_size, "azimuth", 6.0, 0.0);
+    let v = sub(dragged(&listed, 6.0, 0.0), look_at);
+    assert!(line.starts_with("azimuth ="), "{line}");
+    assert!(
+        close(line_values(&line)[0], v[0].atan2(v[2]).to_degrees()),
+        "{line}"
+    );
+    // elevation: its angle above the level plane through look_at.
+    let (listed, line) = drag_one(isometric, iso_size, "elevation", 0.0, -5.0);
+    let v = sub(dragged(&listed, 0.0, -5.0), look_at);
+    let expected = v[1].atan2(v[0].hypot(v[2])).to_degrees();
+    assert!(line.starts_with("elevation ="), "{line}");
+    assert!(close(line_values(&line)[0], expected), "{line}: {expected}");
+    // corner_radius: the eye at (0, 1.5, 0) looks along -z, the far clip at 60; the
+    // corner's middle is 60 (sqrt 2 - r (sqrt 2 - 1)) along the front-right diagonal.
+    let cubic = include_str!("../../../scenes/flexible-panorama-cubic.toml");
+    let cubic_size = ("width = 320\nheight = 120", "width = 48\nheight = 18");
+    let (listed, line) = drag_one(cubic, cubic_size, "corner_radius", -4.0, 0.0);
+    let p = sub(dragged(&listed, -4.0, 0.0), [0.0, 1.5, 0.0]);
+    let s = (p[0] - p[2]) / 2f64.sqrt() / 60.0;
+    let expected = (2f64.sqrt() - s) / (2f64.sqrt() - 1.0);
+    assert!(line.starts_with("corner_radius ="), "{line}");
+    assert!(close(line_values(&line)[0], expected), "{line}: {expected}");
+    assert!(expected > 0.3 && expected < 1.0, "{expected}");
+    // Dragged past the circle (r above 1): kept at 1.
+    let (_, line) = drag_one(cubic, cubic_size, "corner_radius", -400.0, 0.0);
+    assert_eq!(line_values(&line)[0], 1.0, "{line}");
+    // The mcop's v_fov: the middle column (path point 1, its two segments equally long)
+    // looks along directions[1]; twice the angle above it, up being +y made perpendicular.
+    let mcop = include_str!("../../../scenes/flexible-mcop.toml");
+    let (listed, line) = drag_one(mcop, SMALL_PRESET, "v_fov", 0.0, 4.0);
+    let v = sub(dragged(&listed, 0.0, 4.0), [-4.95, 3.0, 4.95]);
+    let forward = unit([4.95, -2.0, -4.95]);
+    let up = unit(sub([0.0, 1.0, 0.0], scale(forward, forward[1])));
+    let expected = 2.0 * dot(v, up).atan2(dot(v, forward)).to_degrees();
+    assert!(line.starts_with("v_fov ="), "{line}");
+    assert!(close(line_values(&line)[0], expected), "{line}: {expected}");
+    // The long scene's first deep area [0.3, 0.08, 50.0] at 48 pixels wide: its centre and
+    // width over the image, its fov from its edge on the slit (0.04 * 100 right of u =
+    // 0.3, that is -16) to the dragged point at the far clip (25 from the slit).
+    let long = include_str!("../../../scenes/flexible-long-scene.toml");
+    let long_size = ("width = 800\nheight = 200", "width = 48\nheight = 12");
+    for (handle, dx, dy, index) in [
+        ("deep.0.center", 3.0, 1.0, 0),
+        ("deep.0.width", 2.0, 0.0, 1),
+        ("deep.0.fov", 4.0, 0.0, 2),
+    ] {
+        let (listed, line) = drag_one(long, long_size, handle, dx, dy);
+        assert!(line.starts_with("deep ="), "{line}");
+        let expected = match index {
+            0 => 0.3 + dx / 48.0,
+            1 => 0.08 + 2.0 * dx / 48.0,
+            _ => {
+                2.0 * ((dragged(&listed, dx, dy)[0] + 16.0) / 25.0)
+                    .atan()
+                    .to_degrees()
+            }
+        };
+        let numbers = line_values(&line);
+        assert!(close(numbers[index], expected), "{line}: {expected}");
+        assert_eq!(numbers[3..], [0.7, 0.08, 50.0], "{line}");
+    }
+}

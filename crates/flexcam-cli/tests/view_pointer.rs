@@ -181,20 +181,26 @@ fn a_pointer_drag_of_a_volume_handle_is_the_drag_line() {
     frame_renders_p(&dir, &[]);
 }
 
-#[test]
-fn a_pointer_drag_of_an_image_handle_is_the_drag_line() {
-    let text = include_str!("../../../scenes/flexible-panorama-edit.toml");
-    let (from, to) = ("width = 320\nheight = 160", "width = 192\nheight = 96");
+/// Drags image handle `handle` of scene `text` (its size `from` made `to`, `width` pixels
+/// wide) with the pointer by (10, 6) window pixels, and checks the saved scene against the
+/// `drag` line of the same move: only the line starting with `key` changed.
+fn pointer_drag_of_image_handle(
+    text: &str,
+    (from, to): (&str, &str),
+    width: f64,
+    handle: &str,
+    key: &str,
+) {
     let Some((dir, layout)) = open((text, from, to)) else {
         return;
     };
     let (_, at) = layout
         .handles
         .iter()
-        .find(|(name, _)| name == "rect.corner.2")
-        .expect("the rectangle's top right corner");
+        .find(|(name, _)| name == handle)
+        .unwrap_or_else(|| panic!("{handle}: {layout:?}"));
     // Window pixels per image pixel.
-    let scale = (layout.image[2] - layout.image[0]) / 192.0;
+    let scale = (layout.image[2] - layout.image[0]) / width;
     let from = whole(*at);
     let to = [from[0] + 10.0, from[1] + 6.0];
     let script = format!(
@@ -208,18 +214,32 @@ fn a_pointer_drag_of_an_image_handle_is_the_drag_line() {
     headless_script(
         &dir,
         &format!(
-            "drag rect.corner.2 {:?} {:?}\nsave d.toml\n",
+            "drag {handle} {:?} {:?}\nsave d.toml\n",
             10.0 / scale,
             6.0 / scale
         ),
     );
     // The window's scale is the f32 it drew with, the test's the drawn width over the
-    // image width: equal to f32 rounding (2^-24), so the rectangle's image fractions (the
-    // move about 0.1) agree within 1e-6. Only the rectangle moved (the drag did not orbit).
+    // image width: equal to f32 rounding (2^-24), so image fractions (the move about 0.1)
+    // agree within 1e-6. Only the handle's key moved (the drag did not orbit).
     let changed = same_scene(&dir, "p.toml", "d.toml", 1e-6);
     assert_eq!(changed.len(), 1, "{changed:?}");
-    assert!(changed[0].starts_with("perspective_rect ="), "{changed:?}");
+    assert!(changed[0].starts_with(key), "{changed:?}");
     frame_renders_p(&dir, &["--method", "raster"]);
+}
+
+#[test]
+fn a_pointer_drag_of_an_image_handle_is_the_drag_line() {
+    let text = include_str!("../../../scenes/flexible-panorama-edit.toml");
+    let size = ("width = 320\nheight = 160", "width = 192\nheight = 96");
+    pointer_drag_of_image_handle(text, size, 192.0, "rect.corner.2", "perspective_rect =");
+}
+
+#[test]
+fn a_pointer_drag_of_a_deep_area_is_the_drag_line() {
+    let text = include_str!("../../../scenes/flexible-long-scene.toml");
+    let size = ("width = 800\nheight = 200", "width = 192\nheight = 48");
+    pointer_drag_of_image_handle(text, size, 192.0, "deep.1.width", "deep =");
 }
 
 #[test]

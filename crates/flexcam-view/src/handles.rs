@@ -17,18 +17,20 @@
 //! | `projector.C.R.start`, `projector.C.R.end` | node (column C, row R) of a projector grid | that node's `start` / `end` in `projectors.projector` (the entry is added when missing) |
 //! | `fov`, `h_fov`, `v_fov` | the point at half the angle right of (`v_fov`: above) a preset's view axis, at the look-at distance | the angle: twice that of the dragged point |
 //! | `width` | half the width right of the look-at point (orthographic, oblique, pushbroom presets) | twice the dragged point's distance right of the axis |
-//! | `clip.near`, `clip.far`, `transition`, `transitions.K` | the point at that distance along the view axis | the dragged point's distance along the axis |
+//! | `clip.near`, `clip.far`, `transition`, `transitions.K`, `z_near`, `z_far` | the point at that distance along the view axis | the dragged point's distance along the axis |
 //! | `path.K` | point K of an mcop camera path | that point |
 //! | `pole`, `center`, `radius` | over the image: the occlusion pole, the magnifier's centre and the point of its circle right of it | u right, v up (`radius`: by the shorter image side) |
 //! | `outline.K`, `profile.K` (`outline.I.K`, `profile.I.K` in `outlines[I]`, `profiles[I]`) | over the image: vertex K of a panorama's `points` outline (at the column of its arc-length fraction) or profile (at the row of its fraction) | that vertex: it turns about the eye, keeping its length, to the direction of the curve's point under the pointer |
 //! | `rect.corner.K` | corner K (0 bottom left, counter-clockwise) of `perspective_rect`, over the image | its two numbers |
 //! | `rect.center` | the rectangle's centre, over the image | all four numbers |
 //! | `shift`, `shear`, `twist`, `converge`, `slit_distance`, `fovs.K`, `generators.K.start` / `.end`, `directions.K`, `strength`, `magnification` | the preset keys that shape the projectors otherwise (module `preset_shape`) | that key |
+//! | `azimuth`, `elevation`, `corner_radius`, the mcop's `v_fov`, `deep.K.center` / `.width` / `.fov` | the preset keys whose drags are clamped to the key's valid range (module `ranged`) | that key |
 //!
 //! Nodes of a grid with `fit` or `aim` are placed before the fit and the aims (the order the
 //! scene format runs them in), so a fit may move a dragged node again.
 
 mod preset_shape;
+mod ranged;
 
 use std::sync::Arc;
 
@@ -184,6 +186,10 @@ enum Edit {
         path: ValuePath,
         shape: preset_shape::Shape,
     },
+    /// A number made by a rule of module `ranged`.
+    Ranged { path: ValuePath, rule: ranged::Rule },
+    /// The number `edit` makes, clamped to `range` (the key's valid range).
+    Clamped { edit: Box<Edit>, range: [f64; 2] },
 }
 
 /// The numbers of a numeric array value.
@@ -229,6 +235,7 @@ pub fn handles(session: &Session) -> Vec<Handle> {
     grid_nodes(session, &mut out);
     preset_keys(session, &mut out);
     preset_shape::handles(session, &mut out);
+    ranged::handles(session, &mut out);
     panorama_points(session, &mut out);
     rect(session, &mut out);
     out
@@ -332,9 +339,9 @@ fn image_pixel(uv: DVec2, width: u32, height: u32) -> DVec2 {
 /// axis; `v_fov`: above it; at the look-at distance from the eye), the `width` of the
 /// orthographic, oblique and pushbroom presets (half of it right of the look-at point),
 /// distances along the view axis (`clip.near`, `clip.far`, also of shape-defined
-/// panoramas; `transition`, `transitions.K`), the mcop camera path's points (`path.K`, the
-/// only handles of an mcop besides the frame's), and over the image the occlusion `pole`, the magnifier's `center` and `radius` (the point
-/// of its circle right of the centre).
+/// panoramas; `transition`, `transitions.K`; the ddoc's `z_near`, `z_far`), the mcop camera path's points (`path.K`), and
+/// over the image the occlusion `pole`, the magnifier's `center` and `radius` (the point of
+/// its circle right of the centre).
 fn preset_keys(session: &Session, out: &mut Vec<Handle>) {
     let ProjectionSpec::Flexible(spec) = session.spec() else {
         return;
@@ -437,15 +444,12 @@ fn preset_keys(session: &Session, out: &mut Vec<Handle>) {
     let Some(preset) = preset else {
         return;
     };
-    if let Some(t) = number("transition") {
-        let path = ValuePath::key("transition");
-        out.push(along(
-            "transition",
-            path,
-            origin + forward * t,
-            forward,
-            1.0,
-        ));
+    // (Each preset has at most one of these: the ddoc its two bend distances.)
+    for key in ["transition", "z_near", "z_far"] {
+        if let Some(t) = number(key) {
+            let path = ValuePath::key(key);
+            out.push(along(key, path, origin + forward * t, forward, 1.0));
+        }
     }
     if let Some(list) = session.value("transitions").and_then(numbers) {
         for (k, t) in list.into_iter().enumerate() {
@@ -632,26 +636,43 @@ impl Handle {
     /// Errors when the value to edit is gone (the projection changed since the handle was
     /// listed).
     pub fn edits(&self, session: &Session, delta: Place) -> Result<Vec<(String, Value)>> {
-        let wrong = || {
-            Error::new(format!(
-                "handle `{}` is moved {}",
-                self.name,
-                match self.place {
-                    Place::World(_) => "in the world (the volume view)",
-                    Place::Image(_) => "over the image",
-                }
-            ))
-        };
-        match (&self.edit, self.place, delta) {
+        if let (&Edit::Node { col, row, end }, Place::World(at), Place::World(d)) =
+            (&self.edit, self.place, delta)
+        {
+            return Ok(vec![node_edit(session, col, row, end, at + d)]);
+        }
+        let (path, value) = self.value(&self.edit, session, delta)?;
+        Ok(vec![path.set(session, value)?])
+    }
+
+    /// The error of a handle moved the wrong way (or whose value is gone).
+    fn wrong(&self) -> Error {
+        Error::new(format!(
+            "handle `{}` is moved {}",
+            self.name,
+            match self.place {
+                Place::World(_) => "in the world (the volume view)",
+                Place::Image(_) => "over the image",
+            }
+        ))
+    }
+
+    /// The value `edit` (this handle's, or one it wraps) sets and its new value for a move
+    /// by `delta`.
+    fn value<'e>(
+        &self,
+        edit: &'e Edit,
+        session: &Session,
+        delta: Place,
+    ) -> Result<(&'e ValuePath, Value)> {
+        let wrong = || self.wrong();
+        match (edit, self.place, delta) {
             (Edit::Point(path), Place::World(at), Place::World(d)) => {
-                Ok(vec![path.set(session, float_array(&(at + d).to_array()))?])
+                Ok((path, float_array(&(at + d).to_array())))
             }
             (Edit::Offset { path, base }, Place::World(at), Place::World(d)) => {
                 let offset = at + d - *base;
-                Ok(vec![path.set(session, float_array(&offset.to_array()))?])
-            }
-            (&Edit::Node { col, row, end }, Place::World(at), Place::World(d)) => {
-                Ok(vec![node_edit(session, col, row, end, at + d)])
+                Ok((path, float_array(&offset.to_array())))
             }
             (
                 Edit::Curve {
@@ -684,7 +705,7 @@ impl Handle {
                     ))
                 })?;
                 let moved = direction * length;
-                Ok(vec![path.set(session, float_array(&moved.to_array()))?])
+                Ok((path, float_array(&moved.to_array())))
             }
             (Edit::Image { path, x, y }, Place::Image(_), Place::Image(d)) => {
                 let value = path.get(session).ok_or_else(wrong)?;
@@ -705,7 +726,7 @@ impl Handle {
                     Some(_) => Value::from(n[0]),
                     None => float_array(&n),
                 };
-                Ok(vec![path.set(session, new)?])
+                Ok((path, new))
             }
             (
                 Edit::Along {
@@ -718,7 +739,7 @@ impl Handle {
                 Place::World(d),
             ) => {
                 let value = factor * (at + d - *origin).dot(*axis);
-                Ok(vec![path.set(session, Value::from(value))?])
+                Ok((path, Value::from(value)))
             }
             (
                 Edit::Angle {
@@ -732,20 +753,35 @@ impl Handle {
             ) => {
                 let v = at + d - *origin;
                 let angle = 2.0 * v.dot(*axis).atan2(v.dot(*forward)).to_degrees();
-                Ok(vec![path.set(session, Value::from(angle))?])
+                Ok((path, Value::from(angle)))
             }
             (Edit::Shape { path, shape }, at, d) => {
-                let to = match (at, d) {
-                    (Place::World(at), Place::World(d)) => Place::World(at + d),
-                    (Place::Image(at), Place::Image(d)) => Place::Image(at + d),
-                    _ => return Err(wrong()),
-                };
                 let old = path.get(session).ok_or_else(wrong)?;
-                let value = shape.value(&self.name, old, to).ok_or_else(wrong)??;
-                Ok(vec![path.set(session, value)?])
+                let value = shape.value(&self.name, old, moved(at, d).ok_or_else(wrong)?);
+                Ok((path, value.ok_or_else(wrong)??))
+            }
+            (Edit::Ranged { path, rule }, at, d) => {
+                let value = rule.value(&self.name, moved(at, d).ok_or_else(wrong)?);
+                Ok((path, Value::from(value.ok_or_else(wrong)??)))
+            }
+            (Edit::Clamped { edit, range }, _, _) => {
+                let (path, value) = self.value(edit, session, delta)?;
+                let n = value.as_float().ok_or_else(wrong)?;
+                // Not `f64::clamp`, which panics on a range made empty by the other numbers.
+                Ok((path, Value::from(n.max(range[0]).min(range[1]))))
             }
             _ => Err(wrong()),
         }
+    }
+}
+
+/// Where a handle at `at` moved by `d` goes; none when the move is not where it lives (the
+/// world or the image).
+fn moved(at: Place, d: Place) -> Option<Place> {
+    match (at, d) {
+        (Place::World(at), Place::World(d)) => Some(Place::World(at + d)),
+        (Place::Image(at), Place::Image(d)) => Some(Place::Image(at + d)),
+        _ => None,
     }
 }
 
@@ -1067,6 +1103,37 @@ mod tests {
         assert_eq!(edits[0].0, "fov");
         let angle = edits[0].1.as_float().unwrap();
         assert!((angle - 80.0).abs() < 1e-12, "{angle}");
+    }
+
+    #[test]
+    fn the_ddoc_bend_distances_are_points_along_the_axis() {
+        let (_dir, session) = session(
+            "type = \"flexible\"\npreset = \"ddoc\"\n\
+             position = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\n\
+             fov = 60.0\nz_near = 2.0\nz_far = 4.0\nclip = [0.5, 10.0]",
+        );
+        let list = handles(&session);
+        assert_eq!(
+            names(&list),
+            [
+                "position",
+                "look_at",
+                "clip.near",
+                "clip.far",
+                "z_near",
+                "z_far",
+                "fov"
+            ]
+        );
+        assert_eq!(
+            find(&list, "z_far").place,
+            Place::World(DVec3::new(0.0, 0.0, -1.0))
+        );
+        let edits = find(&list, "z_near")
+            .edits(&session, Place::World(DVec3::new(0.4, 0.0, -0.5)))
+            .unwrap();
+        assert_eq!(edits[0].0, "z_near");
+        assert_eq!(edits[0].1.as_float(), Some(2.5));
     }
 
     #[test]

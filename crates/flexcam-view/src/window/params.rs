@@ -18,6 +18,9 @@ fn range(kind: &str, key: &str) -> RangeInclusive<f64> {
         (_, "h_fov") => 0.1..=360.0,
         (_, "v_fov") => 0.1..=180.0,
         (_, "width") => 1e-6..=f64::MAX,
+        // The axonometric view has no up at +-90 degrees.
+        (_, "elevation") => -89.9..=89.9,
+        (_, "corner_radius") => 0.0..=1.0,
         _ => f64::MIN..=f64::MAX,
     }
 }
