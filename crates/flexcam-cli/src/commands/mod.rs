@@ -1,6 +1,7 @@
 //! The subcommands.
 
 pub mod animate;
+pub mod atlas_outputs;
 pub mod bench;
 pub mod compare;
 pub mod ddoc_map;

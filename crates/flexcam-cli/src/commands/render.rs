@@ -11,6 +11,7 @@ use flexcam::render::{
 };
 use flexcam::Result;
 
+use super::atlas_outputs::AtlasOutputs;
 use super::scene_args::{
     method_names, print_lines, print_warnings, warning_lines, MethodTuning, SceneArgs, ShadingArg,
 };
@@ -97,6 +98,12 @@ pub struct RenderArgs {
     /// the background).
     #[arg(help_heading = "Outputs", long, value_name = "FILE")]
     aovs: Option<PathBuf>,
+    /// Write the joint texture atlas of every trilinear reflector with `reflection =
+    /// "atlas"` (.png, .exr or .pfm), one image each beside FILE: `STEM-NAME-reflection.EXT`
+    /// for a mirror, `STEM-NAME-refraction.EXT` for glass (and in lit shading its Fresnel
+    /// reflection's `STEM-NAME-reflection.EXT`), NAME the reflector's object name.
+    #[arg(help_heading = "Outputs", long, value_name = "FILE")]
+    atlas: Option<PathBuf>,
     /// Write statistics as one JSON object to FILE, or to standard output with `-`.
     #[arg(help_heading = "Outputs", long, value_name = "FILE|-")]
     stats: Option<OutputTarget>,
@@ -203,6 +210,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             shading
         }
     };
+    let atlases = args
+        .atlas
+        .as_deref()
+        .map(|base| AtlasOutputs::declare(&mut outputs, base, &loaded.scene, shading))
+        .transpose()?;
     let spp = args.spp.unwrap_or(loaded.scene.image.spp);
     let crop = args
         .crop
@@ -222,6 +234,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             depth: depth.is_some() || aovs.is_some(),
             ids: ids.is_some() || ids_preview.is_some() || aovs.is_some(),
             surface: aovs.is_some(),
+            atlases: atlases.is_some(),
         },
         ..RenderOptions::default()
     };
@@ -236,6 +249,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         frame,
         mut counters,
         warnings,
+        atlases: atlas_images,
     } = rendered.map_err(|e| e.or_in_file(&loaded.source))?;
     let warnings = warning_lines(&warnings);
     for &(name, value) in &loaded.build_report.counters {
@@ -258,6 +272,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     if let Some(id) = aovs {
         outputs.stage(id, |tmp| image_io::write_aovs_exr(&frame, tmp))?;
+    }
+    if let Some(atlases) = atlases {
+        atlases.stage(&mut outputs, &atlas_images, encoding)?;
     }
     let facts = RunFacts {
         method: method.name(),

@@ -44,7 +44,8 @@ use crate::render::prepared::PreparedScene;
 use crate::render::shading::normals;
 use crate::render::shading::trace::specular;
 use crate::render::{
-    Counter, Frame, Method, Outputs, RenderOptions, RenderWarning, Rendered, Shading, Stats,
+    AtlasImage, Counter, Frame, Method, Outputs, RenderOptions, RenderWarning, Rendered, Shading,
+    Stats,
 };
 use crate::scene::{Finish, Mesh, Object, ReflectionImage, Scene, TrilinearReflector};
 
@@ -81,6 +82,7 @@ fn with_renderer(
             frame,
             counters,
             warnings: Vec::new(),
+            atlases: Vec::new(),
         });
     }
     let camera = main_camera(scene, main)?;
@@ -100,6 +102,8 @@ fn with_renderer(
         ..*options
     };
     let (mut frame, mut stats) = renderer(&prepared.view(main_scene), main, &main_options)?;
+    let keep_atlases = options.outputs.atlases;
+    let mut atlases = Vec::new();
     let options = &RenderOptions {
         outputs: Outputs::COLOR,
         ..*options
@@ -127,31 +131,37 @@ fn with_renderer(
         if let Some(projection) = &projection {
             let others = prepared.view(without(scene, id));
             let main_view = &frame;
-            let through = |surface: &Trilinear| -> Result<(Frame, Stats, Option<Vec<usize>>)> {
-                Ok(match entry.reflection {
-                    ReflectionImage::Surface => {
-                        let (image, counters) = renderer(&others, surface, options)?;
-                        (image, counters, None)
-                    }
-                    ReflectionImage::EnvMap => {
-                        let (image, counters) =
-                            env_map::image(&others, surface, &reflector.mesh, options)?;
-                        (image, counters, None)
-                    }
-                    ReflectionImage::Atlas => {
-                        let view = atlas::View {
-                            prepared,
-                            others: &others,
-                            id,
-                            main: main_view,
-                            camera: &camera,
-                        };
-                        let (image, counters, missed) = view.image(surface, options, renderer)?;
-                        (image, counters, Some(missed))
-                    }
-                })
-            };
-            let (image, counters, through_missed) = through(projection)?;
+            // The image through a surface of `optic`, its counters, and with the atlas the
+            // pixels it missed (its atlas kept in `atlases` when wanted).
+            let mut through =
+                |surface: &Trilinear, optic: Optic| -> Result<(Frame, Stats, Option<Vec<usize>>)> {
+                    Ok(match entry.reflection {
+                        ReflectionImage::Surface => {
+                            let (image, counters) = renderer(&others, surface, options)?;
+                            (image, counters, None)
+                        }
+                        ReflectionImage::EnvMap => {
+                            let (image, counters) =
+                                env_map::image(&others, surface, &reflector.mesh, options)?;
+                            (image, counters, None)
+                        }
+                        ReflectionImage::Atlas => {
+                            let view = atlas::View {
+                                prepared,
+                                others: &others,
+                                id,
+                                main: main_view,
+                                camera: &camera,
+                            };
+                            let mapped = view.image(surface, options, renderer)?;
+                            if let (true, Some(image)) = (keep_atlases, mapped.atlas) {
+                                atlases.push(AtlasImage { id, optic, image });
+                            }
+                            (mapped.image, mapped.stats, Some(mapped.missed))
+                        }
+                    })
+                };
+            let (image, counters, through_missed) = through(projection, reflector.optic)?;
             missed = through_missed;
             add_camera_triangle_counts(&mut stats, &counters);
             add_atlas_counts(&mut stats, &counters);
@@ -171,7 +181,7 @@ fn with_renderer(
                     left += mirror_left;
                     let rays = entry.camera_rays;
                     let reflection = match surface_projection(&mirror, map, rays, &camera)? {
-                        Some(surface) => through(&surface)?.0,
+                        Some(surface) => through(&surface, Optic::Reflect)?.0,
                         None => Frame::try_new(image.width, image.height, scene.image.background)?,
                     };
                     let split = FresnelSplit::new(prepared, id, camera.clone());
@@ -217,15 +227,10 @@ fn with_renderer(
         frame,
         counters: stats,
         warnings,
+        atlases,
     })
 }
 
-/// Adds the counts and stage times of a reflector surface rendered by camera triangles
-/// (`camera_triangles`, `bounding_fragments`, `rendered_fragments`, `culled_pairs`,
-/// `bounding_regions`, `owner_ms`, `bound_ms`) to `stats`, with its `pairs`, `raster_ms` and
-/// `shade_ms` as `surface_pairs`, `surface_raster_ms` and `surface_shade_ms` (the main view
-/// has its own), and
-/// sets `overdraw` to bounding over rendered fragments of all surfaces so far.
 /// Adds the atlas counters of a reflector image made through its texture atlas
 /// (`atlas_width`, `atlas_height`, `atlas_cell_px` of the last atlas, `atlas_missed_pixels`
 /// summed over reflectors); nothing for other images.
@@ -244,6 +249,11 @@ fn add_atlas_counts(stats: &mut Stats, surface: &Stats) {
     }
 }
 
+/// Adds the counts and stage times of a reflector surface rendered by camera triangles
+/// (`camera_triangles`, `bounding_fragments`, `rendered_fragments`, `culled_pairs`,
+/// `bounding_regions`, `owner_ms`, `bound_ms`) to `stats`, with its `pairs`, `raster_ms` and
+/// `shade_ms` as `surface_pairs`, `surface_raster_ms` and `surface_shade_ms` (the main view
+/// has its own), and sets `overdraw` to bounding over rendered fragments of all surfaces so far.
 pub(super) fn add_camera_triangle_counts(stats: &mut Stats, surface: &Stats) {
     const SUMMED: [(&str, &str); 10] = [
         ("camera_triangles", "camera_triangles"),

@@ -17,6 +17,7 @@ use std::collections::BTreeMap;
 use glam::Vec3;
 
 use crate::error::Result;
+use crate::projection::trilinear_builders::Optic;
 use crate::projection::Projection;
 use crate::try_alloc;
 
@@ -107,6 +108,9 @@ pub struct Outputs {
     /// the method has drawn the frame from its ids and depth (module `surface`), so that no
     /// renderer does per-pixel work for them.
     pub surface: bool,
+    /// [`Rendered::atlases`]: the joint texture atlas of every trilinear reflector with
+    /// `reflection = "atlas"`, as rendered (kept rather than dropped after the final pass).
+    pub atlases: bool,
 }
 
 impl Outputs {
@@ -115,12 +119,14 @@ impl Outputs {
         depth: true,
         ids: true,
         surface: false,
+        atlases: false,
     };
     /// Colour alone.
     pub const COLOR: Outputs = Outputs {
         depth: false,
         ids: false,
         surface: false,
+        atlases: false,
     };
 
     /// The length of a buffer of `pixels` pixels: `pixels` if `wanted`, else 0.
@@ -266,6 +272,23 @@ pub struct Rendered {
     pub counters: Stats,
     /// What the user should be told about this frame (none when everything asked held).
     pub warnings: Vec<RenderWarning>,
+    /// The reflectors' texture atlases, in the order of the scene's trilinear reflectors
+    /// (with `Outputs::atlases`; otherwise empty).
+    pub atlases: Vec<AtlasImage>,
+}
+
+/// The joint texture atlas of one trilinear reflector as rendered (docs/camera-triangles.md,
+/// "The joint texture atlas"): each camera triangle's image in its right triangle, the
+/// background between them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AtlasImage {
+    /// The reflector's object id.
+    pub id: u32,
+    /// The light path rendered into it: the reflection, or for glass the refraction (and,
+    /// in lit shading, a second atlas of its Fresnel reflection).
+    pub optic: Optic,
+    /// The atlas, colour only, `atlas_width` x `atlas_height` texels (`--stats`).
+    pub image: Frame,
 }
 
 /// Renders `prepared` through `projection` as `options` say: the one entry point of every
@@ -305,6 +328,7 @@ pub fn render(
             depth: true,
             ids: true,
             surface: false,
+            ..wanted
         },
         ..*options
     };
@@ -364,6 +388,7 @@ fn render_buffers(
             frame,
             counters,
             warnings: Vec::new(),
+            atlases: Vec::new(),
         }
     };
     if caustics {
@@ -527,7 +552,7 @@ mod tests {
                 let wanted = Outputs {
                     depth,
                     ids,
-                    surface: false,
+                    ..Outputs::COLOR
                 };
                 let got = render(&prepared, main.as_ref(), &options(wanted)).unwrap();
                 let what = format!("{method} {composite_reflectors} {wanted:?}");

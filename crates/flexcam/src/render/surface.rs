@@ -182,6 +182,7 @@ mod tests {
                 depth: false,
                 ids: true,
                 surface: true,
+                atlases: false,
             },
             ..RenderOptions::default()
         }

@@ -60,11 +60,7 @@ pub fn draw(
     };
     let projection = Flexible::new(spec, width, height)?;
     let options = RenderOptions {
-        outputs: Outputs {
-            depth: false,
-            ids: false,
-            surface: false,
-        },
+        outputs: Outputs::COLOR,
         ..RenderOptions::default()
     };
     let prepared = PreparedScene::new(&scene);

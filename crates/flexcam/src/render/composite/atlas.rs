@@ -241,19 +241,25 @@ impl View<'_> {
     /// main view that sees the reflector texture-mapped from it (module doc). Returns the
     /// image in main-image pixels (other pixels hold the background), the atlas render's
     /// stats with `atlas_width`, `atlas_height`, `atlas_cell_px` and
-    /// `atlas_missed_pixels`, and the pixels missed (for the caller to ray cast).
+    /// `atlas_missed_pixels`, the pixels missed (for the caller to ray cast), and the atlas
+    /// as rendered (none for a surface without triangles).
     pub fn image(
         &self,
         surface: &Trilinear,
         options: &RenderOptions,
         render: &super::Renderer,
-    ) -> Result<(Frame, Stats, Vec<usize>)> {
+    ) -> Result<Mapped> {
         let (main, id) = (self.main, self.id);
         let background = self.others.scene().image.background;
         let mut frame = Frame::try_new(main.width, main.height, background)?;
         let Some((atlas, projection)) = Atlas::new(surface)? else {
             let all = (0..main.ids.len()).filter(|&k| main.ids[k] == id).collect();
-            return Ok((frame, Stats::new(), all));
+            return Ok(Mapped {
+                image: frame,
+                stats: Stats::new(),
+                missed: all,
+                atlas: None,
+            });
         };
         let (atlas_image, mut stats) = render(self.others, &projection, options)?;
         let reflector = self
@@ -293,8 +299,25 @@ impl View<'_> {
             stats.insert(name, Counter::Count(u64::from(value)));
         }
         stats.insert("atlas_missed_pixels", Counter::Count(missed.len() as u64));
-        Ok((frame, stats, missed))
+        Ok(Mapped {
+            image: frame,
+            stats,
+            missed,
+            atlas: Some(atlas_image),
+        })
     }
+}
+
+/// What [`View::image`] makes of one reflector.
+pub struct Mapped {
+    /// The reflector's pixels texture-mapped from the atlas, in main-image pixels.
+    pub image: Frame,
+    /// The atlas render's stats and the atlas counters.
+    pub stats: Stats,
+    /// The reflector's pixels the final pass missed (row-major indices).
+    pub missed: Vec<usize>,
+    /// The atlas as rendered.
+    pub atlas: Option<Frame>,
 }
 
 /// The surface's camera mesh (its vertex points and triangles) as a prepared scene of one
