@@ -13,6 +13,8 @@
 //!   undisplaced rectangles. The displacement moves no point across a clip plane (the
 //!   displaced surfaces stay in their planes) and, its slope being below 1, undoing it is a
 //!   continuous map of the image plane onto itself.
+//! - Quadratic projectors through parallel planes: clipped to the planes of t = 0 and 1,
+//!   when no cross-section degenerates or turns over inside (module `quadratic_inverse`).
 //! - A warped far rectangle (the long scene): the parallel-planes chart of each piece of
 //!   the warp, which must all be the same, with cross-sections of one orientation.
 //! - Nested spheres: the image depends only on the direction from the centre; the poles
@@ -47,7 +49,7 @@ pub const END_MARGIN: f64 = 1e-9;
 const MAP_EDGE: f64 = 1e-9;
 
 /// Relative size below which a cross-section counts as degenerate.
-const FLAT: f64 = 1e-12;
+pub(super) const FLAT: f64 = 1e-12;
 
 impl Inverse {
     /// The chart of this volume under `reparam` on an image of `resolution`, or `None` when
@@ -81,6 +83,10 @@ impl Inverse {
             } => {
                 planar_map(reparam).then_some(())?;
                 layers_chart(segments, *normal)
+            }
+            Inverse::Quadratic(q) => {
+                planar_map(reparam).then_some(())?;
+                q.chart()
             }
         }
     }

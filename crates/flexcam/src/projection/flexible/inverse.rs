@@ -23,6 +23,10 @@
 //!   affine far surface, so t follows from p.n as for parallel planes, then (u, v) from the
 //!   2 x 2 solve of the piece whose u range holds the solution (the pieces meet
 //!   continuously at the knots, so a point on a knot gets the same answer from both).
+//! - Quadratic Bezier projectors through three affine surfaces in parallel planes, the
+//!   middle one strictly between the others (the quadratic depth transitions): the depth
+//!   p.n is a quadratic in t, the same for every projector, and the cross-section at that t
+//!   an affine surface (module `quadratic_inverse`).
 //! - Polyline projectors through similar rectangles in parallel planes whose parameters are
 //!   partly displaced by a sampled map (the depth-discontinuity occlusion camera): the
 //!   layered inverse, then the displacement undone by a safeguarded Newton iteration
@@ -43,13 +47,14 @@ use super::control_surface::{
 };
 use super::displaced_inverse::{undisplaced, Displacement};
 use super::panorama::lookup::{self, PanoramaInverse};
+use super::quadratic_inverse::QuadraticPlanes;
 use super::reparam::Reparam;
 use crate::error::{Error, Result};
 use crate::projection::image_coords::Resolution;
 use crate::projection::{AnalyticInverse, Charted, ContinuousInverse, ImagePoint};
 
 /// Relative tolerance for "the same" centre, frame or range, and for the domain edges.
-const SAME: f64 = 1e-12;
+pub(super) const SAME: f64 = 1e-12;
 /// Tolerance on (u, v, t) at the domain boundary, so that edge points are not lost.
 const EDGE: f64 = 1e-9;
 
@@ -100,6 +105,9 @@ pub(super) enum Inverse {
         normal: DVec3,
         displacement: Box<Displacement>,
     },
+    /// Quadratic Bezier projectors through three affine surfaces in parallel planes in
+    /// order along them (module `quadratic_inverse`).
+    Quadratic(QuadraticPlanes),
 }
 
 /// One piece of a warped far rectangle: its u range and the affine surface it is there
@@ -138,7 +146,9 @@ fn warp_pieces(w: &WarpedRectangle) -> Vec<WarpPiece> {
         .collect()
 }
 
-fn affine(s: &Surface) -> Option<Affine> {
+/// `s` as an affine surface, `None` where it is not one (a twisted bilinear quad, a curved
+/// surface).
+pub(super) fn affine(s: &Surface) -> Option<Affine> {
     match *s {
         Surface::Rectangle {
             corner,
@@ -383,6 +393,7 @@ impl Inverse {
                 normal,
             } => warped(near, pieces, *normal, p),
             Inverse::Layers { segments, normal } => layers(segments, *normal, p),
+            Inverse::Quadratic(q) => q.solve(p),
             Inverse::Displaced {
                 segments,
                 normal,
@@ -433,9 +444,19 @@ fn warped(near: &Affine, pieces: &[WarpPiece], n: DVec3, p: DVec3) -> Option<(DV
 
 fn planes(near: &Affine, far: &Affine, n: DVec3, p: DVec3) -> Option<(DVec2, f64)> {
     let t = (p - near.a).dot(n) / (far.a - near.a).dot(n);
-    let a = near.a.lerp(far.a, t);
-    let b = near.b.lerp(far.b, t);
-    let c = near.c.lerp(far.c, t);
+    let section = Affine {
+        a: near.a.lerp(far.a, t),
+        b: near.b.lerp(far.b, t),
+        c: near.c.lerp(far.c, t),
+    };
+    Some((in_section(&section, p)?, t))
+}
+
+/// The (u, v) of `p` on the cross-section `s` of a volume, the affine surface through p's
+/// plane: the 2 x 2 least-squares solve of a + u b + v c = p. `None` where the
+/// cross-section is a point or a segment (b and c parallel or zero): no single (u, v).
+pub(super) fn in_section(s: &Affine, p: DVec3) -> Option<DVec2> {
+    let (a, b, c) = (s.a, s.b, s.c);
     // Least squares in the plane: [b.b b.c; b.c c.c] (u, v) = (b.q, c.q).
     let q = p - a;
     let m = DMat2::from_cols(
@@ -446,7 +467,7 @@ fn planes(near: &Affine, far: &Affine, n: DVec3, p: DVec3) -> Option<(DVec2, f64
     if det.abs() <= SAME * SAME * (b.length_squared() * c.length_squared()) || det == 0.0 {
         return None; // the cross-section is a point or a segment: no single (u, v)
     }
-    Some((m.inverse() * DVec2::new(b.dot(q), c.dot(q)), t))
+    Some(m.inverse() * DVec2::new(b.dot(q), c.dot(q)))
 }
 
 /// u for angle `angle` in the range `range` (radians, span at most 2 pi): of the angles
