@@ -203,3 +203,7 @@ impl QuadraticPlanes {
         })
     }
 }
+
+#[cfg(test)]
+#[path = "quadratic_inverse_tests.rs"]
+mod tests;
