@@ -45,6 +45,7 @@ pub mod presets;
 pub mod projector_grid;
 mod quadratic_inverse;
 pub mod reparam;
+mod section;
 #[cfg(test)]
 mod tests;
 pub mod volume;

@@ -22,7 +22,7 @@
 //!   no t on the branch, `None`;
 //! - a cross-section that is a point or a segment (a pinhole or slit at an end): no (u, v),
 //!   `None` for points in its plane; where one lies strictly inside the volume the image
-//!   turns over there and there is no chart ([`QuadraticPlanes::chart`]);
+//!   turns over there and there is no chart (module `chart`);
 //! - outside the class, each refused with its reason ([`QuadraticPlanes::classify`]): a
 //!   surface that is not flat (a twisted bilinear quad, a curved surface), surfaces that are
 //!   not parallel planes of one normal, none spanning a plane (points and lines only), and a
@@ -30,22 +30,19 @@
 
 use glam::{DVec2, DVec3};
 
-use super::chart::{END_MARGIN, FLAT};
 use super::control_surface::Surface;
-use super::inverse::{affine, in_section, Affine, SAME};
+use super::section::{affine, in_section, Affine, SAME};
 use crate::error::{Error, Result};
-use crate::geometry::solve_cubic;
-use crate::projection::chart::{HalfSpace, InverseChart};
 
 /// The inverse of a quadratic volume between parallel planes.
 #[derive(Debug, Clone, PartialEq)]
 pub(super) struct QuadraticPlanes {
     /// The control surfaces, near (t = 0), middle (the control net), far (t = 1).
-    surfaces: [Affine; 3],
+    pub surfaces: [Affine; 3],
     /// The planes' shared unit normal.
-    normal: DVec3,
+    pub normal: DVec3,
     /// Each surface's offset along `normal`.
-    offsets: [f64; 3],
+    pub offsets: [f64; 3],
 }
 
 /// The Bernstein weights of degree 2 at t.
@@ -113,7 +110,7 @@ impl QuadraticPlanes {
     }
 
     /// The offset along the normal of the volume's cross-section at t.
-    fn depth(&self, t: f64) -> f64 {
+    pub fn depth(&self, t: f64) -> f64 {
         let w = bernstein(t);
         (0..3).map(|k| w[k] * self.offsets[k]).sum()
     }
@@ -146,61 +143,6 @@ impl QuadraticPlanes {
     pub fn solve(&self, p: DVec3) -> Option<(DVec2, f64)> {
         let t = self.t(p)?;
         Some((in_section(&self.section(t), p)?, t))
-    }
-
-    /// The chart: triangles clipped to the planes of t = 0 and t = 1 (pulled in by
-    /// [`END_MARGIN`] at an end whose cross-section is a point or a segment, imaged at
-    /// infinity). `None` where the cross-section degenerates or turns over strictly inside
-    /// the volume: its signed area (b(t) x c(t)) . n, a quartic in t, must keep one sign
-    /// between the ends, which is checked at its critical points (the roots of its
-    /// derivative, a cubic) and at the ends.
-    pub fn chart(&self) -> Option<InverseChart> {
-        let n = self.normal;
-        let [s0, s1, s2] = &self.surfaces;
-        // b(t) = b0 + t beta1 + t^2 beta2, likewise c(t).
-        let b = [s0.b, 2.0 * (s1.b - s0.b), s0.b - 2.0 * s1.b + s2.b];
-        let c = [s0.c, 2.0 * (s1.c - s0.c), s0.c - 2.0 * s1.c + s2.c];
-        let mut e = [0.0; 5];
-        for (i, bi) in b.iter().enumerate() {
-            for (j, cj) in c.iter().enumerate() {
-                e[i + j] += bi.cross(*cj).dot(n);
-            }
-        }
-        let area = |t: f64| e.iter().rev().fold(0.0, |sum, k| sum * t + k);
-        let critical: Vec<f64> = solve_cubic(4.0 * e[4], 3.0 * e[3], 2.0 * e[2], e[1])
-            .iter()
-            .collect();
-        let scale = [0.0, 0.5, 1.0]
-            .iter()
-            .chain(critical.iter().filter(|t| (0.0..=1.0).contains(*t)))
-            .map(|t| area(*t).abs())
-            .fold(0.0, f64::max);
-        let flat = |t: f64| area(t).abs() <= FLAT * scale;
-        let lo = if flat(0.0) { END_MARGIN } else { 0.0 };
-        let hi = if flat(1.0) { 1.0 - END_MARGIN } else { 1.0 };
-        let mut inner = critical
-            .into_iter()
-            .filter(|t| lo < *t && *t < hi)
-            .chain([0.0, 1.0].into_iter().filter(|t| !flat(*t)));
-        let first = area(inner.next()?);
-        let kept = inner.all(|t| !flat(t) && (area(t) > 0.0) == (first > 0.0));
-        (kept && first.abs() > FLAT * scale).then_some(())?;
-        // Inside: depth(lo) <= p . n <= depth(hi) along the direction the depth rises.
-        let up = (self.offsets[2] - self.offsets[0]).signum() * n;
-        let side = |t: f64| (self.offsets[2] - self.offsets[0]).signum() * self.depth(t);
-        Some(InverseChart {
-            clip: vec![
-                HalfSpace {
-                    normal: up,
-                    offset: side(lo),
-                },
-                HalfSpace {
-                    normal: -up,
-                    offset: -side(hi),
-                },
-            ],
-            ..InverseChart::default()
-        })
     }
 }
 
