@@ -171,7 +171,7 @@ fn unbounded_counts_and_memory_are_refused_before_allocating() {
             format!(
                 "{{ surface = \"rectangle\", center = [0, 0, {}], u_axis = [{}, 0, 0], \
                  v_axis = [0, {}, 0] }}",
-                -k - 1,
+                [-1, -3, -2][k],
                 k + 1,
                 k + 1
             )
@@ -193,8 +193,8 @@ fn unbounded_counts_and_memory_are_refused_before_allocating() {
         1,
         "flexcam: bezier.toml:8:12: `segments` must be at most 4096, not 4294967295",
     );
-    // Without `segments` it renders, but not by the raster method (class 5: the message
-    // names the scene file).
+    // Without `segments` it renders, but not by the raster method: its middle plane lies
+    // beyond the far one (class 5: the message names the scene file).
     write(&dir, "bezier.toml", bezier);
     refused(
         &dir,
@@ -208,8 +208,10 @@ fn unbounded_counts_and_memory_are_refused_before_allocating() {
         ],
         1,
         "flexcam: bezier.toml: method raster needs a projection with an analytic inverse; \
-         flexible has none: its projectors are Bezier curves, with no closed-form inverse (use \
-         --method raycast)",
+         flexible has none: its quadratic (Bezier) projectors run through control surfaces \
+         whose middle plane does not lie strictly between the near and far planes, outside \
+         the scanline class of curved projectors (three flat surfaces in parallel planes, the \
+         middle one strictly between the others) (use --method raycast)",
     );
 
     // A 20-byte GLB whose header claims 4 GiB; one whose header claims fewer bytes than the

@@ -219,11 +219,14 @@ fn bad_pieces_are_refused_at_their_place() {
          image (its edges snap to the same pixel boundary)",
     );
     let curved = format!(
-        "{}\n[[projection.pieces]]\nrect = [0.5, 0.0, 1.0, 1.0]\npreset = \"ortho_near_persp_far\"\n\
-         {FRAME}fov = 50.0\ntransition = 3.0\nclip = [0.0, 20.0]\nstyle = \"quadratic\"\n",
+        "{}\n[[projection.pieces]]\nrect = [0.5, 0.0, 1.0, 1.0]\nblend = \"bezier\"\n\
+         segments = 8\nsurfaces = [\n\
+         {{ surface = \"rectangle\", center = [0.0, 2.0, 6.0], u_axis = [0.2, 0.0, 0.0], v_axis = [0.0, 0.15, 0.0] }},\n\
+         {{ surface = \"rectangle\", center = [1.5, 2.5, 1.0], u_axis = [2.4, 0.0, 0.0], v_axis = [0.0, 1.8, 0.0] }},\n\
+         {{ surface = \"rectangle\", center = [0.0, 0.0, -4.0], u_axis = [5.0, 0.0, 0.0], v_axis = [0.0, 3.75, 0.0] }},\n]\n",
         perspective_piece("[0.0, 0.0, 0.5, 1.0]")
     );
-    // Ray casting draws it (a quadratic volume: no inverse).
+    // Ray casting draws it (quadratic projectors drawn as polylines: no inverse).
     fs::write(dir.path().join("scene.toml"), pieces_scene(&curved)).unwrap();
     run_ok(&dir, &["render", "scene.toml", "-o", "out.png"]);
     fs::remove_file(dir.path().join("out.png")).unwrap();
@@ -233,13 +236,15 @@ fn bad_pieces_are_refused_at_their_place() {
         &["--method", "raster"],
         "scene.toml: method raster needs a projection with an analytic inverse; flexible has \
          none: piece 2 (rect [0.5, 0.0, 1.0, 1.0]) has no analytic inverse: its projectors \
-         are Bezier curves, with no closed-form inverse (use --method raycast)",
+         are Bezier curves of degree above 2 or drawn as polylines (`segments`), with no \
+         closed-form inverse (quadratic projectors through three flat parallel surfaces have \
+         one) (use --method raycast)",
     );
 }
 
 /// Polyline projectors through parallel planes raster like the ray caster: the
 /// orthographic-near / perspective-far example and the depth-transition example made
-/// piecewise (`common::raster_agrees`); its own quadratic style is refused with the reason.
+/// piecewise (`common::raster_agrees`).
 #[test]
 fn piecewise_depth_volumes_raster_like_the_ray_caster() {
     let dir = TempDir::new().unwrap();
@@ -278,14 +283,18 @@ fn piecewise_depth_volumes_raster_like_the_ray_caster() {
         (along - f64::from(rendered)).abs() < 1e-5 * along,
         "{along} against {rendered}"
     );
-    let stderr = raster_refusal(&dir, &depth);
-    assert!(
-        stderr.contains(
-            "its projectors are Bezier curves, with no closed-form inverse (use --method \
-             raycast)"
-        ),
-        "{stderr}"
-    );
+}
+
+/// Quadratic projectors through parallel planes raster like the ray caster
+/// (`common::raster_agrees`): the bent example, the quadratic depth transition and the
+/// orthographic-near / perspective-far example made quadratic.
+#[test]
+fn quadratic_depth_volumes_raster_like_the_ray_caster() {
+    let dir = TempDir::new().unwrap();
+    raster_agrees(&dir, &[&scene_example("flexible-quadratic.toml")]);
+    raster_agrees(&dir, &[&scene_example("flexible-depth-transition.toml")]);
+    let ortho = scene_example("flexible-ortho-near-persp-far.toml");
+    raster_agrees(&dir, &[&ortho, "-D", "projection.style=quadratic"]);
 }
 
 /// The stderr of `render SCENE --method raster`, which must fail with exit status 1.

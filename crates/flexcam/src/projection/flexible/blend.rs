@@ -322,6 +322,12 @@ impl BezierVolume {
         &self.surfaces
     }
 
+    /// Whether the projectors are analytic quadratic curves (three surfaces, no
+    /// `segments`), not polylines.
+    pub fn is_quadratic(&self) -> bool {
+        self.polyline_weights.is_none()
+    }
+
     /// The de Casteljau pyramid of the control points at (u, v) down to its last two points,
     /// at `t`: their difference times the degree is dQ/dt.
     fn last_pair(&self, uv: DVec2, t: f64) -> (DVec3, DVec3) {

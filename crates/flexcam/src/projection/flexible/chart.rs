@@ -13,6 +13,8 @@
 //!   undisplaced rectangles. The displacement moves no point across a clip plane (the
 //!   displaced surfaces stay in their planes) and, its slope being below 1, undoing it is a
 //!   continuous map of the image plane onto itself.
+//! - Quadratic projectors through parallel planes: clipped to the planes of t = 0 and 1,
+//!   when no cross-section degenerates or turns over inside (module `quadratic_inverse`).
 //! - A warped far rectangle (the long scene): the parallel-planes chart of each piece of
 //!   the warp, which must all be the same, with cross-sections of one orientation.
 //! - Nested spheres: the image depends only on the direction from the centre; the poles
@@ -32,9 +34,11 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use glam::DVec3;
 
 use super::control_surface::{lerp_range, CylinderPatch, SpherePatch};
-use super::inverse::{Affine, Inverse, Layer, WarpPiece};
+use super::inverse::{Inverse, Layer, WarpPiece};
+use super::quadratic_inverse::QuadraticPlanes;
 use super::reparam::Reparam;
-use crate::geometry::solve_quadratic;
+use super::section::Affine;
+use crate::geometry::{solve_cubic, solve_quadratic};
 use crate::projection::chart::{axis_poles, HalfSpace, InverseChart};
 use crate::projection::image_coords::Resolution;
 
@@ -81,6 +85,10 @@ impl Inverse {
             } => {
                 planar_map(reparam).then_some(())?;
                 layers_chart(segments, *normal)
+            }
+            Inverse::Quadratic(q) => {
+                planar_map(reparam).then_some(())?;
+                quadratic_chart(q)
             }
         }
     }
@@ -150,6 +158,61 @@ fn warped_chart(near: &Affine, pieces: &[WarpPiece], n: DVec3) -> Option<Inverse
     } else {
         None
     }
+}
+
+/// The chart of quadratic projectors through parallel planes: triangles clipped to the
+/// planes of t = 0 and t = 1 (pulled in by [`END_MARGIN`] at an end whose cross-section is a
+/// point or a segment, imaged at infinity). `None` where the cross-section degenerates or turns over strictly inside
+/// the volume: its signed area (b(t) x c(t)) . n, a quartic in t, must keep one sign
+/// between the ends, which is checked at its critical points (the roots of its
+/// derivative, a cubic) and at the ends.
+fn quadratic_chart(q: &QuadraticPlanes) -> Option<InverseChart> {
+    let n = q.normal;
+    let [s0, s1, s2] = &q.surfaces;
+    // b(t) = b0 + t beta1 + t^2 beta2, likewise c(t).
+    let b = [s0.b, 2.0 * (s1.b - s0.b), s0.b - 2.0 * s1.b + s2.b];
+    let c = [s0.c, 2.0 * (s1.c - s0.c), s0.c - 2.0 * s1.c + s2.c];
+    let mut e = [0.0; 5];
+    for (i, bi) in b.iter().enumerate() {
+        for (j, cj) in c.iter().enumerate() {
+            e[i + j] += bi.cross(*cj).dot(n);
+        }
+    }
+    let area = |t: f64| e.iter().rev().fold(0.0, |sum, k| sum * t + k);
+    let critical: Vec<f64> = solve_cubic(4.0 * e[4], 3.0 * e[3], 2.0 * e[2], e[1])
+        .iter()
+        .collect();
+    let scale = [0.0, 0.5, 1.0]
+        .iter()
+        .chain(critical.iter().filter(|t| (0.0..=1.0).contains(*t)))
+        .map(|t| area(*t).abs())
+        .fold(0.0, f64::max);
+    let flat = |t: f64| area(t).abs() <= FLAT * scale;
+    let lo = if flat(0.0) { END_MARGIN } else { 0.0 };
+    let hi = if flat(1.0) { 1.0 - END_MARGIN } else { 1.0 };
+    let mut inner = critical
+        .into_iter()
+        .filter(|t| lo < *t && *t < hi)
+        .chain([0.0, 1.0].into_iter().filter(|t| !flat(*t)));
+    let first = area(inner.next()?);
+    let kept = inner.all(|t| !flat(t) && (area(t) > 0.0) == (first > 0.0));
+    (kept && first.abs() > FLAT * scale).then_some(())?;
+    // Inside: depth(lo) <= p . n <= depth(hi) along the direction the depth rises.
+    let up = (q.offsets[2] - q.offsets[0]).signum() * n;
+    let side = |t: f64| (q.offsets[2] - q.offsets[0]).signum() * q.depth(t);
+    Some(InverseChart {
+        clip: vec![
+            HalfSpace {
+                normal: up,
+                offset: side(lo),
+            },
+            HalfSpace {
+                normal: -up,
+                offset: -side(hi),
+            },
+        ],
+        ..InverseChart::default()
+    })
 }
 
 fn planes_chart(near: &Affine, far: &Affine, n: DVec3) -> Option<InverseChart> {

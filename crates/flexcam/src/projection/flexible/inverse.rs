@@ -23,6 +23,10 @@
 //!   affine far surface, so t follows from p.n as for parallel planes, then (u, v) from the
 //!   2 x 2 solve of the piece whose u range holds the solution (the pieces meet
 //!   continuously at the knots, so a point on a knot gets the same answer from both).
+//! - Quadratic Bezier projectors through three affine surfaces in parallel planes, the
+//!   middle one strictly between the others (the quadratic depth transitions): the depth
+//!   p.n is a quadratic in t, the same for every projector, and the cross-section at that t
+//!   an affine surface (module `quadratic_inverse`).
 //! - Polyline projectors through similar rectangles in parallel planes whose parameters are
 //!   partly displaced by a sampled map (the depth-discontinuity occlusion camera): the
 //!   layered inverse, then the displacement undone by a safeguarded Newton iteration
@@ -36,30 +40,20 @@
 
 use std::f64::consts::PI;
 
-use glam::{DMat2, DVec2, DVec3};
+use glam::{DVec2, DVec3};
 
-use super::control_surface::{
-    CylinderPatch, LineParam, PolarFrame, SpherePatch, Surface, WarpedRectangle,
-};
+use super::control_surface::{CylinderPatch, PolarFrame, SpherePatch, Surface, WarpedRectangle};
 use super::displaced_inverse::{undisplaced, Displacement};
 use super::panorama::lookup::{self, PanoramaInverse};
+use super::quadratic_inverse::QuadraticPlanes;
 use super::reparam::Reparam;
+use super::section::{affine, in_section, Affine, SAME};
 use crate::error::{Error, Result};
 use crate::projection::image_coords::Resolution;
 use crate::projection::{AnalyticInverse, Charted, ContinuousInverse, ImagePoint};
 
-/// Relative tolerance for "the same" centre, frame or range, and for the domain edges.
-const SAME: f64 = 1e-12;
 /// Tolerance on (u, v, t) at the domain boundary, so that edge points are not lost.
 const EDGE: f64 = 1e-9;
-
-/// An affine surface a + u b + v c.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(super) struct Affine {
-    pub a: DVec3,
-    pub b: DVec3,
-    pub c: DVec3,
-}
 
 /// The inverse of one invertible volume.
 #[derive(Debug, Clone, PartialEq)]
@@ -100,6 +94,9 @@ pub(super) enum Inverse {
         normal: DVec3,
         displacement: Box<Displacement>,
     },
+    /// Quadratic Bezier projectors through three affine surfaces in parallel planes in
+    /// order along them (module `quadratic_inverse`).
+    Quadratic(QuadraticPlanes),
 }
 
 /// One piece of a warped far rectangle: its u range and the affine surface it is there
@@ -136,58 +133,6 @@ fn warp_pieces(w: &WarpedRectangle) -> Vec<WarpPiece> {
             }
         })
         .collect()
-}
-
-fn affine(s: &Surface) -> Option<Affine> {
-    match *s {
-        Surface::Rectangle {
-            corner,
-            u_edge,
-            v_edge,
-        } => Some(Affine {
-            a: corner,
-            b: u_edge,
-            c: v_edge,
-        }),
-        Surface::Point(p) => Some(Affine {
-            a: p,
-            b: DVec3::ZERO,
-            c: DVec3::ZERO,
-        }),
-        Surface::Line { start, end, along } => Some(match along {
-            LineParam::U => Affine {
-                a: start,
-                b: end - start,
-                c: DVec3::ZERO,
-            },
-            LineParam::V => Affine {
-                a: start,
-                b: DVec3::ZERO,
-                c: end - start,
-            },
-        }),
-        Surface::Bilinear {
-            corners: [p00, p10, p11, p01],
-        } => {
-            let twist = p11 - p10 - p01 + p00;
-            let scale = (p10 - p00).length() + (p01 - p00).length();
-            (twist.length() <= SAME * scale).then_some(Affine {
-                a: p00,
-                b: p10 - p00,
-                c: p01 - p00,
-            })
-        }
-        Surface::Sphere(_)
-        | Surface::Cylinder(_)
-        | Surface::Bezier(_)
-        | Surface::BSpline(_)
-        | Surface::Nurbs(_)
-        | Surface::Panorama(_)
-        | Surface::Pinched(_)
-        | Surface::Path(_)
-        | Surface::Warped(_)
-        | Surface::Displaced(_) => None,
-    }
 }
 
 fn same(a: DVec3, b: DVec3, scale: f64) -> bool {
@@ -383,6 +328,7 @@ impl Inverse {
                 normal,
             } => warped(near, pieces, *normal, p),
             Inverse::Layers { segments, normal } => layers(segments, *normal, p),
+            Inverse::Quadratic(q) => q.solve(p),
             Inverse::Displaced {
                 segments,
                 normal,
@@ -433,20 +379,12 @@ fn warped(near: &Affine, pieces: &[WarpPiece], n: DVec3, p: DVec3) -> Option<(DV
 
 fn planes(near: &Affine, far: &Affine, n: DVec3, p: DVec3) -> Option<(DVec2, f64)> {
     let t = (p - near.a).dot(n) / (far.a - near.a).dot(n);
-    let a = near.a.lerp(far.a, t);
-    let b = near.b.lerp(far.b, t);
-    let c = near.c.lerp(far.c, t);
-    // Least squares in the plane: [b.b b.c; b.c c.c] (u, v) = (b.q, c.q).
-    let q = p - a;
-    let m = DMat2::from_cols(
-        DVec2::new(b.dot(b), b.dot(c)),
-        DVec2::new(b.dot(c), c.dot(c)),
-    );
-    let det = m.determinant();
-    if det.abs() <= SAME * SAME * (b.length_squared() * c.length_squared()) || det == 0.0 {
-        return None; // the cross-section is a point or a segment: no single (u, v)
-    }
-    Some((m.inverse() * DVec2::new(b.dot(q), c.dot(q)), t))
+    let section = Affine {
+        a: near.a.lerp(far.a, t),
+        b: near.b.lerp(far.b, t),
+        c: near.c.lerp(far.c, t),
+    };
+    Some((in_section(&section, p)?, t))
 }
 
 /// u for angle `angle` in the range `range` (radians, span at most 2 pi): of the angles

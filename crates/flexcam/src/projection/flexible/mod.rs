@@ -43,7 +43,9 @@ mod patch;
 pub mod pieces;
 pub mod presets;
 pub mod projector_grid;
+mod quadratic_inverse;
 pub mod reparam;
+mod section;
 #[cfg(test)]
 mod tests;
 pub mod volume;
@@ -68,6 +70,7 @@ pub use reparam::Reparam;
 pub use volume::{ControlSurface, InterpolatedVolume, RemappedVolume, Volume};
 
 use self::inverse::{BoundInverse, Inverse};
+use self::quadratic_inverse::QuadraticPlanes;
 use super::image_coords::Resolution;
 use super::{
     AnalyticInverse, BuildReport, NoInverse, Projection, Projector, ProjectorHull, Trilinear,
@@ -190,6 +193,9 @@ impl Flexible {
                 Inverse::classify_displaced(v.surfaces(), v.knots()).map(Some)
             }
             Volume::Piecewise(v) => Ok(Inverse::classify_layers(v.surfaces(), v.knots())),
+            Volume::Bezier(v) if v.is_quadratic() => {
+                QuadraticPlanes::classify(v.surfaces()).map(|q| Some(Inverse::Quadratic(q)))
+            }
             _ => Ok(None),
         };
         let inverse = match classified {
@@ -258,9 +264,9 @@ pub fn build_projection(
 }
 
 /// Why `volume` has no analytic inverse when `Inverse::classify` finds none: the scanline
-/// class of Brosz 2011 (7.3) is two control surfaces of one type with a closed-form inverse
+/// class of Brosz 2011 (7.3) is control surfaces of one type with a closed-form inverse
 /// whose depth follows from the point (parallel planes, nested spheres, coaxial cylinders),
-/// straight projectors between them.
+/// straight, polyline or quadratic projectors between them.
 fn no_inverse_reason(volume: &Volume) -> &'static str {
     match volume {
         Volume::Linear(_) => {
@@ -272,7 +278,11 @@ fn no_inverse_reason(volume: &Volume) -> &'static str {
             "its projectors are polylines through control surfaces that are not all flat, \
              parallel and in order along the projectors, with no closed-form inverse"
         }
-        Volume::Bezier(_) => "its projectors are Bezier curves, with no closed-form inverse",
+        Volume::Bezier(_) => {
+            "its projectors are Bezier curves of degree above 2 or drawn as polylines \
+             (`segments`), with no closed-form inverse (quadratic projectors through three \
+             flat parallel surfaces have one)"
+        }
         Volume::Interpolated(v) if !matches!(v.first, Volume::Remapped(_)) => {
             "it interpolates two volumes of different structure, with no closed-form inverse"
         }

@@ -24,10 +24,11 @@
 use glam::{DVec3, Vec2, Vec3};
 
 use super::pixel_rays::PixelRays;
-use crate::geometry::Ray;
+use crate::geometry::{solve_quadratic, Ray};
+use crate::projection::projector::{quadratic_arc_length, quadratic_point};
 use crate::projection::Projector;
 use crate::render::prepared::{Hit, PreparedScene};
-use crate::render::raycast::pieces::{length_before, polyline_segment};
+use crate::render::raycast::pieces::{length_before, polyline_segment, tangent_ray};
 use crate::render::scan::NO_PRIMITIVE;
 use crate::render::shading::trace::{shows_base_color, HitShader};
 use crate::render::shading::{base_color, TextureFilter};
@@ -57,7 +58,7 @@ pub struct Shader<'a> {
 
 /// A pixel's nearest fragment so far: its exact depth (the ray caster's distance along the
 /// projector), the segment of the projector it lies on (0 for a straight one) and the ray
-/// parameter on it, primitive key and clamped barycentrics, all from the one reconstruction
+/// parameter on it (the curve parameter of a quadratic projector), primitive key and clamped barycentrics, all from the one reconstruction
 /// of the fragment ([`Shader::fragment`]), kept for shading.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Visible {
@@ -102,26 +103,23 @@ impl Shader<'_> {
             Projector::Polyline(points) => {
                 let hits = (0..points.len() - 1).filter_map(|k| {
                     let ray = polyline_segment(points, k);
-                    plane.hit_unclamped(&ray).map(|hit| (k, ray, hit))
+                    plane.hit_unclamped(&ray).map(|hit| ((k, ray), hit))
                 });
-                // How far outside the triangle (u, v) lies: <= 0 inside.
-                let outside = |u: f64, v: f64| (-u).max(-v).max(u + v - 1.0);
-                let mut nearest: Option<(usize, Ray, (f64, f64, f64))> = None;
-                for (k, ray, (t, u, v)) in hits {
-                    if outside(u, v) <= 0.0 {
-                        nearest = Some((k, ray, (t, u, v)));
-                        break;
-                    }
-                    if nearest.is_none_or(|(_, _, (_, a, b))| outside(u, v) < outside(a, b)) {
-                        nearest = Some((k, ray, (t, u, v)));
-                    }
-                }
-                let (k, ray, (t, u, v)) = nearest?;
+                let ((k, ray), (t, u, v)) = first_inside(hits)?;
                 let (u, v) = clamp(u, v);
                 (k, length_before(points, k), ray, (t, u, v))
             }
-            // Curved projectors have no inverse, so they are never rasterised.
-            Projector::QuadraticBezier(_) => return None,
+            Projector::QuadraticBezier(p) => {
+                let (_, (s, u, v)) = first_inside(plane.curve_hits(p).map(|hit| ((), hit)))?;
+                let (u, v) = clamp(u, v);
+                return Some(Visible {
+                    depth: quadratic_arc_length(p, s),
+                    segment: 0,
+                    t: s,
+                    key,
+                    barycentric: Vec2::new(u as f32, v as f32),
+                });
+            }
         };
         Some(Visible {
             depth: before + t * ray.direction.length(),
@@ -190,13 +188,15 @@ impl Shader<'_> {
             return None;
         }
         self.caster?;
-        let ray = match self.rays.get(x, y)? {
-            Projector::Straight(ray) => *ray,
-            Projector::Polyline(points) => polyline_segment(points, visible.segment),
-            Projector::QuadraticBezier(_) => return None,
+        // A quadratic projector continues as its tangent ray at the hit, the hit at its
+        // origin, as in the ray caster.
+        let (ray, t) = match self.rays.get(x, y)? {
+            Projector::Straight(ray) => (*ray, visible.t),
+            Projector::Polyline(points) => (polyline_segment(points, visible.segment), visible.t),
+            Projector::QuadraticBezier(p) => (tangent_ray(p, visible.t), 0.0),
         };
         let hit = Hit {
-            t: visible.t,
+            t,
             object,
             triangle,
             barycentric: visible.barycentric,
@@ -268,6 +268,31 @@ impl TrianglePlane {
         Some((t, u, v))
     }
 
+    /// Where quadratic projector `p` meets the plane: each curve parameter s in [0, 1] at
+    /// which it does, ascending, with the unclamped barycentrics of the curve's point there.
+    /// The arithmetic is the ray caster's curve test term for term (the signed distance of
+    /// the curve to the plane is a quadratic in s), so a hit inside the triangle has its s.
+    /// Degenerate cases: a zero-area triangle, or a curve lying in the plane (the quadratic
+    /// identically zero), meets it nowhere, as in the ray caster.
+    pub fn curve_hits(&self, p: &[DVec3; 3]) -> impl Iterator<Item = (f64, f64, f64)> {
+        let (a, e1, e2, p) = (self.a, self.e1, self.e2, *p);
+        let normal = e1.cross(e2);
+        let area2 = normal.length_squared();
+        let [x0, x1, x2] = p.map(|q| normal.dot(q - a));
+        let roots =
+            (area2 != 0.0).then(|| solve_quadratic(x0 - 2.0 * x1 + x2, 2.0 * (x1 - x0), x0));
+        roots
+            .into_iter()
+            .flatten()
+            .filter(|s| (0.0..=1.0).contains(s))
+            .map(move |s| {
+                let w = quadratic_point(&p, s) - a;
+                let u = w.cross(e2).dot(normal) / area2;
+                let v = e1.cross(w).dot(normal) / area2;
+                (s, u, v)
+            })
+    }
+
     /// [`TrianglePlane::hit`] before the barycentrics are clamped onto the triangle.
     pub fn hit_unclamped(&mut self, ray: &Ray) -> Option<(f64, f64, f64)> {
         let (e1, e2) = (self.e1, self.e2);
@@ -302,6 +327,29 @@ impl TrianglePlane {
         }
         Some((t, u_plane, v_plane))
     }
+}
+
+/// Of the hits of a projector's parts on a triangle's plane, in order along the projector
+/// (each with its unclamped parameter and barycentrics), the first inside the triangle, else
+/// (a silhouette pixel) the one nearest the triangle: the least barycentric overshoot.
+fn first_inside<P>(
+    hits: impl Iterator<Item = (P, (f64, f64, f64))>,
+) -> Option<(P, (f64, f64, f64))> {
+    // How far outside the triangle (u, v) lies: <= 0 inside.
+    let outside = |u: f64, v: f64| (-u).max(-v).max(u + v - 1.0);
+    let mut nearest: Option<(P, (f64, f64, f64))> = None;
+    for (part, (t, u, v)) in hits {
+        if outside(u, v) <= 0.0 {
+            return Some((part, (t, u, v)));
+        }
+        if nearest
+            .as_ref()
+            .is_none_or(|(_, (_, a, b))| outside(u, v) < outside(*a, *b))
+        {
+            nearest = Some((part, (t, u, v)));
+        }
+    }
+    nearest
 }
 
 /// Barycentrics (u, v) clamped onto the triangle: negative ones to 0, then a sum above 1

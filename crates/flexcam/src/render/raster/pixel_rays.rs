@@ -2,8 +2,9 @@
 //! renderer: each fragment of the rasteriser reconstructs its scene point exactly by
 //! intersecting its pixel's projector with the plane of its scene triangle (see the
 //! `fragment` module), and looking the projector up is much cheaper than evaluating a
-//! nonlinear projection per fragment. Projectors are straight rays, or polylines for the
-//! polyline volumes between parallel planes that have an inverse.
+//! nonlinear projection per fragment. Projectors are straight rays, or polylines and
+//! quadratic curves for the polyline and quadratic volumes between parallel planes that have
+//! an inverse.
 //!
 //! The image is cut into square tiles of [`TILE`] pixels; a tile's projectors are computed
 //! the first time a fragment needs one of them (by whichever thread gets there first), so

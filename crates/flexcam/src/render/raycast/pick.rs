@@ -7,8 +7,7 @@
 use glam::{DVec2, DVec3};
 
 use super::hull_cull::LiveParts;
-use super::pieces::{length_before, polyline_segment};
-use super::shade::tangent_ray;
+use super::pieces::{length_before, polyline_segment, tangent_ray};
 use crate::geometry::Ray;
 use crate::projection::projector::quadratic_arc_length;
 use crate::projection::{Projection, Projector};

@@ -26,6 +26,24 @@ pub(in crate::render) fn length_before(points: &[DVec3], k: usize) -> f64 {
         .fold(0.0, |sum, pair| sum + (pair[1] - pair[0]).length())
 }
 
+/// The straight ray a quadratic projector `p` continues as at its hit `s`: origin B(s),
+/// direction the tangent B'(s), with the hit at ray parameter 0 (any t is accepted, so that
+/// the f64 refinement may move it by rounding). Degenerate case: where B'(s) = 0 (a cusp of a
+/// curve doubling back on itself) the chord P2 - P0 stands in for the tangent, and P1 - P0
+/// where that is zero too (a closed curve).
+pub(in crate::render) fn tangent_ray(p: &[DVec3; 3], s: f64) -> Ray {
+    let direction = [quadratic_tangent(p, s), p[2] - p[0], p[1] - p[0]]
+        .into_iter()
+        .find(|d| *d != DVec3::ZERO)
+        .unwrap_or(DVec3::X);
+    Ray {
+        origin: quadratic_point(p, s),
+        direction,
+        t_min: f64::NEG_INFINITY,
+        t_max: f64::INFINITY,
+    }
+}
+
 /// Pieces the curve is cut into for the BVH search: more pieces give thinner fattened chords
 /// (the padding falls as 1/PIECES^2), boxes that fewer triangles overlap, and fewer triangles
 /// tested beyond the first hit, but more traversals and more piece boxes in the tile culls.

@@ -9,9 +9,9 @@
 use glam::{DVec3, Vec3};
 
 use super::hull_cull::LiveParts;
-use super::pieces::{length_before, polyline_segment};
+use super::pieces::{length_before, polyline_segment, tangent_ray};
 use crate::geometry::Ray;
-use crate::projection::projector::{quadratic_arc_length, quadratic_point, quadratic_tangent};
+use crate::projection::projector::quadratic_arc_length;
 use crate::projection::Projector;
 use crate::render::prepared::{Hit32, PreparedScene};
 use crate::render::shading::trace::{shows_base_color, HitShader};
@@ -25,24 +25,6 @@ pub(super) struct Sample {
     pub depth: f32,
     pub id: u32,
 }
-/// The straight ray a quadratic projector `p` continues as at its hit `s`: origin B(s),
-/// direction the tangent B'(s), with the hit at ray parameter 0 (any t is accepted, so that
-/// the f64 refinement may move it by rounding). Degenerate case: where B'(s) = 0 (a cusp of a
-/// curve doubling back on itself) the chord P2 - P0 stands in for the tangent, and P1 - P0
-/// where that is zero too (a closed curve).
-pub(super) fn tangent_ray(p: &[DVec3; 3], s: f64) -> Ray {
-    let direction = [quadratic_tangent(p, s), p[2] - p[0], p[1] - p[0]]
-        .into_iter()
-        .find(|d| *d != DVec3::ZERO)
-        .unwrap_or(DVec3::X);
-    Ray {
-        origin: quadratic_point(p, s),
-        direction,
-        t_min: f64::NEG_INFINITY,
-        t_max: f64::INFINITY,
-    }
-}
-
 /// Traces primary rays of one render; counts what it casts.
 pub(super) struct Tracer<'a> {
     /// Shades the hits and counts every ray cast.
