@@ -173,6 +173,9 @@ pub(super) fn fit_pinhole(
     }
 }
 
+/// A camera's grid with its report, and its eye.
+type CameraFit = ((ProjectorGrid, FitReport), DVec3);
+
 /// Why the square-pixel camera gave no grid: the data are merely inconsistent with it (a
 /// point stays behind), or they do not determine it (the reason).
 enum NoSquarePixelGrid {
@@ -262,8 +265,7 @@ impl<'a> Setup<'a> {
     /// points on one plane too), lengthened into view, with its eye and the camera.
     fn square_pixel_fit(
         &self,
-    ) -> std::result::Result<(((ProjectorGrid, FitReport), DVec3), PinholeCamera), NoSquarePixelGrid>
-    {
+    ) -> std::result::Result<(CameraFit, PinholeCamera), NoSquarePixelGrid> {
         let camera =
             match PinholeCamera::fit(self.correspondences, ImageShape::of_prior(self.prior)) {
                 Ok(camera) => camera,
