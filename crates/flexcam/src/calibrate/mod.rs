@@ -95,6 +95,9 @@ fn build_report(fit: &FitReport) -> BuildReport {
     if fit.focal_from_prior {
         counters.push(("fit_focal_from_prior", 1.0));
     }
+    if fit.square_pixel_camera {
+        counters.push(("fit_square_pixel_camera", 1.0));
+    }
     if fit.general_camera {
         counters.push(("fit_general_camera", 1.0));
     }

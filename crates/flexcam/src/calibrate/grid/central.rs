@@ -42,12 +42,16 @@
 //! extent when E moves in some direction: so few points that they absorb any move of E);
 //! image positions all on one line (points on one line through the eye among them); no
 //! pinhole and no eye at which the free directions solve. Data that are merely
-//! inconsistent (two eyes' points mixed) get the pinhole's least-squares fit. The
+//! inconsistent (two eyes' points mixed) get the pinhole's least-squares fit: the general
+//! camera matrix's, or where that keeps a point behind its eye (nearly coplanar noisy points
+//! with one off the plane put its eye in the plane) the square-pixel camera's
+//! ([`FitReport::square_pixel_camera`]). The
 //! square-pixel camera of `starts = "pinhole"` has its own degenerate cases (module
 //! `pinhole_camera`): points on one line, a plane seen edge-on; a plane seen face on leaves
 //! only its focal length free (the prior's is kept, [`FitReport::focal_from_prior`]); data
-//! that keep a point behind every square-pixel camera reached (inconsistent data, such as a
-//! point behind the eye) get the general camera matrix's fit instead
+//! that keep a point behind every square-pixel camera reached, or behind the fitted one's
+//! starts (inconsistent data, such as a point behind the eye), get the general camera
+//! matrix's fit instead
 //! ([`FitReport::general_camera`]).
 
 use std::cell::OnceCell;
@@ -83,10 +87,27 @@ pub(super) fn fit(
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport, DVec3)> {
     let setup = Setup::new(prior, correspondences)?;
-    let pinhole_fit = setup.pinhole_fit();
+    let (pinhole_fit, square_pixels) = match setup.pinhole_fit() {
+        Some(found) => (Some(found), false),
+        // Merely inconsistent data (the general camera the data determine keeps a point
+        // behind its eye, as mixed eyes or one noisy point off a plane do): the square-pixel
+        // camera's least-squares fit, which `fit_pinhole` would give, and the report says so.
+        None if setup.camera().is_some() => {
+            (setup.square_pixel_fit().ok().map(|(found, _)| found), true)
+        }
+        None => (None, false),
+    };
+    let finish_pinhole = |grid: &ProjectorGrid, eye: DVec3| {
+        let (grid, report, eye) = finish(grid, correspondences, eye, prior, true)?;
+        let report = FitReport {
+            square_pixel_camera: square_pixels,
+            ..report
+        };
+        Ok((grid, report, eye))
+    };
     if let Some(((grid, report), eye)) = &pinhole_fit {
         if report.rms_angle_deg.to_radians() <= PINHOLE_EXACT {
-            return finish(grid, correspondences, *eye, prior, true);
+            return finish_pinhole(grid, *eye);
         }
     }
     let (free, extent) = (setup.problem(), setup.extent);
@@ -102,17 +123,16 @@ pub(super) fn fit(
             let at_eye = free.grid_at(eye, &prior_directions(prior))?;
             Ok((super::fit(&at_eye, correspondences)?, eye))
         });
-    let (fitted, eye, pinhole) = match (pinhole_fit, free_fit) {
+    match (pinhole_fit, free_fit) {
         (Some(((grid, report), eye)), Ok(((_, free_report), _)))
             if pinhole_suffices(&report, &free_report, prior.starts().len()) =>
         {
-            (grid, eye, true)
+            finish_pinhole(&grid, eye)
         }
-        (_, Ok(((grid, _), eye))) => (grid, eye, false),
-        (Some(((grid, _), eye)), Err(_)) => (grid, eye, true),
-        (None, Err(e)) => return Err(e),
-    };
-    finish(&fitted, correspondences, eye, prior, pinhole)
+        (_, Ok(((grid, _), eye))) => finish(&grid, correspondences, eye, prior, false),
+        (Some(((grid, _), eye)), Err(_)) => finish_pinhole(&grid, eye),
+        (None, Err(e)) => Err(e),
+    }
 }
 
 /// The pinhole model alone (`starts = "pinhole"`): the eye and the affine direction field
@@ -124,37 +144,43 @@ pub(super) fn fit_pinhole(
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport, DVec3)> {
     let setup = Setup::new(prior, correspondences)?;
-    let camera = match PinholeCamera::fit(correspondences, ImageShape::of_prior(prior)) {
-        Ok(camera) => camera,
-        Err(Undetermined::NotInFront) => {
+    match setup.square_pixel_fit() {
+        Ok((((grid, _), eye), camera)) => {
+            let (grid, report, eye) = finish(&grid, correspondences, eye, prior, true)?;
+            let report = FitReport {
+                focal_from_prior: camera.focal_from_prior(),
+                principal_point: camera.principal_point().map(|uv| uv.to_array()),
+                ..report
+            };
+            Ok((grid, report, eye))
+        }
+        Err(NoSquarePixelGrid::Inconsistent) => {
             // Merely inconsistent data (a point behind every square-pixel camera the starts
-            // reach): the general camera matrix's least-squares fit, which may move the eye
-            // until every point is in front, and the report says so.
+            // reach, or behind the fitted one's starts): the general camera matrix's
+            // least-squares fit, which may move the eye until every point is in front, and
+            // the report says so.
             let ((grid, _), eye) = setup.pinhole_fit().ok_or_else(undetermined)?;
             let (grid, report, eye) = finish(&grid, correspondences, eye, prior, true)?;
             let report = FitReport {
                 general_camera: true,
                 ..report
             };
-            return Ok((grid, report, eye));
+            Ok((grid, report, eye))
         }
-        Err(why) => return Err(Error::new(format!("projector grid fit: {why}"))),
-    };
-    let ((grid, _), eye) = setup
-        .camera_grid(camera.eye(), |uv| camera.direction(uv))
-        .ok_or_else(|| {
-            Error::new(
-                "projector grid fit: the fitted pinhole camera's projectors do not reach \
-                 every point in front of their starts",
-            )
-        })?;
-    let (grid, report, eye) = finish(&grid, correspondences, eye, prior, true)?;
-    let report = FitReport {
-        focal_from_prior: camera.focal_from_prior(),
-        principal_point: camera.principal_point().map(|uv| uv.to_array()),
-        ..report
-    };
-    Ok((grid, report, eye))
+        Err(NoSquarePixelGrid::Undetermined(why)) => {
+            Err(Error::new(format!("projector grid fit: {why}")))
+        }
+    }
+}
+
+/// A camera's grid with its report, and its eye.
+type CameraFit = ((ProjectorGrid, FitReport), DVec3);
+
+/// Why the square-pixel camera gave no grid: the data are merely inconsistent with it (a
+/// point stays behind), or they do not determine it (the reason).
+enum NoSquarePixelGrid {
+    Inconsistent,
+    Undetermined(Undetermined),
 }
 
 /// What both direction fields of a central fit share: the checked data, their extent and
@@ -233,6 +259,23 @@ impl<'a> Setup<'a> {
             .filter_map(|start| problem.descend(start))
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map(|(eye, _)| eye)
+    }
+
+    /// The square-pixel camera's grid (module `pinhole_camera`: 7 unknowns, determined by
+    /// points on one plane too), lengthened into view, with its eye and the camera.
+    fn square_pixel_fit(
+        &self,
+    ) -> std::result::Result<(CameraFit, PinholeCamera), NoSquarePixelGrid> {
+        let camera =
+            match PinholeCamera::fit(self.correspondences, ImageShape::of_prior(self.prior)) {
+                Ok(camera) => camera,
+                Err(Undetermined::NotInFront) => return Err(NoSquarePixelGrid::Inconsistent),
+                Err(why) => return Err(NoSquarePixelGrid::Undetermined(why)),
+            };
+        let found = self
+            .camera_grid(camera.eye(), |uv| camera.direction(uv))
+            .ok_or(NoSquarePixelGrid::Inconsistent)?;
+        Ok((found, camera))
     }
 
     /// The pinhole's grid (module `camera_matrix`: 11 unknowns, which six points in general
@@ -767,6 +810,55 @@ mod tests {
         assert!(farthest_line(&fitted, EYE) < 1e-7);
         assert_eq!(report.sparse_nodes, 0, "{report:?}");
         assert!(report.warning().is_none());
+    }
+
+    #[test]
+    fn nearly_coplanar_noisy_points_get_the_square_pixel_camera() {
+        // Points on the floor (y = 0) seen by a 5 x 5 grid's camera, their image positions
+        // moved by up to 0.005, and one point off the floor: the general camera matrix these
+        // determine keeps a point behind its eye, and 22 or 42 equations leave the free
+        // directions' 75 unknowns no determined eye. The eye model fits the square-pixel
+        // camera instead of erroring, and says so.
+        let grid = |fov| {
+            ProjectorGrid::sample(
+                &perspective(fov, [1.0, 40.0]),
+                (5, 5),
+                GridInterpolation::Bilinear,
+            )
+            .unwrap()
+        };
+        let (truth, prior) = (grid(50.0), grid(70.0));
+        for (seed, count) in [(0u64, 10usize), (10, 20)] {
+            let mut data: Vec<_> = seen_by(&truth, 3 * count, seed)
+                .into_iter()
+                .filter_map(|c| {
+                    let (s, e) = truth.start_end(c.uv);
+                    let t = -s.y / (e.y - s.y);
+                    (t > 0.0 && t < 1.0).then(|| Correspondence {
+                        point: s + t * (e - s),
+                        ..c
+                    })
+                })
+                .take(count)
+                .collect();
+            let mut state = seed;
+            let mut next = || {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            };
+            for c in &mut data {
+                c.uv += DVec2::new(next(), next()) * 0.01;
+            }
+            data.push(seen_by(&truth, 1, seed + 100)[0]);
+            let setup = Setup::new(&prior, &data).unwrap();
+            assert!(setup.camera().is_some() && setup.pinhole_fit().is_none());
+            let (_, report, _) = fit(&prior, &data).unwrap();
+            assert!(report.square_pixel_camera, "{seed}: {report:?}");
+            assert!(report.warning().unwrap().contains("square pixels"));
+            assert!(report.rms_angle_deg < 0.3, "{seed}: {report:?}");
+        }
     }
 
     proptest! {

@@ -183,6 +183,10 @@ pub struct FitReport {
     /// skew and principal point free) because no square-pixel camera keeps every
     /// correspondence's point in front of it (inconsistent data).
     pub general_camera: bool,
+    /// Whether `starts = "eye"` fitted the pinhole camera of square pixels because the
+    /// general camera matrix the data determine keeps a correspondence's point behind its
+    /// eye and the free directions find no determined eye (inconsistent data).
+    pub square_pixel_camera: bool,
     /// The pinhole model's principal point as an image position (u, v) where the data put
     /// it off the image centre (a cropped painting; module `pinhole_camera`); `None` at the
     /// centre and for the other models.
@@ -236,8 +240,14 @@ impl FitReport {
              instead"
                 .to_string()
         });
+        let square = self.square_pixel_camera.then(|| {
+            "the general camera matrix keeps a correspondence's point behind its eye: the \
+             pinhole camera of square pixels is fitted instead"
+                .to_string()
+        });
         let parts: Vec<String> = [
             general,
+            square,
             focal,
             node_warning(self.wild_nodes, self.sparse_nodes),
         ]
