@@ -109,7 +109,7 @@ fn curved_projectors_have_their_exit_ray() {
     let dir = TempDir::new().unwrap();
     let scene = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../scenes/flexible-quadratic.toml"
+        "/../../scenes/flexible-occlusion.toml"
     );
     run_ok(
         &dir,
@@ -314,7 +314,7 @@ fn bad_raymap_requests_are_one_line_and_write_nothing() {
             "q.toml",
             fs::read_to_string(concat!(
                 env!("CARGO_MANIFEST_DIR"),
-                "/../../scenes/flexible-quadratic.toml"
+                "/../../scenes/flexible-occlusion.toml"
             ))
             .unwrap(),
         ),

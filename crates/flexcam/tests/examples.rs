@@ -226,7 +226,7 @@ fn render_scene_example_renders_and_compares() {
     assert!(agreement.id_agreement > 0.99, "{agreement:?}");
     assert_eq!(made.bvh_builds, 1);
     let curved = format!(
-        "{}/../../scenes/flexible-quadratic.toml",
+        "{}/../../scenes/flexible-occlusion.toml",
         env!("CARGO_MANIFEST_DIR")
     );
     let made = two_methods::render_two_ways(&curved, 32, 24).unwrap();
