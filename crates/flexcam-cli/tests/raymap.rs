@@ -109,7 +109,7 @@ fn curved_projectors_have_their_exit_ray() {
     let dir = TempDir::new().unwrap();
     let scene = concat!(
         env!("CARGO_MANIFEST_DIR"),
-        "/../../scenes/flexible-occlusion.toml"
+        "/../../scenes/flexible-quadratic.toml"
     );
     run_ok(
         &dir,
