@@ -48,13 +48,25 @@ pub(crate) fn advise_huge_pages<T>(values: &mut [T]) {
     let _ = values;
 }
 
+/// Makes room for `additional` more values in `values` as `Vec::reserve` does (amortised
+/// doubling) and, when it grew, advises its fresh spare capacity onto huge pages
+/// ([`advise_huge_pages`]): for a buffer that grows to megabytes while it is written once
+/// (the trilinear renderer's outline points), one page fault per 2 MiB of new room instead
+/// of one per 4 KiB. The values are unchanged.
+pub(crate) fn reserve_on_huge_pages<T>(values: &mut Vec<T>, additional: usize) {
+    if values.capacity() - values.len() < additional {
+        values.reserve(additional);
+        advise_huge_pages(values.spare_capacity_mut());
+    }
+}
+
 /// The size of an x86-64 transparent huge page (2 MiB): smaller ranges are not advised.
 #[cfg(target_os = "linux")]
 const HUGE_PAGE: usize = 2 << 20;
 
 #[cfg(test)]
 mod tests {
-    use super::advise_huge_pages;
+    use super::{advise_huge_pages, reserve_on_huge_pages};
 
     /// The contents are unchanged, whatever the slice's alignment and length (empty, shorter
     /// than a page, spanning huge pages), in fresh zeroed memory and in written memory.
@@ -78,5 +90,26 @@ mod tests {
             advise_huge_pages(&mut written[..]);
             assert_eq!(written, copy);
         }
+    }
+
+    /// Growing a buffer by [`reserve_on_huge_pages`] keeps its values and makes the room
+    /// asked for, from empty, across the huge-page size, and when it already has room.
+    #[test]
+    fn reserving_on_huge_pages_keeps_the_values() {
+        let mut values: Vec<u64> = Vec::new();
+        let mut expected = Vec::new();
+        for step in 0..40u64 {
+            let run: Vec<u64> = (0..step * 997).map(|i| i ^ step).collect();
+            let capacity = values.capacity();
+            reserve_on_huge_pages(&mut values, run.len());
+            assert!(values.capacity() - values.len() >= run.len());
+            if capacity - expected.len() >= run.len() {
+                assert_eq!(values.capacity(), capacity, "no growth when there is room");
+            }
+            values.extend_from_slice(&run);
+            expected.extend_from_slice(&run);
+            assert_eq!(values, expected);
+        }
+        assert!(std::mem::size_of_val(&values[..]) > 4 << 20);
     }
 }
