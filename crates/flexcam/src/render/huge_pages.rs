@@ -16,14 +16,9 @@
 pub(crate) fn advise_huge_pages<T>(values: &mut [T]) {
     #[cfg(target_os = "linux")]
     {
-        // SAFETY: `sysconf` has no preconditions.
-        let page = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
-        let Ok(page) = usize::try_from(page) else {
+        let Some(page) = page_size() else {
             return;
         };
-        if !page.is_power_of_two() {
-            return;
-        }
         let start = values.as_mut_ptr() as usize;
         let end = start + std::mem::size_of_val(values);
         let first = start.next_multiple_of(page);
@@ -48,6 +43,50 @@ pub(crate) fn advise_huge_pages<T>(values: &mut [T]) {
     let _ = values;
 }
 
+/// Maps every page of `values` at once, as the first writes would, with one system call
+/// (`madvise(MADV_POPULATE_WRITE)`, Linux 5.14) instead of one page fault per page: for a
+/// buffer about to be written whole, such as a polygon batch allocated to its exact size.
+/// Huge pages advised before ([`advise_huge_pages`]) are honoured. The pages holding the
+/// ends of `values` are included whole (they belong to its allocation); pages already
+/// mapped are left as they are. Elsewhere, or where the call fails (an older kernel), the
+/// pages are mapped by the writes as before; no byte changes either way.
+pub(crate) fn populate_for_writing<T>(values: &mut [T]) {
+    #[cfg(target_os = "linux")]
+    {
+        let Some(page) = page_size() else {
+            return;
+        };
+        let start = values.as_mut_ptr() as usize;
+        let end = start + std::mem::size_of_val(values);
+        if end == start {
+            return;
+        }
+        let first = start & !(page - 1);
+        let last = end.next_multiple_of(page);
+        // SAFETY: [first, last) is the pages holding bytes of `values`, which we borrow
+        // mutably, all inside its allocation's mapping; MADV_POPULATE_WRITE maps them as a
+        // write would (zeroed where not yet mapped) and changes no byte. Failure (EINVAL
+        // before Linux 5.14) is harmless: the writes then map the pages.
+        unsafe {
+            libc::madvise(
+                first as *mut libc::c_void,
+                last - first,
+                libc::MADV_POPULATE_WRITE,
+            );
+        }
+    }
+    #[cfg(not(target_os = "linux"))]
+    let _ = values;
+}
+
+/// The page size, a power of two, or `None` where it cannot be had.
+#[cfg(target_os = "linux")]
+fn page_size() -> Option<usize> {
+    // SAFETY: `sysconf` has no preconditions.
+    let page = unsafe { libc::sysconf(libc::_SC_PAGESIZE) };
+    usize::try_from(page).ok().filter(|p| p.is_power_of_two())
+}
+
 /// Makes room for `additional` more values in `values` as `Vec::reserve` does (amortised
 /// doubling) and, when it grew, advises its fresh spare capacity onto huge pages
 /// ([`advise_huge_pages`]): for a buffer that grows to megabytes while it is written once
@@ -66,10 +105,11 @@ const HUGE_PAGE: usize = 2 << 20;
 
 #[cfg(test)]
 mod tests {
-    use super::{advise_huge_pages, reserve_on_huge_pages};
+    use super::{advise_huge_pages, populate_for_writing, reserve_on_huge_pages};
 
-    /// The contents are unchanged, whatever the slice's alignment and length (empty, shorter
-    /// than a page, spanning huge pages), in fresh zeroed memory and in written memory.
+    /// The contents are unchanged by either call, whatever the slice's alignment and length
+    /// (empty, shorter than a page, spanning huge pages), in fresh zeroed memory, in written
+    /// memory and in spare capacity written after it was populated.
     #[test]
     fn huge_page_advice_changes_no_value() {
         for n in [0, 1, 1023, 1024, 5000, 3 << 20] {
@@ -89,6 +129,19 @@ mod tests {
             let copy = written.clone();
             advise_huge_pages(&mut written[..]);
             assert_eq!(written, copy);
+            for skip in [0, 1, 3].into_iter().filter(|&s| s <= n) {
+                populate_for_writing(&mut written[skip..]);
+                populate_for_writing(&mut zeroed[skip..]);
+            }
+            assert_eq!(written, copy);
+            assert!(zeroed
+                .iter()
+                .enumerate()
+                .all(|(i, &v)| v == if i % 997 == 0 { 5 } else { 0 }));
+            let mut fresh: Vec<u32> = Vec::with_capacity(n);
+            populate_for_writing(fresh.spare_capacity_mut());
+            fresh.extend(copy.iter().copied());
+            assert_eq!(fresh, copy);
         }
     }
 
