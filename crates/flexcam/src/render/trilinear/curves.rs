@@ -9,7 +9,7 @@
 //!   scene edge at every slice depth within its own depth range.
 //! - [`CurveMode::Adaptive`] (the default): each polygon edge is bisected in depth while the
 //!   exact image at the middle depth lies more than [`ADAPTIVE_TOLERANCE_PX`] pixels off the
-//!   chord, up to `steps` segments per edge piece (see `edge_path::refine_around` for the rule).
+//!   chord, up to `steps` segments per edge piece (see `edge_path::refine` for the rule).
 
 use std::fmt;
 use std::str::FromStr;

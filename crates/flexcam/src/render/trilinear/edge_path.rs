@@ -17,7 +17,7 @@
 //!   (extended) domain lines `u = 0`, `v = 0`, `u + v = 1`, so each piece is either wholly
 //!   visible or wholly clipped away;
 //! * **curve samples** inside visible pieces: fixed slices or adaptive bisection
-//!   ([`refine_around`]).
+//!   ([`refine`]).
 //!
 //! Degenerate cases: where the plane at `t` is parallel to the segment, or the parametric
 //! triangle is degenerate at `t` (its plane is undefined), [`EdgePath::at`] gives `None` and
@@ -194,10 +194,26 @@ fn clear_of_roots([c2, c1, c0]: [f64; 3], lo: f64, hi: f64) -> bool {
 /// rational curves of low degree in `t`, and the first split already removes such a crossing
 /// unless it sits exactly at the middle. The first `forced.levels` levels bisect without
 /// the test where the piece is near a degenerate depth ([`Forced`]).
-///
-/// The image at the middle depth, `path.at(0.5 (a.t + b.t))`, is `middle`, already computed
-/// by the caller (the outline tracer computes it to decide whether the piece is visible at
-/// all).
+pub fn refine(
+    path: &EdgePath,
+    map: &ScreenMap,
+    (a, b): (OutlinePoint, OutlinePoint),
+    tolerance: f64,
+    (levels, forced): (u32, Forced),
+    out: &mut Vec<OutlinePoint>,
+) {
+    let t = 0.5 * (a.t + b.t);
+    if levels == 0 || t == a.t || t == b.t {
+        return;
+    }
+    if let Some(middle) = path.at(t) {
+        refine_around(path, map, (a, middle, b), tolerance, (levels, forced), out);
+    }
+}
+
+/// [`refine`] of the piece from `a` to `b` whose image at the middle depth,
+/// `path.at(0.5 (a.t + b.t))`, is `middle`, already computed by the caller (the outline
+/// tracer computes it to decide whether the piece is visible at all).
 pub fn refine_around(
     path: &EdgePath,
     map: &ScreenMap,
@@ -206,81 +222,24 @@ pub fn refine_around(
     (levels, forced): (u32, Forced),
     out: &mut Vec<OutlinePoint>,
 ) {
-    let ends = Ends::of(map, a, b);
-    bisect(path, map, (ends, middle), tolerance, (levels, forced), out);
-}
-
-/// The ends of a piece being refined with their pixel positions: each outline point's
-/// pixel is computed once, when it is found, and handed to both halves it bounds (the
-/// chord test of every level needs the pixels of the piece's ends and middle).
-#[derive(Clone, Copy)]
-struct Ends {
-    a: OutlinePoint,
-    b: OutlinePoint,
-    pixels: (DVec2, DVec2),
-}
-
-impl Ends {
-    fn of(map: &ScreenMap, a: OutlinePoint, b: OutlinePoint) -> Ends {
-        let pixels = (map.pixel(a.u, a.v), map.pixel(b.u, b.v));
-        Ends { a, b, pixels }
-    }
-}
-
-/// Bisects the piece between `ends` (the pixels of its ends known): the image at its middle
-/// depth, then [`bisect`] around it.
-fn halve(
-    path: &EdgePath,
-    map: &ScreenMap,
-    ends: Ends,
-    tolerance: f64,
-    (levels, forced): (u32, Forced),
-    out: &mut Vec<OutlinePoint>,
-) {
-    let t = 0.5 * (ends.a.t + ends.b.t);
-    if levels == 0 || t == ends.a.t || t == ends.b.t {
-        return;
-    }
-    if let Some(middle) = path.at(t) {
-        bisect(path, map, (ends, middle), tolerance, (levels, forced), out);
-    }
-}
-
-/// [`refine_around`] with the pixels of the ends known.
-fn bisect(
-    path: &EdgePath,
-    map: &ScreenMap,
-    (ends, middle): (Ends, OutlinePoint),
-    tolerance: f64,
-    (levels, forced): (u32, Forced),
-    out: &mut Vec<OutlinePoint>,
-) {
-    let Ends { a, b, pixels } = ends;
     if levels == 0 || middle.t == a.t || middle.t == b.t {
         return;
     }
-    let (pa, pb) = pixels;
-    let pm = map.pixel(middle.u, middle.v);
+    let (pa, pb, pm) = (
+        map.pixel(a.u, a.v),
+        map.pixel(b.u, b.v),
+        map.pixel(middle.u, middle.v),
+    );
     if !forced.applies(a.t, b.t) && distance_to_segment(pm, pa, pb) <= tolerance {
         return;
     }
     let next = (levels - 1, forced.next());
-    let first = Ends {
-        a,
-        b: middle,
-        pixels: (pa, pm),
-    };
-    halve(path, map, first, tolerance, next, out);
+    refine(path, map, (a, middle), tolerance, next, out);
     out.push(middle);
-    let second = Ends {
-        a: middle,
-        b,
-        pixels: (pm, pb),
-    };
-    halve(path, map, second, tolerance, next, out);
+    refine(path, map, (middle, b), tolerance, next, out);
 }
 
-/// Bisection levels of [`refine_around`] taken whatever the tolerance, near the depths at which the
+/// Bisection levels of [`refine`] taken whatever the tolerance, near the depths at which the
 /// projection triangle's parametric triangle degenerates: there an edge's image swings far
 /// out and back within a piece, and the test at the middle alone can miss it
 /// (`degenerate_band`). Its coordinates are ratios whose denominator, the parametric
@@ -574,9 +533,7 @@ mod tests {
         };
         let (a, b) = (path.at(0.5).unwrap(), path.at(6.0).unwrap());
         let mut out = Vec::new();
-        let middle = path.at(0.5 * (a.t + b.t)).unwrap();
-        let pieces = (a, middle, b);
-        refine_around(&path, &map, pieces, 0.25, (10, Forced::NONE), &mut out);
+        refine(&path, &map, (a, b), 0.25, (10, Forced::NONE), &mut out);
         assert!(!out.is_empty(), "the image of this edge is curved");
         // Every chord is within the tolerance at densely sampled depths.
         let mut points = vec![a];
@@ -596,7 +553,7 @@ mod tests {
         }
         // With no levels nothing is added; a straight image (orthographic) needs no sample.
         out.clear();
-        refine_around(&path, &map, pieces, 0.25, (0, Forced::NONE), &mut out);
+        refine(&path, &map, (a, b), 0.25, (0, Forced::NONE), &mut out);
         assert!(out.is_empty());
     }
 }

@@ -23,7 +23,7 @@ pub enum Sampling<'a> {
     /// The given depths (the shape's slices, ascending), where they fall on the edge.
     Slices(&'a [f64]),
     /// Bisection to the screen tolerance, at most `levels` deep, the first `forced` levels
-    /// whatever the tolerance on pieces near the degenerate depths (`edge_path::refine_around`).
+    /// whatever the tolerance on pieces near the degenerate depths (`edge_path::refine`).
     Adaptive {
         tolerance: f64,
         levels: u32,
