@@ -26,6 +26,7 @@ use super::view_plane::clipping_base;
 use crate::projection::{
     project_solved_triangle, ProjectionTriangleCache, Shape, Solutions, TriangleShapes, Trilinear,
 };
+use crate::render::huge_pages::reserve_mapped;
 use crate::render::scan::{PolygonBatch, Vertex};
 
 /// The projection stage's result for the whole mesh: every polygon, in projection-triangle
@@ -204,6 +205,7 @@ impl Drawn {
         triangle: u32,
         tested: bool,
     ) {
+        reserve_mapped(&mut self.points, outline.len());
         self.points.extend_from_slice(outline);
         self.shapes.push(DrawnShape {
             end: self.points.len(),
