@@ -52,32 +52,39 @@ pub fn scene_variant(
     Ok(document.to_string())
 }
 
-/// Opens the scene file at `path`, waits for its first refinement, then sets projection key
-/// `key` to each of `values` in turn, waiting after each for the frame's first stage.
-pub fn drag(path: &Path, key: &str, values: &[f64]) -> Result<DragReport> {
-    frames(path, values.len(), |viewer, k| {
+/// Opens the scene file at `path` with `settings`, waits for its first refinement, then sets
+/// projection key `key` to each of `values` in turn, waiting after each for the frame's
+/// first stage.
+pub fn drag(path: &Path, settings: Settings, key: &str, values: &[f64]) -> Result<DragReport> {
+    frames(path, settings, values.len(), |viewer, k| {
         viewer.set(key, Value::from(values[k]))
     })
 }
 
-/// Opens the scene file at `path`, waits for its first refinement, then drags handle
+/// Opens the scene file at `path` with `settings`, waits for its first refinement, then drags handle
 /// `name` by (`dx`, `dy`) pixels (as a script's `drag`) `count` times, waiting after each
 /// for the frame's first stage. The handles and the volume view's sketch are made again
 /// for every frame, as the window does.
 pub fn drag_handle(
     path: &Path,
+    settings: Settings,
     name: &str,
     (dx, dy): (f64, f64),
     count: usize,
 ) -> Result<DragReport> {
-    frames(path, count, |viewer, _| viewer.drag(name, dx, dy))
+    frames(path, settings, count, |viewer, _| viewer.drag(name, dx, dy))
 }
 
-/// Opens the scene file at `path`, waits for its first refinement, then orbits the camera
+/// Opens the scene file at `path` with `settings`, waits for its first refinement, then orbits the camera
 /// by (`yaw`, `pitch`) degrees (as a script's `orbit`) `count` times, waiting after each for
 /// the frame's first stage: the camera moved as a mouse drag in the image moves it.
-pub fn orbit(path: &Path, (yaw, pitch): (f64, f64), count: usize) -> Result<DragReport> {
-    frames(path, count, |viewer, _| {
+pub fn orbit(
+    path: &Path,
+    settings: Settings,
+    (yaw, pitch): (f64, f64),
+    count: usize,
+) -> Result<DragReport> {
+    frames(path, settings, count, |viewer, _| {
         viewer.move_camera(|c| c.orbit(yaw, pitch))
     })
 }
@@ -85,10 +92,11 @@ pub fn orbit(path: &Path, (yaw, pitch): (f64, f64), count: usize) -> Result<Drag
 /// Runs `count` edits (`edit(viewer, k)`), each waited for until its first stage is shown.
 fn frames(
     path: &Path,
+    settings: Settings,
     count: usize,
     mut edit: impl FnMut(&mut Viewer, usize) -> Result<()>,
 ) -> Result<DragReport> {
-    let mut viewer = Viewer::open(path, Settings::DEFAULT)?;
+    let mut viewer = Viewer::open(path, settings)?;
     viewer.idle()?;
     let start = Instant::now();
     let mut label = String::new();

@@ -46,6 +46,9 @@ pub struct Settings {
     /// Samples per pixel of the window's last refinement (ray caster only); no refinement
     /// stage at or below `spp`.
     pub refine_spp: u32,
+    /// Raster previews always at the scene's image size, never reduced to fit a display
+    /// frame (`flexcam bench view --full-size`: the frame rate of full-size frames).
+    pub full_size_previews: bool,
 }
 
 impl Settings {
@@ -56,6 +59,7 @@ impl Settings {
         shading: Shading::Lit,
         spp: 1,
         refine_spp: 4,
+        full_size_previews: false,
     };
 }
 
@@ -118,6 +122,7 @@ pub fn stages(
         let method = fast_method(projection);
         let scale = match method {
             Method::Raycast => preview_scale(projection.resolution()),
+            Method::Raster if settings.full_size_previews => 1,
             Method::Raster => budget_scale(projection.resolution(), raster_ms_per_pixel),
             _ => 1,
         };
@@ -650,6 +655,15 @@ mod tests {
         assert_eq!(
             stages(projection.as_ref(), &direct, slow),
             vec![Stage::Final]
+        );
+        // Full-size previews stay full size however slow the last one was.
+        let full = Settings {
+            full_size_previews: true,
+            ..settings
+        };
+        assert_eq!(
+            stages(projection.as_ref(), &full, slow),
+            vec![raster(1), Stage::Final, Stage::Refine { spp: 4 }]
         );
     }
 

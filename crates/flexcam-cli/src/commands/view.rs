@@ -52,6 +52,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             shading: args.shading.shading(),
             spp: args.spp,
             refine_spp: args.refine_spp,
+            full_size_previews: false,
         },
         list_handles: args.list_handles,
     })

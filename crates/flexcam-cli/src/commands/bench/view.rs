@@ -11,6 +11,7 @@ use clap::Args;
 use flexcam::scene::builtin;
 use flexcam::{Error, Result};
 use flexcam_view::bench::{drag, drag_handle, orbit, scene_variant};
+use flexcam_view::Settings;
 use toml_edit::Value;
 
 /// Arguments of `flexcam bench view`.
@@ -27,6 +28,10 @@ pub struct ViewBenchArgs {
     /// refused when none does.
     #[arg(long, value_name = "TEXT")]
     case: Option<String>,
+    /// Every raster preview at the full 1280 x 720 (the size the frame-rate target is
+    /// for), never halved when the last one missed a 60 Hz display frame as in the window.
+    #[arg(long)]
+    full_size: bool,
 }
 
 /// The viewer's image size in the frame-rate target.
@@ -265,6 +270,10 @@ fn run_cases(args: &ViewBenchArgs, dir: &std::path::Path) -> Result<()> {
             chosen
         }
     };
+    let settings = Settings {
+        full_size_previews: args.full_size,
+        ..Settings::DEFAULT
+    };
     for (i, case) in cases.into_iter().enumerate() {
         let replace = !case.keys.is_empty();
         let text = scene_variant(builtin::text(case.builtin)?, SIZE, &case.keys, replace)?;
@@ -277,14 +286,17 @@ fn run_cases(args: &ViewBenchArgs, dir: &std::path::Path) -> Result<()> {
                 let values: Vec<f64> = (0..n)
                     .map(|k| from + (to - from) * f64::from(k) / f64::from(n - 1))
                     .collect();
-                (drag(&path, key, &values)?, format!("{key} {from}..{to}"))
+                (
+                    drag(&path, settings, key, &values)?,
+                    format!("{key} {from}..{to}"),
+                )
             }
             Drag::Handle(name, dx, dy) => (
-                drag_handle(&path, name, (dx, dy), n as usize)?,
+                drag_handle(&path, settings, name, (dx, dy), n as usize)?,
                 format!("{name} by ({dx}, {dy}) px"),
             ),
             Drag::Orbit(yaw, pitch) => (
-                orbit(&path, (yaw, pitch), n as usize)?,
+                orbit(&path, settings, (yaw, pitch), n as usize)?,
                 format!("orbit ({yaw}, {pitch}) deg"),
             ),
         };

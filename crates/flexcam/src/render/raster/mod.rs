@@ -47,6 +47,7 @@ mod coverage;
 mod flexible_maps_tests;
 mod fragment;
 mod pixel_rays;
+mod pole_clearance;
 mod refine;
 mod seam;
 mod subdivision;
@@ -62,7 +63,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
-use glam::{DVec2, DVec3};
+use glam::DVec2;
 use rayon::prelude::*;
 
 pub use subdivision::Subdivision;
@@ -72,6 +73,7 @@ use self::band_fill::{fill_and_shade, BAND_ROWS};
 use self::coverage::{Bins, ScreenTriangle};
 use self::fragment::{key, Shader, Visible};
 use self::pixel_rays::{PixelRays, Tile};
+use self::pole_clearance::PoleClearance;
 use self::refine::{Node, Refiner};
 use self::seam::{covers_a_centre, place, Placement};
 use crate::error::{Error, Result};
@@ -133,6 +135,8 @@ struct Buffers {
     bins: Vec<Bins>,
     /// Each pixel's visible fragment.
     zbuffer: Vec<Visible>,
+    /// Which scene triangles are far from the poles, while the poles stay put.
+    clearance: PoleClearance,
 }
 
 /// What piece building did, for `--stats`.
@@ -313,8 +317,9 @@ impl<'a> InverseRaster<'a> {
             images,
             bins,
             zbuffer,
+            clearance,
         } = &mut *buffers;
-        let counts = self.pieces(images, bins);
+        let counts = self.pieces(images, bins, clearance);
         let pieces_ms = start.elapsed().as_secs_f64() * 1e3;
         let shader = Shader {
             objects: &self.scene.objects,
@@ -374,9 +379,16 @@ impl<'a> InverseRaster<'a> {
     /// Steps 1 to 3 of the module documentation: the vertex images of every object into
     /// `images`, then the screen triangles of every scene triangle, sorted into bands by
     /// parallel jobs of [`CHUNK`] scene triangles, one element of `bins` per job, with their
-    /// counters (both buffers resized and overwritten).
-    fn pieces(&self, images: &mut Vec<Vec<Option<DVec2>>>, bins: &mut Vec<Bins>) -> PieceCounts {
+    /// counters (both buffers resized and overwritten); which triangles are far from the
+    /// poles is read from `clearance` (brought up to date first).
+    fn pieces(
+        &self,
+        images: &mut Vec<Vec<Option<DVec2>>>,
+        bins: &mut Vec<Bins>,
+        clearance: &mut PoleClearance,
+    ) -> PieceCounts {
         let refiner = Refiner::new(&self.inverse, self.options.subdivision.tolerance);
+        let far = clearance.update(self.scene, &refiner, &self.inverse.chart.poles);
         images.resize_with(self.scene.objects.len(), Vec::new);
         for (object, images) in self.scene.objects.iter().zip(images.iter_mut()) {
             object
@@ -408,7 +420,8 @@ impl<'a> InverseRaster<'a> {
                 let mut grid = Vec::new();
                 for triangle in range.clone() {
                     let part = (&mut *bins, &mut counts);
-                    self.triangle(&refiner, &images[*o], (*o, triangle), &mut grid, part);
+                    let far = far[*o][triangle];
+                    self.triangle(&refiner, &images[*o], (*o, triangle, far), &mut grid, part);
                 }
                 if let Some(progress) = self.options.progress {
                     progress(done.fetch_add(1, Ordering::Relaxed) + 1, jobs.len() as u64);
@@ -422,18 +435,24 @@ impl<'a> InverseRaster<'a> {
     }
 
     /// Clips, subdivides and places triangle `triangle` of object index `object`, whose
-    /// vertex images are `images`, into `bins`.
+    /// vertex images are `images` and which `Refiner::far_from_poles` clears when `far`,
+    /// into `bins`.
     fn triangle(
         &self,
         refiner: &Refiner<'_>,
         images: &[Option<DVec2>],
-        (object, triangle): (usize, usize),
+        (object, triangle, far): (usize, usize, bool),
         grid: &mut Vec<Node>,
         (bins, counts): (&mut Bins, &mut PieceCounts),
     ) {
+        // Arrays built element by element here and below: `array::map` is not inlined in
+        // this function, and its out-of-line calls and copies of the nodes cost about 5 %
+        // of a 123,554-triangle panorama's frame.
         let item = &self.scene.objects[object];
-        let corners = item.mesh.triangles[triangle].map(|i| i as usize);
-        let points: [DVec3; 3] = corners.map(|i| item.mesh.positions[i].as_dvec3());
+        let [a, b, c] = item.mesh.triangles[triangle];
+        let corners = [a as usize, b as usize, c as usize];
+        let position = |k: usize| item.mesh.positions[corners[k]].as_dvec3();
+        let points = [position(0), position(1), position(2)];
         let key = key(object, triangle);
         let (width, height) = self.projection.resolution();
         let size = DVec2::new(f64::from(width), f64::from(height));
@@ -447,16 +466,17 @@ impl<'a> InverseRaster<'a> {
         if !inside {
             counts.clipped += 1;
         }
-        let poles = !refiner.far_from_poles(points);
+        let poles = !far;
         counts.near_poles += u64::from(poles);
         let mut draw = |nodes: [Node; 3]| {
             counts.pieces += 1;
-            let points = nodes.map(|n| n.point);
+            let [na, nb, nc] = nodes;
+            let points = [na.point, nb.point, nc.point];
             if poles && (refiner.is_pole_piece(points) || refiner.is_within_clearance(points)) {
                 counts.pole_pieces += 1;
                 return;
             }
-            let [Some(a), Some(b), Some(c)] = nodes.map(|n| n.image) else {
+            let (Some(a), Some(b), Some(c)) = (na.image, nb.image, nc.image) else {
                 counts.singular += 1;
                 return;
             };
@@ -494,11 +514,11 @@ impl<'a> InverseRaster<'a> {
             });
         };
         if inside {
-            let nodes = [0, 1, 2].map(|k| Node {
+            let node = |k: usize| Node {
                 point: points[k],
                 image: images[corners[k]],
-            });
-            subdivide(nodes, grid);
+            };
+            subdivide([node(0), node(1), node(2)], grid);
         } else {
             let clipped = clip::clip(points, &self.inverse.chart.clip);
             for fan in clipped.fan() {

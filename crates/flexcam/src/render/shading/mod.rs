@@ -126,10 +126,13 @@ pub fn normals_of_face(
     let interpolated = if mesh.normals.is_empty() {
         Vec3::ZERO
     } else {
-        let n = corners.map(|i| match mesh.normals[i] {
+        // Element by element: `array::map` is not inlined here (a per-pixel cost).
+        let vertex = |i: usize| match mesh.normals[i] {
             Vec3::ZERO => face,
             n => n,
-        });
+        };
+        let [a, b, c] = corners;
+        let n = [vertex(a), vertex(b), vertex(c)];
         interpolate(&n, [0, 1, 2], weights(barycentric)).normalize_or_zero()
     };
     let mut shading = if interpolated == Vec3::ZERO {
@@ -179,12 +182,13 @@ pub fn base_color(
 /// distance from the world origin: a floor at object y = 0 translated far away would
 /// otherwise flicker across the checker's cell boundary there.
 fn object_point(object: &Object, corners: [usize; 3], w: Vec3) -> Vec3 {
-    let local = corners.map(|i| {
+    let local = |i: usize| {
         object
             .world_to_object
             .transform_point3(object.mesh.positions[i])
-    });
-    interpolate(&local, [0, 1, 2], w)
+    };
+    let [a, b, c] = corners;
+    interpolate(&[local(a), local(b), local(c)], [0, 1, 2], w)
 }
 
 /// The texture coordinates at barycentrics `barycentric` of triangle `triangle` of `object`,
