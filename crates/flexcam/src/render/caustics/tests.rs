@@ -217,6 +217,7 @@ fn degenerate_map_triangles_carry_no_light() {
         Some(Photon {
             point: DVec3::new(x, 0.0, z),
             id,
+            transmittance: 1.0,
         })
     };
     // Texel (x, y) at k = 3 y + x. The row y = 0 collinear with (0, 1); (2, 1) on object 2.
@@ -275,7 +276,7 @@ fn a_light_inside_the_mirror_sphere_is_refused() {
     assert!(
         error
             .message
-            .contains("inside the mirror's bounding sphere"),
+            .contains("inside the reflector's bounding sphere"),
         "{}",
         error.message
     );
