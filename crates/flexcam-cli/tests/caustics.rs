@@ -120,7 +120,7 @@ fn bad_caustic_keys_are_refused() {
         ),
         (
             FLAT_MIRROR.replace("material = \"mirror\"", "material = \"diffuse\""),
-            "`caustics` needs material \"mirror\"",
+            "`caustics` needs material \"mirror\" or \"glass\", but \"mirror\" is diffuse",
         ),
         (
             FLAT_MIRROR
@@ -133,7 +133,7 @@ fn bad_caustic_keys_are_refused() {
         ),
         (
             FLAT_MIRROR.replace("position = [0.2, 1.0, 0.1]", "position = [0.0, 2.1, 0.0]"),
-            "inside the mirror's bounding sphere",
+            "inside the reflector's bounding sphere",
         ),
     ];
     for (text, message) in cases {

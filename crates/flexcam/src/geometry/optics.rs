@@ -44,9 +44,76 @@ pub(crate) fn refract(direction: DVec3, normal: DVec3, eta: f64) -> Option<Refra
     })
 }
 
+/// The inverse of [`refract`]: the unit normal `n` (facing the side `incident` arrives from)
+/// about which `incident` refracts into `refracted` with relative index `eta`. Snell's law
+/// in vector form, `refracted - eta incident = (eta cos_i - cos_t) n`, gives `n` up to sign
+/// from the two directions alone (the tangential parts cancel), and of the two roots of
+/// `|refracted| = 1` the transmitted one has `refracted . n = -cos_t < 0`. `None` when no
+/// normal refracts `incident` into `refracted`: `refracted` leaves on `incident`'s side (a
+/// reflection), or `eta = 1` (an index-matched interface bends nothing, so every normal or
+/// none fits).
+pub(crate) fn refraction_normal(incident: DVec3, refracted: DVec3, eta: f64) -> Option<DVec3> {
+    if eta == 1.0 {
+        return None;
+    }
+    let n = (refracted - eta * incident).try_normalize()?;
+    let n = if n.dot(incident) > 0.0 { -n } else { n };
+    (refracted.dot(n) < 0.0).then_some(n)
+}
+
 #[cfg(test)]
 mod tests {
+    use proptest::prelude::*;
+
     use super::*;
+
+    proptest! {
+        /// The normal recovered from a refraction is the normal refracted about, and
+        /// refracting about it again gives the same direction and reflectance.
+        #[test]
+        fn refraction_normal_inverts_refract(
+            (ix, iy, iz) in (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0),
+            (nx, ny, nz) in (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0),
+            eta in prop_oneof![0.3f64..0.99, 1.01f64..3.0],
+        ) {
+            let (Some(i), Some(n)) = (
+                DVec3::new(ix, iy, iz).try_normalize(),
+                DVec3::new(nx, ny, nz).try_normalize(),
+            ) else {
+                return Ok(());
+            };
+            let n = if n.dot(i) > 0.0 { -n } else { n };
+            // Away from grazing incidence, where the refracted direction is the tangent and
+            // the normal is lost in rounding.
+            prop_assume!(-i.dot(n) > 1e-3);
+            let Some(r) = refract(i, n, eta) else {
+                return Ok(());
+            };
+            // Away from the critical angle (cos_t = 0), where the same happens leaving.
+            prop_assume!(-r.direction.dot(n) > 1e-3);
+            let back = refraction_normal(i, r.direction, eta).unwrap();
+            prop_assert!((back - n).length() < 1e-9, "{back} against {n}");
+            let again = refract(i, back, eta).unwrap();
+            prop_assert!((again.direction - r.direction).length() < 1e-9);
+            prop_assert!((again.reflectance - r.reflectance).abs() < 1e-9);
+            // A refraction turns a ray by less than 90 degrees (`refracted . incident =
+            // eta sin^2 + cos_i cos_t >= 0`), so a reflection turned by more is none.
+            let mirrored = reflect(i, n);
+            if mirrored.dot(i) < 0.0 {
+                prop_assert_eq!(refraction_normal(i, mirrored, eta), None);
+            }
+        }
+    }
+
+    #[test]
+    fn refraction_normal_degenerate_cases() {
+        let d = DVec3::new(1.0, -1.0, 0.0).normalize();
+        // Index-matched: nothing to recover.
+        assert_eq!(refraction_normal(d, d, 1.0), None);
+        // Normal incidence: the direction itself, against it.
+        let n = refraction_normal(DVec3::NEG_Y, DVec3::NEG_Y, 1.0 / 1.5).unwrap();
+        assert!((n - DVec3::Y).length() < 1e-15, "{n}");
+    }
 
     #[test]
     fn reflection_keeps_tangent_and_flips_normal_component() {

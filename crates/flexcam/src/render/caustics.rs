@@ -53,6 +53,8 @@
 //! map from); a light inside the mirror's bounding sphere has no map that frames it and is
 //! refused.
 
+#[cfg(test)]
+mod glass_tests;
 mod photon_map;
 mod splat;
 #[cfg(test)]

@@ -1,34 +1,36 @@
-//! The photon-location map of one mirror and point light (the first pass of the caustics,
-//! module doc of [`super`]): a square pinhole image from the light framing the mirror's
-//! bounding sphere, each texel holding where the light's ray through its centre lands after
-//! one reflection in the mirror, and the caustic triangles its neighbouring texels make.
+//! The photon-location map of one mirror or glass object and point light (the first pass
+//! of the caustics, module doc of [`super`]): a square pinhole image from the light framing
+//! the object's bounding sphere, each texel holding where the light's ray through its centre
+//! lands after one reflection in the mirror (one refraction into the glass), with the
+//! fraction of the light carried on, and the caustic triangles its neighbouring texels make.
 
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 
 use super::receives;
 use crate::error::{Error, Result};
-use crate::geometry::optics::reflect;
+use crate::geometry::optics::{refract, refraction_normal};
 use crate::projection::trilinear_builders::{
     reflector_surface, Optic, SurfaceRays, SurfaceScreenMap,
 };
-use crate::projection::{CameraFrame, Perspective, Projection};
+use crate::projection::{CameraFrame, Perspective, Projection, Trilinear};
 use crate::render::composite::{perspective_as_trilinear, without, Reflector};
 use crate::render::prepared::PreparedScene;
 use crate::render::shading::normals;
+use crate::render::shading::trace::specular;
 use crate::render::{Frame, Method, Outputs, RenderOptions, Shading, Stats};
 use crate::scene::{CausticReflector, Finish, Mesh, Scene};
 use crate::try_alloc;
 
-/// How a photon-location map is made: through the mirror's camera triangles by a method
+/// How a photon-location map is made: through the reflector's camera triangles by a method
 /// that renders trilinear projections, or exactly by tracing every texel's ray.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(in crate::render) enum PhotonSource {
-    /// The mirror's reflection surface seen from the light, rendered by this method
-    /// (camera triangles or trilinear).
+    /// The reflector's reflection (refraction) surface seen from the light, rendered by
+    /// this method (camera triangles or trilinear).
     Surface(Method),
-    /// The ray caster's exact mirror: each texel's light ray reflected about the mirror's
-    /// interpolated normal where it hits it (the reference).
+    /// The ray caster's exact mirror or glass: each texel's light ray reflected (refracted)
+    /// about the reflector's interpolated normal where it hits it (the reference).
     Exact,
 }
 
@@ -47,11 +49,14 @@ impl PhotonSource {
     }
 }
 
-/// Where one photon lands: a receiver point and the receiver's object id.
+/// Where one photon lands: a receiver point and the receiver's object id, and the fraction
+/// of the light it carries on past the reflector (1 for a mirror; `1 - F` for glass, `F` the
+/// Fresnel reflectance where the light's ray meets it).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(in crate::render) struct Photon {
     pub point: DVec3,
     pub id: u32,
+    pub transmittance: f64,
 }
 
 /// A triangle of light on a receiver: its corners, the receiver's id and its irradiance
@@ -68,15 +73,15 @@ pub(in crate::render) struct PhotonMap {
     pub camera: Perspective,
     pub size: u32,
     pub photons: Vec<Option<Photon>>,
-    /// The counters of the render through the mirror's reflection surface (with camera
+    /// The counters of the render through the reflector's surface (with camera
     /// triangles: `camera_triangles`, `bounding_fragments`, ...); empty for the exact map.
     pub counters: Stats,
 }
 
 impl PhotonMap {
-    /// The map of `caustic`'s mirror lit from `light`, made as `source` says. The scene's
-    /// trilinear reflectors and caustics play no part (the map's renders are plain).
-    /// Errors: those of [`light_camera`]; a mirror that is not one (see [`Reflector::of`]);
+    /// The map of `caustic`'s mirror or glass lit from `light`, made as `source` says. The
+    /// scene's trilinear reflectors and caustics play no part (the map's renders are plain).
+    /// Errors: those of [`light_camera`]; a reflector that is neither (see [`Reflector::of`]);
     /// the method's own; memory that cannot be had for the map (module `try_alloc`).
     pub fn render(
         prepared: &PreparedScene,
@@ -90,14 +95,9 @@ impl PhotonMap {
         let camera = light_camera(light, &reflector.mesh, caustic.map_size)?;
         let (photons, counters) = match source {
             PhotonSource::Exact => (exact(prepared, caustic.id, &camera)?, Stats::new()),
-            PhotonSource::Surface(method) => through_surface(
-                prepared,
-                caustic.id,
-                &reflector.mesh,
-                &camera,
-                method,
-                options,
-            )?,
+            PhotonSource::Surface(method) => {
+                through_surface(prepared, caustic.id, &reflector, &camera, method, options)?
+            }
         };
         Ok(PhotonMap {
             camera,
@@ -120,10 +120,11 @@ impl PhotonMap {
     }
 
     /// The caustic triangles of the map for a light whose radiant intensity times the
-    /// mirror's reflectance is `reflected` (per channel): every texel square `(x, y)`,
+    /// reflector's tint is `reflected` (per channel): every texel square `(x, y)`,
     /// `(x + 1, y + 1)` split along its diagonal from `(x + 1, y)` to `(x, y + 1)`, each half
-    /// whose three photons lie on one object, with irradiance `reflected Ω_a / A` (module
-    /// doc of [`super`]); halves of zero area are left out.
+    /// whose three photons lie on one object, with irradiance `reflected Ω_a T / A`, `T` the
+    /// mean of its photons' transmittances (module doc of [`super`]); halves of zero area
+    /// are left out.
     pub fn caustic_triangles(&self, reflected: Vec3) -> Vec<CausticTriangle> {
         let n = self.size;
         let at = |x: u32, y: u32| self.photons[(y * n + x) as usize];
@@ -149,10 +150,12 @@ impl PhotonMap {
                             return None;
                         }
                         let beam = solid_angle(texels.map(|(x, y)| self.direction(x, y)));
+                        let carried =
+                            (p0.transmittance + p1.transmittance + p2.transmittance) / 3.0;
                         Some(CausticTriangle {
                             points,
                             id: p0.id,
-                            irradiance: reflected * (beam / area) as f32,
+                            irradiance: reflected * (beam * carried / area) as f32,
                         })
                     })
                 })
@@ -189,9 +192,9 @@ pub(in crate::render) fn light_camera(light: DVec3, mesh: &Mesh, size: u32) -> R
     let distance = (centre - light).length();
     if distance.is_nan() || distance <= radius || !centre.is_finite() {
         return Err(Error::new(format!(
-            "a caustic's point light at ({}, {}, {}) lies inside the mirror's bounding sphere \
-             (centre ({:.3}, {:.3}, {:.3}), radius {radius:.3}): move it out to map the \
-             mirror from it",
+            "a caustic's point light at ({}, {}, {}) lies inside the reflector's bounding \
+             sphere (centre ({:.3}, {:.3}, {:.3}), radius {radius:.3}): move it out to map \
+             the reflector from it",
             light.x, light.y, light.z, centre.x, centre.y, centre.z
         )));
     }
@@ -224,24 +227,26 @@ fn plain<'a>(method: Method, options: &RenderOptions<'a>) -> RenderOptions<'a> {
     }
 }
 
-/// The photons of the mirror `id`'s reflection surface seen from `camera` (built from the
-/// mirror's mesh and the light, projective screen map: each texel takes the surface's rays
-/// at the mirror point its light ray meets), the scene without the mirror rendered through
-/// it by `method`; a texel holds a photon where the scene from the light (the mirror made
-/// diffuse, by the trilinear method through the pinhole as two projection triangles) sees
-/// the mirror first and the surface's ray lands on a receiver. Also the counters of the
-/// render through the surface (none where the light sees no surface).
+/// The photons of reflector `id`'s reflection or refraction surface seen from `camera`
+/// (built from the reflector's mesh, optic and the light, projective screen map: each texel
+/// takes the surface's rays at the reflector point its light ray meets), the scene without
+/// the reflector rendered through it by `method`; a texel holds a photon where the scene
+/// from the light (the reflector made diffuse, by the trilinear method through the pinhole
+/// as two projection triangles) sees the reflector first and the surface's ray lands on a
+/// receiver. A refracted photon carries [`surface_transmittance`]; a texel where that has
+/// none holds no photon. Also the counters of the render through the surface (none where
+/// the light sees no surface).
 fn through_surface(
     prepared: &PreparedScene,
     id: u32,
-    mesh: &Mesh,
+    reflector: &Reflector,
     camera: &Perspective,
     method: Method,
     options: &RenderOptions,
 ) -> Result<(Vec<Option<Photon>>, Stats)> {
     let scene = prepared.scene();
     let n = camera.resolution().0 as usize;
-    let Some(surface) = reflector_surface(mesh, camera, Optic::Reflect)?.projection(
+    let Some(surface) = reflector_surface(&reflector.mesh, camera, reflector.optic)?.projection(
         SurfaceScreenMap::Projective,
         SurfaceRays::Interpolated,
         n as u32,
@@ -274,13 +279,49 @@ fn through_surface(
         }
         let centre = DVec2::new((k % n) as f64 + 0.5, (k / n) as f64 + 0.5);
         let ray = surface.ray(centre)?;
-        let point = ray.origin + ray.direction.normalize() * f64::from(reflected.depth[k]);
+        let direction = ray.direction.normalize();
+        let transmittance = match reflector.optic {
+            Optic::Reflect => 1.0,
+            Optic::Refract { ior } => {
+                let incident = camera.ray(centre)?.direction;
+                surface_transmittance(&surface, centre, incident, direction, ior)?
+            }
+        };
         Some(Photon {
-            point,
+            point: ray.origin + direction * f64::from(reflected.depth[k]),
             id: receiver,
+            transmittance,
         })
     };
     Ok((photons(n, photon)?, counters))
+}
+
+/// The Fresnel transmittance `1 - F` of a refraction surface of index `ior` at screen point
+/// `centre` of `surface` (a map texel), where the light's unit ray `incident` becomes the
+/// surface's interpolated unit ray `refracted`. The normal it was refracted about follows
+/// from the two directions ([`refraction_normal`]); the side (entering, relative index
+/// `1 / ior`, or leaving, `ior`) from the winding of the surface's triangle there, as the
+/// ray caster decides it by the face hit. `None` where no normal refracts `incident` into
+/// `refracted` (an interpolation of total internal reflections, which the surface's vertex
+/// rays turn into mirror reflections, or no triangle there); `1` for `ior` 1 (no
+/// interface).
+fn surface_transmittance(
+    surface: &Trilinear,
+    centre: DVec2,
+    incident: DVec3,
+    refracted: DVec3,
+    ior: f64,
+) -> Option<f64> {
+    if ior == 1.0 {
+        return Some(1.0);
+    }
+    let (triangle, _, _) = surface.locate(centre)?;
+    let mesh = surface.mesh();
+    let [a, b, c] = mesh.triangles[triangle].map(|k| mesh.points[k as usize]);
+    let entering = incident.dot((b - a).cross(c - a)) <= 0.0;
+    let eta = if entering { 1.0 / ior } else { ior };
+    let normal = refraction_normal(incident, refracted, eta)?;
+    refract(incident, normal, eta).map(|r| 1.0 - r.reflectance)
 }
 
 /// `scene` without trilinear reflectors or caustics: what a map's renders see.
@@ -291,10 +332,12 @@ fn plain_scene(scene: &Scene) -> Scene {
     plain
 }
 
-/// The exact photons of mirror `id` seen from `camera`: each texel's light ray through the
-/// whole scene; where its first hit is the mirror, reflected about the mirror's interpolated
-/// shading normal there (as the ray caster's mirror reflects) and traced through the scene
-/// without the mirror.
+/// The exact photons of reflector `id` seen from `camera`: each texel's light ray through
+/// the whole scene; where its first hit is the reflector, reflected or refracted about its
+/// interpolated shading normal there as the ray caster's mirror and glass do
+/// ([`specular`]), carrying the glass's Fresnel transmittance, and traced through the scene
+/// without the reflector (one refraction, as the refraction surface has it). A texel under
+/// total internal reflection holds no photon (the light stays on the light's side).
 fn exact(prepared: &PreparedScene, id: u32, camera: &Perspective) -> Result<Vec<Option<Photon>>> {
     let scene = prepared.scene();
     let others = prepared.view(without(scene, id));
@@ -303,23 +346,30 @@ fn exact(prepared: &PreparedScene, id: u32, camera: &Perspective) -> Result<Vec<
         let centre = DVec2::new((k % n) as f64 + 0.5, (k / n) as f64 + 0.5);
         let ray = camera.ray(centre)?;
         let hit = prepared.intersect(&ray)?;
-        let mirror = &scene.objects[hit.object];
-        if mirror.id != id {
+        let reflector = &scene.objects[hit.object];
+        if reflector.id != id {
             return None;
         }
         let seen = normals(
-            mirror,
+            reflector,
             hit.triangle,
             hit.barycentric,
             ray.direction.as_vec3(),
         );
-        let direction = reflect(ray.direction, seen.shading.as_dvec3());
-        let out = prepared.spawn(ray.at(hit.t), seen.geometric.as_dvec3(), direction);
+        let finish = reflector.material.finish;
+        let sent = specular(&ray, &seen, finish);
+        let transmittance = match (finish, sent.fresnel) {
+            (Finish::Glass { .. }, Some((_, reflectance))) => 1.0 - f64::from(reflectance),
+            (Finish::Glass { .. }, None) => return None,
+            _ => 1.0,
+        };
+        let out = prepared.spawn(ray.at(hit.t), seen.geometric.as_dvec3(), sent.main);
         let landed = others.intersect(&out)?;
         let receiver = scene.objects[landed.object].id;
         receives(scene, receiver).then(|| Photon {
             point: out.at(landed.t),
             id: receiver,
+            transmittance,
         })
     };
     photons(n, photon)

@@ -13,7 +13,7 @@ use crate::render::{Counter, Method, Outputs, RenderOptions, Shading, Stats};
 use crate::scene::{self, Light, Mesh, Scene};
 
 /// The two photon maps compared: through camera triangles, and exact.
-const SOURCES: [PhotonSource; 2] = [
+pub(super) const SOURCES: [PhotonSource; 2] = [
     PhotonSource::Surface(Method::CameraTriangles),
     PhotonSource::Exact,
 ];
@@ -27,7 +27,7 @@ fn caustics_scene() -> Scene {
 }
 
 /// The scene's first point light: position and radiant intensity.
-fn point_light(scene: &Scene) -> (DVec3, Vec3) {
+pub(super) fn point_light(scene: &Scene) -> (DVec3, Vec3) {
     scene
         .lights
         .iter()
@@ -42,7 +42,7 @@ fn point_light(scene: &Scene) -> (DVec3, Vec3) {
         .unwrap()
 }
 
-fn map_of(scene: &Scene, source: PhotonSource) -> PhotonMap {
+pub(super) fn map_of(scene: &Scene, source: PhotonSource) -> PhotonMap {
     let prepared = PreparedScene::new(scene);
     let (light, _) = point_light(scene);
     PhotonMap::render(
@@ -56,7 +56,7 @@ fn map_of(scene: &Scene, source: PhotonSource) -> PhotonMap {
 }
 
 /// The scene's pinhole at `width` x `height`.
-fn eye(scene: &Scene, width: u32, height: u32) -> Perspective {
+pub(super) fn eye(scene: &Scene, width: u32, height: u32) -> Perspective {
     let ProjectionSpec::Perspective { frame, fov } = &scene.projection else {
         panic!("not perspective")
     };
@@ -217,6 +217,7 @@ fn degenerate_map_triangles_carry_no_light() {
         Some(Photon {
             point: DVec3::new(x, 0.0, z),
             id,
+            transmittance: 1.0,
         })
     };
     // Texel (x, y) at k = 3 y + x. The row y = 0 collinear with (0, 1); (2, 1) on object 2.
@@ -275,7 +276,7 @@ fn a_light_inside_the_mirror_sphere_is_refused() {
     assert!(
         error
             .message
-            .contains("inside the mirror's bounding sphere"),
+            .contains("inside the reflector's bounding sphere"),
         "{}",
         error.message
     );

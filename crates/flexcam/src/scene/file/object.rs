@@ -255,10 +255,11 @@ pub(super) fn trilinear_reflector(
 
 /// The object's caustic entry (object id `id`) if it asks for `caustics = true`, with the
 /// span of that key (the scene's lights are checked against it once they are read): the
-/// mirror's reflection of each point light is then added as a caustic in `lit` shading,
+/// mirror's reflection (the glass's refraction) of each point light is then added as a
+/// caustic in `lit` shading,
 /// through a photon-location map of `caustic_map` texels a side (default
-/// [`CausticReflector::DEFAULT_MAP_SIZE`]). Errors, at the key: a part that is not a mirror,
-/// a scene whose projection is not perspective (the caustics are splatted into the main
+/// [`CausticReflector::DEFAULT_MAP_SIZE`]). Errors, at the key: a part that is neither
+/// mirror nor glass, parts of different materials (or glass of different indices), a scene whose projection is not perspective (the caustics are splatted into the main
 /// camera's image), a `caustic_map` outside [`CausticReflector::MAP_SIZES`], or
 /// `caustic_map` without `caustics = true`.
 pub(super) fn caustic_reflector(
@@ -295,15 +296,38 @@ pub(super) fn caustic_reflector(
             }
         }
     };
-    if let Some(part) = parts.iter().find(|p| p.material.finish != Finish::Mirror) {
+    let focuses = |finish| matches!(finish, Finish::Mirror | Finish::Glass { .. });
+    if let Some(part) = parts.iter().find(|p| !focuses(p.material.finish)) {
         return Err(src.error(
             &flag.span(),
             format!(
-                "`caustics` needs material \"mirror\", but \"{}\" is {}",
+                "`caustics` needs material \"mirror\" or \"glass\", but \"{}\" is {}",
                 part.name,
                 surface_name(part.material.finish)
             ),
         ));
+    }
+    let named = |finish| match finish {
+        Finish::Glass { ior } => format!("glass of index {ior}"),
+        finish => surface_name(finish).to_string(),
+    };
+    if let [first, rest @ ..] = parts {
+        if let Some(part) = rest
+            .iter()
+            .find(|p| p.material.finish != first.material.finish)
+        {
+            return Err(src.error(
+                &flag.span(),
+                format!(
+                    "`caustics` needs one material for the whole object, but \"{}\" is {} \
+                     and \"{}\" is {}",
+                    first.name,
+                    named(first.material.finish),
+                    part.name,
+                    named(part.material.finish)
+                ),
+            ));
+        }
     }
     if !matches!(projection, ProjectionSpec::Perspective { .. }) {
         return Err(src.error(
