@@ -5,12 +5,9 @@ use std::path::Path;
 
 use glam::{DVec3, Vec3};
 
-use super::photon_map::{solid_angle, triangle_area, CausticTriangle};
-use super::splat::splat;
-use super::tests::{eye, map_of, point_light, SOURCES};
+use super::photon_map::{solid_angle, CausticTriangle};
+use super::tests::{caustic_power, eye_irradiance, map_of, point_light, SOURCES};
 use crate::geometry::optics::refract;
-use crate::render::prepared::PreparedScene;
-use crate::render::{Method, Outputs, RenderOptions, Shading};
 use crate::scene::{self, Finish, Scene};
 
 fn glass_scene() -> Scene {
@@ -202,11 +199,7 @@ fn refraction_caustics_carry_the_light_the_glass_lets_through() {
     }
     let tinted = intensity * glass.material.color;
     for source in SOURCES {
-        let triangles = map_of(&scene, source).caustic_triangles(tinted);
-        let power: f64 = triangles
-            .iter()
-            .map(|t| f64::from(t.irradiance.x) * triangle_area(t.points))
-            .sum();
+        let power = caustic_power(&scene, source, tinted);
         let want = f64::from(tinted.x) * through;
         let lost = 1.0 - power / want;
         eprintln!("{source:?}: power {power:.5}, I tint ∫T dΩ {want:.5}, lost {lost:.5}");
@@ -222,25 +215,7 @@ fn refraction_caustics_carry_the_light_the_glass_lets_through() {
 fn camera_triangle_refraction_caustic_matches_the_exact_one() {
     let mut scene = glass_scene();
     scene.caustics[0].map_size = 128;
-    let (width, height) = (160, 120);
-    let eye = eye(&scene, width, height);
-    let prepared = PreparedScene::new(&scene);
-    let options = RenderOptions {
-        composite_reflectors: false,
-        shading: Shading::Flat,
-        outputs: Outputs::ALL,
-        ..RenderOptions::default()
-    };
-    let main = Method::Raycast.render(&prepared, &eye, &options).unwrap().0;
-    let (_, intensity) = point_light(&scene);
-    let tinted = intensity * scene.objects[0].material.color;
-    let irradiance = |source| {
-        let triangles = map_of(&scene, source).caustic_triangles(tinted);
-        let mut e = vec![Vec3::ZERO; main.color.len()];
-        splat(&eye, &main.ids, &main.depth, &triangles, &mut e).unwrap();
-        e
-    };
-    let [ours, exact] = SOURCES.map(irradiance);
+    let [ours, exact] = eye_irradiance(&scene, 160, 120);
     let (mut difference, mut total, mut lit) = (0.0, 0.0, 0);
     let (mut inner_difference, mut inner_total) = (0.0, 0.0);
     for (a, b) in ours.iter().zip(&exact) {

@@ -68,6 +68,39 @@ pub(super) fn eye(scene: &Scene, width: u32, height: u32) -> Perspective {
 /// mirror (1 x 1, facing down at y = 2) over a floor at y = 0, the light at y = 1 between
 /// them: every caustic triangle's irradiance is the closed form at its centroid, to the
 /// second-order difference between a triangle's mean and its centroid's value.
+/// The power `Σ E A` the caustic triangles of `scene`'s first caustic object carry (red
+/// channel), the light tinted by `tint`, photons from `source`.
+pub(super) fn caustic_power(scene: &Scene, source: PhotonSource, tint: Vec3) -> f64 {
+    map_of(scene, source)
+        .caustic_triangles(tint)
+        .iter()
+        .map(|t| f64::from(t.irradiance.x) * triangle_area(t.points))
+        .sum()
+}
+
+/// The caustic irradiance splatted into the eye's view (`eye`, `width` x `height`), per
+/// pixel, from each photon source of [`SOURCES`] in turn (the light tinted by the first
+/// object's colour); both splat onto the exact main view's ids and depth.
+pub(super) fn eye_irradiance(scene: &Scene, width: u32, height: u32) -> [Vec<Vec3>; 2] {
+    let eye = eye(scene, width, height);
+    let prepared = PreparedScene::new(scene);
+    let options = RenderOptions {
+        composite_reflectors: false,
+        shading: Shading::Flat,
+        outputs: Outputs::ALL,
+        ..RenderOptions::default()
+    };
+    let main = Method::Raycast.render(&prepared, &eye, &options).unwrap().0;
+    let (_, intensity) = point_light(scene);
+    let tint = intensity * scene.objects[0].material.color;
+    SOURCES.map(|source| {
+        let triangles = map_of(scene, source).caustic_triangles(tint);
+        let mut e = vec![Vec3::ZERO; main.color.len()];
+        splat(&eye, &main.ids, &main.depth, &triangles, &mut e).unwrap();
+        e
+    })
+}
+
 #[test]
 fn flat_mirror_gives_the_mirrored_light() {
     let text = r#"
@@ -148,11 +181,7 @@ fn caustics_carry_the_light_the_mirror_reflects() {
         .sum();
     let reflected = intensity * mirror.material.color;
     for source in SOURCES {
-        let triangles = map_of(&scene, source).caustic_triangles(reflected);
-        let power: f64 = triangles
-            .iter()
-            .map(|t| f64::from(t.irradiance.x) * triangle_area(t.points))
-            .sum();
+        let power = caustic_power(&scene, source, reflected);
         let want = f64::from(reflected.x) * mirror_angle;
         let lost = 1.0 - power / want;
         eprintln!("{source:?}: power {power:.5}, I R Ω_mirror {want:.5}, lost {lost:.5}");
@@ -170,25 +199,7 @@ fn caustics_carry_the_light_the_mirror_reflects() {
 fn camera_triangle_caustic_matches_the_exact_one() {
     let mut scene = caustics_scene();
     scene.caustics[0].map_size = 128;
-    let (width, height) = (160, 120);
-    let eye = eye(&scene, width, height);
-    let prepared = PreparedScene::new(&scene);
-    let options = RenderOptions {
-        composite_reflectors: false,
-        shading: Shading::Flat,
-        outputs: Outputs::ALL,
-        ..RenderOptions::default()
-    };
-    let main = Method::Raycast.render(&prepared, &eye, &options).unwrap().0;
-    let (_, intensity) = point_light(&scene);
-    let reflected = intensity * scene.objects[0].material.color;
-    let irradiance = |source| {
-        let triangles = map_of(&scene, source).caustic_triangles(reflected);
-        let mut e = vec![Vec3::ZERO; main.color.len()];
-        splat(&eye, &main.ids, &main.depth, &triangles, &mut e).unwrap();
-        e
-    };
-    let [ours, exact] = SOURCES.map(irradiance);
+    let [ours, exact] = eye_irradiance(&scene, 160, 120);
     let (mut difference, mut total, mut lit) = (0.0, 0.0, 0);
     for (a, b) in ours.iter().zip(&exact) {
         if *a != Vec3::ZERO || *b != Vec3::ZERO {
