@@ -51,7 +51,7 @@ pub(crate) fn advise_huge_pages<T>(values: &mut [T]) {
 /// mapped are left as they are. Elsewhere, or where the call fails (an older kernel), the
 /// pages are mapped by the writes as before; no byte changes either way. A region under
 /// [`POPULATE_MIN`] bytes is left to its page faults.
-pub(crate) fn populate_for_writing<T>(values: &mut [T]) {
+fn populate_for_writing<T>(values: &mut [T]) {
     #[cfg(target_os = "linux")]
     {
         let Some(page) = page_size() else {
@@ -105,9 +105,16 @@ fn page_size() -> Option<usize> {
 pub(crate) fn reserve_mapped<T>(values: &mut Vec<T>, additional: usize) {
     if values.capacity() - values.len() < additional {
         values.reserve(additional);
-        advise_huge_pages(values.spare_capacity_mut());
-        populate_for_writing(values.spare_capacity_mut());
+        map_spare_capacity(values);
     }
+}
+
+/// Maps the spare capacity of `values`, about to be written once, at once: advised onto
+/// huge pages ([`advise_huge_pages`]) and populated ([`populate_for_writing`]). The values
+/// are unchanged.
+pub(crate) fn map_spare_capacity<T>(values: &mut Vec<T>) {
+    advise_huge_pages(values.spare_capacity_mut());
+    populate_for_writing(values.spare_capacity_mut());
 }
 
 /// The size of an x86-64 transparent huge page (2 MiB): smaller ranges are not advised.

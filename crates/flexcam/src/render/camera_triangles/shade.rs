@@ -9,7 +9,7 @@ use glam::{DVec2, Vec2, Vec3};
 
 use super::camera::Camera;
 use super::fragment::BandBuffer;
-use crate::render::prepared::{Hit, PreparedScene};
+use crate::render::prepared::PreparedScene;
 use crate::render::scan::{FrameRows, NO_PRIMITIVE};
 use crate::render::shading::triangle_color::TriangleColor;
 use crate::render::trilinear::SceneGeometry;
@@ -53,12 +53,7 @@ impl Shader<'_> {
             let color = match flat {
                 Some(color) => color.at(barycentric),
                 None => {
-                    let hit = Hit {
-                        t,
-                        object: owner.object as usize,
-                        triangle: owner.triangle as usize,
-                        barycentric,
-                    };
+                    let hit = owner.hit(t, barycentric);
                     let (color, cast) = self.prepared.shade_hit(&ray, hit, self.options);
                     rays += cast;
                     color

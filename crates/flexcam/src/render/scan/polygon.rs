@@ -7,7 +7,7 @@
 use glam::DVec2;
 
 use super::interpolate::Varying;
-use crate::render::huge_pages::{advise_huge_pages, populate_for_writing};
+use crate::render::huge_pages::map_spare_capacity;
 
 /// Largest accepted magnitude of any vertex component (coordinates, depth, attributes). Within
 /// it every difference and interpolation the rasteriser computes is finite; shapes beyond it
@@ -140,13 +140,12 @@ impl<const N: usize> PolygonBatch<N> {
     /// An empty batch with room for `vertices` vertices in `shapes` shapes: a caller that
     /// knows the sizes up front pays no regrowth (each a copy of the batch so far into
     /// fresh memory). The vertices' storage, which the caller is to fill, is fresh memory
-    /// written once: it is advised onto huge pages ([`advise_huge_pages`]) and mapped at
-    /// once ([`populate_for_writing`]), one system call instead of a page fault per 4 KiB
-    /// (a trilinear frame of 108,000 outline points fills 8.7 MB).
+    /// written once: it is mapped at once ([`map_spare_capacity`]: huge pages advised, one
+    /// system call instead of a page fault per 4 KiB; a trilinear frame of 108,000 outline
+    /// points fills 8.7 MB).
     pub fn with_capacity(vertices: usize, shapes: usize) -> Self {
         let mut vertices = Vec::with_capacity(vertices);
-        advise_huge_pages(vertices.spare_capacity_mut());
-        populate_for_writing(vertices.spare_capacity_mut());
+        map_spare_capacity(&mut vertices);
         PolygonBatch {
             vertices,
             shapes: Vec::with_capacity(shapes),

@@ -5,10 +5,11 @@
 
 use std::collections::HashMap;
 
-use glam::DVec3;
+use glam::{DVec3, Vec2};
 
 use super::cull_tree::{Cluster, CullTree};
 use super::hit_terms::HitTerms;
+use crate::render::prepared::Hit;
 use crate::scene::Scene;
 
 /// Which object triangle a scene triangle is.
@@ -20,6 +21,19 @@ pub struct Owner {
     pub id: u32,
     /// Index of the triangle in the object's mesh.
     pub triangle: u32,
+}
+
+impl Owner {
+    /// The hit on this triangle at ray parameter `t` and `barycentric`, as the ray caster
+    /// reports one (for its shading).
+    pub fn hit(&self, t: f64, barycentric: Vec2) -> Hit {
+        Hit {
+            t,
+            object: self.object as usize,
+            triangle: self.triangle as usize,
+            barycentric,
+        }
+    }
 }
 
 /// Every scene vertex (f64, world space) and triangle.

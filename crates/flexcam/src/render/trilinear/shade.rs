@@ -205,12 +205,7 @@ impl Shader<'_> {
                     .and_then(|map| map.projector(self.resolver.position(x, run.y)));
                 match projector {
                     Some(projector) => {
-                        let hit = Hit {
-                            t,
-                            object: owner.object as usize,
-                            triangle: owner.triangle as usize,
-                            barycentric: Vec2::from(drawn.barycentrics[i]),
-                        };
+                        let hit = owner.hit(t, Vec2::from(drawn.barycentrics[i]));
                         let depth = (t * projector.direction.length()) as f32;
                         *slot = Some((projector.ray(), hit, depth));
                     }
@@ -400,15 +395,9 @@ impl Shader<'_> {
         let flat = self.flat_colors.and_then(|colors| colors[k].as_ref());
         let (color, rays) = match flat {
             Some(color) => (color.at(barycentric), 0),
-            None => {
-                let hit = Hit {
-                    t,
-                    object: owner.object as usize,
-                    triangle: owner.triangle as usize,
-                    barycentric,
-                };
-                self.prepared.shade_hit_lazy(ray, hit, self.options)
-            }
+            None => self
+                .prepared
+                .shade_hit_lazy(ray, owner.hit(t, barycentric), self.options),
         };
         Pixel {
             color,

@@ -256,10 +256,10 @@ pub(super) fn trilinear_reflector(
 /// The object's caustic entry (object id `id`) if it asks for `caustics = true`, with the
 /// span of that key (the scene's lights are checked against it once they are read): the
 /// mirror's reflection (the glass's refraction) of each point light is then added as a
-/// caustic in `lit` shading,
-/// through a photon-location map of `caustic_map` texels a side (default
-/// [`CausticReflector::DEFAULT_MAP_SIZE`]). Errors, at the key: a part that is neither
-/// mirror nor glass, parts of different materials (or glass of different indices), a scene whose projection is not perspective (the caustics are splatted into the main
+/// caustic in `lit` shading, through a photon-location map of `caustic_map` texels a side
+/// (default [`CausticReflector::DEFAULT_MAP_SIZE`]). Errors, at the key: a part that is
+/// neither mirror nor glass, parts of different materials (or glass of different indices),
+/// a scene whose projection is not perspective (the caustics are splatted into the main
 /// camera's image), a `caustic_map` outside [`CausticReflector::MAP_SIZES`], or
 /// `caustic_map` without `caustics = true`.
 pub(super) fn caustic_reflector(
