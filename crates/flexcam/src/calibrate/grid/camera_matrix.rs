@@ -139,6 +139,15 @@ impl CameraMatrix {
         self.rows.map(|row| row.map(|v| v * self.facing))
     }
 
+    /// The image position (u, v) of `point`, `None` where it is not in front of the camera
+    /// (at zero or negative depth, the points' side being the front).
+    pub(super) fn project(&self, point: DVec3) -> Option<DVec2> {
+        let h = point.extend(1.0).to_array();
+        let row = |i: usize| (0..4).map(|c| self.rows[i][c] * h[c]).sum::<f64>();
+        let w = row(2);
+        (w * self.facing > 0.0).then(|| DVec2::new(row(0) / w, row(1) / w))
+    }
+
     /// The direction from the eye of the projector of image position `uv`, towards the
     /// points (unnormalised; affine in (u, v)).
     pub(super) fn direction(&self, uv: DVec2) -> DVec3 {

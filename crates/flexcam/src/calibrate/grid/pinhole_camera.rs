@@ -19,7 +19,9 @@
 //! image (Zhang 2000): with K = diag(f, f, 1), the columns h1, h2 of H ~ K (r1 r2 t) give
 //! r1 . r2 = 0 and |r1| = |r2|, two equations linear in 1 / f^2, solved by least squares
 //! (the prior's focal length where they give none within `FOCAL_RANGE` of it); the pose
-//! then from K^-1 H's columns, (r1, r2) made orthonormal.
+//! then from K^-1 H's columns, (r1, r2) made orthonormal. Where every start keeps a point
+//! behind it (the best plane of nearly coplanar points tilted by one point off it), the
+//! starts are moved back along their viewing axes until every point is in front.
 //!
 //! The principal point: where there are at least `PRINCIPAL_MIN_POINTS` (9) points, not
 //! coplanar (the camera matrix exists), and the focal length is determined, the 9-unknown
@@ -75,6 +77,10 @@ const FOCAL_SPREAD: f64 = 0.25;
 /// start (a focal length of thousands of image widths, an eye as far) is where the descent
 /// would stay.
 const FOCAL_RANGE: f64 = 100.0;
+
+/// The least depth (in the points' spread) of every point in front of a start
+/// ([`Data::in_front`]).
+const FRONT_MARGIN: f64 = 0.25;
 
 /// The least noise (image widths) the focal length's standard error is computed with: exact
 /// data miss by rounding only, and a focal length they leave free must still show as free.
@@ -209,12 +215,7 @@ impl PinholeCamera {
             ..pose
         };
         let starts = [general.map(centred), data.start_of_homography(None)];
-        let (best, best_ss) = starts
-            .into_iter()
-            .flatten()
-            .filter_map(|start| data.refine(start, Unknowns::Focal))
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-            .ok_or(Undetermined::NotInFront)?;
+        let (best, best_ss) = data.refine_best(&starts, Unknowns::Focal)?;
         let chosen = general
             .and_then(|start| data.off_centre(start, best, best_ss))
             .unwrap_or(best);
@@ -229,12 +230,10 @@ impl PinholeCamera {
             eye: best.eye * (shape.focal / best.focal),
             ..best
         };
-        let (pose, _) = [Some(rescaled), data.start_of_homography(Some(shape.focal))]
-            .into_iter()
-            .flatten()
-            .filter_map(|start| data.refine(start, Unknowns::Pose))
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-            .ok_or(Undetermined::NotInFront)?;
+        let (pose, _) = data.refine_best(
+            &[Some(rescaled), data.start_of_homography(Some(shape.focal))],
+            Unknowns::Pose,
+        )?;
         Ok(data.camera(pose, true))
     }
 
@@ -274,7 +273,6 @@ impl PinholeCamera {
     }
 
     /// The image position of `point`, `None` where it is not in front of the camera.
-    #[cfg(test)]
     pub(super) fn project(&self, point: DVec3) -> Option<DVec2> {
         let c = self.rotation * (point - self.eye);
         (c.z > 0.0).then(|| self.uv_of(self.focal * DVec2::new(c.x, c.y) / c.z + self.principal))
@@ -407,14 +405,25 @@ impl Data {
         let q2 = lambda * row_y - (lambda * row_y).dot(r3) * r3;
         let fy = q2.length();
         let r2 = q2 / fy;
-        let q1 = lambda * row_x - (lambda * row_x).dot(r3) * r3 - (lambda * row_x).dot(r2) * r2;
-        let fx = q1.length();
-        let r1 = q1 / fx;
-        // A reflection: the data are of the other handedness (square image y flipped).
-        let (r2, principal, handedness) = if r1.dot(r2.cross(r3)) < 0.0 {
-            (-r2, DVec2::new(principal.x, -principal.y), -handedness)
+        // The first row is the unit vector across r2 and r3, so that the rotation is one to
+        // rounding even where the camera matrix is nearly degenerate (nearly coplanar points:
+        // its rows nearly dependent, where subtracting their projections would leave a
+        // first row of rounding error, not orthogonal to the others); fx is the row's
+        // component along it.
+        let across = r2.cross(r3);
+        let along = (lambda * row_x).dot(across);
+        let fx = along.abs();
+        // A reflection (the row runs against r2 x r3): the data are of the other handedness
+        // (square image y flipped).
+        let (r1, r2, principal, handedness) = if along < 0.0 {
+            (
+                -across,
+                -r2,
+                DVec2::new(principal.x, -principal.y),
+                -handedness,
+            )
         } else {
-            (r2, principal, handedness)
+            (across, r2, principal, handedness)
         };
         let pose = Pose {
             focal: 0.5 * (fx + fy),
@@ -550,6 +559,56 @@ impl Data {
                 (next.focal > 0.0).then_some(next)
             },
         )
+    }
+
+    /// The least-error refinement of `unknowns` from any of `starts`; where every start keeps
+    /// a point behind it (inconsistent or nearly coplanar data with a point off the plane),
+    /// from the starts moved back until every point is in front ([`Data::in_front`]).
+    /// `NotInFront` where no refinement can begin even so.
+    fn refine_best(
+        &self,
+        starts: &[Option<Pose>],
+        unknowns: Unknowns,
+    ) -> Result<(Pose, f64), Undetermined> {
+        let best = |moved: bool| {
+            starts
+                .iter()
+                .flatten()
+                .filter_map(|start| match moved {
+                    false => Some(*start),
+                    true => self.in_front(*start),
+                })
+                .filter_map(|start| self.refine(start, unknowns))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+        };
+        best(false)
+            .or_else(|| best(true))
+            .ok_or(Undetermined::NotInFront)
+    }
+
+    /// `pose` with its eye moved back along its viewing axis until every point lies in front
+    /// of it by at least `FRONT_MARGIN` (the points' spread is 1): a start from the points'
+    /// best plane (the homography's) or from a camera matrix whose eye lies among nearly
+    /// coplanar points may keep a point off that plane behind it, where the descent cannot
+    /// begin; moving back keeps the view's direction, and the descent then fits focal length
+    /// and eye. `pose` unchanged where every point is in front; `None` for a non-finite pose.
+    fn in_front(&self, pose: Pose) -> Option<Pose> {
+        let forward = pose.rotation.row(2);
+        let nearest = self
+            .points
+            .iter()
+            .map(|p| forward.dot(*p - pose.eye))
+            .fold(f64::INFINITY, f64::min);
+        if !nearest.is_finite() {
+            return None;
+        }
+        if nearest >= FRONT_MARGIN {
+            return Some(pose);
+        }
+        Some(Pose {
+            eye: pose.eye - (FRONT_MARGIN - nearest) * forward,
+            ..pose
+        })
     }
 
     /// Whether the data leave `pose`'s focal length undetermined: its standard error (the
