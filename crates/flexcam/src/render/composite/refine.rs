@@ -68,7 +68,7 @@
 //!   triangle); edges still over the tolerance at the cap (or below [`MIN_EDGE_PX`]) are
 //!   left as they are and counted ([`Refinement::unsplit`]);
 //! - **a glass's silhouette**: where the eye's ray enters the glass at one end of an edge
-//!   and leaves it at the other ([`Refiner::across_silhouette`]), the exact image itself
+//!   (or its midpoint) and leaves it at another ([`across_silhouette`]), the exact image itself
 //!   jumps (the grazing ray refracted to the critical angle on one side, a ray going on
 //!   nearly straight on the other), so the edge's error stays over any tolerance however
 //!   short it gets; such edges are split down to [`MIN_EDGE_PX`], which confines the jump to
@@ -117,7 +117,7 @@ pub struct Refinement {
     /// Edges still over the tolerance, left unsplit at the depth cap [`MAX_LEVEL`] or
     /// because they are shorter than [`MIN_EDGE_PX`] on screen, silhouette edges aside.
     pub unsplit: usize,
-    /// Edges across a glass's silhouette ([`Refiner::across_silhouette`]) split down to
+    /// Edges across a glass's silhouette ([`across_silhouette`]) split down to
     /// shorter than [`MIN_EDGE_PX`]: the exact image jumps inside them, so no split
     /// brings their error within a tolerance; the jump is confined to under a pixel.
     pub silhouette: usize,
@@ -429,7 +429,7 @@ impl<'a> Refiner<'a> {
             return None;
         }
         let short = sp.pixel.distance(sq.pixel) < MIN_EDGE_PX;
-        if short && self.across_silhouette(&sp, &sq) {
+        if short && across_silhouette(self.optic, [&sp, &sq, &sm]) {
             self.silhouette += 1;
             return None;
         }
@@ -481,14 +481,6 @@ impl<'a> Refiner<'a> {
         }
     }
 
-    /// Whether the eye's ray enters a glass at one end of an edge and leaves it at the other:
-    /// the edge crosses the glass's silhouette, where the exact image jumps (a ray grazing
-    /// the front is bent to the critical angle, one just past it goes on nearly straight).
-    /// Mirrors have no such jump (a grazing reflection is the incident ray on either side).
-    fn across_silhouette(&self, sp: &Sample, sq: &Sample) -> bool {
-        matches!(self.optic, Optic::Refract { .. }) && sp.entering != sq.entering
-    }
-
     /// Whether the screen segment from `a` to `b` lies beyond one side of the main image
     /// (both ends left of it, right of it, above or below it): no pixel sees it.
     fn off_image(&self, a: DVec2, b: DVec2) -> bool {
@@ -509,6 +501,16 @@ impl<'a> Refiner<'a> {
             _ => 0.0,
         }
     }
+}
+
+/// Whether the eye's ray enters a glass (`optic`) at one of an edge's `samples` (its ends
+/// and its midpoint) and leaves it at another: the edge crosses the glass's silhouette,
+/// where the exact image jumps (a ray grazing the front is bent to the critical angle, one
+/// just past it goes on nearly straight). Mirrors have no such jump (a grazing reflection
+/// is the incident ray on either side).
+fn across_silhouette(optic: Optic, samples: [&Sample; 3]) -> bool {
+    matches!(optic, Optic::Refract { .. })
+        && samples.iter().any(|s| s.entering != samples[0].entering)
 }
 
 /// The angle between `a` and `b` (any lengths), accurate for small angles; 0 if either is
