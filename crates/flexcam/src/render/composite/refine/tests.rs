@@ -2,7 +2,6 @@ use glam::{DVec2, DVec3, Vec3};
 
 use super::*;
 use crate::projection::trilinear_builders::{reflector_surface, ReflectorSurface};
-use crate::projection::ProjectionSpec;
 use crate::scene::reflector_fixtures::{
     camera, lens_plane, sphere_and_cube, ReflectorFixture, BALL,
 };
