@@ -1,19 +1,21 @@
 //! End-to-end tests of caustics (object key `caustics = true`, docs/camera-triangles.md):
-//! `flexcam render` adds the caustic of the example scene by camera triangles and by the ray
-//! caster's exact photon map, `flexcam compare` measures one against the other, and bad
-//! caustic keys fail with one line naming the file and key.
+//! `flexcam render` adds the caustic of the example scenes (mirror and glass) by camera
+//! triangles and by the ray caster's exact photon map, `flexcam compare` measures one against
+//! the other, and bad caustic keys fail with one line naming the file and key.
 
 use tempfile::TempDir;
 
 mod common;
-use common::{run, run_json};
+use common::{run, run_json, run_ok};
 
-/// The example scene, by absolute path (its model is relative to it).
+/// The example scene `name`, by absolute path (its model is relative to it).
+fn scene_path(name: &str) -> String {
+    format!("{}/../../scenes/{name}.toml", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The mirror example.
 fn example() -> String {
-    format!(
-        "{}/../../scenes/camtri-caustics.toml",
-        env!("CARGO_MANIFEST_DIR")
-    )
+    scene_path("camtri-caustics")
 }
 
 /// Both photon maps light the floor: the stats count photons, caustic triangles and lit
@@ -77,6 +79,50 @@ fn compare_measures_the_caustic_against_the_exact_one() {
     let report = run_json(&dir, &args);
     let rgb = report["relative_rgb_error"].as_f64().unwrap();
     assert!(rgb < 0.05, "{report}");
+}
+
+/// The glass example at its own size: both photon maps light the floor; the main view's
+/// refraction surface counts the edges across the cap's silhouette (where the exact image
+/// jumps) apart, and the warning names only the edges over the tolerance; the lit frame,
+/// caustic included, is close to the ray caster's.
+#[test]
+fn the_glass_caustic_renders_by_camera_triangles_and_ray_casting() {
+    let dir = TempDir::new().unwrap();
+    let scene = scene_path("camtri-caustic-glass");
+    for method in ["camera-triangles", "raycast"] {
+        let args = [
+            "render", &scene, "--method", method, "--stats", "-", "-o", "g.png",
+        ];
+        let out = run_ok(&dir, &args);
+        let stats: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert!(stats["caustic_pixels"].as_u64().unwrap() > 1000, "{stats}");
+        if method == "camera-triangles" {
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            let unsplit = stats["reflector_unsplit_edges"].as_u64().unwrap();
+            assert!(
+                stats["reflector_silhouette_edges"].as_u64().unwrap() > 0,
+                "{stats}"
+            );
+            assert!(
+                unsplit == 0 || stderr.contains(&format!("{unsplit} edges")),
+                "{stderr}"
+            );
+        }
+    }
+    let args = [
+        "compare",
+        &scene,
+        "--method",
+        "camera-triangles",
+        "--shading",
+        "lit",
+        "--json",
+    ];
+    let report = run_json(&dir, &args);
+    assert!(
+        report["relative_rgb_error"].as_f64().unwrap() < 0.05,
+        "{report}"
+    );
 }
 
 const FLAT_MIRROR: &str = r#"

@@ -64,8 +64,10 @@ type Renderer<'a> =
 /// exactly instead: [`ExactPixels`]; none without `RenderOptions::cast_reflector_gaps`),
 /// `reflector_unsplit_edges` (edges the refinement left over its tolerance at its depth cap
 /// or below a pixel: [`refine`]; a [`RenderWarning::ReflectorOverTolerance`] for each
-/// reflector that has such edges) and `reflector_render_ms` (surface refinement, building
-/// and rendering).
+/// reflector that has such edges), `reflector_silhouette_edges` (edges across a glass's
+/// silhouette, where the exact image jumps, split down to a pixel:
+/// [`refine::Refinement::silhouette`]) and `reflector_render_ms` (surface refinement,
+/// building and rendering).
 ///
 /// Errors: the renderer's; a main view that is not a pinhole ([`main_camera`]);
 /// a reflector id that no object has, or whose material is not mirror or glass.
@@ -112,7 +114,7 @@ fn with_renderer(
     let (mut triangles, mut dropped, mut pixels, mut fresnel_rays) = (0, 0, 0, 0);
     let exact = ExactPixels::new(prepared, &camera, options);
     let (mut exact_pixels, mut uncovered_pixels) = (0, 0);
-    let (mut unsplit, mut warnings) = (0, Vec::new());
+    let (mut unsplit, mut silhouettes, mut warnings) = (0, 0, Vec::new());
     for entry in &scene.trilinear_reflectors {
         let (id, map) = (entry.id, entry.screen_map);
         let reflector = Reflector::of(scene, id)?;
@@ -122,8 +124,9 @@ fn with_renderer(
                  refracted by interpolated rays only)"
             )));
         }
-        let (surface, mut left) =
+        let (surface, mut left, silhouette) =
             refined_surface(&reflector, reflector.optic, entry, &camera, options.method)?;
+        silhouettes += silhouette;
         triangles += surface.mesh.triangles.len();
         dropped += surface.dropped;
         let projection = surface_projection(&surface, map, entry.camera_rays, &camera)?;
@@ -171,7 +174,7 @@ fn with_renderer(
                     paste(&mut frame, id, &image, reflector.tint)?
                 }
                 (Shading::Lit | Shading::Transitions(_), Optic::Refract { .. }) => {
-                    let (mirror, mirror_left) = refined_surface(
+                    let (mirror, mirror_left, mirror_silhouette) = refined_surface(
                         &reflector,
                         Optic::Reflect,
                         entry,
@@ -179,6 +182,7 @@ fn with_renderer(
                         options.method,
                     )?;
                     left += mirror_left;
+                    silhouettes += mirror_silhouette;
                     let rays = entry.camera_rays;
                     let reflection = match surface_projection(&mirror, map, rays, &camera)? {
                         Some(surface) => through(&surface, Optic::Reflect)?.0,
@@ -219,6 +223,7 @@ fn with_renderer(
     stats.insert("reflector_uncovered_pixels", count(uncovered_pixels));
     stats.insert("reflector_exact_pixels", count(exact_pixels));
     stats.insert("reflector_unsplit_edges", count(unsplit));
+    stats.insert("reflector_silhouette_edges", count(silhouettes));
     stats.insert(
         "reflector_render_ms",
         Counter::Value(start.elapsed().as_secs_f64() * 1e3),
@@ -424,19 +429,19 @@ impl Reflector {
 /// The surface of `reflector` for `optic` seen by `camera`, rendered by `method`: its camera
 /// mesh ([`camera_mesh`]: the given size as it is, or, refined with `entry`'s screen map and
 /// tolerance ([`refine`]), the automatic size for camera triangles and the reflector's own
-/// mesh for the other methods), and the number of edges left over the tolerance (see
-/// [`refine::Refinement::unsplit`]).
+/// mesh for the other methods), the number of edges left over the tolerance and the number
+/// split down to a pixel across a glass's silhouette (see [`refine::Refinement`]).
 fn refined_surface(
     reflector: &Reflector,
     optic: Optic,
     entry: &TrilinearReflector,
     camera: &Perspective,
     method: Method,
-) -> Result<(ReflectorSurface, usize)> {
+) -> Result<(ReflectorSurface, usize, usize)> {
     let automatic = method == Method::CameraTriangles;
     let chosen = camera_mesh(&reflector.mesh, entry, camera, optic, automatic)?;
     if !chosen.refine {
-        return Ok((reflector_surface(&*chosen.mesh, camera, optic)?, 0));
+        return Ok((reflector_surface(&*chosen.mesh, camera, optic)?, 0, 0));
     }
     let refined = refine::refine(
         &chosen.mesh,
@@ -448,6 +453,7 @@ fn refined_surface(
     Ok((
         reflector_surface(&refined.mesh, camera, optic)?,
         refined.unsplit,
+        refined.silhouette,
     ))
 }
 

@@ -63,11 +63,6 @@ pub(super) fn eye(scene: &Scene, width: u32, height: u32) -> Perspective {
     Perspective::new(frame, *fov, width, height).unwrap()
 }
 
-/// A flat mirror focuses nothing: its caustic is the mirrored light's direct light,
-/// `E = R I cos θ / d²` from the light mirrored in the mirror's plane (module doc). The
-/// mirror (1 x 1, facing down at y = 2) over a floor at y = 0, the light at y = 1 between
-/// them: every caustic triangle's irradiance is the closed form at its centroid, to the
-/// second-order difference between a triangle's mean and its centroid's value.
 /// The power `Σ E A` the caustic triangles of `scene`'s first caustic object carry (red
 /// channel), the light tinted by `tint`, photons from `source`.
 pub(super) fn caustic_power(scene: &Scene, source: PhotonSource, tint: Vec3) -> f64 {
@@ -101,6 +96,11 @@ pub(super) fn eye_irradiance(scene: &Scene, width: u32, height: u32) -> [Vec<Vec
     })
 }
 
+/// A flat mirror focuses nothing: its caustic is the mirrored light's direct light,
+/// `E = R I cos θ / d²` from the light mirrored in the mirror's plane (module doc). The
+/// mirror (1 x 1, facing down at y = 2) over a floor at y = 0, the light at y = 1 between
+/// them: every caustic triangle's irradiance is the closed form at its centroid, to the
+/// second-order difference between a triangle's mean and its centroid's value.
 #[test]
 fn flat_mirror_gives_the_mirrored_light() {
     let text = r#"

@@ -67,6 +67,13 @@
 //!   a tolerance far below a pixel, cannot explode: at most 4,096 triangles per reflector
 //!   triangle); edges still over the tolerance at the cap (or below [`MIN_EDGE_PX`]) are
 //!   left as they are and counted ([`Refinement::unsplit`]);
+//! - **a glass's silhouette**: where the eye's ray enters the glass at one end of an edge
+//!   (or its midpoint) and leaves it at another ([`across_silhouette`]), the exact image itself
+//!   jumps (the grazing ray refracted to the critical angle on one side, a ray going on
+//!   nearly straight on the other), so the edge's error stays over any tolerance however
+//!   short it gets; such edges are split down to [`MIN_EDGE_PX`], which confines the jump to
+//!   a band under a pixel wide, and counted apart ([`Refinement::silhouette`]), not as over
+//!   the tolerance;
 //! - **a mesh without vertex normals, or a zero normal**: the area-weighted face normal, as
 //!   [`reflector_surface`](crate::projection::trilinear_builders::reflector_surface) uses at the
 //!   original vertices; the refined surface then converges to that smooth mirror, not to the
@@ -77,7 +84,9 @@ use std::collections::HashMap;
 
 use glam::{DVec2, DVec3, Vec3};
 
-use crate::projection::trilinear_builders::{vertex_normals, vertex_ray, Optic, SurfaceScreenMap};
+use crate::projection::trilinear_builders::{
+    enters, vertex_normals, vertex_ray, Optic, SurfaceScreenMap,
+};
 use crate::projection::{ContinuousInverse, Perspective, Projection};
 use crate::scene::Mesh;
 
@@ -106,8 +115,12 @@ pub struct Refinement {
     /// coordinates or colours (a surface uses neither).
     pub mesh: Mesh,
     /// Edges still over the tolerance, left unsplit at the depth cap [`MAX_LEVEL`] or
-    /// because they are shorter than [`MIN_EDGE_PX`] on screen.
+    /// because they are shorter than [`MIN_EDGE_PX`] on screen, silhouette edges aside.
     pub unsplit: usize,
+    /// Edges across a glass's silhouette ([`across_silhouette`]) split down to
+    /// shorter than [`MIN_EDGE_PX`]: the exact image jumps inside them, so no split
+    /// brings their error within a tolerance; the jump is confined to under a pixel.
+    pub silhouette: usize,
 }
 
 /// Refines `reflector` (a world-space mesh) for the surface of `optic` seen by the main
@@ -125,6 +138,7 @@ pub fn refine(
         return Refinement {
             mesh: reflector.clone(),
             unsplit: 0,
+            silhouette: 0,
         };
     }
     refine_where(
@@ -163,6 +177,7 @@ fn refine_where(
             ..Mesh::default()
         },
         unsplit: refiner.unsplit,
+        silhouette: refiner.silhouette,
     }
 }
 
@@ -175,6 +190,8 @@ struct Sample {
     /// `unit` times the vertex's distance from the eye (projective map), or `unit` (affine).
     interpolated: DVec3,
     pixel: DVec2,
+    /// Whether the eye's ray enters the reflector there ([`enters`]).
+    entering: bool,
 }
 
 /// An edge's level and, once decided, its midpoint vertex (`Some(None)`: not split).
@@ -201,6 +218,7 @@ struct Refiner<'a> {
     canonical: Vec<u32>,
     edges: HashMap<(u32, u32), Edge>,
     unsplit: usize,
+    silhouette: usize,
 }
 
 impl<'a> Refiner<'a> {
@@ -228,6 +246,7 @@ impl<'a> Refiner<'a> {
             canonical,
             edges: HashMap::new(),
             unsplit: 0,
+            silhouette: 0,
         };
         refiner.samples = (0..refiner.positions.len())
             .map(|k| refiner.sample_at(refiner.positions[k], refiner.normals[k], refiner.faces[k]))
@@ -245,6 +264,7 @@ impl<'a> Refiner<'a> {
         let normal = normal.as_dvec3().try_normalize()?;
         let pixel = self.camera.project_continuous(point)?.pixel;
         let unit = vertex_ray(incident, normal, face, self.optic);
+        let entering = enters(incident, normal, face);
         let interpolated = match self.map {
             SurfaceScreenMap::Projective => point.distance(eye) * unit,
             SurfaceScreenMap::Affine => unit,
@@ -254,6 +274,7 @@ impl<'a> Refiner<'a> {
             unit,
             interpolated,
             pixel,
+            entering,
         })
     }
 
@@ -407,7 +428,12 @@ impl<'a> Refiner<'a> {
         if self.off_image(sp.pixel, sq.pixel) {
             return None;
         }
-        if level >= MAX_LEVEL || sp.pixel.distance(sq.pixel) < MIN_EDGE_PX {
+        let short = sp.pixel.distance(sq.pixel) < MIN_EDGE_PX;
+        if short && across_silhouette(self.optic, [&sp, &sq, &sm]) {
+            self.silhouette += 1;
+            return None;
+        }
+        if level >= MAX_LEVEL || short {
             self.unsplit += 1;
             return None;
         }
@@ -475,6 +501,16 @@ impl<'a> Refiner<'a> {
             _ => 0.0,
         }
     }
+}
+
+/// Whether the eye's ray enters a glass (`optic`) at one of an edge's `samples` (its ends
+/// and its midpoint) and leaves it at another: the edge crosses the glass's silhouette,
+/// where the exact image jumps (a ray grazing the front is bent to the critical angle, one
+/// just past it goes on nearly straight). Mirrors have no such jump (a grazing reflection
+/// is the incident ray on either side).
+fn across_silhouette(optic: Optic, samples: [&Sample; 3]) -> bool {
+    matches!(optic, Optic::Refract { .. })
+        && samples.iter().any(|s| s.entering != samples[0].entering)
 }
 
 /// The angle between `a` and `b` (any lengths), accurate for small angles; 0 if either is

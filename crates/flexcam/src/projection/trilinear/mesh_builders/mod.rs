@@ -30,6 +30,6 @@ pub use camera::GridCamera;
 pub use grid::{between_surfaces, screen_grid, screen_grid_cells, GridVertex, MAX_GRID_CELLS};
 pub(crate) use reflector::vertex_normals;
 pub use reflector::{
-    reflector_surface, vertex_ray, Optic, ReflectorSurface, SurfaceRays, SurfaceScreenMap,
+    enters, reflector_surface, vertex_ray, Optic, ReflectorSurface, SurfaceRays, SurfaceScreenMap,
 };
 pub use visualisation::{inward_sphere, DetailInContext, FocusView, TwoViews};

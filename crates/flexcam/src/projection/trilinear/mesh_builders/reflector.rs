@@ -49,7 +49,7 @@ pub enum Optic {
 /// A zero `face` (a vertex of degenerate triangles only) takes `normal` as the face.
 pub fn vertex_ray(incident: DVec3, normal: DVec3, face: DVec3, optic: Optic) -> DVec3 {
     let face = if face == DVec3::ZERO { normal } else { face };
-    let entering = incident.dot(face) <= 0.0;
+    let entering = enters(incident, normal, face);
     let towards_ray = if entering { face } else { -face };
     let normal = if normal.dot(towards_ray) < 0.0 {
         -normal
@@ -64,6 +64,14 @@ pub fn vertex_ray(incident: DVec3, normal: DVec3, face: DVec3, optic: Optic) -> 
                 .map_or_else(|| reflect(incident, normal), |r| r.direction)
         }
     }
+}
+
+/// Whether a ray of direction `incident` arrives at a vertex against its face normal `face`
+/// (a zero `face` takes the shading normal `normal`), entering a glass rather than leaving
+/// it: the side [`vertex_ray`] refracts from.
+pub fn enters(incident: DVec3, normal: DVec3, face: DVec3) -> bool {
+    let face = if face == DVec3::ZERO { normal } else { face };
+    incident.dot(face) <= 0.0
 }
 
 /// How a surface's screen positions map to barycentrics of its projection triangles.
