@@ -231,8 +231,8 @@ pub fn refine_around(
         [a, middle, b].map(|x| map.pixel(x.u, x.v)),
         [a, middle, b].map(|x| denominator.at(x)),
     );
-    // `!(<=)`: a NaN bound bisects.
-    if !(bound > tolerance) {
+    // A NaN bound (never returned, but) bisects.
+    if bound <= tolerance {
         return;
     }
     refine(path, map, (a, middle), tolerance, levels - 1, out);
