@@ -24,6 +24,7 @@
 //! docs/trilinear-raster.md lists these cases.
 
 mod central;
+mod chord_error;
 mod clip;
 #[cfg(test)]
 mod cull_tests;

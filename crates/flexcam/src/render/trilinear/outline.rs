@@ -6,9 +6,7 @@ use glam::DVec3;
 
 use super::central::CentralProjection;
 use super::clip::DOMAIN_MARGIN;
-use super::edge_path::{
-    refine_around, CrossingQuadratic, EdgePath, EdgeSurface, Forced, OutlinePoint,
-};
+use super::edge_path::{refine_around, CrossingQuadratic, EdgePath, EdgeSurface, OutlinePoint};
 use super::ray_fan::RayFan;
 use super::screen_map::ScreenMap;
 use super::volume_bounds::VolumeBounds;
@@ -22,13 +20,9 @@ pub enum Sampling<'a> {
     Anchors,
     /// The given depths (the shape's slices, ascending), where they fall on the edge.
     Slices(&'a [f64]),
-    /// Bisection to the screen tolerance, at most `levels` deep, the first `forced` levels
-    /// whatever the tolerance on pieces near the degenerate depths (`edge_path::refine`).
-    Adaptive {
-        tolerance: f64,
-        levels: u32,
-        forced: Forced,
-    },
+    /// Bisection to the screen tolerance, bounded over each whole piece, at most `levels`
+    /// deep (`edge_path::refine`).
+    Adaptive { tolerance: f64, levels: u32 },
 }
 
 /// One projection triangle as the outline tracer needs it.
@@ -356,18 +350,9 @@ fn sample_piece(
                 out[before..].reverse();
             }
         }
-        Sampling::Adaptive {
-            tolerance,
-            levels,
-            forced,
-        } => refine_around(
-            path,
-            &triangle.map,
-            (a, middle, b),
-            tolerance,
-            (levels, forced),
-            out,
-        ),
+        Sampling::Adaptive { tolerance, levels } => {
+            refine_around(path, &triangle.map, (a, middle, b), tolerance, levels, out)
+        }
     }
 }
 

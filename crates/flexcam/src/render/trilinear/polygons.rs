@@ -12,7 +12,7 @@ use super::central;
 use super::clip::clip_outline;
 use super::curves::{CurveMode, CurveOptions, ADAPTIVE_TOLERANCE_PX};
 use super::degenerate_band::DegenerateBand;
-use super::edge_path::{EdgePath, Forced, OutlinePoint};
+use super::edge_path::{EdgePath, OutlinePoint};
 use super::hit_terms::TERMS;
 use super::outline::{
     depth_range, is_outside_domain, slice_depths, trace_outline, EdgeCrossings, ProjectionTriangle,
@@ -65,16 +65,14 @@ pub fn projection_triangles(projection: &Trilinear) -> Vec<ProjectionTriangle> {
         .collect()
 }
 
-/// Bisection levels of adaptive sampling taken whatever the screen tolerance in projection
-/// triangles whose parametric triangle degenerates at some depth: near that depth an edge's
-/// image swings far out and back within one piece, and the test at the middle alone can
-/// miss it (measured on the crossing rays above cube-floor's cube, the test
-/// `projection_triangles_degenerating_inside_the_scene_are_split_there`: 0.0064 relative
-/// RGB error with none, 0.0005 with 3, exact with 5), on the pieces of an edge near the
-/// degenerate depths ([`Forced`]: a piece far from them, relative to its depth extent, is
-/// bisected by the tolerance alone). Slicing takes `2 << FORCED_LEVELS` slices there at
-/// least (10: 0.001; 50: exact).
-const FORCED_LEVELS: u32 = 5;
+/// The least slices per shape in a projection triangle whose parametric triangle
+/// degenerates at some depth: near that depth an edge's image swings far out and back
+/// between two slices, and few slices miss it (measured on the crossing rays above
+/// cube-floor's cube, the test
+/// `projection_triangles_degenerating_inside_the_scene_are_split_there`: 10 slices 0.001
+/// relative RGB error, 50 exact). Adaptive sampling needs no such floor: its error bound
+/// covers the whole piece (`edge_path::refine`).
+const LEAST_SLICES_NEAR_DEGENERATE: u32 = 64;
 
 /// Live pairs per parallel work item of the drawing half. Pairs differ in cost by orders of
 /// magnitude (culled at once, or many curved shapes), so items are small and many: rayon
@@ -418,11 +416,11 @@ impl Pair<'_> {
             let mut slices = std::mem::take(&mut scratch.slices);
             let sampling = match self.curves.mode {
                 CurveMode::Slice => {
-                    // In a degenerating triangle twice as many slices as the forced
-                    // bisection's segments at least (the same reason, [`FORCED_LEVELS`]).
-                    let forced = self.forced_levels();
-                    let least = if forced > 0 { 2 << forced } else { 0 };
-                    slice_depths(&shape, self.curves.steps.max(least), &mut slices);
+                    slice_depths(
+                        &shape,
+                        self.curves.steps.max(self.least_slices()),
+                        &mut slices,
+                    );
                     Sampling::Slices(&slices)
                 }
                 _ => {
@@ -430,7 +428,6 @@ impl Pair<'_> {
                     Sampling::Adaptive {
                         tolerance: ADAPTIVE_TOLERANCE_PX,
                         levels,
-                        forced: self.forced(levels),
                     }
                 }
             };
@@ -520,24 +517,11 @@ impl Pair<'_> {
         }
     }
 
-    /// The bisection levels of adaptive sampling at most `levels` deep taken whatever the
-    /// tolerance near the depths where the projection triangle's parametric triangle
-    /// degenerates ([`FORCED_LEVELS`], [`Forced`]), none in a triangle that does not.
-    fn forced(&self, levels: u32) -> Forced {
-        match self.triangle.degenerate {
-            Some(around) => Forced {
-                levels: FORCED_LEVELS.min(levels),
-                around,
-            },
-            None => Forced::NONE,
-        }
-    }
-
-    /// The least slices' bisection levels in a projection triangle whose parametric
-    /// triangle degenerates at some depth ([`FORCED_LEVELS`]), none elsewhere.
-    fn forced_levels(&self) -> u32 {
+    /// The least slices per shape: [`LEAST_SLICES_NEAR_DEGENERATE`] in a projection
+    /// triangle whose parametric triangle degenerates at some depth, none elsewhere.
+    fn least_slices(&self) -> u32 {
         if self.triangle.degenerate.is_some() {
-            FORCED_LEVELS
+            LEAST_SLICES_NEAR_DEGENERATE
         } else {
             0
         }
@@ -668,7 +652,6 @@ pub(super) mod tests {
         let adaptive = Sampling::Adaptive {
             tolerance: ADAPTIVE_TOLERANCE_PX,
             levels: 8,
-            forced: Forced::NONE,
         };
         [Sampling::Anchors, Sampling::Slices(depths), adaptive]
             .map(|sampling| [(sampling, true), (sampling, false)])
