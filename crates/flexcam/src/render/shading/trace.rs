@@ -22,7 +22,7 @@ use glam::{DVec3, Vec3};
 use crate::geometry::optics::{reflect, refract};
 use crate::geometry::Ray;
 use crate::render::prepared::{Hit, PreparedScene};
-use crate::render::shading::{base_color, normals_of_face, Normals, TextureFilter};
+use crate::render::shading::{base_color, Normals, TextureFilter, TriangleBase, VertexNormals};
 use crate::render::{RenderOptions, Shading};
 use crate::scene::{Finish, Light};
 
@@ -228,6 +228,8 @@ impl<'a> HitShader<'a> {
             return colors;
         }
         let mut points: [Option<DiffusePoint>; 4] = [None; 4];
+        // The triangle looked up last: a quad's pixels nearly always lie on one.
+        let mut surface: Option<Surface> = None;
         for lane in 0..4 {
             let Some((ray, hit)) = hits[lane] else {
                 continue;
@@ -237,7 +239,11 @@ impl<'a> HitShader<'a> {
                 colors[lane] = self.lit(ray, hit, 0, 1.0);
                 continue;
             }
-            let (normals, base) = self.lit_surface(ray, &hit);
+            let on = match surface {
+                Some(s) if (s.object, s.triangle) == (hit.object, hit.triangle) => s,
+                _ => *surface.insert(self.surface(&hit)),
+            };
+            let (normals, base) = self.lit_surface_on(&on, ray, &hit);
             let point = DiffusePoint::new(ray, ray.at(hit.t), &normals, base);
             colors[lane] = point.unshadowed(&self.caster.scene.lights);
             points[lane] = Some(point);
@@ -246,10 +252,11 @@ impl<'a> HitShader<'a> {
         let mut rays: [Option<Ray>; 4] = [None; 4];
         let mut added = [Vec3::ZERO; 4];
         for light in &self.caster.scene.lights {
+            let terms = LightTerms::of(light);
             for lane in 0..4 {
                 rays[lane] = None;
                 if let Some(point) = &points[lane] {
-                    if let Some((ray, light_adds)) = point.light(self.caster, light) {
+                    if let Some((ray, light_adds)) = point.light(self.caster, &terms) {
                         rays[lane] = Some(ray);
                         added[lane] = light_adds;
                         self.counts.shadow += 1;
@@ -276,7 +283,7 @@ impl<'a> HitShader<'a> {
         let point = DiffusePoint::new(ray, position, normals, base);
         let mut color = point.unshadowed(&self.caster.scene.lights);
         for light in &self.caster.scene.lights {
-            if let Some((shadow, added)) = point.light(self.caster, light) {
+            if let Some((shadow, added)) = point.light(self.caster, &LightTerms::of(light)) {
                 self.counts.shadow += 1;
                 if !self.caster.occluded(&shadow) {
                     color += added;
@@ -289,30 +296,59 @@ impl<'a> HitShader<'a> {
     /// What lit shading reads of the surface at `hit`: its normals as seen along `ray` and
     /// its base colour (bilinear texels).
     fn lit_surface(&self, ray: &Ray, hit: &Hit) -> (Normals, Vec3) {
+        self.lit_surface_on(&self.surface(hit), ray, hit)
+    }
+
+    /// [`HitShader::lit_surface`] with `hit`'s triangle looked up as `surface`.
+    #[inline]
+    fn lit_surface_on(&self, surface: &Surface, ray: &Ray, hit: &Hit) -> (Normals, Vec3) {
+        let base = surface.base.at(hit.barycentric, TextureFilter::Bilinear);
+        (self.normals_on(&surface.normals, ray, hit), base)
+    }
+
+    /// The normals at `hit` as seen along `ray`, its triangle's vertex normals being
+    /// `vertex`.
+    #[inline]
+    fn normals_on(&self, vertex: &VertexNormals, ray: &Ray, hit: &Hit) -> Normals {
+        let incoming = ray.direction.as_vec3();
+        match self.caster.displaced_face_normal(hit) {
+            Some(face) => Normals::of_face(face, incoming),
+            None => vertex.normals(
+                self.caster.face_normal(hit.object, hit.triangle),
+                hit.barycentric,
+                incoming,
+            ),
+        }
+    }
+
+    /// What shading reads of the triangle `hit` lies on, looked up once for the hits on it.
+    #[inline]
+    fn surface(&self, hit: &Hit) -> Surface<'a> {
         let object = &self.caster.scene.objects[hit.object];
-        let base = base_color(
-            object,
-            hit.triangle,
-            hit.barycentric,
-            TextureFilter::Bilinear,
-        );
-        (self.normals(ray, hit), base)
+        let points = self.caster.object_points(hit.object);
+        Surface {
+            object: hit.object,
+            triangle: hit.triangle,
+            base: TriangleBase::of(object, hit.triangle, points),
+            normals: VertexNormals::of(object, hit.triangle),
+        }
     }
 
     /// The normals at `hit` as seen along `ray`.
     fn normals(&self, ray: &Ray, hit: &Hit) -> Normals {
-        if let Some(face) = self.caster.displaced_face_normal(hit) {
-            return Normals::of_face(face, ray.direction.as_vec3());
-        }
         let object = &self.caster.scene.objects[hit.object];
-        normals_of_face(
-            object,
-            hit.triangle,
-            self.caster.face_normal(hit.object, hit.triangle),
-            hit.barycentric,
-            ray.direction.as_vec3(),
-        )
+        self.normals_on(&VertexNormals::of(object, hit.triangle), ray, hit)
     }
+}
+
+/// What shading reads of one triangle (object index `object`, triangle `triangle` of its
+/// mesh) before the barycentrics of a hit on it.
+#[derive(Debug, Clone, Copy)]
+struct Surface<'a> {
+    object: usize,
+    triangle: usize,
+    base: TriangleBase<'a>,
+    normals: VertexNormals,
 }
 
 /// A diffuse surface point as lit shading sees it, split from its shadow rays so that
@@ -359,36 +395,85 @@ impl DiffusePoint {
         }
     }
 
-    /// The shadow ray towards `light` (spawned off the surface through `caster`) and what
-    /// the light adds when nothing blocks it; `None` where the light is behind the shading
-    /// normal (no ray is cast).
-    fn light(&self, caster: &PreparedScene, light: &Light) -> Option<(Ray, Vec3)> {
-        let (to_light, t_max, radiance) = light_from(light, self.position);
-        let unit = to_light.normalize_or_zero();
+    /// The shadow ray towards the light of `terms` (spawned off the surface through
+    /// `caster`) and what the light adds when nothing blocks it; `None` where the light is
+    /// behind the shading normal (no ray is cast).
+    #[inline]
+    fn light(&self, caster: &PreparedScene, terms: &LightTerms) -> Option<(Ray, Vec3)> {
+        let (to_light, t_max) = terms.to_light(self.position);
+        let unit = terms.unit(to_light);
         if self.normal.dot(unit) <= 0.0 {
             return None;
         }
         let mut shadow = caster.spawn(self.position, self.geometric, to_light);
         shadow.t_max = t_max;
-        Some((shadow, radiance * self.shade(unit)))
+        Some((shadow, terms.radiance * self.shade(unit)))
     }
 }
 
-/// How `light` reaches surface point `position`: the vector to it (not normalised), the
-/// parameter of a shadow ray along that vector that reaches the light (1 for a point light,
-/// infinity for a directional one), and its radiance.
-pub(in crate::render) fn light_from(light: &Light, position: DVec3) -> (DVec3, f64, Vec3) {
-    match *light {
-        Light::Point {
-            position: p,
-            color,
-            intensity,
-        } => (p.as_dvec3() - position, 1.0, color * intensity),
-        Light::Directional {
-            direction,
-            color,
-            intensity,
-        } => (-direction.as_dvec3(), f64::INFINITY, color * intensity),
+/// What shading reads of a light, with the terms that do not depend on the lit point
+/// worked out once (for all the points of a quad): its radiance and, for a directional
+/// light, the vector towards it and its unit direction.
+#[derive(Debug, Clone, Copy)]
+pub(in crate::render) struct LightTerms {
+    pub radiance: Vec3,
+    reach: Reach,
+}
+
+/// Where a light is, as [`LightTerms`] keeps it.
+#[derive(Debug, Clone, Copy)]
+enum Reach {
+    Point(DVec3),
+    /// The vector towards the light and its unit form (zero for a zero direction).
+    Directional { to_light: DVec3, unit: DVec3 },
+}
+
+impl LightTerms {
+    pub fn of(light: &Light) -> LightTerms {
+        match *light {
+            Light::Point {
+                position,
+                color,
+                intensity,
+            } => LightTerms {
+                radiance: color * intensity,
+                reach: Reach::Point(position.as_dvec3()),
+            },
+            Light::Directional {
+                direction,
+                color,
+                intensity,
+            } => {
+                let to_light = -direction.as_dvec3();
+                LightTerms {
+                    radiance: color * intensity,
+                    reach: Reach::Directional {
+                        to_light,
+                        unit: to_light.normalize_or_zero(),
+                    },
+                }
+            }
+        }
+    }
+
+    /// The vector from surface point `position` to the light (not normalised) and the
+    /// parameter of a shadow ray along it that reaches the light (1 for a point light,
+    /// infinity for a directional one).
+    #[inline]
+    pub fn to_light(&self, position: DVec3) -> (DVec3, f64) {
+        match self.reach {
+            Reach::Point(p) => (p - position, 1.0),
+            Reach::Directional { to_light, .. } => (to_light, f64::INFINITY),
+        }
+    }
+
+    /// `to_light` (from [`LightTerms::to_light`]) normalised, zero where it is zero.
+    #[inline]
+    fn unit(&self, to_light: DVec3) -> DVec3 {
+        match self.reach {
+            Reach::Point(_) => to_light.normalize_or_zero(),
+            Reach::Directional { unit, .. } => unit,
+        }
     }
 }
 
