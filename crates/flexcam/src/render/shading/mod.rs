@@ -205,20 +205,21 @@ impl<'a> TriangleBase<'a> {
     #[inline]
     pub fn of(object: &'a Object, triangle: usize, object_points: Option<&[Vec3]>) -> Self {
         let corners = corners(object, triangle);
-        let object_corners = matches!(object.material.pattern, Pattern::Checker { .. }).then(|| {
-            let [a, b, c] = corners;
-            match object_points {
-                Some(points) => [points[a], points[b], points[c]],
-                None => {
-                    let local = |i: usize| {
-                        object
-                            .world_to_object
-                            .transform_point3(object.mesh.positions[i])
-                    };
-                    [local(a), local(b), local(c)]
+        let object_corners =
+            matches!(object.material.pattern, Pattern::Checker { .. }).then(|| {
+                let [a, b, c] = corners;
+                match object_points {
+                    Some(points) => [points[a], points[b], points[c]],
+                    None => {
+                        let local = |i: usize| {
+                            object
+                                .world_to_object
+                                .transform_point3(object.mesh.positions[i])
+                        };
+                        [local(a), local(b), local(c)]
+                    }
                 }
-            }
-        });
+            });
         TriangleBase {
             object,
             corners,
@@ -607,6 +608,45 @@ mod tests {
         );
         o.world_to_object = Affine3A::from_translation(Vec3::X);
         assert_eq!(base_color(&o, 0, b, TextureFilter::Nearest), Vec3::ZERO);
+    }
+
+    /// A triangle's base colour read through [`TriangleBase`] with the object-space points
+    /// kept per vertex is `base_color`'s, bit for bit, for a moved and rotated checker, and
+    /// for a textured, vertex-coloured mesh (which reads no object-space point).
+    #[test]
+    fn triangle_base_with_kept_points_is_base_color() {
+        let mut checker = object(
+            triangle(),
+            Pattern::Checker {
+                other: Vec3::ZERO,
+                size: 0.3,
+            },
+        );
+        checker.world_to_object =
+            Affine3A::from_rotation_y(0.7) * Affine3A::from_translation(Vec3::new(0.31, -2.0, 5.5));
+        let mut mesh = triangle();
+        mesh.uvs = vec![Vec2::ZERO, Vec2::X, Vec2::Y];
+        mesh.colors = vec![Vec3::ONE, Vec3::splat(0.5), Vec3::X];
+        let texture = Texture {
+            width: 2,
+            height: 2,
+            texels: vec![Vec3::ONE, Vec3::splat(0.2), Vec3::splat(0.7), Vec3::X],
+        };
+        let textured = object(mesh, Pattern::Texture(Arc::new(texture)));
+        for o in [&checker, &textured] {
+            let points = object_points(o);
+            assert_eq!(points.len(), o.mesh.positions.len());
+            let kept = TriangleBase::of(o, 0, Some(&points));
+            for i in 0..20 {
+                for j in 0..(20 - i) {
+                    let b = Vec2::new(i as f32 / 20.0 + 0.01, j as f32 / 20.0 + 0.02);
+                    for filter in [TextureFilter::Nearest, TextureFilter::Bilinear] {
+                        let expected = base_color(o, 0, b, filter);
+                        assert_eq!(kept.at(b, filter).to_array(), expected.to_array());
+                    }
+                }
+            }
+        }
     }
 
     /// A floor triangle at object y = 0 (on a checker cell boundary) translated 1e4 from the

@@ -302,8 +302,16 @@ impl<'a> HitShader<'a> {
     /// [`HitShader::lit_surface`] with `hit`'s triangle looked up as `surface`.
     #[inline]
     fn lit_surface_on(&self, surface: &Surface, ray: &Ray, hit: &Hit) -> (Normals, Vec3) {
-        let base = surface.base.at(hit.barycentric, TextureFilter::Bilinear);
+        let base = self.base_color(hit);
         (self.normals_on(&surface.normals, ray, hit), base)
+    }
+
+    /// The base colour at `hit` (bilinear texels), a checker's object-space corners read
+    /// from the points the prepared scene keeps rather than transformed per hit.
+    fn base_color(&self, hit: &Hit) -> Vec3 {
+        let object = &self.caster.scene.objects[hit.object];
+        let points = self.caster.object_points(hit.object);
+        TriangleBase::of(object, hit.triangle, points).at(hit.barycentric, TextureFilter::Bilinear)
     }
 
     /// The normals at `hit` as seen along `ray`, its triangle's vertex normals being
@@ -323,13 +331,11 @@ impl<'a> HitShader<'a> {
 
     /// What shading reads of the triangle `hit` lies on, looked up once for the hits on it.
     #[inline]
-    fn surface(&self, hit: &Hit) -> Surface<'a> {
+    fn surface(&self, hit: &Hit) -> Surface {
         let object = &self.caster.scene.objects[hit.object];
-        let points = self.caster.object_points(hit.object);
         Surface {
             object: hit.object,
             triangle: hit.triangle,
-            base: TriangleBase::of(object, hit.triangle, points),
             normals: VertexNormals::of(object, hit.triangle),
         }
     }
@@ -342,12 +348,13 @@ impl<'a> HitShader<'a> {
 }
 
 /// What shading reads of one triangle (object index `object`, triangle `triangle` of its
-/// mesh) before the barycentrics of a hit on it.
+/// mesh) before the barycentrics of a hit on it: its vertex normals. The base colour is
+/// read per hit (from the kept object-space points): sharing that lookup as well made a
+/// cube-floor frame slower, not faster.
 #[derive(Debug, Clone, Copy)]
-struct Surface<'a> {
+struct Surface {
     object: usize,
     triangle: usize,
-    base: TriangleBase<'a>,
     normals: VertexNormals,
 }
 
@@ -425,7 +432,10 @@ pub(in crate::render) struct LightTerms {
 enum Reach {
     Point(DVec3),
     /// The vector towards the light and its unit form (zero for a zero direction).
-    Directional { to_light: DVec3, unit: DVec3 },
+    Directional {
+        to_light: DVec3,
+        unit: DVec3,
+    },
 }
 
 impl LightTerms {
@@ -501,5 +511,92 @@ pub(crate) fn specular(ray: &Ray, normals: &Normals, finish: Finish) -> Specular
             main: reflected,
             fresnel: None,
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DVec2, DVec3, Vec3};
+
+    use super::*;
+
+    /// The quads of a 2x2 block of pixels of cube-floor (each lane on the checkered floor or
+    /// the vertex-coloured cube, several lanes on one triangle, or none), shaded together,
+    /// are each what shading the hit alone gives, with the same rays counted.
+    #[test]
+    fn a_quads_shading_is_each_hits_shading() {
+        let scene = crate::scene::load("builtin:cube-floor").unwrap();
+        let prepared = PreparedScene::new(&scene);
+        let projection = scene.projection.build(64, 48).unwrap();
+        let options = RenderOptions {
+            shading: Shading::Lit,
+            ..RenderOptions::default()
+        };
+        let mut quads = 0;
+        for top in (0..48).step_by(2) {
+            for left in (0..64).step_by(2) {
+                let rays: Vec<Ray> = [(0, 0), (1, 0), (0, 1), (1, 1)]
+                    .iter()
+                    .map(|&(dx, dy)| {
+                        let centre = DVec2::new(left as f64 + dx as f64, top as f64 + dy as f64);
+                        projection.ray(centre + 0.5).unwrap()
+                    })
+                    .collect();
+                let hits: Vec<Option<Hit>> = rays.iter().map(|r| prepared.intersect(r)).collect();
+                let lane = |k: usize| hits[k].map(|h| (&rays[k], h));
+                let mut shader = HitShader::new(&prepared, &options);
+                let colors = shader.shade_hits4([lane(0), lane(1), lane(2), lane(3)]);
+                let mut counted = 0;
+                for k in 0..4 {
+                    let (alone, rays_alone) = match hits[k] {
+                        Some(hit) => prepared.shade_hit(&rays[k], hit, &options),
+                        None => (scene.image.background, 0),
+                    };
+                    assert_eq!(
+                        colors[k],
+                        alone,
+                        "pixel ({}, {})",
+                        left + k % 2,
+                        top + k / 2
+                    );
+                    counted += rays_alone;
+                }
+                assert_eq!(shader.counts.secondary + shader.counts.shadow, counted);
+                quads += 1;
+            }
+        }
+        assert_eq!(quads, 32 * 24);
+    }
+
+    /// A light's terms are those it gives every point: a point light's vector reaches it at
+    /// t = 1, a directional light's points against its direction with no end; a zero
+    /// direction (degenerate, refused by the scene loader) gives a zero unit vector, and
+    /// then no ray is cast (the shading normal's dot product with it is 0).
+    #[test]
+    fn light_terms_reach_the_light() {
+        let p = DVec3::new(1.0, 2.0, 3.0);
+        let point = LightTerms::of(&Light::Point {
+            position: Vec3::new(4.0, 6.0, 3.0),
+            color: Vec3::new(1.0, 0.5, 0.25),
+            intensity: 2.0,
+        });
+        assert_eq!(point.radiance, Vec3::new(2.0, 1.0, 0.5));
+        assert_eq!(point.to_light(p), (DVec3::new(3.0, 4.0, 0.0), 1.0));
+        let to_point = DVec3::new(3.0, 4.0, 0.0);
+        assert_eq!(point.unit(to_point), to_point.normalize_or_zero());
+        let sun = LightTerms::of(&Light::Directional {
+            direction: Vec3::new(0.0, -2.0, 0.0),
+            color: Vec3::ONE,
+            intensity: 0.5,
+        });
+        assert_eq!(sun.radiance, Vec3::splat(0.5));
+        assert_eq!(sun.to_light(p), (DVec3::new(0.0, 2.0, 0.0), f64::INFINITY));
+        assert_eq!(sun.unit(DVec3::new(0.0, 2.0, 0.0)), DVec3::Y);
+        let zero = LightTerms::of(&Light::Directional {
+            direction: Vec3::ZERO,
+            color: Vec3::ONE,
+            intensity: 1.0,
+        });
+        assert_eq!(zero.unit(zero.to_light(p).0), DVec3::ZERO);
     }
 }
