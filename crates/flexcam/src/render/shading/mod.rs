@@ -187,9 +187,10 @@ pub fn base_color(
     TriangleBase::of(object, triangle, None).at(barycentric, filter)
 }
 
-/// What [`base_color`] reads of one triangle, looked up once for every hit on it: its
-/// vertex indices and, for a checker, its corners in object space. [`TriangleBase::at`] of a
-/// hit is `base_color`'s, the same arithmetic on the same values.
+/// What [`base_color`] reads of one triangle: its vertex indices and, for a checker, its
+/// corners in object space, transformed or read from points kept per mesh vertex (lit
+/// shading reads the prepared scene's). [`TriangleBase::at`] of a hit is `base_color`'s,
+/// the same arithmetic on the same values.
 #[derive(Debug, Clone, Copy)]
 pub struct TriangleBase<'a> {
     object: &'a Object,
