@@ -28,8 +28,8 @@ use crate::render::bvh::curve_triangle::CurveTriangle;
 use crate::render::bvh::triangle::FastRay;
 use crate::render::bvh::{AllTriangles, Bvh, BvhHit, Keep, TriangleMask};
 use crate::render::displaced::DisplacedSet;
-use crate::render::shading::face_normal;
-use crate::scene::Scene;
+use crate::render::shading::{face_normal, object_points};
+use crate::scene::{Object, Pattern, Scene};
 
 mod displaced_hits;
 mod transition_hits;
@@ -88,6 +88,10 @@ pub struct PreparedScene {
     /// in the numbering of `first_triangle`: the lit shading of each hit reads it instead
     /// of computing it.
     face_normals: Arc<[Vec3]>,
+    /// The mesh positions in object space of every checkered object (`None` for the
+    /// others), by object index: lit shading reads a hit's object-space corners here
+    /// ([`crate::render::shading::TriangleBase`]) instead of transforming them per hit.
+    object_points: Vec<Option<Arc<[Vec3]>>>,
     /// Working memory a renderer leaves for the next render of this scene
     /// ([`PreparedScene::keep_spare`]): the raster's z-buffer, bins and pixel projectors, so
     /// that a sequence of frames (a viewer editing its projection) does not allocate and
@@ -124,6 +128,11 @@ fn occluded_shown(bvh: &Bvh, ray: &FastRay, mask: &TriangleMask) -> bool {
 #[inline(never)]
 fn occluded4_shown(bvh: &Bvh, rays: [Option<&FastRay>; 4], mask: &TriangleMask) -> [bool; 4] {
     bvh.occluded4(rays, mask)
+}
+
+/// Whether `object`'s pattern is a checker, which reads the object-space point of a hit.
+fn checkered(object: &Object) -> bool {
+    matches!(object.material.pattern, Pattern::Checker { .. })
 }
 
 /// The secondary-ray offset of `scene`: [`OFFSET_SCALE`] of its largest coordinate magnitude.
@@ -189,8 +198,12 @@ impl PreparedScene {
             .filter(|o| o.displacement.is_none())
             .flat_map(|o| (0..o.mesh.triangles.len()).map(move |t| face_normal(o, t)))
             .collect();
+        let object_points = (scene.objects.iter())
+            .map(|o| checkered(o).then(|| object_points(o).into()))
+            .collect();
         PreparedScene {
             face_normals,
+            object_points,
             bvh: Arc::new(bvh),
             shown: None,
             scene: scene.clone(),
@@ -236,8 +249,19 @@ impl PreparedScene {
         } else {
             self.displaced.clone()
         };
+        // Kept where the view's object is placed as this scene's (its mesh is this scene's).
+        let object_points = (self.scene.objects.iter().zip(&scene.objects))
+            .zip(&self.object_points)
+            .map(|((a, b), kept)| match kept {
+                Some(points) if a.world_to_object == b.world_to_object => {
+                    checkered(b).then(|| Arc::clone(points))
+                }
+                _ => checkered(b).then(|| object_points(b).into()),
+            })
+            .collect();
         PreparedScene {
             bvh: Arc::clone(&self.bvh),
+            object_points,
             shown,
             first_triangle: Arc::clone(&self.first_triangle),
             offset: offset_of(&scene),
@@ -263,6 +287,13 @@ impl PreparedScene {
     #[inline]
     pub(in crate::render) fn face_normal(&self, object: usize, triangle: usize) -> Vec3 {
         self.face_normals[self.first_triangle[object] as usize + triangle]
+    }
+
+    /// The mesh positions of object index `object` in object space, kept where its pattern
+    /// is a checker (the only pattern that reads them).
+    #[inline]
+    pub(in crate::render) fn object_points(&self, object: usize) -> Option<&[Vec3]> {
+        self.object_points[object].as_deref()
     }
 
     /// The working memory of type `T` the last renderer left ([`PreparedScene::keep_spare`]),

@@ -116,37 +116,61 @@ pub fn normals_of_face(
     barycentric: Vec2,
     incoming: Vec3,
 ) -> Normals {
-    let mesh = &object.mesh;
-    let corners = corners(object, triangle);
-    let Normals {
-        geometric,
-        front_face,
-        ..
-    } = Normals::of_face(face, incoming);
-    let interpolated = if mesh.normals.is_empty() {
-        Vec3::ZERO
-    } else {
+    VertexNormals::of(object, triangle).normals(face, barycentric, incoming)
+}
+
+/// The vertex normals of one triangle, looked up once for every hit on it (the pixels of a
+/// 2x2 quad nearly always lie on one triangle): [`VertexNormals::normals`] of a hit is
+/// [`normals_of_face`]'s, the same arithmetic on the same values.
+#[derive(Debug, Clone, Copy)]
+pub struct VertexNormals(
+    /// The normals at the triangle's corners (zero: the face normal); `None` when the mesh
+    /// has none.
+    Option<[Vec3; 3]>,
+);
+
+impl VertexNormals {
+    /// The vertex normals of triangle `triangle` of `object`.
+    pub fn of(object: &Object, triangle: usize) -> VertexNormals {
+        let normals = &object.mesh.normals;
         // Element by element: `array::map` is not inlined here (a per-pixel cost).
-        let vertex = |i: usize| match mesh.normals[i] {
-            Vec3::ZERO => face,
-            n => n,
-        };
-        let [a, b, c] = corners;
-        let n = [vertex(a), vertex(b), vertex(c)];
-        interpolate(&n, [0, 1, 2], weights(barycentric)).normalize_or_zero()
-    };
-    let mut shading = if interpolated == Vec3::ZERO {
-        face
-    } else {
-        interpolated
-    };
-    if geometric != Vec3::ZERO && shading.dot(geometric) < 0.0 {
-        shading = -shading;
+        VertexNormals((!normals.is_empty()).then(|| {
+            let [a, b, c] = corners(object, triangle);
+            [normals[a], normals[b], normals[c]]
+        }))
     }
-    Normals {
-        geometric,
-        shading,
-        front_face,
+
+    /// The normals at barycentrics `barycentric` of the triangle, whose [`face_normal`] is
+    /// `face`, for a ray travelling along `incoming` (see [`normals`] for the degenerate
+    /// cases).
+    #[inline]
+    pub fn normals(&self, face: Vec3, barycentric: Vec2, incoming: Vec3) -> Normals {
+        let Normals {
+            geometric,
+            front_face,
+            ..
+        } = Normals::of_face(face, incoming);
+        let interpolated = match self.0 {
+            None => Vec3::ZERO,
+            Some([a, b, c]) => {
+                let vertex = |n: Vec3| if n == Vec3::ZERO { face } else { n };
+                let n = [vertex(a), vertex(b), vertex(c)];
+                interpolate(&n, [0, 1, 2], weights(barycentric)).normalize_or_zero()
+            }
+        };
+        let mut shading = if interpolated == Vec3::ZERO {
+            face
+        } else {
+            interpolated
+        };
+        if geometric != Vec3::ZERO && shading.dot(geometric) < 0.0 {
+            shading = -shading;
+        }
+        Normals {
+            geometric,
+            shading,
+            front_face,
+        }
     }
 }
 
@@ -160,35 +184,83 @@ pub fn base_color(
     barycentric: Vec2,
     filter: TextureFilter,
 ) -> Vec3 {
-    let mesh = &object.mesh;
-    let corners = corners(object, triangle);
-    let w = weights(barycentric);
-    let pattern = pattern_color(
-        object,
-        filter,
-        || object_point(object, corners, w),
-        || uv_at(mesh, corners, w),
-    );
-    if mesh.colors.is_empty() {
-        pattern
-    } else {
-        pattern * interpolate(&mesh.colors, corners, w)
+    TriangleBase::of(object, triangle, None).at(barycentric, filter)
+}
+
+/// What [`base_color`] reads of one triangle: its vertex indices and, for a checker, its
+/// corners in object space, transformed or read from points kept per mesh vertex (lit
+/// shading reads the prepared scene's). [`TriangleBase::at`] of a hit is `base_color`'s,
+/// the same arithmetic on the same values.
+#[derive(Debug, Clone, Copy)]
+pub struct TriangleBase<'a> {
+    object: &'a Object,
+    corners: [usize; 3],
+    /// The corners in object space, where the pattern is a checker.
+    object_corners: Option<[Vec3; 3]>,
+}
+
+impl<'a> TriangleBase<'a> {
+    /// Triangle `triangle` of `object`. `object_points`, when given, are the mesh's
+    /// positions in object space (`world_to_object` applied to each, as
+    /// [`object_points`] computes them), read instead of transforming the corners.
+    #[inline]
+    pub fn of(object: &'a Object, triangle: usize, object_points: Option<&[Vec3]>) -> Self {
+        let corners = corners(object, triangle);
+        let object_corners =
+            matches!(object.material.pattern, Pattern::Checker { .. }).then(|| {
+                let [a, b, c] = corners;
+                match object_points {
+                    Some(points) => [points[a], points[b], points[c]],
+                    None => {
+                        let local = |i: usize| {
+                            object
+                                .world_to_object
+                                .transform_point3(object.mesh.positions[i])
+                        };
+                        [local(a), local(b), local(c)]
+                    }
+                }
+            });
+        TriangleBase {
+            object,
+            corners,
+            object_corners,
+        }
+    }
+
+    /// The base colour at barycentrics `barycentric`, textures sampled by `filter`.
+    ///
+    /// The object-space point of a checker is the object-space corners interpolated (as
+    /// [`triangle_color`] does), not the interpolated world point taken to object space,
+    /// whose rounding grows with the distance from the world origin: a floor at object
+    /// y = 0 translated far away would otherwise flicker across the checker's cell boundary
+    /// there.
+    #[inline]
+    pub fn at(&self, barycentric: Vec2, filter: TextureFilter) -> Vec3 {
+        let (object, corners) = (self.object, self.corners);
+        let mesh = &object.mesh;
+        let w = weights(barycentric);
+        let pattern = pattern_color(
+            object,
+            filter,
+            // Called for a checker only, whose object-space corners were looked up.
+            || interpolate(&self.object_corners.unwrap_or_default(), [0, 1, 2], w),
+            || uv_at(mesh, corners, w),
+        );
+        if mesh.colors.is_empty() {
+            pattern
+        } else {
+            pattern * interpolate(&mesh.colors, corners, w)
+        }
     }
 }
 
-/// The object-space point at weights `w` of the triangle with vertices `corners`: the
-/// corners are taken to object space first and then interpolated (as
-/// [`triangle_color`] does), not the interpolated world point, whose rounding grows with the
-/// distance from the world origin: a floor at object y = 0 translated far away would
-/// otherwise flicker across the checker's cell boundary there.
-fn object_point(object: &Object, corners: [usize; 3], w: Vec3) -> Vec3 {
-    let local = |i: usize| {
-        object
-            .world_to_object
-            .transform_point3(object.mesh.positions[i])
-    };
-    let [a, b, c] = corners;
-    interpolate(&[local(a), local(b), local(c)], [0, 1, 2], w)
+/// The positions of `object`'s mesh in object space (`world_to_object` applied to each),
+/// for [`TriangleBase::of`].
+pub fn object_points(object: &Object) -> Vec<Vec3> {
+    (object.mesh.positions.iter())
+        .map(|&p| object.world_to_object.transform_point3(p))
+        .collect()
 }
 
 /// The texture coordinates at barycentrics `barycentric` of triangle `triangle` of `object`,
@@ -537,6 +609,45 @@ mod tests {
         );
         o.world_to_object = Affine3A::from_translation(Vec3::X);
         assert_eq!(base_color(&o, 0, b, TextureFilter::Nearest), Vec3::ZERO);
+    }
+
+    /// A triangle's base colour read through [`TriangleBase`] with the object-space points
+    /// kept per vertex is `base_color`'s, bit for bit, for a moved and rotated checker, and
+    /// for a textured, vertex-coloured mesh (which reads no object-space point).
+    #[test]
+    fn triangle_base_with_kept_points_is_base_color() {
+        let mut checker = object(
+            triangle(),
+            Pattern::Checker {
+                other: Vec3::ZERO,
+                size: 0.3,
+            },
+        );
+        checker.world_to_object =
+            Affine3A::from_rotation_y(0.7) * Affine3A::from_translation(Vec3::new(0.31, -2.0, 5.5));
+        let mut mesh = triangle();
+        mesh.uvs = vec![Vec2::ZERO, Vec2::X, Vec2::Y];
+        mesh.colors = vec![Vec3::ONE, Vec3::splat(0.5), Vec3::X];
+        let texture = Texture {
+            width: 2,
+            height: 2,
+            texels: vec![Vec3::ONE, Vec3::splat(0.2), Vec3::splat(0.7), Vec3::X],
+        };
+        let textured = object(mesh, Pattern::Texture(Arc::new(texture)));
+        for o in [&checker, &textured] {
+            let points = object_points(o);
+            assert_eq!(points.len(), o.mesh.positions.len());
+            let kept = TriangleBase::of(o, 0, Some(&points));
+            for i in 0..20 {
+                for j in 0..(20 - i) {
+                    let b = Vec2::new(i as f32 / 20.0 + 0.01, j as f32 / 20.0 + 0.02);
+                    for filter in [TextureFilter::Nearest, TextureFilter::Bilinear] {
+                        let expected = base_color(o, 0, b, filter);
+                        assert_eq!(kept.at(b, filter).to_array(), expected.to_array());
+                    }
+                }
+            }
+        }
     }
 
     /// A floor triangle at object y = 0 (on a checker cell boundary) translated 1e4 from the

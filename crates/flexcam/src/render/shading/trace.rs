@@ -22,7 +22,7 @@ use glam::{DVec3, Vec3};
 use crate::geometry::optics::{reflect, refract};
 use crate::geometry::Ray;
 use crate::render::prepared::{Hit, PreparedScene};
-use crate::render::shading::{base_color, normals_of_face, Normals, TextureFilter};
+use crate::render::shading::{base_color, Normals, TextureFilter, TriangleBase, VertexNormals};
 use crate::render::{RenderOptions, Shading};
 use crate::scene::{Finish, Light};
 
@@ -228,6 +228,8 @@ impl<'a> HitShader<'a> {
             return colors;
         }
         let mut points: [Option<DiffusePoint>; 4] = [None; 4];
+        // The triangle looked up last: a quad's pixels nearly always lie on one.
+        let mut surface: Option<Surface> = None;
         for lane in 0..4 {
             let Some((ray, hit)) = hits[lane] else {
                 continue;
@@ -237,7 +239,11 @@ impl<'a> HitShader<'a> {
                 colors[lane] = self.lit(ray, hit, 0, 1.0);
                 continue;
             }
-            let (normals, base) = self.lit_surface(ray, &hit);
+            let on = match surface {
+                Some(s) if (s.object, s.triangle) == (hit.object, hit.triangle) => s,
+                _ => *surface.insert(self.surface(&hit)),
+            };
+            let (normals, base) = self.lit_surface_on(&on, ray, &hit);
             let point = DiffusePoint::new(ray, ray.at(hit.t), &normals, base);
             colors[lane] = point.unshadowed(&self.caster.scene.lights);
             points[lane] = Some(point);
@@ -246,10 +252,11 @@ impl<'a> HitShader<'a> {
         let mut rays: [Option<Ray>; 4] = [None; 4];
         let mut added = [Vec3::ZERO; 4];
         for light in &self.caster.scene.lights {
+            let terms = LightTerms::of(light);
             for lane in 0..4 {
                 rays[lane] = None;
                 if let Some(point) = &points[lane] {
-                    if let Some((ray, light_adds)) = point.light(self.caster, light) {
+                    if let Some((ray, light_adds)) = point.light(self.caster, &terms) {
                         rays[lane] = Some(ray);
                         added[lane] = light_adds;
                         self.counts.shadow += 1;
@@ -276,7 +283,7 @@ impl<'a> HitShader<'a> {
         let point = DiffusePoint::new(ray, position, normals, base);
         let mut color = point.unshadowed(&self.caster.scene.lights);
         for light in &self.caster.scene.lights {
-            if let Some((shadow, added)) = point.light(self.caster, light) {
+            if let Some((shadow, added)) = point.light(self.caster, &LightTerms::of(light)) {
                 self.counts.shadow += 1;
                 if !self.caster.occluded(&shadow) {
                     color += added;
@@ -289,30 +296,66 @@ impl<'a> HitShader<'a> {
     /// What lit shading reads of the surface at `hit`: its normals as seen along `ray` and
     /// its base colour (bilinear texels).
     fn lit_surface(&self, ray: &Ray, hit: &Hit) -> (Normals, Vec3) {
+        self.lit_surface_on(&self.surface(hit), ray, hit)
+    }
+
+    /// [`HitShader::lit_surface`] with `hit`'s triangle looked up as `surface`.
+    #[inline]
+    fn lit_surface_on(&self, surface: &Surface, ray: &Ray, hit: &Hit) -> (Normals, Vec3) {
+        let base = self.base_color(hit);
+        (self.normals_on(&surface.normals, ray, hit), base)
+    }
+
+    /// The base colour at `hit` (bilinear texels), a checker's object-space corners read
+    /// from the points the prepared scene keeps rather than transformed per hit.
+    fn base_color(&self, hit: &Hit) -> Vec3 {
         let object = &self.caster.scene.objects[hit.object];
-        let base = base_color(
-            object,
-            hit.triangle,
-            hit.barycentric,
-            TextureFilter::Bilinear,
-        );
-        (self.normals(ray, hit), base)
+        let points = self.caster.object_points(hit.object);
+        TriangleBase::of(object, hit.triangle, points).at(hit.barycentric, TextureFilter::Bilinear)
+    }
+
+    /// The normals at `hit` as seen along `ray`, its triangle's vertex normals being
+    /// `vertex`.
+    #[inline]
+    fn normals_on(&self, vertex: &VertexNormals, ray: &Ray, hit: &Hit) -> Normals {
+        let incoming = ray.direction.as_vec3();
+        match self.caster.displaced_face_normal(hit) {
+            Some(face) => Normals::of_face(face, incoming),
+            None => vertex.normals(
+                self.caster.face_normal(hit.object, hit.triangle),
+                hit.barycentric,
+                incoming,
+            ),
+        }
+    }
+
+    /// What shading reads of the triangle `hit` lies on, looked up once for the hits on it.
+    #[inline]
+    fn surface(&self, hit: &Hit) -> Surface {
+        let object = &self.caster.scene.objects[hit.object];
+        Surface {
+            object: hit.object,
+            triangle: hit.triangle,
+            normals: VertexNormals::of(object, hit.triangle),
+        }
     }
 
     /// The normals at `hit` as seen along `ray`.
     fn normals(&self, ray: &Ray, hit: &Hit) -> Normals {
-        if let Some(face) = self.caster.displaced_face_normal(hit) {
-            return Normals::of_face(face, ray.direction.as_vec3());
-        }
         let object = &self.caster.scene.objects[hit.object];
-        normals_of_face(
-            object,
-            hit.triangle,
-            self.caster.face_normal(hit.object, hit.triangle),
-            hit.barycentric,
-            ray.direction.as_vec3(),
-        )
+        self.normals_on(&VertexNormals::of(object, hit.triangle), ray, hit)
     }
+}
+
+/// What shading reads of one triangle (object index `object`, triangle `triangle` of its
+/// mesh) before the barycentrics of a hit on it: its vertex normals. The base colour is
+/// read per hit (from the kept object-space points): sharing that lookup as well made a
+/// cube-floor frame slower, not faster.
+#[derive(Debug, Clone, Copy)]
+struct Surface {
+    object: usize,
+    triangle: usize,
+    normals: VertexNormals,
 }
 
 /// A diffuse surface point as lit shading sees it, split from its shadow rays so that
@@ -359,36 +402,88 @@ impl DiffusePoint {
         }
     }
 
-    /// The shadow ray towards `light` (spawned off the surface through `caster`) and what
-    /// the light adds when nothing blocks it; `None` where the light is behind the shading
-    /// normal (no ray is cast).
-    fn light(&self, caster: &PreparedScene, light: &Light) -> Option<(Ray, Vec3)> {
-        let (to_light, t_max, radiance) = light_from(light, self.position);
-        let unit = to_light.normalize_or_zero();
+    /// The shadow ray towards the light of `terms` (spawned off the surface through
+    /// `caster`) and what the light adds when nothing blocks it; `None` where the light is
+    /// behind the shading normal (no ray is cast).
+    #[inline]
+    fn light(&self, caster: &PreparedScene, terms: &LightTerms) -> Option<(Ray, Vec3)> {
+        let (to_light, t_max) = terms.to_light(self.position);
+        let unit = terms.unit(to_light);
         if self.normal.dot(unit) <= 0.0 {
             return None;
         }
         let mut shadow = caster.spawn(self.position, self.geometric, to_light);
         shadow.t_max = t_max;
-        Some((shadow, radiance * self.shade(unit)))
+        Some((shadow, terms.radiance * self.shade(unit)))
     }
 }
 
-/// How `light` reaches surface point `position`: the vector to it (not normalised), the
-/// parameter of a shadow ray along that vector that reaches the light (1 for a point light,
-/// infinity for a directional one), and its radiance.
-pub(in crate::render) fn light_from(light: &Light, position: DVec3) -> (DVec3, f64, Vec3) {
-    match *light {
-        Light::Point {
-            position: p,
-            color,
-            intensity,
-        } => (p.as_dvec3() - position, 1.0, color * intensity),
-        Light::Directional {
-            direction,
-            color,
-            intensity,
-        } => (-direction.as_dvec3(), f64::INFINITY, color * intensity),
+/// What shading reads of a light, with the terms that do not depend on the lit point
+/// worked out once (for all the points of a quad): its radiance and, for a directional
+/// light, the vector towards it and its unit direction.
+#[derive(Debug, Clone, Copy)]
+pub(in crate::render) struct LightTerms {
+    pub radiance: Vec3,
+    reach: Reach,
+}
+
+/// Where a light is, as [`LightTerms`] keeps it.
+#[derive(Debug, Clone, Copy)]
+enum Reach {
+    Point(DVec3),
+    /// The vector towards the light and its unit form (zero for a zero direction).
+    Directional {
+        to_light: DVec3,
+        unit: DVec3,
+    },
+}
+
+impl LightTerms {
+    pub fn of(light: &Light) -> LightTerms {
+        match *light {
+            Light::Point {
+                position,
+                color,
+                intensity,
+            } => LightTerms {
+                radiance: color * intensity,
+                reach: Reach::Point(position.as_dvec3()),
+            },
+            Light::Directional {
+                direction,
+                color,
+                intensity,
+            } => {
+                let to_light = -direction.as_dvec3();
+                LightTerms {
+                    radiance: color * intensity,
+                    reach: Reach::Directional {
+                        to_light,
+                        unit: to_light.normalize_or_zero(),
+                    },
+                }
+            }
+        }
+    }
+
+    /// The vector from surface point `position` to the light (not normalised) and the
+    /// parameter of a shadow ray along it that reaches the light (1 for a point light,
+    /// infinity for a directional one).
+    #[inline]
+    pub fn to_light(&self, position: DVec3) -> (DVec3, f64) {
+        match self.reach {
+            Reach::Point(p) => (p - position, 1.0),
+            Reach::Directional { to_light, .. } => (to_light, f64::INFINITY),
+        }
+    }
+
+    /// `to_light` (from [`LightTerms::to_light`]) normalised, zero where it is zero.
+    #[inline]
+    fn unit(&self, to_light: DVec3) -> DVec3 {
+        match self.reach {
+            Reach::Point(_) => to_light.normalize_or_zero(),
+            Reach::Directional { unit, .. } => unit,
+        }
     }
 }
 
@@ -416,5 +511,92 @@ pub(crate) fn specular(ray: &Ray, normals: &Normals, finish: Finish) -> Specular
             main: reflected,
             fresnel: None,
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{DVec2, DVec3, Vec3};
+
+    use super::*;
+
+    /// The quads of a 2x2 block of pixels of cube-floor (each lane on the checkered floor or
+    /// the vertex-coloured cube, several lanes on one triangle, or none), shaded together,
+    /// are each what shading the hit alone gives, with the same rays counted.
+    #[test]
+    fn a_quads_shading_is_each_hits_shading() {
+        let scene = crate::scene::load("builtin:cube-floor").unwrap();
+        let prepared = PreparedScene::new(&scene);
+        let projection = scene.projection.build(64, 48).unwrap();
+        let options = RenderOptions {
+            shading: Shading::Lit,
+            ..RenderOptions::default()
+        };
+        let mut quads = 0;
+        for top in (0..48).step_by(2) {
+            for left in (0..64).step_by(2) {
+                let rays: Vec<Ray> = [(0, 0), (1, 0), (0, 1), (1, 1)]
+                    .iter()
+                    .map(|&(dx, dy)| {
+                        let centre = DVec2::new(left as f64 + dx as f64, top as f64 + dy as f64);
+                        projection.ray(centre + 0.5).unwrap()
+                    })
+                    .collect();
+                let hits: Vec<Option<Hit>> = rays.iter().map(|r| prepared.intersect(r)).collect();
+                let lane = |k: usize| hits[k].map(|h| (&rays[k], h));
+                let mut shader = HitShader::new(&prepared, &options);
+                let colors = shader.shade_hits4([lane(0), lane(1), lane(2), lane(3)]);
+                let mut counted = 0;
+                for k in 0..4 {
+                    let (alone, rays_alone) = match hits[k] {
+                        Some(hit) => prepared.shade_hit(&rays[k], hit, &options),
+                        None => (scene.image.background, 0),
+                    };
+                    assert_eq!(
+                        colors[k],
+                        alone,
+                        "pixel ({}, {})",
+                        left + k % 2,
+                        top + k / 2
+                    );
+                    counted += rays_alone;
+                }
+                assert_eq!(shader.counts.secondary + shader.counts.shadow, counted);
+                quads += 1;
+            }
+        }
+        assert_eq!(quads, 32 * 24);
+    }
+
+    /// A light's terms are those it gives every point: a point light's vector reaches it at
+    /// t = 1, a directional light's points against its direction with no end; a zero
+    /// direction (degenerate, refused by the scene loader) gives a zero unit vector, and
+    /// then no ray is cast (the shading normal's dot product with it is 0).
+    #[test]
+    fn light_terms_reach_the_light() {
+        let p = DVec3::new(1.0, 2.0, 3.0);
+        let point = LightTerms::of(&Light::Point {
+            position: Vec3::new(4.0, 6.0, 3.0),
+            color: Vec3::new(1.0, 0.5, 0.25),
+            intensity: 2.0,
+        });
+        assert_eq!(point.radiance, Vec3::new(2.0, 1.0, 0.5));
+        assert_eq!(point.to_light(p), (DVec3::new(3.0, 4.0, 0.0), 1.0));
+        let to_point = DVec3::new(3.0, 4.0, 0.0);
+        assert_eq!(point.unit(to_point), to_point.normalize_or_zero());
+        let sun = LightTerms::of(&Light::Directional {
+            direction: Vec3::new(0.0, -2.0, 0.0),
+            color: Vec3::ONE,
+            intensity: 0.5,
+        });
+        assert_eq!(sun.radiance, Vec3::splat(0.5));
+        assert_eq!(sun.to_light(p), (DVec3::new(0.0, 2.0, 0.0), f64::INFINITY));
+        assert_eq!(sun.unit(DVec3::new(0.0, 2.0, 0.0)), DVec3::Y);
+        let zero = LightTerms::of(&Light::Directional {
+            direction: Vec3::ZERO,
+            color: Vec3::ONE,
+            intensity: 1.0,
+        });
+        assert_eq!(zero.unit(zero.to_light(p).0), DVec3::ZERO);
     }
 }

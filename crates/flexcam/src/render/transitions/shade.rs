@@ -23,7 +23,7 @@ use crate::displace::transition::{self, partial_view_angle, Blend};
 use crate::geometry::Ray;
 use crate::render::displaced::{ObjectTables, PARTIAL_STEPS};
 use crate::render::prepared::Hit;
-use crate::render::shading::trace::light_from;
+use crate::render::shading::trace::LightTerms;
 use crate::render::shading::{base_color, TextureFilter};
 use crate::scene::{Object, Scene};
 
@@ -236,7 +236,9 @@ impl<'a> Renderer<'a> {
         }
         let mut color = base * AMBIENT;
         for light in lights {
-            let (to_light, t_max, radiance) = light_from(light, position);
+            let terms = LightTerms::of(light);
+            let (to_light, t_max) = terms.to_light(position);
+            let radiance = terms.radiance;
             let term = reflect(to_light.normalize_or_zero());
             if term <= 0.0 {
                 continue;
