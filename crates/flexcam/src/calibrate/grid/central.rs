@@ -153,7 +153,16 @@ pub(super) fn fit_pinhole(
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport, DVec3)> {
     let setup = Setup::new(prior, correspondences)?;
+    // A camera reached only from starts moved back (every start kept a point behind it)
+    // where the general camera matrix has a grid: inconsistent data (a point behind the
+    // eye), whose square-pixel descent may end with its eye on that point; the general
+    // camera's fit moves the eye until every point is in front.
+    let inconsistent =
+        |camera: &PinholeCamera| camera.moved_start() && setup.pinhole_fit().is_some();
     match setup.square_pixel_fit() {
+        Ok((_, camera)) if inconsistent(&camera) => {
+            general_camera_fit(&setup, correspondences, prior)
+        }
         Ok((((grid, _), eye), camera)) => {
             let (grid, report, eye) = finish(&grid, correspondences, eye, prior, true)?;
             let report = FitReport {
@@ -163,23 +172,29 @@ pub(super) fn fit_pinhole(
             };
             Ok((grid, report, eye))
         }
-        Err(NoSquarePixelGrid::Inconsistent) => {
-            // Merely inconsistent data (a point behind every square-pixel camera the starts
-            // reach, or behind the fitted one's starts): the general camera matrix's
-            // least-squares fit, which may move the eye until every point is in front, and
-            // the report says so.
-            let ((grid, _), eye) = setup.pinhole_fit().ok_or_else(undetermined)?;
-            let (grid, report, eye) = finish(&grid, correspondences, eye, prior, true)?;
-            let report = FitReport {
-                general_camera: true,
-                ..report
-            };
-            Ok((grid, report, eye))
-        }
+        // Merely inconsistent data (a point behind every square-pixel camera the starts
+        // reach, or behind the fitted one's starts).
+        Err(NoSquarePixelGrid::Inconsistent) => general_camera_fit(&setup, correspondences, prior),
         Err(NoSquarePixelGrid::Undetermined(why)) => {
             Err(Error::new(format!("projector grid fit: {why}")))
         }
     }
+}
+
+/// The general camera matrix's least-squares fit for `fit_pinhole` on inconsistent data,
+/// which may move the eye until every point is in front, and the report says so.
+fn general_camera_fit(
+    setup: &Setup,
+    correspondences: &[Correspondence],
+    prior: &ProjectorGrid,
+) -> Result<(ProjectorGrid, FitReport, DVec3)> {
+    let ((grid, _), eye) = setup.pinhole_fit().ok_or_else(undetermined)?;
+    let (grid, report, eye) = finish(&grid, correspondences, eye, prior, true)?;
+    let report = FitReport {
+        general_camera: true,
+        ..report
+    };
+    Ok((grid, report, eye))
 }
 
 /// A camera's grid with its report, and its eye.

@@ -198,6 +198,8 @@ pub(super) struct PinholeCamera {
     handedness: f64,
     /// Whether the focal length is the prior's, the data leaving it undetermined.
     focal_from_prior: bool,
+    /// Whether the descent began from starts moved back ([`PinholeCamera::moved_start`]).
+    moved_start: bool,
 }
 
 impl PinholeCamera {
@@ -215,12 +217,12 @@ impl PinholeCamera {
             ..pose
         };
         let starts = [general.map(centred), data.start_of_homography(None)];
-        let (best, best_ss) = data.refine_best(&starts, Unknowns::Focal)?;
+        let (best, best_ss, moved) = data.refine_best(&starts, Unknowns::Focal)?;
         let chosen = general
             .and_then(|start| data.off_centre(start, best, best_ss))
             .unwrap_or(best);
         if !data.focal_undetermined(&chosen) {
-            return Ok(data.camera(chosen, false));
+            return Ok(data.camera(chosen, false, moved));
         }
         // The prior's focal length, from the best pose with its distance scaled by the
         // focal lengths' ratio (the same image of a plane seen face on through the points'
@@ -230,11 +232,11 @@ impl PinholeCamera {
             eye: best.eye * (shape.focal / best.focal),
             ..best
         };
-        let (pose, _) = data.refine_best(
+        let (pose, _, moved) = data.refine_best(
             &[Some(rescaled), data.start_of_homography(Some(shape.focal))],
             Unknowns::Pose,
         )?;
-        Ok(data.camera(pose, true))
+        Ok(data.camera(pose, true, moved))
     }
 
     /// The eye.
@@ -252,6 +254,12 @@ impl PinholeCamera {
     /// undetermined.
     pub(super) fn focal_from_prior(&self) -> bool {
         self.focal_from_prior
+    }
+
+    /// Whether the descent began only from starts moved back to keep every point in front
+    /// (every start the data give kept a point behind it: [`Data::refine_best`]).
+    pub(super) fn moved_start(&self) -> bool {
+        self.moved_start
     }
 
     /// The principal point's image position (u, v), `None` where it is the image centre.
@@ -374,7 +382,7 @@ impl Data {
     }
 
     /// The fitted camera of `pose` in world coordinates.
-    fn camera(&self, pose: Pose, focal_from_prior: bool) -> PinholeCamera {
+    fn camera(&self, pose: Pose, focal_from_prior: bool, moved_start: bool) -> PinholeCamera {
         PinholeCamera {
             focal: pose.focal,
             rotation: pose.rotation,
@@ -383,6 +391,7 @@ impl Data {
             aspect: self.shape.aspect,
             handedness: pose.handedness,
             focal_from_prior,
+            moved_start,
         }
     }
 
@@ -563,13 +572,13 @@ impl Data {
 
     /// The least-error refinement of `unknowns` from any of `starts`; where every start keeps
     /// a point behind it (inconsistent or nearly coplanar data with a point off the plane),
-    /// from the starts moved back until every point is in front ([`Data::in_front`]).
-    /// `NotInFront` where no refinement can begin even so.
+    /// from the starts moved back until every point is in front ([`Data::in_front`]), and
+    /// then whether they were moved. `NotInFront` where no refinement can begin even so.
     fn refine_best(
         &self,
         starts: &[Option<Pose>],
         unknowns: Unknowns,
-    ) -> Result<(Pose, f64), Undetermined> {
+    ) -> Result<(Pose, f64, bool), Undetermined> {
         let best = |moved: bool| {
             starts
                 .iter()
@@ -582,7 +591,8 @@ impl Data {
                 .min_by(|a, b| a.1.total_cmp(&b.1))
         };
         best(false)
-            .or_else(|| best(true))
+            .map(|(pose, ss)| (pose, ss, false))
+            .or_else(|| best(true).map(|(pose, ss)| (pose, ss, true)))
             .ok_or(Undetermined::NotInFront)
     }
 

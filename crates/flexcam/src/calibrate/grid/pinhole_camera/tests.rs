@@ -27,6 +27,7 @@ fn camera(eye: DVec3, target: DVec3, roll: f64, focal: f64, handedness: f64) -> 
         aspect: SHAPE.aspect,
         handedness,
         focal_from_prior: false,
+        moved_start: false,
     }
 }
 
