@@ -470,7 +470,7 @@ impl LightTerms {
     /// parameter of a shadow ray along it that reaches the light (1 for a point light,
     /// infinity for a directional one).
     #[inline]
-    pub fn to_light(&self, position: DVec3) -> (DVec3, f64) {
+    pub fn to_light(self, position: DVec3) -> (DVec3, f64) {
         match self.reach {
             Reach::Point(p) => (p - position, 1.0),
             Reach::Directional { to_light, .. } => (to_light, f64::INFINITY),
