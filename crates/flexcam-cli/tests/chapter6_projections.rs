@@ -254,34 +254,48 @@ fn piecewise_depth_volumes_raster_like_the_ray_caster() {
     );
     let depth = scene_example("flexible-depth-transition.toml");
     raster_agrees(&dir, &[&depth, "-D", "projection.style=piecewise"]);
-    // `project` takes the point `pick` finds at a pixel back to that pixel, with the depth
-    // `render --depth` writes there (the arc length along the polyline projector).
+    // The arc length along the polyline projector.
     let ortho = scene_example("flexible-ortho-near-persp-far.toml");
-    let picked = run_json(&dir, &["pick", &ortho, "100.5,120.5", "--json"]);
+    project_meets_pick_and_depth(&dir, &ortho, [100, 120]);
+}
+
+/// `project` takes the point `pick` finds at the centre of pixel `pixel` of `scene` back to
+/// that centre, with the depth `render --depth` writes there (the distance along the pixel's
+/// projector, straight or curved).
+fn project_meets_pick_and_depth(dir: &TempDir, scene: &str, pixel: [usize; 2]) {
+    let centre = format!("{}.5,{}.5", pixel[0], pixel[1]);
+    let picked = run_json(dir, &["pick", scene, &centre, "--json"]);
     let p = picked["point"].as_array().unwrap();
     let xyz = format!("{},{},{}", p[0], p[1], p[2]);
-    let projected = run_json(&dir, &["project", &ortho, &xyz, "--json"]);
+    let projected = run_json(dir, &["project", scene, &xyz, "--json"]);
     let image = &projected["images"][0];
-    assert!(
-        (image["x"].as_f64().unwrap() - 100.5).abs() < 1e-6,
-        "{projected}"
-    );
-    assert!(
-        (image["y"].as_f64().unwrap() - 120.5).abs() < 1e-6,
-        "{projected}"
-    );
+    for (axis, at) in ["x", "y"].into_iter().zip(pixel) {
+        assert!(
+            (image[axis].as_f64().unwrap() - (at as f64 + 0.5)).abs() < 1e-6,
+            "{projected}"
+        );
+    }
     run_ok(
-        &dir,
-        &["render", &ortho, "--depth", "depth.pfm", "-o", "d.png"],
+        dir,
+        &["render", scene, "--depth", "depth.pfm", "-o", "d.png"],
     );
     let pfm = fs::read(dir.path().join("depth.pfm")).unwrap();
-    let header = "Pf\n240 180\n-1.0\n".len();
-    let at = header + ((180 - 1 - 120) * 240 + 100) * 4;
+    // "Pf\nW H\n-1.0\n", then rows bottom up, little-endian f32.
+    let text = String::from_utf8_lossy(&pfm[..32.min(pfm.len())]).into_owned();
+    let mut lines = text.split('\n');
+    let size: Vec<usize> = lines
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .map(|n| n.parse().unwrap())
+        .collect();
+    let header = text.split('\n').take(3).map(|l| l.len() + 1).sum::<usize>();
+    let at = header + ((size[1] - 1 - pixel[1]) * size[0] + pixel[0]) * 4;
     let rendered = f32::from_le_bytes(pfm[at..at + 4].try_into().unwrap());
     let along = image["depth"].as_f64().unwrap();
     assert!(
         (along - f64::from(rendered)).abs() < 1e-5 * along,
-        "{along} against {rendered}"
+        "{scene}: {along} against {rendered}"
     );
 }
 
@@ -295,6 +309,10 @@ fn quadratic_depth_volumes_raster_like_the_ray_caster() {
     raster_agrees(&dir, &[&scene_example("flexible-depth-transition.toml")]);
     let ortho = scene_example("flexible-ortho-near-persp-far.toml");
     raster_agrees(&dir, &[&ortho, "-D", "projection.style=quadratic"]);
+    // The arc length along the quadratic projector (its curve parameter would be 0.997
+    // where the render's depth is 10.5 at this pixel).
+    let quadratic = scene_example("flexible-quadratic.toml");
+    project_meets_pick_and_depth(&dir, &quadratic, [160, 120]);
 }
 
 /// The stderr of `render SCENE --method raster`, which must fail with exit status 1.

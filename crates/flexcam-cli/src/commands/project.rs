@@ -3,6 +3,7 @@
 //! triangle's cubic, Vallance 2005, chapter 3).
 
 use clap::Args;
+use flexcam::projection::projector::quadratic_arc_length;
 use flexcam::projection::{ImagePoint, Projector};
 use flexcam::{Error, Result};
 use glam::{DVec2, DVec3};
@@ -27,8 +28,8 @@ pub struct ProjectArgs {
 }
 
 /// One image of the point: its continuous pixel position (x right, y down, pixel (x, y)
-/// covering [x, x + 1) x [y, y + 1)), the distance along its pixel's ray (or polyline
-/// projector) from its start (what `render --depth` writes there when nothing is in front)
+/// covering [x, x + 1) x [y, y + 1)), the distance along its pixel's ray (or polyline or
+/// curved projector, by arc length) from its start (what `render --depth` writes there when nothing is in front)
 /// and the ray parameter (a flexible volume's t).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Image {
@@ -80,6 +81,8 @@ pub fn run(args: &ProjectArgs) -> Result<()> {
         .map(|&ImagePoint { pixel, t }| {
             let depth = match projection.projector(pixel) {
                 Some(Projector::Polyline(points)) => arc_length_to(&points, point),
+                // A quadratic volume's t is the curve parameter s of B(s) (the point is B(t)).
+                Some(Projector::QuadraticBezier(curve)) => quadratic_arc_length(&curve, t),
                 _ => {
                     let speed = projection
                         .ray(pixel)
