@@ -153,17 +153,17 @@ pub(super) fn fit_pinhole(
     correspondences: &[Correspondence],
 ) -> Result<(ProjectorGrid, FitReport, DVec3)> {
     let setup = Setup::new(prior, correspondences)?;
-    // A camera reached only from starts moved back (every start kept a point behind it)
-    // where the general camera matrix has a grid: inconsistent data (a point behind the
-    // eye), whose square-pixel descent may end with its eye on that point; the general
-    // camera's fit moves the eye until every point is in front.
-    let inconsistent =
-        |camera: &PinholeCamera| camera.moved_start() && setup.pinhole_fit().is_some();
     match setup.square_pixel_fit() {
-        Ok((_, camera)) if inconsistent(&camera) => {
-            general_camera_fit(&setup, correspondences, prior)
-        }
         Ok((((grid, _), eye), camera)) => {
+            // A camera reached only from starts moved back (every start kept a point behind
+            // it) where the general camera matrix has a grid: inconsistent data (a point
+            // behind the eye), whose square-pixel descent may end with its eye on that
+            // point; the general camera's fit moves the eye until every point is in front.
+            if camera.moved_start() {
+                if let Some(general) = setup.pinhole_fit() {
+                    return general_camera_fit(general, correspondences, prior);
+                }
+            }
             let (grid, report, eye) = finish(&grid, correspondences, eye, prior, true)?;
             let report = FitReport {
                 focal_from_prior: camera.focal_from_prior(),
@@ -174,21 +174,24 @@ pub(super) fn fit_pinhole(
         }
         // Merely inconsistent data (a point behind every square-pixel camera the starts
         // reach, or behind the fitted one's starts).
-        Err(NoSquarePixelGrid::Inconsistent) => general_camera_fit(&setup, correspondences, prior),
+        Err(NoSquarePixelGrid::Inconsistent) => {
+            let general = setup.pinhole_fit().ok_or_else(undetermined)?;
+            general_camera_fit(general, correspondences, prior)
+        }
         Err(NoSquarePixelGrid::Undetermined(why)) => {
             Err(Error::new(format!("projector grid fit: {why}")))
         }
     }
 }
 
-/// The general camera matrix's least-squares fit for `fit_pinhole` on inconsistent data,
-/// which may move the eye until every point is in front, and the report says so.
+/// The general camera matrix's least-squares fit `general` (its grid and eye) finished for
+/// `fit_pinhole` on inconsistent data: the descent may move the eye until every point is in
+/// front, and the report says the general camera was taken.
 fn general_camera_fit(
-    setup: &Setup,
+    ((grid, _), eye): CameraFit,
     correspondences: &[Correspondence],
     prior: &ProjectorGrid,
 ) -> Result<(ProjectorGrid, FitReport, DVec3)> {
-    let ((grid, _), eye) = setup.pinhole_fit().ok_or_else(undetermined)?;
     let (grid, report, eye) = finish(&grid, correspondences, eye, prior, true)?;
     let report = FitReport {
         general_camera: true,
