@@ -433,9 +433,9 @@ mod tests {
     /// grid of [`PlaneChoices`] gets from [`Camera::plane_through`] a plane that its
     /// projections along the corner directions spread less on than on
     /// [`Camera::plane_near`]'s (the bound's hull shrinks with that spread): under half as
-    /// much for over 80 % of the points, more for under 5 % (the one step is an estimate). Degenerate
-    /// cases fall back to `plane_near`: a point behind the rays (parameter `s <= 0`), and a
-    /// per-fragment mirror's camera (no planes along its rays).
+    /// much for over 80 % of the points, more for under 5 % (the one step is an estimate).
+    /// Degenerate cases fall back to `plane_near`: a per-fragment mirror's camera (no planes
+    /// along its rays), and a point behind the rays (parameter `s <= 0`).
     #[test]
     fn plane_through_a_point_holds_it_more_closely() {
         let (projection, _) = mirror_surface("reflect-sphere-cube", SurfaceRays::Interpolated);
@@ -457,11 +457,6 @@ mod tests {
                     cases += 1;
                     tighter += usize::from(a < 0.5 * n);
                     looser += usize::from(a > n);
-                    let behind = camera.cache.ray_point(b.x, b.y, -between);
-                    assert!(same_plane(
-                        camera.plane_through(behind),
-                        camera.plane_near(behind)
-                    ));
                 }
             }
         }
@@ -475,5 +470,28 @@ mod tests {
             let x = camera.cache.ray_point(0.3, 0.3, 1.0);
             assert!(same_plane(camera.plane_through(x), camera.plane()));
         }
+
+        // Slightly diverging rays along +z from the unit triangle: a point behind them
+        // (parameter -5) gets the grid's plane; one in front, a plane holding it closer.
+        let cache = ProjectionTriangleCache::new(
+            [DVec3::ZERO, DVec3::X, DVec3::Y],
+            [
+                DVec3::Z,
+                DVec3::new(0.1, 0.0, 1.0),
+                DVec3::new(0.0, 0.1, 1.0),
+            ],
+        );
+        let screen = [DVec2::ZERO, DVec2::new(100.0, 0.0), DVec2::new(0.0, 100.0)];
+        let map = ScreenMap::new(screen, DVec2::new(100.0, 100.0), cache);
+        let camera = Camera::new(map, cache, None);
+        let behind = cache.ray_point(0.3, 0.3, -5.0);
+        assert!(same_plane(
+            camera.plane_through(behind),
+            camera.plane_near(behind)
+        ));
+        let ahead = cache.ray_point(0.3, 0.3, 5.0 * 1.1);
+        let near = camera.plane_near(ahead).unwrap();
+        let through = camera.plane_through(ahead).unwrap();
+        assert!(spread(&camera, &through, ahead) < 0.5 * spread(&camera, near, ahead));
     }
 }

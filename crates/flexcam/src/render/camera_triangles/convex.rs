@@ -102,7 +102,8 @@ impl Convex {
     #[cfg(test)]
     pub fn clip(&self, a: DVec2, b: DVec2) -> Convex {
         let mut out = *self;
-        out.clip_with(a, b, &mut Convex::EMPTY);
+        let mut scratch = Convex::EMPTY;
+        out.clip_with(a, b, &mut scratch);
         out
     }
 
