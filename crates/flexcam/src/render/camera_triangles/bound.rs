@@ -17,8 +17,8 @@
 //!   pixel rectangle (the paper's viewport; with a projective screen map, to the camera
 //!   triangle itself, where the map has no pole).
 //! - [`Bound::Tight`]: the convex hull of the nine points clipped to the camera triangle, the
-//!   points projected onto the camera triangle's plane along its rays nearest the scene
-//!   triangle ([`Camera::plane_near`]: the argument holds on every plane of the points a
+//!   points projected onto the camera triangle's plane along its rays through the scene
+//!   triangle ([`Camera::plane_through`]: the argument holds on every plane of the points a
 //!   fixed distance along the rays, and projecting onto a plane near the points moves them
 //!   little, however much the rays diverge), and where that region is still large, the same on each quarter of the camera triangle
 //!   (recursively): a quarter is itself a camera triangle (its corner rays are interpolated
@@ -79,22 +79,28 @@ impl std::str::FromStr for Bound {
 pub fn regions(camera: &Camera, q: &[DVec3; 3], bound: Bound, emit: &mut impl FnMut(&Convex)) {
     match bound {
         Bound::Paper => paper(camera, q, emit),
-        Bound::Tight => tight_in(camera, q, CORNERS, 0, emit),
+        Bound::Tight => tight_in(camera, q, tight_plane(camera, q).as_ref(), CORNERS, 0, emit),
     }
+}
+
+/// The plane the tight bound projects scene triangle `q` onto ([`Camera::plane_through`]
+/// its centroid), the same for every piece of the camera triangle.
+pub fn tight_plane(camera: &Camera, q: &[DVec3; 3]) -> Option<CameraPlane> {
+    camera.plane_through((q[0] + q[1] + q[2]) / 3.0)
 }
 
 /// The regions of [`Bound::Tight`] for scene triangle `q` inside the sub-triangle `sub` of
 /// the camera triangle, a piece of its quartering at `depth` (the whole camera triangle:
-/// [`CORNERS`] at depth 0): the union over the pieces of a quartering holds every fragment
-/// the whole would.
+/// [`CORNERS`] at depth 0), projected onto `plane` (the triangle's [`tight_plane`]): the
+/// union over the pieces of a quartering holds every fragment the whole would.
 pub fn tight_in(
     camera: &Camera,
     q: &[DVec3; 3],
+    plane: Option<&CameraPlane>,
     sub: [DVec2; 3],
     depth: u32,
     emit: &mut impl FnMut(&Convex),
 ) {
-    let plane = camera.plane_near((q[0] + q[1] + q[2]) / 3.0);
     let views = sub.map(|b| CornerView::of(camera, plane, q, b));
     let views = views
         .iter()
@@ -119,6 +125,10 @@ fn midpoints([a, b, c]: [DVec2; 3]) -> [DVec2; 3] {
 fn split<T: Copy>([a, b, c]: [T; 3], [ab, bc, ca]: [T; 3]) -> [[T; 3]; 4] {
     [[a, ab, ca], [ab, b, bc], [ca, bc, c], [bc, ca, ab]]
 }
+
+/// [`split`] as indices into `[a, b, c, ab, bc, ca]`: the corners of quarter `i` are
+/// `SPLIT[i]`, for picking what belongs to them without building all four quarters.
+const SPLIT: [[usize; 3]; 4] = [[0, 3, 5], [3, 1, 4], [5, 4, 2], [4, 5, 3]];
 
 /// What the tight bound uses of one corner of a piece, for one scene triangle and plane,
 /// where the piece's cone is its corners' directions ([`Camera::corner_direction`]): the
@@ -242,37 +252,60 @@ impl<'a> PieceTest<'a> {
     }
 }
 
-/// [`PieceTest::misses`] with the projections onto one plane.
+/// [`PieceTest::misses`] with the projections onto one plane. Conservative: a miss is
+/// reported only where a line separates the projected points from the piece (one of its
+/// edges, or an axis of its bounding box), and never where a projection is not [`near`].
 fn misses_along(along: &[AlongDirection; 3], sub: [DVec2; 3], points: &[DVec3]) -> bool {
-    let mut projected = [DVec2::ZERO; 24];
-    let mut n = 0;
+    let separation = Separation::new(sub);
+    let mut outside = Separation::ALL;
     for &q in points.iter().take(8) {
         for a in along {
             match near(a.project(q)) {
-                Some(p) => projected[n] = p,
+                Some(p) => outside &= separation.outside(p),
                 None => return false,
             }
-            n += 1;
         }
     }
-    // Conservative: a miss is reported only where a line separates the points from the
-    // camera triangle (one of its edges, or an axis of its bounding box).
-    separated(&projected[..n], sub)
+    outside != 0
 }
 
-/// Whether some edge of triangle `t` or an axis has all `points` strictly outside.
-fn separated(points: &[DVec2], t: [DVec2; 3]) -> bool {
-    if points.iter().any(|p| !p.is_finite()) {
-        return false;
+/// The lines that may separate points from a triangle: its three edges and the four sides
+/// of its bounding box ([`Separation::outside`]).
+struct Separation {
+    t: [DVec2; 3],
+    orient: f64,
+    lo: DVec2,
+    hi: DVec2,
+}
+
+impl Separation {
+    /// Every line.
+    const ALL: u8 = 0x7f;
+
+    fn new(t: [DVec2; 3]) -> Separation {
+        Separation {
+            t,
+            orient: cross(t[0], t[1], t[2]).signum(),
+            lo: t[0].min(t[1]).min(t[2]),
+            hi: t[0].max(t[1]).max(t[2]),
+        }
     }
-    let edge_out = outside_an_edge(points, t);
-    let lo = t[0].min(t[1]).min(t[2]);
-    let hi = t[0].max(t[1]).max(t[2]);
-    let axis_out = points.iter().all(|p| p.x < lo.x)
-        || points.iter().all(|p| p.x > hi.x)
-        || points.iter().all(|p| p.y < lo.y)
-        || points.iter().all(|p| p.y > hi.y);
-    edge_out || axis_out
+
+    /// The lines that finite point `p` lies strictly beyond, as bits: edge `i` of the
+    /// triangle (from corner `i` to the next) is bit `i`, then `x < lo.x`, `x > hi.x`,
+    /// `y < lo.y`, `y > hi.y`. Points that share a bit all lie beyond that line.
+    #[inline]
+    fn outside(&self, p: DVec2) -> u8 {
+        let t = &self.t;
+        let edge = |i: usize| u8::from(cross(t[i], t[(i + 1) % 3], p) * self.orient < 0.0) << i;
+        edge(0)
+            | edge(1)
+            | edge(2)
+            | u8::from(p.x < self.lo.x) << 3
+            | u8::from(p.x > self.hi.x) << 4
+            | u8::from(p.y < self.lo.y) << 5
+            | u8::from(p.y > self.hi.y) << 6
+    }
 }
 
 /// Whether all `points` (finite) lie strictly outside one edge of triangle `t` (either
@@ -326,7 +359,7 @@ fn paper(camera: &Camera, q: &[DVec3; 3], emit: &mut impl FnMut(&Convex)) {
         bounding_triangle(plane, &directions, &points)
     });
     let Some(triangle) = triangle else {
-        return emit_in_camera(camera, &Convex::from_points(&CORNERS), emit);
+        return emit_in_camera(camera, Convex::from_points(&CORNERS), emit);
     };
     let region = Convex::from_points(&triangle);
     let region = if cross(triangle[0], triangle[1], triangle[2]) < 0.0 {
@@ -340,9 +373,9 @@ fn paper(camera: &Camera, q: &[DVec3; 3], emit: &mut impl FnMut(&Convex)) {
         let pixels = region
             .map(|b| camera.map.pixel(b.x, b.y))
             .clip_to_rect(lo, hi);
-        emit_pixels(&pixels, emit);
+        emit_pixels(pixels, emit);
     } else {
-        emit_in_camera(camera, &region.clip_to_triangle(CORNERS), emit);
+        emit_in_camera(camera, region.clip_to_triangle(CORNERS), emit);
     }
 }
 
@@ -437,19 +470,27 @@ fn tight(
     }
     let pixels = region.area() * camera.pixels_per_area;
     if depth >= MAX_DEPTH || pixels < MIN_SPLIT_PIXELS || covers(camera, q, sub) {
-        return emit_in_camera(camera, &region, emit);
+        return emit_in_camera(camera, region, emit);
     }
     let mids = midpoints(sub);
-    let quarter_views = views.and_then(|views| {
+    // The views of the piece's corners, then of its sides' midpoints (as [`SPLIT`] indexes
+    // them).
+    let corner_views = views.and_then(|views| {
         let mid_views = mids.map(|b| CornerView::of(camera, plane, q, b));
-        let mid_views = [mid_views[0]?, mid_views[1]?, mid_views[2]?];
-        Some(split(views, mid_views))
+        Some([
+            views[0],
+            views[1],
+            views[2],
+            mid_views[0]?,
+            mid_views[1]?,
+            mid_views[2]?,
+        ])
     });
-    for (i, quarter) in split(sub, mids).into_iter().enumerate() {
+    for (quarter, corners) in split(sub, mids).into_iter().zip(SPLIT) {
         // A quarter's rays are among the piece's, so its region lies in the piece's: a
         // quarter that the region misses sees nothing of the triangle.
         if !outside_an_edge(region.points(), quarter) {
-            let views = quarter_views.map(|v| v[i]);
+            let views = corner_views.as_ref().map(|v| corners.map(|c| v[c]));
             tight(camera, plane, q, quarter, views, depth + 1, emit);
         }
     }
@@ -468,12 +509,12 @@ fn covers(camera: &Camera, q: &[DVec3; 3], sub: [DVec2; 3]) -> bool {
 }
 
 /// Emits a region given in barycentrics inside the camera triangle, in pixels.
-fn emit_in_camera(camera: &Camera, region: &Convex, emit: &mut impl FnMut(&Convex)) {
-    emit_pixels(&region.map(|b| camera.map.pixel(b.x, b.y)), emit);
+fn emit_in_camera(camera: &Camera, region: Convex, emit: &mut impl FnMut(&Convex)) {
+    emit_pixels(region.map(|b| camera.map.pixel(b.x, b.y)), emit);
 }
 
 /// Emits a pixel-space region with the rounding margin, if it has an area.
-fn emit_pixels(region: &Convex, emit: &mut impl FnMut(&Convex)) {
+fn emit_pixels(region: Convex, emit: &mut impl FnMut(&Convex)) {
     if region.points().len() >= 3 {
         emit(&region.dilated(MARGIN_PX));
     }

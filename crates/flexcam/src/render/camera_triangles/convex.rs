@@ -32,17 +32,19 @@ impl Convex {
     /// The convex hull of `points` (at most 16; Andrew's monotone chain), counter-clockwise,
     /// collinear points dropped. Non-finite points make the hull empty: no bound can be made.
     pub fn hull(points: &[DVec2]) -> Convex {
-        let mut sorted = [DVec2::ZERO; CAPACITY];
         let n = points.len().min(CAPACITY);
         if points[..n].iter().any(|p| !p.is_finite()) {
             return Convex::EMPTY;
         }
-        sorted[..n].copy_from_slice(&points[..n]);
-        let sorted = &mut sorted[..n];
-        sort_lexicographic(sorted);
+        let mut sorted = [DVec2::ZERO; CAPACITY];
+        sort_lexicographic(&points[..n], &mut sorted[..n]);
+        let sorted = &sorted[..n];
+        if n == 1 {
+            return Convex::from_points(sorted);
+        }
         let mut chain = [DVec2::ZERO; 2 * CAPACITY];
         let mut k = 0;
-        for &p in sorted.iter() {
+        for &p in sorted {
             while k >= 2 && cross(chain[k - 2], chain[k - 1], p) <= 0.0 {
                 k -= 1;
             }
@@ -59,9 +61,6 @@ impl Convex {
         }
         // The last point repeats the first.
         let count = k.saturating_sub(1);
-        if n == 1 {
-            return Convex::from_points(&sorted[..1]);
-        }
         Convex::from_points(&chain[..count.min(CAPACITY)])
     }
 
@@ -77,41 +76,59 @@ impl Convex {
     }
 
     /// The part on the left of the directed line `a -> b` (the line included)
-    /// (Sutherland-Hodgman).
-    pub fn clip(&self, a: DVec2, b: DVec2) -> Convex {
+    /// (Sutherland-Hodgman), in place; `scratch` is working space.
+    fn clip_with(&mut self, a: DVec2, b: DVec2, scratch: &mut Convex) {
         let side = |p: DVec2| cross(a, b, p);
         if self.points().iter().all(|&p| side(p) >= 0.0) {
             // Nothing to cut: the loop below would copy every vertex and add none.
-            return *self;
+            return;
         }
-        let mut out = Convex::EMPTY;
+        scratch.len = 0;
         for i in 0..self.len {
             let (p, q) = (self.points[i], self.points[(i + 1) % self.len]);
             let (sp, sq) = (side(p), side(q));
             if sp >= 0.0 {
-                out.push(p);
+                scratch.push(p);
             }
             if (sp >= 0.0) != (sq >= 0.0) {
-                out.push(p + (q - p) * (sp / (sp - sq)));
+                scratch.push(p + (q - p) * (sp / (sp - sq)));
             }
         }
+        self.points[..scratch.len].copy_from_slice(scratch.points());
+        self.len = scratch.len;
+    }
+
+    /// The part on the left of the directed line `a -> b` (the line included).
+    #[cfg(test)]
+    pub fn clip(&self, a: DVec2, b: DVec2) -> Convex {
+        let mut out = *self;
+        let mut scratch = Convex::EMPTY;
+        out.clip_with(a, b, &mut scratch);
         out
     }
 
+    /// The part inside the convex polygon with corners `corners`, counter-clockwise.
+    fn clip_to_polygon(mut self, corners: &[DVec2]) -> Convex {
+        let mut scratch = Convex::EMPTY;
+        for (i, &a) in corners.iter().enumerate() {
+            self.clip_with(a, corners[(i + 1) % corners.len()], &mut scratch);
+        }
+        self
+    }
+
     /// The part inside triangle `t` (either orientation).
-    pub fn clip_to_triangle(&self, t: [DVec2; 3]) -> Convex {
-        let [a, b, c] = if cross(t[0], t[1], t[2]) >= 0.0 {
+    pub fn clip_to_triangle(self, t: [DVec2; 3]) -> Convex {
+        let t = if cross(t[0], t[1], t[2]) >= 0.0 {
             t
         } else {
             [t[0], t[2], t[1]]
         };
-        self.clip(a, b).clip(b, c).clip(c, a)
+        self.clip_to_polygon(&t)
     }
 
     /// The part inside the axis-aligned rectangle `[lo, hi]`.
-    pub fn clip_to_rect(&self, lo: DVec2, hi: DVec2) -> Convex {
-        let corners = [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
-        (0..4).fold(*self, |poly, i| poly.clip(corners[i], corners[(i + 1) % 4]))
+    pub fn clip_to_rect(self, lo: DVec2, hi: DVec2) -> Convex {
+        self.clip_to_polygon(&[lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)])
     }
 
     /// The area (zero for fewer than three vertices).
@@ -126,39 +143,39 @@ impl Convex {
 
     /// The same polygon with every vertex mapped by `f` (which must keep it convex: an
     /// affine or a projective map without a pole on it).
-    pub fn map(&self, f: impl Fn(DVec2) -> DVec2) -> Convex {
-        let mut out = *self;
-        for p in &mut out.points[..out.len] {
+    pub fn map(mut self, f: impl Fn(DVec2) -> DVec2) -> Convex {
+        for p in &mut self.points[..self.len] {
             *p = f(*p);
         }
-        out
+        self
     }
 
     /// The polygon with each vertex moved `by` away from the vertices' mean: a margin for
     /// rounding, so that a pixel centre on the exact boundary is never lost.
-    pub fn dilated(&self, by: f64) -> Convex {
+    pub fn dilated(self, by: f64) -> Convex {
         if self.len == 0 {
-            return *self;
+            return self;
         }
         let centre = self.points().iter().sum::<DVec2>() / self.len as f64;
         self.map(|p| p + (p - centre).normalize_or_zero() * by)
     }
 }
 
-/// Sorts `points` by `x`, then `y`, in the order of `f64::total_cmp` (an insertion sort on
-/// integer keys: the hulls here have at most 16 points, and the comparator of
-/// `sort_by` costs more than the sort).
-fn sort_lexicographic(points: &mut [DVec2]) {
-    let key = |p: DVec2| (total_key(p.x), total_key(p.y));
-    for i in 1..points.len() {
-        let p = points[i];
-        let k = key(p);
+/// Writes `points` into `out` (as long) sorted by `x`, then `y`, in the order of
+/// `f64::total_cmp` (an insertion sort on integer keys, each computed once: the hulls here
+/// have at most 16 points, and the comparator of `sort_by` costs more than the sort).
+fn sort_lexicographic(points: &[DVec2], out: &mut [DVec2]) {
+    let mut keys = [(0i64, 0i64); CAPACITY];
+    for (i, &p) in points.iter().enumerate().take(CAPACITY) {
+        let k = (total_key(p.x), total_key(p.y));
         let mut j = i;
-        while j > 0 && key(points[j - 1]) > k {
-            points[j] = points[j - 1];
+        while j > 0 && keys[j - 1] > k {
+            keys[j] = keys[j - 1];
+            out[j] = out[j - 1];
             j -= 1;
         }
-        points[j] = p;
+        keys[j] = k;
+        out[j] = p;
     }
 }
 
@@ -190,7 +207,7 @@ mod tests {
             let points: Vec<DVec2> =
                 raw.iter().map(|&(x, y)| DVec2::new(values[x], values[y])).collect();
             let mut ours = points.clone();
-            sort_lexicographic(&mut ours);
+            sort_lexicographic(&points, &mut ours);
             let mut theirs = points;
             theirs.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
             let bits = |p: &[DVec2]| -> Vec<(u64, u64)> {

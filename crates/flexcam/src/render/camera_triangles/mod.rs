@@ -268,11 +268,23 @@ impl<'a> CameraTriangleRenderer<'a> {
                     if method.cull && method.bound == Bound::Tight {
                         counts.pairs = quarter_cull::pieces(camera, scene, &self.groups, buffers);
                         counts.culled = scene.triangles.len() as u64 - counts.pairs;
+                        // A triangle's pieces are consecutive: its corners and plane are
+                        // found once for all of them.
+                        let mut last = None;
                         for piece in &buffers.pieces {
                             let k = piece.triangle as usize;
+                            let (q, plane) = match last {
+                                Some((at, q, plane)) if at == k => (q, plane),
+                                _ => {
+                                    let q = scene.corners(k);
+                                    (q, bound::tight_plane(camera, &q))
+                                }
+                            };
+                            last = Some((k, q, plane));
                             bound::tight_in(
                                 camera,
-                                &scene.corners(k),
+                                &q,
+                                plane.as_ref(),
                                 piece.sub,
                                 piece.depth,
                                 &mut |region| push(k, region),
