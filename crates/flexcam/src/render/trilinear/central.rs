@@ -36,7 +36,7 @@
 //!   is undefined (it is seen edge-on, a line through the whole image): reported as
 //!   [`ThroughFocus`], and the renderer ray casts the projection triangle's pixels.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use super::clip::DOMAIN_MARGIN;
 use super::edge_path::OutlinePoint;
@@ -178,6 +178,14 @@ impl CentralProjection {
             v: self.v.dot(y),
             w: self.w.dot(y),
         }
+    }
+
+    /// The scene point `x`'s `w` (1 on the base, 0 at the focus: its depth is `t0 (1 -
+    /// w)`) and its image, the barycentrics `(u, v)` it is seen at (module doc; not finite
+    /// where `w` is 0): what the occlusion cull (`occlusion`) compares.
+    pub fn depth_and_image(&self, x: DVec3) -> (f64, DVec2) {
+        let p = self.point(x - self.focus);
+        (p.w, DVec2::new(p.u / p.w, p.v / p.w))
     }
 
     /// The depth `t0` at which the rays meet (read by the tests).

@@ -385,19 +385,25 @@ fn check_central(scene: &Scene, projection: &Trilinear, what: &str) -> PairCount
     let central = triangles.iter().filter(|t| t.central.is_some()).count();
     assert!(central > triangles.len() / 2, "{what}: {central} central");
     let mut cache = VertexCache::new(geometry.vertices.len());
-    let pairs: Vec<(u32, u32)> = triangles
+    let mut counts = PairCounts::default();
+    let live: Vec<LivePairs> = triangles
         .iter()
         .enumerate()
-        .flat_map(|(index, triangle)| {
-            let (live, _) = live_pairs(triangle, index as u32, &geometry, &mut cache);
-            live.pairs
-                .into_iter()
-                .map(move |p| (index as u32, p.triangle))
+        .map(|(index, triangle)| {
+            let (live, c) = live_pairs(triangle, index as u32, &geometry, &mut cache);
+            counts.add(&c);
+            live
         })
+        .collect();
+    let pairs: Vec<(u32, u32)> = live
+        .iter()
+        .flat_map(|l| l.pairs.iter().map(move |p| (l.projection, p.triangle)))
         .collect();
     let kept = kept_one_by_one(&triangles, &geometry);
     assert_eq!(pairs, kept, "{what}: live pairs");
-    let culled = project_all(&triangles, &geometry, CurveOptions::ADAPTIVE);
+    // The volume cull alone: `project_all` also drops the pairs hidden behind covers
+    // (`occlusion`), which change no pixel but do change the polygons (tested there).
+    let culled = draw_all(&triangles, &geometry, &live, CurveOptions::ADAPTIVE, counts);
     let all = unculled(&triangles, &geometry);
     let reference = draw_all(
         &triangles,
