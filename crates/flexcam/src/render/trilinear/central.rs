@@ -188,6 +188,20 @@ impl CentralProjection {
         (p.w, DVec2::new(p.u / p.w, p.v / p.w))
     }
 
+    /// Whether [`Self::outlines`] might refuse the scene triangle `scene` as reaching the
+    /// focus ([`ThroughFocus`]): unless its corners' `w` all have one sign and keep twice
+    /// that test's distance from zero, which every clipped point (a convex combination of
+    /// the corners) then keeps too. The occlusion cull hides no such pair, so that the
+    /// projection triangles ray cast for one stay so. NaN corners: true.
+    pub fn may_reach_focus(&self, scene: [DVec3; 3]) -> bool {
+        let y = scene.map(|x| x - self.focus);
+        let reach = y.iter().map(|y| y.length()).fold(0.0, f64::max);
+        let w = y.map(|y| self.w.dot(y));
+        let least = 2.0 * MEETING_TOL * self.w.length() * reach;
+        let clear = w.iter().all(|&w| w > least) || w.iter().all(|&w| w < -least);
+        !clear
+    }
+
     /// The depth `t0` at which the rays meet (read by the tests).
     #[cfg(test)]
     pub fn depth(&self) -> f64 {

@@ -28,8 +28,8 @@
 //! is never hidden; a scene triangle seen edge on (image of zero area), or reaching beyond
 //! the focus or the base, covers nothing; covers meeting only at a vertex, or folded over
 //! an edge, or a mesh whose triangles do not share their vertices, leave a boundary edge
-//! there; a pair reaching the focus behind the covers is hidden like any other (no ray of
-//! the domain reaches it before them), so its projection triangle is not ray cast for it.
+//! there; a pair that may reach the focus (`CentralProjection::may_reach_focus`) is never
+//! hidden, so that a projection triangle ray cast for one is ray cast as before.
 
 use glam::DVec2;
 
@@ -139,7 +139,8 @@ impl Occlusion {
         pairs.retain(|pair| {
             let w = self.corners(central, scene, pair.triangle).map(|s| s.w);
             // A NaN corner fails the comparison: kept.
-            !(w[0] < behind && w[1] < behind && w[2] < behind)
+            let hidden = w[0] < behind && w[1] < behind && w[2] < behind;
+            !hidden || central.may_reach_focus(scene.corners(pair.triangle as usize))
         });
         live.pairs = pairs;
         (before - live.pairs.len()) as u64
@@ -324,8 +325,9 @@ mod tests {
     }
 
     /// Behind a cover at `z = 2` (holding the whole domain): a triangle at `z = 3` and one
-    /// beyond the focus are hidden, one reaching beyond the focus from behind the cover too;
-    /// one in front, one reaching in front of it, and one with a NaN corner are kept.
+    /// beyond the focus are hidden; one reaching from behind the cover across the focus's
+    /// plane (it may reach the focus), one in front, one reaching in front of it, and one
+    /// with a NaN corner are kept.
     #[test]
     fn triangles_wholly_behind_a_cover_are_hidden() {
         let mut nan = flat(3.0, 0.2);
@@ -339,7 +341,7 @@ mod tests {
             [V(-1.0, 0.0, 3.0), V(1.0, 0.0, 1.9), V(0.0, 1.0, 3.5)],
             nan,
         ];
-        assert_eq!(kept(separate(&triangles)), vec![0, 4, 5, 6]);
+        assert_eq!(kept(separate(&triangles)), vec![0, 3, 4, 5, 6]);
     }
 
     /// A cover too small for the domain, one reaching beyond the base or beyond the focus,
