@@ -36,7 +36,7 @@
 //!   is undefined (it is seen edge-on, a line through the whole image): reported as
 //!   [`ThroughFocus`], and the renderer ray casts the projection triangle's pixels.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
 use super::clip::DOMAIN_MARGIN;
 use super::edge_path::OutlinePoint;
@@ -178,6 +178,28 @@ impl CentralProjection {
             v: self.v.dot(y),
             w: self.w.dot(y),
         }
+    }
+
+    /// The scene point `x`'s `w` (1 on the base, 0 at the focus: its depth is `t0 (1 -
+    /// w)`) and its image, the barycentrics `(u, v)` it is seen at (module doc; not finite
+    /// where `w` is 0): what the occlusion cull (`occlusion`) compares.
+    pub fn depth_and_image(&self, x: DVec3) -> (f64, DVec2) {
+        let p = self.point(x - self.focus);
+        (p.w, DVec2::new(p.u / p.w, p.v / p.w))
+    }
+
+    /// Whether [`Self::outlines`] might refuse the scene triangle `scene` as reaching the
+    /// focus ([`ThroughFocus`]): unless its corners' `w` all have one sign and keep twice
+    /// that test's distance from zero, which every clipped point (a convex combination of
+    /// the corners) then keeps too. The occlusion cull hides no such pair, so that the
+    /// projection triangles ray cast for one stay so. NaN corners: true.
+    pub fn may_reach_focus(&self, scene: [DVec3; 3]) -> bool {
+        let y = scene.map(|x| x - self.focus);
+        let reach = y.iter().map(|y| y.length()).fold(0.0, f64::max);
+        let w = y.map(|y| self.w.dot(y));
+        let least = 2.0 * MEETING_TOL * self.w.length() * reach;
+        let clear = w.iter().all(|&w| w > least) || w.iter().all(|&w| w < -least);
+        !clear
     }
 
     /// The depth `t0` at which the rays meet (read by the tests).

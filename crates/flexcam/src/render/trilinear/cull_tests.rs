@@ -6,22 +6,27 @@
 
 use std::sync::Arc;
 
-use glam::{DVec3, Vec3};
+use glam::{DVec2, DVec3, Vec3};
 use proptest::prelude::*;
 
 use super::central::CentralProjection;
 use super::curves::{CurveMode, CurveOptions};
+use super::gbuffer::GBuffer;
 use super::hit_terms::HitTerms;
+use super::hit_terms::TERMS;
+use super::occlusion::Occlusion;
 use super::outline::ProjectionTriangle;
 use super::pair_cull::PairCounts;
 use super::pair_cull::{live_pairs, LivePair, LivePairs, VertexCache};
 use super::polygons::{draw_all, project_all, projection_triangles, ProjectedScene};
+use super::resolve::Resolver;
 use super::resolve::PIXEL_TESTED;
 use super::scene_geometry::SceneGeometry;
+use super::screen_map::ScreenMap;
 use super::tests::{object, scene_of, square};
 use super::workloads;
 use crate::projection::{Trilinear, TrilinearMesh};
-use crate::render::scan::PolygonBatch;
+use crate::render::scan::{PolygonBatch, Scratch};
 use crate::scene::{self, Scene};
 
 /// Every pair with a plane, with no volume cull, its cubics solved directly.
@@ -374,30 +379,27 @@ fn the_tree_changes_no_polygon_of_the_cube() {
 /// culled pairs had no image. Returns the counts.
 fn check_central(scene: &Scene, projection: &Trilinear, what: &str) -> PairCounts {
     let geometry = SceneGeometry::new(scene);
-    let mut triangles = projection_triangles(projection);
-    for triangle in &mut triangles {
-        let cache = *triangle.map.cache();
-        triangle.ray_cast = cache.sweeps_no_volume();
-        triangle.central = (!triangle.ray_cast)
-            .then(|| CentralProjection::of(&cache))
-            .flatten();
-    }
-    let central = triangles.iter().filter(|t| t.central.is_some()).count();
-    assert!(central > triangles.len() / 2, "{what}: {central} central");
+    let triangles = central_triangles(projection, what);
     let mut cache = VertexCache::new(geometry.vertices.len());
-    let pairs: Vec<(u32, u32)> = triangles
+    let mut counts = PairCounts::default();
+    let live: Vec<LivePairs> = triangles
         .iter()
         .enumerate()
-        .flat_map(|(index, triangle)| {
-            let (live, _) = live_pairs(triangle, index as u32, &geometry, &mut cache);
-            live.pairs
-                .into_iter()
-                .map(move |p| (index as u32, p.triangle))
+        .map(|(index, triangle)| {
+            let (live, c) = live_pairs(triangle, index as u32, &geometry, &mut cache);
+            counts.add(&c);
+            live
         })
+        .collect();
+    let pairs: Vec<(u32, u32)> = live
+        .iter()
+        .flat_map(|l| l.pairs.iter().map(move |p| (l.projection, p.triangle)))
         .collect();
     let kept = kept_one_by_one(&triangles, &geometry);
     assert_eq!(pairs, kept, "{what}: live pairs");
-    let culled = project_all(&triangles, &geometry, CurveOptions::ADAPTIVE);
+    // The volume cull alone: `project_all` also drops the pairs hidden behind covers
+    // (`occlusion`), which change no pixel but do change the polygons (tested there).
+    let culled = draw_all(&triangles, &geometry, &live, CurveOptions::ADAPTIVE, counts);
     let all = unculled(&triangles, &geometry);
     let reference = draw_all(
         &triangles,
@@ -411,6 +413,103 @@ fn check_central(scene: &Scene, projection: &Trilinear, what: &str) -> PairCount
     assert_eq!(others, (0, 0), "{what}");
     assert_same_polygons(&culled, &reference, what);
     culled.counts
+}
+
+/// The projection triangles of `projection`, central where their rays meet in one point and
+/// ray cast where they sweep no volume, as the renderer sets them; most of them central.
+fn central_triangles(projection: &Trilinear, what: &str) -> Vec<ProjectionTriangle> {
+    let mut triangles = projection_triangles(projection);
+    for triangle in &mut triangles {
+        let cache = *triangle.map.cache();
+        triangle.ray_cast = cache.sweeps_no_volume();
+        triangle.central = (!triangle.ray_cast)
+            .then(|| CentralProjection::of(&cache))
+            .flatten();
+    }
+    let central = triangles.iter().filter(|t| t.central.is_some()).count();
+    assert!(central > triangles.len() / 2, "{what}: {central} central");
+    triangles
+}
+
+/// The winners (depth and key per pixel) of `polygons` drawn into one band of the whole
+/// `width` x `height` frame, each fragment resolved to its exact hit (pixel centres).
+fn winners(
+    polygons: &PolygonBatch<TERMS>,
+    triangles: &[ProjectionTriangle],
+    geometry: &SceneGeometry,
+    (width, height): (u32, u32),
+) -> (Vec<f64>, Vec<u64>) {
+    let maps: Vec<ScreenMap> = triangles.iter().map(|t| t.map).collect();
+    let resolver = Resolver {
+        maps: &maps,
+        scene: geometry,
+        sample: DVec2::splat(0.5),
+    };
+    let mut buffer = GBuffer::new(width, height).unwrap();
+    buffer.start_band((0, height));
+    let mut scratch = Scratch::default();
+    for k in 0..polygons.len() {
+        buffer.draw(&polygons.get(k), &resolver, &mut scratch);
+    }
+    (buffer.depth, buffer.keys)
+}
+
+/// The occlusion cull changes no pixel: the inward-looking sphere, with its own scene and
+/// with random triangles added around its centre (some through the focus), drawn from the live pairs with and without the
+/// pairs hidden behind covers, has the same winner (depth and key) at every pixel and the
+/// same ray-cast triangles, with fewer polygons where its own cube hides the rest.
+#[test]
+fn pairs_hidden_behind_covers_change_no_pixel() {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../scenes/trilinear-inward-sphere.toml"
+    );
+    let mut scene = scene::load(path).unwrap();
+    let size = (160, 120);
+    let built = scene.projection.build(size.0, size.1).unwrap();
+    let projection = built.trilinear().unwrap();
+    let triangles = central_triangles(projection, "inward sphere");
+    for random in [None, Some((200, 7))] {
+        if let Some((count, seed)) = random {
+            let mut objects = random_scene(count, seed).objects;
+            for object in &mut objects {
+                object.id += 10;
+                for p in &mut Arc::make_mut(&mut object.mesh).positions {
+                    *p += Vec3::new(0.0, 1.5, 1.0);
+                }
+            }
+            scene.objects.extend(objects);
+        }
+        let geometry = SceneGeometry::new(&scene);
+        let mut cache = VertexCache::new(geometry.vertices.len());
+        let mut occlusion = Occlusion::new(geometry.vertices.len());
+        let (mut all, mut hidden, mut dropped) = (Vec::new(), Vec::new(), 0);
+        for (index, triangle) in triangles.iter().enumerate() {
+            let (live, _) = live_pairs(triangle, index as u32, &geometry, &mut cache);
+            let mut fewer = live.clone();
+            if let Some(central) = &triangle.central {
+                dropped += occlusion.cull_hidden(central, &geometry, &mut fewer);
+            }
+            all.push(live);
+            hidden.push(fewer);
+        }
+        let curves = CurveOptions::ADAPTIVE;
+        let counts = PairCounts::default();
+        let all = draw_all(&triangles, &geometry, &all, curves, counts);
+        let fewer = draw_all(&triangles, &geometry, &hidden, curves, counts);
+        let what = format!("{random:?}: {dropped} hidden");
+        assert!(dropped > 0, "{what}");
+        assert!(fewer.polygons.len() < all.polygons.len(), "{what}");
+        assert_eq!(fewer.fallback, all.fallback, "{what}");
+        let (depth, keys) = winners(&all.polygons, &triangles, &geometry, size);
+        let (fewer_depth, fewer_keys) = winners(&fewer.polygons, &triangles, &geometry, size);
+        assert_eq!(fewer_keys, keys, "{what}");
+        let same = |a: &f64, b: &f64| a.to_bits() == b.to_bits();
+        assert!(
+            depth.iter().zip(&fewer_depth).all(|(a, b)| same(a, b)),
+            "{what}"
+        );
+    }
 }
 
 /// The inward-looking sphere (its central projections), with its own scene and with random

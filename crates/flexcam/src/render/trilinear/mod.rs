@@ -34,6 +34,7 @@ mod degenerate_band;
 mod edge_path;
 mod gbuffer;
 mod hit_terms;
+mod occlusion;
 mod outline;
 mod pair_cull;
 mod polygons;

@@ -36,6 +36,9 @@ pub struct PairCounts {
     pub culled_outside: u64,
     /// Pairs skipped because the scene triangle has zero area: no plane, nothing to draw.
     pub culled_zero_area: u64,
+    /// Pairs of a central projection not drawn because their scene triangle lies wholly
+    /// behind one that covers the projection triangle's whole domain (`occlusion`).
+    pub culled_hidden: u64,
     /// Pairs (or tessellated sub-triangles) that could not be cut into shapes; their
     /// projection triangle is ray cast instead.
     pub unprojectable: u64,
@@ -68,6 +71,7 @@ impl PairCounts {
         self.culled_behind += o.culled_behind;
         self.culled_outside += o.culled_outside;
         self.culled_zero_area += o.culled_zero_area;
+        self.culled_hidden += o.culled_hidden;
         self.unprojectable += o.unprojectable;
         self.split_pairs += o.split_pairs;
         self.tested_pairs += o.tested_pairs;
@@ -88,6 +92,7 @@ impl PairCounts {
             ("culled_behind", self.culled_behind),
             ("culled_outside", self.culled_outside),
             ("culled_zero_area", self.culled_zero_area),
+            ("culled_hidden", self.culled_hidden),
             ("unprojectable", self.unprojectable),
             ("split_pairs", self.split_pairs),
             ("tested_pairs", self.tested_pairs),

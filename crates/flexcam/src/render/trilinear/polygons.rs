@@ -1,7 +1,9 @@
 //! Every scene triangle through every projection triangle, into clipped pixel polygons: cull
 //! pairs outside each triangle's ray volume (`pair_cull`: whole subtrees of the scene's box
 //! tree at once, then triangle by triangle), project each remaining scene vertex once (its
-//! cubic), cull pairs whose images cannot be visible, form the shapes, trace their curved
+//! cubic), cull pairs whose images cannot be visible (through a central projection also
+//! those hidden behind a scene triangle covering its whole domain, `occlusion`), form the
+//! shapes, trace their curved
 //! outlines, clip them (pairs reaching a degenerate depth split there, `degenerate_band`),
 //! and append them to one polygon batch.
 
@@ -14,6 +16,7 @@ use super::curves::{CurveMode, CurveOptions, ADAPTIVE_TOLERANCE_PX};
 use super::degenerate_band::DegenerateBand;
 use super::edge_path::{EdgePath, OutlinePoint};
 use super::hit_terms::TERMS;
+use super::occlusion::Occlusion;
 use super::outline::{
     depth_range, is_outside_domain, slice_depths, trace_outline, EdgeCrossings, ProjectionTriangle,
     Sampling,
@@ -82,7 +85,8 @@ const PAIRS_PER_ITEM: usize = 4;
 
 /// Projects every triangle of `scene` through every projection triangle (number `i` is
 /// `triangles[i]`), in two parallel passes: the cull per projection triangle
-/// (`pair_cull::live_pairs`, which also solves the cubics), then the shapes, outlines and
+/// (`pair_cull::live_pairs`, which also solves the cubics, then `occlusion::Occlusion::cull_hidden`),
+/// then the shapes, outlines and
 /// clipping of the live pairs in small items. The result does not depend on the number of
 /// threads or on how the work was split.
 pub fn project_all(
@@ -94,8 +98,17 @@ pub fn project_all(
         .par_iter()
         .enumerate()
         .map_init(
-            || VertexCache::new(scene.vertices.len()),
-            |cache, (index, triangle)| live_pairs(triangle, index as u32, scene, cache),
+            || {
+                let vertices = scene.vertices.len();
+                (VertexCache::new(vertices), Occlusion::new(vertices))
+            },
+            |(cache, occlusion), (index, triangle)| {
+                let (mut live, mut counts) = live_pairs(triangle, index as u32, scene, cache);
+                if let Some(central) = &triangle.central {
+                    counts.culled_hidden = occlusion.cull_hidden(central, scene, &mut live);
+                }
+                (live, counts)
+            },
         )
         .collect();
     let mut counts = PairCounts::default();
