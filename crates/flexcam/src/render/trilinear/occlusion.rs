@@ -85,8 +85,10 @@ fn set_of(covers: &mut [Cover], mut c: u32) -> u32 {
 
 /// The occlusion cull's reused state, one per worker: the scene vertices as the current
 /// projection triangle sees them (each computed once, valid when stamped with the current
-/// generation) and the covers' edges.
+/// generation; allocated on the first cull, so that a worker that draws no central
+/// projection allocates nothing) and the covers' edges.
 pub struct Occlusion {
+    vertices: usize,
     seen: Vec<Seen>,
     generation: u32,
     edges: Vec<CoverEdge>,
@@ -103,13 +105,9 @@ const DOMAIN: [DVec2; 3] = [
 impl Occlusion {
     /// The cull's state for a scene of `vertices` vertices.
     pub fn new(vertices: usize) -> Occlusion {
-        let unseen = Seen {
-            stamp: 0,
-            w: 0.0,
-            image: DVec2::ZERO,
-        };
         Occlusion {
-            seen: vec![unseen; vertices],
+            vertices,
+            seen: Vec::new(),
             generation: 0,
             edges: Vec::new(),
             covers: Vec::new(),
@@ -125,6 +123,14 @@ impl Occlusion {
         scene: &SceneGeometry,
         live: &mut LivePairs,
     ) -> u64 {
+        if self.seen.is_empty() {
+            let unseen = Seen {
+                stamp: 0,
+                w: 0.0,
+                image: DVec2::ZERO,
+            };
+            self.seen = vec![unseen; self.vertices];
+        }
         self.generation = self.generation.wrapping_add(1);
         if self.generation == 0 {
             self.seen.iter_mut().for_each(|s| s.stamp = 0);
