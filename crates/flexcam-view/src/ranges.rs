@@ -57,7 +57,7 @@ mod tests {
                     "cylindrical" | "equirectangular" => &[("h_fov", 180.0), ("v_fov", 90.0)],
                     "pushbroom" => &[("width", 2.0), ("v_fov", 60.0)],
                     "depth_transition" => &[],
-                    _ => &[("fov", 60.0), ("v_fov", 40.0)],
+                    _ => &[("fov", 60.0), ("v_fov", 40.0), ("slit_distance", 1.0)],
                 };
                 let mut text = format!("type = \"flexible\"\npreset = \"{preset}\"\n{frame}");
                 for &(k, d) in keys {
