@@ -517,14 +517,15 @@ impl Bvh {
                             break;
                         }
                     }
-                    active = 0;
-                }
-                while active != 0 {
-                    let r = active.trailing_zeros() as usize;
-                    active &= active - 1;
-                    let ray = rays[r];
-                    for (i, tri) in self.triangles[first..first + count].iter().enumerate() {
-                        if let Some(hit) = tri.intersect(ray, t_max_lanes[r]) {
+                } else {
+                    while active != 0 {
+                        let r = active.trailing_zeros() as usize;
+                        active &= active - 1;
+                        let ray = rays[r];
+                        for (i, tri) in self.triangles[first..first + count].iter().enumerate() {
+                            let Some(hit) = tri.intersect(ray, t_max_lanes[r]) else {
+                                continue;
+                            };
                             if !keep.keeps(first + i) {
                                 continue;
                             }
@@ -532,10 +533,6 @@ impl Bvh {
                                 t_max_lanes[r] = hit.t;
                                 best[r] = Some((first + i, hit));
                                 best_index[r] = first + i;
-                            }
-                            if ANY {
-                                t_max_lanes[r] = f32::NEG_INFINITY;
-                                break;
                             }
                         }
                     }
