@@ -517,15 +517,14 @@ impl Bvh {
                             break;
                         }
                     }
-                } else {
-                    while active != 0 {
-                        let r = active.trailing_zeros() as usize;
-                        active &= active - 1;
-                        let ray = rays[r];
-                        for (i, tri) in self.triangles[first..first + count].iter().enumerate() {
-                            let Some(hit) = tri.intersect(ray, t_max_lanes[r]) else {
-                                continue;
-                            };
+                    active = 0;
+                }
+                while active != 0 {
+                    let r = active.trailing_zeros() as usize;
+                    active &= active - 1;
+                    let ray = rays[r];
+                    for (i, tri) in self.triangles[first..first + count].iter().enumerate() {
+                        if let Some(hit) = tri.intersect(ray, t_max_lanes[r]) {
                             if !keep.keeps(first + i) {
                                 continue;
                             }
@@ -533,6 +532,10 @@ impl Bvh {
                                 t_max_lanes[r] = hit.t;
                                 best[r] = Some((first + i, hit));
                                 best_index[r] = first + i;
+                            }
+                            if ANY {
+                                t_max_lanes[r] = f32::NEG_INFINITY;
+                                break;
                             }
                         }
                     }
