@@ -471,21 +471,12 @@ impl PreparedScene {
     /// with identical answers: coherent shadow rays (a 2x2 quad's, towards one light) share
     /// one BVH traversal ([`Bvh::occluded4`]).
     pub(in crate::render) fn occluded4(&self, rays: [Option<&Ray>; 4]) -> [bool; 4] {
-        // A quad's shadow rays towards a directional light share one direction: its f32
-        // form and reciprocal are worked out once (the same values).
-        let first = rays[0].and_then(FastRay::new);
-        let like_first = |ray: Option<&Ray>| match (ray, rays[0], &first) {
-            (Some(ray), Some(r0), Some(f0)) if ray.direction == r0.direction => {
-                FastRay::with_direction_of(ray, f0)
-            }
-            _ => ray.and_then(FastRay::new),
-        };
         // Spelled out, as in `intersect4_f32`: `array::map` here costs a closure call a ray.
         let fast = [
-            first,
-            like_first(rays[1]),
-            like_first(rays[2]),
-            like_first(rays[3]),
+            rays[0].and_then(FastRay::new),
+            rays[1].and_then(FastRay::new),
+            rays[2].and_then(FastRay::new),
+            rays[3].and_then(FastRay::new),
         ];
         let lanes = fast.each_ref().map(Option::as_ref);
         let blocked = match &self.shown {

@@ -1,7 +1,7 @@
-use glam::{DVec3, Vec3A, Vec4};
+use glam::DVec3;
 
 use super::build::MAX_LEAF;
-use super::triangle::{FastRay, PackedTriangle, RayLanes};
+use super::triangle::{FastRay, PackedTriangle};
 use super::*;
 use crate::geometry::Ray;
 
@@ -567,97 +567,4 @@ fn ordered_walks_visit_each_lane_s_leaves_and_stop_at_the_bound() {
 #[test]
 fn nodes_are_one_cache_line() {
     assert_eq!(std::mem::size_of::<Node>(), 64);
-}
-
-/// Four rays against one triangle at once: each lane says what the one-ray test says, on
-/// random triangles and rays, rays in the triangle's plane (a zero determinant), near-edge
-/// hits (the barycentric bounds), t_max at the hit's own t and just below it, and
-/// degenerate lanes (a subnormal determinant, NaN bounds).
-#[test]
-fn four_ray_triangle_test_is_the_one_ray_test() {
-    let mut rng = Rng(26);
-    let mut hits = 0;
-    let mut cases = 0;
-    for _ in 0..4000 {
-        let [a, b, c] = soup(&mut rng, 1)[0];
-        let Some(tri) = PackedTriangle::new(a.into(), b.into(), c.into()) else {
-            continue;
-        };
-        let target = |rng: &mut Rng| {
-            // Barycentrics from -0.1 to 1.1: some on and past the edges.
-            let (u, v) = (rng.next() * 1.2 - 0.1, rng.next() * 1.2 - 0.1);
-            a + (b - a) * u + (c - a) * v
-        };
-        let mut rays: Vec<FastRay> = (0..4)
-            .map(|k| {
-                let origin = rng.vec(12.0);
-                let mut direction = target(&mut rng) - origin;
-                if k == 3 {
-                    // In the triangle's plane.
-                    direction = (b - a) * rng.next() + (c - a) * rng.next();
-                }
-                let mut ray = Ray::new(origin.as_dvec3(), direction.as_dvec3());
-                ray.t_min = f64::from(rng.next()) * 0.5;
-                FastRay::new(&ray).unwrap()
-            })
-            .collect();
-        // Half the time, one lane's t_max at that lane's hit t, or just below it.
-        let mut t_max: [f32; 4] = std::array::from_fn(|r| rays[r].t_max);
-        if let Some(h) = tri.intersect(&rays[1], rays[1].t_max) {
-            t_max[1] = if rng.next() < 0.5 || h.t <= 0.0 {
-                h.t
-            } else {
-                f32::from_bits(h.t.to_bits() - 1)
-            };
-        }
-        if rng.next() < 0.1 {
-            rays[2].t_min = f32::NAN;
-        }
-        let lanes = RayLanes::new([&rays[0], &rays[1], &rays[2], &rays[3]]);
-        let mask = tri.hits4(&lanes, Vec4::from_array(t_max)).bitmask();
-        for r in 0..4 {
-            let one = tri.intersect(&rays[r], t_max[r]).is_some();
-            assert_eq!(mask >> r & 1 == 1, one, "lane {r}: {tri:?} {:?}", rays[r]);
-            hits += usize::from(one);
-            cases += 1;
-        }
-    }
-    // Both answers are well represented.
-    assert!(
-        hits > cases / 5 && hits < cases * 4 / 5,
-        "{hits} of {cases}"
-    );
-    // A subnormal determinant: the one-ray test refuses it (an infinite reciprocal).
-    let tiny = PackedTriangle::new(
-        Vec3A::ZERO,
-        Vec3A::new(1e-20, 0.0, 0.0),
-        Vec3A::new(0.0, 1e-20, 0.0),
-    )
-    .unwrap();
-    let ray = FastRay::new(&Ray::new(DVec3::new(1e-21, 1e-21, 1.0), -DVec3::Z)).unwrap();
-    let lanes = RayLanes::new([&ray; 4]);
-    let one = tiny.intersect(&ray, ray.t_max).is_some();
-    assert_eq!(tiny.hits4(&lanes, Vec4::splat(ray.t_max)).any(), one);
-}
-
-/// A ray made with the direction of another is what [`FastRay::new`] makes of it.
-#[test]
-fn a_shared_direction_makes_the_same_fast_ray() {
-    let mut rng = Rng(7);
-    let direction = rng.vec(1.0).as_dvec3();
-    let first = FastRay::new(&Ray::new(DVec3::ZERO, direction)).unwrap();
-    for k in 0..50 {
-        let mut ray = Ray::new(rng.vec(5.0).as_dvec3(), direction);
-        ray.t_max = if k % 2 == 0 { f64::INFINITY } else { 3.5 };
-        let shared = FastRay::with_direction_of(&ray, &first).unwrap();
-        let own = FastRay::new(&ray).unwrap();
-        assert_eq!(format!("{shared:?}"), format!("{own:?}"));
-    }
-    // The cases the one-ray constructor refuses, refused alike.
-    let mut empty = Ray::new(DVec3::ONE, direction);
-    empty.t_min = 2.0;
-    empty.t_max = 1.0;
-    assert!(FastRay::with_direction_of(&empty, &first).is_none());
-    let far = Ray::new(DVec3::new(f64::INFINITY, 0.0, 0.0), direction);
-    assert!(FastRay::with_direction_of(&far, &first).is_none());
 }

@@ -7,7 +7,7 @@ use std::mem::MaybeUninit;
 
 use glam::{BVec4A, Vec3, Vec3A, Vec4, Vec4Swizzles};
 
-use super::triangle::{FastHit, FastRay, RayLanes};
+use super::triangle::{FastHit, FastRay};
 use super::{Bvh, BvhHit, Child, Keep, Node, STACK_SIZE};
 use crate::geometry::Aabb;
 
@@ -482,7 +482,6 @@ impl Bvh {
             return [None; 4];
         }
         let packet = Packet::new(rays);
-        let lanes = RayLanes::new(rays);
         let mut t_max = packet.t_max;
         let mut best: [Option<(usize, FastHit)>; 4] = [None; 4];
         let mut best_index = [usize::MAX; 4];
@@ -495,30 +494,6 @@ impl Bvh {
                 // Only the rays that reach this leaf in front of their closest hit.
                 let mut active = entry.cmple(t_max).bitmask();
                 let mut t_max_lanes = t_max.to_array();
-                if ANY {
-                    // The four rays against each triangle at once; a ray that hits stops.
-                    let triangles = &self.triangles[first..first + count];
-                    for (i, tri) in triangles.iter().enumerate() {
-                        let mut hits = tri.hits4(&lanes, t_max).bitmask() & active;
-                        if hits == 0 || !keep.keeps(first + i) {
-                            continue;
-                        }
-                        active &= !hits;
-                        while hits != 0 {
-                            let r = hits.trailing_zeros() as usize;
-                            hits &= hits - 1;
-                            // The hit itself, as the one-ray test finds it.
-                            best[r] = tri
-                                .intersect(rays[r], t_max_lanes[r])
-                                .map(|h| (first + i, h));
-                            t_max_lanes[r] = f32::NEG_INFINITY;
-                        }
-                        if active == 0 {
-                            break;
-                        }
-                    }
-                    active = 0;
-                }
                 while active != 0 {
                     let r = active.trailing_zeros() as usize;
                     active &= active - 1;

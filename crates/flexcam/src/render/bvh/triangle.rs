@@ -1,7 +1,7 @@
 //! Triangles precomputed for the f32 inner loop (Moller-Trumbore on a first vertex and two
 //! edges), and the f32 form of a ray.
 
-use glam::{BVec4A, DVec3, Vec3A, Vec4};
+use glam::{DVec3, Vec3A};
 
 use crate::geometry::Ray;
 
@@ -61,46 +61,6 @@ impl FastRay {
             t_max: ray.t_max as f32,
         })
     }
-
-    /// [`FastRay::new`] of `ray`, whose direction is that of `same` (made by
-    /// [`FastRay::new`] of a ray with exactly `ray`'s direction): the same value, without
-    /// converting the direction and computing its reciprocal again (the shadow rays of a
-    /// quad towards a directional light share one direction).
-    pub fn with_direction_of(ray: &Ray, same: &FastRay) -> Option<FastRay> {
-        // `same` exists, so the direction is finite and not zero.
-        let interval = ray.t_min <= ray.t_max;
-        if !ray.origin.is_finite() || !interval {
-            return None;
-        }
-        Some(FastRay {
-            origin: Vec3A::from(ray.origin.as_vec3()),
-            t_min: ray.t_min as f32,
-            t_max: ray.t_max as f32,
-            ..*same
-        })
-    }
-}
-
-/// Four rays in SoA form (lane r is ray r) for [`PackedTriangle::hits4`]: per axis, the
-/// origins and the directions, and the near ends of the intervals.
-#[derive(Debug, Clone, Copy)]
-pub(in crate::render) struct RayLanes {
-    pub origin: [Vec4; 3],
-    pub direction: [Vec4; 3],
-    pub t_min: Vec4,
-}
-
-impl RayLanes {
-    #[inline(always)]
-    pub fn new(rays: [&FastRay; 4]) -> RayLanes {
-        let axis = |k: usize| Vec4::from_array(rays.map(|r| r.origin[k]));
-        let along = |k: usize| Vec4::from_array(rays.map(|r| r.direction[k]));
-        RayLanes {
-            origin: [axis(0), axis(1), axis(2)],
-            direction: [along(0), along(1), along(2)],
-            t_min: Vec4::from_array(rays.map(|r| r.t_min)),
-        }
-    }
 }
 
 /// A hit found by the f32 inner loop: ray parameter and barycentrics of vertices 1 and 2.
@@ -151,44 +111,5 @@ impl PackedTriangle {
             u: u * inv_det,
             v: v * inv_det,
         })
-    }
-
-    /// Which of four rays hit the triangle, lane r with `t_max[r]`: lane by lane exactly
-    /// whether [`PackedTriangle::intersect`] finds a hit. Each lane makes the same f32
-    /// operations in the same order (the vector products as `glam`'s `Vec3A` makes them:
-    /// a dot product as `(x x' + y y') + z z'`, a cross product's x as `a.y b.z - a.z b.y`;
-    /// products commute exactly, and nothing is fused), its early returns as masks.
-    #[inline(always)]
-    pub fn hits4(&self, rays: &RayLanes, t_max: Vec4) -> BVec4A {
-        let (v0, e1, e2) = (self.v0, self.e1, self.e2);
-        let k = Vec4::splat;
-        let [dx, dy, dz] = rays.direction;
-        // p = d x e2; det = e1 . p.
-        let px = dy * k(e2.z) - dz * k(e2.y);
-        let py = dz * k(e2.x) - dx * k(e2.z);
-        let pz = dx * k(e2.y) - dy * k(e2.x);
-        let det = k(e1.x) * px + k(e1.y) * py + k(e1.z) * pz;
-        let sign = Vec4::ONE.copysign(det);
-        let abs_det = det.abs();
-        // s = origin - v0; u = (s . p) sign.
-        let sx = rays.origin[0] - k(v0.x);
-        let sy = rays.origin[1] - k(v0.y);
-        let sz = rays.origin[2] - k(v0.z);
-        let u = (sx * px + sy * py + sz * pz) * sign;
-        // q = s x e1; v = (d . q) sign.
-        let qx = sy * k(e1.z) - sz * k(e1.y);
-        let qy = sz * k(e1.x) - sx * k(e1.z);
-        let qz = sx * k(e1.y) - sy * k(e1.x);
-        let v = (dx * qx + dy * qy + dz * qz) * sign;
-        let inv_det = Vec4::ONE / abs_det;
-        let t = (k(e2.x) * qx + k(e2.y) * qy + k(e2.z) * qz) * sign * inv_det;
-        det.cmpne(Vec4::ZERO)
-            & u.cmpge(Vec4::ZERO)
-            & u.cmple(abs_det)
-            & v.cmpge(Vec4::ZERO)
-            & (u + v).cmple(abs_det)
-            & t.cmpge(rays.t_min)
-            & t.cmple(t_max)
-            & inv_det.cmplt(Vec4::INFINITY)
     }
 }
