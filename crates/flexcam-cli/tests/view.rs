@@ -855,3 +855,85 @@ fn dragging_the_clamped_keys_of_presets() {
         assert_eq!(numbers[3..], [0.7, 0.08, 50.0], "{line}");
     }
 }
+
+/// A drag of the world handle listed as `listed` (see [`dragged`]) that takes it right of
+/// the view axis and behind the eye (its angle from the axis past 90 degrees, twice that
+/// past 180): the first such direction of the drag plane, a million pixels long.
+fn behind_and_right(listed: &[f64], eye: V3, forward: V3, right: V3) -> (f64, f64) {
+    (0..360)
+        .map(|k| {
+            let (sin, cos) = f64::from(k).to_radians().sin_cos();
+            (1e6 * cos, 1e6 * sin)
+        })
+        .find(|&(dx, dy)| {
+            let v = sub(dragged(listed, dx, dy), eye);
+            dot(v, right) > 0.0 && dot(v, forward) < 0.0
+        })
+        .expect("the drag plane reaches behind the eye")
+}
+
+#[test]
+fn angle_drags_past_their_range_stop_at_its_end() {
+    let ortho_persp = include_str!("../../../scenes/flexible-ortho-near-persp-far.toml");
+    let depth = include_str!("../../../scenes/flexible-depth-transition.toml");
+    let slits = include_str!("../../../scenes/flexible-crossed-slits.toml");
+    let slits_size = ("width = 800\nheight = 600", "width = 48\nheight = 36");
+    // Past 180 degrees, which the loader refuses: the fov handle behind the eye.
+    let (eye, forward, right) = preset_frame();
+    let dir = setup_scene(ortho_persp, SMALL_PRESET.0, SMALL_PRESET.1, "");
+    let (dx, dy) = behind_and_right(&listed(&dir, "fov"), eye, forward, right);
+    // (scene, size, handle, drag, the changed line's start, the number at `index`): across
+    // the view axis (a negative angle) the smallest angle, 0.1; past 180 (or a `fovs` edge
+    // far out, nearly 180) the largest below the loader's 180, 179.9. Each saved scene
+    // renders as the script's frame (`drag_one`).
+    let cases = [
+        (
+            ortho_persp,
+            SMALL_PRESET,
+            "fov",
+            -300.0,
+            0.0,
+            "fov =",
+            0,
+            0.1,
+        ),
+        (ortho_persp, SMALL_PRESET, "fov", dx, dy, "fov =", 0, 179.9),
+        (slits, slits_size, "v_fov", 0.0, 300.0, "v_fov =", 0, 0.1),
+        (depth, SMALL_PRESET, "fovs.1", 1e9, 0.0, "fovs =", 1, 179.9),
+        (depth, SMALL_PRESET, "fovs.0", -300.0, 0.0, "fovs =", 0, 0.1),
+    ];
+    for (text, size, handle, dx, dy, key, index, expected) in cases {
+        let (_, line) = drag_one(text, size, handle, dx, dy);
+        assert!(line.starts_with(key), "{handle}: {line}");
+        assert_eq!(line_values(&line)[index], expected, "{handle}: {line}");
+    }
+}
+
+#[test]
+fn axonometric_and_glc_views_have_a_width_handle() {
+    let isometric = include_str!("../../../scenes/flexible-isometric.toml");
+    let iso_size = ("width = 320\nheight = 240", "width = 48\nheight = 36");
+    // A general linear camera as wide as a 53-degree perspective, at the isometric view's
+    // eye (30 m in front of the scene).
+    let glc = isometric
+        .replace("preset = \"axonometric\"", "preset = \"glc\"")
+        .replace("width = 12.0", "width = 1.0")
+        .replace(
+            "azimuth = 45.0\nelevation = 35.264\n",
+            "generators = [[-0.5, -0.5, -1.0, -1.0], [0.5, -0.5, 1.0, -1.0], [-0.5, 0.5, -1.0, 1.0]]\n",
+        );
+    // The handle lies half the width right of the view's axis point (the axonometric
+    // look-at point, the glc's eye): its offset from there is the axis's right direction.
+    for (text, axis_point, width) in [
+        (isometric, [0.0, 0.5, 0.0], 12.0),
+        (&glc, [0.0, 0.0, 30.0], 1.0),
+    ] {
+        let (listed, line) = drag_one(text, iso_size, "width", 5.0, 2.0);
+        let offset = sub([listed[0], listed[1], listed[2]], axis_point);
+        assert!(close(dot(offset, offset).sqrt(), width / 2.0), "{listed:?}");
+        let right = unit(offset);
+        let expected = 2.0 * dot(sub(dragged(&listed, 5.0, 2.0), axis_point), right);
+        assert!(line.starts_with("width ="), "{line}");
+        assert!(close(line_values(&line)[0], expected), "{line}: {expected}");
+    }
+}

@@ -15,8 +15,8 @@
 //! | `S.corner.K` | corner K of a `bilinear` surface | `corners[K]` |
 //! | `S.R.C` | control point of row R, column C of a `bezier` / `bspline` patch | `control[R][C]` |
 //! | `projector.C.R.start`, `projector.C.R.end` | node (column C, row R) of a projector grid | that node's `start` / `end` in `projectors.projector` (the entry is added when missing) |
-//! | `fov`, `h_fov`, `v_fov` | the point at half the angle right of (`v_fov`: above) a preset's view axis, at the look-at distance | the angle: twice that of the dragged point |
-//! | `width` | half the width right of the look-at point (orthographic, oblique, pushbroom presets) | twice the dragged point's distance right of the axis |
+//! | `fov`, `h_fov`, `v_fov` | the point at half the angle right of (`v_fov`: above) a preset's view axis, at the look-at distance | the angle: twice that of the dragged point, clamped to the preset's range (module `ranges`) |
+//! | `width` | half the width right of the look-at point (orthographic, oblique, pushbroom presets; axonometric: across its turned view), of the eye on the image plane (glc) | twice the dragged point's distance right of the axis |
 //! | `clip.near`, `clip.far`, `transition`, `transitions.K`, `z_near`, `z_far` | the point at that distance along the view axis | the dragged point's distance along the axis |
 //! | `path.K` | point K of an mcop camera path | that point |
 //! | `pole`, `center`, `radius` | over the image: the occlusion pole, the magnifier's centre and the point of its circle right of it | u right, v up (`radius`: by the shorter image side) |
@@ -35,8 +35,10 @@ mod ranged;
 use std::sync::Arc;
 
 use flexcam::calibrate::build_flexible;
-use flexcam::projection::flexible::{PanoramaShape, Reparam, Volume, VolumeSource};
-use flexcam::projection::{CameraBasis, ProjectionSpec};
+use flexcam::projection::flexible::{
+    PanoramaShape, Preset, PresetSpec, Reparam, Volume, VolumeSource,
+};
+use flexcam::projection::{CameraBasis, CameraFrame, ProjectionSpec};
 use flexcam::scene::file::edit::float_array;
 use flexcam::{Error, Result};
 use glam::{DVec2, DVec3};
@@ -407,6 +409,9 @@ fn preset_keys(session: &Session, out: &mut Vec<Handle>) {
     // The mcop columns look along their own directions from the path, the axonometric and
     // general linear cameras along their own keys', not along the frame's view axis.
     if matches!(preset, Some("mcop" | "axonometric" | "glc")) {
+        if let VolumeSource::Preset(p) = &spec.source {
+            out.extend(own_view_width(p));
+        }
         return;
     }
     let Ok(frame) = session.camera() else {
@@ -459,15 +464,8 @@ fn preset_keys(session: &Session, out: &mut Vec<Handle>) {
         }
     }
     if let (Some(extent), "orthographic" | "oblique" | "pushbroom") = (number("width"), preset) {
-        // From the eye along `right` is as far as from the look-at point: factor 2.
         let at = origin + forward * distance + basis.right * extent / 2.0;
-        out.push(along(
-            "width",
-            ValuePath::key("width"),
-            at,
-            basis.right,
-            2.0,
-        ));
+        out.push(width_handle(at, origin, basis.right));
     }
     for (key, axis) in [
         ("fov", basis.right),
@@ -478,17 +476,84 @@ fn preset_keys(session: &Session, out: &mut Vec<Handle>) {
             continue;
         };
         let (sin, cos) = (angle.to_radians() / 2.0).sin_cos();
+        let edit = Edit::Angle {
+            path: ValuePath::key(key),
+            origin,
+            axis,
+            forward,
+        };
         out.push(Handle {
             name: key.into(),
             place: Place::World(origin + distance * (axis * sin + forward * cos)),
             net: None,
-            edit: Edit::Angle {
-                path: ValuePath::key(key),
-                origin,
-                axis,
-                forward,
-            },
+            edit: clamp_angle(edit, Some(preset), key),
         });
+    }
+}
+
+/// The `width` handle at `at`, half the width right of a view's axis through `origin`
+/// (`right` unit): the width is twice the dragged point's distance right of the axis.
+fn width_handle(at: DVec3, origin: DVec3, right: DVec3) -> Handle {
+    Handle {
+        name: "width".into(),
+        place: Place::World(at),
+        net: None,
+        edit: Edit::Along {
+            path: ValuePath::key("width"),
+            origin,
+            axis: right,
+            factor: 2.0,
+        },
+    }
+}
+
+/// The `width` handle of the presets that look along their own keys' directions: the
+/// axonometric view (half the width right of `look_at` across the view from the eye turned
+/// by `azimuth` and `elevation`, up +y, as the preset places it) and the general linear
+/// camera (half the width right of the eye on its image plane, local depth 0, where the
+/// image is `width` wide). `None` for the other presets or a degenerate frame.
+fn own_view_width(preset: &PresetSpec) -> Option<Handle> {
+    let frame = &preset.frame;
+    match preset.preset {
+        Preset::Axonometric {
+            width,
+            azimuth,
+            elevation,
+        } => {
+            let (sin_a, cos_a) = azimuth.to_radians().sin_cos();
+            let (sin_e, cos_e) = elevation.to_radians().sin_cos();
+            let towards_eye = DVec3::new(cos_e * sin_a, sin_e, cos_e * cos_a);
+            let distance = (frame.position - frame.look_at).length();
+            let turned = CameraFrame {
+                position: frame.look_at + distance * towards_eye,
+                look_at: frame.look_at,
+                up: DVec3::Y,
+            };
+            let b = CameraBasis::new(&turned).ok()?;
+            let at = frame.look_at + b.right * width / 2.0;
+            Some(width_handle(at, b.origin, b.right))
+        }
+        Preset::Glc { width, .. } => {
+            let b = CameraBasis::new(frame).ok()?;
+            Some(width_handle(
+                b.origin + b.right * width / 2.0,
+                b.origin,
+                b.right,
+            ))
+        }
+        _ => None,
+    }
+}
+
+/// `edit` of angle key `key` of flexible `preset`, clamped to the range the scene loader
+/// accepts ([`crate::ranges::angle`]): a drag past it stops at its end.
+fn clamp_angle(edit: Edit, preset: Option<&str>, key: &str) -> Edit {
+    match crate::ranges::angle("flexible", preset, key) {
+        Some(range) => Edit::Clamped {
+            edit: Box::new(edit),
+            range,
+        },
+        None => edit,
     }
 }
 

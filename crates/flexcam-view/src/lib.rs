@@ -11,6 +11,7 @@
 pub mod bench;
 pub mod camera;
 pub mod handles;
+pub mod ranges;
 pub mod render_loop;
 pub mod script;
 pub mod session;

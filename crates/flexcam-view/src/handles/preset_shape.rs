@@ -8,7 +8,7 @@
 //! | `twist` | twist: the middle of the far rectangle's right edge, turned | the angle of the dragged point about the view axis, counter-clockwise from the right as seen from the eye, the turn nearest the old one |
 //! | `converge` | inverse_perspective: the world point the projectors meet at | that point |
 //! | `slit_distance` | crossed_slits: the horizontal slit's point on the view axis | the dragged point's distance along the axis |
-//! | `fovs.K` | depth_transition: where view K ends (the next transition or the far clip), its right edge | the angle of view K: its edge through the dragged point's distance right of the axis at that depth, from where view K starts |
+//! | `fovs.K` | depth_transition: where view K ends (the next transition or the far clip), its right edge | the angle of view K: its edge through the dragged point's distance right of the axis at that depth, from where view K starts, within the loader's (0, 180) (module `ranges`) |
 //! | `generators.K.start`, `generators.K.end` | glc: generator ray K's points at local depth 0 and 1 | that point's two numbers: the dragged point across the view axis at that depth |
 //! | `directions.K` | mcop: path point K plus half its direction (half: columns that look at one point, as an mcop's often do, keep their handles apart) | that direction: twice the dragged point less the path point |
 //! | `strength` | over the image: occlusion, the point `strength` image widths right of the pole | the number, by x over the image width |
@@ -270,12 +270,19 @@ pub(super) fn handles(session: &Session, out: &mut Vec<Handle>) {
                     depth,
                 };
                 let place = Place::World(o + depth * forward + end * right);
-                out.push(shaped(
-                    format!("fovs.{k}"),
-                    key("fovs").index(k),
-                    place,
+                let edit = Edit::Shape {
+                    path: key("fovs").index(k),
                     shape,
-                ));
+                };
+                out.push(Handle {
+                    name: format!("fovs.{k}"),
+                    place,
+                    net: None,
+                    edit: Edit::Clamped {
+                        edit: Box::new(edit),
+                        range: crate::ranges::BELOW_HALF_TURN,
+                    },
+                });
                 start = DVec2::new(depth, end);
             }
         }

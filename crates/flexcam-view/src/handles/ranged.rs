@@ -28,8 +28,8 @@ use super::preset_shape::Shape;
 use super::{image_pixel, Edit, Handle, Place, ValuePath};
 use crate::session::Session;
 
-/// The valid range of an angle of view below 180 degrees (the parameter panel's).
-const ANGLE: [f64; 2] = [0.1, 179.9];
+/// The valid range of an angle of view below 180 degrees.
+const ANGLE: [f64; 2] = crate::ranges::BELOW_HALF_TURN;
 
 /// The axonometric elevation's range: (-90, 90) is valid, and at +-90 the view has no up.
 const ELEVATION: [f64; 2] = [-89.9, 89.9];

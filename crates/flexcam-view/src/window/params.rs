@@ -9,18 +9,18 @@ use eframe::egui;
 use flexcam::projection::flexible::presets::PRESET_NAMES;
 use toml_edit::{Item, Value};
 
-/// The valid range of a number key of projection type `kind`, where the scene format bounds
-/// it (angles in degrees); unbounded otherwise.
-fn range(kind: &str, key: &str) -> RangeInclusive<f64> {
-    match (kind, key) {
-        ("perspective", "fov") => 0.1..=179.9,
-        (_, "fov") => 0.1..=360.0,
-        (_, "h_fov") => 0.1..=360.0,
-        (_, "v_fov") => 0.1..=180.0,
-        (_, "width") => 1e-6..=f64::MAX,
+/// The valid range of a number key of projection type `kind` (`variant`: its `preset` or
+/// fisheye `mapping`), where the scene format bounds it (angles in degrees, as
+/// [`crate::ranges::angle`]); unbounded otherwise.
+fn range(kind: &str, variant: Option<&str>, key: &str) -> RangeInclusive<f64> {
+    if let Some([low, high]) = crate::ranges::angle(kind, variant, key) {
+        return low..=high;
+    }
+    match key {
+        "width" => 1e-6..=f64::MAX,
         // The axonometric view has no up at +-90 degrees.
-        (_, "elevation") => -89.9..=89.9,
-        (_, "corner_radius") => 0.0..=1.0,
+        "elevation" => -89.9..=89.9,
+        "corner_radius" => 0.0..=1.0,
         _ => f64::MIN..=f64::MAX,
     }
 }
@@ -34,6 +34,21 @@ fn speed(value: f64) -> f64 {
 /// returns the first change made this frame.
 pub fn show(ui: &mut egui::Ui, kind: &str, prefix: &str, item: &Item) -> Option<(String, Value)> {
     let table = item.as_table_like()?;
+    // The projection table's preset or fisheye mapping, which some ranges depend on.
+    let variant = ["preset", "mapping"]
+        .into_iter()
+        .find_map(|key| table.get(key)?.as_str());
+    shown(ui, kind, variant, prefix, table)
+}
+
+/// [`show`] of `table` with its projection's `variant`.
+fn shown(
+    ui: &mut egui::Ui,
+    kind: &str,
+    variant: Option<&str>,
+    prefix: &str,
+    table: &dyn toml_edit::TableLike,
+) -> Option<(String, Value)> {
     let mut change = None;
     for (key, item) in table.iter() {
         let path = if prefix.is_empty() {
@@ -44,13 +59,15 @@ pub fn show(ui: &mut egui::Ui, kind: &str, prefix: &str, item: &Item) -> Option<
         let edited = if item.is_table_like() {
             egui::CollapsingHeader::new(key)
                 .id_salt(&path)
-                .show(ui, |ui| show(ui, kind, &path, item))
+                .show(ui, |ui| {
+                    shown(ui, kind, variant, &path, item.as_table_like()?)
+                })
                 .body_returned
                 .flatten()
         } else if let Some(value) = item.as_value() {
             ui.horizontal(|ui| {
                 ui.label(key);
-                value_widget(ui, kind, key, value)
+                value_widget(ui, key, range(kind, variant, key), value)
             })
             .inner
             .map(|v| (path, v))
@@ -68,7 +85,12 @@ pub fn show(ui: &mut egui::Ui, kind: &str, prefix: &str, item: &Item) -> Option<
 }
 
 /// The widget of one value; its new value when changed.
-fn value_widget(ui: &mut egui::Ui, kind: &str, key: &str, value: &Value) -> Option<Value> {
+fn value_widget(
+    ui: &mut egui::Ui,
+    key: &str,
+    range: RangeInclusive<f64>,
+    value: &Value,
+) -> Option<Value> {
     match value {
         Value::Float(f) => {
             let mut v = *f.value();
@@ -76,7 +98,7 @@ fn value_widget(ui: &mut egui::Ui, kind: &str, key: &str, value: &Value) -> Opti
             let r = ui.add(
                 egui::DragValue::new(&mut v)
                     .speed(step)
-                    .range(range(kind, key)),
+                    .range(range.clone()),
             );
             r.changed().then(|| Value::from(v))
         }
@@ -115,7 +137,8 @@ fn value_widget(ui: &mut egui::Ui, kind: &str, key: &str, value: &Value) -> Opti
                     let mut changed = false;
                     for v in &mut numbers {
                         let step = speed(*v);
-                        changed |= ui.add(egui::DragValue::new(v).speed(step)).changed();
+                        let value = egui::DragValue::new(v).speed(step).range(range.clone());
+                        changed |= ui.add(value).changed();
                     }
                     changed.then(|| flexcam::scene::file::edit::float_array(&numbers))
                 }
