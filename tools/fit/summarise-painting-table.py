@@ -49,6 +49,8 @@ def main():
     for name in header[3:]:
         worst = min(rows, key=lambda r: percent(r[columns[name]]))
         print(f"{name}: worst {percent(worst[columns[name]]):.2f} (seed {worst[0]})")
+    if not singles:
+        return
     for name in autos:
         k = columns[name]
         ties, behind, reach = 0, 0.0, 0
