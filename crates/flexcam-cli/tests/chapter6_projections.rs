@@ -281,17 +281,16 @@ fn project_meets_pick_and_depth(dir: &TempDir, scene: &str, pixel: [usize; 2]) {
     );
     let pfm = fs::read(dir.path().join("depth.pfm")).unwrap();
     // "Pf\nW H\n-1.0\n", then rows bottom up, little-endian f32.
-    let text = String::from_utf8_lossy(&pfm[..32.min(pfm.len())]).into_owned();
-    let mut lines = text.split('\n');
-    let size: Vec<usize> = lines
-        .nth(1)
+    let mut parts = pfm.splitn(4, |&b| b == b'\n');
+    assert_eq!(parts.next(), Some(&b"Pf"[..]));
+    let size: Vec<usize> = std::str::from_utf8(parts.next().unwrap())
         .unwrap()
         .split(' ')
         .map(|n| n.parse().unwrap())
         .collect();
-    let header = text.split('\n').take(3).map(|l| l.len() + 1).sum::<usize>();
-    let at = header + ((size[1] - 1 - pixel[1]) * size[0] + pixel[0]) * 4;
-    let rendered = f32::from_le_bytes(pfm[at..at + 4].try_into().unwrap());
+    let samples = parts.nth(1).unwrap();
+    let at = ((size[1] - 1 - pixel[1]) * size[0] + pixel[0]) * 4;
+    let rendered = f32::from_le_bytes(samples[at..at + 4].try_into().unwrap());
     let along = image["depth"].as_f64().unwrap();
     assert!(
         (along - f64::from(rendered)).abs() < 1e-5 * along,

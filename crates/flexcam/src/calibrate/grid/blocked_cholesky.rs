@@ -75,13 +75,8 @@ mod tests {
 
     /// A symmetric positive definite matrix of size `n` from a seed: `M M^T + n I`.
     fn spd(n: usize, seed: u64) -> DMatrix<f64> {
-        let mut state = seed;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut draw = crate::calibrate::grid::tests::lcg_uniform(seed);
+        let mut next = || draw() - 0.5;
         let m = DMatrix::from_fn(n, n, |_, _| next());
         &m * m.transpose() + DMatrix::identity(n, n) * n as f64
     }

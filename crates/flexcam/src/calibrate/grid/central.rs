@@ -652,6 +652,7 @@ mod tests {
 
     use super::super::{fit_with, FittedStarts, Starts};
     use super::*;
+    use crate::calibrate::grid::tests::lcg_uniform;
     use crate::projection::flexible::projector_grid::tests::perspective_volume as perspective;
     use crate::projection::flexible::projector_grid::GridInterpolation;
 
@@ -674,13 +675,7 @@ mod tests {
 
     /// `count` points seen by `truth` at seeded image positions and depths t in (0.1, 0.6).
     fn seen_by(truth: &ProjectorGrid, count: usize, seed: u64) -> Vec<Correspondence> {
-        let mut state = seed;
-        let mut next = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = lcg_uniform(seed);
         (0..count)
             .map(|_| {
                 let uv = DVec2::new(next(), next());
@@ -891,13 +886,8 @@ mod tests {
             })
             .take(count)
             .collect();
-        let mut state = seed;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut draw = lcg_uniform(seed);
+        let mut next = || draw() - 0.5;
         for c in &mut data {
             // Kept in the image, as clicks are.
             c.uv = (c.uv + DVec2::new(next(), next()) * 0.01).clamp(DVec2::ZERO, DVec2::ONE);

@@ -143,13 +143,8 @@ mod tests {
     /// A symmetric positive definite matrix of size `n` and half-bandwidth `band` (with
     /// rows of varying width below it) from a seed.
     fn banded_spd(n: usize, band: usize, seed: u64) -> DMatrix<f64> {
-        let mut state = seed;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
+        let mut draw = crate::calibrate::grid::tests::lcg_uniform(seed);
+        let mut next = || draw() - 0.5;
         let mut a = DMatrix::zeros(n, n);
         for i in 0..n {
             // Every third row narrower: envelopes are not a plain band.

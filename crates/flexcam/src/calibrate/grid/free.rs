@@ -577,23 +577,13 @@ mod tests {
 
     use super::super::{fit_with, Starts};
     use super::*;
+    pub(super) use crate::calibrate::grid::tests::lcg_uniform as uniform;
     use crate::projection::flexible::presets::Preset;
     use crate::projection::flexible::projector_grid::tests::{
         perspective_volume as perspective, preset_volume,
     };
     use crate::projection::flexible::projector_grid::GridInterpolation;
     use crate::projection::flexible::LinearVolume;
-
-    /// Deterministic uniform numbers in [0, 1) from `seed` (a linear congruential generator).
-    pub(super) fn uniform(seed: u64) -> impl FnMut() -> f64 {
-        let mut state = seed;
-        move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        }
-    }
 
     /// A known projection the tests take points from: (u, v) and t to a point.
     pub(super) trait Truth {

@@ -10,6 +10,18 @@ use crate::projection::flexible::LinearVolume;
 use crate::projection::projector::quadratic_point;
 use proptest::prelude::*;
 
+/// Deterministic uniform numbers in [0, 1) from `seed` (a linear congruential generator),
+/// shared by the fitting modules' tests (this module's own draws are [`uniform`]'s).
+pub(super) fn lcg_uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut state = seed;
+    move || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 /// Correspondences seen by `truth`: one per cell of a `per_side x per_side` jittered
 /// grid of image positions (so every region of the image has data), each on its projector
 /// at a depth t in (0.05, 0.9).

@@ -141,14 +141,12 @@ impl Occlusion {
         };
         let behind = cover - HIDDEN_MARGIN;
         let before = live.pairs.len();
-        let mut pairs = std::mem::take(&mut live.pairs);
-        pairs.retain(|pair| {
+        live.pairs.retain(|pair| {
             let w = self.corners(central, scene, pair.triangle).map(|s| s.w);
             // A NaN corner fails the comparison: kept.
             let hidden = w[0] < behind && w[1] < behind && w[2] < behind;
             !hidden || central.may_reach_focus(scene.corners(pair.triangle as usize))
         });
-        live.pairs = pairs;
         (before - live.pairs.len()) as u64
     }
 

@@ -3,9 +3,8 @@
 //! tree at once, then triangle by triangle), project each remaining scene vertex once (its
 //! cubic), cull pairs whose images cannot be visible (through a central projection also
 //! those hidden behind a scene triangle covering its whole domain, `occlusion`), form the
-//! shapes, trace their curved
-//! outlines, clip them (pairs reaching a degenerate depth split there, `degenerate_band`),
-//! and append them to one polygon batch.
+//! shapes, trace their curved outlines, clip them (pairs reaching a degenerate depth split
+//! there, `degenerate_band`), and append them to one polygon batch.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -85,9 +84,9 @@ const PAIRS_PER_ITEM: usize = 4;
 
 /// Projects every triangle of `scene` through every projection triangle (number `i` is
 /// `triangles[i]`), in two parallel passes: the cull per projection triangle
-/// (`pair_cull::live_pairs`, which also solves the cubics, then `occlusion::Occlusion::cull_hidden`),
-/// then the shapes, outlines and
-/// clipping of the live pairs in small items. The result does not depend on the number of
+/// (`pair_cull::live_pairs`, which also solves the cubics, then
+/// `occlusion::Occlusion::cull_hidden`), then the shapes, outlines and clipping of the live
+/// pairs in small items. The result does not depend on the number of
 /// threads or on how the work was split.
 pub fn project_all(
     triangles: &[ProjectionTriangle],
