@@ -353,3 +353,62 @@ fn project_refuses_what_it_cannot_project() {
         assert!(err.contains("no analytic inverse"), "{err}");
     }
 }
+
+/// The inward-looking sphere's pole rows: projection triangles whose two pole vertices
+/// coincide, so their rays form a fan and a point on it is seen along a whole segment of
+/// pixels. For pixels of the bottom and top rows, the point `pick` finds there is listed by
+/// `project` with an image through that pixel: a point image on it or a segment (a line of
+/// five numbers, the JSON's `x_end`, `y_end`) passing through it, at one depth.
+#[test]
+fn project_lists_the_segment_along_which_a_fan_triangle_sees_a_point() {
+    let dir = TempDir::new().unwrap();
+    let sphere = scene("trilinear-inward-sphere.toml");
+    let mut segments = 0;
+    for pixel in [
+        "10.5,158.5",
+        "60.5,158.5",
+        "100.5,158.5",
+        "230.5,158.5",
+        "40.5,1.5",
+    ] {
+        let picked = run_json(&dir, &["pick", &sphere, pixel, "--json"]);
+        let point: Vec<String> = picked["point"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| format!("{:?}", c.as_f64().unwrap()))
+            .collect();
+        let point = point.join(",");
+        let (x, y) = pixel.split_once(',').unwrap();
+        let at = [x.parse::<f64>().unwrap(), y.parse::<f64>().unwrap()];
+        let json = run_json(&dir, &["project", &sphere, &point, "--json"]);
+        let through = json["images"].as_array().unwrap().iter().any(|image| {
+            let p = |k: &str| image[k].as_f64();
+            let a = [p("x").unwrap(), p("y").unwrap()];
+            let b = match (p("x_end"), p("y_end")) {
+                (Some(x), Some(y)) => {
+                    segments += 1;
+                    [x, y]
+                }
+                _ => a,
+            };
+            // The distance from the pixel to the segment a b (a point where a == b).
+            let d = [b[0] - a[0], b[1] - a[1]];
+            let length2 = d[0] * d[0] + d[1] * d[1];
+            let s = if length2 == 0.0 {
+                0.0
+            } else {
+                (((at[0] - a[0]) * d[0] + (at[1] - a[1]) * d[1]) / length2).clamp(0.0, 1.0)
+            };
+            (a[0] + s * d[0] - at[0]).hypot(a[1] + s * d[1] - at[1]) < 1e-6
+        });
+        assert!(through, "{pixel}: {json}");
+        let text = String::from_utf8(run_ok(&dir, &["project", &sphere, &point]).stdout).unwrap();
+        assert_eq!(
+            text.lines().count(),
+            json["images"].as_array().unwrap().len(),
+            "{text}"
+        );
+    }
+    assert!(segments >= 4, "{segments} segments");
+}

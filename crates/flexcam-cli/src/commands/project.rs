@@ -21,21 +21,24 @@ pub struct ProjectArgs {
     /// part of the point, not an option).
     #[arg(value_name = "X,Y,Z", allow_hyphen_values = true)]
     point: String,
-    /// Print one JSON object (`point`, `images`: each with `x`, `y`, `depth`, `t`) instead
-    /// of one line per image.
+    /// Print one JSON object (`point`, `images`: each with `x`, `y`, `depth`, `t`, and for an
+    /// image along a segment of pixels `x_end`, `y_end`) instead of one line per image.
     #[arg(long)]
     json: bool,
 }
 
 /// One image of the point: its continuous pixel position (x right, y down, pixel (x, y)
 /// covering [x, x + 1) x [y, y + 1)), the distance along its pixel's ray (or polyline or
-/// curved projector, by arc length) from its start (what `render --depth` writes there when nothing is in front)
-/// and the ray parameter (a flexible volume's t).
+/// curved projector, by arc length) from its start (what `render --depth` writes there when
+/// nothing is in front) and the ray parameter (a flexible volume's t); for an image along a
+/// whole segment of pixels (a trilinear triangle whose rays form a fan), the segment's other
+/// end, every position between seeing the point along the same ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Image {
     pixel: DVec2,
     depth: f64,
     t: f64,
+    end: Option<DVec2>,
 }
 
 /// Runs `flexcam project`: loads the scene's projection, finds every image of the point
@@ -70,34 +73,65 @@ pub fn run(args: &ProjectArgs) -> Result<()> {
     })?;
     let mut found = Vec::new();
     inverse.project(point, &mut found);
+    let mut segments = Vec::new();
+    inverse.project_segments(point, &mut segments);
     let size = DVec2::new(f64::from(loaded.width), f64::from(loaded.height));
-    let mut images: Vec<Image> = found
+    let depth_at = |pixel: DVec2, t: f64| match projection.projector(pixel) {
+        Some(Projector::Polyline(points)) => arc_length_to(&points, point),
+        // A quadratic volume's t is the curve parameter s of B(s) (the point is B(t)).
+        Some(Projector::QuadraticBezier(curve)) => quadratic_arc_length(&curve, t),
+        _ => {
+            let speed = projection
+                .ray(pixel)
+                .map_or(1.0, |ray| ray.direction.length());
+            t * speed
+        }
+    };
+    // A fan triangle's neighbours see the point at its segment's ends: one image.
+    let on_a_segment = |pixel: DVec2| {
+        segments
+            .iter()
+            .flat_map(|s| s.ends)
+            .any(|end| end.distance(pixel) <= SAME_IMAGE_PIXELS)
+    };
+    let points = found
         .iter()
-        .filter(|image| image.t >= 0.0)
+        .filter(|image| image.t >= 0.0 && !on_a_segment(image.pixel))
         .filter(|image| {
             let p = image.pixel;
             p.x >= 0.0 && p.y >= 0.0 && p.x <= size.x && p.y <= size.y
         })
-        .map(|&ImagePoint { pixel, t }| {
-            let depth = match projection.projector(pixel) {
-                Some(Projector::Polyline(points)) => arc_length_to(&points, point),
-                // A quadratic volume's t is the curve parameter s of B(s) (the point is B(t)).
-                Some(Projector::QuadraticBezier(curve)) => quadratic_arc_length(&curve, t),
-                _ => {
-                    let speed = projection
-                        .ray(pixel)
-                        .map_or(1.0, |ray| ray.direction.length());
-                    t * speed
-                }
-            };
-            Image { pixel, depth, t }
-        })
-        .collect();
+        .map(|&ImagePoint { pixel, t }| Image {
+            pixel,
+            depth: depth_at(pixel, t),
+            t,
+            end: None,
+        });
+    let lines = segments
+        .iter()
+        .filter(|segment| segment.t >= 0.0)
+        .filter_map(|segment| {
+            let [a, b] = clip_to_image(segment.ends, size)?;
+            Some(Image {
+                pixel: a,
+                depth: depth_at(0.5 * (a + b), segment.t),
+                t: segment.t,
+                end: Some(b),
+            })
+        });
+    let mut images: Vec<Image> = points.chain(lines).collect();
     images.sort_by(|a, b| a.depth.total_cmp(&b.depth));
     let text = if args.json {
         let images: Vec<_> = images
             .iter()
-            .map(|i| json!({"x": i.pixel.x, "y": i.pixel.y, "depth": i.depth, "t": i.t}))
+            .map(|i| {
+                let mut image = json!({"x": i.pixel.x, "y": i.pixel.y, "depth": i.depth, "t": i.t});
+                if let Some(end) = i.end {
+                    image["x_end"] = json!(end.x);
+                    image["y_end"] = json!(end.y);
+                }
+                image
+            })
             .collect();
         let object = json!({
             "scene": loaded.source,
@@ -109,10 +143,45 @@ pub fn run(args: &ProjectArgs) -> Result<()> {
     } else {
         images
             .iter()
-            .map(|i| format!("{} {} {}\n", i.pixel.x, i.pixel.y, i.depth))
+            .map(|i| match i.end {
+                None => format!("{} {} {}\n", i.pixel.x, i.pixel.y, i.depth),
+                Some(end) => format!(
+                    "{} {} {} {} {}\n",
+                    i.pixel.x, i.pixel.y, i.depth, end.x, end.y
+                ),
+            })
             .collect()
     };
     super::print_stdout(&text)
+}
+
+/// Images of the point this close (in pixels) are one image.
+const SAME_IMAGE_PIXELS: f64 = 1e-6;
+
+/// The part of the segment `ends` inside the image `[0, size.x] x [0, size.y]` (Liang and
+/// Barsky's clip), `None` where none is.
+fn clip_to_image(ends: [DVec2; 2], size: DVec2) -> Option<[DVec2; 2]> {
+    let [a, b] = ends;
+    let d = b - a;
+    let (mut enter, mut leave) = (0.0_f64, 1.0_f64);
+    // Each side as p s <= q for the segment's parameter s in [0, 1].
+    for (p, q) in [
+        (-d.x, a.x),
+        (d.x, size.x - a.x),
+        (-d.y, a.y),
+        (d.y, size.y - a.y),
+    ] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None;
+            }
+        } else if p < 0.0 {
+            enter = enter.max(q / p);
+        } else {
+            leave = leave.min(q / p);
+        }
+    }
+    (enter <= leave).then(|| [a + enter * d, a + leave * d])
 }
 
 /// The arc length along polyline projector `points` from its start to `point`, which lies on

@@ -8,7 +8,7 @@
 
 use glam::DVec3;
 
-use super::{ImagePoint, InverseChart};
+use super::{ImagePoint, ImageSegment, InverseChart};
 
 /// Why a projection has no analytic inverse.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -24,6 +24,13 @@ pub trait AnalyticInverse: Send + Sync {
     /// Appends to `out` every image position of scene point `point`, each with the ray
     /// parameter that reaches it: zero, one or several (a trilinear mesh can fold).
     fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>);
+
+    /// Appends to `out` every image of `point` that is a whole segment of image positions
+    /// (each seeing the point along the same ray), where a projection has such images: a
+    /// trilinear mesh's triangles whose rays form a fan. None by default.
+    fn project_segments(&self, point: DVec3, out: &mut Vec<ImageSegment>) {
+        let _ = (point, out);
+    }
 
     /// The inverse as a continuous map with its chart (see [`super::chart`]); `None` where it
     /// folds or jumps in ways a chart cannot describe.

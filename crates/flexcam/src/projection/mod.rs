@@ -65,10 +65,11 @@ pub use panoramic::{Cylindrical, Equirectangular};
 pub use projector::{Projector, ProjectorHull};
 pub use stereo::{KeepClear, Layout, StereoPair, View};
 pub use trilinear::mesh_builders as trilinear_builders;
+pub use trilinear::ray_fan as trilinear_fan;
 pub use trilinear::{
-    project_solved_triangle, project_triangle, FragmentMirror, ProjectionTriangleCache,
-    ProjectiveMap, SceneEdge, Shape, ShapeVertex, Solutions, TriangleMirror, TriangleShapes,
-    TriangleSolution, Trilinear, Unprojectable,
+    project_solved_triangle, project_triangle, FanSolution, FragmentMirror,
+    ProjectionTriangleCache, ProjectiveMap, RayFan, SceneEdge, Shape, ShapeVertex, Solutions,
+    TriangleMirror, TriangleShapes, TriangleSolution, Trilinear, Unprojectable,
 };
 pub use vr180::{vr180, Vr180};
 
@@ -83,6 +84,18 @@ pub struct ImagePoint {
     /// It may lie outside the image: callers clip.
     pub pixel: DVec2,
     /// The ray parameter at which `ray(pixel)` reaches the point: `ray(pixel).at(t) == point`.
+    pub t: f64,
+}
+
+/// An image of a scene point that is a whole segment of image positions, each seeing the
+/// point along one and the same ray (a trilinear projection triangle whose rays form a fan,
+/// [`RayFan`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImageSegment {
+    /// The segment's ends, as [`ImagePoint::pixel`] (outside the image possibly: callers
+    /// clip).
+    pub ends: [DVec2; 2],
+    /// The ray parameter at which the ray of every position on the segment reaches the point.
     pub t: f64,
 }
 

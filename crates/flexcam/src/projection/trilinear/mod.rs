@@ -19,23 +19,30 @@ pub mod mesh_builders;
 mod obj;
 mod point_projection;
 mod projective_map;
+pub mod ray_fan;
 mod screen_locator;
 mod shapes;
 
 use glam::{DVec2, DVec3};
 
 use super::image_coords::Resolution;
-use super::{AnalyticInverse, Charted, ImagePoint, NoInverse, Projection, TrilinearMesh};
+use super::{
+    AnalyticInverse, Charted, ImagePoint, ImageSegment, NoInverse, Projection, TrilinearMesh,
+};
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
 pub use fragment_mirror::{FragmentMirror, TriangleMirror};
 pub use point_projection::{ProjectionTriangleCache, Solutions, TriangleSolution};
 pub use projective_map::ProjectiveMap;
+pub use ray_fan::{FanSolution, RayFan};
 use screen_locator::ScreenLocator;
 pub use shapes::{
     project_solved_triangle, project_triangle, SceneEdge, Shape, ShapeVertex, TriangleShapes,
     Unprojectable,
 };
+
+/// Images of one point closer than this (in pixels) are one image.
+const DEDUP_PIXELS: f64 = 1e-6;
 
 /// A screen triangle counts as degenerate when twice its area is below this fraction of the
 /// product of its two edge lengths from the first vertex (the sine of its angle there).
@@ -319,56 +326,58 @@ impl AnalyticInverse for Trilinear {
     /// * Images closer than `1e-6` pixels are one image (a point on an edge or vertex shared
     ///   by several projection triangles is found by each of them).
     fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
-        const DEDUP_PIXELS: f64 = 1e-6;
         let start = out.len();
-        let size = self.resolution.size();
+        let mut push = |pixel: DVec2, t: f64| {
+            if !out[start..]
+                .iter()
+                .any(|o| (o.pixel - pixel).length() <= DEDUP_PIXELS)
+            {
+                out.push(ImagePoint { pixel, t });
+            }
+        };
         for (index, cache) in self.caches.iter().enumerate() {
             let solutions = cache.project_point(point);
-            if solutions.is_empty() {
+            if solutions.is_every_t() {
+                self.fan_images(index, point, |[a, b], t| {
+                    if a.distance(b) <= DEDUP_PIXELS {
+                        push(a, t);
+                    }
+                });
                 continue;
             }
-            let [i, j, k] = self.mesh.triangles[index].map(|k| k as usize);
-            let normals = [
-                self.mesh.normals[i],
-                self.mesh.normals[j],
-                self.mesh.normals[k],
-            ];
-            let largest = normals.iter().fold(0.0_f64, |m, n| m.max(n.length()));
+            let i = self.mesh.triangles[index][0] as usize;
+            let largest = self.largest_normal(index);
             for s in solutions.iter().filter(|s| s.inside) {
                 let direction = cache.trinorm(s.u, s.v);
                 let length = direction.length();
                 if length <= 1e-12 * largest {
                     continue;
                 }
-                let t = if s.t >= 0.0 {
-                    s.t
-                } else {
-                    let slack = 64.0
-                        * f64::EPSILON
-                        * (point.abs().max_element()
-                            + self.mesh.points[i].abs().max_element()
-                            + cache.tripoint(s.u, s.v).distance(self.mesh.points[i]));
-                    if -s.t * length > slack {
-                        continue;
-                    }
-                    0.0
+                let base = cache.tripoint(s.u, s.v).distance(self.mesh.points[i]);
+                let Some(t) = self.in_front(point, i, base, s.t, length) else {
+                    continue;
                 };
-                let l = self.screen_at_barycentrics(index, DVec2::new(s.u, s.v));
-                let screen = (1.0 - l.x - l.y) * self.mesh.screen[i]
-                    + l.x * self.mesh.screen[j]
-                    + l.y * self.mesh.screen[k];
-                if !self.covers(index, screen, cache, s, t) {
-                    continue;
+                let screen = self.screen_at(index, DVec2::new(s.u, s.v));
+                if self.covers(index, screen, cache, s, t) {
+                    push(self.pixel_of(screen), t);
                 }
-                let pixel = DVec2::new(screen.x * size.x, (1.0 - screen.y) * size.y);
-                if out[start..]
-                    .iter()
-                    .any(|o| (o.pixel - pixel).length() <= DEDUP_PIXELS)
-                {
-                    continue;
-                }
-                out.push(ImagePoint { pixel, t });
             }
+        }
+    }
+
+    /// Per projection triangle whose rays form a fan ([`RayFan`]; its cubic vanishes for
+    /// every point, so [`Self::project`] finds nothing there), every ray of the fan through
+    /// `point` in front of the view plane (`t` as in [`Self::project`]), seen along the whole
+    /// line of the screen triangle of its apex weight, where that triangle is the one
+    /// [`Projection::ray`] uses (tested at the line's middle). A line of zero length (the
+    /// apex's own ray) is a point and is listed by [`Self::project`] instead.
+    fn project_segments(&self, point: DVec3, out: &mut Vec<ImageSegment>) {
+        for index in 0..self.caches.len() {
+            self.fan_images(index, point, |ends, t| {
+                if ends[0].distance(ends[1]) > DEDUP_PIXELS {
+                    out.push(ImageSegment { ends, t });
+                }
+            });
         }
     }
 
@@ -385,6 +394,78 @@ impl Trilinear {
     /// `screen` reaches the same point at `t` (a shared edge of a continuous mesh), or
     /// picks none (outside the covered screen, where `ray` gives nothing either: the image
     /// position is still reported, callers clip).
+    /// The larger length of triangle `index`'s three vertex normals.
+    fn largest_normal(&self, index: usize) -> f64 {
+        self.mesh.triangles[index].iter().fold(0.0_f64, |m, &k| {
+            m.max(self.mesh.normals[k as usize].length())
+        })
+    }
+
+    /// `t` of a solution of triangle `index` at `base` from its first vertex's base point
+    /// `p_i`, with ray direction length `length`: itself where `t >= 0`, 0 where the point
+    /// is on the base triangle within rounding (`-t |trinorm| <= 64 EPSILON (|point| + |p_i|
+    /// + base)`), else `None` (behind the view plane).
+    fn in_front(&self, point: DVec3, i: usize, base: f64, t: f64, length: f64) -> Option<f64> {
+        if t >= 0.0 {
+            return Some(t);
+        }
+        let slack = 64.0
+            * f64::EPSILON
+            * (point.abs().max_element() + self.mesh.points[i].abs().max_element() + base);
+        (-t * length <= slack).then_some(0.0)
+    }
+
+    /// The screen position of barycentrics `b` of triangle `index` (the inverse of the
+    /// screen-to-barycentrics map of [`Projection::ray`]).
+    fn screen_at(&self, index: usize, b: DVec2) -> DVec2 {
+        let [i, j, k] = self.mesh.triangles[index].map(|k| k as usize);
+        let l = self.screen_at_barycentrics(index, b);
+        (1.0 - l.x - l.y) * self.mesh.screen[i]
+            + l.x * self.mesh.screen[j]
+            + l.y * self.mesh.screen[k]
+    }
+
+    /// The continuous pixel `(s_x W, (1 - s_y) H)` of screen position `s`.
+    fn pixel_of(&self, screen: DVec2) -> DVec2 {
+        let size = self.resolution.size();
+        DVec2::new(screen.x * size.x, (1.0 - screen.y) * size.y)
+    }
+
+    /// Calls `image` with the pixel ends of each line of triangle `index` that sees `point`
+    /// along one ray of its fan, and that ray's `t` (see
+    /// [`AnalyticInverse::project_segments`]); nothing unless the triangle is a fan.
+    fn fan_images(&self, index: usize, point: DVec3, mut image: impl FnMut([DVec2; 2], f64)) {
+        let cache = &self.caches[index];
+        let Some(fan) = RayFan::of(cache) else {
+            return;
+        };
+        let i = self.mesh.triangles[index][0] as usize;
+        let largest = self.largest_normal(index);
+        for solution in fan.project_point(point) {
+            let ray = fan.ray(solution.w);
+            let length = ray.direction.length();
+            if length <= 1e-12 * largest {
+                continue;
+            }
+            let base = ray.origin.distance(self.mesh.points[i]);
+            let Some(t) = self.in_front(point, i, base, solution.t, length) else {
+                continue;
+            };
+            let ends = fan.line_ends(solution.w);
+            let middle = 0.5 * (ends[0] + ends[1]);
+            let at_middle = TriangleSolution {
+                t,
+                u: middle.x,
+                v: middle.y,
+                inside: true,
+                multiplicity: 1,
+            };
+            if self.covers(index, self.screen_at(index, middle), cache, at_middle, t) {
+                image(ends.map(|b| self.pixel_of(self.screen_at(index, b))), t);
+            }
+        }
+    }
+
     fn covers(
         &self,
         index: usize,
@@ -471,6 +552,50 @@ mod tests {
                 assert!((tri.origin - tri.direction - PINHOLE_EYE).length() < 1e-12);
             }
         }
+    }
+
+    /// One projection triangle whose vertices 1 and 2 share a base point and ray (a fan,
+    /// [`RayFan`]), screen corners (0, 0), (1, 0), (0, 1) of a 100 x 100 image: a point on
+    /// the fan's ray of apex weight 0.25 is seen along the screen line of that weight (from
+    /// (75, 100) to (0, 25) in pixels, y down) and not by `project`; a point on the apex's
+    /// own ray is one point image, at the apex; a point off the fan has no image.
+    #[test]
+    fn a_fan_triangle_sees_a_point_along_a_segment() {
+        let (points, normals) = super::ray_fan::pole_row();
+        let mesh = TrilinearMesh {
+            points: points.to_vec(),
+            normals: normals.to_vec(),
+            screen: vec![DVec2::ZERO, DVec2::X, DVec2::Y],
+            triangles: vec![[0, 1, 2]],
+        };
+        let trilinear = Trilinear::new(&mesh, 100, 100).unwrap();
+        let fan = RayFan::of(&trilinear.triangle_caches()[0]).unwrap();
+        let point = fan.ray(0.25).at(1.5);
+        let (mut images, mut segments) = (Vec::new(), Vec::new());
+        trilinear.project(point, &mut images);
+        trilinear.project_segments(point, &mut segments);
+        assert!(images.is_empty(), "{images:?}");
+        assert_eq!(segments.len(), 1, "{segments:?}");
+        let ImageSegment { ends, t } = segments[0];
+        assert!((t - 1.5).abs() < 1e-12, "{t}");
+        assert!(ends[0].distance(DVec2::new(75.0, 100.0)) < 1e-9, "{ends:?}");
+        assert!(ends[1].distance(DVec2::new(0.0, 25.0)) < 1e-9, "{ends:?}");
+        // Every position along it sees the point.
+        for s in [0.1, 0.5, 0.9] {
+            let ray = trilinear.ray(ends[0].lerp(ends[1], s)).unwrap();
+            assert!(ray.at(t).distance(point) < 1e-12);
+        }
+        let apex = points[0] + 2.0 * normals[0];
+        trilinear.project(apex, &mut images);
+        trilinear.project_segments(apex, &mut segments);
+        assert_eq!(segments.len(), 1, "{segments:?}");
+        assert_eq!(images.len(), 1, "{images:?}");
+        assert!(images[0].pixel.distance(DVec2::new(0.0, 100.0)) < 1e-9);
+        assert!((images[0].t - 2.0).abs() < 1e-12);
+        let (mut off, mut off_segments) = (Vec::new(), Vec::new());
+        trilinear.project(point + DVec3::Z * 0.1, &mut off);
+        trilinear.project_segments(point + DVec3::Z * 0.1, &mut off_segments);
+        assert!(off.is_empty() && off_segments.is_empty());
     }
 
     #[test]

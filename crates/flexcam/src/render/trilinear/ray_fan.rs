@@ -1,13 +1,8 @@
-//! Projection triangles whose rays form a one-parameter family, drawn exactly as strips: two
-//! of the three vertices share their base point and ray (the pole rows of a grid over a
-//! sphere, Vallance 2005, 6.3).
-//!
-//! With vertices `j` and `k` equal, the ray at barycentrics `b` depends on the weight `w` of
-//! the third vertex `i` only: `ray(w, t) = P(w) + t D(w)` with `P(w) = p_j + w (p_i - p_j)`
-//! and `D(w) = n_j + w (n_i - n_j)`. The triangle sweeps a ruled surface, no volume, so no
-//! scene point has a cubic with isolated roots (every `t` is one, or none is) and no shape
-//! can be formed; yet every pixel sees along its ray. The pixels of one `w` lie on a line
-//! of the screen triangle parallel to the edge `jk`, and all see along the same ray.
+//! Projection triangles whose rays form a one-parameter family (two of the three vertices
+//! share their base point and ray: [`RayFan`], whose module doc has the rays `ray(w, t) =
+//! P(w) + t D(w)`), drawn exactly as strips: no scene point has a cubic with isolated roots
+//! there, so no shape can be formed, yet every pixel sees along its ray, and the pixels of
+//! one apex weight `w` lie on a line of the screen triangle, all seeing along the same ray.
 //!
 //! Which rays hit a scene triangle `s1 s2 s3` at `t >= 0` is decided exactly on `[0, 1]`:
 //! the ray meets the line of edge `s_a s_b` where `g_ab(w) = det[P(w) - s_a, s_b - s_a,
@@ -24,75 +19,19 @@
 //! Degenerate cases: a scene triangle in the plane of a flat fan (every `g` zero) is seen
 //! edge-on, by no ray, as by the ray caster; a ray that only grazes the scene triangle (a
 //! double root) is an interval of zero width, drawn as nothing; a fan whose vertices `j`,
-//! `k` differ by less than [`FAN_TOL`] of the triangle's size is treated as exact (its rays
+//! `k` differ by less than [`FAN_TOL`](crate::projection::trilinear_fan::FAN_TOL) of the
+//! triangle's size is treated as exact (its rays
 //! differ from the pixels' own projectors by that much, far below a pixel).
 
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 
 use super::clip::DOMAIN_MARGIN;
 use super::edge_path::OutlinePoint;
 use super::resolve::plane_hit;
-use crate::geometry::{solve_quadratic, Ray};
-use crate::projection::ProjectionTriangleCache;
-
-/// How close (relative to the triangle's base size and ray length) two vertices must be
-/// for the triangle to be drawn as a fan.
-pub const FAN_TOL: f64 = 1e-9;
-
-/// The rays of a projection triangle with two equal vertices (module doc).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RayFan {
-    /// The vertex that differs (`i`) and the two equal ones (`j`, `k`), as indices 0..3.
-    apex: usize,
-    pair: [usize; 2],
-    /// `P(w) = origin + w origin_step`, `D(w) = direction + w direction_step`.
-    origin: DVec3,
-    origin_step: DVec3,
-    direction: DVec3,
-    direction_step: DVec3,
-}
-
-/// The barycentrics `(u, v)` of the projection triangle's vertices 0, 1 and 2.
-const CORNERS: [DVec2; 3] = [DVec2::ZERO, DVec2::X, DVec2::Y];
+use crate::geometry::solve_quadratic;
+pub use crate::projection::RayFan;
 
 impl RayFan {
-    /// The fan of the projection triangle of `cache`, `None` unless two of its vertices
-    /// are equal (within [`FAN_TOL`]) and the third is not.
-    pub fn of(cache: &ProjectionTriangleCache) -> Option<RayFan> {
-        let p = CORNERS.map(|b| cache.tripoint(b.x, b.y));
-        let n = CORNERS.map(|b| cache.trinorm(b.x, b.y));
-        let size = (p[1] - p[0])
-            .length()
-            .max((p[2] - p[0]).length())
-            .max((p[2] - p[1]).length());
-        let length = n.iter().map(|d| d.length()).fold(0.0, f64::max);
-        let equal = |a: usize, b: usize| {
-            p[a].distance(p[b]) <= FAN_TOL * size && n[a].distance(n[b]) <= FAN_TOL * length
-        };
-        let apex = (0..3).find(|&i| equal((i + 1) % 3, (i + 2) % 3))?;
-        let pair = [(apex + 1) % 3, (apex + 2) % 3];
-        if equal(apex, pair[0]) || !(size > 0.0 || length > 0.0) {
-            return None;
-        }
-        let j = pair[0];
-        Some(RayFan {
-            apex,
-            pair,
-            origin: p[j],
-            origin_step: p[apex] - p[j],
-            direction: n[j],
-            direction_step: n[apex] - n[j],
-        })
-    }
-
-    /// The ray of weight `w`.
-    fn ray(&self, w: f64) -> Ray {
-        Ray::new(
-            self.origin + w * self.origin_step,
-            self.direction + w * self.direction_step,
-        )
-    }
-
     /// Where the ray of weight `w` hits the scene triangle `scene` at `t >= 0`: its `t`.
     fn hit(&self, scene: [DVec3; 3], w: f64) -> Option<f64> {
         let (t, u, v) = plane_hit(&self.ray(w), scene)?;
@@ -175,14 +114,13 @@ impl RayFan {
     /// the resolver gives each fragment to the triangle its ray hits.
     fn strip(&self, scene: [DVec3; 3], w0: f64, w1: f64) -> [OutlinePoint; 4] {
         let (w0, w1) = ((w0 - DOMAIN_MARGIN).max(0.0), (w1 + DOMAIN_MARGIN).min(1.0));
-        let apex = CORNERS[self.apex];
         let depth = |w: f64| {
             plane_hit(&self.ray(w), scene)
                 .map(|(t, _, _)| t.max(0.0))
                 .unwrap_or(0.0)
         };
         let corner = |side: usize, w: f64| {
-            let uv = CORNERS[self.pair[side]].lerp(apex, w);
+            let uv = self.line_ends(w)[side];
             OutlinePoint {
                 u: uv.x,
                 v: uv.y,
@@ -198,30 +136,12 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
+    use crate::geometry::Ray;
+    use crate::projection::trilinear_fan::pole_row as pole;
+    use crate::projection::ProjectionTriangleCache;
+
     fn fan(p: [DVec3; 3], n: [DVec3; 3]) -> Option<RayFan> {
         RayFan::of(&ProjectionTriangleCache::new(p, n))
-    }
-
-    /// A pole-row triangle of an inward-looking sphere: vertices 1 and 2 both at the pole
-    /// (0, 1, 0) looking at the centre, vertex 0 further down, also looking at the centre.
-    fn pole() -> ([DVec3; 3], [DVec3; 3]) {
-        let pole = DVec3::Y;
-        let low = DVec3::new(0.5, 0.8660254037844386, 0.0);
-        ([low, pole, pole], [-low, -pole, -pole])
-    }
-
-    #[test]
-    fn only_two_equal_vertices_make_a_fan() {
-        let (p, n) = pole();
-        let rays = fan(p, n).expect("a fan");
-        assert_eq!((rays.apex, rays.pair), (0, [1, 2]));
-        // Rotated: the apex is found wherever it is.
-        let rays = fan([p[1], p[0], p[2]], [n[1], n[0], n[2]]).expect("a fan");
-        assert_eq!(rays.apex, 1);
-        // Three distinct vertices, or three equal ones, or equal points with other rays.
-        assert!(fan([p[0], p[1], DVec3::X], [n[0], n[1], -DVec3::X]).is_none());
-        assert!(fan([p[1]; 3], [n[1]; 3]).is_none());
-        assert!(fan(p, [n[0], n[1], DVec3::X]).is_none());
     }
 
     proptest! {
