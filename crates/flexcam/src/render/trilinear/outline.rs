@@ -135,12 +135,19 @@ impl EdgeCrossings {
     /// `triangle`, for polygon edges whose depths lie in `[lo, hi]`: the range of the depths
     /// of all the shapes' vertices ([`depth_range`]). Degenerate cases: an empty range
     /// (`lo >= hi`: no vertex, or all at one depth) has no polygon edge with a depth strictly
-    /// between its ends, so no crossing is kept; a non-finite bound tests nothing clear.
+    /// between its ends, so no crossing is kept, and none is formed (every quadratic would
+    /// be found clear of roots there, [`CrossingQuadratic::clear_between`]: a pair whose
+    /// shapes are all behind the view plane forms none of its nine); a NaN bound is such a
+    /// range too; an infinite one tests nothing clear.
     pub fn new(triangle: &ProjectionTriangle, scene: [DVec3; 3], (lo, hi): (f64, f64)) -> Self {
         let mut crossings = EdgeCrossings {
             formed: true,
             ..EdgeCrossings::none()
         };
+        let has_inside = lo < hi;
+        if !has_inside {
+            return crossings;
+        }
         for edge in [SceneEdge::V1V2, SceneEdge::V1V3, SceneEdge::V2V3] {
             let [a, b] = edge.vertices().map(|k| scene[k as usize]);
             for (slot, surface) in crossings.quadratics[edge.index()]

@@ -151,8 +151,10 @@ pub struct VertexCache {
     generation: u32,
     /// The clusters the tree kept, each with the planes that still cut its box, reused.
     clusters: Vec<(u32, u32)>,
-    /// The live pairs of a central projection as they are found, reused.
+    /// The live pairs of the projection triangle as they are found, reused.
     pairs: Vec<LivePair>,
+    /// The solutions of their vertices' cubics as they are solved, reused.
+    solutions: Vec<Solutions>,
 }
 
 /// [`VertexState::solved`] of a vertex whose cubic no live pair has needed yet.
@@ -184,6 +186,7 @@ impl VertexCache {
             generation: 0,
             clusters: Vec::new(),
             pairs: Vec::new(),
+            solutions: Vec::new(),
         }
     }
 
@@ -229,6 +232,14 @@ pub fn live_pairs(
         .visit(&bounds, |cluster, cutting| kept.push((cluster, cutting)));
     counts.culled_volume = counts.culled_tree;
     kept.sort_unstable();
+    // Gathered in reused storage and copied out at their exact size (as for a central
+    // projection below): every projection triangle's pairs and solutions are kept until
+    // they are drawn, and growing vectors would leave their slack and copies behind in
+    // fresh memory.
+    let mut pairs = std::mem::take(&mut cache.pairs);
+    pairs.clear();
+    let mut solutions = std::mem::take(&mut cache.solutions);
+    solutions.clear();
     let generation = cache.generation;
     for &(cluster, cutting) in &kept {
         for k in scene.clusters[cluster as usize].triangles.clone() {
@@ -260,18 +271,21 @@ pub fn live_pairs(
                 }
                 if state.solved == NOT_SOLVED {
                     counts.vertices_projected += 1;
-                    state.solved = live.solutions.len() as u32;
-                    live.solutions
-                        .push(projector.project_point(scene.vertices[i as usize]));
+                    state.solved = solutions.len() as u32;
+                    solutions.push(projector.project_point(scene.vertices[i as usize]));
                 }
                 state.solved
             });
-            live.pairs.push(LivePair {
+            pairs.push(LivePair {
                 triangle: k as u32,
                 solved,
             });
         }
     }
+    live.pairs = pairs.clone();
+    live.solutions = solutions.clone();
+    cache.pairs = pairs;
+    cache.solutions = solutions;
     cache.clusters = kept;
     (live, counts)
 }
