@@ -8,6 +8,7 @@
 
 mod build;
 pub(in crate::render) mod curve_triangle;
+pub(in crate::render) mod shaft;
 #[cfg(test)]
 mod tests;
 mod traverse;
