@@ -25,7 +25,6 @@ use glam::{DVec3, Vec2, Vec3};
 
 use crate::geometry::{intersect_triangle, Ray};
 use crate::render::bvh::curve_triangle::CurveTriangle;
-use crate::render::bvh::shaft::{ShaftEnd, ShaftLeaves};
 use crate::render::bvh::triangle::FastRay;
 use crate::render::bvh::{AllTriangles, Bvh, BvhHit, Keep, TriangleMask};
 use crate::render::displaced::DisplacedSet;
@@ -483,44 +482,6 @@ impl PreparedScene {
         let blocked = match &self.shown {
             None => self.bvh.occluded4(lanes, &AllTriangles),
             Some(mask) => occluded4_shown(&self.bvh, lanes, mask),
-        };
-        if self.displaced.is_none() {
-            return blocked;
-        }
-        std::array::from_fn(|i| {
-            blocked[i] || rays[i].is_some_and(|ray| self.displaced_occludes(ray))
-        })
-    }
-
-    /// The leaves of the BVH that rays starting in `[min, max]` and ending as `end` says can
-    /// meet ([`Bvh::shaft_leaves`]): for [`PreparedScene::occluded4_among`]. `None` when
-    /// there are too many for that to pay.
-    pub(in crate::render) fn shaft_leaves(
-        &self,
-        min: DVec3,
-        max: DVec3,
-        end: ShaftEnd,
-    ) -> Option<ShaftLeaves> {
-        self.bvh.shaft_leaves(min, max, end)
-    }
-
-    /// [`PreparedScene::occluded4`] of rays that lie in the shaft that gave `leaves`, with
-    /// identical answers, each ray testing only those leaves ([`Bvh::occluded_among`]).
-    pub(in crate::render) fn occluded4_among(
-        &self,
-        rays: [Option<&Ray>; 4],
-        leaves: &ShaftLeaves,
-    ) -> [bool; 4] {
-        let fast = [
-            rays[0].and_then(FastRay::new),
-            rays[1].and_then(FastRay::new),
-            rays[2].and_then(FastRay::new),
-            rays[3].and_then(FastRay::new),
-        ];
-        let lanes = fast.each_ref().map(Option::as_ref);
-        let blocked = match &self.shown {
-            None => self.bvh.occluded4_among(lanes, leaves, &AllTriangles),
-            Some(mask) => self.bvh.occluded4_among(lanes, leaves, mask),
         };
         if self.displaced.is_none() {
             return blocked;

@@ -8,7 +8,6 @@
 
 mod build;
 pub(in crate::render) mod curve_triangle;
-pub(in crate::render) mod shaft;
 #[cfg(test)]
 mod tests;
 mod traverse;

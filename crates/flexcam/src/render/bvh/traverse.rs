@@ -15,7 +15,7 @@ impl Node {
     /// Entry parameters of the ray into the two children's boxes (infinity for a box it
     /// misses within `[t_min, t_max]`), as [`box_entry`] computes them, bit for bit.
     #[inline(always)]
-    pub(super) fn entries(&self, slabs: &Slabs, t_max: f32) -> (f32, f32) {
+    fn entries(&self, slabs: &Slabs, t_max: f32) -> (f32, f32) {
         let t = |axis: usize| {
             let planes = if slabs.negative[axis] {
                 self.planes[axis].zwxy()
@@ -42,7 +42,7 @@ impl Node {
 /// A ray prepared for [`Node::entries`]: per axis, the origin and reciprocal direction
 /// arranged so that `(planes - origin) * inv_direction` is `[near0, near1, -far0, -far1]`
 /// (the planes swapped first where the direction is negative).
-pub(super) struct Slabs {
+struct Slabs {
     origin: [Vec4; 3],
     inv_direction: [Vec4; 3],
     negative: [bool; 3],
@@ -51,7 +51,7 @@ pub(super) struct Slabs {
 
 impl Slabs {
     #[inline(always)]
-    pub(super) fn new(ray: &FastRay) -> Slabs {
+    fn new(ray: &FastRay) -> Slabs {
         let mut slabs = Slabs {
             origin: [Vec4::ZERO; 3],
             inv_direction: [Vec4::ZERO; 3],
@@ -75,7 +75,7 @@ impl Slabs {
 
 /// Whether the four rays' directions have the same sign on every axis (as their reciprocals,
 /// which are never zero, tell).
-pub(super) fn same_signs(rays: [&FastRay; 4]) -> bool {
+fn same_signs(rays: [&FastRay; 4]) -> bool {
     let mask = |r: &FastRay| r.inv_direction.cmplt(Vec3A::ZERO).bitmask();
     let m = mask(rays[0]);
     rays[1..].iter().all(|r| mask(r) == m)
@@ -83,19 +83,19 @@ pub(super) fn same_signs(rays: [&FastRay; 4]) -> bool {
 
 /// Four rays of one direction-sign class in SoA form for [`Packet::entries`]: lane `r` is
 /// ray `r`.
-pub(super) struct Packet {
+struct Packet {
     origin: [Vec4; 3],
     inv_direction: [Vec4; 3],
     /// Per axis, whether the directions are negative (then a box is entered through its max
     /// plane).
     negative: [bool; 3],
     t_min: Vec4,
-    pub(super) t_max: Vec4,
+    t_max: Vec4,
 }
 
 impl Packet {
     #[inline(always)]
-    pub(super) fn new(rays: [&FastRay; 4]) -> Packet {
+    fn new(rays: [&FastRay; 4]) -> Packet {
         let [a, b, c, d] = rays;
         let axis = |o: Vec3A, p: Vec3A, q: Vec3A, r: Vec3A| {
             [
@@ -127,7 +127,7 @@ impl Packet {
     /// (and so of [`Node::entries`]) for each ray: `(plane - origin) * inv_direction` with
     /// the near plane the min plane for a positive direction, the max plane for a negative.
     #[inline(always)]
-    pub(super) fn entries(&self, node: &Node, t_max: Vec4) -> (Vec4, Vec4) {
+    fn entries(&self, node: &Node, t_max: Vec4) -> (Vec4, Vec4) {
         let child = |c: usize| {
             let mut near = self.t_min;
             let mut far = t_max;
@@ -276,7 +276,7 @@ fn skip_hidden<E: Copy>(kept: u8, (t0, t1): (E, E), missed: E) -> (E, E) {
 /// `[ray.t_min, t_max]`, else infinity. The exit parameter is enlarged by a few ulps (Ize,
 /// "Robust BVH ray traversal", 2013) so that rounding never culls a box the ray touches.
 #[inline(always)]
-pub(super) fn box_entry(bounds: &Aabb, ray: &FastRay, t_max: f32) -> f32 {
+fn box_entry(bounds: &Aabb, ray: &FastRay, t_max: f32) -> f32 {
     let t0 = (Vec3A::from(bounds.min) - ray.origin) * ray.inv_direction;
     let t1 = (Vec3A::from(bounds.max) - ray.origin) * ray.inv_direction;
     let near = t0.min(t1).max_element().max(ray.t_min);
@@ -292,7 +292,7 @@ pub(super) fn box_entry(bounds: &Aabb, ray: &FastRay, t_max: f32) -> f32 {
 /// test, by which the exit distance is enlarged.
 const ROBUST_SLACK: f32 = 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 /// Relative margin of [`Bvh::root_overlaps`]: 100 times the f32 rounding of a coordinate.
-pub(super) const ROOT_MARGIN: f64 = 1e-5;
+const ROOT_MARGIN: f64 = 1e-5;
 
 /// The pending far children of a front-to-back walk, each with the entry distance (one ray's
 /// `f32`, or four lanes' `Vec4`) it was pushed with, so that a pop can skip nodes that

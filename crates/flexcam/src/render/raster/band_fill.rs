@@ -24,11 +24,6 @@ use crate::try_alloc;
 /// covers, large enough that few screen triangles (mostly one or two pixels) reach two.
 pub const BAND_ROWS: u32 = 8;
 
-/// Columns of a tile, whose shadow rays are culled together (an even number: whole quads).
-/// Small enough that a tile's points are close together, and its shafts narrow; large
-/// enough that a shaft, found once a tile and light, serves many rays.
-const TILE_COLUMNS: usize = 32;
-
 /// The pixels of a 2x2 quad, as (column, row) offsets from its top left, in the lane order
 /// of the quad's shading.
 const QUAD: [(usize, usize); 4] = [(0, 0), (1, 0), (0, 1), (1, 1)];
@@ -166,60 +161,45 @@ pub fn fill_and_shade(
                     }
                 });
             }
-            // Shaded in tiles of TILE_COLUMNS by the band's rows, each in 2x2 quads (the
-            // last row of an odd band alone): the shadow rays of a tile are culled by its
-            // shafts, and those of a quad traced together.
+            // Shaded in 2x2 quads (the last row of an odd band alone), so that the shadow
+            // rays of neighbouring pixels are traced together.
             let band_rows = visible.len() / row;
-            let mut shafts = Vec::new();
-            for tile in (0..row).step_by(TILE_COLUMNS) {
-                let columns = tile..(tile + TILE_COLUMNS).min(row);
-                let (written, visible) = (&written, &*visible);
-                let tile_pixels = (0..band_rows).flat_map(|y| {
-                    columns.clone().filter_map(move |x| {
-                        let i = y * row + x;
-                        written
-                            .get(i)
-                            .then(|| (x as u32, first + y as u32, &visible[i]))
-                    })
-                });
-                shader.tile_shafts(tile_pixels, &mut shafts);
-                for top in (0..band_rows).step_by(2) {
-                    for left in columns.clone().step_by(2) {
-                        // The quad's pixel indices in the band, where inside it; loops rather
-                        // than `array::map`, which is not inlined here.
-                        let mut quad = [None; 4];
-                        let mut pixels = [None; 4];
-                        for (lane, (dx, dy)) in QUAD.into_iter().enumerate() {
-                            let (x, y) = (left + dx, top + dy);
-                            if x < row && y < band_rows {
-                                let i = y * row + x;
-                                quad[lane] = Some(i);
-                                if written.get(i) {
-                                    pixels[lane] = Some((x as u32, first + y as u32, &visible[i]));
-                                }
+            for top in (0..band_rows).step_by(2) {
+                for left in (0..row).step_by(2) {
+                    // The quad's pixel indices in the band, where inside it; loops rather
+                    // than `array::map`, which is not inlined here.
+                    let mut quad = [None; 4];
+                    let mut pixels = [None; 4];
+                    for (lane, (dx, dy)) in QUAD.into_iter().enumerate() {
+                        let (x, y) = (left + dx, top + dy);
+                        if x < row && y < band_rows {
+                            let i = y * row + x;
+                            quad[lane] = Some(i);
+                            if written.get(i) {
+                                pixels[lane] = Some((x as u32, first + y as u32, &visible[i]));
                             }
                         }
-                        if pixels.iter().all(Option::is_none) {
-                            // Nothing drawn here (the sky beside a model): no shading call.
-                            for i in quad.into_iter().flatten() {
-                                (colors[i], depths[i], ids[i]) = (background, f32::INFINITY, 0);
-                            }
+                    }
+                    if pixels.iter().all(Option::is_none) {
+                        // Nothing drawn here (the sky beside a model): no shading call.
+                        for i in quad.into_iter().flatten() {
+                            (colors[i], depths[i], ids[i]) = (background, f32::INFINITY, 0);
+                        }
+                        continue;
+                    }
+                    let (shaded, rays) = shader.shade4(pixels);
+                    counts.shading_rays += rays;
+                    for lane in 0..4 {
+                        let Some(i) = quad[lane] else {
                             continue;
-                        }
-                        let (shaded, rays) = shader.shade4(pixels, &shafts);
-                        counts.shading_rays += rays;
-                        for lane in 0..4 {
-                            let Some(i) = quad[lane] else {
-                                continue;
-                            };
-                            if pixels[lane].is_some() {
-                                let slot = &visible[i];
-                                (colors[i], depths[i], ids[i]) =
-                                    (shaded[lane], slot.depth as f32, shader.id(slot.key));
-                                counts.covered += 1;
-                            } else {
-                                (colors[i], depths[i], ids[i]) = (background, f32::INFINITY, 0);
-                            }
+                        };
+                        if pixels[lane].is_some() {
+                            let slot = &visible[i];
+                            (colors[i], depths[i], ids[i]) =
+                                (shaded[lane], slot.depth as f32, shader.id(slot.key));
+                            counts.covered += 1;
+                        } else {
+                            (colors[i], depths[i], ids[i]) = (background, f32::INFINITY, 0);
                         }
                     }
                 }

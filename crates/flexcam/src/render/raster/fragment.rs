@@ -27,11 +27,10 @@ use super::pixel_rays::PixelRays;
 use crate::geometry::{solve_quadratic, Ray};
 use crate::projection::projector::{quadratic_arc_length, quadratic_point};
 use crate::projection::Projector;
-use crate::render::bvh::shaft::ShaftLeaves;
 use crate::render::prepared::{Hit, PreparedScene};
 use crate::render::raycast::pieces::{length_before, polyline_segment, tangent_ray};
 use crate::render::scan::NO_PRIMITIVE;
-use crate::render::shading::trace::{shows_base_color, tile_shafts, HitShader};
+use crate::render::shading::trace::{shows_base_color, HitShader};
 use crate::render::shading::{base_color, TextureFilter};
 use crate::render::{RenderOptions, Shading};
 use crate::scene::Object;
@@ -144,15 +143,8 @@ impl Shader<'_> {
     ///
     /// Out of line: inlined, it takes the fill's inlining budget from the fragments'
     /// reconstruction ([`Shader::fragment`]), which then costs more than the call does.
-    ///
-    /// `shafts`: what [`Shader::tile_shafts`] gave for a tile holding the four pixels (or
-    /// nothing), for the quad's shadow rays.
     #[inline(never)]
-    pub fn shade4(
-        &self,
-        pixels: [Option<(u32, u32, &Visible)>; 4],
-        shafts: &[Option<ShaftLeaves>],
-    ) -> ([Vec3; 4], u64) {
+    pub fn shade4(&self, pixels: [Option<(u32, u32, &Visible)>; 4]) -> ([Vec3; 4], u64) {
         let mut colors = [Vec3::ZERO; 4];
         let mut traced = [None; 4];
         let mut rays = [None; 4];
@@ -174,7 +166,6 @@ impl Shader<'_> {
         let lane = |k: usize| Some((rays[k].as_ref()?, traced[k]?));
         let hits = [lane(0), lane(1), lane(2), lane(3)];
         let mut shader = HitShader::new(caster, self.options);
-        shader.shafts = shafts;
         let shaded = shader.shade_hits4(hits);
         for lane in 0..4 {
             if traced[lane].is_some() {
@@ -183,32 +174,6 @@ impl Shader<'_> {
         }
         let counts = shader.counts;
         (colors, counts.secondary + counts.shadow)
-    }
-
-    /// Into `out`, light by light, the BVH leaves that the shadow rays of the pixels
-    /// `(x, y)` with visible fragments `pixels` (a tile of neighbours) can meet
-    /// ([`tile_shafts`], from the box of the points their shading lights); left empty
-    /// where no pixel is shaded by the ray caster or the scene has no lights.
-    pub fn tile_shafts<'v>(
-        &self,
-        pixels: impl Iterator<Item = (u32, u32, &'v Visible)>,
-        out: &mut Vec<Option<ShaftLeaves>>,
-    ) {
-        out.clear();
-        let Some(caster) = self.caster.filter(|c| !c.scene.lights.is_empty()) else {
-            return;
-        };
-        let mut bounds: Option<(DVec3, DVec3)> = None;
-        for (x, y, visible) in pixels {
-            if let Some((ray, hit)) = self.traced_hit(x, y, visible) {
-                let point = ray.at(hit.t);
-                let (min, max) = bounds.get_or_insert((point, point));
-                (*min, *max) = (min.min(point), max.max(point));
-            }
-        }
-        if let Some((min, max)) = bounds {
-            tile_shafts(caster, min, max, out);
-        }
     }
 
     /// The primary ray and hit through which the ray caster shades pixel `(x, y)` whose

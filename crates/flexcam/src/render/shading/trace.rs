@@ -21,7 +21,6 @@ use glam::{DVec3, Vec3};
 
 use crate::geometry::optics::{reflect, refract};
 use crate::geometry::Ray;
-use crate::render::bvh::shaft::{ShaftEnd, ShaftLeaves};
 use crate::render::prepared::{Hit, PreparedScene};
 use crate::render::shading::{base_color, Normals, TextureFilter, TriangleBase, VertexNormals};
 use crate::render::{RenderOptions, Shading};
@@ -102,9 +101,6 @@ pub(in crate::render) struct HitShader<'a> {
     pub shading: Shading,
     pub max_bounces: u32,
     pub counts: RayCounts,
-    /// Light by light, the BVH leaves that the shadow rays of the hits being shaded can meet
-    /// ([`tile_shafts`]; `None` or missing: such rays walk the whole tree).
-    pub shafts: &'a [Option<ShaftLeaves>],
 }
 
 /// Where a specular surface sends a ray.
@@ -130,7 +126,6 @@ impl<'a> HitShader<'a> {
             shading: options.shading,
             max_bounces: options.max_bounces,
             counts: RayCounts::default(),
-            shafts: &[],
         }
     }
 
@@ -256,7 +251,7 @@ impl<'a> HitShader<'a> {
         // Loops over the lanes rather than `array::map`, which is not inlined here.
         let mut rays: [Option<Ray>; 4] = [None; 4];
         let mut added = [Vec3::ZERO; 4];
-        for (index, light) in self.caster.scene.lights.iter().enumerate() {
+        for light in &self.caster.scene.lights {
             let terms = LightTerms::of(light);
             for lane in 0..4 {
                 rays[lane] = None;
@@ -268,16 +263,12 @@ impl<'a> HitShader<'a> {
                     }
                 }
             }
-            let lanes = [
+            let blocked = self.caster.occluded4([
                 rays[0].as_ref(),
                 rays[1].as_ref(),
                 rays[2].as_ref(),
                 rays[3].as_ref(),
-            ];
-            let blocked = match self.shafts.get(index) {
-                Some(Some(leaves)) => self.caster.occluded4_among(lanes, leaves),
-                _ => self.caster.occluded4(lanes),
-            };
+            ]);
             for lane in 0..4 {
                 if rays[lane].is_some() && !blocked[lane] {
                     colors[lane] += added[lane];
@@ -424,30 +415,6 @@ impl DiffusePoint {
         let mut shadow = caster.spawn(self.position, self.geometric, to_light);
         shadow.t_max = t_max;
         Some((shadow, terms.radiance * self.shade(unit)))
-    }
-}
-
-/// Light by light (in the scene's order, into `out`), the BVH leaves that the shadow rays
-/// of lit shading can meet when every shaded point lies in the box `[min, max]`
-/// ([`PreparedScene::shaft_leaves`]): the rays start within the secondary-ray offset of
-/// their point and end within it of a point light (their parameter 1 is the light plus
-/// that offset), or run on along a directional light's vector. Coherent rays, a tile of
-/// pixels', then test only those leaves ([`HitShader::shafts`]).
-pub(in crate::render) fn tile_shafts(
-    caster: &PreparedScene,
-    min: DVec3,
-    max: DVec3,
-    out: &mut Vec<Option<ShaftLeaves>>,
-) {
-    out.clear();
-    // The geometric normal is a unit f32 vector: a little over the offset bounds its step.
-    let pad = DVec3::splat(caster.offset * 1.001);
-    for light in &caster.scene.lights {
-        let end = match LightTerms::of(light).reach {
-            Reach::Point(p) => ShaftEnd::Box(p - pad, p + pad),
-            Reach::Directional { to_light, .. } => ShaftEnd::Direction(to_light),
-        };
-        out.push(caster.shaft_leaves(min - pad, max + pad, end));
     }
 }
 
