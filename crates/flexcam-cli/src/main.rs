@@ -56,9 +56,10 @@ enum Command {
     /// per image, nearest first: pixel x and y (continuous: pixel (x, y) covers
     /// [x, x + 1) x [y, y + 1), y down) and the depth (the distance along that pixel's ray,
     /// as `render --depth` writes it). A trilinear mesh can image a point several times (all
-    /// roots of each projection triangle's cubic) or not at all (no line). Only images inside
-    /// the image and in front of the view plane are listed; projections without an analytic
-    /// inverse are refused.
+    /// roots of each projection triangle's cubic) or not at all (no line); a triangle whose
+    /// rays form a fan (two vertices alike) sees a point along a whole segment of pixels,
+    /// listed as `x y depth x_end y_end`. Only images inside the image and in front of the
+    /// view plane are listed; projections without an analytic inverse are refused.
     Project(commands::project::ProjectArgs),
     /// Write a scene projection's per-pixel rays (origin, direction, and where curved
     /// projectors end) and its STMap against a reference camera, as OpenEXR.
