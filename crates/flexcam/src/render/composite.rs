@@ -535,14 +535,14 @@ impl<'a> ExactPixels<'a> {
     /// reflector, whose triangles are all left out (see [`reflector_surface`]), or a
     /// silhouette pixel that the surface's screen triangles miss. Such a pixel would
     /// otherwise keep the reflector's diffuse colour or show the background.
+    ///
+    /// The surface's coverage is found along rows ([`Trilinear::covered_pixels`]), the same
+    /// test as [`Trilinear::locate`] at each pixel centre.
     pub fn uncovered(&self, frame: &Frame, id: u32, surface: Option<&Trilinear>) -> Vec<usize> {
-        let width = frame.width as usize;
+        let covered = surface.map(|s| s.covered_pixels(frame.width, frame.height));
         (0..frame.ids.len())
             .into_par_iter()
-            .filter(|&k| {
-                frame.ids[k] == id
-                    && surface.is_none_or(|s| s.locate(pixel_centre(k, width)).is_none())
-            })
+            .filter(|&k| frame.ids[k] == id && covered.as_ref().is_none_or(|c| !c[k]))
             .collect()
     }
 
