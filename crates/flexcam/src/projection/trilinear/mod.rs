@@ -552,7 +552,7 @@ mod tests {
             (0.45, 0.4),
         ]
         .map(|(x, y)| DVec2::new(x, y));
-        let mut triangles: Vec<[usize; 3]> = (0..6).map(|k| [6, k, (k + 1) % 6]).collect();
+        let mut triangles: Vec<[u32; 3]> = (0..6).map(|k| [6, k, (k + 1) % 6]).collect();
         triangles.push([0, 2, 4]);
         let mesh = TrilinearMesh {
             points: screen.iter().map(|p| p.extend(0.0)).collect(),

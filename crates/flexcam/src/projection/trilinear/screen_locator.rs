@@ -291,6 +291,22 @@ mod tests {
         tris
     }
 
+    /// `n` counter-clockwise triangles scattered over the unit square, overlapping, of
+    /// `steps` sizes `smallest + k step`.
+    fn scattered(n: usize, smallest: f64, steps: usize, step: f64) -> Vec<[DVec2; 3]> {
+        (0..n)
+            .map(|k| {
+                let (x, y) = ((k * 37 % 101) as f64 / 101.0, (k * 53 % 97) as f64 / 97.0);
+                let size = smallest + (k % steps) as f64 * step;
+                [
+                    DVec2::new(x, y),
+                    DVec2::new(x + size, y + 0.3 * size),
+                    DVec2::new(x - 0.5 * size, y + size),
+                ]
+            })
+            .collect()
+    }
+
     #[test]
     fn barycentrics_reproduce_the_point() {
         let tri = [
@@ -401,21 +417,11 @@ mod tests {
     /// column; no point is reported covered twice by one triangle.
     #[test]
     fn covered_runs_are_the_points_locate_finds() {
-        let mut scattered = Vec::new();
-        for k in 0..60 {
-            let (x, y) = ((k * 37 % 101) as f64 / 101.0, (k * 53 % 97) as f64 / 97.0);
-            let size = 0.02 + (k % 5) as f64 * 0.09;
-            let tri = [
-                DVec2::new(x, y),
-                DVec2::new(x + size, y + 0.3 * size),
-                DVec2::new(x - 0.5 * size, y + size),
-            ];
-            scattered.push(if k % 2 == 0 {
-                tri
-            } else {
-                [tri[0], tri[2], tri[1]]
-            });
-        }
+        let scattered: Vec<[DVec2; 3]> = scattered(60, 0.02, 5, 0.09)
+            .into_iter()
+            .enumerate()
+            .map(|(k, t)| if k % 2 == 0 { t } else { [t[0], t[2], t[1]] })
+            .collect();
         let m = DVec2::new(0.5, 0.5);
         let corners = [
             DVec2::new(0.0, 0.0),
@@ -487,17 +493,7 @@ mod tests {
     /// on overlapping triangles of many sizes (some covering many bins, some one).
     #[test]
     fn bins_list_the_overlapping_triangles_in_index_order() {
-        let mut scattered = Vec::new();
-        for k in 0..200 {
-            let (x, y) = ((k * 37 % 101) as f64 / 101.0, (k * 53 % 97) as f64 / 97.0);
-            let size = 0.01 + (k % 7) as f64 * 0.06;
-            scattered.push([
-                DVec2::new(x, y),
-                DVec2::new(x + size, y + 0.3 * size),
-                DVec2::new(x - 0.5 * size, y + size),
-            ]);
-        }
-        for tris in [grid(6), scattered] {
+        for tris in [grid(6), scattered(200, 0.01, 7, 0.06)] {
             let locator = ScreenLocator::new(tris.clone());
             let n = locator.bins_per_axis;
             assert_eq!(locator.bin_start.len(), n * n + 1);
