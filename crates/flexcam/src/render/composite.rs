@@ -535,13 +535,24 @@ impl<'a> ExactPixels<'a> {
     /// reflector, whose triangles are all left out (see [`reflector_surface`]), or a
     /// silhouette pixel that the surface's screen triangles miss. Such a pixel would
     /// otherwise keep the reflector's diffuse colour or show the background.
+    ///
+    /// The surface's coverage is found along rows ([`Trilinear::covered_pixels`]), the same
+    /// test as [`Trilinear::locate`] at each pixel centre; the pixels are then filtered in
+    /// chunks of [`FILTER_CHUNK`], each a plain loop (a parallel filter per pixel cost more
+    /// than the test). The result is in pixel order.
     pub fn uncovered(&self, frame: &Frame, id: u32, surface: Option<&Trilinear>) -> Vec<usize> {
-        let width = frame.width as usize;
-        (0..frame.ids.len())
-            .into_par_iter()
-            .filter(|&k| {
-                frame.ids[k] == id
-                    && surface.is_none_or(|s| s.locate(pixel_centre(k, width)).is_none())
+        let covered = surface.map(|s| s.covered_pixels(frame.width, frame.height));
+        let covered = covered.as_deref();
+        frame
+            .ids
+            .par_chunks(FILTER_CHUNK)
+            .enumerate()
+            .flat_map_iter(|(chunk, ids)| {
+                let first = chunk * FILTER_CHUNK;
+                ids.iter().enumerate().filter_map(move |(i, &seen)| {
+                    let k = first + i;
+                    (seen == id && covered.is_none_or(|c| !c[k])).then_some(k)
+                })
             })
             .collect()
     }
@@ -567,6 +578,9 @@ impl<'a> ExactPixels<'a> {
         }
     }
 }
+
+/// Pixels per chunk of [`ExactPixels::uncovered`]'s filter.
+const FILTER_CHUNK: usize = 1 << 15;
 
 /// The centre of pixel `k` (row-major) of an image `width` pixels wide.
 fn pixel_centre(k: usize, width: usize) -> DVec2 {

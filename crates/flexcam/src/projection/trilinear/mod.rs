@@ -204,6 +204,24 @@ impl Trilinear {
         })
     }
 
+    /// Whether [`Trilinear::locate`] finds a screen triangle at the centre of each pixel of a
+    /// `width` x `height` grid (row-major; the pixels scaled by this projection's resolution
+    /// as `locate` scales them): the same tests at the same points, made along rows
+    /// ([`ScreenLocator::covered_runs`]) instead of point by point.
+    pub fn covered_pixels(&self, width: u32, height: u32) -> Vec<bool> {
+        let size = self.resolution.size();
+        let columns: Vec<f64> = (0..width).map(|x| (f64::from(x) + 0.5) / size.x).collect();
+        let rows: Vec<f64> = (0..height)
+            .map(|y| 1.0 - (f64::from(y) + 0.5) / size.y)
+            .collect();
+        let mut covered = vec![false; columns.len() * rows.len()];
+        self.locator.covered_runs(&columns, &rows, |y, xs| {
+            let row = y * columns.len();
+            covered[row + xs.start..row + xs.end].fill(true);
+        });
+        covered
+    }
+
     /// The point-projection cache of each projection triangle (same order as the mesh's
     /// triangles): all solutions of a scene point, any `t`, inside or not.
     pub fn triangle_caches(&self) -> &[ProjectionTriangleCache] {
@@ -642,6 +660,46 @@ mod tests {
             (r.direction - DVec3::new(0.0, 0.0, 0.6)).length() < 1e-12,
             "not renormalised"
         );
+    }
+
+    /// `covered_pixels` holds exactly where `locate` finds a triangle at the pixel centre: a
+    /// fan reaching past the screen's edges with a triangle overlapping it, at a resolution
+    /// whose pixel centres are not dyadic, on its own grid and on a wider one.
+    #[test]
+    fn covered_pixels_are_where_locate_finds_a_triangle() {
+        let screen = [
+            (0.0, 0.0),
+            (0.6, -0.1),
+            (1.1, 0.3),
+            (0.7, 0.7),
+            (0.2, 1.0),
+            (-0.05, 0.5),
+            (0.45, 0.4),
+        ]
+        .map(|(x, y)| DVec2::new(x, y));
+        let mut triangles: Vec<[u32; 3]> = (0..6).map(|k| [6, k, (k + 1) % 6]).collect();
+        triangles.push([0, 2, 4]);
+        let mesh = TrilinearMesh {
+            points: screen.iter().map(|p| p.extend(0.0)).collect(),
+            normals: vec![DVec3::Z; screen.len()],
+            screen: screen.to_vec(),
+            triangles,
+        };
+        let t = Trilinear::new(&mesh, 37, 23).unwrap();
+        for (width, height) in [(37, 23), (45, 30)] {
+            let covered = t.covered_pixels(width, height);
+            assert_eq!(covered.len(), (width * height) as usize);
+            let mut count = 0;
+            for y in 0..height {
+                for x in 0..width {
+                    let centre = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                    let k = (y * width + x) as usize;
+                    assert_eq!(covered[k], t.locate(centre).is_some(), "pixel ({x}, {y})");
+                    count += usize::from(covered[k]);
+                }
+            }
+            assert!(count > 0 && count < covered.len());
+        }
     }
 
     fn triangle_mesh() -> TrilinearMesh {

@@ -17,6 +17,8 @@
 //! of a vertex where several edges meet could the rounded signs disagree; on dyadic screen
 //! grids (such as k / 2^n) pixel positions are evaluated exactly.
 
+use std::ops::Range;
+
 use glam::DVec2;
 
 /// Most bins along one axis: bounds the grid's memory for very large meshes.
@@ -104,9 +106,14 @@ impl ScreenLocator {
         (cell.max(0.0) as usize).min(self.bins_per_axis - 1)
     }
 
+    /// The upper corner of the grid: [`ScreenLocator::locate`] finds nothing beyond it.
+    fn max(&self) -> DVec2 {
+        self.min + self.bin_size * self.bins_per_axis as f64
+    }
+
     /// The lowest-index triangle covering `p` under the tie rule, or `None`.
     pub fn locate(&self, p: DVec2) -> Option<ScreenHit> {
-        let max = self.min + self.bin_size * self.bins_per_axis as f64;
+        let max = self.max();
         if !(p.cmpge(self.min).all() && p.cmple(max).all()) {
             return None;
         }
@@ -121,6 +128,56 @@ impl ScreenLocator {
                     v,
                 })
             })
+    }
+
+    /// The points of a grid where [`ScreenLocator::locate`] finds a triangle, as runs along
+    /// its rows: the grid's point `(x, y)` is `(columns[x], rows[y])`, each list monotone
+    /// (ascending or descending), and `run(y, xs)` is called with runs of columns whose union
+    /// over all calls is exactly the covered points of row `y` (the runs of different
+    /// triangles may overlap). Per triangle, every condition `locate` puts on a point (the
+    /// grid's bounds, the triangle's bins, each edge's side) holds on a half-line of a row or
+    /// a column of the grid (each is monotone in one coordinate while the other is fixed), so
+    /// the triangle's points in a row are one interval, found by binary searches: no test per
+    /// point, and the same rounded tests as `locate`, so the same points.
+    pub fn covered_runs(
+        &self,
+        columns: &[f64],
+        rows: &[f64],
+        mut run: impl FnMut(usize, Range<usize>),
+    ) {
+        let max = self.max();
+        // The points within the grid's bounds along `axis`.
+        let bounded = |coords: &[f64], axis: usize| {
+            let from = monotone_part(0..coords.len(), |k| coords[k] >= self.min[axis]);
+            monotone_part(from, |k| coords[k] <= max[axis])
+        };
+        let (inside_x, inside_y) = (bounded(columns, 0), bounded(rows, 1));
+        // The points of `inside` whose bin along `axis` is one of those of `lo..=hi`.
+        let in_bins = |coords: &[f64], inside: Range<usize>, axis: usize, lo: f64, hi: f64| {
+            let (first, last) = (self.bin(lo, axis), self.bin(hi, axis));
+            let from = monotone_part(inside, |k| self.bin(coords[k], axis) >= first);
+            monotone_part(from, |k| self.bin(coords[k], axis) <= last)
+        };
+        for tri in &self.triangles {
+            let lo = tri[0].min(tri[1]).min(tri[2]);
+            let hi = tri[0].max(tri[1]).max(tri[2]);
+            let xs = in_bins(columns, inside_x.clone(), 0, lo.x, hi.x);
+            if xs.is_empty() {
+                continue;
+            }
+            let orientation = orientation(tri);
+            for y in in_bins(rows, inside_y.clone(), 1, lo.y, hi.y) {
+                let mut span = xs.clone();
+                for k in 0..3 {
+                    span = monotone_part(span, |x| {
+                        edge_weight(tri, orientation, k, DVec2::new(columns[x], rows[y])).is_some()
+                    });
+                }
+                if !span.is_empty() {
+                    run(y, span);
+                }
+            }
+        }
     }
 }
 
@@ -144,22 +201,71 @@ fn owns_edge_point(direction: DVec2) -> bool {
     direction.y < 0.0 || (direction.y == 0.0 && direction.x < 0.0)
 }
 
+/// The sign of `tri`'s signed area: 1 counter-clockwise, -1 clockwise.
+fn orientation(tri: &[DVec2; 3]) -> f64 {
+    (tri[1] - tri[0]).perp_dot(tri[2] - tri[0]).signum()
+}
+
+/// The weight of `p` for the edge of `tri` opposite vertex `k` (twice the signed area of the
+/// edge and `p`, positive inside), or `None` when `p` lies outside that edge under the tie
+/// rule. `orientation` is `tri`'s ([`orientation`]). Along a line of points whose one
+/// coordinate is fixed, the weight is monotone in the other coordinate even as rounded (each
+/// difference, product and sum of the edge function is monotone in it), so the points inside
+/// one edge form a half-line, and those inside the triangle an interval
+/// ([`ScreenLocator::covered_runs`]).
+fn edge_weight(tri: &[DVec2; 3], orientation: f64, k: usize, p: DVec2) -> Option<f64> {
+    let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
+    let w = orientation * edge_function(a, b, p);
+    if w < 0.0 || (w == 0.0 && !owns_edge_point(orientation * (b - a))) {
+        None
+    } else {
+        Some(w)
+    }
+}
+
 /// Barycentrics (u, v) of `p` in `tri` if `p` is inside under the tie rule. `tri` must have
 /// non-zero area; either orientation works.
 pub(crate) fn barycentrics(tri: &[DVec2; 3], p: DVec2) -> Option<(f64, f64)> {
-    let orientation = (tri[1] - tri[0]).perp_dot(tri[2] - tri[0]).signum();
+    let orientation = orientation(tri);
     // weights[k] belongs to the edge opposite vertex k.
     let mut weights = [0.0; 3];
     for (k, weight) in weights.iter_mut().enumerate() {
-        let (a, b) = (tri[(k + 1) % 3], tri[(k + 2) % 3]);
-        let w = orientation * edge_function(a, b, p);
-        if w < 0.0 || (w == 0.0 && !owns_edge_point(orientation * (b - a))) {
-            return None;
-        }
-        *weight = w;
+        *weight = edge_weight(tri, orientation, k, p)?;
     }
     let total = weights[0] + weights[1] + weights[2];
     Some((weights[1] / total, weights[2] / total))
+}
+
+/// The indices of `range` where `holds` is true, for a `holds` monotone along `range` (false
+/// then true, or true then false, either part possibly empty): a binary search for the
+/// switch, at most `2 + log2(len)` calls. The result is a part of `range`.
+fn monotone_part(range: Range<usize>, holds: impl Fn(usize) -> bool) -> Range<usize> {
+    if range.is_empty() {
+        return range;
+    }
+    let first = holds(range.start);
+    if first == holds(range.end - 1) {
+        return if first {
+            range
+        } else {
+            range.start..range.start
+        };
+    }
+    // holds(lo) == first, holds(hi) != first.
+    let (mut lo, mut hi) = (range.start, range.end - 1);
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if holds(mid) == first {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    if first {
+        range.start..hi
+    } else {
+        hi..range.end
+    }
 }
 
 #[cfg(test)]
@@ -183,6 +289,22 @@ mod tests {
             }
         }
         tris
+    }
+
+    /// `n` counter-clockwise triangles scattered over the unit square, overlapping, of
+    /// `steps` sizes `smallest + k step`.
+    fn scattered(n: usize, smallest: f64, steps: usize, step: f64) -> Vec<[DVec2; 3]> {
+        (0..n)
+            .map(|k| {
+                let (x, y) = ((k * 37 % 101) as f64 / 101.0, (k * 53 % 97) as f64 / 97.0);
+                let size = smallest + (k % steps) as f64 * step;
+                [
+                    DVec2::new(x, y),
+                    DVec2::new(x + size, y + 0.3 * size),
+                    DVec2::new(x - 0.5 * size, y + size),
+                ]
+            })
+            .collect()
     }
 
     #[test]
@@ -287,23 +409,91 @@ mod tests {
         assert!(locator.locate(DVec2::new(f64::NAN, 0.4)).is_none());
     }
 
+    /// The runs of covered grid points are exactly the points where `locate` finds a
+    /// triangle: on the grid mesh sampled on a lattice through its edges and vertices (the
+    /// tie rule decides every point there), on scattered overlapping triangles of both
+    /// orientations and on a fan, each on grids of pixel centres ascending and descending in
+    /// both axes, wider than the triangles' bounds (points outside them) and of one row or
+    /// column; no point is reported covered twice by one triangle.
+    #[test]
+    fn covered_runs_are_the_points_locate_finds() {
+        let scattered: Vec<[DVec2; 3]> = scattered(60, 0.02, 5, 0.09)
+            .into_iter()
+            .enumerate()
+            .map(|(k, t)| if k % 2 == 0 { t } else { [t[0], t[2], t[1]] })
+            .collect();
+        let m = DVec2::new(0.5, 0.5);
+        let corners = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(1.0, 0.0),
+            DVec2::new(1.0, 1.0),
+            DVec2::new(0.0, 1.0),
+        ];
+        let fan: Vec<[DVec2; 3]> = (0..4)
+            .map(|k| [corners[k], corners[(k + 1) % 4], m])
+            .collect();
+        // Lattices: through the grid's edges and vertices (k / 64), pixel centres over a wider
+        // range, and single lines.
+        let lattice = |n: usize, from: f64, to: f64, centres: bool| -> Vec<f64> {
+            let offset = if centres { 0.5 } else { 0.0 };
+            (0..n)
+                .map(|k| from + (to - from) * (k as f64 + offset) / n as f64)
+                .collect()
+        };
+        let grids = [
+            (
+                lattice(65, 0.0, 65.0 / 64.0, false),
+                lattice(65, 0.0, 65.0 / 64.0, false),
+            ),
+            (lattice(90, -0.2, 1.3, true), lattice(70, -0.1, 1.2, true)),
+            (lattice(37, 0.0, 1.0, true), vec![0.5]),
+            (vec![0.25], lattice(41, 0.0, 1.0, true)),
+        ];
+        for tris in [grid(4), scattered, fan] {
+            let locator = ScreenLocator::new(tris.clone());
+            for (columns, rows) in &grids {
+                for (columns, rows) in [
+                    (columns.clone(), rows.clone()),
+                    (
+                        columns.iter().rev().copied().collect(),
+                        rows.iter().rev().copied().collect(),
+                    ),
+                ] {
+                    let mut count = vec![0usize; columns.len() * rows.len()];
+                    let mut runs = 0;
+                    locator.covered_runs(&columns, &rows, |y, xs| {
+                        runs += 1;
+                        for x in xs {
+                            count[y * columns.len() + x] += 1;
+                        }
+                    });
+                    assert!(runs > 0);
+                    let mut covered = 0;
+                    for (y, &py) in rows.iter().enumerate() {
+                        for (x, &px) in columns.iter().enumerate() {
+                            let p = DVec2::new(px, py);
+                            let found = locator.locate(p).is_some();
+                            let c = count[y * columns.len() + x];
+                            let owners =
+                                tris.iter().filter(|t| barycentrics(t, p).is_some()).count();
+                            assert_eq!(c > 0, found, "point {p}");
+                            assert!(c <= owners, "point {p}: {c} runs, {owners} triangles");
+                            covered += usize::from(found);
+                        }
+                    }
+                    assert!(covered > 0);
+                }
+            }
+        }
+    }
+
     /// Each bin lists exactly the triangles whose bounding boxes overlap it (by the bin
     /// indices of their corners' extremes), in ascending order, and the bins follow each
     /// other without gaps: the counting sort against the definition, on the grid mesh and
     /// on overlapping triangles of many sizes (some covering many bins, some one).
     #[test]
     fn bins_list_the_overlapping_triangles_in_index_order() {
-        let mut scattered = Vec::new();
-        for k in 0..200 {
-            let (x, y) = ((k * 37 % 101) as f64 / 101.0, (k * 53 % 97) as f64 / 97.0);
-            let size = 0.01 + (k % 7) as f64 * 0.06;
-            scattered.push([
-                DVec2::new(x, y),
-                DVec2::new(x + size, y + 0.3 * size),
-                DVec2::new(x - 0.5 * size, y + size),
-            ]);
-        }
-        for tris in [grid(6), scattered] {
+        for tris in [grid(6), scattered(200, 0.01, 7, 0.06)] {
             let locator = ScreenLocator::new(tris.clone());
             let n = locator.bins_per_axis;
             assert_eq!(locator.bin_start.len(), n * n + 1);
