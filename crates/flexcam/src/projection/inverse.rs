@@ -6,9 +6,9 @@
 //! ([`ContinuousInverse`]). Renderers look a capability up once per render and call through
 //! the returned object per point, one dynamic call as for any projection method.
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
-use super::{ImagePoint, ImageSegment, InverseChart};
+use super::{CameraBasis, ImagePoint, ImageSegment, InverseChart};
 
 /// Why a projection has no analytic inverse.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -59,6 +59,56 @@ pub trait ContinuousInverse: Send + Sync {
     /// The image of `point` on the continuous branch: unclipped to the image and to the
     /// visible domain. `None` on the singular set (an eye, a pole).
     fn project_continuous(&self, point: DVec3) -> Option<ImagePoint>;
+
+    /// The branch's pixels in two stages, where it has them ([`StagedInverse`]); `None` by
+    /// default.
+    fn staged(&self) -> Option<&dyn StagedInverse> {
+        None
+    }
+}
+
+/// A continuous inverse whose pixel is computed in two stages: coordinates of the point
+/// that depend only on what [`StagedInverse::key`] names (a panorama's longitude and
+/// latitude: the eye and its frame), then the pixel from those coordinates (dividing by
+/// the angle per pixel: the fields of view and image size). A renderer of many frames keeps
+/// the first stage's results while the key stays the same (a field-of-view slider dragged
+/// in a viewer) and redoes only the second.
+pub trait StagedInverse: Send + Sync {
+    /// Everything [`StagedInverse::coordinates`] reads: which first stage (the projection's
+    /// kind) and the bits of the camera basis it uses. Equal keys give equal coordinates.
+    fn key(&self) -> StageKey;
+
+    /// The first stage: `None` exactly where [`ContinuousInverse::project_continuous`] is
+    /// `None` (the singular set).
+    fn coordinates(&self, point: DVec3) -> Option<DVec2>;
+
+    /// The second stage: from `coordinates` of a point, the pixel
+    /// [`ContinuousInverse::project_continuous`] gives it, the same bits.
+    fn pixel(&self, coordinates: DVec2) -> DVec2;
+}
+
+/// What the first stage of a [`StagedInverse`] depends on: its kind and the bits of the
+/// camera basis (origin, right, up, forward).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StageKey {
+    /// The first stage's name (the projection's kind).
+    pub kind: &'static str,
+    /// The basis's components as bits.
+    pub basis: [u64; 12],
+}
+
+impl StageKey {
+    /// The key of first stage `kind` reading `basis`.
+    pub fn new(kind: &'static str, basis: &CameraBasis) -> Self {
+        let mut bits = [0; 12];
+        let vectors = [basis.origin, basis.right, basis.up, basis.forward];
+        for (k, v) in vectors.iter().enumerate() {
+            for (i, c) in v.to_array().into_iter().enumerate() {
+                bits[3 * k + i] = c.to_bits();
+            }
+        }
+        StageKey { kind, basis: bits }
+    }
 }
 
 /// An image on the continuous branch of a [`SingleImage`] projection.
@@ -81,11 +131,20 @@ pub trait SingleImage: Send + Sync {
 
     /// Where the branch is continuous.
     fn chart(&self) -> InverseChart;
+
+    /// The branch's pixels in two stages, where it has them; `None` by default.
+    fn staged(&self) -> Option<&dyn StagedInverse> {
+        None
+    }
 }
 
 impl<T: SingleImage> ContinuousInverse for T {
     fn project_continuous(&self, point: DVec3) -> Option<ImagePoint> {
         self.branch_image(point).map(|b| b.image)
+    }
+
+    fn staged(&self) -> Option<&dyn StagedInverse> {
+        SingleImage::staged(self)
     }
 }
 

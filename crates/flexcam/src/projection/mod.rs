@@ -55,7 +55,8 @@ pub use fisheye_mapping::{FisheyeMapping, MAPPING_NAMES};
 pub use flexible::{Flexible, FlexibleSpec};
 pub use image_coords::Resolution;
 pub use inverse::{
-    AnalyticInverse, BranchImage, Charted, ContinuousInverse, NoInverse, SingleImage,
+    AnalyticInverse, BranchImage, Charted, ContinuousInverse, NoInverse, SingleImage, StageKey,
+    StagedInverse,
 };
 pub use kannala_brandt::KannalaBrandt;
 pub use linear::{Orthographic, Perspective};

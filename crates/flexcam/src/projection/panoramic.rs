@@ -13,7 +13,7 @@ use super::image_coords::Resolution;
 use super::params::{angle_radians, UpTo};
 use super::{
     AnalyticInverse, BranchImage, CameraFrame, ImagePoint, NoInverse, Projection, Projector,
-    SingleImage, Trilinear,
+    SingleImage, StageKey, StagedInverse, Trilinear,
 };
 use crate::error::Result;
 use crate::geometry::Ray;
@@ -145,15 +145,9 @@ impl Projection for Equirectangular {
 impl SingleImage for Equirectangular {
     fn branch_image(&self, point: DVec3) -> Option<BranchImage> {
         let offset = point - self.basis.origin;
-        let local = self.basis.to_local(offset);
-        if local == DVec3::ZERO {
-            return None;
-        }
-        let lon = longitude(local).unwrap_or(0.0);
-        let lat = local.y.atan2(DVec2::new(local.x, local.z).length());
-        let centred = DVec2::new(lon, lat) / self.radians_per_pixel;
+        let angles = Equirectangular::angles(self.basis.to_local(offset))?;
         let image = ImagePoint {
-            pixel: self.resolution.pixel(centred),
+            pixel: StagedInverse::pixel(self, angles),
             t: offset.length(),
         };
         Some(BranchImage { image, seen: true })
@@ -167,6 +161,38 @@ impl SingleImage for Equirectangular {
             period: Some(2.0 * PI / self.radians_per_pixel.x),
             poles: axis_poles(self.basis.origin, self.basis.up, -top, top),
         }
+    }
+
+    fn staged(&self) -> Option<&dyn StagedInverse> {
+        Some(self)
+    }
+}
+
+impl Equirectangular {
+    /// The longitude and latitude of camera-local offset `local`; `None` at the eye.
+    fn angles(local: DVec3) -> Option<DVec2> {
+        if local == DVec3::ZERO {
+            return None;
+        }
+        let lon = longitude(local).unwrap_or(0.0);
+        let lat = local.y.atan2(DVec2::new(local.x, local.z).length());
+        Some(DVec2::new(lon, lat))
+    }
+}
+
+/// Longitude and latitude (two `atan2` and a square root) depend on the eye and its frame
+/// alone; the pixel divides them by the angle per pixel.
+impl StagedInverse for Equirectangular {
+    fn key(&self) -> StageKey {
+        StageKey::new("equirectangular", &self.basis)
+    }
+
+    fn coordinates(&self, point: DVec3) -> Option<DVec2> {
+        Equirectangular::angles(self.basis.to_local(point - self.basis.origin))
+    }
+
+    fn pixel(&self, angles: DVec2) -> DVec2 {
+        self.resolution.pixel(angles / self.radians_per_pixel)
     }
 }
 
@@ -268,12 +294,9 @@ impl Projection for Cylindrical {
 impl SingleImage for Cylindrical {
     fn branch_image(&self, point: DVec3) -> Option<BranchImage> {
         let offset = point - self.basis.origin;
-        let local = self.basis.to_local(offset);
-        let lon = longitude(local)?;
-        let height = local.y / DVec2::new(local.x, local.z).length();
-        let centred = DVec2::new(lon / self.radians_per_pixel, height / self.height_per_pixel);
+        let coordinates = Cylindrical::coordinates_of(self.basis.to_local(offset))?;
         let image = ImagePoint {
-            pixel: self.resolution.pixel(centred),
+            pixel: StagedInverse::pixel(self, coordinates),
             t: offset.length(),
         };
         Some(BranchImage { image, seen: true })
@@ -287,6 +310,38 @@ impl SingleImage for Cylindrical {
             period: Some(2.0 * PI / self.radians_per_pixel),
             poles: axis_poles(self.basis.origin, self.basis.up, -top, top),
         }
+    }
+
+    fn staged(&self) -> Option<&dyn StagedInverse> {
+        Some(self)
+    }
+}
+
+impl Cylindrical {
+    /// The longitude and height on the unit cylinder of camera-local offset `local`;
+    /// `None` on the cylinder's axis.
+    fn coordinates_of(local: DVec3) -> Option<DVec2> {
+        let lon = longitude(local)?;
+        let height = local.y / DVec2::new(local.x, local.z).length();
+        Some(DVec2::new(lon, height))
+    }
+}
+
+/// Longitude and height (an `atan2` and a square root) depend on the eye and its frame
+/// alone; the pixel divides them by the angle and the height per pixel.
+impl StagedInverse for Cylindrical {
+    fn key(&self) -> StageKey {
+        StageKey::new("cylindrical", &self.basis)
+    }
+
+    fn coordinates(&self, point: DVec3) -> Option<DVec2> {
+        Cylindrical::coordinates_of(self.basis.to_local(point - self.basis.origin))
+    }
+
+    fn pixel(&self, coordinates: DVec2) -> DVec2 {
+        let (lon, height) = (coordinates.x, coordinates.y);
+        let centred = DVec2::new(lon / self.radians_per_pixel, height / self.height_per_pixel);
+        self.resolution.pixel(centred)
     }
 }
 

@@ -46,6 +46,7 @@ mod coverage;
 #[cfg(test)]
 mod flexible_maps_tests;
 mod fragment;
+mod kept_coordinates;
 mod pixel_rays;
 mod pole_clearance;
 mod refine;
@@ -72,6 +73,7 @@ pub use views::render;
 use self::band_fill::{fill_and_shade, BAND_ROWS};
 use self::coverage::{Bins, ScreenTriangle};
 use self::fragment::{key, Shader, Visible};
+use self::kept_coordinates::KeptCoordinates;
 use self::pixel_rays::{PixelRays, Tile};
 use self::pole_clearance::PoleClearance;
 use self::refine::{Node, Refiner};
@@ -137,6 +139,8 @@ struct Buffers {
     zbuffer: Vec<Visible>,
     /// Which scene triangles are far from the poles, while the poles stay put.
     clearance: PoleClearance,
+    /// The first stage of a staged inverse per vertex, while its key stays the same.
+    coordinates: KeptCoordinates,
 }
 
 /// What piece building did, for `--stats`.
@@ -318,8 +322,9 @@ impl<'a> InverseRaster<'a> {
             bins,
             zbuffer,
             clearance,
+            coordinates,
         } = &mut *buffers;
-        let counts = self.pieces(images, bins, clearance);
+        let counts = self.pieces(images, bins, (clearance, coordinates));
         let pieces_ms = start.elapsed().as_secs_f64() * 1e3;
         let shader = Shader {
             objects: &self.scene.objects,
@@ -380,23 +385,33 @@ impl<'a> InverseRaster<'a> {
     /// `images`, then the screen triangles of every scene triangle, sorted into bands by
     /// parallel jobs of [`CHUNK`] scene triangles, one element of `bins` per job, with their
     /// counters (both buffers resized and overwritten); which triangles are far from the
-    /// poles is read from `clearance` (brought up to date first).
+    /// poles is read from `clearance`, and a staged inverse's first stage from
+    /// `coordinates` (both brought up to date first).
     fn pieces(
         &self,
         images: &mut Vec<Vec<Option<DVec2>>>,
         bins: &mut Vec<Bins>,
-        clearance: &mut PoleClearance,
+        (clearance, coordinates): (&mut PoleClearance, &mut KeptCoordinates),
     ) -> PieceCounts {
         let refiner = Refiner::new(&self.inverse, self.options.subdivision.tolerance);
         let far = clearance.update(self.scene, &refiner, &self.inverse.chart.poles);
         images.resize_with(self.scene.objects.len(), Vec::new);
-        for (object, images) in self.scene.objects.iter().zip(images.iter_mut()) {
-            object
-                .mesh
-                .positions
-                .par_iter()
-                .map(|p| refiner.node(p.as_dvec3()).image)
-                .collect_into_vec(images);
+        if let Some(staged) = self.inverse.map.staged() {
+            let coordinates = coordinates.update(self.scene, staged);
+            for (kept, images) in coordinates.iter().zip(images.iter_mut()) {
+                kept.par_iter()
+                    .map(|c| c.map(|c| staged.pixel(c)))
+                    .collect_into_vec(images);
+            }
+        } else {
+            for (object, images) in self.scene.objects.iter().zip(images.iter_mut()) {
+                object
+                    .mesh
+                    .positions
+                    .par_iter()
+                    .map(|p| refiner.node(p.as_dvec3()).image)
+                    .collect_into_vec(images);
+            }
         }
         let images = &*images;
         let jobs: Vec<(usize, Range<usize>)> = self
