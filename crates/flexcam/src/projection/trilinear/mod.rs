@@ -207,7 +207,7 @@ impl Trilinear {
     /// Whether [`Trilinear::locate`] finds a screen triangle at the centre of each pixel of a
     /// `width` x `height` grid (row-major; the pixels scaled by this projection's resolution
     /// as `locate` scales them): the same tests at the same points, made along rows
-    /// ([`ScreenLocator::covered_runs`]) instead of point by point.
+    /// (the screen locator's `covered_runs`) instead of point by point.
     pub fn covered_pixels(&self, width: u32, height: u32) -> Vec<bool> {
         let size = self.resolution.size();
         let columns: Vec<f64> = (0..width).map(|x| (f64::from(x) + 0.5) / size.x).collect();
