@@ -4,7 +4,7 @@
 
 use clap::Args;
 use flexcam::projection::projector::quadratic_arc_length;
-use flexcam::projection::{ImagePoint, Projector};
+use flexcam::projection::{ImagePoint, Projector, SAME_IMAGE_PIXELS};
 use flexcam::{Error, Result};
 use glam::{DVec2, DVec3};
 use serde_json::json;
@@ -154,9 +154,6 @@ pub fn run(args: &ProjectArgs) -> Result<()> {
     };
     super::print_stdout(&text)
 }
-
-/// Images of the point this close (in pixels) are one image.
-const SAME_IMAGE_PIXELS: f64 = 1e-6;
 
 /// The part of the segment `ends` inside the image `[0, size.x] x [0, size.y]` (Liang and
 /// Barsky's clip), `None` where none is.

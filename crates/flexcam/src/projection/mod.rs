@@ -88,6 +88,10 @@ pub struct ImagePoint {
     pub t: f64,
 }
 
+/// Images of one scene point closer than this (in pixels) are one image: a point on an
+/// edge or vertex shared by several pieces of a projection is found by each of them.
+pub const SAME_IMAGE_PIXELS: f64 = 1e-6;
+
 /// An image of a scene point that is a whole segment of image positions, each seeing the
 /// point along one and the same ray (a trilinear projection triangle whose rays form a fan,
 /// [`RayFan`]).

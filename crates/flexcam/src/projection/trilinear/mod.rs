@@ -28,6 +28,7 @@ use glam::{DVec2, DVec3};
 use super::image_coords::Resolution;
 use super::{
     AnalyticInverse, Charted, ImagePoint, ImageSegment, NoInverse, Projection, TrilinearMesh,
+    SAME_IMAGE_PIXELS,
 };
 use crate::error::{Error, Result};
 use crate::geometry::Ray;
@@ -40,9 +41,6 @@ pub use shapes::{
     project_solved_triangle, project_triangle, SceneEdge, Shape, ShapeVertex, TriangleShapes,
     Unprojectable,
 };
-
-/// Images of one point closer than this (in pixels) are one image.
-const DEDUP_PIXELS: f64 = 1e-6;
 
 /// A screen triangle counts as degenerate when twice its area is below this fraction of the
 /// product of its two edge lengths from the first vertex (the sine of its angle there).
@@ -341,14 +339,17 @@ impl AnalyticInverse for Trilinear {
     /// * Where screen triangles overlap, `ray` uses the lowest-index one: a solution of
     ///   another triangle is only kept if the covering triangle's ray there is the same
     ///   (relative `1e-8`), as on a shared edge of a continuous mesh.
-    /// * Images closer than `1e-6` pixels are one image (a point on an edge or vertex shared
-    ///   by several projection triangles is found by each of them).
+    /// * Images closer than [`SAME_IMAGE_PIXELS`] are one image (a point on an edge or
+    ///   vertex shared by several projection triangles is found by each of them).
+    /// * A triangle whose rays form a fan ([`RayFan`]) sees a point on the fan along a
+    ///   segment ([`AnalyticInverse::project_segments`]); only its zero-length lines (the
+    ///   apex's ray) are listed here.
     fn project(&self, point: DVec3, out: &mut Vec<ImagePoint>) {
         let start = out.len();
         let mut push = |pixel: DVec2, t: f64| {
             if !out[start..]
                 .iter()
-                .any(|o| (o.pixel - pixel).length() <= DEDUP_PIXELS)
+                .any(|o| (o.pixel - pixel).length() <= SAME_IMAGE_PIXELS)
             {
                 out.push(ImagePoint { pixel, t });
             }
@@ -357,7 +358,7 @@ impl AnalyticInverse for Trilinear {
             let solutions = cache.project_point(point);
             if solutions.is_every_t() {
                 self.fan_images(index, point, |[a, b], t| {
-                    if a.distance(b) <= DEDUP_PIXELS {
+                    if a.distance(b) <= SAME_IMAGE_PIXELS {
                         push(a, t);
                     }
                 });
@@ -392,7 +393,7 @@ impl AnalyticInverse for Trilinear {
     fn project_segments(&self, point: DVec3, out: &mut Vec<ImageSegment>) {
         for index in 0..self.caches.len() {
             self.fan_images(index, point, |ends, t| {
-                if ends[0].distance(ends[1]) > DEDUP_PIXELS {
+                if ends[0].distance(ends[1]) > SAME_IMAGE_PIXELS {
                     out.push(ImageSegment { ends, t });
                 }
             });
@@ -407,11 +408,6 @@ impl AnalyticInverse for Trilinear {
 }
 
 impl Trilinear {
-    /// Whether the ray at screen position `screen` is that of solution `s` of triangle
-    /// `index`: the locator picks `index` there, or picks another triangle whose ray at
-    /// `screen` reaches the same point at `t` (a shared edge of a continuous mesh), or
-    /// picks none (outside the covered screen, where `ray` gives nothing either: the image
-    /// position is still reported, callers clip).
     /// The larger length of triangle `index`'s three vertex normals.
     fn largest_normal(&self, index: usize) -> f64 {
         self.mesh.triangles[index].iter().fold(0.0_f64, |m, &k| {
@@ -484,6 +480,11 @@ impl Trilinear {
         }
     }
 
+    /// Whether the ray at screen position `screen` is that of solution `s` of triangle
+    /// `index`: the locator picks `index` there, or picks another triangle whose ray at
+    /// `screen` reaches the same point at `t` (a shared edge of a continuous mesh), or
+    /// picks none (outside the covered screen, where `ray` gives nothing either: the image
+    /// position is still reported, callers clip).
     fn covers(
         &self,
         index: usize,
