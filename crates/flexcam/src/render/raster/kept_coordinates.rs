@@ -12,15 +12,15 @@
 use glam::DVec2;
 use rayon::prelude::*;
 
+use super::kept::KeptPerObject;
 use crate::projection::{StageKey, StagedInverse};
 use crate::scene::Scene;
 
 /// Per object, per vertex: the first stage's coordinates (`None` on the singular set), for
-/// the first stage `key`.
+/// the first stage's key.
 #[derive(Debug, Default)]
 pub struct KeptCoordinates {
-    key: Option<StageKey>,
-    coordinates: Vec<Vec<Option<DVec2>>>,
+    coordinates: KeptPerObject<StageKey, Option<DVec2>>,
 }
 
 impl KeptCoordinates {
@@ -28,26 +28,17 @@ impl KeptCoordinates {
     /// computed for the same key and vertex counts, else computed again (in parallel) and
     /// kept.
     pub fn update(&mut self, scene: &Scene, staged: &dyn StagedInverse) -> &[Vec<Option<DVec2>>] {
-        let key = staged.key();
-        let counts_match = self.coordinates.len() == scene.objects.len()
-            && self
-                .coordinates
-                .iter()
-                .zip(&scene.objects)
-                .all(|(kept, object)| kept.len() == object.mesh.positions.len());
-        if self.key != Some(key) || !counts_match {
-            self.key = Some(key);
-            self.coordinates.resize_with(scene.objects.len(), Vec::new);
-            for (object, kept) in scene.objects.iter().zip(self.coordinates.iter_mut()) {
-                object
-                    .mesh
-                    .positions
+        self.coordinates.update(
+            staged.key(),
+            scene,
+            |mesh| mesh.positions.len(),
+            |mesh, kept| {
+                mesh.positions
                     .par_iter()
                     .map(|p| staged.coordinates(p.as_dvec3()))
                     .collect_into_vec(kept);
-            }
-        }
-        &self.coordinates
+            },
+        )
     }
 }
 

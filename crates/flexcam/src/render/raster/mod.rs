@@ -46,6 +46,7 @@ mod coverage;
 #[cfg(test)]
 mod flexible_maps_tests;
 mod fragment;
+mod kept;
 mod kept_coordinates;
 mod pixel_rays;
 mod pole_clearance;

@@ -12,16 +12,16 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::kept::KeptPerObject;
 use super::refine::Refiner;
 use crate::projection::Pole;
 use crate::scene::Scene;
 
 /// Per object, per triangle: whether [`Refiner::far_from_poles`] clears it, for the poles
-/// `poles` (each origin and direction, as bits).
+/// (each origin and direction, as bits).
 #[derive(Debug, Default)]
 pub struct PoleClearance {
-    poles: Vec<[u64; 6]>,
-    far: Vec<Vec<bool>>,
+    far: KeptPerObject<Vec<[u64; 6]>, bool>,
 }
 
 /// The bits of the pole data that [`Refiner::far_from_poles`] reads.
@@ -41,18 +41,11 @@ impl PoleClearance {
     /// those kept when they were computed for the same poles and triangle counts, else
     /// computed again (in parallel) and kept.
     pub fn update(&mut self, scene: &Scene, refiner: &Refiner<'_>, poles: &[Pole]) -> &[Vec<bool>] {
-        let key = key(poles);
-        let counts_match = self.far.len() == scene.objects.len()
-            && self
-                .far
-                .iter()
-                .zip(&scene.objects)
-                .all(|(far, object)| far.len() == object.mesh.triangles.len());
-        if key != self.poles || !counts_match {
-            self.poles = key;
-            self.far.resize_with(scene.objects.len(), Vec::new);
-            for (object, far) in scene.objects.iter().zip(self.far.iter_mut()) {
-                let mesh = &object.mesh;
+        self.far.update(
+            key(poles),
+            scene,
+            |mesh| mesh.triangles.len(),
+            |mesh, far| {
                 mesh.triangles
                     .par_iter()
                     .map(|t| {
@@ -60,9 +53,8 @@ impl PoleClearance {
                         refiner.far_from_poles(points)
                     })
                     .collect_into_vec(far);
-            }
-        }
-        &self.far
+            },
+        )
     }
 }
 
