@@ -32,34 +32,61 @@ pub fn cylinder(radius: f32, height: f32, tessellation: u32) -> Mesh {
             uv: Vec2::new(s, t),
         }
     });
-    // Top cap: t runs from the rim (t = 0) in to the centre (t = 1, collapsed).
-    let centre = CollapsedRows {
-        first: false,
-        last: true,
-    };
-    push_grid(&mut mesh, segments, 1, centre, |s, t| {
+    // Top cap, seen from +y: rim from +x towards -z, then the centre.
+    push_cap(&mut mesh, segments, false, |s, r| {
         let (c, s_) = turn(s);
-        let r = 1.0 - t;
         Vertex {
             position: Vec3::new(radius * r * c, half, -radius * r * s_),
             normal: Vec3::Y,
             uv: Vec2::new(0.5 + 0.5 * r * c, 0.5 + 0.5 * r * s_),
         }
     });
-    // Bottom cap: t runs from the centre (t = 0, collapsed) out to the rim (t = 1).
-    let centre = CollapsedRows {
-        first: true,
-        last: false,
-    };
-    push_grid(&mut mesh, segments, 1, centre, |s, t| {
+    // Bottom cap, seen from -y: the centre, then the rim.
+    push_cap(&mut mesh, segments, true, |s, r| {
         let (c, s_) = turn(s);
         Vertex {
-            position: Vec3::new(radius * t * c, -half, -radius * t * s_),
+            position: Vec3::new(radius * r * c, -half, -radius * r * s_),
             normal: Vec3::NEG_Y,
-            uv: Vec2::new(0.5 + 0.5 * t * c, 0.5 - 0.5 * t * s_),
+            uv: Vec2::new(0.5 + 0.5 * r * c, 0.5 - 0.5 * r * s_),
         }
     });
     mesh
+}
+
+/// Appends a cap: `segments + 1` rim vertices `vertex(s, 1)` (`s = i / segments`, the first
+/// and last coinciding) and one centre vertex `vertex(0, 0)`, joined by a fan of `segments`
+/// triangles around the centre. `centre_first`: the centre is emitted before the rim and the
+/// fan turns the other way (the bottom cap, whose outside is the other side).
+///
+/// One shared centre, not one per segment as [`push_grid`]'s collapsed rows keep for their
+/// uvs (every centre sample here has the same position, normal and uv): with one per segment,
+/// neighbouring fan triangles would share only a rim vertex, the cap would be a ring of
+/// triangles touching at points, and mesh simplification (a reflector's camera mesh, LOD)
+/// would refuse it as non-manifold.
+fn push_cap(
+    mesh: &mut Mesh,
+    segments: u32,
+    centre_first: bool,
+    vertex: impl Fn(f32, f32) -> Vertex,
+) {
+    let mut push = |v: Vertex| {
+        mesh.positions.push(v.position);
+        mesh.normals.push(v.normal);
+        mesh.uvs.push(v.uv);
+        mesh.positions.len() as u32 - 1
+    };
+    let centre = centre_first.then(|| push(vertex(0.0, 0.0)));
+    let rim: Vec<u32> = (0..=segments)
+        .map(|i| push(vertex(i as f32 / segments as f32, 1.0)))
+        .collect();
+    let centre = centre.unwrap_or_else(|| push(vertex(0.0, 0.0)));
+    for pair in rim.windows(2) {
+        mesh.triangles.push(if centre_first {
+            [centre, pair[1], pair[0]]
+        } else {
+            [pair[0], pair[1], centre]
+        });
+    }
 }
 
 #[cfg(test)]
