@@ -59,8 +59,8 @@
 //! and the free fit is clearly better and determined. Inexact data (clicks on a painting)
 //! are fitted by every model and judged by their held-out misses (each fifth of the points
 //! measured against the fit of the other four fifths, the same fifths for every model): a
-//! richer model replaces a simpler one only where a paired test of the per-point
-//! differences finds its misses lower (`select::significantly_better`), and a grid that
+//! richer model replaces a simpler one only where the trimmed mean of its per-point misses
+//! (a fifth of them left out at each end) is lower (`select::lower_held_out`), and a grid that
 //! folds (module `folds`: projectors crossing among the points' depths) is never taken
 //! where another model's does not: the residual at the points rewards models that bend to
 //! the noise, the held-out misses do not.

@@ -37,8 +37,8 @@ pub enum Starts {
     /// Exact data: the kept starts where they meet the data and determine the directions,
     /// else the eye where it meets the data exactly or clearly better, else the free starts
     /// where they meet the data clearly better. Inexact data: the simplest model (pinhole,
-    /// eye, kept, free) that no richer one beats by a paired test of their held-out misses,
-    /// never a folded grid where another is not.
+    /// eye, kept, free) that no richer one beats by the trimmed mean of their held-out misses
+    /// (a fifth left out at each end), never a folded grid where another is not.
     #[default]
     Auto,
 }
