@@ -678,12 +678,12 @@ fn fragments_across_a_shared_edge_resolve_to_the_neighbour() {
     assert_eq!(redirected.barycentric, own.barycentric);
     // The stage rewrites the fragment to the neighbour, at its exact depth, with the
     // neighbour's barycentrics, from the hit terms of the fragment's own triangle.
-    let uv = maps[1].barycentrics(at);
+    let uv = triangles[1].map.barycentrics(at);
     let terms = hit_terms::HitTerms::new(geometry.corners(0)).unwrap();
     let (staged_key, depth, stored) = resolver
         .staged(
             key(0),
-            hit_terms::solve(&terms.at(&maps[1], uv.x, uv.y)),
+            hit_terms::solve(&terms.at(&triangles[1].map, uv.x, uv.y)),
             3,
             3,
         )
