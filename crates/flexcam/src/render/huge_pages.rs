@@ -49,7 +49,8 @@ pub(crate) fn advise_huge_pages<T>(values: &mut [T]) {
 /// Huge pages advised before ([`advise_huge_pages`]) are honoured. The pages holding the
 /// ends of `values` are included whole (they belong to its allocation); pages already
 /// mapped are left as they are. Elsewhere, or where the call fails (an older kernel), the
-/// pages are mapped by the writes as before; no byte changes either way.
+/// pages are mapped by the writes as before; no byte changes either way. A region under
+/// [`POPULATE_MIN`] bytes is left to its page faults.
 fn populate_for_writing<T>(values: &mut [T]) {
     #[cfg(target_os = "linux")]
     {
@@ -58,7 +59,7 @@ fn populate_for_writing<T>(values: &mut [T]) {
         };
         let start = values.as_mut_ptr() as usize;
         let end = start + std::mem::size_of_val(values);
-        if end == start {
+        if end - start < POPULATE_MIN {
             return;
         }
         let first = start & !(page - 1);
@@ -79,9 +80,11 @@ fn populate_for_writing<T>(values: &mut [T]) {
     let _ = values;
 }
 
-/// The least room [`reserve_mapped`] makes (16 pages of 4 KiB): the system call that maps
-/// it costs about as much as a few page faults, and a growing buffer's first steps would be
-/// smaller than a page (74 calls a render of the fan example, most of one page).
+/// The least region [`populate_for_writing`] maps at once (16 pages of 4 KiB): the system
+/// call costs about as much as a few page faults, and a growing buffer's first steps are
+/// smaller than a page (74 calls a render of the fan example without the bound, most of
+/// one page).
+#[cfg(target_os = "linux")]
 const POPULATE_MIN: usize = 64 << 10;
 
 /// The page size, a power of two, or `None` where it cannot be had.
@@ -97,16 +100,14 @@ fn page_size() -> Option<usize> {
 /// pages ([`advise_huge_pages`]) and populated ([`populate_for_writing`]). For a buffer that
 /// grows to megabytes while it is written once (the trilinear renderer's outline points):
 /// one system call per growth instead of a page fault per 4 KiB of it, at the price of
-/// mapping the room not yet used (at most what the last doubling added, or the first
-/// [`POPULATE_MIN`] bytes). The values are unchanged.
+/// mapping the room not yet used (at most what the last doubling added). The values are
+/// unchanged.
 pub(crate) fn reserve_mapped<T: Copy>(values: &mut Vec<T>, additional: usize) {
     if values.capacity() - values.len() < additional {
         // A new buffer, mapped before the values are copied in: growing in place
         // (`Vec::reserve`, a `realloc`) would copy them into fresh pages one page fault
         // at a time where the allocator cannot move the pages themselves.
-        // At least `POPULATE_MIN` bytes (see there).
-        let least = POPULATE_MIN / std::mem::size_of::<T>().max(1);
-        let wanted = (values.len() + additional).max(least);
+        let wanted = values.len() + additional;
         let mut grown = Vec::with_capacity(wanted.max(2 * values.capacity()));
         map_spare_capacity(&mut grown);
         grown.extend_from_slice(values);

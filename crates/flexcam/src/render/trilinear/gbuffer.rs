@@ -18,7 +18,6 @@
 use super::hit_terms::{self, Terms, TERMS};
 use super::resolve::Resolver;
 use crate::error::Result;
-use crate::render::huge_pages::map_spare_capacity;
 use crate::render::scan::{spans, FillRule, Polygon, RasterStats, Scratch, Span, NO_PRIMITIVE};
 use crate::try_alloc;
 
@@ -26,18 +25,6 @@ use crate::try_alloc;
 /// image `width` pixels wide.
 pub(in crate::render) fn band_name(width: u32, rows: u32) -> String {
     format!("a band buffer of {width} x {rows} pixels")
-}
-
-/// `n` copies of `value` in fresh memory whose pages are mapped at once
-/// (`map_spare_capacity`): every band buffer is written whole at its first band, and a
-/// page fault per 4 KiB of it (about 48 for a band of 8,192 pixels) costs more than the one
-/// system call.
-fn mapped<T: Clone>(n: usize, value: T, what: impl FnOnce() -> String) -> Result<Vec<T>> {
-    let mut values = Vec::new();
-    try_alloc::reserve(&mut values, n, what)?;
-    map_spare_capacity(&mut values);
-    values.resize(n, value);
-    Ok(values)
 }
 
 /// The drawn state of one band of rows: per pixel the winner's depth, key and scene
@@ -66,9 +53,9 @@ impl GBuffer {
         Ok(GBuffer {
             width,
             rows: (0, 0),
-            depth: mapped(n, f64::INFINITY, what)?,
-            keys: mapped(n, NO_PRIMITIVE, what)?,
-            barycentrics: mapped(n, [0.0; 2], what)?,
+            depth: try_alloc::filled(n, f64::INFINITY, what)?,
+            keys: try_alloc::filled(n, NO_PRIMITIVE, what)?,
+            barycentrics: try_alloc::zeroed(n, what)?,
         })
     }
 

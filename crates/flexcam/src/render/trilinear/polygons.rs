@@ -99,11 +99,7 @@ pub fn project_all(
     scene: &SceneGeometry,
     curves: CurveOptions,
 ) -> ProjectedScene {
-    // Written once, whole (about 200 bytes a projection triangle): mapped at once, and
-    // turned into the live pairs below in place.
-    let mut culled: Vec<(LivePairs, PairCounts)> = Vec::with_capacity(triangles.len());
-    map_spare_capacity(&mut culled);
-    triangles
+    let culled: Vec<(LivePairs, PairCounts)> = triangles
         .par_iter()
         .enumerate()
         .map_init(
@@ -119,7 +115,7 @@ pub fn project_all(
                 (live, counts)
             },
         )
-        .collect_into_vec(&mut culled);
+        .collect();
     let mut counts = PairCounts::default();
     for (_, c) in &culled {
         counts.add(c);
@@ -227,7 +223,6 @@ impl Drawn {
     ) {
         reserve_mapped(&mut self.points, outline.len());
         self.points.extend_from_slice(outline);
-        reserve_mapped(&mut self.shapes, 1);
         self.shapes.push(DrawnShape {
             end: self.points.len(),
             projection,
