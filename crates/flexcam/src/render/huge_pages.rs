@@ -102,10 +102,16 @@ fn page_size() -> Option<usize> {
 /// one system call per growth instead of a page fault per 4 KiB of it, at the price of
 /// mapping the room not yet used (at most what the last doubling added). The values are
 /// unchanged.
-pub(crate) fn reserve_mapped<T>(values: &mut Vec<T>, additional: usize) {
+pub(crate) fn reserve_mapped<T: Copy>(values: &mut Vec<T>, additional: usize) {
     if values.capacity() - values.len() < additional {
-        values.reserve(additional);
-        map_spare_capacity(values);
+        // A new buffer, mapped before the values are copied in: growing in place
+        // (`Vec::reserve`, a `realloc`) would copy them into fresh pages one page fault
+        // at a time where the allocator cannot move the pages themselves.
+        let wanted = values.len() + additional;
+        let mut grown = Vec::with_capacity(wanted.max(2 * values.capacity()));
+        map_spare_capacity(&mut grown);
+        grown.extend_from_slice(values);
+        *values = grown;
     }
 }
 

@@ -22,7 +22,6 @@ use super::polygons::{draw_all, project_all, projection_triangles, ProjectedScen
 use super::resolve::Resolver;
 use super::resolve::PIXEL_TESTED;
 use super::scene_geometry::SceneGeometry;
-use super::screen_map::ScreenMap;
 use super::tests::{object, scene_of, square};
 use super::workloads;
 use crate::projection::{Trilinear, TrilinearMesh};
@@ -439,9 +438,8 @@ fn winners(
     geometry: &SceneGeometry,
     (width, height): (u32, u32),
 ) -> (Vec<f64>, Vec<u64>) {
-    let maps: Vec<ScreenMap> = triangles.iter().map(|t| t.map).collect();
     let resolver = Resolver {
-        maps: &maps,
+        triangles,
         scene: geometry,
         sample: DVec2::splat(0.5),
     };

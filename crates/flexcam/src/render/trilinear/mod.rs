@@ -186,7 +186,6 @@ impl<'a> TrilinearRenderer<'a> {
         }
         let project_ms = start.elapsed().as_secs_f64() * 1e3;
 
-        let maps: Vec<ScreenMap> = triangles.iter().map(|t| t.map).collect();
         let pattern = SamplePattern::new(options.spp);
         frame.fit(width, height, Outputs::ALL)?;
         let mut samples = Samples::new(frame, &pattern)?;
@@ -196,7 +195,7 @@ impl<'a> TrilinearRenderer<'a> {
         for &sample in &pattern.offsets {
             let pass = Instant::now();
             let resolver = Resolver {
-                maps: &maps,
+                triangles: &triangles,
                 scene: &self.scene,
                 sample,
             };

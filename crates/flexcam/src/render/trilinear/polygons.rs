@@ -28,7 +28,7 @@ use super::view_plane::clipping_base;
 use crate::projection::{
     project_solved_triangle, ProjectionTriangleCache, Shape, Solutions, TriangleShapes, Trilinear,
 };
-use crate::render::huge_pages::reserve_mapped;
+use crate::render::huge_pages::{map_spare_capacity, reserve_mapped};
 use crate::render::scan::{PolygonBatch, Vertex};
 
 /// The projection stage's result for the whole mesh: every polygon, in projection-triangle
@@ -47,7 +47,12 @@ pub struct ProjectedScene {
 /// (`clipping_base`).
 pub fn projection_triangles(projection: &Trilinear) -> Vec<ProjectionTriangle> {
     let mesh = projection.mesh();
-    mesh.triangles
+    // Written once, whole, into fresh memory (about 1 KB a triangle): its pages are mapped
+    // at once rather than by a page fault each (`map_spare_capacity`).
+    let mut triangles = Vec::with_capacity(mesh.triangles.len());
+    map_spare_capacity(&mut triangles);
+    let each = mesh
+        .triangles
         .iter()
         .zip(projection.triangle_caches())
         .map(|(t, cache)| {
@@ -63,8 +68,9 @@ pub fn projection_triangles(projection: &Trilinear) -> Vec<ProjectionTriangle> {
             };
             let map = ScreenMap::of_triangle(projection, [i, j, k], cache);
             ProjectionTriangle::new(base, normals, map)
-        })
-        .collect()
+        });
+    triangles.extend(each);
+    triangles
 }
 
 /// The least slices per shape in a projection triangle whose parametric triangle

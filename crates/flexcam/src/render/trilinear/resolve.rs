@@ -35,6 +35,7 @@
 use glam::{DVec2, DVec3};
 
 use super::hit_terms;
+use super::outline::ProjectionTriangle;
 use super::scene_geometry::SceneGeometry;
 use super::screen_map::ScreenMap;
 use crate::geometry::Ray;
@@ -48,7 +49,9 @@ pub(super) const PIXEL_TESTED: u64 = 1 << 63;
 
 /// Finds the hit of a keyed fragment (module doc).
 pub struct Resolver<'a> {
-    pub maps: &'a [ScreenMap],
+    /// The projection triangles, numbered as the keys' projection indices: their screen
+    /// maps are read in place ([`Resolver::map`]), not copied out per render.
+    pub triangles: &'a [ProjectionTriangle],
     pub scene: &'a SceneGeometry,
     /// Where in each pixel this pass samples, in `[0, 1)^2` (`(0.5, 0.5)`: the centre). The
     /// polygons of the pass are drawn moved so that their pixel centres are these samples
@@ -69,6 +72,11 @@ pub struct FragmentHit {
 }
 
 impl Resolver<'_> {
+    /// The screen map of projection triangle `projection`, `None` past the last.
+    pub fn map(&self, projection: usize) -> Option<&ScreenMap> {
+        self.triangles.get(projection).map(|t| &t.map)
+    }
+
     /// The image position of pixel `(x, y)`'s sample.
     pub fn position(&self, x: u32, y: u32) -> DVec2 {
         DVec2::new(f64::from(x), f64::from(y)) + self.sample
@@ -78,7 +86,7 @@ impl Resolver<'_> {
     /// named by `key` with the scene triangle named by `key`, or with a neighbour of it
     /// (module doc); `None` for a discarded fragment.
     pub fn hit(&self, key: u64, pixel: DVec2) -> Option<FragmentHit> {
-        let map = self.maps.get((key >> 32) as usize)?;
+        let map = self.map((key >> 32) as usize)?;
         let k = (key & u64::from(u32::MAX)) as usize;
         let ray = map.ray(pixel)?;
         let (t, u, v) = plane_hit(&ray, self.scene.corners(k))?;

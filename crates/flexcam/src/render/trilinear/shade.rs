@@ -191,7 +191,7 @@ impl Shader<'_> {
     fn traced_run(&self, drawn: &GBuffer, run: &Run, out: &mut FrameRows<'_>) -> ShadeCounts {
         let k_triangle = run.triangle();
         let owner = self.resolver.scene.owners[k_triangle];
-        let map = self.resolver.maps.get(run.projection());
+        let map = self.resolver.map(run.projection());
         let mut counts = ShadeCounts::default();
         for group in (0..run.len).step_by(4) {
             let lanes = (run.len - group).min(4);
@@ -281,7 +281,7 @@ impl Shader<'_> {
         out: &mut FrameRows<'_>,
         color: &TriangleColor,
     ) -> ShadeCounts {
-        let Some(map) = self.resolver.maps.get(run.projection()) else {
+        let Some(map) = self.resolver.map(run.projection()) else {
             return self.pixels(drawn, run, out, false);
         };
         let directions = map.directions_along_row(self.resolver.position(run.x0, run.y));
@@ -364,7 +364,9 @@ impl Shader<'_> {
     fn rasterised(&self, key: u64, depth: f64, barycentric: Vec2, x: u32, y: u32) -> Option<Pixel> {
         let position = self.resolver.position(x, y);
         if depth < CRACK_FILL_DEPTH {
-            let projector = self.resolver.maps[(key >> 32) as usize].projector(position)?;
+            let projector = self.resolver.triangles[(key >> 32) as usize]
+                .map
+                .projector(position)?;
             Some(
                 self.shaded(key, depth, barycentric, projector.direction, || {
                     projector.ray()

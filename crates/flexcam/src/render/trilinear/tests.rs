@@ -5,6 +5,7 @@ use std::sync::Arc;
 
 use glam::{DVec2, DVec3, Vec3};
 
+use super::outline::ProjectionTriangle;
 use super::*;
 use crate::projection::TrilinearMesh;
 use crate::render::compare::{compare, Comparison};
@@ -623,20 +624,15 @@ fn diagonal_square() -> [[DVec3; 3]; 2] {
     ]
 }
 
-/// The scene geometry of `triangles` (one red object, id 1) and the screen maps of an 8 x 8
-/// pixel view of it through parallel rays along +z over the unit square.
-fn parallel_rays_onto(triangles: &[[DVec3; 3]]) -> (SceneGeometry, Vec<ScreenMap>) {
+/// The scene geometry of `triangles` (one red object, id 1) and the projection triangles of
+/// an 8 x 8 pixel view of it through parallel rays along +z over the unit square.
+fn parallel_rays_onto(triangles: &[[DVec3; 3]]) -> (SceneGeometry, Vec<ProjectionTriangle>) {
     let scene = scene_of(vec![object(1, triangles, Vec3::new(0.9, 0.1, 0.1))]);
     let projection = Trilinear::new(&square([DVec3::Z; 4]), 8, 8).unwrap();
-    let size = DVec2::new(8.0, 8.0);
-    let mesh = projection.mesh();
-    let maps = mesh
-        .triangles
-        .iter()
-        .zip(projection.triangle_caches())
-        .map(|(t, cache)| ScreenMap::new(t.map(|i| mesh.screen[i as usize]), size, *cache))
-        .collect();
-    (SceneGeometry::new(&scene), maps)
+    (
+        SceneGeometry::new(&scene),
+        projection_triangles(&projection),
+    )
 }
 
 /// Where several triangles meet at the edge a fragment crossed (non-manifold), each is
@@ -646,9 +642,9 @@ fn parallel_rays_onto(triangles: &[[DVec3; 3]]) -> (SceneGeometry, Vec<ScreenMap
 fn fragments_across_a_non_manifold_edge_try_every_triangle_there() {
     let [lower, upper] = diagonal_square();
     let fin = [lower[0], lower[2], DVec3::new(0.75, 0.25, 3.0)];
-    let (geometry, maps) = parallel_rays_onto(&[lower, fin, upper]);
+    let (geometry, triangles) = parallel_rays_onto(&[lower, fin, upper]);
     let resolver = Resolver {
-        maps: &maps,
+        triangles: &triangles,
         scene: &geometry,
         sample: DVec2::splat(0.5),
     };
@@ -666,9 +662,9 @@ fn fragments_across_a_non_manifold_edge_try_every_triangle_there() {
 #[test]
 fn fragments_across_a_shared_edge_resolve_to_the_neighbour() {
     let [lower, upper] = diagonal_square();
-    let (geometry, maps) = parallel_rays_onto(&[lower, upper]);
+    let (geometry, triangles) = parallel_rays_onto(&[lower, upper]);
     let resolver = Resolver {
-        maps: &maps,
+        triangles: &triangles,
         scene: &geometry,
         sample: DVec2::splat(0.5),
     };
@@ -682,12 +678,12 @@ fn fragments_across_a_shared_edge_resolve_to_the_neighbour() {
     assert_eq!(redirected.barycentric, own.barycentric);
     // The stage rewrites the fragment to the neighbour, at its exact depth, with the
     // neighbour's barycentrics, from the hit terms of the fragment's own triangle.
-    let uv = maps[1].barycentrics(at);
+    let uv = triangles[1].map.barycentrics(at);
     let terms = hit_terms::HitTerms::new(geometry.corners(0)).unwrap();
     let (staged_key, depth, stored) = resolver
         .staged(
             key(0),
-            hit_terms::solve(&terms.at(&maps[1], uv.x, uv.y)),
+            hit_terms::solve(&terms.at(&triangles[1].map, uv.x, uv.y)),
             3,
             3,
         )
