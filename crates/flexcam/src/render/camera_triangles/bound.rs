@@ -56,6 +56,12 @@ const MIN_SPLIT_PIXELS: f64 = 16.0;
 /// 4-camera-triangle row to 2.9.)
 const MIN_SPLIT_EXCESS_PX: f64 = 12.0;
 
+/// The shallowest pieces [`MIN_SPLIT_EXCESS_PX`] stops: on the whole camera triangle and its
+/// quarters the rays spread so widely that the corners' mean projections say little about
+/// where the image lies (without culling, which hands the bound pieces of depth 2, Table 1's
+/// 25-camera-triangle row rose to overdraw 3.35 with the rule applied from depth 0).
+const EXCESS_FROM_DEPTH: u32 = 2;
+
 /// Which bounding region is rasterised per scene triangle and camera triangle (`--bound`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Bound {
@@ -478,7 +484,8 @@ fn tight(
     let pixels = region.area() * camera.pixels_per_area;
     if depth >= MAX_DEPTH
         || pixels < MIN_SPLIT_PIXELS
-        || excess_pixels(points.as_ref(), sub, pixels, camera) < MIN_SPLIT_EXCESS_PX
+        || (depth >= EXCESS_FROM_DEPTH
+            && excess_pixels(points.as_ref(), sub, pixels, camera) < MIN_SPLIT_EXCESS_PX)
         || covers(camera, q, sub)
     {
         return emit_in_camera(camera, region, emit);
