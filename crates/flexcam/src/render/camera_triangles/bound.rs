@@ -52,8 +52,8 @@ const MIN_SPLIT_PIXELS: f64 = 16.0;
 /// Nor is one that exceeds the estimate of the scene triangle's image in it
 /// ([`excess_pixels`]) by fewer pixels than this: the quarters' hulls and clips would cost
 /// more than the few fragments they could save. (With 12, Table 1's reflection rows keep
-/// their overdraw under 3, 2.68 to 2.85, with 20 to 60 % fewer regions; 16 brings the
-/// 4-camera-triangle row to 2.9.)
+/// their overdraw under 3, 2.66 to 2.86, with 20 to 60 % fewer regions; 16 brought the
+/// 4-camera-triangle row to 2.90.)
 const MIN_SPLIT_EXCESS_PX: f64 = 12.0;
 
 /// The shallowest pieces [`MIN_SPLIT_EXCESS_PX`] stops: on the whole camera triangle and its
