@@ -249,68 +249,68 @@ impl<'a> CameraTriangleRenderer<'a> {
         let per_camera: Vec<(PolygonBatch<0>, PairCounts)> = cameras
             .par_iter()
             .enumerate()
-            .map_init(
-                || (Vec::new(), quarter_cull::Buffers::default()),
-                |(vertices, buffers), (c, camera)| {
-                    let mut batch = PolygonBatch::new();
-                    let mut counts = PairCounts::default();
-                    let mut push = |k: usize, region: &Convex| {
-                        vertices.clear();
-                        vertices.extend(
-                            region
-                                .points()
-                                .iter()
-                                .map(|p| Vertex::new(p.x, p.y, 0.0, [])),
+            .map_init(quarter_cull::Buffers::default, |buffers, (c, camera)| {
+                let mut batch = PolygonBatch::new();
+                let mut counts = PairCounts::default();
+                let mut push = |k: usize, region: &Convex| {
+                    batch.push_from(
+                        region
+                            .points()
+                            .iter()
+                            .map(|p| Vertex::new(p.x, p.y, 0.0, [])),
+                        ((c as u64) << 32) | k as u64,
+                    );
+                    counts.regions += 1;
+                };
+                if method.cull && method.bound == Bound::Tight {
+                    counts.pairs = quarter_cull::pieces(camera, scene, &self.groups, buffers);
+                    counts.culled = scene.triangles.len() as u64 - counts.pairs;
+                    // A triangle's pieces are consecutive: its corners and plane are
+                    // found once for all of them.
+                    let mut last = None;
+                    for piece in &buffers.pieces {
+                        let k = piece.triangle as usize;
+                        let (q, plane) = match last {
+                            Some((at, q, plane)) if at == k => (q, plane),
+                            _ => {
+                                let q = scene.corners(k);
+                                (q, bound::tight_plane(camera, &q))
+                            }
+                        };
+                        last = Some((k, q, plane));
+                        bound::tight_in(
+                            camera,
+                            &q,
+                            plane.as_ref(),
+                            piece.sub,
+                            piece.depth,
+                            &mut |region| push(k, region),
                         );
-                        batch.push(vertices, ((c as u64) << 32) | k as u64);
-                        counts.regions += 1;
-                    };
-                    if method.cull && method.bound == Bound::Tight {
-                        counts.pairs = quarter_cull::pieces(camera, scene, &self.groups, buffers);
-                        counts.culled = scene.triangles.len() as u64 - counts.pairs;
-                        // A triangle's pieces are consecutive: its corners and plane are
-                        // found once for all of them.
-                        let mut last = None;
-                        for piece in &buffers.pieces {
-                            let k = piece.triangle as usize;
-                            let (q, plane) = match last {
-                                Some((at, q, plane)) if at == k => (q, plane),
-                                _ => {
-                                    let q = scene.corners(k);
-                                    (q, bound::tight_plane(camera, &q))
-                                }
-                            };
-                            last = Some((k, q, plane));
-                            bound::tight_in(
-                                camera,
-                                &q,
-                                plane.as_ref(),
-                                piece.sub,
-                                piece.depth,
-                                &mut |region| push(k, region),
-                            );
+                    }
+                } else {
+                    let mut test = bound::PieceTest::new(camera, camera::CORNERS);
+                    for cluster in &scene.clusters {
+                        let size = cluster.triangles.len() as u64;
+                        if method.cull && test.misses(&cluster.box_corners) {
+                            counts.culled += size;
+                            continue;
                         }
-                    } else {
-                        let mut test = bound::PieceTest::new(camera, camera::CORNERS);
-                        for cluster in &scene.clusters {
-                            let size = cluster.triangles.len() as u64;
-                            if method.cull && test.misses(&cluster.box_corners) {
-                                counts.culled += size;
-                                continue;
-                            }
-                            counts.pairs += size;
-                            for k in cluster.triangles.clone() {
-                                bound::regions(camera, &scene.corners(k), method.bound, &mut |r| {
-                                    push(k, r)
-                                });
-                            }
+                        counts.pairs += size;
+                        for k in cluster.triangles.clone() {
+                            bound::regions(camera, &scene.corners(k), method.bound, &mut |r| {
+                                push(k, r)
+                            });
                         }
                     }
-                    (batch, counts)
-                },
-            )
+                }
+                (batch, counts)
+            })
             .collect();
-        let mut all = PolygonBatch::new();
+        // Sized once: growing it while appending would copy the batch so far each time.
+        let mut all = PolygonBatch::with_capacity(
+            per_camera.iter().map(|(b, _)| b.vertex_count()).sum(),
+            per_camera.iter().map(|(b, _)| b.len()).sum(),
+        );
         let mut counts = PairCounts::default();
         for (batch, c) in &per_camera {
             all.append(batch);

@@ -197,6 +197,11 @@ impl<const N: usize> PolygonBatch<N> {
         }
     }
 
+    /// The vertices of all its shapes together (for sizing a batch that gathers several).
+    pub fn vertex_count(&self) -> usize {
+        self.vertices.len()
+    }
+
     pub fn len(&self) -> usize {
         self.shapes.len()
     }
