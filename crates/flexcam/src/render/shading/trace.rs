@@ -254,17 +254,17 @@ impl<'a> HitShader<'a> {
         }
         quad.view = quad.view.normalize();
         let lights = &self.caster.scene.lights;
-        for lane in 0..4 {
+        for (lane, color) in colors.iter_mut().enumerate() {
             if quad.present[lane] {
-                colors[lane] = quad.point(lane).unshadowed(lights);
+                *color = quad.point(lane).unshadowed(lights);
             }
         }
         let mut rays: [Option<Ray>; 4] = [None; 4];
         for light in lights {
             let terms = LightTerms::of(light);
             let lit = quad.light(&terms);
-            for lane in 0..4 {
-                rays[lane] = None;
+            for (lane, ray) in rays.iter_mut().enumerate() {
+                *ray = None;
                 if quad.present[lane] && lit.reaches[lane] {
                     let mut shadow = self.caster.spawn(
                         quad.position.lane(lane),
@@ -272,7 +272,7 @@ impl<'a> HitShader<'a> {
                         lit.to_light.lane(lane),
                     );
                     shadow.t_max = lit.t_max;
-                    rays[lane] = Some(shadow);
+                    *ray = Some(shadow);
                     self.counts.shadow += 1;
                 }
             }
@@ -513,17 +513,13 @@ impl DiffuseQuad {
         let two_dot = F64x4::splat(2.0) * from_light.dot(self.normal);
         let reflected = from_light - self.normal.scale(two_dot);
         let highlight = reflected.dot(-self.view).max(F64x4::splat(0.0));
+        // Not `c <= 0`, as the one-point test: a NaN cosine casts a ray there too.
+        let reaches = |c: f64| c > 0.0 || c.is_nan();
         let c = cos.0;
         QuadLight {
             to_light,
             t_max,
-            // `!(c <= 0)` as the one-point test: a NaN cosine casts a ray there too.
-            reaches: [
-                !(c[0] <= 0.0),
-                !(c[1] <= 0.0),
-                !(c[2] <= 0.0),
-                !(c[3] <= 0.0),
-            ],
+            reaches: [reaches(c[0]), reaches(c[1]), reaches(c[2]), reaches(c[3])],
             cos,
             highlight,
         }
