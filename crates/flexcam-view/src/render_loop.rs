@@ -26,7 +26,7 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use flexcam::image_io::{ByteEncoder, ColorEncoding};
+use flexcam::image_io::{ByteEncoder, ColorEncoding, RgbEncoder};
 use flexcam::projection::{
     AnalyticInverse, NoInverse, Projection, ProjectionSpec, Projector, ProjectorHull, Trilinear,
     View,
@@ -519,13 +519,10 @@ pub fn rgba(frame: &Frame, shading: Shading) -> Result<Vec<u8>> {
         .par_chunks_mut(row * 4)
         .zip(frame.color.par_chunks(row))
         .for_each(|(out, colors)| {
-            for (out, c) in out.chunks_exact_mut(4).zip(colors) {
-                out.copy_from_slice(&[
-                    encoder.byte(c.x),
-                    encoder.byte(c.y),
-                    encoder.byte(c.z),
-                    255,
-                ]);
+            let mut encoder = RgbEncoder::new(encoder);
+            for (out, &c) in out.chunks_exact_mut(4).zip(colors) {
+                let [r, g, b] = encoder.rgb(c);
+                out.copy_from_slice(&[r, g, b, 255]);
             }
         });
     Ok(bytes)

@@ -13,6 +13,8 @@
 
 use std::sync::OnceLock;
 
+use glam::Vec3;
+
 use super::{encode_channel, ColorEncoding};
 
 /// Bits dropped from an input's pattern to index [`ByteEncoder::base`].
@@ -76,9 +78,72 @@ impl ByteEncoder {
     }
 }
 
+/// [`ByteEncoder::byte`] of the three channels of colours taken one after another, each
+/// colour equal to the one before it (the background across a panorama's sky, pixel after
+/// pixel) given the bytes found for that one instead of encoding it again: equal channels
+/// encode alike (`0.0 == -0.0`, both 0; NaN equals nothing and is encoded each time).
+pub struct RgbEncoder<'a> {
+    encoder: &'a ByteEncoder,
+    /// The last colour encoded (NaN before any) and its bytes.
+    last: Vec3,
+    bytes: [u8; 3],
+}
+
+impl<'a> RgbEncoder<'a> {
+    /// Bytes by `encoder`, nothing encoded yet.
+    pub fn new(encoder: &'a ByteEncoder) -> Self {
+        RgbEncoder {
+            encoder,
+            last: Vec3::NAN,
+            bytes: [0; 3],
+        }
+    }
+
+    /// The bytes of `c`'s channels, each [`ByteEncoder::byte`]'s.
+    #[inline]
+    pub fn rgb(&mut self, c: Vec3) -> [u8; 3] {
+        if c != self.last {
+            let e = self.encoder;
+            (self.last, self.bytes) = (c, [e.byte(c.x), e.byte(c.y), e.byte(c.z)]);
+        }
+        self.bytes
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Runs of equal colours, signed zeros, NaN and colours differing in one channel by
+    /// one ulp: each colour's bytes are its channels' own, whatever came before it.
+    #[test]
+    fn repeated_colours_keep_their_bytes() {
+        let up = |v: f32| f32::from_bits(v.to_bits() + 1);
+        let t = ByteEncoder::of(ColorEncoding::Srgb).thresholds[100];
+        let colours = [
+            Vec3::new(0.55, 0.7, 0.9),
+            Vec3::new(0.55, 0.7, 0.9),
+            Vec3::new(0.55, 0.7, up(0.9)),
+            Vec3::new(0.0, -0.0, 0.0),
+            Vec3::new(-0.0, 0.0, -0.0),
+            Vec3::new(f32::NAN, 0.5, 0.5),
+            Vec3::new(f32::NAN, 0.5, 0.5),
+            Vec3::new(0.2, 0.5, 0.5),
+            Vec3::new(f32::from_bits(t.to_bits() - 1), t, t),
+            Vec3::new(t, t, t),
+            Vec3::new(t, t, t),
+            Vec3::new(2.0, f32::INFINITY, -1.0),
+        ];
+        for encoding in ENCODINGS {
+            let encoder = ByteEncoder::of(encoding);
+            let mut rgb = RgbEncoder::new(encoder);
+            for c in colours {
+                let own = [encoder.byte(c.x), encoder.byte(c.y), encoder.byte(c.z)];
+                assert_eq!(rgb.rgb(c), own, "{c} {encoding:?}");
+                assert_eq!(own, c.to_array().map(|v| encode_channel(v, encoding)));
+            }
+        }
+    }
 
     const ENCODINGS: [ColorEncoding; 2] = [ColorEncoding::Srgb, ColorEncoding::Linear];
 

@@ -25,7 +25,7 @@ use glam::Vec3;
 use crate::render::{Frame, Shading};
 
 pub use aovs::write_aovs_exr;
-pub use byte_encoder::ByteEncoder;
+pub use byte_encoder::{ByteEncoder, RgbEncoder};
 pub use color::{encode_channel16, write_color, ColorFormat, PngBits};
 pub use depth::{write_depth, DepthFormat};
 pub use gif::GifFrames;
@@ -90,8 +90,8 @@ pub fn encode_channel(c: f32, encoding: ColorEncoding) -> u8 {
 /// The 8-bit RGB bytes of the colour of `frame`, row by row from the top (allocated
 /// fallibly: an error names the bytes).
 fn rgb_bytes(frame: &Frame, encoding: ColorEncoding) -> crate::error::Result<Vec<u8>> {
-    let encoder = ByteEncoder::of(encoding);
-    let bytes = (frame.color.iter()).flat_map(|c: &Vec3| c.to_array().map(|v| encoder.byte(v)));
+    let mut encoder = RgbEncoder::new(ByteEncoder::of(encoding));
+    let bytes = (frame.color.iter()).flat_map(|&c: &Vec3| encoder.rgb(c));
     crate::try_alloc::collected(3 * frame.color.len(), bytes, || {
         samples_of("8-bit RGB bytes", frame)
     })

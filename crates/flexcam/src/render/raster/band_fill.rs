@@ -89,6 +89,18 @@ impl Written {
     fn set(&mut self, i: usize) {
         self.0[i / 64] |= 1 << (i % 64);
     }
+
+    /// Whether none of the `len` bits from `start` on is set (`len` at most 64, the bits
+    /// within the band).
+    fn none_in(&self, start: usize, len: usize) -> bool {
+        let (word, bit) = (start / 64, start % 64);
+        let mut bits = self.0[word] >> bit;
+        if bit != 0 {
+            bits |= self.0.get(word + 1).map_or(0, |w| w << (64 - bit));
+        }
+        let mask = if len >= 64 { u64::MAX } else { (1 << len) - 1 };
+        bits & mask == 0
+    }
 }
 
 /// Fills the screen triangles of `bins` (those of every piece-building job, each sorted into
@@ -165,7 +177,25 @@ pub fn fill_and_shade(
             // rays of neighbouring pixels are traced together.
             let band_rows = visible.len() / row;
             for top in (0..band_rows).step_by(2) {
-                for left in (0..row).step_by(2) {
+                let quad_rows = top..(top + 2).min(band_rows);
+                let mut left = 0;
+                while left < row {
+                    // A run of up to 64 columns with nothing drawn in the quad's rows (the
+                    // sky beside a model): background at once, no per-quad test.
+                    let span = (row - left).min(64);
+                    if quad_rows
+                        .clone()
+                        .all(|y| written.none_in(y * row + left, span))
+                    {
+                        for y in quad_rows.clone() {
+                            let run = y * row + left..y * row + left + span;
+                            colors[run.clone()].fill(background);
+                            depths[run.clone()].fill(f32::INFINITY);
+                            ids[run].fill(0);
+                        }
+                        left += span;
+                        continue;
+                    }
                     // The quad's pixel indices in the band, where inside it; loops rather
                     // than `array::map`, which is not inlined here.
                     let mut quad = [None; 4];
@@ -185,6 +215,7 @@ pub fn fill_and_shade(
                         for i in quad.into_iter().flatten() {
                             (colors[i], depths[i], ids[i]) = (background, f32::INFINITY, 0);
                         }
+                        left += 2;
                         continue;
                     }
                     let (shaded, rays) = shader.shade4(pixels);
@@ -202,6 +233,7 @@ pub fn fill_and_shade(
                             (colors[i], depths[i], ids[i]) = (background, f32::INFINITY, 0);
                         }
                     }
+                    left += 2;
                 }
             }
             counts
@@ -227,4 +259,39 @@ fn resize(
     })?;
     (frame.width, frame.height) = (width, height);
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `none_in` is "no `get` in the range" for every start and length up to 64 within
+    /// three words holding a few set bits, at word boundaries and inside words.
+    #[test]
+    fn none_in_is_no_bit_set_in_the_range() {
+        let pixels = 150;
+        for set in [
+            vec![],
+            vec![0],
+            vec![63],
+            vec![64],
+            vec![70, 149],
+            vec![127, 128],
+        ] {
+            let mut written = Written::new(pixels);
+            for &i in &set {
+                written.set(i);
+            }
+            for start in 0..pixels {
+                for len in 1..=64.min(pixels - start) {
+                    let expected = (start..start + len).all(|i| !written.get(i));
+                    assert_eq!(
+                        written.none_in(start, len),
+                        expected,
+                        "{set:?} {start} {len}"
+                    );
+                }
+            }
+        }
+    }
 }

@@ -4,6 +4,7 @@
 //! A hit is given as an object, a triangle index within its mesh and the barycentric weights
 //! `(u, v)` of the triangle's second and third vertices (the first has `1 - u - v`).
 
+mod lanes;
 pub mod trace;
 pub mod triangle_color;
 

@@ -19,6 +19,7 @@
 
 use glam::{DVec3, Vec3};
 
+use super::lanes::{DVec3x4, F64x4};
 use crate::geometry::optics::{reflect, refract};
 use crate::geometry::Ray;
 use crate::render::prepared::{Hit, PreparedScene};
@@ -215,7 +216,9 @@ impl<'a> HitShader<'a> {
     /// `None`: no pixel there), each exactly what [`HitShader::shade_hit`] gives it, with
     /// the same rays counted: the shadow rays of the diffuse hits towards each light are
     /// traced four at a time ([`PreparedScene::occluded4`]), which coherent rays (those of
-    /// neighbouring pixels towards one light) make cheaper.
+    /// neighbouring pixels towards one light) make cheaper, and the diffuse hits' view and
+    /// light directions, Lambert and Phong terms are computed in four lanes
+    /// ([`DiffuseQuad`]), the same operations per lane.
     pub(in crate::render) fn shade_hits4(&mut self, hits: [Option<(&Ray, Hit)>; 4]) -> [Vec3; 4] {
         let background = self.caster.scene.image.background;
         let mut colors = [background; 4];
@@ -227,7 +230,7 @@ impl<'a> HitShader<'a> {
             }
             return colors;
         }
-        let mut points: [Option<DiffusePoint>; 4] = [None; 4];
+        let mut quad = DiffuseQuad::default();
         // The triangle looked up last: a quad's pixels nearly always lie on one.
         let mut surface: Option<Surface> = None;
         for lane in 0..4 {
@@ -244,23 +247,33 @@ impl<'a> HitShader<'a> {
                 _ => *surface.insert(self.surface(&hit)),
             };
             let (normals, base) = self.lit_surface_on(&on, ray, &hit);
-            let point = DiffusePoint::new(ray, ray.at(hit.t), &normals, base);
-            colors[lane] = point.unshadowed(&self.caster.scene.lights);
-            points[lane] = Some(point);
+            quad.set(lane, ray, ray.at(hit.t), &normals, base);
         }
-        // Loops over the lanes rather than `array::map`, which is not inlined here.
+        if quad.present == [false; 4] {
+            return colors;
+        }
+        quad.view = quad.view.normalize();
+        let lights = &self.caster.scene.lights;
+        for (lane, color) in colors.iter_mut().enumerate() {
+            if quad.present[lane] {
+                *color = quad.point(lane).unshadowed(lights);
+            }
+        }
         let mut rays: [Option<Ray>; 4] = [None; 4];
-        let mut added = [Vec3::ZERO; 4];
-        for light in &self.caster.scene.lights {
+        for light in lights {
             let terms = LightTerms::of(light);
-            for lane in 0..4 {
-                rays[lane] = None;
-                if let Some(point) = &points[lane] {
-                    if let Some((ray, light_adds)) = point.light(self.caster, &terms) {
-                        rays[lane] = Some(ray);
-                        added[lane] = light_adds;
-                        self.counts.shadow += 1;
-                    }
+            let lit = quad.light(&terms);
+            for (lane, ray) in rays.iter_mut().enumerate() {
+                *ray = None;
+                if quad.present[lane] && lit.reaches[lane] {
+                    let mut shadow = self.caster.spawn(
+                        quad.position.lane(lane),
+                        quad.geometric.lane(lane),
+                        lit.to_light.lane(lane),
+                    );
+                    shadow.t_max = lit.t_max;
+                    *ray = Some(shadow);
+                    self.counts.shadow += 1;
                 }
             }
             let blocked = self.caster.occluded4([
@@ -271,7 +284,8 @@ impl<'a> HitShader<'a> {
             ]);
             for lane in 0..4 {
                 if rays[lane].is_some() && !blocked[lane] {
-                    colors[lane] += added[lane];
+                    colors[lane] += terms.radiance
+                        * lambert_phong(quad.base[lane], lit.cos.0[lane], lit.highlight.0[lane]);
                 }
             }
         }
@@ -387,9 +401,9 @@ impl DiffusePoint {
     /// Lambert and a white Phong highlight for a unit direction `to_light`.
     #[inline]
     fn shade(&self, to_light: DVec3) -> Vec3 {
-        let cos = self.normal.dot(to_light) as f32;
-        let highlight = reflect(-to_light, self.normal).dot(-self.view).max(0.0) as f32;
-        self.base * cos + Vec3::splat(SPECULAR * highlight.powi(SHININESS))
+        let cos = self.normal.dot(to_light);
+        let highlight = reflect(-to_light, self.normal).dot(-self.view).max(0.0);
+        lambert_phong(self.base, cos, highlight)
     }
 
     /// The colour before any light's shadowed term: the ambient term, plus the unshadowed
@@ -415,6 +429,100 @@ impl DiffusePoint {
         let mut shadow = caster.spawn(self.position, self.geometric, to_light);
         shadow.t_max = t_max;
         Some((shadow, terms.radiance * self.shade(unit)))
+    }
+}
+
+/// Lambert and a white Phong highlight on base colour `base`, from the cosine between the
+/// shading normal and the unit direction to the light and the highlight's cosine (the
+/// reflected light direction against the view, at least 0).
+#[inline]
+fn lambert_phong(base: Vec3, cos: f64, highlight: f64) -> Vec3 {
+    base * cos as f32 + Vec3::splat(SPECULAR * (highlight as f32).powi(SHININESS))
+}
+
+/// The diffuse points of a 2x2 quad, [`DiffusePoint`]s stored four lanes a coordinate, so
+/// that the per-light arithmetic of [`DiffusePoint::light`] is done for the four at once
+/// ([`DiffuseQuad::light`]): each lane the same operations on the same values, so the same
+/// bits (lanes without a point compute on zeros and are not read).
+#[derive(Debug, Clone, Copy, Default)]
+struct DiffuseQuad {
+    /// Which lanes hold a point.
+    present: [bool; 4],
+    position: DVec3x4,
+    /// The primary rays' directions, normalised once every lane is set.
+    view: DVec3x4,
+    normal: DVec3x4,
+    geometric: DVec3x4,
+    base: [Vec3; 4],
+}
+
+/// What one light gives the points of a [`DiffuseQuad`], lane by lane.
+struct QuadLight {
+    /// The vector from each point to the light and the shadow rays' parameter at the light.
+    to_light: DVec3x4,
+    t_max: f64,
+    /// Whether the light is in front of the shading normal (else no shadow ray is cast).
+    reaches: [bool; 4],
+    /// The Lambert and highlight cosines of [`lambert_phong`].
+    cos: F64x4,
+    highlight: F64x4,
+}
+
+impl DiffuseQuad {
+    /// Puts a point in lane `lane`: [`DiffusePoint::new`]'s values, the view not yet
+    /// normalised.
+    fn set(&mut self, lane: usize, ray: &Ray, position: DVec3, normals: &Normals, base: Vec3) {
+        self.present[lane] = true;
+        self.position.set(lane, position);
+        self.view.set(lane, ray.direction);
+        self.normal.set(lane, normals.shading.as_dvec3());
+        self.geometric.set(lane, normals.geometric.as_dvec3());
+        self.base[lane] = base;
+    }
+
+    /// Lane `lane` as a [`DiffusePoint`] (the view normalised).
+    fn point(&self, lane: usize) -> DiffusePoint {
+        DiffusePoint {
+            position: self.position.lane(lane),
+            view: self.view.lane(lane),
+            normal: self.normal.lane(lane),
+            geometric: self.geometric.lane(lane),
+            base: self.base[lane],
+        }
+    }
+
+    /// [`DiffusePoint::light`] of every lane, the shadow ray's spawning aside: the same
+    /// vector to the light, unit direction, test against the shading normal and Lambert and
+    /// Phong cosines.
+    #[inline]
+    fn light(&self, terms: &LightTerms) -> QuadLight {
+        let (to_light, unit, t_max) = match terms.reach {
+            Reach::Point(p) => {
+                let to_light = DVec3x4::splat(p) - self.position;
+                (to_light, to_light.normalize_or_zero(), 1.0)
+            }
+            Reach::Directional { to_light, unit } => (
+                DVec3x4::splat(to_light),
+                DVec3x4::splat(unit),
+                f64::INFINITY,
+            ),
+        };
+        let cos = self.normal.dot(unit);
+        // reflect(-unit, normal) = -unit - 2 (-unit . normal) normal.
+        let from_light = -unit;
+        let two_dot = F64x4::splat(2.0) * from_light.dot(self.normal);
+        let reflected = from_light - self.normal.scale(two_dot);
+        let highlight = reflected.dot(-self.view).max(F64x4::splat(0.0));
+        // Not `c <= 0`, as the one-point test: a NaN cosine casts a ray there too.
+        let reaches = |c: f64| c > 0.0 || c.is_nan();
+        let c = cos.0;
+        QuadLight {
+            to_light,
+            t_max,
+            reaches: [reaches(c[0]), reaches(c[1]), reaches(c[2]), reaches(c[3])],
+            cos,
+            highlight,
+        }
     }
 }
 
