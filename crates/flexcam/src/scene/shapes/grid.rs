@@ -5,9 +5,9 @@
 //! (`s` along a row, `t` across rows). Triangles are counter-clockwise seen from the side
 //! `dP/ds x dP/dt` points to, so each shape picks its parametrisation to make that outward.
 //!
-//! A row may collapse to a single point (a sphere pole, a cap centre, the lid top of the
-//! teapot). Each quad touching such a row would have one zero-area triangle; it is left out,
-//! so the row becomes a triangle fan. Vertices on a collapsed row are still emitted per
+//! A row may collapse to a single point (a sphere pole, the lid top of the teapot). Each quad
+//! touching such a row would have one zero-area triangle; it is left out, so the row becomes
+//! a triangle fan. Vertices on a collapsed row are still emitted per
 //! column, so that each fan triangle keeps its own uv and its own limit normal.
 
 use glam::{Vec2, Vec3};
