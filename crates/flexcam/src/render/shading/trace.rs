@@ -266,13 +266,13 @@ impl<'a> HitShader<'a> {
             for (lane, ray) in rays.iter_mut().enumerate() {
                 *ray = None;
                 if quad.present[lane] && lit.reaches[lane] {
-                    let mut shadow = self.caster.spawn(
+                    *ray = Some(shadow_ray(
+                        self.caster,
                         quad.position.lane(lane),
                         quad.geometric.lane(lane),
                         lit.to_light.lane(lane),
-                    );
-                    shadow.t_max = lit.t_max;
-                    *ray = Some(shadow);
+                        lit.t_max,
+                    ));
                     self.counts.shadow += 1;
                 }
             }
@@ -423,13 +423,36 @@ impl DiffusePoint {
     fn light(&self, caster: &PreparedScene, terms: &LightTerms) -> Option<(Ray, Vec3)> {
         let (to_light, t_max) = terms.to_light(self.position);
         let unit = terms.unit(to_light);
-        if self.normal.dot(unit) <= 0.0 {
+        if !light_reaches(self.normal.dot(unit)) {
             return None;
         }
-        let mut shadow = caster.spawn(self.position, self.geometric, to_light);
-        shadow.t_max = t_max;
+        let shadow = shadow_ray(caster, self.position, self.geometric, to_light, t_max);
         Some((shadow, terms.radiance * self.shade(unit)))
     }
+}
+
+/// Whether a light whose unit direction makes cosine `cos` with the shading normal is cast
+/// a shadow ray (and may add its terms): in front of the normal, or a NaN cosine (a
+/// degenerate normal or direction), which is not known to be behind it.
+#[inline]
+fn light_reaches(cos: f64) -> bool {
+    cos > 0.0 || cos.is_nan()
+}
+
+/// The shadow ray from surface point `position` towards the light along `to_light`,
+/// spawned off the surface by its geometric normal `geometric` ([`PreparedScene::spawn`]),
+/// reaching the light at parameter `t_max` ([`LightTerms::to_light`]).
+#[inline]
+fn shadow_ray(
+    caster: &PreparedScene,
+    position: DVec3,
+    geometric: DVec3,
+    to_light: DVec3,
+    t_max: f64,
+) -> Ray {
+    let mut shadow = caster.spawn(position, geometric, to_light);
+    shadow.t_max = t_max;
+    shadow
 }
 
 /// Lambert and a white Phong highlight on base colour `base`, from the cosine between the
@@ -513,13 +536,16 @@ impl DiffuseQuad {
         let two_dot = F64x4::splat(2.0) * from_light.dot(self.normal);
         let reflected = from_light - self.normal.scale(two_dot);
         let highlight = reflected.dot(-self.view).max(F64x4::splat(0.0));
-        // Not `c <= 0`, as the one-point test: a NaN cosine casts a ray there too.
-        let reaches = |c: f64| c > 0.0 || c.is_nan();
         let c = cos.0;
         QuadLight {
             to_light,
             t_max,
-            reaches: [reaches(c[0]), reaches(c[1]), reaches(c[2]), reaches(c[3])],
+            reaches: [
+                light_reaches(c[0]),
+                light_reaches(c[1]),
+                light_reaches(c[2]),
+                light_reaches(c[3]),
+            ],
             cos,
             highlight,
         }
