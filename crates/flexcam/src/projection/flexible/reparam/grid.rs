@@ -138,12 +138,26 @@ impl UvGrid {
 
     /// The image position (s, t) whose (u, v) is `uv`, by Newton's method from the nearest
     /// samples; `None` when it does not converge. Unique inside [0, 1]^2 (the grid does not
-    /// fold); outside, the root nearest the samples tried.
+    /// fold), and a root there is preferred: the border cells' continued polynomials may
+    /// take `uv` again outside, and Newton's method from a near sample may end there.
+    /// Otherwise the root found from the nearest sample that gives one.
     pub fn st(&self, uv: DVec2) -> Option<DVec2> {
-        self.buckets
-            .nearest(&self.samples, uv, STARTS)
-            .into_iter()
-            .find_map(|k| self.newton(uv, self.sample_st(k)))
+        let mut outside = None;
+        for k in self.buckets.nearest(&self.samples, uv, STARTS) {
+            match self.newton(uv, self.sample_st(k)) {
+                Some(st) if Self::in_image(st) => return Some(st),
+                Some(st) => outside = outside.or(Some(st)),
+                None => {}
+            }
+        }
+        outside
+    }
+
+    /// Whether `st` lies in the image [0, 1]^2, up to what Newton's tolerance moves a root
+    /// on the border.
+    fn in_image(st: DVec2) -> bool {
+        const SLACK: f64 = 1e-9;
+        st.cmpge(DVec2::splat(-SLACK)).all() && st.cmple(DVec2::splat(1.0 + SLACK)).all()
     }
 
     /// The (s, t) of sample `k`.
