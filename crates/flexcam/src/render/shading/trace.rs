@@ -3,7 +3,8 @@
 //! secondary rays (mirrors, glass, shadows) are traced through the prepared scene's BVH.
 //!
 //! Specular materials take the same paths in both modes: a mirror reflects about the shading
-//! normal; glass enters when the ray opposes the triangle's face normal (eta = 1/ior), else
+//! normal, lifted back out of the face where that image points into it (interpolated
+//! normals near a coarse mesh's rim: `optics::reflect_above`); glass enters when the ray opposes the triangle's face normal (eta = 1/ior), else
 //! leaves (eta = ior), and reflects on total internal reflection. A ray may bounce at most
 //! `max_bounces` times: a specular surface reached after that yields the background.
 //!
@@ -20,7 +21,7 @@
 use glam::{DVec3, Vec3};
 
 use super::lanes::{DVec3x4, F64x4};
-use crate::geometry::optics::{reflect, refract};
+use crate::geometry::optics::{reflect, reflect_above, refract};
 use crate::geometry::Ray;
 use crate::render::prepared::{Hit, PreparedScene};
 use crate::render::shading::{base_color, Normals, TextureFilter, TriangleBase, VertexNormals};
@@ -627,7 +628,7 @@ impl LightTerms {
 pub(crate) fn specular(ray: &Ray, normals: &Normals, finish: Finish) -> Specular {
     let direction = ray.direction.normalize();
     let normal = normals.shading.as_dvec3();
-    let reflected = reflect(direction, normal);
+    let reflected = reflect_above(direction, normal, normals.geometric.as_dvec3());
     let refracted = match finish {
         Finish::Glass { ior } => {
             let ior = ior as f64;
