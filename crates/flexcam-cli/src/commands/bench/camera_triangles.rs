@@ -15,8 +15,10 @@
 //!   floor, seen through a trilinear projection of 400 camera triangles around it) at 800 x
 //!   600, flat: the camera triangles, fragments and overdraw of the frame, rendered directly.
 //! - A mirror sphere over a floor of about 5,000 scene triangles at 800 x 600: the whole
-//!   frame by camera triangles against `--method raycast` (true mirror), and the agreement
-//!   of the reflector's pixels with the exact reflection (`measures`).
+//!   frame by camera triangles, per camera mesh ([`MIRROR_SPHERE_MESHES`]), against
+//!   `--method raycast` (true mirror), and the agreement of the reflector's pixels with the
+//!   exact reflection (`measures`), over all of them and over those whose exact reflection
+//!   does not show the mirror itself (`self_reflection`).
 //! - `--figure 6` ([`figure6`]): reflection quality per camera mesh size; `--figure 7`
 //!   ([`figure7`]): frames per second of a mirror teapot among moving balls, without and
 //!   with acceleration. Both print a markdown table and write a CSV with `--csv FILE`
