@@ -391,23 +391,24 @@ fn five_thousand(repeat: u32, width: u32, height: u32) -> Result<()> {
         ..options(Method::Raycast)
     };
     let surfaces = render::render(&exact, main.as_ref(), &surface_options)?.frame;
-    let selfish = match reflector {
+    let self_reflected = match reflector {
         Some(index) => self_reflected_pixels(&exact, main.as_ref(), &surfaces, index, id),
         None => vec![false; surfaces.ids.len()],
     };
     println!();
     println!(
-        "Mirror sphere (80 triangles) over {} scene triangles at {width} x {height}, flat: the \
+        "Mirror sphere ({} triangles) over {} scene triangles at {width} x {height}, flat: the \
          whole frame by camera triangles against --method raycast of the exact mirror, {:.1} ms \
          (cpu ms {:.1}); targets: time ratio <= 0.5, agreement >= 0.99. agreement: reflector \
          pixels away from colour edges with the exact colour, over all of them, then over \
          those whose exact reflected ray does not meet the mirror itself ({} of the \
          reflector's pixels do: the ray caster follows them into the faceted mirror, camera \
          triangles reflect the scene without it); rgb: relative RGB error of the frame.",
+        reflector.map_or(0, |index| scene.objects[index].mesh.triangles.len()),
         prepared_triangles(&scene),
         ray_time.median_ms(),
         ray_time.cpu_ms(),
-        marked(&selfish),
+        marked(&self_reflected),
     );
     println!(
         "{:>12} {:>7} {:>8} {:>8} {:>7} {:>6} {:>8} | {:>9} {:>7} {:>12} {:>8}",
@@ -434,7 +435,7 @@ fn five_thousand(repeat: u32, width: u32, height: u32) -> Result<()> {
         )?;
         let (same, pixels) = colour_agreement_inside(&ours.frame, &reference.frame, id, None);
         let (same_rest, rest) =
-            colour_agreement_inside(&ours.frame, &reference.frame, id, Some(&selfish));
+            colour_agreement_inside(&ours.frame, &reference.frame, id, Some(&self_reflected));
         let rgb = compare(&ours.frame, &reference.frame)?.relative_rgb_error;
         println!(
             "{:>12} {:>7} {:>8.2} {:>8.1} {:>7.2} {:>6.1} {:>8.2} | {:>9.4} {:>7} {:>5.4} of {:>6} {:>8.5}",
