@@ -76,7 +76,7 @@ fn application_row(out: &str, name: &str) -> Vec<f64> {
 /// Table 1: three reflection tessellations x two bounds x culling off and on, the caustics
 /// row with its photon map's camera triangles and an overdraw that is bounding over
 /// rendered, the visualisation row's 400 camera triangles around the walker, and the
-/// 5,000-triangle target line.
+/// 5,000-triangle target's rows.
 #[test]
 fn table_1_has_reflection_caustics_and_visualisation_rows() {
     let dir = TempDir::new().unwrap();
@@ -97,8 +97,33 @@ fn table_1_has_reflection_caustics_and_visualisation_rows() {
         &visualisation[8..],
         [400.0, 6841.0, 213248.0, 213248.0, 1.0, 46.0]
     );
-    assert!(out.contains("Mirror sphere over"), "{out}");
-    assert!(out.contains("CPU time of all threads"), "{out}");
+    mirror_sphere_rows(&out);
+}
+
+/// The 5,000-triangle mirror sphere's table: one row per camera mesh, each with camera
+/// triangles, overdraw, ms and its ratio, cpu ms and its ratio, the agreement over its
+/// pixels, then over those without self-reflection (at most as many) and the RGB error.
+fn mirror_sphere_rows(out: &str) {
+    let (_, sphere) = out
+        .split_once("Mirror sphere (80 triangles) over 5012 scene triangles")
+        .unwrap_or_else(|| panic!("no mirror sphere: {out}"));
+    assert!(sphere.contains("cpu ms"), "{sphere}");
+    for name in ["own mesh", "refined 8 px", "automatic"] {
+        let row = sphere
+            .lines()
+            .find_map(|l| l.trim_start().strip_prefix(name))
+            .unwrap_or_else(|| panic!("no {name} row: {sphere}"));
+        let n: Vec<f64> = row
+            .split(['|', ' '])
+            .filter_map(|c| c.parse().ok())
+            .collect();
+        assert_eq!(n.len(), 11, "{name}: {row}");
+        assert!(n[0] > 0.0 && n[1] >= 1.0, "{name}: {row}");
+        for agreement in [n[6], n[8]] {
+            assert!((0.0..=1.0).contains(&agreement), "{name}: {row}");
+        }
+        assert!(n[9] <= n[7], "{name}: {row}");
+    }
 }
 
 /// Figure 6: every reflector scene gets the series 8, 16, ... up to its own triangle count

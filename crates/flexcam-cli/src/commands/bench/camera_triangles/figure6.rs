@@ -144,7 +144,7 @@ pub fn run(settings: &Settings) -> Result<Vec<Row>> {
             };
             let (timing, ours) = timed_render(settings.repeat, &prepared, main.as_ref(), &options)?;
             let (agreement, agreement_pixels) =
-                colour_agreement_inside(&ours.frame, &reference.frame, id);
+                colour_agreement_inside(&ours.frame, &reference.frame, id, None);
             let row = Row {
                 scene: subject.name(),
                 mesh: size,

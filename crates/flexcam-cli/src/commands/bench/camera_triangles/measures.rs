@@ -29,13 +29,21 @@ pub fn value(stats: &render::Stats, name: &str) -> f64 {
 
 /// The fraction of the reference's pixels of object `id` whose colour (over the pixel's
 /// 3 x 3 neighbourhood in the reference) is uniform that `frame` gives exactly, and their
-/// number (1 over none).
-pub fn colour_agreement_inside(frame: &Frame, reference: &Frame, id: u32) -> (f64, u64) {
+/// number (1 over none); pixels marked in `excluded` (one flag per pixel) are not counted.
+pub fn colour_agreement_inside(
+    frame: &Frame,
+    reference: &Frame,
+    id: u32,
+    excluded: Option<&[bool]>,
+) -> (f64, u64) {
     let (w, h) = (reference.width as usize, reference.height as usize);
     let (mut pixels, mut same) = (0u64, 0u64);
     for y in 1..h.saturating_sub(1) {
         for x in 1..w.saturating_sub(1) {
             let k = y * w + x;
+            if excluded.is_some_and(|e| e[k]) {
+                continue;
+            }
             let colour = reference.color[k];
             let uniform = (y - 1..=y + 1).all(|yy| {
                 (x - 1..=x + 1).all(|xx| {
@@ -102,14 +110,24 @@ mod tests {
     #[test]
     fn agreement_counts_pixels_away_from_colour_edges() {
         let reference = reference();
-        assert_eq!(colour_agreement_inside(&reference, &reference, 1), (1.0, 0));
+        assert_eq!(
+            colour_agreement_inside(&reference, &reference, 1, None),
+            (1.0, 0)
+        );
         // Without the blue pixel, (1, 1) and (1, 2) are inside; a wrong colour at (1, 1)
         // halves the agreement.
         let mut plain = reference.clone();
         plain.color[2 * 4 + 1] = Vec3::new(1.0, 0.0, 0.0);
         let mut frame = plain.clone();
         frame.color[4 + 1] = Vec3::ZERO;
-        assert_eq!(colour_agreement_inside(&frame, &plain, 1), (0.5, 2));
+        assert_eq!(colour_agreement_inside(&frame, &plain, 1, None), (0.5, 2));
+        // Excluding the wrong pixel leaves the other one, in agreement.
+        let mut excluded = vec![false; 16];
+        excluded[4 + 1] = true;
+        assert_eq!(
+            colour_agreement_inside(&frame, &plain, 1, Some(&excluded)),
+            (1.0, 1)
+        );
     }
 
     /// The relative RGB error counts the object's pixels alone.
