@@ -84,9 +84,12 @@ pub struct BoxTest {
     /// `u`, `v` and `w` (at least their lengths).
     scale: f64,
     /// The near cone's half-spaces of [`ClipPoint::sides`] (bits 0 to 4) as `normal . y +
-    /// offset >= 0`, each `(normal, |normal|, offset)` with the absolute values of the
-    /// normal's components.
-    near_half_spaces: [(DVec3, DVec3, f64); 5],
+    /// offset >= 0`, stored by component (`normals[0][k]` is the x of half-space `k`'s
+    /// normal), with the absolute values of the normals' components in `sizes`: the five are
+    /// evaluated side by side, one component at a time, at every node of the cull tree.
+    normals: [[f64; 5]; 3],
+    sizes: [[f64; 5]; 3],
+    offsets: [f64; 5],
 }
 
 /// A scene triangle reaching the focus: its image through a central projection is not a
@@ -161,11 +164,15 @@ impl CentralProjection {
     pub fn box_test(&self) -> BoxTest {
         let (u, v, w) = (self.u, self.v, self.w);
         let terms = [u, v, w].map(|a| a.abs().element_sum());
+        let half_spaces = near_half_spaces(u, v, w);
+        let component = |c: usize, f: fn(DVec3) -> DVec3| half_spaces.map(|(n, _)| f(n)[c]);
+        let by_component = |f: fn(DVec3) -> DVec3| [0, 1, 2].map(|c| component(c, f));
         BoxTest {
             focus: self.focus,
             scale: (2.0 + DOMAIN_MARGIN) * (terms[0] + terms[1] + terms[2]),
-            near_half_spaces: near_half_spaces(u, v, w)
-                .map(|(normal, offset)| (normal, normal.abs(), offset)),
+            normals: by_component(|n| n),
+            sizes: by_component(DVec3::abs),
+            offsets: half_spaces.map(|(_, offset)| offset),
         }
     }
 
@@ -372,26 +379,23 @@ impl BoxTest {
         let y = centre - self.focus;
         // The sums of absolute values bound the lengths (no square root per node).
         let margin = BOX_MARGIN * (self.scale * (y.abs().element_sum() + half.element_sum()) + 1.0);
-        let (mut outside, mut inside) = (0, 0);
-        for (k, &(normal, size, offset)) in self.near_half_spaces.iter().enumerate() {
-            let middle = normal.dot(y) + offset;
-            let reach = size.dot(half);
-            // The near cone's half-space `k`, and the far cone's that is its negation
-            // (`k + 5` for the domain planes, 8 for `w >= 0`; none for the view plane).
-            let far = match k {
-                0..=2 => 1 << (k + 5),
-                4 => 1 << 8,
-                _ => 0,
-            };
-            if middle + reach < -margin {
-                outside |= 1 << k;
-                inside |= far;
-            }
-            if middle - reach > margin {
-                inside |= 1 << k;
-                outside |= far;
-            }
+        // Each half-space's least and greatest value over the box, `middle -+ reach`, with
+        // `middle = normal . y + offset` and `reach = |normal| . half` summed in the order
+        // of `DVec3::dot`.
+        let (n, s) = (&self.normals, &self.sizes);
+        let mut near_outside = 0;
+        let mut near_inside = 0;
+        for k in 0..5 {
+            let middle = n[0][k] * y.x + n[1][k] * y.y + n[2][k] * y.z + self.offsets[k];
+            let reach = s[0][k] * half.x + s[1][k] * half.y + s[2][k] * half.z;
+            near_outside |= u32::from(middle + reach < -margin) << k;
+            near_inside |= u32::from(middle - reach > margin) << k;
         }
+        // The far cone's half-spaces that are the near ones turned round: `k + 5` for the
+        // domain planes (bits 0 to 2), 8 for `w >= 0` (bit 4); none for the view plane.
+        let far = |near: u32| (near & 0b111) << 5 | (near & 0b1_0000) << 4;
+        let outside = near_outside | far(near_inside);
+        let inside = near_inside | far(near_outside);
         let outside = outside & active;
         if outside & NEAR_CONE != 0 && outside & FAR_CONE != 0 {
             BoxSide::Outside
