@@ -15,6 +15,7 @@ mod triangle;
 pub use aabb::Aabb;
 pub use bilinear_patch::{BilinearPatch, PatchHit};
 pub use mesh_view::MeshView;
+pub use optics::{reflect_above, REFLECTION_LIFT};
 pub use ray::Ray;
 pub use roots::{solve_cubic, solve_quadratic, Roots};
 pub use triangle::{intersect_triangle, TriangleHit};

@@ -31,7 +31,7 @@ pub(crate) fn reflect(direction: DVec3, normal: DVec3) -> DVec3 {
 /// passes through `-g` the lifted direction along the face turns over (the one
 /// discontinuity); a `geometric` that faces
 /// away from the ray counts as `cos_i = 0` (`h = 0`: lifted into the face's plane).
-pub(crate) fn reflect_above(direction: DVec3, shading: DVec3, geometric: DVec3) -> DVec3 {
+pub fn reflect_above(direction: DVec3, shading: DVec3, geometric: DVec3) -> DVec3 {
     let reflected = reflect(direction, shading);
     let lift = (-0.9 * direction.dot(geometric)).clamp(0.0, REFLECTION_LIFT);
     let height = reflected.dot(geometric);
@@ -46,7 +46,7 @@ pub(crate) fn reflect_above(direction: DVec3, shading: DVec3, geometric: DVec3) 
 
 /// The largest elevation (cosine to the face normal) to which [`reflect_above`] lifts a
 /// reflection that points into its surface.
-pub(crate) const REFLECTION_LIFT: f64 = 0.01;
+pub const REFLECTION_LIFT: f64 = 0.01;
 
 /// A refracted direction and the fraction of light reflected instead.
 #[derive(Debug, Clone, Copy, PartialEq)]

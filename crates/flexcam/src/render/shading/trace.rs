@@ -4,8 +4,10 @@
 //!
 //! Specular materials take the same paths in both modes: a mirror reflects about the shading
 //! normal, lifted back out of the face where that image points into it (interpolated
-//! normals near a coarse mesh's rim: `optics::reflect_above`); glass enters when the ray opposes the triangle's face normal (eta = 1/ior), else
-//! leaves (eta = ior), and reflects on total internal reflection. A ray may bounce at most
+//! normals near a coarse mesh's rim: `optics::reflect_above`); glass enters when the ray
+//! opposes the triangle's face normal (eta = 1/ior), else leaves (eta = ior), and reflects
+//! on total internal reflection (its Fresnel reflection lifted as a mirror's). A ray may
+//! bounce at most
 //! `max_bounces` times: a specular surface reached after that yields the background.
 //!
 //! - `flat`: the base colour of the first non-specular surface (nearest texel), untinted by
