@@ -7,8 +7,8 @@
 //! normals near a coarse mesh's rim: `optics::reflect_above`); glass enters when the ray
 //! opposes the triangle's face normal (eta = 1/ior), else leaves (eta = ior), and reflects
 //! on total internal reflection (its Fresnel reflection lifted as a mirror's). A ray may
-//! bounce at most
-//! `max_bounces` times: a specular surface reached after that yields the background.
+//! bounce at most `max_bounces` times: a specular surface reached after that yields the
+//! background.
 //!
 //! - `flat`: the base colour of the first non-specular surface (nearest texel), untinted by
 //!   the mirrors and glass on the way; no Fresnel mixing.
