@@ -217,7 +217,8 @@ impl LightBuffer {
         match self.source {
             Source::Point { position } => {
                 let end = ray.origin + ray.direction - position;
-                if ray.t_max != 1.0 || !(end.abs().max_element() <= self.margin / 8.0) {
+                let ends_at_light = end.abs().max_element() <= self.margin / 8.0;
+                if ray.t_max != 1.0 || !ends_at_light {
                     return None;
                 }
                 let w = ray.origin - position;
@@ -338,7 +339,10 @@ impl LightBuffer {
     fn blocks<K: Keep>(&self, bvh: &Bvh, leaves: &[u32], ray: &FastRay, keep: &K) -> bool {
         leaves.iter().any(|&index| {
             let leaf = &self.leaves[index as usize];
-            if !(box_entry(&leaf.bounds, ray, ray.t_max) <= ray.t_max) {
+            // Entered: a finite entry (infinity for a box missed) within the interval.
+            let entry = box_entry(&leaf.bounds, ray, ray.t_max);
+            let entered = entry < f32::INFINITY && entry <= ray.t_max;
+            if !entered {
                 return false;
             }
             let first = leaf.first as usize;
@@ -366,7 +370,8 @@ impl LightBuffer {
         for &index in leaves {
             let leaf = &self.leaves[index as usize];
             let entry = packet.box_entries(leaf.bounds.min, leaf.bounds.max, t_max);
-            let mut active = entry.cmple(t_max).bitmask() & open;
+            let entered = entry.cmplt(Vec4::INFINITY) & entry.cmple(t_max);
+            let mut active = entered.bitmask() & open;
             let first = leaf.first as usize;
             let triangles = &bvh.triangles[first..first + leaf.count as usize];
             while active != 0 {
