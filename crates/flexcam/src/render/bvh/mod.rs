@@ -8,6 +8,7 @@
 
 mod build;
 pub(in crate::render) mod curve_triangle;
+mod light_buffer;
 #[cfg(test)]
 mod tests;
 mod traverse;
@@ -15,6 +16,7 @@ pub(in crate::render) mod triangle;
 
 use glam::{Vec3, Vec4};
 
+pub(in crate::render) use self::light_buffer::LightBuffer;
 pub(in crate::render) use self::traverse::{NearSegment, NearSegments4};
 use self::triangle::{FastHit, PackedTriangle};
 use crate::geometry::Aabb;

@@ -6,10 +6,10 @@ use super::*;
 use crate::geometry::Ray;
 
 /// A deterministic generator for test inputs (SplitMix64).
-struct Rng(u64);
+pub(super) struct Rng(pub(super) u64);
 
 impl Rng {
-    fn next(&mut self) -> f32 {
+    pub(super) fn next(&mut self) -> f32 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -17,12 +17,12 @@ impl Rng {
         ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
     }
 
-    fn vec(&mut self, scale: f32) -> Vec3 {
+    pub(super) fn vec(&mut self, scale: f32) -> Vec3 {
         Vec3::new(self.next(), self.next(), self.next()) * 2.0 * scale - scale
     }
 }
 
-fn soup(rng: &mut Rng, n: usize) -> Vec<[Vec3; 3]> {
+pub(super) fn soup(rng: &mut Rng, n: usize) -> Vec<[Vec3; 3]> {
     (0..n)
         .map(|_| {
             let c = rng.vec(10.0);

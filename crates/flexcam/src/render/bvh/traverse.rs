@@ -75,7 +75,7 @@ impl Slabs {
 
 /// Whether the four rays' directions have the same sign on every axis (as their reciprocals,
 /// which are never zero, tell).
-fn same_signs(rays: [&FastRay; 4]) -> bool {
+pub(super) fn same_signs(rays: [&FastRay; 4]) -> bool {
     let mask = |r: &FastRay| r.inv_direction.cmplt(Vec3A::ZERO).bitmask();
     let m = mask(rays[0]);
     rays[1..].iter().all(|r| mask(r) == m)
@@ -83,7 +83,7 @@ fn same_signs(rays: [&FastRay; 4]) -> bool {
 
 /// Four rays of one direction-sign class in SoA form for [`Packet::entries`]: lane `r` is
 /// ray `r`.
-struct Packet {
+pub(super) struct Packet {
     origin: [Vec4; 3],
     inv_direction: [Vec4; 3],
     /// Per axis, whether the directions are negative (then a box is entered through its max
@@ -95,7 +95,7 @@ struct Packet {
 
 impl Packet {
     #[inline(always)]
-    fn new(rays: [&FastRay; 4]) -> Packet {
+    pub(super) fn new(rays: [&FastRay; 4]) -> Packet {
         let [a, b, c, d] = rays;
         let axis = |o: Vec3A, p: Vec3A, q: Vec3A, r: Vec3A| {
             [
@@ -120,6 +120,28 @@ impl Packet {
             t_min: Vec4::new(a.t_min, b.t_min, c.t_min, d.t_min),
             t_max: Vec4::new(a.t_max, b.t_max, c.t_max, d.t_max),
         }
+    }
+
+    /// Entry parameters of the four rays into the box `[min, max]` (infinity where a ray
+    /// misses it within `[t_min, t_max]`), bit for bit [`box_entry`] of each ray, by the
+    /// arithmetic of [`Packet::entries`].
+    #[inline(always)]
+    pub(super) fn box_entries(&self, min: Vec3, max: Vec3, t_max: Vec4) -> Vec4 {
+        let mut near = self.t_min;
+        let mut far = t_max;
+        for axis in 0..3 {
+            let (n, f) = if self.negative[axis] {
+                (max[axis], min[axis])
+            } else {
+                (min[axis], max[axis])
+            };
+            let o = self.origin[axis];
+            let inv = self.inv_direction[axis];
+            near = near.max((Vec4::splat(n) - o) * inv);
+            far = far.min((Vec4::splat(f) - o) * inv);
+        }
+        let inside = near.cmple(far + far.abs() * ROBUST_SLACK);
+        Vec4::select(inside, near, Vec4::INFINITY)
     }
 
     /// Entry parameters of the four rays into the two children's boxes of `node` (infinity
@@ -276,7 +298,7 @@ fn skip_hidden<E: Copy>(kept: u8, (t0, t1): (E, E), missed: E) -> (E, E) {
 /// `[ray.t_min, t_max]`, else infinity. The exit parameter is enlarged by a few ulps (Ize,
 /// "Robust BVH ray traversal", 2013) so that rounding never culls a box the ray touches.
 #[inline(always)]
-fn box_entry(bounds: &Aabb, ray: &FastRay, t_max: f32) -> f32 {
+pub(super) fn box_entry(bounds: &Aabb, ray: &FastRay, t_max: f32) -> f32 {
     let t0 = (Vec3A::from(bounds.min) - ray.origin) * ray.inv_direction;
     let t1 = (Vec3A::from(bounds.max) - ray.origin) * ray.inv_direction;
     let near = t0.min(t1).max_element().max(ray.t_min);

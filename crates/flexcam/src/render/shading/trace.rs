@@ -263,7 +263,7 @@ impl<'a> HitShader<'a> {
             }
         }
         let mut rays: [Option<Ray>; 4] = [None; 4];
-        for light in lights {
+        for (index, light) in lights.iter().enumerate() {
             let terms = LightTerms::of(light);
             let lit = quad.light(&terms);
             for (lane, ray) in rays.iter_mut().enumerate() {
@@ -279,12 +279,15 @@ impl<'a> HitShader<'a> {
                     self.counts.shadow += 1;
                 }
             }
-            let blocked = self.caster.occluded4([
-                rays[0].as_ref(),
-                rays[1].as_ref(),
-                rays[2].as_ref(),
-                rays[3].as_ref(),
-            ]);
+            let blocked = self.caster.occluded4_towards(
+                index,
+                [
+                    rays[0].as_ref(),
+                    rays[1].as_ref(),
+                    rays[2].as_ref(),
+                    rays[3].as_ref(),
+                ],
+            );
             for lane in 0..4 {
                 if rays[lane].is_some() && !blocked[lane] {
                     colors[lane] += terms.radiance
@@ -299,10 +302,10 @@ impl<'a> HitShader<'a> {
     fn direct(&mut self, ray: &Ray, position: DVec3, normals: &Normals, base: Vec3) -> Vec3 {
         let point = DiffusePoint::new(ray, position, normals, base);
         let mut color = point.unshadowed(&self.caster.scene.lights);
-        for light in &self.caster.scene.lights {
+        for (index, light) in self.caster.scene.lights.iter().enumerate() {
             if let Some((shadow, added)) = point.light(self.caster, &LightTerms::of(light)) {
                 self.counts.shadow += 1;
-                if !self.caster.occluded(&shadow) {
+                if !self.caster.occluded_towards(index, &shadow) {
                     color += added;
                 }
             }
