@@ -6,7 +6,10 @@
 //! The screen point at barycentrics `b` of a projection triangle with base points `p_k` and
 //! unit vertex normals `n_k` emits the ray from `P(b) = sum b_k p_k` along
 //! `reflect(i(b), n(b))`, where `i(b) = (P(b) - eye) / |P(b) - eye|` is the eye's unit ray to
-//! that point and `n(b) = N(b) / |N(b)|`, `N(b) = sum b_k n_k`. At a vertex this is the
+//! that point and `n(b) = N(b) / |N(b)|`, `N(b) = sum b_k n_k`, kept out of the base
+//! triangle's face as the ray caster keeps its mirror rays ([`reflect_above`]: where the
+//! interpolated normal leans so far that the mirror image points into the face, near a
+//! coarse mirror's rim, it leaves at a small elevation instead). At a vertex this is the
 //! vertex ray of the interpolated surface (`vertex_ray` with [`Optic::Reflect`]); in between
 //! it is the exact mirror reflection of the eye's ray at `P(b)` for the mirror whose normals
 //! are interpolated as the ray caster interpolates them, where the interpolated vertex rays
@@ -15,7 +18,8 @@
 //!
 //! Degenerate cases (each tested):
 //! - `N(b) = 0` (vertex normals that cancel inside the triangle): no normal, the ray goes on
-//!   along `i(b)` (as `reflect` about a zero normal gives);
+//!   along `i(b)` (as `reflect` about a zero normal gives), not lifted;
+//! - a degenerate base triangle (no face normal): not lifted;
 //! - the eye on the base triangle at `P(b)`: no incident direction, no ray (`None`, as a zero
 //!   interpolated direction gives none).
 //!
@@ -24,7 +28,7 @@
 use glam::{DVec2, DVec3};
 
 use crate::error::{Error, Result};
-use crate::geometry::optics::reflect;
+use crate::geometry::optics::{reflect, reflect_above};
 use crate::geometry::Ray;
 
 /// The per-fragment mirror of a trilinear projection: the eye whose rays it reflects and the
@@ -106,7 +110,23 @@ impl TriangleMirror {
         let point = self.point(b);
         let incident = (point - self.eye).try_normalize()?;
         let normal = self.normal(b).normalize_or_zero();
-        Some(Ray::new(point, reflect(incident, normal)))
+        if normal == DVec3::ZERO {
+            return Some(Ray::new(point, reflect(incident, normal)));
+        }
+        let face = self.face_normal();
+        let face = if face.dot(incident) > 0.0 {
+            -face
+        } else {
+            face
+        };
+        Some(Ray::new(point, reflect_above(incident, normal, face)))
+    }
+
+    /// The unit normal of the base triangle by its winding; zero for a degenerate one.
+    #[inline]
+    pub fn face_normal(&self) -> DVec3 {
+        let [p0, p1, p2] = self.points;
+        (p1 - p0).cross(p2 - p0).normalize_or_zero()
     }
 }
 
@@ -173,6 +193,36 @@ mod tests {
         let mut on = flat();
         on.eye = on.point(DVec2::new(0.25, 0.25));
         assert!(on.ray(DVec2::new(0.25, 0.25)).is_none());
+    }
+
+    /// Near a rim, normals leaning far from the face would mirror the eye's ray into it:
+    /// the ray leaves the face instead, at the ray caster's elevation; a ray mirrored well
+    /// above the face is the plain mirror image.
+    #[test]
+    fn rays_are_kept_out_of_the_face() {
+        let mut m = flat();
+        // The eye looks down at about 45 degrees; normals leaning 70 degrees towards it.
+        m.eye = DVec3::new(-2.0, 0.2, 2.0);
+        let lean = DVec3::new(-0.94, 0.0, 0.34).normalize();
+        m.normals = [lean; 3];
+        let b = DVec2::new(0.3, 0.3);
+        let i = (m.point(b) - m.eye).normalize();
+        assert!(reflect(i, lean).z < 0.0);
+        let ray = m.ray(b).unwrap();
+        assert!((ray.direction.z - crate::geometry::REFLECTION_LIFT).abs() < 1e-12);
+        assert!((ray.direction.length() - 1.0).abs() < 1e-12);
+        // The base triangle wound the other way gives the same ray.
+        let mut turned = m;
+        turned.points.swap(1, 2);
+        turned.normals.swap(1, 2);
+        let turned_ray = turned.ray(DVec2::new(0.3, 0.3)).unwrap();
+        assert!((turned_ray.direction - ray.direction).length() < 1e-12);
+        // Degenerate base triangle: no face, the plain mirror image.
+        let mut line = m;
+        line.points = [DVec3::ZERO, DVec3::X, 2.0 * DVec3::X];
+        let r = line.ray(b).unwrap();
+        let i = (line.point(b) - line.eye).normalize();
+        assert!((r.direction - reflect(i, lean)).length() < 1e-12);
     }
 
     #[test]

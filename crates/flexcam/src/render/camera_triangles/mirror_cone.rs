@@ -28,6 +28,18 @@
 //!    `b` projects along `r(b)` to `b`, hence into the hull of its projections along the
 //!    `D_j`, as [`super::bound`] argues).
 //!
+//! 4. The ray keeps out of the base triangle's face (`reflect_above`): where `r(b)` has
+//!    elevation below `e_max = asin(REFLECTION_LIFT)` over the face (unit normal `g`,
+//!    facing the eye), it is replaced by a direction of the same azimuth, higher but at
+//!    most at `e_max`: on the vertical great circle through `r(b)`, between `r(b)` and the
+//!    point `t` at `e_max`. Along that circle the angle to `a` falls as the elevation rises
+//!    up to the point nearest `a`, whose elevation is at least `elev(a)` (`tan e* = tan
+//!    elev(a) / cos(azimuth difference)`, or the zenith). So when `elev(a) >= e_max` a
+//!    lifted ray is nearer `a` than `r(b)` was and the cone stands. Otherwise (the axis
+//!    itself near or under the face) `angle(t, a) <= angle(t, r(b)) + h <= e_max -
+//!    elev(r(b)) + h`, with `elev(r(b)) >= elev(a) - h`: the half-angle becomes `max(h, 2 h
+//!    + e_max - elev(a))`.
+//!
 //! The angles are computed with `atan2` (accurate to rounding at every angle) and `h` is
 //! enlarged by [`ANGLE_MARGIN`] against rounding. Degenerate cases, each giving `None` (the
 //! bounds then take the whole piece, which holds every fragment): the eye at a corner's or
@@ -37,11 +49,11 @@
 //! cone so wide it bounds nothing). Quartering narrows every spread, so pieces of a camera
 //! triangle that has no cone usually have one.
 
-use std::f64::consts::TAU;
+use std::f64::consts::{FRAC_PI_2, TAU};
 
 use glam::{DVec2, DVec3};
 
-use crate::geometry::optics::reflect;
+use crate::geometry::optics::{reflect, REFLECTION_LIFT};
 use crate::projection::TriangleMirror;
 
 /// The largest spread (radians) of the eye rays or the normals over a piece that still gives
@@ -80,8 +92,20 @@ pub fn axis_and_half_angle(mirror: &TriangleMirror, sub: [DVec2; 3]) -> Option<(
     if spread_i >= MAX_SPREAD || spread_n >= MAX_SPREAD {
         return None;
     }
-    let half = (spread_i + 2.0 * spread_n) * (1.0 + ANGLE_MARGIN) + 1e-12;
-    (half < MAX_HALF_ANGLE).then(|| (reflect(i0, n0), half))
+    let half = spread_i + 2.0 * spread_n;
+    let axis = reflect(i0, n0);
+    // Step 4: the lift out of the face (a degenerate face lifts nothing).
+    let face = mirror.face_normal();
+    let face = if face.dot(i0) > 0.0 { -face } else { face };
+    let elevation = FRAC_PI_2 - angle(face, axis).unwrap_or(FRAC_PI_2);
+    let lift = REFLECTION_LIFT.asin();
+    let half = if face != DVec3::ZERO && elevation < lift {
+        half.max(2.0 * half + lift - elevation)
+    } else {
+        half
+    };
+    let half = half * (1.0 + ANGLE_MARGIN) + 1e-12;
+    (half < MAX_HALF_ANGLE).then_some((axis, half))
 }
 
 /// The angle between `v` and the unit vector `unit`; `None` for a zero or non-finite `v`.
@@ -141,6 +165,31 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A patch near a mirror's rim, where the normals lean so far from the face that some
+    /// mirror images point into it: the lifted rays lie in the cone too.
+    #[test]
+    fn the_cone_holds_lifted_rays() {
+        let lean = |x: f64, y: f64| DVec3::new(-0.94 + x, y, 0.34).normalize();
+        let mirror = TriangleMirror {
+            eye: DVec3::new(-2.0, 0.2, 2.0),
+            points: [DVec3::ZERO, DVec3::X, DVec3::Y],
+            normals: [lean(0.0, 0.0), lean(0.3, 0.0), lean(0.0, 0.3)],
+        };
+        let sub = [DVec2::ZERO, DVec2::X, DVec2::Y];
+        let d = cone(&mirror, sub).unwrap();
+        let m = glam::DMat3::from_cols(d[0], d[1], d[2]).inverse();
+        let (mut lifted, n) = (0, 40);
+        for a in 0..=n {
+            for b in 0..=n - a {
+                let p = DVec2::new(a as f64, b as f64) / n as f64;
+                let r = mirror.ray(p).unwrap().direction;
+                lifted += usize::from(r.z == REFLECTION_LIFT);
+                assert!((m * r).min_element() >= -1e-12, "{p}");
+            }
+        }
+        assert!(lifted > 0);
     }
 
     /// The half-angle shrinks with the piece: a quarter's cone is narrower.
