@@ -402,8 +402,8 @@ fn five_thousand(repeat: u32, width: u32, height: u32) -> Result<()> {
          (cpu ms {:.1}); targets: time ratio <= 0.5, agreement >= 0.99. agreement: reflector \
          pixels away from colour edges with the exact colour, over all of them, then over \
          those whose exact reflected ray does not meet the mirror itself ({} of the \
-         reflector's pixels do: the ray caster follows them into the faceted mirror, camera \
-         triangles reflect the scene without it); rgb: relative RGB error of the frame.",
+         reflector's pixels do: a concave mirror reflects itself, camera triangles reflect \
+         the scene without it); rgb: relative RGB error of the frame.",
         reflector.map_or(0, |index| scene.objects[index].mesh.triangles.len()),
         prepared_triangles(&scene),
         ray_time.median_ms(),
