@@ -151,23 +151,10 @@ impl Packet {
     #[inline(always)]
     fn entries(&self, node: &Node, t_max: Vec4) -> (Vec4, Vec4) {
         let child = |c: usize| {
-            let mut near = self.t_min;
-            let mut far = t_max;
-            for axis in 0..3 {
-                let planes = node.planes[axis];
-                let (lo, hi) = (planes[c], -planes[c + 2]);
-                let (n, f) = if self.negative[axis] {
-                    (hi, lo)
-                } else {
-                    (lo, hi)
-                };
-                let o = self.origin[axis];
-                let inv = self.inv_direction[axis];
-                near = near.max((Vec4::splat(n) - o) * inv);
-                far = far.min((Vec4::splat(f) - o) * inv);
-            }
-            let inside = near.cmple(far + far.abs() * ROBUST_SLACK);
-            Vec4::select(inside, near, Vec4::INFINITY)
+            let [x, y, z] = node.planes;
+            let min = Vec3::new(x[c], y[c], z[c]);
+            let max = Vec3::new(-x[c + 2], -y[c + 2], -z[c + 2]);
+            self.box_entries(min, max, t_max)
         };
         (child(0), child(1))
     }
