@@ -104,8 +104,8 @@ pub struct PreparedScene {
 
 /// The fewest BVH triangles for which shadow rays are answered through light buffers
 /// ([`LightBuffer`]): below it the BVH's walk is as cheap as a cell's lookup (on the
-/// 686-triangle cube-floor the buffers made a lit frame about 15 % slower, on the
-/// 123,554-triangle teapot-dense panorama about 17 % faster; docs/viewer.md, "Speed").
+/// 686-triangle cube-floor a lit frame costs the same either way, on the 123,554-triangle
+/// teapot-dense panorama the buffers save 5 to 11 %; docs/viewer.md, "Speed").
 const LIGHT_BUFFER_TRIANGLES: usize = 8192;
 
 /// Secondary-ray offset relative to the scene's largest coordinate magnitude: 2^-16, about
