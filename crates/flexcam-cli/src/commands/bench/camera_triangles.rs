@@ -357,9 +357,10 @@ fn application_row(settings: &Settings, row: &ApplicationRow) -> Result<()> {
 
 /// The mirror sphere's camera meshes (`[[object]]` keys of the sphere) and their names:
 /// the sphere's own 80 triangles unrefined; refined to `trilinear_refine_px = 8`, the
-/// coarsest of 16, 12, 10, 8, 6 and 4 main-image pixels whose agreement away from the
-/// mirror's self-reflection reaches 0.99 (docs/camera-triangles.md, "The mirror sphere");
-/// the automatic camera mesh (refined to the default 0.5 pixels).
+/// coarsest of 16, 12, 10, 8, 6 and 4 main-image pixels whose agreement reached 0.99 against
+/// the ray caster before its rim rule, away from the rays it followed into the mirror
+/// (docs/camera-triangles.md, "The mirror sphere"); the automatic camera mesh (refined to
+/// the default 0.5 pixels).
 const MIRROR_SPHERE_MESHES: [(&str, &str); 3] = [
     ("own mesh", "trilinear_refine_px = 0"),
     ("refined 8 px", "trilinear_refine_px = 8"),

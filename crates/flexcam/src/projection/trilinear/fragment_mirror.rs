@@ -113,20 +113,23 @@ impl TriangleMirror {
         if normal == DVec3::ZERO {
             return Some(Ray::new(point, reflect(incident, normal)));
         }
-        let face = self.face_normal();
-        let face = if face.dot(incident) > 0.0 {
+        Some(Ray::new(
+            point,
+            reflect_above(incident, normal, self.face_towards(incident)),
+        ))
+    }
+
+    /// The unit normal of the base triangle turned against `incident` (to the side a ray
+    /// along it arrives from); zero for a degenerate triangle.
+    #[inline]
+    pub fn face_towards(&self, incident: DVec3) -> DVec3 {
+        let [p0, p1, p2] = self.points;
+        let face = (p1 - p0).cross(p2 - p0).normalize_or_zero();
+        if face.dot(incident) > 0.0 {
             -face
         } else {
             face
-        };
-        Some(Ray::new(point, reflect_above(incident, normal, face)))
-    }
-
-    /// The unit normal of the base triangle by its winding; zero for a degenerate one.
-    #[inline]
-    pub fn face_normal(&self) -> DVec3 {
-        let [p0, p1, p2] = self.points;
-        (p1 - p0).cross(p2 - p0).normalize_or_zero()
+        }
     }
 }
 

@@ -95,8 +95,7 @@ pub fn axis_and_half_angle(mirror: &TriangleMirror, sub: [DVec2; 3]) -> Option<(
     let half = spread_i + 2.0 * spread_n;
     let axis = reflect(i0, n0);
     // Step 4: the lift out of the face (a degenerate face lifts nothing).
-    let face = mirror.face_normal();
-    let face = if face.dot(i0) > 0.0 { -face } else { face };
+    let face = mirror.face_towards(i0);
     let elevation = FRAC_PI_2 - angle(face, axis).unwrap_or(FRAC_PI_2);
     let lift = REFLECTION_LIFT.asin();
     let half = if face != DVec3::ZERO && elevation < lift {
