@@ -98,8 +98,9 @@ pub struct PreparedScene {
     /// page-fault them again every frame.
     spare: Mutex<Option<Box<dyn Any + Send>>>,
     /// Per light of the scene, its light buffer over the BVH ([`LightBuffer`]), built on
-    /// the first shadow ray and kept for every later one (`None` for a light without one).
-    light_buffers: OnceLock<Vec<Option<LightBuffer>>>,
+    /// the first shadow ray and kept for every later one (`None` for a light without one);
+    /// shared with the views of the same lights, as the BVH is.
+    light_buffers: Arc<OnceLock<Vec<Option<LightBuffer>>>>,
 }
 
 /// The fewest BVH triangles for which shadow rays are answered through light buffers
@@ -236,7 +237,7 @@ impl PreparedScene {
             curve_triangles: Arc::default(),
             displaced: DisplacedSet::new(scene),
             spare: Mutex::default(),
-            light_buffers: OnceLock::new(),
+            light_buffers: Arc::default(),
         }
     }
 
@@ -281,6 +282,7 @@ impl PreparedScene {
                 _ => checkered(b).then(|| object_points(b).into()),
             })
             .collect();
+        let scene_lights_equal = scene.lights == self.scene.lights;
         PreparedScene {
             bvh: Arc::clone(&self.bvh),
             object_points,
@@ -295,7 +297,13 @@ impl PreparedScene {
             face_normals: Arc::clone(&self.face_normals),
             displaced,
             spare: Mutex::default(),
-            light_buffers: OnceLock::new(),
+            // The buffers bin the shared BVH's leaves by the lights' directions; each query
+            // checks its ray against the light, so a view of the same lights reuses them.
+            light_buffers: if scene_lights_equal {
+                Arc::clone(&self.light_buffers)
+            } else {
+                Arc::default()
+            },
         }
     }
 
@@ -579,5 +587,78 @@ impl PreparedScene {
             -1.0
         };
         Ray::new(point + normal * (side * self.offset), direction)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A view of the same lights shares the light buffers (built once for both); a view
+    /// whose light moved builds its own; both answer shadow rays as the walk does.
+    #[test]
+    fn views_of_the_same_lights_share_light_buffers() {
+        let mut scene = crate::scene::file::parse(
+            r#"
+[image]
+width = 8
+height = 8
+[projection]
+type = "perspective"
+position = [0.0, 1.0, 4.0]
+look_at = [0.0, 0.0, 0.0]
+fov = 50.0
+[[object]]
+name = "ball"
+shape = "sphere"
+size = 1.0
+tessellation = 128
+[[object]]
+name = "floor"
+shape = "plane"
+size = [8.0, 8.0]
+translate = [0.0, -1.0, 0.0]
+[[light]]
+type = "point"
+position = [1.0, 4.0, 1.0]
+"#,
+            std::path::Path::new("test"),
+        )
+        .unwrap();
+        let prepared = PreparedScene::new(&scene);
+        assert!(prepared.bvh.all_triangles().len() >= LIGHT_BUFFER_TRIANGLES);
+        let light = DVec3::new(1.0, 4.0, 1.0);
+        // Shadow rays from points of the floor, some behind the ball.
+        let shadow = |from: &PreparedScene, x: f64, z: f64, light: DVec3| {
+            let point = DVec3::new(x, -1.0, z);
+            let mut ray = from.spawn(point, DVec3::Y, light - point);
+            ray.t_max = 1.0;
+            ray
+        };
+        let check = |from: &PreparedScene, light: DVec3| {
+            let mut blocked = 0;
+            for k in 0..400 {
+                let (x, z) = (f64::from(k % 20) * 0.3 - 3.0, f64::from(k / 20) * 0.3 - 3.0);
+                let ray = shadow(from, x, z, light);
+                let walked = from.occluded(&ray);
+                assert_eq!(from.occluded_towards(0, &ray), walked, "{x} {z}");
+                blocked += usize::from(walked);
+            }
+            assert!(blocked > 0 && blocked < 400, "{blocked}");
+        };
+        check(&prepared, light);
+        assert!(prepared.light_buffer(0).is_some());
+        let same = prepared.view(scene.clone());
+        assert!(Arc::ptr_eq(&same.light_buffers, &prepared.light_buffers));
+        check(&same, light);
+        let moved = DVec3::new(-1.0, 4.0, 0.5);
+        scene.lights[0] = Light::Point {
+            position: moved.as_vec3(),
+            color: Vec3::ONE,
+            intensity: 1.0,
+        };
+        let other = prepared.view(scene);
+        assert!(!Arc::ptr_eq(&other.light_buffers, &prepared.light_buffers));
+        check(&other, moved);
     }
 }
